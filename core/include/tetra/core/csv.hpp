@@ -1,0 +1,59 @@
+#pragma once
+// Text tables of INTERFACES §2: UTF-8, '#' starts a comment line (metadata "# key=value" allowed),
+// the first non-comment line is a header, columns are matched by name. Every cell is parsed as a
+// number; an empty cell is kept as "empty" (value NaN), "nan" as NaN. A malformed file is an Error
+// naming the file, the line and the column — never a crash, never a silently skipped row.
+
+#include <charconv>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "tetra/core/result.hpp"
+
+namespace tetra {
+
+struct CsvTable {
+  std::string source;                                            //!< file name used in messages
+  std::vector<std::pair<std::string, std::string>> metadata;     //!< "# key=value" comments, in order
+  std::vector<std::string> columns;                              //!< header names, trimmed
+  std::size_t header_line = 0;                                   //!< 1-based line of the header
+  std::size_t rows = 0;                                          //!< number of data rows
+  std::vector<double> cells;        //!< row-major rows×columns; NaN where empty or "nan"
+  std::vector<std::uint8_t> empty;  //!< row-major; 1 where the cell was empty
+  std::vector<std::size_t> lines;   //!< 1-based file line of each data row
+
+  std::size_t column_count() const { return columns.size(); }
+  //! Index of a column by exact name, or nullopt.
+  std::optional<std::size_t> find_column(std::string_view name) const;
+  double cell(std::size_t row, std::size_t col) const { return cells[row * columns.size() + col]; }
+  bool is_empty(std::size_t row, std::size_t col) const { return empty[row * columns.size() + col] != 0; }
+  //! Last value of a metadata key, or nullopt.
+  std::optional<std::string> meta(std::string_view key) const;
+  //! "FILE:LINE: column 'NAME': " prefix for messages about a cell.
+  std::string where(std::size_t row, std::size_t col) const;
+};
+
+//! Parses a whole table from text; `source` names it in messages.
+Result<CsvTable> parse_csv(std::string_view text, std::string source);
+//! Reads and parses a file.
+Result<CsvTable> read_csv(const std::string& path);
+
+//! Reads a whole file into a string (error names the file).
+Result<std::string> read_text_file(const std::string& path);
+//! Writes `content` to `path` through a temporary file and a rename, so a failed write never
+//! leaves a truncated file behind.
+Status write_text_file(const std::string& path, std::string_view content);
+
+//! Appends the shortest decimal text that reads back to exactly `value` ("nan" for NaN).
+void append_double(std::string& out, double value);
+//! Appends `value` in fixed notation with `decimals` digits after the point.
+void append_fixed(std::string& out, double value, int decimals);
+//! Appends an integer.
+void append_int(std::string& out, long long value);
+
+}  // namespace tetra

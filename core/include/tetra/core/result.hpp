@@ -1,0 +1,54 @@
+#pragma once
+// Error values for the tetra libraries. A library never exits or aborts on bad input:
+// it returns an Error whose message names what was wrong (file, line, field where known).
+// Command-line adapters turn an Error into exit status 2 (bad input) or 1 (other failure).
+
+#include <string>
+#include <utility>
+#include <variant>
+
+namespace tetra {
+
+enum class ErrorKind {
+  kBadInput,  //!< malformed file, bad value, bad usage: the user can fix it (exit 2)
+  kFailure,   //!< anything else: I/O, middleware, internal (exit 1)
+};
+
+struct Error {
+  std::string message;                    //!< one line, no trailing newline
+  ErrorKind kind = ErrorKind::kBadInput;  //!< how a CLI should report it
+};
+
+inline Error bad_input(std::string message) { return Error{std::move(message), ErrorKind::kBadInput}; }
+inline Error failure(std::string message) { return Error{std::move(message), ErrorKind::kFailure}; }
+
+//! Either a value or an Error. Minimal stand-in for C++23 std::expected.
+template <class T>
+class [[nodiscard]] Result {
+ public:
+  Result(T value) : state_(std::move(value)) {}         // NOLINT(google-explicit-constructor)
+  Result(Error error) : state_(std::move(error)) {}     // NOLINT(google-explicit-constructor)
+
+  bool ok() const { return std::holds_alternative<T>(state_); }
+  explicit operator bool() const { return ok(); }
+
+  T& value() & { return std::get<T>(state_); }
+  const T& value() const& { return std::get<T>(state_); }
+  T&& value() && { return std::get<T>(std::move(state_)); }
+  T* operator->() { return &value(); }
+  const T* operator->() const { return &value(); }
+  T& operator*() & { return value(); }
+  const T& operator*() const& { return value(); }
+
+  const Error& error() const { return std::get<Error>(state_); }
+
+ private:
+  std::variant<T, Error> state_;
+};
+
+//! Result of an operation that yields nothing but may fail.
+struct Ok {};
+using Status = Result<Ok>;
+inline Status ok_status() { return Ok{}; }
+
+}  // namespace tetra

@@ -1,0 +1,220 @@
+#include "tetra/core/csv.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace tetra {
+
+namespace {
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+// Strict number parse of a whole cell. Accepts a leading '+', "nan", "inf" (any case).
+bool parse_number(std::string_view s, double& out) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  if (s.empty()) return false;
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+  return ec == std::errc() && ptr == s.data() + s.size();
+}
+
+void parse_metadata(std::string_view comment, CsvTable& table) {
+  // comment without the '#': tokens "key=value" separated by blanks or commas.
+  std::size_t i = 0;
+  while (i < comment.size()) {
+    while (i < comment.size() && (comment[i] == ' ' || comment[i] == '\t' || comment[i] == ',')) ++i;
+    std::size_t j = i;
+    while (j < comment.size() && comment[j] != ' ' && comment[j] != '\t' && comment[j] != ',') ++j;
+    const std::string_view token = comment.substr(i, j - i);
+    const std::size_t eq = token.find('=');
+    if (eq != std::string_view::npos && eq > 0) {
+      table.metadata.emplace_back(std::string(token.substr(0, eq)), std::string(token.substr(eq + 1)));
+    }
+    i = j;
+  }
+}
+
+}  // namespace
+
+std::optional<std::size_t> CsvTable::find_column(std::string_view name) const {
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    if (columns[i] == name) return i;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> CsvTable::meta(std::string_view key) const {
+  std::optional<std::string> found;
+  for (const auto& [k, v] : metadata) {
+    if (k == key) found = v;
+  }
+  return found;
+}
+
+std::string CsvTable::where(std::size_t row, std::size_t col) const {
+  return source + ":" + std::to_string(lines[row]) + ": column '" + columns[col] + "': ";
+}
+
+Result<CsvTable> parse_csv(std::string_view text, std::string source) {
+  CsvTable t;
+  t.source = std::move(source);
+  if (text.size() >= 3 && std::memcmp(text.data(), "\xEF\xBB\xBF", 3) == 0) text.remove_prefix(3);
+
+  std::size_t pos = 0;
+  std::size_t line_no = 0;
+  bool have_header = false;
+  std::vector<std::string_view> fields;
+  // Reserve from a guess of the row count to avoid repeated growth on large files.
+  const std::size_t approx_rows = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+
+  while (pos < text.size()) {
+    const char* begin = text.data() + pos;
+    const void* nl = std::memchr(begin, '\n', text.size() - pos);
+    const std::size_t len = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - begin) : text.size() - pos;
+    std::string_view line(begin, len);
+    pos += len + 1;
+    ++line_no;
+
+    const std::string_view content = trim(line);
+    if (content.empty()) continue;
+    if (content.front() == '#') {
+      parse_metadata(content.substr(1), t);
+      continue;
+    }
+
+    fields.clear();
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t comma = line.find(',', start);
+      if (comma == std::string_view::npos) {
+        fields.push_back(trim(line.substr(start)));
+        break;
+      }
+      fields.push_back(trim(line.substr(start, comma - start)));
+      start = comma + 1;
+    }
+
+    if (!have_header) {
+      for (std::size_t i = 0; i < fields.size(); ++i) {
+        if (fields[i].empty()) {
+          return bad_input(t.source + ":" + std::to_string(line_no) + ": header: column " + std::to_string(i + 1) +
+                           " has no name");
+        }
+        for (std::size_t k = 0; k < i; ++k) {
+          if (fields[k] == fields[i]) {
+            return bad_input(t.source + ":" + std::to_string(line_no) + ": header: column '" +
+                             std::string(fields[i]) + "' appears twice");
+          }
+        }
+        t.columns.emplace_back(fields[i]);
+      }
+      t.header_line = line_no;
+      have_header = true;
+      t.cells.reserve(approx_rows * t.columns.size());
+      t.empty.reserve(approx_rows * t.columns.size());
+      t.lines.reserve(approx_rows);
+      continue;
+    }
+
+    if (fields.size() != t.columns.size()) {
+      return bad_input(t.source + ":" + std::to_string(line_no) + ": expected " + std::to_string(t.columns.size()) +
+                       " fields as in the header, found " + std::to_string(fields.size()));
+    }
+    for (std::size_t c = 0; c < fields.size(); ++c) {
+      const std::string_view cell = fields[c];
+      if (cell.empty()) {
+        t.cells.push_back(std::numeric_limits<double>::quiet_NaN());
+        t.empty.push_back(1);
+        continue;
+      }
+      double v = 0.0;
+      if (!parse_number(cell, v)) {
+        return bad_input(t.source + ":" + std::to_string(line_no) + ": column '" + t.columns[c] + "': '" +
+                         std::string(cell.substr(0, 40)) + "' is not a number");
+      }
+      t.cells.push_back(v);
+      t.empty.push_back(0);
+    }
+    t.lines.push_back(line_no);
+    ++t.rows;
+  }
+  if (!have_header) return bad_input(t.source + ": empty file: no header line");
+  return t;
+}
+
+Result<std::string> read_text_file(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) return bad_input(path + ": cannot open: " + std::strerror(errno));
+  std::string data;
+  char buf[1 << 16];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) data.append(buf, n);
+  const bool err = std::ferror(f) != 0;
+  std::fclose(f);
+  if (err) return failure(path + ": read error");
+  return data;
+}
+
+Result<CsvTable> read_csv(const std::string& path) {
+  auto text = read_text_file(path);
+  if (!text) return text.error();
+  return parse_csv(*text, path);
+}
+
+Status write_text_file(const std::string& path, std::string_view content) {
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (f == nullptr) return failure(path + ": cannot write: " + std::strerror(errno));
+  const bool wrote = std::fwrite(content.data(), 1, content.size(), f) == content.size();
+  const bool closed = std::fclose(f) == 0;
+  if (!wrote || !closed) {
+    std::remove(tmp.c_str());
+    return failure(path + ": write failed");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    return failure(path + ": cannot rename temporary file: " + std::strerror(errno));
+  }
+  return ok_status();
+}
+
+void append_double(std::string& out, double value) {
+  if (std::isnan(value)) {
+    out += "nan";
+    return;
+  }
+  char buf[32];
+  const auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, value);
+  out.append(buf, ptr);
+}
+
+void append_fixed(std::string& out, double value, int decimals) {
+  if (std::isnan(value)) {
+    out += "nan";
+    return;
+  }
+  char buf[64];
+  const auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, value, std::chars_format::fixed, decimals);
+  if (ec != std::errc()) {
+    append_double(out, value);
+    return;
+  }
+  out.append(buf, ptr);
+}
+
+void append_int(std::string& out, long long value) {
+  char buf[24];
+  const auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, value);
+  out.append(buf, ptr);
+}
+
+}  // namespace tetra

@@ -1,0 +1,205 @@
+#include "tetra/core/gyro_log.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "tetra/core/csv.hpp"
+
+namespace tetra {
+
+std::optional<std::string> GyroLog::meta(const std::string& key) const {
+  std::optional<std::string> found;
+  for (const auto& [k, v] : metadata) {
+    if (k == key) found = v;
+  }
+  return found;
+}
+
+namespace {
+
+Result<GyroLog> from_table(CsvTable&& t) {
+  GyroLog log;
+  log.source = t.source;
+  log.metadata = std::move(t.metadata);
+  const std::string head = t.source + ":" + std::to_string(t.header_line) + ": header: ";
+
+  const auto time_col = t.find_column("time_s");
+  if (!time_col) return bad_input(head + "missing column 'time_s'");
+
+  // Gyro columns g1..gN, contiguous from 1.
+  std::vector<std::size_t> gyro_cols;
+  for (int id = 1;; ++id) {
+    const auto c = t.find_column("g" + std::to_string(id));
+    if (!c) break;
+    gyro_cols.push_back(*c);
+  }
+  if (gyro_cols.empty()) return bad_input(head + "no gyro columns (expected g1, g2, ...)");
+  log.gyro_count = static_cast<int>(gyro_cols.size());
+
+  static constexpr std::array<const char*, 4> kRefNames = {"ref_qw", "ref_qx", "ref_qy", "ref_qz"};
+  std::array<std::size_t, 4> ref_cols{};
+  int ref_found = 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (const auto c = t.find_column(kRefNames[k])) {
+      ref_cols[k] = *c;
+      ++ref_found;
+    }
+  }
+  if (ref_found != 0 && ref_found != 4) return bad_input(head + "reference columns must be all of ref_qw,ref_qx,ref_qy,ref_qz");
+  log.has_reference = ref_found == 4;
+
+  // Every column must be known: a typo must not pass silently.
+  const std::size_t known = 1 + gyro_cols.size() + static_cast<std::size_t>(ref_found);
+  if (known != t.column_count()) {
+    for (const auto& name : t.columns) {
+      const bool is_gyro = name.size() > 1 && name[0] == 'g' &&
+                           name.find_first_not_of("0123456789", 1) == std::string::npos &&
+                           std::stoi(name.substr(1)) >= 1 && std::stoi(name.substr(1)) <= log.gyro_count;
+      bool is_ref = false;
+      for (const char* r : kRefNames) is_ref = is_ref || name == r;
+      if (name != "time_s" && !is_gyro && !is_ref) {
+        return bad_input(head + "unknown column '" + name + "' (expected time_s, g1..g" +
+                         std::to_string(log.gyro_count) + ", optional ref_qw..ref_qz)");
+      }
+    }
+  }
+
+  if (const auto units = log.meta("units")) {
+    if (*units == "dps") {
+      log.units_dps = true;
+    } else if (*units != "V") {
+      return bad_input(t.source + ": metadata units='" + *units + "': expected 'V' or 'dps'");
+    }
+  }
+
+  const std::size_t n = t.rows;
+  const auto ng = static_cast<std::size_t>(log.gyro_count);
+  log.time_s.resize(n);
+  log.values.resize(n * ng);
+  log.present.resize(n * ng);
+  if (log.has_reference) {
+    log.reference_wxyz.resize(n);
+    log.reference_present.resize(n);
+  }
+  for (std::size_t r = 0; r < n; ++r) {
+    if (t.is_empty(r, *time_col) || !std::isfinite(t.cell(r, *time_col))) {
+      return bad_input(t.where(r, *time_col) + "time must be a finite number");
+    }
+    log.time_s[r] = t.cell(r, *time_col);
+    for (std::size_t g = 0; g < ng; ++g) {
+      log.values[r * ng + g] = t.cell(r, gyro_cols[g]);
+      log.present[r * ng + g] = t.is_empty(r, gyro_cols[g]) ? 0 : 1;
+    }
+    if (log.has_reference) {
+      int filled = 0;
+      for (std::size_t k = 0; k < 4; ++k) {
+        filled += t.is_empty(r, ref_cols[k]) ? 0 : 1;
+        log.reference_wxyz[r][k] = t.cell(r, ref_cols[k]);
+      }
+      if (filled != 0 && filled != 4) {
+        return bad_input(t.where(r, ref_cols[0]) + "reference quaternion is partly empty");
+      }
+      if (filled == 4) {
+        const auto& q = log.reference_wxyz[r];
+        const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) {
+          return bad_input(t.where(r, ref_cols[0]) + "reference quaternion is not of unit norm");
+        }
+      }
+      log.reference_present[r] = filled == 4 ? 1 : 0;
+    }
+  }
+  log.lines = std::move(t.lines);
+  return log;
+}
+
+}  // namespace
+
+Result<GyroLog> parse_gyro_log(std::string_view text, std::string source) {
+  auto table = parse_csv(text, std::move(source));
+  if (!table) return table.error();
+  return from_table(std::move(table.value()));
+}
+
+Result<GyroLog> read_gyro_log(const std::string& path) {
+  auto table = read_csv(path);
+  if (!table) return table.error();
+  return from_table(std::move(table.value()));
+}
+
+GyroLogWriter::~GyroLogWriter() {
+  if (file_ != nullptr) {
+    std::fclose(file_);
+    std::remove((path_ + ".tmp").c_str());
+  }
+}
+
+Status GyroLogWriter::open(const std::string& path, int gyro_count, bool with_reference, bool units_dps,
+                           const std::vector<std::pair<std::string, std::string>>& comments) {
+  if (file_ != nullptr) return failure(path_ + ": writer already open");
+  if (gyro_count < 1) return bad_input(path + ": a gyro log needs at least one gyro column");
+  path_ = path;
+  gyro_count_ = gyro_count;
+  with_reference_ = with_reference;
+  file_ = std::fopen((path + ".tmp").c_str(), "wb");
+  if (file_ == nullptr) return failure(path + ": cannot write: " + std::strerror(errno));
+  buffer_.clear();
+  if (units_dps) buffer_ += "# units=dps\n";
+  for (const auto& [k, v] : comments) buffer_ += "# " + k + "=" + v + "\n";
+  buffer_ += "time_s";
+  for (int i = 1; i <= gyro_count; ++i) buffer_ += ",g" + std::to_string(i);
+  if (with_reference) buffer_ += ",ref_qw,ref_qx,ref_qy,ref_qz";
+  buffer_ += '\n';
+  return ok_status();
+}
+
+Status GyroLogWriter::write(double time_s, std::span<const double> values, std::span<const std::uint8_t> present,
+                            const std::optional<std::array<double, 4>>& reference_wxyz) {
+  if (file_ == nullptr) return failure("gyro log writer is not open");
+  if (values.size() != static_cast<std::size_t>(gyro_count_) || present.size() != values.size()) {
+    return failure(path_ + ": epoch has the wrong number of gyro values");
+  }
+  append_double(buffer_, time_s);
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    buffer_ += ',';
+    if (present[i] != 0) append_double(buffer_, values[i]);
+  }
+  if (with_reference_) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      buffer_ += ',';
+      if (reference_wxyz) append_double(buffer_, (*reference_wxyz)[k]);
+    }
+  }
+  buffer_ += '\n';
+  if (buffer_.size() > (1U << 20)) return flush();
+  return ok_status();
+}
+
+Status GyroLogWriter::flush() {
+  if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
+    return failure(path_ + ": write failed");
+  }
+  buffer_.clear();
+  return ok_status();
+}
+
+Status GyroLogWriter::close() {
+  if (file_ == nullptr) return failure("gyro log writer is not open");
+  const Status flushed = flush();
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  const std::string tmp = path_ + ".tmp";
+  if (!flushed || !closed) {
+    std::remove(tmp.c_str());
+    return flushed ? failure(path_ + ": write failed") : flushed;
+  }
+  if (std::rename(tmp.c_str(), path_.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    return failure(path_ + ": cannot rename temporary file: " + std::strerror(errno));
+  }
+  return ok_status();
+}
+
+}  // namespace tetra

@@ -1,0 +1,22 @@
+// DDS commands — not yet part of this build.
+#include <iostream>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+
+namespace tetra::cli {
+
+namespace {
+int unavailable(const char* name) {
+  std::cerr << "tetra " << name << ": not available in this build\n";
+  return kExitFailure;
+}
+}  // namespace
+
+int cmd_fusion(int, char**) { return unavailable("fusion"); }
+int cmd_monitor(int, char**) { return unavailable("monitor"); }
+int cmd_command(int, char**) { return unavailable("command"); }
+int cmd_record(int, char**) { return unavailable("record"); }
+int cmd_demo(int, char**) { return unavailable("demo"); }
+
+}  // namespace tetra::cli

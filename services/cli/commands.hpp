@@ -1,0 +1,17 @@
+#pragma once
+// Entry points of the `tetra` subcommands. Each takes the arguments after "tetra" (argv[0] is the
+// subcommand's name) and returns the process exit status.
+
+namespace tetra::cli {
+
+int cmd_calibrate(int argc, char** argv);
+int cmd_allan(int argc, char** argv);
+int cmd_sim(int argc, char** argv);
+int cmd_replay(int argc, char** argv);
+int cmd_fusion(int argc, char** argv);
+int cmd_monitor(int argc, char** argv);
+int cmd_command(int argc, char** argv);
+int cmd_record(int argc, char** argv);
+int cmd_demo(int argc, char** argv);
+
+}  // namespace tetra::cli
