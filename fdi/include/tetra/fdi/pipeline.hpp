@@ -1,0 +1,42 @@
+#pragma once
+// The fusion pipeline: raw epochs in; attitude, health and FDI events out. One object serves
+// `tetra replay` (files) and `tetra fusion` (DDS). Lifecycle: create → step(epoch)… → reset().
+// A library object: it never exits or throws on bad input; bad epochs are rejected and counted.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tetra/core/calibration_file.hpp"
+#include "tetra/core/result.hpp"
+#include "tetra/fdi/config.hpp"
+#include "tetra/fdi/types.hpp"
+
+namespace tetra::fdi {
+
+struct StepResult {
+  bool accepted = false;               //!< false: epoch rejected (and counted), attitude not advanced
+  AttitudeEstimate attitude;           //!< valid when accepted
+  std::vector<FdiEvent> events;        //!< events triggered by this epoch, in order (often empty)
+};
+
+class Pipeline {
+ public:
+  //! Validates the calibration and configuration once; errors name what is wrong.
+  static Result<Pipeline> create(const Calibration& calibration, const PipelineConfig& config);
+
+  //! Back to the initial state (all gyros reinstated, attitude = config initial attitude).
+  void reset();
+  //! Processes one epoch. The returned reference is valid until the next call.
+  const StepResult& step(const Epoch& epoch);
+  //! Operator commands. They return the acknowledgement event (also emitted on the next step()).
+  FdiEvent exclude(int gyro_id, std::int64_t stamp_ns);
+  FdiEvent reinstate(int gyro_id, std::int64_t stamp_ns);
+  FdiEvent reset_command(std::int64_t stamp_ns);
+
+  const Health& health() const;
+  int gyro_count() const;
+  const PipelineConfig& config() const;
+};
+
+}  // namespace tetra::fdi
