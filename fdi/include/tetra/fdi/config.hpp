@@ -2,6 +2,7 @@
 // Pipeline configuration: a struct with in-class defaults, validated once, echoed at start-up.
 // Read from the `pipeline:` map of a YAML file (replay --config, fusion --config).
 
+#include <optional>
 #include <string>
 
 #include <yaml-cpp/yaml.h>
