@@ -39,7 +39,8 @@ GyroChannel::GyroChannel(const GyroCalibration& gyro, const GyroModelOptions& op
 
 double GyroChannel::white_noise_dps() {
   if (white_sigma_dps_ == 0.0) return 0.0;
-  return white_sigma_dps_ * white_rng_.normal();
+  last_white_dps_ = white_sigma_dps_ * white_rng_.normal();
+  return last_white_dps_;
 }
 
 double GyroChannel::bias_instability_dps() {

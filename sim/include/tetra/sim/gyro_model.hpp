@@ -69,6 +69,8 @@ class GyroChannel {
   //! The whole chain for a rate already projected on the axis.
   double sample_axis_V(double rate_dps, double t_s);
 
+  //! [deg/s] the white-noise sample drawn by the last white_noise_dps() call (0 before).
+  double last_white_noise_dps() const { return last_white_dps_; }
   double quantization_step_V() const;  //!< [V] output step of stage 5 (0 without Q)
   double gauss_markov_sigma_dps() const { return gm_sigma_dps_; }  //!< [deg/s] σ_GM
   const Eigen::Vector3d& axis_B() const { return axis_B_; }
@@ -81,6 +83,7 @@ class GyroChannel {
   double bias_V_;                 //!< [V]
   double dt_s_;                   //!< [s] nominal sampling interval
   double white_sigma_dps_ = 0.0;  //!< [deg/s] N/√Δt
+  double last_white_dps_ = 0.0;   //!< [deg/s] last white-noise sample
   double gm_sigma_dps_ = 0.0;     //!< [deg/s] stationary σ of the bias-instability process
   double gm_phi_ = 0.0;           //!< exp(−Δt/T_c)
   double gm_drive_dps_ = 0.0;     //!< [deg/s] σ_GM·√(1−φ²)
