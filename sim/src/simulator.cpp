@@ -17,6 +17,14 @@ std::string number_text(double value) {
   return out;
 }
 
+//! A metadata value: spaces and commas separate key=value tokens, so they become '_'.
+std::string token(std::string text) {
+  for (char& c : text) {
+    if (c == ' ' || c == '\t' || c == ',') c = '_';
+  }
+  return text;
+}
+
 }  // namespace
 
 Simulator::Simulator(Scenario scenario, SimOptions options, TruthMotion motion)
@@ -159,10 +167,10 @@ std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
   std::vector<std::pair<std::string, std::string>> meta;
   const MotionSpec& m = scenario_.motion;
   meta.emplace_back("generator", "tetra sim");
-  meta.emplace_back("scenario", scenario_.name);
+  meta.emplace_back("scenario", token(scenario_.name));
   meta.emplace_back("motion", std::string(motion_kind_name(m.kind)));
   meta.emplace_back("seed", std::to_string(options_.seed));
-  meta.emplace_back("unit", scenario_.unit.unit);
+  meta.emplace_back("unit", token(scenario_.unit.unit));
   meta.emplace_back("rate_hz", number_text(scenario_.rate_hz));
   meta.emplace_back("duration_s", number_text(scenario_.duration_s));
   meta.emplace_back("reference_frame", motion_.reference_frame());
@@ -180,14 +188,15 @@ std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
     meta.emplace_back("acs_peak_accel_dps2", number_text(motion_.acs_peak_accel_dps2()));
     for (const Slew& s : motion_.spec().slews) {
       if (m.kind != MotionKind::kSlews) break;
+      // Metadata values may not contain spaces or commas (they separate key=value tokens).
       std::string text = "axis=";
       append_double(text, s.axis_B.x());
-      text += ' ';
+      text += '/';
       append_double(text, s.axis_B.y());
-      text += ' ';
+      text += '/';
       append_double(text, s.axis_B.z());
-      text += ",angle_deg=" + number_text(s.angle_deg) + ",start_s=" + number_text(s.start_s) +
-              ",duration_s=" + number_text(s.duration_s);
+      text += ";angle_deg=" + number_text(s.angle_deg) + ";start_s=" + number_text(s.start_s) +
+              ";duration_s=" + number_text(s.duration_s);
       meta.emplace_back("slew", text);
     }
   }
@@ -199,7 +208,11 @@ std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
   if (scenario_.drop_probability > 0.0) {
     meta.emplace_back("drop_probability", number_text(scenario_.drop_probability));
   }
-  for (const FaultSpec& f : faults_) meta.emplace_back("fault", format_fault_spec(f));
+  for (const FaultSpec& f : faults_) {
+    std::string text = format_fault_spec(f);
+    for (char& c : text) c = c == ',' ? ';' : c;  // commas separate metadata tokens
+    meta.emplace_back("fault", text);
+  }
   return meta;
 }
 
@@ -311,7 +324,7 @@ Status write_simulation(Simulator& simulator, const std::string& log_path, const
   TruthWriter truth;
   if (!truth_path.empty()) {
     auto truth_meta = meta;
-    truth_meta.emplace_back("truth", "q = body to reference_frame; w = rate of body relative to it, in body");
+    truth_meta.emplace_back("truth", "q_body_to_reference_frame;w_body_relative_to_reference_frame_in_body");
     if (Status st = truth.open(truth_path, truth_meta); !st) return st;
   }
   SimEpoch epoch;

@@ -19,6 +19,14 @@ std::string number_text(double value) {
   return out;
 }
 
+//! Spaces and commas separate metadata tokens: replaced by '_'.
+std::string metadata_token(std::string text) {
+  for (char& c : text) {
+    if (c == ' ' || c == '\t' || c == ',') c = '_';
+  }
+  return text;
+}
+
 }  // namespace
 
 TurntableSequence turntable_sequence(int number) {
@@ -108,7 +116,7 @@ Result<TurntableLog> simulate_turntable(const Calibration& unit, const Turntable
   log.gyro_count = n;
   log.metadata = {{"latitude_deg", number_text(plan.latitude_deg)},
                   {"generator", "tetra sim turntable"},
-                  {"unit", unit.unit},
+                  {"unit", metadata_token(unit.unit)},
                   {"seed", std::to_string(seed)},
                   {"table_rate_dps", number_text(plan.table_rate_dps)},
                   {"revolutions", number_text(plan.revolutions)},
