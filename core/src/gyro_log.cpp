@@ -51,19 +51,17 @@ Result<GyroLog> from_table(CsvTable&& t) {
     return bad_input(head + "reference columns must be all of ref_qw,ref_qx,ref_qy,ref_qz");
   log.has_reference = ref_found == 4;
 
-  // Every column must be known: a typo must not pass silently.
-  const std::size_t known = 1 + gyro_cols.size() + static_cast<std::size_t>(ref_found);
-  if (known != t.column_count()) {
-    for (const auto& name : t.columns) {
-      const bool is_gyro = name.size() > 1 && name[0] == 'g' &&
-                           name.find_first_not_of("0123456789", 1) == std::string::npos &&
-                           std::stoi(name.substr(1)) >= 1 && std::stoi(name.substr(1)) <= log.gyro_count;
-      bool is_ref = false;
-      for (const char* r : kRefNames) is_ref = is_ref || name == r;
-      if (name != "time_s" && !is_gyro && !is_ref) {
-        return bad_input(head + "unknown column '" + name + "' (expected time_s, g1..g" +
-                         std::to_string(log.gyro_count) + ", optional ref_qw..ref_qz)");
-      }
+  // Every column must be used: a typo or a duplicate must not pass silently.
+  std::vector<bool> used(t.column_count(), false);
+  used[*time_col] = true;
+  for (const std::size_t c : gyro_cols) used[c] = true;
+  if (log.has_reference) {
+    for (const std::size_t c : ref_cols) used[c] = true;
+  }
+  for (std::size_t c = 0; c < t.column_count(); ++c) {
+    if (!used[c]) {
+      return bad_input(head + "unknown or duplicate column '" + t.columns[c] + "' (expected time_s, g1..g" +
+                       std::to_string(log.gyro_count) + ", optional ref_qw..ref_qz)");
     }
   }
 

@@ -19,11 +19,36 @@ struct Error {
   ErrorKind kind = ErrorKind::kBadInput;  //!< how a CLI should report it
 };
 
+//! Keeps a message on one line: control characters (which messages may quote from bad input, e.g. a
+//! newline inside a YAML scalar) are written as escapes \n, \r, \t, \xHH.
+inline std::string one_line(const std::string& message) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(message.size());
+  for (const char c : message) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u != 0x7f) {
+      out += c;
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else {
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 0xf];
+    }
+  }
+  return out;
+}
+
 inline Error bad_input(std::string message) {
-  return Error{std::move(message), ErrorKind::kBadInput};
+  return Error{one_line(message), ErrorKind::kBadInput};
 }
 inline Error failure(std::string message) {
-  return Error{std::move(message), ErrorKind::kFailure};
+  return Error{one_line(message), ErrorKind::kFailure};
 }
 
 //! Either a value or an Error. Minimal stand-in for C++23 std::expected.
