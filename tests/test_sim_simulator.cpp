@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "sim_test_util.hpp"
+#include "test_support.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/sim/fault.hpp"
 #include "tetra/sim/scenario.hpp"
@@ -285,6 +286,26 @@ TEST(SimScenario, YamlErrorsNameLineAndKey) {
     ASSERT_FALSE(r.ok()) << text;
     EXPECT_NE(r.error().message.find(needle), std::string::npos) << text << " -> " << r.error().message;
   }
+}
+
+}  // namespace
+}  // namespace tetra::sim
+
+namespace tetra::sim {
+namespace {
+
+TEST(SimScenario, ExampleFilesAreValid) {
+  for (const char* name : {"examples/sim/orbit_fault.yaml", "examples/sim/slews_custom.yaml",
+                           "examples/sim/static_allan.yaml"}) {
+    auto sc = read_scenario(test::source_path(name));
+    ASSERT_TRUE(sc.ok()) << name << ": " << sc.error().message;
+  }
+  // static_allan.yaml loads allan_unit.yaml (seed Table 6): gyro 2 has all of Q, N, B, K.
+  auto sc = read_scenario(test::source_path("examples/sim/static_allan.yaml"));
+  const GyroNoise& n = *sc->unit.gyros[1].noise;
+  EXPECT_EQ(n.quantization_deg, 6e-5);
+  EXPECT_EQ(n.rate_random_walk_dps_per_rts, 6e-8);
+  EXPECT_FALSE(sc->unit.gyros[0].noise->rate_random_walk_dps_per_rts.has_value());
 }
 
 }  // namespace
