@@ -1,4 +1,5 @@
 // tetra sim SCENARIO — simulated gyro data with known truth (see docs/sim.md).
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <iostream>
@@ -21,12 +22,12 @@ namespace {
 constexpr const char* kName = "sim";
 
 void print_progress(double fraction) {
-  std::cerr << "tetra sim: " << static_cast<int>(fraction * 100.0 + 0.5) << " %\n";
+  std::cerr << "tetra sim: " << std::lround(fraction * 100.0) << " %\n";
 }
 
-int run_turntable(const Calibration& unit, const sim::TurntablePlan& plan, std::uint64_t seed,
-                  const std::string& out_path) {
-  auto log = sim::simulate_turntable(unit, plan, seed);
+int run_turntable(const Calibration& unit, const sim::TurntablePlan& plan, const sim::GyroModelOptions& model,
+                  std::uint64_t seed, const std::string& out_path) {
+  auto log = sim::simulate_turntable(unit, plan, seed, model);
   if (!log) return report(kName, log.error());
   const bool to_stdout = out_path.empty() || out_path == "-";
   if (to_stdout) {
@@ -112,13 +113,18 @@ int cmd_sim(int argc, char** argv) {
   }
 
   if (scenario_name == "turntable") {
-    if (opt_minutes->count() || !fault_texts.empty() || opt_ref->count() || !truth_path.empty()) {
-      return report(kName,
-                    bad_input("turntable: --minutes, --fault, --reference-hz and --truth do not apply"));
+    for (const CLI::Option* o :
+         {opt_minutes, opt_ref, opt_ref_noise, opt_acs_amp, opt_acs_acc, opt_jitter, opt_drop}) {
+      if (o->count()) return report(kName, bad_input("turntable: " + o->get_name() + " does not apply"));
+    }
+    if (!fault_texts.empty() || !truth_path.empty()) {
+      return report(kName, bad_input("turntable: --fault and --truth do not apply"));
     }
     if (opt_rate->count()) plan.rate_hz = rate_hz;
     if (opt_lat->count()) plan.latitude_deg = latitude_deg;
-    return run_turntable(unit ? *unit : seed_as_built_unit(), plan, seed, out_path);
+    sim::GyroModelOptions model;
+    if (opt_range->count()) model.range_dps = range_dps;
+    return run_turntable(unit ? *unit : seed_as_built_unit(), plan, model, seed, out_path);
   }
 
   Result<sim::Scenario> scenario = looks_like_file(scenario_name) ? sim::read_scenario(scenario_name)

@@ -78,7 +78,7 @@ Eigen::Vector3d vector3(const Ctx& ctx, const YAML::Node& node, const std::strin
 
 Eigen::Vector3d axis_from(const Ctx& ctx, const YAML::Node& node, const std::string& what) {
   if (node.IsScalar()) {
-    const std::string name = node.Scalar();
+    const std::string& name = node.Scalar();
     if (name == "x" || name == "+x") return Eigen::Vector3d::UnitX();
     if (name == "y" || name == "+y") return Eigen::Vector3d::UnitY();
     if (name == "z" || name == "+z") return Eigen::Vector3d::UnitZ();
