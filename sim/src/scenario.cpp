@@ -272,7 +272,7 @@ Status validate_scenario(const Scenario& sc) {
     return bad_input("gyro_model range_dps must be positive");
   }
   for (const FaultSpec& f : sc.faults) {
-    if (f.gyro > sc.unit.gyro_count()) {
+    if (f.gyro < 1 || f.gyro > sc.unit.gyro_count()) {
       return bad_input("fault '" + format_fault_spec(f) + "': gyro " + std::to_string(f.gyro) +
                        " does not exist (the unit has " + std::to_string(sc.unit.gyro_count()) + " gyros)");
     }

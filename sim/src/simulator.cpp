@@ -38,7 +38,7 @@ Simulator::Simulator(Scenario scenario, SimOptions options, TruthMotion motion)
 Result<Simulator> Simulator::create(const Scenario& scenario, const SimOptions& options) {
   if (Status st = validate_scenario(scenario); !st) return st.error();
   for (const FaultSpec& f : options.faults) {
-    if (f.gyro > scenario.unit.gyro_count()) {
+    if (f.gyro < 1 || f.gyro > scenario.unit.gyro_count()) {
       return bad_input("fault '" + format_fault_spec(f) + "': gyro " + std::to_string(f.gyro) +
                        " does not exist (the unit has " + std::to_string(scenario.unit.gyro_count()) +
                        " gyros)");
