@@ -154,6 +154,20 @@ TEST(SimFaults, ParseRejectsBadSpecsWithTheField) {
   EXPECT_EQ(format_fault_spec(*ok), "gyro=3,kind=ramp,at=1.5,size=-0.25,until=9");
 }
 
+TEST(SimFaults, NoiseFaultNeedsWhiteNoiseToMultiply) {
+  Scenario sc = short_static();
+  sc.unit.gyros[2].noise.reset();
+  SimOptions opt;
+  opt.faults.push_back(parse_fault_spec("gyro=3,kind=noise,at=1,size=3").value());
+  auto sim = Simulator::create(sc, opt);
+  ASSERT_FALSE(sim.ok());
+  EXPECT_NE(sim.error().message.find("gyro 3 has no white noise"), std::string::npos) << sim.error().message;
+  opt.faults[0].gyro = 5;
+  sim = Simulator::create(sc, opt);
+  ASSERT_FALSE(sim.ok());
+  EXPECT_NE(sim.error().message.find("gyro 5 does not exist"), std::string::npos) << sim.error().message;
+}
+
 TEST(SimSimulator, SameSeedSameOutputDifferentSeedDifferent) {
   Scenario sc = builtin_scenario("orbit").value();
   sc.duration_s = 30.0;

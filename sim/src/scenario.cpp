@@ -276,6 +276,13 @@ Status validate_scenario(const Scenario& sc) {
       return bad_input("fault '" + format_fault_spec(f) + "': gyro " + std::to_string(f.gyro) +
                        " does not exist (the unit has " + std::to_string(sc.unit.gyro_count()) + " gyros)");
     }
+    if (f.kind == FaultKind::kNoise) {
+      const auto& noise = sc.unit.gyros[static_cast<std::size_t>(f.gyro - 1)].noise;
+      if (!noise || !noise->arw_dps_rtHz || *noise->arw_dps_rtHz == 0.0) {
+        return bad_input("fault '" + format_fault_spec(f) + "': gyro " + std::to_string(f.gyro) +
+                         " has no white noise (noise: arw_dps_rtHz) for a noise fault to multiply");
+      }
+    }
   }
   return ok_status();
 }
