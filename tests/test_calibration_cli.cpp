@@ -142,6 +142,53 @@ TEST(CalibrateCli, EmptyFile) {
   expect_bad_input("", "1", "empty file");
 }
 
+// Further checks of meaning, beyond the list.
+TEST(CalibrateCli, PairTurningTheSameWay) {
+  auto plan = seed_plan();
+  plan[3].rate_dps = 6.0;  // sequence 4 (lines 21-26) repeats sequence 3's direction
+  expect_bad_input(turntable_text(plan), "21",
+                   "sequence 4 (lines 21-26): pairs with sequence 3 but turns in the same direction");
+}
+
+TEST(CalibrateCli, PairAtDifferentFixedAngles) {
+  auto plan = seed_plan();
+  plan[9].fixed_deg = 80.0;  // sequence 10 (lines 57-62) at inner 80° where sequence 9 is at 90°
+  expect_bad_input(turntable_text(plan), "57",
+                   "holds the other gimbal at 80.0000 deg instead of 90.0000 deg");
+}
+
+TEST(CalibrateCli, BothGimbalsMove) {
+  std::string text = turntable_text(seed_plan());
+  // Sequence 5 turns the outer gimbal with the inner at 0°; nudge the inner angle on its third row
+  // (data row 26, line 29: time 26, inner 0 → 2); the message names the sequence's first line.
+  const std::string row = "\n5,26,0,";
+  const std::size_t at = text.find(row);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, row.size(), "\n5,26,2,");
+  expect_bad_input(text, "27", "sequence 5 (lines 27-32): both gimbals move");
+}
+
+TEST(CalibrateCli, SequenceNotContiguous) {
+  auto plan = seed_plan();
+  std::string text = turntable_text(plan);
+  // Relabel sequence 3's last row (data row 17, line 20) as sequence 1.
+  const std::string row = "\n3,17,";
+  const std::size_t at = text.find(row);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, row.size(), "\n1,17,");
+  expect_bad_input(text, "20", "sequence 1 appears again");
+}
+
+TEST(CalibrateCli, PlanExcitingOnlyTwoAxes) {
+  auto plan = seed_plan();
+  plan.resize(8);  // sequences 1-8: rotations about body X and Y only
+  test::TempDir dir;
+  test::write_file(dir.file("t.csv"), turntable_text(plan));
+  const auto r = test::run_tetra("calibrate " + dir.file("t.csv") + " -o " + dir.file("c.yaml"));
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("excite only 2 independent body axes"), std::string::npos) << r.err;
+}
+
 // Not in the list but part of the contract: no latitude anywhere is bad input.
 TEST(CalibrateCli, NoLatitude) {
   std::string text = turntable_text(seed_plan());
