@@ -37,13 +37,13 @@ Calibration white_noise_unit() {
   return unit;
 }
 
-struct Run {
+struct SimulatedRun {
   CalibrationResult result;
   TurntableMotion motion;
 };
 
-Run calibrate_simulated(const Calibration& unit, const sim::TurntablePlan& plan, std::uint64_t seed,
-                        CalibrationMethod method, BiasModel bias_model = BiasModel::kBody) {
+SimulatedRun calibrate_simulated(const Calibration& unit, const sim::TurntablePlan& plan, std::uint64_t seed,
+                                 CalibrationMethod method, BiasModel bias_model = BiasModel::kBody) {
   auto log = sim::simulate_turntable(unit, plan, seed);
   EXPECT_TRUE(log.ok()) << (log.ok() ? "" : log.error().message);
   auto motion = analyze_turntable(*log, plan.latitude_deg);
@@ -53,7 +53,7 @@ Run calibrate_simulated(const Calibration& unit, const sim::TurntablePlan& plan,
   options.bias_model = bias_model;
   auto result = calibrate(*log, *motion, options);
   EXPECT_TRUE(result.ok()) << (result.ok() ? "" : result.error().message);
-  return Run{std::move(result.value()), std::move(motion.value())};
+  return SimulatedRun{std::move(result.value()), std::move(motion.value())};
 }
 
 //! Checks every estimate against the truth: the absolute tolerances and |error| ≤ 4σ.
@@ -83,7 +83,7 @@ class Accuracy : public ::testing::TestWithParam<CalibrationMethod> {};
 TEST_P(Accuracy, SeedPlan) {
   const Calibration unit = white_noise_unit();
   const sim::TurntablePlan plan;  // 6 deg/s, 1 revolution, 10 Hz, −23.2°
-  const Run run = calibrate_simulated(unit, plan, 21, GetParam());
+  const SimulatedRun run = calibrate_simulated(unit, plan, 21, GetParam());
   expect_recovers(unit, run.result.calibration, "seed plan");
   // White noise at 10 Hz: per-sample σ = N·√10 deg/s → s·N·√10 V ≈ 7e-6 V. The per-sample residual RMS
   // must match that within 5 % (9600 samples: the RMS's own relative spread is 1/√(2·9600) ≈ 0.7 %).
@@ -98,7 +98,7 @@ TEST_P(Accuracy, OtherSequenceOrder) {
   const Calibration unit = white_noise_unit();
   sim::TurntablePlan plan;
   plan.order = {9, 10, 1, 2, 16, 15, 5, 6, 12, 11, 3, 4, 13, 14, 8, 7};
-  const Run run = calibrate_simulated(unit, plan, 22, GetParam());
+  const SimulatedRun run = calibrate_simulated(unit, plan, 22, GetParam());
   expect_recovers(unit, run.result.calibration, "other order");
 }
 
@@ -106,14 +106,14 @@ TEST_P(Accuracy, WrappedEncoderAngles) {
   const Calibration unit = white_noise_unit();
   sim::TurntablePlan plan;
   plan.wrap_angles = true;
-  const Run run = calibrate_simulated(unit, plan, 23, GetParam());
+  const SimulatedRun run = calibrate_simulated(unit, plan, 23, GetParam());
   expect_recovers(unit, run.result.calibration, "wrapped angles");
 }
 
 TEST_P(Accuracy, ThreeGyros) {
   Calibration unit = white_noise_unit();
   unit.gyros.resize(3);
-  const Run run = calibrate_simulated(unit, sim::TurntablePlan{}, 24, GetParam());
+  const SimulatedRun run = calibrate_simulated(unit, sim::TurntablePlan{}, 24, GetParam());
   expect_recovers(unit, run.result.calibration, "3 gyros");
 }
 
@@ -131,7 +131,7 @@ TEST_P(Accuracy, SixGyros) {
     g.axis_B = h[k];
     unit.gyros.push_back(g);
   }
-  const Run run = calibrate_simulated(unit, sim::TurntablePlan{}, 25, GetParam());
+  const SimulatedRun run = calibrate_simulated(unit, sim::TurntablePlan{}, 25, GetParam());
   expect_recovers(unit, run.result.calibration, "6 gyros");
 }
 
@@ -140,15 +140,16 @@ TEST_P(Accuracy, OtherLatitudeAndTableRate) {
   sim::TurntablePlan plan;
   plan.latitude_deg = 52.4;
   plan.table_rate_dps = 10.0;
-  const Run run = calibrate_simulated(unit, plan, 26, GetParam());
+  const SimulatedRun run = calibrate_simulated(unit, plan, 26, GetParam());
   expect_recovers(unit, run.result.calibration, "latitude 52.4, 10 deg/s");
 }
 
+std::string method_name(const ::testing::TestParamInfo<CalibrationMethod>& param_info) {
+  return param_info.param == CalibrationMethod::kBatch ? "batch" : "sixteen";
+}
 INSTANTIATE_TEST_SUITE_P(Calibration, Accuracy,
                          ::testing::Values(CalibrationMethod::kSixteen, CalibrationMethod::kBatch),
-                         [](const auto& info) {
-                           return std::string(to_string(info.param)) == "batch" ? "batch" : "sixteen";
-                         });
+                         method_name);
 
 // The body rates come from the encoders and the kinematics of INTERFACES §1. Expected mean table rates
 // per sequence for the seed's Table 3 plan at 6 deg/s (rows 9–16 differ in sign from seed Table 3, whose
@@ -184,8 +185,10 @@ TEST(CalibrationMotion, BodyRatesFollowTheGimbalKinematics) {
 TEST(CalibrationBiasModel, SeedEquation11IsOffByTheLabEarthRate) {
   const Calibration unit = white_noise_unit();
   const sim::TurntablePlan plan;
-  const Run seed = calibrate_simulated(unit, plan, 31, CalibrationMethod::kSixteen, BiasModel::kSeed);
-  const Run body = calibrate_simulated(unit, plan, 31, CalibrationMethod::kSixteen, BiasModel::kBody);
+  const SimulatedRun seed =
+      calibrate_simulated(unit, plan, 31, CalibrationMethod::kSixteen, BiasModel::kSeed);
+  const SimulatedRun body =
+      calibrate_simulated(unit, plan, 31, CalibrationMethod::kSixteen, BiasModel::kBody);
   const Eigen::Vector3d earth_L_dps = earth_rate_L(plan.latitude_deg * kDegToRad) * kRadToDeg;
   for (int i = 0; i < unit.gyro_count(); ++i) {
     const auto& t = unit.gyros[static_cast<std::size_t>(i)];

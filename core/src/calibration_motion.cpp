@@ -40,6 +40,11 @@ std::string fmt(double value, int decimals) {
   return s;
 }
 
+//! 1-based file line of a row; logs built in memory (no file lines) count rows from 1.
+std::size_t line_of(const TurntableLog& log, std::size_t row) {
+  return row < log.lines.size() ? log.lines[row] : row + 1;
+}
+
 //! A contiguous block of rows with one sequence number.
 struct Run {
   int sequence = 0;
@@ -79,8 +84,8 @@ Result<SequenceMotion> analyze_run(const TurntableLog& log, const Run& run, doub
   m.sequence = run.sequence;
   m.first_row = run.first;
   m.row_count = run.count;
-  m.first_line = log.lines[run.first];
-  m.last_line = log.lines[run.first + run.count - 1];
+  m.first_line = line_of(log, run.first);
+  m.last_line = line_of(log, run.first + run.count - 1);
   const std::string where = lines_of(log, m);
   if (run.count < static_cast<std::size_t>(tol.min_rows_per_sequence)) {
     return bad_input(where + "has " + std::to_string(run.count) + " rows, at least " +
@@ -165,6 +170,11 @@ Result<TurntableMotion> analyze_turntable(const TurntableLog& log, double latitu
     return bad_input(log.source + ": latitude " + fmt(latitude_deg, 6) + " deg is outside [-90, 90]");
   }
   if (log.rows() == 0) return bad_input(log.source + ": no data rows");
+  const std::size_t rows = log.rows();
+  if (log.gyro_count < 1 || log.sequence.size() != rows || log.inner_deg.size() != rows ||
+      log.outer_deg.size() != rows || log.g_V.size() != rows * static_cast<std::size_t>(log.gyro_count)) {
+    return failure(log.source + ": inconsistent turntable log (column lengths differ)");
+  }
   TurntableMotion motion;
   motion.source = log.source;
   motion.latitude_deg = latitude_deg;
@@ -181,9 +191,9 @@ Result<TurntableMotion> analyze_turntable(const TurntableLog& log, double latitu
     const auto seen = run_of_sequence.find(log.sequence[r]);
     if (seen != run_of_sequence.end()) {
       const Run& earlier = runs[seen->second];
-      return bad_input(log.source + ":" + std::to_string(log.lines[r]) + ": sequence " +
+      return bad_input(log.source + ":" + std::to_string(line_of(log, r)) + ": sequence " +
                        std::to_string(log.sequence[r]) + " appears again (it ended at line " +
-                       std::to_string(log.lines[earlier.first + earlier.count - 1]) +
+                       std::to_string(line_of(log, earlier.first + earlier.count - 1)) +
                        "); the rows of a sequence must be contiguous");
     }
     run_of_sequence[log.sequence[r]] = runs.size();
