@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "test_support.hpp"
+#include "tetra/core/calibration_file.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/frames.hpp"
 #include "tetra/core/geometry.hpp"
@@ -211,6 +212,47 @@ TEST(CalibrateCli, BiasModelOnlyWithSixteen) {
                                  dir.file("c.yaml"));
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_NE(r.err.find("--bias-model applies to --method sixteen only"), std::string::npos) << r.err;
+}
+
+// The example data (seed unit with its Table 6 noise, 2 Hz): the command writes a calibration file that
+// reads back and is close to the unit that was simulated. Tolerances: the figures (s 1e-5
+// relative, axes 1e-5, β 2e-6 V); the example's noise (σ(β) ≈ 8e-8 V) is far below them.
+TEST(CalibrateCli, ExampleWithCompare) {
+  test::TempDir dir;
+  const auto r = test::run_tetra("calibrate " + test::source_path("examples/turntable.csv") + " --compare " +
+                                 test::source_path("examples/factory.yaml") + " -o " + dir.file("cal.yaml"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("cf. seed Table 4"), std::string::npos);
+  EXPECT_NE(r.out.find("cf. seed Table 5"), std::string::npos);
+  EXPECT_NE(r.out.find("cf. seed Fig. 4"), std::string::npos);
+  auto cal = read_calibration(dir.file("cal.yaml"));
+  ASSERT_TRUE(cal.ok()) << cal.error().message;
+  EXPECT_EQ(cal->method, "sixteen-position");
+  EXPECT_EQ(cal->unit, "seed-as-built");  // from the file's '# unit=' comment
+  ASSERT_TRUE(cal->latitude_deg.has_value());
+  EXPECT_DOUBLE_EQ(*cal->latitude_deg, -23.2);
+  const Calibration truth = seed_as_built_unit();
+  ASSERT_EQ(cal->gyro_count(), 4);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto& e = cal->gyros[i];
+    const auto& t = truth.gyros[i];
+    EXPECT_NEAR(e.scale_factor_V_per_dps / t.scale_factor_V_per_dps, 1.0, 1e-5) << "gyro " << i + 1;
+    EXPECT_NEAR(e.bias_V, t.bias_V, 2e-6) << "gyro " << i + 1;
+    EXPECT_LT((e.axis_B - t.axis_B).cwiseAbs().maxCoeff(), 1e-5) << "gyro " << i + 1;
+    ASSERT_TRUE(e.sigma.has_value());
+    EXPECT_GT(e.sigma->bias_V, 0.0);
+  }
+}
+
+TEST(CalibrateCli, SeedBiasModelIsLabelledAndQuantified) {
+  test::TempDir dir;
+  const auto r = test::run_tetra("calibrate " + test::source_path("examples/turntable.csv") +
+                                 " --bias-model seed -o " + dir.file("cal.yaml"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("Seed eq. 11 bias minus body-model bias"), std::string::npos);
+  auto cal = read_calibration(dir.file("cal.yaml"));
+  ASSERT_TRUE(cal.ok()) << cal.error().message;
+  EXPECT_EQ(cal->method, "sixteen-position-seed-bias");
 }
 
 TEST(CalibrateCli, HelpNamesEveryOption) {
