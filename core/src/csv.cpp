@@ -149,7 +149,9 @@ Result<CsvTable> parse_csv(std::string_view text, std::string source) {
     t.lines.push_back(line_no);
     ++t.rows;
   }
-  if (!have_header) return bad_input(t.source + ": empty file: no header line");
+  if (!have_header) {
+    return bad_input(t.source + ":" + std::to_string(line_no + 1) + ": empty file: no header line");
+  }
   return t;
 }
 
