@@ -3,9 +3,12 @@
 #include "tetra/core/allan.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <thread>
 
 namespace tetra::allan {
 
@@ -173,6 +176,8 @@ Result<SamplingGrid> uniform_grid(std::span<const double> time_s, double toleran
   }
   grid.slots = slot + 1;
   grid.missing_epochs = grid.slots - n;
+  // The mean step over the whole grid is a better τ0 than the median of rounded time stamps.
+  grid.tau0_s = (time_s[n - 1] - time_s[0]) / static_cast<double>(slot);
   if (grid.missing_epochs > 4 * n) {
     return bad_input(source + ": missing epochs (" + std::to_string(grid.missing_epochs) +
                      ") outnumber the rows four to one: is time_s in seconds?");
@@ -296,7 +301,7 @@ std::vector<std::size_t> valid_runs(std::span<const double> rate, std::span<cons
 // run of consecutive samples is an independent record: the EDF is the sum over the runs long
 // enough for the averaging time (a run of L samples has L + 1 angle points).
 void set_intervals(std::vector<AdevPoint>& points, const std::vector<AvarPoint>& avar,
-                   const std::vector<std::size_t>& runs, double confidence) {
+                   const std::vector<std::size_t>& runs, double confidence, bool with_bounds) {
   const double p_hi = 0.5 * (1.0 + confidence);
   const double p_lo = 0.5 * (1.0 - confidence);
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -311,6 +316,7 @@ void set_intervals(std::vector<AdevPoint>& points, const std::vector<AvarPoint>&
     pt.edf = std::max(1.0, edf);
     const double v = avar[i].avar;
     pt.adev = std::sqrt(v);
+    if (!with_bounds) continue;  // passes before the last only need the EDF for the fit weights
     pt.adev_lo = std::sqrt(v * pt.edf / chi2_quantile(p_hi, pt.edf));
     pt.adev_hi = std::sqrt(v * pt.edf / chi2_quantile(p_lo, pt.edf));
   }
@@ -377,16 +383,16 @@ Result<AllanResult> analyze_series(std::span<const double> rate, std::span<const
   // weights of the fitted model (iteratively reweighted: weights from the measured values favour
   // points that happen to fall low), for a fixed number of passes.
   const std::vector<std::size_t> runs = valid_runs(rate, present);
-  set_intervals(result.points, avar, runs, options.confidence);
+  set_intervals(result.points, avar, runs, options.confidence, false);
   result.fit = fit_noise_terms(result.points);
   for (int pass = 0; pass < 4; ++pass) {
     classify(result.points, result.fit);
-    set_intervals(result.points, avar, runs, options.confidence);
+    set_intervals(result.points, avar, runs, options.confidence, false);
     result.fit = fit_noise_terms(result.points, &result.fit);
   }
   // Intervals consistent with the reported fit.
   classify(result.points, result.fit);
-  set_intervals(result.points, avar, runs, options.confidence);
+  set_intervals(result.points, avar, runs, options.confidence, true);
   return result;
 }
 
@@ -414,9 +420,8 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
   out.tau0_s = grid->tau0_s;
   out.missing_epochs = grid->missing_epochs;
 
-  std::vector<double> rate(grid->slots);
-  std::vector<std::uint8_t> present(grid->slots);
-  for (const int id : ids) {
+  const SamplingGrid& grid_ref = *grid;
+  auto analyse_one = [&](int id) -> Result<GyroAllan> {
     const int g = id - 1;
     GyroAllan gyro;
     gyro.id = id;
@@ -427,27 +432,45 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
       bias = cal.bias_V;
       scale = cal.scale_factor_V_per_dps;
     }
-    std::fill(present.begin(), present.end(), std::uint8_t{0});
-    std::fill(rate.begin(), rate.end(), 0.0);
+    std::vector<double> rate(grid_ref.slots, 0.0);
+    std::vector<std::uint8_t> present(grid_ref.slots, 0);
     for (std::size_t r = 0; r < log.epochs(); ++r) {
-      const std::size_t s = grid->slot[r];
       if (!log.is_present(r, g)) continue;
       const double v = log.value(r, g);
       if (!std::isfinite(v)) {
         ++gyro.invalid;
         continue;
       }
+      const std::size_t s = grid_ref.slot[r];
       rate[s] = calibrate ? (v - bias) / scale : v;
       present[s] = 1;
     }
     std::size_t delivered = 0;
     for (const std::uint8_t p : present) delivered += p;
-    gyro.absent = grid->slots - delivered - gyro.invalid;
-    auto result = analyze_series(rate, present, grid->tau0_s, options.allan);
+    gyro.absent = grid_ref.slots - delivered - gyro.invalid;
+    auto result = analyze_series(rate, present, grid_ref.tau0_s, options.allan);
     if (!result)
       return bad_input(log.source + ": gyro " + std::to_string(id) + ": " + result.error().message);
     gyro.result = std::move(result.value());
-    out.gyros.push_back(std::move(gyro));
+    return gyro;
+  };
+
+  // The gyros are independent: analyse them on up to two threads (the work per gyro is O(n) per τ
+  // and identical in any order, so the results do not depend on the thread count).
+  std::vector<std::optional<Result<GyroAllan>>> results(ids.size());
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t i = next++; i < ids.size(); i = next++) results[i] = analyse_one(ids[i]);
+  };
+  const std::size_t threads =
+      std::min<std::size_t>({2, ids.size(), std::max(1U, std::thread::hardware_concurrency())});
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  for (auto& r : results) {
+    if (!*r) return r->error();
+    out.gyros.push_back(std::move(r->value()));
   }
   return out;
 }

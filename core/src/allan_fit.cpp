@@ -83,57 +83,79 @@ NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weig
   }
 
   // Exact NNLS for five unknowns: the optimum is the unconstrained least-squares solution on its own
-  // support, so the best feasible subset solution is the optimum.
-  double best_cost = b.squaredNorm();
-  Eigen::VectorXd best = Eigen::VectorXd::Zero(kTermCount);
-  for (int mask = 1; mask < (1 << kTermCount); ++mask) {
-    std::vector<int> cols;
-    for (int k = 0; k < kTermCount; ++k) {
-      if ((mask & (1 << k)) != 0) cols.push_back(k);
-    }
-    const auto nc = static_cast<Eigen::Index>(cols.size());
-    if (nc > rows) continue;
-    Eigen::MatrixXd sub(rows, nc);
-    for (Eigen::Index j = 0; j < nc; ++j) sub.col(j) = a.col(cols[static_cast<std::size_t>(j)]);
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(sub);
-    if (qr.rank() < nc) continue;
-    const Eigen::VectorXd coef = qr.solve(b);
-    if ((coef.array() <= 0.0).any()) continue;
-    const double cost = (sub * coef - b).squaredNorm();
-    if (cost < best_cost) {
-      best_cost = cost;
-      best.setZero();
-      for (Eigen::Index j = 0; j < nc; ++j) best(cols[static_cast<std::size_t>(j)]) = coef(j);
-    }
-  }
-  for (int k = 0; k < kTermCount; ++k) {
-    const double c = col_norm(k) > 0.0 ? best(k) / col_norm(k) : 0.0;
-    fit.value[static_cast<std::size_t>(k)] = std::sqrt(std::max(0.0, c));
-  }
-
-  // Observed: the term is the largest contribution at some τ and the other terms alone fall below
-  // the 95 % lower bound of the measured variance there.
-  for (const AdevPoint* p : used) {
-    std::array<double, kTermCount> contribution{};
-    double total = 0.0;
-    int largest = -1;
-    for (int k = 0; k < kTermCount; ++k) {
-      const double v = fit.value[static_cast<std::size_t>(k)];
-      contribution[static_cast<std::size_t>(k)] = v * v * term_basis(k, p->tau_s);
-      total += contribution[static_cast<std::size_t>(k)];
-      if (contribution[static_cast<std::size_t>(k)] > 0.0 &&
-          (largest < 0 ||
-           contribution[static_cast<std::size_t>(k)] > contribution[static_cast<std::size_t>(largest)])) {
-        largest = k;
+  // support, so the best feasible subset solution is the optimum. `allowed` limits the terms.
+  auto nnls = [&](int allowed) {
+    double best_cost = b.squaredNorm();
+    Eigen::VectorXd best = Eigen::VectorXd::Zero(kTermCount);
+    for (int mask = 1; mask < (1 << kTermCount); ++mask) {
+      if ((mask & ~allowed) != 0) continue;
+      std::vector<int> cols;
+      for (int k = 0; k < kTermCount; ++k) {
+        if ((mask & (1 << k)) != 0) cols.push_back(k);
+      }
+      const auto nc = static_cast<Eigen::Index>(cols.size());
+      if (nc > rows) continue;
+      Eigen::MatrixXd sub(rows, nc);
+      for (Eigen::Index j = 0; j < nc; ++j) sub.col(j) = a.col(cols[static_cast<std::size_t>(j)]);
+      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(sub);
+      if (qr.rank() < nc) continue;
+      const Eigen::VectorXd coef = qr.solve(b);
+      if ((coef.array() <= 0.0).any()) continue;
+      const double cost = (sub * coef - b).squaredNorm();
+      if (cost < best_cost) {
+        best_cost = cost;
+        best.setZero();
+        for (Eigen::Index j = 0; j < nc; ++j) best(cols[static_cast<std::size_t>(j)]) = coef(j);
       }
     }
-    if (largest < 0) continue;
-    const auto kl = static_cast<std::size_t>(largest);
-    if (fit.dominant_from_s[kl] == 0.0) fit.dominant_from_s[kl] = p->tau_s;
-    fit.dominant_to_s[kl] = p->tau_s;
-    const double avar = p->adev * p->adev;
-    const double lower95 = avar * p->edf / chi2_quantile(0.975, p->edf);
-    if (total - contribution[kl] < lower95) fit.observed[kl] = true;
+    // Back to σ² coefficients (Q², N², B², K², R²).
+    std::array<double, kTermCount> c{};
+    for (int k = 0; k < kTermCount; ++k) {
+      c[static_cast<std::size_t>(k)] = col_norm(k) > 0.0 ? std::max(0.0, best(k) / col_norm(k)) : 0.0;
+    }
+    return c;
+  };
+  auto model = [](const std::array<double, kTermCount>& c, double tau_s) {
+    double sum = 0.0;
+    for (int k = 0; k < kTermCount; ++k) sum += c[static_cast<std::size_t>(k)] * term_basis(k, tau_s);
+    return sum;
+  };
+
+  constexpr int kAllTerms = (1 << kTermCount) - 1;
+  const std::array<double, kTermCount> coeff = nnls(kAllTerms);
+  for (int k = 0; k < kTermCount; ++k)
+    fit.value[static_cast<std::size_t>(k)] = std::sqrt(coeff[static_cast<std::size_t>(k)]);
+
+  // Where each term dominates.
+  std::vector<int> largest(used.size(), -1);
+  for (std::size_t i = 0; i < used.size(); ++i) {
+    double best = 0.0;
+    for (int k = 0; k < kTermCount; ++k) {
+      const double contribution = coeff[static_cast<std::size_t>(k)] * term_basis(k, used[i]->tau_s);
+      if (contribution > best) {
+        best = contribution;
+        largest[i] = k;
+      }
+    }
+    if (largest[i] < 0) continue;
+    const auto kl = static_cast<std::size_t>(largest[i]);
+    if (fit.dominant_from_s[kl] == 0.0) fit.dominant_from_s[kl] = used[i]->tau_s;
+    fit.dominant_to_s[kl] = used[i]->tau_s;
+  }
+  // Observed: the model re-fitted without the term leaves the 95 % confidence interval of the
+  // measured variance at some τ where the term dominates — the other terms cannot stand in for it.
+  for (int k = 0; k < kTermCount; ++k) {
+    if (fit.dominant_from_s[static_cast<std::size_t>(k)] == 0.0) continue;
+    const std::array<double, kTermCount> without = nnls(kAllTerms & ~(1 << k));
+    for (std::size_t i = 0; i < used.size() && !fit.observed[static_cast<std::size_t>(k)]; ++i) {
+      if (largest[i] != k) continue;
+      const AdevPoint& p = *used[i];
+      const double avar = p.adev * p.adev;
+      const double lower95 = avar * p.edf / chi2_quantile(0.975, p.edf);
+      const double upper95 = avar * p.edf / chi2_quantile(0.025, p.edf);
+      const double alt = model(without, p.tau_s);
+      if (alt < lower95 || alt > upper95) fit.observed[static_cast<std::size_t>(k)] = true;
+    }
   }
   return fit;
 }

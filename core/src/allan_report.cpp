@@ -159,7 +159,7 @@ std::string format_table(const LogAllan& analysis) {
       any = true;
       out += "  " + pad(kTermNames[kk], 18) + sci(r.fit.dominant_from_s[kk]) + " .. " +
              sci(r.fit.dominant_to_s[kk]) + " s" +
-             (r.fit.observed[kk] ? "" : "  (within the confidence interval of the other terms: NO)") + '\n';
+             (r.fit.observed[kk] ? "" : "  (the other terms explain the data as well: NO)") + '\n';
     }
     if (!any) out += "  no term could be fitted: the data cannot tell the noise terms\n";
   }

@@ -64,6 +64,12 @@ std::string sci(double v) {
   return buf;
 }
 
+std::string percent(double fraction) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", 100.0 * fraction);
+  return buf;
+}
+
 // Log-log plot: per gyro a panel with the Allan deviation, its confidence band, the fitted curve and
 // the observed terms. Runs gnuplot (pngcairo, else png).
 Status write_plot(const std::string& png_path, const allan::LogAllan& analysis, double confidence) {
@@ -88,7 +94,7 @@ Status write_plot(const std::string& png_path, const allan::LogAllan& analysis, 
       "{/Symbol t} [s]'\n";
   body += "set ylabel 'Allan deviation [" + analysis.units + "]'\n";
   body += "set multiplot layout " + std::to_string(rows) + "," + std::to_string(cols) + " title " +
-          gp_quote("tetra allan: overlapping Allan deviation, " + num(100.0 * confidence).substr(0, 4) +
+          gp_quote("tetra allan: overlapping Allan deviation, " + percent(confidence) +
                    " % confidence band, IEEE 952 fit") +
           "\n";
   const std::array<const char*, allan::kTermCount> colors = {"#9467bd", "#2ca02c", "#ff7f0e", "#d62728",
@@ -229,7 +235,7 @@ int cmd_allan(int argc, char** argv) {
   std::cout << log_path << ": " << analysis->epochs << " epochs";
   if (analysis->missing_epochs > 0)
     std::cout << " (+" << analysis->missing_epochs << " missing epochs as gaps)";
-  std::cout << ", sampling interval " << num(analysis->tau0_s) << " s (median time step)"
+  std::cout << ", sampling interval " << num(analysis->tau0_s) << " s (from the time column)"
             << (cal && !log->units_dps ? ", calibrated with " + cal_path : std::string()) << "\n\n";
   std::cout << allan::format_table(*analysis);
 

@@ -17,9 +17,10 @@
 // each point weighted by edf/(2σ⁴), the inverse variance of a χ²-distributed variance estimate, σ²
 // taken from the previous pass's model (iteratively reweighted; the measured value on the first
 // pass). With gaps the EDF is summed over the runs of consecutive samples.
-// A term is reported as observed only if, at some τ, it is the largest contribution to the fitted
-// model AND the other fitted terms alone fall below the 95 % lower confidence bound of the measured
-// variance there — i.e. the data need that term. Otherwise it is "not observed" (seed Table 6: "NO").
+// A term is reported as observed only if, at some τ where it is the largest contribution to the
+// fitted model, the model re-fitted WITHOUT that term leaves the 95 % confidence interval of the
+// measured variance — i.e. the other terms cannot stand in for it and the data need it. Otherwise it
+// is "not observed" (seed Table 6: "NO").
 
 #include <array>
 #include <cstdint>
