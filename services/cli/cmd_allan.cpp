@@ -211,12 +211,17 @@ int cmd_allan(int argc, char** argv) {
     cal = std::move(c.value());
   }
 
+  // Progress goes to stderr when a person is watching it; otherwise stderr carries only the
+  // one-line reason of a failure (the exit-status contract).
+  const bool progress = ::isatty(STDERR_FILENO) != 0;
   const auto t0 = Clock::now();
-  std::cerr << "tetra allan: reading " << log_path << "\n";
+  if (progress) std::cerr << "tetra allan: reading " << log_path << "\n";
   auto log = read_gyro_log(log_path);
   if (!log) return report(cmd, log.error());
-  std::cerr << "tetra allan: " << log->epochs() << " epochs x " << log->gyro_count << " gyros read in "
-            << sci(seconds_since(t0)) << " s; analysing\n";
+  if (progress) {
+    std::cerr << "tetra allan: " << log->epochs() << " epochs x " << log->gyro_count << " gyros read in "
+              << sci(seconds_since(t0)) << " s; analysing\n";
+  }
   if (log->units_dps && cal) {
     std::cerr << "tetra allan: the log is already in deg/s; the calibration is used only for "
                  "--update-calibration\n";
@@ -230,7 +235,7 @@ int cmd_allan(int argc, char** argv) {
   options.calibration = cal ? &*cal : nullptr;
   auto analysis = allan::analyze_gyro_log(*log, options);
   if (!analysis) return report(cmd, analysis.error());
-  std::cerr << "tetra allan: analysed in " << sci(seconds_since(t0)) << " s total\n";
+  if (progress) std::cerr << "tetra allan: analysed in " << sci(seconds_since(t0)) << " s total\n";
 
   std::cout << log_path << ": " << analysis->epochs << " epochs";
   if (analysis->missing_epochs > 0)
