@@ -10,6 +10,7 @@
 
 #include "tetra/core/allan.hpp"
 #include "tetra/core/allan_stats.hpp"
+#include "tetra/core/csv.hpp"
 
 namespace tetra {
 namespace {
@@ -422,6 +423,49 @@ TEST(AllanSampling, MissingEpochsBecomeGapsAndJitterIsRefused) {
   EXPECT_NE(r.error().message.find("non-uniform"), std::string::npos) << r.error().message;
   EXPECT_FALSE(allan::uniform_grid(std::vector<double>{0.0}, 0.05, "log.csv").ok());
   EXPECT_FALSE(allan::uniform_grid(std::vector<double>{0.0, 0.01, 0.01}, 0.05, "log.csv").ok());
+}
+
+}  // namespace
+}  // namespace tetra
+
+namespace tetra {
+namespace {
+
+// The CSV reader parses large bodies (> 8 MB) in two halves on two threads; rows, line numbers,
+// metadata order and the first error in file order must be exactly those of one pass.
+TEST(CsvParallelParse, SameTableAndErrorsAsSequential) {
+  std::string text = "# units=dps\ntime_s,g1,g2\n";
+  const std::size_t rows = 300000;  // ~10 MB
+  for (std::size_t i = 0; i < rows; ++i) {
+    if (i == rows * 3 / 4) text += "# note=late\n";
+    text += std::to_string(i) + ".25,0.001234567890123," + (i % 7 == 0 ? "" : "-2.5e-05") + "\n";
+  }
+  ASSERT_GT(text.size(), std::size_t{8} << 20);
+  auto t = parse_csv(text, "big.csv");
+  ASSERT_TRUE(t.ok()) << t.error().message;
+  ASSERT_EQ(t->rows, rows);
+  EXPECT_EQ(t->lines.front(), 3U);
+  EXPECT_EQ(t->lines[rows * 3 / 4 - 1], rows * 3 / 4 - 1 + 3);
+  EXPECT_EQ(t->lines[rows * 3 / 4], rows * 3 / 4 + 4);  // after the comment line
+  EXPECT_EQ(t->lines.back(), rows + 3);
+  EXPECT_DOUBLE_EQ(t->cell(rows - 1, 0), static_cast<double>(rows - 1) + 0.25);
+  EXPECT_TRUE(t->is_empty(rows - 1 - (rows - 1) % 7, 2));
+  EXPECT_EQ(t->meta("note"), std::optional<std::string>("late"));
+  // An error deep in the second half names its own line.
+  std::string bad = text;
+  const std::string needle = "290000.25,0.001234567890123,-2.5e-05\n";
+  const auto at = bad.find(needle);
+  ASSERT_NE(at, std::string::npos);
+  bad.replace(at, needle.size(), "290000.25,x,-2.5e-05\n");
+  auto e = parse_csv(bad, "big.csv");
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.error().message, "big.csv:290004: column 'g1': 'x' is not a number");
+  // Errors in both halves: the first in file order is reported.
+  const std::string early = "10.25,0.001234567890123,-2.5e-05\n";
+  bad.replace(bad.find(early), early.size(), "10.25,0.001234567890123\n");
+  e = parse_csv(bad, "big.csv");
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.error().message, "big.csv:13: expected 3 fields as in the header, found 2");
 }
 
 }  // namespace
