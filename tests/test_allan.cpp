@@ -225,8 +225,10 @@ TEST(AllanSynthetic, RateRampGivesSlopePlusOne) {
   EXPECT_NEAR(slope(r, 300.0, 1800.0), 1.0, 0.1);
 }
 
-// Flicker rate noise by Kasdin's fractional-integration filter (h_0 = 1, h_k = h_{k−1}(k − ½)/k,
-// PSD ∝ 1/f): the Allan deviation is flat — slope 0 within ±0.1 over 1–100 s — and B is observed.
+// Flicker rate noise by Kasdin's fractional-integration filter (h_0 = 1, h_k = h_{k−1}(k − ½)/k) on
+// white innovations of σ = 1e-5: one-sided PSD 2σ²τ0/(2 sin πfτ0) ≈ σ²/(πf), so h₋₁ = σ²/π and the
+// flat Allan variance 2 ln2·h₋₁ = (2 ln2/π)σ², i.e. B = σ in IEEE 952's σ² = (2 ln2/π)B². Checks:
+// slope 0 within ±0.1 over 1–100 s; B within 10 % of 1e-5 (10 seeds scatter ±4 %); B alone observed.
 TEST(AllanSynthetic, FlickerRateGivesFlatFloor) {
   const std::size_t n = 12000;
   std::mt19937_64 rng(17);
@@ -245,7 +247,10 @@ TEST(AllanSynthetic, FlickerRateGivesFlatFloor) {
   }
   const AllanResult r = analyze(y, 0.1);
   EXPECT_NEAR(slope(r, 1.0, 100.0), 0.0, 0.1);
-  EXPECT_TRUE(r.fit.reported(allan::kB).has_value());
+  ASSERT_TRUE(r.fit.reported(allan::kB).has_value());
+  EXPECT_NEAR(*r.fit.reported(allan::kB), 1e-5, 0.10 * 1e-5);
+  EXPECT_FALSE(r.fit.reported(allan::kN).has_value());
+  EXPECT_FALSE(r.fit.reported(allan::kK).has_value());
 }
 
 // Combined Q + N + K at the seed's scale, 100 Hz for one hour: each slope where its term dominates,
