@@ -450,7 +450,8 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
     gyro.absent = grid_ref.slots - delivered - gyro.invalid;
     auto result = analyze_series(rate, present, grid_ref.tau0_s, options.allan);
     if (!result)
-      return bad_input(log.source + ": gyro " + std::to_string(id) + ": " + result.error().message);
+      return bad_input(log.source + ": gyro " + std::to_string(id) + ": " + result.error().message +
+                       (ids.size() > 1 ? " (--gyro N analyses the others alone)" : ""));
     gyro.result = std::move(result.value());
     return gyro;
   };
