@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# Soak (issue 7.4): the simulator at RATE Hz into `tetra fusion` for MINUTES in real time, on a private
+# loopback domain. Not a ctest test (it runs for an hour); docs/reliability.md has the figures.
+#   bench/soak.sh [MINUTES=60] [BUILD_DIR=build] [RATE_HZ=100]
+# Measures, and checks:
+#   lost epochs      epochs the simulator published − epochs the service accepted       must be 0
+#   memory           the service's RSS every 10 s; growth from the end of minute 1 to the end < 1 MB
+#   counters         late, duplicate, out-of-order, gap, unknown gyro, other unit, invalid, absent,
+#                    time-rejected epochs, deadlines missed, liveliness lost, sensor restarts  all 0
+#   events           a fault-free run: no FDI event at all (a detection would be a false alarm)
+#   exit             the service ends on SIGTERM with status 0
+# Prints a summary; the raw data (rss.csv, health.jsonl, logs) stays in the work directory it names.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+minutes=${1:-60}
+build=${2:-build}
+rate=${3:-100}
+domain=${TETRA_SOAK_DOMAIN:-203}
+tetra="$PWD/$build/tetra"
+[ -x "$tetra" ] || { echo "soak: $tetra not built" >&2; exit 1; }
+export CYCLONEDDS_URI="file://$PWD/config/cyclonedds-loopback.xml"
+work=$(mktemp -d /tmp/tetra-soak.XXXXXX)
+fusion_pid=""
+sampler_pid=""
+cleanup() {
+  [ -n "$sampler_pid" ] && kill "$sampler_pid" 2>/dev/null
+  [ -n "$fusion_pid" ] && kill -9 "$fusion_pid" 2>/dev/null
+  wait 2>/dev/null || true
+}
+trap cleanup EXIT
+
+# The simulated unit's own calibration (its as-built truth), so the service is scored on its own merits.
+"$tetra" sim turntable --revolutions 0.5 -o "$work/turntable.csv" 2>/dev/null
+"$tetra" calibrate "$work/turntable.csv" -o "$work/cal.yaml" >/dev/null 2>&1
+printf 'unit: soak-1\ncalibration: cal.yaml\nsample_rate_hz: %s\nspeed: 1\n' "$rate" >"$work/fusion.yaml"
+
+"$tetra" fusion --config "$work/fusion.yaml" --domain "$domain" --log-level warn >"$work/fusion.log" 2>&1 &
+fusion_pid=$!
+# RSS and CPU time of the service every 10 s: time_s,rss_kB,cpu_s
+(
+  clk=$(getconf CLK_TCK)
+  start=$(date +%s)
+  echo "time_s,rss_kB,cpu_s"
+  while kill -0 "$fusion_pid" 2>/dev/null; do
+    rss=$(awk '/^VmRSS:/ {print $2}' "/proc/$fusion_pid/status" 2>/dev/null || echo "")
+    cpu=$(awk -v c="$clk" '{printf "%.2f", ($14 + $15) / c}' "/proc/$fusion_pid/stat" 2>/dev/null || echo "")
+    [ -n "$rss" ] && echo "$(($(date +%s) - start)),$rss,$cpu"
+    sleep 10
+  done
+) >"$work/rss.csv" &
+sampler_pid=$!
+
+echo "soak: $minutes min at $rate Hz, domain $domain, work dir $work" >&2
+"$tetra" sim orbit --dds --dds-unit soak-1 --domain "$domain" --rate-hz "$rate" --minutes "$minutes" \
+  --speed 1 --wait-timeout 30 >"$work/sim.out" 2>"$work/sim.err"
+sleep 2  # the last epoch's latency limit and Health period
+"$tetra" monitor --once --jsonl --unit soak-1 --domain "$domain" --timeout 10 >"$work/health.jsonl"
+kill -TERM "$fusion_pid"
+fusion_rc=0
+wait "$fusion_pid" || fusion_rc=$?
+fusion_pid=""
+kill "$sampler_pid" 2>/dev/null || true
+sampler_pid=""
+
+python3 - "$work" "$fusion_rc" "$minutes" "$rate" <<'PY'
+import csv, json, re, sys
+work, fusion_rc, minutes, rate = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+sim = open(f"{work}/sim.out").read()
+published = int(re.search(r"epochs published: (\d+)", sim).group(1))
+health, events = None, []
+for line in open(f"{work}/health.jsonl"):
+    r = json.loads(line)
+    if r.get("type") == "health": health = r
+    elif r.get("type") == "event": events.append(r)
+if health is None or "counters" not in health:
+    sys.exit("soak: FAIL: no Health from the service")
+c = health["counters"]
+rows = [(int(r["time_s"]), int(r["rss_kB"]), float(r["cpu_s"])) for r in csv.DictReader(open(f"{work}/rss.csv"))]
+after_warmup = [r for r in rows if r[0] >= 60] or rows
+rss_start, rss_end = after_warmup[0][1], rows[-1][1]
+rss_max = max(r[1] for r in rows)
+cpu_share = 100.0 * (rows[-1][2] - rows[0][2]) / max(1, rows[-1][0] - rows[0][0])
+anomalies = {k: v for k, v in c.items() if k not in ("epochs_accepted", "samples_accepted") and v != 0}
+lost = published - c["epochs_accepted"]
+print(f"soak: {minutes:g} min at {rate:g} Hz")
+print(f"  epochs published {published}, accepted {c['epochs_accepted']}, lost {lost}")
+print(f"  samples accepted {c['samples_accepted']} (4 per epoch: {4 * published})")
+print(f"  counters not zero: {anomalies if anomalies else 'none'}")
+print(f"  events: {len(events)} (events_published {health.get('events_published')}), final mode {health['mode']}")
+print(f"  RSS at {after_warmup[0][0]} s {rss_start} kB, at {rows[-1][0]} s {rss_end} kB: growth {rss_end - rss_start} kB; max {rss_max} kB")
+print(f"  service CPU {cpu_share:.1f} % of one core; exit status on SIGTERM {fusion_rc}")
+ok = (lost == 0 and not anomalies and not events and rss_end - rss_start < 1024 and fusion_rc == 0
+      and health["mode"] == "NOMINAL")
+print("soak: PASS" if ok else "soak: FAIL")
+sys.exit(0 if ok else 1)
+PY
