@@ -2,9 +2,13 @@
 // gaps, and the noise-term fit.
 #include <gtest/gtest.h>
 
+#include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <vector>
 
