@@ -2,11 +2,8 @@
 // gaps, and the noise-term fit.
 #include <gtest/gtest.h>
 
-#include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstring>
 #include <numeric>
 #include <optional>
 #include <random>
