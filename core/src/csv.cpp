@@ -167,7 +167,9 @@ Result<CsvTable> parse_csv(std::string_view text, std::string source) {
   std::size_t line_no = 0;
   bool have_header = false;
   if (Status s = parse_lines(text, pos, line_no, t, have_header, true); !s) return s.error();
-  if (!have_header) return bad_input(t.source + ": empty file: no header line");
+  if (!have_header) {
+    return bad_input(t.source + ":" + std::to_string(line_no + 1) + ": empty file: no header line");
+  }
   const std::string_view body = text.substr(std::min(pos, text.size()));
 
   if (body.size() < kParallelBytes) {
