@@ -68,6 +68,9 @@ struct Counters {
   std::uint64_t samples_accepted = 0;
   std::uint64_t samples_invalid = 0;        //!< NaN, Inf or out of range
   std::uint64_t samples_absent = 0;         //!< no sample delivered
+  std::uint64_t epochs_rejected_shape = 0;  //!< epoch with a sample count other than N
+  std::uint64_t samples_outlier = 0;        //!< valid samples left out for one epoch (spike or onset)
+  std::uint64_t spikes = 0;                 //!< confirmed one-epoch spikes (outliers that went away)
 };
 
 struct Health {
