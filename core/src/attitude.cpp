@@ -22,7 +22,8 @@ Eigen::Vector3d AttitudePropagator::earth_rate_B() const {
 }
 
 Eigen::Vector3d AttitudePropagator::step(const Eigen::Vector3d& omega_meas_B_rad_s, double dt_s,
-                                         const Eigen::Vector3d& arw_sq_rad2_s, const Eigen::Vector3d& bias_sigma_rad_s,
+                                         const Eigen::Vector3d& arw_sq_rad2_s,
+                                         const Eigen::Vector3d& bias_sigma_rad_s,
                                          const Eigen::Vector3d& bound_rad_s) {
   const Eigen::Vector3d omega = omega_meas_B_rad_s - earth_rate_B();
   q_RB_ = propagate(q_RB_, omega, dt_s);
@@ -33,7 +34,8 @@ Eigen::Vector3d AttitudePropagator::step(const Eigen::Vector3d& omega_meas_B_rad
 }
 
 Eigen::Vector3d AttitudePropagator::sigma_rad() const {
-  return (var_random_rad2_ + systematic_rad_.cwiseProduct(systematic_rad_) + bound_rad_.cwiseProduct(bound_rad_))
+  return (var_random_rad2_ + systematic_rad_.cwiseProduct(systematic_rad_) +
+          bound_rad_.cwiseProduct(bound_rad_))
       .cwiseSqrt();
 }
 

@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-
 namespace tetra::fdi {
 
 double chi2_survival(double x, int dof) {

@@ -36,25 +36,25 @@ constexpr double kNoiseExpectedMedian = 0.6744897501960817;  //!< median of |N(0
 struct Subset {
   GyroMask mask = 0;
   bool observable = false;
-  int dof = 0;                          //!< parity dimension |S| − 3
-  Eigen::Matrix3Xd pinv;                //!< 3×N weighted pseudoinverse (zero columns outside S)
-  Eigen::MatrixXd parity;               //!< d×N normalized parity in 1/(rad/s) per √s: p = √T·W·y ~ N(0, I)
-  Eigen::Vector3d arw_sq_rad2_s;        //!< [rad²/s] N² per body axis of the rate estimate
-  Eigen::Vector3d bias_sigma_rad_s;     //!< [rad/s] 1σ rate bias per body axis left by the calibration
-  double chi2_threshold = 0.0;          //!< instantaneous χ² threshold
-  double jump_threshold = 0.0;          //!< one-epoch jump χ² threshold
-  double cusum_k = 0.0;                 //!< [σ] CUSUM reference
-  double cusum_h = 0.0;                 //!< [σ] CUSUM threshold
-  double glt_accept = 0.0;              //!< χ²_{d−1} quantile accepting a single-gyro hypothesis
-  double glt_reject = 0.0;              //!< χ²_{d−1} quantile rejecting one
+  int dof = 0;                    //!< parity dimension |S| − 3
+  Eigen::Matrix3Xd pinv;          //!< 3×N weighted pseudoinverse (zero columns outside S)
+  Eigen::MatrixXd parity;         //!< d×N normalized parity in 1/(rad/s) per √s: p = √T·W·y ~ N(0, I)
+  Eigen::Vector3d arw_sq_rad2_s;  //!< [rad²/s] N² per body axis of the rate estimate
+  Eigen::Vector3d bias_sigma_rad_s;  //!< [rad/s] 1σ rate bias per body axis left by the calibration
+  double chi2_threshold = 0.0;       //!< instantaneous χ² threshold
+  double jump_threshold = 0.0;       //!< one-epoch jump χ² threshold
+  double cusum_k = 0.0;              //!< [σ] CUSUM reference
+  double cusum_h = 0.0;              //!< [σ] CUSUM threshold
+  double glt_accept = 0.0;           //!< χ²_{d−1} quantile accepting a single-gyro hypothesis
+  double glt_reject = 0.0;           //!< χ²_{d−1} quantile rejecting one
 };
 
 struct GyroTrack {
   bool excluded = false;
   FaultKind kind = FaultKind::kNone;
-  double sigma_rate_rts = 0.0;  //!< [rad/√s] white rate noise N
-  double bias_rate_sigma = 0.0;   //!< [rad/s] 1σ of the calibrated bias
-  double scale_rel_sigma = 0.0;   //!< [-] 1σ relative scale factor error
+  double sigma_rate_rts = 0.0;   //!< [rad/√s] white rate noise N
+  double bias_rate_sigma = 0.0;  //!< [rad/s] 1σ of the calibrated bias
+  double scale_rel_sigma = 0.0;  //!< [-] 1σ relative scale factor error
   // this epoch
   bool valid = false;  //!< sample present and valid (before the jump test)
   bool use = false;    //!< used in this epoch's solution
@@ -86,16 +86,17 @@ struct GyroTrack {
   std::array<std::int64_t, kSpikeMemory> spike_ns{};
   int spike_n = 0;  //!< total spikes recorded (ring index = n % memory)
   // reference comparison
-  double angle_rad = 0.0;  //!< ∫ (y_i − h_i·ω_e) dt
+  double angle_rad = 0.0;      //!< ∫ (y_i − h_i·ω_e) dt
+  double ref_angle_rad = 0.0;  //!< Σ h_i·log(q_{k−1}* q_k) over the reference's own increments
 };
 
 struct Episode {
-  bool active = false;             //!< a fault is detected and not isolated
+  bool active = false;  //!< a fault is detected and not isolated
   bool declared_unisolated = false;
   std::int64_t detect_ns = 0;
   std::int64_t deadline_ns = 0;
   std::int64_t last_alarm_ns = 0;
-  std::int64_t onset_index = 0;    //!< estimated first faulty epoch (history index)
+  std::int64_t onset_index = 0;  //!< estimated first faulty epoch (history index)
   std::int64_t onset_ns = 0;
   std::string test;
   double statistic = 0.0;
@@ -104,7 +105,9 @@ struct Episode {
   int glt_n = 0;
 };
 
-double deg2rad(double v) { return v * kDegToRad; }
+double deg2rad(double v) {
+  return v * kDegToRad;
+}
 
 }  // namespace
 
@@ -114,8 +117,9 @@ class Pipeline::Impl {
       : cal_(cal),
         config_(config),
         n_(cal.gyro_count()),
-        attitude_(config.initial_q_RB, config.latitude_deg ? std::optional<double>(deg2rad(*config.latitude_deg))
-                                                           : std::nullopt) {}
+        attitude_(config.initial_q_RB,
+                  config.latitude_deg ? std::optional<double>(deg2rad(*config.latitude_deg)) : std::nullopt) {
+  }
 
   Status init();
   void reset();
@@ -140,12 +144,14 @@ class Pipeline::Impl {
   void jump_test(std::int64_t now, GyroMask avail);
   int onset_test(std::int64_t now_index);
   int glt_test(const Subset& s) const;
+  FaultKind classify_drift(int id);
   void reference_update(const Epoch& epoch);
   void isolate(int id, FaultKind kind, const std::string& evidence, const std::string& test, double statistic,
                std::int64_t now);
   Eigen::Vector3d fault_rate_bound(const Subset& s) const;
   void push_history(std::int64_t now);
-  double noise_ratio(const GyroTrack& g) const;
+  //! Robust noise level / expected over the last `last` second differences (0: the whole window).
+  double noise_ratio(const GyroTrack& g, int last = 0) const;
   void update_mode(std::int64_t now);
 
   Calibration cal_;
@@ -175,28 +181,30 @@ class Pipeline::Impl {
   double cusum_neg_ = 0.0;
   std::int64_t cusum_pos_start_ = 0;  //!< history index where the branch last left zero
   std::int64_t cusum_neg_start_ = 0;
-  Eigen::VectorXd mcusum_;            //!< d ≥ 2: Crosier's vector CUSUM
-  Eigen::VectorXd mc_sum_;            //!< Σ p since the vector CUSUM was last zero
+  Eigen::VectorXd mcusum_;  //!< d ≥ 2: Crosier's vector CUSUM
+  Eigen::VectorXd mc_sum_;  //!< Σ p since the vector CUSUM was last zero
   int mc_n_ = 0;
   std::int64_t mc_start_ = 0;
-  Eigen::VectorXd p_ema_;             //!< EMA of the normalized parity (fault size estimate)
-  Eigen::VectorXd p_;                 //!< this epoch's parity
-  Eigen::VectorXd dp_;                //!< scratch
+  Eigen::VectorXd p_ema_;  //!< EMA of the normalized parity (fault size estimate)
+  Eigen::VectorXd p_;      //!< this epoch's parity
+  Eigen::VectorXd dp_;     //!< scratch
   Episode episode_;
-  Eigen::Vector3d omega_meas_ = Eigen::Vector3d::Zero();  //!< [rad/s] last rate estimate (Earth rate included)
+  Eigen::Vector3d omega_meas_ =
+      Eigen::Vector3d::Zero();  //!< [rad/s] last rate estimate (Earth rate included)
   std::int64_t lost_since_ns_ = -1;
 
   // history for the onset test
-  std::vector<double> hist_y_;           //!< kHistory×N
+  std::vector<double> hist_y_;  //!< kHistory×N
   std::vector<GyroMask> hist_valid_;
   std::vector<std::int64_t> hist_ns_;
-  std::vector<double> hist_raw_;         //!< kHistory×N
+  std::vector<double> hist_raw_;  //!< kHistory×N
 
   // reference snapshots
   std::vector<std::int64_t> snap_ns_;
   std::vector<Quaternion> snap_q_;
-  std::vector<double> snap_angle_;  //!< kSnapshots×N
-  int snap_count_ = 0;              //!< total pushed
+  std::vector<double> snap_angle_;       //!< kSnapshots×N
+  std::vector<double> snap_ref_;         //!< kSnapshots×N
+  int snap_count_ = 0;                   //!< total pushed
   mutable std::vector<double> scratch_;  //!< median scratch
   std::vector<double> mean_pre_, mean_post_;
   std::vector<int> n_pre_, n_post_;
@@ -212,9 +220,11 @@ Status Pipeline::Impl::init() {
   for (int i = 0; i < n_; ++i) {
     const auto& g = cal_.gyros[static_cast<std::size_t>(i)];
     auto& t = gyros_[static_cast<std::size_t>(i)];
-    const double n_dps = (g.noise && g.noise->arw_dps_rtHz) ? *g.noise->arw_dps_rtHz : config_.default_arw_dps_rtHz;
+    const double n_dps =
+        (g.noise && g.noise->arw_dps_rtHz) ? *g.noise->arw_dps_rtHz : config_.default_arw_dps_rtHz;
     if (!(n_dps > 0.0) || !std::isfinite(n_dps)) {
-      return bad_input("calibration: gyro " + std::to_string(i + 1) + ": noise.arw_dps_rtHz must be positive");
+      return bad_input("calibration: gyro " + std::to_string(i + 1) +
+                       ": noise.arw_dps_rtHz must be positive");
     }
     t.sigma_rate_rts = deg2rad(n_dps);
     arw[i] = t.sigma_rate_rts;
@@ -236,6 +246,7 @@ Status Pipeline::Impl::init() {
   snap_ns_.assign(kSnapshots, 0);
   snap_q_.assign(kSnapshots, Quaternion::Identity());
   snap_angle_.assign(static_cast<std::size_t>(kSnapshots * n_), 0.0);
+  snap_ref_.assign(static_cast<std::size_t>(kSnapshots * n_), 0.0);
   scratch_.assign(static_cast<std::size_t>(std::max(config_.noise_window, 8)), 0.0);
   mean_pre_.assign(static_cast<std::size_t>(n_), 0.0);
   mean_post_.assign(static_cast<std::size_t>(n_), 0.0);
@@ -407,7 +418,9 @@ std::string Pipeline::Impl::describe_thresholds() const {
 // ---------------------------------------------------------------------------------------------
 // events and modes
 
-void Pipeline::Impl::emit(FdiEvent event) { result_.events.push_back(std::move(event)); }
+void Pipeline::Impl::emit(FdiEvent event) {
+  result_.events.push_back(std::move(event));
+}
 
 void Pipeline::Impl::update_mode(std::int64_t now) {
   const GyroMask active = active_mask();
@@ -488,11 +501,15 @@ void Pipeline::Impl::isolate(int id, FaultKind kind, const std::string& evidence
 // ---------------------------------------------------------------------------------------------
 // per-gyro signatures
 
-double Pipeline::Impl::noise_ratio(const GyroTrack& g) const {
-  const int n = std::min(g.d2_count, config_.noise_window);
-  if (n < config_.noise_window) return kNaN;
+double Pipeline::Impl::noise_ratio(const GyroTrack& g, int last) const {
+  const int n = last > 0 ? std::min({last, g.d2_count, config_.noise_window})
+                         : std::min(g.d2_count, config_.noise_window);
+  if (n < (last > 0 ? std::min(10, config_.noise_window) : config_.noise_window)) return kNaN;
   double* buf = scratch_.data();
-  std::copy(g.d2.begin(), g.d2.begin() + n, buf);
+  for (int k = 0; k < n; ++k) {
+    buf[k] =
+        g.d2[static_cast<std::size_t>((g.d2_head - 1 - k + 2 * config_.noise_window) % config_.noise_window)];
+  }
   std::nth_element(buf, buf + n / 2, buf + n);
   // Δ²y = y_k − 2y_{k−1} + y_{k−2} of white noise has variance 6σ²: median |Δ²y| = 0.6745·√6·σ.
   const double sigma_sample = g.sigma_rate_rts / sqrt_period_;
@@ -513,7 +530,8 @@ void Pipeline::Impl::check_signatures(std::int64_t now) {
       continue;
     }
     if (g.repeat_count >= config_.stuck_repeat_count) {
-      isolate(id, FaultKind::kStuck, g.last_raw == 0.0 ? "zero" : "repeated", "signature", g.repeat_count, now);
+      isolate(id, FaultKind::kStuck, g.last_raw == 0.0 ? "zero" : "repeated", "signature", g.repeat_count,
+              now);
       continue;
     }
     if (g.d2_since_eval >= kNoiseEvalEvery && period_s_ > 0.0) {
@@ -629,7 +647,7 @@ int Pipeline::Impl::onset_test(std::int64_t now_index) {
   const std::int64_t pre_begin = k0 - gap - config_.onset_pre_epochs;
   const std::int64_t pre_end = k0 - gap;
   const std::int64_t post_end = std::min(now_index + 1, k0 + config_.onset_post_max_epochs);
-  if (pre_begin < 0 || pre_begin <= now_index - kHistory || post_end - k0 < 3) return 0;
+  if (pre_begin < 0 || pre_begin <= now_index - kHistory || post_end - k0 < 10) return 0;
   std::fill(mean_pre_.begin(), mean_pre_.end(), 0.0);
   std::fill(mean_post_.begin(), mean_post_.end(), 0.0);
   std::fill(n_pre_.begin(), n_pre_.end(), 0);
@@ -643,13 +661,15 @@ int Pipeline::Impl::onset_test(std::int64_t now_index) {
       t_mean += ns_to_seconds(hist_ns_[slot] - hist_ns_[static_cast<std::size_t>(b % kHistory)]);
       for (int i = 0; i < n_; ++i) {
         if (!has_gyro(hist_valid_[slot], i + 1)) continue;
-        mean[static_cast<std::size_t>(i)] += hist_y_[slot * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)];
+        mean[static_cast<std::size_t>(i)] +=
+            hist_y_[slot * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)];
         ++cnt[static_cast<std::size_t>(i)];
       }
     }
     t_mean /= static_cast<double>(e - b);
     for (int i = 0; i < n_; ++i) {
-      if (cnt[static_cast<std::size_t>(i)] > 0) mean[static_cast<std::size_t>(i)] /= cnt[static_cast<std::size_t>(i)];
+      if (cnt[static_cast<std::size_t>(i)] > 0)
+        mean[static_cast<std::size_t>(i)] /= cnt[static_cast<std::size_t>(i)];
     }
   };
   accumulate(pre_begin, pre_end, mean_pre_, n_pre_, t_pre);
@@ -715,17 +735,69 @@ int Pipeline::Impl::glt_test(const Subset& s) const {
   return (accepted == 1 && rejected == members - 1) ? best : 0;
 }
 
+// Bias or ramp: fit p_j(τ) = c + b·τ to the parity projected on gyro j's direction over the history
+// since the onset (at most kHistory epochs): a step leaves b ≈ 0, a ramp a significant slope.
+// Without parity (three gyros) the data cannot tell: unknown.
+FaultKind Pipeline::Impl::classify_drift(int id) {
+  const GyroMask active = active_mask();
+  const Subset& s = subset(active);
+  if (!s.observable || s.dof < 1) return FaultKind::kUnknown;
+  const Eigen::VectorXd w = s.parity.col(id - 1) / s.parity.col(id - 1).norm();
+  const std::int64_t first = std::max<std::int64_t>(
+      {episode_.active ? episode_.onset_index : epoch_index_ - kHistory + 1, epoch_index_ - kHistory + 1, 0});
+  double n = 0.0;
+  double st = 0.0;
+  double sp = 0.0;
+  double stt = 0.0;
+  double stp = 0.0;
+  const std::int64_t t0 = hist_ns_[static_cast<std::size_t>(first % kHistory)];
+  for (std::int64_t k = first; k <= epoch_index_; ++k) {
+    const auto slot = static_cast<std::size_t>(k % kHistory);
+    if ((hist_valid_[slot] & active) != active) continue;
+    double proj = 0.0;
+    for (int r = 0; r < s.dof; ++r) {
+      double acc = 0.0;
+      for (int i = 0; i < n_; ++i) {
+        if (has_gyro(active, i + 1))
+          acc += s.parity(r, i) * hist_y_[slot * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)];
+      }
+      proj += w[r] * acc * sqrt_period_;
+    }
+    const double t = ns_to_seconds(hist_ns_[slot] - t0);
+    n += 1.0;
+    st += t;
+    sp += proj;
+    stt += t * t;
+    stp += t * proj;
+  }
+  if (n < 20.0) return FaultKind::kUnknown;
+  const double sxx = stt - st * st / n;
+  if (sxx <= 0.0) return FaultKind::kUnknown;
+  const double slope = (stp - st * sp / n) / sxx;   // [σ/s]
+  const double slope_sigma = 1.0 / std::sqrt(sxx);  // unit noise of the normalized parity
+  return std::abs(slope) > 5.0 * slope_sigma ? FaultKind::kRamp : FaultKind::kBias;
+}
+
 // ---------------------------------------------------------------------------------------------
 // reference: per-gyro integrated angle against the rotation the reference saw about that axis
 
 void Pipeline::Impl::reference_update(const Epoch& epoch) {
   const std::int64_t now = epoch.stamp_ns;
   const Quaternion q = canonical(*epoch.reference_q_RB);
+  // The reference's rotation about each gyro axis, summed over its own increments: one increment spans one
+  // reference period, so the non-commutativity of a long window (slews) does not enter.
+  if (snap_count_ > 0) {
+    const auto prev = static_cast<std::size_t>((snap_count_ - 1) % kSnapshots);
+    const Eigen::Vector3d inc_B = quat_log(snap_q_[prev].conjugate() * q);
+    for (int i = 0; i < n_; ++i)
+      gyros_[static_cast<std::size_t>(i)].ref_angle_rad += axes_B_.row(i).dot(inc_B);
+  }
   const int slot = snap_count_ % kSnapshots;
   snap_ns_[static_cast<std::size_t>(slot)] = now;
   snap_q_[static_cast<std::size_t>(slot)] = q;
   for (int i = 0; i < n_; ++i) {
     snap_angle_[static_cast<std::size_t>(slot * n_ + i)] = gyros_[static_cast<std::size_t>(i)].angle_rad;
+    snap_ref_[static_cast<std::size_t>(slot * n_ + i)] = gyros_[static_cast<std::size_t>(i)].ref_angle_rad;
   }
   ++snap_count_;
   // Oldest snapshot inside the window, at least half a window old.
@@ -743,7 +815,6 @@ void Pipeline::Impl::reference_update(const Epoch& epoch) {
   const std::int64_t span_ns = now - snap_ns_[os];
   if (span_ns < window / 2) return;
   const double span = ns_to_seconds(span_ns);
-  const Eigen::Vector3d theta_B = quat_log(snap_q_[os].conjugate() * q);
   const double sig_ref = config_.reference_sigma_arcsec * kArcsecToRad;
   int flagged = 0;
   int loud = 0;
@@ -756,11 +827,14 @@ void Pipeline::Impl::reference_update(const Epoch& epoch) {
     const auto& g = gyros_[static_cast<std::size_t>(i)];
     if (g.excluded) continue;
     ++members;
-    const double rot = axes_B_.row(i).dot(theta_B);
-    const double gyro_angle = g.angle_rad - snap_angle_[os * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)];
+    const double rot =
+        g.ref_angle_rad - snap_ref_[os * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)];
+    const double gyro_angle =
+        g.angle_rad - snap_angle_[os * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)];
     const double err = gyro_angle - rot;
-    const double sig = std::sqrt(2.0 * sig_ref * sig_ref + g.sigma_rate_rts * g.sigma_rate_rts * span +
-                                 std::pow(g.bias_rate_sigma * span, 2) + std::pow(g.scale_rel_sigma * rot, 2));
+    const double sig =
+        std::sqrt(2.0 * sig_ref * sig_ref + g.sigma_rate_rts * g.sigma_rate_rts * span +
+                  std::pow(g.bias_rate_sigma * span, 2) + std::pow(g.scale_rel_sigma * rot, 2));
     const double z = std::abs(err) / sig;
     if (z > config_.reference_threshold_sigma) {
       ++flagged;
@@ -773,9 +847,33 @@ void Pipeline::Impl::reference_update(const Epoch& epoch) {
     }
   }
   if (flagged != 1 || loud != 0 || members < 2) return;
-  // A 1 % or larger disagreement proportional to a rotation of 0.5° or more about the axis is a scale fault.
-  const bool scale = std::abs(culprit_rot) >= deg2rad(0.5) && std::abs(culprit_err) >= 0.01 * std::abs(culprit_rot);
-  isolate(culprit, scale ? FaultKind::kScale : FaultKind::kBias, "reference", "reference", stat, now);
+  (void)culprit_rot;
+  (void)culprit_err;
+  // Scale or rate offset: fit err(τ) = a·τ + b·rot(τ) over the window's snapshots. When the rotation about
+  // the axis is not proportional to time (a slew), a significant b is a scale error; otherwise the data
+  // cannot tell scale from offset and the parity's history decides bias or ramp.
+  double stt = 0.0, str = 0.0, srr = 0.0, ste = 0.0, sre = 0.0;
+  const auto c = static_cast<std::size_t>(culprit - 1);
+  const std::size_t nn = static_cast<std::size_t>(n_);
+  for (int k = old + 1; k < snap_count_; ++k) {
+    const auto ks = static_cast<std::size_t>(k % kSnapshots);
+    const double tau = ns_to_seconds(snap_ns_[ks] - snap_ns_[os]);
+    const double rot = snap_ref_[ks * nn + c] - snap_ref_[os * nn + c];
+    const double err = (snap_angle_[ks * nn + c] - snap_angle_[os * nn + c]) - rot;
+    stt += tau * tau;
+    str += tau * rot;
+    srr += rot * rot;
+    ste += tau * err;
+    sre += rot * err;
+  }
+  FaultKind kind = classify_drift(culprit);
+  const double det = stt * srr - str * str;
+  if (stt > 0.0 && srr > 0.0 && det > 1e-4 * stt * srr) {  // |corr(τ, rot)| < 0.99995
+    const double b = (stt * sre - str * ste) / det;
+    const double sigma_b = std::sqrt(2.0) * sig_ref * std::sqrt(stt / det);
+    if (std::abs(b) > 5.0 * sigma_b) kind = FaultKind::kScale;
+  }
+  isolate(culprit, kind, "reference", "reference", stat, now);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -852,7 +950,8 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
     g.absent_since_ns = -1;
     const double raw = epoch.raw[u];
     double y = kNaN;
-    if (std::isfinite(raw) && std::abs(raw) <= config_.max_abs_raw_V) y = (raw - bias_V_[u]) / scale_V_per_rad_s_[u];
+    if (std::isfinite(raw) && std::abs(raw) <= config_.max_abs_raw_V)
+      y = (raw - bias_V_[u]) / scale_V_per_rad_s_[u];
     if (!std::isfinite(y) || std::abs(y) > max_rate) {
       ++counters.samples_invalid;
       if (g.invalid_since_ns < 0) g.invalid_since_ns = now;
@@ -901,8 +1000,11 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
         avail = without_gyro(avail, i + 1);
         if (g.outlier_run >= config_.onset_confirm_epochs) {
           const bool zero = g.outlier_repeated && g.raw == 0.0;
+          const double r = noise_ratio(g, config_.onset_confirm_epochs);
           if (g.outlier_repeated) {
             isolate(i + 1, FaultKind::kStuck, zero ? "zero" : "repeated", "onset", g.outlier_run, now);
+          } else if (std::isfinite(r) && r > config_.noise_high_ratio) {
+            isolate(i + 1, FaultKind::kNoise, "noise-level", "onset", r, now);
           } else {
             isolate(i + 1, FaultKind::kBias, "onset", "onset", g.outlier_run, now);
           }
@@ -1045,6 +1147,17 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
     }
   }
 
+  // Reference comparison integrals up to this epoch: each gyro's own angle, Earth rate removed.
+  if (dt > 0.0 && period_s_ > 0.0) {
+    const Eigen::Vector3d earth_B = attitude_.earth_rate_B();
+    for (int i = 0; i < n_; ++i) {
+      auto& g = gyros_[static_cast<std::size_t>(i)];
+      if (g.excluded) continue;
+      const double yi = has_gyro(avail, i + 1) ? g.y : axes_B_.row(i).dot(omega_meas_);
+      g.angle_rad += (yi - axes_B_.row(i).dot(earth_B)) * dt;
+    }
+  }
+
   // 5. isolation
   check_signatures(now);
   if (epoch.reference_q_RB && period_s_ > 0.0) reference_update(epoch);
@@ -1058,14 +1171,27 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
     if (culprit > 0) {
       // Kind from the gyro's own samples since the onset: identical raw values are a stuck output.
       bool repeated = true;
-      for (std::int64_t k = std::max(episode_.onset_index, epoch_index_ - kHistory + 1) + 1; k <= epoch_index_; ++k) {
+      for (std::int64_t k = std::max(episode_.onset_index, epoch_index_ - kHistory + 1) + 1;
+           k <= epoch_index_; ++k) {
         const auto slot = static_cast<std::size_t>(k % kHistory);
         const auto prev = static_cast<std::size_t>((k - 1) % kHistory);
-        repeated = repeated && hist_raw_[slot * static_cast<std::size_t>(n_) + static_cast<std::size_t>(culprit - 1)] ==
-                                   hist_raw_[prev * static_cast<std::size_t>(n_) + static_cast<std::size_t>(culprit - 1)];
+        repeated = repeated &&
+                   hist_raw_[slot * static_cast<std::size_t>(n_) + static_cast<std::size_t>(culprit - 1)] ==
+                       hist_raw_[prev * static_cast<std::size_t>(n_) + static_cast<std::size_t>(culprit - 1)];
       }
-      isolate(culprit, repeated ? FaultKind::kStuck : FaultKind::kBias, evidence, episode_.test, episode_.statistic,
-              now);
+      // A noise increase also shifts window means: the second differences since the onset tell it apart.
+      const double r =
+          noise_ratio(gyros_[static_cast<std::size_t>(culprit - 1)],
+                      static_cast<int>(std::max<std::int64_t>(epoch_index_ - episode_.onset_index, 10)));
+      FaultKind kind = FaultKind::kBias;
+      if (repeated) {
+        kind = FaultKind::kStuck;
+      } else if (std::isfinite(r) && r > config_.noise_high_ratio) {
+        kind = FaultKind::kNoise;
+      } else if (evidence == "glt") {
+        kind = classify_drift(culprit);
+      }
+      isolate(culprit, kind, evidence, episode_.test, episode_.statistic, now);
     } else if (!episode_.declared_unisolated && now >= episode_.deadline_ns) {
       episode_.declared_unisolated = true;
       FdiEvent u;
@@ -1106,15 +1232,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
     }
     const Eigen::Vector3d arw = observable ? sol->arw_sq_rad2_s : subset(active_mask()).arw_sq_rad2_s;
     const Eigen::Vector3d bias = observable ? sol->bias_sigma_rad_s : subset(active_mask()).bias_sigma_rad_s;
-    const Eigen::Vector3d earth_B = attitude_.earth_rate_B();
     const Eigen::Vector3d used = attitude_.step(omega_meas_, dt, arw, bias, bound);
-    // Reference comparison integrals: each gyro's own angle, Earth rate removed.
-    for (int i = 0; i < n_; ++i) {
-      auto& g = gyros_[static_cast<std::size_t>(i)];
-      if (g.excluded) continue;
-      const double yi = has_gyro(avail, i + 1) ? g.y : axes_B_.row(i).dot(omega_meas_);
-      g.angle_rad += (yi - axes_B_.row(i).dot(earth_B)) * dt;
-    }
     result_.attitude.omega_B_rad_s = used;
   } else {
     result_.attitude.omega_B_rad_s = omega_meas_ - attitude_.earth_rate_B();
@@ -1236,16 +1354,32 @@ Result<Pipeline> Pipeline::create(const Calibration& calibration, const Pipeline
   return Pipeline(std::move(impl));
 }
 
-void Pipeline::reset() { impl_->reset(); }
-const StepResult& Pipeline::step(const Epoch& epoch) { return impl_->step(epoch); }
-FdiEvent Pipeline::exclude(int gyro_id, std::int64_t stamp_ns) { return impl_->command_exclude(gyro_id, stamp_ns); }
+void Pipeline::reset() {
+  impl_->reset();
+}
+const StepResult& Pipeline::step(const Epoch& epoch) {
+  return impl_->step(epoch);
+}
+FdiEvent Pipeline::exclude(int gyro_id, std::int64_t stamp_ns) {
+  return impl_->command_exclude(gyro_id, stamp_ns);
+}
 FdiEvent Pipeline::reinstate(int gyro_id, std::int64_t stamp_ns) {
   return impl_->command_reinstate(gyro_id, stamp_ns);
 }
-FdiEvent Pipeline::reset_command(std::int64_t stamp_ns) { return impl_->command_reset(stamp_ns); }
-const Health& Pipeline::health() const { return impl_->health(); }
-int Pipeline::gyro_count() const { return impl_->gyro_count(); }
-const PipelineConfig& Pipeline::config() const { return impl_->config(); }
-std::string Pipeline::describe_thresholds() const { return impl_->describe_thresholds(); }
+FdiEvent Pipeline::reset_command(std::int64_t stamp_ns) {
+  return impl_->command_reset(stamp_ns);
+}
+const Health& Pipeline::health() const {
+  return impl_->health();
+}
+int Pipeline::gyro_count() const {
+  return impl_->gyro_count();
+}
+const PipelineConfig& Pipeline::config() const {
+  return impl_->config();
+}
+std::string Pipeline::describe_thresholds() const {
+  return impl_->describe_thresholds();
+}
 
 }  // namespace tetra::fdi

@@ -10,17 +10,21 @@ namespace tetra::fdi {
 
 const char* to_string(Mode mode) {
   switch (mode) {
-    case Mode::kNominal: return "NOMINAL";
-    case Mode::kDegraded: return "DEGRADED";
-    case Mode::kSuspect: return "SUSPECT";
-    case Mode::kLost: return "LOST";
+    case Mode::kNominal:
+      return "NOMINAL";
+    case Mode::kDegraded:
+      return "DEGRADED";
+    case Mode::kSuspect:
+      return "SUSPECT";
+    case Mode::kLost:
+      return "LOST";
   }
   return "LOST";
 }
 
 namespace {
 constexpr std::array<const char*, 10> kKindNames = {"none",  "bias",  "ramp",    "scale",   "stuck",
-                                                     "noise", "spike", "dropout", "invalid", "unknown"};
+                                                    "noise", "spike", "dropout", "invalid", "unknown"};
 }  // namespace
 
 const char* to_string(FaultKind kind) {
@@ -37,24 +41,36 @@ std::optional<FaultKind> fault_kind_from_string(std::string_view text) {
 
 const char* to_string(EventType type) {
   switch (type) {
-    case EventType::kDetected: return "detected";
-    case EventType::kIsolated: return "isolated";
-    case EventType::kUnisolated: return "unisolated";
-    case EventType::kReconfigured: return "reconfigured";
-    case EventType::kCleared: return "cleared";
-    case EventType::kLost: return "lost";
-    case EventType::kCommand: return "command";
+    case EventType::kDetected:
+      return "detected";
+    case EventType::kIsolated:
+      return "isolated";
+    case EventType::kUnisolated:
+      return "unisolated";
+    case EventType::kReconfigured:
+      return "reconfigured";
+    case EventType::kCleared:
+      return "cleared";
+    case EventType::kLost:
+      return "lost";
+    case EventType::kCommand:
+      return "command";
   }
   return "command";
 }
 
 const char* to_string(GyroState state) {
   switch (state) {
-    case GyroState::kOk: return "ok";
-    case GyroState::kAbsent: return "absent";
-    case GyroState::kInvalid: return "invalid";
-    case GyroState::kSuspect: return "suspect";
-    case GyroState::kExcluded: return "excluded";
+    case GyroState::kOk:
+      return "ok";
+    case GyroState::kAbsent:
+      return "absent";
+    case GyroState::kInvalid:
+      return "invalid";
+    case GyroState::kSuspect:
+      return "suspect";
+    case GyroState::kExcluded:
+      return "excluded";
   }
   return "ok";
 }
@@ -65,10 +81,18 @@ void append_json_string(std::string& out, std::string_view text) {
   out += '"';
   for (const char c : text) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           out += ' ';

@@ -7,8 +7,8 @@
 // Uncertainty per body axis a, three independent parts added in quadrature:
 //   random:     σ²_rand,a += N²_a·Δt          (white rate noise N_a [rad/√s]: grows with √t)
 //   systematic: σ_sys,a   += b_a·Δt           (1σ rate bias left by the calibration [rad/s]: grows with t)
-//   bound:      σ_bnd,a   += e_a·Δt           (rate error bound of an unresolved fault [rad/s], added linearly)
-//   σ_a = √(σ²_rand,a + σ²_sys,a + σ²_bnd,a).
+//   bound:      σ_bnd,a   += e_a·Δt           (rate error bound of an unresolved fault [rad/s], added
+//   linearly) σ_a = √(σ²_rand,a + σ²_sys,a + σ²_bnd,a).
 
 #include <optional>
 
@@ -31,8 +31,9 @@ class AttitudePropagator {
   //! One step with the measured body rate (which includes the Earth rate on the ground).
   //! `arw_sq_rad2_s` [rad²/s]: N² per axis; `bias_sigma_rad_s`, `bound_rad_s` [rad/s] per axis.
   //! Returns the rate used for propagation (Earth rate removed in ground mode).
-  Eigen::Vector3d step(const Eigen::Vector3d& omega_meas_B_rad_s, double dt_s, const Eigen::Vector3d& arw_sq_rad2_s,
-                       const Eigen::Vector3d& bias_sigma_rad_s, const Eigen::Vector3d& bound_rad_s);
+  Eigen::Vector3d step(const Eigen::Vector3d& omega_meas_B_rad_s, double dt_s,
+                       const Eigen::Vector3d& arw_sq_rad2_s, const Eigen::Vector3d& bias_sigma_rad_s,
+                       const Eigen::Vector3d& bound_rad_s);
 
   //! Adds an angle bound [rad] per axis at once (e.g. the error a fault caused before it was isolated).
   void add_bound(const Eigen::Vector3d& angle_rad) { bound_rad_ += angle_rad.cwiseAbs(); }
@@ -42,11 +43,11 @@ class AttitudePropagator {
   Eigen::Vector3d sigma_rad() const;
 
  private:
-  Quaternion q_RB_;                    //!< body → reference (L in ground mode); unit norm
+  Quaternion q_RB_;                              //!< body → reference (L in ground mode); unit norm
   std::optional<Eigen::Vector3d> earth_rate_L_;  //!< [rad/s] set in ground-test mode
-  Eigen::Vector3d var_random_rad2_;    //!< [rad²]
-  Eigen::Vector3d systematic_rad_;     //!< [rad]
-  Eigen::Vector3d bound_rad_;          //!< [rad]
+  Eigen::Vector3d var_random_rad2_;              //!< [rad²]
+  Eigen::Vector3d systematic_rad_;               //!< [rad]
+  Eigen::Vector3d bound_rad_;                    //!< [rad]
 };
 
 }  // namespace tetra

@@ -16,9 +16,9 @@
 namespace tetra::fdi {
 
 struct StepResult {
-  bool accepted = false;               //!< false: epoch rejected (and counted), attitude not advanced
-  AttitudeEstimate attitude;           //!< valid when accepted
-  std::vector<FdiEvent> events;        //!< events triggered by this epoch, in order (often empty)
+  bool accepted = false;         //!< false: epoch rejected (and counted), attitude not advanced
+  AttitudeEstimate attitude;     //!< valid when accepted
+  std::vector<FdiEvent> events;  //!< events triggered by this epoch, in order (often empty)
 };
 
 class Pipeline {
