@@ -271,12 +271,10 @@ Status Pipeline::Impl::init() {
 void Pipeline::Impl::prepare(double period_s) {
   period_s_ = period_s;
   sqrt_period_ = std::sqrt(period_s);
-  // Every subset of ≥ 3 gyros is prepared in advance for small packages, so that a missing sample
+  // Every subset (unobservable ones too) is prepared in advance for small packages, so that a missing sample
   // never allocates; larger packages prepare the full set and its leave-one-out subsets.
   if (n_ <= 8) {
-    for (GyroMask m = 1; m <= all_gyros(n_); ++m) {
-      if (tetra::gyro_count(m) >= 3) (void)subset(m);
-    }
+    for (GyroMask m = 0; m <= all_gyros(n_); ++m) (void)subset(m);
   } else {
     (void)subset(all_gyros(n_));
     for (int id = 1; id <= n_; ++id) (void)subset(without_gyro(all_gyros(n_), id));
@@ -1217,6 +1215,21 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   avail &= active_mask();
   const Subset* sol = period_s_ > 0.0 ? &subset(avail) : nullptr;
   observable = sol != nullptr && sol->observable;
+  if (sol == nullptr) {
+    // First epoch: no time step yet, so no sample period and no subset cache; the rate is still
+    // estimated (it is published, not integrated).
+    Eigen::VectorXd arw(n_);
+    for (int i = 0; i < n_; ++i) arw[i] = gyros_[static_cast<std::size_t>(i)].sigma_rate_rts;
+    const auto geometry = GyroGeometry::create(axes_B_, arw);
+    if (geometry && geometry->observable(avail)) {
+      const Eigen::Matrix3Xd pinv = *geometry->pseudoinverse(avail);
+      omega_meas_.setZero();
+      for (int i = 0; i < n_; ++i) {
+        if (has_gyro(avail, i + 1)) omega_meas_ += pinv.col(i) * gyros_[static_cast<std::size_t>(i)].y;
+      }
+      observable = true;
+    }
+  }
   Mode epoch_mode = persistent_mode_;
   if (!observable) epoch_mode = Mode::kLost;
   if (dt > 0.0 && sol != nullptr) {
