@@ -86,7 +86,8 @@ struct GyroTrack {
   std::array<std::int64_t, kSpikeMemory> spike_ns{};
   int spike_n = 0;  //!< total spikes recorded (ring index = n % memory)
   // reference comparison
-  double angle_rad = 0.0;      //!< ∫ (y_i − h_i·ω_e) dt
+  double angle_rad = 0.0;      //!< ∫ (y_i − h_i·ω_e) dt (trapezoid)
+  double prev_int_y = 0.0;     //!< [rad/s] rate integrated at the previous epoch
   double ref_angle_rad = 0.0;  //!< Σ h_i·log(q_{k−1}* q_k) over the reference's own increments
 };
 
@@ -189,6 +190,7 @@ class Pipeline::Impl {
   Eigen::VectorXd p_;      //!< this epoch's parity
   Eigen::VectorXd dp_;     //!< scratch
   Episode episode_;
+  Eigen::Vector3d omega_prev_ = Eigen::Vector3d::Zero();  //!< [rad/s] previous epoch's estimate
   Eigen::Vector3d omega_meas_ =
       Eigen::Vector3d::Zero();  //!< [rad/s] last rate estimate (Earth rate included)
   std::int64_t lost_since_ns_ = -1;
@@ -364,6 +366,7 @@ void Pipeline::Impl::reset() {
   health_.counters = Counters{};
   persistent_mode_ = Mode::kNominal;
   omega_meas_.setZero();
+  omega_prev_.setZero();
   lost_since_ns_ = -1;
   snap_count_ = 0;
   pending_.clear();
@@ -1146,13 +1149,15 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   }
 
   // Reference comparison integrals up to this epoch: each gyro's own angle, Earth rate removed.
-  if (dt > 0.0 && period_s_ > 0.0) {
+  // Samples are instantaneous rates at the sample time: the increment over (t_{k−1}, t_k] is the trapezoid.
+  {
     const Eigen::Vector3d earth_B = attitude_.earth_rate_B();
     for (int i = 0; i < n_; ++i) {
       auto& g = gyros_[static_cast<std::size_t>(i)];
       if (g.excluded) continue;
       const double yi = has_gyro(avail, i + 1) ? g.y : axes_B_.row(i).dot(omega_meas_);
-      g.angle_rad += (yi - axes_B_.row(i).dot(earth_B)) * dt;
+      if (dt > 0.0) g.angle_rad += (0.5 * (g.prev_int_y + yi) - axes_B_.row(i).dot(earth_B)) * dt;
+      g.prev_int_y = yi;
     }
   }
 
@@ -1245,8 +1250,8 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
     }
     const Eigen::Vector3d arw = observable ? sol->arw_sq_rad2_s : subset(active_mask()).arw_sq_rad2_s;
     const Eigen::Vector3d bias = observable ? sol->bias_sigma_rad_s : subset(active_mask()).bias_sigma_rad_s;
-    const Eigen::Vector3d used = attitude_.step(omega_meas_, dt, arw, bias, bound);
-    result_.attitude.omega_B_rad_s = used;
+    (void)attitude_.step(0.5 * (omega_prev_ + omega_meas_), dt, arw, bias, bound);  // trapezoid
+    result_.attitude.omega_B_rad_s = omega_meas_ - attitude_.earth_rate_B();
   } else {
     result_.attitude.omega_B_rad_s = omega_meas_ - attitude_.earth_rate_B();
   }
@@ -1256,6 +1261,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   result_.attitude.mode = epoch_mode;
   result_.attitude.gyros = observable ? avail : GyroMask{0};
   health_.used = result_.attitude.gyros;
+  omega_prev_ = omega_meas_;
   return result_;
 }
 

@@ -111,8 +111,14 @@ class Synth {
       epoch_.raw[static_cast<std::size_t>(i)] = raw;
       epoch_.present[static_cast<std::size_t>(i)] = present ? 1 : 0;
     }
-    // Truth attitude: exact propagation with the rate over the step (constant within it to first order).
-    if (k_ > 0) q_ = propagate(q_, w * kDegToRad, opt_.period_s);
+    // Samples are the instantaneous rate at the sample time (as in sim/); the truth attitude is propagated in
+    // ten sub-steps per sample so that it is exact well below the tests' tolerances.
+    if (k_ > 0) {
+      for (int j = 1; j <= 10; ++j) {
+        q_ = propagate(q_, rate_dps(t - opt_.period_s + (j - 0.5) * opt_.period_s / 10.0) * kDegToRad,
+                       opt_.period_s / 10.0);
+      }
+    }
     epoch_.reference_q_RB.reset();
     if (opt_.reference_period_s > 0.0) {
       const auto every = static_cast<std::int64_t>(std::llround(opt_.reference_period_s / opt_.period_s));
