@@ -1,11 +1,12 @@
 #!/bin/sh
 # Whole-command timing of `tetra replay` over a 100-min 10 Hz log (60 000 epochs), reading and writing
-# included. Usage: bench/replay.sh [BUILD_DIR]   (needs the bench_fusion and tetra targets built)
+# included. Usage: bench/replay.sh [BUILD_DIR]   (needs the tetra target built)
 set -eu
 build=${1:-build}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
-"$build/bench/bench_fusion" --write-log "$dir/orbit.csv" 6000
+# A 100-min orbit with attitude-control motion and its 1 Hz reference, from the simulator.
+"$build/tetra" sim orbit --seed 3 --acs-amplitude 0.04 --acs-accel 1e-4 -o "$dir/orbit.csv" >/dev/null 2>&1
 cat > "$dir/cal.yaml" <<'YAML'
 unit: seed-as-built
 method: seed-tables-4-5

@@ -68,6 +68,8 @@ int cmd_replay(int argc, char** argv) {
   app.add_option("--config", config_path, "YAML file with a 'pipeline:' map of thresholds (docs/fdi.md)");
   app.add_option("--attitude", attitude_path, "attitude output (CSV)")->required();
   app.add_option("--events", events_path, "FDI events output (JSON lines)")->required();
+  bool verbose = false;
+  app.add_flag("-v,--verbose", verbose, "echo the configuration and the derived thresholds on stderr");
   if (auto status = parse(app, argc, argv)) return *status;
 
   fdi::PipelineConfig config;
@@ -99,6 +101,9 @@ int cmd_replay(int argc, char** argv) {
     return report("replay", bad_input(cal_path + ": " + pipeline.error().message));
   }
 
+  if (verbose) {
+    std::fprintf(stderr, "tetra replay: configuration\n%s", fdi::describe(config).c_str());
+  }
   const int n = log->gyro_count;
   std::string att;
   att.reserve(log->epochs() * 160 + 128);
@@ -146,6 +151,7 @@ int cmd_replay(int argc, char** argv) {
   if (auto st = write_text_file(attitude_path, att); !st) return report("replay", st.error());
   if (auto st = write_text_file(events_path, events); !st) return report("replay", st.error());
 
+  if (verbose) std::fprintf(stderr, "tetra replay: thresholds\n%s", pipeline->describe_thresholds().c_str());
   const auto& h = pipeline->health();
   const auto& c = h.counters;
   std::string excluded;
