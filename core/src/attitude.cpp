@@ -25,7 +25,7 @@ Eigen::Vector3d AttitudePropagator::step(const Eigen::Vector3d& omega_meas_B_rad
                                          const Eigen::Vector3d& arw_sq_rad2_s,
                                          const Eigen::Vector3d& bias_sigma_rad_s,
                                          const Eigen::Vector3d& bound_rad_s) {
-  const Eigen::Vector3d omega = omega_meas_B_rad_s - earth_rate_B();
+  Eigen::Vector3d omega = omega_meas_B_rad_s - earth_rate_B();
   q_RB_ = propagate(q_RB_, omega, dt_s);
   var_random_rad2_ += arw_sq_rad2_s * dt_s;
   systematic_rad_ += bias_sigma_rad_s * dt_s;

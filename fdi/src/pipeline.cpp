@@ -241,14 +241,14 @@ Status Pipeline::Impl::init() {
   }
   auto geometry = GyroGeometry::create(axes_B_, arw);
   if (!geometry) return geometry.error();
-  hist_y_.assign(static_cast<std::size_t>(kHistory * n_), 0.0);
-  hist_raw_.assign(static_cast<std::size_t>(kHistory * n_), 0.0);
+  hist_y_.assign(static_cast<std::size_t>(kHistory) * static_cast<std::size_t>(n_), 0.0);
+  hist_raw_.assign(static_cast<std::size_t>(kHistory) * static_cast<std::size_t>(n_), 0.0);
   hist_valid_.assign(kHistory, 0);
   hist_ns_.assign(kHistory, 0);
   snap_ns_.assign(kSnapshots, 0);
   snap_q_.assign(kSnapshots, Quaternion::Identity());
-  snap_angle_.assign(static_cast<std::size_t>(kSnapshots * n_), 0.0);
-  snap_ref_.assign(static_cast<std::size_t>(kSnapshots * n_), 0.0);
+  snap_angle_.assign(static_cast<std::size_t>(kSnapshots) * static_cast<std::size_t>(n_), 0.0);
+  snap_ref_.assign(static_cast<std::size_t>(kSnapshots) * static_cast<std::size_t>(n_), 0.0);
   scratch_.assign(static_cast<std::size_t>(std::max(config_.noise_window, 8)), 0.0);
   mean_pre_.assign(static_cast<std::size_t>(n_), 0.0);
   mean_post_.assign(static_cast<std::size_t>(n_), 0.0);
@@ -797,8 +797,10 @@ void Pipeline::Impl::reference_update(const Epoch& epoch) {
   snap_ns_[static_cast<std::size_t>(slot)] = now;
   snap_q_[static_cast<std::size_t>(slot)] = q;
   for (int i = 0; i < n_; ++i) {
-    snap_angle_[static_cast<std::size_t>(slot * n_ + i)] = gyros_[static_cast<std::size_t>(i)].angle_rad;
-    snap_ref_[static_cast<std::size_t>(slot * n_ + i)] = gyros_[static_cast<std::size_t>(i)].ref_angle_rad;
+    snap_angle_[static_cast<std::size_t>(slot) * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)] =
+        gyros_[static_cast<std::size_t>(i)].angle_rad;
+    snap_ref_[static_cast<std::size_t>(slot) * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)] =
+        gyros_[static_cast<std::size_t>(i)].ref_angle_rad;
   }
   ++snap_count_;
   // Oldest snapshot inside the window, at least half a window old.
