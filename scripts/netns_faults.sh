@@ -35,9 +35,10 @@ cleanup() {
 trap cleanup EXIT
 trap 'exit 130' INT TERM
 
-log() { printf '[%6.1f s] %s\n' "$(echo "$(date +%s.%N) - $t0" | bc)" "$*"; }
+now_ms() { echo $(($(date +%s%N) / 1000000)); }
+t0=$(now_ms)
+log() { local ms=$(($(now_ms) - t0)); printf '[%4d.%01d s] %s\n' $((ms / 1000)) $((ms % 1000 / 100)) "$*"; }
 fail() { echo "netns_faults: FAIL: $*" >&2; exit 1; }
-t0=$(date +%s.%N)
 
 # --- network: hub bridge + one veth pair per host -----------------------------------------------
 ip netns add "$ns_hub"
@@ -93,73 +94,63 @@ start_fusion() {
 start_fusion
 in_ns mon "$tetra" monitor --unit netns-1 --jsonl --period 0.2 --domain $domain >"$work/monitor.jsonl" 2>"$work/monitor.log" &
 pids+=($!)
-# Timeline in simulated (= wall, speed 1) seconds after the simulator starts:
-#   8-13 sensor link down | 18-26 monitor link down, gyro 2 stuck from 20 | 30 service killed, 32 restarted
-in_ns sim "$tetra" sim orbit --dds --dds-unit netns-1 --domain $domain --rate-hz $rate --minutes 0.7 \
-  --reference-hz 0 --fault gyro=2,kind=stuck,at=20 --wait-timeout 30 >"$work/sim.log" 2>&1 &
+# Timeline in seconds after the simulator starts (simulated time = wall time, speed 1):
+#   5-9 sensor link down | 12-20 monitor link down, gyro 2 stuck from 14 | 22 service killed, 23 restarted
+ts=$(now_ms)
+in_ns sim "$tetra" sim orbit --dds --dds-unit netns-1 --domain $domain --rate-hz $rate --minutes 0.5 \
+  --reference-hz 0 --fault gyro=2,kind=stuck,at=14 --wait-timeout 20 >"$work/sim.log" 2>&1 &
 sim_pid=$!
 pids+=("$sim_pid")
-
-# Wait until the service publishes attitude for the simulator's epochs (NOMINAL on the monitor).
-wait_for() {  # seconds, grep pattern on monitor.jsonl, what
-  local deadline=$(($(date +%s) + $1))
-  until grep -q -- "$2" "$work/monitor.jsonl" 2>/dev/null; do
-    [ "$(date +%s)" -lt "$deadline" ] || fail "timeout waiting for $3"
-    sleep 0.2
-  done
+at() {  # sleep until $1 seconds after the simulator started
+  local left=$((ts + $1 * 1000 - $(now_ms)))
+  if [ "$left" -gt 0 ]; then sleep "$((left / 1000)).$(printf '%03d' $((left % 1000)))"; fi
 }
-wait_for 30 '"mode": "NOMINAL"' "the service to run NOMINAL"
-ts=$(date +%s.%N)
-at() { sleep "$(echo "$ts + $1 - $(date +%s.%N)" | bc | sed 's/^-.*/0/')"; }
-log "service NOMINAL; fault schedule starts"
+lines() { wc -l <"$work/monitor.jsonl"; }
+since() { sed -n "$(($1 + 1)),\$p" "$work/monitor.jsonl"; }  # monitor lines after line $1
 
-at 8
-lines_before_cut=$(wc -l <"$work/monitor.jsonl")
+at 4
+grep -q '"mode": "NOMINAL"' "$work/monitor.jsonl" || fail "the service did not reach NOMINAL within 4 s"
+log "service NOMINAL"
+at 5
+n_cut=$(lines)
 link sim down
-at 13
+at 9
+since "$n_cut" | grep -q '"mode": "LOST"' || fail "sensor link cut: the monitor never saw LOST"
+log "check: sensor link cut -> LOST"
+n_up=$(lines)
 link sim up
-at 16
-sed -n "$((lines_before_cut + 1)),\$p" "$work/monitor.jsonl" >"$work/after_sensor_cut.jsonl"
-grep -q '"mode": "LOST"' "$work/after_sensor_cut.jsonl" || fail "sensor link cut: the monitor never saw LOST"
-log "check: sensor link cut -> LOST seen"
+at 11
+since "$n_up" | grep -q '"mode": "NOMINAL"' || fail "sensor link restored: the monitor never saw NOMINAL again"
+log "check: sensor link restored -> NOMINAL"
 
-at 18
+at 12
 link mon down
-lines_mon_cut=$(wc -l <"$work/monitor.jsonl")
-at 26
+n_mon=$(lines)
+at 20
 link mon up
-at 29
-sed -n "$((lines_mon_cut + 1)),\$p" "$work/monitor.jsonl" >"$work/after_monitor_cut.jsonl"
-grep -q '"event": "isolated"' "$work/after_monitor_cut.jsonl" ||
-  fail "monitor link cut: the isolation of gyro 2 (stuck at 20 s) did not reach the monitor after reconnect"
-log "check: monitor reconnect -> event history caught up"
+at 21
+since "$n_mon" | grep -q '"event": "isolated", "gyro": 2' ||
+  fail "monitor link cut: the isolation of gyro 2 (stuck from 14 s) did not reach the monitor after reconnect"
+log "check: monitor reconnected -> caught up with the isolation of gyro 2"
 
-at 30
+at 22
 kill -9 "$fusion_pid"
 log "service killed (SIGKILL)"
-at 32
-lines_restart=$(wc -l <"$work/monitor.jsonl")
+at 23
+n_restart=$(lines)
 start_fusion
 log "service restarted"
-at 38
+at 29
 kill -9 "$fusion_pid" 2>/dev/null || true
 wait "$sim_pid" 2>/dev/null || true
-sed -n "$((lines_restart + 1)),\$p" "$work/monitor.jsonl" >"$work/after_restart.jsonl"
-# A new service starts its counters at zero: its first Health shows fewer accepted epochs than the
-# last Health of the old one.
-python3 - "$work/monitor.jsonl" "$lines_restart" <<'PY' || fail "service restart: the monitor did not see the new service"
-import json, sys
-path, cut = sys.argv[1], int(sys.argv[2])
-rows = [json.loads(l) for l in open(path) if l.strip()]
-health = [(i, r) for i, r in enumerate(rows) if r.get("type") == "health" and "counters" in r]
-before = [r["counters"]["epochs_accepted"] for i, r in health if i < cut]
-after = [r["counters"]["epochs_accepted"] for i, r in health if i >= cut]
-if not before or not after: sys.exit("no health before or after the restart")
-drop = [a for a in after if a < before[-1]]
-if not drop: sys.exit("no health with fresh counters after the restart")
-grow = [a for a in after if a > min(drop)]
-if not grow: sys.exit("the new service's counters never grew")
-print(f"old service last epochs_accepted={before[-1]}, new service first={min(drop)}, then {max(after)}")
-PY
-log "check: service restart -> monitor sees the new service"
+# A new service starts its counters at zero: after the restart the monitor shows a Health with fewer
+# accepted epochs than the old service's last, and then growing.
+accepted() { grep -o '"type": "health".*"epochs_accepted": [0-9]*' | grep -o '[0-9]*$'; }
+last_old=$(head -n "$n_restart" "$work/monitor.jsonl" | accepted | tail -1)
+[ -n "$last_old" ] || fail "service restart: no Health of the old service"
+first_new=$(since "$n_restart" | accepted | awk -v old="$last_old" '$1 < old {print; exit}')
+[ -n "$first_new" ] || fail "service restart: no Health with fresh counters (old service's last: $last_old epochs)"
+last_new=$(since "$n_restart" | accepted | tail -1)
+[ "$last_new" -gt "$first_new" ] || fail "service restart: the new service's counters never grew ($first_new)"
+log "check: service restart -> new service seen ($last_old epochs before, then $first_new, then $last_new)"
 echo "netns_faults: PASS (3 faults; logs in $work)"

@@ -9,6 +9,7 @@ packages=(
   cyclonedds-dev cyclonedds-tools
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox
+  clang libclang-rt-14-dev openssl iproute2   # reliability tests: fuzzers (clang), DDS Security PKI, netns
 )
 
 missing=()
