@@ -51,7 +51,7 @@ Result<GyroLog> from_table(CsvTable&& t) {
     return bad_input(head + "reference columns must be all of ref_qw,ref_qx,ref_qy,ref_qz");
   log.has_reference = ref_found == 4;
 
-  // Every column must be used: a typo or a duplicate must not pass silently.
+  // Every column must be used: a typo must not pass silently (duplicates are refused by parse_csv).
   std::vector<bool> used(t.column_count(), false);
   used[*time_col] = true;
   for (const std::size_t c : gyro_cols) used[c] = true;
@@ -60,7 +60,7 @@ Result<GyroLog> from_table(CsvTable&& t) {
   }
   for (std::size_t c = 0; c < t.column_count(); ++c) {
     if (!used[c]) {
-      return bad_input(head + "unknown or duplicate column '" + t.columns[c] + "' (expected time_s, g1..g" +
+      return bad_input(head + "unknown column '" + t.columns[c] + "' (expected time_s, g1..g" +
                        std::to_string(log.gyro_count) + ", optional ref_qw..ref_qz)");
     }
   }

@@ -45,11 +45,6 @@ Result<TurntableLog> from_table(CsvTable&& t) {
       for (std::size_t g = 0; g < gyro_cols.size(); ++g) known = known || name == "g" + std::to_string(g + 1);
       if (!known) return bad_input(head + "unknown column '" + name + "'");
     }
-    // Every name is known, so one is repeated: a duplicate must not pass silently.
-    for (std::size_t c = 0; c < t.column_count(); ++c) {
-      if (t.find_column(t.columns[c]) != c)
-        return bad_input(head + "duplicate column '" + t.columns[c] + "'");
-    }
   }
   if (t.rows == 0) return bad_input(t.source + ": no data rows");
 
