@@ -472,7 +472,8 @@ void Pipeline::Impl::isolate(int id, FaultKind kind, const std::string& evidence
     const Subset& s = subset(before);
     if (s.observable && s.dof >= 1) {
       const Eigen::VectorXd w = s.parity.col(id - 1) * sqrt_period_;
-      const double f = w.dot(p_ema_) / std::max(w.squaredNorm(), 1e-300);
+      // p_ema_ is sized for N − 3 parity rows; this subset has s.dof of them (fewer once a gyro is out).
+      const double f = w.dot(p_ema_.head(s.dof)) / std::max(w.squaredNorm(), 1e-300);
       const double span = ns_to_seconds(now - episode_.onset_ns);
       attitude_.add_bound(s.pinv.col(id - 1) * f * span);
     }

@@ -13,7 +13,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   const auto log = tetra::parse_gyro_log(text, "fuzz.csv");
   if (!log) return 0;  // the reader has its own target
-  const auto analysis = tetra::analyze_gyro_log(*log, tetra::LogAllanOptions{});
+  const auto analysis = tetra::allan::analyze_gyro_log(*log, tetra::allan::LogAllanOptions{});
   if (!analysis) {
     tetra::fuzz::check_error_message(analysis.error());
     return 0;
@@ -25,8 +25,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       TETRA_FUZZ_CHECK(p.tau_s > 0.0);
     }
   }
-  (void)tetra::format_csv(*analysis);
-  (void)tetra::format_json(*analysis);
-  (void)tetra::format_table(*analysis);
+  (void)tetra::allan::format_csv(*analysis);
+  (void)tetra::allan::format_json(*analysis);
+  (void)tetra::allan::format_table(*analysis);
   return 0;
 }

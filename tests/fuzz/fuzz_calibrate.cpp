@@ -23,7 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
   tetra::CalibrationOptions options;
-  options.method = (knobs & 0x40) != 0 ? tetra::CalibrationMethod::kBatch : tetra::CalibrationMethod::kSixteen;
+  options.method =
+      (knobs & 0x40) != 0 ? tetra::CalibrationMethod::kBatch : tetra::CalibrationMethod::kSixteen;
   options.bias_model = (knobs & 0x80) != 0 ? tetra::BiasModel::kSeed : tetra::BiasModel::kBody;
   const auto result = tetra::calibrate(*log, *motion, options);
   if (!result) {

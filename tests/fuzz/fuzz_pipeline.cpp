@@ -40,11 +40,16 @@ tetra::Calibration unit_with(int n) {
 
 double any_double(FuzzedDataProvider& in) {
   switch (in.ConsumeIntegralInRange<int>(0, 5)) {
-    case 0: return std::numeric_limits<double>::quiet_NaN();
-    case 1: return std::numeric_limits<double>::infinity();
-    case 2: return -std::numeric_limits<double>::infinity();
-    case 3: return in.ConsumeBool() ? 1e300 : -1e-300;
-    default: return in.ConsumeFloatingPoint<double>();
+    case 0:
+      return std::numeric_limits<double>::quiet_NaN();
+    case 1:
+      return std::numeric_limits<double>::infinity();
+    case 2:
+      return -std::numeric_limits<double>::infinity();
+    case 3:
+      return in.ConsumeBool() ? 1e300 : -1e-300;
+    default:
+      return in.ConsumeFloatingPoint<double>();
   }
 }
 
@@ -91,8 +96,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       std::int64_t dt_ns = 10'000'000;
       if (dt_kind >= 224) dt_ns = in.ConsumeIntegralInRange<std::int64_t>(-2'000'000'000, 2'000'000'000);
       if (dt_kind == 255) dt_ns = in.ConsumeIntegral<std::int64_t>() / 4;
-      stamp_ns = (dt_ns > 0 && stamp_ns > std::numeric_limits<std::int64_t>::max() - dt_ns) ? stamp_ns
-                                                                                          : stamp_ns + dt_ns;
+      std::int64_t next_ns = 0;
+      if (!__builtin_add_overflow(stamp_ns, dt_ns, &next_ns)) stamp_ns = next_ns;  // else: time stands still
       epoch.stamp_ns = stamp_ns;
       const tetra::fdi::Counters before = pipeline.health().counters;
       for (int i = 0; i < n; ++i) {
@@ -132,8 +137,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } else {
       const int id = in.ConsumeIntegralInRange<int>(-1, n + 1);
       switch (kind % 4) {
-        case 0: check_event(pipeline.exclude(id, stamp_ns), n); break;
-        case 1: check_event(pipeline.reinstate(id, stamp_ns), n); break;
+        case 0:
+          check_event(pipeline.exclude(id, stamp_ns), n);
+          break;
+        case 1:
+          check_event(pipeline.reinstate(id, stamp_ns), n);
+          break;
         case 2:
           check_event(pipeline.reset_command(stamp_ns), n);
           last_accepted_ns = std::numeric_limits<std::int64_t>::min();

@@ -9,14 +9,15 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  const auto spec = tetra::parse_tau_spec(text);
+  const auto spec = tetra::allan::parse_tau_spec(text);
   if (!spec) {
     tetra::fuzz::check_error_message(spec.error());
     return 0;
   }
-  if (spec->spacing == tetra::TauSpacing::kAll) return 0;  // O(n²) by design; its limit is tested elsewhere
+  if (spec->spacing == tetra::allan::TauSpacing::kAll)
+    return 0;  // O(n²) by design; its limit is tested elsewhere
   constexpr std::size_t kSamples = 100000;
-  const auto factors = tetra::averaging_factors(*spec, kSamples, 0.1);
+  const auto factors = tetra::allan::averaging_factors(*spec, kSamples, 0.1);
   if (!factors) {
     tetra::fuzz::check_error_message(factors.error());
     return 0;

@@ -1,0 +1,224 @@
+// DDS Security (issue 7.1): the demo PKI of scripts/security/make_pki.sh, the three roles, and the
+// three promises — an unauthenticated participant sees nothing and injects nothing; the sensor
+// identity cannot write Command; an identity without the grant cannot write GyroSample. Each test
+// also shows the positive case, so a test cannot pass merely because nothing works.
+// Real Cyclone DDS on loopback, separate processes, one domain per test (171–173); processes are
+// killed by the test. Waits have generous upper bounds that only turn a hang into a failure.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <string>
+#include <thread>
+
+#include "test_support.hpp"
+#include "tetra/core/calibration_file.hpp"
+#include "tetra/dds/entity.hpp"
+#include "tetra/dds/topics.hpp"
+#include "tetra/service/security_profile.hpp"
+
+namespace tetra::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+const bool kLoopback = [] {
+  const std::string uri = "file://" + source_path("config/cyclonedds-loopback.xml");
+  setenv("CYCLONEDDS_URI", uri.c_str(), 1);
+  return true;
+}();
+
+//! A `tetra` child process with its output in a file; SIGKILLed when it goes out of scope.
+class Process {
+ public:
+  Process(const std::vector<std::string>& args, const std::string& log_path) {
+    std::vector<std::string> storage{TETRA_BINARY};
+    storage.insert(storage.end(), args.begin(), args.end());
+    pid_ = fork();
+    if (pid_ == 0) {
+      std::vector<char*> argv;
+      for (auto& a : storage) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      if (FILE* f = std::freopen(log_path.c_str(), "w", stdout)) (void)f;
+      dup2(STDOUT_FILENO, STDERR_FILENO);
+      execv(TETRA_BINARY, argv.data());
+      _exit(127);
+    }
+  }
+  Process(const Process&) = delete;
+  Process& operator=(const Process&) = delete;
+  ~Process() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  int wait_exit() {
+    int status = 0;
+    waitpid(pid_, &status, 0);
+    pid_ = -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+//! The demo PKI, made once for the whole suite (about 2 s of openssl).
+class DdsSecurity : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    pki_ = new TempDir();
+    const auto made = run_shell("bash " + source_path("scripts/security/make_pki.sh") + " " +
+                                pki_->path().string() + " 0-230");
+    ASSERT_EQ(made.exit_status, 0) << made.err << made.out;
+  }
+  static void TearDownTestSuite() {
+    delete pki_;
+    pki_ = nullptr;
+  }
+  void TearDown() override { dds::set_security_profile(std::nullopt); }
+
+  static std::string profile(const std::string& role) { return pki_->file(role + ".yaml"); }
+  static service::SecurityProfile load(const std::string& role) {
+    auto p = service::read_security_profile(profile(role));
+    EXPECT_TRUE(p.ok()) << p.error().message;
+    return p.value();
+  }
+  //! A service configuration (calibration of the simulated unit, the fusion identity) in `dir`.
+  static std::string service_config(const TempDir& dir, const std::string& unit) {
+    Calibration cal = seed_as_built_unit();
+    cal.unit = unit;
+    EXPECT_TRUE(write_calibration(dir.file("cal.yaml"), cal).ok());
+    write_file(dir.file("fusion.yaml"), "unit: " + unit +
+                                            "\ncalibration: cal.yaml\nsample_rate_hz: 50\nspeed: 1\n"
+                                            "max_latency_s: 0.05\nhealth_period_s: 0.2\nsecurity: " +
+                                            profile("fusion") + "\n");
+    return dir.file("fusion.yaml");
+  }
+
+  static TempDir* pki_;
+};
+TempDir* DdsSecurity::pki_ = nullptr;
+
+template <class T>
+int count_taken(const dds::Reader<T>& reader) {
+  int n = 0;
+  (void)reader.take([&](const T&, const dds_sample_info_t&) { ++n; });
+  return n;
+}
+
+TEST_F(DdsSecurity, UnauthenticatedParticipantSeesAndInjectsNothing) {
+  const dds_domainid_t domain = 171;
+  TempDir dir;
+  Process fusion({"fusion", "--config", service_config(dir, "sec-1"), "--domain", std::to_string(domain)},
+                 dir.file("fusion.log"));
+  // The secured sensor: 8 s of an orbit at 50 Hz in real time.
+  Process sim({"sim", "orbit", "--dds", "--dds-unit", "sec-1", "--domain", std::to_string(domain), "--rate-hz",
+               "50", "--minutes", "0.1333", "--reference-hz", "0", "--security", profile("sensor"),
+               "--wait-timeout", "30"},
+              dir.file("sim.log"));
+
+  // The intruder: no credentials. Readers of every output topic, writers of GyroSample and Command.
+  auto participant = dds::Participant::create(domain);
+  ASSERT_TRUE(participant.ok()) << participant.error().message;
+  auto topics = dds::Topics::create(*participant);
+  ASSERT_TRUE(topics.ok()) << topics.error().message;
+  auto health = dds::Reader<tetra_Health>::create(*participant, topics->health, dds::health_qos());
+  auto attitude = dds::Reader<tetra_Attitude>::create(*participant, topics->attitude, dds::attitude_qos());
+  auto events = dds::Reader<tetra_FdiEvent>::create(*participant, topics->event, dds::event_qos());
+  auto samples = dds::Reader<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+  auto gyro_writer = dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+  auto command_writer = dds::Writer<tetra_Command>::create(*participant, topics->command, dds::command_qos());
+  ASSERT_TRUE(health.ok() && attitude.ok() && events.ok() && samples.ok() && gyro_writer.ok() &&
+              command_writer.ok());
+
+  // While the secured chain runs, the intruder writes a reset command and wild samples for the unit.
+  tetra_Command command{};
+  std::snprintf(command.unit, sizeof command.unit, "%s", "sec-1");
+  command.command_id = 4242;
+  command.kind = tetra_COMMAND_RESET;
+  tetra_GyroSample sample{};
+  std::snprintf(sample.unit, sizeof sample.unit, "%s", "sec-1");
+  int seen = 0;
+  for (int k = 0; k < 50; ++k) {  // 5 s
+    sample.gyro = static_cast<std::int16_t>(1 + k % 4);
+    sample.seq = static_cast<std::uint64_t>(1000000 + k);
+    sample.raw = 1.0e3;
+    (void)gyro_writer->write(sample);
+    (void)command_writer->write(command);
+    seen += count_taken(*health) + count_taken(*attitude) + count_taken(*events) + count_taken(*samples);
+    std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_EQ(seen, 0) << "the unauthenticated participant received samples";
+  EXPECT_EQ(gyro_writer->matched_readers().value(), 0u) << "a secured reader matched an unauthenticated writer";
+  EXPECT_EQ(command_writer->matched_readers().value(), 0u);
+
+  // Positive control, with the ground identity: the service ran on the sensor's samples and no
+  // command or wild sample reached it.
+  const auto ground = run_tetra("monitor --once --jsonl --unit sec-1 --timeout 20 --domain " +
+                                std::to_string(domain) + " --security " + profile("ground"));
+  ASSERT_EQ(ground.exit_status, 0) << ground.err << read_file(dir.file("fusion.log"));
+  EXPECT_NE(ground.out.find("\"mode\": \"NOMINAL\""), std::string::npos) << ground.out;
+  EXPECT_EQ(ground.out.find("\"command_id\": 4242"), std::string::npos) << ground.out;
+  EXPECT_NE(ground.out.find("\"samples_invalid\": 0,"), std::string::npos) << ground.out;
+  EXPECT_EQ(ground.out.find("\"epochs_accepted\": 0,"), std::string::npos) << ground.out;
+  // The ground identity may command: acknowledged by the service.
+  const auto reset = run_tetra("command --unit sec-1 --timeout 20 --domain " + std::to_string(domain) +
+                               " --security " + profile("ground") + " reset");
+  EXPECT_EQ(reset.exit_status, 0) << reset.err << reset.out;
+  EXPECT_EQ(sim.wait_exit(), 0) << read_file(dir.file("sim.log"));
+  EXPECT_NE(read_file(dir.file("sim.log")).find("attitudes scored: "), std::string::npos)
+      << read_file(dir.file("sim.log"));
+}
+
+TEST_F(DdsSecurity, SensorCannotWriteCommand) {
+  const dds_domainid_t domain = 172;
+  dds::set_security_profile(load("sensor"));
+  auto participant = dds::Participant::create(domain);
+  ASSERT_TRUE(participant.ok()) << participant.error().message;
+  auto topics = dds::Topics::create(*participant);
+  ASSERT_TRUE(topics.ok()) << topics.error().message;
+  // Allowed: the sensor's own topic.
+  auto gyro = dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+  EXPECT_TRUE(gyro.ok()) << gyro.error().message;
+  // Refused: Command.
+  auto command = dds::Writer<tetra_Command>::create(*participant, topics->command, dds::command_qos());
+  ASSERT_FALSE(command.ok());
+  EXPECT_NE(command.error().message.find("Not Allowed By Security"), std::string::npos) << command.error().message;
+  // The same through the command line.
+  const auto cli = run_tetra("command --unit sec-1 --timeout 5 --domain " + std::to_string(domain) +
+                             " --security " + profile("sensor") + " reset");
+  EXPECT_EQ(cli.exit_status, 1) << cli.err;
+  EXPECT_NE(cli.err.find("Not Allowed By Security"), std::string::npos) << cli.err;
+}
+
+TEST_F(DdsSecurity, OnlySensorsWriteGyroSamples) {
+  const dds_domainid_t domain = 173;
+  for (const char* role : {"ground", "fusion"}) {
+    dds::set_security_profile(load(role));
+    auto participant = dds::Participant::create(domain);
+    ASSERT_TRUE(participant.ok()) << role << ": " << participant.error().message;
+    auto topics = dds::Topics::create(*participant);
+    ASSERT_TRUE(topics.ok()) << topics.error().message;
+    auto writer = dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+    ASSERT_FALSE(writer.ok()) << role << " may write GyroSample";
+    EXPECT_NE(writer.error().message.find("Not Allowed By Security"), std::string::npos)
+        << role << ": " << writer.error().message;
+    // Each may read the samples (positive control: the identity itself is accepted).
+    auto reader = dds::Reader<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+    EXPECT_TRUE(reader.ok()) << role << ": " << reader.error().message;
+  }
+  // A simulator started with the ground identity is refused.
+  const auto sim = run_tetra("sim orbit --dds --dds-unit sec-1 --minutes 0.01 --wait-timeout 2 --domain " +
+                             std::to_string(domain) + " --security " + profile("ground"));
+  EXPECT_EQ(sim.exit_status, 1) << sim.err << sim.out;
+  EXPECT_NE(sim.err.find("Not Allowed By Security"), std::string::npos) << sim.err;
+}
+
+}  // namespace
+}  // namespace tetra::test
