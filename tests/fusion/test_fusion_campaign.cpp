@@ -168,7 +168,7 @@ TEST(Campaign, IsolationWithoutReference) {
   for (int gyro = 1; gyro <= 4; ++gyro) {
     for (const auto& kd : kinds) {
       sim::SimOptions so;
-      so.seed = static_cast<std::uint64_t>(10 * gyro + static_cast<int>(kd.kind));
+      so.seed = 10U * static_cast<std::uint64_t>(gyro) + static_cast<std::uint64_t>(kd.kind);
       so.faults = {fault(gyro, kd.kind, at, kd.size)};
       const auto run = run_campaign(orbit(at + 30.0, false), so, seed_as_built_unit(), orbit_config());
       const std::string what =
@@ -182,7 +182,7 @@ TEST(Campaign, IsolationWithoutReference) {
     }
     {  // recurring spikes: 0.05 deg/s every 15 s
       sim::SimOptions so;
-      so.seed = static_cast<std::uint64_t>(500 + gyro);
+      so.seed = 500U + static_cast<std::uint64_t>(gyro);
       for (int j = 0; j < 8; ++j)
         so.faults.push_back(fault(gyro, sim::FaultKind::kSpike, at + 15.0 * j, 0.05));
       const auto run = run_campaign(orbit(at + 150.0, false), so, seed_as_built_unit(), orbit_config());
@@ -203,7 +203,7 @@ TEST(Campaign, IsolationWithoutReference) {
     }
     for (double size : {1e-3, -3e-3, 1e-2}) {  // abrupt bias steps
       sim::SimOptions so;
-      so.seed = static_cast<std::uint64_t>(700 + gyro);
+      so.seed = 700U + static_cast<std::uint64_t>(gyro);
       so.faults = {fault(gyro, sim::FaultKind::kBias, at, size)};
       const auto run = run_campaign(orbit(at + 30.0, false), so, seed_as_built_unit(), orbit_config());
       const std::string what =
@@ -214,7 +214,7 @@ TEST(Campaign, IsolationWithoutReference) {
     }
     {  // ramp: looks like motion, stays unisolated
       sim::SimOptions so;
-      so.seed = static_cast<std::uint64_t>(900 + gyro);
+      so.seed = 900U + static_cast<std::uint64_t>(gyro);
       so.faults = {fault(gyro, sim::FaultKind::kRamp, at, 1e-5)};
       const auto run = run_campaign(orbit(at + 200.0, false), so, seed_as_built_unit(), orbit_config());
       EXPECT_TRUE(run.unisolated) << test::describe(run);
@@ -240,7 +240,7 @@ TEST(Campaign, IsolationWithReference) {
     for (const auto& [name, kind, size] : {std::tuple{"bias 1e-3", sim::FaultKind::kBias, 1e-3},
                                            std::tuple{"ramp 2e-5", sim::FaultKind::kRamp, 2e-5}}) {
       sim::SimOptions so;
-      so.seed = static_cast<std::uint64_t>(1100 + gyro);
+      so.seed = 1100U + static_cast<std::uint64_t>(gyro);
       so.faults = {fault(gyro, kind, at, size)};
       const auto run = run_campaign(orbit(at + 70.0, true), so, seed_as_built_unit(), orbit_config());
       const std::string what =
@@ -258,7 +258,7 @@ TEST(Campaign, IsolationWithReference) {
     sc->motion.acs.peak_accel_dps2 = 1e-4;
     sc->motion.slews = {{Eigen::Vector3d::UnitX(), 30.0, 120.0, 120.0}};
     sim::SimOptions so;
-    so.seed = static_cast<std::uint64_t>(1200 + gyro);
+    so.seed = 1200U + static_cast<std::uint64_t>(gyro);
     // The fault appears with the slew (120–240 s, cycloidal, peak 0.5 deg/s at 180 s). The kind is what the
     // evidence shows: gyros 2 and 3 also see the orbit's constant pitch rate, where a scale error is a bias.
     so.faults = {fault(gyro, sim::FaultKind::kScale, at, 0.05)};

@@ -19,11 +19,11 @@ using test::TempDir;
 
 // Writes `seconds` of synthetic log (volts) with an optional fault; returns the path.
 std::string write_log(const TempDir& dir, const std::string& name, double seconds,
-                      test::SynthFault fault = {}, test::SynthOptions opt = {}) {
+                      test::SynthFault fault = {}, const test::SynthOptions& opt = {}) {
   const auto cal = seed_as_built_unit();
   test::Synth s(cal, opt, fault);
   GyroLogWriter w;
-  const std::string path = dir.file(name);
+  std::string path = dir.file(name);
   EXPECT_TRUE(w.open(path, 4, opt.reference_period_s > 0.0, false).ok());
   const auto steps = static_cast<int>(std::llround(seconds / opt.period_s));
   for (int k = 0; k < steps; ++k) {
@@ -37,7 +37,7 @@ std::string write_log(const TempDir& dir, const std::string& name, double second
 }
 
 std::string write_cal(const TempDir& dir) {
-  const std::string path = dir.file("cal.yaml");
+  std::string path = dir.file("cal.yaml");
   EXPECT_TRUE(write_calibration(path, seed_as_built_unit()).ok());
   return path;
 }
