@@ -54,8 +54,8 @@ double median(std::vector<double> v) {
 
 TEST(Campaign, SeedExperimentAngle) {
   // lab-orbit at −23.2°, Earth rate removed; "angle" = Σ wy·Δt. Factory data sheet: ≈ 474° (seed 467°).
-  // The truth calibration (the simulated unit's as-built values, standing in for `tetra calibrate`'s output,
-  // which is not on this branch): 360 ± 0.5°.
+  // The truth calibration (the simulated unit's as-built values): 360 ± 0.5°. The same with the calibration
+  // `tetra calibrate` makes: ReplayCli.SeedExperimentFromTheCommandLine.
   auto sc = sim::builtin_scenario("lab-orbit");
   ASSERT_TRUE(sc.ok());
   fdi::PipelineConfig cfg;
