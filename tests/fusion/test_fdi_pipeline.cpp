@@ -351,5 +351,23 @@ TEST(Pipeline, GroundModeRemovesEarthRate) {
               7.2921159e-5 * 600 * kRadToDeg, 0.01);
 }
 
+TEST(Pipeline, ThreeGyrosHaveNoParityButSignaturesStillIsolate) {
+  // Gyros 1–3 of the unit alone: no parity, so χ² and CUSUM are silent (10 min, no event); a stuck gyro is
+  // still isolated by its own series, and with two gyros left the attitude is LOST.
+  Calibration cal = seed_as_built_unit();
+  cal.gyros.resize(3);
+  const Outcome quiet = run({}, 600.0, SynthOptions{}, campaign_config(), cal);
+  EXPECT_TRUE(quiet.events.empty()) << describe(quiet);
+  EXPECT_EQ(quiet.final_mode, Mode::kNominal);
+  const Outcome o =
+      run(SynthFault{2, FaultKind::kStuck, false, 60.0, 0.0}, 70.0, SynthOptions{}, campaign_config(), cal);
+  ASSERT_TRUE(o.isolated_gyro.has_value()) << describe(o);
+  EXPECT_EQ(*o.isolated_gyro, 2);
+  EXPECT_EQ(o.final_mode, Mode::kLost);
+  bool lost = false;
+  for (const auto& e : o.events) lost = lost || e.type == EventType::kLost;
+  EXPECT_TRUE(lost) << describe(o);
+}
+
 }  // namespace
 }  // namespace tetra::fdi
