@@ -507,9 +507,13 @@ double Pipeline::Impl::noise_ratio(const GyroTrack& g, int last) const {
                          : std::min(g.d2_count, config_.noise_window);
   if (n < (last > 0 ? std::min(10, config_.noise_window) : config_.noise_window)) return kNaN;
   double* buf = scratch_.data();
-  for (int k = 0; k < n; ++k) {
-    buf[k] =
-        g.d2[static_cast<std::size_t>((g.d2_head - 1 - k + 2 * config_.noise_window) % config_.noise_window)];
+  if (n == config_.noise_window) {
+    std::copy(g.d2.begin(), g.d2.end(), buf);  // the whole ring: order does not matter for a median
+  } else {
+    for (int k = 0; k < n; ++k) {
+      buf[k] =
+          g.d2[static_cast<std::size_t>((g.d2_head - 1 - k + 2 * config_.noise_window) % config_.noise_window)];
+    }
   }
   std::nth_element(buf, buf + n / 2, buf + n);
   // Δ²y = y_k − 2y_{k−1} + y_{k−2} of white noise has variance 6σ²: median |Δ²y| = 0.6745·√6·σ.

@@ -172,5 +172,39 @@ TEST(ReplayCli, SeedExperimentFromTheCommandLine) {
   EXPECT_EQ(test::read_file(dir.file("ev.jsonl")), "");  // the right calibration raises no alarm
 }
 
+TEST(ReplayCli, RatesInDegreesPerSecondSkipTheCalibrationScale) {
+  // A "# units=dps" log carries rates: the pipeline uses them as they are (the axes of the calibration still
+  // apply). A constant body rate of (0.1, −0.2, 0.3) deg/s projected on the axes, noise-free, comes back
+  // to 1e-12 deg/s (rounding only).
+  TempDir dir;
+  const auto cal = write_cal(dir);
+  const auto unit = seed_as_built_unit();
+  const Eigen::Vector3d w(0.1, -0.2, 0.3);
+  std::string log = "# units=dps\ntime_s,g1,g2,g3,g4\n";
+  for (int k = 0; k < 8; ++k) {  // fewer than stuck_repeat_count identical values: a noise-free gyro is stuck
+    append_double(log, 0.1 * k);
+    for (const auto& g : unit.gyros) {
+      log += ',';
+      append_double(log, g.axis_B.dot(w));
+    }
+    log += '\n';
+  }
+  test::write_file(dir.file("dps.csv"), log);
+  const auto r = run_tetra("replay " + dir.file("dps.csv") + " --calibration " + cal + " --attitude " +
+                           dir.file("att.csv") + " --events " + dir.file("ev.jsonl"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const std::string att = test::read_file(dir.file("att.csv"));
+  const std::string last = att.substr(att.rfind('\n', att.size() - 2) + 1);
+  std::vector<double> cells;
+  std::stringstream ls(last);
+  std::string cell;
+  while (std::getline(ls, cell, ',') && cells.size() < 9) cells.push_back(std::stod(cell));
+  EXPECT_NEAR(cells[5], 0.1, 1e-12);
+  EXPECT_NEAR(cells[6], -0.2, 1e-12);
+  EXPECT_NEAR(cells[7], 0.3, 1e-12);
+  EXPECT_NE(last.find(",NOMINAL,1234"), std::string::npos) << last;
+  EXPECT_EQ(test::read_file(dir.file("ev.jsonl")), "");
+}
+
 }  // namespace
 }  // namespace tetra
