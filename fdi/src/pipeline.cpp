@@ -52,9 +52,10 @@ struct Subset {
 struct GyroTrack {
   bool excluded = false;
   FaultKind kind = FaultKind::kNone;
-  double sigma_rate_rts = 0.0;   //!< [rad/√s] white rate noise N
-  double bias_rate_sigma = 0.0;  //!< [rad/s] 1σ of the calibrated bias
-  double scale_rel_sigma = 0.0;  //!< [-] 1σ relative scale factor error
+  double sigma_rate_rts = 0.0;    //!< [rad/√s] white rate noise N
+  double bias_rate_sigma = 0.0;   //!< [rad/s] 1σ of the calibrated bias
+  double scale_rel_sigma = 0.0;   //!< [-] 1σ relative scale factor error
+  double bias_instability = 0.0;  //!< [rad/s] B of the calibration's noise section (0 if absent)
   // this epoch
   bool valid = false;  //!< sample present and valid (before the jump test)
   bool use = false;    //!< used in this epoch's solution
@@ -229,6 +230,8 @@ Status Pipeline::Impl::init() {
                        ": noise.arw_dps_rtHz must be positive");
     }
     t.sigma_rate_rts = deg2rad(n_dps);
+    if (g.noise && g.noise->bias_instability_dps)
+      t.bias_instability = deg2rad(*g.noise->bias_instability_dps);
     arw[i] = t.sigma_rate_rts;
     const double s = config_.raw_units_dps ? 1.0 : g.scale_factor_V_per_dps;
     scale_V_per_rad_s_.push_back(s / kDegToRad);
@@ -352,8 +355,10 @@ void Pipeline::Impl::reset() {
     const double n = g.sigma_rate_rts;
     const double b = g.bias_rate_sigma;
     const double s = g.scale_rel_sigma;
+    const double bi = g.bias_instability;
     auto d2 = std::move(g.d2);
     g = GyroTrack{};
+    g.bias_instability = bi;
     g.sigma_rate_rts = n;
     g.bias_rate_sigma = b;
     g.scale_rel_sigma = s;
@@ -511,8 +516,8 @@ double Pipeline::Impl::noise_ratio(const GyroTrack& g, int last) const {
     std::copy(g.d2.begin(), g.d2.end(), buf);  // the whole ring: order does not matter for a median
   } else {
     for (int k = 0; k < n; ++k) {
-      buf[k] =
-          g.d2[static_cast<std::size_t>((g.d2_head - 1 - k + 2 * config_.noise_window) % config_.noise_window)];
+      buf[k] = g.d2[static_cast<std::size_t>((g.d2_head - 1 - k + 2 * config_.noise_window) %
+                                             config_.noise_window)];
     }
   }
   std::nth_element(buf, buf + n / 2, buf + n);
@@ -827,8 +832,6 @@ void Pipeline::Impl::reference_update(const Epoch& epoch) {
   int loud = 0;
   int culprit = 0;
   double stat = 0.0;
-  double culprit_rot = 0.0;
-  double culprit_err = 0.0;
   int members = 0;
   for (int i = 0; i < n_; ++i) {
     const auto& g = gyros_[static_cast<std::size_t>(i)];
@@ -839,23 +842,19 @@ void Pipeline::Impl::reference_update(const Epoch& epoch) {
     const double gyro_angle =
         g.angle_rad - snap_angle_[os * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)];
     const double err = gyro_angle - rot;
-    const double sig =
-        std::sqrt(2.0 * sig_ref * sig_ref + g.sigma_rate_rts * g.sigma_rate_rts * span +
-                  std::pow(g.bias_rate_sigma * span, 2) + std::pow(g.scale_rel_sigma * rot, 2));
+    const double sig = std::sqrt(2.0 * sig_ref * sig_ref + g.sigma_rate_rts * g.sigma_rate_rts * span +
+                                 std::pow((g.bias_rate_sigma + g.bias_instability) * span, 2) +
+                                 std::pow(g.scale_rel_sigma * rot, 2));
     const double z = std::abs(err) / sig;
     if (z > config_.reference_threshold_sigma) {
       ++flagged;
       culprit = i + 1;
       stat = z;
-      culprit_rot = rot;
-      culprit_err = err;
     } else if (z > 0.5 * config_.reference_threshold_sigma) {
       ++loud;
     }
   }
   if (flagged != 1 || loud != 0 || members < 2) return;
-  (void)culprit_rot;
-  (void)culprit_err;
   // Scale or rate offset: fit err(τ) = a·τ + b·rot(τ) over the window's snapshots. When the rotation about
   // the axis is not proportional to time (a slew), a significant b is a scale error; otherwise the data
   // cannot tell scale from offset and the parity's history decides bias or ramp.
