@@ -208,6 +208,8 @@ class Pipeline::Impl {
   std::vector<double> snap_angle_;       //!< kSnapshots×N
   std::vector<double> snap_ref_;         //!< kSnapshots×N
   int snap_count_ = 0;                   //!< total pushed
+  int ref_run_gyro_ = 0;                 //!< gyro flagged alone by the last reference comparisons
+  int ref_run_ = 0;                      //!< how many in a row
   mutable std::vector<double> scratch_;  //!< median scratch
   std::vector<double> mean_pre_, mean_post_;
   std::vector<int> n_pre_, n_post_;
@@ -374,6 +376,8 @@ void Pipeline::Impl::reset() {
   omega_prev_.setZero();
   lost_since_ns_ = -1;
   snap_count_ = 0;
+  ref_run_gyro_ = 0;
+  ref_run_ = 0;
   pending_.clear();
   reset_detectors();
   update_mode(0);
@@ -854,7 +858,20 @@ void Pipeline::Impl::reference_update(const Epoch& epoch) {
       ++loud;
     }
   }
-  if (flagged != 1 || loud != 0 || members < 2) return;
+  // One gyro alone beyond the threshold, the others quiet, in `reference_confirm_count` consecutive
+  // comparisons (consecutive windows share no reference sample, so one wild reference sample cannot do it).
+  if (flagged != 1 || loud != 0 || members < 2) {
+    ref_run_gyro_ = 0;
+    ref_run_ = 0;
+    return;
+  }
+  if (culprit != ref_run_gyro_) {
+    ref_run_gyro_ = culprit;
+    ref_run_ = 0;
+  }
+  if (++ref_run_ < config_.reference_confirm_count) return;
+  ref_run_gyro_ = 0;
+  ref_run_ = 0;
   // Scale or rate offset: fit err(τ) = a·τ + b·rot(τ) over the window's snapshots. When the rotation about
   // the axis is not proportional to time (a slew), a significant b is a scale error; otherwise the data
   // cannot tell scale from offset and the parity's history decides bias or ramp.
