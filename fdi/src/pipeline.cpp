@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <unordered_map>
 
@@ -406,7 +407,9 @@ std::string Pipeline::Impl::describe_thresholds() const {
   std::string out = "gyros: " + std::to_string(n_) + "\n";
   for (int i = 0; i < n_; ++i) {
     out += "gyro " + std::to_string(i + 1) + ": N = ";
-    append_double(out, gyros_[static_cast<std::size_t>(i)].sigma_rate_rts * kRadToDeg);
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", gyros_[static_cast<std::size_t>(i)].sigma_rate_rts * kRadToDeg);
+    out += text;
     out += " deg/sqrt(s)\n";
   }
   const auto it = subsets_.find(all_gyros(n_));
