@@ -155,6 +155,8 @@ class Pipeline::Impl {
   void push_history(std::int64_t now);
   //! Robust noise level / expected over the last `last` second differences (0: the whole window).
   double noise_ratio(const GyroTrack& g, int last = 0) const;
+  //! Trimmed RMS noise level / expected over the last `last` second differences (classification).
+  double recent_noise_ratio(const GyroTrack& g, int last) const;
   void update_mode(std::int64_t now);
 
   Calibration cal_;
@@ -533,6 +535,23 @@ double Pipeline::Impl::noise_ratio(const GyroTrack& g, int last) const {
   return buf[n / 2] / (kNoiseExpectedMedian * std::sqrt(6.0) * sigma_sample);
 }
 
+double Pipeline::Impl::recent_noise_ratio(const GyroTrack& g, int last) const {
+  // RMS of the last `last` second differences without their two largest (a step leaves exactly two), over the
+  // expected √6·σ. Efficient on few samples, where the median is not: used to classify at isolation time.
+  const int n = std::min({last, g.d2_count, config_.noise_window});
+  if (n < 6) return kNaN;
+  double* buf = scratch_.data();
+  for (int k = 0; k < n; ++k) {
+    buf[k] =
+        g.d2[static_cast<std::size_t>((g.d2_head - 1 - k + 2 * config_.noise_window) % config_.noise_window)];
+  }
+  std::sort(buf, buf + n);
+  double sum_sq = 0.0;
+  for (int k = 0; k < n - 2; ++k) sum_sq += buf[k] * buf[k];
+  const double sigma_sample = g.sigma_rate_rts / sqrt_period_;
+  return std::sqrt(sum_sq / (n - 2)) / (std::sqrt(6.0) * sigma_sample);
+}
+
 void Pipeline::Impl::check_signatures(std::int64_t now) {
   for (int i = 0; i < n_; ++i) {
     auto& g = gyros_[static_cast<std::size_t>(i)];
@@ -664,7 +683,7 @@ int Pipeline::Impl::onset_test(std::int64_t now_index) {
   const std::int64_t pre_begin = k0 - gap - config_.onset_pre_epochs;
   const std::int64_t pre_end = k0 - gap;
   const std::int64_t post_end = std::min(now_index + 1, k0 + config_.onset_post_max_epochs);
-  if (pre_begin < 0 || pre_begin <= now_index - kHistory || post_end - k0 < 10) return 0;
+  if (pre_begin < 0 || pre_begin <= now_index - kHistory || post_end - k0 < 20) return 0;
   std::fill(mean_pre_.begin(), mean_pre_.end(), 0.0);
   std::fill(mean_post_.begin(), mean_post_.end(), 0.0);
   std::fill(n_pre_.begin(), n_pre_.end(), 0);
@@ -1026,7 +1045,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
         avail = without_gyro(avail, i + 1);
         if (g.outlier_run >= config_.onset_confirm_epochs) {
           const bool zero = g.outlier_repeated && g.raw == 0.0;
-          const double r = noise_ratio(g, config_.onset_confirm_epochs);
+          const double r = recent_noise_ratio(g, config_.onset_confirm_epochs);
           if (g.outlier_repeated) {
             isolate(i + 1, FaultKind::kStuck, zero ? "zero" : "repeated", "onset", g.outlier_run, now);
           } else if (std::isfinite(r) && r > config_.noise_high_ratio) {
@@ -1197,20 +1216,13 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
       evidence = "glt";
     }
     if (culprit > 0) {
-      // Kind from the gyro's own samples since the onset: identical raw values are a stuck output.
-      bool repeated = true;
-      for (std::int64_t k = std::max(episode_.onset_index, epoch_index_ - kHistory + 1) + 1;
-           k <= epoch_index_; ++k) {
-        const auto slot = static_cast<std::size_t>(k % kHistory);
-        const auto prev = static_cast<std::size_t>((k - 1) % kHistory);
-        repeated = repeated &&
-                   hist_raw_[slot * static_cast<std::size_t>(n_) + static_cast<std::size_t>(culprit - 1)] ==
-                       hist_raw_[prev * static_cast<std::size_t>(n_) + static_cast<std::size_t>(culprit - 1)];
-      }
-      // A noise increase also shifts window means: the second differences since the onset tell it apart.
-      const double r =
-          noise_ratio(gyros_[static_cast<std::size_t>(culprit - 1)],
-                      static_cast<int>(std::max<std::int64_t>(epoch_index_ - episode_.onset_index, 10)));
+      // Kind from the gyro's own samples: identical raw values (5 or more in a row, whatever the onset
+      // estimate) are a stuck output; a noise increase also shifts window means, and its second differences
+      // tell it apart.
+      const auto& cg = gyros_[static_cast<std::size_t>(culprit - 1)];
+      const bool repeated = cg.repeat_count >= 5;
+      const double r = recent_noise_ratio(
+          cg, static_cast<int>(std::max<std::int64_t>(epoch_index_ - episode_.onset_index, 20)));
       FaultKind kind = FaultKind::kBias;
       if (repeated) {
         kind = FaultKind::kStuck;
@@ -1219,7 +1231,10 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
       } else if (evidence == "glt") {
         kind = classify_drift(culprit);
       }
-      isolate(culprit, kind, evidence, episode_.test, episode_.statistic, now);
+      // A noise level neither normal nor clearly high: wait for more samples rather than guess the kind.
+      const bool ambiguous = !repeated && std::isfinite(r) && r > 0.5 * config_.noise_high_ratio &&
+                             r <= config_.noise_high_ratio;
+      if (!ambiguous) isolate(culprit, kind, evidence, episode_.test, episode_.statistic, now);
     } else if (!episode_.declared_unisolated && now >= episode_.deadline_ns) {
       episode_.declared_unisolated = true;
       FdiEvent u;
