@@ -31,7 +31,8 @@ constexpr Command kCommands[] = {
 };
 
 void print_usage(std::FILE* out) {
-  std::fprintf(out, "usage: tetra COMMAND [OPTIONS]   (tetra COMMAND --help for a command's options)\n\ncommands:\n");
+  std::fprintf(
+      out, "usage: tetra COMMAND [OPTIONS]   (tetra COMMAND --help for a command's options)\n\ncommands:\n");
   for (const auto& c : kCommands) std::fprintf(out, "  %-10s %s\n", c.name, c.summary);
   std::fprintf(out, "  %-10s %s\n", "help", "this list");
 }
