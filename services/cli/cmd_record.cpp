@@ -125,7 +125,7 @@ int cmd_record(int argc, char** argv) {
   std::optional<std::int64_t> last_attitude_ns;
   std::uint64_t epochs_written = 0;
   bool writers_seen = false;
-  std::optional<std::int64_t> idle_since;
+  std::int64_t idle_since = -1;  // [ns] local time the gyro writers went away; -1: not idle
   const std::int64_t start = monotonic_ns();
   const std::int64_t stop_at =
       duration_s > 0 ? start + static_cast<std::int64_t>(duration_s * 1e9) : INT64_MAX;
@@ -188,22 +188,22 @@ int cmd_record(int argc, char** argv) {
     if (!matched) return report("record", matched.error());
     if (*matched > 0) {
       writers_seen = true;
-      idle_since.reset();
-    } else if (writers_seen && !idle_since) {
+      idle_since = -1;
+    } else if (writers_seen && idle_since < 0) {
       idle_since = now;
     }
     if (shutdown.requested() || now >= stop_at) break;
-    if (until_idle && idle_since) {
+    if (until_idle && idle_since >= 0) {
       // The writers are gone: flush the open epochs, then wait (briefly) for the service's outputs.
       assembler->poll(INT64_MAX, epochs);
       if (auto s = write_epochs(); !s) return report("record", s.error());
       const bool outputs_done =
           attitude_path.empty() || (last_attitude_ns && last_epoch_ns && *last_attitude_ns >= *last_epoch_ns);
-      if (outputs_done || now - *idle_since >= kIdleGrace_ns) break;
+      if (outputs_done || now - idle_since >= kIdleGrace_ns) break;
     }
     std::int64_t wake = std::min(stop_at, now + 1'000'000'000);
     if (auto due = assembler->next_due_ns()) wake = std::min(wake, *due);
-    if (until_idle && idle_since) wake = std::min(wake, *idle_since + kIdleGrace_ns);
+    if (until_idle && idle_since >= 0) wake = std::min(wake, idle_since + kIdleGrace_ns);
     if (auto s = waitset->wait(std::chrono::nanoseconds(wake - now), triggered); !s)
       return report("record", s.error());
   }
