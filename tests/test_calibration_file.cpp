@@ -36,7 +36,8 @@ TEST(CalibrationFile, ExampleFactoryFileLoads) {
 
 std::string three_gyros(const std::string& extra_in_first) {
   return "unit: u\ngyros:\n"
-         "  - id: 1\n    scale_factor_V_per_dps: 0.07\n    bias_V: 0\n    axis: [1, 0, 0]\n" + extra_in_first +
+         "  - id: 1\n    scale_factor_V_per_dps: 0.07\n    bias_V: 0\n    axis: [1, 0, 0]\n" +
+         extra_in_first +
          "  - id: 2\n    scale_factor_V_per_dps: 0.07\n    bias_V: 0\n    axis: [0, 1, 0]\n"
          "  - id: 3\n    scale_factor_V_per_dps: 0.07\n    bias_V: 0\n    axis: [0, 0, 1]\n";
 }
@@ -57,8 +58,9 @@ TEST(CalibrationFile, RejectsNonUnitAxisFewGyrosAndText) {
   EXPECT_NE(a.error().message.find("axis.yaml:6"), std::string::npos) << a.error().message;
   EXPECT_NE(a.error().message.find("unit vector"), std::string::npos);
 
-  const std::string two = "gyros:\n  - {id: 1, scale_factor_V_per_dps: 1, bias_V: 0, axis: [1,0,0]}\n"
-                          "  - {id: 2, scale_factor_V_per_dps: 1, bias_V: 0, axis: [0,1,0]}\n";
+  const std::string two =
+      "gyros:\n  - {id: 1, scale_factor_V_per_dps: 1, bias_V: 0, axis: [1,0,0]}\n"
+      "  - {id: 2, scale_factor_V_per_dps: 1, bias_V: 0, axis: [0,1,0]}\n";
   const auto b = parse_calibration(two, "two.yaml");
   ASSERT_FALSE(b.ok());
   EXPECT_NE(b.error().message.find("at least 3"), std::string::npos);

@@ -12,7 +12,8 @@ namespace tetra {
 namespace {
 
 TEST(Csv, ParsesCommentsMetadataEmptyAndNan) {
-  const auto t = parse_csv("# latitude_deg=-23.2 units=V\nb, a\n1,2\n\n# mid comment\n,nan\n+3.5,-1e-3\n", "x.csv");
+  const auto t =
+      parse_csv("# latitude_deg=-23.2 units=V\nb, a\n1,2\n\n# mid comment\n,nan\n+3.5,-1e-3\n", "x.csv");
   ASSERT_TRUE(t.ok()) << t.error().message;
   EXPECT_EQ(t->columns.size(), 2U);
   EXPECT_EQ(*t->find_column("a"), 1U);
@@ -67,11 +68,11 @@ TEST(GyroLog, RoundTripIsExactAndKeepsAbsentVsInvalid) {
 }
 
 TEST(GyroLog, RejectsMalformedLogs) {
-  EXPECT_FALSE(parse_gyro_log("g1,g2\n1,2\n", "a.csv").ok());             // no time_s
-  EXPECT_FALSE(parse_gyro_log("time_s\n1\n", "b.csv").ok());              // no gyros
-  EXPECT_FALSE(parse_gyro_log("time_s,g1,gx\n1,2,3\n", "c.csv").ok());    // unknown column
-  EXPECT_FALSE(parse_gyro_log("time_s,g1,ref_qw\n1,2,1\n", "d.csv").ok()); // partial reference set
-  EXPECT_FALSE(parse_gyro_log("time_s,g1\n,2\n", "e.csv").ok());          // empty time
+  EXPECT_FALSE(parse_gyro_log("g1,g2\n1,2\n", "a.csv").ok());               // no time_s
+  EXPECT_FALSE(parse_gyro_log("time_s\n1\n", "b.csv").ok());                // no gyros
+  EXPECT_FALSE(parse_gyro_log("time_s,g1,gx\n1,2,3\n", "c.csv").ok());      // unknown column
+  EXPECT_FALSE(parse_gyro_log("time_s,g1,ref_qw\n1,2,1\n", "d.csv").ok());  // partial reference set
+  EXPECT_FALSE(parse_gyro_log("time_s,g1\n,2\n", "e.csv").ok());            // empty time
   const auto units = parse_gyro_log("# units=furlongs\ntime_s,g1\n0,2\n", "f.csv");
   ASSERT_FALSE(units.ok());
   EXPECT_NE(units.error().message.find("units"), std::string::npos);

@@ -1,8 +1,8 @@
 // Geometry of the nominal tetrahedron and of general N-gyro packages (INTERFACES §1).
 #include <cmath>
 
-#include <Eigen/Dense>
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include "tetra/core/geometry.hpp"
 
@@ -52,7 +52,8 @@ TEST(Geometry, NoiseAmplificationAllAndLeaveOneOut) {
   for (int id = 1; id <= 4; ++id) {
     const auto var = g.noise_variance_per_axis(without_gyro(g.all(), id));
     ASSERT_TRUE(var.ok()) << id;
-    EXPECT_TRUE(var->isApprox(expected[id - 1], kTight)) << "gyro " << id << " excluded: " << var->transpose();
+    EXPECT_TRUE(var->isApprox(expected[id - 1], kTight))
+        << "gyro " << id << " excluded: " << var->transpose();
   }
 }
 

@@ -12,7 +12,8 @@ namespace tetra {
 
 Eigen::MatrixX3d Calibration::axes_B() const {
   Eigen::MatrixX3d h(gyros.size(), 3);
-  for (std::size_t i = 0; i < gyros.size(); ++i) h.row(static_cast<Eigen::Index>(i)) = gyros[i].axis_B.transpose();
+  for (std::size_t i = 0; i < gyros.size(); ++i)
+    h.row(static_cast<Eigen::Index>(i)) = gyros[i].axis_B.transpose();
   return h;
 }
 
@@ -58,7 +59,8 @@ struct ParseError {
   std::string message;
 };
 
-void check_keys(const Ctx& ctx, const YAML::Node& map, const std::set<std::string>& allowed, const std::string& what) {
+void check_keys(const Ctx& ctx, const YAML::Node& map, const std::set<std::string>& allowed,
+                const std::string& what) {
   if (!map.IsMap()) throw ParseError{ctx.at(map) + what + ": expected a mapping"};
   for (const auto& kv : map) {
     const auto key = kv.first.as<std::string>();
@@ -90,10 +92,12 @@ std::optional<double> optional_number(const Ctx& ctx, const YAML::Node& parent, 
   return number(ctx, parent, key, what);
 }
 
-Eigen::Vector3d vector3(const Ctx& ctx, const YAML::Node& parent, const std::string& key, const std::string& what) {
+Eigen::Vector3d vector3(const Ctx& ctx, const YAML::Node& parent, const std::string& key,
+                        const std::string& what) {
   const YAML::Node node = parent[key];
   if (!node) throw ParseError{ctx.at(parent) + what + ": missing key '" + key + "'"};
-  if (!node.IsSequence() || node.size() != 3) throw ParseError{ctx.at(node) + what + "." + key + ": expected [x, y, z]"};
+  if (!node.IsSequence() || node.size() != 3)
+    throw ParseError{ctx.at(node) + what + "." + key + ": expected [x, y, z]"};
   Eigen::Vector3d v;
   for (std::size_t i = 0; i < 3; ++i) {
     try {
@@ -113,11 +117,13 @@ GyroCalibration parse_gyro(const Ctx& ctx, const YAML::Node& g, std::size_t inde
   check_keys(ctx, g, {"id", "scale_factor_V_per_dps", "bias_V", "axis", "sigma", "noise"}, what);
   GyroCalibration out;
   const double id = number(ctx, g, "id", what);
-  if (id != std::floor(id) || id < 1 || id > 64) throw ParseError{ctx.at(g["id"]) + what + ".id: must be 1..N"};
+  if (id != std::floor(id) || id < 1 || id > 64)
+    throw ParseError{ctx.at(g["id"]) + what + ".id: must be 1..N"};
   out.id = static_cast<int>(id);
   out.scale_factor_V_per_dps = number(ctx, g, "scale_factor_V_per_dps", what);
   if (out.scale_factor_V_per_dps == 0.0) {
-    throw ParseError{ctx.at(g["scale_factor_V_per_dps"]) + what + ".scale_factor_V_per_dps: must not be zero"};
+    throw ParseError{ctx.at(g["scale_factor_V_per_dps"]) + what +
+                     ".scale_factor_V_per_dps: must not be zero"};
   }
   out.bias_V = number(ctx, g, "bias_V", what);
   const Eigen::Vector3d axis = vector3(ctx, g, "axis", what);
@@ -193,16 +199,19 @@ Result<Calibration> read_calibration(const std::string& path) {
 
 Status validate_calibration(const Calibration& cal, const std::string& source) {
   if (cal.gyros.size() < 3) {
-    return bad_input(source + ": " + std::to_string(cal.gyros.size()) + " gyros listed, at least 3 are needed");
+    return bad_input(source + ": " + std::to_string(cal.gyros.size()) +
+                     " gyros listed, at least 3 are needed");
   }
   for (std::size_t i = 0; i < cal.gyros.size(); ++i) {
     const auto& g = cal.gyros[i];
     if (g.id != static_cast<int>(i + 1)) {
-      return bad_input(source + ": gyros[" + std::to_string(i) + "].id is " + std::to_string(g.id) + ", expected " +
-                       std::to_string(i + 1) + " (ids 1..N in order)");
+      return bad_input(source + ": gyros[" + std::to_string(i) + "].id is " + std::to_string(g.id) +
+                       ", expected " + std::to_string(i + 1) + " (ids 1..N in order)");
     }
-    if (!std::isfinite(g.scale_factor_V_per_dps) || g.scale_factor_V_per_dps == 0.0 || !std::isfinite(g.bias_V)) {
-      return bad_input(source + ": gyro " + std::to_string(g.id) + ": scale factor and bias must be finite, scale non-zero");
+    if (!std::isfinite(g.scale_factor_V_per_dps) || g.scale_factor_V_per_dps == 0.0 ||
+        !std::isfinite(g.bias_V)) {
+      return bad_input(source + ": gyro " + std::to_string(g.id) +
+                       ": scale factor and bias must be finite, scale non-zero");
     }
     if (std::abs(g.axis_B.norm() - 1.0) > 1e-9) {
       return bad_input(source + ": gyro " + std::to_string(g.id) + ": axis is not a unit vector");
@@ -219,7 +228,9 @@ std::string num(double v) {
   return s;
 }
 
-std::string vec(const Eigen::Vector3d& v) { return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]"; }
+std::string vec(const Eigen::Vector3d& v) {
+  return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]";
+}
 
 }  // namespace
 

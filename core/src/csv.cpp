@@ -79,7 +79,8 @@ Result<CsvTable> parse_csv(std::string_view text, std::string source) {
   while (pos < text.size()) {
     const char* begin = text.data() + pos;
     const void* nl = std::memchr(begin, '\n', text.size() - pos);
-    const std::size_t len = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - begin) : text.size() - pos;
+    const std::size_t len =
+        nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - begin) : text.size() - pos;
     std::string_view line(begin, len);
     pos += len + 1;
     ++line_no;
@@ -106,8 +107,8 @@ Result<CsvTable> parse_csv(std::string_view text, std::string source) {
     if (!have_header) {
       for (std::size_t i = 0; i < fields.size(); ++i) {
         if (fields[i].empty()) {
-          return bad_input(t.source + ":" + std::to_string(line_no) + ": header: column " + std::to_string(i + 1) +
-                           " has no name");
+          return bad_input(t.source + ":" + std::to_string(line_no) + ": header: column " +
+                           std::to_string(i + 1) + " has no name");
         }
         for (std::size_t k = 0; k < i; ++k) {
           if (fields[k] == fields[i]) {
@@ -126,8 +127,9 @@ Result<CsvTable> parse_csv(std::string_view text, std::string source) {
     }
 
     if (fields.size() != t.columns.size()) {
-      return bad_input(t.source + ":" + std::to_string(line_no) + ": expected " + std::to_string(t.columns.size()) +
-                       " fields as in the header, found " + std::to_string(fields.size()));
+      return bad_input(t.source + ":" + std::to_string(line_no) + ": expected " +
+                       std::to_string(t.columns.size()) + " fields as in the header, found " +
+                       std::to_string(fields.size()));
     }
     for (std::size_t c = 0; c < fields.size(); ++c) {
       const std::string_view cell = fields[c];

@@ -8,7 +8,9 @@
 
 namespace tetra {
 
-int gyro_count(GyroMask mask) { return std::popcount(mask); }
+int gyro_count(GyroMask mask) {
+  return std::popcount(mask);
+}
 
 std::string mask_to_string(GyroMask mask, int n_gyros) {
   std::string out;
@@ -36,13 +38,14 @@ Eigen::Matrix<double, 4, 3> nominal_tetrahedron_axes() {
 Result<GyroGeometry> GyroGeometry::create(const Eigen::MatrixX3d& axes_B, const Eigen::VectorXd& sigma) {
   const Eigen::Index n = axes_B.rows();
   if (n < 3) return bad_input("geometry: " + std::to_string(n) + " gyros given, at least 3 are needed");
-  if (n > kMaxGyros) return bad_input("geometry: at most " + std::to_string(kMaxGyros) + " gyros are supported");
+  if (n > kMaxGyros)
+    return bad_input("geometry: at most " + std::to_string(kMaxGyros) + " gyros are supported");
   if (sigma.size() != n) return bad_input("geometry: noise vector size does not match the number of gyros");
   for (Eigen::Index i = 0; i < n; ++i) {
     const double norm = axes_B.row(i).norm();
     if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-6) {
-      return bad_input("geometry: axis of gyro " + std::to_string(i + 1) + " has norm " + std::to_string(norm) +
-                       ", expected a unit vector");
+      return bad_input("geometry: axis of gyro " + std::to_string(i + 1) + " has norm " +
+                       std::to_string(norm) + ", expected a unit vector");
     }
     if (!std::isfinite(sigma[i]) || sigma[i] <= 0.0) {
       return bad_input("geometry: noise sigma of gyro " + std::to_string(i + 1) + " must be positive");

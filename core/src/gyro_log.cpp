@@ -47,7 +47,8 @@ Result<GyroLog> from_table(CsvTable&& t) {
       ++ref_found;
     }
   }
-  if (ref_found != 0 && ref_found != 4) return bad_input(head + "reference columns must be all of ref_qw,ref_qx,ref_qy,ref_qz");
+  if (ref_found != 0 && ref_found != 4)
+    return bad_input(head + "reference columns must be all of ref_qw,ref_qx,ref_qy,ref_qz");
   log.has_reference = ref_found == 4;
 
   // Every column must be known: a typo must not pass silently.
@@ -155,7 +156,8 @@ Status GyroLogWriter::open(const std::string& path, int gyro_count, bool with_re
   return ok_status();
 }
 
-Status GyroLogWriter::write(double time_s, std::span<const double> values, std::span<const std::uint8_t> present,
+Status GyroLogWriter::write(double time_s, std::span<const double> values,
+                            std::span<const std::uint8_t> present,
                             const std::optional<std::array<double, 4>>& reference_wxyz) {
   if (file_ == nullptr) return failure("gyro log writer is not open");
   if (values.size() != static_cast<std::size_t>(gyro_count_) || present.size() != values.size()) {

@@ -69,8 +69,8 @@ Result<TurntableLog> from_table(CsvTable&& t) {
     log.sequence[r] = static_cast<int>(seq);
     log.time_s[r] = t.cell(r, cols[1]);
     if (r > 0 && log.time_s[r] <= log.time_s[r - 1]) {
-      return bad_input(t.where(r, cols[1]) + "time goes backwards or repeats (" + std::to_string(log.time_s[r]) +
-                       " after " + std::to_string(log.time_s[r - 1]) + ")");
+      return bad_input(t.where(r, cols[1]) + "time goes backwards or repeats (" +
+                       std::to_string(log.time_s[r]) + " after " + std::to_string(log.time_s[r - 1]) + ")");
     }
     log.inner_deg[r] = t.cell(r, cols[2]);
     log.outer_deg[r] = t.cell(r, cols[3]);

@@ -36,7 +36,9 @@ void write_file(const std::string& path, const std::string& content) {
   out << content;
 }
 
-std::string source_path(const std::string& relative) { return std::string(TETRA_SOURCE_DIR) + "/" + relative; }
+std::string source_path(const std::string& relative) {
+  return std::string(TETRA_SOURCE_DIR) + "/" + relative;
+}
 
 CommandResult run_shell(const std::string& command_line) {
   TempDir dir;
@@ -51,6 +53,8 @@ CommandResult run_shell(const std::string& command_line) {
   return r;
 }
 
-CommandResult run_tetra(const std::string& args) { return run_shell(std::string(TETRA_BINARY) + " " + args); }
+CommandResult run_tetra(const std::string& args) {
+  return run_shell(std::string(TETRA_BINARY) + " " + args);
+}
 
 }  // namespace tetra::test

@@ -15,34 +15,34 @@
 namespace tetra {
 
 struct GyroSigma {
-  double scale_factor_V_per_dps = 0.0;  //!< [V/(deg/s)] 1σ
-  double bias_V = 0.0;                  //!< [V] 1σ
+  double scale_factor_V_per_dps = 0.0;             //!< [V/(deg/s)] 1σ
+  double bias_V = 0.0;                             //!< [V] 1σ
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();  //!< [-] 1σ per component
 };
 
 //! IEEE Std 952 noise terms of one gyro, in deg/s-based units (from `tetra allan`). All optional.
 struct GyroNoise {
-  std::optional<double> quantization_deg;               //!< Q [deg]
-  std::optional<double> arw_dps_rtHz;                   //!< N [deg/s/√Hz] = [deg/√s]: σ_rate = N/√dt
-  std::optional<double> bias_instability_dps;           //!< B [deg/s]
-  std::optional<double> rate_random_walk_dps_per_rts;   //!< K [deg/s/√s]
-  std::optional<double> rate_ramp_dps_per_s;            //!< R [deg/s²]
+  std::optional<double> quantization_deg;              //!< Q [deg]
+  std::optional<double> arw_dps_rtHz;                  //!< N [deg/s/√Hz] = [deg/√s]: σ_rate = N/√dt
+  std::optional<double> bias_instability_dps;          //!< B [deg/s]
+  std::optional<double> rate_random_walk_dps_per_rts;  //!< K [deg/s/√s]
+  std::optional<double> rate_ramp_dps_per_s;           //!< R [deg/s²]
 };
 
 struct GyroCalibration {
-  int id = 0;                                          //!< 1..N
-  double scale_factor_V_per_dps = 0.0;                 //!< s_i [V/(deg/s)]
-  double bias_V = 0.0;                                 //!< β_i [V]
-  Eigen::Vector3d axis_B = Eigen::Vector3d::UnitX();   //!< h_i, unit vector in B
-  std::optional<GyroSigma> sigma;                      //!< 1σ of the estimates
-  std::optional<GyroNoise> noise;                      //!< measured noise
+  int id = 0;                                         //!< 1..N
+  double scale_factor_V_per_dps = 0.0;                //!< s_i [V/(deg/s)]
+  double bias_V = 0.0;                                //!< β_i [V]
+  Eigen::Vector3d axis_B = Eigen::Vector3d::UnitX();  //!< h_i, unit vector in B
+  std::optional<GyroSigma> sigma;                     //!< 1σ of the estimates
+  std::optional<GyroNoise> noise;                     //!< measured noise
 };
 
 struct Calibration {
-  std::string unit = "tetra-1";                 //!< free text
-  std::optional<double> latitude_deg;           //!< [deg] where it was calibrated (information)
-  std::string method;                           //!< "sixteen-position", "batch", "factory", ...
-  std::vector<GyroCalibration> gyros;           //!< ordered by id, ids 1..N
+  std::string unit = "tetra-1";        //!< free text
+  std::optional<double> latitude_deg;  //!< [deg] where it was calibrated (information)
+  std::string method;                  //!< "sixteen-position", "batch", "factory", ...
+  std::vector<GyroCalibration> gyros;  //!< ordered by id, ids 1..N
 
   int gyro_count() const { return static_cast<int>(gyros.size()); }
   //! N×3 axes (rows h_iᵀ).

@@ -18,11 +18,11 @@
 namespace tetra {
 
 struct CsvTable {
-  std::string source;                                            //!< file name used in messages
-  std::vector<std::pair<std::string, std::string>> metadata;     //!< "# key=value" comments, in order
-  std::vector<std::string> columns;                              //!< header names, trimmed
-  std::size_t header_line = 0;                                   //!< 1-based line of the header
-  std::size_t rows = 0;                                          //!< number of data rows
+  std::string source;                                         //!< file name used in messages
+  std::vector<std::pair<std::string, std::string>> metadata;  //!< "# key=value" comments, in order
+  std::vector<std::string> columns;                           //!< header names, trimmed
+  std::size_t header_line = 0;                                //!< 1-based line of the header
+  std::size_t rows = 0;                                       //!< number of data rows
   std::vector<double> cells;        //!< row-major rows×columns; NaN where empty or "nan"
   std::vector<std::uint8_t> empty;  //!< row-major; 1 where the cell was empty
   std::vector<std::size_t> lines;   //!< 1-based file line of each data row

@@ -6,7 +6,8 @@
 //   * weighted least-squares pseudoinverse  H*_S = (H_Sᵀ R_S⁻¹ H_S)⁻¹ H_Sᵀ R_S⁻¹, returned as a 3×N matrix
 //     whose columns for gyros outside S are zero, so ω̂ = H*_S · y for a full-length y;
 //   * per-axis noise variance of ω̂: diag((H_Sᵀ R_S⁻¹ H_S)⁻¹), in the units of σ²;
-//   * parity matrix V_S ((|S|−3)×N, zero columns outside S): V_S H = 0, V_S V_Sᵀ = I. Its sign is fixed so the
+//   * parity matrix V_S ((|S|−3)×N, zero columns outside S): V_S H = 0, V_S V_Sᵀ = I. Its sign is fixed so
+//   the
 //     first non-zero entry of each row is positive (nominal tetrahedron: p ∝ (1, 1, 1, −√3)).
 
 #include <cstdint>
@@ -29,7 +30,9 @@ inline GyroMask all_gyros(int n) {
 inline GyroMask without_gyro(GyroMask mask, int id) {
   return mask & ~(GyroMask{1} << static_cast<unsigned>(id - 1));
 }
-inline bool has_gyro(GyroMask mask, int id) { return ((mask >> static_cast<unsigned>(id - 1)) & 1U) != 0U; }
+inline bool has_gyro(GyroMask mask, int id) {
+  return ((mask >> static_cast<unsigned>(id - 1)) & 1U) != 0U;
+}
 int gyro_count(GyroMask mask);  // number of gyros in the mask
 //! "1234", "124": the ids in the mask, for files and displays (ids ≥ 10 are comma separated).
 std::string mask_to_string(GyroMask mask, int n_gyros);

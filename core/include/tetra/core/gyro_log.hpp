@@ -23,14 +23,14 @@ struct GyroLog {
   std::string source;                                         //!< file name used in messages
   std::vector<std::pair<std::string, std::string>> metadata;  //!< "# key=value" comments, in order
   int gyro_count = 0;                                         //!< N, columns g1..gN
-  bool units_dps = false;              //!< values already rates [deg/s] ("# units=dps"), else [V]
-  std::vector<double> time_s;          //!< [s] per epoch
-  std::vector<double> values;          //!< [V or deg/s] epochs×N row-major; NaN where absent/invalid
-  std::vector<std::uint8_t> present;   //!< epochs×N row-major; 0 where no sample was delivered
-  bool has_reference = false;          //!< ref_* columns exist
+  bool units_dps = false;             //!< values already rates [deg/s] ("# units=dps"), else [V]
+  std::vector<double> time_s;         //!< [s] per epoch
+  std::vector<double> values;         //!< [V or deg/s] epochs×N row-major; NaN where absent/invalid
+  std::vector<std::uint8_t> present;  //!< epochs×N row-major; 0 where no sample was delivered
+  bool has_reference = false;         //!< ref_* columns exist
   std::vector<std::array<double, 4>> reference_wxyz;  //!< body→reference quaternion per epoch
-  std::vector<std::uint8_t> reference_present;       //!< 1 where the row carries a reference
-  std::vector<std::size_t> lines;                    //!< 1-based file line of each epoch
+  std::vector<std::uint8_t> reference_present;        //!< 1 where the row carries a reference
+  std::vector<std::size_t> lines;                     //!< 1-based file line of each epoch
 
   std::size_t epochs() const { return time_s.size(); }
   double value(std::size_t epoch, int gyro_index0) const {

@@ -18,10 +18,16 @@ namespace tetra {
 using Quaternion = Eigen::Quaterniond;
 
 //! Quaternion from scalar-first components (not normalized).
-inline Quaternion from_wxyz(double w, double x, double y, double z) { return Quaternion(w, x, y, z); }
-inline Quaternion from_wxyz(const std::array<double, 4>& q) { return Quaternion(q[0], q[1], q[2], q[3]); }
+inline Quaternion from_wxyz(double w, double x, double y, double z) {
+  return Quaternion(w, x, y, z);
+}
+inline Quaternion from_wxyz(const std::array<double, 4>& q) {
+  return Quaternion(q[0], q[1], q[2], q[3]);
+}
 //! Scalar-first components.
-inline std::array<double, 4> to_wxyz(const Quaternion& q) { return {q.w(), q.x(), q.y(), q.z()}; }
+inline std::array<double, 4> to_wxyz(const Quaternion& q) {
+  return {q.w(), q.x(), q.y(), q.z()};
+}
 
 //! exp of a rotation vector [rad]: the unit quaternion of a rotation by |rotvec| about rotvec/|rotvec|.
 Quaternion quat_exp(const Eigen::Vector3d& rotvec_rad);

@@ -19,15 +19,19 @@ struct Error {
   ErrorKind kind = ErrorKind::kBadInput;  //!< how a CLI should report it
 };
 
-inline Error bad_input(std::string message) { return Error{std::move(message), ErrorKind::kBadInput}; }
-inline Error failure(std::string message) { return Error{std::move(message), ErrorKind::kFailure}; }
+inline Error bad_input(std::string message) {
+  return Error{std::move(message), ErrorKind::kBadInput};
+}
+inline Error failure(std::string message) {
+  return Error{std::move(message), ErrorKind::kFailure};
+}
 
 //! Either a value or an Error. Minimal stand-in for C++23 std::expected.
 template <class T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : state_(std::move(value)) {}         // NOLINT(google-explicit-constructor)
-  Result(Error error) : state_(std::move(error)) {}     // NOLINT(google-explicit-constructor)
+  Result(T value) : state_(std::move(value)) {}      // NOLINT(google-explicit-constructor)
+  Result(Error error) : state_(std::move(error)) {}  // NOLINT(google-explicit-constructor)
 
   bool ok() const { return std::holds_alternative<T>(state_); }
   explicit operator bool() const { return ok(); }
@@ -49,6 +53,8 @@ class [[nodiscard]] Result {
 //! Result of an operation that yields nothing but may fail.
 struct Ok {};
 using Status = Result<Ok>;
-inline Status ok_status() { return Ok{}; }
+inline Status ok_status() {
+  return Ok{};
+}
 
 }  // namespace tetra

@@ -21,12 +21,12 @@ struct TurntableLog {
   std::string source;                                         //!< file name used in messages
   std::vector<std::pair<std::string, std::string>> metadata;  //!< "# key=value" comments
   int gyro_count = 0;                                         //!< N
-  std::vector<int> sequence;        //!< plan index per row (1-based)
-  std::vector<double> time_s;       //!< [s]
-  std::vector<double> inner_deg;    //!< [deg] inner gimbal encoder (body X)
-  std::vector<double> outer_deg;    //!< [deg] outer gimbal encoder
-  std::vector<double> g_V;          //!< [V] rows×N row-major
-  std::vector<std::size_t> lines;   //!< 1-based file line of each row
+  std::vector<int> sequence;                                  //!< plan index per row (1-based)
+  std::vector<double> time_s;                                 //!< [s]
+  std::vector<double> inner_deg;                              //!< [deg] inner gimbal encoder (body X)
+  std::vector<double> outer_deg;                              //!< [deg] outer gimbal encoder
+  std::vector<double> g_V;                                    //!< [V] rows×N row-major
+  std::vector<std::size_t> lines;                             //!< 1-based file line of each row
 
   std::size_t rows() const { return time_s.size(); }
   double g(std::size_t row, int gyro_index0) const {

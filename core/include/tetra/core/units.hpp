@@ -20,6 +20,8 @@ inline std::int64_t seconds_to_ns(double t_s) {
   return static_cast<std::int64_t>(t_s * 1e9 + (t_s >= 0 ? 0.5 : -0.5));
 }
 //! [s] integer nanoseconds to seconds.
-inline double ns_to_seconds(std::int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
+inline double ns_to_seconds(std::int64_t t_ns) {
+  return static_cast<double>(t_ns) * 1e-9;
+}
 
 }  // namespace tetra
