@@ -16,7 +16,7 @@ void append_attitude_row(std::string& out, const fdi::AttitudeEstimate& attitude
     append_double(out, attitude.omega_B_rad_s[i] * kRadToDeg);
   }
   out += ',';
-  append_double(out, attitude.sigma_rad.maxCoeff() * kRadToDeg);
+  append_double(out, attitude.sigma_rad.norm() * kRadToDeg);  // 1σ of the total error angle
   out += ',';
   out += fdi::to_string(attitude.mode);
   out += ',';

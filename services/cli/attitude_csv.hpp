@@ -11,7 +11,8 @@ namespace tetra::cli {
 inline constexpr const char* kAttitudeHeader =
     "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros\n";
 
-//! Appends one row (numbers in shortest round-trip form). sigma_deg is the largest per-axis 1σ.
+//! Appends one row (numbers in shortest round-trip form). sigma_deg is the 1σ of the total error angle (norm
+//! of the per-axis 1σ), as `tetra replay` writes it.
 void append_attitude_row(std::string& out, const fdi::AttitudeEstimate& attitude, int n_gyros);
 
 }  // namespace tetra::cli
