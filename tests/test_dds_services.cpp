@@ -91,13 +91,14 @@ class Process {
 struct ServiceFiles {
   TempDir dir;
   std::string config;
-  ServiceFiles(double rate_hz, const std::string& unit = "tetra-1") {
+  ServiceFiles(double rate_hz, double speed, const std::string& unit = "tetra-1") {
     Calibration cal = seed_as_built_unit();
     cal.unit = unit;
     EXPECT_TRUE(write_calibration(dir.file("cal.yaml"), cal).ok());
     config = dir.file("fusion.yaml");
-    write_file(config, "unit: " + unit + "\ncalibration: cal.yaml\nsample_rate_hz: " +
-                           std::to_string(rate_hz) + "\nmax_latency_s: 0.05\nhealth_period_s: 0.2\n");
+    write_file(config,
+               "unit: " + unit + "\ncalibration: cal.yaml\nsample_rate_hz: " + std::to_string(rate_hz) +
+                   "\nspeed: " + std::to_string(speed) + "\nmax_latency_s: 0.05\nhealth_period_s: 0.2\n");
   }
 };
 
@@ -180,14 +181,16 @@ std::string d(dds_domainid_t domain) {
 // at the identity attitude, so a reference would disagree by design), 100 Hz, 30 s, stuck gyro 2
 // from 10 s, 10 times faster than real time.
 std::string sim_args(dds_domainid_t domain, int wait_readers) {
-  return "sim orbit --dds --domain " + d(domain) +
+  return "sim orbit --dds --dds-unit tetra-1 --domain " + d(domain) +
          " --rate-hz 100 --minutes 0.5 --reference-hz 0 --speed 10 " +
          "--fault gyro=2,kind=stuck,at=10 --wait-readers " + std::to_string(wait_readers);
 }
 
 TEST(DdsServices, StuckGyroIsIsolatedAndAttitudeFlowsDegraded_LateMonitorAndCommand) {
   const dds_domainid_t domain = 161;
-  ServiceFiles files(1000.0);  // 100 Hz × speed 10 on the wall clock
+  // The simulator runs 10 times faster than real time; the service keeps speed 1, so its deadline
+  // (3 periods = 30 ms of wall clock) leaves this loaded 2-core machine a margin.
+  ServiceFiles files(100.0, 1.0);
   Process fusion({"fusion", "--config", files.config, "--domain", d(domain)}, files.dir.file("fusion.log"));
   Observer observer(domain);
   const auto sim = run_tetra(sim_args(domain, 1));
@@ -253,7 +256,7 @@ AttitudeRows read_attitude(const std::string& path) {
 
 TEST(DdsServices, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitudes) {
   const dds_domainid_t domain = 162;
-  ServiceFiles files(1000.0);
+  ServiceFiles files(100.0, 1.0);
   Process fusion({"fusion", "--config", files.config, "--domain", d(domain)}, files.dir.file("fusion.log"));
   Process record({"record", "--config", files.config, "--domain", d(domain), "-o", files.dir.file("rec.csv"),
                   "--attitude", files.dir.file("dds_att.csv"), "--events", files.dir.file("dds_ev.jsonl"),
@@ -287,13 +290,14 @@ TEST(DdsServices, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitudes) {
 
 TEST(DdsServices, SimulatorKilledGoesLostAndRecovers_ServiceKilledResumes) {
   const dds_domainid_t domain = 163;
-  ServiceFiles files(100.0);
+  ServiceFiles files(100.0, 1.0);
   Observer observer(domain);
   auto fusion = std::make_unique<Process>(
       std::vector<std::string>{"fusion", "--config", files.config, "--domain", d(domain)},
       files.dir.file("fusion.log"));
-  const std::vector<std::string> sim_cmd = {"sim", "static",    "--dds", "--domain", d(domain), "--rate-hz",
-                                            "100", "--minutes", "10",    "--speed",  "1"};
+  const std::vector<std::string> sim_cmd = {"sim",      "static",  "--dds",     "--dds-unit", "tetra-1",
+                                            "--domain", d(domain), "--rate-hz", "100",        "--minutes",
+                                            "10",       "--speed", "1"};
   auto sim = std::make_unique<Process>(sim_cmd, files.dir.file("sim1.log"));
   const auto health = [&]() -> const dds::HealthView* {
     const auto it = observer.health.find("tetra-1");
@@ -334,11 +338,11 @@ TEST(DdsServices, SimulatorKilledGoesLostAndRecovers_ServiceKilledResumes) {
 
 TEST(DdsServices, MalformedTrafficIsCountedNeverMixedNeverACrash) {
   const dds_domainid_t domain = 164;
-  ServiceFiles files(100.0);
+  ServiceFiles files(100.0, 1.0);
   Observer observer(domain);
   Process fusion({"fusion", "--config", files.config, "--domain", d(domain)}, files.dir.file("fusion.log"));
   auto writer = dds::Writer<tetra_GyroSample>::create(observer.participant(), observer.topics().gyro_sample,
-                                                      dds::gyro_sample_qos());
+                                                      dds::gyro_sample_qos(std::chrono::milliseconds(10)));
   ASSERT_TRUE(writer.ok());
   // Wait for the service's reader (a DDS condition: the publication-matched status).
   ASSERT_TRUE(observer.wait_until([&] { return *writer->matched_readers() >= 1; }));

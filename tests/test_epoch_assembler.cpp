@@ -138,20 +138,14 @@ TEST(EpochAssembler, AbsentGyroIsNotWaitedForAndReturnsWhenItDelivers) {
   EXPECT_EQ(a.counters().deadlines_missed, 1U);
 }
 
-TEST(EpochAssembler, AllAbsentGivesOneEmptyEpochOnePeriodLater) {
+TEST(EpochAssembler, AbsenceIsCountedOncePerEpisodeAndByReason) {
   auto a = make();
   feed_epoch(a, 0, 0);
+  for (int g = 1; g <= 4; ++g) a.mark_absent(g, AbsentReason::kLiveliness);
+  a.mark_absent(2, AbsentReason::kDeadline);  // already absent: not counted again
   std::vector<fdi::Epoch> out;
   a.poll(0, out);
-  ASSERT_EQ(out.size(), 1U);
-  for (int g = 1; g <= 4; ++g) a.mark_absent(g, AbsentReason::kLiveliness);
-  a.mark_absent(2, AbsentReason::kDeadline);  // already absent: not counted twice
-  a.poll(1, out);
-  ASSERT_EQ(out.size(), 2U);
-  EXPECT_EQ(out[1].stamp_ns, kPeriod);
-  EXPECT_EQ(out[1].present, (std::vector<std::uint8_t>{0, 0, 0, 0}));
-  a.poll(kLatency * 10, out);  // nothing more while silent
-  EXPECT_EQ(out.size(), 2U);
+  EXPECT_EQ(out.size(), 1U);  // only the real epoch: silence creates no epochs
   EXPECT_EQ(a.counters().liveliness_lost, 4U);
   EXPECT_EQ(a.counters().deadlines_missed, 0U);
 }
@@ -163,16 +157,28 @@ TEST(EpochAssembler, RestartAfterSilenceStartsAFreshTimeBase) {
   a.poll(0, out);
   ASSERT_EQ(out.size(), 3U);
   for (int g = 1; g <= 4; ++g) a.mark_absent(g, AbsentReason::kLiveliness);
-  a.poll(0, out);
-  ASSERT_EQ(out.size(), 4U);  // the all-absent epoch
   // A new simulator: sequence numbers and stamps from the start again.
   feed_epoch(a, 0, 100);
   a.poll(100, out);
-  ASSERT_EQ(out.size(), 5U);
-  EXPECT_EQ(out[4].stamp_ns, 0);
-  EXPECT_EQ(out[4].present, (std::vector<std::uint8_t>{1, 1, 1, 1}));
+  ASSERT_EQ(out.size(), 4U);
+  EXPECT_EQ(out[3].stamp_ns, 0);
+  EXPECT_EQ(out[3].present, (std::vector<std::uint8_t>{1, 1, 1, 1}));
   EXPECT_EQ(a.counters().sensor_restarts, 1U);
   EXPECT_EQ(a.counters().samples_out_of_order, 0U);
+}
+
+TEST(EpochAssembler, ResumingAfterSilenceIsNotARestart) {
+  auto a = make();
+  for (int k = 0; k < 3; ++k) feed_epoch(a, k, 0);
+  std::vector<fdi::Epoch> out;
+  a.poll(0, out);
+  for (int g = 1; g <= 4; ++g) a.mark_absent(g, AbsentReason::kDeadline);
+  feed_epoch(a, 5, 1);  // the same sensor after a pause: sequence and time go on
+  a.poll(1, out);
+  ASSERT_EQ(out.size(), 4U);
+  EXPECT_EQ(out[3].stamp_ns, 5 * kPeriod);
+  EXPECT_EQ(a.counters().sensor_restarts, 0U);
+  EXPECT_EQ(a.counters().samples_gap, 8U);  // 2 numbers skipped on each of 4 gyros
 }
 
 TEST(EpochAssembler, WithoutSilenceABackwardStreamIsNotARestart) {

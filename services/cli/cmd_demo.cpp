@@ -151,7 +151,7 @@ int cmd_demo(int argc, char** argv) {
     std::ofstream config(dir + "/fusion.yaml");
     config << "# tetra demo: fusion service configuration\n"
            << "unit: " << unit << "\ncalibration: calibration.yaml\n"
-           << "sample_rate_hz: " << rate_hz * speed << "   # samples per wall-clock second\n"
+           << "sample_rate_hz: " << rate_hz << "\n"
            << "max_latency_s: 0.05\nhealth_period_s: 0.5\n"
            << "pipeline:\n  initial_q_wxyz: [" << json_number(q[0]) << ", " << json_number(q[1]) << ", "
            << json_number(q[2]) << ", " << json_number(q[3]) << "]\n"

@@ -95,13 +95,13 @@ Status assign(std::optional<T>& slot, Result<T> result) {
 
 Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown) {
   period_ns_ = assembler_.config().nominal_period_ns;
-  deadline_ns_ = 3 * period_ns_;
+  deadline_ns_ = config_.deadline_ns();
   if (auto s = assign(participant_, dds::Participant::create(domain)); !s) return s;
   if (auto s = assign(topics_, dds::Topics::create(*participant_)); !s) return s;
   const dds::Topics& t = *topics_;
   if (auto s = assign(gyro_reader_, Reader<tetra_GyroSample>::create(
                                         *participant_, t.gyro_sample,
-                                        dds::gyro_sample_qos(std::chrono::nanoseconds(period_ns_))));
+                                        dds::gyro_sample_qos(std::chrono::nanoseconds(deadline_ns_ / 3))));
       !s) {
     return s;
   }
@@ -125,7 +125,10 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown)
           assign(event_writer_, Writer<tetra_FdiEvent>::create(*participant_, t.event, dds::event_qos()));
       !s)
     return s;
-  if (auto s = gyro_reader_->enable_statuses(DDS_REQUESTED_DEADLINE_MISSED_STATUS); !s) return s;
+  if (auto s = gyro_reader_->enable_statuses(DDS_REQUESTED_DEADLINE_MISSED_STATUS |
+                                             DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS);
+      !s)
+    return s;
 
   if (auto s = assign(waitset_, dds::WaitSet::create(*participant_)); !s) return s;
   auto attach_data = [&](dds_entity_t reader, Token token) -> Status {
@@ -171,8 +174,15 @@ Status FusionService::run(const dds::ShutdownSignal& shutdown) {
     for (const auto token : triggered) {
       if (token == kGyroStatus) {
         std::uint32_t status = 0;
-        (void)dds_take_status(gyro_reader_->handle(), &status, DDS_REQUESTED_DEADLINE_MISSED_STATUS);
-        deadline_status = true;
+        (void)dds_take_status(gyro_reader_->handle(), &status,
+                              DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS);
+        deadline_status = (status & DDS_REQUESTED_DEADLINE_MISSED_STATUS) != 0;
+        if ((status & DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS) != 0) {
+          spdlog::warn(
+              "fusion: a GyroSample writer offers incompatible QoS (its deadline must be at most {} s: "
+              "sample_rate_hz and speed must match the sensor's)",
+              static_cast<double>(deadline_ns_) * 1e-9);
+        }
       }
     }
     // Gyro samples before references: a reference written before an epoch's samples is then
@@ -306,12 +316,17 @@ Status FusionService::publish_event(const fdi::FdiEvent& event, std::uint64_t co
 }
 
 fdi::Health FusionService::current_health() const {
+  // The pipeline's health, with what only the service knows: gyros whose streams stopped (deadline,
+  // liveliness) are absent and out of the solution; with fewer than 3 left the unit is LOST.
   fdi::Health health = pipeline_.health();
   health.gyros.resize(static_cast<std::size_t>(n_gyros_));
   for (int g = 1; g <= n_gyros_; ++g) {
+    if (!assembler_.absent(g)) continue;
     auto& gyro = health.gyros[static_cast<std::size_t>(g - 1)];
-    if (assembler_.absent(g) && gyro.state == fdi::GyroState::kOk) gyro.state = fdi::GyroState::kAbsent;
+    if (gyro.state == fdi::GyroState::kOk) gyro.state = fdi::GyroState::kAbsent;
+    health.used = without_gyro(health.used, g);
   }
+  if (gyro_count(health.used) < 3) health.mode = fdi::Mode::kLost;
   return health;
 }
 

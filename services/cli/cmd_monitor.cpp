@@ -229,7 +229,7 @@ int cmd_monitor(int argc, char** argv) {
       const int n = view.health ? static_cast<int>(view.health->health.gyros.size()) : 4;
       if (jsonl) std::cout << event_json(ev, n) << '\n';
       view.events.push_back(ev);
-      if (view.events.size() > kRecentEvents && !once) view.events.pop_front();
+      if (view.events.size() > kRecentEvents) view.events.pop_front();
     }
     auto a = attitude_reader->take([&](const tetra_Attitude& msg, const dds_sample_info_t&) {
       const std::string unit = dds::from_wire(msg.unit);

@@ -52,8 +52,8 @@ Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t 
   const bool all_absent =
       std::all_of(gyros_.begin(), gyros_.end(), [](const GyroTrack& g) { return g.absent; });
   const GyroTrack& seen = gyros_[index];
-  const bool went_back = (seen.last_seq && seq <= *seen.last_seq) ||
-                         (last_emitted_ns_ && stamp_ns <= *last_emitted_ns_ + config_.tolerance_ns);
+  const bool went_back =
+      (seen.last_seq && seq <= *seen.last_seq) || (seen.last_stamp_ns && stamp_ns <= *seen.last_stamp_ns);
   if (all_absent && went_back) {
     // The unit went silent and came back with a new time base: start afresh.
     for (GyroTrack& g : gyros_) g = GyroTrack{};
@@ -80,7 +80,6 @@ Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t 
     return Verdict::kOutOfOrder;
   }
   track.absent = false;
-  lost_epoch_emitted_ = false;
   if (last_emitted_ns_ && stamp_ns <= *last_emitted_ns_ + config_.tolerance_ns) {
     ++counters_.samples_late;
     return Verdict::kLate;
@@ -122,17 +121,6 @@ void EpochAssembler::mark_absent(int gyro_id, AbsentReason reason) {
   if (track.absent) return;
   track.absent = true;
   ++(reason == AbsentReason::kDeadline ? counters_.deadlines_missed : counters_.liveliness_lost);
-  const bool all_absent =
-      std::all_of(gyros_.begin(), gyros_.end(), [](const GyroTrack& g) { return g.absent; });
-  if (all_absent && pending_.empty() && last_emitted_ns_ && !lost_epoch_emitted_) {
-    // Tell the pipeline the unit went silent: one epoch without any sample, one period later.
-    Pending epoch;
-    epoch.stamp_ns = *last_emitted_ns_ + config_.nominal_period_ns;
-    epoch.raw.assign(static_cast<std::size_t>(config_.gyro_count), std::numeric_limits<double>::quiet_NaN());
-    epoch.present.assign(static_cast<std::size_t>(config_.gyro_count), 0);
-    pending_.push_back(std::move(epoch));
-    lost_epoch_emitted_ = true;
-  }
 }
 
 bool EpochAssembler::absent(int gyro_id) const {

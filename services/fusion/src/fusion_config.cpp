@@ -34,6 +34,10 @@ std::int64_t to_ns(double seconds) {
 
 }  // namespace
 
+std::int64_t FusionConfig::deadline_ns() const {
+  return to_ns(3.0 / (sample_rate_hz * speed));
+}
+
 AssemblerConfig FusionConfig::assembler(int gyro_count) const {
   AssemblerConfig config;
   config.gyro_count = gyro_count;
@@ -63,14 +67,14 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
   if (!root.IsMap()) return bad_input(source + ": expected a YAML map of settings");
   FusionConfig config;
   config.source = source;
-  const std::set<std::string> known = {"unit",          "calibration",     "sample_rate_hz", "tolerance_s",
-                                       "max_latency_s", "health_period_s", "pipeline"};
+  const std::set<std::string> known = {"unit",        "calibration",   "sample_rate_hz",  "speed",
+                                       "tolerance_s", "max_latency_s", "health_period_s", "pipeline"};
   for (const auto& item : root) {
     const auto key = item.first.as<std::string>();
     if (!known.contains(key)) {
       return bad_input(where(source, item.first) + "unknown key '" + key +
-                       "' (allowed: unit, calibration, sample_rate_hz, tolerance_s, max_latency_s, "
-                       "health_period_s, pipeline)");
+                       "' (allowed: unit, calibration, sample_rate_hz, speed, tolerance_s, "
+                       "max_latency_s, health_period_s, pipeline)");
     }
     const YAML::Node& value = item.second;
     if (key == "unit" || key == "calibration") {
@@ -84,6 +88,7 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
       auto x = number(source, value, key.c_str());
       if (!x) return x.error();
       if (key == "sample_rate_hz") config.sample_rate_hz = *x;
+      if (key == "speed") config.speed = *x;
       if (key == "tolerance_s") config.tolerance_s = *x;
       if (key == "max_latency_s") config.max_latency_s = *x;
       if (key == "health_period_s") config.health_period_s = *x;
@@ -108,6 +113,7 @@ Status validate(const FusionConfig& config) {
   if (!(config.sample_rate_hz > 0.0 && config.sample_rate_hz <= 100000.0)) {
     return bad_input(s + ": sample_rate_hz must be in (0, 100000]");
   }
+  if (!(config.speed > 0.0 && config.speed <= 1000.0)) return bad_input(s + ": speed must be in (0, 1000]");
   if (!(config.health_period_s > 0.0 && config.health_period_s <= 1.0)) {
     return bad_input(s + ": health_period_s must be in (0, 1] (Health is published at least at 1 Hz)");
   }
@@ -124,6 +130,8 @@ std::string describe(const FusionConfig& config) {
       << "calibration: " << config.calibration_path << " (" << config.calibration.gyro_count()
       << " gyros, method " << config.calibration.method << ")\n"
       << "sample_rate_hz: " << config.sample_rate_hz << '\n'
+      << "speed: " << config.speed << " (deadline " << static_cast<double>(config.deadline_ns()) * 1e-9
+      << " s)\n"
       << "tolerance_s: " << config.tolerance_s << '\n'
       << "max_latency_s: " << config.max_latency_s << '\n'
       << "health_period_s: " << config.health_period_s << '\n'

@@ -17,8 +17,6 @@
 //   * when every gyro is absent and a sample comes back with a sequence number or stamp at or before
 //     the last ones seen, the sensor restarted: the assembler forgets its time base (counted in
 //     sensor_restarts; the caller resets its pipeline too) and starts again from that sample;
-//   * when every gyro is absent, one all-absent epoch is emitted one nominal period after the last
-//     one, so the pipeline learns that the unit is LOST; nothing more until samples return.
 //   * attitude references are attached to the epoch whose stamp is within the tolerance of theirs.
 // Times: stamps are sensor time [ns]; `now_ns` is the caller's local monotonic clock [ns].
 
@@ -108,7 +106,6 @@ class EpochAssembler {
   std::deque<Pending> pending_;                                 //!< sorted by stamp
   std::deque<std::pair<std::int64_t, Quaternion>> references_;  //!< sorted by stamp
   std::optional<std::int64_t> last_emitted_ns_;
-  bool lost_epoch_emitted_ = false;
   AssemblerCounters counters_;
 };
 

@@ -16,14 +16,18 @@ namespace tetra::service {
 struct FusionConfig {
   std::string unit = "tetra-1";   //!< key of every topic this service reads and writes
   std::string calibration_path;   //!< calibration YAML (relative paths: to the config file)
-  double sample_rate_hz = 100.0;  //!< [Hz] nominal gyro rate; deadline = 3 periods
-  double tolerance_s = 0.001;     //!< [s] stamps this close belong to one epoch (< period/2)
-  double max_latency_s = 0.02;    //!< [s] longest wait for an epoch's missing samples
-  double health_period_s = 0.5;   //!< [s] Health at least this often (and on every change)
-  fdi::PipelineConfig pipeline;   //!< the `pipeline:` map
-  Calibration calibration;        //!< read from calibration_path
-  std::string source;             //!< the config file, for messages
+  double sample_rate_hz = 100.0;  //!< [Hz] nominal gyro rate (sensor time)
+  double speed = 1.0;  //!< [-] sensor seconds per wall-clock second: 1 for a real sensor, X for a simulator X
+                       //!< times faster
+  double tolerance_s = 0.001;    //!< [s] stamps this close belong to one epoch (< period/2)
+  double max_latency_s = 0.02;   //!< [s] longest wait for an epoch's missing samples
+  double health_period_s = 0.5;  //!< [s] Health at least this often (and on every change)
+  fdi::PipelineConfig pipeline;  //!< the `pipeline:` map
+  Calibration calibration;       //!< read from calibration_path
+  std::string source;            //!< the config file, for messages
 
+  //! [ns] wall-clock time after which a silent gyro is absent: 3 sample periods / speed.
+  std::int64_t deadline_ns() const;
   //! The assembler's settings for `gyro_count` gyros.
   AssemblerConfig assembler(int gyro_count) const;
 };
