@@ -48,11 +48,13 @@ class FusionService {
   Status take_gyro_samples(std::int64_t now_ns);
   Status take_references();
   Status take_commands();
-  Status check_deadlines(std::int64_t now_ns, bool dds_reported);
+  //! Marks gyros silent for the deadline absent; true if any became absent.
+  bool check_deadlines(std::int64_t now_ns, bool dds_reported);
   Status process_epochs(std::int64_t now_ns);
   Status publish_event(const fdi::FdiEvent& event, std::uint64_t command_id);
   Status publish_health(std::int64_t now_ns, bool force);
-  fdi::Health current_health() const;
+  //! The health to publish, into `out` (its storage is reused).
+  void current_health(fdi::Health& out) const;
 
   service::FusionConfig config_;
   fdi::Pipeline pipeline_;
@@ -64,6 +66,7 @@ class FusionService {
   std::vector<std::int64_t> last_arrival_ns_;  //!< [ns] local time of each gyro's last sample
   std::int64_t next_health_ns_ = 0;
   std::optional<fdi::Health> last_health_;  //!< as last published
+  fdi::Health health_scratch_;              //!< reused for each comparison
   std::uint64_t event_seq_ = 0;
   std::uint64_t last_restarts_ = 0;
   struct PendingAck {
@@ -171,7 +174,9 @@ Status FusionService::run(const dds::ShutdownSignal& shutdown) {
     if (shutdown.requested()) break;
     now = monotonic_ns();
     bool deadline_status = false;
+    bool command_data = false;
     for (const auto token : triggered) {
+      command_data = command_data || token == kCommandData;
       if (token == kGyroStatus) {
         std::uint32_t status = 0;
         (void)dds_take_status(gyro_reader_->handle(), &status,
@@ -189,10 +194,14 @@ Status FusionService::run(const dds::ShutdownSignal& shutdown) {
     // already in its reader when the epoch completes (docs/dds.md).
     if (auto s = take_gyro_samples(now); !s) return s;
     if (auto s = take_references(); !s) return s;
-    if (auto s = take_commands(); !s) return s;
-    if (auto s = check_deadlines(now, deadline_status); !s) return s;
+    if (command_data) {
+      if (auto s = take_commands(); !s) return s;
+    }
+    const bool newly_absent = check_deadlines(now, deadline_status);
     if (auto s = process_epochs(now); !s) return s;
-    if (auto s = publish_health(now, false); !s) return s;
+    if (command_data || newly_absent || now >= next_health_ns_) {
+      if (auto s = publish_health(now, false); !s) return s;
+    }
   }
   spdlog::info("fusion: signal {} received, shutting down", shutdown.signal_number());
   return publish_health(monotonic_ns(), true);
@@ -270,7 +279,8 @@ Status FusionService::take_commands() {
   return ok_status();
 }
 
-Status FusionService::check_deadlines(std::int64_t now_ns, bool dds_reported) {
+bool FusionService::check_deadlines(std::int64_t now_ns, bool dds_reported) {
+  bool any = false;
   for (int g = 1; g <= n_gyros_; ++g) {
     if (assembler_.absent(g)) continue;
     const std::int64_t since = std::max(last_arrival_ns_[static_cast<std::size_t>(g - 1)], started_ns_);
@@ -278,9 +288,10 @@ Status FusionService::check_deadlines(std::int64_t now_ns, bool dds_reported) {
       spdlog::warn("fusion: gyro {} silent for 3 sample periods{}: absent", g,
                    dds_reported ? " (DDS deadline)" : "");
       assembler_.mark_absent(g, service::AbsentReason::kDeadline);
+      any = true;
     }
   }
-  return ok_status();
+  return any;
 }
 
 Status FusionService::process_epochs(std::int64_t now_ns) {
@@ -315,10 +326,10 @@ Status FusionService::publish_event(const fdi::FdiEvent& event, std::uint64_t co
   return event_writer_->write(wire);
 }
 
-fdi::Health FusionService::current_health() const {
+void FusionService::current_health(fdi::Health& health) const {
   // The pipeline's health, with what only the service knows: gyros whose streams stopped (deadline,
   // liveliness) are absent and out of the solution; with fewer than 3 left the unit is LOST.
-  fdi::Health health = pipeline_.health();
+  health = pipeline_.health();
   health.gyros.resize(static_cast<std::size_t>(n_gyros_));
   for (int g = 1; g <= n_gyros_; ++g) {
     if (!assembler_.absent(g)) continue;
@@ -327,11 +338,11 @@ fdi::Health FusionService::current_health() const {
     health.used = without_gyro(health.used, g);
   }
   if (gyro_count(health.used) < 3) health.mode = fdi::Mode::kLost;
-  return health;
 }
 
 Status FusionService::publish_health(std::int64_t now_ns, bool force) {
-  fdi::Health health = current_health();
+  fdi::Health& health = health_scratch_;
+  current_health(health);
   bool changed = !last_health_ || last_health_->mode != health.mode || last_health_->used != health.used ||
                  last_health_->gyros.size() != health.gyros.size();
   for (std::size_t i = 0; !changed && i < health.gyros.size(); ++i) {
@@ -347,7 +358,11 @@ Status FusionService::publish_health(std::int64_t now_ns, bool force) {
   if (auto s = dds::to_wire(config_.unit, health, assembler_.counters(), wire); !s) return s;
   wire.msg.events_published = event_seq_;
   if (auto s = health_writer_->write(wire.msg); !s) return s;
-  last_health_ = std::move(health);
+  if (last_health_) {
+    *last_health_ = health;  // reuses the storage
+  } else {
+    last_health_ = health;
+  }
   next_health_ns_ = now_ns + static_cast<std::int64_t>(config_.health_period_s * 1e9);
   return ok_status();
 }
