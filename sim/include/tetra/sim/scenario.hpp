@@ -1,0 +1,48 @@
+#pragma once
+// Scenarios: what is simulated (motion, duration, sampling, unit, gyro-model options, attitude
+// reference, faults, sampling imperfections). Built-in by name, or read from a YAML file
+// (format in docs/sim.md; unknown keys are an error, every error names file, line and key).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tetra/core/calibration_file.hpp"
+#include "tetra/core/result.hpp"
+#include "tetra/sim/fault.hpp"
+#include "tetra/sim/gyro_model.hpp"
+#include "tetra/sim/motion.hpp"
+
+namespace tetra::sim {
+
+//! Star-tracker-like attitude reference: q_RB ⊗ exp(δθ), δθ ~ N(0, σ²·I) per axis (in B).
+struct ReferenceOptions {
+  double rate_hz = 0.0;       //!< [Hz] 0 = no reference
+  double noise_arcsec = 0.0;  //!< [arcsec] 1σ per axis
+};
+
+struct Scenario {
+  std::string name = "static";              //!< built-in name or file name (metadata)
+  MotionSpec motion;                        //!< truth motion
+  double duration_s = 7200.0;               //!< [s]
+  double rate_hz = 10.0;                    //!< [Hz] gyro sampling rate
+  Calibration unit = seed_as_built_unit();  //!< the as-built truth of the simulated unit
+  GyroModelOptions model;                   //!< options the calibration file does not carry
+  ReferenceOptions reference;               //!< attitude reference (none by default)
+  std::vector<FaultSpec> faults;            //!< injected faults
+  double jitter_s = 0.0;                    //!< [s] sample times uniform in nominal ± jitter (< period/2)
+  double drop_probability = 0.0;            //!< each gyro sample independently not delivered
+};
+
+//! Names of the built-in scenarios (turntable is separate: see turntable.hpp).
+std::vector<std::string> builtin_scenario_names();
+//! A built-in scenario: static, lab-orbit, orbit, slews (defaults in docs/sim.md).
+Result<Scenario> builtin_scenario(const std::string& name);
+//! A scenario from YAML text; `source` names it in messages and `base_dir` resolves `unit:` paths.
+Result<Scenario> parse_scenario(const std::string& yaml_text, const std::string& source,
+                                const std::string& base_dir = ".");
+Result<Scenario> read_scenario(const std::string& path);
+//! Checks everything the simulator relies on (numbers, fault gyros exist, ...).
+Status validate_scenario(const Scenario& scenario);
+
+}  // namespace tetra::sim

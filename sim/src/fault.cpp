@@ -1,0 +1,136 @@
+#include "tetra/sim/fault.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <utility>
+
+#include "tetra/core/csv.hpp"
+
+namespace tetra::sim {
+
+namespace {
+
+constexpr std::pair<FaultKind, std::string_view> kKinds[] = {
+    {FaultKind::kBias, "bias"},   {FaultKind::kRamp, "ramp"},       {FaultKind::kScale, "scale"},
+    {FaultKind::kStuck, "stuck"}, {FaultKind::kZero, "zero"},       {FaultKind::kNoise, "noise"},
+    {FaultKind::kSpike, "spike"}, {FaultKind::kDropout, "dropout"}, {FaultKind::kInvalid, "invalid"}};
+
+bool kind_takes_size(FaultKind kind) {
+  return kind == FaultKind::kBias || kind == FaultKind::kRamp || kind == FaultKind::kScale ||
+         kind == FaultKind::kNoise || kind == FaultKind::kSpike;
+}
+
+std::optional<double> to_double(std::string_view text) {
+  double value = 0.0;
+  const char* end = text.data() + text.size();
+  auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (ec != std::errc() || ptr != end || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+}  // namespace
+
+std::string_view fault_kind_name(FaultKind kind) {
+  for (const auto& [k, name] : kKinds) {
+    if (k == kind) return name;
+  }
+  return "unknown";
+}
+
+Result<FaultSpec> parse_fault_spec(std::string_view text) {
+  const std::string where = "fault '" + std::string(text) + "': ";
+  FaultSpec fault;
+  bool has_gyro = false;
+  bool has_kind = false;
+  bool has_at = false;
+  std::optional<double> size;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    std::size_t comma = text.find(',', pos);
+    if (comma == std::string_view::npos) comma = text.size();
+    const std::string_view field = text.substr(pos, comma - pos);
+    pos = comma + 1;
+    const std::size_t eq = field.find('=');
+    if (eq == std::string_view::npos) {
+      return bad_input(where + "field '" + std::string(field) + "' is not key=value");
+    }
+    const std::string key(field.substr(0, eq));
+    const std::string_view value = field.substr(eq + 1);
+    if (key == "gyro") {
+      int gyro = 0;
+      auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), gyro);
+      if (ec != std::errc() || ptr != value.data() + value.size() || gyro < 1) {
+        return bad_input(where + "gyro: expected a gyro number 1..N, got '" + std::string(value) + "'");
+      }
+      fault.gyro = gyro;
+      has_gyro = true;
+    } else if (key == "kind") {
+      bool found = false;
+      for (const auto& [k, name] : kKinds) {
+        if (name == value) {
+          fault.kind = k;
+          found = true;
+        }
+      }
+      if (!found) {
+        return bad_input(where + "kind: unknown kind '" + std::string(value) +
+                         "' (known: bias, ramp, scale, stuck, zero, noise, spike, dropout, invalid)");
+      }
+      has_kind = true;
+    } else if (key == "at" || key == "until" || key == "size") {
+      const auto number = to_double(value);
+      if (!number)
+        return bad_input(where + key + ": expected a finite number, got '" + std::string(value) + "'");
+      if (key == "at") {
+        fault.at_s = *number;
+        has_at = true;
+      } else if (key == "until") {
+        fault.until_s = *number;
+      } else {
+        size = *number;
+      }
+    } else {
+      return bad_input(where + "unknown field '" + key + "' (fields: gyro, kind, at, size, until)");
+    }
+    if (comma == text.size()) break;
+  }
+  if (!has_gyro) return bad_input(where + "gyro is missing");
+  if (!has_kind) return bad_input(where + "kind is missing");
+  if (!has_at) return bad_input(where + "at is missing");
+  if (fault.at_s < 0.0) return bad_input(where + "at must not be negative");
+  if (fault.until_s && *fault.until_s <= fault.at_s) return bad_input(where + "until must be after at");
+  if (kind_takes_size(fault.kind)) {
+    if (!size)
+      return bad_input(where + "size is required for kind " + std::string(fault_kind_name(fault.kind)));
+    fault.size = *size;
+    if (fault.kind == FaultKind::kNoise && fault.size < 0.0) {
+      return bad_input(where + "size: a noise multiplier must not be negative");
+    }
+    if (fault.kind == FaultKind::kScale && fault.size <= -1.0) {
+      return bad_input(where + "size: a relative scale change must be above -1");
+    }
+  } else if (size) {
+    return bad_input(where + "size has no meaning for kind " + std::string(fault_kind_name(fault.kind)));
+  }
+  if (fault.kind == FaultKind::kSpike && fault.until_s) {
+    return bad_input(where + "until has no meaning for a spike (one sample at 'at')");
+  }
+  return fault;
+}
+
+std::string format_fault_spec(const FaultSpec& fault) {
+  std::string out =
+      "gyro=" + std::to_string(fault.gyro) + ",kind=" + std::string(fault_kind_name(fault.kind)) + ",at=";
+  append_double(out, fault.at_s);
+  if (kind_takes_size(fault.kind)) {
+    out += ",size=";
+    append_double(out, fault.size);
+  }
+  if (fault.until_s) {
+    out += ",until=";
+    append_double(out, *fault.until_s);
+  }
+  return out;
+}
+
+}  // namespace tetra::sim

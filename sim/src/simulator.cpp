@@ -1,0 +1,349 @@
+#include "tetra/sim/simulator.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "tetra/core/csv.hpp"
+#include "tetra/core/units.hpp"
+
+namespace tetra::sim {
+
+namespace {
+
+std::string number_text(double value) {
+  std::string out;
+  append_double(out, value);
+  return out;
+}
+
+//! A metadata value: spaces and commas separate key=value tokens, so they become '_'.
+std::string token(std::string text) {
+  for (char& c : text) {
+    if (c == ' ' || c == '\t' || c == ',') c = '_';
+  }
+  return text;
+}
+
+}  // namespace
+
+Simulator::Simulator(Scenario scenario, SimOptions options, TruthMotion motion)
+    : scenario_(std::move(scenario)), options_(std::move(options)), motion_(std::move(motion)) {
+  faults_ = scenario_.faults;
+  faults_.insert(faults_.end(), options_.faults.begin(), options_.faults.end());
+  epochs_ = static_cast<std::size_t>(std::llround(scenario_.duration_s * scenario_.rate_hz));
+  reset();
+}
+
+Result<Simulator> Simulator::create(const Scenario& scenario, const SimOptions& options) {
+  if (Status st = validate_scenario(scenario); !st) return st.error();
+  for (const FaultSpec& f : options.faults) {
+    if (f.gyro > scenario.unit.gyro_count()) {
+      return bad_input("fault '" + format_fault_spec(f) + "': gyro " + std::to_string(f.gyro) +
+                       " does not exist (the unit has " + std::to_string(scenario.unit.gyro_count()) +
+                       " gyros)");
+    }
+  }
+  auto motion = TruthMotion::create(scenario.motion, options.seed);
+  if (!motion) return motion.error();
+  return Simulator(scenario, options, std::move(motion.value()));
+}
+
+void Simulator::reset() {
+  const int n = gyro_count();
+  const double dt_s = 1.0 / scenario_.rate_hz;
+  channels_.clear();
+  channels_.reserve(static_cast<std::size_t>(n));
+  drop_rngs_.clear();
+  for (int i = 0; i < n; ++i) {
+    channels_.emplace_back(scenario_.unit.gyros[static_cast<std::size_t>(i)], scenario_.model, dt_s,
+                           options_.seed, i);
+    drop_rngs_.emplace_back(stream_seed(options_.seed, Stream::kDropped, i));
+  }
+  jitter_rng_ = Rng(stream_seed(options_.seed, Stream::kJitter, -1));
+  reference_rng_ = Rng(stream_seed(options_.seed, Stream::kReference, -1));
+  last_output_V_.assign(static_cast<std::size_t>(n), 0.0);
+  has_last_output_.assign(static_cast<std::size_t>(n), 0);
+  stuck_value_V_.assign(faults_.size(), std::nullopt);
+  spike_done_.assign(faults_.size(), 0);
+  last_reference_period_ = -1;
+  k_ = 0;
+}
+
+bool Simulator::next(SimEpoch& out) {
+  if (k_ >= epochs_) return false;
+  const int n = gyro_count();
+  const auto nominal_ns = static_cast<std::int64_t>(
+      std::llround(static_cast<double>(k_) * static_cast<double>(kNanosPerSecond) / scenario_.rate_hz));
+  std::int64_t stamp_ns = nominal_ns;
+  if (scenario_.jitter_s > 0.0) {
+    stamp_ns += seconds_to_ns(scenario_.jitter_s * (2.0 * jitter_rng_.uniform() - 1.0));
+  }
+  const double t_s = static_cast<double>(stamp_ns) / static_cast<double>(kNanosPerSecond);
+  const MotionState truth = motion_.at(t_s);
+  const Eigen::Vector3d sensed_dps = truth.omega_B_rad_s * kRadToDeg;
+
+  out.stamp_ns = stamp_ns;
+  out.time_s = t_s;
+  out.truth_q_RB = truth.q_RB;
+  out.truth_omega_B_rad_s = truth.omega_RB_B_rad_s;
+  out.sensed_omega_B_rad_s = truth.omega_B_rad_s;
+  out.raw_V.resize(static_cast<std::size_t>(n));
+  out.present.resize(static_cast<std::size_t>(n));
+
+  for (int i = 0; i < n; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    GyroChannel& ch = channels_[iu];
+    double v = ch.sample_V(sensed_dps, t_s);
+    bool present = true;
+    // Dropped samples (an option of the scenario, not a fault): drawn every epoch so that the
+    // stream does not depend on anything else.
+    const double drop_draw = drop_rngs_[iu].uniform();
+    if (scenario_.drop_probability > 0.0 && drop_draw < scenario_.drop_probability) present = false;
+    for (std::size_t f = 0; f < faults_.size(); ++f) {
+      const FaultSpec& fault = faults_[f];
+      if (fault.gyro != i + 1 || !fault_active(fault, t_s)) continue;
+      const double s = ch.scale_V_per_dps();
+      switch (fault.kind) {
+        case FaultKind::kBias:
+          v += s * fault.size;
+          break;
+        case FaultKind::kRamp:
+          v += s * fault.size * (t_s - fault.at_s);
+          break;
+        case FaultKind::kScale:
+          v += fault.size * (v - ch.bias_V());
+          break;
+        case FaultKind::kNoise:
+          v += (fault.size - 1.0) * s * ch.last_white_noise_dps();
+          break;
+        case FaultKind::kSpike:
+          if (!spike_done_[f]) {
+            v += s * fault.size;
+            spike_done_[f] = 1;
+          }
+          break;
+        case FaultKind::kStuck:
+          if (!stuck_value_V_[f]) stuck_value_V_[f] = has_last_output_[iu] ? last_output_V_[iu] : v;
+          v = *stuck_value_V_[f];
+          break;
+        case FaultKind::kZero:
+          v = 0.0;
+          break;
+        case FaultKind::kDropout:
+          present = false;
+          break;
+        case FaultKind::kInvalid:
+          v = std::numeric_limits<double>::quiet_NaN();
+          break;
+      }
+    }
+    out.present[iu] = present ? 1 : 0;
+    out.raw_V[iu] = present ? v : std::numeric_limits<double>::quiet_NaN();
+    if (present && std::isfinite(v)) {
+      last_output_V_[iu] = v;
+      has_last_output_[iu] = 1;
+    }
+  }
+
+  out.reference_q_RB.reset();
+  if (scenario_.reference.rate_hz > 0.0) {
+    // Reference period of the nominal epoch time (exact integer arithmetic where the rates allow).
+    const auto period = static_cast<std::int64_t>(
+        std::floor(static_cast<double>(k_) * scenario_.reference.rate_hz / scenario_.rate_hz + 1e-9));
+    if (period != last_reference_period_) {
+      last_reference_period_ = period;
+      const double sigma_rad = scenario_.reference.noise_arcsec * kArcsecToRad;
+      Eigen::Vector3d error_rad;
+      for (int a = 0; a < 3; ++a) error_rad[a] = sigma_rad * reference_rng_.normal();
+      out.reference_q_RB = canonical(truth.q_RB * quat_exp(error_rad));
+    }
+  }
+  ++k_;
+  return true;
+}
+
+std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
+  std::vector<std::pair<std::string, std::string>> meta;
+  const MotionSpec& m = scenario_.motion;
+  meta.emplace_back("generator", "tetra sim");
+  meta.emplace_back("scenario", token(scenario_.name));
+  meta.emplace_back("motion", std::string(motion_kind_name(m.kind)));
+  meta.emplace_back("seed", std::to_string(options_.seed));
+  meta.emplace_back("unit", token(scenario_.unit.unit));
+  meta.emplace_back("rate_hz", number_text(scenario_.rate_hz));
+  meta.emplace_back("duration_s", number_text(scenario_.duration_s));
+  meta.emplace_back("reference_frame", motion_.reference_frame());
+  if (m.kind == MotionKind::kStatic || m.kind == MotionKind::kLabOrbit) {
+    meta.emplace_back("latitude_deg", number_text(m.latitude_deg));
+  }
+  if (m.kind == MotionKind::kLabOrbit) {
+    meta.emplace_back("pitch_axis_B", "+Y");
+    meta.emplace_back("pitch_rate_dps", number_text(m.pitch_rate_dps));
+  }
+  if (m.kind == MotionKind::kOrbit || m.kind == MotionKind::kSlews) {
+    meta.emplace_back("pitch_axis_B", "-Y");
+    meta.emplace_back("orbit_period_s", number_text(m.orbit_period_s));
+    meta.emplace_back("acs_amplitude_deg", number_text(m.acs.amplitude_deg));
+    meta.emplace_back("acs_peak_accel_dps2", number_text(motion_.acs_peak_accel_dps2()));
+    for (const Slew& s : motion_.spec().slews) {
+      if (m.kind != MotionKind::kSlews) break;
+      // Metadata values may not contain spaces or commas (they separate key=value tokens).
+      std::string text = "axis=";
+      append_double(text, s.axis_B.x());
+      text += '/';
+      append_double(text, s.axis_B.y());
+      text += '/';
+      append_double(text, s.axis_B.z());
+      text += ";angle_deg=" + number_text(s.angle_deg) + ";start_s=" + number_text(s.start_s) +
+              ";duration_s=" + number_text(s.duration_s);
+      meta.emplace_back("slew", text);
+    }
+  }
+  if (scenario_.reference.rate_hz > 0.0) {
+    meta.emplace_back("reference_hz", number_text(scenario_.reference.rate_hz));
+    meta.emplace_back("reference_noise_arcsec", number_text(scenario_.reference.noise_arcsec));
+  }
+  if (scenario_.jitter_s > 0.0) meta.emplace_back("jitter_s", number_text(scenario_.jitter_s));
+  if (scenario_.drop_probability > 0.0) {
+    meta.emplace_back("drop_probability", number_text(scenario_.drop_probability));
+  }
+  for (const FaultSpec& f : faults_) {
+    std::string text = format_fault_spec(f);
+    for (char& c : text) c = c == ',' ? ';' : c;  // commas separate metadata tokens
+    meta.emplace_back("fault", text);
+  }
+  return meta;
+}
+
+Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options, Truth* truth) {
+  auto created = Simulator::create(scenario, options);
+  if (!created) return created.error();
+  Simulator& sim = created.value();
+  const int n = sim.gyro_count();
+  GyroLog log;
+  log.source = "simulated " + scenario.name;
+  log.metadata = sim.metadata();
+  log.gyro_count = n;
+  log.has_reference = scenario.reference.rate_hz > 0.0;
+  const std::size_t e = sim.epoch_count();
+  log.time_s.reserve(e);
+  log.values.reserve(e * static_cast<std::size_t>(n));
+  log.present.reserve(e * static_cast<std::size_t>(n));
+  if (truth) *truth = Truth{};
+  SimEpoch epoch;
+  while (sim.next(epoch)) {
+    log.time_s.push_back(epoch.time_s);
+    log.values.insert(log.values.end(), epoch.raw_V.begin(), epoch.raw_V.end());
+    log.present.insert(log.present.end(), epoch.present.begin(), epoch.present.end());
+    log.lines.push_back(log.lines.size() + 1);
+    if (log.has_reference) {
+      log.reference_present.push_back(epoch.reference_q_RB ? 1 : 0);
+      log.reference_wxyz.push_back(epoch.reference_q_RB ? to_wxyz(*epoch.reference_q_RB)
+                                                        : std::array<double, 4>{0.0, 0.0, 0.0, 0.0});
+    }
+    if (truth) {
+      truth->time_s.push_back(epoch.time_s);
+      truth->q_RB.push_back(epoch.truth_q_RB);
+      truth->omega_B_rad_s.push_back(epoch.truth_omega_B_rad_s);
+      truth->sensed_omega_B_rad_s.push_back(epoch.sensed_omega_B_rad_s);
+    }
+  }
+  return log;
+}
+
+namespace {
+
+//! Buffered writer of the truth file through a temporary file renamed on close.
+class TruthWriter {
+ public:
+  ~TruthWriter() {
+    if (file_) {
+      std::fclose(file_);
+      std::remove(temp_.c_str());
+    }
+  }
+  Status open(const std::string& path, const std::vector<std::pair<std::string, std::string>>& comments) {
+    path_ = path;
+    temp_ = path + ".tmp";
+    file_ = std::fopen(temp_.c_str(), "wb");
+    if (!file_) return failure(path + ": cannot open for writing");
+    for (const auto& [key, value] : comments) buffer_ += "# " + key + "=" + value + "\n";
+    buffer_ += "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps\n";
+    return ok_status();
+  }
+  Status write(const SimEpoch& e) {
+    append_double(buffer_, e.time_s);
+    const Quaternion q = canonical(e.truth_q_RB);
+    for (double c : to_wxyz(q)) {
+      buffer_ += ',';
+      append_double(buffer_, c + 0.0);  // + 0.0: never write "-0"
+    }
+    for (int a = 0; a < 3; ++a) {
+      buffer_ += ',';
+      append_double(buffer_, e.truth_omega_B_rad_s[a] * kRadToDeg + 0.0);
+    }
+    buffer_ += '\n';
+    if (buffer_.size() > (1u << 20)) return flush();
+    return ok_status();
+  }
+  Status close() {
+    if (Status st = flush(); !st) return st;
+    const bool ok = std::fclose(file_) == 0;
+    file_ = nullptr;
+    if (!ok || std::rename(temp_.c_str(), path_.c_str()) != 0) {
+      std::remove(temp_.c_str());
+      return failure(path_ + ": cannot write");
+    }
+    return ok_status();
+  }
+
+ private:
+  Status flush() {
+    if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
+      return failure(path_ + ": write failed");
+    }
+    buffer_.clear();
+    return ok_status();
+  }
+  std::FILE* file_ = nullptr;
+  std::string path_;
+  std::string temp_;
+  std::string buffer_;
+};
+
+}  // namespace
+
+Status write_simulation(Simulator& simulator, const std::string& log_path, const std::string& truth_path,
+                        void (*progress)(double fraction)) {
+  const Scenario& sc = simulator.scenario();
+  const bool with_reference = sc.reference.rate_hz > 0.0;
+  const auto meta = simulator.metadata();
+  GyroLogWriter writer;
+  if (Status st = writer.open(log_path, simulator.gyro_count(), with_reference, false, meta); !st) return st;
+  TruthWriter truth;
+  if (!truth_path.empty()) {
+    auto truth_meta = meta;
+    truth_meta.emplace_back("truth", "q_body_to_reference_frame;w_body_relative_to_reference_frame_in_body");
+    if (Status st = truth.open(truth_path, truth_meta); !st) return st;
+  }
+  SimEpoch epoch;
+  const std::size_t total = simulator.epoch_count();
+  const std::size_t every = total / 10 + 1;
+  while (simulator.next(epoch)) {
+    std::optional<std::array<double, 4>> ref;
+    if (epoch.reference_q_RB) ref = to_wxyz(*epoch.reference_q_RB);
+    if (Status st = writer.write(epoch.time_s, epoch.raw_V, epoch.present, ref); !st) return st;
+    if (!truth_path.empty()) {
+      if (Status st = truth.write(epoch); !st) return st;
+    }
+    if (progress && simulator.epochs_done() % every == 0) {
+      progress(static_cast<double>(simulator.epochs_done()) / static_cast<double>(total));
+    }
+  }
+  if (Status st = writer.close(); !st) return st;
+  if (!truth_path.empty()) return truth.close();
+  return ok_status();
+}
+
+}  // namespace tetra::sim

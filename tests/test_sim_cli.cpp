@@ -1,0 +1,97 @@
+// tetra sim on the command line: outputs readable by the core readers, byte-identical reruns,
+// exit 2 with one clear line for bad scenario files and fault specs.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "test_support.hpp"
+#include "tetra/core/gyro_log.hpp"
+#include "tetra/core/turntable_log.hpp"
+
+namespace tetra {
+namespace {
+
+using test::read_file;
+using test::run_tetra;
+using test::TempDir;
+using test::write_file;
+
+std::size_t lines(const std::string& s) {
+  return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
+}
+
+TEST(SimCli, HelpExitsZero) {
+  auto r = run_tetra("sim --help");
+  EXPECT_EQ(r.exit_status, 0);
+  EXPECT_NE(r.out.find("--fault"), std::string::npos);
+}
+
+TEST(SimCli, SameSeedGivesByteIdenticalFilesAndTheReadersAcceptThem) {
+  TempDir dir;
+  const std::string args =
+      " --minutes 2 --rate-hz 50 --fault gyro=2,kind=bias,at=30,size=0.1,until=60 --seed 77";
+  auto a = run_tetra("sim slews" + args + " --out " + dir.file("a.csv") + " --truth " + dir.file("ta.csv"));
+  auto b = run_tetra("sim slews" + args + " --out " + dir.file("b.csv") + " --truth " + dir.file("tb.csv"));
+  ASSERT_EQ(a.exit_status, 0) << a.err;
+  ASSERT_EQ(b.exit_status, 0) << b.err;
+  EXPECT_EQ(read_file(dir.file("a.csv")), read_file(dir.file("b.csv")));
+  EXPECT_EQ(read_file(dir.file("ta.csv")), read_file(dir.file("tb.csv")));
+  auto c = run_tetra("sim slews --minutes 2 --rate-hz 50 --seed 78 --out " + dir.file("c.csv"));
+  ASSERT_EQ(c.exit_status, 0) << c.err;
+  EXPECT_NE(read_file(dir.file("a.csv")), read_file(dir.file("c.csv")));
+
+  auto log = read_gyro_log(dir.file("a.csv"));
+  ASSERT_TRUE(log.ok()) << log.error().message;
+  EXPECT_EQ(log->epochs(), 6000u);  // 2 min at 50 Hz
+  EXPECT_EQ(log->gyro_count, 4);
+  EXPECT_TRUE(log->has_reference);
+  EXPECT_EQ(log->meta("fault"), "gyro=2;kind=bias;at=30;size=0.1;until=60");
+  EXPECT_EQ(log->meta("reference_frame"), "inertial");
+  // Truth: header + one row per epoch after the metadata comments.
+  const std::string truth = read_file(dir.file("ta.csv"));
+  EXPECT_NE(truth.find("\ntime_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps\n"), std::string::npos);
+  EXPECT_EQ(lines(truth.substr(truth.find("time_s,qw"))), 6001u);
+}
+
+TEST(SimCli, TurntableWritesTheCalibrationInput) {
+  TempDir dir;
+  auto r =
+      run_tetra("sim turntable --rate-hz 2 --latitude 10 --order 1,2,3,4 --wrap --out " + dir.file("t.csv"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  auto log = read_turntable_log(dir.file("t.csv"));
+  ASSERT_TRUE(log.ok()) << log.error().message;
+  EXPECT_EQ(log->rows(), 4u * 120u);
+  EXPECT_EQ(log->meta("latitude_deg"), "10");
+  EXPECT_EQ(log->meta("encoder_angles"), "wrapped");
+}
+
+TEST(SimCli, BadInputExitsTwoWithOneClearLine) {
+  TempDir dir;
+  write_file(dir.file("bad.yaml"), "scenario: orbit\nrate_hz: 10\nreference: {hz: 1}\n");
+  write_file(dir.file("badfault.yaml"), "scenario: orbit\nfaults: [\"gyro=1,kind=bias,at=1\"]\n");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"sim orbit --fault gyro=1,kind=melt,at=3 --out " + dir.file("x.csv"), "unknown kind 'melt'"},
+      {"sim orbit --fault gyro=7,kind=zero,at=3 --out " + dir.file("x.csv"), "gyro 7 does not exist"},
+      {"sim orbit --fault gyro=1,kind=bias,at=3 --out " + dir.file("x.csv"), "size is required"},
+      {"sim " + dir.file("bad.yaml") + " --out " + dir.file("x.csv"),
+       "bad.yaml:3: reference: unknown key 'hz'"},
+      {"sim " + dir.file("badfault.yaml") + " --out " + dir.file("x.csv"), "badfault.yaml:2: faults[0]"},
+      {"sim " + dir.file("missing.yaml") + " --out " + dir.file("x.csv"), "missing.yaml: cannot open"},
+      {"sim wobble --out " + dir.file("x.csv"), "unknown scenario 'wobble'"},
+      {"sim static --rate-hz 0 --out " + dir.file("x.csv"), "rate_hz must be positive"},
+      {"sim static --jitter 0.2 --out " + dir.file("x.csv"), "jitter_s"},
+      {"sim static", "--out"},
+      {"sim turntable --order 1,99", "sequence 99"},
+      {"sim orbit --unit " + dir.file("nounit.yaml") + " --out " + dir.file("x.csv"), "nounit.yaml"},
+  };
+  for (const auto& [args, needle] : cases) {
+    auto r = run_tetra(args);
+    EXPECT_EQ(r.exit_status, 2) << args << "\n" << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\n" << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.csv")));
+}
+
+}  // namespace
+}  // namespace tetra
