@@ -41,7 +41,7 @@ int cmd_record(int argc, char** argv) {
   std::string events_path;
   int gyros = 4;
   double rate_hz = 100.0;
-  double tolerance_s = 0.001;
+  double tolerance_s = -1.0;  // [s] default: a quarter period
   double max_latency_s = 0.02;
   double duration_s = 0.0;
   bool until_idle = false;
@@ -52,7 +52,8 @@ int cmd_record(int argc, char** argv) {
   app.add_option("--gyros", gyros, "number of gyros N (columns g1..gN)")
       ->check(CLI::Range(1, dds::kMaxGyrosOnWire));
   app.add_option("--rate", rate_hz, "[Hz] nominal sample rate")->check(CLI::PositiveNumber);
-  app.add_option("--tolerance", tolerance_s, "[s] stamps this close form one epoch")
+  app.add_option("--tolerance", tolerance_s,
+                 "[s] stamps this close form one epoch (default: a quarter period)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-latency", max_latency_s, "[s] longest wait for an epoch's missing samples")
       ->check(CLI::PositiveNumber);
@@ -72,7 +73,8 @@ int cmd_record(int argc, char** argv) {
   } else {
     assembly.gyro_count = gyros;
     assembly.nominal_period_ns = static_cast<std::int64_t>(1e9 / rate_hz + 0.5);
-    assembly.tolerance_ns = static_cast<std::int64_t>(tolerance_s * 1e9 + 0.5);
+    assembly.tolerance_ns = tolerance_s >= 0 ? static_cast<std::int64_t>(tolerance_s * 1e9 + 0.5)
+                                             : assembly.nominal_period_ns / 4;
     assembly.max_latency_ns = static_cast<std::int64_t>(max_latency_s * 1e9 + 0.5);
   }
   auto assembler = service::EpochAssembler::create(assembly);

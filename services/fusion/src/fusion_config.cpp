@@ -42,7 +42,7 @@ AssemblerConfig FusionConfig::assembler(int gyro_count) const {
   AssemblerConfig config;
   config.gyro_count = gyro_count;
   config.nominal_period_ns = to_ns(1.0 / sample_rate_hz);
-  config.tolerance_ns = to_ns(tolerance_s);
+  config.tolerance_ns = tolerance_s ? to_ns(*tolerance_s) : config.nominal_period_ns / 4;
   config.max_latency_ns = to_ns(max_latency_s);
   return config;
 }
@@ -132,7 +132,10 @@ std::string describe(const FusionConfig& config) {
       << "sample_rate_hz: " << config.sample_rate_hz << '\n'
       << "speed: " << config.speed << " (deadline " << static_cast<double>(config.deadline_ns()) * 1e-9
       << " s)\n"
-      << "tolerance_s: " << config.tolerance_s << '\n'
+      << "tolerance_s: "
+      << (config.tolerance_s ? std::to_string(*config.tolerance_s)
+                             : "a quarter period (" + std::to_string(0.25 / config.sample_rate_hz) + ")")
+      << '\n'
       << "max_latency_s: " << config.max_latency_s << '\n'
       << "health_period_s: " << config.health_period_s << '\n'
       << "pipeline:\n"

@@ -4,6 +4,7 @@
 // one `tetra replay --config` reads.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "tetra/core/calibration_file.hpp"
@@ -19,7 +20,8 @@ struct FusionConfig {
   double sample_rate_hz = 100.0;  //!< [Hz] nominal gyro rate (sensor time)
   double speed = 1.0;  //!< [-] sensor seconds per wall-clock second: 1 for a real sensor, X for a simulator X
                        //!< times faster
-  double tolerance_s = 0.001;    //!< [s] stamps this close belong to one epoch (< period/2)
+  std::optional<double>
+      tolerance_s;               //!< [s] stamps this close belong to one epoch (< period/2); default period/4
   double max_latency_s = 0.02;   //!< [s] longest wait for an epoch's missing samples
   double health_period_s = 0.5;  //!< [s] Health at least this often (and on every change)
   fdi::PipelineConfig pipeline;  //!< the `pipeline:` map
