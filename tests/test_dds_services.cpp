@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <map>
@@ -308,6 +309,7 @@ TEST(DdsServices, SimulatorKilledGoesLostAndRecovers_ServiceKilledResumes) {
     return h && h->health.mode == fdi::Mode::kNominal && h->health.counters.epochs_accepted > 50;
   })) << read_file(files.dir.file("fusion.log"));
 
+  const std::int64_t killed_sim_ns = now_ns();
   sim->kill_now(SIGKILL);
   // The deadline (3 periods) marks every gyro absent long before the writer's lease (1 s) ends.
   ASSERT_TRUE(observer.wait_until([&] {
@@ -319,6 +321,9 @@ TEST(DdsServices, SimulatorKilledGoesLostAndRecovers_ServiceKilledResumes) {
     return true;
   })) << read_file(files.dir.file("fusion.log"));
   EXPECT_GE(health()->counters.deadlines_missed, 4U);
+  // A figure for the record, not a pass criterion (timing depends on the machine's load).
+  std::printf("[ figure ] simulator kill -9 to Health LOST with all gyros absent: %.1f ms (deadline 30 ms)\n",
+              static_cast<double>(now_ns() - killed_sim_ns) * 1e-6);
 
   sim = std::make_unique<Process>(sim_cmd, files.dir.file("sim2.log"));
   ASSERT_TRUE(observer.wait_until([&] {
@@ -329,11 +334,15 @@ TEST(DdsServices, SimulatorKilledGoesLostAndRecovers_ServiceKilledResumes) {
   fusion->kill_now(SIGKILL);
   observer.drain();
   observer.attitudes.clear();
+  const std::int64_t restart_ns = now_ns();
   fusion = std::make_unique<Process>(
       std::vector<std::string>{"fusion", "--config", files.config, "--domain", d(domain)},
       files.dir.file("fusion2.log"));
-  ASSERT_TRUE(observer.wait_until([&] { return observer.attitudes.size() >= 10; }))
+  ASSERT_TRUE(observer.wait_until([&] { return !observer.attitudes.empty(); }))
       << read_file(files.dir.file("fusion2.log"));
+  std::printf("[ figure ] service kill -9, new service started: first Attitude after %.1f ms\n",
+              static_cast<double>(now_ns() - restart_ns) * 1e-6);
+  ASSERT_TRUE(observer.wait_until([&] { return observer.attitudes.size() >= 10; }));
 }
 
 TEST(DdsServices, MalformedTrafficIsCountedNeverMixedNeverACrash) {

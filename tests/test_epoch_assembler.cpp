@@ -181,6 +181,22 @@ TEST(EpochAssembler, ResumingAfterSilenceIsNotARestart) {
   EXPECT_EQ(a.counters().samples_gap, 8U);  // 2 numbers skipped on each of 4 gyros
 }
 
+TEST(EpochAssembler, AUnitResumingIsWaitedForAsAWhole) {
+  auto a = make();
+  feed_epoch(a, 0, 0);
+  std::vector<fdi::Epoch> out;
+  a.poll(0, out);
+  for (int g = 1; g <= 4; ++g) a.mark_absent(g, AbsentReason::kDeadline);  // the whole stream paused
+  a.add_sample(1, 2, kPeriod, 0.0, 100);
+  a.poll(100, out);
+  EXPECT_EQ(out.size(), 1U);  // epoch 1 waits for gyros 2..4 again instead of going out with gyro 1 alone
+  for (int g = 2; g <= 4; ++g) EXPECT_EQ(a.add_sample(g, 2, kPeriod, 0.0, 101), Verdict::kAccepted);
+  a.poll(101, out);
+  ASSERT_EQ(out.size(), 2U);
+  EXPECT_EQ(out[1].present, (std::vector<std::uint8_t>{1, 1, 1, 1}));
+  EXPECT_EQ(a.counters().samples_late, 0U);
+}
+
 TEST(EpochAssembler, WithoutSilenceABackwardStreamIsNotARestart) {
   auto a = make();
   for (int k = 0; k < 3; ++k) feed_epoch(a, k, 0);

@@ -162,7 +162,8 @@ int cmd_demo(int argc, char** argv) {
   std::cout << "tetra demo: domain " << domain << " (loopback only), unit " << unit << ", scenario "
             << scenario->name << ", " << fixed(seconds, 0) << " s at " << fixed(rate_hz, 0) << " Hz, "
             << fixed(speed, 1) << "x real time\n"
-            << "  fault: " << fault_text << "\n  service log: " << dir << "/fusion.log\n"
+            << "  fault: " << fault_text << "\n  the service: tetra fusion --config " << dir
+            << "/fusion.yaml\n"
             << std::flush;
   const std::string domain_text = std::to_string(domain);
   Child fusion(spawn_self({"fusion", "--config", dir + "/fusion.yaml", "--domain", domain_text},
@@ -231,7 +232,10 @@ int cmd_demo(int argc, char** argv) {
   }
   watch();
 
-  std::cout << "\nmonitor view (tetra monitor --once):\n" << std::flush;
+  std::cout
+      << "\nmonitor view after the run (tetra monitor --once; the simulator has stopped, so its gyros are "
+         "absent and the unit LOST; the event history is the late joiner's):\n"
+      << std::flush;
   Child monitor(spawn_self({"monitor", "--once", "--unit", unit, "--domain", domain_text, "--timeout", "5"}));
   monitor.wait();
   const int fusion_status = fusion.stop();
@@ -270,8 +274,9 @@ int cmd_demo(int argc, char** argv) {
   }
   std::cout << "at the end "
             << fixed(score->series.empty() ? 0.0 : score->series.back().error_deg * 3600.0, 1) << " arcsec\n"
-            << "  service:           exit status " << fusion_status << " after SIGTERM (log " << dir
-            << "/fusion.log)\n";
+            << "  service:           exit status " << fusion_status << " after SIGTERM"
+            << (keep_dir.empty() ? std::string(" (its log: --keep DIR)") : " (log " + dir + "/fusion.log)")
+            << '\n';
   if (keep_dir.empty()) std::filesystem::remove_all(dir);
   const bool ok = timeline.isolated_s && score->attitudes_scored > 0;
   return ok || shutdown.requested() ? kExitOk : kExitFailure;

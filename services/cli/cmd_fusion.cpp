@@ -63,6 +63,7 @@ class FusionService {
   std::int64_t period_ns_ = 0;
   std::int64_t deadline_ns_ = 0;               //!< [ns] 3 sample periods
   std::int64_t started_ns_ = 0;                //!< [ns] local time the service started
+  std::int64_t resumed_ns_ = 0;                //!< [ns] local time the unit last resumed after silence
   std::vector<std::int64_t> last_arrival_ns_;  //!< [ns] local time of each gyro's last sample
   std::int64_t next_health_ns_ = 0;
   std::optional<fdi::Health> last_health_;  //!< as last published
@@ -166,7 +167,8 @@ Status FusionService::run(const dds::ShutdownSignal& shutdown) {
     // Gyros not yet absent are checked for silence at their deadline too.
     for (int g = 1; g <= n_gyros_; ++g) {
       if (!assembler_.absent(g)) {
-        const std::int64_t since = std::max(last_arrival_ns_[static_cast<std::size_t>(g - 1)], started_ns_);
+        const std::int64_t since =
+            std::max({last_arrival_ns_[static_cast<std::size_t>(g - 1)], started_ns_, resumed_ns_});
         wake = std::min(wake, since + deadline_ns_ + 1);
       }
     }
@@ -208,6 +210,7 @@ Status FusionService::run(const dds::ShutdownSignal& shutdown) {
 }
 
 Status FusionService::take_gyro_samples(std::int64_t now_ns) {
+  const bool was_silent = assembler_.all_absent();
   auto taken = gyro_reader_->take(
       [&](const tetra_GyroSample& sample, const dds_sample_info_t&) {
         if (dds::from_wire(sample.unit) != config_.unit) {
@@ -235,6 +238,7 @@ Status FusionService::take_gyro_samples(std::int64_t now_ns) {
         dds_sample_free(&key, &tetra_GyroSample_desc, DDS_FREE_CONTENTS);
       });
   if (!taken) return taken.error();
+  if (was_silent && !assembler_.all_absent()) resumed_ns_ = now_ns;  // deadlines re-armed from now
   if (assembler_.counters().sensor_restarts != last_restarts_) {
     last_restarts_ = assembler_.counters().sensor_restarts;
     spdlog::warn("fusion: sensor time restarted after the unit went silent: pipeline reset");
@@ -283,7 +287,8 @@ bool FusionService::check_deadlines(std::int64_t now_ns, bool dds_reported) {
   bool any = false;
   for (int g = 1; g <= n_gyros_; ++g) {
     if (assembler_.absent(g)) continue;
-    const std::int64_t since = std::max(last_arrival_ns_[static_cast<std::size_t>(g - 1)], started_ns_);
+    const std::int64_t since =
+        std::max({last_arrival_ns_[static_cast<std::size_t>(g - 1)], started_ns_, resumed_ns_});
     if (now_ns - since >= deadline_ns_) {
       spdlog::warn("fusion: gyro {} silent for 3 sample periods{}: absent", g,
                    dds_reported ? " (DDS deadline)" : "");

@@ -90,6 +90,25 @@ Result<SimDdsScore> run_sim_dds(sim::Simulator& simulator, const SimDdsOptions& 
     if (auto s = waitset->wait(std::chrono::nanoseconds(give_up - now), triggered); !s) return s.error();
   }
 
+  // And (briefly) for the service's Attitude writer, so that the first epochs are scored too.
+  if (options.wait_readers > 0) {
+    if (dds_set_status_mask(attitude_reader->handle(), DDS_SUBSCRIPTION_MATCHED_STATUS) < 0) {
+      return failure("DDS: cannot enable the subscription-matched status");
+    }
+    if (auto s = waitset->attach(attitude_reader->handle(), kMatched); !s) return s.error();
+    const std::int64_t attitude_give_up = monotonic_ns() + 1'000'000'000;
+    for (;;) {
+      std::uint32_t status = 0;
+      (void)dds_take_status(attitude_reader->handle(), &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
+      auto matched = attitude_reader->matched_writers();
+      if (!matched) return matched.error();
+      const std::int64_t now = monotonic_ns();
+      if (*matched > 0 || now >= attitude_give_up || stop_requested()) break;
+      if (auto s = waitset->wait(std::chrono::nanoseconds(attitude_give_up - now), triggered); !s)
+        return s.error();
+    }
+  }
+
   SimDdsScore score;
   std::deque<std::pair<std::int64_t, Quaternion>> truth;  // (stamp, q_RB) of epochs not yet scored
   std::int64_t last_stamp = 0;

@@ -62,6 +62,11 @@ Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t 
     last_emitted_ns_.reset();
     ++counters_.sensor_restarts;
   }
+  if (all_absent) {
+    // The unit resumes: wait for all of its gyros again (those really gone are marked absent again
+    // by their deadline), so a pause of the whole stream does not split its next epochs.
+    for (GyroTrack& g : gyros_) g.absent = false;
+  }
   GyroTrack& track = gyros_[index];
   if (track.last_seq) {
     if (seq == *track.last_seq) {
@@ -121,6 +126,10 @@ void EpochAssembler::mark_absent(int gyro_id, AbsentReason reason) {
   if (track.absent) return;
   track.absent = true;
   ++(reason == AbsentReason::kDeadline ? counters_.deadlines_missed : counters_.liveliness_lost);
+}
+
+bool EpochAssembler::all_absent() const {
+  return std::all_of(gyros_.begin(), gyros_.end(), [](const GyroTrack& g) { return g.absent; });
 }
 
 bool EpochAssembler::absent(int gyro_id) const {

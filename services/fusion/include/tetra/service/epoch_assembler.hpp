@@ -14,6 +14,8 @@
 //     of order (both dropped), a jump counts the skipped numbers as a gap (the sample is kept);
 //     a stamp that does not increase is out of order (dropped); a sample for an epoch already
 //     emitted is late (dropped); a gyro id outside 1..N is unknown (dropped). All are counted;
+//   * when every gyro is absent and any sample arrives, the unit resumes: all gyros are waited for
+//     again (the caller re-arms their deadlines);
 //   * when every gyro is absent and a sample comes back with a sequence number or stamp at or before
 //     the last ones seen, the sensor restarted: the assembler forgets its time base (counted in
 //     sensor_restarts; the caller resets its pipeline too) and starts again from that sample;
@@ -74,6 +76,8 @@ class EpochAssembler {
   //! It is present again as soon as it delivers a sample.
   void mark_absent(int gyro_id, AbsentReason reason);
   bool absent(int gyro_id) const;
+  //! True when every gyro is absent (the unit is silent).
+  bool all_absent() const;
 
   //! Appends to `out` every epoch ready at local time `now_ns`, in increasing stamp order.
   void poll(std::int64_t now_ns, std::vector<fdi::Epoch>& out);
