@@ -13,7 +13,7 @@ DOMAIN=${TETRA_BENCH_DOMAIN:-202}
 export CYCLONEDDS_URI="file://$PWD/config/cyclonedds-loopback.xml"
 WORK=$(mktemp -d)
 FUSION=""
-cleanup() { [ -n "$FUSION" ] && kill "$FUSION" 2>/dev/null; wait 2>/dev/null; rm -rf "$WORK"; }
+cleanup() { [ -n "$FUSION" ] && kill "$FUSION" 2>/dev/null; wait 2>/dev/null; [ -n "${TETRA_BENCH_KEEP:-}" ] && cp -r "$WORK" "$TETRA_BENCH_KEEP"; rm -rf "$WORK"; }
 trap cleanup EXIT
 MINUTES=$(python3 -c "print($SECONDS_RUN/60)")
 "$BUILD/dds_latency" --write-calibration "$WORK/cal.yaml"   # the simulator's unit (seed as built)
@@ -35,8 +35,8 @@ for line in open(sys.argv[1]):
     if h.get("type") != "health":
         continue
     c = h["counters"]
-    print("  service: epochs accepted %d, samples accepted %d, absent %d, late %d, duplicate %d, "
-          "out of order %d, gap %d, deadlines missed %d" % (c["epochs_accepted"], c["samples_accepted"],
+    print("  service: epochs accepted %d (rejected %d), samples accepted %d, absent %d, late %d, duplicate %d, "
+          "out of order %d, gap %d, deadlines missed %d" % (c["epochs_accepted"], c["epochs_rejected_time"], c["samples_accepted"],
           c["samples_absent"], c["samples_late"], c["samples_duplicate"], c["samples_out_of_order"],
           c["samples_gap"], c["deadlines_missed"]))
 PY

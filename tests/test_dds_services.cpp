@@ -196,9 +196,15 @@ TEST(DdsServices, StuckGyroIsIsolatedAndAttitudeFlowsDegraded_LateMonitorAndComm
   Observer observer(domain);
   const auto sim = run_tetra(sim_args(domain, 1));
   ASSERT_EQ(sim.exit_status, 0) << sim.err << sim.out << read_file(files.dir.file("fusion.log"));
-  // Every published epoch came back as an Attitude (3000 epochs: 30 s at 100 Hz).
+  // Every published epoch came back as an Attitude (3000 epochs: 30 s at 100 Hz) — except, under
+  // load, possibly the very first: a volatile writer sends only to readers it has discovered, and
+  // the simulator can see the service's Attitude writer a moment before that writer sees it.
   EXPECT_NE(sim.out.find("epochs published: 3000"), std::string::npos) << sim.out;
-  EXPECT_NE(sim.out.find("attitudes scored: 3000"), std::string::npos) << sim.out;
+  const bool all_scored = sim.out.find("attitudes scored: 3000") != std::string::npos;
+  const bool all_but_first =
+      sim.out.find("attitudes scored: 2999") != std::string::npos &&
+      sim.out.find("epochs without an attitude: 1 (the first at t = 0.000 s)") != std::string::npos;
+  EXPECT_TRUE(all_scored || all_but_first) << sim.out;
   EXPECT_NE(sim.out.find("mode DEGRADED, gyros 134"), std::string::npos) << sim.out;
 
   // A monitor started after the fault still gets the event history (transient-local).
@@ -277,15 +283,17 @@ TEST(DdsServices, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitudes) {
   EXPECT_EQ(dds_events, read_file(files.dir.file("replay_ev.jsonl")));
   // Same epochs, attitudes equal to 1e-9 (the bound; both run the same code on the same
   // doubles, so in practice they are identical).
+  // The recorder can miss the very first Attitude (see the end-to-end test): then it lacks row 1.
   const auto a = read_attitude(files.dir.file("dds_att.csv"));
   const auto b = read_attitude(files.dir.file("replay_att.csv"));
-  ASSERT_EQ(a.numbers.size(), 3000U);
-  ASSERT_EQ(a.numbers.size(), b.numbers.size());
+  ASSERT_EQ(b.numbers.size(), 3000U);
+  ASSERT_TRUE(a.numbers.size() == 3000U || a.numbers.size() == 2999U) << a.numbers.size();
+  const std::size_t offset = b.numbers.size() - a.numbers.size();
   for (std::size_t k = 0; k < a.numbers.size(); ++k) {
     for (std::size_t j = 0; j < 9; ++j) {
-      ASSERT_NEAR(a.numbers[k][j], b.numbers[k][j], 1e-9) << "row " << k + 1 << " column " << j;
+      ASSERT_NEAR(a.numbers[k][j], b.numbers[k + offset][j], 1e-9) << "row " << k + 1 << " column " << j;
     }
-    ASSERT_EQ(a.labels[k], b.labels[k]) << "row " << k + 1;
+    ASSERT_EQ(a.labels[k], b.labels[k + offset]) << "row " << k + 1;
   }
 }
 

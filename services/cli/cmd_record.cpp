@@ -90,13 +90,37 @@ int cmd_record(int argc, char** argv) {
   gyro_qos.reliable().volatile_durability().keep_last(4096);
   dds::Qos deep_qos;
   deep_qos.reliable().volatile_durability().keep_last(4096);
+  auto attitude_reader = dds::Reader<tetra_Attitude>::create(*participant, topics->attitude, deep_qos);
+  if (!attitude_reader) return report("record", attitude_reader.error());
+  if (!attitude_path.empty()) {
+    // Recording the service's output too: match its Attitude writer before the gyro reader exists,
+    // so a simulator waiting for this recorder's gyro reader cannot start before the first attitude
+    // can reach us.
+    auto matched = dds::WaitSet::create(*participant);
+    if (!matched) return report("record", matched.error());
+    if (dds_set_status_mask(attitude_reader->handle(), DDS_SUBSCRIPTION_MATCHED_STATUS) < 0 ||
+        !matched->attach(attitude_reader->handle(), 1)) {
+      return report("record", failure("DDS: cannot wait for the subscription-matched status"));
+    }
+    const std::int64_t give_up = monotonic_ns() + 10'000'000'000;
+    std::vector<std::intptr_t> fired;
+    while (*attitude_reader->matched_writers() == 0 && !shutdown.requested()) {
+      const std::int64_t now = monotonic_ns();
+      if (now >= give_up) {
+        std::cerr << "tetra record: no Attitude writer (fusion service) within 10 s; recording anyway\n";
+        break;
+      }
+      if (auto s = matched->wait(std::chrono::nanoseconds(give_up - now), fired); !s)
+        return report("record", s.error());
+      std::uint32_t status = 0;
+      (void)dds_take_status(attitude_reader->handle(), &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
+    }
+  }
   auto gyro_reader = dds::Reader<tetra_GyroSample>::create(*participant, topics->gyro_sample, gyro_qos);
   if (!gyro_reader) return report("record", gyro_reader.error());
   auto reference_reader =
       dds::Reader<tetra_AttitudeReference>::create(*participant, topics->reference, deep_qos);
   if (!reference_reader) return report("record", reference_reader.error());
-  auto attitude_reader = dds::Reader<tetra_Attitude>::create(*participant, topics->attitude, deep_qos);
-  if (!attitude_reader) return report("record", attitude_reader.error());
   auto event_reader = dds::Reader<tetra_FdiEvent>::create(*participant, topics->event, dds::event_qos());
   if (!event_reader) return report("record", event_reader.error());
   auto waitset = dds::WaitSet::create(*participant);

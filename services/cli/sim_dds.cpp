@@ -115,7 +115,11 @@ Result<SimDdsScore> run_sim_dds(sim::Simulator& simulator, const SimDdsOptions& 
   const auto take_attitudes = [&]() -> Status {
     auto taken = attitude_reader->take([&](const tetra_Attitude& msg, const dds_sample_info_t&) {
       if (dds::from_wire(msg.unit) != unit) return;
-      while (!truth.empty() && truth.front().first < msg.stamp_ns) truth.pop_front();
+      while (!truth.empty() && truth.front().first < msg.stamp_ns) {
+        if (score.missing == 0) score.first_missing_s = ns_to_seconds(truth.front().first);
+        ++score.missing;  // an epoch published, but no attitude for it
+        truth.pop_front();
+      }
       if (truth.empty() || truth.front().first != msg.stamp_ns) return;
       const auto estimate = dds::from_wire(msg);
       const double error_deg = angle_between(estimate.q_RB, truth.front().second) * kRadToDeg;
@@ -210,6 +214,10 @@ int sim_dds_main(sim::Simulator& simulator, const SimDdsOptions& options) {
   if (!score) return report("sim", score.error());
   std::cout << "epochs published: " << score->epochs_published << " in " << fixed(score->wall_s, 2) << " s\n"
             << "attitudes scored: " << score->attitudes_scored << '\n';
+  if (score->missing > 0) {
+    std::cout << "epochs without an attitude: " << score->missing
+              << " (the first at t = " << fixed(score->first_missing_s, 3) << " s)\n";
+  }
   if (score->series.empty()) {
     std::cout << "attitude error: no Attitude received for this unit (is `tetra fusion` running?)\n";
   } else {

@@ -44,6 +44,8 @@ struct ScoredEpoch {
 struct SimDdsScore {
   std::uint64_t epochs_published = 0;
   std::uint64_t attitudes_scored = 0;  //!< received and matched to a truth epoch
+  std::uint64_t missing = 0;           //!< epochs before a received attitude that got none
+  double first_missing_s = 0.0;        //!< [s] the first of them
   double wall_s = 0.0;                 //!< [s] publishing time
   double worst_deg = 0.0;
   double worst_time_s = 0.0;
