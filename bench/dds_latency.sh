@@ -15,15 +15,17 @@ FUSION=""
 cleanup() { [ -n "$FUSION" ] && kill "$FUSION" 2>/dev/null; wait 2>/dev/null; rm -rf "$WORK"; }
 trap cleanup EXIT
 
-floor() {
-  ddsperf -i "$DOMAIN" -D 7 pong >/dev/null 2>&1 &
+floor() {  # MODE: listener (ddsperf's default: handled on the receive thread) or waitset (like tetra)
+  ddsperf -i "$DOMAIN" -D 7 pong "$1" >/dev/null 2>&1 &
   local pong=$!
-  ddsperf -i "$DOMAIN" -D 6 ping "${RATE}Hz" 2>&1 | grep -E " 50% " | tail -n 4
+  ddsperf -i "$DOMAIN" -D 6 ping "${RATE}Hz" "$1" 2>&1 | grep -E " 50% " | tail -n 4
   wait "$pong" 2>/dev/null || true
 }
 
-echo "== ddsperf ping/pong round trip (two one-way hops), ${RATE} Hz, 12-byte samples"
-floor
+echo "== ddsperf ping/pong round trip (two one-way hops), ${RATE} Hz, 12-byte samples, listener"
+floor listener
+echo "== ddsperf ping/pong round trip, waitset (the wake-up structure of tetra fusion and dds_latency)"
+floor waitset
 echo "== tetra fusion: last GyroSample write -> Attitude receive, ${RATE} Hz"
 "$BUILD/dds_latency" --write-calibration "$WORK/cal.yaml"
 printf 'unit: tetra-1\ncalibration: cal.yaml\nsample_rate_hz: %s\n' "$RATE" > "$WORK/fusion.yaml"
@@ -31,5 +33,6 @@ printf 'unit: tetra-1\ncalibration: cal.yaml\nsample_rate_hz: %s\n' "$RATE" > "$
 FUSION=$!
 "$BUILD/dds_latency" --domain "$DOMAIN" --epochs 3000 --rate "$RATE"
 kill "$FUSION"; wait "$FUSION" || true; FUSION=""
-echo "== ddsperf ping/pong again"
-floor
+echo "== ddsperf ping/pong again, listener and waitset"
+floor listener
+floor waitset
