@@ -151,12 +151,12 @@ TEST(SimGyroModel, QuantizationStepAndNoDriftOfTheIntegral) {
     // The integrated output stays within half a step (plus rounding) of the integrated input.
     ASSERT_LE(std::abs(out_integral - in_integral), 0.5 * step_V * dt * (1.0 + 1e-6)) << "sample " << k;
   }
-  // Allan deviation of angle quantization: √3·Q/τ. Here the input also has a slow sinusoid whose
-  // Allan deviation at τ = 0.01–0.1 s is < 1e-9 V, negligible; at τ = 0.1 s: √3·Q/τ in deg/s × s.
-  const double expected_V = std::sqrt(3.0) * 6.0e-5 / 0.1 * std::abs(g.scale_factor_V_per_dps);
-  // The quantization error here is a deterministic sawtooth-like sequence rather than IEEE's
-  // independent model; we only require the order of magnitude (±40 %).
-  EXPECT_NEAR(overlapping_adev(out, 10) / expected_V, 1.0, 0.4);
+  // Allan deviation of angle quantization: √3·Q/τ, exact when the quantization errors of successive
+  // samples are independent and uniform. The input here sweeps slowly through the grid, so the
+  // errors are close to that at lag 1: at τ = Δt we require ±10 % (a wrong step, e.g. δ = Q
+  // instead of √12·Q, is off by 3.5×). At longer τ the slow sinusoid of the input dominates.
+  const double expected_V = std::sqrt(3.0) * 6.0e-5 / dt * std::abs(g.scale_factor_V_per_dps);
+  EXPECT_NEAR(overlapping_adev(out, 1) / expected_V, 1.0, 0.1);
 }
 
 TEST(SimGyroModel, SaturationClampsToTheMeasuringRange) {

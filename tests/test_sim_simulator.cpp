@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "sim_test_util.hpp"
+#include "test_support.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/sim/fault.hpp"
 #include "tetra/sim/scenario.hpp"
@@ -153,6 +154,20 @@ TEST(SimFaults, ParseRejectsBadSpecsWithTheField) {
   EXPECT_EQ(format_fault_spec(*ok), "gyro=3,kind=ramp,at=1.5,size=-0.25,until=9");
 }
 
+TEST(SimFaults, NoiseFaultNeedsWhiteNoiseToMultiply) {
+  Scenario sc = short_static();
+  sc.unit.gyros[2].noise.reset();
+  SimOptions opt;
+  opt.faults.push_back(parse_fault_spec("gyro=3,kind=noise,at=1,size=3").value());
+  auto sim = Simulator::create(sc, opt);
+  ASSERT_FALSE(sim.ok());
+  EXPECT_NE(sim.error().message.find("gyro 3 has no white noise"), std::string::npos) << sim.error().message;
+  opt.faults[0].gyro = 5;
+  sim = Simulator::create(sc, opt);
+  ASSERT_FALSE(sim.ok());
+  EXPECT_NE(sim.error().message.find("gyro 5 does not exist"), std::string::npos) << sim.error().message;
+}
+
 TEST(SimSimulator, SameSeedSameOutputDifferentSeedDifferent) {
   Scenario sc = builtin_scenario("orbit").value();
   sc.duration_s = 30.0;
@@ -285,6 +300,26 @@ TEST(SimScenario, YamlErrorsNameLineAndKey) {
     ASSERT_FALSE(r.ok()) << text;
     EXPECT_NE(r.error().message.find(needle), std::string::npos) << text << " -> " << r.error().message;
   }
+}
+
+}  // namespace
+}  // namespace tetra::sim
+
+namespace tetra::sim {
+namespace {
+
+TEST(SimScenario, ExampleFilesAreValid) {
+  for (const char* name : {"examples/sim/orbit_fault.yaml", "examples/sim/slews_custom.yaml",
+                           "examples/sim/static_allan.yaml"}) {
+    auto sc = read_scenario(test::source_path(name));
+    ASSERT_TRUE(sc.ok()) << name << ": " << sc.error().message;
+  }
+  // static_allan.yaml loads allan_unit.yaml (seed Table 6): gyro 2 has all of Q, N, B, K.
+  auto sc = read_scenario(test::source_path("examples/sim/static_allan.yaml"));
+  const GyroNoise& n = *sc->unit.gyros[1].noise;
+  EXPECT_EQ(n.quantization_deg, 6e-5);
+  EXPECT_EQ(n.rate_random_walk_dps_per_rts, 6e-8);
+  EXPECT_FALSE(sc->unit.gyros[0].noise->rate_random_walk_dps_per_rts.has_value());
 }
 
 }  // namespace

@@ -1,14 +1,262 @@
-// tetra calibrate — not yet part of this build.
+// tetra calibrate — turntable calibration: scale factor, bias and axis of every gyro with their 1σ,
+// printed like seed Tables 3–5, written as a calibration file (INTERFACES §2.3).
+#include <cmath>
+#include <cstdio>
 #include <iostream>
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "tetra/core/calibration.hpp"
+#include "tetra/core/calibration_file.hpp"
+#include "tetra/core/csv.hpp"
+#include "tetra/core/geometry.hpp"
+#include "tetra/core/turntable_log.hpp"
+#include "tetra/core/units.hpp"
 
 namespace tetra::cli {
 
-int cmd_calibrate(int /*argc*/, char** /*argv*/) {
-  std::cerr << "tetra calibrate: not available in this build\n";
-  return kExitFailure;
+namespace {
+
+constexpr const char* kName = "calibrate";
+
+template <class... Args>
+std::string format(const char* fmt, Args... args) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, fmt, args...);
+  return buf;
+}
+
+Result<double> latitude_from(const TurntableLog& log, const std::optional<double>& option_deg) {
+  if (option_deg) return *option_deg;
+  const auto text = log.meta("latitude_deg");
+  if (!text) {
+    return bad_input(log.source +
+                     ": no latitude: give --latitude DEG or a '# latitude_deg=DEG' comment line in the file");
+  }
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(*text, &used);
+    if (used != text->size()) throw std::invalid_argument("trailing text");
+    return v;
+  } catch (const std::exception&) {
+    return bad_input(log.source + ": comment '# latitude_deg=" + *text + "' is not a number");
+  }
+}
+
+void print_plan(const TurntableLog& log, const TurntableMotion& motion) {
+  std::cout
+      << "Rotation plan derived from the encoders (cf. seed Table 3; body rate = table + Earth, mean)\n";
+  std::cout << " seq  lines          gimbal   rate[deg/s]  turned[deg]  other gimbal[deg]"
+               "   omega_B x[deg/s]    y[deg/s]    z[deg/s]\n";
+  for (const auto& m : motion.sequences) {
+    const Eigen::Vector3d w = m.rate_B_dps();
+    const std::string lines = std::to_string(m.first_line) + "-" + std::to_string(m.last_line);
+    std::cout << format(" %3d  %-13s  %-6s  %+11.5f  %+11.3f  %s %+9.4f   %+12.6f  %+10.6f  %+10.6f\n",
+                        m.sequence, lines.c_str(), to_string(m.rotating), m.rate_dps, m.turned_deg,
+                        m.rotating == Gimbal::kInner ? "outer" : "inner", m.fixed_angle_deg, w.x(), w.y(),
+                        w.z());
+  }
+  std::cout << format("(%zu rows, %d gyros, latitude %+.4f deg)\n\n", log.rows(), log.gyro_count,
+                      motion.latitude_deg);
+}
+
+void print_estimates(const CalibrationResult& result, const CalibrationOptions& options,
+                     const std::optional<Calibration>& reference, const std::string& reference_name) {
+  const Calibration& cal = result.calibration;
+  std::cout << "Scale factors and biases (cf. seed Table 4), method " << to_string(options.method);
+  if (options.method == CalibrationMethod::kSixteen)
+    std::cout << ", bias model " << to_string(options.bias_model);
+  std::cout << "\n";
+  std::cout << " gyro  scale[V/(deg/s)]    1-sigma";
+  if (reference) std::cout << "  diff wrt ref";
+  std::cout << "      bias[V]    1-sigma";
+  if (reference) std::cout << "  diff wrt ref";
+  std::cout << "   resid RMS[V]: samples  seq.means\n";
+  for (int i = 0; i < cal.gyro_count(); ++i) {
+    const auto& g = cal.gyros[static_cast<std::size_t>(i)];
+    std::cout << format(" %4d  %16.8f  %9.2e", g.id, g.scale_factor_V_per_dps,
+                        g.sigma->scale_factor_V_per_dps);
+    if (reference) {
+      std::cout << format(
+          "  %+12.6f",
+          g.scale_factor_V_per_dps - reference->gyros[static_cast<std::size_t>(i)].scale_factor_V_per_dps);
+    }
+    std::cout << format("  %+11.8f  %9.2e", g.bias_V, g.sigma->bias_V);
+    if (reference)
+      std::cout << format("  %+12.6f", g.bias_V - reference->gyros[static_cast<std::size_t>(i)].bias_V);
+    std::cout << format("   %20.3e  %9.3e\n", result.fit.sample_rms_V(i), result.fit.sequence_rms_V(i));
+  }
+  std::cout << "\n";
+
+  std::cout << "Sensing axes H~ in B, unit vectors (cf. seed Table 5)\n";
+  std::cout << " gyro           x            y            z      1-sigma x    1-sigma y    1-sigma z";
+  if (reference) std::cout << "   angle to ref[deg]";
+  std::cout << "\n";
+  for (int i = 0; i < cal.gyro_count(); ++i) {
+    const auto& g = cal.gyros[static_cast<std::size_t>(i)];
+    std::cout << format(" %4d  %+11.7f  %+11.7f  %+11.7f  %11.2e  %11.2e  %11.2e", g.id, g.axis_B.x(),
+                        g.axis_B.y(), g.axis_B.z(), g.sigma->axis.x(), g.sigma->axis.y(), g.sigma->axis.z());
+    if (reference) {
+      const Eigen::Vector3d& h_ref = reference->gyros[static_cast<std::size_t>(i)].axis_B;
+      const double angle_deg = std::atan2(g.axis_B.cross(h_ref).norm(), g.axis_B.dot(h_ref)) * kRadToDeg;
+      std::cout << format("   %17.4f", angle_deg);
+    }
+    std::cout << "\n";
+  }
+  if (reference) {
+    std::cout << " " << reference_name << " axes:\n";
+    for (const auto& g : reference->gyros) {
+      std::cout << format(" %4d  %+11.7f  %+11.7f  %+11.7f\n", g.id, g.axis_B.x(), g.axis_B.y(),
+                          g.axis_B.z());
+    }
+  } else if (cal.gyro_count() == 4) {
+    const auto nominal = nominal_tetrahedron_axes();
+    std::cout << " nominal tetrahedron:\n";
+    for (int i = 0; i < 4; ++i) {
+      std::cout << format(" %4d  %+11.7f  %+11.7f  %+11.7f\n", i + 1, nominal(i, 0), nominal(i, 1),
+                          nominal(i, 2));
+    }
+  }
+  std::cout << "\n";
+}
+
+void print_comparison(const TurntableMotion& motion, const CalibrationFit& reference_fit,
+                      const CalibrationFit& fit, const std::string& reference_name, int gyro_count) {
+  std::cout << "Mean residual per sequence [V], measured - predicted (cf. seed Fig. 4): '" << reference_name
+            << "' | new\n";
+  std::cout << " seq";
+  for (int i = 1; i <= gyro_count; ++i) std::cout << format("     g%d ref        g%d new  ", i, i);
+  std::cout << "\n";
+  for (std::size_t j = 0; j < motion.sequences.size(); ++j) {
+    std::cout << format(" %3d", motion.sequences[j].sequence);
+    for (int i = 0; i < gyro_count; ++i) {
+      const auto row = static_cast<Eigen::Index>(j);
+      std::cout << format("  %+10.3e  %+10.3e ", reference_fit.sequence_residual_V(row, i),
+                          fit.sequence_residual_V(row, i));
+    }
+    std::cout << "\n";
+  }
+  std::cout << " RMS";
+  for (int i = 0; i < gyro_count; ++i) {
+    std::cout << format("  %10.3e  %10.3e ", reference_fit.sequence_rms_V(i), fit.sequence_rms_V(i));
+  }
+  std::cout << "\n ratio ref/new:";
+  for (int i = 0; i < gyro_count; ++i) {
+    std::cout << format("  g%d %.3g", i + 1, reference_fit.sequence_rms_V(i) / fit.sequence_rms_V(i));
+  }
+  std::cout << "\n\n";
+}
+
+}  // namespace
+
+int cmd_calibrate(int argc, char** argv) {
+  CLI::App app{
+      "Turntable calibration (seed eqs. 4-11): scale factor, bias and sensing axis of every gyro with their "
+      "1-sigma, from a turntable log (INTERFACES 2.1). Body rates come from the encoder angles.",
+      kName};
+  std::string input;
+  std::string output;
+  std::optional<double> latitude_deg;
+  std::string method_name = "sixteen";
+  std::string bias_model_name = "body";
+  std::string compare_path;
+  std::string unit_name;
+  app.add_option("TURNTABLE.csv", input, "turntable log: sequence,time_s,inner_deg,outer_deg,g1..gN")
+      ->required();
+  app.add_option("-o,--output", output, "calibration file to write (YAML, INTERFACES 2.3)")->required();
+  app.add_option("--latitude", latitude_deg,
+                 "[deg] geodetic latitude of the table (default: the file's '# latitude_deg=' comment)");
+  app.add_option(
+         "--method", method_name,
+         "sixteen: per-sequence means and pair differences (seed); batch: least squares over every sample")
+      ->check(CLI::IsMember({"sixteen", "batch"}))
+      ->capture_default_str();
+  app.add_option("--bias-model", bias_model_name,
+                 "sixteen only. body: Earth rate projected into B per sequence; seed: the seed's eq. 11 "
+                 "(lab-frame Earth rate, wrong while the body is rotated)")
+      ->check(CLI::IsMember({"body", "seed"}))
+      ->capture_default_str();
+  app.add_option(
+      "--compare", compare_path,
+      "another calibration (e.g. examples/factory.yaml): print its per-sequence residuals beside the new "
+      "one's (seed Fig. 4)");
+  app.add_option("--unit", unit_name,
+                 "unit name for the calibration file (default: '# unit=' comment or tetra-1)");
+  if (auto status = parse(app, argc, argv)) return *status;
+
+  CalibrationOptions options;
+  options.method = method_name == "batch" ? CalibrationMethod::kBatch : CalibrationMethod::kSixteen;
+  options.bias_model = bias_model_name == "seed" ? BiasModel::kSeed : BiasModel::kBody;
+  if (options.method == CalibrationMethod::kBatch && bias_model_name != "body") {
+    return report(
+        kName, bad_input("--bias-model applies to --method sixteen only (batch fits the bias per sample)"));
+  }
+
+  auto log = read_turntable_log(input);
+  if (!log) return report(kName, log.error());
+  auto latitude = latitude_from(*log, latitude_deg);
+  if (!latitude) return report(kName, latitude.error());
+  if (latitude_deg) {
+    if (const auto in_file = log->meta("latitude_deg")) {
+      std::cerr << "tetra calibrate: using --latitude " << *latitude_deg << " (the file says " << *in_file
+                << ")\n";
+    }
+  }
+  options.unit = !unit_name.empty() ? unit_name : log->meta("unit").value_or("tetra-1");
+
+  std::optional<Calibration> reference;
+  if (!compare_path.empty()) {
+    auto ref = read_calibration(compare_path);
+    if (!ref) return report(kName, ref.error());
+    if (ref->gyro_count() != log->gyro_count) {
+      return report(kName, bad_input(compare_path + ": has " + std::to_string(ref->gyro_count()) +
+                                     " gyros, " + input + " has " + std::to_string(log->gyro_count)));
+    }
+    reference = std::move(ref.value());
+  }
+
+  auto motion = analyze_turntable(*log, *latitude);
+  if (!motion) return report(kName, motion.error());
+  auto result = calibrate(*log, *motion, options);
+  if (!result) return report(kName, result.error());
+
+  print_plan(*log, *motion);
+  print_estimates(*result, options, reference, compare_path);
+  if (reference) {
+    auto reference_fit = evaluate_calibration(*log, *motion, *reference);
+    if (!reference_fit) return report(kName, reference_fit.error());
+    print_comparison(*motion, *reference_fit, result->fit, compare_path, log->gyro_count);
+  }
+  if (options.method == CalibrationMethod::kSixteen && options.bias_model == BiasModel::kSeed) {
+    CalibrationOptions body = options;
+    body.bias_model = BiasModel::kBody;
+    if (auto body_result = calibrate(*log, *motion, body)) {
+      std::cout << "Seed eq. 11 bias minus body-model bias [V]:";
+      for (int i = 0; i < log->gyro_count; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        std::cout << format("  g%d %+.3e", i + 1,
+                            result->calibration.gyros[k].bias_V - body_result->calibration.gyros[k].bias_V);
+      }
+      std::cout << "\n(eq. 11 subtracts the lab-frame Earth rate although the body is rotated; see "
+                   "docs/calibration.md)\n\n";
+    }
+  }
+  std::cout
+      << "1-sigma: "
+      << (options.method == CalibrationMethod::kSixteen
+              ? "per-sequence standard deviation of the mean, propagated"
+              : "residual covariance of the fit")
+      << "; both assume white noise within a sequence, so correlated noise (bias instability, rate random "
+         "walk) makes them optimistic.\n";
+
+  auto written = write_calibration(output, result->calibration);
+  if (!written) return report(kName, written.error());
+  std::cerr << "tetra calibrate: wrote " << output << "\n";
+  return kExitOk;
 }
 
 }  // namespace tetra::cli

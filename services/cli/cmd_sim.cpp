@@ -1,4 +1,5 @@
 // tetra sim SCENARIO — simulated gyro data with known truth (see docs/sim.md).
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <iostream>
@@ -24,12 +25,12 @@ namespace {
 constexpr const char* kName = "sim";
 
 void print_progress(double fraction) {
-  std::cerr << "tetra sim: " << static_cast<int>(fraction * 100.0 + 0.5) << " %\n";
+  std::cerr << "tetra sim: " << std::lround(fraction * 100.0) << " %\n";
 }
 
-int run_turntable(const Calibration& unit, const sim::TurntablePlan& plan, std::uint64_t seed,
-                  const std::string& out_path) {
-  auto log = sim::simulate_turntable(unit, plan, seed);
+int run_turntable(const Calibration& unit, const sim::TurntablePlan& plan, const sim::GyroModelOptions& model,
+                  std::uint64_t seed, const std::string& out_path) {
+  auto log = sim::simulate_turntable(unit, plan, seed, model);
   if (!log) return report(kName, log.error());
   const bool to_stdout = out_path.empty() || out_path == "-";
   if (to_stdout) {
@@ -70,6 +71,7 @@ int cmd_sim(int argc, char** argv) {
   double jitter_s = 0.0;
   double drop_probability = 0.0;
   double range_dps = 0.0;
+  double orbit_period_min = 0.0;
   sim::TurntablePlan plan;
   app.add_option("SCENARIO", scenario_name, "turntable | static | lab-orbit | orbit | slews | FILE.yaml")
       ->required();
@@ -93,6 +95,8 @@ int cmd_sim(int argc, char** argv) {
                                      "[deg] orbit/slews: attitude-control motion amplitude (0 = none)");
   auto* opt_acs_acc =
       app.add_option("--acs-accel", acs_accel_dps2, "[deg/s^2] orbit/slews: its peak acceleration");
+  auto* opt_period =
+      app.add_option("--orbit-period", orbit_period_min, "[min] orbit/slews: orbit period (one pitch turn)");
   auto* opt_jitter = app.add_option("--jitter", jitter_s, "[s] sample-time jitter, uniform +-");
   auto* opt_drop =
       app.add_option("--drop", drop_probability, "probability that a gyro sample is not delivered");
@@ -119,13 +123,18 @@ int cmd_sim(int argc, char** argv) {
   }
 
   if (scenario_name == "turntable") {
-    if (opt_minutes->count() || !fault_texts.empty() || opt_ref->count() || !truth_path.empty()) {
-      return report(kName,
-                    bad_input("turntable: --minutes, --fault, --reference-hz and --truth do not apply"));
+    for (const CLI::Option* o :
+         {opt_minutes, opt_ref, opt_ref_noise, opt_acs_amp, opt_acs_acc, opt_period, opt_jitter, opt_drop}) {
+      if (o->count()) return report(kName, bad_input("turntable: " + o->get_name() + " does not apply"));
+    }
+    if (!fault_texts.empty() || !truth_path.empty()) {
+      return report(kName, bad_input("turntable: --fault and --truth do not apply"));
     }
     if (opt_rate->count()) plan.rate_hz = rate_hz;
     if (opt_lat->count()) plan.latitude_deg = latitude_deg;
-    return run_turntable(unit ? *unit : seed_as_built_unit(), plan, seed, out_path);
+    sim::GyroModelOptions model;
+    if (opt_range->count()) model.range_dps = range_dps;
+    return run_turntable(unit ? *unit : seed_as_built_unit(), plan, model, seed, out_path);
   }
 
   Result<sim::Scenario> scenario = looks_like_file(scenario_name) ? sim::read_scenario(scenario_name)
@@ -140,6 +149,7 @@ int cmd_sim(int argc, char** argv) {
   if (opt_ref_noise->count()) sc.reference.noise_arcsec = reference_noise_arcsec;
   if (opt_acs_amp->count()) sc.motion.acs.amplitude_deg = acs_amplitude_deg;
   if (opt_acs_acc->count()) sc.motion.acs.peak_accel_dps2 = acs_accel_dps2;
+  if (opt_period->count()) sc.motion.orbit_period_s = orbit_period_min * 60.0;
   if (opt_jitter->count()) sc.jitter_s = jitter_s;
   if (opt_drop->count()) sc.drop_probability = drop_probability;
   if (opt_range->count()) sc.model.range_dps = range_dps;

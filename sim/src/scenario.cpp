@@ -78,7 +78,7 @@ Eigen::Vector3d vector3(const Ctx& ctx, const YAML::Node& node, const std::strin
 
 Eigen::Vector3d axis_from(const Ctx& ctx, const YAML::Node& node, const std::string& what) {
   if (node.IsScalar()) {
-    const std::string name = node.Scalar();
+    const std::string& name = node.Scalar();
     if (name == "x" || name == "+x") return Eigen::Vector3d::UnitX();
     if (name == "y" || name == "+y") return Eigen::Vector3d::UnitY();
     if (name == "z" || name == "+z") return Eigen::Vector3d::UnitZ();
@@ -272,9 +272,16 @@ Status validate_scenario(const Scenario& sc) {
     return bad_input("gyro_model range_dps must be positive");
   }
   for (const FaultSpec& f : sc.faults) {
-    if (f.gyro > sc.unit.gyro_count()) {
+    if (f.gyro < 1 || f.gyro > sc.unit.gyro_count()) {
       return bad_input("fault '" + format_fault_spec(f) + "': gyro " + std::to_string(f.gyro) +
                        " does not exist (the unit has " + std::to_string(sc.unit.gyro_count()) + " gyros)");
+    }
+    if (f.kind == FaultKind::kNoise) {
+      const auto& noise = sc.unit.gyros[static_cast<std::size_t>(f.gyro - 1)].noise;
+      if (!noise || !noise->arw_dps_rtHz || *noise->arw_dps_rtHz == 0.0) {
+        return bad_input("fault '" + format_fault_spec(f) + "': gyro " + std::to_string(f.gyro) +
+                         " has no white noise (noise: arw_dps_rtHz) for a noise fault to multiply");
+      }
     }
   }
   return ok_status();

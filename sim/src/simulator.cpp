@@ -36,14 +36,10 @@ Simulator::Simulator(Scenario scenario, SimOptions options, TruthMotion motion)
 }
 
 Result<Simulator> Simulator::create(const Scenario& scenario, const SimOptions& options) {
-  if (Status st = validate_scenario(scenario); !st) return st.error();
-  for (const FaultSpec& f : options.faults) {
-    if (f.gyro > scenario.unit.gyro_count()) {
-      return bad_input("fault '" + format_fault_spec(f) + "': gyro " + std::to_string(f.gyro) +
-                       " does not exist (the unit has " + std::to_string(scenario.unit.gyro_count()) +
-                       " gyros)");
-    }
-  }
+  // Validate the scenario with the run's extra faults, so they get the same checks.
+  Scenario all = scenario;
+  all.faults.insert(all.faults.end(), options.faults.begin(), options.faults.end());
+  if (Status st = validate_scenario(all); !st) return st.error();
   auto motion = TruthMotion::create(scenario.motion, options.seed);
   if (!motion) return motion.error();
   return Simulator(scenario, options, std::move(motion.value()));

@@ -18,6 +18,7 @@
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/quaternion.hpp"
 #include "tetra/core/result.hpp"
+#include "tetra/core/units.hpp"
 #include "tetra/sim/gyro_model.hpp"
 #include "tetra/sim/motion.hpp"
 #include "tetra/sim/scenario.hpp"
@@ -51,6 +52,8 @@ class Simulator {
 
   int gyro_count() const { return scenario_.unit.gyro_count(); }
   std::size_t epoch_count() const { return epochs_; }
+  //! [ns] nominal interval between epochs (a real-time publisher paces on it).
+  std::int64_t period_ns() const { return seconds_to_ns(1.0 / scenario_.rate_hz); }
   std::size_t epochs_done() const { return k_; }
   const Scenario& scenario() const { return scenario_; }
   const TruthMotion& motion() const { return motion_; }

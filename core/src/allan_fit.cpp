@@ -1,0 +1,163 @@
+// Non-negative weighted least-squares fit of the IEEE Std 952 terms to an Allan curve.
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <Eigen/Dense>
+
+#include "tetra/core/allan.hpp"
+
+namespace tetra::allan {
+
+const char* term_symbol(int term) {
+  static constexpr const char* kSymbols[kTermCount] = {"Q", "N", "B", "K", "R"};
+  return term >= 0 && term < kTermCount ? kSymbols[term] : "?";
+}
+
+double term_basis(int term, double tau_s) {
+  switch (term) {
+    case kQ:
+      return 3.0 / (tau_s * tau_s);
+    case kN:
+      return 1.0 / tau_s;
+    case kB:
+      return 2.0 * std::numbers::ln2 / std::numbers::pi;
+    case kK:
+      return tau_s / 3.0;
+    case kR:
+      return tau_s * tau_s / 2.0;
+    default:
+      return 0.0;
+  }
+}
+
+NoiseType term_noise_type(int term) {
+  switch (term) {
+    case kQ:
+      return NoiseType::kWhitePhase;
+    case kN:
+      return NoiseType::kWhiteRate;
+    case kB:
+      return NoiseType::kFlickerRate;
+    default:
+      return NoiseType::kRandomWalkRate;
+  }
+}
+
+double NoiseFit::model_avar(double tau_s) const {
+  double sum = 0.0;
+  for (int k = 0; k < kTermCount; ++k) {
+    const double v = value[static_cast<std::size_t>(k)];
+    sum += v * v * term_basis(k, tau_s);
+  }
+  return sum;
+}
+
+NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weights_from) {
+  NoiseFit fit;
+  // Rows scaled by √(edf/2)/σ²: the residual of a row is the error of the model in units of the
+  // standard deviation of the variance estimate (Var s² = 2σ⁴/edf for a χ² estimate). σ² is the
+  // previous fit's model where given, else the measured value.
+  std::vector<const AdevPoint*> used;
+  for (const AdevPoint& p : points) {
+    if (p.terms > 0 && p.adev > 0.0 && std::isfinite(p.adev) && p.edf > 0.0) used.push_back(&p);
+  }
+  const auto rows = static_cast<Eigen::Index>(used.size());
+  fit.points_used = static_cast<int>(rows);
+  if (rows == 0) return fit;
+  Eigen::MatrixXd a(rows, kTermCount);
+  Eigen::VectorXd b(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    const AdevPoint& p = *used[static_cast<std::size_t>(i)];
+    const double avar = p.adev * p.adev;
+    const double model = weights_from != nullptr ? weights_from->model_avar(p.tau_s) : 0.0;
+    const double w = std::sqrt(0.5 * p.edf) / (model > 0.0 ? model : avar);
+    for (int k = 0; k < kTermCount; ++k) a(i, k) = w * term_basis(k, p.tau_s);
+    b(i) = w * avar;
+  }
+  // Column scaling: the basis functions span many decades.
+  Eigen::VectorXd col_norm(kTermCount);
+  for (int k = 0; k < kTermCount; ++k) {
+    col_norm(k) = a.col(k).norm();
+    if (col_norm(k) > 0.0) a.col(k) /= col_norm(k);
+  }
+
+  // Exact NNLS for five unknowns: the optimum is the unconstrained least-squares solution on its own
+  // support, so the best feasible subset solution is the optimum. `allowed` limits the terms.
+  auto nnls = [&](int allowed) {
+    double best_cost = b.squaredNorm();
+    Eigen::VectorXd best = Eigen::VectorXd::Zero(kTermCount);
+    for (int mask = 1; mask < (1 << kTermCount); ++mask) {
+      if ((mask & ~allowed) != 0) continue;
+      std::vector<int> cols;
+      for (int k = 0; k < kTermCount; ++k) {
+        if ((mask & (1 << k)) != 0) cols.push_back(k);
+      }
+      const auto nc = static_cast<Eigen::Index>(cols.size());
+      if (nc > rows) continue;
+      Eigen::MatrixXd sub(rows, nc);
+      for (Eigen::Index j = 0; j < nc; ++j) sub.col(j) = a.col(cols[static_cast<std::size_t>(j)]);
+      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(sub);
+      if (qr.rank() < nc) continue;
+      const Eigen::VectorXd coef = qr.solve(b);
+      if ((coef.array() <= 0.0).any()) continue;
+      const double cost = (sub * coef - b).squaredNorm();
+      if (cost < best_cost) {
+        best_cost = cost;
+        best.setZero();
+        for (Eigen::Index j = 0; j < nc; ++j) best(cols[static_cast<std::size_t>(j)]) = coef(j);
+      }
+    }
+    // Back to σ² coefficients (Q², N², B², K², R²).
+    std::array<double, kTermCount> c{};
+    for (int k = 0; k < kTermCount; ++k) {
+      c[static_cast<std::size_t>(k)] = col_norm(k) > 0.0 ? std::max(0.0, best(k) / col_norm(k)) : 0.0;
+    }
+    return c;
+  };
+  auto model = [](const std::array<double, kTermCount>& c, double tau_s) {
+    double sum = 0.0;
+    for (int k = 0; k < kTermCount; ++k) sum += c[static_cast<std::size_t>(k)] * term_basis(k, tau_s);
+    return sum;
+  };
+
+  constexpr int kAllTerms = (1 << kTermCount) - 1;
+  const std::array<double, kTermCount> coeff = nnls(kAllTerms);
+  for (int k = 0; k < kTermCount; ++k)
+    fit.value[static_cast<std::size_t>(k)] = std::sqrt(coeff[static_cast<std::size_t>(k)]);
+
+  // Where each term dominates.
+  std::vector<int> largest(used.size(), -1);
+  for (std::size_t i = 0; i < used.size(); ++i) {
+    double best = 0.0;
+    for (int k = 0; k < kTermCount; ++k) {
+      const double contribution = coeff[static_cast<std::size_t>(k)] * term_basis(k, used[i]->tau_s);
+      if (contribution > best) {
+        best = contribution;
+        largest[i] = k;
+      }
+    }
+    if (largest[i] < 0) continue;
+    const auto kl = static_cast<std::size_t>(largest[i]);
+    if (fit.dominant_from_s[kl] == 0.0) fit.dominant_from_s[kl] = used[i]->tau_s;
+    fit.dominant_to_s[kl] = used[i]->tau_s;
+  }
+  // Observed: the model re-fitted without the term leaves the 95 % confidence interval of the
+  // measured variance at some τ where the term dominates — the other terms cannot stand in for it.
+  for (int k = 0; k < kTermCount; ++k) {
+    if (fit.dominant_from_s[static_cast<std::size_t>(k)] == 0.0) continue;
+    const std::array<double, kTermCount> without = nnls(kAllTerms & ~(1 << k));
+    for (std::size_t i = 0; i < used.size() && !fit.observed[static_cast<std::size_t>(k)]; ++i) {
+      if (largest[i] != k) continue;
+      const AdevPoint& p = *used[i];
+      const double avar = p.adev * p.adev;
+      const double lower95 = avar * p.edf / chi2_quantile(0.975, p.edf);
+      const double upper95 = avar * p.edf / chi2_quantile(0.025, p.edf);
+      const double alt = model(without, p.tau_s);
+      if (alt < lower95 || alt > upper95) fit.observed[static_cast<std::size_t>(k)] = true;
+    }
+  }
+  return fit;
+}
+
+}  // namespace tetra::allan

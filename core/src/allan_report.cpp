@@ -1,0 +1,192 @@
+// Reports of an Allan analysis: CSV and JSON of INTERFACES §2.6, a table like seed Table 6, and the
+// calibration file's noise sections.
+#include <cmath>
+#include <cstdio>
+
+#include "tetra/core/allan.hpp"
+#include "tetra/core/csv.hpp"
+
+namespace tetra::allan {
+
+namespace {
+
+std::string sci(double v, int digits = 2) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.*e", digits, v);
+  return buf;
+}
+
+std::string pad(std::string s, std::size_t width) {
+  // Width in code points, so that "√" and "²" count as one column.
+  std::size_t cols = 0;
+  for (const char ch : s) cols += (static_cast<unsigned char>(ch) & 0xC0) != 0x80 ? 1 : 0;
+  if (cols < width) s.append(width - cols, ' ');
+  return s;
+}
+
+// Units of each term for rate data in `rate_unit` ("deg/s" or "V").
+std::array<std::string, kTermCount> term_units(const std::string& rate_unit) {
+  if (rate_unit == "deg/s") return {"deg", "deg/√s", "deg/s", "deg/s/√s", "deg/s²"};
+  return {"V·s", "V·√s", "V", "V/√s", "V/s"};
+}
+
+constexpr std::array<const char*, kTermCount> kTermNames = {
+    "quantization", "angle random walk", "bias instability", "rate random walk", "rate ramp"};
+
+}  // namespace
+
+double customary_factor(int term) {
+  switch (term) {
+    case kQ:
+      return 1.0;
+    case kN:
+      return 60.0;
+    case kB:
+      return 3600.0;
+    case kK:
+      return 3600.0 * 60.0;
+    case kR:
+      return 3600.0 * 3600.0;
+    default:
+      return 1.0;
+  }
+}
+
+std::string format_csv(const LogAllan& analysis) {
+  std::string out = "gyro,tau_s,adev,adev_lo,adev_hi,n\n";
+  for (const GyroAllan& g : analysis.gyros) {
+    for (const AdevPoint& p : g.result.points) {
+      append_int(out, g.id);
+      out += ',';
+      append_double(out, p.tau_s);
+      out += ',';
+      append_double(out, p.adev);
+      out += ',';
+      append_double(out, p.adev_lo);
+      out += ',';
+      append_double(out, p.adev_hi);
+      out += ',';
+      append_int(out, p.terms);
+      out += '\n';
+    }
+  }
+  return out;
+}
+
+std::string format_json(const LogAllan& analysis) {
+  std::string out = "{\"units\": \"" + analysis.units + "\", \"tau0_s\": ";
+  append_double(out, analysis.tau0_s);
+  out += ", \"gyros\": [";
+  for (std::size_t i = 0; i < analysis.gyros.size(); ++i) {
+    const GyroAllan& g = analysis.gyros[i];
+    out += i == 0 ? "\n  " : ",\n  ";
+    out += "{\"id\": ";
+    append_int(out, g.id);
+    for (int k = 0; k < kTermCount; ++k) {
+      out += ", \"";
+      out += term_symbol(k);
+      out += "\": ";
+      if (const auto v = g.result.fit.reported(k)) {
+        append_double(out, *v);
+      } else {
+        out += "null";
+      }
+    }
+    out += ", \"samples\": ";
+    append_int(out, static_cast<long long>(g.result.present_samples));
+    out += ", \"absent\": ";
+    append_int(out, static_cast<long long>(g.absent));
+    out += ", \"invalid\": ";
+    append_int(out, static_cast<long long>(g.invalid));
+    out += "}";
+  }
+  out += "\n]}\n";
+  return out;
+}
+
+std::string format_table(const LogAllan& analysis) {
+  std::string out;
+  const auto units = term_units(analysis.units);
+  out += "Allan variance noise terms (IEEE Std 952-1997), units " + analysis.units +
+         ", tau0 = " + sci(analysis.tau0_s, 3) + " s; NO = not observed in these data\n";
+  const std::size_t w = 16;
+  out += pad("gyro", 6);
+  for (int k = 0; k < kTermCount; ++k) {
+    out += pad(std::string(term_symbol(k)) + " [" + units[static_cast<std::size_t>(k)] + "]", w);
+  }
+  out += '\n';
+  for (const GyroAllan& g : analysis.gyros) {
+    out += pad(std::to_string(g.id), 6);
+    for (int k = 0; k < kTermCount; ++k) {
+      const auto v = g.result.fit.reported(k);
+      out += pad(v ? sci(*v) : "NO", w);
+    }
+    out += '\n';
+  }
+  if (analysis.units == "deg/s") {
+    out += "\nIn customary units (bias instability B; the flat floor of the Allan deviation is 0.664 B)\n";
+    const std::array<std::string, kTermCount> customary = {"deg", "deg/√h", "deg/h", "deg/h/√h", "deg/h²"};
+    out += pad("gyro", 6);
+    for (int k = 0; k < kTermCount; ++k) {
+      out += pad(std::string(term_symbol(k)) + " [" + customary[static_cast<std::size_t>(k)] + "]", w);
+    }
+    out += '\n';
+    for (const GyroAllan& g : analysis.gyros) {
+      out += pad(std::to_string(g.id), 6);
+      for (int k = 0; k < kTermCount; ++k) {
+        const auto v = g.result.fit.reported(k);
+        out += pad(v ? sci(*v * customary_factor(k)) : "NO", w);
+      }
+      out += '\n';
+    }
+  } else {
+    out += "\n(customary units deg/√h, deg/h, ... need rates in deg/s: give --calibration CAL.yaml)\n";
+  }
+  out += "\nWhere each term dominates the fitted curve (tau range) and the data behind each gyro:\n";
+  for (const GyroAllan& g : analysis.gyros) {
+    const AllanResult& r = g.result;
+    out += "gyro " + std::to_string(g.id) + ": " + std::to_string(r.present_samples) + " samples used, " +
+           std::to_string(g.absent) + " absent, " + std::to_string(g.invalid) + " invalid; " +
+           std::to_string(r.points.size()) + " averaging times";
+    if (!r.points.empty()) {
+      out += " " + sci(r.points.front().tau_s) + " .. " + sci(r.points.back().tau_s) + " s";
+    }
+    out += '\n';
+    bool any = false;
+    for (int k = 0; k < kTermCount; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      if (r.fit.dominant_from_s[kk] == 0.0) continue;
+      any = true;
+      out += "  " + pad(kTermNames[kk], 18) + sci(r.fit.dominant_from_s[kk]) + " .. " +
+             sci(r.fit.dominant_to_s[kk]) + " s" +
+             (r.fit.observed[kk] ? "" : "  (the other terms explain the data as well: NO)") + '\n';
+    }
+    if (!any) out += "  no term could be fitted: the data cannot tell the noise terms\n";
+  }
+  return out;
+}
+
+Status update_calibration_noise(Calibration& cal, const LogAllan& analysis) {
+  if (analysis.units != "deg/s") {
+    return bad_input(
+        "--update-calibration needs rates in deg/s: the noise terms of a volts log are not in the "
+        "calibration file's units");
+  }
+  for (const GyroAllan& g : analysis.gyros) {
+    if (g.id < 1 || g.id > cal.gyro_count()) {
+      return bad_input("--update-calibration: gyro " + std::to_string(g.id) +
+                       " is not in the calibration file");
+    }
+    GyroNoise noise;
+    const NoiseFit& f = g.result.fit;
+    noise.quantization_deg = f.reported(kQ);
+    noise.arw_dps_rtHz = f.reported(kN);
+    noise.bias_instability_dps = f.reported(kB);
+    noise.rate_random_walk_dps_per_rts = f.reported(kK);
+    noise.rate_ramp_dps_per_s = f.reported(kR);
+    cal.gyros[static_cast<std::size_t>(g.id - 1)].noise = noise;
+  }
+  return ok_status();
+}
+
+}  // namespace tetra::allan

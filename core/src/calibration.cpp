@@ -1,0 +1,264 @@
+// The two calibration estimators (seed eqs. 4–11 and a batch least-squares fit) and the residuals of
+// any calibration on turntable data. See calibration.hpp for the equations.
+#include "tetra/core/calibration.hpp"
+
+#include <cmath>
+#include <string>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include "tetra/core/frames.hpp"
+#include "tetra/core/units.hpp"
+
+namespace tetra {
+
+namespace {
+
+using Vector4d = Eigen::Matrix<double, 4, 1>;
+using Matrix4d = Eigen::Matrix<double, 4, 4>;
+
+Eigen::Index idx(std::size_t i) {
+  return static_cast<Eigen::Index>(i);
+}
+
+//! Per-sequence means of every gyro (M×N) [V].
+Eigen::MatrixXd sequence_means(const TurntableLog& log, const TurntableMotion& motion) {
+  const int n_gyros = log.gyro_count;
+  Eigen::MatrixXd mean = Eigen::MatrixXd::Zero(idx(motion.sequences.size()), n_gyros);
+  for (std::size_t j = 0; j < motion.sequences.size(); ++j) {
+    const SequenceMotion& m = motion.sequences[j];
+    for (std::size_t r = m.first_row; r < m.first_row + m.row_count; ++r) {
+      for (int i = 0; i < n_gyros; ++i) mean(idx(j), i) += log.g(r, i);
+    }
+    mean.row(idx(j)) /= static_cast<double>(m.row_count);
+  }
+  return mean;
+}
+
+//! 1σ of each sequence mean (M×N) [V]: the scatter of g_i − x_i·ω_B about its own sequence mean
+//! (the deterministic rate signal removed), sample standard deviation / √n.
+Eigen::MatrixXd sequence_sigma_of_mean(const TurntableLog& log, const TurntableMotion& motion,
+                                       const Eigen::MatrixX3d& x) {
+  const int n_gyros = log.gyro_count;
+  const auto m_count = idx(motion.sequences.size());
+  Eigen::MatrixXd sigma(m_count, n_gyros);
+  Eigen::VectorXd sum(n_gyros);
+  Eigen::VectorXd sum_sq(n_gyros);
+  for (std::size_t j = 0; j < motion.sequences.size(); ++j) {
+    const SequenceMotion& m = motion.sequences[j];
+    // Shift by the first row's value so the sums do not lose precision.
+    Eigen::VectorXd shift(n_gyros);
+    for (int i = 0; i < n_gyros; ++i) {
+      shift(i) = log.g(m.first_row, i) - x.row(i).dot(motion.rate_B_dps[m.first_row]);
+    }
+    sum.setZero();
+    sum_sq.setZero();
+    for (std::size_t r = m.first_row; r < m.first_row + m.row_count; ++r) {
+      const Eigen::Vector3d& w = motion.rate_B_dps[r];
+      for (int i = 0; i < n_gyros; ++i) {
+        const double e = log.g(r, i) - x.row(i).dot(w) - shift(i);
+        sum(i) += e;
+        sum_sq(i) += e * e;
+      }
+    }
+    const double n = static_cast<double>(m.row_count);
+    for (int i = 0; i < n_gyros; ++i) {
+      const double variance = std::max(0.0, (sum_sq(i) - sum(i) * sum(i) / n) / (n - 1.0));
+      sigma(idx(j), i) = std::sqrt(variance / n);
+    }
+  }
+  return sigma;
+}
+
+//! Fills a gyro's estimate from x = s·h and β with the 4×4 covariance of (x, β):
+//! s = |x|, h = x/s; ∂s/∂x = hᵀ, ∂h/∂x = (I − h hᵀ)/s.
+GyroCalibration to_gyro(int id, const Eigen::Vector3d& x, double bias_V, const Matrix4d& cov) {
+  GyroCalibration g;
+  g.id = id;
+  g.scale_factor_V_per_dps = x.norm();
+  g.axis_B = x / g.scale_factor_V_per_dps;
+  g.bias_V = bias_V;
+  const Eigen::Matrix3d cov_x = cov.topLeftCorner<3, 3>();
+  const Eigen::Matrix3d j_h =
+      (Eigen::Matrix3d::Identity() - g.axis_B * g.axis_B.transpose()) / g.scale_factor_V_per_dps;
+  GyroSigma s;
+  s.scale_factor_V_per_dps = std::sqrt(std::max(0.0, g.axis_B.dot(cov_x * g.axis_B)));
+  s.bias_V = std::sqrt(std::max(0.0, cov(3, 3)));
+  s.axis = (j_h * cov_x * j_h.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
+  g.sigma = s;
+  return g;
+}
+
+Result<CalibrationResult> calibrate_sixteen(const TurntableLog& log, const TurntableMotion& motion,
+                                            const CalibrationOptions& options) {
+  const int n_gyros = log.gyro_count;
+  const std::size_t m_count = motion.sequences.size();
+  const std::size_t pairs = m_count / 2;
+  const Eigen::MatrixXd g_mean = sequence_means(log, motion);
+
+  // Eqs. 5–7: Δḡ = Ω x with Ω rows ω̄(2k−1) − ω̄(2k) (encoder-derived, Earth rate included).
+  // x = Ω# Δḡ = Ω# S ḡ =: L ḡ, with S (P×M) the pair-difference operator.
+  Eigen::MatrixXd omega(idx(pairs), 3);
+  Eigen::MatrixXd pair_diff = Eigen::MatrixXd::Zero(idx(pairs), idx(m_count));
+  for (std::size_t p = 0; p < pairs; ++p) {
+    omega.row(idx(p)) =
+        (motion.sequences[2 * p].rate_B_dps() - motion.sequences[2 * p + 1].rate_B_dps()).transpose();
+    pair_diff(idx(p), idx(2 * p)) = 1.0;
+    pair_diff(idx(p), idx(2 * p + 1)) = -1.0;
+  }
+  const Eigen::Matrix3d normal = omega.transpose() * omega;
+  const Eigen::MatrixXd to_x = normal.ldlt().solve(omega.transpose() * pair_diff);  // L, 3×M
+
+  // Eq. 10/11: β = cᵀ ḡ. Body: β = mean_j(ḡ_j − x·ω̄_j). Seed eq. 11: β = mean_j ḡ_j − x·ω_e^L.
+  Eigen::Vector3d subtracted_dps = Eigen::Vector3d::Zero();
+  if (options.bias_model == BiasModel::kBody) {
+    for (const auto& m : motion.sequences) subtracted_dps += m.rate_B_dps();
+    subtracted_dps /= static_cast<double>(m_count);
+  } else {
+    subtracted_dps = earth_rate_L(motion.latitude_deg * kDegToRad) * kRadToDeg;
+  }
+  const Eigen::VectorXd to_bias =
+      Eigen::VectorXd::Constant(idx(m_count), 1.0 / static_cast<double>(m_count)) -
+      to_x.transpose() * subtracted_dps;
+
+  Eigen::MatrixX3d x(n_gyros, 3);
+  Eigen::VectorXd bias(n_gyros);
+  for (int i = 0; i < n_gyros; ++i) {
+    x.row(i) = (to_x * g_mean.col(i)).transpose();
+    bias(i) = to_bias.dot(g_mean.col(i));
+  }
+  const Eigen::MatrixXd sigma_mean = sequence_sigma_of_mean(log, motion, x);
+
+  // Linear propagation: (x, β) = [L; cᵀ] ḡ_i with cov(ḡ_i) = diag(σ_mean²).
+  Eigen::MatrixXd to_params(4, idx(m_count));
+  to_params.topRows(3) = to_x;
+  to_params.row(3) = to_bias.transpose();
+  CalibrationResult result;
+  result.calibration.unit = options.unit;
+  result.calibration.latitude_deg = motion.latitude_deg;
+  result.calibration.method =
+      options.bias_model == BiasModel::kBody ? "sixteen-position" : "sixteen-position-seed-bias";
+  for (int i = 0; i < n_gyros; ++i) {
+    const Eigen::VectorXd var = sigma_mean.col(i).array().square();
+    const Matrix4d cov = to_params * var.asDiagonal() * to_params.transpose();
+    result.calibration.gyros.push_back(to_gyro(i + 1, x.row(i).transpose(), bias(i), cov));
+  }
+  result.sequence_sigma_mean_V = sigma_mean;
+  return result;
+}
+
+Result<CalibrationResult> calibrate_batch(const TurntableLog& log, const TurntableMotion& motion,
+                                          const CalibrationOptions& options) {
+  const int n_gyros = log.gyro_count;
+  // Regressor a = (ω_B, 1) is the same for every gyro: one normal matrix, N right-hand sides.
+  Matrix4d normal = Matrix4d::Zero();
+  Eigen::Matrix<double, 4, Eigen::Dynamic> rhs = Eigen::Matrix<double, 4, Eigen::Dynamic>::Zero(4, n_gyros);
+  const std::size_t rows = log.rows();
+  for (const auto& m : motion.sequences) {
+    for (std::size_t r = m.first_row; r < m.first_row + m.row_count; ++r) {
+      const Eigen::Vector3d& w = motion.rate_B_dps[r];
+      const Vector4d a(w.x(), w.y(), w.z(), 1.0);
+      normal.selfadjointView<Eigen::Lower>().rankUpdate(a);
+      for (int i = 0; i < n_gyros; ++i) rhs.col(i) += a * log.g(r, i);
+    }
+  }
+  normal = normal.selfadjointView<Eigen::Lower>();
+  const Eigen::LDLT<Matrix4d> ldlt(normal);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) {
+    return bad_input(log.source +
+                     ": the batch fit is singular: the samples do not separate rates and biases");
+  }
+  const Eigen::Matrix<double, 4, Eigen::Dynamic> theta = ldlt.solve(rhs);
+  const Matrix4d normal_inv = ldlt.solve(Matrix4d::Identity());
+
+  Eigen::VectorXd rss = Eigen::VectorXd::Zero(n_gyros);
+  for (std::size_t r = 0; r < rows; ++r) {
+    const Eigen::Vector3d& w = motion.rate_B_dps[r];
+    for (int i = 0; i < n_gyros; ++i) {
+      const double e = log.g(r, i) - theta.col(i).head<3>().dot(w) - theta(3, i);
+      rss(i) += e * e;
+    }
+  }
+  const double dof = static_cast<double>(rows) - 4.0;
+  if (dof < 1.0) return bad_input(log.source + ": too few rows for the batch fit");
+
+  CalibrationResult result;
+  result.calibration.unit = options.unit;
+  result.calibration.latitude_deg = motion.latitude_deg;
+  result.calibration.method = "batch";
+  Eigen::MatrixX3d x(n_gyros, 3);
+  for (int i = 0; i < n_gyros; ++i) {
+    x.row(i) = theta.col(i).head<3>().transpose();
+    const Matrix4d cov = (rss(i) / dof) * normal_inv;
+    result.calibration.gyros.push_back(to_gyro(i + 1, theta.col(i).head<3>(), theta(3, i), cov));
+  }
+  result.sequence_sigma_mean_V = sequence_sigma_of_mean(log, motion, x);
+  return result;
+}
+
+}  // namespace
+
+Result<CalibrationFit> evaluate_calibration(const TurntableLog& log, const TurntableMotion& motion,
+                                            const Calibration& calibration) {
+  const int n_gyros = log.gyro_count;
+  if (calibration.gyro_count() != n_gyros) {
+    return bad_input("the calibration has " + std::to_string(calibration.gyro_count()) + " gyros, " +
+                     log.source + " has " + std::to_string(n_gyros));
+  }
+  if (motion.rate_B_dps.size() != log.rows())
+    return failure("evaluate_calibration: motion does not match the log");
+  const Eigen::MatrixX3d axes = calibration.axes_B();
+  Eigen::MatrixX3d x(n_gyros, 3);
+  Eigen::VectorXd bias(n_gyros);
+  for (int i = 0; i < n_gyros; ++i) {
+    x.row(i) = calibration.gyros[static_cast<std::size_t>(i)].scale_factor_V_per_dps * axes.row(i);
+    bias(i) = calibration.gyros[static_cast<std::size_t>(i)].bias_V;
+  }
+  CalibrationFit fit;
+  const auto m_count = idx(motion.sequences.size());
+  fit.sequence_residual_V = Eigen::MatrixXd::Zero(m_count, n_gyros);
+  Eigen::VectorXd sum_sq = Eigen::VectorXd::Zero(n_gyros);
+  std::size_t samples = 0;
+  for (std::size_t j = 0; j < motion.sequences.size(); ++j) {
+    const SequenceMotion& m = motion.sequences[j];
+    for (std::size_t r = m.first_row; r < m.first_row + m.row_count; ++r) {
+      const Eigen::Vector3d& w = motion.rate_B_dps[r];
+      for (int i = 0; i < n_gyros; ++i) {
+        const double e = log.g(r, i) - x.row(i).dot(w) - bias(i);
+        fit.sequence_residual_V(idx(j), i) += e;
+        sum_sq(i) += e * e;
+      }
+    }
+    fit.sequence_residual_V.row(idx(j)) /= static_cast<double>(m.row_count);
+    samples += m.row_count;
+  }
+  fit.sample_rms_V = (sum_sq / static_cast<double>(samples)).cwiseSqrt();
+  fit.sequence_rms_V = (fit.sequence_residual_V.colwise().squaredNorm() / static_cast<double>(m_count))
+                           .transpose()
+                           .cwiseSqrt();
+  return fit;
+}
+
+Result<CalibrationResult> calibrate(const TurntableLog& log, const TurntableMotion& motion,
+                                    const CalibrationOptions& options) {
+  if (motion.rate_B_dps.size() != log.rows() || motion.sequences.empty()) {
+    return failure("calibrate: the motion was not derived from this log");
+  }
+  auto result = options.method == CalibrationMethod::kSixteen ? calibrate_sixteen(log, motion, options)
+                                                              : calibrate_batch(log, motion, options);
+  if (!result) return result;
+  for (const auto& g : result->calibration.gyros) {
+    if (!std::isfinite(g.scale_factor_V_per_dps) || g.scale_factor_V_per_dps <= 0.0 ||
+        !std::isfinite(g.bias_V)) {
+      return bad_input(log.source + ": gyro " + std::to_string(g.id) +
+                       " has no usable estimate (its output does not follow the table rates)");
+    }
+  }
+  auto fit = evaluate_calibration(log, motion, result->calibration);
+  if (!fit) return fit.error();
+  result->fit = std::move(fit.value());
+  return result;
+}
+
+}  // namespace tetra
