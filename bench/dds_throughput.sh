@@ -3,8 +3,7 @@
 #   bench/dds_throughput.sh [BUILD_DIR] [SECONDS]     (defaults: build, 60)
 # 1. 2 kHz epochs (8 k samples/s) in real time for SECONDS: epochs published by the simulator vs
 #    epochs the service accepted and attitudes the simulator got back (zero lost is the goal);
-# 2. 100 Hz for SECONDS: the service's CPU share of one core and its peak resident memory
-#    (/usr/bin/time -v).
+# 2. 100 Hz for SECONDS: the service's CPU share of one core and its peak resident memory (/proc).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
@@ -22,9 +21,9 @@ sed -i 's/^unit: .*/unit: tetra-1/' "$WORK/cal.yaml"
 run() {  # RATE_HZ: service + simulator for SECONDS_RUN, then the service's counters
   local rate=$1
   printf 'unit: tetra-1\ncalibration: cal.yaml\nsample_rate_hz: %s\nmax_latency_s: 0.01\n' "$rate" > "$WORK/fusion.yaml"
-  /usr/bin/time -v "$BUILD/tetra" fusion --config "$WORK/fusion.yaml" --domain "$DOMAIN" --log-level warn \
-    > "$WORK/fusion.log" 2> "$WORK/fusion.time" &
+  "$BUILD/tetra" fusion --config "$WORK/fusion.yaml" --domain "$DOMAIN" --log-level warn > "$WORK/fusion.log" 2>&1 &
   FUSION=$!
+  local started=$(date +%s.%N)
   "$BUILD/tetra" sim static --dds --dds-unit tetra-1 --domain "$DOMAIN" --rate-hz "$rate" --minutes "$MINUTES" \
     --speed 1 2> "$WORK/sim.err" | sed "s/^/  sim: /" || { cat "$WORK/sim.err" "$WORK/fusion.log" "$WORK/fusion.time"; exit 1; }
   "$BUILD/tetra" monitor --once --jsonl --unit tetra-1 --domain "$DOMAIN" > "$WORK/health.jsonl"
@@ -40,8 +39,19 @@ for line in open(sys.argv[1]):
           c["samples_absent"], c["samples_late"], c["samples_duplicate"], c["samples_out_of_order"],
           c["samples_gap"], c["deadlines_missed"]))
 PY
+  # CPU time and peak resident memory of the service over its whole life so far (/proc).
+  python3 - "$FUSION" "$started" <<'PY'
+import os, sys, time
+pid, started = sys.argv[1], float(sys.argv[2])
+fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
+ticks = os.sysconf("SC_CLK_TCK")
+cpu_s = (int(fields[11]) + int(fields[12])) / ticks
+elapsed = time.time() - started
+hwm = [l for l in open(f"/proc/{pid}/status") if l.startswith("VmHWM")][0].split()[1]
+print("  service: CPU %.2f s over %.1f s = %.1f %% of one core; peak RSS %.1f MB" %
+      (cpu_s, elapsed, 100 * cpu_s / elapsed, int(hwm) / 1024))
+PY
   kill -TERM "$FUSION"; wait "$FUSION" || true; FUSION=""
-  grep -E "Percent of CPU|Maximum resident|Elapsed" "$WORK/fusion.time" | sed 's/^\s*/  service: /'
 }
 
 echo "== 2 kHz epochs (8 k samples/s), ${SECONDS_RUN} s real time"

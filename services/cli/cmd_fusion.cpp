@@ -69,6 +69,7 @@ class FusionService {
   std::optional<fdi::Health> last_health_;  //!< as last published
   fdi::Health health_scratch_;              //!< reused for each comparison
   std::uint64_t event_seq_ = 0;
+  std::uint32_t gyro_writers_ = 0;  //!< matched GyroSample writers (published in Health)
   std::uint64_t last_restarts_ = 0;
   struct PendingAck {
     fdi::EventType type;
@@ -130,7 +131,8 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown)
       !s)
     return s;
   if (auto s = gyro_reader_->enable_statuses(DDS_REQUESTED_DEADLINE_MISSED_STATUS |
-                                             DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS);
+                                             DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
+                                             DDS_SUBSCRIPTION_MATCHED_STATUS);
       !s)
     return s;
 
@@ -177,13 +179,23 @@ Status FusionService::run(const dds::ShutdownSignal& shutdown) {
     now = monotonic_ns();
     bool deadline_status = false;
     bool command_data = false;
+    bool matched_changed = false;
     for (const auto token : triggered) {
       command_data = command_data || token == kCommandData;
       if (token == kGyroStatus) {
         std::uint32_t status = 0;
         (void)dds_take_status(gyro_reader_->handle(), &status,
-                              DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS);
+                              DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
+                                  DDS_SUBSCRIPTION_MATCHED_STATUS);
         deadline_status = (status & DDS_REQUESTED_DEADLINE_MISSED_STATUS) != 0;
+        if ((status & DDS_SUBSCRIPTION_MATCHED_STATUS) != 0) {
+          // A sensor (or simulator) came or went: say so in Health at once (a simulator waits for it).
+          auto matched = gyro_reader_->matched_writers();
+          if (!matched) return matched.error();
+          gyro_writers_ = *matched;
+          spdlog::info("fusion: {} GyroSample writer(s) matched", gyro_writers_);
+          matched_changed = true;
+        }
         if ((status & DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS) != 0) {
           spdlog::warn(
               "fusion: a GyroSample writer offers incompatible QoS (its deadline must be at most {} s: "
@@ -201,8 +213,8 @@ Status FusionService::run(const dds::ShutdownSignal& shutdown) {
     }
     const bool newly_absent = check_deadlines(now, deadline_status);
     if (auto s = process_epochs(now); !s) return s;
-    if (command_data || newly_absent || now >= next_health_ns_) {
-      if (auto s = publish_health(now, false); !s) return s;
+    if (command_data || newly_absent || matched_changed || now >= next_health_ns_) {
+      if (auto s = publish_health(now, matched_changed); !s) return s;
     }
   }
   spdlog::info("fusion: signal {} received, shutting down", shutdown.signal_number());
@@ -362,6 +374,7 @@ Status FusionService::publish_health(std::int64_t now_ns, bool force) {
   dds::WireHealth wire;
   if (auto s = dds::to_wire(config_.unit, health, assembler_.counters(), wire); !s) return s;
   wire.msg.events_published = event_seq_;
+  wire.msg.gyro_writers = gyro_writers_;
   if (auto s = health_writer_->write(wire.msg); !s) return s;
   if (last_health_) {
     *last_health_ = health;  // reuses the storage

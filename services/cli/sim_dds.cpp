@@ -90,6 +90,37 @@ Result<SimDdsScore> run_sim_dds(sim::Simulator& simulator, const SimDdsOptions& 
     if (auto s = waitset->wait(std::chrono::nanoseconds(give_up - now), triggered); !s) return s.error();
   }
 
+  // A volatile reader receives only what is written after IT has discovered the writer, which can
+  // be a moment after the writer has discovered the reader. So wait, when a service for this unit
+  // exists (its Health arrives within a second), until its Health says it hears a GyroSample writer.
+  if (options.wait_readers > 0) {
+    auto health_reader = dds::Reader<tetra_Health>::create(*participant, topics->health, dds::health_qos());
+    if (!health_reader) return health_reader.error();
+    auto health_data = dds::Condition::data_available(health_reader->handle());
+    if (!health_data) return health_data.error();
+    auto health_waitset = dds::WaitSet::create(*participant);
+    if (!health_waitset) return health_waitset.error();
+    if (auto s = health_waitset->attach(health_data->handle(), 1); !s) return s.error();
+    bool service_seen = false;
+    bool service_hears = false;
+    const std::int64_t first_give_up = monotonic_ns() + 1'000'000'000;
+    const std::int64_t hears_give_up =
+        monotonic_ns() + static_cast<std::int64_t>(options.wait_timeout_s * 1e9);
+    std::vector<std::intptr_t> fired;
+    for (;;) {
+      auto taken = health_reader->take([&](const tetra_Health& h, const dds_sample_info_t&) {
+        if (dds::from_wire(h.unit) != unit) return;
+        service_seen = true;
+        service_hears = service_hears || h.gyro_writers > 0;
+      });
+      if (!taken) return taken.error();
+      const std::int64_t now = monotonic_ns();
+      const std::int64_t limit = service_seen ? hears_give_up : first_give_up;
+      if (service_hears || now >= limit || stop_requested()) break;
+      if (auto s = health_waitset->wait(std::chrono::nanoseconds(limit - now), fired); !s) return s.error();
+    }
+  }
+
   // And (briefly) for the service's Attitude writer, so that the first epochs are scored too.
   if (options.wait_readers > 0) {
     if (dds_set_status_mask(attitude_reader->handle(), DDS_SUBSCRIPTION_MATCHED_STATUS) < 0) {

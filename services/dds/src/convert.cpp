@@ -158,6 +158,7 @@ HealthView from_wire(const tetra_Health& in) {
   out.counters.samples_other_unit = c.samples_other_unit;
   out.counters.sensor_restarts = c.sensor_restarts;
   out.events_published = in.events_published;
+  out.gyro_writers = in.gyro_writers;
   out.counters.deadlines_missed = c.deadlines_missed;
   out.counters.liveliness_lost = c.liveliness_lost;
   return out;

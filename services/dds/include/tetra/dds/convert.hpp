@@ -48,6 +48,7 @@ struct HealthView {
   fdi::Health health;
   service::AssemblerCounters counters;
   std::uint64_t events_published = 0;  //!< event_seq of the service's last event
+  std::uint32_t gyro_writers = 0;      //!< GyroSample writers the service has matched
 };
 HealthView from_wire(const tetra_Health& in);
 
