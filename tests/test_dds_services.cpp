@@ -47,6 +47,7 @@ class Process {
   Process(const std::vector<std::string>& args, const std::string& log_path) {
     std::vector<std::string> storage{TETRA_BINARY};
     storage.insert(storage.end(), args.begin(), args.end());
+    std::fflush(stdout);  // or the child's freopen() would write our buffered output a second time
     pid_ = fork();
     if (pid_ == 0) {
       std::vector<char*> argv;
