@@ -117,46 +117,71 @@ TEST_F(DdsSecurity, UnauthenticatedParticipantSeesAndInjectsNothing) {
   TempDir dir;
   Process fusion({"fusion", "--config", service_config(dir, "sec-1"), "--domain", std::to_string(domain)},
                  dir.file("fusion.log"));
-  // The secured sensor: 8 s of an orbit at 50 Hz in real time.
-  Process sim({"sim", "orbit", "--dds", "--dds-unit", "sec-1", "--domain", std::to_string(domain), "--rate-hz",
-               "50", "--minutes", "0.1333", "--reference-hz", "0", "--security", profile("sensor"),
-               "--wait-timeout", "30"},
-              dir.file("sim.log"));
+  // The secured sensor: 12 s of an orbit at 50 Hz in real time.
+  Process sim(
+      {"sim", "orbit", "--dds", "--dds-unit", "sec-1", "--domain", std::to_string(domain), "--rate-hz", "50",
+       "--minutes", "0.2", "--reference-hz", "0", "--security", profile("sensor"), "--wait-timeout", "30"},
+      dir.file("sim.log"));
 
-  // The intruder: no credentials. Readers of every output topic, writers of GyroSample and Command.
-  auto participant = dds::Participant::create(domain);
-  ASSERT_TRUE(participant.ok()) << participant.error().message;
-  auto topics = dds::Topics::create(*participant);
-  ASSERT_TRUE(topics.ok()) << topics.error().message;
-  auto health = dds::Reader<tetra_Health>::create(*participant, topics->health, dds::health_qos());
-  auto attitude = dds::Reader<tetra_Attitude>::create(*participant, topics->attitude, dds::attitude_qos());
-  auto events = dds::Reader<tetra_FdiEvent>::create(*participant, topics->event, dds::event_qos());
-  auto samples = dds::Reader<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
-  auto gyro_writer = dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
-  auto command_writer = dds::Writer<tetra_Command>::create(*participant, topics->command, dds::command_qos());
-  ASSERT_TRUE(health.ok() && attitude.ok() && events.ok() && samples.ok() && gyro_writer.ok() &&
-              command_writer.ok());
-
-  // While the secured chain runs, the intruder writes a reset command and wild samples for the unit.
-  tetra_Command command{};
-  std::snprintf(command.unit, sizeof command.unit, "%s", "sec-1");
-  command.command_id = 4242;
-  command.kind = tetra_COMMAND_RESET;
-  tetra_GyroSample sample{};
-  std::snprintf(sample.unit, sizeof sample.unit, "%s", "sec-1");
-  int seen = 0;
-  for (int k = 0; k < 50; ++k) {  // 5 s
-    sample.gyro = static_cast<std::int16_t>(1 + k % 4);
-    sample.seq = static_cast<std::uint64_t>(1000000 + k);
-    sample.raw = 1.0e3;
-    (void)gyro_writer->write(sample);
-    (void)command_writer->write(command);
-    seen += count_taken(*health) + count_taken(*attitude) + count_taken(*events) + count_taken(*samples);
-    std::this_thread::sleep_for(100ms);
+  // The eavesdropper: no credentials, a reader on each of the six topics, for 3 s of the secured run.
+  {
+    auto participant = dds::Participant::create(domain);
+    ASSERT_TRUE(participant.ok()) << participant.error().message;
+    auto topics = dds::Topics::create(*participant);
+    ASSERT_TRUE(topics.ok()) << topics.error().message;
+    auto health = dds::Reader<tetra_Health>::create(*participant, topics->health, dds::health_qos());
+    auto attitude = dds::Reader<tetra_Attitude>::create(*participant, topics->attitude, dds::attitude_qos());
+    auto events = dds::Reader<tetra_FdiEvent>::create(*participant, topics->event, dds::event_qos());
+    auto samples =
+        dds::Reader<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+    auto references =
+        dds::Reader<tetra_AttitudeReference>::create(*participant, topics->reference, dds::reference_qos());
+    auto commands = dds::Reader<tetra_Command>::create(*participant, topics->command, dds::command_qos());
+    ASSERT_TRUE(health.ok() && attitude.ok() && events.ok() && samples.ok() && references.ok() &&
+                commands.ok());
+    int seen = 0;
+    for (int k = 0; k < 30; ++k) {
+      seen += count_taken(*health) + count_taken(*attitude) + count_taken(*events) + count_taken(*samples) +
+              count_taken(*references) + count_taken(*commands);
+      std::this_thread::sleep_for(100ms);
+    }
+    EXPECT_EQ(seen, 0) << "the unauthenticated participant received samples";
+    for (dds_entity_t reader : {health->handle(), attitude->handle(), events->handle(), samples->handle(),
+                                references->handle(), commands->handle()}) {
+      dds_subscription_matched_status_t matched{};
+      ASSERT_EQ(dds_get_subscription_matched_status(reader, &matched), DDS_RETCODE_OK);
+      EXPECT_EQ(matched.total_count, 0u) << "an unauthenticated reader matched a secured writer";
+    }
   }
-  EXPECT_EQ(seen, 0) << "the unauthenticated participant received samples";
-  EXPECT_EQ(gyro_writer->matched_readers().value(), 0u) << "a secured reader matched an unauthenticated writer";
-  EXPECT_EQ(command_writer->matched_readers().value(), 0u);
+  // The injector: no credentials, writes a reset command and wild samples for the unit for 3 s.
+  {
+    auto participant = dds::Participant::create(domain);
+    ASSERT_TRUE(participant.ok()) << participant.error().message;
+    auto topics = dds::Topics::create(*participant);
+    ASSERT_TRUE(topics.ok()) << topics.error().message;
+    auto gyro_writer =
+        dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+    auto command_writer =
+        dds::Writer<tetra_Command>::create(*participant, topics->command, dds::command_qos());
+    ASSERT_TRUE(gyro_writer.ok() && command_writer.ok());
+    tetra_Command command{};
+    std::snprintf(command.unit, sizeof command.unit, "%s", "sec-1");
+    command.command_id = 4242;
+    command.kind = tetra_COMMAND_RESET;
+    tetra_GyroSample sample{};
+    std::snprintf(sample.unit, sizeof sample.unit, "%s", "sec-1");
+    for (int k = 0; k < 30; ++k) {
+      sample.gyro = static_cast<std::int16_t>(1 + k % 4);
+      sample.seq = static_cast<std::uint64_t>(1000000 + k);
+      sample.raw = 1.0e3;
+      EXPECT_TRUE(gyro_writer->write(sample).ok());
+      EXPECT_TRUE(command_writer->write(command).ok());
+      std::this_thread::sleep_for(100ms);
+    }
+    EXPECT_EQ(gyro_writer->matched_readers().value(), 0u)
+        << "a secured reader matched an unauthenticated writer";
+    EXPECT_EQ(command_writer->matched_readers().value(), 0u);
+  }
 
   // Positive control, with the ground identity: the service ran on the sensor's samples and no
   // command or wild sample reached it.
@@ -184,12 +209,14 @@ TEST_F(DdsSecurity, SensorCannotWriteCommand) {
   auto topics = dds::Topics::create(*participant);
   ASSERT_TRUE(topics.ok()) << topics.error().message;
   // Allowed: the sensor's own topic.
-  auto gyro = dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+  auto gyro =
+      dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
   EXPECT_TRUE(gyro.ok()) << gyro.error().message;
   // Refused: Command.
   auto command = dds::Writer<tetra_Command>::create(*participant, topics->command, dds::command_qos());
   ASSERT_FALSE(command.ok());
-  EXPECT_NE(command.error().message.find("Not Allowed By Security"), std::string::npos) << command.error().message;
+  EXPECT_NE(command.error().message.find("Not Allowed By Security"), std::string::npos)
+      << command.error().message;
   // The same through the command line.
   const auto cli = run_tetra("command --unit sec-1 --timeout 5 --domain " + std::to_string(domain) +
                              " --security " + profile("sensor") + " reset");
@@ -205,12 +232,14 @@ TEST_F(DdsSecurity, OnlySensorsWriteGyroSamples) {
     ASSERT_TRUE(participant.ok()) << role << ": " << participant.error().message;
     auto topics = dds::Topics::create(*participant);
     ASSERT_TRUE(topics.ok()) << topics.error().message;
-    auto writer = dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+    auto writer =
+        dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
     ASSERT_FALSE(writer.ok()) << role << " may write GyroSample";
     EXPECT_NE(writer.error().message.find("Not Allowed By Security"), std::string::npos)
         << role << ": " << writer.error().message;
     // Each may read the samples (positive control: the identity itself is accepted).
-    auto reader = dds::Reader<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+    auto reader =
+        dds::Reader<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
     EXPECT_TRUE(reader.ok()) << role << ": " << reader.error().message;
   }
   // A simulator started with the ground identity is refused.

@@ -112,8 +112,10 @@ XML
      xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_permissions.xsd">
   <permissions>
 XML
-  # sensor: the unit's gyros and star tracker (and `sim --dds`, which also scores the service's Attitude)
-  grant sensor "GyroSample AttitudeReference" "Attitude"
+  # sensor: the unit's gyros and star tracker, `sim --dds` (which scores the service's Attitude). It
+  # may read the other topics only because a participant creates every topic of the unit and Cyclone
+  # refuses to create a topic the grant does not name; it may write nothing but its samples.
+  grant sensor "GyroSample AttitudeReference" "Attitude Health FdiEvent Command"
   # fusion: the service
   grant fusion "Attitude Health FdiEvent" "GyroSample AttitudeReference Command"
   # ground: monitor, command, record

@@ -403,6 +403,7 @@ int cmd_fusion(int argc, char** argv) {
 
   auto config = service::read_fusion_config(config_path);
   if (!config) return report("fusion", config.error());
+  if (config->security) dds::set_security_profile(config->security);
   auto pipeline = fdi::Pipeline::create(config->calibration, config->pipeline);
   if (!pipeline) return report("fusion", pipeline.error());
   auto assembler = service::EpochAssembler::create(config->assembler(pipeline->gyro_count()));

@@ -8,12 +8,24 @@
 #include <ctime>
 #include <filesystem>
 
+#include "tetra/dds/entity.hpp"
+#include "tetra/service/security_profile.hpp"
+
 namespace tetra::cli {
 
 void add_domain_option(CLI::App& app, dds_domainid_t& domain) {
   domain = DDS_DOMAIN_DEFAULT;
   app.add_option("--domain", domain, "DDS domain id (default: the Cyclone configuration's, normally 0)")
       ->check(CLI::Range(0, 232));
+  // Opt-in DDS Security (docs/reliability.md): the participant's identity and permissions.
+  app.add_option_function<std::string>(
+      "--security",
+      [](const std::string& path) {
+        auto profile = service::read_security_profile(path);
+        if (!profile) throw CLI::ValidationError("--security", profile.error().message);
+        dds::set_security_profile(std::move(profile).value());
+      },
+      "DDS Security profile YAML of this participant's role (scripts/security/make_pki.sh)");
 }
 
 std::int64_t monotonic_ns() {

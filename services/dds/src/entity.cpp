@@ -8,6 +8,39 @@ Error dds_error(const std::string& what, dds_return_t rc) {
   return failure("DDS " + what + ": " + dds_strretcode(rc));
 }
 
+namespace {
+
+std::optional<service::SecurityProfile>& process_security_profile() {
+  static std::optional<service::SecurityProfile> profile;
+  return profile;
+}
+
+//! Cyclone's built-in plugins (libdds_security_{auth,ac,crypto}) and the profile's documents.
+void set_security_properties(dds_qos_t* qos, const service::SecurityProfile& p) {
+  const auto file = [](const std::string& path) { return "file:" + path; };
+  dds_qset_prop(qos, "dds.sec.auth.library.path", "dds_security_auth");
+  dds_qset_prop(qos, "dds.sec.auth.library.init", "init_authentication");
+  dds_qset_prop(qos, "dds.sec.auth.library.finalize", "finalize_authentication");
+  dds_qset_prop(qos, "dds.sec.auth.identity_ca", file(p.identity_ca).c_str());
+  dds_qset_prop(qos, "dds.sec.auth.identity_certificate", file(p.identity_certificate).c_str());
+  dds_qset_prop(qos, "dds.sec.auth.private_key", file(p.private_key).c_str());
+  dds_qset_prop(qos, "dds.sec.access.library.path", "dds_security_ac");
+  dds_qset_prop(qos, "dds.sec.access.library.init", "init_access_control");
+  dds_qset_prop(qos, "dds.sec.access.library.finalize", "finalize_access_control");
+  dds_qset_prop(qos, "dds.sec.access.permissions_ca", file(p.permissions_ca).c_str());
+  dds_qset_prop(qos, "dds.sec.access.governance", file(p.governance).c_str());
+  dds_qset_prop(qos, "dds.sec.access.permissions", file(p.permissions).c_str());
+  dds_qset_prop(qos, "dds.sec.crypto.library.path", "dds_security_crypto");
+  dds_qset_prop(qos, "dds.sec.crypto.library.init", "init_crypto");
+  dds_qset_prop(qos, "dds.sec.crypto.library.finalize", "finalize_crypto");
+}
+
+}  // namespace
+
+void set_security_profile(std::optional<service::SecurityProfile> profile) {
+  process_security_profile() = std::move(profile);
+}
+
 void Entity::reset() {
   if (handle_ > 0) (void)dds_delete(handle_);
   handle_ = 0;
@@ -58,8 +91,15 @@ Qos& Qos::no_autodispose() {
 }
 
 Result<Participant> Participant::create(dds_domainid_t domain) {
-  const dds_entity_t handle = dds_create_participant(domain, nullptr, nullptr);
-  if (handle < 0) return dds_error("create participant on domain " + std::to_string(domain), handle);
+  const auto& security = process_security_profile();
+  Qos qos;
+  if (security) set_security_properties(qos.mutable_qos(), *security);
+  const dds_entity_t handle = dds_create_participant(domain, security ? qos.get() : nullptr, nullptr);
+  if (handle < 0) {
+    return dds_error("create participant on domain " + std::to_string(domain) +
+                         (security ? " with DDS Security profile " + security->source : std::string()),
+                     handle);
+  }
   return Participant(Entity(handle));
 }
 

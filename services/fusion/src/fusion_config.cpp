@@ -68,18 +68,27 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
   FusionConfig config;
   config.source = source;
   const std::set<std::string> known = {"unit",        "calibration",   "sample_rate_hz",  "speed",
-                                       "tolerance_s", "max_latency_s", "health_period_s", "pipeline"};
+                                       "tolerance_s", "max_latency_s", "health_period_s", "pipeline",
+                                       "security"};
   for (const auto& item : root) {
     const auto key = item.first.as<std::string>();
     if (!known.contains(key)) {
       return bad_input(where(source, item.first) + "unknown key '" + key +
                        "' (allowed: unit, calibration, sample_rate_hz, speed, tolerance_s, "
-                       "max_latency_s, health_period_s, pipeline)");
+                       "max_latency_s, health_period_s, pipeline, security)");
     }
     const YAML::Node& value = item.second;
     if (key == "unit" || key == "calibration") {
       if (!value.IsScalar()) return bad_input(where(source, value) + key + " must be text");
       (key == "unit" ? config.unit : config.calibration_path) = value.as<std::string>();
+    } else if (key == "security") {
+      if (!value.IsScalar()) return bad_input(where(source, value) + "security must be a file name");
+      std::filesystem::path profile_path(value.as<std::string>());
+      if (profile_path.is_relative() && !base_dir.empty())
+        profile_path = std::filesystem::path(base_dir) / profile_path;
+      auto profile = read_security_profile(profile_path.string());
+      if (!profile) return bad_input(where(source, value) + "security: " + profile.error().message);
+      config.security = std::move(profile).value();
     } else if (key == "pipeline") {
       auto pipeline = fdi::pipeline_config_from_yaml(value, source);
       if (!pipeline) return pipeline.error();
@@ -138,6 +147,7 @@ std::string describe(const FusionConfig& config) {
       << '\n'
       << "max_latency_s: " << config.max_latency_s << '\n'
       << "health_period_s: " << config.health_period_s << '\n'
+      << (config.security ? describe(*config.security) : std::string("security: none")) << '\n'
       << "pipeline:\n"
       << fdi::describe(config.pipeline);
   return out.str();

@@ -12,16 +12,22 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "tetra/core/result.hpp"
+#include "tetra/service/security_profile.hpp"
 
 namespace tetra::dds {
 
 //! "what: dds_strretcode(rc)" as a failure.
 Error dds_error(const std::string& what, dds_return_t rc);
+
+//! DDS Security for every participant this process creates from now on; nullopt (the default): none.
+//! The profile's documents become the participant's dds.sec.* QoS properties (docs/reliability.md).
+void set_security_profile(std::optional<service::SecurityProfile> profile);
 
 //! Owns one dds_entity_t (participant, topic, reader, writer, condition, waitset).
 class Entity {
@@ -71,6 +77,7 @@ class Qos {
   Qos& no_autodispose();
 
   const dds_qos_t* get() const { return qos_; }
+  dds_qos_t* mutable_qos() { return qos_; }
 
  private:
   dds_qos_t* qos_ = nullptr;

@@ -11,6 +11,7 @@
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/config.hpp"
 #include "tetra/service/epoch_assembler.hpp"
+#include "tetra/service/security_profile.hpp"
 
 namespace tetra::service {
 
@@ -26,7 +27,9 @@ struct FusionConfig {
   double health_period_s = 0.5;  //!< [s] Health at least this often (and on every change)
   fdi::PipelineConfig pipeline;  //!< the `pipeline:` map
   Calibration calibration;       //!< read from calibration_path
-  std::string source;            //!< the config file, for messages
+  std::optional<SecurityProfile> security;  //!< `security: PROFILE.yaml` (opt-in DDS Security; relative: to
+                                            //!< the config file)
+  std::string source;                       //!< the config file, for messages
 
   //! [ns] wall-clock time after which a silent gyro is absent: 3 sample periods / speed.
   std::int64_t deadline_ns() const;
