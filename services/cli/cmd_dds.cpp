@@ -13,10 +13,20 @@ int unavailable(const char* name) {
 }
 }  // namespace
 
-int cmd_fusion(int, char**) { return unavailable("fusion"); }
-int cmd_monitor(int, char**) { return unavailable("monitor"); }
-int cmd_command(int, char**) { return unavailable("command"); }
-int cmd_record(int, char**) { return unavailable("record"); }
-int cmd_demo(int, char**) { return unavailable("demo"); }
+int cmd_fusion(int, char**) {
+  return unavailable("fusion");
+}
+int cmd_monitor(int, char**) {
+  return unavailable("monitor");
+}
+int cmd_command(int, char**) {
+  return unavailable("command");
+}
+int cmd_record(int, char**) {
+  return unavailable("record");
+}
+int cmd_demo(int, char**) {
+  return unavailable("demo");
+}
 
 }  // namespace tetra::cli

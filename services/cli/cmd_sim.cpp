@@ -14,6 +14,9 @@
 #include "tetra/sim/scenario.hpp"
 #include "tetra/sim/simulator.hpp"
 #include "tetra/sim/turntable.hpp"
+#if TETRA_WITH_DDS
+#include "sim_dds.hpp"
+#endif
 
 namespace tetra::cli {
 
@@ -106,6 +109,10 @@ int cmd_sim(int argc, char** argv) {
                  "turntable: sequence numbers in the order run, e.g. 1,2,5,6 (default 1..16)")
       ->delimiter(',');
   app.add_flag("--wrap", plan.wrap_angles, "turntable: write encoder angles wrapped to (-180, 180]");
+#if TETRA_WITH_DDS
+  SimDdsOptions dds_options;
+  add_sim_dds_options(app, dds_options);
+#endif
   if (auto status = parse(app, argc, argv)) return *status;
 
   std::optional<Calibration> unit;
@@ -154,7 +161,14 @@ int cmd_sim(int argc, char** argv) {
     if (!fault) return report(kName, fault.error());
     options.faults.push_back(fault.value());
   }
-  if (out_path.empty()) return report(kName, bad_input("--out LOG.csv is required"));
+#if TETRA_WITH_DDS
+  if (dds_options.enabled) {
+    auto simulator = sim::Simulator::create(sc, options);
+    if (!simulator) return report(kName, simulator.error());
+    return sim_dds_main(*simulator, dds_options);
+  }
+#endif
+  if (out_path.empty()) return report(kName, bad_input("--out LOG.csv is required (or --dds)"));
 
   auto simulator = sim::Simulator::create(sc, options);
   if (!simulator) return report(kName, simulator.error());

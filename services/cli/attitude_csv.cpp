@@ -1,0 +1,27 @@
+#include "attitude_csv.hpp"
+
+#include "tetra/core/csv.hpp"
+#include "tetra/core/units.hpp"
+
+namespace tetra::cli {
+
+void append_attitude_row(std::string& out, const fdi::AttitudeEstimate& attitude, int n_gyros) {
+  append_double(out, ns_to_seconds(attitude.stamp_ns));
+  for (const double c : to_wxyz(attitude.q_RB)) {
+    out += ',';
+    append_double(out, c);
+  }
+  for (int i = 0; i < 3; ++i) {
+    out += ',';
+    append_double(out, attitude.omega_B_rad_s[i] * kRadToDeg);
+  }
+  out += ',';
+  append_double(out, attitude.sigma_rad.norm() * kRadToDeg);  // 1σ of the total error angle
+  out += ',';
+  out += fdi::to_string(attitude.mode);
+  out += ',';
+  out += mask_to_string(attitude.gyros, n_gyros);
+  out += '\n';
+}
+
+}  // namespace tetra::cli

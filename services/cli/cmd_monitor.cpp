@@ -1,0 +1,300 @@
+// tetra monitor — ground monitoring of every unit on the domain (docs/dds.md).
+//
+// Reads Health and FdiEvent (transient-local: a late monitor still gets the current health and the
+// event history) and Attitude. Shows a dashboard refreshed every --period (≤ 0.5 s: ≥ 2 Hz), or with
+// --jsonl streams the same as JSON lines; --once prints every unit's current health (and its event
+// history) as soon as they have arrived, and exits.
+
+#include <unistd.h>
+#include <algorithm>
+#include <cstdio>
+#include <deque>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "dds_common.hpp"
+#include "tetra/core/units.hpp"
+#include "tetra/dds/convert.hpp"
+#include "tetra/dds/entity.hpp"
+#include "tetra/dds/shutdown.hpp"
+#include "tetra/dds/topics.hpp"
+
+namespace tetra::cli {
+
+namespace {
+
+using dds::Reader;
+
+enum Token : std::intptr_t { kHealth = 1, kEvent, kAttitude, kShutdown };
+
+constexpr std::size_t kRecentEvents = 8;  // shown per unit on the dashboard
+
+struct UnitView {
+  std::optional<dds::HealthView> health;
+  std::optional<fdi::AttitudeEstimate> attitude;
+  std::uint64_t attitudes_received = 0;
+  std::uint64_t attitudes_at_last_refresh = 0;
+  double attitude_rate_hz = 0.0;      //!< [Hz] measured between refreshes
+  std::deque<dds::EventView> events;  //!< the most recent events (for the dashboard)
+  std::uint64_t max_event_seq = 0;
+};
+
+std::string event_json(const dds::EventView& e, int n_gyros) {
+  // The INTERFACES §2.5 object, with the unit, sequence number and command id added in front.
+  std::string body = fdi::to_json(e.event, n_gyros);
+  std::string head = "{\"type\": \"event\", \"unit\": " + json_string(e.unit) +
+                     ", \"event_seq\": " + std::to_string(e.event_seq);
+  if (e.command_id != 0) head += ", \"command_id\": " + std::to_string(e.command_id);
+  return head + (body.size() > 2 ? ", " + body.substr(1) : "}");
+}
+
+std::string health_json(const std::string& unit, const UnitView& view) {
+  std::ostringstream out;
+  out << "{\"type\": \"health\", \"unit\": " << json_string(unit);
+  if (view.health) {
+    const fdi::Health& h = view.health->health;
+    const int n = static_cast<int>(h.gyros.size());
+    const auto& c = view.health->counters;
+    out << ", \"time_s\": " << json_number(ns_to_seconds(h.stamp_ns)) << ", \"mode\": \""
+        << fdi::to_string(h.mode) << "\", \"gyros_used\": \"" << mask_to_string(h.used, n)
+        << "\", \"gyros\": [";
+    for (int i = 0; i < n; ++i) {
+      out << (i ? ", " : "") << "{\"id\": " << i + 1 << ", \"state\": \""
+          << fdi::to_string(h.gyros[static_cast<std::size_t>(i)].state) << "\", \"kind\": \""
+          << fdi::to_string(h.gyros[static_cast<std::size_t>(i)].kind) << "\"}";
+    }
+    out << "], \"parity_residual\": " << json_number(h.parity_residual)
+        << ", \"chi2\": " << json_number(h.chi2) << ", \"chi2_threshold\": " << json_number(h.chi2_threshold)
+        << ", \"cusum\": " << json_number(h.cusum)
+        << ", \"cusum_threshold\": " << json_number(h.cusum_threshold) << ", \"counters\": {"
+        << "\"epochs_accepted\": " << h.counters.epochs_accepted
+        << ", \"epochs_rejected_time\": " << h.counters.epochs_rejected_time
+        << ", \"samples_accepted\": " << h.counters.samples_accepted
+        << ", \"samples_invalid\": " << h.counters.samples_invalid
+        << ", \"samples_absent\": " << h.counters.samples_absent << ", \"samples_late\": " << c.samples_late
+        << ", \"samples_duplicate\": " << c.samples_duplicate
+        << ", \"samples_out_of_order\": " << c.samples_out_of_order << ", \"samples_gap\": " << c.samples_gap
+        << ", \"samples_unknown_gyro\": " << c.samples_unknown_gyro
+        << ", \"samples_other_unit\": " << c.samples_other_unit
+        << ", \"deadlines_missed\": " << c.deadlines_missed << ", \"liveliness_lost\": " << c.liveliness_lost
+        << ", \"sensor_restarts\": " << c.sensor_restarts
+        << "}, \"events_published\": " << view.health->events_published;
+  }
+  if (view.attitude) {
+    const auto& a = *view.attitude;
+    const auto q = to_wxyz(a.q_RB);
+    out << ", \"attitude\": {\"time_s\": " << json_number(ns_to_seconds(a.stamp_ns)) << ", \"q\": ["
+        << json_number(q[0]) << ", " << json_number(q[1]) << ", " << json_number(q[2]) << ", "
+        << json_number(q[3]) << "], \"rate_dps\": [" << json_number(a.omega_B_rad_s.x() * kRadToDeg) << ", "
+        << json_number(a.omega_B_rad_s.y() * kRadToDeg) << ", "
+        << json_number(a.omega_B_rad_s.z() * kRadToDeg)
+        << "], \"sigma_deg\": " << json_number(a.sigma_rad.maxCoeff() * kRadToDeg) << ", \"mode\": \""
+        << fdi::to_string(a.mode) << "\", \"rate_hz\": " << json_number(view.attitude_rate_hz) << "}";
+  }
+  out << "}";
+  return out.str();
+}
+
+std::string dashboard_block(const std::string& unit, const UnitView& view) {
+  std::ostringstream out;
+  out << "unit " << unit;
+  if (!view.health) return out.str() + "   (no health yet)\n";
+  const fdi::Health& h = view.health->health;
+  const int n = static_cast<int>(h.gyros.size());
+  const auto& c = view.health->counters;
+  out << "   mode " << fdi::to_string(h.mode) << "   gyros " << mask_to_string(h.used, n)
+      << "   t = " << fixed(ns_to_seconds(h.stamp_ns), 3) << " s\n";
+  out << "  gyro  state     fault\n";
+  for (int i = 0; i < n; ++i) {
+    const auto& g = h.gyros[static_cast<std::size_t>(i)];
+    char line[80];
+    std::snprintf(line, sizeof line, "  %-4d  %-8s  %s\n", i + 1, fdi::to_string(g.state),
+                  g.kind == fdi::FaultKind::kNone ? "-" : fdi::to_string(g.kind));
+    out << line;
+  }
+  out << "  parity residual " << fixed(h.parity_residual, 2) << " σ   chi2 " << fixed(h.chi2, 2) << " / "
+      << fixed(h.chi2_threshold, 2) << "   cusum " << fixed(h.cusum, 2) << " / "
+      << fixed(h.cusum_threshold, 2) << '\n';
+  if (view.attitude) {
+    const auto& a = *view.attitude;
+    const auto q = to_wxyz(a.q_RB);
+    out << "  attitude q = (" << fixed(q[0], 6) << ", " << fixed(q[1], 6) << ", " << fixed(q[2], 6) << ", "
+        << fixed(q[3], 6) << ")  σ " << fixed(a.sigma_rad.maxCoeff() * kRadToDeg, 4) << " deg   rate ("
+        << fixed(a.omega_B_rad_s.x() * kRadToDeg, 4) << ", " << fixed(a.omega_B_rad_s.y() * kRadToDeg, 4)
+        << ", " << fixed(a.omega_B_rad_s.z() * kRadToDeg, 4) << ") deg/s   "
+        << fixed(view.attitude_rate_hz, 1) << " Hz\n";
+  } else {
+    out << "  attitude: none received\n";
+  }
+  out << "  epochs " << h.counters.epochs_accepted << " (rejected " << h.counters.epochs_rejected_time
+      << ")   samples " << h.counters.samples_accepted << " | invalid " << h.counters.samples_invalid
+      << "  absent " << h.counters.samples_absent << "  late " << c.samples_late << "  duplicate "
+      << c.samples_duplicate << "  out-of-order " << c.samples_out_of_order << "  gap " << c.samples_gap
+      << "  unknown-gyro " << c.samples_unknown_gyro << "  other-unit " << c.samples_other_unit
+      << "  deadlines " << c.deadlines_missed << "  liveliness " << c.liveliness_lost << '\n';
+  out << "  recent events:" << (view.events.empty() ? " none\n" : "\n");
+  for (const auto& e : view.events) out << "    " << fdi::to_json(e.event, n) << '\n';
+  return out.str();
+}
+
+}  // namespace
+
+int cmd_monitor(int argc, char** argv) {
+  dds::ShutdownSignal shutdown;
+  CLI::App app{"Ground monitoring: health, attitude and events of every unit on the DDS domain.", "monitor"};
+  std::string unit_filter;
+  bool jsonl = false;
+  bool once = false;
+  double period_s = 0.4;
+  double duration_s = 0.0;
+  double timeout_s = 5.0;
+  dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
+  app.add_option("--unit", unit_filter, "show only this unit (default: every unit discovered)");
+  app.add_flag("--jsonl", jsonl, "JSON lines on stdout instead of the dashboard");
+  app.add_flag("--once", once, "print each unit's current health (and event history) and exit");
+  app.add_option("--period", period_s, "[s] refresh period (≤ 0.5: at least 2 Hz)")
+      ->check(CLI::Range(0.01, 0.5));
+  app.add_option("--duration", duration_s, "[s] stop after this long (default: until SIGINT/SIGTERM)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--timeout", timeout_s, "[s] with --once: give up when no unit answers within this")
+      ->check(CLI::PositiveNumber);
+  add_domain_option(app, domain);
+  if (auto exit = parse(app, argc, argv)) return *exit;
+
+  auto participant = dds::Participant::create(domain);
+  if (!participant) return report("monitor", participant.error());
+  auto topics = dds::Topics::create(*participant);
+  if (!topics) return report("monitor", topics.error());
+  auto health_reader = Reader<tetra_Health>::create(*participant, topics->health, dds::health_qos());
+  if (!health_reader) return report("monitor", health_reader.error());
+  auto event_reader = Reader<tetra_FdiEvent>::create(*participant, topics->event, dds::event_qos());
+  if (!event_reader) return report("monitor", event_reader.error());
+  auto attitude_reader = Reader<tetra_Attitude>::create(*participant, topics->attitude, dds::attitude_qos());
+  if (!attitude_reader) return report("monitor", attitude_reader.error());
+  auto waitset = dds::WaitSet::create(*participant);
+  if (!waitset) return report("monitor", waitset.error());
+  std::vector<dds::Condition> conditions;
+  for (auto [reader, token] :
+       {std::pair{health_reader->handle(), kHealth}, std::pair{event_reader->handle(), kEvent},
+        std::pair{attitude_reader->handle(), kAttitude}}) {
+    auto condition = dds::Condition::data_available(reader);
+    if (!condition) return report("monitor", condition.error());
+    if (auto s = waitset->attach(condition->handle(), token); !s) return report("monitor", s.error());
+    conditions.push_back(std::move(condition).value());
+  }
+  if (auto s = health_reader->enable_statuses(DDS_SUBSCRIPTION_MATCHED_STATUS); !s)
+    return report("monitor", s.error());
+  if (auto s = waitset->attach(health_reader->handle(), kHealth); !s) return report("monitor", s.error());
+  auto guard = dds::Condition::guard(*participant);
+  if (!guard) return report("monitor", guard.error());
+  if (auto s = waitset->attach(guard->handle(), kShutdown); !s) return report("monitor", s.error());
+  shutdown.set_guard(guard->handle());
+
+  std::map<std::string, UnitView> units;
+  std::vector<dds::EventView> new_events;
+  const bool tty = isatty(STDOUT_FILENO) != 0;
+  const auto wanted = [&](const std::string& unit) { return unit_filter.empty() || unit == unit_filter; };
+  const std::int64_t start = monotonic_ns();
+  const std::int64_t period_ns = static_cast<std::int64_t>(period_s * 1e9);
+  const std::int64_t stop_at =
+      duration_s > 0 ? start + static_cast<std::int64_t>(duration_s * 1e9) : INT64_MAX;
+  const std::int64_t give_up_at = start + static_cast<std::int64_t>(timeout_s * 1e9);
+  std::int64_t next_refresh = start + period_ns;
+  std::int64_t last_refresh = start;
+  std::vector<std::intptr_t> triggered;
+
+  for (;;) {
+    std::uint32_t status = 0;
+    (void)dds_take_status(health_reader->handle(), &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
+    auto h = health_reader->take([&](const tetra_Health& msg, const dds_sample_info_t&) {
+      auto view = dds::from_wire(msg);
+      if (wanted(view.unit)) units[view.unit].health = std::move(view);
+    });
+    if (!h) return report("monitor", h.error());
+    new_events.clear();
+    auto e = event_reader->take([&](const tetra_FdiEvent& msg, const dds_sample_info_t&) {
+      auto view = dds::from_wire(msg);
+      if (wanted(view.unit)) new_events.push_back(std::move(view));
+    });
+    if (!e) return report("monitor", e.error());
+    std::sort(new_events.begin(), new_events.end(), [](const auto& a, const auto& b) {
+      return a.unit != b.unit ? a.unit < b.unit : a.event_seq < b.event_seq;
+    });
+    for (auto& ev : new_events) {
+      UnitView& view = units[ev.unit];
+      view.max_event_seq = std::max(view.max_event_seq, ev.event_seq);
+      const int n = view.health ? static_cast<int>(view.health->health.gyros.size()) : 4;
+      if (jsonl) std::cout << event_json(ev, n) << '\n';
+      view.events.push_back(ev);
+      if (view.events.size() > kRecentEvents) view.events.pop_front();
+    }
+    auto a = attitude_reader->take([&](const tetra_Attitude& msg, const dds_sample_info_t&) {
+      const std::string unit = dds::from_wire(msg.unit);
+      if (!wanted(unit)) return;
+      UnitView& view = units[unit];
+      view.attitude = dds::from_wire(msg);
+      ++view.attitudes_received;
+    });
+    if (!a) return report("monitor", a.error());
+    if (jsonl) std::cout.flush();
+
+    const std::int64_t now = monotonic_ns();
+    if (shutdown.requested()) break;
+    if (once) {
+      // Done when every matched Health writer has delivered and each unit's event history is complete.
+      auto matched = health_reader->matched_writers();
+      if (!matched) return report("monitor", matched.error());
+      std::size_t complete = 0;
+      for (const auto& [unit, view] : units) {
+        if (view.health && view.max_event_seq >= view.health->events_published) ++complete;
+      }
+      const bool all_here =
+          complete > 0 && complete == units.size() && (!unit_filter.empty() || complete >= *matched);
+      if (all_here) {
+        for (const auto& [unit, view] : units) {
+          if (!view.health) continue;
+          if (jsonl) {
+            std::cout << health_json(unit, view) << '\n';
+          } else {
+            std::cout << dashboard_block(unit, view);
+          }
+        }
+        return kExitOk;
+      }
+      if (now >= give_up_at) {
+        std::cerr << "tetra monitor: no health from "
+                  << (unit_filter.empty() ? "any unit" : "unit " + unit_filter) << " within " << timeout_s
+                  << " s\n";
+        return kExitFailure;
+      }
+    } else if (now >= next_refresh) {
+      const double dt = static_cast<double>(now - last_refresh) * 1e-9;
+      for (auto& [unit, view] : units) {
+        view.attitude_rate_hz =
+            static_cast<double>(view.attitudes_received - view.attitudes_at_last_refresh) / dt;
+        view.attitudes_at_last_refresh = view.attitudes_received;
+      }
+      last_refresh = now;
+      next_refresh = now + period_ns;
+      if (jsonl) {
+        for (const auto& [unit, view] : units) std::cout << health_json(unit, view) << '\n';
+      } else {
+        std::string screen = tty ? "\033[H\033[2J" : "";
+        screen += "tetra monitor — " + std::to_string(units.size()) + " unit(s)\n";
+        for (const auto& [unit, view] : units) screen += dashboard_block(unit, view);
+        std::cout << screen << (tty ? "" : "\n");
+      }
+      std::cout.flush();
+    }
+    if (now >= stop_at) break;
+    const std::int64_t wake = once ? give_up_at : std::min(next_refresh, stop_at);
+    if (auto s = waitset->wait(std::chrono::nanoseconds(wake - now), triggered); !s)
+      return report("monitor", s.error());
+  }
+  return kExitOk;
+}
+
+}  // namespace tetra::cli

@@ -1,0 +1,109 @@
+#include "dds_common.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+
+namespace tetra::cli {
+
+void add_domain_option(CLI::App& app, dds_domainid_t& domain) {
+  domain = DDS_DOMAIN_DEFAULT;
+  app.add_option("--domain", domain, "DDS domain id (default: the Cyclone configuration's, normally 0)")
+      ->check(CLI::Range(0, 232));
+}
+
+std::int64_t monotonic_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+std::int64_t wall_ns() {
+  return dds_time();
+}
+
+std::string self_executable() {
+  return std::filesystem::read_symlink("/proc/self/exe").string();
+}
+
+int spawn_self(const std::vector<std::string>& args, const std::string& stdout_path,
+               const std::string& stderr_path) {
+  const std::string exe = self_executable();
+  std::vector<std::string> storage;
+  storage.push_back(exe);
+  storage.insert(storage.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : storage) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid != 0) return pid;  // parent (or -1)
+  // Child: signal mask and redirections, then exec. Only async-signal-safe calls from here on.
+  sigset_t set;
+  sigemptyset(&set);
+  sigprocmask(SIG_SETMASK, &set, nullptr);
+  if (!stdout_path.empty()) {
+    const int fd = open(stdout_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) dup2(fd, STDOUT_FILENO);
+  }
+  if (!stderr_path.empty()) {
+    const int fd = open(stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) dup2(fd, STDERR_FILENO);
+  }
+  execv(exe.c_str(), argv.data());
+  _exit(127);
+}
+
+std::string fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+}  // namespace tetra::cli
+
+#include <charconv>
+#include <cmath>
+
+namespace tetra::cli {
+
+std::string json_number(double value) {
+  if (!std::isfinite(value)) return "null";
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
+}
+
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buffer[8];
+          std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+          out += buffer;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+}  // namespace tetra::cli

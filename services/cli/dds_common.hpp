@@ -1,0 +1,44 @@
+#pragma once
+// Plumbing shared by the DDS subcommands: the --domain option, the local clock, spawning
+// the program itself (demo), and small formatting helpers.
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <dds/dds.h>
+#include <CLI/CLI.hpp>
+
+namespace tetra::cli {
+
+//! Adds `--domain ID` (default: DDS_DOMAIN_DEFAULT, i.e. the Cyclone configuration's, normally 0).
+void add_domain_option(CLI::App& app, dds_domainid_t& domain);
+
+//! [ns] local monotonic clock (for latency limits and periods; never on the wire).
+std::int64_t monotonic_ns();
+
+//! [ns] wall clock as DDS stamps it (source timestamps).
+std::int64_t wall_ns();
+
+//! Path of the running program (/proc/self/exe).
+std::string self_executable();
+
+//! Starts `self_executable() args...` as a child with SIGINT/SIGTERM unblocked; stdout/stderr
+//! go to the given files (empty: inherited). Returns the pid, or -1.
+int spawn_self(const std::vector<std::string>& args, const std::string& stdout_path = "",
+               const std::string& stderr_path = "");
+
+//! "%.6f" style fixed formatting without iostreams state.
+std::string fixed(double value, int decimals);
+
+}  // namespace tetra::cli
+
+namespace tetra::cli {
+
+//! JSON number in shortest round-trip form; `null` for NaN and infinities.
+std::string json_number(double value);
+//! JSON string literal with escapes.
+std::string json_string(const std::string& text);
+
+}  // namespace tetra::cli

@@ -1,0 +1,255 @@
+#pragma once
+// A small RAII layer over the Cyclone DDS C API (Debian's 0.10.2 has no C++ binding).
+//
+// * Every entity is owned by exactly one move-only object and deleted with dds_delete().
+// * Every return code is checked; failures become tetra::Error values whose message carries
+//   dds_strretcode() and what was being done ("create reader GyroSample: Precondition not met").
+// * Readers hand samples to a callback on loaned memory (valid only inside the callback), so
+//   strings and sequences of the generated C types never need copying or freeing here.
+// This is the only header of tetra that includes dds/dds.h besides the services' own sources.
+
+#include <dds/dds.h>
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tetra/core/result.hpp"
+
+namespace tetra::dds {
+
+//! "what: dds_strretcode(rc)" as a failure.
+Error dds_error(const std::string& what, dds_return_t rc);
+
+//! Owns one dds_entity_t (participant, topic, reader, writer, condition, waitset).
+class Entity {
+ public:
+  Entity() = default;
+  explicit Entity(dds_entity_t handle) : handle_(handle) {}
+  Entity(const Entity&) = delete;
+  Entity& operator=(const Entity&) = delete;
+  Entity(Entity&& other) noexcept : handle_(std::exchange(other.handle_, 0)) {}
+  Entity& operator=(Entity&& other) noexcept {
+    if (this != &other) {
+      reset();
+      handle_ = std::exchange(other.handle_, 0);
+    }
+    return *this;
+  }
+  ~Entity() { reset(); }
+
+  dds_entity_t handle() const { return handle_; }
+  bool valid() const { return handle_ > 0; }
+  void reset();
+
+ private:
+  dds_entity_t handle_ = 0;
+};
+
+//! A QoS object built fluently: Qos().reliable().keep_last(64).deadline(...).
+class Qos {
+ public:
+  Qos();
+  Qos(const Qos&) = delete;
+  Qos& operator=(const Qos&) = delete;
+  Qos(Qos&& other) noexcept : qos_(std::exchange(other.qos_, nullptr)) {}
+  ~Qos();
+
+  Qos& reliable(std::chrono::nanoseconds max_blocking = std::chrono::milliseconds(100));
+  Qos& best_effort();
+  Qos& keep_last(int depth);
+  Qos& keep_all();
+  Qos& volatile_durability();
+  //! Transient-local durability; late joiners receive up to `depth` samples per instance
+  //! (sized by DURABILITY_SERVICE, not HISTORY — see docs/dds.md).
+  Qos& transient_local(int depth);
+  Qos& deadline(std::chrono::nanoseconds period);
+  Qos& automatic_liveliness(std::chrono::nanoseconds lease);
+  //! Keep instances when a writer is deleted (no dispose), so readers see "no writers", not "disposed".
+  Qos& no_autodispose();
+
+  const dds_qos_t* get() const { return qos_; }
+
+ private:
+  dds_qos_t* qos_ = nullptr;
+};
+
+//! Domain participant. `domain` DDS_DOMAIN_DEFAULT takes the id of the configuration.
+class Participant {
+ public:
+  static Result<Participant> create(dds_domainid_t domain);
+  dds_entity_t handle() const { return entity_.handle(); }
+
+ private:
+  explicit Participant(Entity entity) : entity_(std::move(entity)) {}
+  Entity entity_;
+};
+
+//! A topic of the generated C type described by `descriptor`.
+class Topic {
+ public:
+  static Result<Topic> create(const Participant& participant, const dds_topic_descriptor_t* descriptor,
+                              const std::string& name, const Qos& qos);
+  dds_entity_t handle() const { return entity_.handle(); }
+  const std::string& name() const { return name_; }
+
+ private:
+  Topic(Entity entity, std::string name) : entity_(std::move(entity)), name_(std::move(name)) {}
+  Entity entity_;
+  std::string name_;
+};
+
+//! Writer of samples of type `T` (a generated C struct).
+template <class T>
+class Writer {
+ public:
+  static Result<Writer> create(const Participant& participant, const Topic& topic, const Qos& qos) {
+    const dds_entity_t handle = dds_create_writer(participant.handle(), topic.handle(), qos.get(), nullptr);
+    if (handle < 0) return dds_error("create writer " + topic.name(), handle);
+    return Writer(Entity(handle), topic.name());
+  }
+  Status write(const T& sample) const {
+    const dds_return_t rc = dds_write(entity_.handle(), &sample);
+    if (rc < 0) return dds_error("write " + name_, rc);
+    return ok_status();
+  }
+  //! Unregisters the instance of `sample`'s key (readers see "no writers" for it).
+  Status unregister(const T& sample) const {
+    const dds_return_t rc = dds_unregister_instance(entity_.handle(), &sample);
+    if (rc < 0) return dds_error("unregister " + name_, rc);
+    return ok_status();
+  }
+  //! Number of matched readers now.
+  Result<std::uint32_t> matched_readers() const {
+    dds_publication_matched_status_t status{};
+    const dds_return_t rc = dds_get_publication_matched_status(entity_.handle(), &status);
+    if (rc < 0) return dds_error("publication matched status " + name_, rc);
+    return status.current_count;
+  }
+  //! Blocks until every matched reliable reader acknowledged what was written, or the timeout.
+  Status wait_for_acks(std::chrono::nanoseconds timeout) const {
+    const dds_return_t rc = dds_wait_for_acks(entity_.handle(), timeout.count());
+    if (rc < 0) return dds_error("wait for acknowledgements " + name_, rc);
+    return ok_status();
+  }
+  dds_entity_t handle() const { return entity_.handle(); }
+
+ private:
+  Writer(Entity entity, std::string name) : entity_(std::move(entity)), name_(std::move(name)) {}
+  Entity entity_;
+  std::string name_;
+};
+
+//! Reader of samples of type `T` (a generated C struct).
+template <class T>
+class Reader {
+ public:
+  static Result<Reader> create(const Participant& participant, const Topic& topic, const Qos& qos) {
+    const dds_entity_t handle = dds_create_reader(participant.handle(), topic.handle(), qos.get(), nullptr);
+    if (handle < 0) return dds_error("create reader " + topic.name(), handle);
+    return Reader(Entity(handle), topic.name());
+  }
+
+  //! Takes every available sample and calls `on_sample(const T&, const dds_sample_info_t&)` for
+  //! each one with valid data, oldest first per instance, and `on_state(const dds_sample_info_t&)`
+  //! (if given) for invalid samples (dispose / unregister notifications). Returns the number taken.
+  template <class OnSample>
+  Result<int> take(OnSample&& on_sample) const {
+    return take(std::forward<OnSample>(on_sample), [](const dds_sample_info_t&) {});
+  }
+  template <class OnSample, class OnState>
+  Result<int> take(OnSample&& on_sample, OnState&& on_state) const {
+    constexpr int kBatch = 64;
+    int total = 0;
+    for (;;) {
+      void* samples[kBatch] = {nullptr};
+      dds_sample_info_t infos[kBatch];
+      const dds_return_t n = dds_take(entity_.handle(), samples, infos, kBatch, kBatch);
+      if (n < 0) return dds_error("take " + name_, n);
+      for (int i = 0; i < n; ++i) {
+        if (infos[i].valid_data) {
+          on_sample(*static_cast<const T*>(samples[i]), infos[i]);
+        } else {
+          on_state(infos[i]);
+        }
+      }
+      if (n > 0) (void)dds_return_loan(entity_.handle(), samples, n);
+      total += n;
+      if (n < kBatch) return total;
+    }
+  }
+  //! Key fields of an instance (e.g. from a deadline-missed status), as a full sample with only the
+  //! key filled. Strings inside are owned by `out`: call free_contents() afterwards.
+  Status instance_key(dds_instance_handle_t instance, T& out) const {
+    const dds_return_t rc = dds_instance_get_key(entity_.handle(), instance, &out);
+    if (rc < 0) return dds_error("instance key " + name_, rc);
+    return ok_status();
+  }
+  //! Number of matched writers now.
+  Result<std::uint32_t> matched_writers() const {
+    dds_subscription_matched_status_t status{};
+    const dds_return_t rc = dds_get_subscription_matched_status(entity_.handle(), &status);
+    if (rc < 0) return dds_error("subscription matched status " + name_, rc);
+    return status.current_count;
+  }
+  //! Enables the given communication statuses (DDS_*_STATUS) so a waitset can wake on them.
+  Status enable_statuses(std::uint32_t mask) const {
+    const dds_return_t rc = dds_set_status_mask(entity_.handle(), mask);
+    if (rc < 0) return dds_error("status mask " + name_, rc);
+    return ok_status();
+  }
+  dds_entity_t handle() const { return entity_.handle(); }
+  const std::string& name() const { return name_; }
+
+ private:
+  Reader(Entity entity, std::string name) : entity_(std::move(entity)), name_(std::move(name)) {}
+  Entity entity_;
+  std::string name_;
+};
+
+//! A condition a waitset can wait on: a reader's "data available" read condition, or a guard.
+class Condition {
+ public:
+  //! Triggers while the reader holds any sample.
+  static Result<Condition> data_available(dds_entity_t reader);
+  //! Set by hand (e.g. from a signal-handling thread) with trigger().
+  static Result<Condition> guard(const Participant& participant);
+  Status trigger() const;
+  Status clear() const;
+  dds_entity_t handle() const { return entity_.handle(); }
+
+ private:
+  explicit Condition(Entity entity) : entity_(std::move(entity)) {}
+  Entity entity_;
+};
+
+//! A waitset: attach entities with a token, wait() returns the tokens of the triggered ones.
+class WaitSet {
+ public:
+  static Result<WaitSet> create(const Participant& participant);
+  //! Attaches a condition, or a reader/writer (triggers on its enabled statuses).
+  Status attach(dds_entity_t entity, std::intptr_t token);
+  //! Blocks up to `timeout` (negative: 0). `triggered` receives the tokens (empty on timeout).
+  Status wait(std::chrono::nanoseconds timeout, std::vector<std::intptr_t>& triggered) const;
+
+ private:
+  explicit WaitSet(Entity entity) : entity_(std::move(entity)) {}
+  Entity entity_;
+  std::vector<dds_entity_t> attached_;
+};
+
+//! Copies `text` into a bounded IDL string (char[N+1]); error if it does not fit.
+template <std::size_t N>
+Status copy_bounded(char (&dest)[N], const std::string& text, const char* field) {
+  if (text.size() >= N) {
+    return bad_input(std::string(field) + " '" + text + "' is longer than " + std::to_string(N - 1) +
+                     " characters");
+  }
+  text.copy(dest, text.size());
+  dest[text.size()] = '\0';
+  return ok_status();
+}
+
+}  // namespace tetra::dds

@@ -1,0 +1,37 @@
+#pragma once
+// The six tetra topics and their QoS (INTERFACES §4), created once per participant.
+
+#include <chrono>
+
+#include "tetra.h"  // generated from idl/tetra.idl
+#include "tetra/dds/entity.hpp"
+
+namespace tetra::dds {
+
+inline constexpr int kGyroSampleDepth = 64;
+inline constexpr int kReferenceDepth = 8;
+inline constexpr int kEventDepth = 256;  //!< events kept for late joiners, per unit
+inline constexpr int kCommandDepth = 16;
+inline constexpr int kMaxGyrosOnWire = tetra_MAX_GYROS;
+inline constexpr std::chrono::milliseconds kWriterLease{1000};  //!< automatic liveliness of writers
+
+//! reliable / volatile / keep-last 64; deadline = 3 × `sample_period` (none if zero).
+Qos gyro_sample_qos(std::chrono::nanoseconds sample_period = std::chrono::nanoseconds{0});
+Qos reference_qos();  //!< reliable / volatile / keep-last 8
+Qos attitude_qos();   //!< reliable / volatile / keep-last 1
+Qos health_qos();     //!< reliable / transient-local / keep-last 1
+Qos event_qos();      //!< reliable / transient-local / keep-last 256 (durability service 256)
+Qos command_qos();    //!< reliable / volatile / keep-last 16
+
+struct Topics {
+  Topic gyro_sample;
+  Topic reference;
+  Topic attitude;
+  Topic health;
+  Topic event;
+  Topic command;
+
+  static Result<Topics> create(const Participant& participant);
+};
+
+}  // namespace tetra::dds

@@ -1,0 +1,211 @@
+#include "tetra/dds/convert.hpp"
+
+#include "tetra/core/quaternion.hpp"
+#include "tetra/dds/entity.hpp"
+
+namespace tetra::dds {
+
+tetra_Mode to_wire(fdi::Mode mode) {
+  switch (mode) {
+    case fdi::Mode::kNominal:
+      return tetra_MODE_NOMINAL;
+    case fdi::Mode::kDegraded:
+      return tetra_MODE_DEGRADED;
+    case fdi::Mode::kSuspect:
+      return tetra_MODE_SUSPECT;
+    case fdi::Mode::kLost:
+      return tetra_MODE_LOST;
+  }
+  return tetra_MODE_LOST;
+}
+fdi::Mode from_wire(tetra_Mode mode) {
+  switch (mode) {
+    case tetra_MODE_NOMINAL:
+      return fdi::Mode::kNominal;
+    case tetra_MODE_DEGRADED:
+      return fdi::Mode::kDegraded;
+    case tetra_MODE_SUSPECT:
+      return fdi::Mode::kSuspect;
+    case tetra_MODE_LOST:
+      return fdi::Mode::kLost;
+  }
+  return fdi::Mode::kLost;
+}
+
+// The IDL enumerators are declared in the same order as the library's enums.
+tetra_FaultKind to_wire(fdi::FaultKind kind) {
+  return static_cast<tetra_FaultKind>(static_cast<int>(kind));
+}
+fdi::FaultKind from_wire(tetra_FaultKind kind) {
+  const int value = static_cast<int>(kind);
+  return value >= 0 && value <= static_cast<int>(fdi::FaultKind::kUnknown)
+             ? static_cast<fdi::FaultKind>(value)
+             : fdi::FaultKind::kUnknown;
+}
+tetra_GyroState to_wire(fdi::GyroState state) {
+  return static_cast<tetra_GyroState>(static_cast<int>(state));
+}
+fdi::GyroState from_wire(tetra_GyroState state) {
+  const int value = static_cast<int>(state);
+  return value >= 0 && value <= static_cast<int>(fdi::GyroState::kExcluded)
+             ? static_cast<fdi::GyroState>(value)
+             : fdi::GyroState::kAbsent;
+}
+tetra_EventType to_wire(fdi::EventType type) {
+  return static_cast<tetra_EventType>(static_cast<int>(type));
+}
+fdi::EventType from_wire(tetra_EventType type) {
+  const int value = static_cast<int>(type);
+  return value >= 0 && value <= static_cast<int>(fdi::EventType::kCommand)
+             ? static_cast<fdi::EventType>(value)
+             : fdi::EventType::kCommand;
+}
+static_assert(static_cast<int>(tetra_FAULT_UNKNOWN) == static_cast<int>(fdi::FaultKind::kUnknown));
+static_assert(static_cast<int>(tetra_GYRO_EXCLUDED) == static_cast<int>(fdi::GyroState::kExcluded));
+static_assert(static_cast<int>(tetra_EVENT_COMMAND) == static_cast<int>(fdi::EventType::kCommand));
+
+Status to_wire(const std::string& unit, const fdi::AttitudeEstimate& attitude, tetra_Attitude& out) {
+  if (auto status = copy_bounded(out.unit, unit, "unit"); !status) return status;
+  out.stamp_ns = attitude.stamp_ns;
+  const auto q = to_wxyz(attitude.q_RB);
+  for (std::size_t i = 0; i < 4; ++i) out.q_RB[i] = q[i];
+  for (int i = 0; i < 3; ++i) {
+    out.omega_B_rad_s[i] = attitude.omega_B_rad_s[i];
+    out.sigma_rad[i] = attitude.sigma_rad[i];
+  }
+  out.mode = to_wire(attitude.mode);
+  out.gyros = attitude.gyros;
+  return ok_status();
+}
+
+fdi::AttitudeEstimate from_wire(const tetra_Attitude& in) {
+  fdi::AttitudeEstimate out;
+  out.stamp_ns = in.stamp_ns;
+  out.q_RB = from_wxyz(in.q_RB[0], in.q_RB[1], in.q_RB[2], in.q_RB[3]);
+  for (int i = 0; i < 3; ++i) {
+    out.omega_B_rad_s[i] = in.omega_B_rad_s[i];
+    out.sigma_rad[i] = in.sigma_rad[i];
+  }
+  out.mode = from_wire(in.mode);
+  out.gyros = in.gyros;
+  return out;
+}
+
+Status to_wire(const std::string& unit, const fdi::Health& health, const service::AssemblerCounters& counters,
+               WireHealth& out) {
+  if (auto status = copy_bounded(out.msg.unit, unit, "unit"); !status) return status;
+  if (health.gyros.size() > out.gyros.size()) return bad_input("health: more gyros than the wire carries");
+  out.msg.stamp_ns = health.stamp_ns;
+  out.msg.mode = to_wire(health.mode);
+  out.msg.used = health.used;
+  for (std::size_t i = 0; i < health.gyros.size(); ++i) {
+    out.gyros[i].state = to_wire(health.gyros[i].state);
+    out.gyros[i].kind = to_wire(health.gyros[i].kind);
+  }
+  out.msg.gyros._buffer = out.gyros.data();
+  out.msg.gyros._length = static_cast<std::uint32_t>(health.gyros.size());
+  out.msg.gyros._maximum = static_cast<std::uint32_t>(out.gyros.size());
+  out.msg.gyros._release = false;
+  out.msg.parity_residual = health.parity_residual;
+  out.msg.chi2 = health.chi2;
+  out.msg.cusum = health.cusum;
+  out.msg.chi2_threshold = health.chi2_threshold;
+  out.msg.cusum_threshold = health.cusum_threshold;
+  tetra_SampleCounters& c = out.msg.counters;
+  c.epochs_accepted = health.counters.epochs_accepted;
+  c.epochs_rejected_time = health.counters.epochs_rejected_time;
+  c.samples_accepted = health.counters.samples_accepted;
+  c.samples_invalid = health.counters.samples_invalid;
+  c.samples_absent = health.counters.samples_absent;
+  c.samples_late = counters.samples_late;
+  c.samples_duplicate = counters.samples_duplicate;
+  c.samples_out_of_order = counters.samples_out_of_order;
+  c.samples_gap = counters.samples_gap;
+  c.samples_unknown_gyro = counters.samples_unknown_gyro;
+  c.samples_other_unit = counters.samples_other_unit;
+  c.sensor_restarts = counters.sensor_restarts;
+  c.deadlines_missed = counters.deadlines_missed;
+  c.liveliness_lost = counters.liveliness_lost;
+  return ok_status();
+}
+
+HealthView from_wire(const tetra_Health& in) {
+  HealthView out;
+  out.unit = from_wire(in.unit);
+  fdi::Health& h = out.health;
+  h.stamp_ns = in.stamp_ns;
+  h.mode = from_wire(in.mode);
+  h.used = in.used;
+  for (std::uint32_t i = 0; i < in.gyros._length; ++i) {
+    h.gyros.push_back({from_wire(in.gyros._buffer[i].state), from_wire(in.gyros._buffer[i].kind)});
+  }
+  h.parity_residual = in.parity_residual;
+  h.chi2 = in.chi2;
+  h.cusum = in.cusum;
+  h.chi2_threshold = in.chi2_threshold;
+  h.cusum_threshold = in.cusum_threshold;
+  const tetra_SampleCounters& c = in.counters;
+  h.counters.epochs_accepted = c.epochs_accepted;
+  h.counters.epochs_rejected_time = c.epochs_rejected_time;
+  h.counters.samples_accepted = c.samples_accepted;
+  h.counters.samples_invalid = c.samples_invalid;
+  h.counters.samples_absent = c.samples_absent;
+  out.counters.samples_late = c.samples_late;
+  out.counters.samples_duplicate = c.samples_duplicate;
+  out.counters.samples_out_of_order = c.samples_out_of_order;
+  out.counters.samples_gap = c.samples_gap;
+  out.counters.samples_unknown_gyro = c.samples_unknown_gyro;
+  out.counters.samples_other_unit = c.samples_other_unit;
+  out.counters.sensor_restarts = c.sensor_restarts;
+  out.events_published = in.events_published;
+  out.gyro_writers = in.gyro_writers;
+  out.counters.deadlines_missed = c.deadlines_missed;
+  out.counters.liveliness_lost = c.liveliness_lost;
+  return out;
+}
+
+namespace {
+template <std::size_t N>
+void copy_truncated(char (&dest)[N], const std::string& text) {
+  const std::size_t n = std::min(text.size(), N - 1);
+  text.copy(dest, n);
+  dest[n] = '\0';
+}
+}  // namespace
+
+Status to_wire(const EventView& view, tetra_FdiEvent& out) {
+  if (auto status = copy_bounded(out.unit, view.unit, "unit"); !status) return status;
+  const fdi::FdiEvent& e = view.event;
+  if (auto status = copy_bounded(out.test, e.test, "event test"); !status) return status;
+  if (auto status = copy_bounded(out.evidence, e.evidence, "event evidence"); !status) return status;
+  copy_truncated(out.detail, e.detail);
+  out.event_seq = view.event_seq;
+  out.command_id = view.command_id;
+  out.stamp_ns = e.stamp_ns;
+  out.type = to_wire(e.type);
+  out.gyro = static_cast<std::int16_t>(e.gyro.value_or(0));
+  out.statistic = e.statistic;
+  out.kind = to_wire(e.kind);
+  out.gyros = e.gyros;
+  return ok_status();
+}
+
+EventView from_wire(const tetra_FdiEvent& in) {
+  EventView out;
+  out.unit = from_wire(in.unit);
+  out.event_seq = in.event_seq;
+  out.command_id = in.command_id;
+  fdi::FdiEvent& e = out.event;
+  e.stamp_ns = in.stamp_ns;
+  e.type = from_wire(in.type);
+  if (in.gyro > 0) e.gyro = in.gyro;
+  e.test = from_wire(in.test);
+  e.statistic = in.statistic;
+  e.kind = from_wire(in.kind);
+  e.evidence = from_wire(in.evidence);
+  e.gyros = in.gyros;
+  e.detail = from_wire(in.detail);
+  return out;
+}
+
+}  // namespace tetra::dds

@@ -1,0 +1,122 @@
+#include "tetra/dds/entity.hpp"
+
+#include <algorithm>
+
+namespace tetra::dds {
+
+Error dds_error(const std::string& what, dds_return_t rc) {
+  return failure("DDS " + what + ": " + dds_strretcode(rc));
+}
+
+void Entity::reset() {
+  if (handle_ > 0) (void)dds_delete(handle_);
+  handle_ = 0;
+}
+
+Qos::Qos() : qos_(dds_create_qos()) {}
+Qos::~Qos() {
+  if (qos_ != nullptr) dds_delete_qos(qos_);
+}
+
+Qos& Qos::reliable(std::chrono::nanoseconds max_blocking) {
+  dds_qset_reliability(qos_, DDS_RELIABILITY_RELIABLE, max_blocking.count());
+  return *this;
+}
+Qos& Qos::best_effort() {
+  dds_qset_reliability(qos_, DDS_RELIABILITY_BEST_EFFORT, 0);
+  return *this;
+}
+Qos& Qos::keep_last(int depth) {
+  dds_qset_history(qos_, DDS_HISTORY_KEEP_LAST, depth);
+  return *this;
+}
+Qos& Qos::keep_all() {
+  dds_qset_history(qos_, DDS_HISTORY_KEEP_ALL, DDS_LENGTH_UNLIMITED);
+  return *this;
+}
+Qos& Qos::volatile_durability() {
+  dds_qset_durability(qos_, DDS_DURABILITY_VOLATILE);
+  return *this;
+}
+Qos& Qos::transient_local(int depth) {
+  dds_qset_durability(qos_, DDS_DURABILITY_TRANSIENT_LOCAL);
+  dds_qset_durability_service(qos_, 0, DDS_HISTORY_KEEP_LAST, depth, DDS_LENGTH_UNLIMITED,
+                              DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
+  return *this;
+}
+Qos& Qos::deadline(std::chrono::nanoseconds period) {
+  dds_qset_deadline(qos_, period.count());
+  return *this;
+}
+Qos& Qos::automatic_liveliness(std::chrono::nanoseconds lease) {
+  dds_qset_liveliness(qos_, DDS_LIVELINESS_AUTOMATIC, lease.count());
+  return *this;
+}
+Qos& Qos::no_autodispose() {
+  dds_qset_writer_data_lifecycle(qos_, false);
+  return *this;
+}
+
+Result<Participant> Participant::create(dds_domainid_t domain) {
+  const dds_entity_t handle = dds_create_participant(domain, nullptr, nullptr);
+  if (handle < 0) return dds_error("create participant on domain " + std::to_string(domain), handle);
+  return Participant(Entity(handle));
+}
+
+Result<Topic> Topic::create(const Participant& participant, const dds_topic_descriptor_t* descriptor,
+                            const std::string& name, const Qos& qos) {
+  const dds_entity_t handle =
+      dds_create_topic(participant.handle(), descriptor, name.c_str(), qos.get(), nullptr);
+  if (handle < 0) return dds_error("create topic " + name, handle);
+  return Topic(Entity(handle), name);
+}
+
+Result<Condition> Condition::data_available(dds_entity_t reader) {
+  const dds_entity_t handle = dds_create_readcondition(reader, DDS_ANY_STATE);
+  if (handle < 0) return dds_error("create read condition", handle);
+  return Condition(Entity(handle));
+}
+
+Result<Condition> Condition::guard(const Participant& participant) {
+  const dds_entity_t handle = dds_create_guardcondition(participant.handle());
+  if (handle < 0) return dds_error("create guard condition", handle);
+  return Condition(Entity(handle));
+}
+
+Status Condition::trigger() const {
+  const dds_return_t rc = dds_set_guardcondition(entity_.handle(), true);
+  if (rc < 0) return dds_error("set guard condition", rc);
+  return ok_status();
+}
+
+Status Condition::clear() const {
+  const dds_return_t rc = dds_set_guardcondition(entity_.handle(), false);
+  if (rc < 0) return dds_error("clear guard condition", rc);
+  return ok_status();
+}
+
+Result<WaitSet> WaitSet::create(const Participant& participant) {
+  const dds_entity_t handle = dds_create_waitset(participant.handle());
+  if (handle < 0) return dds_error("create waitset", handle);
+  return WaitSet(Entity(handle));
+}
+
+Status WaitSet::attach(dds_entity_t entity, std::intptr_t token) {
+  const dds_return_t rc = dds_waitset_attach(entity_.handle(), entity, static_cast<dds_attach_t>(token));
+  if (rc < 0) return dds_error("attach to waitset", rc);
+  attached_.push_back(entity);
+  return ok_status();
+}
+
+Status WaitSet::wait(std::chrono::nanoseconds timeout, std::vector<std::intptr_t>& triggered) const {
+  triggered.assign(std::max<std::size_t>(attached_.size(), 1), 0);
+  std::vector<dds_attach_t> xs(triggered.size());
+  const dds_return_t n =
+      dds_waitset_wait(entity_.handle(), xs.data(), xs.size(), std::max<std::int64_t>(timeout.count(), 0));
+  if (n < 0) return dds_error("wait", n);
+  triggered.resize(static_cast<std::size_t>(n));
+  for (std::size_t i = 0; i < triggered.size(); ++i) triggered[i] = static_cast<std::intptr_t>(xs[i]);
+  return ok_status();
+}
+
+}  // namespace tetra::dds

@@ -1,0 +1,55 @@
+#include "tetra/dds/topics.hpp"
+
+namespace tetra::dds {
+
+Qos gyro_sample_qos(std::chrono::nanoseconds sample_period) {
+  Qos qos;
+  qos.reliable().volatile_durability().keep_last(kGyroSampleDepth).automatic_liveliness(kWriterLease);
+  if (sample_period.count() > 0) qos.deadline(3 * sample_period);
+  return qos;
+}
+Qos reference_qos() {
+  Qos qos;
+  qos.reliable().volatile_durability().keep_last(kReferenceDepth);
+  return qos;
+}
+Qos attitude_qos() {
+  Qos qos;
+  qos.reliable().volatile_durability().keep_last(1);
+  return qos;
+}
+Qos health_qos() {
+  Qos qos;
+  qos.reliable().transient_local(1).keep_last(1);
+  return qos;
+}
+Qos event_qos() {
+  Qos qos;
+  qos.reliable().transient_local(kEventDepth).keep_last(kEventDepth);
+  return qos;
+}
+Qos command_qos() {
+  Qos qos;
+  qos.reliable().volatile_durability().keep_last(kCommandDepth);
+  return qos;
+}
+
+Result<Topics> Topics::create(const Participant& participant) {
+  auto gyro = Topic::create(participant, &tetra_GyroSample_desc, "GyroSample", gyro_sample_qos());
+  if (!gyro) return gyro.error();
+  auto reference =
+      Topic::create(participant, &tetra_AttitudeReference_desc, "AttitudeReference", reference_qos());
+  if (!reference) return reference.error();
+  auto attitude = Topic::create(participant, &tetra_Attitude_desc, "Attitude", attitude_qos());
+  if (!attitude) return attitude.error();
+  auto health = Topic::create(participant, &tetra_Health_desc, "Health", health_qos());
+  if (!health) return health.error();
+  auto event = Topic::create(participant, &tetra_FdiEvent_desc, "FdiEvent", event_qos());
+  if (!event) return event.error();
+  auto command = Topic::create(participant, &tetra_Command_desc, "Command", command_qos());
+  if (!command) return command.error();
+  return Topics{std::move(gyro).value(),   std::move(reference).value(), std::move(attitude).value(),
+                std::move(health).value(), std::move(event).value(),     std::move(command).value()};
+}
+
+}  // namespace tetra::dds

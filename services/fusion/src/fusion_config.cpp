@@ -1,0 +1,146 @@
+#include "tetra/service/fusion_config.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+namespace tetra::service {
+
+namespace {
+
+std::string where(const std::string& source, const YAML::Node& node) {
+  const auto mark = node.Mark();
+  if (mark.line < 0) return source + ": ";
+  return source + ":" + std::to_string(mark.line + 1) + ": ";
+}
+
+Result<double> number(const std::string& source, const YAML::Node& node, const char* key) {
+  try {
+    const double value = node.as<double>();
+    if (!std::isfinite(value)) return bad_input(where(source, node) + key + " is not finite");
+    return value;
+  } catch (const YAML::Exception&) {
+    return bad_input(where(source, node) + key + " is not a number");
+  }
+}
+
+std::int64_t to_ns(double seconds) {
+  return static_cast<std::int64_t>(std::llround(seconds * 1e9));
+}
+
+}  // namespace
+
+std::int64_t FusionConfig::deadline_ns() const {
+  return to_ns(3.0 / (sample_rate_hz * speed));
+}
+
+AssemblerConfig FusionConfig::assembler(int gyro_count) const {
+  AssemblerConfig config;
+  config.gyro_count = gyro_count;
+  config.nominal_period_ns = to_ns(1.0 / sample_rate_hz);
+  config.tolerance_ns = tolerance_s ? to_ns(*tolerance_s) : config.nominal_period_ns / 4;
+  config.max_latency_ns = to_ns(max_latency_s);
+  return config;
+}
+
+Result<FusionConfig> read_fusion_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return bad_input(path + ": cannot open the fusion configuration");
+  std::stringstream text;
+  text << in.rdbuf();
+  const auto dir = std::filesystem::path(path).parent_path().string();
+  return parse_fusion_config(text.str(), path, dir);
+}
+
+Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std::string& source,
+                                         const std::string& base_dir) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    return bad_input(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  if (!root.IsMap()) return bad_input(source + ": expected a YAML map of settings");
+  FusionConfig config;
+  config.source = source;
+  const std::set<std::string> known = {"unit",        "calibration",   "sample_rate_hz",  "speed",
+                                       "tolerance_s", "max_latency_s", "health_period_s", "pipeline"};
+  for (const auto& item : root) {
+    const auto key = item.first.as<std::string>();
+    if (!known.contains(key)) {
+      return bad_input(where(source, item.first) + "unknown key '" + key +
+                       "' (allowed: unit, calibration, sample_rate_hz, speed, tolerance_s, "
+                       "max_latency_s, health_period_s, pipeline)");
+    }
+    const YAML::Node& value = item.second;
+    if (key == "unit" || key == "calibration") {
+      if (!value.IsScalar()) return bad_input(where(source, value) + key + " must be text");
+      (key == "unit" ? config.unit : config.calibration_path) = value.as<std::string>();
+    } else if (key == "pipeline") {
+      auto pipeline = fdi::pipeline_config_from_yaml(value, source);
+      if (!pipeline) return pipeline.error();
+      config.pipeline = std::move(pipeline).value();
+    } else {
+      auto x = number(source, value, key.c_str());
+      if (!x) return x.error();
+      if (key == "sample_rate_hz") config.sample_rate_hz = *x;
+      if (key == "speed") config.speed = *x;
+      if (key == "tolerance_s") config.tolerance_s = *x;
+      if (key == "max_latency_s") config.max_latency_s = *x;
+      if (key == "health_period_s") config.health_period_s = *x;
+    }
+  }
+  if (config.calibration_path.empty())
+    return bad_input(source + ": missing key 'calibration' (a calibration YAML)");
+  std::filesystem::path cal(config.calibration_path);
+  if (cal.is_relative() && !base_dir.empty()) cal = std::filesystem::path(base_dir) / cal;
+  config.calibration_path = cal.string();
+  auto calibration = read_calibration(config.calibration_path);
+  if (!calibration) return calibration.error();
+  config.calibration = std::move(calibration).value();
+  if (auto status = validate(config); !status) return status.error();
+  return config;
+}
+
+Status validate(const FusionConfig& config) {
+  const std::string& s = config.source;
+  if (config.unit.empty() || config.unit.size() > 31)
+    return bad_input(s + ": unit must have 1 to 31 characters");
+  if (!(config.sample_rate_hz > 0.0 && config.sample_rate_hz <= 100000.0)) {
+    return bad_input(s + ": sample_rate_hz must be in (0, 100000]");
+  }
+  if (!(config.speed > 0.0 && config.speed <= 1000.0)) return bad_input(s + ": speed must be in (0, 1000]");
+  if (!(config.health_period_s > 0.0 && config.health_period_s <= 1.0)) {
+    return bad_input(s + ": health_period_s must be in (0, 1] (Health is published at least at 1 Hz)");
+  }
+  if (config.calibration.gyro_count() > 16) return bad_input(s + ": at most 16 gyros go on the wire");
+  if (auto status = validate(config.assembler(config.calibration.gyro_count())); !status) {
+    return bad_input(s + ": " + status.error().message);
+  }
+  return fdi::validate(config.pipeline);
+}
+
+std::string describe(const FusionConfig& config) {
+  std::ostringstream out;
+  out << "unit: " << config.unit << '\n'
+      << "calibration: " << config.calibration_path << " (" << config.calibration.gyro_count()
+      << " gyros, method " << config.calibration.method << ")\n"
+      << "sample_rate_hz: " << config.sample_rate_hz << '\n'
+      << "speed: " << config.speed << " (deadline " << static_cast<double>(config.deadline_ns()) * 1e-9
+      << " s)\n"
+      << "tolerance_s: "
+      << (config.tolerance_s ? std::to_string(*config.tolerance_s)
+                             : "a quarter period (" + std::to_string(0.25 / config.sample_rate_hz) + ")")
+      << '\n'
+      << "max_latency_s: " << config.max_latency_s << '\n'
+      << "health_period_s: " << config.health_period_s << '\n'
+      << "pipeline:\n"
+      << fdi::describe(config.pipeline);
+  return out.str();
+}
+
+}  // namespace tetra::service
