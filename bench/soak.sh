@@ -52,9 +52,9 @@ fusion_pid=$!
 ) >"$work/rss.csv" &
 sampler_pid=$!
 
-# The ground's view during the run, once a second (the counters as of the simulator's last epoch are
+# The ground's view during the run, twice a second (the counters as of the simulator's last epoch are
 # judged, not those after it stopped, when every gyro is rightly absent).
-"$tetra" monitor --jsonl --unit soak-1 --domain "$domain" --period 1 >"$work/stream.jsonl" 2>/dev/null &
+"$tetra" monitor --jsonl --unit soak-1 --domain "$domain" --period 0.5 >"$work/stream.jsonl" 2>"$work/monitor.err" &
 monitor_pid=$!
 echo "soak: $minutes min at $rate Hz, domain $domain, work dir $work" >&2
 "$tetra" sim orbit --dds --dds-unit soak-1 --domain "$domain" --rate-hz "$rate" --minutes "$minutes" \
@@ -102,7 +102,7 @@ print(f"  epochs published {published}, accepted {c['epochs_accepted']}, lost {l
 print(f"  samples accepted {c['samples_accepted']} (4 per epoch: {4 * published})")
 print(f"  counters not zero while the simulator ran: {anomalies if anomalies else 'none'}")
 print(f"  counters not zero after it stopped: { {k: v for k, v in c.items() if k not in ('epochs_accepted', 'samples_accepted') and v != 0} }")
-print(f"  Health modes seen once a second during the run: {modes}")
+print(f"  Health modes seen twice a second during the run: {modes}")
 print(f"  events: {len(events)} (events_published {health.get('events_published')}); mode at the end of the data "
       f"{running['mode'] if running else '?'}, after it {health['mode']}")
 print(f"  RSS at {after_warmup[0][0]} s {rss_start} kB, at {rows[-1][0]} s {rss_end} kB: growth {rss_end - rss_start} kB; max {rss_max} kB")
