@@ -75,9 +75,14 @@ import csv, json, re, sys
 work, fusion_rc, minutes, rate = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
 stream = [json.loads(l) for l in open(f"{work}/stream.jsonl") if l.strip()]
 stream = [r for r in stream if r.get("type") == "health" and "counters" in r]
+# The data ends at the first Health that counts the last epoch; what follows is the simulator's exit.
+running = None
+if stream:
+    last = max(r["counters"]["epochs_accepted"] for r in stream)
+    end = next(i for i, r in enumerate(stream) if r["counters"]["epochs_accepted"] == last)
+    stream, running = stream[: end + 1], stream[end]
 modes = {}
 for r in stream: modes[r["mode"]] = modes.get(r["mode"], 0) + 1
-running = stream[-1] if stream else None  # the last Health the monitor printed while the simulator ran
 sim = open(f"{work}/sim.out").read()
 published = int(re.search(r"epochs published: (\d+)", sim).group(1))
 health, events = None, []
