@@ -75,12 +75,13 @@ import csv, json, re, sys
 work, fusion_rc, minutes, rate = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
 stream = [json.loads(l) for l in open(f"{work}/stream.jsonl") if l.strip()]
 stream = [r for r in stream if r.get("type") == "health" and "counters" in r]
-# The data ends at the first Health that counts the last epoch; what follows is the simulator's exit.
+# Health stamped with the last epoch already reports the simulator's exit (gyros absent): judge the
+# run on the Health before it.
 running = None
 if stream:
-    last = max(r["counters"]["epochs_accepted"] for r in stream)
-    end = next(i for i, r in enumerate(stream) if r["counters"]["epochs_accepted"] == last)
-    stream, running = stream[: end + 1], stream[end]
+    last_t = max(r["time_s"] for r in stream)
+    stream = [r for r in stream if r["time_s"] < last_t]
+    running = stream[-1] if stream else None
 modes = {}
 for r in stream: modes[r["mode"]] = modes.get(r["mode"], 0) + 1
 sim = open(f"{work}/sim.out").read()
