@@ -71,6 +71,7 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
                                        "tolerance_s", "max_latency_s", "health_period_s", "pipeline",
                                        "security"};
   for (const auto& item : root) {
+    if (!item.first.IsScalar()) return bad_input(where(source, item.first) + "a key must be text");
     const auto key = item.first.as<std::string>();
     if (!known.contains(key)) {
       return bad_input(where(source, item.first) + "unknown key '" + key +
