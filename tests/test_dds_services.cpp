@@ -3,6 +3,7 @@
 // Waits are on DDS conditions (waitsets) or process exits, each with a generous upper bound that
 // only turns a hang into a failure; nothing asserts on elapsed time.
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -47,14 +48,18 @@ class Process {
   Process(const std::vector<std::string>& args, const std::string& log_path) {
     std::vector<std::string> storage{TETRA_BINARY};
     storage.insert(storage.end(), args.begin(), args.end());
-    std::fflush(stdout);  // or the child's freopen() would write our buffered output a second time
+    std::vector<char*> argv;  // built before fork(): the child of a threaded process must not allocate
+    argv.reserve(storage.size() + 1);
+    for (auto& a : storage) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::fflush(stdout);  // or the child would inherit our buffered output
     pid_ = fork();
     if (pid_ == 0) {
-      std::vector<char*> argv;
-      for (auto& a : storage) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      if (FILE* f = std::freopen(log_path.c_str(), "w", stdout)) (void)f;
-      dup2(STDOUT_FILENO, STDERR_FILENO);
+      const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (fd >= 0) {
+        dup2(fd, STDOUT_FILENO);
+        dup2(fd, STDERR_FILENO);
+      }
       execv(TETRA_BINARY, argv.data());
       _exit(127);
     }
@@ -387,7 +392,8 @@ TEST(DdsServices, MalformedTrafficIsCountedNeverMixedNeverACrash) {
     ++seq;
     stamp += 10'000'000;
     for (int g = 1; g <= 4; ++g)
-      sample("tetra-1", g, seq, stamp, g == nan_on_gyro ? std::nan("") : cal.gyros[g - 1].bias_V);
+      sample("tetra-1", g, seq, stamp,
+             g == nan_on_gyro ? std::nan("") : cal.gyros[static_cast<std::size_t>(g - 1)].bias_V);
   };
   for (int k = 0; k < 20; ++k) epoch();
   epoch(3);                                                           // one NaN sample (gyro 3)
