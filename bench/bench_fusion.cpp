@@ -46,6 +46,7 @@ void BM_PipelineStepSuspect(benchmark::State& state) {
   tetra::test::Synth s(tetra::seed_as_built_unit(), opt,
                        tetra::test::SynthFault{1, tetra::fdi::FaultKind::kRamp, false, 10.0, 1e-5});
   std::vector<tetra::fdi::Epoch> epochs;
+  epochs.reserve(60000);
   for (int k = 0; k < 60000; ++k) epochs.push_back(s.next());
   auto p = tetra::fdi::Pipeline::create(tetra::seed_as_built_unit(), tetra::fdi::PipelineConfig{});
   auto warm_up = [&] {

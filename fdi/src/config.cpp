@@ -49,6 +49,7 @@ const std::vector<KeyDef>& scalar_keys() {
       {"reference_window_s", &PipelineConfig::reference_window_s},
       {"reference_sigma_arcsec", &PipelineConfig::reference_sigma_arcsec},
       {"reference_threshold_sigma", &PipelineConfig::reference_threshold_sigma},
+      {"reference_confirm_count", &PipelineConfig::reference_confirm_count},
       {"glt_false_alarm_probability", &PipelineConfig::glt_false_alarm_probability},
   };
   return keys;
@@ -169,6 +170,8 @@ Status validate(const PipelineConfig& c) {
       {"reference_window_s", positive(c.reference_window_s), "> 0"},
       {"reference_sigma_arcsec", positive(c.reference_sigma_arcsec), "> 0"},
       {"reference_threshold_sigma", positive(c.reference_threshold_sigma), "> 0"},
+      {"reference_confirm_count", c.reference_confirm_count >= 1 && c.reference_confirm_count <= 100,
+       "in [1, 100]"},
       {"glt_false_alarm_probability", probability(c.glt_false_alarm_probability), "in (0, 0.5)"},
   };
   for (const auto& check : checks) {

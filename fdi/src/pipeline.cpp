@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <unordered_map>
 
@@ -52,9 +53,10 @@ struct Subset {
 struct GyroTrack {
   bool excluded = false;
   FaultKind kind = FaultKind::kNone;
-  double sigma_rate_rts = 0.0;   //!< [rad/√s] white rate noise N
-  double bias_rate_sigma = 0.0;  //!< [rad/s] 1σ of the calibrated bias
-  double scale_rel_sigma = 0.0;  //!< [-] 1σ relative scale factor error
+  double sigma_rate_rts = 0.0;    //!< [rad/√s] white rate noise N
+  double bias_rate_sigma = 0.0;   //!< [rad/s] 1σ of the calibrated bias
+  double scale_rel_sigma = 0.0;   //!< [-] 1σ relative scale factor error
+  double bias_instability = 0.0;  //!< [rad/s] B of the calibration's noise section (0 if absent)
   // this epoch
   bool valid = false;  //!< sample present and valid (before the jump test)
   bool use = false;    //!< used in this epoch's solution
@@ -153,6 +155,8 @@ class Pipeline::Impl {
   void push_history(std::int64_t now);
   //! Robust noise level / expected over the last `last` second differences (0: the whole window).
   double noise_ratio(const GyroTrack& g, int last = 0) const;
+  //! Trimmed RMS noise level / expected over the last `last` second differences (classification).
+  double recent_noise_ratio(const GyroTrack& g, int last) const;
   void update_mode(std::int64_t now);
 
   Calibration cal_;
@@ -207,6 +211,8 @@ class Pipeline::Impl {
   std::vector<double> snap_angle_;       //!< kSnapshots×N
   std::vector<double> snap_ref_;         //!< kSnapshots×N
   int snap_count_ = 0;                   //!< total pushed
+  int ref_run_gyro_ = 0;                 //!< gyro flagged alone by the last reference comparisons
+  int ref_run_ = 0;                      //!< how many in a row
   mutable std::vector<double> scratch_;  //!< median scratch
   std::vector<double> mean_pre_, mean_post_;
   std::vector<int> n_pre_, n_post_;
@@ -229,6 +235,8 @@ Status Pipeline::Impl::init() {
                        ": noise.arw_dps_rtHz must be positive");
     }
     t.sigma_rate_rts = deg2rad(n_dps);
+    if (g.noise && g.noise->bias_instability_dps)
+      t.bias_instability = deg2rad(*g.noise->bias_instability_dps);
     arw[i] = t.sigma_rate_rts;
     const double s = config_.raw_units_dps ? 1.0 : g.scale_factor_V_per_dps;
     scale_V_per_rad_s_.push_back(s / kDegToRad);
@@ -352,8 +360,10 @@ void Pipeline::Impl::reset() {
     const double n = g.sigma_rate_rts;
     const double b = g.bias_rate_sigma;
     const double s = g.scale_rel_sigma;
+    const double bi = g.bias_instability;
     auto d2 = std::move(g.d2);
     g = GyroTrack{};
+    g.bias_instability = bi;
     g.sigma_rate_rts = n;
     g.bias_rate_sigma = b;
     g.scale_rel_sigma = s;
@@ -369,6 +379,8 @@ void Pipeline::Impl::reset() {
   omega_prev_.setZero();
   lost_since_ns_ = -1;
   snap_count_ = 0;
+  ref_run_gyro_ = 0;
+  ref_run_ = 0;
   pending_.clear();
   reset_detectors();
   update_mode(0);
@@ -397,7 +409,9 @@ std::string Pipeline::Impl::describe_thresholds() const {
   std::string out = "gyros: " + std::to_string(n_) + "\n";
   for (int i = 0; i < n_; ++i) {
     out += "gyro " + std::to_string(i + 1) + ": N = ";
-    append_double(out, gyros_[static_cast<std::size_t>(i)].sigma_rate_rts * kRadToDeg);
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", gyros_[static_cast<std::size_t>(i)].sigma_rate_rts * kRadToDeg);
+    out += text;
     out += " deg/sqrt(s)\n";
   }
   const auto it = subsets_.find(all_gyros(n_));
@@ -507,14 +521,35 @@ double Pipeline::Impl::noise_ratio(const GyroTrack& g, int last) const {
                          : std::min(g.d2_count, config_.noise_window);
   if (n < (last > 0 ? std::min(10, config_.noise_window) : config_.noise_window)) return kNaN;
   double* buf = scratch_.data();
-  for (int k = 0; k < n; ++k) {
-    buf[k] =
-        g.d2[static_cast<std::size_t>((g.d2_head - 1 - k + 2 * config_.noise_window) % config_.noise_window)];
+  if (n == config_.noise_window) {
+    std::copy(g.d2.begin(), g.d2.end(), buf);  // the whole ring: order does not matter for a median
+  } else {
+    for (int k = 0; k < n; ++k) {
+      buf[k] = g.d2[static_cast<std::size_t>((g.d2_head - 1 - k + 2 * config_.noise_window) %
+                                             config_.noise_window)];
+    }
   }
   std::nth_element(buf, buf + n / 2, buf + n);
   // Δ²y = y_k − 2y_{k−1} + y_{k−2} of white noise has variance 6σ²: median |Δ²y| = 0.6745·√6·σ.
   const double sigma_sample = g.sigma_rate_rts / sqrt_period_;
   return buf[n / 2] / (kNoiseExpectedMedian * std::sqrt(6.0) * sigma_sample);
+}
+
+double Pipeline::Impl::recent_noise_ratio(const GyroTrack& g, int last) const {
+  // RMS of the last `last` second differences without their two largest (a step leaves exactly two), over the
+  // expected √6·σ. Efficient on few samples, where the median is not: used to classify at isolation time.
+  const int n = std::min({last, g.d2_count, config_.noise_window});
+  if (n < 6) return kNaN;
+  double* buf = scratch_.data();
+  for (int k = 0; k < n; ++k) {
+    buf[k] =
+        g.d2[static_cast<std::size_t>((g.d2_head - 1 - k + 2 * config_.noise_window) % config_.noise_window)];
+  }
+  std::sort(buf, buf + n);
+  double sum_sq = 0.0;
+  for (int k = 0; k < n - 2; ++k) sum_sq += buf[k] * buf[k];
+  const double sigma_sample = g.sigma_rate_rts / sqrt_period_;
+  return std::sqrt(sum_sq / (n - 2)) / (std::sqrt(6.0) * sigma_sample);
 }
 
 void Pipeline::Impl::check_signatures(std::int64_t now) {
@@ -648,7 +683,7 @@ int Pipeline::Impl::onset_test(std::int64_t now_index) {
   const std::int64_t pre_begin = k0 - gap - config_.onset_pre_epochs;
   const std::int64_t pre_end = k0 - gap;
   const std::int64_t post_end = std::min(now_index + 1, k0 + config_.onset_post_max_epochs);
-  if (pre_begin < 0 || pre_begin <= now_index - kHistory || post_end - k0 < 10) return 0;
+  if (pre_begin < 0 || pre_begin <= now_index - kHistory || post_end - k0 < 20) return 0;
   std::fill(mean_pre_.begin(), mean_pre_.end(), 0.0);
   std::fill(mean_post_.begin(), mean_post_.end(), 0.0);
   std::fill(n_pre_.begin(), n_pre_.end(), 0);
@@ -823,8 +858,6 @@ void Pipeline::Impl::reference_update(const Epoch& epoch) {
   int loud = 0;
   int culprit = 0;
   double stat = 0.0;
-  double culprit_rot = 0.0;
-  double culprit_err = 0.0;
   int members = 0;
   for (int i = 0; i < n_; ++i) {
     const auto& g = gyros_[static_cast<std::size_t>(i)];
@@ -835,23 +868,32 @@ void Pipeline::Impl::reference_update(const Epoch& epoch) {
     const double gyro_angle =
         g.angle_rad - snap_angle_[os * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)];
     const double err = gyro_angle - rot;
-    const double sig =
-        std::sqrt(2.0 * sig_ref * sig_ref + g.sigma_rate_rts * g.sigma_rate_rts * span +
-                  std::pow(g.bias_rate_sigma * span, 2) + std::pow(g.scale_rel_sigma * rot, 2));
+    const double sig = std::sqrt(2.0 * sig_ref * sig_ref + g.sigma_rate_rts * g.sigma_rate_rts * span +
+                                 std::pow((g.bias_rate_sigma + g.bias_instability) * span, 2) +
+                                 std::pow(g.scale_rel_sigma * rot, 2));
     const double z = std::abs(err) / sig;
     if (z > config_.reference_threshold_sigma) {
       ++flagged;
       culprit = i + 1;
       stat = z;
-      culprit_rot = rot;
-      culprit_err = err;
     } else if (z > 0.5 * config_.reference_threshold_sigma) {
       ++loud;
     }
   }
-  if (flagged != 1 || loud != 0 || members < 2) return;
-  (void)culprit_rot;
-  (void)culprit_err;
+  // One gyro alone beyond the threshold, the others quiet, in `reference_confirm_count` consecutive
+  // comparisons (consecutive windows share no reference sample, so one wild reference sample cannot do it).
+  if (flagged != 1 || loud != 0 || members < 2) {
+    ref_run_gyro_ = 0;
+    ref_run_ = 0;
+    return;
+  }
+  if (culprit != ref_run_gyro_) {
+    ref_run_gyro_ = culprit;
+    ref_run_ = 0;
+  }
+  if (++ref_run_ < config_.reference_confirm_count) return;
+  ref_run_gyro_ = 0;
+  ref_run_ = 0;
   // Scale or rate offset: fit err(τ) = a·τ + b·rot(τ) over the window's snapshots. When the rotation about
   // the axis is not proportional to time (a slew), a significant b is a scale error; otherwise the data
   // cannot tell scale from offset and the parity's history decides bias or ramp.
@@ -1003,7 +1045,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
         avail = without_gyro(avail, i + 1);
         if (g.outlier_run >= config_.onset_confirm_epochs) {
           const bool zero = g.outlier_repeated && g.raw == 0.0;
-          const double r = noise_ratio(g, config_.onset_confirm_epochs);
+          const double r = recent_noise_ratio(g, config_.onset_confirm_epochs);
           if (g.outlier_repeated) {
             isolate(i + 1, FaultKind::kStuck, zero ? "zero" : "repeated", "onset", g.outlier_run, now);
           } else if (std::isfinite(r) && r > config_.noise_high_ratio) {
@@ -1174,20 +1216,13 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
       evidence = "glt";
     }
     if (culprit > 0) {
-      // Kind from the gyro's own samples since the onset: identical raw values are a stuck output.
-      bool repeated = true;
-      for (std::int64_t k = std::max(episode_.onset_index, epoch_index_ - kHistory + 1) + 1;
-           k <= epoch_index_; ++k) {
-        const auto slot = static_cast<std::size_t>(k % kHistory);
-        const auto prev = static_cast<std::size_t>((k - 1) % kHistory);
-        repeated = repeated &&
-                   hist_raw_[slot * static_cast<std::size_t>(n_) + static_cast<std::size_t>(culprit - 1)] ==
-                       hist_raw_[prev * static_cast<std::size_t>(n_) + static_cast<std::size_t>(culprit - 1)];
-      }
-      // A noise increase also shifts window means: the second differences since the onset tell it apart.
-      const double r =
-          noise_ratio(gyros_[static_cast<std::size_t>(culprit - 1)],
-                      static_cast<int>(std::max<std::int64_t>(epoch_index_ - episode_.onset_index, 10)));
+      // Kind from the gyro's own samples: identical raw values (5 or more in a row, whatever the onset
+      // estimate) are a stuck output; a noise increase also shifts window means, and its second differences
+      // tell it apart.
+      const auto& cg = gyros_[static_cast<std::size_t>(culprit - 1)];
+      const bool repeated = cg.repeat_count >= 5;
+      const double r = recent_noise_ratio(
+          cg, static_cast<int>(std::max<std::int64_t>(epoch_index_ - episode_.onset_index, 20)));
       FaultKind kind = FaultKind::kBias;
       if (repeated) {
         kind = FaultKind::kStuck;
@@ -1196,7 +1231,10 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
       } else if (evidence == "glt") {
         kind = classify_drift(culprit);
       }
-      isolate(culprit, kind, evidence, episode_.test, episode_.statistic, now);
+      // A noise level neither normal nor clearly high: wait for more samples rather than guess the kind.
+      const bool ambiguous = !repeated && std::isfinite(r) && r > 0.5 * config_.noise_high_ratio &&
+                             r <= config_.noise_high_ratio;
+      if (!ambiguous) isolate(culprit, kind, evidence, episode_.test, episode_.statistic, now);
     } else if (!episode_.declared_unisolated && now >= episode_.deadline_ns) {
       episode_.declared_unisolated = true;
       FdiEvent u;

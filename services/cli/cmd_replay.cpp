@@ -113,7 +113,12 @@ int cmd_replay(int argc, char** argv) {
   fdi::Epoch epoch;
   epoch.raw.resize(static_cast<std::size_t>(n));
   epoch.present.resize(static_cast<std::size_t>(n));
+  // Progress on stderr for long logs (a 100-min 10 Hz orbit takes about 0.1 s and prints nothing).
+  const std::size_t progress_every = log->epochs() >= 2'000'000 ? log->epochs() / 10 : 0;
   for (std::size_t k = 0; k < log->epochs(); ++k) {
+    if (progress_every != 0 && k != 0 && k % progress_every == 0) {
+      std::fprintf(stderr, "tetra replay: %zu%% (%zu epochs)\n", 100 * k / log->epochs(), k);
+    }
     epoch.stamp_ns = seconds_to_ns(log->time_s[k]);
     for (int i = 0; i < n; ++i) {
       epoch.raw[static_cast<std::size_t>(i)] = log->value(k, i);

@@ -65,9 +65,7 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
     e.reference_q_RB = se.reference_q_RB;
     const auto& r = pipeline->step(e);
     for (const auto& ev : r.events) {
-      if (ev.type == fdi::EventType::kCommand || ev.type == fdi::EventType::kReconfigured) {
-        if (ev.type == fdi::EventType::kCommand) continue;
-      }
+      if (ev.type == fdi::EventType::kCommand) continue;  // operator acknowledgements are not FDI results
       run.events.push_back(ev);
       const double t = ns_to_seconds(ev.stamp_ns);
       if (ev.type == fdi::EventType::kDetected && !run.first_detected_s) run.first_detected_s = t;
@@ -95,7 +93,7 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
 
 inline std::string describe(const CampaignRun& run, int n_gyros = 4) {
   std::string s;
-  for (const auto& e : run.events) s += fdi::to_json(e, n_gyros) + (e.detail.empty() ? "" : "") + "\n";
+  for (const auto& e : run.events) s += fdi::to_json(e, n_gyros) + "\n";
   return s;
 }
 

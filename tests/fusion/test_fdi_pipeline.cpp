@@ -39,8 +39,8 @@ PipelineConfig campaign_config() {
   return c;
 }
 
-Outcome run(const SynthFault& fault, double duration_s, SynthOptions opt = {},
-            PipelineConfig cfg = campaign_config(), Calibration cal = seed_as_built_unit()) {
+Outcome run(const SynthFault& fault, double duration_s, const SynthOptions& opt = {},
+            const PipelineConfig& cfg = campaign_config(), const Calibration& cal = seed_as_built_unit()) {
   auto p = Pipeline::create(cal, cfg);
   EXPECT_TRUE(p.ok());
   Synth s(cal, opt, fault);
@@ -128,7 +128,7 @@ TEST(Pipeline, SignatureFaultsIsolatedOnEveryGyroWithTheRightKind) {
       f.zero = c.zero;
       f.at_s = 60.0;
       SynthOptions opt;
-      opt.seed = static_cast<std::uint64_t>(gyro * 100 + static_cast<int>(c.kind));
+      opt.seed = 100U * static_cast<std::uint64_t>(gyro) + static_cast<std::uint64_t>(c.kind);
       const Outcome o = run(f, 60.0 + c.within_s + 10.0, opt);
       const std::string what =
           std::string(to_string(c.kind)) + (c.zero ? "/zero" : "") + " on gyro " + std::to_string(gyro);
@@ -150,7 +150,7 @@ TEST(Pipeline, BiasStepsDetectedInTimeAndNeverMisisolated) {
     for (double size : {1e-3, -1e-3, 2e-4, 1e-2}) {
       SynthFault f{gyro, FaultKind::kBias, false, 60.0, size};
       SynthOptions opt;
-      opt.seed = static_cast<std::uint64_t>(1000 + gyro);
+      opt.seed = 1000U + static_cast<std::uint64_t>(gyro);
       const Outcome o = run(f, 100.0, opt);
       const std::string what = "bias " + std::to_string(size) + " on gyro " + std::to_string(gyro);
       ASSERT_TRUE(o.detected_s.has_value()) << what;
@@ -169,7 +169,7 @@ TEST(Pipeline, RampsAreDetectedAndEndUnisolatedWithoutReference) {
   for (int gyro = 1; gyro <= 4; ++gyro) {
     SynthFault f{gyro, FaultKind::kRamp, false, 60.0, 1e-5};
     SynthOptions opt;
-    opt.seed = static_cast<std::uint64_t>(2000 + gyro);
+    opt.seed = 2000U + static_cast<std::uint64_t>(gyro);
     const Outcome o = run(f, 60.0 + 90.0, opt);
     ASSERT_TRUE(o.detected_s.has_value()) << gyro;
     EXPECT_LE(*o.detected_s, 60.0) << gyro;
@@ -188,7 +188,7 @@ TEST(Pipeline, ReferenceIsolatesBiasRampAndScale) {
   for (int gyro = 1; gyro <= 4; ++gyro) {
     for (const auto& [kind, size] : {std::pair{FaultKind::kBias, 1e-3}, std::pair{FaultKind::kRamp, 2e-5}}) {
       SynthFault f{gyro, kind, false, 60.0, size};
-      opt.seed = static_cast<std::uint64_t>(3000 + gyro);
+      opt.seed = 3000U + static_cast<std::uint64_t>(gyro);
       const Outcome o = run(f, 60.0 + 70.0, opt);
       const std::string what = std::string(to_string(kind)) + " on gyro " + std::to_string(gyro);
       ASSERT_TRUE(o.isolated_gyro.has_value()) << what << "\n" << describe(o);
@@ -317,7 +317,7 @@ TEST(Pipeline, FiveGyrosIsolateABiasByGlt) {
   for (int gyro = 1; gyro <= 5; ++gyro) {
     SynthFault f{gyro, FaultKind::kBias, false, 60.0, 4e-4};
     SynthOptions opt;
-    opt.seed = static_cast<std::uint64_t>(4000 + gyro);
+    opt.seed = 4000U + static_cast<std::uint64_t>(gyro);
     const Outcome o = run(f, 120.0, opt, campaign_config(), cal);
     ASSERT_TRUE(o.isolated_gyro.has_value()) << gyro << "\n" << describe(o);
     EXPECT_EQ(*o.isolated_gyro, gyro) << describe(o);
@@ -349,6 +349,24 @@ TEST(Pipeline, GroundModeRemovesEarthRate) {
   EXPECT_LT(angle_between(g->attitude.q_RB, Quaternion::Identity()), 5.0 * g->attitude.sigma_rad.norm());
   EXPECT_NEAR(angle_between(q->attitude.q_RB, Quaternion::Identity()) * kRadToDeg,
               7.2921159e-5 * 600 * kRadToDeg, 0.01);
+}
+
+TEST(Pipeline, ThreeGyrosHaveNoParityButSignaturesStillIsolate) {
+  // Gyros 1–3 of the unit alone: no parity, so χ² and CUSUM are silent (10 min, no event); a stuck gyro is
+  // still isolated by its own series, and with two gyros left the attitude is LOST.
+  Calibration cal = seed_as_built_unit();
+  cal.gyros.resize(3);
+  const Outcome quiet = run({}, 600.0, SynthOptions{}, campaign_config(), cal);
+  EXPECT_TRUE(quiet.events.empty()) << describe(quiet);
+  EXPECT_EQ(quiet.final_mode, Mode::kNominal);
+  const Outcome o =
+      run(SynthFault{2, FaultKind::kStuck, false, 60.0, 0.0}, 70.0, SynthOptions{}, campaign_config(), cal);
+  ASSERT_TRUE(o.isolated_gyro.has_value()) << describe(o);
+  EXPECT_EQ(*o.isolated_gyro, 2);
+  EXPECT_EQ(o.final_mode, Mode::kLost);
+  bool lost = false;
+  for (const auto& e : o.events) lost = lost || e.type == EventType::kLost;
+  EXPECT_TRUE(lost) << describe(o);
 }
 
 }  // namespace

@@ -50,6 +50,7 @@ struct PipelineConfig {
   double reference_window_s = 30.0;        //!< [s] window of the reference comparison
   double reference_sigma_arcsec = 5.0;     //!< [arcsec] 1σ per axis of the attitude reference
   double reference_threshold_sigma = 6.0;  //!< [σ] reference disagreement threshold
+  int reference_confirm_count = 3;         //!< [-] consecutive reference comparisons that must agree
   double glt_false_alarm_probability = 1.0e-9;  //!< [-] N ≥ 5: rejecting a single-gyro hypothesis
 };
 
