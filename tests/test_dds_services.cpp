@@ -422,5 +422,32 @@ TEST(DdsServices, MalformedTrafficIsCountedNeverMixedNeverACrash) {
   EXPECT_EQ(fusion.signal_and_wait(SIGINT), 0) << "the service survived and shut down cleanly";
 }
 
+TEST(DdsServices, CommandLineErrorsAndAbsentServicesGiveTheExitStatusOfTheContract) {
+  // Bad usage or input: 2 and one line naming what is wrong.
+  auto r = run_tetra("fusion --config /nonexistent/fusion.yaml");
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("/nonexistent/fusion.yaml"), std::string::npos) << r.err;
+  TempDir dir;
+  write_file(dir.file("f.yaml"), "calibration: cal.yaml\nsampel_rate_hz: 100\n");
+  r = run_tetra("fusion --config " + dir.file("f.yaml"));
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("f.yaml:2:"), std::string::npos) << r.err;
+  EXPECT_EQ(run_tetra("command --unit tetra-1 exclude").exit_status, 2);    // which gyro?
+  EXPECT_EQ(run_tetra("command --unit tetra-1 reset 2").exit_status, 2);    // reset takes none
+  EXPECT_EQ(run_tetra("command --unit tetra-1 explode 2").exit_status, 2);  // no such command
+  EXPECT_EQ(run_tetra("record --unit tetra-1").exit_status, 2);             // -o is required
+  EXPECT_EQ(run_tetra("monitor --period 2").exit_status, 2);                // < 2 Hz refused
+  for (const char* sub : {"fusion", "monitor", "command", "record", "demo"}) {
+    EXPECT_EQ(run_tetra(std::string(sub) + " --help").exit_status, 0) << sub;
+  }
+  // Nobody on the domain: 1, and the reason.
+  r = run_tetra("command --unit tetra-1 reset --timeout 0.3 --domain 165");
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("no fusion service found"), std::string::npos) << r.err;
+  r = run_tetra("monitor --once --timeout 0.3 --domain 165");
+  EXPECT_EQ(r.exit_status, 1);
+  EXPECT_NE(r.err.find("no health"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace tetra::test
