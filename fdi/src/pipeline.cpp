@@ -142,6 +142,8 @@ class Pipeline::Impl {
   void prepare(double period_s);
   GyroMask active_mask() const;
   void emit(FdiEvent event);
+  //! A "detected" event: `test` raised the alarm with `statistic`.
+  void emit_detected(const std::string& test, double statistic, std::int64_t now);
   void reset_detectors();
   void check_signatures(std::int64_t now);
   void jump_test(std::int64_t now, GyroMask avail);
@@ -444,6 +446,15 @@ void Pipeline::Impl::emit(FdiEvent event) {
   result_.events.push_back(std::move(event));
 }
 
+void Pipeline::Impl::emit_detected(const std::string& test, double statistic, std::int64_t now) {
+  FdiEvent d;
+  d.stamp_ns = now;
+  d.type = EventType::kDetected;
+  d.test = test;
+  d.statistic = statistic;
+  emit(std::move(d));
+}
+
 void Pipeline::Impl::update_mode(std::int64_t now) {
   const GyroMask active = active_mask();
   Mode mode = Mode::kNominal;
@@ -482,12 +493,7 @@ void Pipeline::Impl::isolate(int id, FaultKind kind, const std::string& evidence
   if (g.excluded) return;
   const GyroMask before = active_mask();
   if (!episode_.active) {
-    FdiEvent d;
-    d.stamp_ns = now;
-    d.type = EventType::kDetected;
-    d.test = test;
-    d.statistic = statistic;
-    emit(std::move(d));
+    emit_detected(test, statistic, now);
   } else if (period_s_ > 0.0) {
     // The fault corrupted the rate from its onset until now: keep that in the attitude uncertainty.
     const Subset& s = subset(before);
@@ -1183,12 +1189,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
           episode_.glt_sum.head(s.dof) = mc_sum_.head(s.dof);
           episode_.glt_n = mc_n_;
         }
-        FdiEvent d;
-        d.stamp_ns = now;
-        d.type = EventType::kDetected;
-        d.test = test;
-        d.statistic = statistic;
-        emit(std::move(d));
+        emit_detected(test, statistic, now);
         // The fault acted since its onset: widen the uncertainty for the time already spent.
         attitude_.add_bound(fault_rate_bound(subset(act)) * ns_to_seconds(now - episode_.onset_ns));
       }

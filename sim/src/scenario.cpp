@@ -11,18 +11,13 @@
 
 #include "tetra/core/csv.hpp"
 #include "tetra/core/yaml_reader.hpp"
+#include "text.hpp"
 
 namespace tetra::sim {
 
 namespace {
 
 constexpr double kMaxEpochs = 2.0e9;  // a guard against absurd durations × rates
-
-std::string number_text(double value) {
-  std::string out;
-  append_double(out, value);
-  return out;
-}
 
 // Sets `out` from parent[key] when the key is present; leaves the default otherwise.
 Status maybe_number(const YamlReader& yaml, const YAML::Node& parent, const std::string& key,
