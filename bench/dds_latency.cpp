@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,9 @@ int fail(const std::string& what) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
   using namespace tetra;
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
   int epochs = 3000;
@@ -100,7 +103,7 @@ int main(int argc, char** argv) {
     std::int64_t t0 = 0;
     for (int g = 1; g <= 4; ++g) {
       sample.gyro = static_cast<std::uint16_t>(g);
-      sample.seq = static_cast<std::uint64_t>(k + 1);
+      sample.seq = static_cast<std::uint64_t>(k) + 1;
       sample.stamp_ns = stamp;
       sample.raw = cal.gyros[static_cast<std::size_t>(g - 1)].bias_V;
       if (g == 4) t0 = now_ns();
@@ -142,4 +145,14 @@ int main(int argc, char** argv) {
       "(no attitude: %d)\n",
       latency_us.size(), rate_hz, pct(0.5), pct(0.9), pct(0.99), latency_us.back(), missing);
   return missing == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    return fail(std::string("internal error: ") + e.what());
+  }
 }

@@ -1,12 +1,14 @@
 #include "tetra/core/calibration_file.hpp"
 
 #include <cmath>
-#include <set>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/yaml_reader.hpp"
 
 namespace tetra {
 
@@ -45,120 +47,73 @@ Calibration seed_as_built_unit() {
 
 namespace {
 
-struct Ctx {
-  const std::string& source;
-  std::string at(const YAML::Node& node) const {
-    const auto mark = node.Mark();
-    if (mark.line < 0) return source + ": ";
-    return source + ":" + std::to_string(mark.line + 1) + ": ";
-  }
-};
-
-// Exceptions never leave this file: parse_calibration catches them and returns an Error.
-struct ParseError {
-  std::string message;
-};
-
-void check_keys(const Ctx& ctx, const YAML::Node& map, const std::set<std::string>& allowed,
-                const std::string& what) {
-  if (!map.IsMap()) throw ParseError{ctx.at(map) + what + ": expected a mapping"};
-  for (const auto& kv : map) {
-    const auto key = kv.first.as<std::string>();
-    if (allowed.count(key) == 0) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      throw ParseError{ctx.at(kv.first) + what + ": unknown key '" + key + "' (allowed: " + list + ")"};
-    }
-  }
-}
-
-double number(const Ctx& ctx, const YAML::Node& parent, const std::string& key, const std::string& what) {
-  const YAML::Node node = parent[key];
-  if (!node) throw ParseError{ctx.at(parent) + what + ": missing key '" + key + "'"};
-  try {
-    const double v = node.as<double>();
-    if (!std::isfinite(v)) throw ParseError{ctx.at(node) + what + "." + key + ": must be finite"};
-    return v;
-  } catch (const YAML::Exception&) {
-    throw ParseError{ctx.at(node) + what + "." + key + ": '" + (node.IsScalar() ? node.Scalar() : "?") +
-                     "' is not a number"};
-  }
-}
-
-std::optional<double> optional_number(const Ctx& ctx, const YAML::Node& parent, const std::string& key,
-                                      const std::string& what) {
-  const YAML::Node node = parent[key];
-  if (!node || node.IsNull()) return std::nullopt;
-  return number(ctx, parent, key, what);
-}
-
-Eigen::Vector3d vector3(const Ctx& ctx, const YAML::Node& parent, const std::string& key,
-                        const std::string& what) {
-  const YAML::Node node = parent[key];
-  if (!node) throw ParseError{ctx.at(parent) + what + ": missing key '" + key + "'"};
-  if (!node.IsSequence() || node.size() != 3)
-    throw ParseError{ctx.at(node) + what + "." + key + ": expected [x, y, z]"};
-  Eigen::Vector3d v;
-  for (std::size_t i = 0; i < 3; ++i) {
-    try {
-      v[static_cast<Eigen::Index>(i)] = node[i].as<double>();
-    } catch (const YAML::Exception&) {
-      throw ParseError{ctx.at(node[i]) + what + "." + key + "[" + std::to_string(i) + "]: not a number"};
-    }
-    if (!std::isfinite(v[static_cast<Eigen::Index>(i)])) {
-      throw ParseError{ctx.at(node[i]) + what + "." + key + ": must be finite"};
-    }
-  }
-  return v;
-}
-
-GyroCalibration parse_gyro(const Ctx& ctx, const YAML::Node& g, std::size_t index) {
+Result<GyroCalibration> parse_gyro(const YamlReader& yaml, const YAML::Node& g, std::size_t index) {
   const std::string what = "gyros[" + std::to_string(index) + "]";
-  check_keys(ctx, g, {"id", "scale_factor_V_per_dps", "bias_V", "axis", "sigma", "noise"}, what);
+  if (Status st =
+          yaml.check_keys(g, {"id", "scale_factor_V_per_dps", "bias_V", "axis", "sigma", "noise"}, what);
+      !st)
+    return st.error();
   GyroCalibration out;
-  const double id = number(ctx, g, "id", what);
-  if (id != std::floor(id) || id < 1 || id > 64)
-    throw ParseError{ctx.at(g["id"]) + what + ".id: must be 1..N"};
-  out.id = static_cast<int>(id);
-  out.scale_factor_V_per_dps = number(ctx, g, "scale_factor_V_per_dps", what);
-  if (out.scale_factor_V_per_dps == 0.0) {
-    throw ParseError{ctx.at(g["scale_factor_V_per_dps"]) + what +
-                     ".scale_factor_V_per_dps: must not be zero"};
-  }
-  out.bias_V = number(ctx, g, "bias_V", what);
-  const Eigen::Vector3d axis = vector3(ctx, g, "axis", what);
-  const double norm = axis.norm();
+  const auto id = yaml.required_number(g, "id", what);
+  if (!id) return id.error();
+  if (*id != std::floor(*id) || *id < 1 || *id > 64) return yaml.error(g["id"], what + ".id", "must be 1..N");
+  out.id = static_cast<int>(*id);
+  const auto scale = yaml.required_number(g, "scale_factor_V_per_dps", what);
+  if (!scale) return scale.error();
+  if (*scale == 0.0)
+    return yaml.error(g["scale_factor_V_per_dps"], what + ".scale_factor_V_per_dps", "must not be zero");
+  out.scale_factor_V_per_dps = *scale;
+  const auto bias = yaml.required_number(g, "bias_V", what);
+  if (!bias) return bias.error();
+  out.bias_V = *bias;
+  const auto axis = yaml.required_vector3(g, "axis", what);
+  if (!axis) return axis.error();
+  const double norm = axis->norm();
   if (std::abs(norm - 1.0) > 1e-3) {
     std::ostringstream msg;
-    msg << ctx.at(g["axis"]) << what << ".axis: norm " << norm << " is not 1 (a unit vector is required)";
-    throw ParseError{msg.str()};
+    msg << "norm " << norm << " is not 1 (a unit vector is required)";
+    return yaml.error(g["axis"], what + ".axis", msg.str());
   }
   // Normalize five-decimal table values; leave full-precision unit vectors bit-exact.
-  out.axis_B = std::abs(norm - 1.0) > 1e-12 ? Eigen::Vector3d(axis / norm) : axis;
+  out.axis_B = std::abs(norm - 1.0) > 1e-12 ? Eigen::Vector3d(*axis / norm) : *axis;
   if (const YAML::Node s = g["sigma"]; s && !s.IsNull()) {
     const std::string sw = what + ".sigma";
-    check_keys(ctx, s, {"scale_factor_V_per_dps", "bias_V", "axis"}, sw);
+    if (Status st = yaml.check_keys(s, {"scale_factor_V_per_dps", "bias_V", "axis"}, sw); !st)
+      return st.error();
     GyroSigma sigma;
-    sigma.scale_factor_V_per_dps = optional_number(ctx, s, "scale_factor_V_per_dps", sw).value_or(0.0);
-    sigma.bias_V = optional_number(ctx, s, "bias_V", sw).value_or(0.0);
-    if (s["axis"]) sigma.axis = vector3(ctx, s, "axis", sw);
+    const auto sigma_scale = yaml.optional_number(s, "scale_factor_V_per_dps", sw);
+    if (!sigma_scale) return sigma_scale.error();
+    const auto sigma_bias = yaml.optional_number(s, "bias_V", sw);
+    if (!sigma_bias) return sigma_bias.error();
+    sigma.scale_factor_V_per_dps = sigma_scale->value_or(0.0);
+    sigma.bias_V = sigma_bias->value_or(0.0);
+    if (s["axis"]) {
+      const auto sigma_axis = yaml.required_vector3(s, "axis", sw);
+      if (!sigma_axis) return sigma_axis.error();
+      sigma.axis = *sigma_axis;
+    }
     out.sigma = sigma;
   }
   if (const YAML::Node n = g["noise"]; n && !n.IsNull()) {
     const std::string nw = what + ".noise";
-    check_keys(ctx, n,
-               {"quantization_deg", "arw_dps_rtHz", "bias_instability_dps", "rate_random_walk_dps_per_rts",
-                "rate_ramp_dps_per_s"},
-               nw);
     GyroNoise noise;
-    noise.quantization_deg = optional_number(ctx, n, "quantization_deg", nw);
-    noise.arw_dps_rtHz = optional_number(ctx, n, "arw_dps_rtHz", nw);
-    noise.bias_instability_dps = optional_number(ctx, n, "bias_instability_dps", nw);
-    noise.rate_random_walk_dps_per_rts = optional_number(ctx, n, "rate_random_walk_dps_per_rts", nw);
-    noise.rate_ramp_dps_per_s = optional_number(ctx, n, "rate_ramp_dps_per_s", nw);
-    for (const auto& v : {noise.quantization_deg, noise.arw_dps_rtHz, noise.bias_instability_dps,
-                          noise.rate_random_walk_dps_per_rts, noise.rate_ramp_dps_per_s}) {
-      if (v && *v < 0.0) throw ParseError{ctx.at(n) + nw + ": noise terms must not be negative"};
+    const std::pair<const char*, std::optional<double>*> terms[] = {
+        {"quantization_deg", &noise.quantization_deg},
+        {"arw_dps_rtHz", &noise.arw_dps_rtHz},
+        {"bias_instability_dps", &noise.bias_instability_dps},
+        {"rate_random_walk_dps_per_rts", &noise.rate_random_walk_dps_per_rts},
+        {"rate_ramp_dps_per_s", &noise.rate_ramp_dps_per_s},
+    };
+    std::vector<std::string> allowed;
+    for (const auto& [key, field] : terms) allowed.emplace_back(key);
+    if (Status st = yaml.check_keys(n, allowed, nw); !st) return st.error();
+    for (const auto& [key, field] : terms) {
+      auto v = yaml.optional_number(n, key, nw);
+      if (!v) return v.error();
+      *field = *v;
+    }
+    for (const auto& [key, field] : terms) {
+      if (*field && **field < 0.0) return yaml.error(n, nw, "noise terms must not be negative");
     }
     out.noise = noise;
   }
@@ -168,26 +123,31 @@ GyroCalibration parse_gyro(const Ctx& ctx, const YAML::Node& g, std::size_t inde
 }  // namespace
 
 Result<Calibration> parse_calibration(const std::string& yaml_text, const std::string& source) {
-  const Ctx ctx{source};
+  const YamlReader yaml{source};
   try {
     const YAML::Node root = YAML::Load(yaml_text);
     if (!root || root.IsNull()) return bad_input(source + ": empty calibration file");
-    check_keys(ctx, root, {"unit", "latitude_deg", "method", "gyros"}, "calibration");
+    if (Status st = yaml.check_keys(root, {"unit", "latitude_deg", "method", "gyros"}, "calibration"); !st)
+      return st.error();
     Calibration cal;
     cal.unit = root["unit"] ? root["unit"].as<std::string>() : "";
-    cal.latitude_deg = optional_number(ctx, root, "latitude_deg", "calibration");
+    const auto latitude = yaml.optional_number(root, "latitude_deg", "calibration");
+    if (!latitude) return latitude.error();
+    cal.latitude_deg = *latitude;
     cal.method = root["method"] ? root["method"].as<std::string>() : "";
     const YAML::Node gyros = root["gyros"];
     if (!gyros) return bad_input(source + ": missing key 'gyros'");
-    if (!gyros.IsSequence()) return bad_input(ctx.at(gyros) + "gyros: expected a list");
-    for (std::size_t i = 0; i < gyros.size(); ++i) cal.gyros.push_back(parse_gyro(ctx, gyros[i], i));
+    if (!gyros.IsSequence()) return yaml.error(gyros, "gyros", "expected a list");
+    for (std::size_t i = 0; i < gyros.size(); ++i) {
+      auto gyro = parse_gyro(yaml, gyros[i], i);
+      if (!gyro) return gyro.error();
+      cal.gyros.push_back(std::move(*gyro));
+    }
     const Status valid = validate_calibration(cal, source);
     if (!valid) return valid.error();
     return cal;
-  } catch (const ParseError& e) {
-    return bad_input(e.message);
   } catch (const YAML::Exception& e) {
-    return bad_input(source + ":" + std::to_string(e.mark.line + 1) + ": YAML: " + e.msg);
+    return yaml.error(e, "YAML");
   }
 }
 

@@ -58,12 +58,16 @@ std::optional<std::size_t> CsvTable::find_column(std::string_view name) const {
   return std::nullopt;
 }
 
-std::optional<std::string> CsvTable::meta(std::string_view key) const {
+std::optional<std::string> last_meta(const Metadata& metadata, std::string_view key) {
   std::optional<std::string> found;
   for (const auto& [k, v] : metadata) {
     if (k == key) found = v;
   }
   return found;
+}
+
+std::optional<std::string> CsvTable::meta(std::string_view key) const {
+  return last_meta(metadata, key);
 }
 
 std::string CsvTable::where(std::size_t row, std::size_t col) const {

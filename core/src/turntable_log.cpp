@@ -7,11 +7,7 @@
 namespace tetra {
 
 std::optional<std::string> TurntableLog::meta(const std::string& key) const {
-  std::optional<std::string> found;
-  for (const auto& [k, v] : metadata) {
-    if (k == key) found = v;
-  }
-  return found;
+  return last_meta(metadata, key);
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/yaml_reader.hpp"
 
 namespace tetra::fdi {
 
@@ -55,56 +56,49 @@ const std::vector<KeyDef>& scalar_keys() {
   return keys;
 }
 
-std::string at(const std::string& source, const YAML::Node& node) {
-  const auto mark = node.Mark();
-  if (mark.line < 0) return source + ": ";
-  return source + ":" + std::to_string(mark.line + 1) + ": ";
-}
-
 }  // namespace
 
 Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const std::string& source) {
   PipelineConfig config;
   if (!node || node.IsNull()) return config;
-  if (!node.IsMap()) return bad_input(at(source, node) + "pipeline: expected a mapping");
+  const YamlReader yaml{source};
+  std::vector<std::string> allowed = {"latitude_deg", "initial_q_wxyz"};
+  for (const auto& def : scalar_keys()) allowed.emplace_back(def.name);
+  if (Status st = yaml.check_keys(node, allowed, "pipeline"); !st) return st.error();
   try {
     for (const auto& kv : node) {
-      const auto key = kv.first.as<std::string>();
+      const std::string key = kv.first.Scalar();
       const YAML::Node& value = kv.second;
-      const std::string where = at(source, kv.first) + "pipeline." + key + ": ";
+      const std::string what = "pipeline." + key;
       if (key == "latitude_deg") {
-        const double v = value.as<double>();
-        if (!std::isfinite(v)) return bad_input(where + "must be finite");
-        config.latitude_deg = v;
+        const auto v = yaml.number(value, what);
+        if (!v) return v.error();
+        config.latitude_deg = *v;
         continue;
       }
       if (key == "initial_q_wxyz") {
-        if (!value.IsSequence() || value.size() != 4) return bad_input(where + "expected [w, x, y, z]");
+        if (!value.IsSequence() || value.size() != 4)
+          return yaml.error(kv.first, what, "expected [w, x, y, z]");
         config.initial_q_RB = from_wxyz(value[0].as<double>(), value[1].as<double>(), value[2].as<double>(),
                                         value[3].as<double>());
         continue;
       }
-      bool found = false;
       for (const auto& def : scalar_keys()) {
         if (key != def.name) continue;
-        found = true;
-        if (!value.IsScalar()) return bad_input(where + "expected a scalar");
+        if (!value.IsScalar()) return yaml.error(kv.first, what, "expected a scalar");
         if (const auto* d = std::get_if<double PipelineConfig::*>(&def.field)) {
-          config.*(*d) = value.as<double>();
+          const auto v = yaml.number(value, what);
+          if (!v) return v.error();
+          config.*(*d) = *v;
         } else if (const auto* i = std::get_if<int PipelineConfig::*>(&def.field)) {
           config.*(*i) = value.as<int>();
         } else {
           config.*std::get<bool PipelineConfig::*>(def.field) = value.as<bool>();
         }
       }
-      if (!found) {
-        std::string list = "latitude_deg, initial_q_wxyz";
-        for (const auto& def : scalar_keys()) list += std::string(", ") + def.name;
-        return bad_input(where + "unknown key (allowed: " + list + ")");
-      }
     }
   } catch (const YAML::Exception& e) {
-    return bad_input(source + ":" + std::to_string(e.mark.line + 1) + ": pipeline: " + e.msg);
+    return yaml.error(e, "pipeline");
   }
   if (auto st = validate(config); !st) return bad_input(source + ": " + st.error().message);
   return config;
@@ -117,7 +111,7 @@ Result<PipelineConfig> read_pipeline_config(const std::string& path) {
   try {
     root = YAML::Load(*text);
   } catch (const YAML::Exception& e) {
-    return bad_input(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    return YamlReader{path}.error(e, "");
   }
   if (!root || root.IsNull()) return PipelineConfig{};
   if (!root.IsMap()) return bad_input(path + ": expected a mapping with a 'pipeline:' key");

@@ -142,6 +142,8 @@ class Pipeline::Impl {
   void prepare(double period_s);
   GyroMask active_mask() const;
   void emit(FdiEvent event);
+  //! A "detected" event: `test` raised the alarm with `statistic`.
+  void emit_detected(const std::string& test, double statistic, std::int64_t now);
   void reset_detectors();
   void check_signatures(std::int64_t now);
   void jump_test(std::int64_t now, GyroMask avail);
@@ -158,6 +160,13 @@ class Pipeline::Impl {
   //! Trimmed RMS noise level / expected over the last `last` second differences (classification).
   double recent_noise_ratio(const GyroTrack& g, int last) const;
   void update_mode(std::int64_t now);
+  //! Clears a gyro's exclusion and the fault evidence it carried (reinstate, reset).
+  static void reinstate_track(GyroTrack& g);
+  //! Queues and returns the acknowledgement "COMMAND ID: OUTCOME" of an operator command; when the
+  //! command `changed` the gyro set, first resets the detectors and the mode, then also queues the
+  //! reconfigured (or lost) event that follows it.
+  FdiEvent acknowledge(const std::string& command, int id, const std::string& outcome, bool changed,
+                       std::int64_t stamp_ns);
 
   Calibration cal_;
   PipelineConfig config_;
@@ -437,6 +446,15 @@ void Pipeline::Impl::emit(FdiEvent event) {
   result_.events.push_back(std::move(event));
 }
 
+void Pipeline::Impl::emit_detected(const std::string& test, double statistic, std::int64_t now) {
+  FdiEvent d;
+  d.stamp_ns = now;
+  d.type = EventType::kDetected;
+  d.test = test;
+  d.statistic = statistic;
+  emit(std::move(d));
+}
+
 void Pipeline::Impl::update_mode(std::int64_t now) {
   const GyroMask active = active_mask();
   Mode mode = Mode::kNominal;
@@ -475,12 +493,7 @@ void Pipeline::Impl::isolate(int id, FaultKind kind, const std::string& evidence
   if (g.excluded) return;
   const GyroMask before = active_mask();
   if (!episode_.active) {
-    FdiEvent d;
-    d.stamp_ns = now;
-    d.type = EventType::kDetected;
-    d.test = test;
-    d.statistic = statistic;
-    emit(std::move(d));
+    emit_detected(test, statistic, now);
   } else if (period_s_ > 0.0) {
     // The fault corrupted the rate from its onset until now: keep that in the attitude uncertainty.
     const Subset& s = subset(before);
@@ -1177,12 +1190,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
           episode_.glt_sum.head(s.dof) = mc_sum_.head(s.dof);
           episode_.glt_n = mc_n_;
         }
-        FdiEvent d;
-        d.stamp_ns = now;
-        d.type = EventType::kDetected;
-        d.test = test;
-        d.statistic = statistic;
-        emit(std::move(d));
+        emit_detected(test, statistic, now);
         // The fault acted since its onset: widen the uncertainty for the time already spent.
         attitude_.add_bound(fault_rate_bound(subset(act)) * ns_to_seconds(now - episode_.onset_ns));
       }
@@ -1309,25 +1317,29 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
 // ---------------------------------------------------------------------------------------------
 // operator commands
 
-FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns) {
+void Pipeline::Impl::reinstate_track(GyroTrack& g) {
+  g.excluded = false;
+  g.kind = FaultKind::kNone;
+  g.spike_n = 0;
+  g.repeat_count = 0;
+  g.d2_count = 0;
+  g.d2_since_eval = 0;
+}
+
+FdiEvent Pipeline::Impl::acknowledge(const std::string& command, int id, const std::string& outcome,
+                                     bool changed, std::int64_t stamp_ns) {
+  if (changed) {
+    reset_detectors();
+    update_mode(stamp_ns);
+  }
   FdiEvent ack;
   ack.stamp_ns = stamp_ns;
   ack.type = EventType::kCommand;
   ack.gyro = id;
-  if (id < 1 || id > n_) {
-    ack.detail = "exclude " + std::to_string(id) + ": rejected, no such gyro";
-  } else if (gyros_[static_cast<std::size_t>(id - 1)].excluded) {
-    ack.detail = "exclude " + std::to_string(id) + ": already excluded";
-  } else {
-    gyros_[static_cast<std::size_t>(id - 1)].excluded = true;
-    gyros_[static_cast<std::size_t>(id - 1)].kind = FaultKind::kUnknown;
-    reset_detectors();
-    ack.detail = "exclude " + std::to_string(id) + ": done";
-    update_mode(stamp_ns);
-  }
+  ack.detail = command + " " + std::to_string(id) + ": " + outcome;
   ack.gyros = active_mask();
   pending_.push_back(ack);
-  if (ack.detail.ends_with("done")) {
+  if (changed) {
     FdiEvent rc;
     rc.stamp_ns = stamp_ns;
     rc.type = persistent_mode_ == Mode::kLost ? EventType::kLost : EventType::kReconfigured;
@@ -1337,50 +1349,27 @@ FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns) {
   return ack;
 }
 
+FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns) {
+  if (id < 1 || id > n_) return acknowledge("exclude", id, "rejected, no such gyro", false, stamp_ns);
+  auto& g = gyros_[static_cast<std::size_t>(id - 1)];
+  if (g.excluded) return acknowledge("exclude", id, "already excluded", false, stamp_ns);
+  g.excluded = true;
+  g.kind = FaultKind::kUnknown;
+  return acknowledge("exclude", id, "done", true, stamp_ns);
+}
+
 FdiEvent Pipeline::Impl::command_reinstate(int id, std::int64_t stamp_ns) {
-  FdiEvent ack;
-  ack.stamp_ns = stamp_ns;
-  ack.type = EventType::kCommand;
-  ack.gyro = id;
-  if (id < 1 || id > n_) {
-    ack.detail = "reinstate " + std::to_string(id) + ": rejected, no such gyro";
-  } else if (!gyros_[static_cast<std::size_t>(id - 1)].excluded) {
-    ack.detail = "reinstate " + std::to_string(id) + ": not excluded";
-  } else {
-    auto& g = gyros_[static_cast<std::size_t>(id - 1)];
-    g.excluded = false;
-    g.kind = FaultKind::kNone;
-    g.spike_n = 0;
-    g.repeat_count = 0;
-    g.d2_count = 0;
-    g.d2_since_eval = 0;
-    snap_count_ = 0;  // the reinstated gyro's angle has a gap: restart the reference windows
-    reset_detectors();
-    ack.detail = "reinstate " + std::to_string(id) + ": done";
-    update_mode(stamp_ns);
-  }
-  ack.gyros = active_mask();
-  pending_.push_back(ack);
-  if (ack.detail.ends_with("done")) {
-    FdiEvent rc;
-    rc.stamp_ns = stamp_ns;
-    rc.type = persistent_mode_ == Mode::kLost ? EventType::kLost : EventType::kReconfigured;
-    rc.gyros = active_mask();
-    pending_.push_back(rc);
-  }
-  return ack;
+  if (id < 1 || id > n_) return acknowledge("reinstate", id, "rejected, no such gyro", false, stamp_ns);
+  auto& g = gyros_[static_cast<std::size_t>(id - 1)];
+  if (!g.excluded) return acknowledge("reinstate", id, "not excluded", false, stamp_ns);
+  reinstate_track(g);
+  snap_count_ = 0;  // the reinstated gyro's angle has a gap: restart the reference windows
+  return acknowledge("reinstate", id, "done", true, stamp_ns);
 }
 
 FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   // FDI reset: every gyro reinstated, detectors and episode cleared; the attitude and time go on.
-  for (auto& g : gyros_) {
-    g.excluded = false;
-    g.kind = FaultKind::kNone;
-    g.spike_n = 0;
-    g.repeat_count = 0;
-    g.d2_count = 0;
-    g.d2_since_eval = 0;
-  }
+  for (auto& g : gyros_) reinstate_track(g);
   snap_count_ = 0;
   reset_detectors();
   update_mode(stamp_ns);

@@ -238,6 +238,14 @@ int cmd_demo(int argc, char** argv) {
       << std::flush;
   Child monitor(spawn_self({"monitor", "--once", "--unit", unit, "--domain", domain_text, "--timeout", "5"}));
   monitor.wait();
+
+  // The operator's side: reinstate the failed gyro; the service obeys and acknowledges it as an event.
+  const std::string gyro_text = std::to_string(fault->gyro);
+  std::cout << "\noperator: tetra command --unit " << unit << " reinstate " << gyro_text << '\n'
+            << std::flush;
+  Child command(spawn_self(
+      {"command", "--unit", unit, "reinstate", gyro_text, "--domain", domain_text, "--timeout", "5"}));
+  const bool acknowledged = command.wait() == 0;
   const int fusion_status = fusion.stop();
 
   // Summary.
@@ -274,6 +282,8 @@ int cmd_demo(int argc, char** argv) {
   }
   std::cout << "at the end "
             << fixed(score->series.empty() ? 0.0 : score->series.back().error_deg * 3600.0, 1) << " arcsec\n"
+            << "  operator command:  reinstate " << gyro_text
+            << (acknowledged ? ", acknowledged" : ", NOT acknowledged") << '\n'
             << "  service:           exit status " << fusion_status << " after SIGTERM"
             << (keep_dir.empty() ? std::string(" (its log: --keep DIR)") : " (log " + dir + "/fusion.log)")
             << '\n';

@@ -15,7 +15,8 @@ namespace tetra::cli {
 
 namespace {
 enum Token : std::intptr_t { kAttitude = 1, kMatched, kShutdown };
-}
+constexpr std::int64_t kDiscoverySettle_ns = 200'000'000;  //!< [ns] see run_sim_dds
+}  // namespace
 
 void add_sim_dds_options(CLI::App& app, SimDdsOptions& options) {
   app.add_flag("--dds", options.enabled,
@@ -136,6 +137,16 @@ Result<SimDdsScore> run_sim_dds(sim::Simulator& simulator, const SimDdsOptions& 
       const std::int64_t now = monotonic_ns();
       if (*matched > 0 || now >= attitude_give_up || stop_requested()) break;
       if (auto s = waitset->wait(std::chrono::nanoseconds(attitude_give_up - now), triggered); !s)
+        return s.error();
+    }
+  }
+
+  // Other readers (a recorder) give no such sign of having discovered our writer: allow them a
+  // settling time well above the 3–20 ms discovery takes on loopback, before the first sample.
+  if (options.wait_readers > 1) {
+    const std::int64_t settle_until = monotonic_ns() + kDiscoverySettle_ns;
+    for (std::int64_t now = monotonic_ns(); now < settle_until && !stop_requested(); now = monotonic_ns()) {
+      if (auto s = waitset->wait(std::chrono::nanoseconds(settle_until - now), triggered); !s)
         return s.error();
     }
   }

@@ -3,12 +3,15 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <set>
+#include <initializer_list>
 #include <sstream>
+#include <utility>
 
 #include <yaml-cpp/yaml.h>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/yaml_reader.hpp"
+#include "text.hpp"
 
 namespace tetra::sim {
 
@@ -16,159 +19,141 @@ namespace {
 
 constexpr double kMaxEpochs = 2.0e9;  // a guard against absurd durations × rates
 
-std::string number_text(double value) {
-  std::string out;
-  append_double(out, value);
-  return out;
-}
-
-// --- YAML helpers. Exceptions never leave this file: parse_scenario turns them into an Error. ---
-
-struct ParseError {
-  std::string message;
-};
-
-struct Ctx {
-  const std::string& source;
-  std::string at(const YAML::Node& node) const {
-    const auto mark = node.Mark();
-    if (mark.line < 0) return source + ": ";
-    return source + ":" + std::to_string(mark.line + 1) + ": ";
-  }
-};
-
-void check_keys(const Ctx& ctx, const YAML::Node& map, const std::set<std::string>& allowed,
-                const std::string& what) {
-  if (!map.IsMap()) throw ParseError{ctx.at(map) + what + ": expected a mapping"};
-  for (const auto& kv : map) {
-    const auto key = kv.first.as<std::string>();
-    if (allowed.count(key) == 0) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      throw ParseError{ctx.at(kv.first) + what + "unknown key '" + key + "' (allowed: " + list + ")"};
-    }
-  }
-}
-
-double number(const Ctx& ctx, const YAML::Node& node, const std::string& what) {
-  try {
-    const double v = node.as<double>();
-    if (!std::isfinite(v)) throw ParseError{ctx.at(node) + what + ": must be finite"};
-    return v;
-  } catch (const YAML::Exception&) {
-    throw ParseError{ctx.at(node) + what + ": '" + (node.IsScalar() ? node.Scalar() : std::string("?")) +
-                     "' is not a number"};
-  }
-}
-
-void maybe_number(const Ctx& ctx, const YAML::Node& parent, const std::string& key, const std::string& prefix,
-                  double& out) {
+// Sets `out` from parent[key] when the key is present; leaves the default otherwise.
+Status maybe_number(const YamlReader& yaml, const YAML::Node& parent, const std::string& key,
+                    const std::string& what, double& out) {
   const YAML::Node node = parent[key];
-  if (node) out = number(ctx, node, prefix + key);
+  if (!node) return ok_status();
+  auto v = yaml.number(node, YamlReader::child(what, key));
+  if (!v) return v.error();
+  out = *v;
+  return ok_status();
 }
 
-Eigen::Vector3d vector3(const Ctx& ctx, const YAML::Node& node, const std::string& what) {
-  if (!node.IsSequence() || node.size() != 3) throw ParseError{ctx.at(node) + what + ": expected [x, y, z]"};
-  Eigen::Vector3d v;
-  for (std::size_t i = 0; i < 3; ++i) {
-    v[static_cast<Eigen::Index>(i)] = number(ctx, node[i], what + "[" + std::to_string(i) + "]");
+Status maybe_numbers(const YamlReader& yaml, const YAML::Node& parent, const std::string& what,
+                     std::initializer_list<std::pair<const char*, double*>> fields) {
+  for (const auto& [key, out] : fields) {
+    if (Status st = maybe_number(yaml, parent, key, what, *out); !st) return st;
   }
-  return v;
+  return ok_status();
 }
 
-Eigen::Vector3d axis_from(const Ctx& ctx, const YAML::Node& node, const std::string& what) {
+Result<Eigen::Vector3d> axis_from(const YamlReader& yaml, const YAML::Node& node, const std::string& what) {
   if (node.IsScalar()) {
     const std::string& name = node.Scalar();
-    if (name == "x" || name == "+x") return Eigen::Vector3d::UnitX();
-    if (name == "y" || name == "+y") return Eigen::Vector3d::UnitY();
-    if (name == "z" || name == "+z") return Eigen::Vector3d::UnitZ();
-    if (name == "-x") return -Eigen::Vector3d::UnitX();
-    if (name == "-y") return -Eigen::Vector3d::UnitY();
-    if (name == "-z") return -Eigen::Vector3d::UnitZ();
-    throw ParseError{ctx.at(node) + what + ": '" + name + "' is not an axis (x, y, z, -x, ... or [x, y, z])"};
+    if (name == "x" || name == "+x") return Eigen::Vector3d(Eigen::Vector3d::UnitX());
+    if (name == "y" || name == "+y") return Eigen::Vector3d(Eigen::Vector3d::UnitY());
+    if (name == "z" || name == "+z") return Eigen::Vector3d(Eigen::Vector3d::UnitZ());
+    if (name == "-x") return Eigen::Vector3d(-Eigen::Vector3d::UnitX());
+    if (name == "-y") return Eigen::Vector3d(-Eigen::Vector3d::UnitY());
+    if (name == "-z") return Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
+    return yaml.error(node, what, "'" + name + "' is not an axis (x, y, z, -x, ... or [x, y, z])");
   }
-  const Eigen::Vector3d v = vector3(ctx, node, what);
-  if (v.norm() < 1e-9) throw ParseError{ctx.at(node) + what + ": must not be the zero vector"};
-  return v.normalized();
+  const auto v = yaml.vector3(node, what);
+  if (!v) return v.error();
+  if (v->norm() < 1e-9) return yaml.error(node, what, "must not be the zero vector");
+  return Eigen::Vector3d(v->normalized());
 }
 
-Scenario parse_yaml(const YAML::Node& root, const Ctx& ctx, const std::string& base_dir) {
-  check_keys(ctx, root,
-             {"scenario", "duration_s", "rate_hz", "latitude_deg", "pitch_rate_dps", "orbit_period_s", "acs",
-              "slews", "reference", "unit", "gyro_model", "jitter_s", "drop_probability", "faults"},
-             "");
+Result<Slew> parse_slew(const YamlReader& yaml, const YAML::Node& s, const std::string& what) {
+  if (Status st = yaml.check_keys(s, {"axis", "angle_deg", "start_s", "duration_s"}, what); !st)
+    return st.error();
+  for (const char* key : {"axis", "angle_deg", "start_s", "duration_s"}) {
+    if (!s[key]) return yaml.error(s, what + "." + key, "missing");
+  }
+  Slew slew;
+  const auto axis = axis_from(yaml, s["axis"], what + ".axis");
+  if (!axis) return axis.error();
+  slew.axis_B = *axis;
+  if (Status st = maybe_numbers(
+          yaml, s, what,
+          {{"angle_deg", &slew.angle_deg}, {"start_s", &slew.start_s}, {"duration_s", &slew.duration_s}});
+      !st)
+    return st.error();
+  if (slew.duration_s <= 0.0) return yaml.error(s["duration_s"], what + ".duration_s", "must be positive");
+  return slew;
+}
+
+Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, const std::string& base_dir) {
+  if (Status st = yaml.check_keys(
+          root,
+          {"scenario", "duration_s", "rate_hz", "latitude_deg", "pitch_rate_dps", "orbit_period_s", "acs",
+           "slews", "reference", "unit", "gyro_model", "jitter_s", "drop_probability", "faults"},
+          "");
+      !st)
+    return st.error();
   const YAML::Node base = root["scenario"];
-  if (!base) throw ParseError{ctx.at(root) + "missing key 'scenario' (static, lab-orbit, orbit or slews)"};
+  if (!base) return yaml.error(root, "", "missing key 'scenario' (static, lab-orbit, orbit or slews)");
   auto builtin = builtin_scenario(base.as<std::string>());
-  if (!builtin) throw ParseError{ctx.at(base) + "scenario: " + builtin.error().message};
+  if (!builtin) return yaml.error(base, "scenario", builtin.error().message);
   Scenario sc = builtin.value();
-  sc.name = ctx.source;
-  maybe_number(ctx, root, "duration_s", "", sc.duration_s);
-  maybe_number(ctx, root, "rate_hz", "", sc.rate_hz);
-  maybe_number(ctx, root, "latitude_deg", "", sc.motion.latitude_deg);
-  maybe_number(ctx, root, "pitch_rate_dps", "", sc.motion.pitch_rate_dps);
-  maybe_number(ctx, root, "orbit_period_s", "", sc.motion.orbit_period_s);
-  maybe_number(ctx, root, "jitter_s", "", sc.jitter_s);
-  maybe_number(ctx, root, "drop_probability", "", sc.drop_probability);
+  sc.name = yaml.source();
+  if (Status st = maybe_numbers(yaml, root, "",
+                                {{"duration_s", &sc.duration_s},
+                                 {"rate_hz", &sc.rate_hz},
+                                 {"latitude_deg", &sc.motion.latitude_deg},
+                                 {"pitch_rate_dps", &sc.motion.pitch_rate_dps},
+                                 {"orbit_period_s", &sc.motion.orbit_period_s},
+                                 {"jitter_s", &sc.jitter_s},
+                                 {"drop_probability", &sc.drop_probability}});
+      !st)
+    return st.error();
   if (const YAML::Node acs = root["acs"]) {
-    check_keys(ctx, acs, {"amplitude_deg", "peak_accel_dps2"}, "acs: ");
-    maybe_number(ctx, acs, "amplitude_deg", "acs.", sc.motion.acs.amplitude_deg);
-    maybe_number(ctx, acs, "peak_accel_dps2", "acs.", sc.motion.acs.peak_accel_dps2);
+    if (Status st = yaml.check_keys(acs, {"amplitude_deg", "peak_accel_dps2"}, "acs"); !st) return st.error();
+    if (Status st = maybe_numbers(yaml, acs, "acs",
+                                  {{"amplitude_deg", &sc.motion.acs.amplitude_deg},
+                                   {"peak_accel_dps2", &sc.motion.acs.peak_accel_dps2}});
+        !st)
+      return st.error();
   }
   if (const YAML::Node slews = root["slews"]) {
-    if (!slews.IsSequence()) throw ParseError{ctx.at(slews) + "slews: expected a list"};
-    if (sc.motion.kind != MotionKind::kSlews) {
-      throw ParseError{ctx.at(slews) + "slews: only the 'slews' scenario has slews"};
-    }
+    if (!slews.IsSequence()) return yaml.error(slews, "slews", "expected a list");
+    if (sc.motion.kind != MotionKind::kSlews)
+      return yaml.error(slews, "slews", "only the 'slews' scenario has slews");
     sc.motion.slews.clear();
     for (std::size_t i = 0; i < slews.size(); ++i) {
-      const YAML::Node s = slews[i];
-      const std::string what = "slews[" + std::to_string(i) + "].";
-      check_keys(ctx, s, {"axis", "angle_deg", "start_s", "duration_s"}, what + " ");
-      Slew slew;
-      for (const char* key : {"axis", "angle_deg", "start_s", "duration_s"}) {
-        if (!s[key]) throw ParseError{ctx.at(s) + what + key + ": missing"};
-      }
-      slew.axis_B = axis_from(ctx, s["axis"], what + "axis");
-      slew.angle_deg = number(ctx, s["angle_deg"], what + "angle_deg");
-      slew.start_s = number(ctx, s["start_s"], what + "start_s");
-      slew.duration_s = number(ctx, s["duration_s"], what + "duration_s");
-      if (slew.duration_s <= 0.0)
-        throw ParseError{ctx.at(s["duration_s"]) + what + "duration_s: must be positive"};
-      sc.motion.slews.push_back(slew);
+      auto slew = parse_slew(yaml, slews[i], "slews[" + std::to_string(i) + "]");
+      if (!slew) return slew.error();
+      sc.motion.slews.push_back(*slew);
     }
   }
   if (const YAML::Node ref = root["reference"]) {
-    check_keys(ctx, ref, {"rate_hz", "noise_arcsec"}, "reference: ");
-    maybe_number(ctx, ref, "rate_hz", "reference.", sc.reference.rate_hz);
-    maybe_number(ctx, ref, "noise_arcsec", "reference.", sc.reference.noise_arcsec);
+    if (Status st = yaml.check_keys(ref, {"rate_hz", "noise_arcsec"}, "reference"); !st) return st.error();
+    if (Status st =
+            maybe_numbers(yaml, ref, "reference",
+                          {{"rate_hz", &sc.reference.rate_hz}, {"noise_arcsec", &sc.reference.noise_arcsec}});
+        !st)
+      return st.error();
   }
   if (const YAML::Node model = root["gyro_model"]) {
-    check_keys(ctx, model, {"bias_instability_correlation_s", "range_dps"}, "gyro_model: ");
-    maybe_number(ctx, model, "bias_instability_correlation_s", "gyro_model.",
-                 sc.model.bias_instability_correlation_s);
-    if (const YAML::Node range = model["range_dps"]; range && !range.IsNull()) {
-      sc.model.range_dps = number(ctx, range, "gyro_model.range_dps");
-    }
+    if (Status st = yaml.check_keys(model, {"bias_instability_correlation_s", "range_dps"}, "gyro_model");
+        !st)
+      return st.error();
+    if (Status st = maybe_number(yaml, model, "bias_instability_correlation_s", "gyro_model",
+                                 sc.model.bias_instability_correlation_s);
+        !st)
+      return st.error();
+    const auto range = yaml.optional_number(model, "range_dps", "gyro_model");
+    if (!range) return range.error();
+    if (*range) sc.model.range_dps = **range;
   }
   if (const YAML::Node unit = root["unit"]) {
     std::filesystem::path path = unit.as<std::string>();
     if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
     auto cal = read_calibration(path.string());
-    if (!cal) throw ParseError{ctx.at(unit) + "unit: " + cal.error().message};
+    if (!cal) return yaml.error(unit, "unit", cal.error().message);
     sc.unit = std::move(cal.value());
   }
   if (const YAML::Node faults = root["faults"]) {
-    if (!faults.IsSequence()) throw ParseError{ctx.at(faults) + "faults: expected a list of fault specs"};
+    if (!faults.IsSequence()) return yaml.error(faults, "faults", "expected a list of fault specs");
     for (std::size_t i = 0; i < faults.size(); ++i) {
       auto fault = parse_fault_spec(faults[i].as<std::string>());
-      if (!fault)
-        throw ParseError{ctx.at(faults[i]) + "faults[" + std::to_string(i) + "]: " + fault.error().message};
+      if (!fault) return yaml.error(faults[i], "faults[" + std::to_string(i) + "]", fault.error().message);
       sc.faults.push_back(fault.value());
     }
   }
   // Range checks with the line of the key where it exists.
-  if (Status st = validate_scenario(sc); !st) throw ParseError{ctx.at(root) + st.error().message};
+  if (Status st = validate_scenario(sc); !st) return yaml.error(root, "", st.error().message);
   return sc;
 }
 
@@ -216,16 +201,13 @@ Result<Scenario> builtin_scenario(const std::string& name) {
 
 Result<Scenario> parse_scenario(const std::string& yaml_text, const std::string& source,
                                 const std::string& base_dir) {
-  const Ctx ctx{source};
+  const YamlReader yaml{source};
   try {
     const YAML::Node root = YAML::Load(yaml_text);
     if (!root || root.IsNull()) return bad_input(source + ": empty scenario file");
-    return parse_yaml(root, ctx, base_dir);
-  } catch (const ParseError& e) {
-    return bad_input(e.message);
+    return parse_yaml(root, yaml, base_dir);
   } catch (const YAML::Exception& e) {
-    const int line = e.mark.line < 0 ? 0 : e.mark.line + 1;
-    return bad_input(source + ":" + std::to_string(line) + ": " + e.msg);
+    return yaml.error(e, "");
   }
 }
 

@@ -6,26 +6,9 @@
 
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"
+#include "text.hpp"
 
 namespace tetra::sim {
-
-namespace {
-
-std::string number_text(double value) {
-  std::string out;
-  append_double(out, value);
-  return out;
-}
-
-//! A metadata value: spaces and commas separate key=value tokens, so they become '_'.
-std::string token(std::string text) {
-  for (char& c : text) {
-    if (c == ' ' || c == '\t' || c == ',') c = '_';
-  }
-  return text;
-}
-
-}  // namespace
 
 Simulator::Simulator(Scenario scenario, SimOptions options, TruthMotion motion)
     : scenario_(std::move(scenario)), options_(std::move(options)), motion_(std::move(motion)) {
@@ -163,10 +146,10 @@ std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
   std::vector<std::pair<std::string, std::string>> meta;
   const MotionSpec& m = scenario_.motion;
   meta.emplace_back("generator", "tetra sim");
-  meta.emplace_back("scenario", token(scenario_.name));
+  meta.emplace_back("scenario", metadata_token(scenario_.name));
   meta.emplace_back("motion", std::string(motion_kind_name(m.kind)));
   meta.emplace_back("seed", std::to_string(options_.seed));
-  meta.emplace_back("unit", token(scenario_.unit.unit));
+  meta.emplace_back("unit", metadata_token(scenario_.unit.unit));
   meta.emplace_back("rate_hz", number_text(scenario_.rate_hz));
   meta.emplace_back("duration_s", number_text(scenario_.duration_s));
   meta.emplace_back("reference_frame", motion_.reference_frame());

@@ -6,26 +6,13 @@
 #include "tetra/core/csv.hpp"
 #include "tetra/core/frames.hpp"
 #include "tetra/core/units.hpp"
+#include "text.hpp"
 
 namespace tetra::sim {
 
 namespace {
 
 constexpr std::size_t kMaxRows = 50'000'000;  // a guard against absurd plans (memory)
-
-std::string number_text(double value) {
-  std::string out;
-  append_double(out, value);
-  return out;
-}
-
-//! Spaces and commas separate metadata tokens: replaced by '_'.
-std::string metadata_token(std::string text) {
-  for (char& c : text) {
-    if (c == ' ' || c == '\t' || c == ',') c = '_';
-  }
-  return text;
-}
 
 }  // namespace
 

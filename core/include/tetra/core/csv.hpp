@@ -17,6 +17,11 @@
 
 namespace tetra {
 
+//! "# key=value" metadata comments of a text file, in file order.
+using Metadata = std::vector<std::pair<std::string, std::string>>;
+//! The last value of `key` in `metadata` (a later line overrides an earlier one), or nullopt.
+std::optional<std::string> last_meta(const Metadata& metadata, std::string_view key);
+
 struct CsvTable {
   std::string source;                                         //!< file name used in messages
   std::vector<std::pair<std::string, std::string>> metadata;  //!< "# key=value" comments, in order

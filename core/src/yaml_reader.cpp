@@ -1,0 +1,87 @@
+#include "tetra/core/yaml_reader.hpp"
+
+#include <cmath>
+
+namespace tetra {
+
+std::string YamlReader::at(const YAML::Node& node) const {
+  const auto mark = node.Mark();
+  if (mark.line < 0) return source_ + ": ";
+  return source_ + ":" + std::to_string(mark.line + 1) + ": ";
+}
+
+Error YamlReader::error(const YAML::Node& node, const std::string& what, const std::string& message) const {
+  return bad_input(at(node) + (what.empty() ? "" : what + ": ") + message);
+}
+
+Error YamlReader::error(const YAML::Exception& e, const std::string& what) const {
+  const int line = e.mark.line < 0 ? 0 : e.mark.line + 1;
+  return bad_input(source_ + ":" + std::to_string(line) + ": " + (what.empty() ? "" : what + ": ") + e.msg);
+}
+
+std::string YamlReader::child(const std::string& what, const std::string& key) {
+  return what.empty() ? key : what + "." + key;
+}
+
+Status YamlReader::check_keys(const YAML::Node& map, const std::vector<std::string>& allowed,
+                              const std::string& what) const {
+  if (!map.IsMap()) return error(map, what, "expected a mapping");
+  for (const auto& kv : map) {
+    if (!kv.first.IsScalar()) return error(kv.first, what, "keys must be plain names");
+    const std::string& key = kv.first.Scalar();
+    bool known = false;
+    for (const auto& a : allowed) known = known || a == key;
+    if (!known) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      return error(kv.first, what, "unknown key '" + key + "' (allowed: " + list + ")");
+    }
+  }
+  return ok_status();
+}
+
+Result<double> YamlReader::number(const YAML::Node& node, const std::string& what) const {
+  double v = 0.0;
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, v)) {
+    return error(node, what,
+                 "'" + (node.IsScalar() ? node.Scalar() : std::string("?")) + "' is not a number");
+  }
+  if (!std::isfinite(v)) return error(node, what, "must be finite");
+  return v;
+}
+
+Result<double> YamlReader::required_number(const YAML::Node& parent, const std::string& key,
+                                           const std::string& what) const {
+  const YAML::Node node = parent[key];
+  if (!node) return error(parent, what, "missing key '" + key + "'");
+  return number(node, child(what, key));
+}
+
+Result<std::optional<double>> YamlReader::optional_number(const YAML::Node& parent, const std::string& key,
+                                                          const std::string& what) const {
+  const YAML::Node node = parent[key];
+  if (!node || node.IsNull()) return std::optional<double>{};
+  auto v = number(node, child(what, key));
+  if (!v) return v.error();
+  return std::optional<double>{*v};
+}
+
+Result<Eigen::Vector3d> YamlReader::vector3(const YAML::Node& node, const std::string& what) const {
+  if (!node.IsSequence() || node.size() != 3) return error(node, what, "expected [x, y, z]");
+  Eigen::Vector3d v;
+  for (std::size_t i = 0; i < 3; ++i) {
+    auto c = number(node[i], what + "[" + std::to_string(i) + "]");
+    if (!c) return c.error();
+    v[static_cast<Eigen::Index>(i)] = *c;
+  }
+  return v;
+}
+
+Result<Eigen::Vector3d> YamlReader::required_vector3(const YAML::Node& parent, const std::string& key,
+                                                     const std::string& what) const {
+  const YAML::Node node = parent[key];
+  if (!node) return error(parent, what, "missing key '" + key + "'");
+  return vector3(node, child(what, key));
+}
+
+}  // namespace tetra

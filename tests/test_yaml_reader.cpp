@@ -1,0 +1,82 @@
+// The shared YAML reading helpers: every error starts "FILE:LINE: " and names the field by its path.
+#include <gtest/gtest.h>
+
+#include "tetra/core/yaml_reader.hpp"
+
+namespace tetra {
+namespace {
+
+TEST(YamlReader, UnknownKeyNamesItsLineAndListsAllowedKeysInOrder) {
+  const YamlReader yaml{"f.yaml"};
+  const YAML::Node root = YAML::Load("a: 1\nnoise:\n  arw: 2\n  bogus: 3\n");
+  EXPECT_TRUE(yaml.check_keys(root, {"a", "noise"}, "").ok());
+  const auto st = yaml.check_keys(root["noise"], {"arw", "bi"}, "gyros[0].noise");
+  ASSERT_FALSE(st.ok());
+  EXPECT_EQ(st.error().message, "f.yaml:4: gyros[0].noise: unknown key 'bogus' (allowed: arw, bi)");
+  const auto root_st = yaml.check_keys(root, {"noise"}, "");
+  ASSERT_FALSE(root_st.ok());
+  EXPECT_EQ(root_st.error().message, "f.yaml:1: unknown key 'a' (allowed: noise)");
+  const auto not_map = yaml.check_keys(root["a"], {"x"}, "a");
+  ASSERT_FALSE(not_map.ok());
+  EXPECT_EQ(not_map.error().message, "f.yaml:1: a: expected a mapping");
+}
+
+TEST(YamlReader, NumbersMustBeFiniteNumbers) {
+  const YamlReader yaml{"n.yaml"};
+  const YAML::Node root = YAML::Load("x: 2.5\ny: abc\nz: .inf\nw: [1]\nnull_key: ~\n");
+  const auto x = yaml.required_number(root, "x", "");
+  ASSERT_TRUE(x.ok());
+  EXPECT_EQ(*x, 2.5);  // exact: 2.5 is representable
+  const auto y = yaml.required_number(root, "y", "g");
+  ASSERT_FALSE(y.ok());
+  EXPECT_EQ(y.error().message, "n.yaml:2: g.y: 'abc' is not a number");
+  const auto z = yaml.number(root["z"], "z");
+  ASSERT_FALSE(z.ok());
+  EXPECT_EQ(z.error().message, "n.yaml:3: z: must be finite");
+  const auto w = yaml.number(root["w"], "w");
+  ASSERT_FALSE(w.ok());
+  EXPECT_EQ(w.error().message, "n.yaml:4: w: '?' is not a number");
+  const auto missing = yaml.required_number(root, "v", "g");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.error().message, "n.yaml:1: g: missing key 'v'");
+
+  const auto absent = yaml.optional_number(root, "v", "");
+  ASSERT_TRUE(absent.ok());
+  EXPECT_FALSE(absent->has_value());
+  const auto null_value = yaml.optional_number(root, "null_key", "");
+  ASSERT_TRUE(null_value.ok());
+  EXPECT_FALSE(null_value->has_value());
+  const auto present = yaml.optional_number(root, "x", "");
+  ASSERT_TRUE(present.ok());
+  EXPECT_EQ(present->value_or(0.0), 2.5);
+  EXPECT_FALSE(yaml.optional_number(root, "y", "").ok());
+}
+
+TEST(YamlReader, Vector3NeedsThreeFiniteNumbers) {
+  const YamlReader yaml{"v.yaml"};
+  const YAML::Node root = YAML::Load("a: [1, -2, 0.5]\nb: [1, 2]\nc: [1, x, 3]\n");
+  const auto a = yaml.required_vector3(root, "a", "g");
+  ASSERT_TRUE(a.ok());
+  EXPECT_EQ(*a, Eigen::Vector3d(1.0, -2.0, 0.5));  // exact: small binary fractions
+  const auto b = yaml.required_vector3(root, "b", "g");
+  ASSERT_FALSE(b.ok());
+  EXPECT_EQ(b.error().message, "v.yaml:2: g.b: expected [x, y, z]");
+  const auto c = yaml.vector3(root["c"], "c");
+  ASSERT_FALSE(c.ok());
+  EXPECT_EQ(c.error().message, "v.yaml:3: c[1]: 'x' is not a number");
+}
+
+TEST(YamlReader, SyntaxErrorsCarryTheLine) {
+  const YamlReader yaml{"s.yaml"};
+  try {
+    (void)YAML::Load("a: 1\nb: [unclosed\n");
+    FAIL() << "yaml-cpp accepted an unclosed flow sequence";
+  } catch (const YAML::Exception& e) {
+    const std::string message = yaml.error(e, "YAML").message;
+    EXPECT_EQ(message.rfind("s.yaml:", 0), 0U) << message;
+    EXPECT_NE(message.find(": YAML: "), std::string::npos) << message;
+  }
+}
+
+}  // namespace
+}  // namespace tetra
