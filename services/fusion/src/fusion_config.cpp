@@ -3,30 +3,15 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <set>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
+#include "tetra/core/yaml_reader.hpp"
+
 namespace tetra::service {
 
 namespace {
-
-std::string where(const std::string& source, const YAML::Node& node) {
-  const auto mark = node.Mark();
-  if (mark.line < 0) return source + ": ";
-  return source + ":" + std::to_string(mark.line + 1) + ": ";
-}
-
-Result<double> number(const std::string& source, const YAML::Node& node, const char* key) {
-  try {
-    const double value = node.as<double>();
-    if (!std::isfinite(value)) return bad_input(where(source, node) + key + " is not finite");
-    return value;
-  } catch (const YAML::Exception&) {
-    return bad_input(where(source, node) + key + " is not a number");
-  }
-}
 
 std::int64_t to_ns(double seconds) {
   return static_cast<std::int64_t>(std::llround(seconds * 1e9));
@@ -67,35 +52,34 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
   if (!root.IsMap()) return bad_input(source + ": expected a YAML map of settings");
   FusionConfig config;
   config.source = source;
-  const std::set<std::string> known = {"unit",        "calibration",   "sample_rate_hz",  "speed",
-                                       "tolerance_s", "max_latency_s", "health_period_s", "pipeline",
-                                       "security"};
+  const YamlReader reader(source);
+  if (auto keys = reader.check_keys(root,
+                                    {"unit", "calibration", "sample_rate_hz", "speed", "tolerance_s",
+                                     "max_latency_s", "health_period_s", "pipeline", "security"},
+                                    "");
+      !keys) {
+    return keys.error();
+  }
   for (const auto& item : root) {
-    if (!item.first.IsScalar()) return bad_input(where(source, item.first) + "a key must be text");
-    const auto key = item.first.as<std::string>();
-    if (!known.contains(key)) {
-      return bad_input(where(source, item.first) + "unknown key '" + key +
-                       "' (allowed: unit, calibration, sample_rate_hz, speed, tolerance_s, "
-                       "max_latency_s, health_period_s, pipeline, security)");
-    }
+    const std::string& key = item.first.Scalar();
     const YAML::Node& value = item.second;
     if (key == "unit" || key == "calibration") {
-      if (!value.IsScalar()) return bad_input(where(source, value) + key + " must be text");
+      if (!value.IsScalar()) return bad_input(reader.at(value) + key + " must be text");
       (key == "unit" ? config.unit : config.calibration_path) = value.as<std::string>();
     } else if (key == "security") {
-      if (!value.IsScalar()) return bad_input(where(source, value) + "security must be a file name");
+      if (!value.IsScalar()) return bad_input(reader.at(value) + "security must be a file name");
       std::filesystem::path profile_path(value.as<std::string>());
       if (profile_path.is_relative() && !base_dir.empty())
         profile_path = std::filesystem::path(base_dir) / profile_path;
       auto profile = read_security_profile(profile_path.string());
-      if (!profile) return bad_input(where(source, value) + "security: " + profile.error().message);
+      if (!profile) return bad_input(reader.at(value) + "security: " + profile.error().message);
       config.security = std::move(profile).value();
     } else if (key == "pipeline") {
       auto pipeline = fdi::pipeline_config_from_yaml(value, source);
       if (!pipeline) return pipeline.error();
       config.pipeline = std::move(pipeline).value();
     } else {
-      auto x = number(source, value, key.c_str());
+      auto x = reader.number(value, key);
       if (!x) return x.error();
       if (key == "sample_rate_hz") config.sample_rate_hz = *x;
       if (key == "speed") config.speed = *x;
