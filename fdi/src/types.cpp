@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/json.hpp"
 #include "tetra/core/units.hpp"
 
 namespace tetra::fdi {
@@ -76,33 +77,6 @@ const char* to_string(GyroState state) {
 }
 
 namespace {
-
-void append_json_string(std::string& out, std::string_view text) {
-  out += '"';
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += ' ';
-        } else {
-          out += c;
-        }
-    }
-  }
-  out += '"';
-}
 
 void append_gyro_list(std::string& out, GyroMask mask, int n_gyros) {
   out += '[';

@@ -8,6 +8,7 @@
 #include <ctime>
 #include <filesystem>
 
+#include "tetra/core/json.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/service/security_profile.hpp"
 
@@ -77,45 +78,18 @@ std::string fixed(double value, int decimals) {
 
 }  // namespace tetra::cli
 
-#include <charconv>
-#include <cmath>
-
 namespace tetra::cli {
 
 std::string json_number(double value) {
-  if (!std::isfinite(value)) return "null";
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  return std::string(buffer, result.ptr);
+  std::string out;
+  append_json_number(out, value);
+  return out;
 }
 
 std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buffer[8];
-          std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
-          out += buffer;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
+  std::string out;
+  append_json_string(out, text);
+  return out;
 }
 
 }  // namespace tetra::cli
