@@ -10,9 +10,8 @@ namespace {
 
 TEST(Json, StringEscapesQuotesBackslashesAndControlCharacters) {
   std::string out;
-  append_json_string(out, std::string("a\"b\\c\nd\te\x01"
-                                      "f\x1f",
-                                      11));
+  const std::string text = std::string("a\"b\\c\nd\te\x01") + "f\x1f";  // \x01 and \x1f: control characters
+  append_json_string(out, text);
   EXPECT_EQ(out, R"("a\"b\\c\nd\te\u0001f\u001f")");
 }
 
