@@ -255,6 +255,17 @@ TEST(CalibrateCli, SeedBiasModelIsLabelledAndQuantified) {
   EXPECT_EQ(cal->method, "sixteen-position-seed-bias");
 }
 
+TEST(CalibrateCli, CompareWithOtherGyroCount) {
+  test::TempDir dir;
+  Calibration three = seed_as_built_unit();
+  three.gyros.resize(3);
+  ASSERT_TRUE(write_calibration(dir.file("three.yaml"), three).ok());
+  const auto r = test::run_tetra("calibrate " + test::source_path("examples/turntable.csv") + " --compare " +
+                                 dir.file("three.yaml") + " -o " + dir.file("cal.yaml"));
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("three.yaml: has 3 gyros"), std::string::npos) << r.err;
+}
+
 TEST(CalibrateCli, HelpNamesEveryOption) {
   const auto r = test::run_tetra("calibrate --help");
   EXPECT_EQ(r.exit_status, 0);

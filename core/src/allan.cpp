@@ -409,6 +409,8 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
   if (ids.empty()) {
     for (int id = 1; id <= log.gyro_count; ++id) ids.push_back(id);
   }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
   for (const int id : ids) {
     if (id < 1 || id > log.gyro_count) {
       return bad_input("--gyro " + std::to_string(id) + ": the log has gyros 1.." +

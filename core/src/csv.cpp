@@ -1,5 +1,10 @@
 #include "tetra/core/csv.hpp"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -233,6 +238,24 @@ Result<std::string> read_text_file(const std::string& path) {
 }
 
 Result<CsvTable> read_csv(const std::string& path) {
+  // A regular file is parsed straight from a read-only mapping: no copy of the text in memory (a
+  // 2 h, 100 Hz log is ~45 MB). Anything else (pipes, empty files) is read into a string.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd >= 0) {
+    struct stat st {};
+    if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+      const auto size = static_cast<std::size_t>(st.st_size);
+      void* map = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+      ::close(fd);
+      if (map != MAP_FAILED) {
+        auto table = parse_csv(std::string_view(static_cast<const char*>(map), size), path);
+        ::munmap(map, size);
+        return table;
+      }
+    } else {
+      ::close(fd);
+    }
+  }
   auto text = read_text_file(path);
   if (!text) return text.error();
   return parse_csv(*text, path);

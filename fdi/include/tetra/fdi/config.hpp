@@ -1,6 +1,7 @@
 #pragma once
 // Pipeline configuration: a struct with in-class defaults, validated once, echoed at start-up.
 // Read from the `pipeline:` map of a YAML file (replay --config, fusion --config).
+// Every key, its unit, its default and how the thresholds follow from it: docs/fdi.md.
 
 #include <optional>
 #include <string>
@@ -13,13 +14,50 @@
 namespace tetra::fdi {
 
 struct PipelineConfig {
-  // Fields are added by the pipeline implementation; each with its unit and a default.
-  std::optional<double> latitude_deg;                   //!< [deg] ground-test mode: remove Earth rate
-  Quaternion initial_q_RB = Quaternion::Identity();     //!< initial attitude (relative to L in ground mode)
+  // --- attitude
+  std::optional<double> latitude_deg;                //!< [deg] ground-test mode: remove Earth rate
+  Quaternion initial_q_RB = Quaternion::Identity();  //!< initial attitude (relative to L in ground mode)
+
+  // --- input
+  bool raw_units_dps = false;    //!< samples are already rates [deg/s] (log "# units=dps"): no s, β applied
+  double sample_period_s = 0.0;  //!< [s] nominal sample period; 0 = the first time step seen
+  double max_abs_raw_V = 10.0;   //!< [V] a raw sample beyond this is invalid
+  double max_abs_rate_dps = 100.0;       //!< [deg/s] a calibrated rate beyond this is invalid
+  double default_arw_dps_rtHz = 3.0e-5;  //!< [deg/√s] N of a gyro without `noise:` (seed Table 6)
+
+  // --- detection on the parity residual
+  double chi2_false_alarm_probability = 1.0e-9;  //!< [-] per epoch, instantaneous χ² test
+  double cusum_min_fault_dps = 2.0e-4;  //!< [deg/s] smallest bias step on any gyro the CUSUM is sized for
+  double cusum_arl0_epochs = 1.0e8;     //!< [epochs] in-control average run length (two-sided)
+  double clear_after_s = 30.0;          //!< [s] no alarm for this long ends a SUSPECT episode
+
+  // --- isolation
+  double isolation_window_s = 5.0;                //!< [s] evidence is sought this long before `unisolated`
+  double max_angular_acceleration_dps2 = 1.0e-3;  //!< [deg/s²] bound on the vehicle's angular acceleration
+  double onset_sigma = 5.0;                       //!< [σ] margin of the onset (physical possibility) test
+  int onset_pre_epochs = 20;                      //!< [epochs] window before the estimated onset
+  int onset_post_max_epochs = 50;                 //!< [epochs] at most this many epochs after the onset
+  double jump_false_alarm_probability = 1.0e-9;   //!< [-] per epoch, test of a one-epoch jump of the parity
+  int onset_confirm_epochs = 10;           //!< [epochs] an outlier this persistent is a step, not a spike
+  double dropout_timeout_s = 1.0;          //!< [s] absent this long → dropout
+  double invalid_timeout_s = 1.0;          //!< [s] invalid this long → invalid
+  int stuck_repeat_count = 10;             //!< [samples] identical raw values in a row → stuck
+  int noise_window = 30;                   //!< [samples] window of the noise-level (2nd difference) test
+  double noise_high_ratio = 4.0;           //!< [-] robust noise level / expected above this → noise
+  double noise_low_ratio = 0.05;           //!< [-] robust noise level / expected below this → stuck
+  int spike_count = 3;                     //!< [-] this many one-epoch outliers in the window → spike
+  double spike_window_s = 120.0;           //!< [s] window of the spike count
+  double reference_window_s = 30.0;        //!< [s] window of the reference comparison
+  double reference_sigma_arcsec = 5.0;     //!< [arcsec] 1σ per axis of the attitude reference
+  double reference_threshold_sigma = 6.0;  //!< [σ] reference disagreement threshold
+  double glt_false_alarm_probability = 1.0e-9;  //!< [-] N ≥ 5: rejecting a single-gyro hypothesis
 };
 
 //! Parses a `pipeline:` YAML map (unknown keys are errors naming the line); `source` names the file.
 Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const std::string& source);
+//! Reads a YAML file whose top level holds a `pipeline:` map (other top-level keys are ignored,
+//! so one file can configure the DDS service too).
+Result<PipelineConfig> read_pipeline_config(const std::string& path);
 //! Validates ranges; error names the field.
 Status validate(const PipelineConfig& config);
 //! Multi-line "key: value" echo of every field, for start-up logs.

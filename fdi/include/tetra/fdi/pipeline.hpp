@@ -3,6 +3,7 @@
 // `tetra replay` (files) and `tetra fusion` (DDS). Lifecycle: create → step(epoch)… → reset().
 // A library object: it never exits or throws on bad input; bad epochs are rejected and counted.
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,13 +16,19 @@
 namespace tetra::fdi {
 
 struct StepResult {
-  bool accepted = false;               //!< false: epoch rejected (and counted), attitude not advanced
-  AttitudeEstimate attitude;           //!< valid when accepted
-  std::vector<FdiEvent> events;        //!< events triggered by this epoch, in order (often empty)
+  bool accepted = false;         //!< false: epoch rejected (and counted), attitude not advanced
+  AttitudeEstimate attitude;     //!< valid when accepted
+  std::vector<FdiEvent> events;  //!< events triggered by this epoch, in order (often empty)
 };
 
 class Pipeline {
  public:
+  Pipeline(Pipeline&&) noexcept;
+  Pipeline& operator=(Pipeline&&) noexcept;
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+  ~Pipeline();
+
   //! Validates the calibration and configuration once; errors name what is wrong.
   static Result<Pipeline> create(const Calibration& calibration, const PipelineConfig& config);
 
@@ -37,6 +44,13 @@ class Pipeline {
   const Health& health() const;
   int gyro_count() const;
   const PipelineConfig& config() const;
+  //! Start-up echo: the thresholds derived from the configuration and the calibration (multi-line).
+  std::string describe_thresholds() const;
+
+ private:
+  class Impl;
+  explicit Pipeline(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;  //!< all state; created once, never reallocated in step()
 };
 
 }  // namespace tetra::fdi

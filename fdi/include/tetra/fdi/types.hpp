@@ -22,33 +22,52 @@ namespace tetra::fdi {
 enum class Mode : std::uint8_t { kNominal, kDegraded, kSuspect, kLost };
 const char* to_string(Mode mode);  // "NOMINAL", "DEGRADED", "SUSPECT", "LOST"
 
-enum class FaultKind : std::uint8_t { kNone, kBias, kRamp, kScale, kStuck, kNoise, kSpike, kDropout, kInvalid, kUnknown };
+enum class FaultKind : std::uint8_t {
+  kNone,
+  kBias,
+  kRamp,
+  kScale,
+  kStuck,
+  kNoise,
+  kSpike,
+  kDropout,
+  kInvalid,
+  kUnknown
+};
 const char* to_string(FaultKind kind);  // "none", "bias", ..., "unknown"
 std::optional<FaultKind> fault_kind_from_string(std::string_view text);
 
 //! detected, isolated, unisolated (detected and the data cannot tell which gyro), reconfigured,
 //! cleared, lost; and command (acknowledgement of an operator command — an addition to §2.5).
-enum class EventType : std::uint8_t { kDetected, kIsolated, kUnisolated, kReconfigured, kCleared, kLost, kCommand };
+enum class EventType : std::uint8_t {
+  kDetected,
+  kIsolated,
+  kUnisolated,
+  kReconfigured,
+  kCleared,
+  kLost,
+  kCommand
+};
 const char* to_string(EventType type);
 
 //! One input epoch: up to N raw samples taken at one sensor time, and an optional reference.
 struct Epoch {
-  std::int64_t stamp_ns = 0;                  //!< [ns] sensor time of the epoch
-  std::vector<double> raw;                    //!< [V] (or [deg/s] when the log says units=dps), size N
-  std::vector<std::uint8_t> present;          //!< size N; 0 = no sample delivered this epoch
-  std::optional<Quaternion> reference_q_RB;   //!< attitude reference (e.g. star tracker), body → reference
+  std::int64_t stamp_ns = 0;                 //!< [ns] sensor time of the epoch
+  std::vector<double> raw;                   //!< [V] (or [deg/s] when the log says units=dps), size N
+  std::vector<std::uint8_t> present;         //!< size N; 0 = no sample delivered this epoch
+  std::optional<Quaternion> reference_q_RB;  //!< attitude reference (e.g. star tracker), body → reference
 };
 
 struct FdiEvent {
-  std::int64_t stamp_ns = 0;             //!< [ns] time of the epoch that triggered the event
+  std::int64_t stamp_ns = 0;  //!< [ns] time of the epoch that triggered the event
   EventType type = EventType::kDetected;
-  std::optional<int> gyro;               //!< 1..N: isolated gyro, or the gyro a command named
-  std::string test;                      //!< detected: "chi2", "cusum", "signature", "reference", ...
+  std::optional<int> gyro;  //!< 1..N: isolated gyro, or the gyro a command named
+  std::string test;         //!< detected: "chi2", "cusum", "signature", "reference", ...
   double statistic = std::numeric_limits<double>::quiet_NaN();  //!< detected: value of the test statistic
-  FaultKind kind = FaultKind::kUnknown;  //!< isolated: classified fault kind
-  std::string evidence;                  //!< isolated: "variance", "onset", "reference", "invalid", ...
-  GyroMask gyros = 0;                    //!< reconfigured / cleared / lost: the gyros used from now on
-  std::string detail;                    //!< free text: e.g. the command acknowledged and its outcome
+  FaultKind kind = FaultKind::kUnknown;                         //!< isolated: classified fault kind
+  std::string evidence;  //!< isolated: "variance", "onset", "reference", "invalid", ...
+  GyroMask gyros = 0;    //!< reconfigured / cleared / lost: the gyros used from now on
+  std::string detail;    //!< free text: e.g. the command acknowledged and its outcome
 };
 
 //! One JSON object (one line, no newline) per INTERFACES §2.5; `n_gyros` formats the `gyros` lists.
@@ -64,20 +83,23 @@ struct GyroHealth {
 
 struct Counters {
   std::uint64_t epochs_accepted = 0;
-  std::uint64_t epochs_rejected_time = 0;   //!< time not increasing (duplicate, backward, out of order)
+  std::uint64_t epochs_rejected_time = 0;  //!< time not increasing (duplicate, backward, out of order)
   std::uint64_t samples_accepted = 0;
   std::uint64_t samples_invalid = 0;        //!< NaN, Inf or out of range
   std::uint64_t samples_absent = 0;         //!< no sample delivered
+  std::uint64_t epochs_rejected_shape = 0;  //!< epoch with a sample count other than N
+  std::uint64_t samples_outlier = 0;        //!< valid samples left out for one epoch (spike or onset)
+  std::uint64_t spikes = 0;                 //!< confirmed one-epoch spikes (outliers that went away)
 };
 
 struct Health {
   std::int64_t stamp_ns = 0;
   Mode mode = Mode::kNominal;
-  GyroMask used = 0;                    //!< gyros in the current solution
-  std::vector<GyroHealth> gyros;        //!< size N
-  double parity_residual = 0.0;         //!< normalized parity residual (dimensionless, σ units)
-  double chi2 = 0.0;                    //!< instantaneous χ² statistic
-  double cusum = 0.0;                   //!< CUSUM statistic (largest of its branches)
+  GyroMask used = 0;              //!< gyros in the current solution
+  std::vector<GyroHealth> gyros;  //!< size N
+  double parity_residual = 0.0;   //!< normalized parity residual (dimensionless, σ units)
+  double chi2 = 0.0;              //!< instantaneous χ² statistic
+  double cusum = 0.0;             //!< CUSUM statistic (largest of its branches)
   double chi2_threshold = 0.0;
   double cusum_threshold = 0.0;
   Counters counters;
@@ -86,11 +108,12 @@ struct Health {
 //! The estimate published every accepted epoch (INTERFACES §2.4).
 struct AttitudeEstimate {
   std::int64_t stamp_ns = 0;
-  Quaternion q_RB = Quaternion::Identity();          //!< body → reference
-  Eigen::Vector3d omega_B_rad_s = Eigen::Vector3d::Zero();  //!< rate used for propagation (Earth rate removed in ground mode)
-  Eigen::Vector3d sigma_rad = Eigen::Vector3d::Zero();      //!< 1σ attitude uncertainty per body axis
+  Quaternion q_RB = Quaternion::Identity();  //!< body → reference
+  Eigen::Vector3d omega_B_rad_s =
+      Eigen::Vector3d::Zero();  //!< rate used for propagation (Earth rate removed in ground mode)
+  Eigen::Vector3d sigma_rad = Eigen::Vector3d::Zero();  //!< 1σ attitude uncertainty per body axis
   Mode mode = Mode::kNominal;
-  GyroMask gyros = 0;                                //!< gyros used
+  GyroMask gyros = 0;  //!< gyros used
 };
 
 }  // namespace tetra::fdi

@@ -1,0 +1,53 @@
+#pragma once
+// Attitude propagation from body rates, with a per-axis uncertainty.
+//
+//   q_RB ← q_RB ⊗ exp(½ ω Δt)   (exact exponential map, quaternion.hpp), ω = ω_B − ω_e^B in ground mode,
+//   where ω_e^B = C_BL·ω_e^L is the Earth rate seen in B at the current attitude relative to the lab L.
+//
+// Uncertainty per body axis a, three independent parts added in quadrature:
+//   random:     σ²_rand,a += N²_a·Δt          (white rate noise N_a [rad/√s]: grows with √t)
+//   systematic: σ_sys,a   += b_a·Δt           (1σ rate bias left by the calibration [rad/s]: grows with t)
+//   bound:      σ_bnd,a   += e_a·Δt           (rate error bound of an unresolved fault [rad/s], added
+//   linearly) σ_a = √(σ²_rand,a + σ²_sys,a + σ²_bnd,a).
+
+#include <optional>
+
+#include <Eigen/Core>
+
+#include "tetra/core/quaternion.hpp"
+
+namespace tetra {
+
+class AttitudePropagator {
+ public:
+  //! `latitude_rad` set: ground-test mode (Earth rate removed); q0: initial attitude (relative to L then).
+  AttitudePropagator(const Quaternion& q0_RB, std::optional<double> latitude_rad);
+
+  void reset(const Quaternion& q0_RB);
+
+  //! [rad/s] Earth rate in B at the current attitude; zero outside ground-test mode.
+  Eigen::Vector3d earth_rate_B() const;
+
+  //! One step with the measured body rate (which includes the Earth rate on the ground).
+  //! `arw_sq_rad2_s` [rad²/s]: N² per axis; `bias_sigma_rad_s`, `bound_rad_s` [rad/s] per axis.
+  //! Returns the rate used for propagation (Earth rate removed in ground mode).
+  Eigen::Vector3d step(const Eigen::Vector3d& omega_meas_B_rad_s, double dt_s,
+                       const Eigen::Vector3d& arw_sq_rad2_s, const Eigen::Vector3d& bias_sigma_rad_s,
+                       const Eigen::Vector3d& bound_rad_s);
+
+  //! Adds an angle bound [rad] per axis at once (e.g. the error a fault caused before it was isolated).
+  void add_bound(const Eigen::Vector3d& angle_rad) { bound_rad_ += angle_rad.cwiseAbs(); }
+
+  const Quaternion& q_RB() const { return q_RB_; }
+  //! [rad] 1σ per body axis.
+  Eigen::Vector3d sigma_rad() const;
+
+ private:
+  Quaternion q_RB_;                              //!< body → reference (L in ground mode); unit norm
+  std::optional<Eigen::Vector3d> earth_rate_L_;  //!< [rad/s] set in ground-test mode
+  Eigen::Vector3d var_random_rad2_;              //!< [rad²]
+  Eigen::Vector3d systematic_rad_;               //!< [rad]
+  Eigen::Vector3d bound_rad_;                    //!< [rad]
+};
+
+}  // namespace tetra

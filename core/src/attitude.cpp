@@ -1,0 +1,42 @@
+#include "tetra/core/attitude.hpp"
+
+#include "tetra/core/frames.hpp"
+
+namespace tetra {
+
+AttitudePropagator::AttitudePropagator(const Quaternion& q0_RB, std::optional<double> latitude_rad) {
+  if (latitude_rad) earth_rate_L_ = earth_rate_L(*latitude_rad);
+  reset(q0_RB);
+}
+
+void AttitudePropagator::reset(const Quaternion& q0_RB) {
+  q_RB_ = q0_RB.normalized();
+  var_random_rad2_.setZero();
+  systematic_rad_.setZero();
+  bound_rad_.setZero();
+}
+
+Eigen::Vector3d AttitudePropagator::earth_rate_B() const {
+  if (!earth_rate_L_) return Eigen::Vector3d::Zero();
+  return q_RB_.conjugate() * (*earth_rate_L_);
+}
+
+Eigen::Vector3d AttitudePropagator::step(const Eigen::Vector3d& omega_meas_B_rad_s, double dt_s,
+                                         const Eigen::Vector3d& arw_sq_rad2_s,
+                                         const Eigen::Vector3d& bias_sigma_rad_s,
+                                         const Eigen::Vector3d& bound_rad_s) {
+  Eigen::Vector3d omega = omega_meas_B_rad_s - earth_rate_B();
+  q_RB_ = propagate(q_RB_, omega, dt_s);
+  var_random_rad2_ += arw_sq_rad2_s * dt_s;
+  systematic_rad_ += bias_sigma_rad_s * dt_s;
+  bound_rad_ += bound_rad_s * dt_s;
+  return omega;
+}
+
+Eigen::Vector3d AttitudePropagator::sigma_rad() const {
+  return (var_random_rad2_ + systematic_rad_.cwiseProduct(systematic_rad_) +
+          bound_rad_.cwiseProduct(bound_rad_))
+      .cwiseSqrt();
+}
+
+}  // namespace tetra

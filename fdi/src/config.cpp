@@ -1,0 +1,210 @@
+#include "tetra/fdi/config.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <variant>
+#include <vector>
+
+#include "tetra/core/csv.hpp"
+
+namespace tetra::fdi {
+
+namespace {
+
+using Field = std::variant<double PipelineConfig::*, int PipelineConfig::*, bool PipelineConfig::*>;
+
+struct KeyDef {
+  const char* name;
+  Field field;
+};
+
+// Every scalar key of the `pipeline:` map (latitude_deg and initial_q_wxyz are handled apart).
+const std::vector<KeyDef>& scalar_keys() {
+  static const std::vector<KeyDef> keys = {
+      {"raw_units_dps", &PipelineConfig::raw_units_dps},
+      {"sample_period_s", &PipelineConfig::sample_period_s},
+      {"max_abs_raw_V", &PipelineConfig::max_abs_raw_V},
+      {"max_abs_rate_dps", &PipelineConfig::max_abs_rate_dps},
+      {"default_arw_dps_rtHz", &PipelineConfig::default_arw_dps_rtHz},
+      {"chi2_false_alarm_probability", &PipelineConfig::chi2_false_alarm_probability},
+      {"cusum_min_fault_dps", &PipelineConfig::cusum_min_fault_dps},
+      {"cusum_arl0_epochs", &PipelineConfig::cusum_arl0_epochs},
+      {"clear_after_s", &PipelineConfig::clear_after_s},
+      {"isolation_window_s", &PipelineConfig::isolation_window_s},
+      {"max_angular_acceleration_dps2", &PipelineConfig::max_angular_acceleration_dps2},
+      {"onset_sigma", &PipelineConfig::onset_sigma},
+      {"onset_pre_epochs", &PipelineConfig::onset_pre_epochs},
+      {"onset_post_max_epochs", &PipelineConfig::onset_post_max_epochs},
+      {"jump_false_alarm_probability", &PipelineConfig::jump_false_alarm_probability},
+      {"onset_confirm_epochs", &PipelineConfig::onset_confirm_epochs},
+      {"dropout_timeout_s", &PipelineConfig::dropout_timeout_s},
+      {"invalid_timeout_s", &PipelineConfig::invalid_timeout_s},
+      {"stuck_repeat_count", &PipelineConfig::stuck_repeat_count},
+      {"noise_window", &PipelineConfig::noise_window},
+      {"noise_high_ratio", &PipelineConfig::noise_high_ratio},
+      {"noise_low_ratio", &PipelineConfig::noise_low_ratio},
+      {"spike_count", &PipelineConfig::spike_count},
+      {"spike_window_s", &PipelineConfig::spike_window_s},
+      {"reference_window_s", &PipelineConfig::reference_window_s},
+      {"reference_sigma_arcsec", &PipelineConfig::reference_sigma_arcsec},
+      {"reference_threshold_sigma", &PipelineConfig::reference_threshold_sigma},
+      {"glt_false_alarm_probability", &PipelineConfig::glt_false_alarm_probability},
+  };
+  return keys;
+}
+
+std::string at(const std::string& source, const YAML::Node& node) {
+  const auto mark = node.Mark();
+  if (mark.line < 0) return source + ": ";
+  return source + ":" + std::to_string(mark.line + 1) + ": ";
+}
+
+}  // namespace
+
+Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const std::string& source) {
+  PipelineConfig config;
+  if (!node || node.IsNull()) return config;
+  if (!node.IsMap()) return bad_input(at(source, node) + "pipeline: expected a mapping");
+  try {
+    for (const auto& kv : node) {
+      const auto key = kv.first.as<std::string>();
+      const YAML::Node& value = kv.second;
+      const std::string where = at(source, kv.first) + "pipeline." + key + ": ";
+      if (key == "latitude_deg") {
+        const double v = value.as<double>();
+        if (!std::isfinite(v)) return bad_input(where + "must be finite");
+        config.latitude_deg = v;
+        continue;
+      }
+      if (key == "initial_q_wxyz") {
+        if (!value.IsSequence() || value.size() != 4) return bad_input(where + "expected [w, x, y, z]");
+        config.initial_q_RB = from_wxyz(value[0].as<double>(), value[1].as<double>(), value[2].as<double>(),
+                                        value[3].as<double>());
+        continue;
+      }
+      bool found = false;
+      for (const auto& def : scalar_keys()) {
+        if (key != def.name) continue;
+        found = true;
+        if (!value.IsScalar()) return bad_input(where + "expected a scalar");
+        if (const auto* d = std::get_if<double PipelineConfig::*>(&def.field)) {
+          config.*(*d) = value.as<double>();
+        } else if (const auto* i = std::get_if<int PipelineConfig::*>(&def.field)) {
+          config.*(*i) = value.as<int>();
+        } else {
+          config.*std::get<bool PipelineConfig::*>(def.field) = value.as<bool>();
+        }
+      }
+      if (!found) {
+        std::string list = "latitude_deg, initial_q_wxyz";
+        for (const auto& def : scalar_keys()) list += std::string(", ") + def.name;
+        return bad_input(where + "unknown key (allowed: " + list + ")");
+      }
+    }
+  } catch (const YAML::Exception& e) {
+    return bad_input(source + ":" + std::to_string(e.mark.line + 1) + ": pipeline: " + e.msg);
+  }
+  if (auto st = validate(config); !st) return bad_input(source + ": " + st.error().message);
+  return config;
+}
+
+Result<PipelineConfig> read_pipeline_config(const std::string& path) {
+  auto text = read_text_file(path);
+  if (!text) return text.error();
+  YAML::Node root;
+  try {
+    root = YAML::Load(*text);
+  } catch (const YAML::Exception& e) {
+    return bad_input(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  if (!root || root.IsNull()) return PipelineConfig{};
+  if (!root.IsMap()) return bad_input(path + ": expected a mapping with a 'pipeline:' key");
+  return pipeline_config_from_yaml(root["pipeline"], path);
+}
+
+Status validate(const PipelineConfig& c) {
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  auto probability = [](double v) { return std::isfinite(v) && v > 0.0 && v < 0.5; };
+  if (c.latitude_deg && (!std::isfinite(*c.latitude_deg) || std::abs(*c.latitude_deg) > 90.0)) {
+    return bad_input("pipeline.latitude_deg: must be within [-90, 90]");
+  }
+  const double qn = c.initial_q_RB.norm();
+  if (!std::isfinite(qn) || std::abs(qn - 1.0) > 1e-3) {
+    return bad_input("pipeline.initial_q_wxyz: must be a unit quaternion (norm within 1e-3 of 1)");
+  }
+  if (!std::isfinite(c.sample_period_s) || c.sample_period_s < 0.0) {
+    return bad_input("pipeline.sample_period_s: must be >= 0 (0 = from the data)");
+  }
+  struct Check {
+    const char* name;
+    bool ok;
+    const char* rule;
+  };
+  const Check checks[] = {
+      {"max_abs_raw_V", positive(c.max_abs_raw_V), "> 0"},
+      {"max_abs_rate_dps", positive(c.max_abs_rate_dps), "> 0"},
+      {"default_arw_dps_rtHz", positive(c.default_arw_dps_rtHz), "> 0"},
+      {"chi2_false_alarm_probability", probability(c.chi2_false_alarm_probability), "in (0, 0.5)"},
+      {"cusum_min_fault_dps", positive(c.cusum_min_fault_dps), "> 0"},
+      {"cusum_arl0_epochs", std::isfinite(c.cusum_arl0_epochs) && c.cusum_arl0_epochs >= 10.0, ">= 10"},
+      {"clear_after_s", positive(c.clear_after_s), "> 0"},
+      {"isolation_window_s", positive(c.isolation_window_s), "> 0"},
+      {"max_angular_acceleration_dps2", positive(c.max_angular_acceleration_dps2), "> 0"},
+      {"onset_sigma", positive(c.onset_sigma), "> 0"},
+      {"onset_pre_epochs", c.onset_pre_epochs >= 2 && c.onset_pre_epochs <= 200, "in [2, 200]"},
+      {"onset_post_max_epochs", c.onset_post_max_epochs >= 2 && c.onset_post_max_epochs <= 200,
+       "in [2, 200]"},
+      {"jump_false_alarm_probability", probability(c.jump_false_alarm_probability), "in (0, 0.5)"},
+      {"onset_confirm_epochs", c.onset_confirm_epochs >= 2 && c.onset_confirm_epochs <= 100, "in [2, 100]"},
+      {"dropout_timeout_s", positive(c.dropout_timeout_s), "> 0"},
+      {"invalid_timeout_s", positive(c.invalid_timeout_s), "> 0"},
+      {"stuck_repeat_count", c.stuck_repeat_count >= 3, ">= 3"},
+      {"noise_window", c.noise_window >= 8 && c.noise_window <= 256, "in [8, 256]"},
+      {"noise_high_ratio", std::isfinite(c.noise_high_ratio) && c.noise_high_ratio > 1.0, "> 1"},
+      {"noise_low_ratio",
+       std::isfinite(c.noise_low_ratio) && c.noise_low_ratio > 0.0 && c.noise_low_ratio < 1.0, "in (0, 1)"},
+      {"spike_count", c.spike_count >= 2 && c.spike_count <= 64, "in [2, 64]"},
+      {"spike_window_s", positive(c.spike_window_s), "> 0"},
+      {"reference_window_s", positive(c.reference_window_s), "> 0"},
+      {"reference_sigma_arcsec", positive(c.reference_sigma_arcsec), "> 0"},
+      {"reference_threshold_sigma", positive(c.reference_threshold_sigma), "> 0"},
+      {"glt_false_alarm_probability", probability(c.glt_false_alarm_probability), "in (0, 0.5)"},
+  };
+  for (const auto& check : checks) {
+    if (!check.ok) return bad_input(std::string("pipeline.") + check.name + ": must be " + check.rule);
+  }
+  return ok_status();
+}
+
+std::string describe(const PipelineConfig& c) {
+  std::string out;
+  out += "latitude_deg: ";
+  if (c.latitude_deg) {
+    append_double(out, *c.latitude_deg);
+  } else {
+    out += "none (no Earth-rate removal)";
+  }
+  out += "\ninitial_q_wxyz: [";
+  const auto q = to_wxyz(c.initial_q_RB);
+  for (std::size_t i = 0; i < 4; ++i) {
+    if (i) out += ", ";
+    append_double(out, q[i]);
+  }
+  out += "]\n";
+  for (const auto& def : scalar_keys()) {
+    out += def.name;
+    out += ": ";
+    if (const auto* d = std::get_if<double PipelineConfig::*>(&def.field)) {
+      append_double(out, c.*(*d));
+    } else if (const auto* i = std::get_if<int PipelineConfig::*>(&def.field)) {
+      append_int(out, c.*(*i));
+    } else {
+      out += (c.*std::get<bool PipelineConfig::*>(def.field)) ? "true" : "false";
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+}  // namespace tetra::fdi

@@ -1,0 +1,355 @@
+// The pipeline on synthetic epochs (tests/fusion/synth.hpp): fault-free accuracy and silence, each fault kind
+// on each gyro, reference isolation, input checks, operator commands, N = 5 GLT. Statistics are seeded; every
+// tolerance says where it comes from.
+#include <cmath>
+#include <map>
+#include <optional>
+
+#include <gtest/gtest.h>
+
+#include "synth.hpp"
+#include "tetra/core/frames.hpp"
+#include "tetra/fdi/pipeline.hpp"
+
+namespace tetra::fdi {
+namespace {
+
+using test::Synth;
+using test::SynthFault;
+using test::SynthOptions;
+
+struct Outcome {
+  std::vector<FdiEvent> events;
+  std::optional<double> detected_s;  //!< first detected event, time after the fault's onset
+  std::optional<double> isolated_s;
+  std::optional<int> isolated_gyro;
+  FaultKind isolated_kind = FaultKind::kNone;
+  bool unisolated = false;
+  Mode final_mode = Mode::kNominal;
+  double final_error_deg = 0.0;
+  double final_sigma_deg = 0.0;
+  int wrong_exclusions = 0;
+};
+
+PipelineConfig campaign_config() {
+  PipelineConfig c;
+  // The synthetic motion's peak angular acceleration is 2π·2e-3/100 = 1.3e-4 deg/s²; the bound is set above
+  // it.
+  c.max_angular_acceleration_dps2 = 2e-4;
+  return c;
+}
+
+Outcome run(const SynthFault& fault, double duration_s, SynthOptions opt = {},
+            PipelineConfig cfg = campaign_config(), Calibration cal = seed_as_built_unit()) {
+  auto p = Pipeline::create(cal, cfg);
+  EXPECT_TRUE(p.ok());
+  Synth s(cal, opt, fault);
+  Outcome o;
+  const auto steps = static_cast<int>(std::llround(duration_s / opt.period_s));
+  for (int k = 0; k < steps; ++k) {
+    const auto& r = p->step(s.next());
+    const double t = s.time_s() - fault.at_s;
+    for (const auto& e : r.events) {
+      o.events.push_back(e);
+      if (e.type == EventType::kDetected && !o.detected_s) o.detected_s = t;
+      if (e.type == EventType::kUnisolated) o.unisolated = true;
+      if (e.type == EventType::kIsolated) {
+        if (!o.isolated_s) {
+          o.isolated_s = t;
+          o.isolated_gyro = e.gyro;
+          o.isolated_kind = e.kind;
+        }
+        if (e.gyro != fault.gyro) ++o.wrong_exclusions;
+      }
+    }
+    o.final_mode = r.attitude.mode;
+    o.final_error_deg = angle_between(r.attitude.q_RB, s.truth_q()) * kRadToDeg;
+    o.final_sigma_deg = r.attitude.sigma_rad.norm() * kRadToDeg;
+  }
+  return o;
+}
+
+std::string describe(const Outcome& o) {
+  std::string s;
+  for (const auto& e : o.events) s += to_json(e, 5) + "\n";
+  return s;
+}
+
+TEST(Pipeline, FaultFreeOrbitIsSilentAndAccurate) {
+  // 100 min at 10 Hz. The attitude error is a random walk of N·√t per axis: 3e-5·√6000 ≈ 2.3e-3 deg, about
+  // 1.6e-3 deg per axis after the 4-gyro averaging; 4σ of the total angle is the bound.
+  SynthOptions opt;
+  opt.seed = 11;
+  const Outcome o = run({}, 6000.0, opt);
+  EXPECT_TRUE(o.events.empty()) << describe(o);
+  EXPECT_EQ(o.final_mode, Mode::kNominal);
+  EXPECT_LT(o.final_error_deg, 4.0 * o.final_sigma_deg);
+  // sigma itself is the random-walk level, not inflated: within 30 % of 3e-5·√6000·√(Σ axis variances).
+  EXPECT_GT(o.final_sigma_deg, 1e-3);
+  EXPECT_LT(o.final_sigma_deg, 4e-3);
+}
+
+TEST(Pipeline, NoFalseAlarmInTenSeededOrbits) {
+  // Ten 100-min orbits (600 k epochs). CUSUM ARL0 = 1e8 epochs and χ² P_fa = 1e-9 per epoch give an expected
+  // 0.006 alarms in total: any alarm here is a design error, not bad luck.
+  int alarms = 0;
+  for (std::uint64_t seed = 100; seed < 110; ++seed) {
+    SynthOptions opt;
+    opt.seed = seed;
+    const Outcome o = run({}, 6000.0, opt);
+    alarms += static_cast<int>(o.events.size());
+  }
+  EXPECT_EQ(alarms, 0);
+}
+
+struct Case {
+  FaultKind kind;
+  double size;
+  bool zero;
+  double within_s;
+  FaultKind expect_kind;
+};
+
+TEST(Pipeline, SignatureFaultsIsolatedOnEveryGyroWithTheRightKind) {
+  const Case cases[] = {
+      {FaultKind::kStuck, 0.0, false, 5.0, FaultKind::kStuck},
+      {FaultKind::kStuck, 0.0, true, 5.0, FaultKind::kStuck},
+      {FaultKind::kNoise, 10.0, false, 5.0, FaultKind::kNoise},
+      {FaultKind::kDropout, 0.0, false, 5.0, FaultKind::kDropout},
+      {FaultKind::kInvalid, 0.0, false, 5.0, FaultKind::kInvalid},
+      {FaultKind::kSpike, 0.05, false, 120.0, FaultKind::kSpike},
+  };
+  for (int gyro = 1; gyro <= 4; ++gyro) {
+    for (const auto& c : cases) {
+      SynthFault f;
+      f.gyro = gyro;
+      f.kind = c.kind;
+      f.size = c.size;
+      f.zero = c.zero;
+      f.at_s = 60.0;
+      SynthOptions opt;
+      opt.seed = static_cast<std::uint64_t>(gyro * 100 + static_cast<int>(c.kind));
+      const Outcome o = run(f, 60.0 + c.within_s + 10.0, opt);
+      const std::string what =
+          std::string(to_string(c.kind)) + (c.zero ? "/zero" : "") + " on gyro " + std::to_string(gyro);
+      ASSERT_TRUE(o.isolated_s.has_value()) << what << "\n" << describe(o);
+      EXPECT_EQ(*o.isolated_gyro, gyro) << what;
+      EXPECT_EQ(o.isolated_kind, c.expect_kind) << what << "\n" << describe(o);
+      EXPECT_LE(*o.isolated_s, c.within_s) << what;
+      EXPECT_EQ(o.wrong_exclusions, 0) << what;
+      EXPECT_EQ(o.final_mode, Mode::kDegraded) << what;
+    }
+  }
+}
+
+TEST(Pipeline, BiasStepsDetectedInTimeAndNeverMisisolated) {
+  // Requirements: ≥ 1e-3 deg/s within 1 s, ≥ 2e-4 deg/s within 30 s. Theory (docs/fdi.md): CUSUM delays of
+  // about 0.5 s and 4.5 s for the weakest gyro direction. Isolation by onset or `unisolated`, never a wrong
+  // gyro.
+  for (int gyro = 1; gyro <= 4; ++gyro) {
+    for (double size : {1e-3, -1e-3, 2e-4, 1e-2}) {
+      SynthFault f{gyro, FaultKind::kBias, false, 60.0, size};
+      SynthOptions opt;
+      opt.seed = static_cast<std::uint64_t>(1000 + gyro);
+      const Outcome o = run(f, 100.0, opt);
+      const std::string what = "bias " + std::to_string(size) + " on gyro " + std::to_string(gyro);
+      ASSERT_TRUE(o.detected_s.has_value()) << what;
+      EXPECT_LE(*o.detected_s, std::abs(size) >= 1e-3 ? 1.0 : 30.0) << what;
+      EXPECT_EQ(o.wrong_exclusions, 0) << what << "\n" << describe(o);
+      EXPECT_TRUE(o.isolated_gyro.has_value() || o.unisolated) << what;
+      if (std::abs(size) >= 1e-2) {
+        EXPECT_EQ(o.isolated_gyro, gyro) << what;  // a 1e-2 step is 100σ in one epoch: the onset must tell
+        EXPECT_EQ(o.isolated_kind, FaultKind::kBias) << what;
+      }
+    }
+  }
+}
+
+TEST(Pipeline, RampsAreDetectedAndEndUnisolatedWithoutReference) {
+  for (int gyro = 1; gyro <= 4; ++gyro) {
+    SynthFault f{gyro, FaultKind::kRamp, false, 60.0, 1e-5};
+    SynthOptions opt;
+    opt.seed = static_cast<std::uint64_t>(2000 + gyro);
+    const Outcome o = run(f, 60.0 + 90.0, opt);
+    ASSERT_TRUE(o.detected_s.has_value()) << gyro;
+    EXPECT_LE(*o.detected_s, 60.0) << gyro;
+    EXPECT_TRUE(o.unisolated) << describe(o);
+    EXPECT_FALSE(o.isolated_gyro.has_value()) << describe(o);
+    EXPECT_EQ(o.final_mode, Mode::kSuspect);
+    // Sigma inflated to cover every single-gyro hypothesis: the real error is within it.
+    EXPECT_LT(o.final_error_deg, o.final_sigma_deg) << gyro;
+  }
+}
+
+TEST(Pipeline, ReferenceIsolatesBiasRampAndScale) {
+  SynthOptions opt;
+  opt.reference_period_s = 1.0;
+  opt.reference_sigma_arcsec = 5.0;
+  for (int gyro = 1; gyro <= 4; ++gyro) {
+    for (const auto& [kind, size] : {std::pair{FaultKind::kBias, 1e-3}, std::pair{FaultKind::kRamp, 2e-5}}) {
+      SynthFault f{gyro, kind, false, 60.0, size};
+      opt.seed = static_cast<std::uint64_t>(3000 + gyro);
+      const Outcome o = run(f, 60.0 + 70.0, opt);
+      const std::string what = std::string(to_string(kind)) + " on gyro " + std::to_string(gyro);
+      ASSERT_TRUE(o.isolated_gyro.has_value()) << what << "\n" << describe(o);
+      EXPECT_EQ(*o.isolated_gyro, gyro) << what;
+      EXPECT_LE(*o.isolated_s, 60.0) << what;
+    }
+    // +5 % scale appearing with a 1 deg/s slew about an axis every gyro sees (projections 0.25 to 0.87).
+    SynthOptions slew = opt;
+    slew.slew_start_s = 60.0;
+    slew.slew_axis = Eigen::Vector3d(0.6, 0.48, 0.64);
+    SynthFault f{gyro, FaultKind::kScale, false, 60.0, 0.05};
+    PipelineConfig cfg = campaign_config();
+    cfg.max_angular_acceleration_dps2 = 0.5;  // the slew accelerates at 0.2 deg/s²
+    const Outcome o = run(f, 120.0, slew, cfg);
+    ASSERT_TRUE(o.isolated_gyro.has_value()) << "scale on gyro " << gyro << "\n" << describe(o);
+    EXPECT_EQ(*o.isolated_gyro, gyro);
+    EXPECT_EQ(o.wrong_exclusions, 0) << describe(o);
+    EXPECT_EQ(o.isolated_kind, FaultKind::kScale) << describe(o);
+  }
+}
+
+TEST(Pipeline, RejectsAndCountsBadTimesAndShapes) {
+  const auto cal = seed_as_built_unit();
+  auto p = Pipeline::create(cal, PipelineConfig{});
+  ASSERT_TRUE(p.ok());
+  Synth s(cal, SynthOptions{});
+  Epoch e = s.next();
+  EXPECT_TRUE(p->step(e).accepted);
+  EXPECT_FALSE(p->step(e).accepted);  // duplicate time
+  Epoch back = e;
+  back.stamp_ns -= 1;
+  EXPECT_FALSE(p->step(back).accepted);  // backward
+  Epoch shape = s.next();
+  shape.raw.pop_back();
+  EXPECT_FALSE(p->step(shape).accepted);
+  Epoch bad = s.next();
+  bad.raw[0] = std::numeric_limits<double>::infinity();
+  bad.raw[1] = 1e6;  // out of range
+  bad.present[2] = 0;
+  const auto& r = p->step(bad);
+  EXPECT_TRUE(r.accepted);
+  EXPECT_EQ(r.attitude.mode, Mode::kLost);  // one usable gyro this epoch
+  EXPECT_EQ(r.attitude.gyros, 0U);
+  const auto& c = p->health().counters;
+  EXPECT_EQ(c.epochs_rejected_time, 2U);
+  EXPECT_EQ(c.epochs_rejected_shape, 1U);
+  EXPECT_EQ(c.samples_invalid, 2U);
+  EXPECT_EQ(c.samples_absent, 1U);
+  EXPECT_TRUE(std::isfinite(r.attitude.q_RB.w()));
+}
+
+TEST(Pipeline, MissingSampleSwitchesToThreeGyroSolution) {
+  // Gyro 3 absent every other epoch for 0.5 s (shorter than the dropout timeout): the epoch uses gyros 1, 2,
+  // 4 and the rate stays within 6σ of the truth (3-gyro σ per axis ≲ 1.3e-4 deg/s).
+  const auto cal = seed_as_built_unit();
+  auto p = Pipeline::create(cal, campaign_config());
+  Synth s(cal, SynthOptions{});
+  for (int k = 0; k < 50; ++k) {
+    Epoch e = s.next();
+    if (k % 2 == 1) e.present[2] = 0;
+    const auto& r = p->step(e);
+    if (k == 0) continue;
+    EXPECT_EQ(r.attitude.gyros, k % 2 == 1 ? 0b1011U : 0b1111U);
+    EXPECT_LT((r.attitude.omega_B_rad_s * kRadToDeg - s.rate_dps(s.time_s())).norm(), 6 * 1.3e-4);
+    EXPECT_TRUE(r.events.empty());
+  }
+}
+
+TEST(Pipeline, OperatorCommandsExcludeReinstateReset) {
+  const auto cal = seed_as_built_unit();
+  auto p = Pipeline::create(cal, campaign_config());
+  Synth s(cal, SynthOptions{});
+  for (int k = 0; k < 10; ++k) (void)p->step(s.next());
+  const FdiEvent ack = p->exclude(2, 1);
+  EXPECT_EQ(ack.type, EventType::kCommand);
+  EXPECT_EQ(ack.gyros, 0b1101U);
+  const auto& r = p->step(s.next());
+  ASSERT_EQ(r.events.size(), 2U);  // the acknowledgement, then the reconfiguration
+  EXPECT_EQ(r.events[1].type, EventType::kReconfigured);
+  EXPECT_EQ(r.attitude.mode, Mode::kDegraded);
+  EXPECT_EQ(r.attitude.gyros, 0b1101U);
+  EXPECT_EQ(p->exclude(9, 2).detail.find("rejected") != std::string::npos, true);
+  (void)p->exclude(1, 3);  // gyros 3 and 4 left: not observable
+  const auto& lost = p->step(s.next());
+  EXPECT_EQ(lost.attitude.mode, Mode::kLost);
+  bool lost_event = false;
+  for (const auto& e : lost.events) lost_event = lost_event || e.type == EventType::kLost;
+  EXPECT_TRUE(lost_event);
+  (void)p->reinstate(1, 5);
+  EXPECT_EQ(p->step(s.next()).attitude.mode, Mode::kDegraded);
+  (void)p->reset_command(6);
+  const auto& back = p->step(s.next());
+  EXPECT_EQ(back.attitude.mode, Mode::kNominal);
+  EXPECT_EQ(back.attitude.gyros, 0b1111U);
+}
+
+TEST(Pipeline, ExclusionIsLatchedAfterTheFaultGoes) {
+  // A dropout of 3 s isolates the gyro; when it delivers again it stays excluded until reinstated.
+  const auto cal = seed_as_built_unit();
+  auto p = Pipeline::create(cal, campaign_config());
+  Synth s(cal, SynthOptions{}, SynthFault{4, FaultKind::kDropout, false, 10.0, 0.0});
+  for (int k = 0; k < 130; ++k) (void)p->step(s.next());
+  for (int k = 0; k < 50; ++k) {
+    Epoch e = s.next();
+    e.present[3] = 1;  // the synthetic dropout still computes a healthy value
+    EXPECT_EQ(p->step(e).attitude.gyros, 0b0111U);
+  }
+  (void)p->reinstate(4, 0);
+  Epoch e = s.next();
+  e.present[3] = 1;
+  EXPECT_EQ(p->step(e).attitude.gyros, 0b1111U);
+}
+
+TEST(Pipeline, FiveGyrosIsolateABiasByGlt) {
+  // Five gyros: the tetrahedron plus a skewed fifth axis; the parity space is two-dimensional, so the GLT
+  // tells which gyro a small persistent bias sits on (the residual of the right hypothesis is χ²₁, the others
+  // grow with n).
+  Calibration cal = seed_as_built_unit();
+  GyroCalibration g5;
+  g5.id = 5;
+  g5.scale_factor_V_per_dps = 0.08;
+  g5.bias_V = 1e-4;
+  g5.noise = cal.gyros[0].noise;
+  g5.axis_B = Eigen::Vector3d(0.3, 0.5, -0.6).normalized();
+  cal.gyros.push_back(g5);
+  for (int gyro = 1; gyro <= 5; ++gyro) {
+    SynthFault f{gyro, FaultKind::kBias, false, 60.0, 4e-4};
+    SynthOptions opt;
+    opt.seed = static_cast<std::uint64_t>(4000 + gyro);
+    const Outcome o = run(f, 120.0, opt, campaign_config(), cal);
+    ASSERT_TRUE(o.isolated_gyro.has_value()) << gyro << "\n" << describe(o);
+    EXPECT_EQ(*o.isolated_gyro, gyro) << describe(o);
+    EXPECT_EQ(o.wrong_exclusions, 0);
+  }
+}
+
+TEST(Pipeline, GroundModeRemovesEarthRate) {
+  // A unit at rest in the lab: gyros measure only the Earth rate; with --latitude the attitude stays put
+  // (error below 5σ of the random walk after 10 min), without it the attitude follows the Earth (≈ 2.5° in 10
+  // min).
+  const auto cal = seed_as_built_unit();
+  const double lat = -23.2 * kDegToRad;
+  SynthOptions opt;
+  opt.acs_amplitude_dps = 0.0;
+  opt.rate0_dps = earth_rate_L(lat) * kRadToDeg;  // identity attitude: B = L
+  PipelineConfig cfg;
+  cfg.latitude_deg = -23.2;
+  auto ground = Pipeline::create(cal, cfg);
+  auto plain = Pipeline::create(cal, PipelineConfig{});
+  Synth s(cal, opt);
+  const StepResult* g = nullptr;
+  const StepResult* q = nullptr;
+  for (int k = 0; k < 6000; ++k) {
+    const auto& e = s.next();
+    g = &ground->step(e);
+    q = &plain->step(e);
+  }
+  EXPECT_LT(angle_between(g->attitude.q_RB, Quaternion::Identity()), 5.0 * g->attitude.sigma_rad.norm());
+  EXPECT_NEAR(angle_between(q->attitude.q_RB, Quaternion::Identity()) * kRadToDeg,
+              7.2921159e-5 * 600 * kRadToDeg, 0.01);
+}
+
+}  // namespace
+}  // namespace tetra::fdi
