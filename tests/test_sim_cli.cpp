@@ -83,6 +83,8 @@ TEST(SimCli, BadInputExitsTwoWithOneClearLine) {
       {"sim static --jitter 0.2 --out " + dir.file("x.csv"), "jitter_s"},
       {"sim static", "--out"},
       {"sim turntable --order 1,99", "sequence 99"},
+      {"sim turntable --minutes 3", "--minutes does not apply"},
+      {"sim orbit --wrap --out " + dir.file("x.csv"), "--wrap applies to the turntable scenario only"},
       {"sim orbit --unit " + dir.file("nounit.yaml") + " --out " + dir.file("x.csv"), "nounit.yaml"},
   };
   for (const auto& [args, needle] : cases) {

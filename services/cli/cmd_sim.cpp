@@ -101,14 +101,16 @@ int cmd_sim(int argc, char** argv) {
   auto* opt_drop =
       app.add_option("--drop", drop_probability, "probability that a gyro sample is not delivered");
   auto* opt_range = app.add_option("--range", range_dps, "[deg/s] measuring range (saturation)");
-  app.add_option("--table-rate", plan.table_rate_dps, "[deg/s] turntable: gimbal rate")
-      ->capture_default_str();
-  app.add_option("--revolutions", plan.revolutions, "turntable: revolutions per sequence")
-      ->capture_default_str();
-  app.add_option("--order", plan.order,
-                 "turntable: sequence numbers in the order run, e.g. 1,2,5,6 (default 1..16)")
-      ->delimiter(',');
-  app.add_flag("--wrap", plan.wrap_angles, "turntable: write encoder angles wrapped to (-180, 180]");
+  auto* opt_table = app.add_option("--table-rate", plan.table_rate_dps, "[deg/s] turntable: gimbal rate")
+                        ->capture_default_str();
+  auto* opt_revs = app.add_option("--revolutions", plan.revolutions, "turntable: revolutions per sequence")
+                       ->capture_default_str();
+  auto* opt_order =
+      app.add_option("--order", plan.order,
+                     "turntable: sequence numbers in the order run, e.g. 1,2,5,6 (default 1..16)")
+          ->delimiter(',');
+  auto* opt_wrap =
+      app.add_flag("--wrap", plan.wrap_angles, "turntable: write encoder angles wrapped to (-180, 180]");
 #if TETRA_WITH_DDS
   SimDdsOptions dds_options;
   add_sim_dds_options(app, dds_options);
@@ -137,6 +139,10 @@ int cmd_sim(int argc, char** argv) {
     return run_turntable(unit ? *unit : seed_as_built_unit(), plan, model, seed, out_path);
   }
 
+  for (const CLI::Option* o : {opt_table, opt_revs, opt_order, opt_wrap}) {
+    if (o->count())
+      return report(kName, bad_input(o->get_name() + " applies to the turntable scenario only"));
+  }
   Result<sim::Scenario> scenario = looks_like_file(scenario_name) ? sim::read_scenario(scenario_name)
                                                                   : sim::builtin_scenario(scenario_name);
   if (!scenario) return report(kName, scenario.error());
