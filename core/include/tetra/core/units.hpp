@@ -21,7 +21,7 @@ inline std::int64_t seconds_to_ns(double t_s) {
 }
 //! [s] integer nanoseconds to seconds.
 inline double ns_to_seconds(std::int64_t t_ns) {
-  return static_cast<double>(t_ns) * 1e-9;
+  return static_cast<double>(t_ns) / 1e9;  // division: correctly rounded (39.98, not 39.980000000000004)
 }
 
 }  // namespace tetra
