@@ -1,12 +1,13 @@
 #include "attitude_csv.hpp"
 
 #include "tetra/core/csv.hpp"
-#include "tetra/core/units.hpp"
+#include "tetra/core/units.hpp"  // kRadToDeg
 
 namespace tetra::cli {
 
-void append_attitude_row(std::string& out, const fdi::AttitudeEstimate& attitude, int n_gyros) {
-  append_double(out, ns_to_seconds(attitude.stamp_ns));
+void append_attitude_row(std::string& out, double time_s, const fdi::AttitudeEstimate& attitude,
+                         int n_gyros) {
+  append_double(out, time_s);
   for (const double c : to_wxyz(attitude.q_RB)) {
     out += ',';
     append_double(out, c);

@@ -196,7 +196,7 @@ int cmd_record(int argc, char** argv) {
     auto a = attitude_reader->take([&](const tetra_Attitude& s, const dds_sample_info_t&) {
       if (dds::from_wire(s.unit) != unit) return;
       const auto attitude = dds::from_wire(s);
-      append_attitude_row(attitude_text, attitude, n);
+      append_attitude_row(attitude_text, ns_to_seconds(attitude.stamp_ns), attitude, n);
       last_attitude_ns = attitude.stamp_ns;
     });
     if (!a) return report("record", a.error());

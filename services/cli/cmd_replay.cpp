@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "attitude_csv.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "tetra/core/calibration_file.hpp"
@@ -107,7 +108,7 @@ int cmd_replay(int argc, char** argv) {
   const int n = log->gyro_count;
   std::string att;
   att.reserve(log->epochs() * 160 + 128);
-  att += "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros\n";
+  att += kAttitudeHeader;
   std::string events;
   std::map<std::string, int> event_counts;
   fdi::Epoch epoch;
@@ -134,24 +135,7 @@ int cmd_replay(int argc, char** argv) {
       ++event_counts[fdi::to_string(e.type)];
     }
     if (!r.accepted) continue;
-    const auto& a = r.attitude;
-    append_double(att, log->time_s[k]);
-    const auto q = to_wxyz(a.q_RB);
-    for (double c : q) {
-      att += ',';
-      append_double(att, c);
-    }
-    for (int axis = 0; axis < 3; ++axis) {
-      att += ',';
-      append_double(att, a.omega_B_rad_s[axis] * kRadToDeg);
-    }
-    att += ',';
-    append_double(att, a.sigma_rad.norm() * kRadToDeg);  // 1σ of the total error angle
-    att += ',';
-    att += fdi::to_string(a.mode);
-    att += ',';
-    att += mask_to_string(a.gyros, n);
-    att += '\n';
+    append_attitude_row(att, log->time_s[k], r.attitude, n);  // the log's own time, bit for bit
   }
   if (auto st = write_text_file(attitude_path, att); !st) return report("replay", st.error());
   if (auto st = write_text_file(events_path, events); !st) return report("replay", st.error());
