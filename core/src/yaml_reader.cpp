@@ -19,6 +19,14 @@ Error YamlReader::error(const YAML::Exception& e, const std::string& what) const
   return bad_input(source_ + ":" + std::to_string(line) + ": " + (what.empty() ? "" : what + ": ") + e.msg);
 }
 
+Result<YAML::Node> YamlReader::load(const std::string& text) const {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    return error(e, "");
+  }
+}
+
 std::string YamlReader::child(const std::string& what, const std::string& key) {
   return what.empty() ? key : what + "." + key;
 }

@@ -43,16 +43,13 @@ Result<FusionConfig> read_fusion_config(const std::string& path) {
 
 Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std::string& source,
                                          const std::string& base_dir) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    return bad_input(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+  const YamlReader reader(source);
+  auto loaded = reader.load(yaml_text);
+  if (!loaded) return loaded.error();
+  const YAML::Node root = std::move(loaded).value();
   if (!root.IsMap()) return bad_input(source + ": expected a YAML map of settings");
   FusionConfig config;
   config.source = source;
-  const YamlReader reader(source);
   if (auto keys = reader.check_keys(root,
                                     {"unit", "calibration", "sample_rate_hz", "speed", "tolerance_s",
                                      "max_latency_s", "health_period_s", "pipeline", "security"},

@@ -5,18 +5,15 @@
 #include <fstream>
 #include <sstream>
 #include <utility>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
+
+#include "tetra/core/yaml_reader.hpp"
 
 namespace tetra::service {
 
 namespace {
-
-std::string where(const std::string& source, const YAML::Node& node) {
-  const auto mark = node.Mark();
-  if (mark.line < 0) return source + ": ";
-  return source + ":" + std::to_string(mark.line + 1) + ": ";
-}
 
 //! The keys in file order of make_pki.sh, with the member each one fills.
 using Field = std::pair<const char*, std::string SecurityProfile::*>;
@@ -33,36 +30,28 @@ constexpr std::array<Field, 6> kFields = {{
 
 Result<SecurityProfile> parse_security_profile(const std::string& yaml_text, const std::string& source,
                                                const std::string& base_dir) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    return bad_input(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+  const YamlReader reader(source);
+  auto loaded = reader.load(yaml_text);
+  if (!loaded) return loaded.error();
+  const YAML::Node root = std::move(loaded).value();
   if (!root.IsMap()) return bad_input(source + ": expected a YAML map of the six security documents");
+  std::vector<std::string> allowed;
+  for (const auto& f : kFields) allowed.emplace_back(f.first);
+  if (auto keys = reader.check_keys(root, allowed, ""); !keys) return keys.error();
   SecurityProfile profile;
   profile.source = source;
-  try {
-    for (const auto& item : root) {
-      const auto key = item.first.as<std::string>();
-      const Field* field = nullptr;
-      for (const auto& f : kFields) {
-        if (key == f.first) field = &f;
-      }
-      if (field == nullptr) {
-        return bad_input(where(source, item.first) + "unknown key '" + key +
-                         "' (allowed: identity_ca, identity_certificate, private_key, permissions_ca, "
-                         "governance, permissions)");
-      }
-      if (!item.second.IsScalar() || item.second.Scalar().empty()) {
-        return bad_input(where(source, item.second) + key + " must be a file name");
-      }
-      std::filesystem::path path(item.second.Scalar());
-      if (path.is_relative() && !base_dir.empty()) path = std::filesystem::path(base_dir) / path;
-      profile.*(field->second) = path.string();
+  for (const auto& item : root) {
+    const std::string& key = item.first.Scalar();
+    const Field* field = nullptr;  // found: check_keys allowed only these names
+    for (const auto& f : kFields) {
+      if (key == f.first) field = &f;
     }
-  } catch (const YAML::Exception& e) {
-    return bad_input(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    if (!item.second.IsScalar() || item.second.Scalar().empty()) {
+      return reader.error(item.second, key, "must be a file name");
+    }
+    std::filesystem::path path(item.second.Scalar());
+    if (path.is_relative() && !base_dir.empty()) path = std::filesystem::path(base_dir) / path;
+    profile.*(field->second) = path.string();
   }
   for (const auto& [key, member] : kFields) {
     if ((profile.*member).empty()) return bad_input(source + ": missing key '" + key + "'");

@@ -30,6 +30,9 @@ class YamlReader {
   //! "FILE:LINE: what: message" (or "FILE:LINE: message" when `what` is empty), as a bad-input Error.
   Error error(const YAML::Node& node, const std::string& what, const std::string& message) const;
 
+  //! Parses a whole document; a syntax error becomes "FILE:LINE: message".
+  Result<YAML::Node> load(const std::string& text) const;
+
   //! A yaml-cpp exception (syntax error, bad conversion) as "FILE:LINE: what: message".
   Error error(const YAML::Exception& e, const std::string& what) const;
 
