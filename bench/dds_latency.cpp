@@ -2,13 +2,19 @@
 // of that epoch's Attitude, measured by one process that plays the sensor and the consumer, against
 // a running `tetra fusion` (bench/dds_latency.sh starts everything and runs ddsperf beside it).
 //
-//   dds_latency --domain D [--epochs N] [--rate HZ] [--unit U]
+//   dds_latency --domain D [--epochs N] [--rate HZ] [--unit U] [--receive waitset|listener]
+//               [--gyro-spacing-us US]
+// --receive: how this program learns of an Attitude: a waitset wakes its main thread (like
+//   `ddsperf ... waitset`), or a listener on Cyclone's receive thread stamps it (like ddsperf's default).
+// --gyro-spacing-us: time between the writes of one epoch's four samples (0: back to back, one burst).
 //   dds_latency --write-calibration CAL.yaml      (the calibration the service must use)
 // Prints p50, p90, p99 and max in microseconds, and the number of epochs without an Attitude.
 
 #include <time.h>
 
 #include <algorithm>
+#include <condition_variable>
+#include <mutex>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -28,6 +34,40 @@ std::int64_t now_ns() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
+void sleep_until_ns(std::int64_t t_ns) {
+  timespec ts{static_cast<time_t>(t_ns / 1'000'000'000), static_cast<long>(t_ns % 1'000'000'000)};
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) != 0) {
+  }
+}
+
+//! What the Attitude listener saw last, for the main thread (listener mode).
+struct Arrivals {
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::int64_t stamp_ns = -1;    //!< [ns] sensor time of the last Attitude taken
+  std::int64_t arrived_ns = 0;   //!< [ns] local monotonic time it was taken
+};
+
+void on_attitude(dds_entity_t reader, void* arg) {
+  auto& arrivals = *static_cast<Arrivals*>(arg);
+  void* samples[8] = {nullptr};
+  dds_sample_info_t infos[8];
+  const dds_return_t n = dds_take(reader, samples, infos, 8, 8);
+  const std::int64_t now = now_ns();
+  std::int64_t stamp = -1;
+  for (dds_return_t i = 0; i < n; ++i) {
+    if (infos[i].valid_data) stamp = std::max(stamp, static_cast<const tetra_Attitude*>(samples[i])->stamp_ns);
+  }
+  if (n > 0) (void)dds_return_loan(reader, samples, n);
+  if (stamp < 0) return;
+  {
+    std::lock_guard lock(arrivals.mutex);
+    arrivals.stamp_ns = stamp;
+    arrivals.arrived_ns = now;
+  }
+  arrivals.changed.notify_one();
+}
+
 int fail(const std::string& what) {
   std::fprintf(stderr, "dds_latency: %s\n", what.c_str());
   return 1;
@@ -43,6 +83,8 @@ int run(int argc, char** argv) {
   int epochs = 3000;
   double rate_hz = 100.0;
   std::string unit = "tetra-1";
+  bool listener = false;
+  std::int64_t spacing_ns = 0;
   if (argc == 3 && !std::strcmp(argv[1], "--write-calibration")) {
     // The calibration the service needs for what this program writes (the seed's as-built unit).
     Calibration cal = seed_as_built_unit();
@@ -59,6 +101,12 @@ int run(int argc, char** argv) {
       rate_hz = std::atof(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--unit"))
       unit = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--receive") && !std::strcmp(argv[i + 1], "listener"))
+      listener = true;
+    else if (!std::strcmp(argv[i], "--receive") && !std::strcmp(argv[i + 1], "waitset"))
+      listener = false;
+    else if (!std::strcmp(argv[i], "--gyro-spacing-us"))
+      spacing_ns = static_cast<std::int64_t>(std::atof(argv[i + 1]) * 1e3);
     else
       return fail(std::string("unknown option ") + argv[i]);
   }
@@ -90,6 +138,15 @@ int run(int argc, char** argv) {
     (void)dds_take_status(reader->handle(), &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
   }
 
+  Arrivals arrivals;
+  if (listener) {
+    dds_listener_t* l = dds_create_listener(&arrivals);
+    dds_lset_data_available(l, on_attitude);
+    const dds_return_t rc = dds_set_listener(reader->handle(), l);
+    dds_delete_listener(l);
+    if (rc < 0) return fail("set listener");
+  }
+
   // Raw values at the biases: zero rate on every gyro, a quiet NOMINAL unit.
   const Calibration cal = seed_as_built_unit();
   tetra_GyroSample sample{};
@@ -106,32 +163,41 @@ int run(int argc, char** argv) {
       sample.seq = static_cast<std::uint64_t>(k) + 1;
       sample.stamp_ns = stamp;
       sample.raw = cal.gyros[static_cast<std::size_t>(g - 1)].bias_V;
+      if (g > 1 && spacing_ns > 0) sleep_until_ns(now_ns() + spacing_ns);
       if (g == 4) t0 = now_ns();
       if (!writer->write(sample)) return fail("write");
     }
     bool received = false;
+    std::int64_t t1 = 0;
     const std::int64_t deadline = t0 + 500'000'000;
-    while (!received) {
-      auto taken = reader->take([&](const tetra_Attitude& a, const dds_sample_info_t&) {
-        if (a.stamp_ns == stamp) received = true;
-      });
-      if (!taken) return fail("take");
-      if (received) break;
-      const std::int64_t now = now_ns();
-      if (now >= deadline) break;
-      (void)waitset->wait(std::chrono::nanoseconds(deadline - now), triggered);
+    if (listener) {
+      std::unique_lock lock(arrivals.mutex);
+      received = arrivals.changed.wait_for(lock, std::chrono::nanoseconds(deadline - t0),
+                                           [&] { return arrivals.stamp_ns >= stamp; });
+      t1 = arrivals.arrived_ns;
+    } else {
+      while (!received) {
+        auto taken = reader->take([&](const tetra_Attitude& a, const dds_sample_info_t&) {
+          if (a.stamp_ns == stamp) received = true;
+        });
+        if (!taken) return fail("take");
+        if (received) break;
+        const std::int64_t now = now_ns();
+        if (now >= deadline) break;
+        (void)waitset->wait(std::chrono::nanoseconds(deadline - now), triggered);
+      }
+      t1 = now_ns();
     }
-    const std::int64_t t1 = now_ns();
-    if (!received) {
+    if (k < warmup) {
+      // Warm-up: the service's writer may match this reader after its first Attitude (volatile).
+    } else if (!received) {
       ++missing;
-    } else if (k >= warmup) {
+    } else {
       latency_us.push_back(static_cast<double>(t1 - t0) * 1e-3);
     }
     next += period_ns;
-    for (std::int64_t now = now_ns(); now < next; now = now_ns()) {
-      (void)waitset->wait(std::chrono::nanoseconds(next - now), triggered);
-      (void)reader->take([](const tetra_Attitude&, const dds_sample_info_t&) {});
-    }
+    sleep_until_ns(std::max(next, now_ns()));
+    if (!listener) (void)reader->take([](const tetra_Attitude&, const dds_sample_info_t&) {});
   }
   if (latency_us.empty()) return fail("no Attitude received");
   std::sort(latency_us.begin(), latency_us.end());
@@ -140,10 +206,10 @@ int run(int argc, char** argv) {
                                static_cast<std::size_t>(p * static_cast<double>(latency_us.size())))];
   };
   std::printf(
-      "gyro-write-to-attitude latency over %zu epochs at %.0f Hz: p50 %.1f us  p90 %.1f us  p99 %.1f us  max "
+      "gyro-write-to-attitude latency (%s) over %zu epochs at %.0f Hz: p50 %.1f us  p90 %.1f us  p99 %.1f us  max "
       "%.1f us  "
       "(no attitude: %d)\n",
-      latency_us.size(), rate_hz, pct(0.5), pct(0.9), pct(0.99), latency_us.back(), missing);
+      listener ? "listener" : "waitset", latency_us.size(), rate_hz, pct(0.5), pct(0.9), pct(0.99), latency_us.back(), missing);
   return missing == 0 ? 0 : 1;
 }
 

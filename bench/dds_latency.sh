@@ -2,7 +2,9 @@
 # Latency of `tetra fusion` on loopback, beside the DDS floor measured by ddsperf in the same run.
 #   bench/dds_latency.sh [BUILD_DIR]      (default: build)
 # 1. ddsperf ping/pong round trip = two one-way hops, the floor of "write -> service -> read";
-# 2. dds_latency against a running `tetra fusion`: last GyroSample write of an epoch -> its Attitude;
+# 2. dds_latency against a running `tetra fusion`: last GyroSample write of an epoch -> its Attitude,
+#    with the service's gyro samples dispatched by a listener (default) and by the waitset, the four
+#    samples of an epoch written 100 us apart (asynchronous gyro streams) and back to back;
 # 3. ddsperf again, to bracket the (shared, noisy) machine's load.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,24 +17,46 @@ FUSION=""
 cleanup() { [ -n "$FUSION" ] && kill "$FUSION" 2>/dev/null; wait 2>/dev/null; rm -rf "$WORK"; }
 trap cleanup EXIT
 
-floor() {  # MODE: listener (ddsperf's default: handled on the receive thread) or waitset (like tetra)
+# floor MODE: ddsperf ping/pong in MODE, listener (ddsperf's default: handled on the receive thread)
+# or waitset; prints the median over its one-second reports of p50 and p99, and appends p50 to
+# $WORK/floor_MODE.
+floor() {
   ddsperf -i "$DOMAIN" -D 7 pong "$1" >/dev/null 2>&1 &
   local pong=$!
-  ddsperf -i "$DOMAIN" -D 6 ping "${RATE}Hz" "$1" 2>&1 | grep -E " 50% " | tail -n 4
+  ddsperf -i "$DOMAIN" -D 6 ping "${RATE}Hz" "$1" 2>&1 | grep -E " 50% " | tail -n 4 |
+    sed -E 's/.* 50% ([0-9.]+)us .* 99% ([0-9.]+)us .*/\1 \2/' | sort -n |
+    awk -v mode="$1" -v out="$WORK/floor_$1" '{p50[NR] = $1; p99[NR] = $2}
+      END {m = int((NR + 1) / 2); printf "ddsperf %-8s round trip: p50 %.1f us  p99 %.1f us (median of %d one-second reports)\n", mode, p50[m], p99[m], NR;
+           printf "%.1f\n", p50[m] >> out}'
   wait "$pong" 2>/dev/null || true
 }
 
-echo "== ddsperf ping/pong round trip (two one-way hops), ${RATE} Hz, 12-byte samples, listener"
-floor listener
-echo "== ddsperf ping/pong round trip, waitset (the wake-up structure of tetra fusion and dds_latency)"
-floor waitset
-echo "== tetra fusion: last GyroSample write -> Attitude receive, ${RATE} Hz"
 "$BUILD/dds_latency" --write-calibration "$WORK/cal.yaml"
-printf 'unit: tetra-1\ncalibration: cal.yaml\nsample_rate_hz: %s\n' "$RATE" > "$WORK/fusion.yaml"
-"$BUILD/tetra" fusion --config "$WORK/fusion.yaml" --domain "$DOMAIN" --log-level warn > "$WORK/fusion.log" 2>&1 &
-FUSION=$!
-"$BUILD/dds_latency" --domain "$DOMAIN" --epochs 3000 --rate "$RATE"
-kill "$FUSION"; wait "$FUSION" || true; FUSION=""
-echo "== ddsperf ping/pong again, listener and waitset"
+# run DISPATCH RECEIVE SPACING_US: a service with `gyro_dispatch: DISPATCH`, this program receiving
+# its Attitude the RECEIVE way, the four samples of an epoch SPACING_US apart (0: one burst).
+run() {
+  printf 'unit: tetra-1\ncalibration: cal.yaml\nsample_rate_hz: %s\ngyro_dispatch: %s\n' "$RATE" "$1" \
+    > "$WORK/fusion.yaml"
+  "$BUILD/tetra" fusion --config "$WORK/fusion.yaml" --domain "$DOMAIN" --log-level warn > "$WORK/fusion.log" 2>&1 &
+  FUSION=$!
+  echo "-- service gyro_dispatch $1, Attitude received by a $2, samples ${3} us apart"
+  "$BUILD/dds_latency" --domain "$DOMAIN" --epochs 3000 --rate "$RATE" --receive "$2" --gyro-spacing-us "$3" |
+    tee -a "$WORK/tetra_$2"
+  kill "$FUSION"; wait "$FUSION" || true; FUSION=""
+}
+echo "== tetra fusion: last GyroSample write -> Attitude receive, ${RATE} Hz"
+echo "   (compare listener with ddsperf's listener mode, waitset with its waitset mode)"
+run listener listener 100   # four asynchronous gyro streams
+run listener listener 0     # one writer, four samples back to back
+run waitset waitset 100
+run waitset waitset 0
+echo "== ddsperf ping/pong again"
 floor listener
 floor waitset
+echo "== p50 / DDS floor (the floor: mean of the two ddsperf runs in the same mode)"
+for mode in listener waitset; do
+  f=$(awk '{s += $1} END {printf "%.1f", s / NR}' "$WORK/floor_$mode")
+  sed -E 's/.* p50 ([0-9.]+) us .*/\1/' "$WORK/tetra_$mode" | while read -r p50; do
+    awk -v m="$mode" -v p="$p50" -v f="$f" 'BEGIN {printf "%-8s p50 %6.1f us / floor %6.1f us = %.2f\n", m, p, f, p / f}'
+  done
+done

@@ -98,14 +98,16 @@ class Process {
 struct ServiceFiles {
   TempDir dir;
   std::string config;
-  ServiceFiles(double rate_hz, double speed, const std::string& unit = "tetra-1") {
+  ServiceFiles(double rate_hz, double speed, const std::string& unit = "tetra-1",
+               const std::string& gyro_dispatch = "listener") {
     Calibration cal = seed_as_built_unit();
     cal.unit = unit;
     EXPECT_TRUE(write_calibration(dir.file("cal.yaml"), cal).ok());
     config = dir.file("fusion.yaml");
     write_file(config,
                "unit: " + unit + "\ncalibration: cal.yaml\nsample_rate_hz: " + std::to_string(rate_hz) +
-                   "\nspeed: " + std::to_string(speed) + "\nmax_latency_s: 0.05\nhealth_period_s: 0.2\n");
+                   "\nspeed: " + std::to_string(speed) + "\nmax_latency_s: 0.05\nhealth_period_s: 0.2\n" +
+                   "gyro_dispatch: " + gyro_dispatch + "\n");
   }
 };
 
@@ -266,9 +268,13 @@ AttitudeRows read_attitude(const std::string& path) {
   return rows;
 }
 
-TEST(DdsServices, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitudes) {
-  const dds_domainid_t domain = 162;
-  ServiceFiles files(100.0, 1.0);
+//! The same for both ways gyro samples reach the pipeline (docs/dds.md, "Latency").
+class DdsReplayEquivalence : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(DdsReplayEquivalence, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitudes) {
+  const bool listener = std::string(GetParam()) == "listener";
+  const dds_domainid_t domain = listener ? 162 : 166;
+  ServiceFiles files(100.0, 1.0, "tetra-1", GetParam());
   Process fusion({"fusion", "--config", files.config, "--domain", d(domain)}, files.dir.file("fusion.log"));
   Process record({"record", "--config", files.config, "--domain", d(domain), "-o", files.dir.file("rec.csv"),
                   "--attitude", files.dir.file("dds_att.csv"), "--events", files.dir.file("dds_ev.jsonl"),
@@ -307,6 +313,9 @@ TEST(DdsServices, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitudes) {
     ASSERT_EQ(a.labels[k], b.labels[it->second]) << "t = " << a.numbers[k][0];
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(GyroDispatch, DdsReplayEquivalence, ::testing::Values("listener", "waitset"),
+                         [](const auto& param_info) { return std::string(param_info.param); });
 
 TEST(DdsServices, SimulatorKilledGoesLostAndRecovers_ServiceKilledResumes) {
   const dds_domainid_t domain = 163;

@@ -31,6 +31,18 @@ TEST_F(FusionConfigTest, MinimalFileTakesTheDefaults) {
   EXPECT_EQ(assembler.nominal_period_ns, 10'000'000);
   EXPECT_EQ(assembler.tolerance_ns, 2'500'000);  // a quarter period by default
   EXPECT_EQ(assembler.max_latency_ns, 20'000'000);
+  EXPECT_EQ(config->gyro_dispatch, service::GyroDispatch::kListener);
+}
+
+TEST_F(FusionConfigTest, GyroDispatchIsListenerOrWaitset) {
+  auto waitset = parse("calibration: cal.yaml\ngyro_dispatch: waitset\n");
+  ASSERT_TRUE(waitset.ok()) << waitset.error().message;
+  EXPECT_EQ(waitset->gyro_dispatch, service::GyroDispatch::kWaitset);
+  EXPECT_NE(service::describe(*waitset).find("gyro_dispatch: waitset"), std::string::npos);
+  auto bad = parse("calibration: cal.yaml\ngyro_dispatch: polling\n");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("f.yaml:2:"), std::string::npos) << bad.error().message;
+  EXPECT_NE(bad.error().message.find("gyro_dispatch"), std::string::npos) << bad.error().message;
 }
 
 TEST_F(FusionConfigTest, SpeedShortensTheWallClockDeadline) {

@@ -2,14 +2,19 @@
 //
 // Reads GyroSample, AttitudeReference and Command of its unit; writes Attitude (every accepted
 // epoch), Health (every `health_period_s` and on every change) and FdiEvent (pipeline events and
-// command acknowledgements). One waitset drives everything: data on any reader, the gyro reader's
-// deadline status, the latency limit of the oldest open epoch, the Health period, and SIGINT/SIGTERM.
+// command acknowledgements). One waitset drives everything but the gyro samples themselves: the
+// reference and command readers, the gyro reader's statuses (deadline, liveliness, matches), the
+// latency limit of the oldest open epoch, silent gyros, the Health period, and SIGINT/SIGTERM.
+// Gyro samples are handed to the same code by a data-available listener on Cyclone's receive thread
+// (`gyro_dispatch: listener`, the default: an epoch is fused and its Attitude written without a
+// thread wake-up) or by the waitset (`gyro_dispatch: waitset`). One mutex serializes the two threads.
 
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <deque>
 #include <iostream>
+#include <mutex>
 #include <unordered_map>
 
 #include "cli_common.hpp"
@@ -30,7 +35,7 @@ using namespace std::chrono_literals;
 using dds::Reader;
 using dds::Writer;
 
-enum Token : std::intptr_t { kGyroData = 1, kGyroStatus, kReferenceData, kCommandData, kShutdown };
+enum Token : std::intptr_t { kGyroData = 1, kGyroStatus, kReferenceData, kCommandData, kWake, kShutdown };
 
 class FusionService {
  public:
@@ -40,11 +45,26 @@ class FusionService {
         assembler_(std::move(assembler)),
         n_gyros_(pipeline_.gyro_count()),
         last_arrival_ns_(static_cast<std::size_t>(n_gyros_), 0) {}
+  ~FusionService() { stop_listener(); }
+  FusionService(const FusionService&) = delete;
+  FusionService& operator=(const FusionService&) = delete;
 
   Status open(dds_domainid_t domain, dds::ShutdownSignal& shutdown);
   Status run(const dds::ShutdownSignal& shutdown);
 
  private:
+  bool listener_dispatch() const { return config_.gyro_dispatch == service::GyroDispatch::kListener; }
+  //! The gyro reader's listener, on Cyclone's receive thread.
+  static void on_gyro_data(dds_entity_t reader, void* self);
+  //! Removes the listener; returns once no callback runs (call without holding mutex_).
+  void stop_listener();
+  Status loop(const dds::ShutdownSignal& shutdown);
+  //! Everything a waitset wake-up calls for: statuses, samples, commands, deadlines, timers.
+  Status handle_wakeup(const std::vector<std::intptr_t>& triggered, std::int64_t now_ns);
+  //! Takes gyro samples and references, and fuses the epochs they complete.
+  Status ingest(std::int64_t now_ns);
+  //! [ns] the next time the waitset thread has work without any sample arriving.
+  std::int64_t next_wake_ns(std::int64_t now_ns) const;
   Status take_gyro_samples(std::int64_t now_ns);
   Status take_references();
   Status take_commands();
@@ -56,6 +76,8 @@ class FusionService {
   //! The health to publish, into `out` (its storage is reused).
   void current_health(fdi::Health& out) const;
 
+  //! Serializes the waitset thread and the gyro listener: every member below is used under it.
+  std::mutex mutex_;
   service::FusionConfig config_;
   fdi::Pipeline pipeline_;
   service::EpochAssembler assembler_;
@@ -78,6 +100,9 @@ class FusionService {
   };
   std::deque<PendingAck> acks_published_;  //!< acknowledgements sent before the pipeline repeats them
   std::vector<fdi::Epoch> epochs_;
+  std::int64_t scheduled_wake_ns_ = 0;   //!< [ns] when the waitset thread wakes by itself next
+  std::optional<Error> listener_error_;  //!< a failure inside the listener, for run() to return
+  bool listening_ = false;
 
   std::optional<dds::Participant> participant_;
   std::optional<dds::Topics> topics_;
@@ -88,6 +113,7 @@ class FusionService {
   std::optional<Writer<tetra_Health>> health_writer_;
   std::optional<Writer<tetra_FdiEvent>> event_writer_;
   std::vector<dds::Condition> conditions_;
+  std::optional<dds::Condition> wake_;  //!< the listener wakes the waitset thread for an epoch's deadline
   std::optional<dds::WaitSet> waitset_;
 };
 
@@ -144,10 +170,14 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown)
     conditions_.push_back(std::move(condition).value());
     return ok_status();
   };
-  if (auto s = attach_data(gyro_reader_->handle(), kGyroData); !s) return s;
+  if (!listener_dispatch()) {
+    if (auto s = attach_data(gyro_reader_->handle(), kGyroData); !s) return s;
+  }
   if (auto s = attach_data(reference_reader_->handle(), kReferenceData); !s) return s;
   if (auto s = attach_data(command_reader_->handle(), kCommandData); !s) return s;
   if (auto s = waitset_->attach(gyro_reader_->handle(), kGyroStatus); !s) return s;
+  if (auto s = assign(wake_, dds::Condition::guard(*participant_)); !s) return s;
+  if (auto s = waitset_->attach(wake_->handle(), kWake); !s) return s;
   auto guard = dds::Condition::guard(*participant_);
   if (!guard) return guard.error();
   if (auto s = waitset_->attach(guard->handle(), kShutdown); !s) return s;
@@ -156,69 +186,134 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown)
   return ok_status();
 }
 
+void FusionService::on_gyro_data(dds_entity_t, void* self) {
+  auto& service = *static_cast<FusionService*>(self);
+  const std::lock_guard lock(service.mutex_);
+  if (service.listener_error_) return;
+  auto status = service.ingest(monotonic_ns());
+  if (!status) service.listener_error_ = status.error();
+  // An epoch still waiting for samples is due before the waitset thread would wake by itself.
+  const auto due = service.assembler_.next_due_ns();
+  if (!status || (due && *due < service.scheduled_wake_ns_)) (void)service.wake_->trigger();
+}
+
+void FusionService::stop_listener() {
+  if (listening_ && gyro_reader_) (void)gyro_reader_->on_data_available(nullptr, nullptr);
+  listening_ = false;
+}
+
 Status FusionService::run(const dds::ShutdownSignal& shutdown) {
-  started_ns_ = monotonic_ns();
-  next_health_ns_ = started_ns_;
-  if (auto s = publish_health(started_ns_, true); !s) return s;
-  spdlog::info("fusion: unit {} running, {} gyros, {} Hz", config_.unit, n_gyros_, config_.sample_rate_hz);
+  {
+    const std::lock_guard lock(mutex_);
+    started_ns_ = monotonic_ns();
+    next_health_ns_ = started_ns_;
+    if (auto s = publish_health(started_ns_, true); !s) return s;
+  }
+  if (listener_dispatch()) {
+    if (auto s = gyro_reader_->on_data_available(&FusionService::on_gyro_data, this); !s) return s;
+    listening_ = true;
+  }
+  spdlog::info("fusion: unit {} running, {} gyros, {} Hz, gyro samples dispatched by the {}", config_.unit,
+               n_gyros_, config_.sample_rate_hz, listener_dispatch() ? "listener" : "waitset");
+  const Status status = loop(shutdown);
+  stop_listener();  // before anything the listener uses goes away
+  if (!status) return status;
+  spdlog::info("fusion: signal {} received, shutting down", shutdown.signal_number());
+  const std::lock_guard lock(mutex_);
+  return publish_health(monotonic_ns(), true);
+}
+
+Status FusionService::loop(const dds::ShutdownSignal& shutdown) {
   std::vector<std::intptr_t> triggered;
+  std::int64_t wake = 0;
+  {
+    const std::lock_guard lock(mutex_);
+    wake = scheduled_wake_ns_ = next_wake_ns(monotonic_ns());
+  }
   while (!shutdown.requested()) {
-    std::int64_t now = monotonic_ns();
-    std::int64_t wake = next_health_ns_;
-    if (auto due = assembler_.next_due_ns()) wake = std::min(wake, *due);
-    // Gyros not yet absent are checked for silence at their deadline too.
-    for (int g = 1; g <= n_gyros_; ++g) {
-      if (!assembler_.absent(g)) {
-        const std::int64_t since =
-            std::max({last_arrival_ns_[static_cast<std::size_t>(g - 1)], started_ns_, resumed_ns_});
-        wake = std::min(wake, since + deadline_ns_ + 1);
-      }
-    }
-    if (auto s = waitset_->wait(std::chrono::nanoseconds(wake - now), triggered); !s) return s;
+    if (auto s = waitset_->wait(std::chrono::nanoseconds(wake - monotonic_ns()), triggered); !s) return s;
     if (shutdown.requested()) break;
-    now = monotonic_ns();
-    bool deadline_status = false;
-    bool command_data = false;
-    bool matched_changed = false;
-    for (const auto token : triggered) {
-      command_data = command_data || token == kCommandData;
-      if (token == kGyroStatus) {
-        std::uint32_t status = 0;
-        (void)dds_take_status(gyro_reader_->handle(), &status,
-                              DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
-                                  DDS_SUBSCRIPTION_MATCHED_STATUS);
-        deadline_status = (status & DDS_REQUESTED_DEADLINE_MISSED_STATUS) != 0;
-        if ((status & DDS_SUBSCRIPTION_MATCHED_STATUS) != 0) {
-          // A sensor (or simulator) came or went: say so in Health at once (a simulator waits for it).
-          auto matched = gyro_reader_->matched_writers();
-          if (!matched) return matched.error();
-          gyro_writers_ = *matched;
-          spdlog::info("fusion: {} GyroSample writer(s) matched", gyro_writers_);
-          matched_changed = true;
-        }
-        if ((status & DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS) != 0) {
-          spdlog::warn(
-              "fusion: a GyroSample writer offers incompatible QoS (its deadline must be at most {} s: "
-              "sample_rate_hz and speed must match the sensor's)",
-              static_cast<double>(deadline_ns_) * 1e-9);
-        }
+    const std::lock_guard lock(mutex_);
+    if (auto s = wake_->clear(); !s) return s;
+    if (listener_error_) return *listener_error_;
+    const std::int64_t now = monotonic_ns();
+    if (auto s = handle_wakeup(triggered, now); !s) return s;
+    // A listener that opens an epoch after this sees the new time, and wakes this thread if the
+    // epoch is due earlier; one that opened it before is in this computation.
+    wake = scheduled_wake_ns_ = next_wake_ns(now);
+  }
+  return ok_status();
+}
+
+std::int64_t FusionService::next_wake_ns(std::int64_t now_ns) const {
+  std::int64_t wake = next_health_ns_;
+  if (auto due = assembler_.next_due_ns()) wake = std::min(wake, *due);
+  std::int64_t last_any_arrival = 0;
+  for (int g = 1; g <= n_gyros_; ++g) {
+    const std::int64_t arrival = last_arrival_ns_[static_cast<std::size_t>(g - 1)];
+    last_any_arrival = std::max(last_any_arrival, arrival);
+    // Gyros not yet absent are checked for silence at their deadline.
+    if (!assembler_.absent(g))
+      wake = std::min(wake, std::max({arrival, started_ns_, resumed_ns_}) + deadline_ns_ + 1);
+  }
+  // While samples flow, an epoch the next sample opens is due no earlier than this: waking here
+  // spares the listener from waking this thread for every epoch.
+  const std::int64_t next_epoch_due = last_any_arrival + assembler_.config().max_latency_ns;
+  if (listener_dispatch() && next_epoch_due > now_ns) wake = std::min(wake, next_epoch_due);
+  return wake;
+}
+
+Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered, std::int64_t now) {
+  bool deadline_status = false;
+  bool command_data = false;
+  bool gyro_data = false;
+  bool matched_changed = false;
+  for (const auto token : triggered) {
+    command_data = command_data || token == kCommandData;
+    gyro_data = gyro_data || token == kGyroData;
+    if (token == kGyroStatus) {
+      std::uint32_t status = 0;
+      (void)dds_take_status(gyro_reader_->handle(), &status,
+                            DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
+                                DDS_SUBSCRIPTION_MATCHED_STATUS);
+      deadline_status = (status & DDS_REQUESTED_DEADLINE_MISSED_STATUS) != 0;
+      if ((status & DDS_SUBSCRIPTION_MATCHED_STATUS) != 0) {
+        // A sensor (or simulator) came or went: say so in Health at once (a simulator waits for it).
+        auto matched = gyro_reader_->matched_writers();
+        if (!matched) return matched.error();
+        gyro_writers_ = *matched;
+        spdlog::info("fusion: {} GyroSample writer(s) matched", gyro_writers_);
+        matched_changed = true;
       }
-    }
-    // Gyro samples before references: a reference written before an epoch's samples is then
-    // already in its reader when the epoch completes (docs/dds.md).
-    if (auto s = take_gyro_samples(now); !s) return s;
-    if (auto s = take_references(); !s) return s;
-    if (command_data) {
-      if (auto s = take_commands(); !s) return s;
-    }
-    const bool newly_absent = check_deadlines(now, deadline_status);
-    if (auto s = process_epochs(now); !s) return s;
-    if (command_data || newly_absent || matched_changed || now >= next_health_ns_) {
-      if (auto s = publish_health(now, matched_changed); !s) return s;
+      if ((status & DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS) != 0) {
+        spdlog::warn(
+            "fusion: a GyroSample writer offers incompatible QoS (its deadline must be at most {} s: "
+            "sample_rate_hz and speed must match the sensor's)",
+            static_cast<double>(deadline_ns_) * 1e-9);
+      }
     }
   }
-  spdlog::info("fusion: signal {} received, shutting down", shutdown.signal_number());
-  return publish_health(monotonic_ns(), true);
+  if (gyro_data) {
+    if (auto s = ingest(now); !s) return s;
+  }
+  if (auto s = take_references(); !s) return s;
+  if (command_data) {
+    if (auto s = take_commands(); !s) return s;
+  }
+  const bool newly_absent = check_deadlines(now, deadline_status);
+  if (auto s = process_epochs(now); !s) return s;
+  if (command_data || newly_absent || matched_changed || now >= next_health_ns_) {
+    if (auto s = publish_health(now, matched_changed); !s) return s;
+  }
+  return ok_status();
+}
+
+Status FusionService::ingest(std::int64_t now_ns) {
+  // Gyro samples before references: a reference written before an epoch's samples is then
+  // already in its reader when the epoch completes (docs/dds.md).
+  if (auto s = take_gyro_samples(now_ns); !s) return s;
+  if (auto s = take_references(); !s) return s;
+  return process_epochs(now_ns);
 }
 
 Status FusionService::take_gyro_samples(std::int64_t now_ns) {

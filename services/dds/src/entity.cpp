@@ -149,13 +149,13 @@ Status WaitSet::attach(dds_entity_t entity, std::intptr_t token) {
 }
 
 Status WaitSet::wait(std::chrono::nanoseconds timeout, std::vector<std::intptr_t>& triggered) const {
-  triggered.assign(std::max<std::size_t>(attached_.size(), 1), 0);
-  std::vector<dds_attach_t> xs(triggered.size());
-  const dds_return_t n =
-      dds_waitset_wait(entity_.handle(), xs.data(), xs.size(), std::max<std::int64_t>(timeout.count(), 0));
+  results_.resize(std::max<std::size_t>(attached_.size(), 1));
+  const dds_return_t n = dds_waitset_wait(entity_.handle(), results_.data(), results_.size(),
+                                          std::max<std::int64_t>(timeout.count(), 0));
   if (n < 0) return dds_error("wait", n);
-  triggered.resize(static_cast<std::size_t>(n));
-  for (std::size_t i = 0; i < triggered.size(); ++i) triggered[i] = static_cast<std::intptr_t>(xs[i]);
+  triggered.clear();
+  for (dds_return_t i = 0; i < std::min<dds_return_t>(n, static_cast<dds_return_t>(results_.size())); ++i)
+    triggered.push_back(static_cast<std::intptr_t>(results_[static_cast<std::size_t>(i)]));
   return ok_status();
 }
 

@@ -52,7 +52,7 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
   config.source = source;
   if (auto keys = reader.check_keys(root,
                                     {"unit", "calibration", "sample_rate_hz", "speed", "tolerance_s",
-                                     "max_latency_s", "health_period_s", "pipeline", "security"},
+                                     "max_latency_s", "health_period_s", "gyro_dispatch", "pipeline", "security"},
                                     "");
       !keys) {
     return keys.error();
@@ -63,6 +63,11 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
     if (key == "unit" || key == "calibration") {
       if (!value.IsScalar()) return bad_input(reader.at(value) + key + " must be text");
       (key == "unit" ? config.unit : config.calibration_path) = value.as<std::string>();
+    } else if (key == "gyro_dispatch") {
+      const std::string text = value.IsScalar() ? value.Scalar() : std::string();
+      if (text != "listener" && text != "waitset")
+        return bad_input(reader.at(value) + "gyro_dispatch must be 'listener' or 'waitset'");
+      config.gyro_dispatch = text == "listener" ? GyroDispatch::kListener : GyroDispatch::kWaitset;
     } else if (key == "security") {
       if (!value.IsScalar()) return bad_input(reader.at(value) + "security must be a file name");
       std::filesystem::path profile_path(value.as<std::string>());
@@ -129,6 +134,7 @@ std::string describe(const FusionConfig& config) {
       << '\n'
       << "max_latency_s: " << config.max_latency_s << '\n'
       << "health_period_s: " << config.health_period_s << '\n'
+      << "gyro_dispatch: " << (config.gyro_dispatch == GyroDispatch::kListener ? "listener" : "waitset") << '\n'
       << (config.security ? describe(*config.security) : std::string("security: none")) << '\n'
       << "pipeline:\n"
       << fdi::describe(config.pipeline);

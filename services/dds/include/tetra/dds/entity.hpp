@@ -201,6 +201,17 @@ class Reader {
     if (rc < 0) return dds_error("subscription matched status " + name_, rc);
     return status.current_count;
   }
+  //! Calls `callback(reader, arg)` on Cyclone's receive thread whenever samples arrive (no thread
+  //! wake-up between the network and the callback); nullptr removes it, after waiting for a running
+  //! callback to return. The callback may take and write; it must not delete entities.
+  Status on_data_available(dds_on_data_available_fn callback, void* arg) const {
+    dds_listener_t* listener = dds_create_listener(arg);
+    if (callback != nullptr) dds_lset_data_available(listener, callback);
+    const dds_return_t rc = dds_set_listener(entity_.handle(), callback != nullptr ? listener : nullptr);
+    dds_delete_listener(listener);
+    if (rc < 0) return dds_error("set listener " + name_, rc);
+    return ok_status();
+  }
   //! Enables the given communication statuses (DDS_*_STATUS) so a waitset can wake on them.
   Status enable_statuses(std::uint32_t mask) const {
     const dds_return_t rc = dds_set_status_mask(entity_.handle(), mask);
@@ -245,6 +256,7 @@ class WaitSet {
   explicit WaitSet(Entity entity) : entity_(std::move(entity)) {}
   Entity entity_;
   std::vector<dds_entity_t> attached_;
+  mutable std::vector<dds_attach_t> results_;  //!< wait()'s scratch: no allocation per wake-up
 };
 
 //! Copies `text` into a bounded IDL string (char[N+1]); error if it does not fit.

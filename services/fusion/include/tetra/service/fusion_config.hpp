@@ -15,6 +15,12 @@
 
 namespace tetra::service {
 
+//! Which thread runs an epoch once its samples arrive (docs/dds.md, "Latency").
+enum class GyroDispatch {
+  kListener,  //!< Cyclone's receive thread, through a data-available listener: no thread wake-up
+  kWaitset,   //!< the service's waitset thread, woken by the gyro reader's read condition
+};
+
 struct FusionConfig {
   std::string unit = "tetra-1";   //!< key of every topic this service reads and writes
   std::string calibration_path;   //!< calibration YAML (relative paths: to the config file)
@@ -25,6 +31,7 @@ struct FusionConfig {
       tolerance_s;               //!< [s] stamps this close belong to one epoch (< period/2); default period/4
   double max_latency_s = 0.02;   //!< [s] longest wait for an epoch's missing samples
   double health_period_s = 0.5;  //!< [s] Health at least this often (and on every change)
+  GyroDispatch gyro_dispatch = GyroDispatch::kListener;  //!< `gyro_dispatch: listener | waitset`
   fdi::PipelineConfig pipeline;  //!< the `pipeline:` map
   Calibration calibration;       //!< read from calibration_path
   std::optional<SecurityProfile> security;  //!< `security: PROFILE.yaml` (opt-in DDS Security; relative: to
