@@ -38,15 +38,23 @@ printf 'unit: soak-1\ncalibration: cal.yaml\nsample_rate_hz: %s\nspeed: 1\n' "$r
 
 "$tetra" fusion --config "$work/fusion.yaml" --domain "$domain" --log-level warn >"$work/fusion.log" 2>&1 &
 fusion_pid=$!
-# RSS and CPU time of the service every 10 s: time_s,rss_kB,cpu_s
+smaps() {  # PID: its mappings with more than 64 kB resident: range, name, kB
+  awk '/^[0-9a-f]+-[0-9a-f]+ / {range = $1; name = $6} /^Rss:/ && $2 > 64 {print range, name, $2}' "/proc/$1/smaps"
+}
+# RSS (total, anonymous, file-backed) and CPU time of the service every 10 s
 (
   clk=$(getconf CLK_TCK)
   start=$(date +%s)
-  echo "time_s,rss_kB,cpu_s"
+  echo "time_s,rss_kB,anon_kB,file_kB,cpu_s"
   while kill -0 "$fusion_pid" 2>/dev/null; do
-    rss=$(awk '/^VmRSS:/ {print $2}' "/proc/$fusion_pid/status" 2>/dev/null || echo "")
+    mem=$(awk '/^VmRSS:/ {r = $2} /^RssAnon:/ {a = $2} /^RssFile:/ {f = $2} END {if (r) print r "," a "," f}' \
+      "/proc/$fusion_pid/status" 2>/dev/null || echo "")
     cpu=$(awk -v c="$clk" '{printf "%.2f", ($14 + $15) / c}' "/proc/$fusion_pid/stat" 2>/dev/null || echo "")
-    [ -n "$rss" ] && echo "$(($(date +%s) - start)),$rss,$cpu"
+    [ -n "$mem" ] && echo "$(($(date +%s) - start)),$mem,$cpu"
+    # Where the memory is, after the warm-up: mappings over 64 kB resident (for the end, see below).
+    if [ "$(($(date +%s) - start))" -ge 60 ] && [ ! -e "$work/smaps_60s.txt" ]; then
+      smaps "$fusion_pid" >"$work/smaps_60s.txt"
+    fi
     sleep 10
   done
 ) >"$work/rss.csv" &
@@ -62,6 +70,7 @@ echo "soak: $minutes min at $rate Hz, domain $domain, work dir $work" >&2
 kill "$monitor_pid" 2>/dev/null || true
 sleep 2  # the last epoch's latency limit and Health period
 "$tetra" monitor --once --jsonl --unit soak-1 --domain "$domain" --timeout 10 >"$work/health.jsonl"
+smaps "$fusion_pid" >"$work/smaps_end.txt" 2>/dev/null || true
 kill -TERM "$fusion_pid"
 fusion_rc=0
 wait "$fusion_pid" || fusion_rc=$?
@@ -94,7 +103,8 @@ for line in open(f"{work}/health.jsonl"):
 if health is None or "counters" not in health:
     sys.exit("soak: FAIL: no Health from the service")
 c = health["counters"]
-rows = [(int(r["time_s"]), int(r["rss_kB"]), float(r["cpu_s"])) for r in csv.DictReader(open(f"{work}/rss.csv"))]
+rows = [(int(r["time_s"]), int(r["rss_kB"]), float(r["cpu_s"]), int(r["anon_kB"]), int(r["file_kB"]))
+        for r in csv.DictReader(open(f"{work}/rss.csv"))]
 after_warmup = [r for r in rows if r[0] >= 60] or rows
 rss_start, rss_end = after_warmup[0][1], rows[-1][1]
 rss_max = max(r[1] for r in rows)
