@@ -1,8 +1,9 @@
-// DDS Security (issue 7.1): the demo PKI of scripts/security/make_pki.sh, the three roles, and the
-// three promises — an unauthenticated participant sees nothing and injects nothing; the sensor
-// identity cannot write Command; an identity without the grant cannot write GyroSample. Each test
-// also shows the positive case, so a test cannot pass merely because nothing works.
-// Real Cyclone DDS on loopback, separate processes, one domain per test (171–173); processes are
+// DDS Security (issue 7.1): the demo PKI of scripts/security/make_pki.sh (units sec-1 and sec-2), its
+// roles, and the promises — an unauthenticated participant sees nothing and injects nothing; a
+// sensor identity cannot write Command; an identity without the grant cannot write GyroSample; the
+// sensor of one unit cannot write GyroSample for another. Each test also shows the positive case, so
+// a test cannot pass merely because nothing works.
+// Real Cyclone DDS on loopback, separate processes, one domain per test (171–174); processes are
 // killed by the test. Waits have generous upper bounds that only turn a hang into a failure.
 
 #include <gtest/gtest.h>
@@ -74,7 +75,7 @@ class DdsSecurity : public ::testing::Test {
   static void SetUpTestSuite() {
     pki_ = new TempDir();
     const auto made = run_shell("bash " + source_path("scripts/security/make_pki.sh") + " " +
-                                pki_->path().string() + " 0-230");
+                                pki_->path().string() + " 0-230 sec-1 sec-2");
     ASSERT_EQ(made.exit_status, 0) << made.err << made.out;
   }
   static void TearDownTestSuite() {
@@ -120,7 +121,7 @@ TEST_F(DdsSecurity, UnauthenticatedParticipantSeesAndInjectsNothing) {
   // The secured sensor: 12 s of an orbit at 50 Hz in real time.
   Process sim(
       {"sim", "orbit", "--dds", "--dds-unit", "sec-1", "--domain", std::to_string(domain), "--rate-hz", "50",
-       "--minutes", "0.2", "--reference-hz", "0", "--security", profile("sensor"), "--wait-timeout", "30"},
+       "--minutes", "0.2", "--reference-hz", "0", "--security", profile("sensor-sec-1"), "--wait-timeout", "30"},
       dir.file("sim.log"));
 
   // The eavesdropper: no credentials, a reader on each of the six topics, for 3 s of the secured run.
@@ -203,8 +204,8 @@ TEST_F(DdsSecurity, UnauthenticatedParticipantSeesAndInjectsNothing) {
 
 TEST_F(DdsSecurity, SensorCannotWriteCommand) {
   const dds_domainid_t domain = 172;
-  dds::set_security_profile(load("sensor"));
-  auto participant = dds::Participant::create(domain);
+  dds::set_security_profile(load("sensor-sec-1"));
+  auto participant = dds::Participant::create(domain, "sec-1");
   ASSERT_TRUE(participant.ok()) << participant.error().message;
   auto topics = dds::Topics::create(*participant);
   ASSERT_TRUE(topics.ok()) << topics.error().message;
@@ -219,7 +220,7 @@ TEST_F(DdsSecurity, SensorCannotWriteCommand) {
       << command.error().message;
   // The same through the command line.
   const auto cli = run_tetra("command --unit sec-1 --timeout 5 --domain " + std::to_string(domain) +
-                             " --security " + profile("sensor") + " reset");
+                             " --security " + profile("sensor-sec-1") + " reset");
   EXPECT_EQ(cli.exit_status, 1) << cli.err;
   EXPECT_NE(cli.err.find("Not Allowed By Security"), std::string::npos) << cli.err;
 }
@@ -247,6 +248,84 @@ TEST_F(DdsSecurity, OnlySensorsWriteGyroSamples) {
                              std::to_string(domain) + " --security " + profile("ground"));
   EXPECT_EQ(sim.exit_status, 1) << sim.err << sim.out;
   EXPECT_NE(sim.err.find("Not Allowed By Security"), std::string::npos) << sim.err;
+}
+
+TEST_F(DdsSecurity, SensorOfAnotherUnitCannotWriteGyroSamplesForThisUnit) {
+  const dds_domainid_t domain = 174;
+  // Unit sec-2's sensor may write in its own unit's partition only.
+  dds::set_security_profile(load("sensor-sec-2"));
+  {
+    auto participant = dds::Participant::create(domain, "sec-1");
+    ASSERT_TRUE(participant.ok()) << participant.error().message;
+    EXPECT_EQ(participant->partition(), "tetra.sec-1");
+    auto topics = dds::Topics::create(*participant);
+    ASSERT_TRUE(topics.ok()) << topics.error().message;
+    auto writer =
+        dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+    ASSERT_FALSE(writer.ok()) << "sensor-sec-2 may write GyroSample for unit sec-1";
+    EXPECT_NE(writer.error().message.find("Not Allowed By Security"), std::string::npos)
+        << writer.error().message;
+  }
+  // Positive control: the same identity writes for its own unit.
+  {
+    auto participant = dds::Participant::create(domain, "sec-2");
+    ASSERT_TRUE(participant.ok()) << participant.error().message;
+    auto topics = dds::Topics::create(*participant);
+    ASSERT_TRUE(topics.ok()) << topics.error().message;
+    auto writer =
+        dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+    EXPECT_TRUE(writer.ok()) << writer.error().message;
+  }
+  // A unit name that would be a partition pattern is refused with security.
+  auto wild = dds::Participant::create(domain, "sec-*");
+  ASSERT_FALSE(wild.ok());
+  EXPECT_NE(wild.error().message.find("sec-*"), std::string::npos) << wild.error().message;
+
+  // Through the command line: a simulator of unit sec-1 with sec-2's identity is refused ...
+  const auto sim = run_tetra("sim orbit --dds --dds-unit sec-1 --minutes 0.01 --wait-timeout 2 --domain " +
+                             std::to_string(domain) + " --security " + profile("sensor-sec-2"));
+  EXPECT_EQ(sim.exit_status, 1) << sim.err << sim.out;
+  EXPECT_NE(sim.err.find("Not Allowed By Security"), std::string::npos) << sim.err;
+
+  // ... and samples keyed for sec-1 but written in sec-2's partition never reach sec-1's service.
+  TempDir dir;
+  Process fusion({"fusion", "--config", service_config(dir, "sec-1"), "--domain", std::to_string(domain)},
+                 dir.file("fusion.log"));
+  {
+    auto participant = dds::Participant::create(domain, "sec-2");
+    ASSERT_TRUE(participant.ok()) << participant.error().message;
+    auto topics = dds::Topics::create(*participant);
+    ASSERT_TRUE(topics.ok()) << topics.error().message;
+    auto writer =
+        dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+    ASSERT_TRUE(writer.ok()) << writer.error().message;
+    const Calibration cal = seed_as_built_unit();
+    tetra_GyroSample sample{};
+    std::snprintf(sample.unit, sizeof sample.unit, "%s", "sec-1");
+    for (int k = 0; k < 60; ++k) {  // 3 s at 20 Hz
+      for (int g = 1; g <= 4; ++g) {
+        sample.gyro = static_cast<std::uint16_t>(g);
+        sample.seq = static_cast<std::uint64_t>(k + 1);
+        sample.stamp_ns = static_cast<std::int64_t>(k + 1) * 50'000'000;
+        sample.raw = cal.gyros[static_cast<std::size_t>(g - 1)].bias_V;
+        EXPECT_TRUE(writer->write(sample).ok());
+      }
+      std::this_thread::sleep_for(50ms);
+    }
+    EXPECT_EQ(writer->matched_readers().value(), 0u) << "sec-1's service matched sec-2's sensor";
+  }
+  dds::set_security_profile(std::nullopt);
+  const auto before = run_tetra("monitor --once --jsonl --unit sec-1 --timeout 20 --domain " +
+                                std::to_string(domain) + " --security " + profile("ground"));
+  ASSERT_EQ(before.exit_status, 0) << before.err << read_file(dir.file("fusion.log"));
+  EXPECT_NE(before.out.find("\"samples_accepted\": 0,"), std::string::npos) << before.out;
+  EXPECT_NE(before.out.find("\"samples_other_unit\": 0,"), std::string::npos) << before.out;
+  // Positive control: sec-1's own sensor is heard.
+  const auto own = run_tetra("sim orbit --dds --dds-unit sec-1 --rate-hz 50 --minutes 0.05 --reference-hz 0 "
+                             "--wait-timeout 30 --domain " +
+                             std::to_string(domain) + " --security " + profile("sensor-sec-1"));
+  ASSERT_EQ(own.exit_status, 0) << own.err << read_file(dir.file("fusion.log"));
+  EXPECT_NE(own.out.find("attitudes scored: "), std::string::npos) << own.out << own.err;
 }
 
 }  // namespace

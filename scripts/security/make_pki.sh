@@ -1,26 +1,41 @@
 #!/usr/bin/env bash
 # Demo PKI and signed DDS Security documents for tetra (docs/reliability.md, "DDS Security").
-#   scripts/security/make_pki.sh OUT_DIR [DOMAIN_RANGE]      DOMAIN_RANGE default 0-230
+#   scripts/security/make_pki.sh OUT_DIR [DOMAIN_RANGE] [UNIT...]
+#       DOMAIN_RANGE default 0-230; UNITs (default tetra-1): one sensor identity each
 # Creates in OUT_DIR:
 #   identity_ca.pem / identity_ca.key        signs every participant certificate
 #   permissions_ca.pem / permissions_ca.key  signs governance and permissions
-#   <role>.pem / <role>.key                  identity of each role: sensor, fusion, ground
+#   <role>.pem / <role>.key                  identity of each role: sensor-<UNIT> per unit, fusion,
+#                                            ground
 #   governance.xml(.p7s)                     unauthenticated participants refused; discovery,
 #                                            liveliness and data encrypted; access control on
-#   permissions.xml(.p7s)                    per role what it may publish and subscribe (default DENY)
+#   permissions.xml(.p7s)                    per role what it may publish and subscribe, in which
+#                                            partitions (default DENY): a secured participant serving
+#                                            unit U is in partition tetra.U (docs/reliability.md), so
+#                                            sensor-U may write samples for unit U only
 #   <role>.yaml                              the security profile a tetra DDS command takes
 #                                            (fusion config `security:`, --security for the others)
 # DEMO ONLY: unencrypted private keys, ten-year validity, no revocation. Never ship these keys.
 set -euo pipefail
-out=${1:?usage: make_pki.sh OUT_DIR [DOMAIN_MIN-DOMAIN_MAX]}
+out=${1:?usage: make_pki.sh OUT_DIR [DOMAIN_MIN-DOMAIN_MAX] [UNIT...]}
 range=${2:-0-230}
+shift $(($# >= 2 ? 2 : $#))
+units=("$@")
+[ ${#units[@]} -gt 0 ] || units=(tetra-1)
+for unit in "${units[@]}"; do
+  case "$unit" in
+    *[\*\?\[\]\\\ ,]* | "") echo "make_pki: unit '$unit': no blanks, commas or * ? [ ] \\ in a unit name" >&2; exit 2 ;;
+  esac
+done
 dmin=${range%-*}
 dmax=${range#*-}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 cd "$out"
 umask 077
-roles=(sensor fusion ground)
+roles=()
+for unit in "${units[@]}"; do roles+=("sensor-$unit"); done
+roles+=(fusion ground)
 days=3650
 # Subject names: the permissions document must repeat them exactly, written "CN=..,O=..,C=.." with
 # no blank after the commas (with blanks the handshake fails, DDS_NOTES.md).
@@ -78,8 +93,8 @@ XML
 
 # --- permissions: one grant per role, everything else denied ---
 topics() { for t in "$@"; do printf '            <topic>%s</topic>\n' "$t"; done; }
-grant() {  # role, published topics (space separated), subscribed topics
-  local role=$1 pub=$2 sub=$3
+grant() {  # role, partition (pattern), published topics (space separated), subscribed topics
+  local role=$1 partition=$2 pub=$3 sub=$4
   cat <<XML
     <grant name="${role}_grant">
       <subject_name>$(subject "$role")</subject_name>
@@ -91,13 +106,13 @@ XML
     printf '        <publish>\n          <topics>\n'
     # shellcheck disable=SC2086
     topics $pub
-    printf '          </topics>\n        </publish>\n'
+    printf '          </topics>\n          <partitions><partition>%s</partition></partitions>\n        </publish>\n' "$partition"
   fi
   if [ -n "$sub" ]; then
     printf '        <subscribe>\n          <topics>\n'
     # shellcheck disable=SC2086
     topics $sub
-    printf '          </topics>\n        </subscribe>\n'
+    printf '          </topics>\n          <partitions><partition>%s</partition></partitions>\n        </subscribe>\n' "$partition"
   fi
   cat <<XML
       </allow_rule>
@@ -112,14 +127,16 @@ XML
      xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_permissions.xsd">
   <permissions>
 XML
-  # sensor: the unit's gyros and star tracker, `sim --dds` (which scores the service's Attitude). It
-  # may read the other topics only because a participant creates every topic of the unit and Cyclone
-  # refuses to create a topic the grant does not name; it may write nothing but its samples.
-  grant sensor "GyroSample AttitudeReference" "Attitude Health FdiEvent Command"
-  # fusion: the service
-  grant fusion "Attitude Health FdiEvent" "GyroSample AttitudeReference Command"
-  # ground: monitor, command, record
-  grant ground "Command" "GyroSample AttitudeReference Attitude Health FdiEvent"
+  # sensor-U: unit U's gyros and star tracker, `sim --dds` (which scores the service's Attitude), in
+  # U's partition only. It may read the other topics only because a participant creates every topic
+  # and Cyclone refuses to create a topic the grant does not name; it may write nothing but samples.
+  for unit in "${units[@]}"; do
+    grant "sensor-$unit" "tetra.$unit" "GyroSample AttitudeReference" "Attitude Health FdiEvent Command"
+  done
+  # fusion: the service, of any unit
+  grant fusion "tetra.*" "Attitude Health FdiEvent" "GyroSample AttitudeReference Command"
+  # ground: monitor, command, record, of any unit
+  grant ground "tetra.*" "Command" "GyroSample AttitudeReference Attitude Health FdiEvent"
   cat <<XML
   </permissions>
 </dds>
@@ -143,4 +160,4 @@ permissions: $out/permissions.p7s
 YAML
 done
 chmod 0644 ./*.pem ./*.xml ./*.p7s ./*.yaml
-echo "make_pki: $out: identity CA, permissions CA, roles ${roles[*]}, domains $dmin-$dmax"
+echo "make_pki: $out: identity CA, permissions CA, roles ${roles[*]}, domains $dmin-$dmax, units ${units[*]}"

@@ -51,7 +51,7 @@ int cmd_command(int argc, char** argv) {
                                        : tetra_COMMAND_REINSTATE;
   command.gyro = static_cast<std::int16_t>(gyro);
 
-  auto participant = dds::Participant::create(domain);
+  auto participant = dds::Participant::create(domain, unit);
   if (!participant) return report("command", participant.error());
   auto topics = dds::Topics::create(*participant);
   if (!topics) return report("command", topics.error());

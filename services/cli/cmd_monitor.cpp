@@ -164,7 +164,7 @@ int cmd_monitor(int argc, char** argv) {
   add_domain_option(app, domain);
   if (auto exit = parse(app, argc, argv)) return *exit;
 
-  auto participant = dds::Participant::create(domain);
+  auto participant = dds::Participant::create(domain, unit_filter);
   if (!participant) return report("monitor", participant.error());
   auto topics = dds::Topics::create(*participant);
   if (!topics) return report("monitor", topics.error());

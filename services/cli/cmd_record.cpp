@@ -81,7 +81,7 @@ int cmd_record(int argc, char** argv) {
   if (!assembler) return report("record", assembler.error());
   const int n = assembly.gyro_count;
 
-  auto participant = dds::Participant::create(domain);
+  auto participant = dds::Participant::create(domain, unit);
   if (!participant) return report("record", participant.error());
   auto topics = dds::Topics::create(*participant);
   if (!topics) return report("record", topics.error());

@@ -39,7 +39,7 @@ Result<SimDdsScore> run_sim_dds(sim::Simulator& simulator, const SimDdsOptions& 
   const std::string unit = options.unit.empty() ? simulator.scenario().unit.unit : options.unit;
   const int n = simulator.gyro_count();
   const double rate_hz = simulator.scenario().rate_hz;
-  auto participant = dds::Participant::create(options.domain);
+  auto participant = dds::Participant::create(options.domain, unit);
   if (!participant) return participant.error();
   auto topics = dds::Topics::create(*participant);
   if (!topics) return topics.error();

@@ -89,9 +89,32 @@ Qos& Qos::no_autodispose() {
   dds_qset_writer_data_lifecycle(qos_, false);
   return *this;
 }
+Qos& Qos::partition(const std::string& name) {
+  dds_qset_partition1(qos_, name.c_str());
+  return *this;
+}
+Qos Qos::copy() const {
+  Qos out;
+  (void)dds_copy_qos(out.qos_, qos_);
+  return out;
+}
 
-Result<Participant> Participant::create(dds_domainid_t domain) {
+std::string unit_partition(const std::string& unit) {
+  return "tetra." + (unit.empty() ? std::string("*") : unit);
+}
+
+Qos Participant::endpoint_qos(const Qos& qos) const {
+  Qos out = qos.copy();
+  if (!partition_.empty()) out.partition(partition_);
+  return out;
+}
+
+Result<Participant> Participant::create(dds_domainid_t domain, const std::string& unit) {
   const auto& security = process_security_profile();
+  // A unit name is a partition name here: pattern characters would widen the grant's reach.
+  if (security && unit.find_first_of("*?[]\\") != std::string::npos) {
+    return bad_input("unit '" + unit + "': with DDS Security a unit name cannot contain * ? [ ] or \\");
+  }
   Qos qos;
   if (security) set_security_properties(qos.mutable_qos(), *security);
   const dds_entity_t handle = dds_create_participant(domain, security ? qos.get() : nullptr, nullptr);
@@ -100,7 +123,7 @@ Result<Participant> Participant::create(dds_domainid_t domain) {
                          (security ? " with DDS Security profile " + security->source : std::string()),
                      handle);
   }
-  return Participant(Entity(handle));
+  return Participant(Entity(handle), security ? unit_partition(unit) : std::string());
 }
 
 Result<Topic> Topic::create(const Participant& participant, const dds_topic_descriptor_t* descriptor,

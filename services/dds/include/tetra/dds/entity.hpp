@@ -75,6 +75,8 @@ class Qos {
   Qos& automatic_liveliness(std::chrono::nanoseconds lease);
   //! Keep instances when a writer is deleted (no dispose), so readers see "no writers", not "disposed".
   Qos& no_autodispose();
+  Qos& partition(const std::string& name);
+  Qos copy() const;
 
   const dds_qos_t* get() const { return qos_; }
   dds_qos_t* mutable_qos() { return qos_; }
@@ -83,15 +85,27 @@ class Qos {
   dds_qos_t* qos_ = nullptr;
 };
 
-//! Domain participant. `domain` DDS_DOMAIN_DEFAULT takes the id of the configuration.
+//! The DDS partition of a secured participant serving `unit` ("": every unit, a pattern): permissions
+//! grant per topic and partition, so one partition per unit lets them grant per unit.
+std::string unit_partition(const std::string& unit);
+
+//! Domain participant. `domain` DDS_DOMAIN_DEFAULT takes the id of the configuration. `unit` names the
+//! unit it serves ("": every unit). With a security profile (set_security_profile) its readers and
+//! writers are created in unit_partition(unit); without one, in the default partition (INTERFACES §4).
 class Participant {
  public:
-  static Result<Participant> create(dds_domainid_t domain);
+  static Result<Participant> create(dds_domainid_t domain, const std::string& unit = {});
   dds_entity_t handle() const { return entity_.handle(); }
+  //! The partition of its readers and writers ("": the default partition).
+  const std::string& partition() const { return partition_; }
+  //! `qos` in this participant's partition, for a reader or writer.
+  Qos endpoint_qos(const Qos& qos) const;
 
  private:
-  explicit Participant(Entity entity) : entity_(std::move(entity)) {}
+  Participant(Entity entity, std::string partition)
+      : entity_(std::move(entity)), partition_(std::move(partition)) {}
   Entity entity_;
+  std::string partition_;
 };
 
 //! A topic of the generated C type described by `descriptor`.
@@ -113,7 +127,9 @@ template <class T>
 class Writer {
  public:
   static Result<Writer> create(const Participant& participant, const Topic& topic, const Qos& qos) {
-    const dds_entity_t handle = dds_create_writer(participant.handle(), topic.handle(), qos.get(), nullptr);
+    const Qos endpoint = participant.endpoint_qos(qos);
+    const dds_entity_t handle =
+        dds_create_writer(participant.handle(), topic.handle(), endpoint.get(), nullptr);
     if (handle < 0) return dds_error("create writer " + topic.name(), handle);
     return Writer(Entity(handle), topic.name());
   }
@@ -154,7 +170,9 @@ template <class T>
 class Reader {
  public:
   static Result<Reader> create(const Participant& participant, const Topic& topic, const Qos& qos) {
-    const dds_entity_t handle = dds_create_reader(participant.handle(), topic.handle(), qos.get(), nullptr);
+    const Qos endpoint = participant.endpoint_qos(qos);
+    const dds_entity_t handle =
+        dds_create_reader(participant.handle(), topic.handle(), endpoint.get(), nullptr);
     if (handle < 0) return dds_error("create reader " + topic.name(), handle);
     return Reader(Entity(handle), topic.name());
   }
