@@ -14,11 +14,11 @@
 
 #include <algorithm>
 #include <condition_variable>
-#include <mutex>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -44,8 +44,8 @@ void sleep_until_ns(std::int64_t t_ns) {
 struct Arrivals {
   std::mutex mutex;
   std::condition_variable changed;
-  std::int64_t stamp_ns = -1;    //!< [ns] sensor time of the last Attitude taken
-  std::int64_t arrived_ns = 0;   //!< [ns] local monotonic time it was taken
+  std::int64_t stamp_ns = -1;   //!< [ns] sensor time of the last Attitude taken
+  std::int64_t arrived_ns = 0;  //!< [ns] local monotonic time it was taken
 };
 
 void on_attitude(dds_entity_t reader, void* arg) {
@@ -56,7 +56,8 @@ void on_attitude(dds_entity_t reader, void* arg) {
   const std::int64_t now = now_ns();
   std::int64_t stamp = -1;
   for (dds_return_t i = 0; i < n; ++i) {
-    if (infos[i].valid_data) stamp = std::max(stamp, static_cast<const tetra_Attitude*>(samples[i])->stamp_ns);
+    if (infos[i].valid_data)
+      stamp = std::max(stamp, static_cast<const tetra_Attitude*>(samples[i])->stamp_ns);
   }
   if (n > 0) (void)dds_return_loan(reader, samples, n);
   if (stamp < 0) return;
@@ -206,10 +207,12 @@ int run(int argc, char** argv) {
                                static_cast<std::size_t>(p * static_cast<double>(latency_us.size())))];
   };
   std::printf(
-      "gyro-write-to-attitude latency (%s) over %zu epochs at %.0f Hz: p50 %.1f us  p90 %.1f us  p99 %.1f us  max "
+      "gyro-write-to-attitude latency (%s) over %zu epochs at %.0f Hz: p50 %.1f us  p90 %.1f us  p99 %.1f us "
+      " max "
       "%.1f us  "
       "(no attitude: %d)\n",
-      listener ? "listener" : "waitset", latency_us.size(), rate_hz, pct(0.5), pct(0.9), pct(0.99), latency_us.back(), missing);
+      listener ? "listener" : "waitset", latency_us.size(), rate_hz, pct(0.5), pct(0.9), pct(0.99),
+      latency_us.back(), missing);
   return missing == 0 ? 0 : 1;
 }
 

@@ -8,8 +8,6 @@
 
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -21,53 +19,14 @@
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
 #include "tetra/service/security_profile.hpp"
+#include "tetra_process.hpp"
 
 namespace tetra::test {
 namespace {
 
 using namespace std::chrono_literals;
 
-const bool kLoopback = [] {
-  const std::string uri = "file://" + source_path("config/cyclonedds-loopback.xml");
-  setenv("CYCLONEDDS_URI", uri.c_str(), 1);
-  return true;
-}();
-
-//! A `tetra` child process with its output in a file; SIGKILLed when it goes out of scope.
-class Process {
- public:
-  Process(const std::vector<std::string>& args, const std::string& log_path) {
-    std::vector<std::string> storage{TETRA_BINARY};
-    storage.insert(storage.end(), args.begin(), args.end());
-    pid_ = fork();
-    if (pid_ == 0) {
-      std::vector<char*> argv;
-      for (auto& a : storage) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      if (FILE* f = std::freopen(log_path.c_str(), "w", stdout)) (void)f;
-      dup2(STDOUT_FILENO, STDERR_FILENO);
-      execv(TETRA_BINARY, argv.data());
-      _exit(127);
-    }
-  }
-  Process(const Process&) = delete;
-  Process& operator=(const Process&) = delete;
-  ~Process() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  int wait_exit() {
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    pid_ = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-
- private:
-  pid_t pid_ = -1;
-};
+const bool kLoopback = use_loopback_dds();
 
 //! The demo PKI, made once for the whole suite (about 2 s of openssl).
 class DdsSecurity : public ::testing::Test {
@@ -116,13 +75,14 @@ int count_taken(const dds::Reader<T>& reader) {
 TEST_F(DdsSecurity, UnauthenticatedParticipantSeesAndInjectsNothing) {
   const dds_domainid_t domain = 171;
   TempDir dir;
-  Process fusion({"fusion", "--config", service_config(dir, "sec-1"), "--domain", std::to_string(domain)},
-                 dir.file("fusion.log"));
+  TetraProcess fusion(
+      {"fusion", "--config", service_config(dir, "sec-1"), "--domain", std::to_string(domain)},
+      dir.file("fusion.log"));
   // The secured sensor: 12 s of an orbit at 50 Hz in real time.
-  Process sim(
-      {"sim", "orbit", "--dds", "--dds-unit", "sec-1", "--domain", std::to_string(domain), "--rate-hz", "50",
-       "--minutes", "0.2", "--reference-hz", "0", "--security", profile("sensor-sec-1"), "--wait-timeout", "30"},
-      dir.file("sim.log"));
+  TetraProcess sim({"sim", "orbit", "--dds", "--dds-unit", "sec-1", "--domain", std::to_string(domain),
+                    "--rate-hz", "50", "--minutes", "0.2", "--reference-hz", "0", "--security",
+                    profile("sensor-sec-1"), "--wait-timeout", "30"},
+                   dir.file("sim.log"));
 
   // The eavesdropper: no credentials, a reader on each of the six topics, for 3 s of the secured run.
   {
@@ -172,8 +132,8 @@ TEST_F(DdsSecurity, UnauthenticatedParticipantSeesAndInjectsNothing) {
     tetra_GyroSample sample{};
     std::snprintf(sample.unit, sizeof sample.unit, "%s", "sec-1");
     for (int k = 0; k < 30; ++k) {
-      sample.gyro = static_cast<std::int16_t>(1 + k % 4);
-      sample.seq = static_cast<std::uint64_t>(1000000 + k);
+      sample.gyro = static_cast<std::uint16_t>(1 + k % 4);
+      sample.seq = 1000000U + static_cast<std::uint64_t>(k);
       sample.raw = 1.0e3;
       EXPECT_TRUE(gyro_writer->write(sample).ok());
       EXPECT_TRUE(command_writer->write(command).ok());
@@ -289,8 +249,9 @@ TEST_F(DdsSecurity, SensorOfAnotherUnitCannotWriteGyroSamplesForThisUnit) {
 
   // ... and samples keyed for sec-1 but written in sec-2's partition never reach sec-1's service.
   TempDir dir;
-  Process fusion({"fusion", "--config", service_config(dir, "sec-1"), "--domain", std::to_string(domain)},
-                 dir.file("fusion.log"));
+  TetraProcess fusion(
+      {"fusion", "--config", service_config(dir, "sec-1"), "--domain", std::to_string(domain)},
+      dir.file("fusion.log"));
   {
     auto participant = dds::Participant::create(domain, "sec-2");
     ASSERT_TRUE(participant.ok()) << participant.error().message;
@@ -305,7 +266,7 @@ TEST_F(DdsSecurity, SensorOfAnotherUnitCannotWriteGyroSamplesForThisUnit) {
     for (int k = 0; k < 60; ++k) {  // 3 s at 20 Hz
       for (int g = 1; g <= 4; ++g) {
         sample.gyro = static_cast<std::uint16_t>(g);
-        sample.seq = static_cast<std::uint64_t>(k + 1);
+        sample.seq = static_cast<std::uint64_t>(k) + 1;
         sample.stamp_ns = static_cast<std::int64_t>(k + 1) * 50'000'000;
         sample.raw = cal.gyros[static_cast<std::size_t>(g - 1)].bias_V;
         EXPECT_TRUE(writer->write(sample).ok());
@@ -321,9 +282,10 @@ TEST_F(DdsSecurity, SensorOfAnotherUnitCannotWriteGyroSamplesForThisUnit) {
   EXPECT_NE(before.out.find("\"samples_accepted\": 0,"), std::string::npos) << before.out;
   EXPECT_NE(before.out.find("\"samples_other_unit\": 0,"), std::string::npos) << before.out;
   // Positive control: sec-1's own sensor is heard.
-  const auto own = run_tetra("sim orbit --dds --dds-unit sec-1 --rate-hz 50 --minutes 0.05 --reference-hz 0 "
-                             "--wait-timeout 30 --domain " +
-                             std::to_string(domain) + " --security " + profile("sensor-sec-1"));
+  const auto own = run_tetra(
+      "sim orbit --dds --dds-unit sec-1 --rate-hz 50 --minutes 0.05 --reference-hz 0 "
+      "--wait-timeout 30 --domain " +
+      std::to_string(domain) + " --security " + profile("sensor-sec-1"));
   ASSERT_EQ(own.exit_status, 0) << own.err << read_file(dir.file("fusion.log"));
   EXPECT_NE(own.out.find("attitudes scored: "), std::string::npos) << own.out << own.err;
 }

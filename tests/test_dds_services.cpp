@@ -1,13 +1,10 @@
 // Acceptance tests of the DDS services (issue 6): real Cyclone DDS on loopback, separate processes.
-// Every test uses its own domain id and kills what it starts (Process's destructor: SIGKILL).
+// Every test uses its own domain id and kills what it starts (TetraProcess's destructor: SIGKILL).
 // Waits are on DDS conditions (waitsets) or process exits, each with a generous upper bound that
 // only turns a hang into a failure; nothing asserts on elapsed time.
 
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -23,6 +20,7 @@
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
+#include "tetra_process.hpp"
 
 namespace tetra::test {
 namespace {
@@ -30,69 +28,13 @@ namespace {
 using namespace std::chrono_literals;
 
 // Loopback-only discovery for this process and every child it starts.
-const bool kLoopback = [] {
-  const std::string uri = "file://" + source_path("config/cyclonedds-loopback.xml");
-  setenv("CYCLONEDDS_URI", uri.c_str(), 1);
-  return true;
-}();
+const bool kLoopback = use_loopback_dds();
 
 std::int64_t now_ns() {
   timespec ts{};
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
-
-//! A `tetra` child process; SIGKILLed and reaped when it goes out of scope.
-class Process {
- public:
-  Process(const std::vector<std::string>& args, const std::string& log_path) {
-    std::vector<std::string> storage{TETRA_BINARY};
-    storage.insert(storage.end(), args.begin(), args.end());
-    std::vector<char*> argv;  // built before fork(): the child of a threaded process must not allocate
-    argv.reserve(storage.size() + 1);
-    for (auto& a : storage) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    std::fflush(stdout);  // or the child would inherit our buffered output
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      if (fd >= 0) {
-        dup2(fd, STDOUT_FILENO);
-        dup2(fd, STDERR_FILENO);
-      }
-      execv(TETRA_BINARY, argv.data());
-      _exit(127);
-    }
-  }
-  Process(const Process&) = delete;
-  Process& operator=(const Process&) = delete;
-  ~Process() { kill_now(SIGKILL); }
-  void kill_now(int sig) {
-    if (pid_ <= 0) return;
-    ::kill(pid_, sig);
-    waitpid(pid_, nullptr, 0);
-    pid_ = -1;
-  }
-  //! Sends `sig` and waits for the exit; returns the exit status (-1: killed by a signal).
-  int signal_and_wait(int sig) {
-    if (pid_ <= 0) return -1;
-    ::kill(pid_, sig);
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    pid_ = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-  int wait_exit() {
-    if (pid_ <= 0) return -1;
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    pid_ = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-
- private:
-  pid_t pid_ = -1;
-};
 
 //! The service's configuration and calibration in a temporary folder.
 struct ServiceFiles {
@@ -200,7 +142,8 @@ TEST(DdsServices, StuckGyroIsIsolatedAndAttitudeFlowsDegraded_LateMonitorAndComm
   // The simulator runs 10 times faster than real time; the service keeps speed 1, so its deadline
   // (3 periods = 30 ms of wall clock) leaves this loaded 2-core machine a margin.
   ServiceFiles files(100.0, 1.0);
-  Process fusion({"fusion", "--config", files.config, "--domain", d(domain)}, files.dir.file("fusion.log"));
+  TetraProcess fusion({"fusion", "--config", files.config, "--domain", d(domain)},
+                      files.dir.file("fusion.log"));
   Observer observer(domain);
   const auto sim = run_tetra(sim_args(domain, 1));
   ASSERT_EQ(sim.exit_status, 0) << sim.err << sim.out << read_file(files.dir.file("fusion.log"));
@@ -275,11 +218,12 @@ TEST_P(DdsReplayEquivalence, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitude
   const bool listener = std::string(GetParam()) == "listener";
   const dds_domainid_t domain = listener ? 162 : 166;
   ServiceFiles files(100.0, 1.0, "tetra-1", GetParam());
-  Process fusion({"fusion", "--config", files.config, "--domain", d(domain)}, files.dir.file("fusion.log"));
-  Process record({"record", "--config", files.config, "--domain", d(domain), "-o", files.dir.file("rec.csv"),
-                  "--attitude", files.dir.file("dds_att.csv"), "--events", files.dir.file("dds_ev.jsonl"),
-                  "--until-idle"},
-                 files.dir.file("record.log"));
+  TetraProcess fusion({"fusion", "--config", files.config, "--domain", d(domain)},
+                      files.dir.file("fusion.log"));
+  TetraProcess record({"record", "--config", files.config, "--domain", d(domain), "-o",
+                       files.dir.file("rec.csv"), "--attitude", files.dir.file("dds_att.csv"), "--events",
+                       files.dir.file("dds_ev.jsonl"), "--until-idle"},
+                      files.dir.file("record.log"));
   const auto sim = run_tetra(sim_args(domain, 2));  // waits for the service and the recorder
   ASSERT_EQ(sim.exit_status, 0) << sim.err;
   ASSERT_EQ(record.wait_exit(), 0) << read_file(files.dir.file("record.log"));
@@ -321,13 +265,13 @@ TEST(DdsServices, SimulatorKilledGoesLostAndRecovers_ServiceKilledResumes) {
   const dds_domainid_t domain = 163;
   ServiceFiles files(100.0, 1.0);
   Observer observer(domain);
-  auto fusion = std::make_unique<Process>(
+  auto fusion = std::make_unique<TetraProcess>(
       std::vector<std::string>{"fusion", "--config", files.config, "--domain", d(domain)},
       files.dir.file("fusion.log"));
   const std::vector<std::string> sim_cmd = {"sim",      "static",  "--dds",     "--dds-unit", "tetra-1",
                                             "--domain", d(domain), "--rate-hz", "100",        "--minutes",
                                             "10",       "--speed", "1"};
-  auto sim = std::make_unique<Process>(sim_cmd, files.dir.file("sim1.log"));
+  auto sim = std::make_unique<TetraProcess>(sim_cmd, files.dir.file("sim1.log"));
   const auto health = [&]() -> const dds::HealthView* {
     const auto it = observer.health.find("tetra-1");
     return it == observer.health.end() ? nullptr : &it->second;
@@ -353,7 +297,7 @@ TEST(DdsServices, SimulatorKilledGoesLostAndRecovers_ServiceKilledResumes) {
   std::printf("[ figure ] simulator kill -9 to Health LOST with all gyros absent: %.1f ms (deadline 30 ms)\n",
               static_cast<double>(now_ns() - killed_sim_ns) * 1e-6);
 
-  sim = std::make_unique<Process>(sim_cmd, files.dir.file("sim2.log"));
+  sim = std::make_unique<TetraProcess>(sim_cmd, files.dir.file("sim2.log"));
   ASSERT_TRUE(observer.wait_until([&] {
     const auto* h = health();
     return h && h->health.mode == fdi::Mode::kNominal && h->counters.sensor_restarts == 1;
@@ -363,7 +307,7 @@ TEST(DdsServices, SimulatorKilledGoesLostAndRecovers_ServiceKilledResumes) {
   observer.drain();
   observer.attitudes.clear();
   const std::int64_t restart_ns = now_ns();
-  fusion = std::make_unique<Process>(
+  fusion = std::make_unique<TetraProcess>(
       std::vector<std::string>{"fusion", "--config", files.config, "--domain", d(domain)},
       files.dir.file("fusion2.log"));
   ASSERT_TRUE(observer.wait_until([&] { return !observer.attitudes.empty(); }))
@@ -377,7 +321,8 @@ TEST(DdsServices, MalformedTrafficIsCountedNeverMixedNeverACrash) {
   const dds_domainid_t domain = 164;
   ServiceFiles files(100.0, 1.0);
   Observer observer(domain);
-  Process fusion({"fusion", "--config", files.config, "--domain", d(domain)}, files.dir.file("fusion.log"));
+  TetraProcess fusion({"fusion", "--config", files.config, "--domain", d(domain)},
+                      files.dir.file("fusion.log"));
   auto writer = dds::Writer<tetra_GyroSample>::create(observer.participant(), observer.topics().gyro_sample,
                                                       dds::gyro_sample_qos(std::chrono::milliseconds(10)));
   ASSERT_TRUE(writer.ok());

@@ -215,7 +215,7 @@ Status FusionService::run(const dds::ShutdownSignal& shutdown) {
   }
   spdlog::info("fusion: unit {} running, {} gyros, {} Hz, gyro samples dispatched by the {}", config_.unit,
                n_gyros_, config_.sample_rate_hz, listener_dispatch() ? "listener" : "waitset");
-  const Status status = loop(shutdown);
+  Status status = loop(shutdown);
   stop_listener();  // before anything the listener uses goes away
   if (!status) return status;
   spdlog::info("fusion: signal {} received, shutting down", shutdown.signal_number());

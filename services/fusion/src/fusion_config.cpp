@@ -50,10 +50,11 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
   if (!root.IsMap()) return bad_input(source + ": expected a YAML map of settings");
   FusionConfig config;
   config.source = source;
-  if (auto keys = reader.check_keys(root,
-                                    {"unit", "calibration", "sample_rate_hz", "speed", "tolerance_s",
-                                     "max_latency_s", "health_period_s", "gyro_dispatch", "pipeline", "security"},
-                                    "");
+  if (auto keys =
+          reader.check_keys(root,
+                            {"unit", "calibration", "sample_rate_hz", "speed", "tolerance_s", "max_latency_s",
+                             "health_period_s", "gyro_dispatch", "pipeline", "security"},
+                            "");
       !keys) {
     return keys.error();
   }
@@ -134,7 +135,8 @@ std::string describe(const FusionConfig& config) {
       << '\n'
       << "max_latency_s: " << config.max_latency_s << '\n'
       << "health_period_s: " << config.health_period_s << '\n'
-      << "gyro_dispatch: " << (config.gyro_dispatch == GyroDispatch::kListener ? "listener" : "waitset") << '\n'
+      << "gyro_dispatch: " << (config.gyro_dispatch == GyroDispatch::kListener ? "listener" : "waitset")
+      << '\n'
       << (config.security ? describe(*config.security) : std::string("security: none")) << '\n'
       << "pipeline:\n"
       << fdi::describe(config.pipeline);

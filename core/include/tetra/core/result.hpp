@@ -44,10 +44,10 @@ inline std::string one_line(const std::string& message) {
   return out;
 }
 
-inline Error bad_input(std::string message) {
+inline Error bad_input(const std::string& message) {
   return Error{one_line(message), ErrorKind::kBadInput};
 }
-inline Error failure(std::string message) {
+inline Error failure(const std::string& message) {
   return Error{one_line(message), ErrorKind::kFailure};
 }
 

@@ -32,8 +32,8 @@ struct FusionConfig {
   double max_latency_s = 0.02;   //!< [s] longest wait for an epoch's missing samples
   double health_period_s = 0.5;  //!< [s] Health at least this often (and on every change)
   GyroDispatch gyro_dispatch = GyroDispatch::kListener;  //!< `gyro_dispatch: listener | waitset`
-  fdi::PipelineConfig pipeline;  //!< the `pipeline:` map
-  Calibration calibration;       //!< read from calibration_path
+  fdi::PipelineConfig pipeline;                          //!< the `pipeline:` map
+  Calibration calibration;                               //!< read from calibration_path
   std::optional<SecurityProfile> security;  //!< `security: PROFILE.yaml` (opt-in DDS Security; relative: to
                                             //!< the config file)
   std::string source;                       //!< the config file, for messages
