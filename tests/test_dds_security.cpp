@@ -49,6 +49,17 @@ class DdsSecurity : public ::testing::Test {
     EXPECT_TRUE(p.ok()) << p.error().message;
     return p.value();
   }
+  //! Whether this process's identity may create a GyroSample writer for `unit` on `domain`.
+  static Status gyro_writer_for(dds_domainid_t domain, const std::string& unit) {
+    auto participant = dds::Participant::create(domain, unit);
+    if (!participant) return participant.error();
+    auto topics = dds::Topics::create(*participant);
+    if (!topics) return topics.error();
+    auto writer =
+        dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
+    if (!writer) return writer.error();
+    return ok_status();
+  }
   //! A service configuration (calibration of the simulated unit, the fusion identity) in `dir`.
   static std::string service_config(const TempDir& dir, const std::string& unit) {
     Calibration cal = seed_as_built_unit();
@@ -214,28 +225,14 @@ TEST_F(DdsSecurity, SensorOfAnotherUnitCannotWriteGyroSamplesForThisUnit) {
   const dds_domainid_t domain = 174;
   // Unit sec-2's sensor may write in its own unit's partition only.
   dds::set_security_profile(load("sensor-sec-2"));
-  {
-    auto participant = dds::Participant::create(domain, "sec-1");
-    ASSERT_TRUE(participant.ok()) << participant.error().message;
-    EXPECT_EQ(participant->partition(), "tetra.sec-1");
-    auto topics = dds::Topics::create(*participant);
-    ASSERT_TRUE(topics.ok()) << topics.error().message;
-    auto writer =
-        dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
-    ASSERT_FALSE(writer.ok()) << "sensor-sec-2 may write GyroSample for unit sec-1";
-    EXPECT_NE(writer.error().message.find("Not Allowed By Security"), std::string::npos)
-        << writer.error().message;
-  }
-  // Positive control: the same identity writes for its own unit.
-  {
-    auto participant = dds::Participant::create(domain, "sec-2");
-    ASSERT_TRUE(participant.ok()) << participant.error().message;
-    auto topics = dds::Topics::create(*participant);
-    ASSERT_TRUE(topics.ok()) << topics.error().message;
-    auto writer =
-        dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
-    EXPECT_TRUE(writer.ok()) << writer.error().message;
-  }
+  const Status other = gyro_writer_for(domain, "sec-1");
+  ASSERT_FALSE(other.ok()) << "sensor-sec-2 may write GyroSample for unit sec-1";
+  EXPECT_NE(other.error().message.find("Not Allowed By Security"), std::string::npos)
+      << other.error().message;
+  // Positive control: the same identity writes for its own unit, in its own partition.
+  const Status own_unit = gyro_writer_for(domain, "sec-2");
+  EXPECT_TRUE(own_unit.ok()) << own_unit.error().message;
+  EXPECT_EQ(dds::unit_partition("sec-2"), "tetra.sec-2");
   // A unit name that would be a partition pattern is refused with security.
   auto wild = dds::Participant::create(domain, "sec-*");
   ASSERT_FALSE(wild.ok());
