@@ -1,0 +1,382 @@
+#include "fusion_service.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "cli_common.hpp"
+#include "dds_common.hpp"
+#include "tetra/dds/convert.hpp"
+
+namespace tetra::cli {
+
+namespace {
+
+enum Token : std::intptr_t { kGyroData = 1, kGyroStatus, kReferenceData, kCommandData, kWake, kShutdown };
+
+template <class T>
+Status assign(std::optional<T>& slot, Result<T> result) {
+  if (!result) return result.error();
+  slot.emplace(std::move(result).value());
+  return ok_status();
+}
+
+}  // namespace
+
+Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown) {
+  period_ns_ = assembler_.config().nominal_period_ns;
+  deadline_ns_ = config_.deadline_ns();
+  if (auto s = assign(participant_, dds::Participant::create(domain, config_.unit)); !s) return s;
+  if (auto s = assign(topics_, dds::Topics::create(*participant_)); !s) return s;
+  const dds::Topics& t = *topics_;
+  if (auto s = assign(gyro_reader_, dds::Reader<tetra_GyroSample>::create(
+                                        *participant_, t.gyro_sample,
+                                        dds::gyro_sample_qos(std::chrono::nanoseconds(deadline_ns_ / 3))));
+      !s) {
+    return s;
+  }
+  if (auto s = assign(reference_reader_, dds::Reader<tetra_AttitudeReference>::create(
+                                             *participant_, t.reference, dds::reference_qos()));
+      !s)
+    return s;
+  if (auto s = assign(command_reader_,
+                      dds::Reader<tetra_Command>::create(*participant_, t.command, dds::command_qos()));
+      !s)
+    return s;
+  if (auto s = assign(attitude_writer_,
+                      dds::Writer<tetra_Attitude>::create(*participant_, t.attitude, dds::attitude_qos()));
+      !s)
+    return s;
+  if (auto s = assign(health_writer_,
+                      dds::Writer<tetra_Health>::create(*participant_, t.health, dds::health_qos()));
+      !s)
+    return s;
+  if (auto s = assign(event_writer_,
+                      dds::Writer<tetra_FdiEvent>::create(*participant_, t.event, dds::event_qos()));
+      !s)
+    return s;
+  if (auto s = gyro_reader_->enable_statuses(DDS_REQUESTED_DEADLINE_MISSED_STATUS |
+                                             DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
+                                             DDS_SUBSCRIPTION_MATCHED_STATUS);
+      !s)
+    return s;
+
+  if (auto s = assign(waitset_, dds::WaitSet::create(*participant_)); !s) return s;
+  auto attach_data = [&](dds_entity_t reader, Token token) -> Status {
+    auto condition = dds::Condition::data_available(reader);
+    if (!condition) return condition.error();
+    if (auto s = waitset_->attach(condition->handle(), token); !s) return s;
+    conditions_.push_back(std::move(condition).value());
+    return ok_status();
+  };
+  if (!listener_dispatch()) {
+    if (auto s = attach_data(gyro_reader_->handle(), kGyroData); !s) return s;
+  }
+  if (auto s = attach_data(reference_reader_->handle(), kReferenceData); !s) return s;
+  if (auto s = attach_data(command_reader_->handle(), kCommandData); !s) return s;
+  if (auto s = waitset_->attach(gyro_reader_->handle(), kGyroStatus); !s) return s;
+  if (auto s = assign(wake_, dds::Condition::guard(*participant_)); !s) return s;
+  if (auto s = waitset_->attach(wake_->handle(), kWake); !s) return s;
+  auto guard = dds::Condition::guard(*participant_);
+  if (!guard) return guard.error();
+  if (auto s = waitset_->attach(guard->handle(), kShutdown); !s) return s;
+  shutdown.set_guard(guard->handle());
+  conditions_.push_back(std::move(guard).value());
+  return ok_status();
+}
+
+void FusionService::on_gyro_data(dds_entity_t, void* self) {
+  auto& service = *static_cast<FusionService*>(self);
+  const std::lock_guard lock(service.mutex_);
+  if (service.listener_error_) return;
+  auto status = service.ingest(monotonic_ns());
+  if (!status) service.listener_error_ = status.error();
+  // An epoch still waiting for samples is due before the waitset thread would wake by itself.
+  const auto due = service.assembler_.next_due_ns();
+  if (!status || (due && *due < service.scheduled_wake_ns_)) (void)service.wake_->trigger();
+}
+
+void FusionService::stop_listener() {
+  if (listening_ && gyro_reader_) (void)gyro_reader_->on_data_available(nullptr, nullptr);
+  listening_ = false;
+}
+
+Status FusionService::run(const dds::ShutdownSignal& shutdown) {
+  {
+    const std::lock_guard lock(mutex_);
+    started_ns_ = monotonic_ns();
+    next_health_ns_ = started_ns_;
+    if (auto s = publish_health(started_ns_, true); !s) return s;
+  }
+  if (listener_dispatch()) {
+    if (auto s = gyro_reader_->on_data_available(&FusionService::on_gyro_data, this); !s) return s;
+    listening_ = true;
+  }
+  spdlog::info("fusion: unit {} running, {} gyros, {} Hz, gyro samples dispatched by the {}", config_.unit,
+               n_gyros_, config_.sample_rate_hz, listener_dispatch() ? "listener" : "waitset");
+  Status status = loop(shutdown);
+  stop_listener();  // before anything the listener uses goes away
+  if (!status) return status;
+  spdlog::info("fusion: signal {} received, shutting down", shutdown.signal_number());
+  const std::lock_guard lock(mutex_);
+  return publish_health(monotonic_ns(), true);
+}
+
+Status FusionService::loop(const dds::ShutdownSignal& shutdown) {
+  std::vector<std::intptr_t> triggered;
+  std::int64_t wake = 0;
+  {
+    const std::lock_guard lock(mutex_);
+    wake = scheduled_wake_ns_ = next_wake_ns(monotonic_ns());
+  }
+  while (!shutdown.requested()) {
+    if (auto s = waitset_->wait(std::chrono::nanoseconds(wake - monotonic_ns()), triggered); !s) return s;
+    if (shutdown.requested()) break;
+    const std::lock_guard lock(mutex_);
+    if (auto s = wake_->clear(); !s) return s;
+    if (listener_error_) return *listener_error_;
+    const std::int64_t now = monotonic_ns();
+    if (auto s = handle_wakeup(triggered, now); !s) return s;
+    // A listener that opens an epoch after this sees the new time, and wakes this thread if the
+    // epoch is due earlier; one that opened it before is in this computation.
+    wake = scheduled_wake_ns_ = next_wake_ns(now);
+  }
+  return ok_status();
+}
+
+std::int64_t FusionService::next_wake_ns(std::int64_t now_ns) const {
+  std::int64_t wake = next_health_ns_;
+  if (auto due = assembler_.next_due_ns()) wake = std::min(wake, *due);
+  std::int64_t last_any_arrival = 0;
+  for (int g = 1; g <= n_gyros_; ++g) {
+    const std::int64_t arrival = last_arrival_ns_[static_cast<std::size_t>(g - 1)];
+    last_any_arrival = std::max(last_any_arrival, arrival);
+    // Gyros not yet absent are checked for silence at their deadline.
+    if (!assembler_.absent(g))
+      wake = std::min(wake, std::max({arrival, started_ns_, resumed_ns_}) + deadline_ns_ + 1);
+  }
+  // While samples flow, an epoch the next sample opens is due no earlier than this: waking here
+  // spares the listener from waking this thread for every epoch.
+  const std::int64_t next_epoch_due = last_any_arrival + assembler_.config().max_latency_ns;
+  if (listener_dispatch() && next_epoch_due > now_ns) wake = std::min(wake, next_epoch_due);
+  return wake;
+}
+
+Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered, std::int64_t now) {
+  bool deadline_status = false;
+  bool command_data = false;
+  bool gyro_data = false;
+  bool matched_changed = false;
+  for (const auto token : triggered) {
+    command_data = command_data || token == kCommandData;
+    gyro_data = gyro_data || token == kGyroData;
+    if (token == kGyroStatus) {
+      std::uint32_t status = 0;
+      (void)dds_take_status(gyro_reader_->handle(), &status,
+                            DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
+                                DDS_SUBSCRIPTION_MATCHED_STATUS);
+      deadline_status = (status & DDS_REQUESTED_DEADLINE_MISSED_STATUS) != 0;
+      if ((status & DDS_SUBSCRIPTION_MATCHED_STATUS) != 0) {
+        // A sensor (or simulator) came or went: say so in Health at once (a simulator waits for it).
+        auto matched = gyro_reader_->matched_writers();
+        if (!matched) return matched.error();
+        gyro_writers_ = *matched;
+        spdlog::info("fusion: {} GyroSample writer(s) matched", gyro_writers_);
+        matched_changed = true;
+      }
+      if ((status & DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS) != 0) {
+        spdlog::warn(
+            "fusion: a GyroSample writer offers incompatible QoS (its deadline must be at most {} s: "
+            "sample_rate_hz and speed must match the sensor's)",
+            static_cast<double>(deadline_ns_) * 1e-9);
+      }
+    }
+  }
+  if (gyro_data) {
+    if (auto s = ingest(now); !s) return s;
+  }
+  if (auto s = take_references(); !s) return s;
+  if (command_data) {
+    if (auto s = take_commands(); !s) return s;
+  }
+  const bool newly_absent = check_deadlines(now, deadline_status);
+  if (auto s = process_epochs(now); !s) return s;
+  if (command_data || newly_absent || matched_changed || now >= next_health_ns_) {
+    if (auto s = publish_health(now, matched_changed); !s) return s;
+  }
+  return ok_status();
+}
+
+Status FusionService::ingest(std::int64_t now_ns) {
+  // Gyro samples before references: a reference written before an epoch's samples is then
+  // already in its reader when the epoch completes (docs/dds.md).
+  if (auto s = take_gyro_samples(now_ns); !s) return s;
+  if (auto s = take_references(); !s) return s;
+  return process_epochs(now_ns);
+}
+
+Status FusionService::take_gyro_samples(std::int64_t now_ns) {
+  const bool was_silent = assembler_.all_absent();
+  auto taken = gyro_reader_->take(
+      [&](const tetra_GyroSample& sample, const dds_sample_info_t&) {
+        if (dds::from_wire(sample.unit) != config_.unit) {
+          ++assembler_.counters().samples_other_unit;
+          return;
+        }
+        const int gyro = sample.gyro;
+        const auto verdict = assembler_.add_sample(gyro, sample.seq, sample.stamp_ns, sample.raw, now_ns);
+        if (gyro >= 1 && gyro <= n_gyros_) last_arrival_ns_[static_cast<std::size_t>(gyro - 1)] = now_ns;
+        if (verdict != service::Verdict::kAccepted) {
+          spdlog::debug("fusion: gyro {} seq {} stamp {} ns: {}", gyro, sample.seq, sample.stamp_ns,
+                        service::to_string(verdict));
+        }
+      },
+      [&](const dds_sample_info_t& info) {
+        // No writer left for an instance (liveliness lost, writer gone): that gyro is absent.
+        if (info.instance_state == DDS_IST_ALIVE) return;
+        tetra_GyroSample key{};
+        if (gyro_reader_->instance_key(info.instance_handle, key) &&
+            dds::from_wire(key.unit) == config_.unit) {
+          if (!assembler_.absent(key.gyro))
+            spdlog::warn("fusion: gyro {} has no live writer: absent", key.gyro);
+          assembler_.mark_absent(key.gyro, service::AbsentReason::kLiveliness);
+        }
+        dds_sample_free(&key, &tetra_GyroSample_desc, DDS_FREE_CONTENTS);
+      });
+  if (!taken) return taken.error();
+  if (was_silent && !assembler_.all_absent()) resumed_ns_ = now_ns;  // deadlines re-armed from now
+  if (assembler_.counters().sensor_restarts != last_restarts_) {
+    last_restarts_ = assembler_.counters().sensor_restarts;
+    spdlog::warn("fusion: sensor time restarted after the unit went silent: pipeline reset");
+    pipeline_.reset();
+  }
+  return ok_status();
+}
+
+Status FusionService::take_references() {
+  auto taken = reference_reader_->take([&](const tetra_AttitudeReference& ref, const dds_sample_info_t&) {
+    if (dds::from_wire(ref.unit) != config_.unit) return;
+    assembler_.add_reference(ref.stamp_ns, from_wxyz(ref.q_RB[0], ref.q_RB[1], ref.q_RB[2], ref.q_RB[3]));
+  });
+  if (!taken) return taken.error();
+  return ok_status();
+}
+
+Status FusionService::take_commands() {
+  std::vector<tetra_Command> commands;
+  auto taken = command_reader_->take([&](const tetra_Command& command, const dds_sample_info_t&) {
+    if (dds::from_wire(command.unit) == config_.unit) commands.push_back(command);
+  });
+  if (!taken) return taken.error();
+  for (const auto& command : commands) {
+    const std::int64_t stamp = pipeline_.health().stamp_ns;
+    fdi::FdiEvent ack;
+    switch (command.kind) {
+      case tetra_COMMAND_RESET:
+        ack = pipeline_.reset_command(stamp);
+        break;
+      case tetra_COMMAND_EXCLUDE:
+        ack = pipeline_.exclude(command.gyro, stamp);
+        break;
+      case tetra_COMMAND_REINSTATE:
+        ack = pipeline_.reinstate(command.gyro, stamp);
+        break;
+    }
+    spdlog::info("fusion: command {} acknowledged: {}", command.command_id, fdi::to_json(ack, n_gyros_));
+    acks_published_.push_back({ack.type, ack.gyro, ack.detail});
+    if (auto s = publish_event(ack, command.command_id); !s) return s;
+  }
+  return ok_status();
+}
+
+bool FusionService::check_deadlines(std::int64_t now_ns, bool dds_reported) {
+  bool any = false;
+  for (int g = 1; g <= n_gyros_; ++g) {
+    if (assembler_.absent(g)) continue;
+    const std::int64_t since =
+        std::max({last_arrival_ns_[static_cast<std::size_t>(g - 1)], started_ns_, resumed_ns_});
+    if (now_ns - since >= deadline_ns_) {
+      spdlog::warn("fusion: gyro {} silent for 3 sample periods{}: absent", g,
+                   dds_reported ? " (DDS deadline)" : "");
+      assembler_.mark_absent(g, service::AbsentReason::kDeadline);
+      any = true;
+    }
+  }
+  return any;
+}
+
+Status FusionService::process_epochs(std::int64_t now_ns) {
+  epochs_.clear();
+  assembler_.poll(now_ns, epochs_);
+  for (const auto& epoch : epochs_) {
+    const fdi::StepResult& result = pipeline_.step(epoch);
+    // Events before the attitude of the same epoch: a reader that has the attitude has its events.
+    for (const auto& event : result.events) {
+      if (event.type == fdi::EventType::kCommand && !acks_published_.empty() &&
+          acks_published_.front().gyro == event.gyro && acks_published_.front().detail == event.detail) {
+        acks_published_.pop_front();  // already published when the command was obeyed
+        continue;
+      }
+      if (auto s = publish_event(event, 0); !s) return s;
+    }
+    if (result.accepted) {
+      tetra_Attitude wire{};
+      if (auto s = dds::to_wire(config_.unit, result.attitude, wire); !s) return s;
+      if (auto s = attitude_writer_->write(wire); !s) return s;
+    }
+    if (auto s = publish_health(now_ns, false); !s) return s;
+  }
+  return ok_status();
+}
+
+Status FusionService::publish_event(const fdi::FdiEvent& event, std::uint64_t command_id) {
+  dds::EventView view{config_.unit, ++event_seq_, command_id, event};
+  tetra_FdiEvent wire{};
+  if (auto s = dds::to_wire(view, wire); !s) return s;
+  if (event.type != fdi::EventType::kCommand) spdlog::info("fusion: event {}", fdi::to_json(event, n_gyros_));
+  return event_writer_->write(wire);
+}
+
+void FusionService::current_health(fdi::Health& health) const {
+  // The pipeline's health, with what only the service knows: gyros whose streams stopped (deadline,
+  // liveliness) are absent and out of the solution; with fewer than 3 left the unit is LOST.
+  health = pipeline_.health();
+  health.gyros.resize(static_cast<std::size_t>(n_gyros_));
+  for (int g = 1; g <= n_gyros_; ++g) {
+    if (!assembler_.absent(g)) continue;
+    auto& gyro = health.gyros[static_cast<std::size_t>(g - 1)];
+    if (gyro.state == fdi::GyroState::kOk) gyro.state = fdi::GyroState::kAbsent;
+    health.used = without_gyro(health.used, g);
+  }
+  if (gyro_count(health.used) < 3) health.mode = fdi::Mode::kLost;
+}
+
+Status FusionService::publish_health(std::int64_t now_ns, bool force) {
+  fdi::Health& health = health_scratch_;
+  current_health(health);
+  bool changed = !last_health_ || last_health_->mode != health.mode || last_health_->used != health.used ||
+                 last_health_->gyros.size() != health.gyros.size();
+  for (std::size_t i = 0; !changed && i < health.gyros.size(); ++i) {
+    changed = last_health_->gyros[i].state != health.gyros[i].state ||
+              last_health_->gyros[i].kind != health.gyros[i].kind;
+  }
+  if (!force && !changed && now_ns < next_health_ns_) return ok_status();
+  if (changed && last_health_) {
+    spdlog::info("fusion: health {} gyros {}", fdi::to_string(health.mode),
+                 mask_to_string(health.used, n_gyros_));
+  }
+  dds::WireHealth wire;
+  if (auto s = dds::to_wire(config_.unit, health, assembler_.counters(), wire); !s) return s;
+  wire.msg.events_published = event_seq_;
+  wire.msg.gyro_writers = gyro_writers_;
+  if (auto s = health_writer_->write(wire.msg); !s) return s;
+  if (last_health_) {
+    *last_health_ = health;  // reuses the storage
+  } else {
+    last_health_ = health;
+  }
+  next_health_ns_ = now_ns + static_cast<std::int64_t>(config_.health_period_s * 1e9);
+  return ok_status();
+}
+
+}  // namespace tetra::cli

@@ -1,0 +1,114 @@
+#pragma once
+// The fusion service of `tetra fusion` (docs/dds.md): the pipeline of `tetra replay` on DDS.
+//
+// Reads GyroSample, AttitudeReference and Command of its unit; writes Attitude (every accepted
+// epoch), Health (every `health_period_s` and on every change) and FdiEvent (pipeline events and
+// command acknowledgements). One waitset drives everything but the gyro samples themselves: the
+// reference and command readers, the gyro reader's statuses (deadline, liveliness, matches), the
+// latency limit of the oldest open epoch, silent gyros, the Health period, and SIGINT/SIGTERM.
+// Gyro samples are handed to the same code by a data-available listener on Cyclone's receive thread
+// (`gyro_dispatch: listener`, the default: an epoch is fused and its Attitude written without a
+// thread wake-up) or by the waitset (`gyro_dispatch: waitset`). One mutex serializes the two threads.
+
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tetra/core/result.hpp"
+#include "tetra/dds/entity.hpp"
+#include "tetra/dds/shutdown.hpp"
+#include "tetra/dds/topics.hpp"
+#include "tetra/fdi/pipeline.hpp"
+#include "tetra/service/epoch_assembler.hpp"
+#include "tetra/service/fusion_config.hpp"
+
+namespace tetra::cli {
+
+//! One unit's service: open() creates its DDS entities, run() serves until SIGINT/SIGTERM (or a
+//! DDS failure, returned as an error) and publishes a last Health.
+class FusionService {
+ public:
+  FusionService(service::FusionConfig config, fdi::Pipeline pipeline, service::EpochAssembler assembler)
+      : config_(std::move(config)),
+        pipeline_(std::move(pipeline)),
+        assembler_(std::move(assembler)),
+        n_gyros_(pipeline_.gyro_count()),
+        last_arrival_ns_(static_cast<std::size_t>(n_gyros_), 0) {}
+  ~FusionService() { stop_listener(); }
+  FusionService(const FusionService&) = delete;
+  FusionService& operator=(const FusionService&) = delete;
+
+  //! Participant, topics, readers, writers and the waitset on `domain`; `shutdown` gets its guard.
+  Status open(dds_domainid_t domain, dds::ShutdownSignal& shutdown);
+  //! Serves until `shutdown` is requested.
+  Status run(const dds::ShutdownSignal& shutdown);
+
+ private:
+  bool listener_dispatch() const { return config_.gyro_dispatch == service::GyroDispatch::kListener; }
+  //! The gyro reader's listener, on Cyclone's receive thread.
+  static void on_gyro_data(dds_entity_t reader, void* self);
+  //! Removes the listener; returns once no callback runs (call without holding mutex_).
+  void stop_listener();
+  Status loop(const dds::ShutdownSignal& shutdown);
+  //! Everything a waitset wake-up calls for: statuses, samples, commands, deadlines, timers.
+  Status handle_wakeup(const std::vector<std::intptr_t>& triggered, std::int64_t now_ns);
+  //! Takes gyro samples and references, and fuses the epochs they complete.
+  Status ingest(std::int64_t now_ns);
+  //! [ns] the next time the waitset thread has work without any sample arriving.
+  std::int64_t next_wake_ns(std::int64_t now_ns) const;
+  Status take_gyro_samples(std::int64_t now_ns);
+  Status take_references();
+  Status take_commands();
+  //! Marks gyros silent for the deadline absent; true if any became absent.
+  bool check_deadlines(std::int64_t now_ns, bool dds_reported);
+  Status process_epochs(std::int64_t now_ns);
+  Status publish_event(const fdi::FdiEvent& event, std::uint64_t command_id);
+  Status publish_health(std::int64_t now_ns, bool force);
+  //! The health to publish, into `out` (its storage is reused).
+  void current_health(fdi::Health& out) const;
+
+  //! Serializes the waitset thread and the gyro listener: every member below is used under it.
+  std::mutex mutex_;
+  service::FusionConfig config_;
+  fdi::Pipeline pipeline_;
+  service::EpochAssembler assembler_;
+  int n_gyros_;
+  std::int64_t period_ns_ = 0;
+  std::int64_t deadline_ns_ = 0;               //!< [ns] 3 sample periods
+  std::int64_t started_ns_ = 0;                //!< [ns] local time the service started
+  std::int64_t resumed_ns_ = 0;                //!< [ns] local time the unit last resumed after silence
+  std::vector<std::int64_t> last_arrival_ns_;  //!< [ns] local time of each gyro's last sample
+  std::int64_t next_health_ns_ = 0;
+  std::optional<fdi::Health> last_health_;  //!< as last published
+  fdi::Health health_scratch_;              //!< reused for each comparison
+  std::uint64_t event_seq_ = 0;
+  std::uint32_t gyro_writers_ = 0;  //!< matched GyroSample writers (published in Health)
+  std::uint64_t last_restarts_ = 0;
+  struct PendingAck {
+    fdi::EventType type;
+    std::optional<int> gyro;
+    std::string detail;
+  };
+  std::deque<PendingAck> acks_published_;  //!< acknowledgements sent before the pipeline repeats them
+  std::vector<fdi::Epoch> epochs_;
+  std::int64_t scheduled_wake_ns_ = 0;   //!< [ns] when the waitset thread wakes by itself next
+  std::optional<Error> listener_error_;  //!< a failure inside the listener, for run() to return
+  bool listening_ = false;
+
+  std::optional<dds::Participant> participant_;
+  std::optional<dds::Topics> topics_;
+  std::optional<dds::Reader<tetra_GyroSample>> gyro_reader_;
+  std::optional<dds::Reader<tetra_AttitudeReference>> reference_reader_;
+  std::optional<dds::Reader<tetra_Command>> command_reader_;
+  std::optional<dds::Writer<tetra_Attitude>> attitude_writer_;
+  std::optional<dds::Writer<tetra_Health>> health_writer_;
+  std::optional<dds::Writer<tetra_FdiEvent>> event_writer_;
+  std::vector<dds::Condition> conditions_;
+  std::optional<dds::Condition> wake_;  //!< the listener wakes the waitset thread for an epoch's deadline
+  std::optional<dds::WaitSet> waitset_;
+};
+
+}  // namespace tetra::cli
