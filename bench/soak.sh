@@ -42,16 +42,19 @@ fusion_pid=$!
 smaps() {  # PID: its mappings with more than 64 kB resident: range, name, kB
   awk '/^[0-9a-f]+-[0-9a-f]+ / {range = $1; name = $6} /^Rss:/ && $2 > 64 {print range, name, $2}' "/proc/$1/smaps"
 }
-# RSS (total, anonymous, file-backed) and CPU time of the service every 10 s
+# RSS (total, anonymous, file-backed) and CPU time of the service, and the machine's steal time,
+# every 10 s
 (
   clk=$(getconf CLK_TCK)
   start=$(date +%s)
-  echo "time_s,rss_kB,anon_kB,file_kB,cpu_s"
+  echo "time_s,rss_kB,anon_kB,file_kB,cpu_s,steal_s"
   while kill -0 "$fusion_pid" 2>/dev/null; do
     mem=$(awk '/^VmRSS:/ {r = $2} /^RssAnon:/ {a = $2} /^RssFile:/ {f = $2} END {if (r) print r "," a "," f}' \
       "/proc/$fusion_pid/status" 2>/dev/null || echo "")
     cpu=$(awk -v c="$clk" '{printf "%.2f", ($14 + $15) / c}' "/proc/$fusion_pid/stat" 2>/dev/null || echo "")
-    [ -n "$mem" ] && echo "$(($(date +%s) - start)),$mem,$cpu"
+    # CPU time the hypervisor took from this machine's CPUs since boot (a VM's stalls show here)
+    steal=$(awk -v c="$clk" '/^cpu / {printf "%.2f", $9 / c}' /proc/stat)
+    [ -n "$mem" ] && echo "$(($(date +%s) - start)),$mem,$cpu,$steal"
     # Where the memory is, after the warm-up: mappings over 64 kB resident (for the end, see below).
     if [ "$(($(date +%s) - start))" -ge 60 ] && [ ! -e "$work/smaps_60s.txt" ]; then
       smaps "$fusion_pid" >"$work/smaps_60s.txt"

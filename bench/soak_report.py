@@ -44,7 +44,7 @@ def main() -> int:
         print("soak: FAIL: no Health from the service")
         return 1
     c = health["counters"]
-    rows = [(int(r["time_s"]), int(r["rss_kB"]), float(r["cpu_s"]), int(r.get("anon_kB") or 0))
+    rows = [(int(r["time_s"]), int(r["rss_kB"]), float(r["cpu_s"]), float(r.get("steal_s") or 0))
             for r in csv.DictReader(open(f"{work}/rss.csv"))]
     after_warmup = [r for r in rows if r[0] >= 60] or rows
     span = after_warmup[-1][0] - after_warmup[0][0]
@@ -75,6 +75,12 @@ def main() -> int:
     print(f"  RSS lower envelope: {trough_first[1]} kB at {trough_first[0]} s, {trough_last[1]} kB at "
           f"{trough_last[0]} s: growth {growth_kB} kB, {growth_per_hour_kB:.0f} kB per hour")
     print(f"  service CPU {cpu_share:.1f} % of one core; exit status on SIGTERM {fusion_rc}")
+    if rows[-1][3] > 0:
+        print(f"  steal time (the hypervisor's, both CPUs) during the run: {rows[-1][3] - rows[0][3]:.2f} s")
+    # When a gyro was declared absent: the service's own log, to set beside load and steal time.
+    silent = [line.split("]")[0].strip("[")[:8] for line in open(f"{work}/fusion.log") if "silent for" in line]
+    if silent:
+        print(f"  gyros declared silent at (wall clock): {sorted(set(silent))}")
     ok = (lost == 0 and not anomalies and not events and growth_per_hour_kB < 1024 and fusion_rc == 0
           and running is not None and running["mode"] == "NOMINAL")
     print("soak: PASS" if ok else "soak: FAIL")

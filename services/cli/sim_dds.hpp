@@ -4,6 +4,7 @@
 // scores it live against the truth (error now, worst, at the end). Also used in-process by `tetra demo`.
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <string>
 #include <vector>
@@ -49,7 +50,9 @@ struct SimDdsScore {
   double wall_s = 0.0;                 //!< [s] publishing time
   double worst_deg = 0.0;
   double worst_time_s = 0.0;
-  std::vector<ScoredEpoch> series;  //!< every scored epoch, in order
+  //! Every scored epoch, in order. A deque: an hour at 100 Hz never moves the whole series at once
+  //! (a vector doubling its 30 MB would stall the simulator for tens of milliseconds).
+  std::deque<ScoredEpoch> series;
 };
 
 //! Runs the simulator on the wire until its end (or a shutdown signal). `on_progress` is called
