@@ -31,6 +31,9 @@ floor() {
   wait "$pong" 2>/dev/null || true
 }
 
+echo "== ddsperf ping/pong round trip (two one-way hops), ${RATE} Hz, 12-byte samples"
+floor listener
+floor waitset
 "$BUILD/dds_latency" --write-calibration "$WORK/cal.yaml"
 # run DISPATCH RECEIVE SPACING_US: a service with `gyro_dispatch: DISPATCH`, this program receiving
 # its Attitude the RECEIVE way, the four samples of an epoch SPACING_US apart (0: one burst).
