@@ -24,7 +24,6 @@ Status assign(std::optional<T>& slot, Result<T> result) {
 }  // namespace
 
 Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown) {
-  period_ns_ = assembler_.config().nominal_period_ns;
   deadline_ns_ = config_.deadline_ns();
   if (auto s = assign(participant_, dds::Participant::create(domain, config_.unit)); !s) return s;
   if (auto s = assign(topics_, dds::Topics::create(*participant_)); !s) return s;

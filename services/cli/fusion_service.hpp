@@ -76,7 +76,6 @@ class FusionService {
   fdi::Pipeline pipeline_;
   service::EpochAssembler assembler_;
   int n_gyros_;
-  std::int64_t period_ns_ = 0;
   std::int64_t deadline_ns_ = 0;               //!< [ns] 3 sample periods
   std::int64_t started_ns_ = 0;                //!< [ns] local time the service started
   std::int64_t resumed_ns_ = 0;                //!< [ns] local time the unit last resumed after silence
