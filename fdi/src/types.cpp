@@ -76,6 +76,76 @@ const char* to_string(GyroState state) {
   return "ok";
 }
 
+const char* to_string(DetectionTest test) {
+  switch (test) {
+    case DetectionTest::kNone:
+      return "";
+    case DetectionTest::kChi2:
+      return "chi2";
+    case DetectionTest::kCusum:
+      return "cusum";
+    case DetectionTest::kSignature:
+      return "signature";
+    case DetectionTest::kOnset:
+      return "onset";
+    case DetectionTest::kReference:
+      return "reference";
+  }
+  return "";
+}
+
+DetectionTest detection_test_from_string(std::string_view text) {
+  for (auto t : {DetectionTest::kChi2, DetectionTest::kCusum, DetectionTest::kSignature,
+                 DetectionTest::kOnset, DetectionTest::kReference}) {
+    if (text == to_string(t)) return t;
+  }
+  return DetectionTest::kNone;
+}
+
+namespace {
+constexpr std::array<const char*, 11> kEvidenceNames = {
+    "",      "invalid",   "timeout", "repeated", "zero", "variance", "noise-level", "recurring-spikes",
+    "onset", "reference", "glt"};
+}  // namespace
+
+const char* to_string(Evidence evidence) {
+  const auto i = static_cast<std::size_t>(evidence);
+  return i < kEvidenceNames.size() ? kEvidenceNames[i] : "";
+}
+
+Evidence evidence_from_string(std::string_view text) {
+  for (std::size_t i = 1; i < kEvidenceNames.size(); ++i) {
+    if (text == kEvidenceNames[i]) return static_cast<Evidence>(i);
+  }
+  return Evidence::kNone;
+}
+
+const char* to_string(CommandVerb verb) {
+  switch (verb) {
+    case CommandVerb::kExclude:
+      return "exclude";
+    case CommandVerb::kReinstate:
+      return "reinstate";
+    case CommandVerb::kReset:
+      return "reset";
+  }
+  return "reset";
+}
+
+const char* to_string(CommandOutcome outcome) {
+  switch (outcome) {
+    case CommandOutcome::kDone:
+      return "done";
+    case CommandOutcome::kNoSuchGyro:
+      return "rejected, no such gyro";
+    case CommandOutcome::kAlreadyExcluded:
+      return "already excluded";
+    case CommandOutcome::kNotExcluded:
+      return "not excluded";
+  }
+  return "done";
+}
+
 namespace {
 
 void append_gyro_list(std::string& out, GyroMask mask, int n_gyros) {
@@ -101,7 +171,7 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
     case EventType::kDetected:
     case EventType::kUnisolated:
       out += ", \"gyro\": null, \"test\": ";
-      append_json_string(out, event.test);
+      append_json_string(out, to_string(event.test));
       out += ", \"statistic\": ";
       if (std::isfinite(event.statistic)) {
         append_double(out, event.statistic);
@@ -119,10 +189,10 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
       out += ", \"kind\": ";
       append_json_string(out, to_string(event.kind));
       out += ", \"evidence\": ";
-      append_json_string(out, event.evidence);
-      if (!event.test.empty()) {
+      append_json_string(out, to_string(event.evidence));
+      if (event.test != DetectionTest::kNone) {
         out += ", \"test\": ";
-        append_json_string(out, event.test);
+        append_json_string(out, to_string(event.test));
       }
       break;
     case EventType::kReconfigured:

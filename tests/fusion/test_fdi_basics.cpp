@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "tetra/fdi/config.hpp"
 #include "tetra/fdi/detectors.hpp"
@@ -77,7 +78,7 @@ TEST(Events, JsonLinesFollowTheContract) {
   FdiEvent d;
   d.stamp_ns = 1'800'400'000'000;
   d.type = EventType::kDetected;
-  d.test = "cusum";
+  d.test = DetectionTest::kCusum;
   d.statistic = 14.25;
   EXPECT_EQ(to_json(d, 4),
             R"({"time_s": 1800.4, "event": "detected", "gyro": null, "test": "cusum", "statistic": 14.25})");
@@ -86,7 +87,7 @@ TEST(Events, JsonLinesFollowTheContract) {
   i.type = EventType::kIsolated;
   i.gyro = 2;
   i.kind = FaultKind::kStuck;
-  i.evidence = "variance";
+  i.evidence = Evidence::kVariance;
   EXPECT_EQ(to_json(i, 4),
             R"({"time_s": 1801, "event": "isolated", "gyro": 2, "kind": "stuck", "evidence": "variance"})");
   FdiEvent r;

@@ -11,6 +11,7 @@
 //   TETRA_BLESS=1 build/tests/test_golden_trace      # rewrites tests/fusion/golden/*.trace
 // and commit the new files with the reason in the message.
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -133,9 +134,8 @@ std::vector<GoldenScenario> scenarios() {
   add(base("stuck", "orbit", 90.0), {fault(3, K::kStuck, 60.0)});
   add(base("zero", "orbit", 90.0), {fault(4, K::kZero, 60.0)});
   add(base("noise", "orbit", 120.0), {fault(2, K::kNoise, 60.0, 10.0)});
-  add(base("spikes", "orbit", 150.0),
-      {fault(1, K::kSpike, 30.0, 0.05), fault(1, K::kSpike, 45.0, 0.05), fault(1, K::kSpike, 60.0, 0.05),
-       fault(1, K::kSpike, 75.0, 0.05)});
+  add(base("spikes", "orbit", 150.0), {fault(1, K::kSpike, 30.0, 0.05), fault(1, K::kSpike, 45.0, 0.05),
+                                       fault(1, K::kSpike, 60.0, 0.05), fault(1, K::kSpike, 75.0, 0.05)});
   add(base("dropout", "orbit", 90.0), {fault(3, K::kDropout, 60.0)});
   add(base("invalid_transient", "orbit", 90.0), {fault(2, K::kInvalid, 60.0, 0.0, 60.5)});
   add(base("invalid", "orbit", 90.0), {fault(2, K::kInvalid, 60.0)});
@@ -174,7 +174,7 @@ std::vector<GoldenScenario> scenarios() {
   }
   {
     GoldenScenario g = base("operator_commands", "orbit", 200.0);
-    g.commands = {{20.0, Op::kExclude, 2},  {40.0, Op::kExclude, 7},   {60.0, Op::kExclude, 3},
+    g.commands = {{20.0, Op::kExclude, 2},   {40.0, Op::kExclude, 7},   {60.0, Op::kExclude, 3},
                   {80.0, Op::kReinstate, 2}, {90.0, Op::kReinstate, 2}, {120.0, Op::kReset, 0}};
     add(g, {fault(1, K::kStuck, 150.0)});
   }
@@ -203,9 +203,9 @@ std::string full(double v) {
 std::string event_line(const fdi::FdiEvent& e, std::int64_t epoch) {
   std::ostringstream s;
   s << "E " << epoch << " " << e.stamp_ns << " " << fdi::to_string(e.type)
-    << " gyro=" << (e.gyro ? std::to_string(*e.gyro) : "-") << " test=" << e.test
+    << " gyro=" << (e.gyro ? std::to_string(*e.gyro) : "-") << " test=" << fdi::to_string(e.test)
     << " statistic=" << hexfloat(e.statistic) << " kind=" << fdi::to_string(e.kind)
-    << " evidence=" << e.evidence << " gyros=" << e.gyros << " detail=" << e.detail;
+    << " evidence=" << fdi::to_string(e.evidence) << " gyros=" << e.gyros << " detail=" << e.detail;
   return s.str();
 }
 
@@ -246,11 +246,13 @@ std::string block_line(std::int64_t block, const Fnv& h, const fdi::AttitudeEsti
 
 std::string health_line(const fdi::Health& h) {
   const auto& c = h.counters;
-  std::string s = "H mode=" + std::string(fdi::to_string(h.mode)) + " used=" + std::to_string(h.used) +
-                  " states=";
-  for (const auto& g : h.gyros) s += std::string(fdi::to_string(g.state)) + "/" + fdi::to_string(g.kind) + ",";
-  s += " accepted=" + std::to_string(c.epochs_accepted) + " rejected_time=" +
-       std::to_string(c.epochs_rejected_time) + " rejected_shape=" + std::to_string(c.epochs_rejected_shape) +
+  std::string s =
+      "H mode=" + std::string(fdi::to_string(h.mode)) + " used=" + std::to_string(h.used) + " states=";
+  for (const auto& g : h.gyros)
+    s += std::string(fdi::to_string(g.state)) + "/" + fdi::to_string(g.kind) + ",";
+  s += " accepted=" + std::to_string(c.epochs_accepted) +
+       " rejected_time=" + std::to_string(c.epochs_rejected_time) +
+       " rejected_shape=" + std::to_string(c.epochs_rejected_shape) +
        " samples=" + std::to_string(c.samples_accepted) + " invalid=" + std::to_string(c.samples_invalid) +
        " absent=" + std::to_string(c.samples_absent) + " outliers=" + std::to_string(c.samples_outlier) +
        " spikes=" + std::to_string(c.spikes);
@@ -338,7 +340,8 @@ TEST_P(GoldenTrace, MatchesTheCheckedInTrace) {
     return;
   }
   const std::vector<std::string> golden = read_lines(path);
-  ASSERT_FALSE(golden.empty()) << path << " is missing: TETRA_BLESS=1 " << "writes it";
+  ASSERT_FALSE(golden.empty()) << path << " is missing: TETRA_BLESS=1 "
+                               << "writes it";
   const std::size_t n = std::min(golden.size(), now.size());
   for (std::size_t i = 0; i < n; ++i) {
     ASSERT_EQ(golden[i], now[i]) << "scenario " << g.name << ": first difference at line " << i + 1 << " of "
@@ -350,7 +353,18 @@ TEST_P(GoldenTrace, MatchesTheCheckedInTrace) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenarios, GoldenTrace, ::testing::ValuesIn(scenarios()),
-                         [](const ::testing::TestParamInfo<GoldenScenario>& param_info) { return param_info.param.name; });
+                         [](const ::testing::TestParamInfo<GoldenScenario>& param_info) {
+                           return param_info.param.name;
+                         });
+
+TEST(GoldenTrace, SeesTheLastBitOfOneSample) {
+  // The gate must see a change that no tolerance-based test would: gyro 1's bias one ulp off changes the last
+  // bit of its calibrated rate, and the trace must differ (the block hashes take every bit of every output).
+  GoldenScenario g = scenarios().front();
+  const auto before = trace(g);
+  g.calibration.gyros[0].bias_V = std::nextafter(g.calibration.gyros[0].bias_V, 1.0);
+  EXPECT_NE(before, trace(g));
+}
 
 TEST(GoldenTrace, CoversEveryFaultKindAndPackageSize) {
   // The gate is only as good as its coverage: every simulator fault kind, N = 3..6, a reference, ground mode

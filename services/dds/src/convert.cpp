@@ -176,8 +176,8 @@ void copy_truncated(char (&dest)[N], const std::string& text) {
 Status to_wire(const EventView& view, tetra_FdiEvent& out) {
   if (auto status = copy_bounded(out.unit, view.unit, "unit"); !status) return status;
   const fdi::FdiEvent& e = view.event;
-  if (auto status = copy_bounded(out.test, e.test, "event test"); !status) return status;
-  if (auto status = copy_bounded(out.evidence, e.evidence, "event evidence"); !status) return status;
+  if (auto status = copy_bounded(out.test, std::string(fdi::to_string(e.test)), "event test"); !status) return status;
+  if (auto status = copy_bounded(out.evidence, std::string(fdi::to_string(e.evidence)), "event evidence"); !status) return status;
   copy_truncated(out.detail, e.detail);
   out.event_seq = view.event_seq;
   out.command_id = view.command_id;
@@ -199,10 +199,10 @@ EventView from_wire(const tetra_FdiEvent& in) {
   e.stamp_ns = in.stamp_ns;
   e.type = from_wire(in.type);
   if (in.gyro > 0) e.gyro = in.gyro;
-  e.test = from_wire(in.test);
+  e.test = fdi::detection_test_from_string(from_wire(in.test));
   e.statistic = in.statistic;
   e.kind = from_wire(in.kind);
-  e.evidence = from_wire(in.evidence);
+  e.evidence = fdi::evidence_from_string(from_wire(in.evidence));
   e.gyros = in.gyros;
   e.detail = from_wire(in.detail);
   return out;

@@ -6,10 +6,12 @@
 #include <optional>
 #include <string>
 
-#include <yaml-cpp/yaml.h>
-
 #include "tetra/core/quaternion.hpp"
 #include "tetra/core/result.hpp"
+
+namespace YAML {
+class Node;  // yaml-cpp; only callers that hold a parsed node include it
+}  // namespace YAML
 
 namespace tetra::fdi {
 

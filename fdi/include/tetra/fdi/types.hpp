@@ -50,6 +50,36 @@ enum class EventType : std::uint8_t {
 };
 const char* to_string(EventType type);
 
+//! The test that raised a detection (or triggered an isolation).
+enum class DetectionTest : std::uint8_t { kNone, kChi2, kCusum, kSignature, kOnset, kReference };
+const char* to_string(DetectionTest test);  // "", "chi2", "cusum", "signature", "onset", "reference"
+//! The test named by `text` (as written by to_string); kNone for any other text.
+DetectionTest detection_test_from_string(std::string_view text);
+
+//! What told which gyro failed.
+enum class Evidence : std::uint8_t {
+  kNone,
+  kInvalid,          //!< invalid samples for invalid_timeout_s
+  kTimeout,          //!< absent for dropout_timeout_s
+  kRepeated,         //!< identical raw values in a row
+  kZero,             //!< identical raw values, all 0 V
+  kVariance,         //!< robust noise level too low
+  kNoiseLevel,       //!< robust noise level too high
+  kRecurringSpikes,  //!< confirmed one-epoch outliers, noise otherwise normal
+  kOnset,            //!< abrupt onset no physical motion explains
+  kReference,        //!< attitude reference
+  kGlt               //!< generalized likelihood test (N ≥ 5)
+};
+const char* to_string(Evidence evidence);  // "", "invalid", "timeout", "repeated", "zero", "variance", ...
+//! The evidence named by `text` (as written by to_string); kNone for any other text.
+Evidence evidence_from_string(std::string_view text);
+
+//! Operator commands and their outcome (the acknowledgement).
+enum class CommandVerb : std::uint8_t { kExclude, kReinstate, kReset };
+const char* to_string(CommandVerb verb);  // "exclude", "reinstate", "reset"
+enum class CommandOutcome : std::uint8_t { kDone, kNoSuchGyro, kAlreadyExcluded, kNotExcluded };
+const char* to_string(CommandOutcome outcome);  // "done", "rejected, no such gyro", ...
+
 //! One input epoch: up to N raw samples taken at one sensor time, and an optional reference.
 struct Epoch {
   std::int64_t stamp_ns = 0;                 //!< [ns] sensor time of the epoch
@@ -61,13 +91,15 @@ struct Epoch {
 struct FdiEvent {
   std::int64_t stamp_ns = 0;  //!< [ns] time of the epoch that triggered the event
   EventType type = EventType::kDetected;
-  std::optional<int> gyro;  //!< 1..N: isolated gyro, or the gyro a command named
-  std::string test;         //!< detected: "chi2", "cusum", "signature", "reference", ...
+  std::optional<int> gyro;                    //!< 1..N: isolated gyro, or the gyro a command named
+  DetectionTest test = DetectionTest::kNone;  //!< detected, unisolated, isolated: the test
   double statistic = std::numeric_limits<double>::quiet_NaN();  //!< detected: value of the test statistic
   FaultKind kind = FaultKind::kUnknown;                         //!< isolated: classified fault kind
-  std::string evidence;  //!< isolated: "variance", "onset", "reference", "invalid", ...
-  GyroMask gyros = 0;    //!< reconfigured / cleared / lost: the gyros used from now on
-  std::string detail;    //!< free text: e.g. the command acknowledged and its outcome
+  Evidence evidence = Evidence::kNone;                          //!< isolated: what told the gyro
+  GyroMask gyros = 0;  //!< reconfigured / cleared / lost / command: the gyros used from now on
+  std::optional<CommandVerb> command;              //!< command: the verb acknowledged
+  CommandOutcome outcome = CommandOutcome::kDone;  //!< command: its outcome
+  std::string detail;  //!< free text: e.g. the command acknowledged and its outcome
 };
 
 //! One JSON object (one line, no newline) per INTERFACES §2.5; `n_gyros` formats the `gyros` lists.

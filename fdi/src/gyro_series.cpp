@@ -1,0 +1,199 @@
+#include "gyro_series.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "tetra/core/units.hpp"
+
+namespace tetra::fdi::detail {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr int kNoiseEvalEvery = 10;  //!< [samples] the noise-level test runs this often
+constexpr double kNoiseExpectedMedian = 0.6744897501960817;  //!< median of |N(0,1)|
+}  // namespace
+
+Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const PipelineConfig& config) {
+  std::vector<GyroConstants> out;
+  for (std::size_t i = 0; i < cal.gyros.size(); ++i) {
+    const auto& g = cal.gyros[i];
+    GyroConstants c;
+    const double n_dps =
+        (g.noise && g.noise->arw_dps_rtHz) ? *g.noise->arw_dps_rtHz : config.default_arw_dps_rtHz;
+    if (!(n_dps > 0.0) || !std::isfinite(n_dps)) {
+      return bad_input("calibration: gyro " + std::to_string(i + 1) +
+                       ": noise.arw_dps_rtHz must be positive");
+    }
+    c.arw_rad_rts = n_dps * kDegToRad;
+    if (g.noise && g.noise->bias_instability_dps)
+      c.bias_instability_rad_s = *g.noise->bias_instability_dps * kDegToRad;
+    const double s = config.raw_units_dps ? 1.0 : g.scale_factor_V_per_dps;
+    c.scale_V_per_rad_s = s / kDegToRad;
+    c.bias_V = config.raw_units_dps ? 0.0 : g.bias_V;
+    if (g.sigma && !config.raw_units_dps) {
+      c.bias_sigma_rad_s = g.sigma->bias_V / std::abs(g.scale_factor_V_per_dps) * kDegToRad;
+      c.scale_rel_sigma = g.sigma->scale_factor_V_per_dps / std::abs(g.scale_factor_V_per_dps);
+    }
+    out.push_back(c);
+  }
+  return out;
+}
+
+GyroSeries::GyroSeries(std::vector<GyroConstants> constants, const PipelineConfig& config)
+    : constants_(std::move(constants)), config_(config), tracks_(constants_.size()) {
+  for (auto& t : tracks_) t.d2.assign(static_cast<std::size_t>(config_.noise_window), 0.0);
+  scratch_.assign(static_cast<std::size_t>(std::max(config_.noise_window, 8)), 0.0);
+}
+
+void GyroSeries::reset() {
+  for (auto& t : tracks_) {
+    auto d2 = std::move(t.d2);
+    t = Track{};
+    t.d2 = std::move(d2);
+  }
+}
+
+void GyroSeries::forget_evidence(int id) {
+  auto& t = tracks_[static_cast<std::size_t>(id - 1)];
+  t.spike_n = 0;
+  t.repeat_count = 0;
+  t.d2_count = 0;
+  t.d2_since_eval = 0;
+}
+
+void GyroSeries::ingest(const Epoch& epoch, EpochFrame& frame, Counters& counters) {
+  const double max_rate = config_.max_abs_rate_dps * kDegToRad;
+  frame.valid = 0;
+  for (std::size_t u = 0; u < tracks_.size(); ++u) {
+    auto& t = tracks_[u];
+    if (epoch.present[u] == 0) {
+      ++counters.samples_absent;
+      if (t.absent_since_ns < 0) t.absent_since_ns = frame.now_ns;
+      t.consecutive = 0;
+      continue;
+    }
+    t.absent_since_ns = -1;
+    const double raw = epoch.raw[u];
+    double y = kNaN;
+    if (std::isfinite(raw) && std::abs(raw) <= config_.max_abs_raw_V)
+      y = (raw - constants_[u].bias_V) / constants_[u].scale_V_per_rad_s;
+    if (!std::isfinite(y) || std::abs(y) > max_rate) {
+      ++counters.samples_invalid;
+      if (t.invalid_since_ns < 0) t.invalid_since_ns = frame.now_ns;
+      t.consecutive = 0;
+      continue;
+    }
+    t.invalid_since_ns = -1;
+    ++counters.samples_accepted;
+    frame.valid |= GyroMask{1} << static_cast<unsigned>(u);
+    frame.raw[u] = raw;
+    frame.y_rad_s[u] = y;
+    ingest_sample(t, raw, y);
+  }
+}
+
+void GyroSeries::ingest_sample(Track& t, double raw, double y) {
+  t.repeat_count = (t.has_last_raw && raw == t.last_raw) ? t.repeat_count + 1 : 1;
+  t.has_last_raw = true;
+  t.last_raw = raw;
+  if (t.consecutive >= 2) {  // second difference Δ²y = y_k − 2y_{k−1} + y_{k−2}
+    t.d2[static_cast<std::size_t>(t.d2_head)] = std::abs(y - 2.0 * t.y1 + t.y2);
+    t.d2_head = (t.d2_head + 1) % config_.noise_window;
+    ++t.d2_count;
+    ++t.d2_since_eval;
+  }
+  t.y2 = t.y1;
+  t.y1 = y;
+  t.consecutive = std::min(t.consecutive + 1, 2);
+}
+
+void GyroSeries::record_spike(int id, std::int64_t now_ns) {
+  auto& t = tracks_[static_cast<std::size_t>(id - 1)];
+  t.spike_ns[static_cast<std::size_t>(t.spike_n % kSpikeMemory)] = now_ns;
+  ++t.spike_n;
+}
+
+double* GyroSeries::recent(const Track& t, int n) const {
+  const int w = config_.noise_window;
+  double* buf = scratch_.data();
+  for (int k = 0; k < n; ++k) buf[k] = t.d2[static_cast<std::size_t>((t.d2_head - 1 - k + 2 * w) % w)];
+  return buf;
+}
+
+double GyroSeries::noise_ratio(int id, double sqrt_period, int last) const {
+  const Track& t = track(id);
+  const int w = config_.noise_window;
+  const int n = last > 0 ? std::min({last, t.d2_count, w}) : std::min(t.d2_count, w);
+  if (n < (last > 0 ? std::min(10, w) : w)) return kNaN;
+  double* buf = scratch_.data();
+  if (n == w) {
+    std::copy(t.d2.begin(), t.d2.end(), buf);  // the whole ring: order does not matter for a median
+  } else {
+    buf = recent(t, n);
+  }
+  std::nth_element(buf, buf + n / 2, buf + n);
+  // Δ²y of white noise has variance 6σ²: median |Δ²y| = 0.6745·√6·σ.
+  const double sigma_sample = constants(id).arw_rad_rts / sqrt_period;
+  return buf[n / 2] / (kNoiseExpectedMedian * std::sqrt(6.0) * sigma_sample);
+}
+
+double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) const {
+  // RMS of the last `last` second differences without their two largest (a step leaves exactly two), over
+  // the expected √6·σ. Efficient on few samples, where the median is not.
+  const Track& t = track(id);
+  const int n = std::min({last, t.d2_count, config_.noise_window});
+  if (n < 6) return kNaN;
+  double* buf = recent(t, n);
+  std::sort(buf, buf + n);
+  double sum_sq = 0.0;
+  for (int k = 0; k < n - 2; ++k) sum_sq += buf[k] * buf[k];
+  const double sigma_sample = constants(id).arw_rad_rts / sqrt_period;
+  return std::sqrt(sum_sq / (n - 2)) / (std::sqrt(6.0) * sigma_sample);
+}
+
+void GyroSeries::check(std::int64_t now_ns, GyroMask excluded, double period_s, Isolations& out) {
+  for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
+    if (!has_gyro(excluded, id))
+      (void)check_one(id, tracks_[static_cast<std::size_t>(id - 1)], now_ns, period_s, out);
+  }
+}
+
+bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_s, Isolations& out) {
+  auto found = [&](FaultKind kind, Evidence evidence, double statistic) {
+    out.push_back({id, kind, evidence, DetectionTest::kSignature, statistic});
+    return true;
+  };
+  if (t.absent_since_ns >= 0 && now_ns - t.absent_since_ns >= seconds_to_ns(config_.dropout_timeout_s))
+    return found(FaultKind::kDropout, Evidence::kTimeout, ns_to_seconds(now_ns - t.absent_since_ns));
+  if (t.invalid_since_ns >= 0 && now_ns - t.invalid_since_ns >= seconds_to_ns(config_.invalid_timeout_s))
+    return found(FaultKind::kInvalid, Evidence::kInvalid, ns_to_seconds(now_ns - t.invalid_since_ns));
+  if (t.repeat_count >= config_.stuck_repeat_count)
+    return found(FaultKind::kStuck, t.last_raw == 0.0 ? Evidence::kZero : Evidence::kRepeated,
+                 t.repeat_count);
+  const double sqrt_period = std::sqrt(period_s);
+  if (t.d2_since_eval >= kNoiseEvalEvery && period_s > 0.0) {
+    t.d2_since_eval = 0;
+    const double r = noise_ratio(id, sqrt_period);
+    if (std::isfinite(r) && r > config_.noise_high_ratio)
+      return found(FaultKind::kNoise, Evidence::kNoiseLevel, r);
+    if (std::isfinite(r) && r < config_.noise_low_ratio)
+      return found(FaultKind::kStuck, Evidence::kVariance, r);
+  }
+  // Recurring spikes: enough confirmed one-epoch outliers within the window, the first one old enough for the
+  // noise-level test to have spoken, and the gyro's noise level otherwise normal.
+  if (t.spike_n < config_.spike_count) return false;
+  const std::int64_t t_first =
+      t.spike_ns[static_cast<std::size_t>((t.spike_n - config_.spike_count) % kSpikeMemory)];
+  const std::int64_t age = now_ns - t_first;
+  if (age > seconds_to_ns(config_.spike_window_s) ||
+      age < seconds_to_ns(3.0 * kNoiseEvalEvery * period_s + config_.noise_window * period_s))
+    return false;
+  const double r = noise_ratio(id, sqrt_period);
+  if (std::isfinite(r) && r < 0.5 * config_.noise_high_ratio)
+    return found(FaultKind::kSpike, Evidence::kRecurringSpikes, config_.spike_count);
+  return false;
+}
+
+}  // namespace tetra::fdi::detail

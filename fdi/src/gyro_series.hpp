@@ -1,0 +1,89 @@
+#pragma once
+// Input validation, calibration and each gyro's own series: the per-gyro signatures of docs/fdi.md
+// (invalid, dropout, repeated values, noise level, recurring spikes). A gyro's signature needs only its own
+// samples, so it tells which gyro failed by construction.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "epoch_frame.hpp"
+#include "tetra/core/calibration_file.hpp"
+#include "tetra/core/result.hpp"
+#include "tetra/fdi/config.hpp"
+#include "tetra/fdi/types.hpp"
+
+namespace tetra::fdi::detail {
+
+//! What the calibration says of one gyro, in SI.
+struct GyroConstants {
+  double scale_V_per_rad_s = 1.0;       //!< [V/(rad/s)] (1 per rad/s·deg when the log is in deg/s)
+  double bias_V = 0.0;                  //!< [V]
+  double arw_rad_rts = 0.0;             //!< [rad/√s] white rate noise N
+  double bias_sigma_rad_s = 0.0;        //!< [rad/s] 1σ of the calibrated bias
+  double scale_rel_sigma = 0.0;         //!< [-] 1σ relative scale factor error
+  double bias_instability_rad_s = 0.0;  //!< [rad/s] B of the calibration's noise section (0 if absent)
+};
+
+//! Per-gyro constants from the calibration; error names the gyro and field.
+Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const PipelineConfig& config);
+
+class GyroSeries {
+ public:
+  GyroSeries(std::vector<GyroConstants> constants, const PipelineConfig& config);
+
+  //! Validates and calibrates the epoch's samples into `frame` (y, raw, valid) and updates each gyro's
+  //! series.
+  void ingest(const Epoch& epoch, EpochFrame& frame, Counters& counters);
+  //! The signatures of every gyro not in `excluded`; isolations appended to `out` in gyro order.
+  void check(std::int64_t now_ns, GyroMask excluded, double period_s, Isolations& out);
+
+  //! A confirmed one-epoch outlier that went away: a spike of gyro `id`.
+  void record_spike(int id, std::int64_t now_ns);
+  //! Robust noise level / expected over the last `last` second differences (0: the whole window); NaN if too
+  //! few.
+  double noise_ratio(int id, double sqrt_period, int last = 0) const;
+  //! Trimmed RMS noise level / expected over the last `last` second differences (classification at
+  //! isolation).
+  double recent_noise_ratio(int id, double sqrt_period, int last) const;
+  //! Identical raw values in a row of gyro `id`.
+  int repeat_count(int id) const { return track(id).repeat_count; }
+  bool absent(int id) const { return track(id).absent_since_ns >= 0; }
+  bool invalid(int id) const { return track(id).invalid_since_ns >= 0; }
+  const GyroConstants& constants(int id) const { return constants_[static_cast<std::size_t>(id - 1)]; }
+
+  //! A reinstated gyro starts its signature evidence afresh.
+  void forget_evidence(int id);
+  void reset();
+
+ private:
+  static constexpr int kSpikeMemory = 64;  //!< spike times kept per gyro
+  struct Track {
+    std::int64_t absent_since_ns = -1;
+    std::int64_t invalid_since_ns = -1;
+    bool has_last_raw = false;
+    double last_raw = 0.0;
+    int repeat_count = 0;
+    int consecutive = 0;     //!< valid samples in a row (up to 2)
+    double y1 = 0.0;         //!< [rad/s] previous sample
+    double y2 = 0.0;         //!< [rad/s] the one before
+    std::vector<double> d2;  //!< ring of |Δ²y| [rad/s], size noise_window
+    int d2_count = 0;
+    int d2_head = 0;
+    int d2_since_eval = 0;
+    std::array<std::int64_t, kSpikeMemory> spike_ns{};
+    int spike_n = 0;  //!< total spikes recorded (ring index = n % memory)
+  };
+  const Track& track(int id) const { return tracks_[static_cast<std::size_t>(id - 1)]; }
+  void ingest_sample(Track& t, double raw, double y);
+  //! The last `n` second differences of `t` into the scratch buffer.
+  double* recent(const Track& t, int n) const;
+  bool check_one(int id, Track& t, std::int64_t now_ns, double period_s, Isolations& out);
+
+  std::vector<GyroConstants> constants_;
+  const PipelineConfig& config_;
+  std::vector<Track> tracks_;
+  mutable std::vector<double> scratch_;
+};
+
+}  // namespace tetra::fdi::detail

@@ -1,0 +1,242 @@
+#include "isolator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tetra/core/units.hpp"
+
+namespace tetra::fdi::detail {
+
+Isolator::Isolator(int n_gyros, const PipelineConfig& config)
+    : n_(n_gyros),
+      config_(config),
+      glt_sum_(Eigen::VectorXd::Zero(std::max(1, n_gyros - 3))),
+      hist_y_(static_cast<std::size_t>(kHistory) * static_cast<std::size_t>(n_gyros), 0.0),
+      hist_valid_(kHistory, 0),
+      hist_ns_(kHistory, 0),
+      mean_pre_(static_cast<std::size_t>(n_gyros), 0.0),
+      mean_post_(static_cast<std::size_t>(n_gyros), 0.0),
+      n_pre_(static_cast<std::size_t>(n_gyros), 0),
+      n_post_(static_cast<std::size_t>(n_gyros), 0) {
+  // One scratch vector per parity dimension, so the GLT never resizes (allocates) one.
+  for (int d = 0; d <= std::max(1, n_gyros - 3); ++d) {
+    glt_mean_.push_back(Eigen::VectorXd::Zero(d));
+    glt_w_.push_back(Eigen::VectorXd::Zero(d));
+  }
+}
+
+void Isolator::close() {
+  episode_.active = false;
+  episode_.declared_unisolated = false;
+  glt_sum_.setZero();
+  glt_n_ = 0;
+}
+
+std::int64_t Isolator::time_of(std::int64_t index) const {
+  return hist_ns_[static_cast<std::size_t>(index % kHistory)];
+}
+
+void Isolator::record(const EpochFrame& frame) {
+  const auto slot = static_cast<std::size_t>(frame.index % kHistory);
+  hist_ns_[slot] = frame.now_ns;
+  std::copy(frame.y_rad_s.begin(), frame.y_rad_s.end(),
+            hist_y_.begin() + static_cast<std::ptrdiff_t>(slot * n_));
+  hist_valid_[slot] = frame.valid;
+}
+
+bool Isolator::open(const Detection& detection, std::int64_t now_ns, std::int64_t index, const Subset& s,
+                    const ParityDetector& detector) {
+  if (episode_.active) return false;
+  episode_.active = true;
+  episode_.declared_unisolated = false;
+  episode_.detect_ns = now_ns;
+  episode_.deadline_ns = now_ns + seconds_to_ns(config_.isolation_window_s);
+  episode_.onset_index = detection.onset_index;
+  episode_.onset_ns = time_of(std::max<std::int64_t>(detection.onset_index, 0));
+  if (index - detection.onset_index >= kHistory) episode_.onset_ns = now_ns;
+  episode_.test = detection.test;
+  episode_.statistic = detection.statistic;
+  if (s.dof >= 2) {  // the GLT starts from the parity the vector CUSUM summed since its change time
+    glt_sum_.head(s.dof) = detector.vector_sum().head(s.dof);
+    glt_n_ = detector.vector_count();
+  }
+  return true;
+}
+
+void Isolator::accumulate(const Eigen::VectorXd& p, int dof) {
+  if (!episode_.active || dof < 2) return;
+  glt_sum_.head(dof) += p.head(dof);
+  ++glt_n_;
+}
+
+Verdict Isolator::decide(std::int64_t now_ns, std::int64_t index, GyroMask active, SubsetCache& subsets,
+                         const GyroSeries& series, Isolation& found) {
+  if (!episode_.active) return Verdict::kNone;
+  Evidence evidence = Evidence::kOnset;
+  int culprit = onset_test(index, active, subsets, series);
+  if (culprit == 0) {
+    culprit = glt_test(subsets.get(active));
+    evidence = Evidence::kGlt;
+  }
+  if (culprit > 0) {
+    // Kind from the gyro's own samples: identical raw values (5 or more in a row, whatever the onset
+    // estimate) are a stuck output; a noise increase also shifts window means, and its second differences
+    // tell it apart.
+    const bool repeated = series.repeat_count(culprit) >= 5;
+    const double r =
+        series.recent_noise_ratio(culprit, subsets.sqrt_period(),
+                                  static_cast<int>(std::max<std::int64_t>(index - episode_.onset_index, 20)));
+    FaultKind kind = FaultKind::kBias;
+    if (repeated) {
+      kind = FaultKind::kStuck;
+    } else if (std::isfinite(r) && r > config_.noise_high_ratio) {
+      kind = FaultKind::kNoise;
+    } else if (evidence == Evidence::kGlt) {
+      kind = classify_drift(culprit, index, active, subsets);
+    }
+    // A noise level neither normal nor clearly high: wait for more samples rather than guess the kind.
+    const bool ambiguous =
+        !repeated && std::isfinite(r) && r > 0.5 * config_.noise_high_ratio && r <= config_.noise_high_ratio;
+    if (ambiguous) return Verdict::kNone;
+    found = {culprit, kind, evidence, episode_.test, episode_.statistic};
+    return Verdict::kIsolated;
+  }
+  if (!episode_.declared_unisolated && now_ns >= episode_.deadline_ns) {
+    episode_.declared_unisolated = true;
+    return Verdict::kUnisolated;
+  }
+  if (now_ns - episode_.last_alarm_ns > seconds_to_ns(config_.clear_after_s)) {
+    episode_.active = false;
+    return Verdict::kCleared;
+  }
+  return Verdict::kNone;
+}
+
+double Isolator::window_means(std::int64_t b, std::int64_t e, std::vector<double>& mean,
+                              std::vector<int>& count) const {
+  double t_mean = 0.0;
+  for (std::int64_t k = b; k < e; ++k) {
+    const auto slot = static_cast<std::size_t>(k % kHistory);
+    t_mean += ns_to_seconds(hist_ns_[slot] - time_of(b));
+    for (int i = 0; i < n_; ++i) {
+      if (!has_gyro(hist_valid_[slot], i + 1)) continue;
+      mean[static_cast<std::size_t>(i)] += y_at(slot, i);
+      ++count[static_cast<std::size_t>(i)];
+    }
+  }
+  t_mean /= static_cast<double>(e - b);
+  for (std::size_t i = 0; i < mean.size(); ++i) {
+    if (count[i] > 0) mean[i] /= count[i];
+  }
+  return t_mean;
+}
+
+int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subsets,
+                         const GyroSeries& series) {
+  const std::int64_t k0 = episode_.onset_index;
+  const std::int64_t gap = 2;
+  const std::int64_t pre_begin = k0 - gap - config_.onset_pre_epochs;
+  const std::int64_t pre_end = k0 - gap;
+  const std::int64_t post_end = std::min(index + 1, k0 + config_.onset_post_max_epochs);
+  if (pre_begin < 0 || pre_begin <= index - kHistory || post_end - k0 < 20) return 0;
+  std::fill(mean_pre_.begin(), mean_pre_.end(), 0.0);
+  std::fill(mean_post_.begin(), mean_post_.end(), 0.0);
+  std::fill(n_pre_.begin(), n_pre_.end(), 0);
+  std::fill(n_post_.begin(), n_post_.end(), 0);
+  const double t_pre = window_means(pre_begin, pre_end, mean_pre_, n_pre_);
+  const double t_post = window_means(k0, post_end, mean_post_, n_post_);
+  const double separation = ns_to_seconds(time_of(k0) - time_of(pre_begin)) + t_post - t_pre;
+  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
+  // 1: the window means of `mask` are consistent with a possible motion; 0: not; −1: cannot judge.
+  auto consistent = [&](GyroMask mask) -> int {
+    const Subset& h = subsets.get(mask);
+    if (!h.observable) return -1;
+    Eigen::Vector3d dw = Eigen::Vector3d::Zero();
+    double var = 0.0;
+    for (int i = 0; i < n_; ++i) {
+      if (!has_gyro(mask, i + 1)) continue;
+      const auto u = static_cast<std::size_t>(i);
+      if (n_pre_[u] < 2 || n_post_[u] < 2) return -1;
+      dw += h.pinv.col(i) * (mean_post_[u] - mean_pre_[u]);
+      const double sig = series.constants(i + 1).arw_rad_rts / subsets.sqrt_period();
+      var += h.pinv.col(i).squaredNorm() * sig * sig * (1.0 / n_pre_[u] + 1.0 / n_post_[u]);
+    }
+    return dw.norm() <= a_max * separation + config_.onset_sigma * std::sqrt(var) ? 1 : 0;
+  };
+  if (consistent(active) != 0) return 0;  // no abrupt change beyond motion: nothing to tell
+  int count = 0;
+  int culprit = 0;
+  for (int j = 1; j <= n_; ++j) {
+    if (!has_gyro(active, j)) continue;
+    const int c = consistent(without_gyro(active, j));
+    if (c < 0) return 0;
+    if (c == 1) {
+      ++count;
+      culprit = j;
+    }
+  }
+  return count == 1 ? culprit : 0;
+}
+
+// GLT on the mean normalized parity since the onset (N ≥ 5): the residual after fitting a fault of gyro i is
+// χ²_{d−1} under hypothesis i. Isolate i when it is accepted and every other is rejected.
+int Isolator::glt_test(const Subset& s) const {
+  if (s.dof < 2 || glt_n_ < 3) return 0;
+  const double n = glt_n_;
+  Eigen::VectorXd& mean = glt_mean_[static_cast<std::size_t>(s.dof)];
+  Eigen::VectorXd& w = glt_w_[static_cast<std::size_t>(s.dof)];
+  mean = glt_sum_.head(s.dof) / n;
+  int best = 0;
+  int accepted = 0;
+  int rejected = 0;
+  int members = 0;
+  for (int i = 0; i < n_; ++i) {
+    if (!has_gyro(s.mask, i + 1)) continue;
+    ++members;
+    w = s.parity.col(i);
+    const double proj = w.dot(mean);
+    const double r = n * (mean.squaredNorm() - proj * proj / w.squaredNorm());
+    if (r <= s.glt_accept) {
+      ++accepted;
+      best = i + 1;
+    } else if (r > s.glt_reject) {
+      ++rejected;
+    }
+  }
+  return (accepted == 1 && rejected == members - 1) ? best : 0;
+}
+
+// Bias or ramp: fit p_j(τ) = c + b·τ to the parity projected on gyro j's direction over the history since the
+// onset (at most kHistory epochs): a step leaves b ≈ 0, a ramp a significant slope. Without parity (three
+// gyros) the data cannot tell: unknown.
+FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets) const {
+  const Subset& s = subsets.get(active);
+  if (!s.observable || s.dof < 1) return FaultKind::kUnknown;
+  const double w_norm = s.parity.col(id - 1).norm();
+  const std::int64_t first = std::max<std::int64_t>(
+      {episode_.active ? episode_.onset_index : index - kHistory + 1, index - kHistory + 1, 0});
+  double n = 0.0, st = 0.0, sp = 0.0, stt = 0.0, stp = 0.0;
+  double p[kMaxGyros];
+  const std::int64_t t0 = time_of(first);
+  for (std::int64_t k = first; k <= index; ++k) {
+    const auto slot = static_cast<std::size_t>(k % kHistory);
+    if ((hist_valid_[slot] & active) != active) continue;
+    (void)apply_parity(s, active, &hist_y_[slot * static_cast<std::size_t>(n_)], 1.0, p);
+    double proj = 0.0;
+    for (int r = 0; r < s.dof; ++r) proj += s.parity(r, id - 1) / w_norm * p[r] * subsets.sqrt_period();
+    const double t = ns_to_seconds(hist_ns_[slot] - t0);
+    n += 1.0;
+    st += t;
+    sp += proj;
+    stt += t * t;
+    stp += t * proj;
+  }
+  if (n < 20.0) return FaultKind::kUnknown;
+  const double sxx = stt - st * st / n;
+  if (sxx <= 0.0) return FaultKind::kUnknown;
+  const double slope = (stp - st * sp / n) / sxx;   // [σ/s]
+  const double slope_sigma = 1.0 / std::sqrt(sxx);  // unit noise of the normalized parity
+  return std::abs(slope) > 5.0 * slope_sigma ? FaultKind::kRamp : FaultKind::kBias;
+}
+
+}  // namespace tetra::fdi::detail

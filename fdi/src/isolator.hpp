@@ -1,0 +1,86 @@
+#pragma once
+// Isolation of a detected fault (docs/fdi.md, "Isolation"): the episode a detection opens, the history of
+// calibrated rates, the onset test (window means before and after the CUSUM's change time against physically
+// possible motion), the GLT for N ≥ 5, and the bias-or-ramp classification. It isolates only when exactly one
+// single-gyro hypothesis explains the data; otherwise the episode ends `unisolated` or `cleared`.
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "epoch_frame.hpp"
+#include "gyro_series.hpp"
+#include "parity_detector.hpp"
+#include "subset_cache.hpp"
+#include "tetra/fdi/config.hpp"
+
+namespace tetra::fdi::detail {
+
+struct Episode {
+  bool active = false;  //!< a fault is detected and not isolated
+  bool declared_unisolated = false;
+  std::int64_t detect_ns = 0;
+  std::int64_t deadline_ns = 0;  //!< evidence is sought until then
+  std::int64_t last_alarm_ns = 0;
+  std::int64_t onset_index = 0;  //!< estimated first faulty epoch
+  std::int64_t onset_ns = 0;
+  DetectionTest test = DetectionTest::kNone;
+  double statistic = 0.0;
+};
+
+//! What the episode concluded this epoch.
+enum class Verdict : std::uint8_t { kNone, kIsolated, kUnisolated, kCleared };
+
+class Isolator {
+ public:
+  Isolator(int n_gyros, const PipelineConfig& config);
+
+  //! Keeps the epoch's calibrated rates for the onset test and the drift classification.
+  void record(const EpochFrame& frame);
+  //! A detection opens an episode (no-op when one is open). Returns true when it opened one.
+  bool open(const Detection& detection, std::int64_t now_ns, std::int64_t index, const Subset& s,
+            const ParityDetector& detector);
+  //! Every alarm, opening or not, keeps the episode alive.
+  void alarmed(std::int64_t now_ns) { episode_.last_alarm_ns = now_ns; }
+  //! The CUSUM saw this epoch: the GLT accumulates its parity while an episode is open.
+  void accumulate(const Eigen::VectorXd& p, int dof);
+  //! Seeks evidence for the open episode. `found` is set with kIsolated.
+  Verdict decide(std::int64_t now_ns, std::int64_t index, GyroMask active, SubsetCache& subsets,
+                 const GyroSeries& series, Isolation& found);
+  //! Bias or ramp, from the parity projected on gyro `id` since the onset; unknown without parity.
+  FaultKind classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets) const;
+  //! Closes the episode (after a reconfiguration or an operator command).
+  void close();
+
+  const Episode& episode() const { return episode_; }
+  //! [ns] time of a history epoch.
+  std::int64_t time_of(std::int64_t index) const;
+
+ private:
+  static constexpr int kHistory = 256;  //!< [epochs] history kept for the onset test
+  int onset_test(std::int64_t index, GyroMask active, SubsetCache& subsets, const GyroSeries& series);
+  int glt_test(const Subset& s) const;
+  //! Window means of each gyro's rate over history epochs [b, e); returns the mean time offset from b [s].
+  double window_means(std::int64_t b, std::int64_t e, std::vector<double>& mean,
+                      std::vector<int>& count) const;
+  double y_at(std::size_t slot, int i) const {
+    return hist_y_[slot * static_cast<std::size_t>(n_) + static_cast<std::size_t>(i)];
+  }
+
+  int n_;
+  const PipelineConfig& config_;
+  Episode episode_;
+  Eigen::VectorXd glt_sum_;  //!< Σ p since the onset (d ≥ 2)
+  int glt_n_ = 0;
+  std::vector<double> hist_y_;  //!< kHistory×N [rad/s]
+  std::vector<GyroMask> hist_valid_;
+  std::vector<std::int64_t> hist_ns_;
+  std::vector<double> mean_pre_, mean_post_;
+  std::vector<int> n_pre_, n_post_;
+  mutable std::vector<Eigen::VectorXd> glt_mean_;  //!< scratch per parity dimension (never resized)
+  mutable std::vector<Eigen::VectorXd> glt_w_;
+};
+
+}  // namespace tetra::fdi::detail

@@ -1,0 +1,110 @@
+#include "outlier_gate.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tetra/core/units.hpp"
+
+namespace tetra::fdi::detail {
+
+OutlierGate::OutlierGate(int n_gyros, const PipelineConfig& config)
+    : config_(config),
+      tracks_(static_cast<std::size_t>(n_gyros)),
+      dy_(static_cast<std::size_t>(n_gyros), 0.0),
+      p_(static_cast<std::size_t>(std::max(1, n_gyros - 3)), 0.0) {}
+
+void OutlierGate::restart() {
+  for (auto& t : tracks_) {
+    t.outlier_run = 0;
+    t.has_last_good = false;
+  }
+}
+
+void OutlierGate::reset() {
+  for (auto& t : tracks_) t = Track{};
+}
+
+void OutlierGate::update(EpochFrame& frame, SubsetCache& subsets, GyroSeries& series, Counters& counters,
+                         Isolations& out) {
+  const int culprit = jump_culprit(frame, subsets, series);
+  if (culprit > 0) {
+    auto& t = tracks_[static_cast<std::size_t>(culprit - 1)];
+    const double raw = frame.raw[static_cast<std::size_t>(culprit - 1)];
+    ++counters.samples_outlier;
+    t.outlier_repeated = t.outlier_run == 0 || (t.outlier_repeated && raw == t.outlier_first_raw);
+    if (t.outlier_run == 0) t.outlier_first_raw = raw;
+    ++t.outlier_run;
+  }
+  for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
+    if (!has_gyro(frame.usable, id)) continue;
+    auto& t = tracks_[static_cast<std::size_t>(id - 1)];
+    if (id == culprit) {  // left out of this epoch; a persistent outlier is an abrupt step
+      frame.usable = without_gyro(frame.usable, id);
+      if (t.outlier_run >= config_.onset_confirm_epochs)
+        out.push_back(classify_step(id, frame, series, subsets.sqrt_period()));
+      continue;
+    }
+    if (t.outlier_run > 0) {  // the outlier went away: a spike
+      t.outlier_run = 0;
+      ++counters.spikes;
+      series.record_spike(id, frame.now_ns);
+    }
+    t.has_last_good = true;
+    t.last_good_y = frame.y_rad_s[static_cast<std::size_t>(id - 1)];
+    t.last_good_ns = frame.now_ns;
+  }
+}
+
+Isolation OutlierGate::classify_step(int id, const EpochFrame& frame, const GyroSeries& series,
+                                     double sqrt_period) const {
+  const auto& t = tracks_[static_cast<std::size_t>(id - 1)];
+  const bool zero = t.outlier_repeated && frame.raw[static_cast<std::size_t>(id - 1)] == 0.0;
+  const double r = series.recent_noise_ratio(id, sqrt_period, config_.onset_confirm_epochs);
+  if (t.outlier_repeated)
+    return {id, FaultKind::kStuck, zero ? Evidence::kZero : Evidence::kRepeated, DetectionTest::kOnset,
+            static_cast<double>(t.outlier_run)};
+  if (std::isfinite(r) && r > config_.noise_high_ratio)
+    return {id, FaultKind::kNoise, Evidence::kNoiseLevel, DetectionTest::kOnset, r};
+  return {id, FaultKind::kBias, Evidence::kOnset, DetectionTest::kOnset, static_cast<double>(t.outlier_run)};
+}
+
+int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, const GyroSeries& series) {
+  const GyroMask avail = frame.usable;
+  const Subset& s = subsets.get(avail);
+  if (!s.observable || s.dof < 1) return 0;
+  double dt_max = 0.0;
+  for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
+    if (!has_gyro(avail, id)) continue;
+    const auto& t = tracks_[static_cast<std::size_t>(id - 1)];
+    if (!t.has_last_good) return 0;
+    dt_max = std::max(dt_max, ns_to_seconds(frame.now_ns - t.last_good_ns));
+    dy_[static_cast<std::size_t>(id - 1)] = frame.y_rad_s[static_cast<std::size_t>(id - 1)] - t.last_good_y;
+  }
+  // Δp = √T·W·Δy/√2 (a difference of two samples has twice the variance).
+  const double scale = subsets.sqrt_period() / std::sqrt(2.0);
+  if (apply_parity(s, avail, dy_.data(), scale, p_.data()) <= s.jump_threshold) return 0;
+  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
+  int consistent = 0;
+  int culprit = 0;
+  for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
+    if (!has_gyro(avail, j)) continue;
+    const Subset& h = subsets.get(without_gyro(avail, j));
+    if (!h.observable) return 0;  // cannot judge: no outlier call
+    const Eigen::Vector3d dw = apply_pinv(h.pinv, h.mask, dy_.data());
+    double var = 0.0;
+    for (int i = 1; i <= static_cast<int>(tracks_.size()); ++i) {
+      if (!has_gyro(h.mask, i)) continue;
+      const double sig = series.constants(i).arw_rad_rts / subsets.sqrt_period();
+      var += h.pinv.col(i - 1).squaredNorm() * 2.0 * sig * sig;
+    }
+    bool ok = dw.norm() <= a_max * dt_max + config_.onset_sigma * std::sqrt(var);
+    if (ok && h.dof >= 1) ok = apply_parity(h, h.mask, dy_.data(), scale, p_.data()) <= h.jump_threshold;
+    if (ok) {
+      ++consistent;
+      culprit = j;
+    }
+  }
+  return consistent == 1 ? culprit : 0;
+}
+
+}  // namespace tetra::fdi::detail

@@ -1,0 +1,50 @@
+#pragma once
+// One-epoch jump test (docs/fdi.md, "One-epoch jump test"): a significant jump of the parity that exactly one
+// single-gyro hypothesis explains with a physically possible motion leaves that gyro's sample out of this
+// epoch. An outlier that goes away was a spike; one that persists `onset_confirm_epochs` is an abrupt step.
+
+#include <cstdint>
+#include <vector>
+
+#include "epoch_frame.hpp"
+#include "gyro_series.hpp"
+#include "subset_cache.hpp"
+#include "tetra/fdi/config.hpp"
+
+namespace tetra::fdi::detail {
+
+class OutlierGate {
+ public:
+  OutlierGate(int n_gyros, const PipelineConfig& config);
+
+  //! Leaves this epoch's outlier (if any) out of `frame.usable`, records spikes in `series`, and appends a
+  //! persistent outlier (an abrupt step) to `out`.
+  void update(EpochFrame& frame, SubsetCache& subsets, GyroSeries& series, Counters& counters,
+              Isolations& out);
+  //! Outlier runs of this gyro (> 0: its sample is being left out).
+  int outlier_run(int id) const { return tracks_[static_cast<std::size_t>(id - 1)].outlier_run; }
+  //! Forgets every gyro's last good sample and outlier run (after a reconfiguration).
+  void restart();
+  void reset();
+
+ private:
+  struct Track {
+    bool has_last_good = false;
+    double last_good_y = 0.0;  //!< [rad/s]
+    std::int64_t last_good_ns = 0;
+    int outlier_run = 0;
+    double outlier_first_raw = 0.0;
+    bool outlier_repeated = true;
+  };
+  //! The single gyro whose jump explains the parity jump with a possible motion, or 0.
+  int jump_culprit(const EpochFrame& frame, SubsetCache& subsets, const GyroSeries& series);
+  Isolation classify_step(int id, const EpochFrame& frame, const GyroSeries& series,
+                          double sqrt_period) const;
+
+  const PipelineConfig& config_;
+  std::vector<Track> tracks_;
+  std::vector<double> dy_;  //!< [rad/s] change of each gyro since its last good sample
+  std::vector<double> p_;   //!< parity scratch
+};
+
+}  // namespace tetra::fdi::detail

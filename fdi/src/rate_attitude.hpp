@@ -1,0 +1,59 @@
+#pragma once
+// Rate and attitude (docs/fdi.md, "Per epoch" 4 and 7, and "Attitude uncertainty"): the weighted
+// least-squares rate over the usable gyros, the trapezoid propagation of the attitude, and its per-axis
+// uncertainty — random, systematic, and the bound of an unresolved fault or of a lost rate.
+
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "epoch_frame.hpp"
+#include "subset_cache.hpp"
+#include "tetra/core/attitude.hpp"
+#include "tetra/fdi/config.hpp"
+
+namespace tetra::fdi::detail {
+
+//! [rad/s] per axis: the rate error under every single-gyro hypothesis of the subset, gyro i carrying the
+//! fault f_i = wᵢᵀp̄/|wᵢ|² (p̄ the parity EMA), which moves the estimate by H*(:, i)·f_i; the per-axis maximum.
+Eigen::Vector3d fault_rate_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period);
+
+//! [rad] per axis: the angle error a fault on gyro `id` caused since `span_s` ago, from the parity EMA.
+Eigen::Vector3d fault_angle_error(const Subset& s, int id, const Eigen::VectorXd& parity_ema,
+                                  double sqrt_period, double span_s);
+
+class RateAttitude {
+ public:
+  RateAttitude(const PipelineConfig& config);
+
+  //! The rate estimate of the usable gyros of `s` (kept when the subset is not observable).
+  void measure(const Subset& s, const EpochFrame& frame);
+  //! Before the sample period is known (first epoch): the estimate straight from the geometry.
+  bool measure_unprepared(const GyroGeometry& geometry, const EpochFrame& frame);
+  //! Propagates over the epoch with `sol` the solution's subset (`fallback`: the active set's, when `sol` is
+  //! not observable) and `fault_bound_rad_s` the bound of an unresolved fault.
+  void propagate(const EpochFrame& frame, const Subset& sol, const Subset& fallback,
+                 const Eigen::Vector3d& fault_bound_rad_s);
+  //! Ends the epoch: the published rate and the previous rate for the next trapezoid.
+  void finish_epoch() { omega_prev_ = omega_meas_; }
+
+  void add_bound(const Eigen::Vector3d& angle_rad) { propagator_.add_bound(angle_rad); }
+  void reset(const Quaternion& q0_RB);
+
+  //! [rad/s] last rate estimate, Earth rate included.
+  const Eigen::Vector3d& omega_meas_B() const { return omega_meas_; }
+  //! [rad/s] rate of B relative to the reference frame (Earth rate removed in ground mode).
+  Eigen::Vector3d omega_BR_B() const { return omega_meas_ - propagator_.earth_rate_B(); }
+  Eigen::Vector3d earth_rate_B() const { return propagator_.earth_rate_B(); }
+  const Quaternion& q_RB() const { return propagator_.q_RB(); }
+  Eigen::Vector3d sigma_rad() const { return propagator_.sigma_rad(); }
+
+ private:
+  const PipelineConfig& config_;
+  AttitudePropagator propagator_;
+  Eigen::Vector3d omega_prev_ = Eigen::Vector3d::Zero();  //!< [rad/s] previous epoch's estimate
+  Eigen::Vector3d omega_meas_ = Eigen::Vector3d::Zero();  //!< [rad/s] last estimate (Earth rate included)
+  std::int64_t lost_since_ns_ = -1;
+};
+
+}  // namespace tetra::fdi::detail

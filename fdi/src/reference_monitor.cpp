@@ -1,0 +1,141 @@
+#include "reference_monitor.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tetra/core/units.hpp"
+
+namespace tetra::fdi::detail {
+
+ReferenceMonitor::ReferenceMonitor(const Eigen::MatrixX3d& axes_B, const PipelineConfig& config)
+    : axes_B_(axes_B),
+      config_(config),
+      n_(static_cast<std::size_t>(axes_B.rows())),
+      tracks_(n_),
+      snap_ns_(kSnapshots, 0),
+      snap_q_(kSnapshots, Quaternion::Identity()),
+      snap_angle_(static_cast<std::size_t>(kSnapshots) * n_, 0.0),
+      snap_ref_(static_cast<std::size_t>(kSnapshots) * n_, 0.0) {}
+
+void ReferenceMonitor::reset() {
+  for (auto& t : tracks_) t = Track{};
+  snap_count_ = 0;
+  run_gyro_ = 0;
+  run_ = 0;
+}
+
+void ReferenceMonitor::integrate(const EpochFrame& frame, GyroMask excluded,
+                                 const Eigen::Vector3d& omega_meas_B_rad_s,
+                                 const Eigen::Vector3d& earth_B_rad_s) {
+  // Samples are instantaneous rates at the sample time: the increment over (t_{k−1}, t_k] is the trapezoid.
+  for (std::size_t u = 0; u < n_; ++u) {
+    const int id = static_cast<int>(u) + 1;
+    if (has_gyro(excluded, id)) continue;
+    auto& t = tracks_[u];
+    const auto row = static_cast<Eigen::Index>(u);
+    const double yi =
+        has_gyro(frame.usable, id) ? frame.y_rad_s[u] : axes_B_.row(row).dot(omega_meas_B_rad_s);
+    if (frame.dt_s > 0.0)
+      t.angle_rad += (0.5 * (t.prev_int_y + yi) - axes_B_.row(row).dot(earth_B_rad_s)) * frame.dt_s;
+    t.prev_int_y = yi;
+  }
+}
+
+void ReferenceMonitor::snapshot(std::int64_t now_ns, const Quaternion& q) {
+  // The reference's rotation about each gyro axis, summed over its own increments: one increment spans one
+  // reference period, so the non-commutativity of a long window (slews) does not enter.
+  if (snap_count_ > 0) {
+    const Eigen::Vector3d inc_B = quat_log(snap_q_[slot(snap_count_ - 1)].conjugate() * q);
+    for (std::size_t i = 0; i < n_; ++i)
+      tracks_[i].ref_angle_rad += axes_B_.row(static_cast<Eigen::Index>(i)).dot(inc_B);
+  }
+  const std::size_t s = slot(snap_count_);
+  snap_ns_[s] = now_ns;
+  snap_q_[s] = q;
+  for (std::size_t i = 0; i < n_; ++i) {
+    snap_angle_[s * n_ + i] = tracks_[i].angle_rad;
+    snap_ref_[s * n_ + i] = tracks_[i].ref_angle_rad;
+  }
+  ++snap_count_;
+}
+
+int ReferenceMonitor::window_start(std::int64_t now_ns) const {
+  const std::int64_t window = seconds_to_ns(config_.reference_window_s);
+  for (int k = std::max(0, snap_count_ - kSnapshots); k < snap_count_ - 1; ++k) {
+    if (now_ns - snap_ns_[slot(k)] > window) continue;
+    return now_ns - snap_ns_[slot(k)] < window / 2 ? -1 : k;
+  }
+  return -1;
+}
+
+std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, const Quaternion& q_RB,
+                                                         GyroMask excluded, const GyroSeries& series) {
+  snapshot(now_ns, canonical(q_RB));
+  const int old = window_start(now_ns);
+  if (old < 0) return std::nullopt;
+  const double span = ns_to_seconds(now_ns - snap_ns_[slot(old)]);
+  const double sig_ref = config_.reference_sigma_arcsec * kArcsecToRad;
+  int flagged = 0, loud = 0, culprit = 0, members = 0;
+  double stat = 0.0;
+  for (std::size_t i = 0; i < n_; ++i) {
+    const int id = static_cast<int>(i) + 1;
+    if (has_gyro(excluded, id)) continue;
+    ++members;
+    const auto& t = tracks_[i];
+    const GyroConstants& c = series.constants(id);
+    const double rot = t.ref_angle_rad - snap_ref(old, static_cast<int>(i));
+    const double err = (t.angle_rad - snap_angle(old, static_cast<int>(i))) - rot;
+    const double sig = std::sqrt(2.0 * sig_ref * sig_ref + c.arw_rad_rts * c.arw_rad_rts * span +
+                                 std::pow((c.bias_sigma_rad_s + c.bias_instability_rad_s) * span, 2) +
+                                 std::pow(c.scale_rel_sigma * rot, 2));
+    const double z = std::abs(err) / sig;
+    if (z > config_.reference_threshold_sigma) {
+      ++flagged;
+      culprit = id;
+      stat = z;
+    } else if (z > 0.5 * config_.reference_threshold_sigma) {
+      ++loud;
+    }
+  }
+  // One gyro alone beyond the threshold, the others quiet, in `reference_confirm_count` consecutive
+  // comparisons (consecutive windows share no reference sample, so one wild reference sample cannot do it).
+  if (flagged != 1 || loud != 0 || members < 2) {
+    run_gyro_ = 0;
+    run_ = 0;
+    return std::nullopt;
+  }
+  if (culprit != run_gyro_) {
+    run_gyro_ = culprit;
+    run_ = 0;
+  }
+  if (++run_ < config_.reference_confirm_count) return std::nullopt;
+  run_gyro_ = 0;
+  run_ = 0;
+  return ReferenceFinding{culprit, stat, scale_significant(culprit, old)};
+}
+
+bool ReferenceMonitor::scale_significant(int culprit, int old) const {
+  // Scale or rate offset: fit err(τ) = a·τ + b·rot(τ) over the window's snapshots. When the rotation about
+  // the axis is not proportional to time (a slew), a significant b is a scale error; otherwise the data
+  // cannot tell scale from offset.
+  const int c = culprit - 1;
+  double stt = 0.0, str = 0.0, srr = 0.0, ste = 0.0, sre = 0.0;
+  for (int k = old + 1; k < snap_count_; ++k) {
+    const double tau = ns_to_seconds(snap_ns_[slot(k)] - snap_ns_[slot(old)]);
+    const double rot = snap_ref(k, c) - snap_ref(old, c);
+    const double err = (snap_angle(k, c) - snap_angle(old, c)) - rot;
+    stt += tau * tau;
+    str += tau * rot;
+    srr += rot * rot;
+    ste += tau * err;
+    sre += rot * err;
+  }
+  const double det = stt * srr - str * str;
+  if (!(stt > 0.0 && srr > 0.0 && det > 1e-4 * stt * srr)) return false;  // |corr(τ, rot)| ≥ 0.99995
+  const double b = (stt * sre - str * ste) / det;
+  const double sig_ref = config_.reference_sigma_arcsec * kArcsecToRad;
+  const double sigma_b = std::sqrt(2.0) * sig_ref * std::sqrt(stt / det);
+  return std::abs(b) > 5.0 * sigma_b;
+}
+
+}  // namespace tetra::fdi::detail

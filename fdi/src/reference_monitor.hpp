@@ -1,0 +1,69 @@
+#pragma once
+// Attitude-reference monitor (docs/fdi.md, "Attitude reference"): each gyro's integrated angle against the
+// rotation the reference saw about that gyro's axis, over windows of `reference_window_s`. One gyro alone
+// beyond the threshold, every other quiet, in `reference_confirm_count` consecutive windows isolates it.
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "epoch_frame.hpp"
+#include "gyro_series.hpp"
+#include "tetra/core/quaternion.hpp"
+#include "tetra/fdi/config.hpp"
+
+namespace tetra::fdi::detail {
+
+//! The reference's finding: the gyro and whether a scale error (rather than an offset) explains it.
+struct ReferenceFinding {
+  int gyro = 0;
+  double statistic = 0.0;  //!< [σ] disagreement of the gyro
+  bool scale = false;      //!< the error follows the rotation during a slew: a scale-factor error
+};
+
+class ReferenceMonitor {
+ public:
+  ReferenceMonitor(const Eigen::MatrixX3d& axes_B, const PipelineConfig& config);
+
+  //! Integrates each active gyro's angle up to this epoch (trapezoid; a gyro without a usable sample
+  //! contributes the rate estimate's projection), Earth rate `earth_B_rad_s` removed.
+  void integrate(const EpochFrame& frame, GyroMask excluded, const Eigen::Vector3d& omega_meas_B_rad_s,
+                 const Eigen::Vector3d& earth_B_rad_s);
+  //! A reference sample: compares the last window; a confirmed single-gyro disagreement is returned.
+  std::optional<ReferenceFinding> update(std::int64_t now_ns, const Quaternion& q_RB, GyroMask excluded,
+                                         const GyroSeries& series);
+  //! The windows start again (a reinstated gyro's angle has a gap).
+  void restart_windows() { snap_count_ = 0; }
+  void reset();
+
+ private:
+  static constexpr int kSnapshots = 512;  //!< reference snapshots kept
+  struct Track {
+    double angle_rad = 0.0;      //!< ∫ (y_i − h_i·ω_e) dt (trapezoid)
+    double prev_int_y = 0.0;     //!< [rad/s] rate integrated at the previous epoch
+    double ref_angle_rad = 0.0;  //!< Σ h_i·log(q_{k−1}* q_k) over the reference's own increments
+  };
+  void snapshot(std::int64_t now_ns, const Quaternion& q);
+  //! Index of the oldest snapshot inside the window and at least half a window old, or −1.
+  int window_start(std::int64_t now_ns) const;
+  bool scale_significant(int culprit, int old) const;
+  double snap_angle(int k, int i) const { return snap_angle_[slot(k) * n_ + static_cast<std::size_t>(i)]; }
+  double snap_ref(int k, int i) const { return snap_ref_[slot(k) * n_ + static_cast<std::size_t>(i)]; }
+  static std::size_t slot(int k) { return static_cast<std::size_t>(k % kSnapshots); }
+
+  Eigen::MatrixX3d axes_B_;
+  const PipelineConfig& config_;
+  std::size_t n_;
+  std::vector<Track> tracks_;
+  std::vector<std::int64_t> snap_ns_;
+  std::vector<Quaternion> snap_q_;
+  std::vector<double> snap_angle_;  //!< kSnapshots×N
+  std::vector<double> snap_ref_;    //!< kSnapshots×N
+  int snap_count_ = 0;              //!< total pushed
+  int run_gyro_ = 0;                //!< gyro flagged alone by the last comparisons
+  int run_ = 0;                     //!< how many in a row
+};
+
+}  // namespace tetra::fdi::detail

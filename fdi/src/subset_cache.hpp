@@ -1,0 +1,70 @@
+#pragma once
+// Everything that depends on the gyro subset only — weighted pseudoinverse, whitened parity matrix, noise per
+// axis, the thresholds of the parity tests — computed once per subset, and the two kernels every stage uses
+// to apply them (docs/fdi.md, "Noise model and normalized parity").
+
+#include <unordered_map>
+
+#include <Eigen/Core>
+
+#include "tetra/core/geometry.hpp"
+#include "tetra/core/result.hpp"
+#include "tetra/fdi/config.hpp"
+
+namespace tetra::fdi::detail {
+
+struct Subset {
+  GyroMask mask = 0;
+  bool observable = false;
+  int dof = 0;                    //!< parity dimension |S| − 3
+  Eigen::Matrix3Xd pinv;          //!< 3×N weighted pseudoinverse (zero columns outside S)
+  Eigen::MatrixXd parity;         //!< d×N normalized parity in 1/(rad/s) per √s: p = √T·W·y ~ N(0, I)
+  Eigen::Vector3d arw_sq_rad2_s;  //!< [rad²/s] N² per body axis of the rate estimate
+  Eigen::Vector3d bias_sigma_rad_s;  //!< [rad/s] 1σ rate bias per body axis left by the calibration
+  double chi2_threshold = 0.0;       //!< instantaneous χ² threshold
+  double jump_threshold = 0.0;       //!< one-epoch jump χ² threshold
+  double cusum_k = 0.0;              //!< [σ] CUSUM reference
+  double cusum_h = 0.0;              //!< [σ] CUSUM threshold
+  double glt_accept = 0.0;           //!< χ²_{d−1} quantile accepting a single-gyro hypothesis
+  double glt_reject = 0.0;           //!< χ²_{d−1} quantile rejecting one
+};
+
+class SubsetCache {
+ public:
+  //! `geometry` weighted by each gyro's white rate noise N_i [rad/√s]; `bias_sigma_rad_s`: 1σ of each
+  //! calibrated bias; `config` outlives the cache.
+  SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s, const PipelineConfig& config);
+
+  //! The sample period T is known: thresholds follow from it. Every subset is built now for N ≤ 8 (a missing
+  //! sample then never allocates); for larger N the full set and its leave-one-out subsets.
+  void prepare(double period_s);
+  bool ready() const { return period_s_ > 0.0; }
+  double period_s() const { return period_s_; }
+  double sqrt_period() const { return sqrt_period_; }
+
+  //! The subset's constants, built on first use (only once `ready()`).
+  const Subset& get(GyroMask mask);
+  //! The subset's constants if built already, else null.
+  const Subset* find(GyroMask mask) const;
+  //! Without a sample period, the full-rank test alone (at least 3 gyros spanning 3-D).
+  bool observable(GyroMask mask);
+  const GyroGeometry& geometry() const { return geometry_; }
+  int gyro_count() const { return geometry_.gyro_count(); }
+
+ private:
+  void build(Subset& s, GyroMask mask) const;
+
+  GyroGeometry geometry_;             //!< weighted by N_i
+  Eigen::VectorXd bias_sigma_rad_s_;  //!< [rad/s] per gyro
+  const PipelineConfig* config_;      //!< owned by the pipeline, outlives the cache
+  double period_s_ = 0.0;
+  double sqrt_period_ = 0.0;
+  std::unordered_map<GyroMask, Subset> subsets_;
+};
+
+//! p_r = scale·Σ_{i∈mask} W(r, i)·v_i for the subset's d rows; returns Σ p_r². The one parity kernel.
+double apply_parity(const Subset& s, GyroMask mask, const double* v, double scale, double* p);
+//! ω = Σ_{i∈mask} H*(:, i)·v_i. The one rate kernel.
+Eigen::Vector3d apply_pinv(const Eigen::Matrix3Xd& pinv, GyroMask mask, const double* v);
+
+}  // namespace tetra::fdi::detail

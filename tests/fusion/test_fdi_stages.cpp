@@ -1,0 +1,325 @@
+// Each stage of the pipeline on its own (fdi/src/*.hpp): the invariants a stage promises, checked without the
+// rest of the pipeline around it. The whole pipeline is guarded by the golden trace (test_golden_trace.cpp).
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "gyro_series.hpp"
+#include "gyro_set.hpp"
+#include "isolator.hpp"
+#include "outlier_gate.hpp"
+#include "parity_detector.hpp"
+#include "rate_attitude.hpp"
+#include "reference_monitor.hpp"
+#include "subset_cache.hpp"
+#include "tetra/core/units.hpp"
+#include "tetra/fdi/detectors.hpp"
+
+namespace tetra::fdi::detail {
+namespace {
+
+constexpr double kPeriod = 0.1;                   //!< [s] 10 Hz
+constexpr double kArw = 3.0e-5 * kDegToRad;       //!< [rad/√s] the seed unit's N
+const double kSigma = kArw / std::sqrt(kPeriod);  //!< [rad/s] per-sample noise
+
+struct Fixture {
+  PipelineConfig config;
+  Calibration cal = seed_as_built_unit();
+  std::vector<GyroConstants> constants;
+  std::unique_ptr<SubsetCache> subsets;
+  explicit Fixture(int n = 4) {
+    if (n == 3) cal.gyros.resize(3);
+    constants = *gyro_constants(cal, config);
+    Eigen::VectorXd arw(n), bias(n);
+    for (int i = 0; i < n; ++i) {
+      arw[i] = constants[static_cast<std::size_t>(i)].arw_rad_rts;
+      bias[i] = constants[static_cast<std::size_t>(i)].bias_sigma_rad_s;
+    }
+    subsets = std::make_unique<SubsetCache>(*GyroGeometry::create(cal.axes_B(), arw), bias, config);
+    subsets->prepare(kPeriod);
+  }
+  //! Calibrated rates of a body rate ω (no noise).
+  std::vector<double> rates(const Eigen::Vector3d& omega) const {
+    std::vector<double> y;
+    for (const auto& g : cal.gyros) y.push_back(g.axis_B.dot(omega));
+    return y;
+  }
+  //! A raw epoch whose calibrated rates are `y` [rad/s].
+  Epoch raw_epoch(std::int64_t ns, const std::vector<double>& y) const {
+    Epoch e;
+    e.stamp_ns = ns;
+    for (std::size_t i = 0; i < y.size(); ++i) {
+      e.raw.push_back(y[i] * constants[i].scale_V_per_rad_s + constants[i].bias_V);
+      e.present.push_back(1);
+    }
+    return e;
+  }
+};
+
+TEST(SubsetCache, ParityAnnihilatesMotionAndPseudoinverseRecoversIt) {
+  // V H = 0 and H* H = I for every observable subset: a noise-free rate leaves no parity (to 1e-9 σ, rounding
+  // of rates of 1 rad/s over σ ≈ 1.7e-6 rad/s) and is recovered to 1e-15 rad/s relative.
+  Fixture f;
+  const Eigen::Vector3d omega(0.3, -0.7, 0.5);
+  const auto y = f.rates(omega);
+  double p[4];
+  for (GyroMask m = 0; m <= all_gyros(4); ++m) {
+    const Subset& s = f.subsets->get(m);
+    EXPECT_EQ(s.observable, gyro_count(m) >= 3) << m;
+    if (!s.observable) continue;
+    EXPECT_EQ(s.dof, gyro_count(m) - 3);
+    EXPECT_LT((apply_pinv(s.pinv, m, y.data()) - omega).norm(), 1e-15 * 10);
+    EXPECT_LT(apply_parity(s, m, y.data(), f.subsets->sqrt_period(), p), 1e-18);
+  }
+  EXPECT_FALSE(f.subsets->observable(0b0011));
+}
+
+TEST(SubsetCache, ThresholdsFollowFromTheConfiguration) {
+  Fixture f;
+  const Subset& s = f.subsets->get(0b1111);
+  EXPECT_DOUBLE_EQ(s.chi2_threshold, chi2_threshold(f.config.chi2_false_alarm_probability, 1));
+  EXPECT_NEAR(s.cusum_h, cusum_threshold(s.cusum_k, f.config.cusum_arl0_epochs), 1e-12);
+  // k = δ_min/2 with δ_min the smallest parity shift of a cusum_min_fault_dps step: gyros 1–3 move the
+  // tetrahedron's parity by f/(√6 σ) (docs/fdi.md: k = 0.438 at 10 Hz for the nominal unit; the as-built
+  // unit's axes differ by arcminutes, hence 1 %).
+  EXPECT_NEAR(s.cusum_k, 0.438, 0.438 * 0.01);
+}
+
+TEST(GyroSeries, ValidatesCalibratesAndCounts) {
+  Fixture f;
+  GyroSeries series(f.constants, f.config);
+  EpochFrame frame;
+  frame.resize(4);
+  Counters counters;
+  Epoch e = f.raw_epoch(100, f.rates(Eigen::Vector3d(0.01, 0.0, 0.0)));
+  e.present[1] = 0;
+  e.raw[2] = std::numeric_limits<double>::quiet_NaN();
+  e.raw[3] = 1e6;  // beyond max_abs_raw_V
+  frame.now_ns = 100;
+  series.ingest(e, frame, counters);
+  EXPECT_EQ(frame.valid, 0b0001U);
+  EXPECT_NEAR(frame.y_rad_s[0], 0.01 * f.cal.gyros[0].axis_B.x(), 1e-15);
+  EXPECT_EQ(counters.samples_accepted, 1U);
+  EXPECT_EQ(counters.samples_absent, 1U);
+  EXPECT_EQ(counters.samples_invalid, 2U);
+  EXPECT_TRUE(series.absent(2));
+  EXPECT_TRUE(series.invalid(3));
+}
+
+TEST(GyroSeries, SignaturesNameTheGyroAndItsKind) {
+  // Dropout after dropout_timeout_s, stuck after stuck_repeat_count identical values; a healthy gyro's robust
+  // noise level is near 1 (median of 30 second differences: ±30 % covers its spread at 3σ).
+  Fixture f;
+  GyroSeries series(f.constants, f.config);
+  EpochFrame frame;
+  frame.resize(4);
+  Counters counters;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  Isolations found;
+  bool dropout = false, stuck = false;
+  double ratio = 0.0;
+  for (int k = 0; k < 400 && !(dropout && stuck); ++k) {
+    std::vector<double> y(4);
+    for (auto& v : y) v = noise(rng);
+    Epoch e = f.raw_epoch(seconds_to_ns(k * kPeriod), y);
+    if (k >= 100) e.present[1] = 0;  // gyro 2 silent from 10 s
+    if (k >= 200) e.raw[2] = 0.25;   // gyro 3 stuck from 20 s
+    frame.now_ns = e.stamp_ns;
+    series.ingest(e, frame, counters);
+    series.check(frame.now_ns, 0, kPeriod, found);
+    if (k == 99) ratio = series.noise_ratio(1, std::sqrt(kPeriod));
+    for (const auto& iso : found) {
+      if (iso.gyro == 2) {
+        EXPECT_EQ(iso.kind, FaultKind::kDropout);
+        EXPECT_GE(k, 110);  // 1 s after the first missing sample
+        dropout = true;
+      }
+      if (iso.gyro == 3) {
+        EXPECT_EQ(iso.kind, FaultKind::kStuck);
+        EXPECT_EQ(iso.evidence, Evidence::kRepeated);
+        stuck = true;
+      }
+      EXPECT_TRUE(iso.gyro == 2 || iso.gyro == 3) << iso.gyro;
+    }
+    found.clear();
+  }
+  EXPECT_TRUE(dropout && stuck);
+  EXPECT_NEAR(ratio, 1.0, 0.3);
+}
+
+TEST(OutlierGate, ASpikeIsLeftOutForOneEpochAndCounted) {
+  Fixture f;
+  GyroSeries series(f.constants, f.config);
+  OutlierGate gate(4, f.config);
+  EpochFrame frame;
+  frame.resize(4);
+  Counters counters;
+  Isolations found;
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  for (int k = 0; k < 50; ++k) {
+    auto y = f.rates(Eigen::Vector3d(0.0, -0.06, 0.0) * kDegToRad);
+    for (auto& v : y) v += noise(rng);
+    if (k == 30) y[1] += 0.05 * kDegToRad;  // one-epoch spike on gyro 2
+    frame.now_ns = seconds_to_ns(k * kPeriod);
+    frame.index = k;
+    series.ingest(f.raw_epoch(frame.now_ns, y), frame, counters);
+    frame.usable = frame.valid;
+    gate.update(frame, *f.subsets, series, counters, found);
+    EXPECT_EQ(frame.usable, k == 30 ? 0b1101U : 0b1111U) << k;
+  }
+  EXPECT_TRUE(found.empty());
+  EXPECT_EQ(counters.samples_outlier, 1U);
+  EXPECT_EQ(counters.spikes, 1U);
+}
+
+TEST(ParityDetector, CusumDetectsAShiftInTheoryTimeAndRestarts) {
+  // A parity shift of δ = 2 σ: the CUSUM crosses h after ≈ ARL(δ − k) epochs (Siegmund; noise-free here, so
+  // the deterministic crossing (h + 1.166)/(δ − k) ± 1 epoch is the check). The χ² stays silent (2² < 37).
+  Fixture f;
+  ParityDetector detector(4);
+  detector.restart(0);
+  const Subset& s = f.subsets->get(0b1111);
+  EpochFrame frame;
+  frame.resize(4);
+  frame.usable = 0b1111;
+  frame.dt_s = kPeriod;
+  // y along the parity direction with |p| = 2: y = W⁺ p / √T.
+  const Eigen::VectorXd w = s.parity.row(0).transpose();
+  const Eigen::VectorXd y = w / w.squaredNorm() * 2.0 / f.subsets->sqrt_period();
+  for (int i = 0; i < 4; ++i) frame.y_rad_s[static_cast<std::size_t>(i)] = y[i];
+  Health health;
+  int alarm_at = -1;
+  for (int k = 0; k < 100 && alarm_at < 0; ++k) {
+    frame.index = k;
+    const Detection d = detector.update(frame, s, 0b1111, f.subsets->sqrt_period(), health);
+    EXPECT_TRUE(d.cusum_ran);
+    EXPECT_NEAR(health.parity_residual, 2.0, 1e-9);
+    if (d.alarm) {
+      EXPECT_EQ(d.test, DetectionTest::kCusum);
+      EXPECT_EQ(d.onset_index, 0);
+      alarm_at = k;
+    }
+  }
+  const double expected = s.cusum_h / (2.0 - s.cusum_k);
+  EXPECT_NEAR(alarm_at + 1, expected, 1.0);
+  detector.restart_after_alarm();
+  frame.index = 200;
+  EXPECT_FALSE(detector.update(frame, s, 0b1111, f.subsets->sqrt_period(), health).alarm);
+  EXPECT_NEAR(health.cusum, 2.0 - s.cusum_k, 1e-9);
+}
+
+TEST(Isolator, OnsetTestTellsTheSteppedGyroAndClassifiesIt) {
+  // A 0.02 deg/s step on gyro 3 with the body still: the rate change it implies (≈ 0.01 deg/s) is beyond what
+  // max_angular_acceleration_dps2 (1e-3 deg/s²) allows over the ≈ 3.5 s between the window centres, and only
+  // "gyro 3 jumped" leaves a possible motion, so the onset test isolates gyro 3 (kind bias) once 20 epochs
+  // follow the onset.
+  Fixture f;
+  GyroSeries series(f.constants, f.config);
+  Isolator isolator(4, f.config);
+  ParityDetector detector(4);
+  EpochFrame frame;
+  frame.resize(4);
+  Counters counters;
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  Isolation found;
+  Verdict verdict = Verdict::kNone;
+  for (int k = 0; k < 100 && verdict == Verdict::kNone; ++k) {
+    std::vector<double> y(4);
+    for (auto& v : y) v = noise(rng);
+    if (k >= 50) y[2] += 2e-2 * kDegToRad;
+    frame.now_ns = seconds_to_ns(k * kPeriod);
+    frame.index = k;
+    series.ingest(f.raw_epoch(frame.now_ns, y), frame, counters);
+    isolator.record(frame);
+    if (k == 52) {
+      Detection d{true, DetectionTest::kCusum, 30.0, 50, true};
+      ASSERT_TRUE(isolator.open(d, frame.now_ns, k, f.subsets->get(0b1111), detector));
+    }
+    if (isolator.episode().active)
+      verdict = isolator.decide(frame.now_ns, k, 0b1111, *f.subsets, series, found);
+  }
+  ASSERT_EQ(verdict, Verdict::kIsolated);
+  EXPECT_EQ(found.gyro, 3);
+  EXPECT_EQ(found.kind, FaultKind::kBias);
+  EXPECT_EQ(found.evidence, Evidence::kOnset);
+  isolator.close();
+  EXPECT_FALSE(isolator.episode().active);
+}
+
+TEST(ReferenceMonitor, ADriftingGyroIsFoundAgainstTheReference) {
+  // The body turns at 0.1 deg/s about Z; gyro 2 carries a 2e-3 deg/s bias. The reference (exact here) sees
+  // the true rotation; gyro 2's angle drifts 0.06° per 30-s window against a σ of ≈ 2e-3°: after
+  // reference_confirm_count consecutive windows it is the only one flagged.
+  Fixture f;
+  GyroSeries series(f.constants, f.config);
+  ReferenceMonitor monitor(f.cal.axes_B(), f.config);
+  EpochFrame frame;
+  frame.resize(4);
+  frame.dt_s = kPeriod;
+  const Eigen::Vector3d omega(0.0, 0.0, 0.1 * kDegToRad);
+  std::optional<ReferenceFinding> finding;
+  double found_at = -1.0;
+  for (int k = 0; k <= 1500 && !finding; ++k) {
+    const double t = k * kPeriod;
+    auto y = f.rates(omega);
+    y[1] += 2e-3 * kDegToRad;
+    for (std::size_t i = 0; i < 4; ++i) frame.y_rad_s[i] = y[i];
+    frame.usable = 0b1111;
+    frame.now_ns = seconds_to_ns(t);
+    monitor.integrate(frame, 0, omega, Eigen::Vector3d::Zero());
+    if (k % 10 == 0) finding = monitor.update(frame.now_ns, quat_exp(omega * t), 0, series);
+    if (finding) found_at = t;
+  }
+  ASSERT_TRUE(finding.has_value());
+  EXPECT_EQ(finding->gyro, 2);
+  EXPECT_FALSE(finding->scale);
+  EXPECT_LE(found_at, 4 * f.config.reference_window_s);
+}
+
+TEST(GyroSet, ExclusionsAreLatchedUntilReinstated) {
+  GyroSet set(4);
+  EXPECT_EQ(set.active(), 0b1111U);
+  set.exclude(2, FaultKind::kStuck);
+  EXPECT_EQ(set.active(), 0b1101U);
+  EXPECT_EQ(set.kind(2), FaultKind::kStuck);
+  EXPECT_TRUE(set.is_excluded(2));
+  EXPECT_FALSE(set.contains(5));
+  set.reinstate(2);
+  EXPECT_EQ(set.active(), 0b1111U);
+  EXPECT_EQ(set.kind(2), FaultKind::kNone);
+}
+
+TEST(RateAttitude, ConstantRatePropagatesExactly) {
+  // q(t) = exp(ω t) for a constant rate (exact exponential map, trapezoid of equal rates): 600 steps leave
+  // less than 1e-12 rad of rounding.
+  Fixture f;
+  RateAttitude attitude(f.config);
+  attitude.reset(Quaternion::Identity());
+  EpochFrame frame;
+  frame.resize(4);
+  frame.usable = 0b1111;
+  frame.dt_s = kPeriod;
+  const Eigen::Vector3d omega(0.01, -0.02, 0.03);
+  const auto y = f.rates(omega);
+  for (std::size_t i = 0; i < 4; ++i) frame.y_rad_s[i] = y[i];
+  const Subset& s = f.subsets->get(0b1111);
+  attitude.measure(s, frame);
+  attitude.finish_epoch();
+  for (int k = 1; k <= 600; ++k) {
+    frame.now_ns = seconds_to_ns(k * kPeriod);
+    attitude.measure(s, frame);
+    attitude.propagate(frame, s, s, Eigen::Vector3d::Zero());
+    attitude.finish_epoch();
+  }
+  EXPECT_LT(angle_between(attitude.q_RB(), quat_exp(omega * 60.0)), 1e-12);
+  // Random part of σ: N_a·√t per axis.
+  EXPECT_NEAR(attitude.sigma_rad()[0],
+              std::sqrt(s.arw_sq_rad2_s[0] * 60.0 + std::pow(s.bias_sigma_rad_s[0] * 60.0, 2)), 1e-12);
+}
+
+}  // namespace
+}  // namespace tetra::fdi::detail
