@@ -382,7 +382,6 @@ FdiEvent Pipeline::Impl::acknowledge(CommandVerb verb, int id, CommandOutcome ou
   ack.outcome = outcome;
   ack.detail = std::string(to_string(verb)) + " " + std::to_string(id) + ": " + to_string(outcome);
   ack.gyros = gyro_set_.active();
-  pending_.push_back(ack);
   if (changed) {
     FdiEvent rc;
     rc.stamp_ns = stamp_ns;
@@ -421,7 +420,6 @@ FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   ack.command = CommandVerb::kReset;
   ack.gyros = gyro_set_.active();
   ack.detail = "reset: done, all gyros reinstated";
-  pending_.push_back(ack);
   FdiEvent c;
   c.stamp_ns = stamp_ns;
   c.type = EventType::kCleared;

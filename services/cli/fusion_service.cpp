@@ -282,7 +282,6 @@ Status FusionService::take_commands() {
         break;
     }
     spdlog::info("fusion: command {} acknowledged: {}", command.command_id, fdi::to_json(ack, n_gyros_));
-    acks_published_.push_back({ack.type, ack.gyro, ack.detail});
     if (auto s = publish_event(ack, command.command_id); !s) return s;
   }
   return ok_status();
@@ -311,11 +310,6 @@ Status FusionService::process_epochs(std::int64_t now_ns) {
     const fdi::StepResult& result = pipeline_.step(epoch);
     // Events before the attitude of the same epoch: a reader that has the attitude has its events.
     for (const auto& event : result.events) {
-      if (event.type == fdi::EventType::kCommand && !acks_published_.empty() &&
-          acks_published_.front().gyro == event.gyro && acks_published_.front().detail == event.detail) {
-        acks_published_.pop_front();  // already published when the command was obeyed
-        continue;
-      }
       if (auto s = publish_event(event, 0); !s) return s;
     }
     if (result.accepted) {

@@ -11,7 +11,6 @@
 // thread wake-up) or by the waitset (`gyro_dispatch: waitset`). One mutex serializes the two threads.
 
 #include <cstdint>
-#include <deque>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -86,12 +85,6 @@ class FusionService {
   std::uint64_t event_seq_ = 0;
   std::uint32_t gyro_writers_ = 0;  //!< matched GyroSample writers (published in Health)
   std::uint64_t last_restarts_ = 0;
-  struct PendingAck {
-    fdi::EventType type;
-    std::optional<int> gyro;
-    std::string detail;
-  };
-  std::deque<PendingAck> acks_published_;  //!< acknowledgements sent before the pipeline repeats them
   std::vector<fdi::Epoch> epochs_;
   std::int64_t scheduled_wake_ns_ = 0;   //!< [ns] when the waitset thread wakes by itself next
   std::optional<Error> listener_error_;  //!< a failure inside the listener, for run() to return

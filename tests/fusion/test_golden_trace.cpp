@@ -70,6 +70,11 @@ struct GoldenScenario {
   std::vector<OperatorCommand> commands;
 };
 
+// Failure messages name the scenario, not its bytes.
+void PrintTo(const GoldenScenario& g, std::ostream* os) {
+  *os << g.name;
+}
+
 GyroCalibration extra_gyro(int id, const Eigen::Vector3d& axis, const Calibration& like) {
   GyroCalibration g = like.gyros[0];
   g.id = id;
@@ -259,18 +264,17 @@ std::string health_line(const fdi::Health& h) {
   return s;
 }
 
-void apply(fdi::Pipeline& p, const OperatorCommand& c, std::int64_t stamp_ns) {
+//! Applies an operator command; returns its acknowledgement.
+fdi::FdiEvent apply(fdi::Pipeline& p, const OperatorCommand& c, std::int64_t stamp_ns) {
   switch (c.op) {
     case Op::kExclude:
-      (void)p.exclude(c.gyro, stamp_ns);
-      break;
+      return p.exclude(c.gyro, stamp_ns);
     case Op::kReinstate:
-      (void)p.reinstate(c.gyro, stamp_ns);
-      break;
+      return p.reinstate(c.gyro, stamp_ns);
     case Op::kReset:
-      (void)p.reset_command(stamp_ns);
       break;
   }
+  return p.reset_command(stamp_ns);
 }
 
 //! The trace of one scenario, one line per event, per block of epochs, and the final health.
@@ -291,7 +295,8 @@ std::vector<std::string> trace(const GoldenScenario& g) {
   fdi::AttitudeEstimate last;
   do {
     while (next_command < g.commands.size() && g.commands[next_command].at_s <= se.time_s)
-      apply(*pipeline, g.commands[next_command++], se.stamp_ns);
+      lines.push_back("C" +
+                      event_line(apply(*pipeline, g.commands[next_command++], se.stamp_ns), index).substr(1));
     e.stamp_ns = se.stamp_ns;
     e.raw = se.raw_V;
     e.present = se.present;

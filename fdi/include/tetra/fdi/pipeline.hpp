@@ -36,7 +36,9 @@ class Pipeline {
   void reset();
   //! Processes one epoch. The returned reference is valid until the next call.
   const StepResult& step(const Epoch& epoch);
-  //! Operator commands. They return the acknowledgement event (also emitted on the next step()).
+  //! Operator commands. Each returns its acknowledgement (an event of type kCommand), once: the caller
+  //! publishes or records it. What the command changed (reconfigured, lost, cleared) comes with the next
+  //! step()'s events.
   FdiEvent exclude(int gyro_id, std::int64_t stamp_ns);
   FdiEvent reinstate(int gyro_id, std::int64_t stamp_ns);
   FdiEvent reset_command(std::int64_t stamp_ns);
