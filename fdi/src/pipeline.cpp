@@ -240,6 +240,8 @@ void Pipeline::Impl::publish_attitude() {
   } else {
     const Subset& sol = subsets_.get(frame_.usable);
     observable = sol.observable;
+    // A gyro isolated during this epoch leaves the published set: the rate is the one of the gyros published.
+    attitude_.measure(sol, frame_);
     if (frame_.dt_s > 0.0) {
       const Subset& active = subsets_.get(gyro_set_.active());
       const Eigen::Vector3d bound =
