@@ -71,6 +71,7 @@ class Pipeline::Impl {
   std::string describe_thresholds() const;
 
   const Health& health() const { return health_; }
+  bool observable(GyroMask gyros) const { return subsets_.geometry().observable(gyros); }
   int gyro_count() const { return n_; }
   const PipelineConfig& config() const { return config_; }
 
@@ -488,6 +489,9 @@ FdiEvent Pipeline::reinstate(int gyro_id, std::int64_t stamp_ns) {
 }
 FdiEvent Pipeline::reset_command(std::int64_t stamp_ns) {
   return impl_->command_reset(stamp_ns);
+}
+bool Pipeline::observable(GyroMask gyros) const {
+  return impl_->observable(gyros);
 }
 const Health& Pipeline::health() const {
   return impl_->health();

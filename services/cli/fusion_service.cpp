@@ -332,7 +332,7 @@ Status FusionService::publish_event(const fdi::FdiEvent& event, std::uint64_t co
 
 void FusionService::current_health(fdi::Health& health) const {
   // The pipeline's health, with what only the service knows: gyros whose streams stopped (deadline,
-  // liveliness) are absent and out of the solution; with fewer than 3 left the unit is LOST.
+  // liveliness) are absent and out of the solution; when the rest cannot determine the attitude, LOST.
   health = pipeline_.health();
   health.gyros.resize(static_cast<std::size_t>(n_gyros_));
   for (int g = 1; g <= n_gyros_; ++g) {
@@ -341,7 +341,7 @@ void FusionService::current_health(fdi::Health& health) const {
     if (gyro.state == fdi::GyroState::kOk) gyro.state = fdi::GyroState::kAbsent;
     health.used = without_gyro(health.used, g);
   }
-  if (gyro_count(health.used) < 3) health.mode = fdi::Mode::kLost;
+  if (!pipeline_.observable(health.used)) health.mode = fdi::Mode::kLost;
 }
 
 Status FusionService::publish_health(std::int64_t now_ns, bool force) {

@@ -371,3 +371,22 @@ TEST(Pipeline, ThreeGyrosHaveNoParityButSignaturesStillIsolate) {
 
 }  // namespace
 }  // namespace tetra::fdi
+
+namespace tetra::fdi {
+namespace {
+
+TEST(Pipeline, ObservabilityIsTheRankOfTheAxesNotTheCount) {
+  // The one rule for LOST: three gyros whose axes span 3-D determine the attitude, two never do, and three
+  // coplanar axes do not either (a count of 3 would say they do).
+  Calibration cal = seed_as_built_unit();
+  cal.gyros[2].axis_B =
+      (cal.gyros[0].axis_B + cal.gyros[1].axis_B).normalized();  // gyro 3 in gyros 1–2's plane
+  auto p = Pipeline::create(cal, PipelineConfig{});
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  EXPECT_TRUE(p->observable(0b1011));
+  EXPECT_FALSE(p->observable(0b0111));
+  EXPECT_FALSE(p->observable(0b0011));
+}
+
+}  // namespace
+}  // namespace tetra::fdi

@@ -43,6 +43,9 @@ class Pipeline {
   FdiEvent reinstate(int gyro_id, std::int64_t stamp_ns);
   FdiEvent reset_command(std::int64_t stamp_ns);
 
+  //! True when these gyros determine the attitude: at least three whose axes span 3-D (the one rule for
+  //! LOST, shared by the pipeline and whoever adds what only it knows, e.g. a service's silent streams).
+  bool observable(GyroMask gyros) const;
   const Health& health() const;
   int gyro_count() const;
   const PipelineConfig& config() const;
