@@ -113,6 +113,7 @@ class Pipeline::Impl {
   std::vector<FdiEvent> pending_;  //!< what operator commands caused, emitted with the next step
   Health health_;
   Mode persistent_mode_ = Mode::kNominal;
+  GyroMask measured_ = 0;  //!< the gyros of this epoch's rate estimate so far
   bool has_time_ = false;
   std::int64_t last_ns_ = 0;
 };
@@ -129,6 +130,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   series_.ingest(epoch, frame_, health_.counters);
   isolator_.record(frame_);
   frame_.usable = frame_.valid & gyro_set_.active();
+  measured_ = ~GyroMask{0};
   if (subsets_.ready()) {
     reject_outliers();
     detect();
@@ -169,6 +171,7 @@ void Pipeline::Impl::reject_outliers() {
 void Pipeline::Impl::detect() {
   const Subset& s = subsets_.get(frame_.usable);
   attitude_.measure(s, frame_);
+  measured_ = frame_.usable;
   const GyroMask active = gyro_set_.active();
   const Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), health_);
   if (d.cusum_ran) isolator_.accumulate(detector_.parity(), s.dof);
@@ -242,7 +245,7 @@ void Pipeline::Impl::publish_attitude() {
     const Subset& sol = subsets_.get(frame_.usable);
     observable = sol.observable;
     // A gyro isolated during this epoch leaves the published set: the rate is the one of the gyros published.
-    attitude_.measure(sol, frame_);
+    if (frame_.usable != measured_) attitude_.measure(sol, frame_);
     if (frame_.dt_s > 0.0) {
       const Subset& active = subsets_.get(gyro_set_.active());
       const Eigen::Vector3d bound =
