@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "tetra/core/allan.hpp"
+#include "tetra/core/json.hpp"
 #include "tetra/core/csv.hpp"
 
 namespace tetra::allan {
@@ -73,8 +74,19 @@ std::string format_csv(const LogAllan& analysis) {
   return out;
 }
 
-std::string format_json(const LogAllan& analysis) {
-  std::string out = "{\"units\": \"" + analysis.units + "\", \"tau0_s\": ";
+std::string format_json(const LogAllan& analysis, const std::vector<std::pair<std::string, std::string>>& provenance) {
+  std::string out = "{";
+  if (!provenance.empty()) {
+    out += "\"provenance\": {";
+    for (std::size_t i = 0; i < provenance.size(); ++i) {
+      if (i != 0) out += ", ";
+      append_json_string(out, provenance[i].first);
+      out += ": ";
+      append_json_string(out, provenance[i].second);
+    }
+    out += "},\n ";
+  }
+  out += "\"units\": \"" + analysis.units + "\", \"tau0_s\": ";
   append_double(out, analysis.tau0_s);
   out += ", \"gyros\": [";
   for (std::size_t i = 0; i < analysis.gyros.size(); ++i) {

@@ -3,9 +3,47 @@
 #include <cstdio>
 #include <iostream>
 
+#include "tetra/core/csv.hpp"
+#include "tetra/core/provenance.hpp"
+
 namespace tetra::cli {
 
+namespace {
+
+bool starts_with(const std::string& text, const char* prefix) {
+  return text.rfind(prefix, 0) == 0;
+}
+
+// Plain decimal numbers only: CLI11 alone reads "0x10" as 16, "" as nothing and "1,5" as 1 or 15.
+CLI::Validator plain_number(bool integer) {
+  return CLI::Validator(
+      [integer](std::string& text) -> std::string {
+        if (integer) {
+          std::size_t i = (!text.empty() && (text[0] == '-' || text[0] == '+')) ? 1 : 0;
+          const bool digits = i < text.size() && text.find_first_not_of("0123456789", i) == std::string::npos;
+          return digits ? std::string() : "'" + text + "' is not a whole decimal number";
+        }
+        return parse_decimal(text) ? std::string() : "'" + text + "' is not a finite decimal number";
+      },
+      "", "plain decimal");
+}
+
+// Every numeric option takes plain decimal numbers; a single-valued option given twice is an error.
+void harden(CLI::App& app) {
+  for (CLI::Option* opt : app.get_options()) {
+    const std::string type = opt->get_type_name();
+    if (starts_with(type, "FLOAT")) opt->check(plain_number(false));
+    if (starts_with(type, "INT") || starts_with(type, "UINT")) opt->check(plain_number(true));
+    if (opt->get_expected_max() == 1 && opt->get_items_expected_max() == 1)
+      opt->multi_option_policy(CLI::MultiOptionPolicy::Throw);
+  }
+}
+
+}  // namespace
+
 std::optional<int> parse(CLI::App& app, int argc, char** argv) {
+  harden(app);
+  app.set_version_flag("--version", std::string("tetra ") + kVersion);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -13,6 +51,9 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv) {
     return kExitOk;
   } catch (const CLI::CallForAllHelp&) {
     std::cout << app.help("", CLI::AppFormatMode::All);
+    return kExitOk;
+  } catch (const CLI::CallForVersion&) {
+    std::cout << "tetra " << kVersion << "\n";
     return kExitOk;
   } catch (const CLI::ParseError& e) {
     std::cerr << "tetra " << app.get_name() << ": " << e.what() << " (see 'tetra " << app.get_name()

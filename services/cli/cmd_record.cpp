@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <iostream>
 #include <map>
+#include <string>
+#include <tuple>
 
 #include "attitude_csv.hpp"
 #include "cli_common.hpp"
@@ -14,6 +16,8 @@
 #include "dds_common.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/output_files.hpp"
+#include "tetra/core/provenance.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
@@ -28,6 +32,17 @@ namespace {
 using namespace std::chrono_literals;
 enum Token : std::intptr_t { kData = 1, kShutdown };
 constexpr std::int64_t kIdleGrace_ns = 2'000'000'000;  //!< [ns] wait for the service's last outputs
+
+}  // namespace
+
+namespace {
+
+Metadata record_metadata(const std::string& unit, const RunFiles& files) {
+  Metadata meta = {{"unit", unit}, {"source", "tetra record"}};
+  const auto p = provenance_metadata(provenance(files.input_paths()));
+  meta.insert(meta.end(), p.begin(), p.end());
+  return meta;
+}
 
 }  // namespace
 
@@ -63,6 +78,20 @@ int cmd_record(int argc, char** argv) {
   app.add_flag("--until-idle", until_idle, "stop when the gyro writers have come and gone");
   add_domain_option(app, domain);
   if (auto exit = parse(app, argc, argv)) return *exit;
+
+  RunFiles files;
+  if (!config_path.empty()) files.add_input(config_path, "--config");
+  OutputFile* log_out = nullptr;
+  OutputFile* attitude_out = nullptr;
+  OutputFile* events_out = nullptr;
+  for (auto [path, label, slot] : {std::tuple{&out_path, "--out", &log_out},
+                                   std::tuple{&attitude_path, "--attitude", &attitude_out},
+                                   std::tuple{&events_path, "--events", &events_out}}) {
+    if (path->empty()) continue;
+    auto out = files.add(*path, label);
+    if (!out) return report("record", out.error());
+    *slot = *out;
+  }
 
   service::AssemblerConfig assembly;
   if (!config_path.empty()) {
@@ -160,8 +189,7 @@ int cmd_record(int argc, char** argv) {
   auto write_epochs = [&]() -> Status {
     for (const auto& epoch : epochs) {
       if (!log_open) {
-        if (auto s = log.open(out_path, n, true, false, {{"unit", unit}, {"source", "tetra record"}}); !s)
-          return s;
+        if (auto s = log.open(*log_out, n, true, false, record_metadata(unit, files)); !s) return s;
         log_open = true;
       }
       for (int i = 0; i < n; ++i)
@@ -236,19 +264,22 @@ int cmd_record(int argc, char** argv) {
   assembler->poll(INT64_MAX, epochs);
   if (auto s = write_epochs(); !s) return report("record", s.error());
   if (!log_open) {
-    if (auto s = log.open(out_path, n, true, false, {{"unit", unit}, {"source", "tetra record"}}); !s) {
+    if (auto s = log.open(*log_out, n, true, false, record_metadata(unit, files)); !s) {
       return report("record", s.error());
     }
   }
   if (auto s = log.close(); !s) return report("record", s.error());
-  if (!attitude_path.empty()) {
-    if (auto s = write_text_file(attitude_path, attitude_text); !s) return report("record", s.error());
+  if (attitude_out) {
+    std::string text;
+    for (const auto& [key, value] : record_metadata(unit, files)) append_metadata(text, key, value);
+    if (auto s = attitude_out->write(text + attitude_text); !s) return report("record", s.error());
   }
-  if (!events_path.empty()) {
+  if (events_out) {
     std::string text;
     for (const auto& [seq, line] : event_lines) text += line + '\n';
-    if (auto s = write_text_file(events_path, text); !s) return report("record", s.error());
+    if (auto s = events_out->write(text); !s) return report("record", s.error());
   }
+  if (auto s = files.commit(); !s) return report("record", s.error());
   const auto& c = assembler->counters();
   std::cerr << "tetra record: " << epochs_written << " epochs of unit "
             << (unit.empty() ? "(none seen)" : unit) << " written to " << out_path << " (late "

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/output_files.hpp"
 #include "tetra/core/quaternion.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/core/units.hpp"
@@ -97,5 +98,10 @@ Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options
 //! `progress` is called now and then with the fraction done.
 Status write_simulation(Simulator& simulator, const std::string& log_path, const std::string& truth_path,
                         void (*progress)(double fraction) = nullptr);
+//! The same into outputs of a larger run (the caller's RunFiles commits them); `extra_metadata` (e.g.
+//! provenance) follows the simulator's own "# key=value" lines. `truth` may be null.
+Status write_simulation(Simulator& simulator, OutputFile& log, OutputFile* truth,
+                        const std::vector<std::pair<std::string, std::string>>& extra_metadata,
+                        void (*progress)(double fraction));
 
 }  // namespace tetra::sim
