@@ -1,4 +1,4 @@
-// The command-line contract (INTERFACES §3): help everywhere, exit 2 on bad usage.
+// The command-line contract (docs/interfaces.md §3): help everywhere, exit 2 on bad usage.
 #include <gtest/gtest.h>
 
 #include "test_support.hpp"

@@ -185,7 +185,7 @@ TEST(DdsServices, StuckGyroIsIsolatedAndAttitudeFlowsDegraded_LateMonitorAndComm
   EXPECT_EQ(fusion.signal_and_wait(SIGTERM), 0) << "clean shutdown on SIGTERM";
 }
 
-// Parses an attitude CSV (INTERFACES 2.4) into rows of numbers and the mode/gyros text.
+// Parses an attitude CSV (docs/interfaces.md §2.4) into rows of numbers and the mode/gyros text.
 struct AttitudeRows {
   std::vector<std::array<double, 9>> numbers;
   std::vector<std::string> labels;

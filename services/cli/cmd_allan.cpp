@@ -181,7 +181,7 @@ int cmd_allan(int argc, char** argv) {
   double confidence = allan::kOneSigmaConfidence;
   double dt_tolerance = 0.05;
   app.add_option("log", log_path,
-                 "gyro log (INTERFACES 2.2): time_s,g1..gN; volts, or deg/s with '# units=dps'")
+                 "gyro log (docs/interfaces.md §2.2): time_s,g1..gN; volts, or deg/s with '# units=dps'")
       ->required();
   app.add_option("--calibration", cal_path, "calibration YAML: volts become deg/s as (g - bias)/scale");
   app.add_flag("--update-calibration", update_cal,

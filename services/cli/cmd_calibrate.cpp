@@ -1,5 +1,5 @@
 // tetra calibrate — turntable calibration: scale factor, bias and axis of every gyro with their 1σ,
-// printed like seed Tables 3–5, written as a calibration file (INTERFACES §2.3).
+// printed like seed Tables 3–5, written as a calibration file (docs/interfaces.md §2.3).
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -155,7 +155,7 @@ void print_comparison(const TurntableMotion& motion, const CalibrationFit& refer
 int cmd_calibrate(int argc, char** argv) {
   CLI::App app{
       "Turntable calibration (seed eqs. 4-11): scale factor, bias and sensing axis of every gyro with their "
-      "1-sigma, from a turntable log (INTERFACES 2.1). Body rates come from the encoder angles.",
+      "1-sigma, from a turntable log (docs/interfaces.md §2.1). Body rates come from the encoder angles.",
       kName};
   std::string input;
   std::string output;
@@ -166,7 +166,7 @@ int cmd_calibrate(int argc, char** argv) {
   std::string unit_name;
   app.add_option("TURNTABLE.csv", input, "turntable log: sequence,time_s,inner_deg,outer_deg,g1..gN")
       ->required();
-  app.add_option("-o,--output", output, "calibration file to write (YAML, INTERFACES 2.3; - for standard output)")
+  app.add_option("-o,--output", output, "calibration file to write (YAML, docs/interfaces.md §2.3; - for standard output)")
       ->required();
   app.add_option("--latitude", latitude_deg,
                  "[deg] geodetic latitude of the table (default: the file's '# latitude_deg=' comment)")

@@ -1,5 +1,5 @@
 // tetra record -o LOG.csv — the gyro and reference streams of one unit on DDS, written as a
-// replayable gyro log (INTERFACES §2.2). Epochs are assembled exactly as `tetra fusion` does (same
+// replayable gyro log (docs/interfaces.md §2.2). Epochs are assembled exactly as `tetra fusion` does (same
 // assembler, same settings when given the service's --config), so `tetra replay` of the log sees
 // the epochs the service saw. Optionally also the service's Attitude (§2.4) and FdiEvents (§2.5).
 // Stops on SIGINT/SIGTERM, after --duration, or with --until-idle when the gyro writers are gone.
@@ -61,7 +61,7 @@ int cmd_record(int argc, char** argv) {
   double duration_s = 0.0;
   bool until_idle = false;
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
-  app.add_option("-o,--out", out_path, "gyro log to write (CSV, INTERFACES 2.2)")->required();
+  app.add_option("-o,--out", out_path, "gyro log to write (CSV, docs/interfaces.md §2.2)")->required();
   app.add_option("--unit", unit, "the unit to record (default: the first one seen)");
   app.add_option("--config", config_path, "take unit, gyro count and assembly settings from a fusion config");
   app.add_option("--gyros", gyros, "number of gyros N (columns g1..gN)")
@@ -72,8 +72,8 @@ int cmd_record(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-latency", max_latency_s, "[s] longest wait for an epoch's missing samples")
       ->check(CLI::PositiveNumber);
-  app.add_option("--attitude", attitude_path, "also write the service's Attitude (CSV, INTERFACES 2.4)");
-  app.add_option("--events", events_path, "also write the service's FdiEvents (JSON lines, INTERFACES 2.5)");
+  app.add_option("--attitude", attitude_path, "also write the service's Attitude (CSV, docs/interfaces.md §2.4)");
+  app.add_option("--events", events_path, "also write the service's FdiEvents (JSON lines, docs/interfaces.md §2.5)");
   app.add_option("--duration", duration_s, "[s] stop after this long")->check(CLI::PositiveNumber);
   app.add_flag("--until-idle", until_idle, "stop when the gyro writers have come and gone");
   add_domain_option(app, domain);

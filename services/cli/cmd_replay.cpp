@@ -1,4 +1,4 @@
-// tetra replay — the whole fusion pipeline offline: gyro log in; attitude (INTERFACES §2.4) and FDI
+// tetra replay — the whole fusion pipeline offline: gyro log in; attitude (docs/interfaces.md §2.4) and FDI
 // events (§2.5) out; a summary on stderr. The same Pipeline object serves the DDS service.
 #include <array>
 #include <cmath>
@@ -48,7 +48,7 @@ Result<Quaternion> parse_quaternion(const std::string& text) {
 
 int cmd_replay(int argc, char** argv) {
   CLI::App app{
-      "Run the fusion and fault-detection pipeline over a gyro log (INTERFACES §2.2): writes the attitude "
+      "Run the fusion and fault-detection pipeline over a gyro log (docs/interfaces.md §2.2): writes the attitude "
       "(§2.4) and the FDI events (§2.5); prints a summary on stderr.",
       "replay"};
   std::string log_path;
@@ -59,7 +59,7 @@ int cmd_replay(int argc, char** argv) {
   std::optional<double> latitude_deg;
   std::string initial_q;
   app.add_option("LOG", log_path, "gyro log (CSV)")->required();
-  app.add_option("--calibration", cal_path, "calibration file (YAML, INTERFACES §2.3)")->required();
+  app.add_option("--calibration", cal_path, "calibration file (YAML, docs/interfaces.md §2.3)")->required();
   app.add_option("--latitude", latitude_deg,
                  "[deg] ground-test mode: remove the Earth rate at this geodetic latitude")
       ->check(CLI::Range(-90.0, 90.0));

@@ -88,7 +88,7 @@ int cmd_sim(int argc, char** argv) {
       app.add_option("--latitude", latitude_deg, "[deg] geodetic latitude (turntable, static, lab-orbit)")
           ->check(CLI::Range(-90.0, 90.0));
   app.add_option("--fault", fault_texts,
-                 "gyro=N,kind=K,at=S[,size=X][,until=S] (repeatable; INTERFACES 2.7)");
+                 "gyro=N,kind=K,at=S[,size=X][,until=S] (repeatable; docs/interfaces.md §2.7)");
   auto* opt_ref = app.add_option("--reference-hz", reference_hz, "[Hz] attitude reference rate (0 = none)");
   auto* opt_ref_noise =
       app.add_option("--reference-noise", reference_noise_arcsec, "[arcsec] reference 1-sigma per axis");

@@ -1,5 +1,5 @@
 #pragma once
-// Calibration file (INTERFACES §2.3), YAML. Unknown keys are an error; every error names the file,
+// Calibration file (docs/interfaces.md §2.3), YAML. Unknown keys are an error; every error names the file,
 // the line and the key. Units: scale factor [V/(deg/s)], bias [V], axis unit vector in B.
 // Axes whose norm is within 1e-3 of one are accepted and normalized (tables are often printed to
 // five decimals); others are rejected.

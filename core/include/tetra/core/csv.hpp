@@ -1,5 +1,5 @@
 #pragma once
-// Text tables of INTERFACES §2: UTF-8, '#' starts a comment line (metadata "# key=value" allowed, the
+// Text tables of docs/interfaces.md §2: UTF-8, '#' starts a comment line (metadata "# key=value" allowed, the
 // value with %XX escapes for blanks, commas, '%' and control characters),
 // the first non-comment line is a header, columns are matched by name. Every cell is parsed as a
 // number; an empty cell is kept as "empty" (value NaN), "nan" as NaN. A malformed file is an Error

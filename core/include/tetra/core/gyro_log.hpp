@@ -1,5 +1,5 @@
 #pragma once
-// Gyro log (INTERFACES §2.2): time_s,g1..gN[,ref_qw,ref_qx,ref_qy,ref_qz].
+// Gyro log (docs/interfaces.md §2.2): time_s,g1..gN[,ref_qw,ref_qx,ref_qy,ref_qz].
 // An empty gyro cell means "no sample this epoch" (present = 0); "nan" means an invalid sample
 // (present = 1, value NaN). Values are volts unless the file says "# units=dps" (deg/s).
 // Reference columns are all four or none; on a row they are all filled or all empty.

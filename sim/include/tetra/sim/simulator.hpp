@@ -93,7 +93,7 @@ struct Truth {
 //! reference); the truth too when `truth` is given.
 Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options, Truth* truth = nullptr);
 
-//! Runs the simulator to files: the gyro log (INTERFACES §2.2) and, if `truth_path` is not empty,
+//! Runs the simulator to files: the gyro log (docs/interfaces.md §2.2) and, if `truth_path` is not empty,
 //! the truth (time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps: attitude body → R and rate of B relative to R).
 //! `progress` is called now and then with the fraction done.
 Status write_simulation(Simulator& simulator, const std::string& log_path, const std::string& truth_path,
