@@ -71,7 +71,7 @@ void parse_metadata(std::string_view comment, CsvTable& table) {
 
 bool parse_number(std::string_view s, double& out) {
   if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  if (s.empty()) return false;
+  if (s.empty() || s.find('(') != std::string_view::npos) return false;  // no "nan(payload)"
   const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
   return ec == std::errc() && ptr == s.data() + s.size();
 }

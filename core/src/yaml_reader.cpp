@@ -32,9 +32,17 @@ std::string key_path(const std::string& what, const std::string& key) {
 }  // namespace
 
 Status YamlReader::check_unique_keys(const YAML::Node& node, const std::string& what) const {
+  std::size_t budget = kMaxYamlNodes;
+  return check_unique_keys(node, what, budget);
+}
+
+Status YamlReader::check_unique_keys(const YAML::Node& node, const std::string& what, std::size_t& budget) const {
+  // Aliases make a small text a huge tree ("a billion laughs"): the walk is bounded, like the file.
+  if (budget == 0) return error(node, what, "more than " + std::to_string(kMaxYamlNodes) + " nodes (aliases?)");
+  --budget;
   if (node.IsSequence()) {
     for (std::size_t i = 0; i < node.size(); ++i) {
-      if (Status st = check_unique_keys(node[i], what + "[" + std::to_string(i) + "]"); !st) return st;
+      if (Status st = check_unique_keys(node[i], what + "[" + std::to_string(i) + "]", budget); !st) return st;
     }
   } else if (node.IsMap()) {
     std::vector<std::string> seen;
@@ -44,7 +52,7 @@ Status YamlReader::check_unique_keys(const YAML::Node& node, const std::string& 
         if (s == key) return error(kv.first, what, "key '" + key + "' appears twice");
       }
       seen.push_back(key);
-      if (Status st = check_unique_keys(kv.second, key_path(what, key)); !st) return st;
+      if (Status st = check_unique_keys(kv.second, key_path(what, key), budget); !st) return st;
     }
   }
   return ok_status();

@@ -1,5 +1,7 @@
 #include "cli_common.hpp"
 
+#include <charconv>
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
 
@@ -15,13 +17,27 @@ bool starts_with(const std::string& text, const char* prefix) {
 }
 
 // Plain decimal numbers only: CLI11 alone reads "0x10" as 16, "" as nothing and "1,5" as 1 or 15.
-CLI::Validator plain_number(bool integer) {
+enum class NumberForm { kReal, kInteger, kUnsigned };
+
+template <class T>
+bool whole_number(const std::string& text) {
+  T value{};
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  return !text.empty() && ec == std::errc() && ptr == text.data() + text.size();
+}
+
+CLI::Validator plain_number(NumberForm form) {
   return CLI::Validator(
-      [integer](std::string& text) -> std::string {
-        if (integer) {
-          std::size_t i = (!text.empty() && (text[0] == '-' || text[0] == '+')) ? 1 : 0;
-          const bool digits = i < text.size() && text.find_first_not_of("0123456789", i) == std::string::npos;
-          return digits ? std::string() : "'" + text + "' is not a whole decimal number";
+      [form](std::string& text) -> std::string {
+        switch (form) {
+          case NumberForm::kInteger:
+            return whole_number<std::int64_t>(text) ? std::string() : "'" + text + "' is not a whole number";
+          case NumberForm::kUnsigned:
+            return whole_number<std::uint64_t>(text)
+                       ? std::string()
+                       : "'" + text + "' is not a whole number in 0.." + std::to_string(UINT64_MAX);
+          case NumberForm::kReal:
+            break;
         }
         return parse_decimal(text) ? std::string() : "'" + text + "' is not a finite decimal number";
       },
@@ -32,8 +48,9 @@ CLI::Validator plain_number(bool integer) {
 void harden(CLI::App& app) {
   for (CLI::Option* opt : app.get_options()) {
     const std::string type = opt->get_type_name();
-    if (starts_with(type, "FLOAT")) opt->check(plain_number(false));
-    if (starts_with(type, "INT") || starts_with(type, "UINT")) opt->check(plain_number(true));
+    if (starts_with(type, "FLOAT")) opt->check(plain_number(NumberForm::kReal));
+    if (starts_with(type, "INT")) opt->check(plain_number(NumberForm::kInteger));
+    if (starts_with(type, "UINT")) opt->check(plain_number(NumberForm::kUnsigned));
     if (opt->get_expected_max() == 1 && opt->get_items_expected_max() == 1)
       opt->multi_option_policy(CLI::MultiOptionPolicy::Throw);
   }

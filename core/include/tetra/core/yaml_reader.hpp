@@ -33,8 +33,10 @@ class YamlReader {
   //! Parses a file's one document; a syntax error becomes "FILE:LINE: message". A second document
   //! and a key given twice in any mapping, at any depth, are errors naming the line and key path.
   Result<YAML::Node> load(const std::string& text) const;
-  //! Every mapping below `node` has distinct keys.
+  //! Every mapping below `node` has distinct keys; at most kMaxYamlNodes nodes are walked.
   Status check_unique_keys(const YAML::Node& node, const std::string& what) const;
+  //! [nodes] largest YAML tree read (aliases included).
+  static constexpr std::size_t kMaxYamlNodes = 1'000'000;
 
   //! A scalar as text ("expected a text value" for a list or a mapping).
   Result<std::string> text(const YAML::Node& node, const std::string& what) const;
@@ -70,6 +72,7 @@ class YamlReader {
   static std::string child(const std::string& what, const std::string& key);
 
  private:
+  Status check_unique_keys(const YAML::Node& node, const std::string& what, std::size_t& budget) const;
   std::string source_;
 };
 
