@@ -4,8 +4,8 @@
 #include <cstdio>
 
 #include "tetra/core/allan.hpp"
-#include "tetra/core/json.hpp"
 #include "tetra/core/csv.hpp"
+#include "tetra/core/json.hpp"
 
 namespace tetra::allan {
 
@@ -80,7 +80,8 @@ std::string format_csv(const LogAllan& analysis) {
   return out;
 }
 
-std::string format_json(const LogAllan& analysis, const std::vector<std::pair<std::string, std::string>>& provenance) {
+std::string format_json(const LogAllan& analysis,
+                        const std::vector<std::pair<std::string, std::string>>& provenance) {
   std::string out = "{";
   if (!provenance.empty()) {
     out += "\"provenance\": {";

@@ -94,9 +94,9 @@ Result<GyroCalibration> parse_gyro(const YamlReader& yaml, const YAML::Node& g, 
       sigma.axis = *sigma_axis;
     }
     for (const char* key : {"scale_factor_V_per_dps", "bias_V", "axis"}) {
-      const double smallest = std::string(key) == "axis" ? sigma.axis.minCoeff()
+      const double smallest = std::string(key) == "axis"     ? sigma.axis.minCoeff()
                               : std::string(key) == "bias_V" ? sigma.bias_V
-                                                              : sigma.scale_factor_V_per_dps;
+                                                             : sigma.scale_factor_V_per_dps;
       if (smallest < 0.0) return yaml.error(s[key], sw + "." + key, "a 1-sigma must not be negative");
     }
     out.sigma = sigma;
@@ -243,7 +243,8 @@ std::string format_calibration(const Calibration& cal, const Metadata& comments)
   // yaml-cpp's emitter quotes and escapes text (a unit name with a quote, a backslash or a newline
   // reads back unchanged); numbers are written in shortest round-trip form.
   YAML::Emitter out;
-  out << YAML::Comment("tetra calibration: y_i = (g_i - bias_V) / scale_factor_V_per_dps = axis . omega_B [deg/s]");
+  out << YAML::Comment(
+      "tetra calibration: y_i = (g_i - bias_V) / scale_factor_V_per_dps = axis . omega_B [deg/s]");
   for (const auto& [key, value] : comments) {
     out << YAML::Newline << YAML::Comment(key + "=" + one_line(value));
   }

@@ -28,7 +28,6 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-
 int hex_digit(char c) {
   if (c >= '0' && c <= '9') return c - '0';
   if (c >= 'A' && c <= 'F') return c - 'A' + 10;
@@ -41,7 +40,8 @@ std::string unescape_meta(std::string_view value) {
   std::string out;
   out.reserve(value.size());
   for (std::size_t i = 0; i < value.size(); ++i) {
-    if (value[i] == '%' && i + 2 < value.size() && hex_digit(value[i + 1]) >= 0 && hex_digit(value[i + 2]) >= 0) {
+    if (value[i] == '%' && i + 2 < value.size() && hex_digit(value[i + 1]) >= 0 &&
+        hex_digit(value[i + 2]) >= 0) {
       out += static_cast<char>(hex_digit(value[i + 1]) * 16 + hex_digit(value[i + 2]));
       i += 2;
     } else {
@@ -142,8 +142,9 @@ Status parse_lines(std::string_view text, std::size_t& pos, std::size_t& line_no
 
     if (!have_header) {
       if (fields.size() > kMaxColumns) {
-        return bad_input(t.source + ":" + std::to_string(line_no) + ": header: " + std::to_string(fields.size()) +
-                         " columns, at most " + std::to_string(kMaxColumns) + " are read");
+        return bad_input(t.source + ":" + std::to_string(line_no) +
+                         ": header: " + std::to_string(fields.size()) + " columns, at most " +
+                         std::to_string(kMaxColumns) + " are read");
       }
       for (std::size_t i = 0; i < fields.size(); ++i) {
         if (fields[i].empty()) {
@@ -196,7 +197,8 @@ constexpr std::size_t kParallelBytes = std::size_t{8} << 20;
 void reserve_rows(CsvTable& t, std::string_view body) {
   // A row of C cells takes at least C bytes (C-1 commas and a newline): blank lines reserve nothing.
   const std::size_t lines = static_cast<std::size_t>(std::count(body.begin(), body.end(), '\n')) + 1;
-  const std::size_t approx_rows = std::min(lines, body.size() / std::max<std::size_t>(t.columns.size(), 1) + 1);
+  const std::size_t approx_rows =
+      std::min(lines, body.size() / std::max<std::size_t>(t.columns.size(), 1) + 1);
   t.cells.reserve(approx_rows * t.columns.size());
   t.empty.reserve(approx_rows * t.columns.size());
   t.lines.reserve(approx_rows);

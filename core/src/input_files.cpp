@@ -38,7 +38,8 @@ Status check_input(const std::string& path, std::size_t max_bytes, bool seekable
                      (S_ISFIFO(st.st_mode) ? " (this input is read more than once)" : ""));
   }
   if (S_ISREG(st.st_mode) && static_cast<std::size_t>(st.st_size) > max_bytes) {
-    return bad_input(path + ": is larger than the limit of " + size_text(max_bytes) + " for this kind of file");
+    return bad_input(path + ": is larger than the limit of " + size_text(max_bytes) +
+                     " for this kind of file");
   }
   if (::access(path.c_str(), R_OK) != 0) return bad_input(path + ": cannot open: " + std::strerror(errno));
   return ok_status();

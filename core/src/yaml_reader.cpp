@@ -36,13 +36,16 @@ Status YamlReader::check_unique_keys(const YAML::Node& node, const std::string& 
   return check_unique_keys(node, what, budget);
 }
 
-Status YamlReader::check_unique_keys(const YAML::Node& node, const std::string& what, std::size_t& budget) const {
+Status YamlReader::check_unique_keys(const YAML::Node& node, const std::string& what,
+                                     std::size_t& budget) const {
   // Aliases make a small text a huge tree ("a billion laughs"): the walk is bounded, like the file.
-  if (budget == 0) return error(node, what, "more than " + std::to_string(kMaxYamlNodes) + " nodes (aliases?)");
+  if (budget == 0)
+    return error(node, what, "more than " + std::to_string(kMaxYamlNodes) + " nodes (aliases?)");
   --budget;
   if (node.IsSequence()) {
     for (std::size_t i = 0; i < node.size(); ++i) {
-      if (Status st = check_unique_keys(node[i], what + "[" + std::to_string(i) + "]", budget); !st) return st;
+      if (Status st = check_unique_keys(node[i], what + "[" + std::to_string(i) + "]", budget); !st)
+        return st;
     }
   } else if (node.IsMap()) {
     std::vector<std::string> seen;

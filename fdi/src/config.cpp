@@ -99,7 +99,8 @@ Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const s
         } else if (const auto* i = std::get_if<int PipelineConfig::*>(&def.field)) {
           const auto v = yaml.number(value, what);
           if (!v) return v.error();
-          if (*v != std::floor(*v) || std::abs(*v) > 1e9) return yaml.error(value, what, "must be a whole number");
+          if (*v != std::floor(*v) || std::abs(*v) > 1e9)
+            return yaml.error(value, what, "must be a whole number");
           config.*(*i) = static_cast<int>(*v);
         } else {
           const std::string& b = value.Scalar();

@@ -1,6 +1,6 @@
 #pragma once
-// Attitude rows (docs/interfaces.md §2.4) as `tetra replay --attitude` and `tetra record --attitude` write them:
-// time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros
+// Attitude rows (docs/interfaces.md §2.4) as `tetra replay --attitude` and `tetra record --attitude` write
+// them: time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros
 
 #include <string>
 

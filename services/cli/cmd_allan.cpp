@@ -220,8 +220,9 @@ int cmd_allan(int argc, char** argv) {
   OutputFile* json_out = nullptr;
   OutputFile* plot_out = nullptr;
   OutputFile* cal_out = nullptr;
-  for (auto [path, label, slot] : {std::tuple{&csv_path, "--csv", &csv_out}, std::tuple{&json_path, "--json", &json_out},
-                                   std::tuple{&plot_path, "--plot", &plot_out}}) {
+  for (auto [path, label, slot] :
+       {std::tuple{&csv_path, "--csv", &csv_out}, std::tuple{&json_path, "--json", &json_out},
+        std::tuple{&plot_path, "--plot", &plot_out}}) {
     if (path->empty()) continue;
     auto out = files.add(*path, label);
     if (!out) return report(cmd, out.error());

@@ -166,7 +166,8 @@ int cmd_calibrate(int argc, char** argv) {
   std::string unit_name;
   app.add_option("TURNTABLE.csv", input, "turntable log: sequence,time_s,inner_deg,outer_deg,g1..gN")
       ->required();
-  app.add_option("-o,--output", output, "calibration file to write (YAML, docs/interfaces.md §2.3; - for standard output)")
+  app.add_option("-o,--output", output,
+                 "calibration file to write (YAML, docs/interfaces.md §2.3; - for standard output)")
       ->required();
   app.add_option("--latitude", latitude_deg,
                  "[deg] geodetic latitude of the table (default: the file's '# latitude_deg=' comment)")

@@ -102,7 +102,8 @@ int cmd_demo(int argc, char** argv) {
   app.add_option("--scenario", scenario_name,
                  "simulated motion: static, lab-orbit, orbit, slews or FILE.yaml")
       ->capture_default_str();
-  app.add_option("--fault", fault_text, "the injected failure (docs/interfaces.md §2.7)")->capture_default_str();
+  app.add_option("--fault", fault_text, "the injected failure (docs/interfaces.md §2.7)")
+      ->capture_default_str();
   app.add_option("--seconds", seconds, "[s] simulated duration")
       ->check(CLI::Range(5.0, 600.0))
       ->capture_default_str();

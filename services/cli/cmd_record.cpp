@@ -72,8 +72,10 @@ int cmd_record(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-latency", max_latency_s, "[s] longest wait for an epoch's missing samples")
       ->check(CLI::PositiveNumber);
-  app.add_option("--attitude", attitude_path, "also write the service's Attitude (CSV, docs/interfaces.md §2.4)");
-  app.add_option("--events", events_path, "also write the service's FdiEvents (JSON lines, docs/interfaces.md §2.5)");
+  app.add_option("--attitude", attitude_path,
+                 "also write the service's Attitude (CSV, docs/interfaces.md §2.4)");
+  app.add_option("--events", events_path,
+                 "also write the service's FdiEvents (JSON lines, docs/interfaces.md §2.5)");
   app.add_option("--duration", duration_s, "[s] stop after this long")->check(CLI::PositiveNumber);
   app.add_flag("--until-idle", until_idle, "stop when the gyro writers have come and gone");
   add_domain_option(app, domain);
@@ -84,9 +86,9 @@ int cmd_record(int argc, char** argv) {
   OutputFile* log_out = nullptr;
   OutputFile* attitude_out = nullptr;
   OutputFile* events_out = nullptr;
-  for (auto [path, label, slot] : {std::tuple{&out_path, "--out", &log_out},
-                                   std::tuple{&attitude_path, "--attitude", &attitude_out},
-                                   std::tuple{&events_path, "--events", &events_out}}) {
+  for (auto [path, label, slot] :
+       {std::tuple{&out_path, "--out", &log_out}, std::tuple{&attitude_path, "--attitude", &attitude_out},
+        std::tuple{&events_path, "--events", &events_out}}) {
     if (path->empty()) continue;
     auto out = files.add(*path, label);
     if (!out) return report("record", out.error());

@@ -48,7 +48,8 @@ Result<Quaternion> parse_quaternion(const std::string& text) {
 
 int cmd_replay(int argc, char** argv) {
   CLI::App app{
-      "Run the fusion and fault-detection pipeline over a gyro log (docs/interfaces.md §2.2): writes the attitude "
+      "Run the fusion and fault-detection pipeline over a gyro log (docs/interfaces.md §2.2): writes the "
+      "attitude "
       "(§2.4) and the FDI events (§2.5); prints a summary on stderr.",
       "replay"};
   std::string log_path;

@@ -198,7 +198,8 @@ int cmd_sim(int argc, char** argv) {
   if (!simulator) return report(kName, simulator.error());
   const bool long_run = simulator->epoch_count() > 2'000'000;
   const auto meta = provenance_metadata(provenance(files.input_paths()));
-  if (Status st = sim::write_simulation(*simulator, *log_out, truth_out, meta, long_run ? print_progress : nullptr);
+  if (Status st =
+          sim::write_simulation(*simulator, *log_out, truth_out, meta, long_run ? print_progress : nullptr);
       !st) {
     return report(kName, st.error());
   }

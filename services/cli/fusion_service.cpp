@@ -28,9 +28,10 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown)
   if (auto s = assign(participant_, dds::Participant::create(domain, config_.unit)); !s) return s;
   if (auto s = assign(topics_, dds::Topics::create(*participant_)); !s) return s;
   const dds::Topics& t = *topics_;
-  if (auto s = assign(gyro_reader_, dds::Reader<tetra_GyroSample>::create(
-                                        *participant_, t.gyro_sample,
-                                        dds::gyro_sample_reader_qos(std::chrono::nanoseconds(deadline_ns_ / 3))));
+  if (auto s =
+          assign(gyro_reader_, dds::Reader<tetra_GyroSample>::create(
+                                   *participant_, t.gyro_sample,
+                                   dds::gyro_sample_reader_qos(std::chrono::nanoseconds(deadline_ns_ / 3))));
       !s) {
     return s;
   }
@@ -189,7 +190,8 @@ Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered,
         const std::uint32_t policy = qos_status.last_policy_id;
         if (policy == DDS_DEADLINE_QOS_POLICY_ID) {
           spdlog::warn(
-              "fusion: a GyroSample writer offers incompatible QoS: deadline (policy id {}; its deadline must "
+              "fusion: a GyroSample writer offers incompatible QoS: deadline (policy id {}; its deadline "
+              "must "
               "be at most {} s: sample_rate_hz and speed must match the sensor's)",
               policy, static_cast<double>(deadline_ns_) * 1e-9);
         } else {
@@ -268,9 +270,10 @@ void FusionService::warn_other_unit(std::int64_t now_ns) {
   const std::uint64_t other = assembler_.counters().samples_other_unit;
   if (other == other_at_warning_ || now_ns < next_other_warning_ns_) return;
   if (own_samples_ == own_at_warning_) {
-    spdlog::warn("fusion: hearing GyroSample for unit '{}' ({} samples of other units so far) and none for "
-                 "this service's unit '{}': check the unit names",
-                 other_unit_heard_, other, config_.unit);
+    spdlog::warn(
+        "fusion: hearing GyroSample for unit '{}' ({} samples of other units so far) and none for "
+        "this service's unit '{}': check the unit names",
+        other_unit_heard_, other, config_.unit);
   }
   other_at_warning_ = other;
   own_at_warning_ = own_samples_;

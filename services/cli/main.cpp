@@ -87,6 +87,7 @@ int main(int argc, char** argv) {
       }
     }
   }
-  std::cerr << "tetra: unknown command '" << tetra::one_line(std::string(name)) << "' (tetra help lists them)\n";
+  std::cerr << "tetra: unknown command '" << tetra::one_line(std::string(name))
+            << "' (tetra help lists them)\n";
   return tetra::cli::kExitBadInput;
 }

@@ -13,8 +13,10 @@ Qos gyro_sample_reader_qos(std::chrono::nanoseconds sample_period) {
   // (a sensor driver that leaves liveliness at its default still matches); the deadline detects a
   // silent gyro.
   Qos qos;
-  qos.reliable().volatile_durability().keep_last(kGyroSampleDepth).automatic_liveliness(
-      std::chrono::nanoseconds(DDS_INFINITY));
+  qos.reliable()
+      .volatile_durability()
+      .keep_last(kGyroSampleDepth)
+      .automatic_liveliness(std::chrono::nanoseconds(DDS_INFINITY));
   if (sample_period.count() > 0) qos.deadline(3 * sample_period);
   return qos;
 }

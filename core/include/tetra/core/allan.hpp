@@ -187,7 +187,8 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
 
 //! docs/interfaces.md §2.6 CSV: gyro,tau_s,adev,adev_lo,adev_hi,n.
 std::string format_csv(const LogAllan& analysis);
-//! docs/interfaces.md §2.6 JSON: {"units": ..., "gyros": [{"id", "Q", "N", "B", "K", "R"}]}, null = not observed.
+//! docs/interfaces.md §2.6 JSON: {"units": ..., "gyros": [{"id", "Q", "N", "B", "K", "R"}]}, null = not
+//! observed.
 std::string format_json(const LogAllan& analysis,
                         const std::vector<std::pair<std::string, std::string>>& provenance = {});
 //! A table like seed Table 6, in the input's units and (for deg/s) in deg/√h, deg/h, deg/h/√h, deg/h².

@@ -50,9 +50,9 @@ class OutputFile {
  private:
   friend class RunFiles;
   OutputFile() = default;
-  Status sync();      // fsync and close the temporary file (regular outputs)
+  Status sync();  // fsync and close the temporary file (regular outputs)
   Status rename_into_place();
-  void discard();     // removes an uncommitted temporary file
+  void discard();  // removes an uncommitted temporary file
 
   std::string path_;    // as given
   std::string label_;   // the option that named it ("--attitude"), for messages

@@ -45,8 +45,8 @@ TurntableSequence turntable_sequence(int number);
 double wrap_deg(double angle_deg);
 
 //! The 16 sequences of seed Table 3 as encoder angles (fixed angle of one gimbal, the other rotating +w then
-//! -w), body rates and Earth rate in B from the kinematics of docs/interfaces.md §1 (NOT Table 3's body-rate signs),
-//! gyro outputs from `unit` (scale factors, biases, axes, and the noise terms present in its `noise:`
+//! -w), body rates and Earth rate in B from the kinematics of docs/interfaces.md §1 (NOT Table 3's body-rate
+//! signs), gyro outputs from `unit` (scale factors, biases, axes, and the noise terms present in its `noise:`
 //! sections).
 Result<TurntableLog> simulate_turntable(const Calibration& unit, const TurntablePlan& plan,
                                         std::uint64_t seed);
