@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <climits>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
@@ -84,6 +85,8 @@ OutputFile::~OutputFile() {
 
 Status OutputFile::write(std::string_view data) {
   if (fd_ < 0) return failure(path_ + ": output is closed");
+  // Text printed through stdio or std::cout (synchronized with stdio) comes first on standard output.
+  if (fd_ == STDOUT_FILENO) std::fflush(stdout);
   return write_all(fd_, data, path_);
 }
 
