@@ -1,4 +1,4 @@
-// `tetra allan` end to end: outputs of INTERFACES §2.6, calibration in and out, and the bad-input
+// `tetra allan` end to end: outputs of docs/interfaces.md §2.6, calibration in and out, and the bad-input
 // contract (exit 2 with one line naming the reason).
 #include <gtest/gtest.h>
 

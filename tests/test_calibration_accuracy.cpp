@@ -179,9 +179,9 @@ INSTANTIATE_TEST_SUITE_P(Calibration, Accuracy,
                          ::testing::Values(CalibrationMethod::kSixteen, CalibrationMethod::kBatch),
                          method_name);
 
-// The body rates come from the encoders and the kinematics of INTERFACES §1. Expected mean table rates
-// per sequence for the seed's Table 3 plan at 6 deg/s (rows 9–16 differ in sign from seed Table 3, whose
-// signs do not follow from any consistent gimbal kinematics):
+// The body rates come from the encoders and the kinematics of docs/interfaces.md §1. Expected mean table
+// rates per sequence for the seed's Table 3 plan at 6 deg/s (rows 9–16 differ in sign from seed Table 3,
+// whose signs do not follow from any consistent gimbal kinematics):
 //   ω_B = (inner_dot, outer_dot·cos(inner), −outer_dot·sin(inner)).
 TEST(CalibrationMotion, BodyRatesFollowTheGimbalKinematics) {
   const double w = 6.0;

@@ -1,4 +1,5 @@
-// Calibration YAML (INTERFACES §2.3): round trip, unknown keys and bad values rejected with line numbers.
+// Calibration YAML (docs/interfaces.md §2.3): round trip, unknown keys and bad values rejected with line
+// numbers.
 #include <gtest/gtest.h>
 
 #include "test_support.hpp"

@@ -1,4 +1,4 @@
-// The command-line contract (INTERFACES §3): help everywhere, exit 2 on bad usage.
+// The command-line contract (docs/interfaces.md §3): help everywhere, exit 2 on bad usage.
 #include <gtest/gtest.h>
 
 #include "test_support.hpp"
@@ -20,6 +20,26 @@ TEST(Cli, UnknownCommandIsBadUsage) {
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_NE(r.err.find("unknown command 'frobnicate'"), std::string::npos);
   EXPECT_EQ(test::run_tetra("").exit_status, 2);
+}
+
+TEST(Cli, HelpOfAnUnknownCommandIsBadUsage) {
+  const auto r = test::run_tetra("help frobnicate");
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(r.err, "tetra help: unknown command 'frobnicate' (tetra help lists them)\n");
+  EXPECT_EQ(test::run_tetra("help sim").exit_status, 0);
+}
+
+TEST(Cli, VersionEverywhere) {
+  const auto r = test::run_tetra("--version");
+  EXPECT_EQ(r.exit_status, 0);
+  EXPECT_EQ(r.out, std::string("tetra ") + TETRA_VERSION + "\n");
+  EXPECT_EQ(test::run_tetra("sim --version").out, r.out);
+}
+
+TEST(Cli, SingleValuedOptionGivenTwiceIsRefusedNamingIt) {
+  const auto r = test::run_tetra("sim static --minutes 1 --minutes 2 -o /dev/null");
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_NE(r.err.find("--minutes"), std::string::npos) << r.err;
 }
 
 }  // namespace

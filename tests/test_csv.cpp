@@ -1,4 +1,4 @@
-// Text tables and gyro logs (INTERFACES §2, §2.2): header by name, comments, empty vs nan, errors
+// Text tables and gyro logs (docs/interfaces.md §2, §2.2): header by name, comments, empty vs nan, errors
 // that name file, line and column.
 #include <cmath>
 

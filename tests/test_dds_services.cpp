@@ -185,7 +185,7 @@ TEST(DdsServices, StuckGyroIsIsolatedAndAttitudeFlowsDegraded_LateMonitorAndComm
   EXPECT_EQ(fusion.signal_and_wait(SIGTERM), 0) << "clean shutdown on SIGTERM";
 }
 
-// Parses an attitude CSV (INTERFACES 2.4) into rows of numbers and the mode/gyros text.
+// Parses an attitude CSV (docs/interfaces.md §2.4) into rows of numbers and the mode/gyros text.
 struct AttitudeRows {
   std::vector<std::array<double, 9>> numbers;
   std::vector<std::string> labels;
@@ -373,6 +373,40 @@ TEST(DdsServices, MalformedTrafficIsCountedNeverMixedNeverACrash) {
   EXPECT_EQ(observer.health.count("intruder"), 0U);  // nobody fuses the intruder's samples
   EXPECT_EQ(observer.attitude_units.count("intruder"), 0U);
   EXPECT_EQ(fusion.signal_and_wait(SIGINT), 0) << "the service survived and shut down cleanly";
+}
+
+TEST(DdsServices, DefaultLivelinessWriterMatchesAndAnotherUnitIsWarnedAbout) {
+  // A sensor driver with the topic table's reliability, durability, history and deadline but the
+  // default liveliness matches the service; samples for another unit only are warned about, by name.
+  const dds_domainid_t domain = 165;
+  ServiceFiles files(100.0, 1.0);
+  Observer observer(domain);
+  TetraProcess fusion({"fusion", "--config", files.config, "--domain", d(domain)},
+                      files.dir.file("fusion.log"));
+  dds::Qos qos;
+  qos.reliable()
+      .volatile_durability()
+      .keep_last(dds::kGyroSampleDepth)
+      .deadline(std::chrono::milliseconds(30));
+  auto writer =
+      dds::Writer<tetra_GyroSample>::create(observer.participant(), observer.topics().gyro_sample, qos);
+  ASSERT_TRUE(writer.ok());
+  ASSERT_TRUE(observer.wait_until([&] { return *writer->matched_readers() >= 1; }))
+      << read_file(files.dir.file("fusion.log"));
+  for (std::uint64_t k = 1; k <= 20; ++k) {
+    tetra_GyroSample m{};
+    EXPECT_TRUE(dds::copy_bounded(m.unit, "tetra-9", "unit").ok());
+    m.gyro = 1;
+    m.seq = k;
+    m.stamp_ns = static_cast<std::int64_t>(k) * 10'000'000;
+    EXPECT_TRUE(writer->write(m).ok());
+  }
+  ASSERT_TRUE(observer.wait_until([&] {
+    return read_file(files.dir.file("fusion.log")).find("hearing GyroSample for unit 'tetra-9'") !=
+           std::string::npos;
+  })) << read_file(files.dir.file("fusion.log"));
+  EXPECT_EQ(read_file(files.dir.file("fusion.log")).find("incompatible QoS"), std::string::npos);
+  EXPECT_EQ(fusion.signal_and_wait(SIGINT), 0);
 }
 
 TEST(DdsServices, CommandLineErrorsAndAbsentServicesGiveTheExitStatusOfTheContract) {

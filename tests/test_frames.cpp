@@ -1,4 +1,4 @@
-// Turntable kinematics and the Earth rate (INTERFACES §1).
+// Turntable kinematics and the Earth rate (docs/interfaces.md §1).
 #include <cmath>
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Geometry of the nominal tetrahedron and of general N-gyro packages (INTERFACES §1).
+// Geometry of the nominal tetrahedron and of general N-gyro packages (docs/interfaces.md §1).
 #include <cmath>
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Quaternion convention (INTERFACES §1): Hamilton, body→reference, q ← q ⊗ exp(½ ω Δt).
+// Quaternion convention (docs/interfaces.md §1): Hamilton, body→reference, q ← q ⊗ exp(½ ω Δt).
 #include <cmath>
 #include <random>
 

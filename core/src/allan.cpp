@@ -368,7 +368,11 @@ Result<AllanResult> analyze_series(std::span<const double> rate, std::span<const
   std::vector<AvarPoint> all = overlapping_avar(rate, present, tau0_s, *ms);
   std::vector<AvarPoint> avar;
   for (const AvarPoint& p : all) {
-    if (p.terms > 0 && std::isfinite(p.avar)) avar.push_back(p);
+    if (p.terms > 0 && std::isfinite(p.avar)) {
+      avar.push_back(p);
+    } else {
+      result.uncomputed_tau_s.push_back(p.tau_s);
+    }
   }
   if (avar.empty()) {
     return bad_input(

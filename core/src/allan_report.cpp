@@ -1,10 +1,11 @@
-// Reports of an Allan analysis: CSV and JSON of INTERFACES §2.6, a table like seed Table 6, and the
+// Reports of an Allan analysis: CSV and JSON of docs/interfaces.md §2.6, a table like seed Table 6, and the
 // calibration file's noise sections.
 #include <cmath>
 #include <cstdio>
 
 #include "tetra/core/allan.hpp"
 #include "tetra/core/csv.hpp"
+#include "tetra/core/json.hpp"
 
 namespace tetra::allan {
 
@@ -69,12 +70,30 @@ std::string format_csv(const LogAllan& analysis) {
       append_int(out, p.terms);
       out += '\n';
     }
+    for (const double tau_s : g.result.uncomputed_tau_s) {
+      append_int(out, g.id);
+      out += ',';
+      append_double(out, tau_s);
+      out += ",nan,nan,nan,0\n";  // requested, not computable: no window of consecutive samples
+    }
   }
   return out;
 }
 
-std::string format_json(const LogAllan& analysis) {
-  std::string out = "{\"units\": \"" + analysis.units + "\", \"tau0_s\": ";
+std::string format_json(const LogAllan& analysis,
+                        const std::vector<std::pair<std::string, std::string>>& provenance) {
+  std::string out = "{";
+  if (!provenance.empty()) {
+    out += "\"provenance\": {";
+    for (std::size_t i = 0; i < provenance.size(); ++i) {
+      if (i != 0) out += ", ";
+      append_json_string(out, provenance[i].first);
+      out += ": ";
+      append_json_string(out, provenance[i].second);
+    }
+    out += "},\n ";
+  }
+  out += "\"units\": \"" + analysis.units + "\", \"tau0_s\": ";
   append_double(out, analysis.tau0_s);
   out += ", \"gyros\": [";
   for (std::size_t i = 0; i < analysis.gyros.size(); ++i) {
@@ -98,6 +117,12 @@ std::string format_json(const LogAllan& analysis) {
     append_int(out, static_cast<long long>(g.absent));
     out += ", \"invalid\": ";
     append_int(out, static_cast<long long>(g.invalid));
+    out += ", \"uncomputed_tau_s\": [";
+    for (std::size_t k = 0; k < g.result.uncomputed_tau_s.size(); ++k) {
+      if (k != 0) out += ", ";
+      append_json_number(out, g.result.uncomputed_tau_s[k]);
+    }
+    out += "]";
     out += "}";
   }
   out += "\n]}\n";
@@ -122,6 +147,12 @@ std::string format_table(const LogAllan& analysis) {
       out += pad(v ? sci(*v) : "NO", w);
     }
     out += '\n';
+  }
+  for (const GyroAllan& g : analysis.gyros) {
+    if (g.result.uncomputed_tau_s.empty()) continue;
+    out += "gyro " + std::to_string(g.id) + ": averaging times not computable (gaps leave no window):";
+    for (const double tau_s : g.result.uncomputed_tau_s) out += " " + sci(tau_s, 3);
+    out += " s\n";
   }
   if (analysis.units == "deg/s") {
     out += "\nIn customary units (bias instability B; the flat floor of the Allan deviation is 0.664 B)\n";

@@ -159,7 +159,10 @@ double overlapping_avar_edf(NoiseType type, double phase_points, double m) {
       edf = (3.0 * (n - 1.0) / (2.0 * m) - 2.0 * (n - 2.0) / n) * (4.0 * m * m / (4.0 * m * m + 5.0));
       break;
     case NoiseType::kFlickerRate:
-      edf = m == 1.0 ? 2.0 * (n - 2.0) / (2.3 * n - 4.9) : 5.0 * n * n / (4.0 * m * (n + 3.0 * m));
+      // m = 1: 2(N-2)^2/(2.3N-4.9) (Howe, Allan and Barnes 1981; NIST SP 1065 prints it without the
+      // square, which gives EDF < 1 for any N and intervals about 100 times too wide).
+      edf =
+          m == 1.0 ? 2.0 * (n - 2.0) * (n - 2.0) / (2.3 * n - 4.9) : 5.0 * n * n / (4.0 * m * (n + 3.0 * m));
       break;
     case NoiseType::kRandomWalkRate:
       edf = (n - 2.0) / m * ((n - 1.0) * (n - 1.0) - 3.0 * m * (n - 1.0) + 4.0 * m * m) /

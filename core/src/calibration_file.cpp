@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/input_files.hpp"
 #include "tetra/core/yaml_reader.hpp"
 
 namespace tetra {
@@ -92,6 +93,12 @@ Result<GyroCalibration> parse_gyro(const YamlReader& yaml, const YAML::Node& g, 
       if (!sigma_axis) return sigma_axis.error();
       sigma.axis = *sigma_axis;
     }
+    for (const char* key : {"scale_factor_V_per_dps", "bias_V", "axis"}) {
+      const double smallest = std::string(key) == "axis"     ? sigma.axis.minCoeff()
+                              : std::string(key) == "bias_V" ? sigma.bias_V
+                                                             : sigma.scale_factor_V_per_dps;
+      if (smallest < 0.0) return yaml.error(s[key], sw + "." + key, "a 1-sigma must not be negative");
+    }
     out.sigma = sigma;
   }
   if (const YAML::Node n = g["noise"]; n && !n.IsNull()) {
@@ -113,7 +120,7 @@ Result<GyroCalibration> parse_gyro(const YamlReader& yaml, const YAML::Node& g, 
       *field = *v;
     }
     for (const auto& [key, field] : terms) {
-      if (*field && **field < 0.0) return yaml.error(n, nw, "noise terms must not be negative");
+      if (*field && **field < 0.0) return yaml.error(n[key], nw + "." + key, "must not be negative");
     }
     out.noise = noise;
   }
@@ -125,16 +132,24 @@ Result<GyroCalibration> parse_gyro(const YamlReader& yaml, const YAML::Node& g, 
 Result<Calibration> parse_calibration(const std::string& yaml_text, const std::string& source) {
   const YamlReader yaml{source};
   try {
-    const YAML::Node root = YAML::Load(yaml_text);
+    auto loaded = yaml.load(yaml_text);
+    if (!loaded) return loaded.error();
+    const YAML::Node root = *loaded;
     if (!root || root.IsNull()) return bad_input(source + ": empty calibration file");
     if (Status st = yaml.check_keys(root, {"unit", "latitude_deg", "method", "gyros"}, "calibration"); !st)
       return st.error();
     Calibration cal;
-    cal.unit = root["unit"] ? root["unit"].as<std::string>() : "";
-    const auto latitude = yaml.optional_number(root, "latitude_deg", "calibration");
+    auto unit = yaml.optional_text(root, "unit", "");
+    if (!unit) return unit.error();
+    cal.unit = *unit;
+    const auto latitude = yaml.optional_number(root, "latitude_deg", "");
     if (!latitude) return latitude.error();
+    if (*latitude && std::abs(**latitude) > 90.0)
+      return yaml.error(root["latitude_deg"], "latitude_deg", "must be within [-90, 90] deg");
     cal.latitude_deg = *latitude;
-    cal.method = root["method"] ? root["method"].as<std::string>() : "";
+    auto method = yaml.optional_text(root, "method", "");
+    if (!method) return method.error();
+    cal.method = *method;
     const YAML::Node gyros = root["gyros"];
     if (!gyros) return bad_input(source + ": missing key 'gyros'");
     if (!gyros.IsSequence()) return yaml.error(gyros, "gyros", "expected a list");
@@ -152,7 +167,7 @@ Result<Calibration> parse_calibration(const std::string& yaml_text, const std::s
 }
 
 Result<Calibration> read_calibration(const std::string& path) {
-  auto text = read_text_file(path);
+  auto text = read_input(path, kMaxYamlBytes);
   if (!text) return text.error();
   return parse_calibration(*text, path);
 }
@@ -188,47 +203,67 @@ std::string num(double v) {
   return s;
 }
 
-std::string vec(const Eigen::Vector3d& v) {
-  return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]";
+void emit_vector(YAML::Emitter& out, const Eigen::Vector3d& v) {
+  out << YAML::Flow << YAML::BeginSeq << num(v.x()) << num(v.y()) << num(v.z()) << YAML::EndSeq;
+}
+
+void emit_gyro(YAML::Emitter& out, const GyroCalibration& g) {
+  out << YAML::BeginMap;
+  out << YAML::Key << "id" << YAML::Value << g.id;
+  out << YAML::Key << "scale_factor_V_per_dps" << YAML::Value << num(g.scale_factor_V_per_dps);
+  out << YAML::Key << "bias_V" << YAML::Value << num(g.bias_V);
+  out << YAML::Key << "axis" << YAML::Value;
+  emit_vector(out, g.axis_B);
+  if (g.sigma) {
+    out << YAML::Key << "sigma" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "scale_factor_V_per_dps" << YAML::Value << num(g.sigma->scale_factor_V_per_dps);
+    out << YAML::Key << "bias_V" << YAML::Value << num(g.sigma->bias_V);
+    out << YAML::Key << "axis" << YAML::Value;
+    emit_vector(out, g.sigma->axis);
+    out << YAML::EndMap;
+  }
+  if (g.noise) {
+    out << YAML::Key << "noise" << YAML::Value << YAML::BeginMap;
+    const auto put = [&out](const char* key, const std::optional<double>& v) {
+      if (v) out << YAML::Key << key << YAML::Value << num(*v);
+    };
+    put("quantization_deg", g.noise->quantization_deg);
+    put("arw_dps_rtHz", g.noise->arw_dps_rtHz);
+    put("bias_instability_dps", g.noise->bias_instability_dps);
+    put("rate_random_walk_dps_per_rts", g.noise->rate_random_walk_dps_per_rts);
+    put("rate_ramp_dps_per_s", g.noise->rate_ramp_dps_per_s);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
 }
 
 }  // namespace
 
-std::string format_calibration(const Calibration& cal) {
-  std::string out;
-  out += "# tetra calibration: y_i = (g_i - bias_V) / scale_factor_V_per_dps = axis . omega_B [deg/s]\n";
-  out += "unit: \"" + cal.unit + "\"\n";
-  if (cal.latitude_deg) out += "latitude_deg: " + num(*cal.latitude_deg) + "\n";
-  if (!cal.method.empty()) out += "method: " + cal.method + "\n";
-  out += "gyros:\n";
-  for (const auto& g : cal.gyros) {
-    out += "  - id: " + std::to_string(g.id) + "\n";
-    out += "    scale_factor_V_per_dps: " + num(g.scale_factor_V_per_dps) + "\n";
-    out += "    bias_V: " + num(g.bias_V) + "\n";
-    out += "    axis: " + vec(g.axis_B) + "\n";
-    if (g.sigma) {
-      out += "    sigma:\n";
-      out += "      scale_factor_V_per_dps: " + num(g.sigma->scale_factor_V_per_dps) + "\n";
-      out += "      bias_V: " + num(g.sigma->bias_V) + "\n";
-      out += "      axis: " + vec(g.sigma->axis) + "\n";
-    }
-    if (g.noise) {
-      out += "    noise:\n";
-      const auto put = [&out](const char* key, const std::optional<double>& v) {
-        if (v) out += std::string("      ") + key + ": " + num(*v) + "\n";
-      };
-      put("quantization_deg", g.noise->quantization_deg);
-      put("arw_dps_rtHz", g.noise->arw_dps_rtHz);
-      put("bias_instability_dps", g.noise->bias_instability_dps);
-      put("rate_random_walk_dps_per_rts", g.noise->rate_random_walk_dps_per_rts);
-      put("rate_ramp_dps_per_s", g.noise->rate_ramp_dps_per_s);
-    }
+std::string format_calibration(const Calibration& cal, const Metadata& comments) {
+  // yaml-cpp's emitter quotes and escapes text (a unit name with a quote, a backslash or a newline
+  // reads back unchanged); numbers are written in shortest round-trip form.
+  YAML::Emitter out;
+  out << YAML::Comment(
+      "tetra calibration: y_i = (g_i - bias_V) / scale_factor_V_per_dps = axis . omega_B [deg/s]");
+  for (const auto& [key, value] : comments) {
+    out << YAML::Newline << YAML::Comment(key + "=" + one_line(value));
   }
-  return out;
+  out << YAML::BeginMap;
+  out << YAML::Key << "unit" << YAML::Value << YAML::DoubleQuoted << cal.unit;
+  if (cal.latitude_deg) out << YAML::Key << "latitude_deg" << YAML::Value << num(*cal.latitude_deg);
+  if (!cal.method.empty()) out << YAML::Key << "method" << YAML::Value << YAML::DoubleQuoted << cal.method;
+  out << YAML::Key << "gyros" << YAML::Value << YAML::BeginSeq;
+  for (const auto& g : cal.gyros) emit_gyro(out, g);
+  out << YAML::EndSeq << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
 }
 
 Status write_calibration(const std::string& path, const Calibration& cal) {
   return write_text_file(path, format_calibration(cal));
+}
+
+Status write_calibration(OutputFile& out, const Calibration& cal, const Metadata& comments) {
+  return out.write(format_calibration(cal, comments));
 }
 
 }  // namespace tetra

@@ -1,5 +1,8 @@
 #include "tetra/core/csv.hpp"
 
+#include "tetra/core/input_files.hpp"
+#include "tetra/core/output_files.hpp"
+
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -25,12 +28,27 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-// Strict number parse of a whole cell. Accepts a leading '+', "nan", "inf" (any case).
-bool parse_number(std::string_view s, double& out) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  if (s.empty()) return false;
-  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  return ec == std::errc() && ptr == s.data() + s.size();
+int hex_digit(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  return -1;
+}
+
+// Undoes append_metadata's %XX escapes; a '%' not followed by two hex digits stays as it is.
+std::string unescape_meta(std::string_view value) {
+  std::string out;
+  out.reserve(value.size());
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    if (value[i] == '%' && i + 2 < value.size() && hex_digit(value[i + 1]) >= 0 &&
+        hex_digit(value[i + 2]) >= 0) {
+      out += static_cast<char>(hex_digit(value[i + 1]) * 16 + hex_digit(value[i + 2]));
+      i += 2;
+    } else {
+      out += value[i];
+    }
+  }
+  return out;
 }
 
 void parse_metadata(std::string_view comment, CsvTable& table) {
@@ -43,13 +61,26 @@ void parse_metadata(std::string_view comment, CsvTable& table) {
     const std::string_view token = comment.substr(i, j - i);
     const std::size_t eq = token.find('=');
     if (eq != std::string_view::npos && eq > 0) {
-      table.metadata.emplace_back(std::string(token.substr(0, eq)), std::string(token.substr(eq + 1)));
+      table.metadata.emplace_back(std::string(token.substr(0, eq)), unescape_meta(token.substr(eq + 1)));
     }
     i = j;
   }
 }
 
 }  // namespace
+
+bool parse_number(std::string_view s, double& out) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  if (s.empty() || s.find('(') != std::string_view::npos) return false;  // no "nan(payload)"
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+  return ec == std::errc() && ptr == s.data() + s.size();
+}
+
+std::optional<double> parse_decimal(std::string_view s) {
+  double v = 0.0;
+  if (!parse_number(s, v) || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
 
 std::optional<std::size_t> CsvTable::find_column(std::string_view name) const {
   for (std::size_t i = 0; i < columns.size(); ++i) {
@@ -110,6 +141,11 @@ Status parse_lines(std::string_view text, std::size_t& pos, std::size_t& line_no
     }
 
     if (!have_header) {
+      if (fields.size() > kMaxColumns) {
+        return bad_input(t.source + ":" + std::to_string(line_no) +
+                         ": header: " + std::to_string(fields.size()) + " columns, at most " +
+                         std::to_string(kMaxColumns) + " are read");
+      }
       for (std::size_t i = 0; i < fields.size(); ++i) {
         if (fields[i].empty()) {
           return bad_input(t.source + ":" + std::to_string(line_no) + ": header: column " +
@@ -159,7 +195,10 @@ Status parse_lines(std::string_view text, std::size_t& pos, std::size_t& line_no
 constexpr std::size_t kParallelBytes = std::size_t{8} << 20;
 
 void reserve_rows(CsvTable& t, std::string_view body) {
-  const std::size_t approx_rows = static_cast<std::size_t>(std::count(body.begin(), body.end(), '\n')) + 1;
+  // A row of C cells takes at least C bytes (C-1 commas and a newline): blank lines reserve nothing.
+  const std::size_t lines = static_cast<std::size_t>(std::count(body.begin(), body.end(), '\n')) + 1;
+  const std::size_t approx_rows =
+      std::min(lines, body.size() / std::max<std::size_t>(t.columns.size(), 1) + 1);
   t.cells.reserve(approx_rows * t.columns.size());
   t.empty.reserve(approx_rows * t.columns.size());
   t.lines.reserve(approx_rows);
@@ -219,31 +258,13 @@ Result<CsvTable> parse_csv(std::string_view text, std::string source) {
 }
 
 Result<std::string> read_text_file(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return bad_input(path + ": cannot open: " + std::strerror(errno));
-  std::string data;
-  // Regular files: one allocation of the whole size and one read (large logs are tens of MB);
-  // then keep reading in case the file grew or is not seekable.
-  if (std::fseek(f, 0, SEEK_END) == 0) {
-    const long size = std::ftell(f);
-    std::rewind(f);
-    if (size > 0) {
-      data.resize(static_cast<std::size_t>(size));
-      data.resize(std::fread(data.data(), 1, data.size(), f));
-    }
-  }
-  char buf[1 << 16];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) data.append(buf, n);
-  const bool err = std::ferror(f) != 0;
-  std::fclose(f);
-  if (err) return failure(path + ": read error");
-  return data;
+  return read_input(path, kMaxTableBytes);
 }
 
 Result<CsvTable> read_csv(const std::string& path) {
   // A regular file is parsed straight from a read-only mapping: no copy of the text in memory (a
   // 2 h, 100 Hz log is ~45 MB). Anything else (pipes, empty files) is read into a string.
+  if (Status st = check_input(path, kMaxTableBytes, false); !st) return st.error();
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd >= 0) {
     struct stat st {};
@@ -266,20 +287,27 @@ Result<CsvTable> read_csv(const std::string& path) {
 }
 
 Status write_text_file(const std::string& path, std::string_view content) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (f == nullptr) return failure(path + ": cannot write: " + std::strerror(errno));
-  const bool wrote = std::fwrite(content.data(), 1, content.size(), f) == content.size();
-  const bool closed = std::fclose(f) == 0;
-  if (!wrote || !closed) {
-    std::remove(tmp.c_str());
-    return failure(path + ": write failed");
+  RunFiles files;
+  if (Status st = files.put(path, "output", content); !st) return st;
+  return files.commit();
+}
+
+void append_metadata(std::string& out, std::string_view key, std::string_view value) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  out += "# ";
+  out += key;
+  out += '=';
+  for (const char c : value) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u <= 0x20 || u == 0x7f || c == ',' || c == '%') {
+      out += '%';
+      out += kHex[u >> 4U];
+      out += kHex[u & 0xFU];
+    } else {
+      out += c;
+    }
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return failure(path + ": cannot rename temporary file: " + std::strerror(errno));
-  }
-  return ok_status();
+  out += '\n';
 }
 
 void append_double(std::string& out, double value) {

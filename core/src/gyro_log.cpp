@@ -124,25 +124,27 @@ Result<GyroLog> read_gyro_log(const std::string& path) {
   return from_table(std::move(table.value()));
 }
 
-GyroLogWriter::~GyroLogWriter() {
-  if (file_ != nullptr) {
-    std::fclose(file_);
-    std::remove((path_ + ".tmp").c_str());
-  }
-}
+GyroLogWriter::~GyroLogWriter() = default;
 
 Status GyroLogWriter::open(const std::string& path, int gyro_count, bool with_reference, bool units_dps,
                            const std::vector<std::pair<std::string, std::string>>& comments) {
-  if (file_ != nullptr) return failure(path_ + ": writer already open");
-  if (gyro_count < 1) return bad_input(path + ": a gyro log needs at least one gyro column");
-  path_ = path;
+  if (out_ != nullptr) return failure(out_->path() + ": writer already open");
+  own_ = std::make_unique<RunFiles>();
+  auto out = own_->add(path, "output");
+  if (!out) return out.error();
+  return open(**out, gyro_count, with_reference, units_dps, comments);
+}
+
+Status GyroLogWriter::open(OutputFile& out, int gyro_count, bool with_reference, bool units_dps,
+                           const std::vector<std::pair<std::string, std::string>>& comments) {
+  if (out_ != nullptr) return failure(out_->path() + ": writer already open");
+  if (gyro_count < 1) return bad_input(out.path() + ": a gyro log needs at least one gyro column");
+  out_ = &out;
   gyro_count_ = gyro_count;
   with_reference_ = with_reference;
-  file_ = std::fopen((path + ".tmp").c_str(), "wb");
-  if (file_ == nullptr) return failure(path + ": cannot write: " + std::strerror(errno));
   buffer_.clear();
   if (units_dps) buffer_ += "# units=dps\n";
-  for (const auto& [k, v] : comments) buffer_ += "# " + k + "=" + v + "\n";
+  for (const auto& [k, v] : comments) append_metadata(buffer_, k, v);
   buffer_ += "time_s";
   for (int i = 1; i <= gyro_count; ++i) buffer_ += ",g" + std::to_string(i);
   if (with_reference) buffer_ += ",ref_qw,ref_qx,ref_qy,ref_qz";
@@ -153,9 +155,9 @@ Status GyroLogWriter::open(const std::string& path, int gyro_count, bool with_re
 Status GyroLogWriter::write(double time_s, std::span<const double> values,
                             std::span<const std::uint8_t> present,
                             const std::optional<std::array<double, 4>>& reference_wxyz) {
-  if (file_ == nullptr) return failure("gyro log writer is not open");
+  if (out_ == nullptr) return failure("gyro log writer is not open");
   if (values.size() != static_cast<std::size_t>(gyro_count_) || present.size() != values.size()) {
-    return failure(path_ + ": epoch has the wrong number of gyro values");
+    return failure(out_->path() + ": epoch has the wrong number of gyro values");
   }
   append_double(buffer_, time_s);
   for (std::size_t i = 0; i < values.size(); ++i) {
@@ -174,26 +176,20 @@ Status GyroLogWriter::write(double time_s, std::span<const double> values,
 }
 
 Status GyroLogWriter::flush() {
-  if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
-    return failure(path_ + ": write failed");
-  }
+  if (Status st = out_->write(buffer_); !st) return st;
   buffer_.clear();
   return ok_status();
 }
 
 Status GyroLogWriter::close() {
-  if (file_ == nullptr) return failure("gyro log writer is not open");
+  if (out_ == nullptr) return failure("gyro log writer is not open");
   const Status flushed = flush();
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  const std::string tmp = path_ + ".tmp";
-  if (!flushed || !closed) {
-    std::remove(tmp.c_str());
-    return flushed ? failure(path_ + ": write failed") : flushed;
-  }
-  if (std::rename(tmp.c_str(), path_.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return failure(path_ + ": cannot rename temporary file: " + std::strerror(errno));
+  out_ = nullptr;
+  if (!flushed) return flushed;
+  if (own_) {
+    const Status committed = own_->commit();
+    own_.reset();
+    return committed;
   }
   return ok_status();
 }

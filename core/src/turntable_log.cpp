@@ -99,7 +99,7 @@ Result<TurntableLog> read_turntable_log(const std::string& path) {
 std::string format_turntable_log(const TurntableLog& log) {
   std::string out;
   out.reserve(log.rows() * static_cast<std::size_t>(40 + 14 * log.gyro_count));
-  for (const auto& [k, v] : log.metadata) out += "# " + k + "=" + v + "\n";
+  for (const auto& [k, v] : log.metadata) append_metadata(out, k, v);
   out += "sequence,time_s,inner_deg,outer_deg";
   for (int g = 1; g <= log.gyro_count; ++g) out += ",g" + std::to_string(g);
   out += '\n';

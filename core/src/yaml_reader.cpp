@@ -1,6 +1,9 @@
 #include "tetra/core/yaml_reader.hpp"
 
 #include <cmath>
+#include <vector>
+
+#include "tetra/core/csv.hpp"
 
 namespace tetra {
 
@@ -19,12 +22,69 @@ Error YamlReader::error(const YAML::Exception& e, const std::string& what) const
   return bad_input(source_ + ":" + std::to_string(line) + ": " + (what.empty() ? "" : what + ": ") + e.msg);
 }
 
+namespace {
+
+// "a.b[2]" path of a key below `what`.
+std::string key_path(const std::string& what, const std::string& key) {
+  return what.empty() ? key : what + "." + key;
+}
+
+}  // namespace
+
+Status YamlReader::check_unique_keys(const YAML::Node& node, const std::string& what) const {
+  std::size_t budget = kMaxYamlNodes;
+  return check_unique_keys(node, what, budget);
+}
+
+Status YamlReader::check_unique_keys(const YAML::Node& node, const std::string& what,
+                                     std::size_t& budget) const {
+  // Aliases make a small text a huge tree ("a billion laughs"): the walk is bounded, like the file.
+  if (budget == 0)
+    return error(node, what, "more than " + std::to_string(kMaxYamlNodes) + " nodes (aliases?)");
+  --budget;
+  if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      if (Status st = check_unique_keys(node[i], what + "[" + std::to_string(i) + "]", budget); !st)
+        return st;
+    }
+  } else if (node.IsMap()) {
+    std::vector<std::string> seen;
+    for (const auto& kv : node) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
+      for (const auto& s : seen) {
+        if (s == key) return error(kv.first, what, "key '" + key + "' appears twice");
+      }
+      seen.push_back(key);
+      if (Status st = check_unique_keys(kv.second, key_path(what, key), budget); !st) return st;
+    }
+  }
+  return ok_status();
+}
+
 Result<YAML::Node> YamlReader::load(const std::string& text) const {
   try {
-    return YAML::Load(text);
+    std::vector<YAML::Node> docs = YAML::LoadAll(text);
+    if (docs.empty()) return YAML::Node();
+    if (docs.size() > 1) {
+      return error(docs[1], "", "a second YAML document ('---'): a file holds exactly one");
+    }
+    if (Status st = check_unique_keys(docs[0], ""); !st) return st.error();
+    return docs[0];
   } catch (const YAML::Exception& e) {
     return error(e, "");
   }
+}
+
+Result<std::string> YamlReader::text(const YAML::Node& node, const std::string& what) const {
+  if (!node.IsScalar()) return error(node, what, "expected a text value");
+  return node.Scalar();
+}
+
+Result<std::string> YamlReader::optional_text(const YAML::Node& parent, const std::string& key,
+                                              const std::string& what) const {
+  const YAML::Node node = parent[key];
+  if (!node || node.IsNull()) return std::string();
+  return text(node, child(what, key));
 }
 
 std::string YamlReader::child(const std::string& what, const std::string& key) {
@@ -50,7 +110,7 @@ Status YamlReader::check_keys(const YAML::Node& map, const std::vector<std::stri
 
 Result<double> YamlReader::number(const YAML::Node& node, const std::string& what) const {
   double v = 0.0;
-  if (!node.IsScalar() || !YAML::convert<double>::decode(node, v)) {
+  if (!node.IsScalar() || !parse_number(node.Scalar(), v)) {
     return error(node, what,
                  "'" + (node.IsScalar() ? node.Scalar() : std::string("?")) + "' is not a number");
   }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/input_files.hpp"
 #include "tetra/core/yaml_reader.hpp"
 
 namespace tetra::fdi {
@@ -79,8 +80,13 @@ Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const s
       if (key == "initial_q_wxyz") {
         if (!value.IsSequence() || value.size() != 4)
           return yaml.error(kv.first, what, "expected [w, x, y, z]");
-        config.initial_q_RB = from_wxyz(value[0].as<double>(), value[1].as<double>(), value[2].as<double>(),
-                                        value[3].as<double>());
+        double q[4] = {};
+        for (std::size_t k = 0; k < 4; ++k) {
+          const auto c = yaml.number(value[k], what + "[" + std::to_string(k) + "]");
+          if (!c) return c.error();
+          q[k] = *c;
+        }
+        config.initial_q_RB = from_wxyz(q[0], q[1], q[2], q[3]);
         continue;
       }
       for (const auto& def : scalar_keys()) {
@@ -91,9 +97,15 @@ Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const s
           if (!v) return v.error();
           config.*(*d) = *v;
         } else if (const auto* i = std::get_if<int PipelineConfig::*>(&def.field)) {
-          config.*(*i) = value.as<int>();
+          const auto v = yaml.number(value, what);
+          if (!v) return v.error();
+          if (*v != std::floor(*v) || std::abs(*v) > 1e9)
+            return yaml.error(value, what, "must be a whole number");
+          config.*(*i) = static_cast<int>(*v);
         } else {
-          config.*std::get<bool PipelineConfig::*>(def.field) = value.as<bool>();
+          const std::string& b = value.Scalar();
+          if (b != "true" && b != "false") return yaml.error(value, what, "'" + b + "' is not true or false");
+          config.*std::get<bool PipelineConfig::*>(def.field) = b == "true";
         }
       }
     }
@@ -105,16 +117,15 @@ Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const s
 }
 
 Result<PipelineConfig> read_pipeline_config(const std::string& path) {
-  auto text = read_text_file(path);
+  auto text = read_input(path, kMaxYamlBytes);
   if (!text) return text.error();
-  YAML::Node root;
-  try {
-    root = YAML::Load(*text);
-  } catch (const YAML::Exception& e) {
-    return YamlReader{path}.error(e, "");
-  }
+  const YamlReader yaml{path};
+  auto loaded = yaml.load(*text);
+  if (!loaded) return loaded.error();
+  const YAML::Node root = *loaded;
   if (!root || root.IsNull()) return PipelineConfig{};
   if (!root.IsMap()) return bad_input(path + ": expected a mapping with a 'pipeline:' key");
+  if (Status st = yaml.check_keys(root, {"pipeline"}, ""); !st) return st.error();
   return pipeline_config_from_yaml(root["pipeline"], path);
 }
 

@@ -21,8 +21,16 @@ void append_attitude_row(std::string& out, double time_s, const fdi::AttitudeEst
   out += ',';
   out += fdi::to_string(attitude.mode);
   out += ',';
-  out += mask_to_string(attitude.gyros, n_gyros);
+  out += gyros_cell(attitude.gyros, n_gyros);
   out += '\n';
+}
+
+std::string gyros_cell(GyroMask mask, int n_gyros) {
+  std::string cell = mask_to_string(mask, n_gyros);  // "1234"; "1,2,10" from 10 gyros on
+  for (char& c : cell) {
+    if (c == ',') c = ';';  // one CSV field for any N: "1;2;10"
+  }
+  return cell;
 }
 
 }  // namespace tetra::cli

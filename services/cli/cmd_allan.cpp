@@ -10,6 +10,7 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "cli_common.hpp"
@@ -18,6 +19,9 @@
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/input_files.hpp"
+#include "tetra/core/output_files.hpp"
+#include "tetra/core/provenance.hpp"
 
 namespace tetra::cli {
 
@@ -72,7 +76,7 @@ std::string percent(double fraction) {
 
 // Log-log plot: per gyro a panel with the Allan deviation, its confidence band, the fitted curve and
 // the observed terms. Runs gnuplot (pngcairo, else png).
-Status write_plot(const std::string& png_path, const allan::LogAllan& analysis, double confidence) {
+Status write_plot(OutputFile& png, const allan::LogAllan& analysis, double confidence) {
   char dir_template[] = "/tmp/tetra-allan-XXXXXX";
   if (::mkdtemp(dir_template) == nullptr) return failure("--plot: cannot create a temporary directory");
   const std::filesystem::path dir(dir_template);
@@ -135,6 +139,7 @@ Status write_plot(const std::string& png_path, const allan::LogAllan& analysis, 
   const std::string defs =
       "bQ(t) = 3.0/(t*t)\nbN(t) = 1.0/t\nbB(t) = 2.0*log(2.0)/pi\nbK(t) = t/3.0\nbR(t) = t*t/2.0\n";
   const std::string size = std::to_string(cols * 640) + "," + std::to_string(rows * 480);
+  const std::string png_path = (dir / "plot.png").string();
   const std::string out = "set output " + gp_quote(png_path) + "\n";
   for (const char* terminal : {"pngcairo", "png"}) {
     const std::string script_file = (dir / "plot.gp").string();
@@ -144,13 +149,17 @@ Status write_plot(const std::string& png_path, const allan::LogAllan& analysis, 
     const std::string err_file = (dir / "gnuplot.err").string();
     const int rc =
         std::system(("gnuplot " + shell_quote(script_file) + " 2>" + shell_quote(err_file)).c_str());
-    if (rc == 0) return ok_status();
+    if (rc == 0) {
+      auto image = read_input(png_path, kMaxTableBytes);
+      if (!image) return failure("--plot: gnuplot wrote no image");
+      return png.write(*image);
+    }
     if (rc == -1 || (WIFEXITED(rc) && WEXITSTATUS(rc) == 127)) {
       return failure(
           "--plot: gnuplot not found (install the Debian package gnuplot-nox; see scripts/setup.sh)");
     }
   }
-  return failure("--plot: gnuplot could not write " + png_path);
+  return failure("--plot: gnuplot could not write " + png.path());
 }
 
 }  // namespace
@@ -172,7 +181,7 @@ int cmd_allan(int argc, char** argv) {
   double confidence = allan::kOneSigmaConfidence;
   double dt_tolerance = 0.05;
   app.add_option("log", log_path,
-                 "gyro log (INTERFACES 2.2): time_s,g1..gN; volts, or deg/s with '# units=dps'")
+                 "gyro log (docs/interfaces.md §2.2): time_s,g1..gN; volts, or deg/s with '# units=dps'")
       ->required();
   app.add_option("--calibration", cal_path, "calibration YAML: volts become deg/s as (g - bias)/scale");
   app.add_flag("--update-calibration", update_cal,
@@ -203,6 +212,27 @@ int cmd_allan(int argc, char** argv) {
   }
   auto tau_spec = allan::parse_tau_spec(taus);
   if (!tau_spec) return report(cmd, tau_spec.error());
+
+  RunFiles files;
+  files.add_input(log_path, "log");
+  if (!cal_path.empty()) files.add_input(cal_path, "--calibration");
+  OutputFile* csv_out = nullptr;
+  OutputFile* json_out = nullptr;
+  OutputFile* plot_out = nullptr;
+  OutputFile* cal_out = nullptr;
+  for (auto [path, label, slot] :
+       {std::tuple{&csv_path, "--csv", &csv_out}, std::tuple{&json_path, "--json", &json_out},
+        std::tuple{&plot_path, "--plot", &plot_out}}) {
+    if (path->empty()) continue;
+    auto out = files.add(*path, label);
+    if (!out) return report(cmd, out.error());
+    *slot = *out;
+  }
+  if (update_cal) {
+    auto out = files.add(cal_path, "--update-calibration", cal_path);
+    if (!out) return report(cmd, out.error());
+    cal_out = *out;
+  }
 
   std::optional<Calibration> cal;
   if (!cal_path.empty()) {
@@ -244,21 +274,24 @@ int cmd_allan(int argc, char** argv) {
             << (cal && !log->units_dps ? ", calibrated with " + cal_path : std::string()) << "\n\n";
   std::cout << allan::format_table(*analysis);
 
-  if (!csv_path.empty()) {
-    if (Status s = write_text_file(csv_path, allan::format_csv(*analysis)); !s) return report(cmd, s.error());
+  const auto meta = provenance_metadata(provenance(files.input_paths()));
+  if (csv_out) {
+    std::string text;
+    for (const auto& [key, value] : meta) append_metadata(text, key, value);
+    if (Status s = csv_out->write(text + allan::format_csv(*analysis)); !s) return report(cmd, s.error());
   }
-  if (!json_path.empty()) {
-    if (Status s = write_text_file(json_path, allan::format_json(*analysis)); !s)
-      return report(cmd, s.error());
+  if (json_out) {
+    if (Status s = json_out->write(allan::format_json(*analysis, meta)); !s) return report(cmd, s.error());
   }
-  if (!plot_path.empty()) {
-    if (Status s = write_plot(plot_path, *analysis, confidence); !s) return report(cmd, s.error());
+  if (plot_out) {
+    if (Status s = write_plot(*plot_out, *analysis, confidence); !s) return report(cmd, s.error());
   }
-  if (update_cal) {
+  if (cal_out) {
     if (Status s = allan::update_calibration_noise(*cal, *analysis); !s) return report(cmd, s.error());
-    if (Status s = write_calibration(cal_path, *cal); !s) return report(cmd, s.error());
-    std::cerr << "tetra allan: noise terms written to " << cal_path << "\n";
+    if (Status s = write_calibration(*cal_out, *cal, meta); !s) return report(cmd, s.error());
   }
+  if (Status s = files.commit(); !s) return report(cmd, s.error());
+  if (cal_out) std::cerr << "tetra allan: noise terms written to " << cal_path << "\n";
   return kExitOk;
 }
 

@@ -1,5 +1,5 @@
 // tetra calibrate — turntable calibration: scale factor, bias and axis of every gyro with their 1σ,
-// printed like seed Tables 3–5, written as a calibration file (INTERFACES §2.3).
+// printed like seed Tables 3–5, written as a calibration file (docs/interfaces.md §2.3).
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -14,6 +14,8 @@
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/geometry.hpp"
+#include "tetra/core/output_files.hpp"
+#include "tetra/core/provenance.hpp"
 #include "tetra/core/turntable_log.hpp"
 #include "tetra/core/units.hpp"
 
@@ -37,14 +39,11 @@ Result<double> latitude_from(const TurntableLog& log, const std::optional<double
     return bad_input(log.source +
                      ": no latitude: give --latitude DEG or a '# latitude_deg=DEG' comment line in the file");
   }
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(*text, &used);
-    if (used != text->size()) throw std::invalid_argument("trailing text");
-    return v;
-  } catch (const std::exception&) {
-    return bad_input(log.source + ": comment '# latitude_deg=" + *text + "' is not a number");
-  }
+  const auto v = parse_decimal(*text);
+  if (!v) return bad_input(log.source + ": comment '# latitude_deg=" + *text + "' is not a decimal number");
+  if (std::abs(*v) > 90.0)
+    return bad_input(log.source + ": comment '# latitude_deg=" + *text + "' is outside [-90, 90] deg");
+  return *v;
 }
 
 void print_plan(const TurntableLog& log, const TurntableMotion& motion) {
@@ -156,7 +155,7 @@ void print_comparison(const TurntableMotion& motion, const CalibrationFit& refer
 int cmd_calibrate(int argc, char** argv) {
   CLI::App app{
       "Turntable calibration (seed eqs. 4-11): scale factor, bias and sensing axis of every gyro with their "
-      "1-sigma, from a turntable log (INTERFACES 2.1). Body rates come from the encoder angles.",
+      "1-sigma, from a turntable log (docs/interfaces.md §2.1). Body rates come from the encoder angles.",
       kName};
   std::string input;
   std::string output;
@@ -167,9 +166,12 @@ int cmd_calibrate(int argc, char** argv) {
   std::string unit_name;
   app.add_option("TURNTABLE.csv", input, "turntable log: sequence,time_s,inner_deg,outer_deg,g1..gN")
       ->required();
-  app.add_option("-o,--output", output, "calibration file to write (YAML, INTERFACES 2.3)")->required();
+  app.add_option("-o,--output", output,
+                 "calibration file to write (YAML, docs/interfaces.md §2.3; - for standard output)")
+      ->required();
   app.add_option("--latitude", latitude_deg,
-                 "[deg] geodetic latitude of the table (default: the file's '# latitude_deg=' comment)");
+                 "[deg] geodetic latitude of the table (default: the file's '# latitude_deg=' comment)")
+      ->check(CLI::Range(-90.0, 90.0));
   app.add_option(
          "--method", method_name,
          "sixteen: per-sequence means and pair differences (seed); batch: least squares over every sample")
@@ -195,6 +197,12 @@ int cmd_calibrate(int argc, char** argv) {
     return report(
         kName, bad_input("--bias-model applies to --method sixteen only (batch fits the bias per sample)"));
   }
+
+  RunFiles files;
+  files.add_input(input, "TURNTABLE.csv");
+  if (!compare_path.empty()) files.add_input(compare_path, "--compare");
+  auto out = files.add(output, "--output");
+  if (!out) return report(kName, out.error());
 
   auto log = read_turntable_log(input);
   if (!log) return report(kName, log.error());
@@ -253,8 +261,10 @@ int cmd_calibrate(int argc, char** argv) {
       << "; both assume white noise within a sequence, so correlated noise (bias instability, rate random "
          "walk) makes them optimistic.\n";
 
-  auto written = write_calibration(output, result->calibration);
-  if (!written) return report(kName, written.error());
+  const auto meta = provenance_metadata(provenance(files.input_paths()));
+  if (auto written = write_calibration(**out, result->calibration, meta); !written)
+    return report(kName, written.error());
+  if (auto committed = files.commit(); !committed) return report(kName, committed.error());
   std::cerr << "tetra calibrate: wrote " << output << "\n";
   return kExitOk;
 }

@@ -12,12 +12,16 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <sstream>
+#include <string>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "dds_common.hpp"
 #include "sim_dds.hpp"
 #include "tetra/core/calibration_file.hpp"
+#include "tetra/core/csv.hpp"
+#include "tetra/core/json.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
@@ -98,7 +102,8 @@ int cmd_demo(int argc, char** argv) {
   app.add_option("--scenario", scenario_name,
                  "simulated motion: static, lab-orbit, orbit, slews or FILE.yaml")
       ->capture_default_str();
-  app.add_option("--fault", fault_text, "the injected failure (INTERFACES 2.7)")->capture_default_str();
+  app.add_option("--fault", fault_text, "the injected failure (docs/interfaces.md §2.7)")
+      ->capture_default_str();
   app.add_option("--seconds", seconds, "[s] simulated duration")
       ->check(CLI::Range(5.0, 600.0))
       ->capture_default_str();
@@ -148,15 +153,17 @@ int cmd_demo(int argc, char** argv) {
     return report("demo", s.error());
   {
     const auto q = to_wxyz(first.truth_q_RB);
-    std::ofstream config(dir + "/fusion.yaml");
+    std::string unit_text;
+    append_json_string(unit_text, unit);  // a JSON string is a YAML double-quoted scalar: any name reads back
+    std::ostringstream config;
     config << "# tetra demo: fusion service configuration\n"
-           << "unit: " << unit << "\ncalibration: calibration.yaml\n"
+           << "unit: " << unit_text << "\ncalibration: calibration.yaml\n"
            << "sample_rate_hz: " << rate_hz << "\n"
            << "max_latency_s: 0.05\nhealth_period_s: 0.5\n"
            << "pipeline:\n  initial_q_wxyz: [" << json_number(q[0]) << ", " << json_number(q[1]) << ", "
            << json_number(q[2]) << ", " << json_number(q[3]) << "]\n"
            << "  sample_period_s: " << json_number(1.0 / rate_hz) << '\n';
-    if (!config) return report("demo", failure(dir + "/fusion.yaml: cannot write"));
+    if (auto s = write_text_file(dir + "/fusion.yaml", config.str()); !s) return report("demo", s.error());
   }
 
   std::cout << "tetra demo: domain " << domain << " (loopback only), unit " << unit << ", scenario "

@@ -43,7 +43,7 @@ struct UnitView {
 };
 
 std::string event_json(const dds::EventView& e, int n_gyros) {
-  // The INTERFACES §2.5 object, with the unit, sequence number and command id added in front.
+  // The docs/interfaces.md §2.5 object, with the unit, sequence number and command id added in front.
   std::string body = fdi::to_json(e.event, n_gyros);
   std::string head = "{\"type\": \"event\", \"unit\": " + json_string(e.unit) +
                      ", \"event_seq\": " + std::to_string(e.event_seq);

@@ -1,5 +1,5 @@
 // tetra record -o LOG.csv — the gyro and reference streams of one unit on DDS, written as a
-// replayable gyro log (INTERFACES §2.2). Epochs are assembled exactly as `tetra fusion` does (same
+// replayable gyro log (docs/interfaces.md §2.2). Epochs are assembled exactly as `tetra fusion` does (same
 // assembler, same settings when given the service's --config), so `tetra replay` of the log sees
 // the epochs the service saw. Optionally also the service's Attitude (§2.4) and FdiEvents (§2.5).
 // Stops on SIGINT/SIGTERM, after --duration, or with --until-idle when the gyro writers are gone.
@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <iostream>
 #include <map>
+#include <string>
+#include <tuple>
 
 #include "attitude_csv.hpp"
 #include "cli_common.hpp"
@@ -14,6 +16,8 @@
 #include "dds_common.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/output_files.hpp"
+#include "tetra/core/provenance.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
@@ -28,6 +32,17 @@ namespace {
 using namespace std::chrono_literals;
 enum Token : std::intptr_t { kData = 1, kShutdown };
 constexpr std::int64_t kIdleGrace_ns = 2'000'000'000;  //!< [ns] wait for the service's last outputs
+
+}  // namespace
+
+namespace {
+
+Metadata record_metadata(const std::string& unit, const RunFiles& files) {
+  Metadata meta = {{"unit", unit}, {"source", "tetra record"}};
+  const auto p = provenance_metadata(provenance(files.input_paths()));
+  meta.insert(meta.end(), p.begin(), p.end());
+  return meta;
+}
 
 }  // namespace
 
@@ -46,7 +61,7 @@ int cmd_record(int argc, char** argv) {
   double duration_s = 0.0;
   bool until_idle = false;
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
-  app.add_option("-o,--out", out_path, "gyro log to write (CSV, INTERFACES 2.2)")->required();
+  app.add_option("-o,--out", out_path, "gyro log to write (CSV, docs/interfaces.md §2.2)")->required();
   app.add_option("--unit", unit, "the unit to record (default: the first one seen)");
   app.add_option("--config", config_path, "take unit, gyro count and assembly settings from a fusion config");
   app.add_option("--gyros", gyros, "number of gyros N (columns g1..gN)")
@@ -57,12 +72,28 @@ int cmd_record(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-latency", max_latency_s, "[s] longest wait for an epoch's missing samples")
       ->check(CLI::PositiveNumber);
-  app.add_option("--attitude", attitude_path, "also write the service's Attitude (CSV, INTERFACES 2.4)");
-  app.add_option("--events", events_path, "also write the service's FdiEvents (JSON lines, INTERFACES 2.5)");
+  app.add_option("--attitude", attitude_path,
+                 "also write the service's Attitude (CSV, docs/interfaces.md §2.4)");
+  app.add_option("--events", events_path,
+                 "also write the service's FdiEvents (JSON lines, docs/interfaces.md §2.5)");
   app.add_option("--duration", duration_s, "[s] stop after this long")->check(CLI::PositiveNumber);
   app.add_flag("--until-idle", until_idle, "stop when the gyro writers have come and gone");
   add_domain_option(app, domain);
   if (auto exit = parse(app, argc, argv)) return *exit;
+
+  RunFiles files;
+  if (!config_path.empty()) files.add_input(config_path, "--config");
+  OutputFile* log_out = nullptr;
+  OutputFile* attitude_out = nullptr;
+  OutputFile* events_out = nullptr;
+  for (auto [path, label, slot] :
+       {std::tuple{&out_path, "--out", &log_out}, std::tuple{&attitude_path, "--attitude", &attitude_out},
+        std::tuple{&events_path, "--events", &events_out}}) {
+    if (path->empty()) continue;
+    auto out = files.add(*path, label);
+    if (!out) return report("record", out.error());
+    *slot = *out;
+  }
 
   service::AssemblerConfig assembly;
   if (!config_path.empty()) {
@@ -160,8 +191,7 @@ int cmd_record(int argc, char** argv) {
   auto write_epochs = [&]() -> Status {
     for (const auto& epoch : epochs) {
       if (!log_open) {
-        if (auto s = log.open(out_path, n, true, false, {{"unit", unit}, {"source", "tetra record"}}); !s)
-          return s;
+        if (auto s = log.open(*log_out, n, true, false, record_metadata(unit, files)); !s) return s;
         log_open = true;
       }
       for (int i = 0; i < n; ++i)
@@ -236,19 +266,22 @@ int cmd_record(int argc, char** argv) {
   assembler->poll(INT64_MAX, epochs);
   if (auto s = write_epochs(); !s) return report("record", s.error());
   if (!log_open) {
-    if (auto s = log.open(out_path, n, true, false, {{"unit", unit}, {"source", "tetra record"}}); !s) {
+    if (auto s = log.open(*log_out, n, true, false, record_metadata(unit, files)); !s) {
       return report("record", s.error());
     }
   }
   if (auto s = log.close(); !s) return report("record", s.error());
-  if (!attitude_path.empty()) {
-    if (auto s = write_text_file(attitude_path, attitude_text); !s) return report("record", s.error());
+  if (attitude_out) {
+    std::string text;
+    for (const auto& [key, value] : record_metadata(unit, files)) append_metadata(text, key, value);
+    if (auto s = attitude_out->write(text + attitude_text); !s) return report("record", s.error());
   }
-  if (!events_path.empty()) {
+  if (events_out) {
     std::string text;
     for (const auto& [seq, line] : event_lines) text += line + '\n';
-    if (auto s = write_text_file(events_path, text); !s) return report("record", s.error());
+    if (auto s = events_out->write(text); !s) return report("record", s.error());
   }
+  if (auto s = files.commit(); !s) return report("record", s.error());
   const auto& c = assembler->counters();
   std::cerr << "tetra record: " << epochs_written << " epochs of unit "
             << (unit.empty() ? "(none seen)" : unit) << " written to " << out_path << " (late "

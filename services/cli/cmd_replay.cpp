@@ -1,4 +1,4 @@
-// tetra replay — the whole fusion pipeline offline: gyro log in; attitude (INTERFACES §2.4) and FDI
+// tetra replay — the whole fusion pipeline offline: gyro log in; attitude (docs/interfaces.md §2.4) and FDI
 // events (§2.5) out; a summary on stderr. The same Pipeline object serves the DDS service.
 #include <array>
 #include <cmath>
@@ -14,6 +14,8 @@
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/output_files.hpp"
+#include "tetra/core/provenance.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/config.hpp"
 #include "tetra/fdi/pipeline.hpp"
@@ -29,13 +31,9 @@ Result<Quaternion> parse_quaternion(const std::string& text) {
   std::size_t n = 0;
   while (std::getline(ss, item, ',')) {
     if (n >= 4) return bad_input("--initial-q: expected four numbers w,x,y,z, got more");
-    try {
-      std::size_t used = 0;
-      q[n] = std::stod(item, &used);
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      return bad_input("--initial-q: '" + item + "' is not a number");
-    }
+    const auto v = parse_decimal(item);
+    if (!v) return bad_input("--initial-q: '" + item + "' is not a decimal number");
+    q[n] = *v;
     ++n;
   }
   if (n != 4) return bad_input("--initial-q: expected four numbers w,x,y,z");
@@ -50,7 +48,8 @@ Result<Quaternion> parse_quaternion(const std::string& text) {
 
 int cmd_replay(int argc, char** argv) {
   CLI::App app{
-      "Run the fusion and fault-detection pipeline over a gyro log (INTERFACES §2.2): writes the attitude "
+      "Run the fusion and fault-detection pipeline over a gyro log (docs/interfaces.md §2.2): writes the "
+      "attitude "
       "(§2.4) and the FDI events (§2.5); prints a summary on stderr.",
       "replay"};
   std::string log_path;
@@ -61,9 +60,10 @@ int cmd_replay(int argc, char** argv) {
   std::optional<double> latitude_deg;
   std::string initial_q;
   app.add_option("LOG", log_path, "gyro log (CSV)")->required();
-  app.add_option("--calibration", cal_path, "calibration file (YAML, INTERFACES §2.3)")->required();
+  app.add_option("--calibration", cal_path, "calibration file (YAML, docs/interfaces.md §2.3)")->required();
   app.add_option("--latitude", latitude_deg,
-                 "[deg] ground-test mode: remove the Earth rate at this geodetic latitude");
+                 "[deg] ground-test mode: remove the Earth rate at this geodetic latitude")
+      ->check(CLI::Range(-90.0, 90.0));
   app.add_option("--initial-q", initial_q,
                  "initial attitude w,x,y,z (relative to the lab frame in ground mode)");
   app.add_option("--config", config_path, "YAML file with a 'pipeline:' map of thresholds (docs/fdi.md)");
@@ -72,6 +72,15 @@ int cmd_replay(int argc, char** argv) {
   bool verbose = false;
   app.add_flag("-v,--verbose", verbose, "echo the configuration and the derived thresholds on stderr");
   if (auto status = parse(app, argc, argv)) return *status;
+
+  RunFiles files;
+  files.add_input(log_path, "LOG");
+  files.add_input(cal_path, "--calibration");
+  if (!config_path.empty()) files.add_input(config_path, "--config");
+  auto attitude_out = files.add(attitude_path, "--attitude");
+  if (!attitude_out) return report("replay", attitude_out.error());
+  auto events_out = files.add(events_path, "--events");
+  if (!events_out) return report("replay", events_out.error());
 
   fdi::PipelineConfig config;
   if (!config_path.empty()) {
@@ -107,7 +116,9 @@ int cmd_replay(int argc, char** argv) {
   }
   const int n = log->gyro_count;
   std::string att;
-  att.reserve(log->epochs() * 160 + 128);
+  att.reserve(log->epochs() * 160 + 1024);
+  for (const auto& [key, value] : provenance_metadata(provenance(files.input_paths())))
+    append_metadata(att, key, value);
   att += kAttitudeHeader;
   std::string events;
   std::map<std::string, int> event_counts;
@@ -137,8 +148,9 @@ int cmd_replay(int argc, char** argv) {
     if (!r.accepted) continue;
     append_attitude_row(att, log->time_s[k], r.attitude, n);  // the log's own time, bit for bit
   }
-  if (auto st = write_text_file(attitude_path, att); !st) return report("replay", st.error());
-  if (auto st = write_text_file(events_path, events); !st) return report("replay", st.error());
+  if (auto st = (*attitude_out)->write(att); !st) return report("replay", st.error());
+  if (auto st = (*events_out)->write(events); !st) return report("replay", st.error());
+  if (auto st = files.commit(); !st) return report("replay", st.error());
 
   if (verbose) std::fprintf(stderr, "tetra replay: thresholds\n%s", pipeline->describe_thresholds().c_str());
   const auto& h = pipeline->health();

@@ -9,6 +9,8 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "tetra/core/calibration_file.hpp"
+#include "tetra/core/output_files.hpp"
+#include "tetra/core/provenance.hpp"
 #include "tetra/core/turntable_log.hpp"
 #include "tetra/sim/fault.hpp"
 #include "tetra/sim/scenario.hpp"
@@ -29,17 +31,15 @@ void print_progress(double fraction) {
 }
 
 int run_turntable(const Calibration& unit, const sim::TurntablePlan& plan, const sim::GyroModelOptions& model,
-                  std::uint64_t seed, const std::string& out_path) {
+                  std::uint64_t seed, RunFiles& files, OutputFile& out) {
   auto log = sim::simulate_turntable(unit, plan, seed, model);
   if (!log) return report(kName, log.error());
-  const bool to_stdout = out_path.empty() || out_path == "-";
-  if (to_stdout) {
-    std::cout << format_turntable_log(*log);
-  } else if (Status st = write_turntable_log(out_path, *log); !st) {
-    return report(kName, st.error());
-  }
+  const auto meta = provenance_metadata(provenance(files.input_paths()));
+  log->metadata.insert(log->metadata.end(), meta.begin(), meta.end());
+  if (Status st = out.write(format_turntable_log(*log)); !st) return report(kName, st.error());
+  if (Status st = files.commit(); !st) return report(kName, st.error());
   std::cerr << "tetra sim: turntable: " << log->rows() << " rows, " << unit.gyro_count() << " gyros"
-            << (to_stdout ? std::string() : " -> " + out_path) << '\n';
+            << (out.path() == "-" ? std::string() : " -> " + out.path()) << '\n';
   return kExitOk;
 }
 
@@ -80,14 +80,15 @@ int cmd_sim(int argc, char** argv) {
   app.add_option("--unit", unit_path,
                  "calibration YAML of the simulated unit (the as-built truth, with its noise: sections); "
                  "default: the seed paper's unit");
-  app.add_option("--out,-o", out_path, "output log (turntable: default standard output)");
+  app.add_option("--out,-o", out_path, "output log (- = standard output; turntable: the default)");
   app.add_option("--truth", truth_path, "truth file: time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps");
   auto* opt_rate = app.add_option("--rate-hz", rate_hz, "[Hz] gyro sampling rate");
   auto* opt_minutes = app.add_option("--minutes", minutes, "[min] duration (not for turntable)");
   auto* opt_lat =
-      app.add_option("--latitude", latitude_deg, "[deg] geodetic latitude (turntable, static, lab-orbit)");
+      app.add_option("--latitude", latitude_deg, "[deg] geodetic latitude (turntable, static, lab-orbit)")
+          ->check(CLI::Range(-90.0, 90.0));
   app.add_option("--fault", fault_texts,
-                 "gyro=N,kind=K,at=S[,size=X][,until=S] (repeatable; INTERFACES 2.7)");
+                 "gyro=N,kind=K,at=S[,size=X][,until=S] (repeatable; docs/interfaces.md §2.7)");
   auto* opt_ref = app.add_option("--reference-hz", reference_hz, "[Hz] attitude reference rate (0 = none)");
   auto* opt_ref_noise =
       app.add_option("--reference-noise", reference_noise_arcsec, "[arcsec] reference 1-sigma per axis");
@@ -117,6 +118,23 @@ int cmd_sim(int argc, char** argv) {
 #endif
   if (auto status = parse(app, argc, argv)) return *status;
 
+  RunFiles files;
+  if (!unit_path.empty()) files.add_input(unit_path, "--unit");
+  if (looks_like_file(scenario_name)) files.add_input(scenario_name, "SCENARIO");
+  if (scenario_name == "turntable" && out_path.empty()) out_path = "-";
+  OutputFile* log_out = nullptr;
+  OutputFile* truth_out = nullptr;
+  if (!out_path.empty()) {
+    auto out = files.add(out_path, "--out");
+    if (!out) return report(kName, out.error());
+    log_out = *out;
+  }
+  if (!truth_path.empty() && scenario_name != "turntable") {
+    auto out = files.add(truth_path, "--truth");
+    if (!out) return report(kName, out.error());
+    truth_out = *out;
+  }
+
   std::optional<Calibration> unit;
   if (!unit_path.empty()) {
     auto read = read_calibration(unit_path);
@@ -136,7 +154,7 @@ int cmd_sim(int argc, char** argv) {
     if (opt_lat->count()) plan.latitude_deg = latitude_deg;
     sim::GyroModelOptions model;
     if (opt_range->count()) model.range_dps = range_dps;
-    return run_turntable(unit ? *unit : seed_as_built_unit(), plan, model, seed, out_path);
+    return run_turntable(unit ? *unit : seed_as_built_unit(), plan, model, seed, files, *log_out);
   }
 
   for (const CLI::Option* o : {opt_table, opt_revs, opt_order, opt_wrap}) {
@@ -174,16 +192,18 @@ int cmd_sim(int argc, char** argv) {
     return sim_dds_main(*simulator, dds_options);
   }
 #endif
-  if (out_path.empty()) return report(kName, bad_input("--out LOG.csv is required (or --dds)"));
+  if (log_out == nullptr) return report(kName, bad_input("--out LOG.csv is required (or --dds)"));
 
   auto simulator = sim::Simulator::create(sc, options);
   if (!simulator) return report(kName, simulator.error());
   const bool long_run = simulator->epoch_count() > 2'000'000;
+  const auto meta = provenance_metadata(provenance(files.input_paths()));
   if (Status st =
-          sim::write_simulation(*simulator, out_path, truth_path, long_run ? print_progress : nullptr);
+          sim::write_simulation(*simulator, *log_out, truth_out, meta, long_run ? print_progress : nullptr);
       !st) {
     return report(kName, st.error());
   }
+  if (Status st = files.commit(); !st) return report(kName, st.error());
   std::cerr << "tetra sim: " << sc.name << ": " << simulator->epoch_count() << " epochs, "
             << simulator->gyro_count() << " gyros -> " << out_path
             << (truth_path.empty() ? std::string() : ", truth -> " + truth_path) << '\n';

@@ -28,9 +28,10 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown)
   if (auto s = assign(participant_, dds::Participant::create(domain, config_.unit)); !s) return s;
   if (auto s = assign(topics_, dds::Topics::create(*participant_)); !s) return s;
   const dds::Topics& t = *topics_;
-  if (auto s = assign(gyro_reader_, dds::Reader<tetra_GyroSample>::create(
-                                        *participant_, t.gyro_sample,
-                                        dds::gyro_sample_qos(std::chrono::nanoseconds(deadline_ns_ / 3))));
+  if (auto s =
+          assign(gyro_reader_, dds::Reader<tetra_GyroSample>::create(
+                                   *participant_, t.gyro_sample,
+                                   dds::gyro_sample_reader_qos(std::chrono::nanoseconds(deadline_ns_ / 3))));
       !s) {
     return s;
   }
@@ -184,10 +185,19 @@ Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered,
         matched_changed = true;
       }
       if ((status & DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS) != 0) {
-        spdlog::warn(
-            "fusion: a GyroSample writer offers incompatible QoS (its deadline must be at most {} s: "
-            "sample_rate_hz and speed must match the sensor's)",
-            static_cast<double>(deadline_ns_) * 1e-9);
+        dds_requested_incompatible_qos_status_t qos_status{};
+        (void)dds_get_requested_incompatible_qos_status(gyro_reader_->handle(), &qos_status);
+        const std::uint32_t policy = qos_status.last_policy_id;
+        if (policy == DDS_DEADLINE_QOS_POLICY_ID) {
+          spdlog::warn(
+              "fusion: a GyroSample writer offers incompatible QoS: deadline (policy id {}; its deadline "
+              "must "
+              "be at most {} s: sample_rate_hz and speed must match the sensor's)",
+              policy, static_cast<double>(deadline_ns_) * 1e-9);
+        } else {
+          spdlog::warn("fusion: a GyroSample writer offers incompatible QoS: {} (policy id {}; docs/dds.md)",
+                       dds::qos_policy_name(policy), policy);
+        }
       }
     }
   }
@@ -220,8 +230,10 @@ Status FusionService::take_gyro_samples(std::int64_t now_ns) {
       [&](const tetra_GyroSample& sample, const dds_sample_info_t&) {
         if (dds::from_wire(sample.unit) != config_.unit) {
           ++assembler_.counters().samples_other_unit;
+          other_unit_heard_ = dds::from_wire(sample.unit);
           return;
         }
+        ++own_samples_;
         const int gyro = sample.gyro;
         const auto verdict = assembler_.add_sample(gyro, sample.seq, sample.stamp_ns, sample.raw, now_ns);
         if (gyro >= 1 && gyro <= n_gyros_) last_arrival_ns_[static_cast<std::size_t>(gyro - 1)] = now_ns;
@@ -243,6 +255,7 @@ Status FusionService::take_gyro_samples(std::int64_t now_ns) {
         dds_sample_free(&key, &tetra_GyroSample_desc, DDS_FREE_CONTENTS);
       });
   if (!taken) return taken.error();
+  warn_other_unit(now_ns);
   if (was_silent && !assembler_.all_absent()) resumed_ns_ = now_ns;  // deadlines re-armed from now
   if (assembler_.counters().sensor_restarts != last_restarts_) {
     last_restarts_ = assembler_.counters().sensor_restarts;
@@ -250,6 +263,21 @@ Status FusionService::take_gyro_samples(std::int64_t now_ns) {
     pipeline_.reset();
   }
   return ok_status();
+}
+
+void FusionService::warn_other_unit(std::int64_t now_ns) {
+  // Rate-limited (once per kOtherUnitWarnPeriod_ns): samples for another unit and none for ours.
+  const std::uint64_t other = assembler_.counters().samples_other_unit;
+  if (other == other_at_warning_ || now_ns < next_other_warning_ns_) return;
+  if (own_samples_ == own_at_warning_) {
+    spdlog::warn(
+        "fusion: hearing GyroSample for unit '{}' ({} samples of other units so far) and none for "
+        "this service's unit '{}': check the unit names",
+        other_unit_heard_, other, config_.unit);
+  }
+  other_at_warning_ = other;
+  own_at_warning_ = own_samples_;
+  next_other_warning_ns_ = now_ns + kOtherUnitWarnPeriod_ns;
 }
 
 Status FusionService::take_references() {

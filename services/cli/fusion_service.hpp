@@ -60,6 +60,7 @@ class FusionService {
   std::int64_t next_wake_ns(std::int64_t now_ns) const;
   Status take_gyro_samples(std::int64_t now_ns);
   Status take_references();
+  void warn_other_unit(std::int64_t now_ns);
   Status take_commands();
   //! Marks gyros silent for the deadline absent; true if any became absent.
   bool check_deadlines(std::int64_t now_ns, bool dds_reported);
@@ -75,8 +76,14 @@ class FusionService {
   fdi::Pipeline pipeline_;
   service::EpochAssembler assembler_;
   int n_gyros_;
-  std::int64_t deadline_ns_ = 0;               //!< [ns] 3 sample periods
-  std::int64_t started_ns_ = 0;                //!< [ns] local time the service started
+  std::int64_t deadline_ns_ = 0;  //!< [ns] 3 sample periods
+  std::int64_t started_ns_ = 0;   //!< [ns] local time the service started
+  static constexpr std::int64_t kOtherUnitWarnPeriod_ns = 10'000'000'000;
+  std::string other_unit_heard_;               //!< the last other unit a GyroSample was heard for
+  std::uint64_t own_samples_ = 0;              //!< GyroSamples for this unit, ever
+  std::uint64_t own_at_warning_ = 0;           //!< own_samples_ at the last check
+  std::uint64_t other_at_warning_ = 0;         //!< samples_other_unit at the last check
+  std::int64_t next_other_warning_ns_ = 0;     //!< [ns] local time before which no other-unit warning
   std::int64_t resumed_ns_ = 0;                //!< [ns] local time the unit last resumed after silence
   std::vector<std::int64_t> last_arrival_ns_;  //!< [ns] local time of each gyro's last sample
   std::int64_t next_health_ns_ = 0;

@@ -1,6 +1,7 @@
 // tetra — calibration, noise characterization, simulation, fault-tolerant fusion and DDS services
 // for redundant gyro packages.
 
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -9,6 +10,7 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "tetra/core/provenance.hpp"
 
 namespace {
 
@@ -34,30 +36,47 @@ void print_usage(std::FILE* out) {
   std::fprintf(
       out, "usage: tetra COMMAND [OPTIONS]   (tetra COMMAND --help for a command's options)\n\ncommands:\n");
   for (const auto& c : kCommands) std::fprintf(out, "  %-10s %s\n", c.name, c.summary);
-  std::fprintf(out, "  %-10s %s\n", "help", "this list");
+  std::fprintf(out, "  %-10s %s\n", "help", "this list (help COMMAND: that command's options)");
+  std::fprintf(out, "  %-10s %s\n", "--version", "tetra's version");
+}
+
+int help(int argc, char** argv) {
+  if (argc < 3) {
+    print_usage(stdout);
+    return tetra::cli::kExitOk;
+  }
+  if (argc > 3) {
+    std::cerr << "tetra help: give one command name (tetra help COMMAND)\n";
+    return tetra::cli::kExitBadInput;
+  }
+  for (const auto& c : kCommands) {
+    if (std::string_view(argv[2]) == c.name) {
+      char help_flag[] = "--help";
+      char* args[] = {argv[2], help_flag};
+      return c.run(2, args);
+    }
+  }
+  std::cerr << "tetra help: unknown command '" << tetra::one_line(argv[2]) << "' (tetra help lists them)\n";
+  return tetra::cli::kExitBadInput;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A closed pipe on standard output is a write error (EPIPE) that each writer reports, never a
+  // signal that kills the run before its files are written.
+  std::signal(SIGPIPE, SIG_IGN);
+  tetra::record_command_line(argc, argv);
   if (argc < 2) {
     print_usage(stderr);
     return tetra::cli::kExitBadInput;
   }
   const std::string_view name = argv[1];
-  if (name == "help" || name == "--help" || name == "-h") {
-    if (argc >= 3) {
-      for (const auto& c : kCommands) {
-        if (std::string_view(argv[2]) == c.name) {
-          char help_flag[] = "--help";
-          char* args[] = {argv[2], help_flag};
-          return c.run(2, args);
-        }
-      }
-    }
-    print_usage(stdout);
+  if (name == "--version") {
+    std::cout << "tetra " << tetra::kVersion << "\n";
     return tetra::cli::kExitOk;
   }
+  if (name == "help" || name == "--help" || name == "-h") return help(argc, argv);
   for (const auto& c : kCommands) {
     if (name == c.name) {
       try {
@@ -68,7 +87,7 @@ int main(int argc, char** argv) {
       }
     }
   }
-  std::cerr << "tetra: unknown command '" << name << "'\n";
-  print_usage(stderr);
+  std::cerr << "tetra: unknown command '" << tetra::one_line(std::string(name))
+            << "' (tetra help lists them)\n";
   return tetra::cli::kExitBadInput;
 }

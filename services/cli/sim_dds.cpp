@@ -262,6 +262,12 @@ int sim_dds_main(sim::Simulator& simulator, const SimDdsOptions& options) {
   }
   if (score->series.empty()) {
     std::cout << "attitude error: no Attitude received for this unit (is `tetra fusion` running?)\n";
+    if (!shutdown.requested() && options.wait_readers > 0 && score->epochs_published > 0) {
+      // Loud, not silent: a service for another unit (or none) ignored every sample.
+      const std::string unit = options.unit.empty() ? simulator.scenario().unit.unit : options.unit;
+      return report("sim", failure("--dds: no service accepted the samples of unit '" + unit +
+                                   "' (no Attitude came back; check the service's unit against --dds-unit)"));
+    }
   } else {
     std::cout << "attitude error now: " << fixed(score->series.back().error_deg, 6) << " deg (mode "
               << score->series.back().mode << ", gyros " << score->series.back().gyros << ")\n"

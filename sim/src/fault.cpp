@@ -1,8 +1,10 @@
 #include "tetra/sim/fault.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 #include "tetra/core/csv.hpp"
 
@@ -44,6 +46,7 @@ Result<FaultSpec> parse_fault_spec(std::string_view text) {
   bool has_kind = false;
   bool has_at = false;
   std::optional<double> size;
+  std::vector<std::string> seen;
   std::size_t pos = 0;
   while (pos <= text.size()) {
     std::size_t comma = text.find(',', pos);
@@ -56,6 +59,9 @@ Result<FaultSpec> parse_fault_spec(std::string_view text) {
     }
     const std::string key(field.substr(0, eq));
     const std::string_view value = field.substr(eq + 1);
+    if (std::find(seen.begin(), seen.end(), key) != seen.end())
+      return bad_input(where + key + ": given twice");
+    seen.push_back(key);
     if (key == "gyro") {
       int gyro = 0;
       auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), gyro);

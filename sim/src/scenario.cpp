@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/input_files.hpp"
 #include "tetra/core/yaml_reader.hpp"
 #include "text.hpp"
 
@@ -84,7 +85,9 @@ Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, cons
     return st.error();
   const YAML::Node base = root["scenario"];
   if (!base) return yaml.error(root, "", "missing key 'scenario' (static, lab-orbit, orbit or slews)");
-  auto builtin = builtin_scenario(base.as<std::string>());
+  auto base_name = yaml.text(base, "scenario");
+  if (!base_name) return base_name.error();
+  auto builtin = builtin_scenario(*base_name);
   if (!builtin) return yaml.error(base, "scenario", builtin.error().message);
   Scenario sc = builtin.value();
   sc.name = yaml.source();
@@ -138,7 +141,9 @@ Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, cons
     if (*range) sc.model.range_dps = **range;
   }
   if (const YAML::Node unit = root["unit"]) {
-    std::filesystem::path path = unit.as<std::string>();
+    auto unit_path = yaml.text(unit, "unit");
+    if (!unit_path) return unit_path.error();
+    std::filesystem::path path = *unit_path;
     if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
     auto cal = read_calibration(path.string());
     if (!cal) return yaml.error(unit, "unit", cal.error().message);
@@ -147,7 +152,9 @@ Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, cons
   if (const YAML::Node faults = root["faults"]) {
     if (!faults.IsSequence()) return yaml.error(faults, "faults", "expected a list of fault specs");
     for (std::size_t i = 0; i < faults.size(); ++i) {
-      auto fault = parse_fault_spec(faults[i].as<std::string>());
+      auto spec = yaml.text(faults[i], "faults[" + std::to_string(i) + "]");
+      if (!spec) return spec.error();
+      auto fault = parse_fault_spec(*spec);
       if (!fault) return yaml.error(faults[i], "faults[" + std::to_string(i) + "]", fault.error().message);
       sc.faults.push_back(fault.value());
     }
@@ -203,7 +210,9 @@ Result<Scenario> parse_scenario(const std::string& yaml_text, const std::string&
                                 const std::string& base_dir) {
   const YamlReader yaml{source};
   try {
-    const YAML::Node root = YAML::Load(yaml_text);
+    auto loaded = yaml.load(yaml_text);
+    if (!loaded) return loaded.error();
+    const YAML::Node root = *loaded;
     if (!root || root.IsNull()) return bad_input(source + ": empty scenario file");
     return parse_yaml(root, yaml, base_dir);
   } catch (const YAML::Exception& e) {
@@ -212,12 +221,10 @@ Result<Scenario> parse_scenario(const std::string& yaml_text, const std::string&
 }
 
 Result<Scenario> read_scenario(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return bad_input(path + ": cannot open scenario file");
-  std::ostringstream text;
-  text << in.rdbuf();
+  auto text = read_input(path, kMaxYamlBytes);
+  if (!text) return text.error();
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  return parse_scenario(text.str(), path, parent.empty() ? "." : parent.string());
+  return parse_scenario(*text, path, parent.empty() ? "." : parent.string());
 }
 
 Status validate_scenario(const Scenario& sc) {
@@ -257,6 +264,10 @@ Status validate_scenario(const Scenario& sc) {
     if (f.gyro < 1 || f.gyro > sc.unit.gyro_count()) {
       return bad_input("fault '" + format_fault_spec(f) + "': gyro " + std::to_string(f.gyro) +
                        " does not exist (the unit has " + std::to_string(sc.unit.gyro_count()) + " gyros)");
+    }
+    if (f.at_s >= sc.duration_s) {
+      return bad_input("fault '" + format_fault_spec(f) + "': starts at " + number_text(f.at_s) +
+                       " s, at or after the end of the run (" + number_text(sc.duration_s) + " s)");
     }
     if (f.kind == FaultKind::kNoise) {
       const auto& noise = sc.unit.gyros[static_cast<std::size_t>(f.gyro - 1)].noise;

@@ -233,23 +233,13 @@ Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options
 
 namespace {
 
-//! Buffered writer of the truth file through a temporary file renamed on close.
+//! Buffered writer of the truth file into an output of the run.
 class TruthWriter {
  public:
-  ~TruthWriter() {
-    if (file_) {
-      std::fclose(file_);
-      std::remove(temp_.c_str());
-    }
-  }
-  Status open(const std::string& path, const std::vector<std::pair<std::string, std::string>>& comments) {
-    path_ = path;
-    temp_ = path + ".tmp";
-    file_ = std::fopen(temp_.c_str(), "wb");
-    if (!file_) return failure(path + ": cannot open for writing");
-    for (const auto& [key, value] : comments) buffer_ += "# " + key + "=" + value + "\n";
+  void open(OutputFile& out, const std::vector<std::pair<std::string, std::string>>& comments) {
+    out_ = &out;
+    for (const auto& [key, value] : comments) append_metadata(buffer_, key, value);
     buffer_ += "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps\n";
-    return ok_status();
   }
   Status write(const SimEpoch& e) {
     append_double(buffer_, e.time_s);
@@ -266,28 +256,14 @@ class TruthWriter {
     if (buffer_.size() > (1u << 20)) return flush();
     return ok_status();
   }
-  Status close() {
-    if (Status st = flush(); !st) return st;
-    const bool ok = std::fclose(file_) == 0;
-    file_ = nullptr;
-    if (!ok || std::rename(temp_.c_str(), path_.c_str()) != 0) {
-      std::remove(temp_.c_str());
-      return failure(path_ + ": cannot write");
-    }
+  Status flush() {
+    if (Status st = out_->write(buffer_); !st) return st;
+    buffer_.clear();
     return ok_status();
   }
 
  private:
-  Status flush() {
-    if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
-      return failure(path_ + ": write failed");
-    }
-    buffer_.clear();
-    return ok_status();
-  }
-  std::FILE* file_ = nullptr;
-  std::string path_;
-  std::string temp_;
+  OutputFile* out_ = nullptr;
   std::string buffer_;
 };
 
@@ -295,16 +271,33 @@ class TruthWriter {
 
 Status write_simulation(Simulator& simulator, const std::string& log_path, const std::string& truth_path,
                         void (*progress)(double fraction)) {
+  RunFiles files;
+  auto log = files.add(log_path, "--out");
+  if (!log) return log.error();
+  OutputFile* truth = nullptr;
+  if (!truth_path.empty()) {
+    auto t = files.add(truth_path, "--truth");
+    if (!t) return t.error();
+    truth = *t;
+  }
+  if (Status st = write_simulation(simulator, **log, truth, {}, progress); !st) return st;
+  return files.commit();
+}
+
+Status write_simulation(Simulator& simulator, OutputFile& log, OutputFile* truth_out,
+                        const std::vector<std::pair<std::string, std::string>>& extra_metadata,
+                        void (*progress)(double fraction)) {
   const Scenario& sc = simulator.scenario();
   const bool with_reference = sc.reference.rate_hz > 0.0;
-  const auto meta = simulator.metadata();
+  auto meta = simulator.metadata();
+  meta.insert(meta.end(), extra_metadata.begin(), extra_metadata.end());
   GyroLogWriter writer;
-  if (Status st = writer.open(log_path, simulator.gyro_count(), with_reference, false, meta); !st) return st;
+  if (Status st = writer.open(log, simulator.gyro_count(), with_reference, false, meta); !st) return st;
   TruthWriter truth;
-  if (!truth_path.empty()) {
+  if (truth_out != nullptr) {
     auto truth_meta = meta;
     truth_meta.emplace_back("truth", "q_body_to_reference_frame;w_body_relative_to_reference_frame_in_body");
-    if (Status st = truth.open(truth_path, truth_meta); !st) return st;
+    truth.open(*truth_out, truth_meta);
   }
   SimEpoch epoch;
   const std::size_t total = simulator.epoch_count();
@@ -313,7 +306,7 @@ Status write_simulation(Simulator& simulator, const std::string& log_path, const
     std::optional<std::array<double, 4>> ref;
     if (epoch.reference_q_RB) ref = to_wxyz(*epoch.reference_q_RB);
     if (Status st = writer.write(epoch.time_s, epoch.raw_V, epoch.present, ref); !st) return st;
-    if (!truth_path.empty()) {
+    if (truth_out != nullptr) {
       if (Status st = truth.write(epoch); !st) return st;
     }
     if (progress && simulator.epochs_done() % every == 0) {
@@ -321,7 +314,7 @@ Status write_simulation(Simulator& simulator, const std::string& log_path, const
     }
   }
   if (Status st = writer.close(); !st) return st;
-  if (!truth_path.empty()) return truth.close();
+  if (truth_out != nullptr) return truth.flush();
   return ok_status();
 }
 

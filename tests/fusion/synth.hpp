@@ -1,7 +1,7 @@
 #pragma once
 // Small synthetic epochs for the pipeline's unit tests and benchmarks (the full simulator lives in sim/):
 // a body rate of a constant part plus a slow sinusoidal attitude-control motion, the measurement model of
-// INTERFACES §1 with seeded white noise, and injected faults.
+// docs/interfaces.md §1 with seeded white noise, and injected faults.
 
 #include <cmath>
 #include <cstdint>

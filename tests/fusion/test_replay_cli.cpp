@@ -1,5 +1,5 @@
-// `tetra replay` end to end: outputs per INTERFACES §2.4/§2.5, the summary, and bad input (exit 2, file and
-// line named, or a counted rejection — never a crash).
+// `tetra replay` end to end: outputs per docs/interfaces.md §2.4, §2.5, the summary, and bad input (exit 2,
+// file and line named, or a counted rejection — never a crash).
 #include <algorithm>
 #include <cmath>
 #include <sstream>

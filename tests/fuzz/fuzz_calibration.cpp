@@ -1,4 +1,4 @@
-// libFuzzer target: the calibration YAML reader (core/calibration_file.hpp, INTERFACES §2.3) on
+// libFuzzer target: the calibration YAML reader (core/calibration_file.hpp, docs/interfaces.md §2.3) on
 // arbitrary bytes, and the round trip: an accepted calibration is valid, and what
 // format_calibration writes reads back to the same gyros.
 #include <cstddef>

@@ -1,4 +1,4 @@
-// libFuzzer target: the fault specification parser (sim/fault.hpp, INTERFACES §2.7) on arbitrary
+// libFuzzer target: the fault specification parser (sim/fault.hpp, docs/interfaces.md §2.7) on arbitrary
 // bytes, and its round trip through format_fault_spec.
 #include <cstddef>
 #include <cstdint>

@@ -1,4 +1,4 @@
-// libFuzzer target: the gyro log reader (core/gyro_log.hpp, INTERFACES §2.2) on arbitrary bytes.
+// libFuzzer target: the gyro log reader (core/gyro_log.hpp, docs/interfaces.md §2.2) on arbitrary bytes.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>

@@ -1,4 +1,4 @@
-// libFuzzer target: the turntable log reader (core/turntable_log.hpp, INTERFACES §2.1) on arbitrary
+// libFuzzer target: the turntable log reader (core/turntable_log.hpp, docs/interfaces.md §2.1) on arbitrary
 // bytes, and the writer's round trip: what the reader accepts, format_turntable_log writes back and
 // the reader reads again to the same numbers, bit for bit.
 #include <cstddef>

@@ -8,6 +8,18 @@ Qos gyro_sample_qos(std::chrono::nanoseconds sample_period) {
   if (sample_period.count() > 0) qos.deadline(3 * sample_period);
   return qos;
 }
+Qos gyro_sample_reader_qos(std::chrono::nanoseconds sample_period) {
+  // What the service needs and no more: the writers' automatic 1 s lease is not required of them
+  // (a sensor driver that leaves liveliness at its default still matches); the deadline detects a
+  // silent gyro.
+  Qos qos;
+  qos.reliable()
+      .volatile_durability()
+      .keep_last(kGyroSampleDepth)
+      .automatic_liveliness(std::chrono::nanoseconds(DDS_INFINITY));
+  if (sample_period.count() > 0) qos.deadline(3 * sample_period);
+  return qos;
+}
 Qos reference_qos() {
   Qos qos;
   qos.reliable().volatile_durability().keep_last(kReferenceDepth);
@@ -32,6 +44,31 @@ Qos command_qos() {
   Qos qos;
   qos.reliable().volatile_durability().keep_last(kCommandDepth);
   return qos;
+}
+
+const char* qos_policy_name(std::uint32_t policy_id) {
+  switch (policy_id) {
+    case DDS_DURABILITY_QOS_POLICY_ID:
+      return "durability";
+    case DDS_PRESENTATION_QOS_POLICY_ID:
+      return "presentation";
+    case DDS_DEADLINE_QOS_POLICY_ID:
+      return "deadline";
+    case DDS_LATENCYBUDGET_QOS_POLICY_ID:
+      return "latency budget";
+    case DDS_OWNERSHIP_QOS_POLICY_ID:
+      return "ownership";
+    case DDS_LIVELINESS_QOS_POLICY_ID:
+      return "liveliness";
+    case DDS_RELIABILITY_QOS_POLICY_ID:
+      return "reliability";
+    case DDS_DESTINATIONORDER_QOS_POLICY_ID:
+      return "destination order";
+    case DDS_DATA_REPRESENTATION_QOS_POLICY_ID:
+      return "data representation";
+    default:
+      return "unknown";
+  }
 }
 
 Result<Topics> Topics::create(const Participant& participant) {

@@ -7,6 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "tetra/core/input_files.hpp"
 #include "tetra/core/yaml_reader.hpp"
 
 namespace tetra::service {
@@ -33,12 +34,10 @@ AssemblerConfig FusionConfig::assembler(int gyro_count) const {
 }
 
 Result<FusionConfig> read_fusion_config(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return bad_input(path + ": cannot open the fusion configuration");
-  std::stringstream text;
-  text << in.rdbuf();
+  auto text = read_input(path, kMaxYamlBytes);
+  if (!text) return text.error();
   const auto dir = std::filesystem::path(path).parent_path().string();
-  return parse_fusion_config(text.str(), path, dir);
+  return parse_fusion_config(*text, path, dir);
 }
 
 Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std::string& source,
@@ -63,7 +62,7 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
     const YAML::Node& value = item.second;
     if (key == "unit" || key == "calibration") {
       if (!value.IsScalar()) return bad_input(reader.at(value) + key + " must be text");
-      (key == "unit" ? config.unit : config.calibration_path) = value.as<std::string>();
+      (key == "unit" ? config.unit : config.calibration_path) = value.Scalar();
     } else if (key == "gyro_dispatch") {
       const std::string text = value.IsScalar() ? value.Scalar() : std::string();
       if (text != "listener" && text != "waitset")
@@ -71,7 +70,7 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
       config.gyro_dispatch = text == "listener" ? GyroDispatch::kListener : GyroDispatch::kWaitset;
     } else if (key == "security") {
       if (!value.IsScalar()) return bad_input(reader.at(value) + "security must be a file name");
-      std::filesystem::path profile_path(value.as<std::string>());
+      std::filesystem::path profile_path(value.Scalar());
       if (profile_path.is_relative() && !base_dir.empty())
         profile_path = std::filesystem::path(base_dir) / profile_path;
       auto profile = read_security_profile(profile_path.string());

@@ -9,6 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "tetra/core/input_files.hpp"
 #include "tetra/core/yaml_reader.hpp"
 
 namespace tetra::service {
@@ -60,11 +61,9 @@ Result<SecurityProfile> parse_security_profile(const std::string& yaml_text, con
 }
 
 Result<SecurityProfile> read_security_profile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return bad_input(path + ": cannot open the DDS Security profile");
-  std::stringstream text;
-  text << in.rdbuf();
-  auto profile = parse_security_profile(text.str(), path, std::filesystem::path(path).parent_path().string());
+  auto text = read_input(path, kMaxYamlBytes);
+  if (!text) return text.error();
+  auto profile = parse_security_profile(*text, path, std::filesystem::path(path).parent_path().string());
   if (!profile) return profile;
   for (const auto& [key, member] : kFields) {
     const std::string& file = profile.value().*member;

@@ -147,6 +147,9 @@ struct AllanResult {
   std::size_t samples = 0;          //!< rate samples on the grid (gaps included)
   std::size_t present_samples = 0;  //!< samples delivered and finite
   std::vector<AdevPoint> points;    //!< one per averaging time with at least one term
+  //! [s] requested averaging times that could not be computed (gaps leave no window of 2m consecutive
+  //! samples): reported in every output (CSV rows with adev nan and n 0, JSON, table), never dropped.
+  std::vector<double> uncomputed_tau_s;
   NoiseFit fit;
 };
 
@@ -182,10 +185,12 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
 
 // --- reports -----------------------------------------------------------------------------------
 
-//! INTERFACES §2.6 CSV: gyro,tau_s,adev,adev_lo,adev_hi,n.
+//! docs/interfaces.md §2.6 CSV: gyro,tau_s,adev,adev_lo,adev_hi,n.
 std::string format_csv(const LogAllan& analysis);
-//! INTERFACES §2.6 JSON: {"units": ..., "gyros": [{"id", "Q", "N", "B", "K", "R"}]}, null = not observed.
-std::string format_json(const LogAllan& analysis);
+//! docs/interfaces.md §2.6 JSON: {"units": ..., "gyros": [{"id", "Q", "N", "B", "K", "R"}]}, null = not
+//! observed.
+std::string format_json(const LogAllan& analysis,
+                        const std::vector<std::pair<std::string, std::string>>& provenance = {});
 //! A table like seed Table 6, in the input's units and (for deg/s) in deg/√h, deg/h, deg/h/√h, deg/h².
 std::string format_table(const LogAllan& analysis);
 

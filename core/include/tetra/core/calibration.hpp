@@ -1,10 +1,10 @@
 #pragma once
 // Turntable calibration of a redundant gyro package (seed paper, Kuga et al., eqs. 4–11).
 //
-// Model (INTERFACES §1): g_i = s_i · (h_i · ω_B) + β_i + η_i, with g [V], s [V/(deg/s)], β [V], ω_B [deg/s]
-// including the Earth rate, h_i a unit vector in B. Both estimators solve for x_i = s_i·h_i (the seed's
-// h̃_i/K_i) and β_i by linear least squares, then apply the unit-norm constraint (seed eq. 8):
-// s_i = |x_i|, h_i = x_i / |x_i|.
+// Model (docs/interfaces.md §1): g_i = s_i · (h_i · ω_B) + β_i + η_i, with g [V], s [V/(deg/s)], β [V], ω_B
+// [deg/s] including the Earth rate, h_i a unit vector in B. Both estimators solve for x_i = s_i·h_i (the
+// seed's h̃_i/K_i) and β_i by linear least squares, then apply the unit-norm constraint (seed eq. 8): s_i =
+// |x_i|, h_i = x_i / |x_i|.
 //
 // The body rate of every sample comes from the encoder angles, never from a table of nominal rates:
 // per sequence, the rotating gimbal's unwrapped angle is fitted by a straight line (its slope is the

@@ -1,5 +1,5 @@
 #pragma once
-// Calibration file (INTERFACES §2.3), YAML. Unknown keys are an error; every error names the file,
+// Calibration file (docs/interfaces.md §2.3), YAML. Unknown keys are an error; every error names the file,
 // the line and the key. Units: scale factor [V/(deg/s)], bias [V], axis unit vector in B.
 // Axes whose norm is within 1e-3 of one are accepted and normalized (tables are often printed to
 // five decimals); others are rejected.
@@ -10,6 +10,8 @@
 
 #include <Eigen/Core>
 
+#include "tetra/core/csv.hpp"
+#include "tetra/core/output_files.hpp"
 #include "tetra/core/result.hpp"
 
 namespace tetra {
@@ -58,7 +60,12 @@ Result<Calibration> parse_calibration(const std::string& yaml_text, const std::s
 //! Validates: N ≥ 3, ids 1..N in order, finite values, scale factor ≠ 0, unit axes.
 Status validate_calibration(const Calibration& cal, const std::string& source);
 
-std::string format_calibration(const Calibration& cal);
+//! The calibration as YAML (yaml-cpp's emitter: any unit name round-trips); `comments` ("key=value",
+//! e.g. provenance_metadata()) become comment lines at the top.
+std::string format_calibration(const Calibration& cal, const Metadata& comments = {});
+//! Writes one calibration file on its own (atomically; see RunFiles).
 Status write_calibration(const std::string& path, const Calibration& cal);
+//! Writes the calibration into an output of a run (committed with the run).
+Status write_calibration(OutputFile& out, const Calibration& cal, const Metadata& comments);
 
 }  // namespace tetra

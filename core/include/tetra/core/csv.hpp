@@ -1,5 +1,6 @@
 #pragma once
-// Text tables of INTERFACES §2: UTF-8, '#' starts a comment line (metadata "# key=value" allowed),
+// Text tables of docs/interfaces.md §2: UTF-8, '#' starts a comment line (metadata "# key=value" allowed, the
+// value with %XX escapes for blanks, commas, '%' and control characters),
 // the first non-comment line is a header, columns are matched by name. Every cell is parsed as a
 // number; an empty cell is kept as "empty" (value NaN), "nan" as NaN. A malformed file is an Error
 // naming the file, the line and the column — never a crash, never a silently skipped row.
@@ -43,17 +44,29 @@ struct CsvTable {
   std::string where(std::size_t row, std::size_t col) const;
 };
 
+//! [columns] widest header read (a gyro log has at most 64 gyros and a few more columns).
+inline constexpr std::size_t kMaxColumns = 1024;
+
+//! Strict number parse of a whole cell: plain decimal ("-1.5", "2e-3", a leading '+'), "nan" or
+//! "inf" (any case). Hexadecimal, a decimal comma, blanks or trailing text are refused.
+bool parse_number(std::string_view text, double& out);
+//! A finite plain decimal number (as parse_number, without nan and inf), or nullopt.
+std::optional<double> parse_decimal(std::string_view text);
+
 //! Parses a whole table from text; `source` names it in messages.
 Result<CsvTable> parse_csv(std::string_view text, std::string source);
-//! Reads and parses a file.
+//! Reads and parses a file (a regular file or a FIFO of at most kMaxTableBytes).
 Result<CsvTable> read_csv(const std::string& path);
 
-//! Reads a whole file into a string (error names the file).
+//! Reads a whole file into a string (error names the file; at most kMaxTableBytes, see read_input).
 Result<std::string> read_text_file(const std::string& path);
-//! Writes `content` to `path` through a temporary file and a rename, so a failed write never
-//! leaves a truncated file behind.
+//! Writes one output of a run of its own (RunFiles: refuses a folder, replaces a regular file
+//! atomically, writes a device or FIFO straight). Commands with several outputs use RunFiles.
 Status write_text_file(const std::string& path, std::string_view content);
 
+//! Appends the metadata line "# key=value": blanks, commas, '%' and control characters of the value
+//! are written %XX (read back by parse_csv), so any value round-trips. `key` must be a plain name.
+void append_metadata(std::string& out, std::string_view key, std::string_view value);
 //! Appends the shortest decimal text that reads back to exactly `value` ("nan" for NaN).
 void append_double(std::string& out, double value);
 //! Appends `value` in fixed notation with `decimals` digits after the point.

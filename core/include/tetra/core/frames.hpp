@@ -1,5 +1,5 @@
 #pragma once
-// Frames for ground tests (INTERFACES §1).
+// Frames for ground tests (docs/interfaces.md §1).
 //   B: body frame, the unit's analytical trihedron XYZ (gyro 4 along +X).
 //   L: lab frame, X up, Y east, Z north.
 // Two-axis turntable: inner axis = body X; C_LB = R_y(outer) · R_x(inner) (active, right-handed).

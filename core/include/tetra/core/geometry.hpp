@@ -37,7 +37,7 @@ int gyro_count(GyroMask mask);  // number of gyros in the mask
 //! "1234", "124": the ids in the mask, for files and displays (ids ≥ 10 are comma separated).
 std::string mask_to_string(GyroMask mask, int n_gyros);
 
-//! Nominal tetrahedron axes (INTERFACES §1, seed Table 5 nominal rows), 4×3, rows h_iᵀ in B.
+//! Nominal tetrahedron axes (docs/interfaces.md §1, seed Table 5 nominal rows), 4×3, rows h_iᵀ in B.
 Eigen::Matrix<double, 4, 3> nominal_tetrahedron_axes();
 
 class GyroGeometry {

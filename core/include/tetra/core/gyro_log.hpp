@@ -1,5 +1,5 @@
 #pragma once
-// Gyro log (INTERFACES §2.2): time_s,g1..gN[,ref_qw,ref_qx,ref_qy,ref_qz].
+// Gyro log (docs/interfaces.md §2.2): time_s,g1..gN[,ref_qw,ref_qx,ref_qy,ref_qz].
 // An empty gyro cell means "no sample this epoch" (present = 0); "nan" means an invalid sample
 // (present = 1, value NaN). Values are volts unless the file says "# units=dps" (deg/s).
 // Reference columns are all four or none; on a row they are all filled or all empty.
@@ -9,12 +9,14 @@
 #include <array>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "tetra/core/output_files.hpp"
 #include "tetra/core/result.hpp"
 
 namespace tetra {
@@ -45,8 +47,8 @@ struct GyroLog {
 Result<GyroLog> read_gyro_log(const std::string& path);
 Result<GyroLog> parse_gyro_log(std::string_view text, std::string source);
 
-//! Streams a gyro log to disk (through a temporary file renamed on close()).
-//! Numbers are written in shortest round-trip form: the same inputs give byte-identical files.
+//! Streams a gyro log to disk. Numbers are written in shortest round-trip form: the same inputs give
+//! byte-identical files.
 class GyroLogWriter {
  public:
   GyroLogWriter() = default;
@@ -54,19 +56,23 @@ class GyroLogWriter {
   GyroLogWriter& operator=(const GyroLogWriter&) = delete;
   ~GyroLogWriter();
 
-  //! Opens `path`; `comments` are written as "# key=value" lines before the header.
+  //! Opens `path` as a run of its own (RunFiles: atomic replace on close()); `comments` are written as
+  //! "# key=value" lines before the header.
   Status open(const std::string& path, int gyro_count, bool with_reference, bool units_dps,
+              const std::vector<std::pair<std::string, std::string>>& comments = {});
+  //! Writes into an output of a larger run; close() flushes, the run's RunFiles::commit() commits.
+  Status open(OutputFile& out, int gyro_count, bool with_reference, bool units_dps,
               const std::vector<std::pair<std::string, std::string>>& comments = {});
   //! One epoch. `present[i] == 0` writes an empty cell; NaN writes "nan".
   Status write(double time_s, std::span<const double> values, std::span<const std::uint8_t> present,
                const std::optional<std::array<double, 4>>& reference_wxyz = std::nullopt);
-  //! Flushes, closes and renames into place.
+  //! Flushes (and, when opened by path, renames into place).
   Status close();
 
  private:
   Status flush();
-  std::FILE* file_ = nullptr;
-  std::string path_;
+  std::unique_ptr<RunFiles> own_;
+  OutputFile* out_ = nullptr;
   std::string buffer_;
   int gyro_count_ = 0;
   bool with_reference_ = false;

@@ -1,5 +1,5 @@
 #pragma once
-// Attitude quaternion convention — the only place tetra defines or converts it (INTERFACES §1):
+// Attitude quaternion convention — the only place tetra defines or converts it (docs/interfaces.md §1):
 //   * Hamilton product, scalar first in files and on the wire: (w, x, y, z);
 //   * q_RB maps body → reference: v_R = q ⊗ v_B ⊗ q*  (Eigen: v_R = q * v_B, q.toRotationMatrix() = C_RB);
 //   * propagation with the body rate ω_B over Δt: q ← q ⊗ exp(½ ω_B Δt), exp of the rotation vector

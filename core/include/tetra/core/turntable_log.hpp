@@ -1,5 +1,5 @@
 #pragma once
-// Turntable log (INTERFACES §2.1), the input of `tetra calibrate`:
+// Turntable log (docs/interfaces.md §2.1), the input of `tetra calibrate`:
 //   sequence,time_s,inner_deg,outer_deg,g1,...,gN
 // `sequence` is the 1-based index in the rotation plan (pairs 2k−1, 2k are opposite rotations of the
 // same gimbal at the same fixed angle of the other gimbal); encoder angles in degrees, wrapped or

@@ -1,6 +1,6 @@
 #pragma once
 // Physical constants and unit conversions. Inside the code everything is SI (rad, rad/s, s, V);
-// files and the command line use degrees, deg/s, volts and seconds (INTERFACES §1).
+// files and the command line use degrees, deg/s, volts and seconds (docs/interfaces.md §1).
 
 #include <cstdint>
 #include <numbers>

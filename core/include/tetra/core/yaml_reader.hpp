@@ -30,8 +30,19 @@ class YamlReader {
   //! "FILE:LINE: what: message" (or "FILE:LINE: message" when `what` is empty), as a bad-input Error.
   Error error(const YAML::Node& node, const std::string& what, const std::string& message) const;
 
-  //! Parses a whole document; a syntax error becomes "FILE:LINE: message".
+  //! Parses a file's one document; a syntax error becomes "FILE:LINE: message". A second document
+  //! and a key given twice in any mapping, at any depth, are errors naming the line and key path.
   Result<YAML::Node> load(const std::string& text) const;
+  //! Every mapping below `node` has distinct keys; at most kMaxYamlNodes nodes are walked.
+  Status check_unique_keys(const YAML::Node& node, const std::string& what) const;
+  //! [nodes] largest YAML tree read (aliases included).
+  static constexpr std::size_t kMaxYamlNodes = 1'000'000;
+
+  //! A scalar as text ("expected a text value" for a list or a mapping).
+  Result<std::string> text(const YAML::Node& node, const std::string& what) const;
+  //! parent[key] as text, or "" when absent or null.
+  Result<std::string> optional_text(const YAML::Node& parent, const std::string& key,
+                                    const std::string& what) const;
 
   //! A yaml-cpp exception (syntax error, bad conversion) as "FILE:LINE: what: message".
   Error error(const YAML::Exception& e, const std::string& what) const;
@@ -41,7 +52,8 @@ class YamlReader {
   Status check_keys(const YAML::Node& map, const std::vector<std::string>& allowed,
                     const std::string& what) const;
 
-  //! A finite number: "'abc' is not a number" / "must be finite" otherwise.
+  //! A finite plain decimal number: "'abc' is not a number" (hexadecimal, a decimal comma, YAML's
+  //! .inf and the like included) / "must be finite" otherwise.
   Result<double> number(const YAML::Node& node, const std::string& what) const;
   //! parent[key] as a finite number; "what: missing key 'key'" when absent.
   Result<double> required_number(const YAML::Node& parent, const std::string& key,
@@ -60,6 +72,7 @@ class YamlReader {
   static std::string child(const std::string& what, const std::string& key);
 
  private:
+  Status check_unique_keys(const YAML::Node& node, const std::string& what, std::size_t& budget) const;
   std::string source_;
 };
 

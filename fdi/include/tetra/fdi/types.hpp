@@ -1,6 +1,6 @@
 #pragma once
 // Data exchanged by the fusion pipeline: input epochs, attitude output, health and FDI events
-// (INTERFACES §2.4, §2.5, §4). Plain data, no middleware: services/ converts these to and from DDS
+// (docs/interfaces.md §2.4, §2.5, §4). Plain data, no middleware: services/ converts these to and from DDS
 // types, and `tetra replay` to and from files.
 
 #include <cstdint>
@@ -102,7 +102,7 @@ struct FdiEvent {
   std::string detail;  //!< free text: e.g. the command acknowledged and its outcome
 };
 
-//! One JSON object (one line, no newline) per INTERFACES §2.5; `n_gyros` formats the `gyros` lists.
+//! One JSON object (one line, no newline) per docs/interfaces.md §2.5; `n_gyros` formats the `gyros` lists.
 std::string to_json(const FdiEvent& event, int n_gyros);
 
 enum class GyroState : std::uint8_t { kOk, kAbsent, kInvalid, kSuspect, kExcluded };
@@ -137,7 +137,7 @@ struct Health {
   Counters counters;
 };
 
-//! The estimate published every accepted epoch (INTERFACES §2.4).
+//! The estimate published every accepted epoch (docs/interfaces.md §2.4).
 struct AttitudeEstimate {
   std::int64_t stamp_ns = 0;
   Quaternion q_RB = Quaternion::Identity();  //!< body → reference

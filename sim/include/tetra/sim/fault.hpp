@@ -1,5 +1,5 @@
 #pragma once
-// Fault injection (INTERFACES §2.7): "gyro=N,kind=K,at=SECONDS[,size=X][,until=SECONDS]".
+// Fault injection (docs/interfaces.md §2.7): "gyro=N,kind=K,at=SECONDS[,size=X][,until=SECONDS]".
 //
 // A fault is active on the epochs whose time t (the time written in the log) satisfies
 // at ≤ t < until (no until: to the end). It is the last stage of the gyro model, applied to the

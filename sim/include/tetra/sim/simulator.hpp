@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/output_files.hpp"
 #include "tetra/core/quaternion.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/core/units.hpp"
@@ -92,10 +93,15 @@ struct Truth {
 //! reference); the truth too when `truth` is given.
 Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options, Truth* truth = nullptr);
 
-//! Runs the simulator to files: the gyro log (INTERFACES §2.2) and, if `truth_path` is not empty,
+//! Runs the simulator to files: the gyro log (docs/interfaces.md §2.2) and, if `truth_path` is not empty,
 //! the truth (time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps: attitude body → R and rate of B relative to R).
 //! `progress` is called now and then with the fraction done.
 Status write_simulation(Simulator& simulator, const std::string& log_path, const std::string& truth_path,
                         void (*progress)(double fraction) = nullptr);
+//! The same into outputs of a larger run (the caller's RunFiles commits them); `extra_metadata` (e.g.
+//! provenance) follows the simulator's own "# key=value" lines. `truth` may be null.
+Status write_simulation(Simulator& simulator, OutputFile& log, OutputFile* truth,
+                        const std::vector<std::pair<std::string, std::string>>& extra_metadata,
+                        void (*progress)(double fraction));
 
 }  // namespace tetra::sim

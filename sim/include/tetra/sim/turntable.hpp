@@ -1,13 +1,13 @@
 #pragma once
 // Turntable simulation: the 16-sequence rotation plan of seed Table 3 on a two-axis table, written as
-// the turntable log of INTERFACES §2.1 (the input of `tetra calibrate`).
+// the turntable log of docs/interfaces.md §2.1 (the input of `tetra calibrate`).
 //
 // Sequences (w = table rate; odd sequence +w, even −w; the rotating gimbal starts at encoder 0):
 //   1, 2   inner rotating, outer fixed at   0°       9, 10  outer rotating, inner fixed at  90°
 //   3, 4   inner rotating, outer fixed at 180°      11, 12  outer rotating, inner fixed at −90°
 //   5, 6   outer rotating, inner fixed at   0°      13, 14  outer rotating, inner fixed at  30°
 //   7, 8   outer rotating, inner fixed at 180°      15, 16  outer rotating, inner fixed at −30°
-// Body rates come from the kinematics of INTERFACES §1 (tetra/core/frames.hpp), not from the signs
+// Body rates come from the kinematics of docs/interfaces.md §1 (tetra/core/frames.hpp), not from the signs
 // printed in Table 3: e.g. sequence 9 (inner at 90°, outer +w) turns the body about −Z.
 // Each sequence lasts `revolutions` full turns, sampled at `rate_hz` from the start of the turn
 // (the last sample is one step before the turn closes), sequences back to back on one time axis.
@@ -45,8 +45,8 @@ TurntableSequence turntable_sequence(int number);
 double wrap_deg(double angle_deg);
 
 //! The 16 sequences of seed Table 3 as encoder angles (fixed angle of one gimbal, the other rotating +w then
-//! -w), body rates and Earth rate in B from the kinematics of INTERFACES §1 (NOT Table 3's body-rate signs),
-//! gyro outputs from `unit` (scale factors, biases, axes, and the noise terms present in its `noise:`
+//! -w), body rates and Earth rate in B from the kinematics of docs/interfaces.md §1 (NOT Table 3's body-rate
+//! signs), gyro outputs from `unit` (scale factors, biases, axes, and the noise terms present in its `noise:`
 //! sections).
 Result<TurntableLog> simulate_turntable(const Calibration& unit, const TurntablePlan& plan,
                                         std::uint64_t seed);

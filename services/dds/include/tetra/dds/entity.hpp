@@ -91,7 +91,8 @@ std::string unit_partition(const std::string& unit);
 
 //! Domain participant. `domain` DDS_DOMAIN_DEFAULT takes the id of the configuration. `unit` names the
 //! unit it serves ("": every unit). With a security profile (set_security_profile) its readers and
-//! writers are created in unit_partition(unit); without one, in the default partition (INTERFACES §4).
+//! writers are created in unit_partition(unit); without one, in the default partition (docs/interfaces.md
+//! §4).
 class Participant {
  public:
   static Result<Participant> create(dds_domainid_t domain, const std::string& unit = {});

@@ -1,7 +1,8 @@
 #pragma once
-// The six tetra topics and their QoS (INTERFACES §4), created once per participant.
+// The six tetra topics and their QoS (docs/interfaces.md §4), created once per participant.
 
 #include <chrono>
+#include <cstdint>
 
 #include "tetra.h"  // generated from idl/tetra.idl
 #include "tetra/dds/entity.hpp"
@@ -17,6 +18,11 @@ inline constexpr std::chrono::milliseconds kWriterLease{1000};  //!< automatic l
 
 //! reliable / volatile / keep-last 64; deadline = 3 × `sample_period` (none if zero).
 Qos gyro_sample_qos(std::chrono::nanoseconds sample_period = std::chrono::nanoseconds{0});
+//! What a GyroSample reader requests: gyro_sample_qos() without a liveliness requirement (automatic,
+//! infinite lease), so a writer with the default liveliness and the table's other policies matches.
+Qos gyro_sample_reader_qos(std::chrono::nanoseconds sample_period);
+//! The name of a Cyclone QoS policy id (dds_qos_policy_id_t), e.g. "liveliness"; "unknown" otherwise.
+const char* qos_policy_name(std::uint32_t policy_id);
 Qos reference_qos();  //!< reliable / volatile / keep-last 8
 Qos attitude_qos();   //!< reliable / volatile / keep-last 1
 Qos health_qos();     //!< reliable / transient-local / keep-last 1

@@ -1,0 +1,103 @@
+#pragma once
+// The outputs of one run (docs/formats.md, "Outputs"). Every command writes its files through one
+// RunFiles object:
+// - an output that is the same file as an input or as another output (device and inode, through
+//   symbolic links; the same final path when it does not exist yet) is refused before anything is
+//   written;
+// - a regular file (or a path that does not exist yet) is written to a unique temporary file in the
+//   same folder and replaces the target only in commit(), after fsync: a run that fails leaves every
+//   pre-existing output byte-identical. A symbolic link is written through to its target;
+// - `-` (standard output), character devices (/dev/null) and FIFOs are written straight and never
+//   replaced;
+// - a write error, EPIPE included, is an Error naming the path; nothing raises a signal (the
+//   command line ignores SIGPIPE).
+
+#include <sys/types.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tetra/core/result.hpp"
+
+namespace tetra {
+
+//! Device and inode of an existing file, through symbolic links.
+struct FileId {
+  dev_t device = 0;
+  ino_t inode = 0;
+  bool operator==(const FileId&) const = default;
+};
+//! The identity of `path`, or nullopt when it does not exist.
+std::optional<FileId> file_id(const std::string& path);
+
+//! One output file of a run; made by RunFiles::add.
+class OutputFile {
+ public:
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+  ~OutputFile();
+
+  //! The path as the user gave it (for messages).
+  const std::string& path() const { return path_; }
+  //! True for standard output, devices and FIFOs (written straight, never replaced).
+  bool is_stream() const { return stream_; }
+  //! Appends `data`; an Error names the path (a full disk, a closed pipe).
+  Status write(std::string_view data);
+
+ private:
+  friend class RunFiles;
+  OutputFile() = default;
+  Status sync();  // fsync and close the temporary file (regular outputs)
+  Status rename_into_place();
+  void discard();  // removes an uncommitted temporary file
+
+  std::string path_;    // as given
+  std::string label_;   // the option that named it ("--attitude"), for messages
+  std::string target_;  // final path, symbolic links resolved
+  std::string temp_;    // temporary file next to target_ (regular outputs)
+  int fd_ = -1;
+  bool stream_ = false;
+  bool committed_ = false;
+};
+
+//! The inputs and outputs of one run.
+class RunFiles {
+ public:
+  RunFiles() = default;
+  RunFiles(const RunFiles&) = delete;
+  RunFiles& operator=(const RunFiles&) = delete;
+  ~RunFiles();  // discards every output not committed
+
+  //! Records an input (`label` names it in messages: a path, or the option that gave it). A path that
+  //! does not exist is ignored here (its reader reports it).
+  void add_input(const std::string& path, const std::string& label);
+  //! Opens an output named by option `label` ("--attitude", "-o"). Refused (bad input naming the
+  //! option and the path) when it is the same file as an input or another output, a folder, or
+  //! cannot be created. `replaces_input` allows exactly one named input to be replaced (an update in
+  //! place, e.g. `allan --update-calibration`).
+  Result<OutputFile*> add(const std::string& path, const std::string& label,
+                          const std::string& replaces_input = "");
+  //! add() and write() in one step.
+  Status put(const std::string& path, const std::string& label, std::string_view content);
+  //! fsyncs every regular output, then renames each into place. Call once, when the run succeeded.
+  Status commit();
+  //! Input and output paths, for provenance metadata.
+  std::vector<std::string> input_paths() const;
+
+ private:
+  struct Input {
+    std::string path;
+    std::string label;
+    FileId id;
+  };
+  Status check_distinct(const OutputFile& out, const std::optional<FileId>& id,
+                        const std::string& replaces_input) const;
+  std::vector<Input> inputs_;
+  std::vector<std::string> input_paths_;
+  std::vector<std::unique_ptr<OutputFile>> outputs_;
+};
+
+}  // namespace tetra

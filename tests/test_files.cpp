@@ -1,0 +1,165 @@
+// The input and output layers (docs/formats.md, "Inputs" and "Outputs"), strict numbers, metadata
+// escapes, JSON UTF-8 and the flicker-rate EDF at m = 1.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "test_support.hpp"
+#include "tetra/core/allan_stats.hpp"
+#include "tetra/core/csv.hpp"
+#include "tetra/core/input_files.hpp"
+#include "tetra/core/json.hpp"
+#include "tetra/core/output_files.hpp"
+
+namespace tetra {
+namespace {
+
+using test::read_file;
+using test::TempDir;
+using test::write_file;
+
+bool has_temporary(const TempDir& dir) {
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+    if (entry.path().filename().string().find(".tetra-") != std::string::npos) return true;
+  }
+  return false;
+}
+
+TEST(OutputFiles, OutputEqualToAnInputIsRefusedThroughLinks) {
+  TempDir dir;
+  write_file(dir.file("in.csv"), "data\n");
+  std::filesystem::create_symlink(dir.file("in.csv"), dir.file("link.csv"));
+  RunFiles files;
+  files.add_input(dir.file("in.csv"), "LOG");
+  const auto out = files.add(dir.file("link.csv"), "--attitude");
+  ASSERT_FALSE(out.ok());
+  EXPECT_NE(out.error().message.find("--attitude"), std::string::npos);
+  EXPECT_NE(out.error().message.find("same file as the input LOG"), std::string::npos);
+  EXPECT_EQ(read_file(dir.file("in.csv")), "data\n");
+}
+
+TEST(OutputFiles, TwoOutputsTheSameFileAreRefused) {
+  TempDir dir;
+  RunFiles files;
+  ASSERT_TRUE(files.add(dir.file("a.csv"), "--csv").ok());
+  const auto second = files.add(dir.path().string() + "/./a.csv", "--json");
+  ASSERT_FALSE(second.ok());
+  EXPECT_NE(second.error().message.find("same file as the output --csv"), std::string::npos);
+}
+
+TEST(OutputFiles, NothingChangesUntilCommitAndNoTemporaryIsLeft) {
+  TempDir dir;
+  write_file(dir.file("a.csv"), "old a\n");
+  write_file(dir.file("b.csv"), "old b\n");
+  {
+    RunFiles files;
+    ASSERT_TRUE(files.put(dir.file("a.csv"), "--a", "new a\n").ok());
+    ASSERT_TRUE(files.put(dir.file("b.csv"), "--b", "new b\n").ok());
+    EXPECT_EQ(read_file(dir.file("a.csv")), "old a\n");
+    // The run fails here: no commit.
+  }
+  EXPECT_EQ(read_file(dir.file("a.csv")), "old a\n");
+  EXPECT_EQ(read_file(dir.file("b.csv")), "old b\n");
+  EXPECT_FALSE(has_temporary(dir));
+
+  RunFiles files;
+  ASSERT_TRUE(files.put(dir.file("a.csv"), "--a", "new a\n").ok());
+  ASSERT_TRUE(files.commit().ok());
+  EXPECT_EQ(read_file(dir.file("a.csv")), "new a\n");
+  EXPECT_FALSE(has_temporary(dir));
+}
+
+TEST(OutputFiles, SymlinkIsWrittenThroughAndKeptAndModeKept) {
+  TempDir dir;
+  write_file(dir.file("real.yaml"), "old\n");
+  ASSERT_EQ(::chmod(dir.file("real.yaml").c_str(), 0640), 0);
+  std::filesystem::create_symlink("real.yaml", dir.file("link.yaml"));
+  RunFiles files;
+  ASSERT_TRUE(files.put(dir.file("link.yaml"), "-o", "new\n").ok());
+  ASSERT_TRUE(files.commit().ok());
+  EXPECT_TRUE(std::filesystem::is_symlink(dir.file("link.yaml")));
+  EXPECT_EQ(read_file(dir.file("real.yaml")), "new\n");
+  struct stat st {};
+  ASSERT_EQ(::stat(dir.file("real.yaml").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0640U);
+}
+
+TEST(OutputFiles, DevNullIsWrittenStraightNeverReplaced) {
+  RunFiles files;
+  auto out = files.add("/dev/null", "--attitude");
+  ASSERT_TRUE(out.ok());
+  EXPECT_TRUE((*out)->is_stream());
+  ASSERT_TRUE(files.add("/dev/null", "--events").ok());  // a sink may take two outputs
+  ASSERT_TRUE((*out)->write("x").ok());
+  ASSERT_TRUE(files.commit().ok());
+  struct stat st {};
+  ASSERT_EQ(::stat("/dev/null", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode));
+}
+
+TEST(OutputFiles, FolderAndMissingFolderAreRefusedNamingTheOption) {
+  TempDir dir;
+  RunFiles files;
+  const auto folder = files.add(dir.path().string(), "--csv");
+  ASSERT_FALSE(folder.ok());
+  EXPECT_NE(folder.error().message.find("--csv"), std::string::npos);
+  const auto missing = files.add(dir.file("no/such.csv"), "--json");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("--json"), std::string::npos);
+}
+
+TEST(InputFiles, FoldersDevicesAndSizeLimitsAreClearErrors) {
+  TempDir dir;
+  const auto folder = read_input(dir.path().string(), 100);
+  ASSERT_FALSE(folder.ok());
+  EXPECT_NE(folder.error().message.find("is a folder"), std::string::npos);
+  const auto zero = read_input("/dev/zero", 100);
+  ASSERT_FALSE(zero.ok());
+  EXPECT_NE(zero.error().message.find("/dev/zero: is a character device"), std::string::npos);
+  write_file(dir.file("big.yaml"), std::string(200, 'x'));
+  const auto big = read_input(dir.file("big.yaml"), 100);
+  ASSERT_FALSE(big.ok());
+  EXPECT_NE(big.error().message.find("larger than the limit"), std::string::npos);
+}
+
+TEST(StrictNumbers, OnlyPlainDecimal) {
+  EXPECT_TRUE(parse_decimal("-1.5e-3"));
+  EXPECT_TRUE(parse_decimal("+2"));
+  for (const char* bad : {"", "0x10", "0x1p3", "1,5", " 1", "1 ", "nan", "inf", "nan(1)", "1e999", "--1"}) {
+    EXPECT_FALSE(parse_decimal(bad)) << bad;
+  }
+}
+
+TEST(Metadata, AnyValueRoundTrips) {
+  const std::string value = "a \"b\" \\ c,d%e\nf#g=h";
+  std::string text;
+  append_metadata(text, "unit", value);
+  EXPECT_EQ(text.find('\n'), text.size() - 1);  // one line
+  text += "time_s\n0\n";
+  const auto table = parse_csv(text, "t.csv");
+  ASSERT_TRUE(table.ok()) << table.error().message;
+  EXPECT_EQ(table->meta("unit").value_or(""), value);
+}
+
+TEST(Json, InvalidUtf8BecomesReplacementCharacters) {
+  std::string out;
+  append_json_string(out, "ok \xC3\xA9 \xFF \xE2\x82 \xED\xA0\x80 \xF0\x9F\x98\x80");
+  EXPECT_EQ(out, "\"ok \xC3\xA9 \\ufffd \\ufffd\\ufffd \\ufffd\\ufffd\\ufffd \xF0\x9F\x98\x80\"");
+}
+
+TEST(AllanEdf, FlickerRateAtMOneGrowsWithTheRecord) {
+  // Howe, Allan & Barnes: 2(N-2)^2/(2.3N-4.9) at m = 1, about 0.87 N; near the m = 2 value
+  // 5N^2/(8(N+6)) ≈ 0.62 N, never ~1 (tolerance 1e-9 relative: the formula evaluated directly).
+  const double n = 10001.0;
+  const double edf = allan::overlapping_avar_edf(allan::NoiseType::kFlickerRate, n, 1.0);
+  EXPECT_NEAR(edf, 2.0 * (n - 2.0) * (n - 2.0) / (2.3 * n - 4.9), 1e-9 * edf);
+  EXPECT_GT(edf, 0.8 * n);
+  EXPECT_GT(edf, allan::overlapping_avar_edf(allan::NoiseType::kFlickerRate, n, 2.0));
+}
+
+}  // namespace
+}  // namespace tetra
