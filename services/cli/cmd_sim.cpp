@@ -17,6 +17,7 @@
 #include "tetra/sim/turntable.hpp"
 #if TETRA_WITH_DDS
 #include "sim_dds.hpp"
+#include "sim_dds_loop.hpp"
 #endif
 
 namespace tetra::cli {
@@ -170,6 +171,10 @@ int cmd_sim(int argc, char** argv) {
     if (!fault) return report(kName, fault.error());
     options.faults.push_back(fault.value());
   }
+#if TETRA_WITH_DDS
+  if (loop_options.enabled && dds_options.enabled)
+    return sim_dds_closed_loop_main(sc, options, loop_options, dds_options);
+#endif
   if (loop_options.enabled) return sim_closed_loop_main(sc, options, loop_options);
 #if TETRA_WITH_DDS
   if (dds_options.enabled) {

@@ -115,7 +115,7 @@ PointingSummary summarize(const ClosedLoopRecord& record, const ClosedLoopSimula
   return s;
 }
 
-std::string summary_json(const PointingSummary& s) {
+std::string summary_json(const PointingSummary& s, bool with_fdi) {
   std::string out = "{\n";
   add_number(out, "pointing_bound_deg", s.bound_deg);
   add_number(out, "rms_deg", s.rms_deg);
@@ -151,7 +151,9 @@ std::string summary_json(const PointingSummary& s) {
   append_json_number(out += ", \"hold_epochs\": ", static_cast<double>(s.counters.hold_epochs));
   append_json_number(out += ", \"safe_epochs\": ", static_cast<double>(s.counters.safe_epochs));
   append_json_number(out += ", \"safe_entries\": ", static_cast<double>(s.counters.safe_entries));
-  out += "},\n  \"fdi\": {\"outcome\": ";
+  out += "},\n  \"fdi\": ";
+  if (!with_fdi) return out + "null\n}\n";
+  out += "{\"outcome\": ";
   append_json_string(out, outcome_name(s.fdi.outcome));
   out += ", ";
   add_optional(out, "detection_delay_s", s.fdi.detection_delay_s);

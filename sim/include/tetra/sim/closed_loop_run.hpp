@@ -73,6 +73,7 @@ struct PointingSample {
 struct ClosedLoopRecord {
   std::vector<PointingSample> series;
   std::vector<fdi::FdiEvent> events;
+  bool fdi_events = true;  //!< false: the estimator's events were not seen (no FDI verdict)
   ControlCounters counters;
   std::uint64_t estimates_received = 0;      //!< epochs with an estimate of that very epoch
   double max_wheel_momentum_fraction = 0.0;  //!< largest |h_i| / h_max seen

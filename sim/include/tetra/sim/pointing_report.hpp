@@ -45,8 +45,9 @@ struct PointingSummary {
 };
 
 PointingSummary summarize(const ClosedLoopRecord& record, const ClosedLoopSimulator& simulator);
-//! One JSON object (pretty, multi-line) with every field of the summary.
-std::string summary_json(const PointingSummary& summary);
+//! One JSON object (pretty, multi-line) with every field of the summary; "fdi": null without
+//! `with_fdi` (the run's FDI events were not seen).
+std::string summary_json(const PointingSummary& summary, bool with_fdi = true);
 //! The series: time_s,error_deg,estimated_error_deg,knowledge_error_deg,sigma_deg,age_s,mode,gyros,
 //! control,speed_rpm_1..n,torque_Nm_1..n (written through a temporary file renamed on success).
 Status write_pointing_csv(const std::string& path, const ClosedLoopRecord& record, int n_gyros);
