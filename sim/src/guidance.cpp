@@ -27,7 +27,7 @@ SlewProfile trapezoid_profile(double total_rad, double max_rate_rad_s, double ma
   const double t_acc = w_peak / a;
   const double t_total = trapezoid_duration_s(angle, max_rate_rad_s, a);
   if (u_s >= t_total) {
-    p.angle_rad = total_rad;
+    p.angle_rad = angle;
   } else if (u_s < t_acc) {
     p = {0.5 * a * u_s * u_s, a * u_s, a};
   } else if (u_s < t_total - t_acc) {
