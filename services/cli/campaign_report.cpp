@@ -31,7 +31,8 @@ Result<std::vector<CampaignRow>> read_rows(const std::string& path) {
     auto row = sim::parse_campaign_row(line);
     if (row) rows.push_back(*row);
   }
-  std::sort(rows.begin(), rows.end(), [](const CampaignRow& a, const CampaignRow& b) { return a.run < b.run; });
+  std::sort(rows.begin(), rows.end(),
+            [](const CampaignRow& a, const CampaignRow& b) { return a.run < b.run; });
   return rows;
 }
 
@@ -71,7 +72,8 @@ std::string outcome_matrix(const std::vector<CampaignRow>& rows) {
       for (Outcome o : kOutcomes) {
         const auto c = it->second.find(o);
         if (c == it->second.end()) continue;
-        cell += (cell.empty() ? "" : ", ") + std::to_string(c->second) + " " + std::string(sim::outcome_name(o));
+        cell +=
+            (cell.empty() ? "" : ", ") + std::to_string(c->second) + " " + std::string(sim::outcome_name(o));
       }
       out += " " + cell + " |";
     }
@@ -86,7 +88,8 @@ std::string delay_table(const std::vector<CampaignRow>& rows) {
     if (r.kind != "none") by_kind[r.kind].push_back(&r);
   }
   std::string out =
-      "| kind | runs | detected | median detection [s] | max detection [s] | isolated | median isolation [s] | "
+      "| kind | runs | detected | median detection [s] | max detection [s] | isolated | median isolation [s] "
+      "| "
       "max isolation [s] | median CUSUM theory [s] |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& [kind, list] : by_kind) {
     std::vector<double> det;
@@ -100,8 +103,8 @@ std::string delay_table(const std::vector<CampaignRow>& rows) {
     out += "| " + kind + " | " + std::to_string(list.size()) + " | " + std::to_string(det.size()) + " | " +
            (det.empty() ? "–" : g(quantile(det, 0.5))) + " | " + (det.empty() ? "–" : g(quantile(det, 1.0))) +
            " | " + std::to_string(iso.size()) + " | " + (iso.empty() ? "–" : g(quantile(iso, 0.5))) + " | " +
-           (iso.empty() ? "–" : g(quantile(iso, 1.0))) + " | " + (theory.empty() ? "–" : g(quantile(theory, 0.5))) +
-           " |\n";
+           (iso.empty() ? "–" : g(quantile(iso, 1.0))) + " | " +
+           (theory.empty() ? "–" : g(quantile(theory, 0.5))) + " |\n";
   }
   return out;
 }
@@ -112,7 +115,8 @@ Status plot_delays(const std::vector<CampaignRow>& rows, const std::string& png)
   std::string data;
   for (const CampaignRow& r : rows) {
     if (r.theory_delay_s && r.fdi.detection_delay_s) {
-      data += g(*r.theory_delay_s) + ' ' + g(std::max(*r.fdi.detection_delay_s, 1e-2)) + ' ' + std::to_string(r.gyro) + '\n';
+      data += g(*r.theory_delay_s) + ' ' + g(std::max(*r.fdi.detection_delay_s, 1e-2)) + ' ' +
+              std::to_string(r.gyro) + '\n';
     }
   }
   if (data.empty()) return ok_status();
@@ -122,7 +126,9 @@ Status plot_delays(const std::vector<CampaignRow>& rows, const std::string& png)
       "set logscale xy\nset grid\nset key top left\nset xlabel 'CUSUM theory (Siegmund ARL) [s]'\n"
       "set ylabel 'measured detection delay [s] (0 plotted at 0.01)'\n"
       "set title 'bias faults: detection delay against the CUSUM theory'\n"
-      "plot " + gp_quote(file) + " using 1:2:3 with points pt 7 ps 0.8 lc variable title 'runs (colour: gyro)', "
+      "plot " +
+      gp_quote(file) +
+      " using 1:2:3 with points pt 7 ps 0.8 lc variable title 'runs (colour: gyro)', "
       "x with lines lw 2 dt 2 lc rgb 'black' title 'measured = theory'\n";
   return run_gnuplot(dir->path(), png, 800, 600, body, "report");
 }
@@ -146,11 +152,17 @@ Status plot_pointing(const std::vector<CampaignRow>& rows, const std::string& pn
   const std::string file = (dir->path() / "pointing.dat").string();
   if (Status s = write_text_file(file, data); !s) return s;
   const std::string body =
-      "set logscale x\nset grid\nset key bottom right\nset xlabel 'max pointing error after the fault [deg]'\n"
+      "set logscale x\nset grid\nset key bottom right\nset xlabel 'max pointing error after the fault "
+      "[deg]'\n"
       "set ylabel 'fraction of runs'\nset yrange [0:1.02]\n"
       "set title 'pointing error after the fault: distribution over the runs'\n"
-      "set arrow from " + g(bound) + ", graph 0 to " + g(bound) + ", graph 1 nohead dt 2 lw 2\n"
-      "plot " + gp_quote(file) + " using 1:2 with steps lw 2 title 'empirical CDF', 1/0 with lines dt 2 lw 2 lc rgb 'black' title 'bound " +
+      "set arrow from " +
+      g(bound) + ", graph 0 to " + g(bound) +
+      ", graph 1 nohead dt 2 lw 2\n"
+      "plot " +
+      gp_quote(file) +
+      " using 1:2 with steps lw 2 title 'empirical CDF', 1/0 with lines dt 2 lw 2 lc rgb 'black' title "
+      "'bound " +
       g(bound) + " deg'\n";
   return run_gnuplot(dir->path(), png, 800, 600, body, "report");
 }
@@ -178,7 +190,9 @@ Status plot_outcomes(const std::vector<CampaignRow>& rows, const std::string& pn
       "set style data histograms\nset style histogram rowstacked\nset style fill solid 0.9 border -1\n"
       "set boxwidth 0.8\nset xtics rotate by -60 font ',8'\nset ylabel 'runs'\nset key outside right\n"
       "set title 'isolation outcome per fault kind and gyro'\nset datafile separator ' '\n"
-      "plot " + gp_quote(file) + " using 2:xtic(1) title 'right' lc rgb '#2ca02c', '' using 3 title 'unisolated' lc rgb '#1f77b4', "
+      "plot " +
+      gp_quote(file) +
+      " using 2:xtic(1) title 'right' lc rgb '#2ca02c', '' using 3 title 'unisolated' lc rgb '#1f77b4', "
       "'' using 4 title 'wrong' lc rgb '#d62728', '' using 5 title 'missed' lc rgb '#7f7f7f'\n";
   return run_gnuplot(dir->path(), png, 1000, 600, body, "report");
 }
@@ -202,8 +216,10 @@ std::string pointing_section(const std::vector<CampaignRow>& rows) {
   }
   if (max_after.empty()) return "No faulty runs.\n";
   return fmt::format(
-      "Max pointing error after the fault [deg]: median {}, 90 % {}, 99 % {}, max {}. Within the bound ({} deg) "
-      "throughout: {} of {} runs. Recovered below the bound by the end: {} (median time {} s); not recovered: {}.\n",
+      "Max pointing error after the fault [deg]: median {}, 90 % {}, 99 % {}, max {}. Within the bound ({} "
+      "deg) "
+      "throughout: {} of {} runs. Recovered below the bound by the end: {} (median time {} s); not "
+      "recovered: {}.\n",
       g(quantile(max_after, 0.5)), g(quantile(max_after, 0.9)), g(quantile(max_after, 0.99)),
       g(quantile(max_after, 1.0)), g(bound), within, max_after.size(), recover.size(),
       recover.empty() ? "–" : g(quantile(recover, 0.5)), not_recovered);
@@ -213,9 +229,10 @@ std::string wrong_section(const std::vector<CampaignRow>& rows) {
   std::string out;
   for (const CampaignRow& r : rows) {
     if (r.fdi.outcome != Outcome::kWrong) continue;
-    out += fmt::format("- run {}: {} gyro={} kind={} at={} size={} seed={} → isolated gyro {}\n", r.run, r.scenario,
-                       r.gyro, r.kind, g(r.onset_s), g(r.size), r.seed,
-                       r.fdi.isolated_gyro ? std::to_string(*r.fdi.isolated_gyro) : std::string("(before the onset)"));
+    out += fmt::format(
+        "- run {}: {} gyro={} kind={} at={} size={} seed={} → isolated gyro {}\n", r.run, r.scenario, r.gyro,
+        r.kind, g(r.onset_s), g(r.size), r.seed,
+        r.fdi.isolated_gyro ? std::to_string(*r.fdi.isolated_gyro) : std::string("(before the onset)"));
   }
   return out.empty() ? "None.\n" : out;
 }
@@ -238,9 +255,11 @@ Status write_campaign_report(const std::string& runs_csv, const std::string& out
   md += "## Detection and isolation delays\n\n" + delay_table(*rows) +
         "\nCUSUM theory: Siegmund's ARL for the parity shift a bias step makes on its gyro "
         "(fdi/include/tetra/fdi/detectors.hpp).\n\n![delays](delay_vs_theory.png)\n\n";
-  md += fmt::format("## False alarms\n\n{} detections before the fault onset in {} h of fault-free flight: {} per hour.\n\n",
-                    false_alarms, g(fault_free_s / 3600.0),
-                    fault_free_s > 0.0 ? g(false_alarms / (fault_free_s / 3600.0)) : std::string("–"));
+  md += fmt::format(
+      "## False alarms\n\n{} detections before the fault onset in {} h of fault-free flight: {} per "
+      "hour.\n\n",
+      false_alarms, g(fault_free_s / 3600.0),
+      fault_free_s > 0.0 ? g(false_alarms / (fault_free_s / 3600.0)) : std::string("–"));
   md += "## Pointing\n\n" + pointing_section(*rows) + "\n![pointing](pointing_cdf.png)\n";
   if (Status s = write_text_file((dir / "report.md").string(), md); !s) return s;
   if (Status s = plot_delays(*rows, (dir / "delay_vs_theory.png").string()); !s) return s;

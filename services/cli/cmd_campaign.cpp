@@ -32,7 +32,8 @@ Result<std::set<std::size_t>> done_runs(const std::string& path) {
   if (!in) return done;
   std::string line;
   if (!std::getline(in, line)) return done;
-  if (line != sim::campaign_csv_header()) return bad_input(path + ":1: not the header of a campaign of this version");
+  if (line != sim::campaign_csv_header())
+    return bad_input(path + ":1: not the header of a campaign of this version");
   std::string kept = line + "\n";
   while (std::getline(in, line)) {
     auto row = sim::parse_campaign_row(line);
@@ -72,9 +73,11 @@ struct Progress {
   void print(bool final) const {
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const std::size_t left = total - done_before - done_now;
-    std::string eta = done_now ? duration_text(elapsed / static_cast<double>(done_now) * static_cast<double>(left)) : "?";
-    std::cerr << (isatty(2) ? "\r" : "") << "tetra campaign: " << done_before + done_now << "/" << total << " runs, " << duration_text(elapsed)
-              << " elapsed, " << (final ? "done" : "about " + eta + " left") << (isatty(2) && !final ? "   " : "\n")
+    std::string eta =
+        done_now ? duration_text(elapsed / static_cast<double>(done_now) * static_cast<double>(left)) : "?";
+    std::cerr << (isatty(2) ? "\r" : "") << "tetra campaign: " << done_before + done_now << "/" << total
+              << " runs, " << duration_text(elapsed) << " elapsed, "
+              << (final ? "done" : "about " + eta + " left") << (isatty(2) && !final ? "   " : "\n")
               << std::flush;
   }
 };
@@ -84,7 +87,8 @@ Status run_pending(const sim::CampaignSpec& spec, const std::vector<sim::Campaig
   int fds[2];
   if (::pipe(fds) != 0) return failure("cannot create a pipe");
   std::vector<pid_t> pids;
-  const auto n_jobs = static_cast<std::size_t>(std::max(1, std::min<int>(jobs, static_cast<int>(pending.size()))));
+  const auto n_jobs =
+      static_cast<std::size_t>(std::max(1, std::min<int>(jobs, static_cast<int>(pending.size()))));
   for (std::size_t w = 0; w < n_jobs; ++w) {
     std::vector<sim::CampaignCase> share;
     for (std::size_t i = w; i < pending.size(); i += n_jobs) share.push_back(pending[i]);
@@ -135,7 +139,8 @@ Status run_pending(const sim::CampaignSpec& spec, const std::vector<sim::Campaig
 
 int cmd_campaign(int argc, char** argv) {
   CLI::App app{
-      "Fault-injection campaign: closed-loop scenarios x fault kinds x gyros x onsets x sizes x seeds, run in "
+      "Fault-injection campaign: closed-loop scenarios x fault kinds x gyros x onsets x sizes x seeds, run "
+      "in "
       "parallel processes with the fusion pipeline in process; one row per run and a report with plots "
       "(docs/campaign.md). Interrupted campaigns continue where they stopped.",
       kName};
@@ -173,11 +178,13 @@ int cmd_campaign(int argc, char** argv) {
             << " already done, " << jobs << " jobs\n";
   Progress progress{cases.size(), cases.size() - pending.size()};
   if (!pending.empty()) {
-    if (Status st = run_pending(*spec, pending, jobs, runs_path, progress); !st) return report(kName, st.error());
+    if (Status st = run_pending(*spec, pending, jobs, runs_path, progress); !st)
+      return report(kName, st.error());
   }
   if (no_report) return kExitOk;
   if (Status st = write_campaign_report(runs_path, out_dir); !st) return report(kName, st.error());
-  std::cerr << "tetra campaign: report -> " << (std::filesystem::path(out_dir) / "report.md").string() << '\n';
+  std::cerr << "tetra campaign: report -> " << (std::filesystem::path(out_dir) / "report.md").string()
+            << '\n';
   return kExitOk;
 }
 

@@ -38,7 +38,8 @@ Status parse_kinds_and_sizes(const YamlReader& yaml, const YAML::Node& root, Cam
     spec.kinds.push_back(*kind);
     if (!kind_takes_size(*kind)) continue;
     if (!sizes || !sizes[(*kinds)[i]])
-      return yaml.error(root["kinds"][i], "sizes." + (*kinds)[i], "missing (kind " + (*kinds)[i] + " needs sizes)");
+      return yaml.error(root["kinds"][i], "sizes." + (*kinds)[i],
+                        "missing (kind " + (*kinds)[i] + " needs sizes)");
     auto values = list_of<double>(yaml, sizes, (*kinds)[i]);
     if (!values) return values.error();
     spec.sizes.emplace_back(*kind, *values);
@@ -61,7 +62,8 @@ Result<CampaignSpec> parse_spec(const YAML::Node& root, const YamlReader& yaml, 
     if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
     auto sc = read_scenario(path.string());
     if (!sc) return yaml.error(root["scenarios"][i], "scenarios", sc.error().message);
-    if (!sc->closed_loop) return yaml.error(root["scenarios"][i], "scenarios", path.string() + " has no closed_loop section");
+    if (!sc->closed_loop)
+      return yaml.error(root["scenarios"][i], "scenarios", path.string() + " has no closed_loop section");
     spec.scenario_paths.push_back(path.string());
     spec.scenarios.push_back(std::move(sc.value()));
   }
@@ -118,7 +120,8 @@ Result<CampaignSpec> read_campaign_spec(const std::string& path) {
     for (const Scenario& sc : spec->scenarios) {
       for (int g : spec->gyros) {
         if (g < 1 || g > sc.unit.gyro_count())
-          return yaml.error(root["gyros"], "gyros", "gyro " + std::to_string(g) + " does not exist in " + sc.name);
+          return yaml.error(root["gyros"], "gyros",
+                            "gyro " + std::to_string(g) + " does not exist in " + sc.name);
       }
     }
     return spec;
@@ -162,7 +165,8 @@ std::optional<double> cusum_theory_delay_s(const Calibration& unit, const fdi::P
   for (int i = 0; i < n; ++i) {
     const GyroCalibration& g = unit.gyros[static_cast<std::size_t>(i)];
     axes.row(i) = g.axis_B.transpose();
-    const double arw = g.noise && g.noise->arw_dps_rtHz ? *g.noise->arw_dps_rtHz : config.default_arw_dps_rtHz;
+    const double arw =
+        g.noise && g.noise->arw_dps_rtHz ? *g.noise->arw_dps_rtHz : config.default_arw_dps_rtHz;
     sigma_dps[i] = arw / std::sqrt(dt_s);
   }
   auto geometry = GyroGeometry::create(axes, sigma_dps);
@@ -204,7 +208,8 @@ Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCa
   row.seed = c.seed;
   row.fdi = summary.fdi;
   if (c.fault && c.fault->kind == FaultKind::kBias) {
-    row.theory_delay_s = cusum_theory_delay_s(sc.unit, spec.pipeline, sc.rate_hz, c.fault->gyro, c.fault->size);
+    row.theory_delay_s =
+        cusum_theory_delay_s(sc.unit, spec.pipeline, sc.rate_hz, c.fault->gyro, c.fault->size);
   }
   row.final_knowledge_error_deg = summary.final_knowledge_error_deg;
   row.final_sigma_deg = summary.final_sigma_deg;
@@ -235,8 +240,8 @@ std::string campaign_csv_row(const CampaignRow& r) {
   out += r.fdi.isolated_gyro ? std::to_string(*r.fdi.isolated_gyro) : std::string();
   out += "," + opt_text(r.fdi.detection_delay_s) + "," + opt_text(r.fdi.isolation_delay_s) + "," +
          opt_text(r.theory_delay_s) + "," + std::to_string(r.fdi.false_alarms) + ",";
-  for (double v : {r.fdi.fault_free_s, r.final_knowledge_error_deg, r.final_sigma_deg, r.pointing_max_before_deg,
-                   r.pointing_rms_after_deg, r.pointing_max_after_deg}) {
+  for (double v : {r.fdi.fault_free_s, r.final_knowledge_error_deg, r.final_sigma_deg,
+                   r.pointing_max_before_deg, r.pointing_rms_after_deg, r.pointing_max_after_deg}) {
     append_double(out, v);
     out += ',';
   }
@@ -252,10 +257,13 @@ Result<CampaignRow> parse_campaign_row(const std::string& line) {
   std::stringstream in(line);
   for (std::string field; std::getline(in, field, ',');) f.push_back(field);
   if (!line.empty() && line.back() == ',') f.emplace_back();
-  if (f.size() != 22) return bad_input("campaign row with " + std::to_string(f.size()) + " fields (22 expected)");
+  if (f.size() != 22)
+    return bad_input("campaign row with " + std::to_string(f.size()) + " fields (22 expected)");
   try {
     const auto num = [](const std::string& s) { return std::stod(s); };
-    const auto opt = [](const std::string& s) { return s.empty() ? std::nullopt : std::optional<double>(std::stod(s)); };
+    const auto opt = [](const std::string& s) {
+      return s.empty() ? std::nullopt : std::optional<double>(std::stod(s));
+    };
     CampaignRow r;
     r.run = std::stoul(f[0]);
     r.scenario = f[1];
@@ -265,7 +273,8 @@ Result<CampaignRow> parse_campaign_row(const std::string& line) {
     r.size = num(f[5]);
     r.seed = std::stoull(f[6]);
     bool known = false;
-    for (Outcome o : {Outcome::kNone, Outcome::kRight, Outcome::kWrong, Outcome::kUnisolated, Outcome::kMissed}) {
+    for (Outcome o :
+         {Outcome::kNone, Outcome::kRight, Outcome::kWrong, Outcome::kUnisolated, Outcome::kMissed}) {
       if (outcome_name(o) == f[7]) {
         r.fdi.outcome = o;
         known = true;

@@ -20,8 +20,8 @@ struct CampaignSpec {
   std::vector<std::string> scenario_paths;  //!< closed-loop scenario files (resolved against the spec)
   std::vector<Scenario> scenarios;          //!< read from them
   std::vector<FaultKind> kinds;
-  std::vector<int> gyros;       //!< 1..N
-  std::vector<double> onsets_s;  //!< [s]
+  std::vector<int> gyros;                                        //!< 1..N
+  std::vector<double> onsets_s;                                  //!< [s]
   std::vector<std::pair<FaultKind, std::vector<double>>> sizes;  //!< per kind that takes a size
   std::vector<std::uint64_t> seeds;
   std::optional<double> duration_s;  //!< overrides the scenarios' duration
