@@ -53,6 +53,7 @@ const std::vector<KeyDef>& scalar_keys() {
       {"reference_threshold_sigma", &PipelineConfig::reference_threshold_sigma},
       {"reference_confirm_count", &PipelineConfig::reference_confirm_count},
       {"glt_false_alarm_probability", &PipelineConfig::glt_false_alarm_probability},
+      {"exclusion_enabled", &PipelineConfig::exclusion_enabled},
   };
   return keys;
 }

@@ -8,6 +8,7 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "sim_closed_loop.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/output_files.hpp"
 #include "tetra/core/provenance.hpp"
@@ -18,6 +19,7 @@
 #include "tetra/sim/turntable.hpp"
 #if TETRA_WITH_DDS
 #include "sim_dds.hpp"
+#include "sim_dds_loop.hpp"
 #endif
 
 namespace tetra::cli {
@@ -112,6 +114,8 @@ int cmd_sim(int argc, char** argv) {
           ->delimiter(',');
   auto* opt_wrap =
       app.add_flag("--wrap", plan.wrap_angles, "turntable: write encoder angles wrapped to (-180, 180]");
+  ClosedLoopCliOptions loop_options;
+  add_closed_loop_options(app, loop_options);
 #if TETRA_WITH_DDS
   SimDdsOptions dds_options;
   add_sim_dds_options(app, dds_options);
@@ -185,6 +189,11 @@ int cmd_sim(int argc, char** argv) {
     if (!fault) return report(kName, fault.error());
     options.faults.push_back(fault.value());
   }
+#if TETRA_WITH_DDS
+  if (loop_options.enabled && dds_options.enabled)
+    return sim_dds_closed_loop_main(sc, options, loop_options, dds_options);
+#endif
+  if (loop_options.enabled) return sim_closed_loop_main(sc, options, loop_options);
 #if TETRA_WITH_DDS
   if (dds_options.enabled) {
     auto simulator = sim::Simulator::create(sc, options);

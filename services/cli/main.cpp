@@ -30,6 +30,7 @@ constexpr Command kCommands[] = {
     {"command", tetra::cli::cmd_command, "send an operator command (reset, exclude, reinstate) over DDS"},
     {"record", tetra::cli::cmd_record, "record the gyro streams seen on DDS as a replayable gyro log"},
     {"demo", tetra::cli::cmd_demo, "simulator + service + monitor on loopback with a fault mid-run"},
+    {"campaign", tetra::cli::cmd_campaign, "fault-injection campaign over the closed loop, with a report"},
 };
 
 void print_usage(std::FILE* out) {

@@ -17,11 +17,6 @@ constexpr std::pair<FaultKind, std::string_view> kKinds[] = {
     {FaultKind::kStuck, "stuck"}, {FaultKind::kZero, "zero"},       {FaultKind::kNoise, "noise"},
     {FaultKind::kSpike, "spike"}, {FaultKind::kDropout, "dropout"}, {FaultKind::kInvalid, "invalid"}};
 
-bool kind_takes_size(FaultKind kind) {
-  return kind == FaultKind::kBias || kind == FaultKind::kRamp || kind == FaultKind::kScale ||
-         kind == FaultKind::kNoise || kind == FaultKind::kSpike;
-}
-
 std::optional<double> to_double(std::string_view text) {
   double value = 0.0;
   const char* end = text.data() + text.size();
@@ -31,6 +26,18 @@ std::optional<double> to_double(std::string_view text) {
 }
 
 }  // namespace
+
+bool kind_takes_size(FaultKind kind) {
+  return kind == FaultKind::kBias || kind == FaultKind::kRamp || kind == FaultKind::kScale ||
+         kind == FaultKind::kNoise || kind == FaultKind::kSpike;
+}
+
+std::optional<FaultKind> fault_kind_from_name(std::string_view name) {
+  for (const auto& [k, text] : kKinds) {
+    if (text == name) return k;
+  }
+  return std::nullopt;
+}
 
 std::string_view fault_kind_name(FaultKind kind) {
   for (const auto& [k, name] : kKinds) {

@@ -13,48 +13,13 @@
 #include "tetra/core/input_files.hpp"
 #include "tetra/core/yaml_reader.hpp"
 #include "text.hpp"
+#include "yaml_fields.hpp"
 
 namespace tetra::sim {
 
 namespace {
 
 constexpr double kMaxEpochs = 2.0e9;  // a guard against absurd durations × rates
-
-// Sets `out` from parent[key] when the key is present; leaves the default otherwise.
-Status maybe_number(const YamlReader& yaml, const YAML::Node& parent, const std::string& key,
-                    const std::string& what, double& out) {
-  const YAML::Node node = parent[key];
-  if (!node) return ok_status();
-  auto v = yaml.number(node, YamlReader::child(what, key));
-  if (!v) return v.error();
-  out = *v;
-  return ok_status();
-}
-
-Status maybe_numbers(const YamlReader& yaml, const YAML::Node& parent, const std::string& what,
-                     std::initializer_list<std::pair<const char*, double*>> fields) {
-  for (const auto& [key, out] : fields) {
-    if (Status st = maybe_number(yaml, parent, key, what, *out); !st) return st;
-  }
-  return ok_status();
-}
-
-Result<Eigen::Vector3d> axis_from(const YamlReader& yaml, const YAML::Node& node, const std::string& what) {
-  if (node.IsScalar()) {
-    const std::string& name = node.Scalar();
-    if (name == "x" || name == "+x") return Eigen::Vector3d(Eigen::Vector3d::UnitX());
-    if (name == "y" || name == "+y") return Eigen::Vector3d(Eigen::Vector3d::UnitY());
-    if (name == "z" || name == "+z") return Eigen::Vector3d(Eigen::Vector3d::UnitZ());
-    if (name == "-x") return Eigen::Vector3d(-Eigen::Vector3d::UnitX());
-    if (name == "-y") return Eigen::Vector3d(-Eigen::Vector3d::UnitY());
-    if (name == "-z") return Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
-    return yaml.error(node, what, "'" + name + "' is not an axis (x, y, z, -x, ... or [x, y, z])");
-  }
-  const auto v = yaml.vector3(node, what);
-  if (!v) return v.error();
-  if (v->norm() < 1e-9) return yaml.error(node, what, "must not be the zero vector");
-  return Eigen::Vector3d(v->normalized());
-}
 
 Result<Slew> parse_slew(const YamlReader& yaml, const YAML::Node& s, const std::string& what) {
   if (Status st = yaml.check_keys(s, {"axis", "angle_deg", "start_s", "duration_s"}, what); !st)
@@ -76,11 +41,11 @@ Result<Slew> parse_slew(const YamlReader& yaml, const YAML::Node& s, const std::
 }
 
 Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, const std::string& base_dir) {
-  if (Status st = yaml.check_keys(
-          root,
-          {"scenario", "duration_s", "rate_hz", "latitude_deg", "pitch_rate_dps", "orbit_period_s", "acs",
-           "slews", "reference", "unit", "gyro_model", "jitter_s", "drop_probability", "faults"},
-          "");
+  if (Status st = yaml.check_keys(root,
+                                  {"scenario", "duration_s", "rate_hz", "latitude_deg", "pitch_rate_dps",
+                                   "orbit_period_s", "acs", "slews", "reference", "unit", "gyro_model",
+                                   "jitter_s", "drop_probability", "faults", "closed_loop"},
+                                  "");
       !st)
     return st.error();
   const YAML::Node base = root["scenario"];
@@ -158,6 +123,13 @@ Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, cons
       if (!fault) return yaml.error(faults[i], "faults[" + std::to_string(i) + "]", fault.error().message);
       sc.faults.push_back(fault.value());
     }
+  }
+  if (const YAML::Node loop = root["closed_loop"]) {
+    if (sc.motion.kind != MotionKind::kOrbit)
+      return yaml.error(loop, "closed_loop", "needs 'scenario: orbit' (the orbit the spacecraft flies)");
+    auto spec = parse_closed_loop(yaml, loop);
+    if (!spec) return spec.error();
+    sc.closed_loop = std::move(spec.value());
   }
   // Range checks with the line of the key where it exists.
   if (Status st = validate_scenario(sc); !st) return yaml.error(root, "", st.error().message);
@@ -276,6 +248,11 @@ Status validate_scenario(const Scenario& sc) {
                          " has no white noise (noise: arw_dps_rtHz) for a noise fault to multiply");
       }
     }
+  }
+  if (sc.closed_loop) {
+    if (Status st = validate_closed_loop(*sc.closed_loop); !st)
+      return bad_input("closed_loop: " + st.error().message);
+    if (sc.jitter_s != 0.0) return bad_input("closed_loop: jitter_s does not apply in closed loop");
   }
   return ok_status();
 }

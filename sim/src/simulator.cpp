@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"
@@ -11,17 +10,24 @@
 namespace tetra::sim {
 
 Simulator::Simulator(Scenario scenario, SimOptions options, TruthMotion motion)
-    : scenario_(std::move(scenario)), options_(std::move(options)), motion_(std::move(motion)) {
-  faults_ = scenario_.faults;
-  faults_.insert(faults_.end(), options_.faults.begin(), options_.faults.end());
+    : scenario_(std::move(scenario)),
+      options_(std::move(options)),
+      motion_(std::move(motion)),
+      package_(scenario_, all_faults(scenario_, options_), options_.seed) {
   epochs_ = static_cast<std::size_t>(std::llround(scenario_.duration_s * scenario_.rate_hz));
   reset();
+}
+
+std::vector<FaultSpec> all_faults(const Scenario& scenario, const SimOptions& options) {
+  std::vector<FaultSpec> faults = scenario.faults;
+  faults.insert(faults.end(), options.faults.begin(), options.faults.end());
+  return faults;
 }
 
 Result<Simulator> Simulator::create(const Scenario& scenario, const SimOptions& options) {
   // Validate the scenario with the run's extra faults, so they get the same checks.
   Scenario all = scenario;
-  all.faults.insert(all.faults.end(), options.faults.begin(), options.faults.end());
+  all.faults = all_faults(scenario, options);
   if (Status st = validate_scenario(all); !st) return st.error();
   auto motion = TruthMotion::create(scenario.motion, options.seed);
   if (!motion) return motion.error();
@@ -29,29 +35,13 @@ Result<Simulator> Simulator::create(const Scenario& scenario, const SimOptions& 
 }
 
 void Simulator::reset() {
-  const int n = gyro_count();
-  const double dt_s = 1.0 / scenario_.rate_hz;
-  channels_.clear();
-  channels_.reserve(static_cast<std::size_t>(n));
-  drop_rngs_.clear();
-  for (int i = 0; i < n; ++i) {
-    channels_.emplace_back(scenario_.unit.gyros[static_cast<std::size_t>(i)], scenario_.model, dt_s,
-                           options_.seed, i);
-    drop_rngs_.emplace_back(stream_seed(options_.seed, Stream::kDropped, i));
-  }
+  package_.reset();
   jitter_rng_ = Rng(stream_seed(options_.seed, Stream::kJitter, -1));
-  reference_rng_ = Rng(stream_seed(options_.seed, Stream::kReference, -1));
-  last_output_V_.assign(static_cast<std::size_t>(n), 0.0);
-  has_last_output_.assign(static_cast<std::size_t>(n), 0);
-  stuck_value_V_.assign(faults_.size(), std::nullopt);
-  spike_done_.assign(faults_.size(), 0);
-  last_reference_period_ = -1;
   k_ = 0;
 }
 
 bool Simulator::next(SimEpoch& out) {
   if (k_ >= epochs_) return false;
-  const int n = gyro_count();
   const auto nominal_ns = static_cast<std::int64_t>(
       std::llround(static_cast<double>(k_) * static_cast<double>(kNanosPerSecond) / scenario_.rate_hz));
   std::int64_t stamp_ns = nominal_ns;
@@ -60,84 +50,13 @@ bool Simulator::next(SimEpoch& out) {
   }
   const double t_s = static_cast<double>(stamp_ns) / static_cast<double>(kNanosPerSecond);
   const MotionState truth = motion_.at(t_s);
-  const Eigen::Vector3d sensed_dps = truth.omega_B_rad_s * kRadToDeg;
-
   out.stamp_ns = stamp_ns;
   out.time_s = t_s;
   out.truth_q_RB = truth.q_RB;
   out.truth_omega_B_rad_s = truth.omega_RB_B_rad_s;
   out.sensed_omega_B_rad_s = truth.omega_B_rad_s;
-  out.raw_V.resize(static_cast<std::size_t>(n));
-  out.present.resize(static_cast<std::size_t>(n));
-
-  for (int i = 0; i < n; ++i) {
-    const auto iu = static_cast<std::size_t>(i);
-    GyroChannel& ch = channels_[iu];
-    double v = ch.sample_V(sensed_dps, t_s);
-    bool present = true;
-    // Dropped samples (an option of the scenario, not a fault): drawn every epoch so that the
-    // stream does not depend on anything else.
-    const double drop_draw = drop_rngs_[iu].uniform();
-    if (scenario_.drop_probability > 0.0 && drop_draw < scenario_.drop_probability) present = false;
-    for (std::size_t f = 0; f < faults_.size(); ++f) {
-      const FaultSpec& fault = faults_[f];
-      if (fault.gyro != i + 1 || !fault_active(fault, t_s)) continue;
-      const double s = ch.scale_V_per_dps();
-      switch (fault.kind) {
-        case FaultKind::kBias:
-          v += s * fault.size;
-          break;
-        case FaultKind::kRamp:
-          v += s * fault.size * (t_s - fault.at_s);
-          break;
-        case FaultKind::kScale:
-          v += fault.size * (v - ch.bias_V());
-          break;
-        case FaultKind::kNoise:
-          v += (fault.size - 1.0) * s * ch.last_white_noise_dps();
-          break;
-        case FaultKind::kSpike:
-          if (!spike_done_[f]) {
-            v += s * fault.size;
-            spike_done_[f] = 1;
-          }
-          break;
-        case FaultKind::kStuck:
-          if (!stuck_value_V_[f]) stuck_value_V_[f] = has_last_output_[iu] ? last_output_V_[iu] : v;
-          v = *stuck_value_V_[f];
-          break;
-        case FaultKind::kZero:
-          v = 0.0;
-          break;
-        case FaultKind::kDropout:
-          present = false;
-          break;
-        case FaultKind::kInvalid:
-          v = std::numeric_limits<double>::quiet_NaN();
-          break;
-      }
-    }
-    out.present[iu] = present ? 1 : 0;
-    out.raw_V[iu] = present ? v : std::numeric_limits<double>::quiet_NaN();
-    if (present && std::isfinite(v)) {
-      last_output_V_[iu] = v;
-      has_last_output_[iu] = 1;
-    }
-  }
-
-  out.reference_q_RB.reset();
-  if (scenario_.reference.rate_hz > 0.0) {
-    // Reference period of the nominal epoch time (exact integer arithmetic where the rates allow).
-    const auto period = static_cast<std::int64_t>(
-        std::floor(static_cast<double>(k_) * scenario_.reference.rate_hz / scenario_.rate_hz + 1e-9));
-    if (period != last_reference_period_) {
-      last_reference_period_ = period;
-      const double sigma_rad = scenario_.reference.noise_arcsec * kArcsecToRad;
-      Eigen::Vector3d error_rad;
-      for (int a = 0; a < 3; ++a) error_rad[a] = sigma_rad * reference_rng_.normal();
-      out.reference_q_RB = canonical(truth.q_RB * quat_exp(error_rad));
-    }
-  }
+  package_.sample(truth.omega_B_rad_s * kRadToDeg, t_s, out.raw_V, out.present);
+  out.reference_q_RB = package_.reference(k_, truth.q_RB);
   ++k_;
   return true;
 }
@@ -187,7 +106,7 @@ std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
   if (scenario_.drop_probability > 0.0) {
     meta.emplace_back("drop_probability", number_text(scenario_.drop_probability));
   }
-  for (const FaultSpec& f : faults_) {
+  for (const FaultSpec& f : package_.faults()) {
     std::string text = format_fault_spec(f);
     for (char& c : text) c = c == ',' ? ';' : c;  // commas separate metadata tokens
     meta.emplace_back("fault", text);

@@ -54,6 +54,10 @@ struct PipelineConfig {
   double reference_threshold_sigma = 6.0;  //!< [σ] reference disagreement threshold
   int reference_confirm_count = 3;         //!< [-] consecutive reference comparisons that must agree
   double glt_false_alarm_probability = 1.0e-9;  //!< [-] N ≥ 5: rejecting a single-gyro hypothesis
+  //! false: a gyro isolated as faulty stays in the solution (detection and isolation still run and
+  //! report; for experiments that measure what exclusion is worth). Honoured by the closed-loop
+  //! simulator, which reinstates such a gyro on the epoch it was excluded.
+  bool exclusion_enabled = true;
 };
 
 //! Parses a `pipeline:` YAML map (unknown keys are errors naming the line); `source` names the file.

@@ -39,6 +39,9 @@ Result<FaultSpec> parse_fault_spec(std::string_view text);
 //! Text form accepted by parse_fault_spec.
 std::string format_fault_spec(const FaultSpec& fault);
 std::string_view fault_kind_name(FaultKind kind);
+std::optional<FaultKind> fault_kind_from_name(std::string_view name);
+//! True for the kinds that need a size (bias, ramp, scale, noise, spike).
+bool kind_takes_size(FaultKind kind);
 
 //! True where the fault is active at time `t_s`.
 inline bool fault_active(const FaultSpec& fault, double t_s) {

@@ -9,6 +9,7 @@
 
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/result.hpp"
+#include "tetra/sim/closed_loop_spec.hpp"
 #include "tetra/sim/fault.hpp"
 #include "tetra/sim/gyro_model.hpp"
 #include "tetra/sim/motion.hpp"
@@ -22,16 +23,17 @@ struct ReferenceOptions {
 };
 
 struct Scenario {
-  std::string name = "static";              //!< built-in name or file name (metadata)
-  MotionSpec motion;                        //!< truth motion
-  double duration_s = 7200.0;               //!< [s]
-  double rate_hz = 10.0;                    //!< [Hz] gyro sampling rate
-  Calibration unit = seed_as_built_unit();  //!< the as-built truth of the simulated unit
-  GyroModelOptions model;                   //!< options the calibration file does not carry
-  ReferenceOptions reference;               //!< attitude reference (none by default)
-  std::vector<FaultSpec> faults;            //!< injected faults
-  double jitter_s = 0.0;                    //!< [s] sample times uniform in nominal ± jitter (< period/2)
-  double drop_probability = 0.0;            //!< each gyro sample independently not delivered
+  std::string name = "static";                //!< built-in name or file name (metadata)
+  MotionSpec motion;                          //!< truth motion
+  double duration_s = 7200.0;                 //!< [s]
+  double rate_hz = 10.0;                      //!< [Hz] gyro sampling rate
+  Calibration unit = seed_as_built_unit();    //!< the as-built truth of the simulated unit
+  GyroModelOptions model;                     //!< options the calibration file does not carry
+  ReferenceOptions reference;                 //!< attitude reference (none by default)
+  std::vector<FaultSpec> faults;              //!< injected faults
+  double jitter_s = 0.0;                      //!< [s] sample times uniform in nominal ± jitter (< period/2)
+  double drop_probability = 0.0;              //!< each gyro sample independently not delivered
+  std::optional<ClosedLoopSpec> closed_loop;  //!< closed loop: dynamics and control (closed_loop.hpp)
 };
 
 //! Names of the built-in scenarios (turntable is separate: see turntable.hpp).

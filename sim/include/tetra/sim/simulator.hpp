@@ -21,6 +21,7 @@
 #include "tetra/core/result.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/sim/gyro_model.hpp"
+#include "tetra/sim/gyro_package.hpp"
 #include "tetra/sim/motion.hpp"
 #include "tetra/sim/scenario.hpp"
 
@@ -66,20 +67,15 @@ class Simulator {
 
   Scenario scenario_;
   SimOptions options_;
-  std::vector<FaultSpec> faults_;  //!< scenario's and options' together
   TruthMotion motion_;
+  GyroPackage package_;  //!< gyros, faults (the scenario's and the options'), drops, reference
   std::size_t epochs_ = 0;
   std::size_t k_ = 0;
-  std::vector<GyroChannel> channels_;
   Rng jitter_rng_;
-  Rng reference_rng_;
-  std::vector<Rng> drop_rngs_;
-  std::vector<double> last_output_V_;  //!< per gyro: last delivered value
-  std::vector<std::uint8_t> has_last_output_;
-  std::vector<std::optional<double>> stuck_value_V_;  //!< per fault
-  std::vector<std::uint8_t> spike_done_;              //!< per fault
-  std::int64_t last_reference_period_ = -1;
 };
+
+//! The scenario's faults followed by the options'.
+std::vector<FaultSpec> all_faults(const Scenario& scenario, const SimOptions& options);
 
 //! Ground truth of a simulated run, one entry per epoch.
 struct Truth {

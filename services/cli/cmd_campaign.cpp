@@ -1,0 +1,191 @@
+// tetra campaign SPEC.yaml — fault-injection campaigns over the closed loop (docs/campaign.md).
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <spdlog/fmt/fmt.h>
+
+#include "campaign_report.hpp"
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "tetra/sim/campaign.hpp"
+
+namespace tetra::cli {
+
+namespace {
+
+constexpr const char* kName = "campaign";
+
+//! Run ids already in `runs.csv` (a torn last line, from an interrupted run, is dropped and redone).
+Result<std::set<std::size_t>> done_runs(const std::string& path) {
+  std::set<std::size_t> done;
+  std::ifstream in(path);
+  if (!in) return done;
+  std::string line;
+  if (!std::getline(in, line)) return done;
+  if (line != sim::campaign_csv_header())
+    return bad_input(path + ":1: not the header of a campaign of this version");
+  std::string kept = line + "\n";
+  while (std::getline(in, line)) {
+    auto row = sim::parse_campaign_row(line);
+    if (!row) continue;
+    done.insert(row->run);
+    kept += line + "\n";
+  }
+  in.close();
+  std::ofstream rewrite(path, std::ios::trunc);  // without the torn line
+  rewrite << kept;
+  if (!rewrite) return failure(path + ": cannot rewrite");
+  return done;
+}
+
+//! A worker process: runs its share of the cases, one row per line on `fd` (each write below
+//! PIPE_BUF, so lines of several workers never interleave).
+[[noreturn]] void worker(const sim::CampaignSpec& spec, const std::vector<sim::CampaignCase>& cases, int fd) {
+  for (const sim::CampaignCase& c : cases) {
+    auto row = sim::run_campaign_case(spec, c);
+    const std::string line = row ? sim::campaign_csv_row(*row) + "\n" : "error " + row.error().message + "\n";
+    if (::write(fd, line.data(), line.size()) != static_cast<ssize_t>(line.size())) ::_exit(1);
+  }
+  ::_exit(0);
+}
+
+std::string duration_text(double s) {
+  if (s < 120.0) return fmt::format("{:.0f} s", s);
+  if (s < 7200.0) return fmt::format("{:.1f} min", s / 60.0);
+  return fmt::format("{:.1f} h", s / 3600.0);
+}
+
+struct Progress {
+  std::size_t total = 0;
+  std::size_t done_before = 0;
+  std::size_t done_now = 0;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  void print(bool final) const {
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const std::size_t left = total - done_before - done_now;
+    std::string eta =
+        done_now ? duration_text(elapsed / static_cast<double>(done_now) * static_cast<double>(left)) : "?";
+    std::cerr << (isatty(2) ? "\r" : "") << "tetra campaign: " << done_before + done_now << "/" << total
+              << " runs, " << duration_text(elapsed) << " elapsed, "
+              << (final ? "done" : "about " + eta + " left") << (isatty(2) && !final ? "   " : "\n")
+              << std::flush;
+  }
+};
+
+Status run_pending(const sim::CampaignSpec& spec, const std::vector<sim::CampaignCase>& pending, int jobs,
+                   const std::string& runs_path, Progress& progress) {
+  int fds[2];
+  if (::pipe(fds) != 0) return failure("cannot create a pipe");
+  std::vector<pid_t> pids;
+  const auto n_jobs =
+      static_cast<std::size_t>(std::max(1, std::min<int>(jobs, static_cast<int>(pending.size()))));
+  for (std::size_t w = 0; w < n_jobs; ++w) {
+    std::vector<sim::CampaignCase> share;
+    for (std::size_t i = w; i < pending.size(); i += n_jobs) share.push_back(pending[i]);
+    std::cout.flush();
+    const pid_t pid = ::fork();
+    if (pid < 0) return failure("cannot fork a worker");
+    if (pid == 0) {
+      ::close(fds[0]);
+      worker(spec, share, fds[1]);
+    }
+    pids.push_back(pid);
+  }
+  ::close(fds[1]);
+  std::FILE* in = ::fdopen(fds[0], "r");
+  std::ofstream out(runs_path, std::ios::app);
+  std::string first_error;
+  auto next_print = std::chrono::steady_clock::now();
+  char* buffer = nullptr;
+  std::size_t capacity = 0;
+  while (::getline(&buffer, &capacity, in) > 0) {
+    std::string line(buffer);
+    if (line.rfind("error ", 0) == 0) {
+      if (first_error.empty()) first_error = line.substr(6, line.size() - 7);
+      continue;
+    }
+    out << line << std::flush;  // one complete row at a time: an interruption loses no finished run
+    ++progress.done_now;
+    if (std::chrono::steady_clock::now() >= next_print) {
+      progress.print(false);
+      next_print += std::chrono::seconds(1);
+    }
+  }
+  std::free(buffer);
+  std::fclose(in);
+  bool workers_ok = true;
+  for (pid_t pid : pids) {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    workers_ok = workers_ok && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  }
+  progress.print(true);
+  if (!first_error.empty()) return failure("a run failed: " + first_error);
+  if (!workers_ok || !out) return failure(runs_path + ": a worker failed or the file could not be written");
+  return ok_status();
+}
+
+}  // namespace
+
+int cmd_campaign(int argc, char** argv) {
+  CLI::App app{
+      "Fault-injection campaign: closed-loop scenarios x fault kinds x gyros x onsets x sizes x seeds, run "
+      "in "
+      "parallel processes with the fusion pipeline in process; one row per run and a report with plots "
+      "(docs/campaign.md). Interrupted campaigns continue where they stopped.",
+      kName};
+  std::string spec_path;
+  std::string out_dir;
+  int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  bool no_report = false;
+  app.add_option("SPEC", spec_path, "campaign spec YAML")->required();
+  app.add_option("--out,-o", out_dir, "output folder: runs.csv, report.md, plots")->required();
+  app.add_option("--jobs,-j", jobs, "worker processes (default: the number of cores)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_flag("--no-report", no_report, "only the runs (no report, no plots)");
+  if (auto status = parse(app, argc, argv)) return *status;
+
+  auto spec = sim::read_campaign_spec(spec_path);
+  if (!spec) return report(kName, spec.error());
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) return report(kName, failure(out_dir + ": cannot create the folder"));
+  const std::string runs_path = (std::filesystem::path(out_dir) / "runs.csv").string();
+  auto done = done_runs(runs_path);
+  if (!done) return report(kName, done.error());
+  if (done->empty()) {
+    std::ofstream header(runs_path, std::ios::trunc);
+    header << sim::campaign_csv_header() << '\n';
+    if (!header) return report(kName, failure(runs_path + ": cannot write"));
+  }
+  const std::vector<sim::CampaignCase> cases = sim::expand_campaign(*spec);
+  std::vector<sim::CampaignCase> pending;
+  for (const sim::CampaignCase& c : cases) {
+    if (done->count(c.index) == 0) pending.push_back(c);
+  }
+  std::cerr << "tetra campaign: " << cases.size() << " runs, " << cases.size() - pending.size()
+            << " already done, " << jobs << " jobs\n";
+  Progress progress{cases.size(), cases.size() - pending.size()};
+  if (!pending.empty()) {
+    if (Status st = run_pending(*spec, pending, jobs, runs_path, progress); !st)
+      return report(kName, st.error());
+  }
+  if (no_report) return kExitOk;
+  if (Status st = write_campaign_report(runs_path, out_dir); !st) return report(kName, st.error());
+  std::cerr << "tetra campaign: report -> " << (std::filesystem::path(out_dir) / "report.md").string()
+            << '\n';
+  return kExitOk;
+}
+
+}  // namespace tetra::cli

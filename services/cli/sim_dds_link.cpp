@@ -1,0 +1,185 @@
+#include "sim_dds_link.hpp"
+
+#include "cli_common.hpp"
+#include "dds_common.hpp"
+#include "tetra/dds/convert.hpp"
+
+namespace tetra::cli {
+
+namespace {
+enum Token : std::intptr_t { kAttitude = 1, kMatched, kShutdown };
+constexpr std::int64_t kDiscoverySettle_ns = 200'000'000;  //!< [ns] see wait_for_service
+}  // namespace
+
+Result<std::unique_ptr<SimDdsLink>> SimDdsLink::open(const std::string& unit, double rate_hz,
+                                                     const SimDdsOptions& options,
+                                                     const dds::ShutdownSignal* shutdown) {
+  auto participant = dds::Participant::create(options.domain, unit);
+  if (!participant) return participant.error();
+  auto topics = dds::Topics::create(*participant);
+  if (!topics) return topics.error();
+  // The deadline offered is 3 periods of the wall-clock rate (none when unpaced).
+  const auto period =
+      options.speed > 0 ? std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / (rate_hz * options.speed)))
+                        : std::chrono::nanoseconds(0);
+  dds::Qos gyro_qos = dds::gyro_sample_qos(period);
+  gyro_qos.no_autodispose();
+  auto gyro_writer = dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, gyro_qos);
+  if (!gyro_writer) return gyro_writer.error();
+  auto reference_writer =
+      dds::Writer<tetra_AttitudeReference>::create(*participant, topics->reference, dds::reference_qos());
+  if (!reference_writer) return reference_writer.error();
+  dds::Qos attitude_qos;
+  attitude_qos.reliable().volatile_durability().keep_last(1024);  // score every epoch, not only the latest
+  auto attitude_reader = dds::Reader<tetra_Attitude>::create(*participant, topics->attitude, attitude_qos);
+  if (!attitude_reader) return attitude_reader.error();
+  std::unique_ptr<SimDdsLink> link(new SimDdsLink(
+      unit, std::move(participant.value()), std::move(topics.value()), std::move(gyro_writer.value()),
+      std::move(reference_writer.value()), std::move(attitude_reader.value())));
+  link->shutdown_ = shutdown;
+  if (auto s = dds::copy_bounded(link->sample_.unit, unit, "unit"); !s) return s.error();
+  if (auto s = dds::copy_bounded(link->reference_.unit, unit, "unit"); !s) return s.error();
+  if (auto s = link->wait_for_readers(options); !s) return s.error();
+  if (auto s = link->wait_for_service(options); !s) return s.error();
+  return link;
+}
+
+Status SimDdsLink::wait_for_readers(const SimDdsOptions& options) {
+  auto waitset = dds::WaitSet::create(participant_);
+  if (!waitset) return waitset.error();
+  waitset_ = std::move(waitset.value());
+  auto data = dds::Condition::data_available(attitude_reader_.handle());
+  if (!data) return data.error();
+  data_ = std::move(data.value());
+  if (auto s = waitset_->attach(data_->handle(), kAttitude); !s) return s.error();
+  if (dds_set_status_mask(gyro_writer_.handle(), DDS_PUBLICATION_MATCHED_STATUS) < 0) {
+    return failure("DDS: cannot enable the publication-matched status");
+  }
+  if (auto s = waitset_->attach(gyro_writer_.handle(), kMatched); !s) return s.error();
+  auto guard = dds::Condition::guard(participant_);
+  if (!guard) return guard.error();
+  guard_ = std::move(guard.value());
+  if (auto s = waitset_->attach(guard_->handle(), kShutdown); !s) return s.error();
+  if (shutdown_ != nullptr) const_cast<dds::ShutdownSignal*>(shutdown_)->set_guard(guard_->handle());
+
+  // Wait for the readers (the service, a recorder) so that the first samples are not lost.
+  const std::int64_t give_up = monotonic_ns() + static_cast<std::int64_t>(options.wait_timeout_s * 1e9);
+  for (;;) {
+    std::uint32_t status = 0;
+    (void)dds_take_status(gyro_writer_.handle(), &status, DDS_PUBLICATION_MATCHED_STATUS);
+    auto matched = gyro_writer_.matched_readers();
+    if (!matched) return matched.error();
+    if (static_cast<int>(*matched) >= options.wait_readers) break;
+    if (stop_requested()) return failure("interrupted while waiting for readers");
+    const std::int64_t now = monotonic_ns();
+    if (now >= give_up) {
+      return failure("only " + std::to_string(*matched) + " of " + std::to_string(options.wait_readers) +
+                     " GyroSample readers appeared within " + fixed(options.wait_timeout_s, 1) + " s");
+    }
+    if (auto s = waitset_->wait(std::chrono::nanoseconds(give_up - now), triggered_); !s) return s.error();
+  }
+  return ok_status();
+}
+
+Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
+  // A volatile reader receives only what is written after IT has discovered the writer, which can
+  // be a moment after the writer has discovered the reader. So wait, when a service for this unit
+  // exists (its Health arrives within a second), until its Health says it hears a GyroSample writer.
+  if (options.wait_readers > 0) {
+    auto health_reader = dds::Reader<tetra_Health>::create(participant_, topics_.health, dds::health_qos());
+    if (!health_reader) return health_reader.error();
+    auto health_data = dds::Condition::data_available(health_reader->handle());
+    if (!health_data) return health_data.error();
+    auto health_waitset = dds::WaitSet::create(participant_);
+    if (!health_waitset) return health_waitset.error();
+    if (auto s = health_waitset->attach(health_data->handle(), 1); !s) return s.error();
+    bool service_seen = false;
+    bool service_hears = false;
+    const std::int64_t first_give_up = monotonic_ns() + 1'000'000'000;
+    const std::int64_t hears_give_up =
+        monotonic_ns() + static_cast<std::int64_t>(options.wait_timeout_s * 1e9);
+    std::vector<std::intptr_t> fired;
+    for (;;) {
+      auto taken = health_reader->take([&](const tetra_Health& h, const dds_sample_info_t&) {
+        if (dds::from_wire(h.unit) != unit_) return;
+        service_seen = true;
+        service_hears = service_hears || h.gyro_writers > 0;
+      });
+      if (!taken) return taken.error();
+      const std::int64_t now = monotonic_ns();
+      const std::int64_t limit = service_seen ? hears_give_up : first_give_up;
+      if (service_hears || now >= limit || stop_requested()) break;
+      if (auto s = health_waitset->wait(std::chrono::nanoseconds(limit - now), fired); !s) return s.error();
+    }
+  }
+
+  // And (briefly) for the service's Attitude writer, so that the first epochs are scored too.
+  if (options.wait_readers > 0) {
+    if (dds_set_status_mask(attitude_reader_.handle(), DDS_SUBSCRIPTION_MATCHED_STATUS) < 0) {
+      return failure("DDS: cannot enable the subscription-matched status");
+    }
+    if (auto s = waitset_->attach(attitude_reader_.handle(), kMatched); !s) return s.error();
+    const std::int64_t attitude_give_up = monotonic_ns() + 1'000'000'000;
+    for (;;) {
+      std::uint32_t status = 0;
+      (void)dds_take_status(attitude_reader_.handle(), &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
+      auto matched = attitude_reader_.matched_writers();
+      if (!matched) return matched.error();
+      const std::int64_t now = monotonic_ns();
+      if (*matched > 0 || now >= attitude_give_up || stop_requested()) break;
+      if (auto s = waitset_->wait(std::chrono::nanoseconds(attitude_give_up - now), triggered_); !s)
+        return s.error();
+    }
+  }
+
+  // Other readers (a recorder) give no such sign of having discovered our writer: allow them a
+  // settling time well above the 3–20 ms discovery takes on loopback, before the first sample.
+  if (options.wait_readers > 1) {
+    const std::int64_t settle_until = monotonic_ns() + kDiscoverySettle_ns;
+    for (std::int64_t now = monotonic_ns(); now < settle_until && !stop_requested(); now = monotonic_ns()) {
+      if (auto s = waitset_->wait(std::chrono::nanoseconds(settle_until - now), triggered_); !s)
+        return s.error();
+    }
+  }
+  return ok_status();
+}
+
+Status SimDdsLink::publish(const sim::SimEpoch& epoch, std::uint64_t k) {
+  if (epoch.reference_q_RB) {
+    reference_.stamp_ns = epoch.stamp_ns;
+    const auto q = to_wxyz(*epoch.reference_q_RB);
+    for (std::size_t i = 0; i < 4; ++i) reference_.q_RB[i] = q[i];
+    if (auto s = reference_writer_.write(reference_); !s) return s.error();
+  }
+  for (std::size_t g = 1; g <= epoch.present.size(); ++g) {
+    if (epoch.present[g - 1] == 0) continue;  // not delivered (dropout)
+    sample_.gyro = static_cast<std::uint16_t>(g);
+    sample_.seq = k;  // the sensor's count: a dropped sample leaves a gap
+    sample_.stamp_ns = epoch.stamp_ns;
+    sample_.raw = epoch.raw_V[g - 1];
+    sample_.flags = 0;
+    if (auto s = gyro_writer_.write(sample_); !s) return s.error();
+  }
+  return ok_status();
+}
+
+Status SimDdsLink::take_attitudes(const std::function<void(const fdi::AttitudeEstimate&)>& on_attitude) {
+  auto taken = attitude_reader_.take([&](const tetra_Attitude& msg, const dds_sample_info_t&) {
+    if (dds::from_wire(msg.unit) != unit_) return;
+    on_attitude(dds::from_wire(msg));
+  });
+  if (!taken) return taken.error();
+  return ok_status();
+}
+
+Status SimDdsLink::wait_until(std::int64_t until_ns) {
+  const std::int64_t now = monotonic_ns();
+  if (now >= until_ns || stop_requested()) return ok_status();
+  return waitset_->wait(std::chrono::nanoseconds(until_ns - now), triggered_);
+}
+
+void SimDdsLink::wait_for_acks() {
+  (void)gyro_writer_.wait_for_acks(std::chrono::seconds(2));
+}
+
+}  // namespace tetra::cli

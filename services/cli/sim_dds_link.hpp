@@ -1,0 +1,70 @@
+#pragma once
+// The simulator's end of the wire (`tetra sim --dds`, open or closed loop): the GyroSample and
+// AttitudeReference writers, the Attitude reader, and the wait at start-up for the service (and any
+// other gyro reader) to hear the writer before the first sample is published.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <dds/dds.h>
+
+#include "sim_dds.hpp"
+#include "tetra/core/result.hpp"
+#include "tetra/dds/entity.hpp"
+#include "tetra/dds/shutdown.hpp"
+#include "tetra/dds/topics.hpp"
+#include "tetra/fdi/types.hpp"
+#include "tetra/sim/simulator.hpp"
+
+namespace tetra::cli {
+
+class SimDdsLink {
+ public:
+  //! Creates the entities and waits for `options.wait_readers` gyro readers (see sim_dds_link.cpp).
+  static Result<std::unique_ptr<SimDdsLink>> open(const std::string& unit, double rate_hz,
+                                                  const SimDdsOptions& options,
+                                                  const dds::ShutdownSignal* shutdown);
+  //! Publishes one epoch: the reference first (the service has it when the epoch completes), then
+  //! the gyro samples delivered, with sequence number `k`.
+  Status publish(const sim::SimEpoch& epoch, std::uint64_t k);
+  //! Takes the Attitude samples of this unit received so far, in order.
+  Status take_attitudes(const std::function<void(const fdi::AttitudeEstimate&)>& on_attitude);
+  //! Blocks until data arrives on the Attitude reader, a shutdown is requested or the monotonic
+  //! time `until_ns` passes.
+  Status wait_until(std::int64_t until_ns);
+  bool stop_requested() const { return shutdown_ != nullptr && shutdown_->requested(); }
+  //! Waits (up to 2 s) until the samples written are acknowledged.
+  void wait_for_acks();
+
+ private:
+  SimDdsLink(std::string unit, dds::Participant participant, dds::Topics topics,
+             dds::Writer<tetra_GyroSample> gyro_writer, dds::Writer<tetra_AttitudeReference> reference_writer,
+             dds::Reader<tetra_Attitude> attitude_reader)
+      : unit_(std::move(unit)),
+        participant_(std::move(participant)),
+        topics_(std::move(topics)),
+        gyro_writer_(std::move(gyro_writer)),
+        reference_writer_(std::move(reference_writer)),
+        attitude_reader_(std::move(attitude_reader)) {}
+  Status wait_for_readers(const SimDdsOptions& options);
+  Status wait_for_service(const SimDdsOptions& options);
+
+  std::string unit_;
+  dds::Participant participant_;
+  dds::Topics topics_;
+  dds::Writer<tetra_GyroSample> gyro_writer_;
+  dds::Writer<tetra_AttitudeReference> reference_writer_;
+  dds::Reader<tetra_Attitude> attitude_reader_;
+  std::optional<dds::WaitSet> waitset_;
+  std::optional<dds::Condition> data_;
+  std::optional<dds::Condition> guard_;
+  const dds::ShutdownSignal* shutdown_ = nullptr;
+  std::vector<std::intptr_t> triggered_;
+  tetra_GyroSample sample_{};
+  tetra_AttitudeReference reference_{};
+};
+
+}  // namespace tetra::cli
