@@ -127,7 +127,7 @@ class Pipeline::Impl {
   Status init();
   void reset();
   const StepResult& step(const Epoch& epoch);
-  FdiEvent command_exclude(int id, std::int64_t stamp_ns);
+  FdiEvent command_exclude(int id, std::int64_t stamp_ns, bool force);
   FdiEvent command_reinstate(int id, std::int64_t stamp_ns);
   FdiEvent command_reset(std::int64_t stamp_ns);
   std::string describe_thresholds() const;
@@ -1337,6 +1337,7 @@ FdiEvent Pipeline::Impl::acknowledge(const std::string& command, int id, const s
   ack.type = EventType::kCommand;
   ack.gyro = id;
   ack.detail = command + " " + std::to_string(id) + ": " + outcome;
+  ack.refused = !changed;
   ack.gyros = active_mask();
   pending_.push_back(ack);
   if (changed) {
@@ -1349,10 +1350,16 @@ FdiEvent Pipeline::Impl::acknowledge(const std::string& command, int id, const s
   return ack;
 }
 
-FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns) {
+FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns, bool force) {
   if (id < 1 || id > n_) return acknowledge("exclude", id, "rejected, no such gyro", false, stamp_ns);
   auto& g = gyros_[static_cast<std::size_t>(id - 1)];
   if (g.excluded) return acknowledge("exclude", id, "already excluded", false, stamp_ns);
+  const GyroMask after = without_gyro(active_mask(), id);
+  const bool observable = period_s_ > 0.0 ? subset(after).observable : tetra::gyro_count(after) >= 3;
+  if (!observable && !force) {
+    return acknowledge("exclude", id, "refused, the rest could not determine attitude (force overrides)",
+                       false, stamp_ns);
+  }
   g.excluded = true;
   g.kind = FaultKind::kUnknown;
   return acknowledge("exclude", id, "done", true, stamp_ns);
@@ -1409,8 +1416,8 @@ void Pipeline::reset() {
 const StepResult& Pipeline::step(const Epoch& epoch) {
   return impl_->step(epoch);
 }
-FdiEvent Pipeline::exclude(int gyro_id, std::int64_t stamp_ns) {
-  return impl_->command_exclude(gyro_id, stamp_ns);
+FdiEvent Pipeline::exclude(int gyro_id, std::int64_t stamp_ns, bool force) {
+  return impl_->command_exclude(gyro_id, stamp_ns, force);
 }
 FdiEvent Pipeline::reinstate(int gyro_id, std::int64_t stamp_ns) {
   return impl_->command_reinstate(gyro_id, stamp_ns);

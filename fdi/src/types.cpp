@@ -140,6 +140,7 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
       }
       out += ", \"gyros\": ";
       append_gyro_list(out, event.gyros, n_gyros);
+      out += event.refused ? ", \"accepted\": false" : ", \"accepted\": true";
       break;
   }
   if (!event.detail.empty()) {

@@ -13,5 +13,6 @@ int cmd_monitor(int argc, char** argv);
 int cmd_command(int argc, char** argv);
 int cmd_record(int argc, char** argv);
 int cmd_demo(int argc, char** argv);
+int cmd_ground(int argc, char** argv);
 
 }  // namespace tetra::cli

@@ -159,6 +159,7 @@ HealthView from_wire(const tetra_Health& in) {
   out.counters.sensor_restarts = c.sensor_restarts;
   out.events_published = in.events_published;
   out.gyro_writers = in.gyro_writers;
+  out.health_period_s = in.health_period_s;
   out.counters.deadlines_missed = c.deadlines_missed;
   out.counters.liveliness_lost = c.liveliness_lost;
   return out;
@@ -187,7 +188,23 @@ Status to_wire(const EventView& view, tetra_FdiEvent& out) {
   out.statistic = e.statistic;
   out.kind = to_wire(e.kind);
   out.gyros = e.gyros;
-  return ok_status();
+  out.refused = e.refused;
+  out.command = view.command.kind;
+  out.force = view.command.force;
+  if (auto status = copy_bounded(out.operator_id, view.command.operator_id, "operator id"); !status)
+    return status;
+  return copy_bounded(out.origin, view.command.origin, "command origin");
+}
+
+const char* to_string(tetra_CommandKind kind) {
+  switch (kind) {
+    case tetra_COMMAND_EXCLUDE:
+      return "exclude";
+    case tetra_COMMAND_REINSTATE:
+      return "reinstate";
+    default:
+      return "reset";
+  }
 }
 
 EventView from_wire(const tetra_FdiEvent& in) {
@@ -205,6 +222,8 @@ EventView from_wire(const tetra_FdiEvent& in) {
   e.evidence = from_wire(in.evidence);
   e.gyros = in.gyros;
   e.detail = from_wire(in.detail);
+  e.refused = in.refused;
+  out.command = {in.command, in.force, from_wire(in.operator_id), from_wire(in.origin)};
   return out;
 }
 

@@ -37,7 +37,9 @@ class Pipeline {
   //! Processes one epoch. The returned reference is valid until the next call.
   const StepResult& step(const Epoch& epoch);
   //! Operator commands. They return the acknowledgement event (also emitted on the next step()).
-  FdiEvent exclude(int gyro_id, std::int64_t stamp_ns);
+  //! exclude refuses (acknowledgement `refused`) to leave a set of gyros that cannot determine the
+  //! rate, unless `force`.
+  FdiEvent exclude(int gyro_id, std::int64_t stamp_ns, bool force = false);
   FdiEvent reinstate(int gyro_id, std::int64_t stamp_ns);
   FdiEvent reset_command(std::int64_t stamp_ns);
 

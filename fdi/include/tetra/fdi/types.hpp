@@ -68,6 +68,7 @@ struct FdiEvent {
   std::string evidence;  //!< isolated: "variance", "onset", "reference", "invalid", ...
   GyroMask gyros = 0;    //!< reconfigured / cleared / lost: the gyros used from now on
   std::string detail;    //!< free text: e.g. the command acknowledged and its outcome
+  bool refused = false;  //!< command: refused (the detail says why), nothing changed
 };
 
 //! One JSON object (one line, no newline) per INTERFACES §2.5; `n_gyros` formats the `gyros` lists.

@@ -19,7 +19,7 @@ inline constexpr std::chrono::milliseconds kWriterLease{1000};  //!< automatic l
 Qos gyro_sample_qos(std::chrono::nanoseconds sample_period = std::chrono::nanoseconds{0});
 Qos reference_qos();  //!< reliable / volatile / keep-last 8
 Qos attitude_qos();   //!< reliable / volatile / keep-last 1
-Qos health_qos();     //!< reliable / transient-local / keep-last 1
+Qos health_qos();     //!< reliable / transient-local / keep-last 1 / automatic liveliness, kWriterLease
 Qos event_qos();      //!< reliable / transient-local / keep-last 256 (durability service 256)
 Qos command_qos();    //!< reliable / volatile / keep-last 16
 
