@@ -1,16 +1,17 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Real-browser test of the ground station (issue 16): headless Chromium driven by Selenium on the
-Open MCT application served by `tetra demo --web`.
+Open MCT application served by `tetra ground`, with `tetra fusion` and `tetra sim --dds` as processes.
 
-The page loads and shows the unit NOMINAL; the simulator's fault (gyro 2 stuck) makes it DEGRADED
-with gyro 2 excluded; a command issued from the page (reinstate gyro 2, confirmed in the dialog) is
-acknowledged; after `kill -9` of the fusion service the page shows STALE. Screenshots of each step
-are kept in --out. Waits are bounded (they only turn a hang into a failure); nothing is timed.
+The page loads first (on a loaded machine a browser takes seconds to start), then the simulator
+starts: the page shows the unit NOMINAL; the simulator's fault (gyro 2 stuck at 10 s) makes it
+DEGRADED with gyro 2 excluded; a command issued from the page (reinstate gyro 2, confirmed in the
+dialog) is acknowledged; after `kill -9` of the fusion service the page shows STALE. Screenshots of
+each step are kept in --out. Waits are bounded (they only turn a hang into a failure); nothing is
+timed.
 """
 
 import argparse
 import os
-import re
 import signal
 import socket
 import subprocess
@@ -25,21 +26,13 @@ from selenium.webdriver.support import expected_conditions as ec
 from selenium.webdriver.support.ui import WebDriverWait
 
 
+UNIT = "ground-test"
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
-
-
-def wait_for_line(path, pattern, limit_s):
-    deadline = time.monotonic() + limit_s
-    while time.monotonic() < deadline:
-        if os.path.exists(path):
-            m = re.search(pattern, open(path, encoding="utf-8", errors="replace").read())
-            if m:
-                return m
-        time.sleep(0.1)
-    return None
 
 
 def http_ready(port, limit_s):
@@ -62,25 +55,25 @@ def main():
     ap.add_argument("--tetra", required=True)
     ap.add_argument("--source", required=True)
     ap.add_argument("--out", required=True, help="screenshots and logs")
-    ap.add_argument("--domain", default="183")
+    ap.add_argument("--domain", default="183")  # private to this test (tests/CMakeLists.txt)
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
+    # Loopback-only discovery for every process of the test (as the C++ DDS tests do).
+    os.environ["CYCLONEDDS_URI"] = "file://" + os.path.join(args.source, "config", "cyclonedds-loopback.xml")
     port = free_port()
-    demo_log = os.path.join(args.out, "demo.log")
-    keep = os.path.join(args.out, "demo")
-    # 60 s of orbit in real time, gyro 2 stuck from 8 s; the test ends it once it has what it needs.
-    demo = subprocess.Popen(
-        [args.tetra, "demo", "--web", "--listen", f"127.0.0.1:{port}", "--domain", args.domain,
-         "--seconds", "60", "--speed", "1", "--fault", "gyro=2,kind=stuck,at=8", "--keep", keep],
-        stdout=open(demo_log, "w"), stderr=subprocess.STDOUT)
-    driver = None
-    step = "start"
-    try:
-        pid_match = wait_for_line(demo_log, r"service pid (\d+)", 30)
-        assert pid_match, "the demo did not start its service"
-        service_pid = int(pid_match.group(1))
-        assert http_ready(port, 30), "the ground station does not answer"
+    children = []
 
+    def spawn(argv, log):
+        child = subprocess.Popen(argv, stdout=open(os.path.join(args.out, log), "w"),
+                                 stderr=subprocess.STDOUT)
+        children.append(child)
+        return child
+
+    driver = None
+    step = "start the browser"
+    try:
+        # The browser first: on a loaded machine it takes seconds to start, and the page must see the
+        # unit NOMINAL before the fault.
         options = Options()
         for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
                      "--window-size=1600,1000"):
@@ -89,9 +82,27 @@ def main():
         driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
         wait = WebDriverWait(driver, 60, poll_frequency=0.2)
 
-        step = "page loads, unit NOMINAL"
-        driver.get(f"http://127.0.0.1:{port}/#/browse/tetra:units/tetra:unit~tetra-1")
+        step = "start the ground station and the service"
+        data = os.path.join(args.source, "tests", "ground", "data")
+        domain = ["--domain", args.domain]
+        spawn([args.tetra, "ground", "--listen", f"127.0.0.1:{port}"] + domain, "ground.log")
+        fusion = spawn([args.tetra, "fusion", "--config", os.path.join(data, "fusion.yaml")] + domain,
+                       "fusion.log")
+        assert http_ready(port, 30), "the ground station does not answer"
+
+        step = "page loads"
+        driver.get(f"http://127.0.0.1:{port}/#/browse/tetra:units/tetra:unit~{UNIT}")
         wait.until(ec.presence_of_element_located((By.ID, "tetra-mode")))
+        wait.until(lambda d: text_of(d, "tetra-mode") != "no health yet")
+
+        step = "start the simulator"
+        # 2 min of orbit at 50 Hz in real time, gyro 2 stuck from 10 s; stopped once the test is done.
+        spawn([args.tetra, "sim", "orbit", "--dds", "--dds-unit", UNIT, "--unit",
+               os.path.join(data, "calibration.yaml"), "--rate-hz", "50", "--minutes", "2",
+               "--reference-hz", "0", "--speed", "1", "--fault", "gyro=2,kind=stuck,at=10",
+               "--wait-readers", "1"] + domain, "sim.log")
+
+        step = "unit NOMINAL"
         wait.until(lambda d: text_of(d, "tetra-mode") == "NOMINAL")
         wait.until(lambda d: text_of(d, "tetra-link") == "LIVE")
         driver.save_screenshot(os.path.join(args.out, "1_nominal.png"))
@@ -112,7 +123,8 @@ def main():
         driver.save_screenshot(os.path.join(args.out, "4_acknowledged.png"))
 
         step = "STALE after the service is killed"
-        os.kill(service_pid, signal.SIGKILL)
+        fusion.kill()
+        fusion.wait()
         wait.until(lambda d: "STALE" in text_of(d, "tetra-link") or "LOST" in text_of(d, "tetra-link"))
         driver.save_screenshot(os.path.join(args.out, "5_stale.png"))
         print("ground_browser: all steps passed; screenshots in", args.out)
@@ -121,18 +133,24 @@ def main():
         if driver is not None:
             driver.save_screenshot(os.path.join(args.out, "failed.png"))
         print(f"ground_browser: FAILED at step '{step}': {exc!r}", file=sys.stderr)
-        if os.path.exists(demo_log):
-            print(open(demo_log, encoding="utf-8", errors="replace").read()[-3000:], file=sys.stderr)
+        for log in ("ground.log", "fusion.log", "sim.log"):
+            path = os.path.join(args.out, log)
+            if os.path.exists(path):
+                text = open(path, encoding="utf-8", errors="replace").read()[-1500:]
+                print(f"--- {log}\n{text}", file=sys.stderr)
         return 1
     finally:
         if driver is not None:
             driver.quit()
-        demo.send_signal(signal.SIGTERM)
-        try:
-            demo.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            demo.kill()
-            demo.wait()
+        for child in children:
+            if child.poll() is None:
+                child.send_signal(signal.SIGTERM)
+        for child in children:
+            try:
+                child.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                child.kill()
+                child.wait()
 
 
 if __name__ == "__main__":

@@ -4,7 +4,6 @@
 // failure; nothing asserts on elapsed time.
 
 #include <gtest/gtest.h>
-#include <httplib.h>
 #include <signal.h>
 
 #include <atomic>
@@ -15,6 +14,8 @@
 #include "test_support.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra_process.hpp"
+// After Eigen (through the headers above): httplib.h brings <resolv.h>, whose `_res` macro breaks Eigen.
+#include <httplib.h>
 
 namespace tetra::test {
 namespace {
@@ -153,11 +154,15 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   ASSERT_TRUE(attitude && attitude->status == 200);
   const json rows = json::parse(attitude->body);
   ASSERT_GT(rows.size(), 10U);
+  // Never closer than 0.1 s of sensor time (less half a 100 Hz sample of slack); mostly exactly 0.1 s
+  // apart: Attitude is keep-last 1, so a loaded machine may skip a sample and make a gap a bit longer.
+  std::size_t exact = 0;
   for (std::size_t i = 1; i < rows.size(); ++i) {
-    // 0.1 s apart in sensor time (one 100 Hz sample of slack for an epoch the service skipped).
     const double dt = rows[i]["sensor_time_s"].get<double>() - rows[i - 1]["sensor_time_s"].get<double>();
-    EXPECT_NEAR(dt, 0.1, 0.0101) << i;
+    EXPECT_GE(dt, 0.0949) << i;
+    exact += std::abs(dt - 0.1) < 1e-3 ? 1 : 0;
   }
+  EXPECT_GE(exact, (rows.size() - 1) * 8 / 10) << "fewer than 80 % of the gaps are 0.1 s";
   auto history_events = client.Get("/api/history?unit=tetra-1&kind=event");
   ASSERT_TRUE(history_events && history_events->status == 200);
   EXPECT_NE(history_events->body.find("\"isolated\""), std::string::npos);

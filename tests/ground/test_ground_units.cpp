@@ -68,7 +68,7 @@ TEST(Encode, ParityFieldsAreNotAvailableWithFewerThanFourGyros) {
   EXPECT_TRUE(three["cusum"].is_null());
   EXPECT_TRUE(three["parity_residual"].is_null());
   EXPECT_EQ(three["gyros_used"], json::array({1, 2, 3}));
-  EXPECT_DOUBLE_EQ(three["utc_ms"].get<double>(), 1'790'000'000'000'000.0);
+  EXPECT_DOUBLE_EQ(three["utc_ms"].get<double>(), 1'790'000'000'000.0);  // ns -> ms
 }
 
 TEST(Encode, AcknowledgementCarriesTheAuditTrail) {

@@ -1,11 +1,11 @@
 #include "tetra/ground/http_api.hpp"
 
-#include <httplib.h>
-
 #include <filesystem>
 
 #include "tetra/dds/topics.hpp"
 #include "tetra/ground/encode.hpp"
+// After Eigen (through the headers above): httplib.h brings <resolv.h>, whose `_res` macro breaks Eigen.
+#include <httplib.h>
 
 namespace tetra::ground {
 
