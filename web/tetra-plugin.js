@@ -499,7 +499,18 @@ function TetraPlugin(options) {
       show(element) {
         root = skeleton();
         element.appendChild(root);
-        stops.push(listen('health', (m) => m.unit === unit && ((state.health = m), render())));
+        stops.push(
+          listen('health', (m) => {
+            if (m.unit !== unit) return;
+            state.health = m;
+            render();
+            // Latency from the service's write (DDS source timestamp) to this display, for
+            // bench/ground_latency.py (same host, same clock); the newest 10000.
+            const lat = (window.tetraHealthLatencyMs = window.tetraHealthLatencyMs || []);
+            lat.push(Date.now() - m.utc_ms);
+            if (lat.length > 10000) lat.shift();
+          })
+        );
         stops.push(listen('attitude', (m) => m.unit === unit && ((state.attitude = m), render())));
         stops.push(listen('link', (m) => m.unit === unit && ((state.link = m), render())));
         stops.push(

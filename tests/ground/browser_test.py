@@ -46,6 +46,16 @@ def http_ready(port, limit_s):
     return False
 
 
+def start_browser():
+    """Debian's Chromium, headless, through Debian's chromedriver."""
+    options = Options()
+    for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                 "--window-size=1600,1000"):
+        options.add_argument(flag)
+    options.binary_location = "/usr/bin/chromium"
+    return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+
+
 def text_of(driver, element_id):
     return driver.find_element(By.ID, element_id).text
 
@@ -74,12 +84,7 @@ def main():
     try:
         # The browser first: on a loaded machine it takes seconds to start, and the page must see the
         # unit NOMINAL before the fault.
-        options = Options()
-        for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                     "--window-size=1600,1000"):
-            options.add_argument(flag)
-        options.binary_location = "/usr/bin/chromium"
-        driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+        driver = start_browser()
         wait = WebDriverWait(driver, 60, poll_frequency=0.2)
 
         step = "start the ground station and the service"
