@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_clock.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
@@ -19,17 +20,8 @@
 
 namespace {
 
-std::int64_t now_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-void sleep_until_ns(std::int64_t t_ns) {
-  timespec ts{static_cast<time_t>(t_ns / 1'000'000'000), static_cast<long>(t_ns % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) != 0) {
-  }
-}
+using tetra::bench::now_ns;
+using tetra::bench::sleep_until_ns;
 
 template <class T>
 T must(tetra::Result<T> r, const char* what) {
@@ -58,8 +50,9 @@ int main(int argc, char** argv) {
   }
   auto participant = must(dds::Participant::create(static_cast<dds_domainid_t>(domain)), "participant");
   auto topics = must(dds::Topics::create(participant), "topics");
-  auto attitude_writer = must(dds::Writer<tetra_Attitude>::create(participant, topics.attitude, dds::attitude_qos()),
-                              "attitude writer");
+  auto attitude_writer =
+      must(dds::Writer<tetra_Attitude>::create(participant, topics.attitude, dds::attitude_qos()),
+           "attitude writer");
   auto health_writer =
       must(dds::Writer<tetra_Health>::create(participant, topics.health, dds::health_qos()), "health writer");
   auto event_writer =
@@ -85,7 +78,8 @@ int main(int argc, char** argv) {
     sleep_until_ns(start + k * period_ns);
     fdi::AttitudeEstimate a;
     a.stamp_ns = k * period_ns;
-    a.q_RB = Quaternion(Eigen::AngleAxisd(1e-3 * static_cast<double>(k) * kDegToRad, Eigen::Vector3d::UnitY()));
+    a.q_RB =
+        Quaternion(Eigen::AngleAxisd(1e-3 * static_cast<double>(k) * kDegToRad, Eigen::Vector3d::UnitY()));
     a.gyros = 0b1111;
     for (std::size_t u = 0; u < names.size(); ++u) {
       tetra_Attitude wire{};
@@ -100,17 +94,20 @@ int main(int argc, char** argv) {
         }
       }
       if (k % event_every == event_every - 1) {
-        dds::EventView view{names[u], static_cast<std::uint64_t>(k / event_every + 1), 0, fdi::FdiEvent{}, {}};
+        dds::EventView view{
+            names[u], static_cast<std::uint64_t>(k / event_every + 1), 0, fdi::FdiEvent{}, {}};
         view.event.stamp_ns = a.stamp_ns;
         view.event.type = fdi::EventType::kDetected;
         view.event.test = "chi2";
-        tetra_FdiEvent wire{};
-        if (dds::to_wire(view, wire) && event_writer.write(wire)) ++events;
+        tetra_FdiEvent event_wire{};
+        if (dds::to_wire(view, event_wire) && event_writer.write(event_wire)) ++events;
       }
     }
   }
-  std::printf("ground_load_publisher: %d units, %.0f s at %.0f Hz: %llu attitudes, %llu health, %llu events written\n",
-              units, seconds, rate_hz, static_cast<unsigned long long>(attitudes),
-              static_cast<unsigned long long>(healths), static_cast<unsigned long long>(events));
+  std::printf(
+      "ground_load_publisher: %d units, %.0f s at %.0f Hz: %llu attitudes, %llu health, %llu events "
+      "written\n",
+      units, seconds, rate_hz, static_cast<unsigned long long>(attitudes),
+      static_cast<unsigned long long>(healths), static_cast<unsigned long long>(events));
   return 0;
 }

@@ -224,7 +224,8 @@ std::string without_stream_events(const std::string& events) {
   std::istringstream in(events);
   std::string out;
   for (std::string line; std::getline(in, line);) {
-    if (line.find("all gyros silent") == std::string::npos && line.find("gyro samples back") == std::string::npos)
+    if (line.find("all gyros silent") == std::string::npos &&
+        line.find("gyro samples back") == std::string::npos)
       out += line + '\n';
   }
   return out;
@@ -239,11 +240,11 @@ TEST_P(DdsReplayEquivalence, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitude
   ServiceFiles files(100.0, 1.0, "tetra-1", GetParam());
   TetraProcess fusion({"fusion", "--config", files.config, "--domain", d(domain)},
                       files.dir.file("fusion.log"));
-  TetraProcess record({"record", "--config", files.config, "--domain", d(domain), "-o",
-                       files.dir.file("rec.csv"), "--attitude", files.dir.file("dds_att.csv"), "--events",
-                       files.dir.file("dds_ev.jsonl"), "--commands", files.dir.file("dds_cmd.jsonl"),
-                       "--until-idle"},
-                      files.dir.file("record.log"));
+  TetraProcess record(
+      {"record", "--config", files.config, "--domain", d(domain), "-o", files.dir.file("rec.csv"),
+       "--attitude", files.dir.file("dds_att.csv"), "--events", files.dir.file("dds_ev.jsonl"), "--commands",
+       files.dir.file("dds_cmd.jsonl"), "--until-idle"},
+      files.dir.file("record.log"));
   TetraProcess sim(split_args(sim_args(domain, 2)), files.dir.file("sim.log"));  // waits for both
   // An operator command somewhere in the run (where exactly does not matter: replay re-applies it
   // where the service obeyed it). Accepted before gyro 2 is isolated, refused after.
@@ -252,10 +253,10 @@ TEST_P(DdsReplayEquivalence, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitude
   ASSERT_EQ(sim.wait_exit(), 0) << read_file(files.dir.file("sim.log"));
   ASSERT_EQ(record.wait_exit(), 0) << read_file(files.dir.file("record.log"));
   EXPECT_NE(read_file(files.dir.file("dds_cmd.jsonl")).find("\"command\":\"exclude\""), std::string::npos);
-  const auto replay = run_tetra(
-      "replay " + files.dir.file("rec.csv") + " --calibration " + files.dir.file("cal.yaml") +
-      " --attitude " + files.dir.file("replay_att.csv") + " --events " + files.dir.file("replay_ev.jsonl") +
-      " --commands " + files.dir.file("dds_cmd.jsonl"));
+  const auto replay =
+      run_tetra("replay " + files.dir.file("rec.csv") + " --calibration " + files.dir.file("cal.yaml") +
+                " --attitude " + files.dir.file("replay_att.csv") + " --events " +
+                files.dir.file("replay_ev.jsonl") + " --commands " + files.dir.file("dds_cmd.jsonl"));
   ASSERT_EQ(replay.exit_status, 0) << replay.err;
 
   // Same events, in the same order, with the same numbers (both sides format with to_json), the

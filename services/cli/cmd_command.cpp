@@ -38,7 +38,8 @@ std::string login_name() {
 std::string ack_line(const dds::EventView& ack, int n_gyros) {
   const std::string body = fdi::to_json(ack.event, n_gyros);
   const std::string head = "{\"unit\": " + json_string(ack.unit) + ", \"command_id\": \"" +
-                           std::to_string(ack.command_id) + "\", \"command\": \"" + dds::to_string(ack.command.kind) +
+                           std::to_string(ack.command_id) + "\", \"command\": \"" +
+                           dds::to_string(ack.command.kind) +
                            "\", \"force\": " + (ack.command.force ? "true" : "false") +
                            ", \"operator\": " + json_string(ack.command.operator_id) +
                            ", \"origin\": " + json_string(ack.command.origin);
@@ -64,10 +65,12 @@ int cmd_command(int argc, char** argv) {
   app.add_option("action", action, "reset, exclude or reinstate")
       ->required()
       ->check(CLI::IsMember({"reset", "exclude", "reinstate"}));
-  app.add_option("gyro", request.gyro, "gyro id (exclude, reinstate)")->check(CLI::Range(1, dds::kMaxGyrosOnWire));
+  app.add_option("gyro", request.gyro, "gyro id (exclude, reinstate)")
+      ->check(CLI::Range(1, dds::kMaxGyrosOnWire));
   app.add_flag("--force", request.force,
                "exclude even if the remaining gyros could not determine attitude (the unit goes LOST)");
-  app.add_option("--operator", request.operator_id, "operator id for the audit trail (default: the login name)");
+  app.add_option("--operator", request.operator_id,
+                 "operator id for the audit trail (default: the login name)");
   app.add_option("--origin", request.origin, "where the command comes from (default: cli@HOSTNAME)");
   app.add_option("--timeout", timeout_s, "[s] wait this long for a service and its acknowledgement")
       ->check(CLI::PositiveNumber);
@@ -76,7 +79,8 @@ int cmd_command(int argc, char** argv) {
   if (action == "reset" && request.gyro != 0) return report("command", bad_input("reset takes no gyro id"));
   if (action != "reset" && request.gyro == 0)
     return report("command", bad_input(action + " needs a gyro id, e.g. '" + action + " 2'"));
-  if (request.force && action != "exclude") return report("command", bad_input("--force applies to exclude only"));
+  if (request.force && action != "exclude")
+    return report("command", bad_input("--force applies to exclude only"));
   request.kind = action == "reset"     ? tetra_COMMAND_RESET
                  : action == "exclude" ? tetra_COMMAND_EXCLUDE
                                        : tetra_COMMAND_REINSTATE;

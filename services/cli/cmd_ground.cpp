@@ -22,7 +22,8 @@ namespace {
 //! "HOST:PORT" -> host and port (port 0: any free port).
 Status parse_listen(const std::string& text, std::string& host, int& port) {
   const auto colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0) return bad_input("--listen '" + text + "': expected HOST:PORT");
+  if (colon == std::string::npos || colon == 0)
+    return bad_input("--listen '" + text + "': expected HOST:PORT");
   host = text.substr(0, colon);
   try {
     std::size_t used = 0;
@@ -46,7 +47,8 @@ int cmd_ground(int argc, char** argv) {
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
   app.add_option("--listen", listen, "HOST:PORT to serve on (default loopback only; port 0: any free port)");
   app.add_option("--web", web_dir, "the web application's directory (with node_modules/ from npm ci)");
-  app.add_option("--history", store_config.history_s, "[s] history kept per unit")->check(CLI::Range(1.0, 86400.0));
+  app.add_option("--history", store_config.history_s, "[s] history kept per unit")
+      ->check(CLI::Range(1.0, 86400.0));
   app.add_option("--attitude-rate", store_config.attitude_rate_hz,
                  "[Hz] attitude rate streamed to browsers and kept in history")
       ->check(CLI::Range(0.1, 100.0));
@@ -57,14 +59,16 @@ int cmd_ground(int argc, char** argv) {
 
   ground::ServerConfig server_config;
   server_config.web_dir = web_dir;
-  if (auto s = parse_listen(listen, server_config.host, server_config.port); !s) return report("ground", s.error());
+  if (auto s = parse_listen(listen, server_config.host, server_config.port); !s)
+    return report("ground", s.error());
   auto readers = ground::GroundReaders::open(domain, "", shutdown);
   if (!readers) return report("ground", readers.error());
   ground::GroundStore store(store_config);
   ground::GroundBridge bridge(std::move(readers).value(), store);
   const auto timeout = std::chrono::milliseconds(static_cast<std::int64_t>(command_timeout_s * 1000));
   ground::GroundServer server(
-      store, [&](const ground::CommandRequest& request) { return bridge.send(request, timeout); }, server_config);
+      store, [&](const ground::CommandRequest& request) { return bridge.send(request, timeout); },
+      server_config);
   if (auto s = server.start(); !s) return report("ground", s.error());
   std::cout << "tetra ground: http://" << server_config.host << ':' << server.port() << "/" << std::endl;
   auto status = bridge.run(shutdown);

@@ -246,13 +246,14 @@ int cmd_monitor(int argc, char** argv) {
       view.events.push_back(ev);
       if (view.events.size() > kRecentEvents) view.events.pop_front();
     }
-    auto a = readers->take_attitudes([&](const std::string& unit, fdi::AttitudeEstimate&& attitude, std::int64_t) {
-      if (!wanted(unit)) return;
-      UnitView& view = units[unit];
-      view.attitude = attitude;
-      view.attitude_received_ns = received;
-      ++view.attitudes_received;
-    });
+    auto a =
+        readers->take_attitudes([&](const std::string& unit, fdi::AttitudeEstimate&& attitude, std::int64_t) {
+          if (!wanted(unit)) return;
+          UnitView& view = units[unit];
+          view.attitude = attitude;
+          view.attitude_received_ns = received;
+          ++view.attitudes_received;
+        });
     if (!a) return report("monitor", a.error());
     if (jsonl) std::cout.flush();
 

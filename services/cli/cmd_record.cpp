@@ -61,8 +61,9 @@ int cmd_record(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--attitude", attitude_path, "also write the service's Attitude (CSV, INTERFACES 2.4)");
   app.add_option("--events", events_path, "also write the service's FdiEvents (JSON lines, INTERFACES 2.5)");
-  app.add_option("--commands", commands_path,
-                 "also write the operator commands the service acknowledged (JSON lines, for replay --commands)");
+  app.add_option(
+      "--commands", commands_path,
+      "also write the operator commands the service acknowledged (JSON lines, for replay --commands)");
   app.add_option("--duration", duration_s, "[s] stop after this long")->check(CLI::PositiveNumber);
   app.add_flag("--until-idle", until_idle, "stop when the gyro writers have come and gone");
   add_domain_option(app, domain);

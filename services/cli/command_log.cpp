@@ -17,14 +17,17 @@ Result<RecordedCommand> parse_line(const std::string& line, const std::string& w
   const json j = json::parse(line, nullptr, false);
   if (j.is_discarded() || !j.is_object()) return bad_input(where + ": not a JSON object");
   RecordedCommand c;
-  if (!j.contains("time_s") || !j["time_s"].is_number()) return bad_input(where + ": field 'time_s' (number) missing");
+  if (!j.contains("time_s") || !j["time_s"].is_number())
+    return bad_input(where + ": field 'time_s' (number) missing");
   c.stamp_ns = seconds_to_ns(j["time_s"].get<double>());
-  if (!j.contains("command") || !j["command"].is_string()) return bad_input(where + ": field 'command' missing");
+  if (!j.contains("command") || !j["command"].is_string())
+    return bad_input(where + ": field 'command' missing");
   c.action = j["command"].get<std::string>();
   if (c.action != "reset" && c.action != "exclude" && c.action != "reinstate")
     return bad_input(where + ": field 'command' must be reset, exclude or reinstate");
   if (c.action != "reset") {
-    if (!j.contains("gyro") || !j["gyro"].is_number_integer()) return bad_input(where + ": field 'gyro' missing");
+    if (!j.contains("gyro") || !j["gyro"].is_number_integer())
+      return bad_input(where + ": field 'gyro' missing");
     c.gyro = static_cast<int>(j["gyro"].get<std::int64_t>());
   }
   if (j.contains("force")) {

@@ -14,12 +14,7 @@ namespace {
 
 enum Token : std::intptr_t { kGyroData = 1, kGyroStatus, kReferenceData, kCommandData, kWake, kShutdown };
 
-template <class T>
-Status assign(std::optional<T>& slot, Result<T> result) {
-  if (!result) return result.error();
-  slot.emplace(std::move(result).value());
-  return ok_status();
-}
+using dds::assign;
 
 }  // namespace
 
@@ -270,7 +265,9 @@ Status FusionService::take_commands() {
   });
   if (!taken) return taken.error();
   for (const auto& command : commands) {
-    const std::int64_t stamp = pipeline_.health().stamp_ns;
+    // Stamped with the sensor time of the last epoch fused; before the first, 1 ns before time zero
+    // (so that `replay --commands` applies it before an epoch stamped 0, as here).
+    const std::int64_t stamp = fused_any_ ? pipeline_.health().stamp_ns : -1;
     fdi::FdiEvent ack;
     switch (command.kind) {
       case tetra_COMMAND_RESET:
@@ -330,6 +327,7 @@ Status FusionService::process_epochs(std::int64_t now_ns) {
   assembler_.poll(now_ns, epochs_);
   for (const auto& epoch : epochs_) {
     const fdi::StepResult& result = pipeline_.step(epoch);
+    fused_any_ = true;
     // Events before the attitude of the same epoch: a reader that has the attitude has its events.
     for (const auto& event : result.events) {
       if (event.type == fdi::EventType::kCommand && !acks_published_.empty() &&

@@ -90,6 +90,7 @@ class FusionService {
   std::uint32_t gyro_writers_ = 0;  //!< matched GyroSample writers (published in Health)
   std::uint64_t last_restarts_ = 0;
   bool all_silent_ = false;  //!< every gyro absent (reported as an event)
+  bool fused_any_ = false;   //!< an epoch has been fused (commands are stamped with its time)
   struct PendingAck {
     fdi::EventType type;
     std::optional<int> gyro;

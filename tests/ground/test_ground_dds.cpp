@@ -110,20 +110,22 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
              "unit: tetra-1\ncalibration: cal.yaml\nsample_rate_hz: 100\nspeed: 1\nmax_latency_s: 0.05\n"
              "health_period_s: 0.2\n");
   auto fusion = std::make_unique<TetraProcess>(
-      std::vector<std::string>{"fusion", "--config", dir.file("fusion.yaml"), "--domain", d}, dir.file("fusion.log"));
+      std::vector<std::string>{"fusion", "--config", dir.file("fusion.yaml"), "--domain", d},
+      dir.file("fusion.log"));
   TetraProcess ground({"ground", "--listen", "127.0.0.1:0", "--domain", d}, dir.file("ground.log"));
   const int port = ground_port(dir.file("ground.log"));
   ASSERT_GT(port, 0) << read_file(dir.file("ground.log"));
   // 40 s of orbit at 100 Hz, 4 times real time; gyro 2 stuck from 8 s (2 s of wall clock).
-  TetraProcess sim({"sim", "orbit", "--dds", "--dds-unit", "tetra-1", "--domain", d, "--rate-hz", "100", "--minutes",
-                    "0.67", "--reference-hz", "0", "--speed", "4", "--fault", "gyro=2,kind=stuck,at=8",
-                    "--wait-readers", "1"},
+  TetraProcess sim({"sim", "orbit", "--dds", "--dds-unit", "tetra-1", "--domain", d, "--rate-hz", "100",
+                    "--minutes", "0.67", "--reference-hz", "0", "--speed", "4", "--fault",
+                    "gyro=2,kind=stuck,at=8", "--wait-readers", "1"},
                    dir.file("sim.log"));
 
   // The stream: NOMINAL first, then the isolation of gyro 2 and DEGRADED.
   const auto events = read_stream(port, [](const std::vector<Sse>& ev) {
     bool isolated = false;
-    for (const auto& e : ev) isolated = isolated || (e.event == "event" && e.data.value("event", "") == "isolated");
+    for (const auto& e : ev)
+      isolated = isolated || (e.event == "event" && e.data.value("event", "") == "isolated");
     return isolated && health_with(ev, "DEGRADED");
   });
   ASSERT_TRUE(health_with(events, "NOMINAL")) << read_file(dir.file("ground.log"));
@@ -143,7 +145,8 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   ASSERT_GT(last_id, 10U);
 
   // Resuming after an id gives the messages after it, in order.
-  const auto resumed = read_stream(port, [](const std::vector<Sse>& ev) { return ev.size() >= 3; }, last_id - 5, 10s);
+  const auto resumed = read_stream(
+      port, [](const std::vector<Sse>& ev) { return ev.size() >= 3; }, last_id - 5, 10s);
   ASSERT_GE(resumed.size(), 3U);
   EXPECT_EQ(resumed[0].id, last_id - 4);
   EXPECT_EQ(resumed[1].id, last_id - 3);
@@ -174,7 +177,8 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   // which cannot determine the rate: refused, through POST and from the command line (exit 1); with
   // force, obeyed (the unit goes LOST); the FDI reset is accepted; a malformed request is a 400.
   int status = 0;
-  json ack = post_command(port, {{"unit", "tetra-1"}, {"action", "exclude"}, {"gyro", 1}, {"operator", "test"}}, status);
+  json ack = post_command(
+      port, {{"unit", "tetra-1"}, {"action", "exclude"}, {"gyro", 1}, {"operator", "test"}}, status);
   ASSERT_EQ(status, 200) << ack.dump();
   EXPECT_FALSE(ack["accepted"].get<bool>()) << ack.dump();
   EXPECT_NE(ack["detail"].get<std::string>().find("refused"), std::string::npos) << ack.dump();
@@ -196,13 +200,17 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
 
   // kill -9 of the service: the ground says STALE (or SERVICE LOST) within a few Health periods.
   fusion->kill_now(SIGKILL);
-  const auto lost = read_stream(port, [](const std::vector<Sse>& ev) {
-    for (const auto& e : ev) {
-      if (e.event == "link" && e.data.value("state", "") != "LIVE" && e.data.value("state", "") != "WAITING")
-        return true;
-    }
-    return false;
-  }, 0, 20s);
+  const auto lost = read_stream(
+      port,
+      [](const std::vector<Sse>& ev) {
+        for (const auto& e : ev) {
+          if (e.event == "link" && e.data.value("state", "") != "LIVE" &&
+              e.data.value("state", "") != "WAITING")
+            return true;
+        }
+        return false;
+      },
+      0, 20s);
   bool stale = false;
   for (const auto& e : lost) stale = stale || (e.event == "link" && e.data.value("state", "") != "LIVE");
   EXPECT_TRUE(stale);

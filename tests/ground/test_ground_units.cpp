@@ -91,8 +91,8 @@ TEST(Encode, AcknowledgementCarriesTheAuditTrail) {
 
 TEST(LinkState, StaleAfterThreeHealthPeriodsServiceLostWithoutWriter) {
   EXPECT_EQ(link_state(std::nullopt, 0.5, true), Link::kWaiting);
-  EXPECT_EQ(link_state(1'400'000'000, 0.5, true), Link::kLive);    // 1.4 s < 3 × 0.5 s
-  EXPECT_EQ(link_state(1'600'000'000, 0.5, true), Link::kStale);   // 1.6 s > 1.5 s
+  EXPECT_EQ(link_state(1'400'000'000, 0.5, true), Link::kLive);   // 1.4 s < 3 × 0.5 s
+  EXPECT_EQ(link_state(1'600'000'000, 0.5, true), Link::kStale);  // 1.6 s > 1.5 s
   EXPECT_EQ(link_state(100'000'000, 0.5, false), Link::kServiceLost);
   EXPECT_STREQ(to_string(Link::kServiceLost), "SERVICE LOST");
 }
@@ -118,7 +118,8 @@ TEST(Store, HistoryIsBoundedAndSelectsTheTimeRange) {
   config.history_s = 10;
   config.health_rate_hz = 2;  // capacity 20
   GroundStore store(config);
-  for (int k = 0; k < 50; ++k) store.add_health(health("u", 0b1111), kUtc0_ns + std::int64_t{500'000'000} * k, 0);
+  for (int k = 0; k < 50; ++k)
+    store.add_health(health("u", 0b1111), kUtc0_ns + std::int64_t{500'000'000} * k, 0);
   auto all = store.history("u", "health", 0, 1e300, 0);
   ASSERT_TRUE(all.ok());
   EXPECT_EQ(all->size(), 20U);  // the newest 20 of 50
@@ -198,17 +199,19 @@ TEST(CommandRequest, ValidatesEveryField) {
   ASSERT_TRUE(to_wire(*ok, 9, wire).ok());
   EXPECT_STREQ(wire.operator_id, "bob");
   EXPECT_STREQ(wire.origin, "ground@127.0.0.1");
-  for (const char* bad : {"", "[]", R"({"action":"reset","operator":"x"})", R"({"unit":"u","action":"reset"})",
-                          R"({"unit":"u","action":"explode","operator":"x"})",
-                          R"({"unit":"u","action":"exclude","operator":"x"})",
-                          R"({"unit":"u","action":"exclude","gyro":99,"operator":"x"})",
-                          R"({"unit":"u","action":"exclude","gyro":"2","operator":"x"})",
-                          R"({"unit":"u","action":"reset","gyro":1,"operator":"x"})",
-                          R"({"unit":"u","action":"reset","force":"yes","operator":"x"})"}) {
+  for (const char* bad :
+       {"", "[]", R"({"action":"reset","operator":"x"})", R"({"unit":"u","action":"reset"})",
+        R"({"unit":"u","action":"explode","operator":"x"})",
+        R"({"unit":"u","action":"exclude","operator":"x"})",
+        R"({"unit":"u","action":"exclude","gyro":99,"operator":"x"})",
+        R"({"unit":"u","action":"exclude","gyro":"2","operator":"x"})",
+        R"({"unit":"u","action":"reset","gyro":1,"operator":"x"})",
+        R"({"unit":"u","action":"reset","force":"yes","operator":"x"})"}) {
     EXPECT_FALSE(parse_command_request(bad, "o").ok()) << bad;
   }
   const std::string long_operator(40, 'x');
-  auto too_long = parse_command_request(R"({"unit":"u","action":"reset","operator":")" + long_operator + "\"}", "o");
+  auto too_long =
+      parse_command_request(R"({"unit":"u","action":"reset","operator":")" + long_operator + "\"}", "o");
   ASSERT_TRUE(too_long.ok());
   EXPECT_FALSE(to_wire(*too_long, 1, wire).ok());
 }

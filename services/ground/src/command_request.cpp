@@ -20,7 +20,8 @@ Result<CommandRequest> parse_command_request(const std::string& body, const std:
   if (!j.contains("operator") || !j["operator"].is_string() || j["operator"].get<std::string>().empty())
     return bad_input("command: field 'operator' (string, the operator's id) missing");
   c.operator_id = j["operator"].get<std::string>();
-  const std::string action = j.contains("action") && j["action"].is_string() ? j["action"].get<std::string>() : "";
+  const std::string action =
+      j.contains("action") && j["action"].is_string() ? j["action"].get<std::string>() : "";
   if (action == "reset") {
     c.kind = tetra_COMMAND_RESET;
   } else if (action == "exclude") {
@@ -30,14 +31,16 @@ Result<CommandRequest> parse_command_request(const std::string& body, const std:
   } else {
     return bad_input("command: field 'action' must be reset, exclude or reinstate");
   }
-  if (j.contains("gyro") && !j["gyro"].is_number_integer()) return bad_input("command: field 'gyro' must be an integer");
+  if (j.contains("gyro") && !j["gyro"].is_number_integer())
+    return bad_input("command: field 'gyro' must be an integer");
   c.gyro = j.contains("gyro") && j["gyro"].is_number_integer() && j["gyro"].get<std::int64_t>() <= 1000
                ? static_cast<int>(j["gyro"].get<std::int64_t>())
                : (j.contains("gyro") ? -1 : 0);
   if (c.kind != tetra_COMMAND_RESET && (c.gyro < 1 || c.gyro > dds::kMaxGyrosOnWire))
     return bad_input("command: field 'gyro' must be 1.." + std::to_string(dds::kMaxGyrosOnWire));
   if (c.kind == tetra_COMMAND_RESET && c.gyro != 0) return bad_input("command: reset takes no 'gyro'");
-  if (j.contains("force") && !j["force"].is_boolean()) return bad_input("command: field 'force' must be true or false");
+  if (j.contains("force") && !j["force"].is_boolean())
+    return bad_input("command: field 'force' must be true or false");
   c.force = j.contains("force") && j["force"].get<bool>();
   return c;
 }

@@ -21,7 +21,8 @@ bool CommandTracker::offer(const dds::EventView& event) {
   return true;
 }
 
-std::optional<dds::EventView> CommandTracker::wait(std::uint64_t command_id, std::chrono::milliseconds timeout) {
+std::optional<dds::EventView> CommandTracker::wait(std::uint64_t command_id,
+                                                   std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
   auto it = pending_.find(command_id);
   if (it == pending_.end()) return std::nullopt;

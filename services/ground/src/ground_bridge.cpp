@@ -20,9 +20,10 @@ Status GroundBridge::take_all(std::int64_t now_ns) {
     store_.add_event(event, utc_ns);
   });
   if (!e) return e;
-  return readers_.take_attitudes([&](const std::string& unit, fdi::AttitudeEstimate&& attitude, std::int64_t utc_ns) {
-    store_.add_attitude(unit, attitude, utc_ns, now_ns);
-  });
+  return readers_.take_attitudes(
+      [&](const std::string& unit, fdi::AttitudeEstimate&& attitude, std::int64_t utc_ns) {
+        store_.add_attitude(unit, attitude, utc_ns, now_ns);
+      });
 }
 
 Status GroundBridge::run(const dds::ShutdownSignal& shutdown) {

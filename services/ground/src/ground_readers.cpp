@@ -4,12 +4,7 @@ namespace tetra::ground {
 
 namespace {
 
-template <class T>
-Status assign(std::optional<T>& slot, Result<T> result) {
-  if (!result) return result.error();
-  slot.emplace(std::move(result).value());
-  return ok_status();
-}
+using dds::assign;
 
 }  // namespace
 
@@ -24,13 +19,15 @@ Result<GroundReaders> GroundReaders::open(dds_domainid_t domain, const std::stri
     return s.error();
   if (auto s = assign(r.event_, dds::Reader<tetra_FdiEvent>::create(p, t.event, dds::event_qos())); !s)
     return s.error();
-  if (auto s = assign(r.attitude_, dds::Reader<tetra_Attitude>::create(p, t.attitude, dds::attitude_qos())); !s)
+  if (auto s = assign(r.attitude_, dds::Reader<tetra_Attitude>::create(p, t.attitude, dds::attitude_qos()));
+      !s)
     return s.error();
   if (auto s = assign(r.command_, dds::Writer<tetra_Command>::create(p, t.command, dds::command_qos())); !s)
     return s.error();
   if (auto s = assign(r.waitset_, dds::WaitSet::create(p)); !s) return s.error();
-  for (auto [reader, token] : {std::pair{r.health_->handle(), kHealthToken}, std::pair{r.event_->handle(), kEventToken},
-                               std::pair{r.attitude_->handle(), kAttitudeToken}}) {
+  for (auto [reader, token] :
+       {std::pair{r.health_->handle(), kHealthToken}, std::pair{r.event_->handle(), kEventToken},
+        std::pair{r.attitude_->handle(), kAttitudeToken}}) {
     auto condition = dds::Condition::data_available(reader);
     if (!condition) return condition.error();
     if (auto s = r.waitset_->attach(condition->handle(), token); !s) return s.error();
@@ -52,7 +49,9 @@ Status GroundReaders::take_health(const std::function<void(dds::HealthView&&, st
   std::uint32_t status = 0;
   (void)dds_take_status(health_->handle(), &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
   auto taken = health_->take(
-      [&](const tetra_Health& msg, const dds_sample_info_t& info) { on_health(dds::from_wire(msg), info.source_timestamp); },
+      [&](const tetra_Health& msg, const dds_sample_info_t& info) {
+        on_health(dds::from_wire(msg), info.source_timestamp);
+      },
       [&](const dds_sample_info_t& info) {
         if (info.instance_state == DDS_IST_ALIVE) return;
         tetra_Health key{};
@@ -64,8 +63,9 @@ Status GroundReaders::take_health(const std::function<void(dds::HealthView&&, st
 }
 
 Status GroundReaders::take_events(const std::function<void(dds::EventView&&, std::int64_t)>& on_event) const {
-  auto taken = event_->take(
-      [&](const tetra_FdiEvent& msg, const dds_sample_info_t& info) { on_event(dds::from_wire(msg), info.source_timestamp); });
+  auto taken = event_->take([&](const tetra_FdiEvent& msg, const dds_sample_info_t& info) {
+    on_event(dds::from_wire(msg), info.source_timestamp);
+  });
   if (!taken) return taken.error();
   return ok_status();
 }

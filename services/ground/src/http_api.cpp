@@ -57,7 +57,10 @@ double number_param(const httplib::Request& req, const char* name, double fallba
 }  // namespace
 
 GroundServer::GroundServer(GroundStore& store, SendCommand send, ServerConfig config)
-    : store_(store), send_(std::move(send)), config_(std::move(config)), server_(std::make_unique<httplib::Server>()) {}
+    : store_(store),
+      send_(std::move(send)),
+      config_(std::move(config)),
+      server_(std::make_unique<httplib::Server>()) {}
 
 GroundServer::~GroundServer() {
   stop();
@@ -69,7 +72,8 @@ Status GroundServer::start() {
     return bad_input("--web " + config_.web_dir + ": no such directory");
   }
   if (!server_->set_mount_point("/openmct", openmct.string())) {
-    return failure(openmct.string() + " missing: run `npm ci` in " + config_.web_dir + " (scripts/setup.sh does)");
+    return failure(openmct.string() + " missing: run `npm ci` in " + config_.web_dir +
+                   " (scripts/setup.sh does)");
   }
   const int threads = config_.worker_threads;
   server_->new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<std::size_t>(threads)); };
@@ -96,13 +100,14 @@ void GroundServer::routes() {
   });
   s.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
     reply_json(res, 200,
-               {{"last_event_id", store_.last_id()}, {"stream_dropped", store_.stream_dropped()},
+               {{"last_event_id", store_.last_id()},
+                {"stream_dropped", store_.stream_dropped()},
                 {"units", store_.units_json(steady_now_ns())}});
   });
   s.Get("/api/history", [this](const httplib::Request& req, httplib::Response& res) {
     const auto max_points = static_cast<std::size_t>(number_param(req, "max", 5000));
-    auto h = store_.history(req.get_param_value("unit"), req.get_param_value("kind"), number_param(req, "start", 0),
-                            number_param(req, "end", 1e300), max_points);
+    auto h = store_.history(req.get_param_value("unit"), req.get_param_value("kind"),
+                            number_param(req, "start", 0), number_param(req, "end", 1e300), max_points);
     if (!h) return reply_error(res, 404, h.error().message);
     reply_json(res, 200, *h);
   });
@@ -112,24 +117,26 @@ void GroundServer::routes() {
     cursor->fresh = cursor->after == 0;
     res.set_header("Cache-Control", "no-cache");
     res.set_header("X-Accel-Buffering", "no");  // nginx: pass events through unbuffered
-    res.set_chunked_content_provider("text/event-stream", [this, cursor](std::size_t, httplib::DataSink& sink) {
-      if (stopping_) return false;
-      std::string out;
-      if (cursor->fresh) {
-        cursor->fresh = false;
-        cursor->after = store_.last_id();
-        out += "retry: 1000\n\n";
-        for (const auto& m : store_.snapshot(steady_now_ns())) append_message(out, m);
-      }
-      const StreamRead read = store_.read_stream(cursor->after, 512, std::chrono::milliseconds(config_.stream_wait_ms));
-      if (read.gap) out += "event: reset\ndata: {}\n\n";  // the browser reloads history
-      for (const auto& m : read.messages) {
-        append_message(out, m);
-        cursor->after = m.id;
-      }
-      if (out.empty()) out = ": keep-alive\n\n";
-      return !stopping_ && sink.write(out.data(), out.size());
-    });
+    res.set_chunked_content_provider(
+        "text/event-stream", [this, cursor](std::size_t, httplib::DataSink& sink) {
+          if (stopping_) return false;
+          std::string out;
+          if (cursor->fresh) {
+            cursor->fresh = false;
+            cursor->after = store_.last_id();
+            out += "retry: 1000\n\n";
+            for (const auto& m : store_.snapshot(steady_now_ns())) append_message(out, m);
+          }
+          const StreamRead read =
+              store_.read_stream(cursor->after, 512, std::chrono::milliseconds(config_.stream_wait_ms));
+          if (read.gap) out += "event: reset\ndata: {}\n\n";  // the browser reloads history
+          for (const auto& m : read.messages) {
+            append_message(out, m);
+            cursor->after = m.id;
+          }
+          if (out.empty()) out = ": keep-alive\n\n";
+          return !stopping_ && sink.write(out.data(), out.size());
+        });
   });
   s.Post("/api/command", [this](const httplib::Request& req, httplib::Response& res) {
     auto request = parse_command_request(req.body, "ground@" + req.remote_addr);

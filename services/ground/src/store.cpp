@@ -11,7 +11,8 @@ namespace tetra::ground {
 using nlohmann::json;
 
 std::int64_t steady_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
@@ -24,7 +25,9 @@ GroundStore::Unit* GroundStore::unit(const std::string& name) {
   auto it = units_.find(name);
   if (it != units_.end()) return &it->second;
   if (units_.size() >= config_.max_units) return nullptr;
-  const auto items = [&](double rate_hz) { return static_cast<std::size_t>(std::ceil(config_.history_s * rate_hz)); };
+  const auto items = [&](double rate_hz) {
+    return static_cast<std::size_t>(std::ceil(config_.history_s * rate_hz));
+  };
   return &units_
               .try_emplace(name, items(config_.health_rate_hz), items(config_.attitude_rate_hz),
                            config_.events_per_unit)
@@ -115,7 +118,8 @@ void GroundStore::update_links(std::int64_t now_ns) {
   }
 }
 
-StreamRead GroundStore::read_stream(std::uint64_t after, std::size_t max, std::chrono::milliseconds wait) const {
+StreamRead GroundStore::read_stream(std::uint64_t after, std::size_t max,
+                                    std::chrono::milliseconds wait) const {
   std::unique_lock lock(mutex_);
   arrived_.wait_for(lock, wait, [&] { return next_id_ - 1 > after; });
   StreamRead read;
@@ -125,8 +129,8 @@ StreamRead GroundStore::read_stream(std::uint64_t after, std::size_t max, std::c
     read.gap = after != 0;
     after = first - 1;
   }
-  for (std::size_t i = static_cast<std::size_t>(after + 1 - first); i < stream_.size() && read.messages.size() < max;
-       ++i) {
+  for (std::size_t i = static_cast<std::size_t>(after + 1 - first);
+       i < stream_.size() && read.messages.size() < max; ++i) {
     read.messages.push_back(stream_[i]);
   }
   return read;
@@ -181,7 +185,8 @@ Result<json> GroundStore::history(const std::string& name, const std::string& ki
   const auto collect = [&](const auto& ring, auto encode) {
     const auto before = [](double ms) { return [ms](const auto& item) { return utc_ms(item.utc_ns) < ms; }; };
     const std::size_t first = ring.partition_point(before(start_ms));
-    const std::size_t last = ring.partition_point([end_ms](const auto& item) { return utc_ms(item.utc_ns) <= end_ms; });
+    const std::size_t last =
+        ring.partition_point([end_ms](const auto& item) { return utc_ms(item.utc_ns) <= end_ms; });
     if (last <= first) return;
     const std::size_t count = last - first;
     const std::size_t stride = max_points == 0 ? 1 : (count + max_points - 1) / max_points;

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "tetra/core/result.hpp"
 #include "tetra.h"  // generated from idl/tetra.idl
+#include "tetra/core/result.hpp"
 
 namespace tetra::ground {
 

@@ -21,14 +21,14 @@ enum ReaderToken : std::intptr_t { kHealthToken = 1, kEventToken, kAttitudeToken
 class GroundReaders {
  public:
   //! Opens everything on `domain`; `unit` "" reads every unit. `shutdown` gets the waitset's guard.
-  static Result<GroundReaders> open(dds_domainid_t domain, const std::string& unit, dds::ShutdownSignal& shutdown);
+  static Result<GroundReaders> open(dds_domainid_t domain, const std::string& unit,
+                                    dds::ShutdownSignal& shutdown);
 
   Status take_health(const std::function<void(dds::HealthView&&, std::int64_t utc_ns)>& on_health,
                      const std::function<void(const std::string& unit)>& on_writer_lost) const;
   Status take_events(const std::function<void(dds::EventView&&, std::int64_t utc_ns)>& on_event) const;
-  Status take_attitudes(
-      const std::function<void(const std::string& unit, fdi::AttitudeEstimate&&, std::int64_t utc_ns)>& on_attitude)
-      const;
+  Status take_attitudes(const std::function<void(const std::string& unit, fdi::AttitudeEstimate&&,
+                                                 std::int64_t utc_ns)>& on_attitude) const;
   //! Waits up to `timeout` for data or the shutdown guard.
   Status wait(std::chrono::nanoseconds timeout, std::vector<std::intptr_t>& triggered) const;
   //! Health writers matched (fusion services heard).

@@ -27,9 +27,9 @@ namespace tetra::ground {
 std::int64_t steady_now_ns();
 
 struct StoreConfig {
-  double history_s = 3600.0;        //!< [s] history kept per unit (Health, Attitude)
-  double attitude_rate_hz = 10.0;   //!< [Hz] Attitude kept and streamed (decimated from the service's)
-  double health_rate_hz = 4.0;      //!< [Hz] Health rate the history is sized for (periodic + changes)
+  double history_s = 3600.0;       //!< [s] history kept per unit (Health, Attitude)
+  double attitude_rate_hz = 10.0;  //!< [Hz] Attitude kept and streamed (decimated from the service's)
+  double health_rate_hz = 4.0;     //!< [Hz] Health rate the history is sized for (periodic + changes)
   std::size_t events_per_unit = 4096;
   std::size_t stream_capacity = 16384;  //!< messages a reconnecting browser can catch up on
   std::size_t max_units = 64;
