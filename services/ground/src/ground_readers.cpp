@@ -5,6 +5,7 @@ namespace tetra::ground {
 namespace {
 
 using dds::assign;
+constexpr int kAttitudeDepth = 64;  //!< samples per unit: 0.64 s of a 100 Hz service
 
 }  // namespace
 
@@ -19,8 +20,11 @@ Result<GroundReaders> GroundReaders::open(dds_domainid_t domain, const std::stri
     return s.error();
   if (auto s = assign(r.event_, dds::Reader<tetra_FdiEvent>::create(p, t.event, dds::event_qos())); !s)
     return s.error();
-  if (auto s = assign(r.attitude_, dds::Reader<tetra_Attitude>::create(p, t.attitude, dds::attitude_qos()));
-      !s)
+  // A deeper history than the writer's keep-last 1: a busy ground thread still sees every epoch, so the
+  // attitude it keeps is exactly one per attitude period (docs/ground.md).
+  auto attitude_qos = dds::attitude_qos();
+  attitude_qos.keep_last(kAttitudeDepth);
+  if (auto s = assign(r.attitude_, dds::Reader<tetra_Attitude>::create(p, t.attitude, attitude_qos)); !s)
     return s.error();
   if (auto s = assign(r.command_, dds::Writer<tetra_Command>::create(p, t.command, dds::command_qos())); !s)
     return s.error();
