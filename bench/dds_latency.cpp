@@ -22,23 +22,15 @@
 #include <string>
 #include <vector>
 
+#include "bench_clock.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
 
 namespace {
 
-std::int64_t now_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-void sleep_until_ns(std::int64_t t_ns) {
-  timespec ts{static_cast<time_t>(t_ns / 1'000'000'000), static_cast<long>(t_ns % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) != 0) {
-  }
-}
+using tetra::bench::now_ns;
+using tetra::bench::sleep_until_ns;
 
 //! What the Attitude listener saw last, for the main thread (listener mode).
 struct Arrivals {

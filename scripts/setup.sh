@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Installs what tetra needs to build, test and plot, from Debian 12's packages.
+# Installs what tetra needs to build, test and plot, from Debian 12's packages, then the ground
+# station's web application (web/: Open MCT, pinned by web/package-lock.json) with `npm ci`.
 # As root it runs apt-get; otherwise it prints the exact command to run.
 set -euo pipefail
+cd "$(dirname "$0")/.."
 
 packages=(
   build-essential cmake pkg-config
@@ -10,7 +12,24 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox
   clang libclang-rt-14-dev openssl iproute2   # reliability tests: fuzzers (clang), DDS Security PKI, netns
+  libcpp-httplib-dev nlohmann-json3-dev        # tetra ground: HTTP server, JSON
+  chromium chromium-driver python3-selenium    # the ground station's browser test
 )
+# Node.js and npm for web/ (Debian's nodejs and npm, unless a node with npm is already installed).
+command -v npm >/dev/null || packages+=(nodejs npm)
+
+# The web application's packages: `npm ci` installs exactly the versions of web/package-lock.json.
+web_packages() {
+  local want have
+  want=$(node -p "require('./web/package-lock.json').packages['node_modules/openmct'].version")
+  have=$(node -p "try { require('./web/node_modules/openmct/package.json').version } catch (e) { '' }")
+  if [ "$want" = "$have" ] && [ -f web/node_modules/openmct/dist/openmct.js ]; then
+    echo "setup: web/node_modules up to date"
+    return 0
+  fi
+  echo "setup: npm ci in web/"
+  (cd web && npm ci --ignore-scripts --no-audit --no-fund --loglevel=error)
+}
 
 missing=()
 for p in "${packages[@]}"; do
@@ -19,6 +38,7 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages present"
+  web_packages
   exit 0
 fi
 
@@ -32,3 +52,4 @@ echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 apt-get update -qq
 apt-get install -y -qq --no-install-recommends "${missing[@]}"
+web_packages

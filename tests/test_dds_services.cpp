@@ -211,6 +211,26 @@ AttitudeRows read_attitude(const std::string& path) {
   return rows;
 }
 
+//! Shell-like words of `text` (no quoting: the test's arguments have none).
+std::vector<std::string> split_args(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<std::string> words;
+  for (std::string w; in >> w;) words.push_back(w);
+  return words;
+}
+
+//! Events lines without the service's reports on its gyro streams (all silent / samples back).
+std::string without_stream_events(const std::string& events) {
+  std::istringstream in(events);
+  std::string out;
+  for (std::string line; std::getline(in, line);) {
+    if (line.find("all gyros silent") == std::string::npos &&
+        line.find("gyro samples back") == std::string::npos)
+      out += line + '\n';
+  }
+  return out;
+}
+
 //! The same for both ways gyro samples reach the pipeline (docs/dds.md, "Latency").
 class DdsReplayEquivalence : public ::testing::TestWithParam<const char*> {};
 
@@ -220,21 +240,31 @@ TEST_P(DdsReplayEquivalence, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitude
   ServiceFiles files(100.0, 1.0, "tetra-1", GetParam());
   TetraProcess fusion({"fusion", "--config", files.config, "--domain", d(domain)},
                       files.dir.file("fusion.log"));
-  TetraProcess record({"record", "--config", files.config, "--domain", d(domain), "-o",
-                       files.dir.file("rec.csv"), "--attitude", files.dir.file("dds_att.csv"), "--events",
-                       files.dir.file("dds_ev.jsonl"), "--until-idle"},
-                      files.dir.file("record.log"));
-  const auto sim = run_tetra(sim_args(domain, 2));  // waits for the service and the recorder
-  ASSERT_EQ(sim.exit_status, 0) << sim.err;
+  TetraProcess record(
+      {"record", "--config", files.config, "--domain", d(domain), "-o", files.dir.file("rec.csv"),
+       "--attitude", files.dir.file("dds_att.csv"), "--events", files.dir.file("dds_ev.jsonl"), "--commands",
+       files.dir.file("dds_cmd.jsonl"), "--until-idle"},
+      files.dir.file("record.log"));
+  TetraProcess sim(split_args(sim_args(domain, 2)), files.dir.file("sim.log"));  // waits for both
+  // An operator command somewhere in the run (where exactly does not matter: replay re-applies it
+  // where the service obeyed it). Accepted before gyro 2 is isolated, refused after.
+  const auto command = run_tetra("command --unit tetra-1 exclude 1 --operator test --domain " + d(domain));
+  ASSERT_NE(command.out.find("\"event\": \"command\""), std::string::npos) << command.err;
+  ASSERT_EQ(sim.wait_exit(), 0) << read_file(files.dir.file("sim.log"));
   ASSERT_EQ(record.wait_exit(), 0) << read_file(files.dir.file("record.log"));
-  const auto replay = run_tetra(
-      "replay " + files.dir.file("rec.csv") + " --calibration " + files.dir.file("cal.yaml") +
-      " --attitude " + files.dir.file("replay_att.csv") + " --events " + files.dir.file("replay_ev.jsonl"));
+  EXPECT_NE(read_file(files.dir.file("dds_cmd.jsonl")).find("\"command\":\"exclude\""), std::string::npos);
+  const auto replay =
+      run_tetra("replay " + files.dir.file("rec.csv") + " --calibration " + files.dir.file("cal.yaml") +
+                " --attitude " + files.dir.file("replay_att.csv") + " --events " +
+                files.dir.file("replay_ev.jsonl") + " --commands " + files.dir.file("dds_cmd.jsonl"));
   ASSERT_EQ(replay.exit_status, 0) << replay.err;
 
-  // Same events, in the same order, with the same numbers (both sides format with to_json).
-  const std::string dds_events = read_file(files.dir.file("dds_ev.jsonl"));
+  // Same events, in the same order, with the same numbers (both sides format with to_json), the
+  // command's acknowledgement included. The service's own events about its gyro streams (all silent
+  // before the simulator starts and after it ends, back in between) have no counterpart in a log.
+  const std::string dds_events = without_stream_events(read_file(files.dir.file("dds_ev.jsonl")));
   EXPECT_FALSE(dds_events.empty());
+  EXPECT_NE(dds_events.find("\"event\": \"command\""), std::string::npos);
   EXPECT_EQ(dds_events, read_file(files.dir.file("replay_ev.jsonl")));
   // Same epochs, attitudes equal to 1e-9 (the bound; both run the same code on the same
   // doubles, so in practice they are identical).

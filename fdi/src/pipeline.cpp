@@ -65,7 +65,7 @@ class Pipeline::Impl {
 
   void reset();
   const StepResult& step(const Epoch& epoch);
-  FdiEvent command_exclude(int id, std::int64_t stamp_ns);
+  FdiEvent command_exclude(int id, std::int64_t stamp_ns, bool force);
   FdiEvent command_reinstate(int id, std::int64_t stamp_ns);
   FdiEvent command_reset(std::int64_t stamp_ns);
   std::string describe_thresholds() const;
@@ -398,11 +398,13 @@ FdiEvent Pipeline::Impl::acknowledge(CommandVerb verb, int id, CommandOutcome ou
   return ack;
 }
 
-FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns) {
+FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns, bool force) {
   const auto verb = CommandVerb::kExclude;
   if (!gyro_set_.contains(id)) return acknowledge(verb, id, CommandOutcome::kNoSuchGyro, false, stamp_ns);
   if (gyro_set_.is_excluded(id))
     return acknowledge(verb, id, CommandOutcome::kAlreadyExcluded, false, stamp_ns);
+  if (!force && !subsets_.observable(without_gyro(gyro_set_.active(), id)))
+    return acknowledge(verb, id, CommandOutcome::kRefusedUnobservable, false, stamp_ns);
   gyro_set_.exclude(id, FaultKind::kUnknown);
   return acknowledge(verb, id, CommandOutcome::kDone, true, stamp_ns);
 }
@@ -484,8 +486,8 @@ void Pipeline::reset() {
 const StepResult& Pipeline::step(const Epoch& epoch) {
   return impl_->step(epoch);
 }
-FdiEvent Pipeline::exclude(int gyro_id, std::int64_t stamp_ns) {
-  return impl_->command_exclude(gyro_id, stamp_ns);
+FdiEvent Pipeline::exclude(int gyro_id, std::int64_t stamp_ns, bool force) {
+  return impl_->command_exclude(gyro_id, stamp_ns, force);
 }
 FdiEvent Pipeline::reinstate(int gyro_id, std::int64_t stamp_ns) {
   return impl_->command_reinstate(gyro_id, stamp_ns);

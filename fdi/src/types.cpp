@@ -142,8 +142,18 @@ const char* to_string(CommandOutcome outcome) {
       return "already excluded";
     case CommandOutcome::kNotExcluded:
       return "not excluded";
+    case CommandOutcome::kRefusedUnobservable:
+      return "refused, the rest could not determine attitude (force overrides)";
   }
   return "done";
+}
+
+std::optional<CommandOutcome> command_outcome_from_string(std::string_view text) {
+  for (auto o : {CommandOutcome::kDone, CommandOutcome::kNoSuchGyro, CommandOutcome::kAlreadyExcluded,
+                 CommandOutcome::kNotExcluded, CommandOutcome::kRefusedUnobservable}) {
+    if (text == to_string(o)) return o;
+  }
+  return std::nullopt;
 }
 
 namespace {
@@ -210,6 +220,7 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
       }
       out += ", \"gyros\": ";
       append_gyro_list(out, event.gyros, n_gyros);
+      out += event.refused() ? ", \"accepted\": false" : ", \"accepted\": true";
       break;
   }
   if (!event.detail.empty()) {

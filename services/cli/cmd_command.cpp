@@ -1,12 +1,14 @@
-// tetra command --unit U (reset | exclude N | reinstate N) — an operator command over DDS.
-// Waits for a fusion service to match, sends the Command, and waits for its acknowledgement (an
-// FdiEvent carrying the command's id), which it prints as a JSON line. Exit 0 when acknowledged,
-// 1 when no service answers within --timeout, 2 on bad usage.
+// tetra command --unit U (reset | exclude N [--force] | reinstate N) — an operator command over DDS.
+// Waits for a fusion service to match, sends the Command (with the operator's id and the origin),
+// and waits for its acknowledgement (an FdiEvent carrying the command's id), which it prints as a
+// JSON line. Exit 0 when accepted, 1 when refused or when no service answers within --timeout,
+// 2 on bad usage.
 
 #include <unistd.h>
 
 #include <algorithm>
 #include <bit>
+#include <cstdlib>
 #include <iostream>
 
 #include "cli_common.hpp"
@@ -15,41 +17,77 @@
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
+#include "tetra/ground/command_request.hpp"
+#include "tetra/ground/command_tracker.hpp"
 
 namespace tetra::cli {
 
 namespace {
 enum Token : std::intptr_t { kMatched = 1, kEvent };
+
+//! The login name, for the audit trail when --operator is not given.
+std::string login_name() {
+  for (const char* var : {"LOGNAME", "USER"}) {
+    if (const char* name = std::getenv(var); name != nullptr && *name != '\0') return name;
+  }
+  return "unknown";
 }
+
+//! The acknowledgement as one JSON line: the event (docs/interfaces.md §2.5 form, with "accepted") after the
+//! command's id and audit fields.
+std::string ack_line(const dds::EventView& ack, int n_gyros) {
+  const std::string body = fdi::to_json(ack.event, n_gyros);
+  const std::string head = "{\"unit\": " + json_string(ack.unit) + ", \"command_id\": \"" +
+                           std::to_string(ack.command_id) + "\", \"command\": \"" +
+                           dds::to_string(ack.command.kind) +
+                           "\", \"force\": " + (ack.command.force ? "true" : "false") +
+                           ", \"operator\": " + json_string(ack.command.operator_id) +
+                           ", \"origin\": " + json_string(ack.command.origin);
+  return head + (body.size() > 2 ? ", " + body.substr(1) : "}");
+}
+
+std::string host_name() {
+  char name[256] = {};
+  return gethostname(name, sizeof name - 1) == 0 ? std::string(name) : std::string("localhost");
+}
+}  // namespace
 
 int cmd_command(int argc, char** argv) {
   CLI::App app{"Send an operator command to a unit's fusion service and wait for its acknowledgement.",
                "command"};
-  std::string unit;
+  ground::CommandRequest request;
   std::string action;
-  int gyro = 0;
+  request.operator_id = login_name();
+  request.origin = "cli@" + host_name();
   double timeout_s = 5.0;
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
-  app.add_option("--unit", unit, "the unit to command")->required();
+  app.add_option("--unit", request.unit, "the unit to command")->required();
   app.add_option("action", action, "reset, exclude or reinstate")
       ->required()
       ->check(CLI::IsMember({"reset", "exclude", "reinstate"}));
-  app.add_option("gyro", gyro, "gyro id (exclude, reinstate)")->check(CLI::Range(1, dds::kMaxGyrosOnWire));
+  app.add_option("gyro", request.gyro, "gyro id (exclude, reinstate)")
+      ->check(CLI::Range(1, dds::kMaxGyrosOnWire));
+  app.add_flag("--force", request.force,
+               "exclude even if the remaining gyros could not determine attitude (the unit goes LOST)");
+  app.add_option("--operator", request.operator_id,
+                 "operator id for the audit trail (default: the login name)");
+  app.add_option("--origin", request.origin, "where the command comes from (default: cli@HOSTNAME)");
   app.add_option("--timeout", timeout_s, "[s] wait this long for a service and its acknowledgement")
       ->check(CLI::PositiveNumber);
   add_domain_option(app, domain);
   if (auto exit = parse(app, argc, argv)) return *exit;
-  if (action == "reset" && gyro != 0) return report("command", bad_input("reset takes no gyro id"));
-  if (action != "reset" && gyro == 0)
+  if (action == "reset" && request.gyro != 0) return report("command", bad_input("reset takes no gyro id"));
+  if (action != "reset" && request.gyro == 0)
     return report("command", bad_input(action + " needs a gyro id, e.g. '" + action + " 2'"));
-
-  tetra_Command command{};
-  if (auto s = dds::copy_bounded(command.unit, unit, "--unit"); !s) return report("command", s.error());
-  command.command_id = (static_cast<std::uint64_t>(wall_ns()) << 16) ^ static_cast<std::uint64_t>(getpid());
-  command.kind = action == "reset"     ? tetra_COMMAND_RESET
+  if (request.force && action != "exclude")
+    return report("command", bad_input("--force applies to exclude only"));
+  request.kind = action == "reset"     ? tetra_COMMAND_RESET
                  : action == "exclude" ? tetra_COMMAND_EXCLUDE
                                        : tetra_COMMAND_REINSTATE;
-  command.gyro = static_cast<std::int16_t>(gyro);
+  tetra_Command command{};
+  if (auto s = ground::to_wire(request, ground::new_command_id(wall_ns(), getpid()), command); !s)
+    return report("command", s.error());
+  const std::string& unit = request.unit;
 
   auto participant = dds::Participant::create(domain, unit);
   if (!participant) return report("command", participant.error());
@@ -87,9 +125,11 @@ int cmd_command(int argc, char** argv) {
     });
     if (!taken) return report("command", taken.error());
     if (ack) {
-      std::cout << fdi::to_json(ack->event, std::max(4, static_cast<int>(std::bit_width(ack->event.gyros))))
-                << '\n';
-      return kExitOk;
+      const int n = std::max(4, static_cast<int>(std::bit_width(ack->event.gyros)));
+      std::cout << ack_line(*ack, n) << '\n';
+      if (!ack->event.refused()) return kExitOk;
+      std::cerr << "tetra command: refused by unit " << unit << ": " << ack->event.detail << '\n';
+      return kExitFailure;
     }
     const std::int64_t now = monotonic_ns();
     if (now >= give_up) {

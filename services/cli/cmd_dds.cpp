@@ -28,5 +28,8 @@ int cmd_record(int, char**) {
 int cmd_demo(int, char**) {
   return unavailable("demo");
 }
+int cmd_ground(int, char**) {
+  return unavailable("ground");
+}
 
 }  // namespace tetra::cli

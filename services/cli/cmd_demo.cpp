@@ -2,6 +2,8 @@
 // failure injected mid-run, and a summary (docs/dds.md). The simulator runs in this process (it
 // scores the attitude it receives against its truth); the service is a separate `tetra fusion`
 // process; the monitor's view is printed once a second and, at the end, by `tetra monitor --once`.
+// With --web, a `tetra ground` process serves the ground station in the browser (docs/ground.md)
+// and stays up after the summary until SIGINT/SIGTERM.
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -98,6 +100,8 @@ int cmd_demo(int argc, char** argv) {
   double speed = 2.0;
   std::uint64_t seed = 1;
   std::string keep_dir;
+  bool web = false;
+  std::string listen = "127.0.0.1:8080";
   dds_domainid_t domain = static_cast<dds_domainid_t>(150 + getpid() % 80);
   app.add_option("--scenario", scenario_name,
                  "simulated motion: static, lab-orbit, orbit, slews or FILE.yaml")
@@ -115,6 +119,8 @@ int cmd_demo(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--seed", seed, "simulation seed")->capture_default_str();
   app.add_option("--keep", keep_dir, "keep the service's configuration and log in this folder");
+  app.add_flag("--web", web, "also run the ground station in the browser (tetra ground) and print its URL");
+  app.add_option("--listen", listen, "--web: HOST:PORT of the ground station")->capture_default_str();
   app.add_option("--domain", domain, "DDS domain id (default: 150 + pid % 80, private to this run)")
       ->check(CLI::Range(0, 232));
   if (auto exit = parse(app, argc, argv)) return *exit;
@@ -176,6 +182,16 @@ int cmd_demo(int argc, char** argv) {
   Child fusion(spawn_self({"fusion", "--config", dir + "/fusion.yaml", "--domain", domain_text},
                           dir + "/fusion.log", dir + "/fusion.log"));
   if (fusion.pid() <= 0) return report("demo", failure("cannot start tetra fusion"));
+  std::cout << "  service pid " << fusion.pid() << '\n';
+  Child ground(web ? spawn_self({"ground", "--listen", listen, "--domain", domain_text}, dir + "/ground.log",
+                                dir + "/ground.log")
+                   : -1);
+  if (web) {
+    if (ground.pid() <= 0) return report("demo", failure("cannot start tetra ground"));
+    std::cout << "  ground station: http://" << listen << "/  (open it in a browser; log " << dir
+              << "/ground.log)\n"
+              << std::flush;
+  }
 
   // The monitor's side, in this process: Health and events.
   auto participant = dds::Participant::create(domain);
@@ -294,6 +310,13 @@ int cmd_demo(int argc, char** argv) {
             << "  service:           exit status " << fusion_status << " after SIGTERM"
             << (keep_dir.empty() ? std::string(" (its log: --keep DIR)") : " (log " + dir + "/fusion.log)")
             << '\n';
+  if (web && !shutdown.requested()) {
+    std::cout << "\nthe ground station stays up at http://" << listen
+              << "/ (the service has stopped: it shows SERVICE LOST); Ctrl-C to end\n"
+              << std::flush;
+    while (!shutdown.requested()) usleep(100'000);  // no DDS entity left to wait on
+  }
+  ground.stop();
   if (keep_dir.empty()) std::filesystem::remove_all(dir);
   const bool ok = timeline.isolated_s && score->attitudes_scored > 0;
   return ok || shutdown.requested() ? kExitOk : kExitFailure;

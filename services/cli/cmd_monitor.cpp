@@ -3,13 +3,16 @@
 // Reads Health and FdiEvent (transient-local: a late monitor still gets the current health and the
 // event history) and Attitude. Shows a dashboard refreshed every --period (≤ 0.5 s: ≥ 2 Hz), or with
 // --jsonl streams the same as JSON lines; --once prints every unit's current health (and its event
-// history) as soon as they have arrived, and exits.
+// history) as soon as they have arrived, and exits. A unit whose last Health is older than three of
+// the service's Health periods is shown STALE, one whose Health writer lost its liveliness (service
+// killed or gone) SERVICE LOST, with the age of its health and attitude (docs/ground.md).
 
 #include <unistd.h>
 #include <algorithm>
 #include <cstdio>
 #include <deque>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -21,14 +24,13 @@
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/shutdown.hpp"
 #include "tetra/dds/topics.hpp"
+#include "tetra/ground/encode.hpp"
+#include "tetra/ground/ground_readers.hpp"
+#include "tetra/ground/link_state.hpp"
 
 namespace tetra::cli {
 
 namespace {
-
-using dds::Reader;
-
-enum Token : std::intptr_t { kHealth = 1, kEvent, kAttitude, kShutdown };
 
 constexpr std::size_t kRecentEvents = 8;  // shown per unit on the dashboard
 
@@ -40,7 +42,26 @@ struct UnitView {
   double attitude_rate_hz = 0.0;      //!< [Hz] measured between refreshes
   std::deque<dds::EventView> events;  //!< the most recent events (for the dashboard)
   std::uint64_t max_event_seq = 0;
+  std::optional<std::int64_t> health_received_ns;    //!< [ns] monotonic
+  std::optional<std::int64_t> attitude_received_ns;  //!< [ns] monotonic
+  bool writer_alive = true;                          //!< the service's Health writer is alive
+  ground::Link link = ground::Link::kWaiting;
 };
+
+//! "age 0.4 s" of a value received at `received_ns`, or "none".
+std::string age_text(const std::optional<std::int64_t>& received_ns, std::int64_t now_ns) {
+  return received_ns ? fixed(ns_to_seconds(now_ns - *received_ns), 1) + " s" : std::string("none");
+}
+
+void update_link(UnitView& view, std::int64_t now_ns) {
+  const auto age = view.health_received_ns ? std::optional(now_ns - *view.health_received_ns) : std::nullopt;
+  view.link = ground::link_state(age, view.health ? view.health->health_period_s : 0.0, view.writer_alive);
+}
+
+//! A value of the parity space, or "not available" (fewer than four gyros: no parity space).
+std::string parity_text(const fdi::Health& h, double value) {
+  return ground::parity_available(h) ? fixed(value, 2) : std::string("not available");
+}
 
 std::string event_json(const dds::EventView& e, int n_gyros) {
   // The docs/interfaces.md §2.5 object, with the unit, sequence number and command id added in front.
@@ -51,9 +72,14 @@ std::string event_json(const dds::EventView& e, int n_gyros) {
   return head + (body.size() > 2 ? ", " + body.substr(1) : "}");
 }
 
-std::string health_json(const std::string& unit, const UnitView& view) {
+std::string health_json(const std::string& unit, const UnitView& view, std::int64_t now_ns) {
   std::ostringstream out;
-  out << "{\"type\": \"health\", \"unit\": " << json_string(unit);
+  const auto age = [&](const std::optional<std::int64_t>& received) {
+    return received ? json_number(ns_to_seconds(now_ns - *received)) : std::string("null");
+  };
+  out << "{\"type\": \"health\", \"unit\": " << json_string(unit) << ", \"link\": \""
+      << ground::to_string(view.link) << "\", \"health_age_s\": " << age(view.health_received_ns)
+      << ", \"attitude_age_s\": " << age(view.attitude_received_ns);
   if (view.health) {
     const fdi::Health& h = view.health->health;
     const int n = static_cast<int>(h.gyros.size());
@@ -66,9 +92,14 @@ std::string health_json(const std::string& unit, const UnitView& view) {
           << fdi::to_string(h.gyros[static_cast<std::size_t>(i)].state) << "\", \"kind\": \""
           << fdi::to_string(h.gyros[static_cast<std::size_t>(i)].kind) << "\"}";
     }
-    out << "], \"parity_residual\": " << json_number(h.parity_residual)
-        << ", \"chi2\": " << json_number(h.chi2) << ", \"chi2_threshold\": " << json_number(h.chi2_threshold)
-        << ", \"cusum\": " << json_number(h.cusum)
+    // Fewer than four gyros: no parity space, the parity fields are null ("not available").
+    const double na = std::numeric_limits<double>::quiet_NaN();
+    const bool parity = ground::parity_available(h);
+    out << "], \"parity_available\": " << (parity ? "true" : "false")
+        << ", \"parity_residual\": " << json_number(parity ? h.parity_residual : na)
+        << ", \"chi2\": " << json_number(parity ? h.chi2 : na)
+        << ", \"chi2_threshold\": " << json_number(h.chi2_threshold)
+        << ", \"cusum\": " << json_number(parity ? h.cusum : na)
         << ", \"cusum_threshold\": " << json_number(h.cusum_threshold) << ", \"counters\": {"
         << "\"epochs_accepted\": " << h.counters.epochs_accepted
         << ", \"epochs_rejected_time\": " << h.counters.epochs_rejected_time
@@ -98,10 +129,15 @@ std::string health_json(const std::string& unit, const UnitView& view) {
   return out.str();
 }
 
-std::string dashboard_block(const std::string& unit, const UnitView& view) {
+std::string dashboard_block(const std::string& unit, const UnitView& view, std::int64_t now_ns) {
   std::ostringstream out;
   out << "unit " << unit;
   if (!view.health) return out.str() + "   (no health yet)\n";
+  if (view.link != ground::Link::kLive) {
+    out << "   *** " << ground::to_string(view.link) << " *** (what follows is the last health received)";
+  }
+  out << "   health age " << age_text(view.health_received_ns, now_ns) << ", attitude age "
+      << age_text(view.attitude_received_ns, now_ns) << '\n';
   const fdi::Health& h = view.health->health;
   const int n = static_cast<int>(h.gyros.size());
   const auto& c = view.health->counters;
@@ -115,8 +151,8 @@ std::string dashboard_block(const std::string& unit, const UnitView& view) {
                   g.kind == fdi::FaultKind::kNone ? "-" : fdi::to_string(g.kind));
     out << line;
   }
-  out << "  parity residual " << fixed(h.parity_residual, 2) << " σ   chi2 " << fixed(h.chi2, 2) << " / "
-      << fixed(h.chi2_threshold, 2) << "   cusum " << fixed(h.cusum, 2) << " / "
+  out << "  parity residual " << parity_text(h, h.parity_residual) << " σ   chi2 " << parity_text(h, h.chi2)
+      << " / " << fixed(h.chi2_threshold, 2) << "   cusum " << parity_text(h, h.cusum) << " / "
       << fixed(h.cusum_threshold, 2) << '\n';
   if (view.attitude) {
     const auto& a = *view.attitude;
@@ -164,34 +200,8 @@ int cmd_monitor(int argc, char** argv) {
   add_domain_option(app, domain);
   if (auto exit = parse(app, argc, argv)) return *exit;
 
-  auto participant = dds::Participant::create(domain, unit_filter);
-  if (!participant) return report("monitor", participant.error());
-  auto topics = dds::Topics::create(*participant);
-  if (!topics) return report("monitor", topics.error());
-  auto health_reader = Reader<tetra_Health>::create(*participant, topics->health, dds::health_qos());
-  if (!health_reader) return report("monitor", health_reader.error());
-  auto event_reader = Reader<tetra_FdiEvent>::create(*participant, topics->event, dds::event_qos());
-  if (!event_reader) return report("monitor", event_reader.error());
-  auto attitude_reader = Reader<tetra_Attitude>::create(*participant, topics->attitude, dds::attitude_qos());
-  if (!attitude_reader) return report("monitor", attitude_reader.error());
-  auto waitset = dds::WaitSet::create(*participant);
-  if (!waitset) return report("monitor", waitset.error());
-  std::vector<dds::Condition> conditions;
-  for (auto [reader, token] :
-       {std::pair{health_reader->handle(), kHealth}, std::pair{event_reader->handle(), kEvent},
-        std::pair{attitude_reader->handle(), kAttitude}}) {
-    auto condition = dds::Condition::data_available(reader);
-    if (!condition) return report("monitor", condition.error());
-    if (auto s = waitset->attach(condition->handle(), token); !s) return report("monitor", s.error());
-    conditions.push_back(std::move(condition).value());
-  }
-  if (auto s = health_reader->enable_statuses(DDS_SUBSCRIPTION_MATCHED_STATUS); !s)
-    return report("monitor", s.error());
-  if (auto s = waitset->attach(health_reader->handle(), kHealth); !s) return report("monitor", s.error());
-  auto guard = dds::Condition::guard(*participant);
-  if (!guard) return report("monitor", guard.error());
-  if (auto s = waitset->attach(guard->handle(), kShutdown); !s) return report("monitor", s.error());
-  shutdown.set_guard(guard->handle());
+  auto readers = ground::GroundReaders::open(domain, unit_filter, shutdown);
+  if (!readers) return report("monitor", readers.error());
 
   std::map<std::string, UnitView> units;
   std::vector<dds::EventView> new_events;
@@ -207,16 +217,21 @@ int cmd_monitor(int argc, char** argv) {
   std::vector<std::intptr_t> triggered;
 
   for (;;) {
-    std::uint32_t status = 0;
-    (void)dds_take_status(health_reader->handle(), &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
-    auto h = health_reader->take([&](const tetra_Health& msg, const dds_sample_info_t&) {
-      auto view = dds::from_wire(msg);
-      if (wanted(view.unit)) units[view.unit].health = std::move(view);
-    });
+    const std::int64_t received = monotonic_ns();
+    auto h = readers->take_health(
+        [&](dds::HealthView&& view, std::int64_t) {
+          if (!wanted(view.unit)) return;
+          UnitView& unit = units[view.unit];
+          unit.health = std::move(view);
+          unit.health_received_ns = received;
+          unit.writer_alive = true;
+        },
+        [&](const std::string& unit) {
+          if (wanted(unit)) units[unit].writer_alive = false;
+        });
     if (!h) return report("monitor", h.error());
     new_events.clear();
-    auto e = event_reader->take([&](const tetra_FdiEvent& msg, const dds_sample_info_t&) {
-      auto view = dds::from_wire(msg);
+    auto e = readers->take_events([&](dds::EventView&& view, std::int64_t) {
       if (wanted(view.unit)) new_events.push_back(std::move(view));
     });
     if (!e) return report("monitor", e.error());
@@ -231,21 +246,23 @@ int cmd_monitor(int argc, char** argv) {
       view.events.push_back(ev);
       if (view.events.size() > kRecentEvents) view.events.pop_front();
     }
-    auto a = attitude_reader->take([&](const tetra_Attitude& msg, const dds_sample_info_t&) {
-      const std::string unit = dds::from_wire(msg.unit);
-      if (!wanted(unit)) return;
-      UnitView& view = units[unit];
-      view.attitude = dds::from_wire(msg);
-      ++view.attitudes_received;
-    });
+    auto a =
+        readers->take_attitudes([&](const std::string& unit, fdi::AttitudeEstimate&& attitude, std::int64_t) {
+          if (!wanted(unit)) return;
+          UnitView& view = units[unit];
+          view.attitude = attitude;
+          view.attitude_received_ns = received;
+          ++view.attitudes_received;
+        });
     if (!a) return report("monitor", a.error());
     if (jsonl) std::cout.flush();
 
     const std::int64_t now = monotonic_ns();
+    for (auto& [unit, view] : units) update_link(view, now);
     if (shutdown.requested()) break;
     if (once) {
       // Done when every matched Health writer has delivered and each unit's event history is complete.
-      auto matched = health_reader->matched_writers();
+      auto matched = readers->health_writers();
       if (!matched) return report("monitor", matched.error());
       std::size_t complete = 0;
       for (const auto& [unit, view] : units) {
@@ -257,9 +274,9 @@ int cmd_monitor(int argc, char** argv) {
         for (const auto& [unit, view] : units) {
           if (!view.health) continue;
           if (jsonl) {
-            std::cout << health_json(unit, view) << '\n';
+            std::cout << health_json(unit, view, now) << '\n';
           } else {
-            std::cout << dashboard_block(unit, view);
+            std::cout << dashboard_block(unit, view, now);
           }
         }
         return kExitOk;
@@ -280,18 +297,18 @@ int cmd_monitor(int argc, char** argv) {
       last_refresh = now;
       next_refresh = now + period_ns;
       if (jsonl) {
-        for (const auto& [unit, view] : units) std::cout << health_json(unit, view) << '\n';
+        for (const auto& [unit, view] : units) std::cout << health_json(unit, view, now) << '\n';
       } else {
         std::string screen = tty ? "\033[H\033[2J" : "";
         screen += "tetra monitor — " + std::to_string(units.size()) + " unit(s)\n";
-        for (const auto& [unit, view] : units) screen += dashboard_block(unit, view);
+        for (const auto& [unit, view] : units) screen += dashboard_block(unit, view, now);
         std::cout << screen << (tty ? "" : "\n");
       }
       std::cout.flush();
     }
     if (now >= stop_at) break;
     const std::int64_t wake = once ? give_up_at : std::min(next_refresh, stop_at);
-    if (auto s = waitset->wait(std::chrono::nanoseconds(wake - now), triggered); !s)
+    if (auto s = readers->wait(std::chrono::nanoseconds(wake - now), triggered); !s)
       return report("monitor", s.error());
   }
   return kExitOk;

@@ -23,6 +23,7 @@
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/shutdown.hpp"
 #include "tetra/dds/topics.hpp"
+#include "tetra/ground/encode.hpp"
 #include "tetra/service/fusion_config.hpp"
 
 namespace tetra::cli {
@@ -54,6 +55,7 @@ int cmd_record(int argc, char** argv) {
   std::string config_path;
   std::string attitude_path;
   std::string events_path;
+  std::string commands_path;
   int gyros = 4;
   double rate_hz = 100.0;
   double tolerance_s = -1.0;  // [s] default: a quarter period
@@ -76,6 +78,9 @@ int cmd_record(int argc, char** argv) {
                  "also write the service's Attitude (CSV, docs/interfaces.md §2.4)");
   app.add_option("--events", events_path,
                  "also write the service's FdiEvents (JSON lines, docs/interfaces.md §2.5)");
+  app.add_option(
+      "--commands", commands_path,
+      "also write the operator commands the service acknowledged (JSON lines, for replay --commands)");
   app.add_option("--duration", duration_s, "[s] stop after this long")->check(CLI::PositiveNumber);
   app.add_flag("--until-idle", until_idle, "stop when the gyro writers have come and gone");
   add_domain_option(app, domain);
@@ -86,9 +91,11 @@ int cmd_record(int argc, char** argv) {
   OutputFile* log_out = nullptr;
   OutputFile* attitude_out = nullptr;
   OutputFile* events_out = nullptr;
+  OutputFile* commands_out = nullptr;
   for (auto [path, label, slot] :
        {std::tuple{&out_path, "--out", &log_out}, std::tuple{&attitude_path, "--attitude", &attitude_out},
-        std::tuple{&events_path, "--events", &events_out}}) {
+        std::tuple{&events_path, "--events", &events_out},
+        std::tuple{&commands_path, "--commands", &commands_out}}) {
     if (path->empty()) continue;
     auto out = files.add(*path, label);
     if (!out) return report("record", out.error());
@@ -175,7 +182,8 @@ int cmd_record(int argc, char** argv) {
   GyroLogWriter log;
   bool log_open = false;
   std::string attitude_text = kAttitudeHeader;
-  std::map<std::uint64_t, std::string> event_lines;  // by event_seq: written in order
+  std::map<std::uint64_t, std::string> event_lines;    // by event_seq: written in order
+  std::map<std::uint64_t, std::string> command_lines;  // acknowledgements, by event_seq
   std::vector<fdi::Epoch> epochs;
   std::vector<double> values(static_cast<std::size_t>(n));
   std::optional<std::int64_t> last_epoch_ns;
@@ -232,7 +240,9 @@ int cmd_record(int argc, char** argv) {
     if (!a) return report("record", a.error());
     auto e = event_reader->take([&](const tetra_FdiEvent& s, const dds_sample_info_t&) {
       const auto view = dds::from_wire(s);
-      if (view.unit == unit) event_lines[view.event_seq] = fdi::to_json(view.event, n);
+      if (view.unit != unit) return;
+      event_lines[view.event_seq] = fdi::to_json(view.event, n);
+      if (view.command_id != 0) command_lines[view.event_seq] = ground::ack_json(view, n).dump();
     });
     if (!e) return report("record", e.error());
     assembler->poll(now, epochs);
@@ -280,6 +290,11 @@ int cmd_record(int argc, char** argv) {
     std::string text;
     for (const auto& [seq, line] : event_lines) text += line + '\n';
     if (auto s = events_out->write(text); !s) return report("record", s.error());
+  }
+  if (commands_out) {
+    std::string text;
+    for (const auto& [seq, line] : command_lines) text += line + '\n';
+    if (auto s = commands_out->write(text); !s) return report("record", s.error());
   }
   if (auto s = files.commit(); !s) return report("record", s.error());
   const auto& c = assembler->counters();

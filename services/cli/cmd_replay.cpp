@@ -10,6 +10,7 @@
 
 #include "attitude_csv.hpp"
 #include "cli_common.hpp"
+#include "command_log.hpp"
 #include "commands.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/csv.hpp"
@@ -69,6 +70,10 @@ int cmd_replay(int argc, char** argv) {
   app.add_option("--config", config_path, "YAML file with a 'pipeline:' map of thresholds (docs/fdi.md)");
   app.add_option("--attitude", attitude_path, "attitude output (CSV)")->required();
   app.add_option("--events", events_path, "FDI events output (JSON lines)")->required();
+  std::string commands_path;
+  app.add_option("--commands", commands_path,
+                 "operator commands to re-apply where the service obeyed them (JSON lines of tetra record "
+                 "--commands)");
   bool verbose = false;
   app.add_flag("-v,--verbose", verbose, "echo the configuration and the derived thresholds on stderr");
   if (auto status = parse(app, argc, argv)) return *status;
@@ -77,6 +82,7 @@ int cmd_replay(int argc, char** argv) {
   files.add_input(log_path, "LOG");
   files.add_input(cal_path, "--calibration");
   if (!config_path.empty()) files.add_input(config_path, "--config");
+  if (!commands_path.empty()) files.add_input(commands_path, "--commands");
   auto attitude_out = files.add(attitude_path, "--attitude");
   if (!attitude_out) return report("replay", attitude_out.error());
   auto events_out = files.add(events_path, "--events");
@@ -99,6 +105,13 @@ int cmd_replay(int argc, char** argv) {
   if (!cal) return report("replay", cal.error());
   auto log = read_gyro_log(log_path);
   if (!log) return report("replay", log.error());
+  std::vector<RecordedCommand> commands;
+  if (!commands_path.empty()) {
+    auto c = read_command_log(commands_path);
+    if (!c) return report("replay", c.error());
+    commands = std::move(c).value();
+  }
+  std::size_t next_command = 0;
   if (log->gyro_count != cal->gyro_count()) {
     return report("replay", bad_input(log_path + ": the log has " + std::to_string(log->gyro_count) +
                                       " gyro columns, the calibration " + cal_path + " has " +
@@ -136,6 +149,13 @@ int cmd_replay(int argc, char** argv) {
       epoch.raw[static_cast<std::size_t>(i)] = log->value(k, i);
       epoch.present[static_cast<std::size_t>(i)] = log->is_present(k, i) ? 1 : 0;
     }
+    // Commands the service obeyed after the last epoch before this one: the same place in the stream.
+    // Each acknowledgement is written where the service published it: before the epoch's own events.
+    for (; next_command < commands.size() && commands[next_command].stamp_ns < epoch.stamp_ns;
+         ++next_command) {
+      events += fdi::to_json(apply(*pipeline, commands[next_command]), n);
+      events += '\n';
+    }
     epoch.reference_q_RB.reset();
     if (log->has_reference && log->reference_present[k] != 0)
       epoch.reference_q_RB = from_wxyz(log->reference_wxyz[k]);
@@ -147,6 +167,12 @@ int cmd_replay(int argc, char** argv) {
     }
     if (!r.accepted) continue;
     append_attitude_row(att, log->time_s[k], r.attitude, n);  // the log's own time, bit for bit
+  }
+  // Commands after the last epoch: acknowledged (their other effects would show on a next epoch).
+  for (; next_command < commands.size(); ++next_command) {
+    events += fdi::to_json(apply(*pipeline, commands[next_command]), n);
+    events += '
+';
   }
   if (auto st = (*attitude_out)->write(att); !st) return report("replay", st.error());
   if (auto st = (*events_out)->write(events); !st) return report("replay", st.error());

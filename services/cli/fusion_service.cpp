@@ -14,12 +14,7 @@ namespace {
 
 enum Token : std::intptr_t { kGyroData = 1, kGyroStatus, kReferenceData, kCommandData, kWake, kShutdown };
 
-template <class T>
-Status assign(std::optional<T>& slot, Result<T> result) {
-  if (!result) return result.error();
-  slot.emplace(std::move(result).value());
-  return ok_status();
-}
+using dds::assign;
 
 }  // namespace
 
@@ -209,6 +204,7 @@ Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered,
     if (auto s = take_commands(); !s) return s;
   }
   const bool newly_absent = check_deadlines(now, deadline_status);
+  if (auto s = report_silence(); !s) return s;
   if (auto s = process_epochs(now); !s) return s;
   if (command_data || newly_absent || matched_changed || now >= next_health_ns_) {
     if (auto s = publish_health(now, matched_changed); !s) return s;
@@ -221,6 +217,7 @@ Status FusionService::ingest(std::int64_t now_ns) {
   // already in its reader when the epoch completes (docs/dds.md).
   if (auto s = take_gyro_samples(now_ns); !s) return s;
   if (auto s = take_references(); !s) return s;
+  if (auto s = report_silence(); !s) return s;
   return process_epochs(now_ns);
 }
 
@@ -296,23 +293,44 @@ Status FusionService::take_commands() {
   });
   if (!taken) return taken.error();
   for (const auto& command : commands) {
-    const std::int64_t stamp = pipeline_.health().stamp_ns;
+    // Stamped with the sensor time of the last epoch fused; before the first, 1 ns before time zero
+    // (so that `replay --commands` applies it before an epoch stamped 0, as here).
+    const std::int64_t stamp = fused_any_ ? pipeline_.health().stamp_ns : -1;
     fdi::FdiEvent ack;
     switch (command.kind) {
       case tetra_COMMAND_RESET:
         ack = pipeline_.reset_command(stamp);
         break;
       case tetra_COMMAND_EXCLUDE:
-        ack = pipeline_.exclude(command.gyro, stamp);
+        ack = pipeline_.exclude(command.gyro, stamp, command.force);
         break;
       case tetra_COMMAND_REINSTATE:
         ack = pipeline_.reinstate(command.gyro, stamp);
         break;
     }
-    spdlog::info("fusion: command {} acknowledged: {}", command.command_id, fdi::to_json(ack, n_gyros_));
-    if (auto s = publish_event(ack, command.command_id); !s) return s;
+    const dds::CommandAudit audit{command.kind, command.force, dds::from_wire(command.operator_id),
+                                  dds::from_wire(command.origin)};
+    spdlog::info("fusion: command {} from operator '{}' at '{}' {}: {}", command.command_id,
+                 audit.operator_id, audit.origin, ack.refused() ? "refused" : "accepted",
+                 fdi::to_json(ack, n_gyros_));
+    if (auto s = publish_event(ack, command.command_id, audit); !s) return s;
   }
   return ok_status();
+}
+
+Status FusionService::report_silence() {
+  // Every gyro silent, or the first sample after that: events, so the ground sees even a brief loss.
+  const bool silent = assembler_.all_absent();
+  if (silent == all_silent_) return ok_status();
+  all_silent_ = silent;
+  fdi::FdiEvent event;
+  event.stamp_ns = pipeline_.health().stamp_ns;
+  event.type = silent ? fdi::EventType::kLost : fdi::EventType::kCleared;
+  event.detail = silent ? "all gyros silent" : "gyro samples back";
+  for (int g = 1; g <= n_gyros_; ++g) {
+    if (!assembler_.absent(g)) event.gyros |= GyroMask{1} << static_cast<unsigned>(g - 1);
+  }
+  return publish_event(event, 0, {});
 }
 
 bool FusionService::check_deadlines(std::int64_t now_ns, bool dds_reported) {
@@ -336,9 +354,10 @@ Status FusionService::process_epochs(std::int64_t now_ns) {
   assembler_.poll(now_ns, epochs_);
   for (const auto& epoch : epochs_) {
     const fdi::StepResult& result = pipeline_.step(epoch);
+    fused_any_ = true;
     // Events before the attitude of the same epoch: a reader that has the attitude has its events.
     for (const auto& event : result.events) {
-      if (auto s = publish_event(event, 0); !s) return s;
+      if (auto s = publish_event(event, 0, {}); !s) return s;
     }
     if (result.accepted) {
       tetra_Attitude wire{};
@@ -350,8 +369,9 @@ Status FusionService::process_epochs(std::int64_t now_ns) {
   return ok_status();
 }
 
-Status FusionService::publish_event(const fdi::FdiEvent& event, std::uint64_t command_id) {
-  dds::EventView view{config_.unit, ++event_seq_, command_id, event};
+Status FusionService::publish_event(const fdi::FdiEvent& event, std::uint64_t command_id,
+                                    const dds::CommandAudit& audit) {
+  dds::EventView view{config_.unit, ++event_seq_, command_id, event, audit};
   tetra_FdiEvent wire{};
   if (auto s = dds::to_wire(view, wire); !s) return s;
   if (event.type != fdi::EventType::kCommand) spdlog::info("fusion: event {}", fdi::to_json(event, n_gyros_));
@@ -390,6 +410,7 @@ Status FusionService::publish_health(std::int64_t now_ns, bool force) {
   if (auto s = dds::to_wire(config_.unit, health, assembler_.counters(), wire); !s) return s;
   wire.msg.events_published = event_seq_;
   wire.msg.gyro_writers = gyro_writers_;
+  wire.msg.health_period_s = config_.health_period_s;
   if (auto s = health_writer_->write(wire.msg); !s) return s;
   if (last_health_) {
     *last_health_ = health;  // reuses the storage

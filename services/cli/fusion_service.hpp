@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "tetra/core/result.hpp"
+#include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/shutdown.hpp"
 #include "tetra/dds/topics.hpp"
@@ -65,7 +66,9 @@ class FusionService {
   //! Marks gyros silent for the deadline absent; true if any became absent.
   bool check_deadlines(std::int64_t now_ns, bool dds_reported);
   Status process_epochs(std::int64_t now_ns);
-  Status publish_event(const fdi::FdiEvent& event, std::uint64_t command_id);
+  Status publish_event(const fdi::FdiEvent& event, std::uint64_t command_id, const dds::CommandAudit& audit);
+  //! An event when every gyro has gone silent, and when samples come back.
+  Status report_silence();
   Status publish_health(std::int64_t now_ns, bool force);
   //! The health to publish, into `out` (its storage is reused).
   void current_health(fdi::Health& out) const;
@@ -92,6 +95,8 @@ class FusionService {
   std::uint64_t event_seq_ = 0;
   std::uint32_t gyro_writers_ = 0;  //!< matched GyroSample writers (published in Health)
   std::uint64_t last_restarts_ = 0;
+  bool all_silent_ = false;  //!< every gyro absent (reported as an event)
+  bool fused_any_ = false;   //!< an epoch has been fused (commands are stamped with its time)
   std::vector<fdi::Epoch> epochs_;
   std::int64_t scheduled_wake_ns_ = 0;   //!< [ns] when the waitset thread wakes by itself next
   std::optional<Error> listener_error_;  //!< a failure inside the listener, for run() to return

@@ -29,6 +29,7 @@ constexpr Command kCommands[] = {
     {"monitor", tetra::cli::cmd_monitor, "ground monitoring of every unit on the DDS domain"},
     {"command", tetra::cli::cmd_command, "send an operator command (reset, exclude, reinstate) over DDS"},
     {"record", tetra::cli::cmd_record, "record the gyro streams seen on DDS as a replayable gyro log"},
+    {"ground", tetra::cli::cmd_ground, "the ground station in the browser: DDS to HTTP bridge, Open MCT"},
     {"demo", tetra::cli::cmd_demo, "simulator + service + monitor on loopback with a fault mid-run"},
     {"campaign", tetra::cli::cmd_campaign, "fault-injection campaign over the closed loop, with a report"},
 };

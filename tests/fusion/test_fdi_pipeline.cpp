@@ -271,7 +271,13 @@ TEST(Pipeline, OperatorCommandsExcludeReinstateReset) {
   EXPECT_EQ(r.attitude.mode, Mode::kDegraded);
   EXPECT_EQ(r.attitude.gyros, 0b1101U);
   EXPECT_EQ(p->exclude(9, 2).detail.find("rejected") != std::string::npos, true);
-  (void)p->exclude(1, 3);  // gyros 3 and 4 left: not observable
+  // Gyros 3 and 4 would be left: not observable, so refused unless forced (safe commanding).
+  const FdiEvent refused = p->exclude(1, 3);
+  EXPECT_TRUE(refused.refused());
+  EXPECT_NE(refused.detail.find("refused"), std::string::npos) << refused.detail;
+  EXPECT_NE(fdi::to_json(refused, 4).find("\"accepted\": false"), std::string::npos);
+  EXPECT_EQ(p->step(s.next()).attitude.mode, Mode::kDegraded);
+  EXPECT_FALSE(p->exclude(1, 3, true).refused());
   const auto& lost = p->step(s.next());
   EXPECT_EQ(lost.attitude.mode, Mode::kLost);
   bool lost_event = false;

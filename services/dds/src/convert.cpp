@@ -159,6 +159,7 @@ HealthView from_wire(const tetra_Health& in) {
   out.counters.sensor_restarts = c.sensor_restarts;
   out.events_published = in.events_published;
   out.gyro_writers = in.gyro_writers;
+  out.health_period_s = in.health_period_s;
   out.counters.deadlines_missed = c.deadlines_missed;
   out.counters.liveliness_lost = c.liveliness_lost;
   return out;
@@ -176,8 +177,11 @@ void copy_truncated(char (&dest)[N], const std::string& text) {
 Status to_wire(const EventView& view, tetra_FdiEvent& out) {
   if (auto status = copy_bounded(out.unit, view.unit, "unit"); !status) return status;
   const fdi::FdiEvent& e = view.event;
-  if (auto status = copy_bounded(out.test, std::string(fdi::to_string(e.test)), "event test"); !status) return status;
-  if (auto status = copy_bounded(out.evidence, std::string(fdi::to_string(e.evidence)), "event evidence"); !status) return status;
+  if (auto status = copy_bounded(out.test, std::string(fdi::to_string(e.test)), "event test"); !status)
+    return status;
+  if (auto status = copy_bounded(out.evidence, std::string(fdi::to_string(e.evidence)), "event evidence");
+      !status)
+    return status;
   copy_truncated(out.detail, e.detail);
   out.event_seq = view.event_seq;
   out.command_id = view.command_id;
@@ -187,8 +191,36 @@ Status to_wire(const EventView& view, tetra_FdiEvent& out) {
   out.statistic = e.statistic;
   out.kind = to_wire(e.kind);
   out.gyros = e.gyros;
-  return ok_status();
+  out.refused = e.refused();
+  out.command = view.command.kind;
+  out.force = view.command.force;
+  if (auto status = copy_bounded(out.operator_id, view.command.operator_id, "operator id"); !status)
+    return status;
+  return copy_bounded(out.origin, view.command.origin, "command origin");
 }
+
+const char* to_string(tetra_CommandKind kind) {
+  switch (kind) {
+    case tetra_COMMAND_EXCLUDE:
+      return "exclude";
+    case tetra_COMMAND_REINSTATE:
+      return "reinstate";
+    default:
+      return "reset";
+  }
+}
+
+namespace {
+//! A command's outcome from its acknowledgement text ("exclude 2: already excluded"); a refusal whose text
+//! does not say which is taken as the only refusal that changes nothing on purpose.
+fdi::CommandOutcome outcome_from_wire(const std::string& detail, bool refused) {
+  const auto colon = detail.find(": ");
+  if (colon != std::string::npos) {
+    if (auto o = fdi::command_outcome_from_string(std::string_view(detail).substr(colon + 2))) return *o;
+  }
+  return refused ? fdi::CommandOutcome::kRefusedUnobservable : fdi::CommandOutcome::kDone;
+}
+}  // namespace
 
 EventView from_wire(const tetra_FdiEvent& in) {
   EventView out;
@@ -205,6 +237,8 @@ EventView from_wire(const tetra_FdiEvent& in) {
   e.evidence = fdi::evidence_from_string(from_wire(in.evidence));
   e.gyros = in.gyros;
   e.detail = from_wire(in.detail);
+  e.outcome = outcome_from_wire(e.detail, in.refused);
+  out.command = {in.command, in.force, from_wire(in.operator_id), from_wire(in.origin)};
   return out;
 }
 

@@ -32,7 +32,8 @@ Qos attitude_qos() {
 }
 Qos health_qos() {
   Qos qos;
-  qos.reliable().transient_local(1).keep_last(1);
+  // Liveliness: a ground reader learns within a lease that the service is gone (kill -9 included).
+  qos.reliable().transient_local(1).keep_last(1).automatic_liveliness(kWriterLease);
   return qos;
 }
 Qos event_qos() {

@@ -38,8 +38,9 @@ class Pipeline {
   const StepResult& step(const Epoch& epoch);
   //! Operator commands. Each returns its acknowledgement (an event of type kCommand), once: the caller
   //! publishes or records it. What the command changed (reconfigured, lost, cleared) comes with the next
-  //! step()'s events.
-  FdiEvent exclude(int gyro_id, std::int64_t stamp_ns);
+  //! step()'s events. `exclude` refuses to leave a set of gyros that cannot determine the attitude, unless
+  //! `force`; a refused command changes nothing and its acknowledgement says why (`refused()`).
+  FdiEvent exclude(int gyro_id, std::int64_t stamp_ns, bool force = false);
   FdiEvent reinstate(int gyro_id, std::int64_t stamp_ns);
   FdiEvent reset_command(std::int64_t stamp_ns);
 

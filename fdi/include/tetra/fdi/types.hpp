@@ -77,8 +77,16 @@ Evidence evidence_from_string(std::string_view text);
 //! Operator commands and their outcome (the acknowledgement).
 enum class CommandVerb : std::uint8_t { kExclude, kReinstate, kReset };
 const char* to_string(CommandVerb verb);  // "exclude", "reinstate", "reset"
-enum class CommandOutcome : std::uint8_t { kDone, kNoSuchGyro, kAlreadyExcluded, kNotExcluded };
+enum class CommandOutcome : std::uint8_t {
+  kDone,
+  kNoSuchGyro,
+  kAlreadyExcluded,
+  kNotExcluded,
+  kRefusedUnobservable  //!< the gyros left could not determine the attitude (`force` overrides)
+};
 const char* to_string(CommandOutcome outcome);  // "done", "rejected, no such gyro", ...
+//! The outcome named by `text` (as written by to_string), if any.
+std::optional<CommandOutcome> command_outcome_from_string(std::string_view text);
 
 //! One input epoch: up to N raw samples taken at one sensor time, and an optional reference.
 struct Epoch {
@@ -100,6 +108,9 @@ struct FdiEvent {
   std::optional<CommandVerb> command;              //!< command: the verb acknowledged
   CommandOutcome outcome = CommandOutcome::kDone;  //!< command: its outcome
   std::string detail;  //!< free text: e.g. the command acknowledged and its outcome
+
+  //! command: refused (the outcome says why); nothing changed.
+  bool refused() const { return type == EventType::kCommand && outcome != CommandOutcome::kDone; }
 };
 
 //! One JSON object (one line, no newline) per docs/interfaces.md §2.5; `n_gyros` formats the `gyros` lists.

@@ -49,15 +49,27 @@ struct HealthView {
   service::AssemblerCounters counters;
   std::uint64_t events_published = 0;  //!< event_seq of the service's last event
   std::uint32_t gyro_writers = 0;      //!< GyroSample writers the service has matched
+  double health_period_s = 0.0;        //!< [s] the service writes Health at least this often
 };
 HealthView from_wire(const tetra_Health& in);
 
-//! An event with its per-run sequence number and, for acknowledgements, the command's id.
+//! What an acknowledgement says of the command it answers (audit trail).
+struct CommandAudit {
+  tetra_CommandKind kind = tetra_COMMAND_RESET;
+  bool force = false;
+  std::string operator_id;
+  std::string origin;
+};
+//! "reset", "exclude", "reinstate".
+const char* to_string(tetra_CommandKind kind);
+
+//! An event with its per-run sequence number and, for acknowledgements, the command's id and audit.
 struct EventView {
   std::string unit;
   std::uint64_t event_seq = 0;
   std::uint64_t command_id = 0;
   fdi::FdiEvent event;
+  CommandAudit command;  //!< acknowledgements (command_id != 0) only
 };
 //! Long free text is cut to the wire's bound (the detail is informative only).
 Status to_wire(const EventView& view, tetra_FdiEvent& out);

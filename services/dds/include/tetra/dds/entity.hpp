@@ -290,4 +290,12 @@ Status copy_bounded(char (&dest)[N], const std::string& text, const char* field)
   return ok_status();
 }
 
+//! Moves a created entity into `slot`, or returns the error (for members created one by one).
+template <class T>
+Status assign(std::optional<T>& slot, Result<T> result) {
+  if (!result) return result.error();
+  slot.emplace(std::move(result).value());
+  return ok_status();
+}
+
 }  // namespace tetra::dds

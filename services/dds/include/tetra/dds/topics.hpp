@@ -25,7 +25,7 @@ Qos gyro_sample_reader_qos(std::chrono::nanoseconds sample_period);
 const char* qos_policy_name(std::uint32_t policy_id);
 Qos reference_qos();  //!< reliable / volatile / keep-last 8
 Qos attitude_qos();   //!< reliable / volatile / keep-last 1
-Qos health_qos();     //!< reliable / transient-local / keep-last 1
+Qos health_qos();     //!< reliable / transient-local / keep-last 1 / automatic liveliness, kWriterLease
 Qos event_qos();      //!< reliable / transient-local / keep-last 256 (durability service 256)
 Qos command_qos();    //!< reliable / volatile / keep-last 16
 

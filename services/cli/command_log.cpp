@@ -1,0 +1,65 @@
+#include "command_log.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <sstream>
+
+#include "tetra/core/csv.hpp"
+#include "tetra/core/units.hpp"
+
+namespace tetra::cli {
+
+namespace {
+
+using nlohmann::json;
+
+Result<RecordedCommand> parse_line(const std::string& line, const std::string& where) {
+  const json j = json::parse(line, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return bad_input(where + ": not a JSON object");
+  RecordedCommand c;
+  if (!j.contains("time_s") || !j["time_s"].is_number())
+    return bad_input(where + ": field 'time_s' (number) missing");
+  c.stamp_ns = seconds_to_ns(j["time_s"].get<double>());
+  if (!j.contains("command") || !j["command"].is_string())
+    return bad_input(where + ": field 'command' missing");
+  c.action = j["command"].get<std::string>();
+  if (c.action != "reset" && c.action != "exclude" && c.action != "reinstate")
+    return bad_input(where + ": field 'command' must be reset, exclude or reinstate");
+  if (c.action != "reset") {
+    if (!j.contains("gyro") || !j["gyro"].is_number_integer())
+      return bad_input(where + ": field 'gyro' missing");
+    c.gyro = static_cast<int>(j["gyro"].get<std::int64_t>());
+  }
+  if (j.contains("force")) {
+    if (!j["force"].is_boolean()) return bad_input(where + ": field 'force' must be true or false");
+    c.force = j["force"].get<bool>();
+  }
+  return c;
+}
+
+}  // namespace
+
+Result<std::vector<RecordedCommand>> read_command_log(const std::string& path) {
+  auto text = read_text_file(path);
+  if (!text) return text.error();
+  std::vector<RecordedCommand> commands;
+  std::istringstream in(*text);
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (line.empty()) continue;
+    auto c = parse_line(line, path + ":" + std::to_string(number));
+    if (!c) return c.error();
+    if (!commands.empty() && c->stamp_ns < commands.back().stamp_ns)
+      return bad_input(path + ":" + std::to_string(number) + ": field 'time_s' goes backwards");
+    commands.push_back(std::move(c).value());
+  }
+  return commands;
+}
+
+fdi::FdiEvent apply(fdi::Pipeline& pipeline, const RecordedCommand& command) {
+  if (command.action == "exclude") return pipeline.exclude(command.gyro, command.stamp_ns, command.force);
+  if (command.action == "reinstate") return pipeline.reinstate(command.gyro, command.stamp_ns);
+  return pipeline.reset_command(command.stamp_ns);
+}
+
+}  // namespace tetra::cli

@@ -1,0 +1,60 @@
+#include "tetra/ground/command_request.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "tetra/dds/entity.hpp"
+#include "tetra/dds/topics.hpp"
+
+namespace tetra::ground {
+
+using nlohmann::json;
+
+Result<CommandRequest> parse_command_request(const std::string& body, const std::string& origin) {
+  const json j = json::parse(body, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return bad_input("command: the body is not a JSON object");
+  CommandRequest c;
+  c.origin = origin;
+  if (!j.contains("unit") || !j["unit"].is_string() || j["unit"].get<std::string>().empty())
+    return bad_input("command: field 'unit' (string) missing");
+  c.unit = j["unit"].get<std::string>();
+  if (!j.contains("operator") || !j["operator"].is_string() || j["operator"].get<std::string>().empty())
+    return bad_input("command: field 'operator' (string, the operator's id) missing");
+  c.operator_id = j["operator"].get<std::string>();
+  const std::string action =
+      j.contains("action") && j["action"].is_string() ? j["action"].get<std::string>() : "";
+  if (action == "reset") {
+    c.kind = tetra_COMMAND_RESET;
+  } else if (action == "exclude") {
+    c.kind = tetra_COMMAND_EXCLUDE;
+  } else if (action == "reinstate") {
+    c.kind = tetra_COMMAND_REINSTATE;
+  } else {
+    return bad_input("command: field 'action' must be reset, exclude or reinstate");
+  }
+  if (j.contains("gyro") && !j["gyro"].is_number_integer())
+    return bad_input("command: field 'gyro' must be an integer");
+  c.gyro = j.contains("gyro") && j["gyro"].is_number_integer() && j["gyro"].get<std::int64_t>() <= 1000
+               ? static_cast<int>(j["gyro"].get<std::int64_t>())
+               : (j.contains("gyro") ? -1 : 0);
+  if (c.kind != tetra_COMMAND_RESET && (c.gyro < 1 || c.gyro > dds::kMaxGyrosOnWire))
+    return bad_input("command: field 'gyro' must be 1.." + std::to_string(dds::kMaxGyrosOnWire));
+  if (c.kind == tetra_COMMAND_RESET && c.gyro != 0) return bad_input("command: reset takes no 'gyro'");
+  if (j.contains("force") && !j["force"].is_boolean())
+    return bad_input("command: field 'force' must be true or false");
+  c.force = j.contains("force") && j["force"].get<bool>();
+  return c;
+}
+
+Status to_wire(const CommandRequest& request, std::uint64_t command_id, tetra_Command& out) {
+  out = tetra_Command{};
+  if (auto s = dds::copy_bounded(out.unit, request.unit, "unit"); !s) return s;
+  if (auto s = dds::copy_bounded(out.operator_id, request.operator_id, "operator"); !s) return s;
+  if (auto s = dds::copy_bounded(out.origin, request.origin, "origin"); !s) return s;
+  out.command_id = command_id;
+  out.kind = request.kind;
+  out.gyro = static_cast<std::int16_t>(request.gyro);
+  out.force = request.force;
+  return ok_status();
+}
+
+}  // namespace tetra::ground

@@ -1,0 +1,220 @@
+// Unit tests of the ground station's parts without DDS or HTTP: ring buffer, encoders, store
+// (decimation, history, stream resume), link states, command requests and acknowledgement matching.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <thread>
+
+#include "tetra/core/units.hpp"
+#include "tetra/ground/command_request.hpp"
+#include "tetra/ground/command_tracker.hpp"
+#include "tetra/ground/encode.hpp"
+#include "tetra/ground/link_state.hpp"
+#include "tetra/ground/ring_buffer.hpp"
+#include "tetra/ground/store.hpp"
+
+namespace tetra::ground {
+namespace {
+
+using namespace std::chrono_literals;
+using nlohmann::json;
+
+constexpr std::int64_t kUtc0_ns = 1'790'000'000'000'000'000;  // 2026-09-21, an arbitrary UTC
+
+dds::HealthView health(const std::string& unit, GyroMask used, int n = 4) {
+  dds::HealthView h;
+  h.unit = unit;
+  h.health.gyros.resize(static_cast<std::size_t>(n));
+  h.health.used = used;
+  h.health.chi2 = 1.5;
+  h.health.chi2_threshold = 10.8;
+  h.health.cusum = 2.0;
+  h.health.cusum_threshold = 8.0;
+  h.health.parity_residual = 0.7;
+  h.health_period_s = 0.5;
+  return h;
+}
+
+TEST(RingBuffer, KeepsTheNewestItemsAndCountsWhatItDrops) {
+  RingBuffer<int> ring(3);
+  for (int i = 1; i <= 5; ++i) ring.push(i);
+  ASSERT_EQ(ring.size(), 3U);
+  EXPECT_EQ(ring[0], 3);
+  EXPECT_EQ(ring[2], 5);
+  EXPECT_EQ(ring.newest(), 5);
+  EXPECT_EQ(ring.dropped(), 2U);
+  EXPECT_EQ(ring.partition_point([](int v) { return v < 4; }), 1U);
+  EXPECT_EQ(ring.partition_point([](int v) { return v < 100; }), 3U);
+}
+
+TEST(Encode, EulerAnglesOfKnownRotations) {
+  // 30° about Z: yaw 30, roll and pitch 0; 20° about X: roll 20. Exact to rounding (1e-9 deg).
+  const Quaternion yaw(Eigen::AngleAxisd(30 * kDegToRad, Eigen::Vector3d::UnitZ()));
+  EXPECT_NEAR(euler_zyx_deg(yaw).yaw_deg, 30.0, 1e-9);
+  EXPECT_NEAR(euler_zyx_deg(yaw).roll_deg, 0.0, 1e-9);
+  const Quaternion roll(Eigen::AngleAxisd(20 * kDegToRad, Eigen::Vector3d::UnitX()));
+  EXPECT_NEAR(euler_zyx_deg(roll).roll_deg, 20.0, 1e-9);
+  EXPECT_NEAR(euler_zyx_deg(roll).pitch_deg, 0.0, 1e-9);
+}
+
+TEST(Encode, ParityFieldsAreNotAvailableWithFewerThanFourGyros) {
+  const json four = health_json(health("u", 0b1111), kUtc0_ns);
+  EXPECT_TRUE(four["parity_available"].get<bool>());
+  EXPECT_DOUBLE_EQ(four["chi2"].get<double>(), 1.5);
+  const json three = health_json(health("u", 0b0111), kUtc0_ns);
+  EXPECT_FALSE(three["parity_available"].get<bool>());
+  EXPECT_TRUE(three["chi2"].is_null());
+  EXPECT_TRUE(three["cusum"].is_null());
+  EXPECT_TRUE(three["parity_residual"].is_null());
+  EXPECT_EQ(three["gyros_used"], json::array({1, 2, 3}));
+  EXPECT_DOUBLE_EQ(three["utc_ms"].get<double>(), 1'790'000'000'000.0);  // ns -> ms
+}
+
+TEST(Encode, AcknowledgementCarriesTheAuditTrail) {
+  dds::EventView ack;
+  ack.unit = "u";
+  ack.event_seq = 7;
+  ack.command_id = 0xFFFF'FFFF'FFFF'FFF0ULL;  // beyond 2^53: must survive as text
+  ack.event.type = fdi::EventType::kCommand;
+  ack.event.gyro = 2;
+  ack.event.outcome = fdi::CommandOutcome::kRefusedUnobservable;
+  ack.event.detail = "exclude 2: refused";
+  ack.command = {tetra_COMMAND_EXCLUDE, false, "alice", "ground@127.0.0.1"};
+  const json j = ack_json(ack, 4);
+  EXPECT_FALSE(j["accepted"].get<bool>());
+  EXPECT_EQ(j["command"], "exclude");
+  EXPECT_EQ(j["operator"], "alice");
+  EXPECT_EQ(j["origin"], "ground@127.0.0.1");
+  EXPECT_EQ(j["command_id"], "18446744073709551600");
+}
+
+TEST(LinkState, StaleAfterThreeHealthPeriodsServiceLostWithoutWriter) {
+  EXPECT_EQ(link_state(std::nullopt, 0.5, true), Link::kWaiting);
+  EXPECT_EQ(link_state(1'400'000'000, 0.5, true), Link::kLive);   // 1.4 s < 3 × 0.5 s
+  EXPECT_EQ(link_state(1'600'000'000, 0.5, true), Link::kStale);  // 1.6 s > 1.5 s
+  EXPECT_EQ(link_state(100'000'000, 0.5, false), Link::kServiceLost);
+  EXPECT_STREQ(to_string(Link::kServiceLost), "SERVICE LOST");
+}
+
+TEST(Store, AttitudeIsDecimatedToTheStatedRate) {
+  StoreConfig config;
+  config.history_s = 60;
+  config.attitude_rate_hz = 10;
+  GroundStore store(config);
+  fdi::AttitudeEstimate a;
+  // 100 Hz for 2 s of sensor time: 20 kept at 10 Hz (every 10th sample).
+  for (int k = 0; k < 200; ++k) {
+    a.stamp_ns = std::int64_t{10'000'000} * k;
+    store.add_attitude("u", a, kUtc0_ns + a.stamp_ns, 0);
+  }
+  auto h = store.history("u", "attitude", 0, 1e300, 0);
+  ASSERT_TRUE(h.ok());
+  EXPECT_EQ(h->size(), 20U);
+}
+
+TEST(Store, HistoryIsBoundedAndSelectsTheTimeRange) {
+  StoreConfig config;
+  config.history_s = 10;
+  config.health_rate_hz = 2;  // capacity 20
+  GroundStore store(config);
+  for (int k = 0; k < 50; ++k)
+    store.add_health(health("u", 0b1111), kUtc0_ns + std::int64_t{500'000'000} * k, 0);
+  auto all = store.history("u", "health", 0, 1e300, 0);
+  ASSERT_TRUE(all.ok());
+  EXPECT_EQ(all->size(), 20U);  // the newest 20 of 50
+  const double t30_ms = utc_ms(kUtc0_ns + std::int64_t{500'000'000} * 30);
+  const double t39_ms = utc_ms(kUtc0_ns + std::int64_t{500'000'000} * 39);
+  auto some = store.history("u", "health", t30_ms, t39_ms, 0);
+  ASSERT_TRUE(some.ok());
+  EXPECT_EQ(some->size(), 10U);
+  auto thinned = store.history("u", "health", 0, 1e300, 5);
+  EXPECT_LE(thinned->size(), 5U);
+  EXPECT_FALSE(store.history("nobody", "health", 0, 1, 0).ok());
+  EXPECT_FALSE(store.history("u", "bogus", 0, 1, 0).ok());
+}
+
+TEST(Store, StreamResumesAfterTheLastIdAndReportsAGap) {
+  StoreConfig config;
+  config.stream_capacity = 8;
+  GroundStore store(config);
+  for (int k = 0; k < 5; ++k) store.add_health(health("u", 0b1111), kUtc0_ns + k, 0);
+  auto read = store.read_stream(3, 100, 0ms);
+  ASSERT_EQ(read.messages.size(), 2U);
+  EXPECT_EQ(read.messages[0].id, 4U);
+  EXPECT_FALSE(read.gap);
+  for (int k = 0; k < 10; ++k) store.add_health(health("u", 0b1111), kUtc0_ns + k, 0);
+  read = store.read_stream(3, 100, 0ms);  // ids 4..7 were pushed out of the 8-message ring
+  EXPECT_TRUE(read.gap);
+  EXPECT_EQ(read.messages.front().id, 8U);
+  EXPECT_EQ(read.messages.back().id, 15U);
+}
+
+TEST(Store, LinkGoesStaleThenServiceLostAndIsStreamed) {
+  GroundStore store(StoreConfig{});
+  store.add_health(health("u", 0b1111), kUtc0_ns, 0);
+  store.update_links(100'000'000);
+  EXPECT_EQ(store.units_json(100'000'000)[0]["state"], "LIVE");
+  store.update_links(2'000'000'000);  // 2 s > 3 × 0.5 s
+  EXPECT_EQ(store.units_json(2'000'000'000)[0]["state"], "STALE");
+  store.set_writer_alive("u", false, 2'100'000'000);
+  EXPECT_EQ(store.units_json(2'100'000'000)[0]["state"], "SERVICE LOST");
+  auto read = store.read_stream(0, 100, 0ms);
+  int links = 0;
+  for (const auto& m : read.messages) links += m.event == "link" ? 1 : 0;
+  EXPECT_EQ(links, 3);
+}
+
+TEST(CommandTracker, MatchesAnAcknowledgementByIdAndUnit) {
+  CommandTracker tracker;
+  tracker.expect(42, "u");
+  dds::EventView other;
+  other.unit = "v";
+  other.command_id = 42;  // same id, another unit: not ours
+  EXPECT_FALSE(tracker.offer(other));
+  dds::EventView ack;
+  ack.unit = "u";
+  ack.command_id = 42;
+  std::thread answer([&] {
+    std::this_thread::sleep_for(10ms);
+    EXPECT_TRUE(tracker.offer(ack));
+  });
+  auto got = tracker.wait(42, 5s);
+  answer.join();
+  ASSERT_TRUE(got.has_value());
+  EXPECT_EQ(got->command_id, 42U);
+  EXPECT_EQ(tracker.pending(), 0U);
+  tracker.expect(43, "u");
+  EXPECT_FALSE(tracker.wait(43, 1ms).has_value());  // nobody answers: forgotten after the timeout
+  EXPECT_EQ(tracker.pending(), 0U);
+}
+
+TEST(CommandRequest, ValidatesEveryField) {
+  auto ok = parse_command_request(R"({"unit":"u","action":"exclude","gyro":2,"force":true,"operator":"bob"})",
+                                  "ground@127.0.0.1");
+  ASSERT_TRUE(ok.ok());
+  EXPECT_EQ(ok->kind, tetra_COMMAND_EXCLUDE);
+  EXPECT_TRUE(ok->force);
+  tetra_Command wire{};
+  ASSERT_TRUE(to_wire(*ok, 9, wire).ok());
+  EXPECT_STREQ(wire.operator_id, "bob");
+  EXPECT_STREQ(wire.origin, "ground@127.0.0.1");
+  for (const char* bad :
+       {"", "[]", R"({"action":"reset","operator":"x"})", R"({"unit":"u","action":"reset"})",
+        R"({"unit":"u","action":"explode","operator":"x"})",
+        R"({"unit":"u","action":"exclude","operator":"x"})",
+        R"({"unit":"u","action":"exclude","gyro":99,"operator":"x"})",
+        R"({"unit":"u","action":"exclude","gyro":"2","operator":"x"})",
+        R"({"unit":"u","action":"reset","gyro":1,"operator":"x"})",
+        R"({"unit":"u","action":"reset","force":"yes","operator":"x"})"}) {
+    EXPECT_FALSE(parse_command_request(bad, "o").ok()) << bad;
+  }
+  const std::string long_operator(40, 'x');
+  auto too_long =
+      parse_command_request(R"({"unit":"u","action":"reset","operator":")" + long_operator + "\"}", "o");
+  ASSERT_TRUE(too_long.ok());
+  EXPECT_FALSE(to_wire(*too_long, 1, wire).ok());
+}
+
+}  // namespace
+}  // namespace tetra::ground

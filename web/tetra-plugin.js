@@ -1,0 +1,579 @@
+// The tetra plugin for Open MCT: an object tree per unit, realtime telemetry from the ground
+// station's event stream (/api/stream, server-sent events), history from /api/history, limits from
+// the service's own thresholds, a unit status view (the default display: mode, link state, gyro
+// states, parity/CUSUM against thresholds, sigma, attitude, events) and commands with confirmation.
+/* exported TetraPlugin */
+/* global EventSource */
+// eslint-disable-next-line no-unused-vars
+function TetraPlugin(options) {
+  'use strict';
+  const base = (options && options.baseUrl) || '';
+  const NS = 'tetra';
+
+  // --- telemetry points of a unit: where each comes from in the stream's messages ---------------
+  const q = (i) => (m) => m.q[i];
+  const vec = (field, i) => (m) => m[field][i];
+  const euler = (axis) => (m) => m.euler_deg[axis];
+  function attitudePoints() {
+    return [
+      ['q_w', 'Quaternion w', '', q(0)],
+      ['q_x', 'Quaternion x', '', q(1)],
+      ['q_y', 'Quaternion y', '', q(2)],
+      ['q_z', 'Quaternion z', '', q(3)],
+      ['roll_deg', 'Roll (Z-Y-X)', 'deg', euler('roll')],
+      ['pitch_deg', 'Pitch (Z-Y-X)', 'deg', euler('pitch')],
+      ['yaw_deg', 'Yaw (Z-Y-X)', 'deg', euler('yaw')],
+      ['rate_x_dps', 'Rate X', 'deg/s', vec('rate_dps', 0)],
+      ['rate_y_dps', 'Rate Y', 'deg/s', vec('rate_dps', 1)],
+      ['rate_z_dps', 'Rate Z', 'deg/s', vec('rate_dps', 2)],
+      ['sigma_x_deg', 'Sigma X', 'deg', vec('sigma_deg', 0)],
+      ['sigma_y_deg', 'Sigma Y', 'deg', vec('sigma_deg', 1)],
+      ['sigma_z_deg', 'Sigma Z', 'deg', vec('sigma_deg', 2)]
+    ].map(([key, name, units, get]) => ({ key, name, units, source: 'attitude', get }));
+  }
+  function healthPoints(gyroCount) {
+    const points = [
+      { key: 'mode', name: 'Mode', source: 'health', get: (m) => m.mode, text: true },
+      {
+        key: 'parity_residual',
+        name: 'Parity residual',
+        units: 'sigma',
+        source: 'health',
+        get: (m) => m.parity_residual
+      },
+      {
+        key: 'chi2',
+        name: 'Chi-squared',
+        source: 'health',
+        get: (m) => m.chi2,
+        limit: (m) => m.chi2_threshold
+      },
+      {
+        key: 'cusum',
+        name: 'CUSUM',
+        source: 'health',
+        get: (m) => m.cusum,
+        limit: (m) => m.cusum_threshold
+      },
+      {
+        key: 'health_age_s',
+        name: 'Health age',
+        units: 's',
+        source: 'link',
+        get: (m) => m.health_age_s,
+        limit: (m) => m.stale_after_s
+      },
+      { key: 'link', name: 'Link state', source: 'link', get: (m) => m.state, text: true }
+    ];
+    for (let g = 1; g <= gyroCount; g++) {
+      points.push({
+        key: 'gyro' + g + '_state',
+        name: 'Gyro ' + g + ' state',
+        source: 'health',
+        text: true,
+        get: (m) => (m.gyros[g - 1] ? m.gyros[g - 1].state : undefined)
+      });
+    }
+    return points;
+  }
+  function eventPoint() {
+    return {
+      key: 'events',
+      name: 'FDI events',
+      source: 'event',
+      text: true,
+      get: (m) => m.event + (m.gyro ? ' gyro ' + m.gyro : '') + (m.detail ? ': ' + m.detail : '')
+    };
+  }
+  function pointsOf(unit) {
+    return attitudePoints()
+      .concat(healthPoints(unit.gyro_count || 4))
+      .concat([eventPoint()]);
+  }
+
+  // --- the ground station's REST and stream ----------------------------------------------------
+  let unitsCache = null;
+  async function units() {
+    if (!unitsCache) {
+      const response = await fetch(base + '/api/units');
+      unitsCache = await response.json();
+      setTimeout(() => (unitsCache = null), 2000);
+    }
+    return unitsCache;
+  }
+  async function unitNamed(name) {
+    return (await units()).find((u) => u.unit === name) || { unit: name, gyro_count: 4 };
+  }
+
+  // One EventSource for the page; listeners by message type. The browser reconnects by itself and
+  // sends Last-Event-ID, so the ground resumes the stream where it broke off.
+  const listeners = { health: new Set(), attitude: new Set(), event: new Set(), link: new Set(), reset: new Set() };
+  const streamState = { connected: false, listeners: new Set() };
+  let source = null;
+  function stream() {
+    if (source) return;
+    source = new EventSource(base + '/api/stream');
+    for (const type of Object.keys(listeners)) {
+      source.addEventListener(type, (e) => {
+        const message = type === 'reset' ? {} : JSON.parse(e.data);
+        listeners[type].forEach((l) => l(message));
+      });
+    }
+    const setConnected = (c) => {
+      streamState.connected = c;
+      streamState.listeners.forEach((l) => l(c));
+    };
+    source.onopen = () => setConnected(true);
+    source.onerror = () => setConnected(false);
+  }
+  function listen(type, fn) {
+    stream();
+    listeners[type].add(fn);
+    return () => listeners[type].delete(fn);
+  }
+
+  function datum(point, message) {
+    const value = point.get(message);
+    const d = { utc: message.utc_ms, value: value === null || value === undefined ? NaN : value };
+    if (message.sensor_time_s !== undefined) d.sensor_time = message.sensor_time_s;
+    if (point.limit) d.limit = point.limit(message);
+    if (point.text && value === null) d.value = 'not available';
+    return d;
+  }
+
+  // --- object tree --------------------------------------------------------------------------------
+  const id = (key) => ({ namespace: NS, key });
+  function parseKey(key) {
+    const [kind, unit, point] = key.split('~');
+    return { kind, unit, point };
+  }
+  const objectProvider = {
+    async get(identifier) {
+      const key = identifier.key;
+      if (key === 'units') {
+        const list = await units();
+        return {
+          identifier,
+          name: 'tetra units',
+          type: 'folder',
+          location: 'ROOT',
+          composition: list.map((u) => id('unit~' + u.unit))
+        };
+      }
+      const { kind, unit, point } = parseKey(key);
+      const u = await unitNamed(unit);
+      if (kind === 'unit') {
+        return {
+          identifier,
+          name: 'Unit ' + unit,
+          type: 'tetra.unit',
+          location: NS + ':units',
+          unit,
+          composition: pointsOf(u).map((p) => id('point~' + unit + '~' + p.key))
+        };
+      }
+      const p = pointsOf(u).find((x) => x.key === point);
+      if (!p) return undefined;
+      const valueMeta = {
+        key: 'value',
+        name: p.name,
+        hints: { range: 1 }
+      };
+      if (p.text) {
+        valueMeta.format = 'string';
+      } else {
+        valueMeta.format = 'float';
+        if (p.units) valueMeta.unit = p.units;
+      }
+      return {
+        identifier,
+        name: p.name + ' (' + unit + ')',
+        type: p.text ? 'tetra.telemetry.text' : 'tetra.telemetry',
+        location: NS + ':unit~' + unit,
+        unit,
+        point: p.key,
+        telemetry: {
+          values: [
+            { key: 'utc', source: 'utc', name: 'UTC (DDS source timestamp)', format: 'utc', hints: { domain: 1 } },
+            { key: 'sensor_time', name: 'Sensor time', unit: 's', format: 'float', hints: { domain: 2 } },
+            valueMeta
+          ].concat(p.limit ? [{ key: 'limit', name: 'Limit', format: 'float' }] : [])
+        }
+      };
+    }
+  };
+
+  function pointOf(domainObject) {
+    return unitNamed(domainObject.unit).then((u) => pointsOf(u).find((p) => p.key === domainObject.point));
+  }
+  const isPoint = (o) => o.type === 'tetra.telemetry' || o.type === 'tetra.telemetry.text';
+
+  const realtimeProvider = {
+    supportsSubscribe: isPoint,
+    subscribe(domainObject, callback) {
+      let stop = () => {};
+      let cancelled = false;
+      pointOf(domainObject).then((p) => {
+        if (!p || cancelled) return;
+        stop = listen(p.source, (m) => {
+          if (m.unit === domainObject.unit) callback(datum(p, m));
+        });
+      });
+      return () => {
+        cancelled = true;
+        stop();
+      };
+    }
+  };
+
+  const historicalProvider = {
+    supportsRequest: isPoint,
+    async request(domainObject, opts) {
+      const p = await pointOf(domainObject);
+      if (!p || p.source === 'link') return [];
+      const url =
+        base +
+        '/api/history?unit=' +
+        encodeURIComponent(domainObject.unit) +
+        '&kind=' +
+        p.source +
+        '&start=' +
+        (opts.start || 0) +
+        '&end=' +
+        (opts.end || Date.now()) +
+        '&max=2000';
+      const response = await fetch(url);
+      if (!response.ok) return [];
+      const rows = await response.json();
+      return rows.map((m) => datum(p, m));
+    }
+  };
+
+  // Limits: the service's thresholds travel with each value; beyond them the value is red.
+  const limitProvider = {
+    supportsLimits: (o) => isPoint(o) && ['chi2', 'cusum', 'health_age_s'].includes(o.point),
+    getLimitEvaluator() {
+      return {
+        evaluate(d) {
+          if (typeof d.value === 'number' && typeof d.limit === 'number' && d.value > d.limit) {
+            return { cssClass: 'is-limit--upr is-limit--red', name: 'Above threshold' };
+          }
+          return undefined;
+        }
+      };
+    },
+    getLimits() {
+      return { limits: () => Promise.resolve({}) };
+    }
+  };
+
+  // --- commands -------------------------------------------------------------------------------------
+  function operatorId() {
+    return window.localStorage.getItem('tetra.operator') || 'operator';
+  }
+  async function sendCommand(openmct, command) {
+    const body = Object.assign({ operator: operatorId() }, command);
+    try {
+      const response = await fetch(base + '/api/command', {
+        method: 'POST',
+        headers: { 'Content-Type': 'application/json' },
+        body: JSON.stringify(body)
+      });
+      const answer = await response.json();
+      if (!response.ok) {
+        openmct.notifications.error('Command not sent: ' + answer.error);
+      } else if (answer.accepted) {
+        openmct.notifications.info('Accepted: ' + answer.detail);
+      } else {
+        openmct.notifications.alert('Refused: ' + answer.detail);
+      }
+      return answer;
+    } catch (err) {
+      openmct.notifications.error('Command failed: ' + err);
+      return { error: String(err) };
+    }
+  }
+  function describe(command) {
+    return command.action + (command.gyro ? ' gyro ' + command.gyro : '') + (command.force ? ' (FORCE)' : '');
+  }
+  //! Asks for confirmation, then sends; resolves with the acknowledgement (or null when cancelled).
+  function confirmAndSend(openmct, command) {
+    return new Promise((resolve) => {
+      const dialog = openmct.overlays.dialog({
+        iconClass: command.force ? 'error' : 'alert',
+        message:
+          'Send "' + describe(command) + '" to unit ' + command.unit + ' as operator "' + operatorId() + '"?',
+        buttons: [
+          {
+            label: 'Send command',
+            emphasis: true,
+            callback: async () => {
+              dialog.dismiss();
+              resolve(await sendCommand(openmct, command));
+            }
+          },
+          {
+            label: 'Cancel',
+            callback: () => {
+              dialog.dismiss();
+              resolve(null);
+            }
+          }
+        ]
+      });
+    });
+  }
+
+  // --- the unit status view (default display of a unit) ----------------------------------------------
+  function el(tag, attrs, text) {
+    const e = document.createElement(tag);
+    Object.entries(attrs || {}).forEach(([k, v]) => e.setAttribute(k, v));
+    if (text !== undefined) e.textContent = text;
+    return e;
+  }
+  const fmt = (v, digits) => (v === null || v === undefined || Number.isNaN(v) ? 'not available' : v.toFixed(digits));
+  const utcText = (ms) => (ms ? new Date(ms).toISOString().replace('T', ' ').replace('Z', ' UTC') : '-');
+
+  function unitView(openmct, domainObject) {
+    const unit = domainObject.unit;
+    const stops = [];
+    let root = null;
+    const state = { health: null, attitude: null, link: null, events: [] };
+    const MAX_EVENTS = 50;
+
+    function bar(label, value, limit) {
+      const row = el('div', { class: 'tetra-bar' });
+      row.appendChild(el('span', { class: 'tetra-bar__label' }, label));
+      const track = el('span', { class: 'tetra-bar__track' });
+      const available = typeof value === 'number';
+      const fraction = available && limit > 0 ? Math.min(1, value / limit) : 0;
+      const fill = el('span', {
+        class: 'tetra-bar__fill' + (available && value > limit ? ' tetra-bar__fill--over' : ''),
+        style: 'width:' + (100 * fraction).toFixed(1) + '%'
+      });
+      track.appendChild(fill);
+      row.appendChild(track);
+      row.appendChild(el('span', { class: 'tetra-bar__value' }, fmt(value, 2) + ' / ' + fmt(limit, 2)));
+      return row;
+    }
+
+    function commandButton(label, command) {
+      const b = el('button', { class: 'c-button tetra-command', 'data-command': describe(command) }, label);
+      b.addEventListener('click', async () => {
+        const answer = await confirmAndSend(openmct, command);
+        if (answer && root) {
+          const out = root.querySelector('#tetra-ack');
+          out.textContent =
+            answer.error !== undefined
+              ? 'error: ' + answer.error
+              : (answer.accepted ? 'ACCEPTED: ' : 'REFUSED: ') + answer.detail;
+          out.className = answer.accepted ? 'tetra-ack tetra-ack--ok' : 'tetra-ack tetra-ack--refused';
+        }
+      });
+      return b;
+    }
+
+    function render() {
+      if (!root) return;
+      const h = state.health;
+      const a = state.attitude;
+      const link = state.link ? state.link.state : 'WAITING';
+      const stale = link !== 'LIVE';
+      root.querySelector('#tetra-mode').textContent = h ? h.mode : 'no health yet';
+      root.querySelector('#tetra-mode').className = 'tetra-mode tetra-mode--' + (h ? h.mode : 'NONE');
+      const linkEl = root.querySelector('#tetra-link');
+      // A lost service means stale data too: both words, so STALE is always there to see.
+      linkEl.textContent = link === 'SERVICE LOST' ? 'STALE \u00b7 SERVICE LOST' : link;
+      linkEl.className = 'tetra-link tetra-link--' + link.replace(' ', '_');
+      root.querySelector('#tetra-ages').textContent = state.link
+        ? 'health age ' +
+          fmt(state.link.health_age_s, 1) +
+          ' s, attitude age ' +
+          fmt(state.link.attitude_age_s, 1) +
+          ' s (stale after ' +
+          fmt(state.link.stale_after_s, 1) +
+          ' s)'
+        : '';
+      root.classList.toggle('tetra-unit--stale', stale);
+      root.querySelector('#tetra-time').textContent = h
+        ? 'Health ' + utcText(h.utc_ms) + ' (sensor time ' + fmt(h.sensor_time_s, 3) + ' s)'
+        : '';
+
+      const gyros = root.querySelector('#tetra-gyros');
+      // Rebuilt only when it changes (buttons stay put while an operator reaches for them).
+      const gyroKey = h ? JSON.stringify([h.gyros, h.gyros_used]) : '';
+      if (h && gyros.dataset.key !== gyroKey) {
+        gyros.dataset.key = gyroKey;
+        gyros.innerHTML = '';
+        h.gyros.forEach((g) => {
+          const tr = el('tr', { class: 'tetra-gyro tetra-gyro--' + g.state, 'data-gyro': String(g.id) });
+          tr.appendChild(el('td', {}, String(g.id)));
+          tr.appendChild(el('td', { class: 'tetra-gyro__state' }, g.state));
+          tr.appendChild(el('td', {}, g.kind === 'none' ? '-' : g.kind));
+          tr.appendChild(el('td', {}, h.gyros_used.includes(g.id) ? 'used' : '-'));
+          const cmd = el('td');
+          if (g.state === 'excluded') {
+            cmd.appendChild(commandButton('Reinstate', { unit, action: 'reinstate', gyro: g.id }));
+          } else {
+            cmd.appendChild(commandButton('Exclude', { unit, action: 'exclude', gyro: g.id }));
+            cmd.appendChild(commandButton('Exclude (force)', { unit, action: 'exclude', gyro: g.id, force: true }));
+          }
+          tr.appendChild(cmd);
+          gyros.appendChild(tr);
+        });
+      }
+      const parity = root.querySelector('#tetra-parity');
+      parity.innerHTML = '';
+      if (h) {
+        if (!h.parity_available) {
+          parity.appendChild(el('div', { class: 'tetra-na' }, 'parity, chi2, CUSUM: not available (fewer than four gyros)'));
+        } else {
+          parity.appendChild(el('div', {}, 'parity residual ' + fmt(h.parity_residual, 2) + ' sigma'));
+          parity.appendChild(bar('chi2', h.chi2, h.chi2_threshold));
+          parity.appendChild(bar('CUSUM', h.cusum, h.cusum_threshold));
+        }
+      }
+      const att = root.querySelector('#tetra-attitude');
+      att.innerHTML = '';
+      if (a) {
+        att.appendChild(el('div', {}, 'q (w,x,y,z) = ' + a.q.map((v) => v.toFixed(6)).join(', ')));
+        att.appendChild(
+          el(
+            'div',
+            {},
+            'roll ' + a.euler_deg.roll.toFixed(3) + ' deg, pitch ' + a.euler_deg.pitch.toFixed(3) + ' deg, yaw ' +
+              a.euler_deg.yaw.toFixed(3) + ' deg'
+          )
+        );
+        att.appendChild(el('div', {}, 'rate ' + a.rate_dps.map((v) => v.toFixed(4)).join(', ') + ' deg/s'));
+        att.appendChild(
+          el('div', { id: 'tetra-sigma' }, 'sigma ' + a.sigma_deg.map((v) => v.toFixed(4)).join(', ') + ' deg')
+        );
+        att.appendChild(el('div', {}, utcText(a.utc_ms) + ' (sensor time ' + a.sensor_time_s.toFixed(3) + ' s)'));
+      }
+      const events = root.querySelector('#tetra-events');
+      const eventKey = String(state.events.length) + '/' + (state.events.length ? state.events[state.events.length - 1].utc_ms : 0);
+      if (events.dataset.key === eventKey) return;
+      events.dataset.key = eventKey;
+      events.innerHTML = '';
+      state.events
+        .slice()
+        .reverse()
+        .forEach((e) => {
+          const tr = el('tr', { class: 'tetra-event tetra-event--' + e.event });
+          tr.appendChild(el('td', {}, utcText(e.utc_ms)));
+          tr.appendChild(el('td', {}, fmt(e.sensor_time_s, 3)));
+          tr.appendChild(el('td', {}, e.event));
+          tr.appendChild(el('td', {}, e.gyro ? String(e.gyro) : '-'));
+          let detail = e.detail || e.kind || e.test || '';
+          if (e.operator) detail += ' [' + e.operator + ' @ ' + e.origin + (e.accepted ? ', accepted' : ', refused') + ']';
+          tr.appendChild(el('td', {}, detail));
+          events.appendChild(tr);
+        });
+    }
+
+    function skeleton() {
+      const r = el('div', { class: 'tetra-unit', 'data-unit': unit });
+      r.innerHTML =
+        '<div class="tetra-head"><span class="tetra-name"></span>' +
+        '<span id="tetra-mode" class="tetra-mode"></span><span id="tetra-link" class="tetra-link"></span>' +
+        '<span id="tetra-ages" class="tetra-ages"></span></div>' +
+        '<div id="tetra-time" class="tetra-time"></div>' +
+        '<div class="tetra-grid"><section><h2>Gyros</h2><table class="tetra-table"><thead><tr><th>gyro</th>' +
+        '<th>state</th><th>fault</th><th>solution</th><th>command</th></tr></thead><tbody id="tetra-gyros"></tbody>' +
+        '</table><div class="tetra-commands"></div><div id="tetra-ack" class="tetra-ack"></div>' +
+        '<label class="tetra-operator">operator <input id="tetra-operator" size="12"/></label></section>' +
+        '<section><h2>Parity and CUSUM</h2><div id="tetra-parity"></div><h2>Attitude</h2>' +
+        '<div id="tetra-attitude"></div></section></div>' +
+        '<section><h2>FDI events</h2><table class="tetra-table"><thead><tr><th>UTC</th><th>sensor time [s]</th>' +
+        '<th>event</th><th>gyro</th><th>detail</th></tr></thead><tbody id="tetra-events"></tbody></table></section>';
+      r.querySelector('.tetra-name').textContent = 'Unit ' + unit;
+      r.querySelector('.tetra-commands').appendChild(commandButton('FDI reset', { unit, action: 'reset' }));
+      const op = r.querySelector('#tetra-operator');
+      op.value = operatorId();
+      op.addEventListener('change', () => window.localStorage.setItem('tetra.operator', op.value));
+      return r;
+    }
+
+    return {
+      show(element) {
+        root = skeleton();
+        element.appendChild(root);
+        stops.push(
+          listen('health', (m) => {
+            if (m.unit !== unit) return;
+            state.health = m;
+            render();
+            // Latency from the service's write (DDS source timestamp) to this display, for
+            // bench/ground_latency.py (same host, same clock); the newest 10000.
+            const lat = (window.tetraHealthLatencyMs = window.tetraHealthLatencyMs || []);
+            lat.push(Date.now() - m.utc_ms);
+            if (lat.length > 10000) lat.shift();
+          })
+        );
+        stops.push(listen('attitude', (m) => m.unit === unit && ((state.attitude = m), render())));
+        stops.push(listen('link', (m) => m.unit === unit && ((state.link = m), render())));
+        stops.push(
+          listen('event', (m) => {
+            if (m.unit !== unit) return;
+            state.events.push(m);
+            if (state.events.length > MAX_EVENTS) state.events.shift();
+            render();
+          })
+        );
+        const lost = (connected) => {
+          if (!connected && root) {
+            state.link = Object.assign({}, state.link || {}, { state: 'GROUND LINK LOST' });
+            render();
+          }
+        };
+        streamState.listeners.add(lost);
+        stops.push(() => streamState.listeners.delete(lost));
+        fetch(base + '/api/history?unit=' + encodeURIComponent(unit) + '&kind=event&max=' + MAX_EVENTS)
+          .then((r) => (r.ok ? r.json() : []))
+          .then((rows) => {
+            const seen = new Set(state.events.map((e) => e.event_seq + '/' + e.utc_ms));
+            state.events = rows.filter((e) => !seen.has(e.event_seq + '/' + e.utc_ms)).concat(state.events);
+            state.events.sort((x, y) => x.utc_ms - y.utc_ms);
+            render();
+          });
+        render();
+      },
+      destroy() {
+        stops.forEach((s) => s());
+        root = null;
+      }
+    };
+  }
+
+  return function install(openmct) {
+    openmct.objects.addRoot(id('units'), openmct.priority.HIGH);
+    openmct.objects.addProvider(NS, objectProvider);
+    openmct.types.addType('tetra.unit', {
+      name: 'tetra unit',
+      description: 'A redundant gyro package and its fusion service',
+      cssClass: 'icon-telemetry'
+    });
+    openmct.types.addType('tetra.telemetry', { name: 'tetra telemetry', cssClass: 'icon-telemetry' });
+    openmct.types.addType('tetra.telemetry.text', { name: 'tetra state', cssClass: 'icon-telemetry' });
+    openmct.telemetry.addProvider(realtimeProvider);
+    openmct.telemetry.addProvider(historicalProvider);
+    openmct.telemetry.addProvider(limitProvider);
+    openmct.objectViews.addProvider({
+      key: 'tetra.unit-status',
+      name: 'Unit status',
+      cssClass: 'icon-layout',
+      canView: (o) => o.type === 'tetra.unit',
+      view: (o) => unitView(openmct, o),
+      priority: () => openmct.priority.HIGH
+    });
+    openmct.actions.register({
+      key: 'tetra.fdi-reset',
+      name: 'FDI reset (tetra)',
+      cssClass: 'icon-refresh',
+      group: 'action',
+      appliesTo: (objectPath) => objectPath[0] && objectPath[0].type === 'tetra.unit',
+      invoke: (objectPath) => confirmAndSend(openmct, { unit: objectPath[0].unit, action: 'reset' })
+    });
+  };
+}
