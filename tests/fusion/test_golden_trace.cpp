@@ -59,6 +59,7 @@ struct OperatorCommand {
   double at_s = 0.0;
   Op op = Op::kExclude;
   int gyro = 0;
+  bool force = false;  //!< exclude: even when the rest cannot determine the attitude
 };
 
 struct GoldenScenario {
@@ -179,8 +180,11 @@ std::vector<GoldenScenario> scenarios() {
   }
   {
     GoldenScenario g = base("operator_commands", "orbit", 200.0);
-    g.commands = {{20.0, Op::kExclude, 2},   {40.0, Op::kExclude, 7},   {60.0, Op::kExclude, 3},
-                  {80.0, Op::kReinstate, 2}, {90.0, Op::kReinstate, 2}, {120.0, Op::kReset, 0}};
+    // Gyro 2 out, a gyro that does not exist, gyro 1 refused (gyros 3 and 4 alone cannot determine the
+    // attitude), gyro 3 forced out (LOST), gyro 2 back, again (not excluded), reset.
+    g.commands = {{20.0, Op::kExclude, 2},       {40.0, Op::kExclude, 7},   {50.0, Op::kExclude, 1},
+                  {60.0, Op::kExclude, 3, true}, {80.0, Op::kReinstate, 2}, {90.0, Op::kReinstate, 2},
+                  {120.0, Op::kReset, 0}};
     add(g, {fault(1, K::kStuck, 150.0)});
   }
   {
@@ -268,7 +272,7 @@ std::string health_line(const fdi::Health& h) {
 fdi::FdiEvent apply(fdi::Pipeline& p, const OperatorCommand& c, std::int64_t stamp_ns) {
   switch (c.op) {
     case Op::kExclude:
-      return p.exclude(c.gyro, stamp_ns);
+      return p.exclude(c.gyro, stamp_ns, c.force);
     case Op::kReinstate:
       return p.reinstate(c.gyro, stamp_ns);
     case Op::kReset:
