@@ -15,9 +15,11 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "tetra/core/allan.hpp"
+#include "tetra/core/allan_kalibr.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/service/ros2_view_config.hpp"
 
 namespace tetra::cli {
 
@@ -169,6 +171,7 @@ int cmd_allan(int argc, char** argv) {
   std::string csv_path;
   std::string json_path;
   std::string plot_path;
+  std::string kalibr_path;
   double confidence = allan::kOneSigmaConfidence;
   double dt_tolerance = 0.05;
   app.add_option("log", log_path,
@@ -184,6 +187,10 @@ int cmd_allan(int argc, char** argv) {
   app.add_option("--csv", csv_path, "write gyro,tau_s,adev,adev_lo,adev_hi,n");
   app.add_option("--json", json_path, "write the noise terms as JSON (null = not observed)");
   app.add_option("--plot", plot_path, "write a log-log PNG plot (needs gnuplot)");
+  app.add_option(
+      "--kalibr", kalibr_path,
+      "write Kalibr's imu.yaml: gyroscope noise density and random walk of the body axes, in rad/s "
+      "(needs --calibration)");
   app.add_option("--confidence", confidence,
                  "two-sided confidence level of the intervals (default 0.683 = 1 sigma)");
   app.add_option("--dt-tolerance", dt_tolerance,
@@ -194,6 +201,8 @@ int cmd_allan(int argc, char** argv) {
   const std::string cmd = "allan";
   if (update_cal && cal_path.empty())
     return report(cmd, bad_input("--update-calibration needs --calibration CAL.yaml"));
+  if (!kalibr_path.empty() && cal_path.empty())
+    return report(cmd, bad_input("--kalibr needs --calibration CAL.yaml (the gyro axes)"));
   if (!(dt_tolerance > 0.0 && dt_tolerance < 0.5)) {
     return report(cmd,
                   bad_input("--dt-tolerance " + num(dt_tolerance) + ": expected a fraction in (0, 0.5)"));
@@ -249,6 +258,13 @@ int cmd_allan(int argc, char** argv) {
   }
   if (!json_path.empty()) {
     if (Status s = write_text_file(json_path, allan::format_json(*analysis)); !s)
+      return report(cmd, s.error());
+  }
+  if (!kalibr_path.empty()) {
+    auto noise = allan::kalibr_gyro_noise(*analysis, *cal);
+    if (!noise) return report(cmd, noise.error());
+    const std::string rostopic = "/tetra/" + service::ros2_name(cal->unit) + "/imu";  // the ROS 2 view's
+    if (Status s = write_text_file(kalibr_path, allan::format_kalibr(*noise, rostopic)); !s)
       return report(cmd, s.error());
   }
   if (!plot_path.empty()) {
