@@ -1,5 +1,8 @@
 #!/usr/bin/env bash
-# Installs what tetra needs to build, test and plot, from Debian 12's packages.
+# Installs what tetra needs from Debian 12's packages.
+#   setup.sh          what building and running the program needs (scripts/run.sh)
+#   setup.sh --test   that and what the test suite needs: GoogleTest, Google Benchmark, gnuplot (allan
+#                     --plot), clang (fuzzers), openssl (DDS Security PKI), iproute2 (netns tests)
 # As root it runs apt-get; otherwise it prints the exact command to run.
 set -euo pipefail
 
@@ -7,10 +10,15 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev
   cyclonedds-dev cyclonedds-tools
-  libgtest-dev libgmock-dev libbenchmark-dev
-  gnuplot-nox
-  clang libclang-rt-14-dev openssl iproute2   # reliability tests: fuzzers (clang), DDS Security PKI, netns
+  help2man                                    # man pages from the --help texts (cmake --install)
 )
+if [ "${1:-}" = "--test" ]; then
+  packages+=(
+    libgtest-dev libgmock-dev libbenchmark-dev
+    gnuplot-nox
+    clang libclang-rt-14-dev openssl iproute2   # reliability tests: fuzzers (clang), DDS Security PKI, netns
+  )
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -117,9 +118,6 @@ void every_topic_readable(dds::DataRepresentation representation, int domain) {
   // Two GyroSample readers: the service's and this test's.
   const auto sim = run_tetra(sim_args(domain, 2, flag));
   ASSERT_EQ(sim.exit_status, 0) << sim.err << sim.out << read_file(files.dir.file("fusion.log"));
-  const auto cmd =
-      run_tetra("command --unit tetra-1 reinstate 2 --domain " + std::to_string(domain) + " " + flag);
-  EXPECT_EQ(cmd.exit_status, 0) << cmd.err;
   const auto drain_all = [&] {
     gyro.drain();
     reference.drain();
@@ -128,6 +126,20 @@ void every_topic_readable(dds::DataRepresentation representation, int domain) {
     event.drain();
     command.drain();
   };
+  // `tetra command` writes once a Command reader has matched — this test's or the service's, whichever
+  // it discovers first — and then waits for the service's acknowledgement. Only the Command sample this
+  // test's reader receives matters here, so the exit status (1 when the service was not the first reader
+  // matched) is not checked; it is sent again until this reader has one.
+  for (int attempt = 0; attempt < 10 && command.count == 0; ++attempt) {
+    (void)run_tetra("command --unit tetra-1 reinstate 2 --timeout 2 --domain " + std::to_string(domain) +
+                    " " + flag);
+    poll_until(
+        [&] {
+          command.drain();
+          return command.count > 0;
+        },
+        2s);
+  }
   EXPECT_TRUE(poll_until([&] {
     drain_all();
     return gyro.count > 0 && reference.count > 0 && attitude.count > 0 && health.count > 0 &&
@@ -252,26 +264,31 @@ TEST(DdsInterop, Ros2ViewReadByPlainReadersWithRosTypeNamesTopicsAndQos) {
     ++compared;
   }
   EXPECT_GE(static_cast<std::size_t>(compared), epochs * 8 / 10);  // both sides of a stamp received
+  ASSERT_FALSE(imus.empty());
+  EXPECT_GT(imus.back().orientation_covariance[0], 0.0);  // grows as the rate is integrated
   // Imu: the body frame; covariances present for orientation and rate, "not measured" (-1) for acceleration.
   EXPECT_EQ(imu_frames_ok, static_cast<int>(imus.size()));
   for (const auto& m : imus) {
-    EXPECT_GT(m.orientation_covariance[0], 0.0);
+    EXPECT_GE(m.orientation_covariance[0], 0.0);  // 0 at the start: the initial attitude is given exactly
     EXPECT_GT(m.angular_velocity_covariance[0], 0.0);
     EXPECT_EQ(m.angular_velocity_covariance[1], m.angular_velocity_covariance[3]);  // symmetric
     EXPECT_EQ(m.linear_acceleration_covariance[0], -1.0);
   }
-  // Diagnostics: one status for the unit and one per gyro; gyro 2 stuck from 4 s -> excluded (ERROR) and
-  // the unit DEGRADED (WARN).
+  // Diagnostics: one status for the unit and one per gyro. The run goes NOMINAL (unit OK), then gyro 2
+  // stuck from 4 s is excluded (gyro ERROR, unit DEGRADED: WARN); before the first samples and after the
+  // last the unit is LOST (ERROR).
   ASSERT_FALSE(diagnostics.empty());
   ASSERT_EQ(diagnostics.front().size(), 5U);
   EXPECT_EQ(diagnostics.front()[0].name, "tetra/tetra_1: fusion");
   EXPECT_EQ(diagnostics.front()[0].hardware_id, "tetra-1");
-  EXPECT_EQ(diagnostics.front()[0].level, 0) << diagnostics.front()[0].message;
-  const auto& last = diagnostics.back();
-  ASSERT_EQ(last.size(), 5U);
-  EXPECT_EQ(last[0].level, 1) << last[0].message;
-  EXPECT_EQ(last[2].name, "tetra/tetra_1: gyro 2");
-  EXPECT_EQ(last[2].level, 2) << last[2].message;
+  EXPECT_EQ(diagnostics.front()[2].name, "tetra/tetra_1: gyro 2");
+  const auto seen = [&](int unit_level, int gyro2_level) {
+    return std::any_of(diagnostics.begin(), diagnostics.end(), [&](const std::vector<RosStatus>& d) {
+      return d.size() == 5 && d[0].level == unit_level && d[2].level == gyro2_level;
+    });
+  };
+  EXPECT_TRUE(seen(0, 0)) << "never NOMINAL";
+  EXPECT_TRUE(seen(1, 2)) << "never DEGRADED with gyro 2 excluded";
   EXPECT_EQ(fusion.signal_and_wait(SIGTERM), 0);
 }
 

@@ -83,7 +83,8 @@ std::optional<Eigen::Matrix3d> rate_covariance(const Calibration& calibration, G
   }
   Eigen::FullPivLU<Eigen::Matrix3d> lu(information);
   if (count < 3 || !lu.isInvertible()) return std::nullopt;
-  return lu.inverse();
+  const Eigen::Matrix3d inverse = lu.inverse();
+  return 0.5 * (inverse + inverse.transpose());  // exactly symmetric, as a covariance is
 }
 
 std::uint8_t diagnostic_level(fdi::Mode mode) {
