@@ -16,6 +16,8 @@ page() {  # page PROGRAM NAME-LINE
   name=$(basename "$program")
   help2man --no-info --no-discard-stderr --section=1 --version-string="$version" --name="$summary" \
     --output="$out/$name.1" "$program"
+  # A command's help says "Usage: CMD [OPTIONS]"; the synopsis gets the program's name in front.
+  [ "$name" = tetra ] || sed -i "s/^\.B ${name#tetra-}\$/.B tetra ${name#tetra-}/" "$out/$name.1"
   gzip -9nf "$out/$name.1"
 }
 
