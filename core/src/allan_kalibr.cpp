@@ -4,8 +4,8 @@
 #include <optional>
 
 #include <yaml-cpp/yaml.h>
-#include <Eigen/LU>
 
+#include "tetra/core/rate_covariance.hpp"
 #include "tetra/core/units.hpp"
 
 namespace tetra::allan {
@@ -13,14 +13,12 @@ namespace tetra::allan {
 namespace {
 
 //! Largest body-axis value of a white (or random-walk) term combined by least squares over gyros with
-//! per-gyro values `x` [same unit]: sqrt(max diag((Σ h hᵀ / x²)⁻¹)); nullopt if the axes do not span 3-D.
+//! per-gyro values `x`: sqrt(max diag((Σ h hᵀ / x²)⁻¹)); nullopt if the axes do not span 3-D.
 std::optional<double> body_axis_value(const std::vector<Eigen::Vector3d>& axes,
                                       const std::vector<double>& x) {
-  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < axes.size(); ++i) information += axes[i] * axes[i].transpose() / (x[i] * x[i]);
-  Eigen::FullPivLU<Eigen::Matrix3d> lu(information);
-  if (axes.size() < 3 || !lu.isInvertible()) return std::nullopt;
-  return std::sqrt(lu.inverse().diagonal().maxCoeff());
+  const auto covariance = least_squares_rate_covariance(axes, x);
+  if (!covariance) return std::nullopt;
+  return std::sqrt(covariance->diagonal().maxCoeff());
 }
 
 const GyroCalibration* find_gyro(const Calibration& calibration, int id) {

@@ -1,9 +1,10 @@
 #include "tetra/dds/ros2_view.hpp"
 
-#include <Eigen/LU>
+#include <cmath>
 
 #include "tetra/core/csv.hpp"
 #include "tetra/core/geometry.hpp"
+#include "tetra/core/rate_covariance.hpp"
 #include "tetra/core/units.hpp"
 
 namespace tetra::dds {
@@ -71,20 +72,16 @@ std::string ros2_imu_topic(const std::string& name) {
 
 std::optional<Eigen::Matrix3d> rate_covariance(const Calibration& calibration, GyroMask used,
                                                double sample_rate_hz, double default_arw_dps_rtHz) {
-  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
-  int count = 0;
+  std::vector<Eigen::Vector3d> axes;
+  std::vector<double> sigmas_rad_s;
   for (const GyroCalibration& gyro : calibration.gyros) {
     if (!has_gyro(used, gyro.id)) continue;
     const double arw_dps_rtHz =
         gyro.noise && gyro.noise->arw_dps_rtHz ? *gyro.noise->arw_dps_rtHz : default_arw_dps_rtHz;
-    const double sigma_rad_s = arw_dps_rtHz * kDegToRad * std::sqrt(sample_rate_hz);  // N / √dt
-    information += gyro.axis_B * gyro.axis_B.transpose() / (sigma_rad_s * sigma_rad_s);
-    ++count;
+    axes.push_back(gyro.axis_B);
+    sigmas_rad_s.push_back(arw_dps_rtHz * kDegToRad * std::sqrt(sample_rate_hz));  // N / √dt
   }
-  Eigen::FullPivLU<Eigen::Matrix3d> lu(information);
-  if (count < 3 || !lu.isInvertible()) return std::nullopt;
-  const Eigen::Matrix3d inverse = lu.inverse();
-  return 0.5 * (inverse + inverse.transpose());  // exactly symmetric, as a covariance is
+  return least_squares_rate_covariance(axes, sigmas_rad_s);
 }
 
 std::uint8_t diagnostic_level(fdi::Mode mode) {
@@ -154,9 +151,12 @@ Status Ros2View::publish(const fdi::AttitudeEstimate& attitude) {
   imu.angular_velocity.x = attitude.omega_B_rad_s.x();
   imu.angular_velocity.y = attitude.omega_B_rad_s.y();
   imu.angular_velocity.z = attitude.omega_B_rad_s.z();
-  const auto rate = rate_covariance(settings_.calibration, attitude.gyros, settings_.sample_rate_hz,
-                                    settings_.default_arw_dps_rtHz);
-  if (rate) {
+  if (!rate_covariance_ || rate_covariance_->first != attitude.gyros) {  // only when the gyros in use change
+    rate_covariance_.emplace(attitude.gyros,
+                             rate_covariance(settings_.calibration, attitude.gyros, settings_.sample_rate_hz,
+                                             settings_.default_arw_dps_rtHz));
+  }
+  if (const auto& rate = rate_covariance_->second) {
     set_covariance(imu.angular_velocity_covariance, *rate);
   } else {
     imu.angular_velocity_covariance[0] = kUnknownCovariance;

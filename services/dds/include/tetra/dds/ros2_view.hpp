@@ -7,6 +7,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -64,6 +65,8 @@ class Ros2View {
   std::optional<Writer<geometry_msgs_msg_dds__QuaternionStamped_>> attitude_writer_;
   std::optional<Writer<sensor_msgs_msg_dds__Imu_>> imu_writer_;
   std::optional<Writer<diagnostic_msgs_msg_dds__DiagnosticArray_>> diagnostics_writer_;
+  //! The rate covariance of the gyros last in use (computed again only when they change).
+  std::optional<std::pair<GyroMask, std::optional<Eigen::Matrix3d>>> rate_covariance_;
   // Storage the DiagnosticArray's strings and sequences point into (reused from one Health to the next).
   std::vector<std::array<std::string, 3>> status_text_;              //!< name, message, hardware_id
   std::vector<std::vector<std::array<std::string, 2>>> key_values_;  //!< key, value
