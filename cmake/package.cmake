@@ -21,11 +21,9 @@ set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_RECOMMENDS "gnuplot-nox")  # tetra allan --plot
 # Headers and static libraries: what tetraConfig.cmake and tetra.pc ask for.
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libeigen3-dev (>= 3.3), libyaml-cpp-dev, pkg-config")
-set(CPACK_COMPONENT_RUNTIME_DESCRIPTION
-    "calibration, Allan variance, simulation and fault-tolerant fusion for redundant gyro packages\n"
-    "The tetra program: calibration, Allan deviation, simulation with faults, the fusion and fault-detection\n"
-    "pipeline, and its DDS service and ground tools (Eclipse Cyclone DDS).")
-set(CPACK_COMPONENT_DEV_DESCRIPTION
-    "tetra's C++20 libraries: tetra::core, tetra::fdi, tetra::sim\n"
-    "Static libraries, headers, CMake package (find_package(tetra)) and pkg-config file (tetra.pc).")
+# Extended descriptions (the synopsis of both is CPACK_PACKAGE_DESCRIPTION_SUMMARY).
+set(CPACK_DEBIAN_RUNTIME_DESCRIPTION "The tetra program: turntable calibration, Allan deviation, simulation with faults, the fusion and
+fault-detection pipeline, and its DDS service and ground tools (Eclipse Cyclone DDS).")
+set(CPACK_DEBIAN_DEV_DESCRIPTION "The C++20 libraries tetra::core, tetra::fdi and tetra::sim: static libraries, headers, the CMake package (find_package(tetra)) and the pkg-config file (tetra.pc)
+of tetra's calibration, Allan analysis, fusion pipeline and simulator.")
 include(CPack)
