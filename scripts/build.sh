@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Configures and builds tetra in ./build (Release). Extra arguments go to cmake --build.
+# TETRA_BUILD_TESTS=OFF configures without the tests and benchmarks (and their packages); default ON.
 # ccache is used when installed (rebuilds of unchanged sources are then near free).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -7,5 +8,7 @@ launcher=()
 if command -v ccache >/dev/null; then
   launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 fi
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" >/dev/null
+tests=${TETRA_BUILD_TESTS:-ON}
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTETRA_BUILD_TESTS="$tests" -DTETRA_BUILD_BENCH="$tests" \
+  "${launcher[@]}" >/dev/null
 cmake --build build -j "$(nproc)" "$@"

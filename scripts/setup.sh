@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
-# Installs what tetra needs to build, test and plot, from Debian 12's packages, then the ground
-# station's web application (web/: Open MCT, pinned by web/package-lock.json) with `npm ci`.
+# Installs what tetra needs from Debian 12's packages, then the ground station's web application (web/:
+# Open MCT, pinned by web/package-lock.json) with `npm ci`.
+#   setup.sh          what building and running the program needs (scripts/run.sh)
+#   setup.sh --test   that and what the test suite needs: GoogleTest, Google Benchmark, gnuplot (allan
+#                     --plot), clang (fuzzers), openssl (DDS Security PKI), iproute2 (netns tests), chromium
+#                     and selenium (the ground station's browser test)
 # As root it runs apt-get; otherwise it prints the exact command to run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,14 +13,19 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev
   cyclonedds-dev cyclonedds-tools
-  libgtest-dev libgmock-dev libbenchmark-dev
-  gnuplot-nox
-  clang libclang-rt-14-dev openssl iproute2   # reliability tests: fuzzers (clang), DDS Security PKI, netns
-  libcpp-httplib-dev nlohmann-json3-dev        # tetra ground: HTTP server, JSON
-  chromium chromium-driver python3-selenium    # the ground station's browser test
+  libcpp-httplib-dev nlohmann-json3-dev       # tetra ground: HTTP server, JSON
+  help2man                                    # man pages from the --help texts (cmake --install)
 )
 # Node.js and npm for web/ (Debian's nodejs and npm, unless a node with npm is already installed).
 command -v npm >/dev/null || packages+=(nodejs npm)
+if [ "${1:-}" = "--test" ]; then
+  packages+=(
+    libgtest-dev libgmock-dev libbenchmark-dev
+    gnuplot-nox
+    clang libclang-rt-14-dev openssl iproute2   # reliability tests: fuzzers (clang), DDS Security PKI, netns
+    chromium chromium-driver python3-selenium    # the ground station's browser test
+  )
+fi
 
 # The web application's packages: `npm ci` installs exactly the versions of web/package-lock.json.
 web_packages() {

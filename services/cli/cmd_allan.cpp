@@ -16,12 +16,14 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "tetra/core/allan.hpp"
+#include "tetra/core/allan_kalibr.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/input_files.hpp"
 #include "tetra/core/output_files.hpp"
 #include "tetra/core/provenance.hpp"
+#include "tetra/service/ros2_view_config.hpp"
 
 namespace tetra::cli {
 
@@ -178,6 +180,7 @@ int cmd_allan(int argc, char** argv) {
   std::string csv_path;
   std::string json_path;
   std::string plot_path;
+  std::string kalibr_path;
   double confidence = allan::kOneSigmaConfidence;
   double dt_tolerance = 0.05;
   app.add_option("log", log_path,
@@ -193,6 +196,10 @@ int cmd_allan(int argc, char** argv) {
   app.add_option("--csv", csv_path, "write gyro,tau_s,adev,adev_lo,adev_hi,n");
   app.add_option("--json", json_path, "write the noise terms as JSON (null = not observed)");
   app.add_option("--plot", plot_path, "write a log-log PNG plot (needs gnuplot)");
+  app.add_option(
+      "--kalibr", kalibr_path,
+      "write Kalibr's imu.yaml: gyroscope noise density and random walk of the body axes, in rad/s "
+      "(needs --calibration)");
   app.add_option("--confidence", confidence,
                  "two-sided confidence level of the intervals (default 0.683 = 1 sigma)");
   app.add_option("--dt-tolerance", dt_tolerance,
@@ -203,6 +210,8 @@ int cmd_allan(int argc, char** argv) {
   const std::string cmd = "allan";
   if (update_cal && cal_path.empty())
     return report(cmd, bad_input("--update-calibration needs --calibration CAL.yaml"));
+  if (!kalibr_path.empty() && cal_path.empty())
+    return report(cmd, bad_input("--kalibr needs --calibration CAL.yaml (the gyro axes)"));
   if (!(dt_tolerance > 0.0 && dt_tolerance < 0.5)) {
     return report(cmd,
                   bad_input("--dt-tolerance " + num(dt_tolerance) + ": expected a fraction in (0, 0.5)"));
@@ -219,10 +228,11 @@ int cmd_allan(int argc, char** argv) {
   OutputFile* csv_out = nullptr;
   OutputFile* json_out = nullptr;
   OutputFile* plot_out = nullptr;
+  OutputFile* kalibr_out = nullptr;
   OutputFile* cal_out = nullptr;
   for (auto [path, label, slot] :
        {std::tuple{&csv_path, "--csv", &csv_out}, std::tuple{&json_path, "--json", &json_out},
-        std::tuple{&plot_path, "--plot", &plot_out}}) {
+        std::tuple{&plot_path, "--plot", &plot_out}, std::tuple{&kalibr_path, "--kalibr", &kalibr_out}}) {
     if (path->empty()) continue;
     auto out = files.add(*path, label);
     if (!out) return report(cmd, out.error());
@@ -285,6 +295,12 @@ int cmd_allan(int argc, char** argv) {
   }
   if (plot_out) {
     if (Status s = write_plot(*plot_out, *analysis, confidence); !s) return report(cmd, s.error());
+  }
+  if (kalibr_out) {
+    auto noise = allan::kalibr_gyro_noise(*analysis, *cal);
+    if (!noise) return report(cmd, noise.error());
+    const std::string rostopic = "/tetra/" + service::ros2_name(cal->unit) + "/imu";  // the ROS 2 view's
+    if (Status s = kalibr_out->write(allan::format_kalibr(*noise, rostopic)); !s) return report(cmd, s.error());
   }
   if (cal_out) {
     if (Status s = allan::update_calibration_noise(*cal, *analysis); !s) return report(cmd, s.error());

@@ -27,6 +27,16 @@ void add_domain_option(CLI::App& app, dds_domainid_t& domain) {
         dds::set_security_profile(std::move(profile).value());
       },
       "DDS Security profile YAML of this participant's role (scripts/security/make_pki.sh)");
+  // Every type is @final: its writers can send either encoding (docs/dds.md, "Data representation").
+  app.add_option_function<std::string>(
+         "--data-representation",
+         [](const std::string& name) {
+           dds::set_data_representation(name == "xcdr2" ? dds::DataRepresentation::kXcdr2
+                                                        : dds::DataRepresentation::kXcdr1);
+         },
+         "CDR encoding of this process's writers: xcdr1 (default; every DDS-XTypes reader accepts it) or "
+         "xcdr2 (for XCDR2-only readers); its readers accept both")
+      ->check(CLI::IsMember({"xcdr1", "xcdr2"}));
 }
 
 std::int64_t monotonic_ns() {

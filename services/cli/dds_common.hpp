@@ -13,7 +13,8 @@
 namespace tetra::cli {
 
 //! Adds `--domain ID` (default: DDS_DOMAIN_DEFAULT, i.e. the Cyclone configuration's, normally 0) and
-//! `--security PROFILE.yaml` (opt-in DDS Security for every participant of the process).
+//! `--security PROFILE.yaml` (opt-in DDS Security for every participant of the process) and
+//! `--data-representation xcdr1|xcdr2` (the encoding of the process's writers).
 void add_domain_option(CLI::App& app, dds_domainid_t& domain);
 
 //! [ns] local monotonic clock (for latency limits and periods; never on the wire).

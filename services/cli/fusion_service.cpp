@@ -50,6 +50,11 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown)
                       dds::Writer<tetra_FdiEvent>::create(*participant_, t.event, dds::event_qos()));
       !s)
     return s;
+  if (config_.ros2.enabled) {
+    dds::Ros2View::Settings ros2{config_.ros2.resolved(config_.unit), config_.unit, config_.calibration,
+                                 config_.sample_rate_hz, config_.pipeline.default_arw_dps_rtHz};
+    if (auto s = assign(ros2_view_, dds::Ros2View::create(*participant_, std::move(ros2))); !s) return s;
+  }
   if (auto s = gyro_reader_->enable_statuses(DDS_REQUESTED_DEADLINE_MISSED_STATUS |
                                              DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
                                              DDS_SUBSCRIPTION_MATCHED_STATUS);
@@ -363,6 +368,9 @@ Status FusionService::process_epochs(std::int64_t now_ns) {
       tetra_Attitude wire{};
       if (auto s = dds::to_wire(config_.unit, result.attitude, wire); !s) return s;
       if (auto s = attitude_writer_->write(wire); !s) return s;
+      if (ros2_view_) {
+        if (auto s = ros2_view_->publish(result.attitude); !s) return s;
+      }
     }
     if (auto s = publish_health(now_ns, false); !s) return s;
   }
@@ -412,6 +420,9 @@ Status FusionService::publish_health(std::int64_t now_ns, bool force) {
   wire.msg.gyro_writers = gyro_writers_;
   wire.msg.health_period_s = config_.health_period_s;
   if (auto s = health_writer_->write(wire.msg); !s) return s;
+  if (ros2_view_) {
+    if (auto s = ros2_view_->publish(health); !s) return s;
+  }
   if (last_health_) {
     *last_health_ = health;  // reuses the storage
   } else {

@@ -19,6 +19,7 @@
 #include "tetra/core/result.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
+#include "tetra/dds/ros2_view.hpp"
 #include "tetra/dds/shutdown.hpp"
 #include "tetra/dds/topics.hpp"
 #include "tetra/fdi/pipeline.hpp"
@@ -110,6 +111,7 @@ class FusionService {
   std::optional<dds::Writer<tetra_Attitude>> attitude_writer_;
   std::optional<dds::Writer<tetra_Health>> health_writer_;
   std::optional<dds::Writer<tetra_FdiEvent>> event_writer_;
+  std::optional<dds::Ros2View> ros2_view_;  //!< `ros2: enabled: true` (docs/ros2.md)
   std::vector<dds::Condition> conditions_;
   std::optional<dds::Condition> wake_;  //!< the listener wakes the waitset thread for an epoch's deadline
   std::optional<dds::WaitSet> waitset_;

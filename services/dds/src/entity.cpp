@@ -10,6 +10,16 @@ Error dds_error(const std::string& what, dds_return_t rc) {
 
 namespace {
 
+DataRepresentation& process_data_representation() {
+  static DataRepresentation representation = DataRepresentation::kXcdr1;
+  return representation;
+}
+
+dds_data_representation_id_t wire_id(DataRepresentation representation) {
+  return representation == DataRepresentation::kXcdr1 ? DDS_DATA_REPRESENTATION_XCDR1
+                                                      : DDS_DATA_REPRESENTATION_XCDR2;
+}
+
 std::optional<service::SecurityProfile>& process_security_profile() {
   static std::optional<service::SecurityProfile> profile;
   return profile;
@@ -36,6 +46,13 @@ void set_security_properties(dds_qos_t* qos, const service::SecurityProfile& p) 
 }
 
 }  // namespace
+
+void set_data_representation(DataRepresentation representation) {
+  process_data_representation() = representation;
+}
+DataRepresentation data_representation() {
+  return process_data_representation();
+}
 
 void set_security_profile(std::optional<service::SecurityProfile> profile) {
   process_security_profile() = std::move(profile);
@@ -93,6 +110,23 @@ Qos& Qos::partition(const std::string& name) {
   dds_qset_partition1(qos_, name.c_str());
   return *this;
 }
+Qos& Qos::data_representation(DataRepresentation representation) {
+  const dds_data_representation_id_t id = wire_id(representation);
+  dds_qset_data_representation(qos_, 1, &id);
+  return *this;
+}
+Qos& Qos::accept_xcdr1_and_xcdr2() {
+  const dds_data_representation_id_t ids[] = {DDS_DATA_REPRESENTATION_XCDR1, DDS_DATA_REPRESENTATION_XCDR2};
+  dds_qset_data_representation(qos_, 2, ids);
+  return *this;
+}
+bool Qos::has_data_representation() const {
+  uint32_t n = 0;
+  dds_data_representation_id_t* ids = nullptr;
+  const bool present = dds_qget_data_representation(qos_, &n, &ids);
+  dds_free(ids);
+  return present;
+}
 Qos Qos::copy() const {
   Qos out;
   (void)dds_copy_qos(out.qos_, qos_);
@@ -106,6 +140,17 @@ std::string unit_partition(const std::string& unit) {
 Qos Participant::endpoint_qos(const Qos& qos) const {
   Qos out = qos.copy();
   if (!partition_.empty()) out.partition(partition_);
+  return out;
+}
+
+Qos Participant::writer_qos(const Qos& qos) const {
+  Qos out = endpoint_qos(qos);
+  if (!out.has_data_representation()) out.data_representation(process_data_representation());
+  return out;
+}
+Qos Participant::reader_qos(const Qos& qos) const {
+  Qos out = endpoint_qos(qos);
+  if (!out.has_data_representation()) out.accept_xcdr1_and_xcdr2();
   return out;
 }
 

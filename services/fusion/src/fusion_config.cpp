@@ -52,7 +52,7 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
   if (auto keys =
           reader.check_keys(root,
                             {"unit", "calibration", "sample_rate_hz", "speed", "tolerance_s", "max_latency_s",
-                             "health_period_s", "gyro_dispatch", "pipeline", "security"},
+                             "health_period_s", "gyro_dispatch", "pipeline", "security", "ros2"},
                             "");
       !keys) {
     return keys.error();
@@ -76,6 +76,10 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
       auto profile = read_security_profile(profile_path.string());
       if (!profile) return bad_input(reader.at(value) + "security: " + profile.error().message);
       config.security = std::move(profile).value();
+    } else if (key == "ros2") {
+      auto ros2 = ros2_view_config_from_yaml(value, reader);
+      if (!ros2) return ros2.error();
+      config.ros2 = std::move(ros2).value();
     } else if (key == "pipeline") {
       auto pipeline = fdi::pipeline_config_from_yaml(value, source);
       if (!pipeline) return pipeline.error();
@@ -137,6 +141,7 @@ std::string describe(const FusionConfig& config) {
       << "gyro_dispatch: " << (config.gyro_dispatch == GyroDispatch::kListener ? "listener" : "waitset")
       << '\n'
       << (config.security ? describe(*config.security) : std::string("security: none")) << '\n'
+      << describe(config.ros2, config.unit) << '\n'
       << "pipeline:\n"
       << fdi::describe(config.pipeline);
   return out.str();

@@ -25,6 +25,16 @@ namespace tetra::dds {
 //! "what: dds_strretcode(rc)" as a failure.
 Error dds_error(const std::string& what, dds_return_t rc);
 
+//! The CDR encoding a writer sends (DDS-XTypes data representation). Every tetra type is @final, so
+//! either works; a writer offers exactly one, and a reader matches a writer only if it accepts that one
+//! (docs/dds.md, "Data representation"). tetra's readers accept both.
+enum class DataRepresentation { kXcdr1, kXcdr2 };
+
+//! The representation of every writer this process creates from now on (default XCDR1, which every
+//! DDS-XTypes reader accepts by default), unless the writer's QoS names its own.
+void set_data_representation(DataRepresentation representation);
+DataRepresentation data_representation();
+
 //! DDS Security for every participant this process creates from now on; nullopt (the default): none.
 //! The profile's documents become the participant's dds.sec.* QoS properties (docs/reliability.md).
 void set_security_profile(std::optional<service::SecurityProfile> profile);
@@ -76,6 +86,10 @@ class Qos {
   //! Keep instances when a writer is deleted (no dispose), so readers see "no writers", not "disposed".
   Qos& no_autodispose();
   Qos& partition(const std::string& name);
+  //! A writer's one representation, or the list a reader accepts.
+  Qos& data_representation(DataRepresentation representation);
+  Qos& accept_xcdr1_and_xcdr2();
+  bool has_data_representation() const;
   Qos copy() const;
 
   const dds_qos_t* get() const { return qos_; }
@@ -101,6 +115,10 @@ class Participant {
   const std::string& partition() const { return partition_; }
   //! `qos` in this participant's partition, for a reader or writer.
   Qos endpoint_qos(const Qos& qos) const;
+  //! endpoint_qos() with the process's data representation (set_data_representation) unless `qos` has one.
+  Qos writer_qos(const Qos& qos) const;
+  //! endpoint_qos() accepting XCDR1 and XCDR2 unless `qos` restricts it.
+  Qos reader_qos(const Qos& qos) const;
 
  private:
   Participant(Entity entity, std::string partition)
@@ -128,7 +146,7 @@ template <class T>
 class Writer {
  public:
   static Result<Writer> create(const Participant& participant, const Topic& topic, const Qos& qos) {
-    const Qos endpoint = participant.endpoint_qos(qos);
+    const Qos endpoint = participant.writer_qos(qos);
     const dds_entity_t handle =
         dds_create_writer(participant.handle(), topic.handle(), endpoint.get(), nullptr);
     if (handle < 0) return dds_error("create writer " + topic.name(), handle);
@@ -171,7 +189,7 @@ template <class T>
 class Reader {
  public:
   static Result<Reader> create(const Participant& participant, const Topic& topic, const Qos& qos) {
-    const Qos endpoint = participant.endpoint_qos(qos);
+    const Qos endpoint = participant.reader_qos(qos);
     const dds_entity_t handle =
         dds_create_reader(participant.handle(), topic.handle(), endpoint.get(), nullptr);
     if (handle < 0) return dds_error("create reader " + topic.name(), handle);

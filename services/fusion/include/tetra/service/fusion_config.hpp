@@ -11,6 +11,7 @@
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/config.hpp"
 #include "tetra/service/epoch_assembler.hpp"
+#include "tetra/service/ros2_view_config.hpp"
 #include "tetra/service/security_profile.hpp"
 
 namespace tetra::service {
@@ -36,6 +37,7 @@ struct FusionConfig {
   Calibration calibration;                               //!< read from calibration_path
   std::optional<SecurityProfile> security;  //!< `security: PROFILE.yaml` (opt-in DDS Security; relative: to
                                             //!< the config file)
+  Ros2ViewConfig ros2;                      //!< `ros2:` the optional ROS 2 view (docs/ros2.md)
   std::string source;                       //!< the config file, for messages
 
   //! [ns] wall-clock time after which a silent gyro is absent: 3 sample periods / speed.
