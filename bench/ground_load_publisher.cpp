@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
             names[u], static_cast<std::uint64_t>(k / event_every + 1), 0, fdi::FdiEvent{}, {}};
         view.event.stamp_ns = a.stamp_ns;
         view.event.type = fdi::EventType::kDetected;
-        view.event.test = "chi2";
+        view.event.test = fdi::DetectionTest::kChi2;
         tetra_FdiEvent event_wire{};
         if (dds::to_wire(view, event_wire) && event_writer.write(event_wire)) ++events;
       }

@@ -41,7 +41,7 @@ struct LoopFiles {
 };
 
 TEST(DdsClosedLoop, LockstepEqualsInProcessBitForBit) {
-  const int domain = 181;
+  const int domain = 211;
   LoopFiles files(10.0, 120.0, 1.0);
   const auto local =
       run_tetra("sim " + files.scenario + " --closed-loop --pointing " + files.dir.file("local.csv"));
@@ -63,7 +63,7 @@ TEST(DdsClosedLoop, LockstepEqualsInProcessBitForBit) {
 // is the scenario's 0.05°; the measured maximum is about 0.0003° (a margin of two orders of magnitude,
 // for a loaded machine where Attitudes come late and the controller holds its command).
 TEST(DdsClosedLoop, RealTimeAt100HzHoldsThePointingBound) {
-  const int domain = 182;
+  const int domain = 212;
   LoopFiles files(100.0, 20.0, 1.0);
   TetraProcess fusion({"fusion", "--config", files.config, "--domain", std::to_string(domain)},
                       files.dir.file("fusion.log"));

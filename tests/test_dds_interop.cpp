@@ -153,11 +153,11 @@ void every_topic_readable(dds::DataRepresentation representation, int domain) {
 }
 
 TEST(DdsInterop, EveryTopicReadableByAnXcdr1OnlyReader) {
-  every_topic_readable(dds::DataRepresentation::kXcdr1, 181);
+  every_topic_readable(dds::DataRepresentation::kXcdr1, 213);
 }
 
 TEST(DdsInterop, EveryTopicReadableByAnXcdr2OnlyReader) {
-  every_topic_readable(dds::DataRepresentation::kXcdr2, 182);
+  every_topic_readable(dds::DataRepresentation::kXcdr2, 214);
 }
 
 // --- ROS 2 view ---------------------------------------------------------------------------------
@@ -177,7 +177,7 @@ std::int64_t stamp_of(const builtin_interfaces_msg_dds__Time_& t) {
 }
 
 TEST(DdsInterop, Ros2ViewReadByPlainReadersWithRosTypeNamesTopicsAndQos) {
-  const int domain = 183;
+  const int domain = 215;
   ServiceFiles files("ros2:\n  enabled: true\n");
   TetraProcess fusion({"fusion", "--config", files.config, "--domain", std::to_string(domain)},
                       files.dir.file("fusion.log"));

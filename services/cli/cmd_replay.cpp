@@ -171,8 +171,7 @@ int cmd_replay(int argc, char** argv) {
   // Commands after the last epoch: acknowledged (their other effects would show on a next epoch).
   for (; next_command < commands.size(); ++next_command) {
     events += fdi::to_json(apply(*pipeline, commands[next_command]), n);
-    events += '
-';
+    events += '\n';
   }
   if (auto st = (*attitude_out)->write(att); !st) return report("replay", st.error());
   if (auto st = (*events_out)->write(events); !st) return report("replay", st.error());
