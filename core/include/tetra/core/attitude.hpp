@@ -1,8 +1,10 @@
 #pragma once
 // Attitude propagation from body rates, with a per-axis uncertainty.
 //
-//   q_RB ← q_RB ⊗ exp(½ ω Δt)   (exact exponential map, quaternion.hpp), ω = ω_B − ω_e^B in ground mode,
-//   where ω_e^B = C_BL·ω_e^L is the Earth rate seen in B at the current attitude relative to the lab L.
+//   q_RB ← q_RB ⊗ exp(½ ω Δt)   (exact exponential map, quaternion.hpp); in ground mode (R = the lab L, which
+//   turns with the Earth) q_LB ← exp(−½ ω_e^L Δt) ⊗ q_LB ⊗ exp(½ ω_B Δt): exact for the measured rate ω_B
+//   constant in B and the Earth rate ω_e^L constant in L over the step. The published rate relative to L is
+//   ω_B − ω_e^B, with ω_e^B = C_BL·ω_e^L the Earth rate seen in B at the current attitude.
 //
 // Uncertainty per body axis a, three independent parts added in quadrature:
 //   random:     σ²_rand,a += N²_a·Δt          (white rate noise N_a [rad/√s]: grows with √t)
