@@ -293,6 +293,15 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   e.evidence = iso.evidence;
   e.test = iso.test;
   e.statistic = iso.statistic;
+  if (!config_.exclusion_enabled) {
+    // An experiment that measures what exclusion is worth: the finding is reported, the gyro stays in the
+    // solution, and detection starts again (a fault that persists is found again).
+    e.detail = "exclusion_enabled is false: gyro kept";
+    emit(std::move(e));
+    restart_detectors();
+    update_mode(now);
+    return;
+  }
   emit(std::move(e));
   gyro_set_.exclude(iso.gyro, iso.kind);
   restart_detectors();

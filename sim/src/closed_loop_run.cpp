@@ -60,13 +60,6 @@ Result<EstimatorOutput> PipelineEstimator::estimate(const SimEpoch& epoch) {
   EstimatorOutput out;
   if (step.accepted) out.latest = step.attitude;
   out.events = step.events;
-  if (!pipeline_.config().exclusion_enabled) {
-    for (const fdi::FdiEvent& e : step.events) {
-      if (e.type == fdi::EventType::kIsolated && e.gyro) {
-        (void)pipeline_.reinstate(*e.gyro, epoch.stamp_ns);  // its acknowledgement comes with the next step
-      }
-    }
-  }
   return out;
 }
 

@@ -36,8 +36,8 @@ class Estimator {
   virtual Result<EstimatorOutput> estimate(const SimEpoch& epoch) = 0;
 };
 
-//! The fusion pipeline in process. With `exclusion_enabled: false` in its configuration, a gyro the
-//! pipeline excludes is reinstated on the same epoch (it keeps detecting and isolating).
+//! The fusion pipeline in process (with `exclusion_enabled: false` in its configuration it reports isolations
+//! and keeps the gyros).
 class PipelineEstimator final : public Estimator {
  public:
   //! `initial_q_NB`: the pipeline starts from the true initial attitude (as after star-tracker
