@@ -266,8 +266,9 @@ TEST_P(DdsReplayEquivalence, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitude
   EXPECT_FALSE(dds_events.empty());
   EXPECT_NE(dds_events.find("\"event\": \"command\""), std::string::npos);
   EXPECT_EQ(dds_events, read_file(files.dir.file("replay_ev.jsonl")));
-  // Same epochs, attitudes equal to 1e-9 (the bound; both run the same code on the same
-  // doubles, so in practice they are identical).
+  // Same epochs, the same attitudes bit for bit: both run the same pipeline on the same doubles (the log
+  // keeps every raw value and time in shortest round-trip text) and both write shortest round-trip text, so
+  // the parsed numbers are equal, not merely close.
   // Attitude is keep-last 1 (the latest is what matters): the recorder may miss some under load
   // (see the end-to-end test). Every attitude it did receive must equal replay's attitude of the same
   // epoch, and it must have received at least 95 %.
@@ -281,8 +282,7 @@ TEST_P(DdsReplayEquivalence, ReplayOfTheRecordedLogGivesTheSameEventsAndAttitude
     const auto it = replay_row.find(a.numbers[k][0]);
     ASSERT_NE(it, replay_row.end()) << "an epoch replay did not see: t = " << a.numbers[k][0];
     for (std::size_t j = 1; j < 9; ++j) {
-      ASSERT_NEAR(a.numbers[k][j], b.numbers[it->second][j], 1e-9)
-          << "t = " << a.numbers[k][0] << " column " << j;
+      ASSERT_EQ(a.numbers[k][j], b.numbers[it->second][j]) << "t = " << a.numbers[k][0] << " column " << j;
     }
     ASSERT_EQ(a.labels[k], b.labels[it->second]) << "t = " << a.numbers[k][0];
   }
