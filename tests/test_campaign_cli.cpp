@@ -41,6 +41,7 @@ TEST(CampaignCli, RunsResumesAndReports) {
     EXPECT_NE(rows[i].find(fault_free ? ",none," : ",right,"), std::string::npos) << rows[i];
   }
   const std::string report = read_file(out + "/report.md");
+  EXPECT_NE(report.find("10 runs"), std::string::npos) << report;  // every row read back
   EXPECT_NE(report.find("## Wrong exclusions\n\nNone."), std::string::npos) << report;
 
   // Interrupted: the last row torn in the middle and another missing. Resuming redoes exactly those.

@@ -58,7 +58,7 @@ struct ServiceFiles {
 };
 
 //! 9 s of orbit at 100 Hz, 10 times faster than real time, a 1 Hz attitude reference, gyro 2 stuck from 4 s.
-std::string sim_args(int domain, int wait_readers, const std::string& extra = "") {
+std::string sim_args(dds_domainid_t domain, int wait_readers, const std::string& extra = "") {
   return "sim orbit --dds --dds-unit tetra-1 --domain " + std::to_string(domain) +
          " --rate-hz 100 --minutes 0.15 --reference-hz 1 --speed 10 --fault gyro=2,kind=stuck,at=4 "
          "--wait-readers " +
@@ -94,7 +94,7 @@ Counted<T> counted_reader(const dds::Participant& p, const dds::Topic& topic, dd
 
 // Every topic is @final, so a reader restricted to one representation can be created for each; the
 // processes' writers send the representation `--data-representation` names, and the reader receives.
-void every_topic_readable(dds::DataRepresentation representation, int domain) {
+void every_topic_readable(dds::DataRepresentation representation, dds_domainid_t domain) {
   const std::string flag = representation == dds::DataRepresentation::kXcdr1 ? "--data-representation xcdr1"
                                                                              : "--data-representation xcdr2";
   ServiceFiles files;
@@ -177,7 +177,7 @@ std::int64_t stamp_of(const builtin_interfaces_msg_dds__Time_& t) {
 }
 
 TEST(DdsInterop, Ros2ViewReadByPlainReadersWithRosTypeNamesTopicsAndQos) {
-  const int domain = 215;
+  const dds_domainid_t domain = 215;
   ServiceFiles files("ros2:\n  enabled: true\n");
   TetraProcess fusion({"fusion", "--config", files.config, "--domain", std::to_string(domain)},
                       files.dir.file("fusion.log"));

@@ -229,10 +229,12 @@ std::string wrong_section(const std::vector<CampaignRow>& rows) {
   std::string out;
   for (const CampaignRow& r : rows) {
     if (r.fdi.outcome != Outcome::kWrong) continue;
-    out += fmt::format(
-        "- run {}: {} gyro={} kind={} at={} size={} seed={} → isolated gyro {}\n", r.run, r.scenario, r.gyro,
-        r.kind, g(r.onset_s), g(r.size), r.seed,
-        r.fdi.isolated_gyro ? std::to_string(*r.fdi.isolated_gyro) : std::string("(before the onset)"));
+    const std::string fault = r.kind == "none" ? std::string("no fault")
+                                               : fmt::format("gyro={},kind={},at={},size={}", r.gyro, r.kind,
+                                                             g(r.onset_s), g(r.size));
+    out += fmt::format("- run {}: {} {}, seed {} → healthy gyro {} isolated at t = {} s\n", r.run, r.scenario,
+                       fault, r.seed, r.fdi.wrong_gyro ? std::to_string(*r.fdi.wrong_gyro) : std::string("?"),
+                       r.fdi.wrong_at_s ? g(*r.fdi.wrong_at_s) : std::string("?"));
   }
   return out.empty() ? "None.\n" : out;
 }

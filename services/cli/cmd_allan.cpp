@@ -1,7 +1,4 @@
 // tetra allan — Allan deviation with confidence intervals and the IEEE 952 noise terms of a gyro log.
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -15,6 +12,7 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "gnuplot.hpp"
 #include "tetra/core/allan.hpp"
 #include "tetra/core/allan_kalibr.hpp"
 #include "tetra/core/calibration_file.hpp"
@@ -33,29 +31,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-// A path inside single quotes for the shell.
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) {
-    if (c == '\'') {
-      out += "'\\''";
-    } else {
-      out += c;
-    }
-  }
-  return out + "'";
-}
-
-// A string inside single quotes for gnuplot ('' is a quote).
-std::string gp_quote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) {
-    if (c == '\'') out += '\'';
-    out += c;
-  }
-  return out + "'";
 }
 
 std::string num(double v) {
@@ -79,16 +54,9 @@ std::string percent(double fraction) {
 // Log-log plot: per gyro a panel with the Allan deviation, its confidence band, the fitted curve and
 // the observed terms. Runs gnuplot (pngcairo, else png).
 Status write_plot(OutputFile& png, const allan::LogAllan& analysis, double confidence) {
-  char dir_template[] = "/tmp/tetra-allan-XXXXXX";
-  if (::mkdtemp(dir_template) == nullptr) return failure("--plot: cannot create a temporary directory");
-  const std::filesystem::path dir(dir_template);
-  struct Cleanup {
-    std::filesystem::path dir;
-    ~Cleanup() {
-      std::error_code ec;
-      std::filesystem::remove_all(dir, ec);
-    }
-  } cleanup{dir};
+  auto temp = TempDir::create("tetra-allan");
+  if (!temp) return failure("--plot: " + temp.error().message);
+  const std::filesystem::path& dir = temp->path();
 
   const std::size_t panels = analysis.gyros.size();
   const std::size_t cols = panels <= 1 ? 1 : 2;
@@ -140,28 +108,15 @@ Status write_plot(OutputFile& png, const allan::LogAllan& analysis, double confi
   body += "unset multiplot\n";
   const std::string defs =
       "bQ(t) = 3.0/(t*t)\nbN(t) = 1.0/t\nbB(t) = 2.0*log(2.0)/pi\nbK(t) = t/3.0\nbR(t) = t*t/2.0\n";
-  const std::string size = std::to_string(cols * 640) + "," + std::to_string(rows * 480);
+  // gnuplot writes into the temporary directory; the image reaches --plot through the output layer.
   const std::string png_path = (dir / "plot.png").string();
-  const std::string out = "set output " + gp_quote(png_path) + "\n";
-  for (const char* terminal : {"pngcairo", "png"}) {
-    const std::string script_file = (dir / "plot.gp").string();
-    const std::string script = std::string("set terminal ") + terminal + " size " + size + " enhanced\n" +
-                               out + defs + body + "set output\n";
-    if (Status s = write_text_file(script_file, script); !s) return s;
-    const std::string err_file = (dir / "gnuplot.err").string();
-    const int rc =
-        std::system(("gnuplot " + shell_quote(script_file) + " 2>" + shell_quote(err_file)).c_str());
-    if (rc == 0) {
-      auto image = read_input(png_path, kMaxTableBytes);
-      if (!image) return failure("--plot: gnuplot wrote no image");
-      return png.write(*image);
-    }
-    if (rc == -1 || (WIFEXITED(rc) && WEXITSTATUS(rc) == 127)) {
-      return failure(
-          "--plot: gnuplot not found (install the Debian package gnuplot-nox; see scripts/setup.sh)");
-    }
-  }
-  return failure("--plot: gnuplot could not write " + png.path());
+  if (Status s = run_gnuplot(dir, png_path, static_cast<int>(cols * 640), static_cast<int>(rows * 480),
+                             defs + body, "--plot");
+      !s)
+    return s;
+  auto image = read_input(png_path, kMaxTableBytes);
+  if (!image) return failure("--plot: gnuplot wrote no image");
+  return png.write(*image);
 }
 
 }  // namespace
@@ -300,7 +255,8 @@ int cmd_allan(int argc, char** argv) {
     auto noise = allan::kalibr_gyro_noise(*analysis, *cal);
     if (!noise) return report(cmd, noise.error());
     const std::string rostopic = "/tetra/" + service::ros2_name(cal->unit) + "/imu";  // the ROS 2 view's
-    if (Status s = kalibr_out->write(allan::format_kalibr(*noise, rostopic)); !s) return report(cmd, s.error());
+    if (Status s = kalibr_out->write(allan::format_kalibr(*noise, rostopic)); !s)
+      return report(cmd, s.error());
   }
   if (cal_out) {
     if (Status s = allan::update_calibration_noise(*cal, *analysis); !s) return report(cmd, s.error());

@@ -46,6 +46,26 @@ std::string ack_line(const dds::EventView& ack, int n_gyros) {
   return head + (body.size() > 2 ? ", " + body.substr(1) : "}");
 }
 
+//! The command's kind from the action word, checked against the gyro id and --force.
+Status set_action(ground::CommandRequest& request, const std::string& action) {
+  if (action == "reset" && request.gyro != 0) return bad_input("reset takes no gyro id");
+  if (action != "reset" && request.gyro == 0)
+    return bad_input(action + " needs a gyro id, e.g. '" + action + " 2'");
+  if (request.force && action != "exclude") return bad_input("--force applies to exclude only");
+  request.kind = action == "reset"     ? tetra_COMMAND_RESET
+                 : action == "exclude" ? tetra_COMMAND_EXCLUDE
+                                       : tetra_COMMAND_REINSTATE;
+  return ok_status();
+}
+
+//! Prints the acknowledgement; exit 0 when accepted, 1 (with the reason on stderr) when refused.
+int print_ack(const dds::EventView& ack) {
+  std::cout << ack_line(ack, std::max(4, static_cast<int>(std::bit_width(ack.event.gyros)))) << '\n';
+  if (!ack.event.refused()) return kExitOk;
+  std::cerr << "tetra command: refused by unit " << ack.unit << ": " << ack.event.detail << '\n';
+  return kExitFailure;
+}
+
 std::string host_name() {
   char name[256] = {};
   return gethostname(name, sizeof name - 1) == 0 ? std::string(name) : std::string("localhost");
@@ -76,14 +96,7 @@ int cmd_command(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   add_domain_option(app, domain);
   if (auto exit = parse(app, argc, argv)) return *exit;
-  if (action == "reset" && request.gyro != 0) return report("command", bad_input("reset takes no gyro id"));
-  if (action != "reset" && request.gyro == 0)
-    return report("command", bad_input(action + " needs a gyro id, e.g. '" + action + " 2'"));
-  if (request.force && action != "exclude")
-    return report("command", bad_input("--force applies to exclude only"));
-  request.kind = action == "reset"     ? tetra_COMMAND_RESET
-                 : action == "exclude" ? tetra_COMMAND_EXCLUDE
-                                       : tetra_COMMAND_REINSTATE;
+  if (auto s = set_action(request, action); !s) return report("command", s.error());
   tetra_Command command{};
   if (auto s = ground::to_wire(request, ground::new_command_id(wall_ns(), getpid()), command); !s)
     return report("command", s.error());
@@ -124,13 +137,7 @@ int cmd_command(int argc, char** argv) {
       if (msg.command_id == command.command_id && dds::from_wire(msg.unit) == unit) ack = dds::from_wire(msg);
     });
     if (!taken) return report("command", taken.error());
-    if (ack) {
-      const int n = std::max(4, static_cast<int>(std::bit_width(ack->event.gyros)));
-      std::cout << ack_line(*ack, n) << '\n';
-      if (!ack->event.refused()) return kExitOk;
-      std::cerr << "tetra command: refused by unit " << unit << ": " << ack->event.detail << '\n';
-      return kExitFailure;
-    }
+    if (ack) return print_ack(*ack);
     const std::int64_t now = monotonic_ns();
     if (now >= give_up) {
       std::cerr << "tetra command: "

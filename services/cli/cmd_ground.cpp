@@ -43,10 +43,14 @@ int cmd_ground(int argc, char** argv) {
   std::string listen = "127.0.0.1:8080";
   std::string web_dir = TETRA_WEB_DIR;
   ground::StoreConfig store_config;
+  ground::ServerConfig server_config;
   double command_timeout_s = 5.0;
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
   app.add_option("--listen", listen, "HOST:PORT to serve on (default loopback only; port 0: any free port)");
   app.add_option("--web", web_dir, "the web application's directory (with node_modules/ from npm ci)");
+  app.add_option("--records", server_config.records_dir,
+                 "serve the attitude and event files of tetra record in this folder (/api/records)")
+      ->check(CLI::ExistingDirectory);
   app.add_option("--history", store_config.history_s, "[s] history kept per unit")
       ->check(CLI::Range(1.0, 86400.0));
   app.add_option("--attitude-rate", store_config.attitude_rate_hz,
@@ -57,7 +61,6 @@ int cmd_ground(int argc, char** argv) {
   add_domain_option(app, domain);
   if (auto exit = parse(app, argc, argv)) return *exit;
 
-  ground::ServerConfig server_config;
   server_config.web_dir = web_dir;
   if (auto s = parse_listen(listen, server_config.host, server_config.port); !s)
     return report("ground", s.error());

@@ -189,6 +189,9 @@ int cmd_sim(int argc, char** argv) {
     if (!fault) return report(kName, fault.error());
     options.faults.push_back(fault.value());
   }
+  if (loop_options.enabled && (!out_path.empty() || !truth_path.empty())) {
+    return report(kName, bad_input("--out and --truth do not apply with --closed-loop (see --pointing)"));
+  }
 #if TETRA_WITH_DDS
   if (loop_options.enabled && dds_options.enabled)
     return sim_dds_closed_loop_main(sc, options, loop_options, dds_options);

@@ -227,7 +227,7 @@ std::string campaign_csv_header() {
   return "run,scenario,kind,gyro,onset_s,size,seed,outcome,isolated_gyro,detection_delay_s,isolation_delay_s,"
          "theory_delay_s,false_alarms,fault_free_s,final_knowledge_error_deg,final_sigma_deg,"
          "pointing_max_before_deg,pointing_rms_after_deg,pointing_max_after_deg,recover_s,bound_deg,"
-         "max_wheel_momentum_fraction";
+         "max_wheel_momentum_fraction,wrong_gyro,wrong_at_s";
 }
 
 std::string campaign_csv_row(const CampaignRow& r) {
@@ -249,6 +249,9 @@ std::string campaign_csv_row(const CampaignRow& r) {
   append_double(out, r.bound_deg);
   out += ',';
   append_double(out, r.max_wheel_momentum_fraction);
+  out += ',';
+  out += r.fdi.wrong_gyro ? std::to_string(*r.fdi.wrong_gyro) : std::string();
+  out += "," + opt_text(r.fdi.wrong_at_s);
   return out;
 }
 
@@ -257,8 +260,8 @@ Result<CampaignRow> parse_campaign_row(const std::string& line) {
   std::stringstream in(line);
   for (std::string field; std::getline(in, field, ',');) f.push_back(field);
   if (!line.empty() && line.back() == ',') f.emplace_back();
-  if (f.size() != 22)
-    return bad_input("campaign row with " + std::to_string(f.size()) + " fields (22 expected)");
+  if (f.size() != 24)
+    return bad_input("campaign row with " + std::to_string(f.size()) + " fields (24 expected)");
   try {
     const auto num = [](const std::string& s) { return std::stod(s); };
     const auto opt = [](const std::string& s) {
@@ -295,6 +298,8 @@ Result<CampaignRow> parse_campaign_row(const std::string& line) {
     r.recover_s = opt(f[19]);
     r.bound_deg = num(f[20]);
     r.max_wheel_momentum_fraction = num(f[21]);
+    if (!f[22].empty()) r.fdi.wrong_gyro = std::stoi(f[22]);
+    r.fdi.wrong_at_s = opt(f[23]);
     return r;
   } catch (const std::exception&) {
     return bad_input("campaign row: a field is not a number");

@@ -38,7 +38,7 @@ std::int64_t ClosedLoopSimulator::stamp_ns(std::size_t k) const {
 }
 
 double ClosedLoopSimulator::time_s(std::size_t k) const {
-  return static_cast<double>(stamp_ns(k)) / static_cast<double>(kNanosPerSecond);
+  return ns_to_seconds(stamp_ns(k));
 }
 
 bool ClosedLoopSimulator::next(SimEpoch& out) {

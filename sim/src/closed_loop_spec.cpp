@@ -198,7 +198,7 @@ Status validate_closed_loop(const ClosedLoopSpec& s) {
       eig.eigenvalues().minCoeff() <= 0.0) {
     return bad_input("inertia_kg_m2 must be symmetric positive definite");
   }
-  if (!positive(s.dynamics_hz)) return bad_input("dynamics_hz must be positive");
+  if (!positive(s.dynamics_hz) || s.dynamics_hz > 1.0e5) return bad_input("dynamics_hz must be in (0, 1e5]");
   if (!positive(s.pointing_bound_deg)) return bad_input("pointing_bound_deg must be positive");
   if (!positive(s.wheels.max_torque_Nm) || !positive(s.wheels.max_momentum_Nms) ||
       !positive(s.wheels.inertia_kg_m2))

@@ -26,7 +26,6 @@ FdiVerdict judge_fdi(const std::vector<fdi::FdiEvent>& events, const std::vector
   const FaultSpec* fault = faults.empty() ? nullptr : &faults.front();
   const double onset_s = fault ? fault->at_s : duration_s;
   v.fault_free_s = std::min(onset_s, duration_s);
-  bool wrong = false;
   for (const fdi::FdiEvent& e : events) {
     const double t = ns_to_seconds(e.stamp_ns);
     if (e.type == fdi::EventType::kDetected) {
@@ -36,14 +35,17 @@ FdiVerdict judge_fdi(const std::vector<fdi::FdiEvent>& events, const std::vector
         v.detection_delay_s = t - onset_s;
       }
     } else if (e.type == fdi::EventType::kIsolated && e.gyro) {
-      if (!fault || *e.gyro != fault->gyro) wrong = true;
+      if ((!fault || *e.gyro != fault->gyro) && !v.wrong_gyro) {
+        v.wrong_gyro = *e.gyro;
+        v.wrong_at_s = t;
+      }
       if (t >= onset_s && !v.isolation_delay_s) {
         v.isolation_delay_s = t - onset_s;
         v.isolated_gyro = *e.gyro;
       }
     }
   }
-  if (wrong) {
+  if (v.wrong_gyro) {
     v.outcome = Outcome::kWrong;
   } else if (!fault) {
     v.outcome = Outcome::kNone;

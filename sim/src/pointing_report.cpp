@@ -105,10 +105,18 @@ PointingSummary summarize(const ClosedLoopRecord& record, const ClosedLoopSimula
     s.final_knowledge_error_deg = last.knowledge_error_deg;
     s.final_sigma_deg = last.sigma_deg;
   }
+  double age_sum_s = 0.0;
+  std::size_t ages = 0;
   for (const PointingSample& p : record.series) {
     if (p.torque_limited) s.torque_limited_s += dt_s;
     if (p.momentum_limited) s.momentum_limited_s += dt_s;
+    if (std::isfinite(p.estimate_age_s)) {
+      age_sum_s += p.estimate_age_s;
+      ++ages;
+      s.max_estimate_age_s = std::max(s.max_estimate_age_s, p.estimate_age_s);
+    }
   }
+  if (ages > 0) s.mean_estimate_age_s = age_sum_s / static_cast<double>(ages);
   s.max_wheel_momentum_fraction = record.max_wheel_momentum_fraction;
   s.counters = record.counters;
   s.fdi = judge_fdi(record.events, simulator.faults(), duration_s);
@@ -151,6 +159,8 @@ std::string summary_json(const PointingSummary& s, bool with_fdi) {
   append_json_number(out += ", \"hold_epochs\": ", static_cast<double>(s.counters.hold_epochs));
   append_json_number(out += ", \"safe_epochs\": ", static_cast<double>(s.counters.safe_epochs));
   append_json_number(out += ", \"safe_entries\": ", static_cast<double>(s.counters.safe_entries));
+  append_json_number(out += ", \"mean_estimate_age_s\": ", s.mean_estimate_age_s);
+  append_json_number(out += ", \"max_estimate_age_s\": ", s.max_estimate_age_s);
   out += "},\n  \"fdi\": ";
   if (!with_fdi) return out + "null\n}\n";
   out += "{\"outcome\": ";

@@ -6,11 +6,13 @@
 #include <cmath>
 #include <thread>
 
+#include "test_support.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/ground/command_request.hpp"
 #include "tetra/ground/command_tracker.hpp"
 #include "tetra/ground/encode.hpp"
 #include "tetra/ground/link_state.hpp"
+#include "tetra/ground/record_files.hpp"
 #include "tetra/ground/ring_buffer.hpp"
 #include "tetra/ground/store.hpp"
 
@@ -214,6 +216,28 @@ TEST(CommandRequest, ValidatesEveryField) {
       parse_command_request(R"({"unit":"u","action":"reset","operator":")" + long_operator + "\"}", "o");
   ASSERT_TRUE(too_long.ok());
   EXPECT_FALSE(to_wire(*too_long, 1, wire).ok());
+}
+
+TEST(RecordFiles, AttitudeAndEventFilesAreServedBySensorTime) {
+  test::TempDir dir;
+  test::write_file(dir.file("att.csv"),
+                   "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros\n"
+                   "0.1,1,0,0,0,0,0.06,0,0.001,NOMINAL,1234\n"
+                   "0.2,1,0,0,0,0,0.06,0,0.001,DEGRADED,134\n");
+  test::write_file(dir.file("ev.jsonl"), "{\"time_s\": 0.15, \"event\": \"isolated\", \"gyro\": 2}\n");
+  test::write_file(dir.file("log.csv"), "time_s,g1,g2,g3,g4\n0,1,2,3,4\n");  // a gyro log: not listed
+  auto list = list_records(dir.path().string());
+  ASSERT_TRUE(list.ok()) << list.error().message;
+  EXPECT_EQ(list->size(), 2U);
+  auto att = read_record(dir.path().string(), "att.csv", 0.15, 1.0, 0);
+  ASSERT_TRUE(att.ok()) << att.error().message;
+  ASSERT_EQ(att->size(), 1U);
+  EXPECT_EQ((*att)[0]["mode"], "DEGRADED");
+  auto ev = read_record(dir.path().string(), "ev.jsonl", 0, 1, 0);
+  ASSERT_TRUE(ev.ok());
+  EXPECT_EQ((*ev)[0]["event"], "isolated");
+  EXPECT_FALSE(read_record(dir.path().string(), "../etc/passwd", 0, 1, 0).ok());
+  EXPECT_FALSE(read_record(dir.path().string(), "log.csv", 0, 1, 0).ok());
 }
 
 }  // namespace

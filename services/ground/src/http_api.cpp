@@ -4,6 +4,7 @@
 
 #include "tetra/dds/topics.hpp"
 #include "tetra/ground/encode.hpp"
+#include "tetra/ground/record_files.hpp"
 // After Eigen (through the headers above): httplib.h brings <resolv.h>, whose `_res` macro breaks Eigen.
 #include <httplib.h>
 
@@ -110,6 +111,16 @@ void GroundServer::routes() {
                             number_param(req, "start", 0), number_param(req, "end", 1e300), max_points);
     if (!h) return reply_error(res, 404, h.error().message);
     reply_json(res, 200, *h);
+  });
+  s.Get("/api/records", [this](const httplib::Request& req, httplib::Response& res) {
+    if (config_.records_dir.empty()) return reply_error(res, 404, "no --records folder given");
+    auto r = req.has_param("file")
+                 ? read_record(config_.records_dir, req.get_param_value("file"),
+                               number_param(req, "start", -1e300), number_param(req, "end", 1e300),
+                               static_cast<std::size_t>(number_param(req, "max", 5000)))
+                 : list_records(config_.records_dir);
+    if (!r) return reply_error(res, 404, r.error().message);
+    reply_json(res, 200, *r);
   });
   s.Get("/api/stream", [this](const httplib::Request& req, httplib::Response& res) {
     auto cursor = std::make_shared<StreamCursor>();

@@ -24,6 +24,8 @@ struct FdiVerdict {
   std::optional<double> detection_delay_s;  //!< [s] first detection at or after the onset
   std::optional<double> isolation_delay_s;  //!< [s] first isolation at or after the onset
   std::optional<int> isolated_gyro;         //!< 1..N: the gyro of the first isolation
+  std::optional<int> wrong_gyro;            //!< 1..N: the first healthy gyro isolated
+  std::optional<double> wrong_at_s;         //!< [s] when
   int false_alarms = 0;                     //!< detections before the onset (all, without a fault)
   double fault_free_s = 0.0;                //!< [s] time before the onset (the run without a fault)
 };

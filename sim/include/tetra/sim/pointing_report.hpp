@@ -40,6 +40,8 @@ struct PointingSummary {
   double torque_limited_s = 0.0;    //!< [s] time the commanded torque was scaled down
   double momentum_limited_s = 0.0;  //!< [s] time a wheel sat at its momentum limit
   ControlCounters counters;
+  double mean_estimate_age_s = 0.0;  //!< [s] age of the estimate the controller used (epochs with one)
+  double max_estimate_age_s = 0.0;   //!< [s]
   FdiVerdict fdi;
   bool within_bound_after_recovery = true;  //!< every fault segment recovered
 };

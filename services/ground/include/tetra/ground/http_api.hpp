@@ -28,6 +28,7 @@ struct ServerConfig {
   std::string host = "127.0.0.1";
   int port = 8080;            //!< 0: any free port (see GroundServer::port())
   std::string web_dir;        //!< the web application (index.html, tetra-plugin.js, node_modules/openmct)
+  std::string records_dir;    //!< `tetra record` files served by /api/records ("": none)
   int worker_threads = 32;    //!< concurrent connections (each browser holds one for its stream)
   int stream_wait_ms = 1000;  //!< [ms] a keep-alive comment at least this often on a quiet stream
 };
