@@ -55,8 +55,8 @@ struct PipelineConfig {
   int reference_confirm_count = 3;         //!< [-] consecutive reference comparisons that must agree
   double glt_false_alarm_probability = 1.0e-9;  //!< [-] N ≥ 5: rejecting a single-gyro hypothesis
   //! false: a gyro isolated as faulty stays in the solution (detection and isolation still run and
-  //! report; for experiments that measure what exclusion is worth). Honoured by the closed-loop
-  //! simulator, which reinstates such a gyro on the epoch it was excluded.
+  //! report; for experiments that measure what exclusion is worth). The `isolated` event then says
+  //! "gyro kept" and detection starts again; replay, the service and the closed-loop simulator alike.
   bool exclusion_enabled = true;
 };
 
