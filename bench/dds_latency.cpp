@@ -24,6 +24,7 @@
 
 #include "bench_clock.hpp"
 #include "tetra/core/calibration_file.hpp"
+#include "tetra/core/units.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
 
@@ -103,7 +104,7 @@ int run(int argc, char** argv) {
     else
       return fail(std::string("unknown option ") + argv[i]);
   }
-  const std::int64_t period_ns = static_cast<std::int64_t>(1e9 / rate_hz);
+  const std::int64_t period_ns = seconds_to_ns(1.0 / rate_hz);
   auto participant = dds::Participant::create(domain);
   if (!participant) return fail(participant.error().message);
   auto topics = dds::Topics::create(*participant);

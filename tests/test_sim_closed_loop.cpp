@@ -33,7 +33,7 @@ class TruthEstimator final : public Estimator {
     fdi::AttitudeEstimate e;
     e.stamp_ns = epoch.stamp_ns;
     e.q_RB = epoch.truth_q_RB;
-    e.omega_B_rad_s = epoch.sensed_omega_B_rad_s;
+    e.omega_BR_B_rad_s = epoch.omega_BN_B_rad_s;
     out.latest = e;
     return out;
   }

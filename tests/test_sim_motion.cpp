@@ -37,10 +37,10 @@ TEST(SimMotion, LabOrbitReturnsToIdentityAfter360DegreesAndMatchesClosedForm) {
     const double angle = 0.06 * kDegToRad * t;
     const Quaternion expected(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()));
     EXPECT_LT(angle_between(m.at(t).q_RB, expected), 1e-12) << "t = " << t;
-    EXPECT_LT((m.at(t).omega_RB_B_rad_s - Eigen::Vector3d(0, 0.06 * kDegToRad, 0)).norm(), 1e-18);
+    EXPECT_LT((m.at(t).omega_BR_B_rad_s - Eigen::Vector3d(0, 0.06 * kDegToRad, 0)).norm(), 1e-18);
     // The gyros also sense the Earth rate: C_LBᵀ·ω_e^L with C_LB = R_y(angle) (outer gimbal).
     const Eigen::Vector3d earth_B = turntable_earth_rate_B(0.0, angle, -23.2 * kDegToRad);
-    EXPECT_LT((m.at(t).omega_B_rad_s - m.at(t).omega_RB_B_rad_s - earth_B).norm(), 1e-18);
+    EXPECT_LT((m.at(t).omega_BN_B_rad_s - m.at(t).omega_BR_B_rad_s - earth_B).norm(), 1e-18);
   }
 }
 
@@ -56,7 +56,7 @@ TEST(SimMotion, OrbitPitchesAboutMinusYOncePerPeriod) {
     const Quaternion expected(Eigen::AngleAxisd(-n * t, Eigen::Vector3d::UnitY()));
     EXPECT_LT(angle_between(m.at(t).q_RB, expected), 1e-12) << "t = " << t;
   }
-  EXPECT_LT((m.at(10.0).omega_B_rad_s - Eigen::Vector3d(0, -n, 0)).norm(), 1e-18);
+  EXPECT_LT((m.at(10.0).omega_BN_B_rad_s - Eigen::Vector3d(0, -n, 0)).norm(), 1e-18);
 }
 
 TEST(SimMotion, RatesAreTheDerivativeOfTheAttitudeWithAcsAndSlews) {
@@ -69,7 +69,7 @@ TEST(SimMotion, RatesAreTheDerivativeOfTheAttitudeWithAcsAndSlews) {
   // ~h²·|ω⃛| < 1e-12 rad/s, rounding ~1e-16/h = 1e-13 rad/s; 1e-10 rad/s leaves margin while the
   // rates themselves are ~1e-3..1e-2 rad/s, so a wrong sign or frame would fail by 7+ orders.
   for (double t : {10.0, 1230.0, 1260.0, 1300.0, 2000.0, 2450.0, 3650.0, 4850.0, 5500.0}) {
-    const Eigen::Vector3d analytic = m.at(t).omega_RB_B_rad_s;
+    const Eigen::Vector3d analytic = m.at(t).omega_BR_B_rad_s;
     EXPECT_LT((numeric_rate(m, t, 1e-3) - analytic).norm(), 1e-10) << "t = " << t;
   }
 }
@@ -92,11 +92,11 @@ TEST(SimMotion, SlewIsRestToRestAndEndsAtTheCommandedAngle) {
   // profile 1 − cos(2πu) at u = 0 and 1).
   for (double t : {100.0, 250.0}) {
     const Eigen::Vector3d extra =
-        m.at(t).omega_RB_B_rad_s - m.at(t).q_RB.conjugate() * orbit.at(t).q_RB * orbit.at(t).omega_RB_B_rad_s;
+        m.at(t).omega_BR_B_rad_s - m.at(t).q_RB.conjugate() * orbit.at(t).q_RB * orbit.at(t).omega_BR_B_rad_s;
     EXPECT_LT(extra.norm(), 1e-15) << "t = " << t;
   }
   // Mid-slew the profile's peak rate 2Φ/T about +Z.
-  const Eigen::Vector3d mid = m.at(175.0).omega_RB_B_rad_s;
+  const Eigen::Vector3d mid = m.at(175.0).omega_BR_B_rad_s;
   EXPECT_NEAR(mid.z(), 2.0 * 45.0 * kDegToRad / 150.0, 1e-12);
 }
 
@@ -114,7 +114,7 @@ TEST(SimMotion, AcsMotionStaysWithinItsStatedBounds) {
   double max_accel = 0.0;
   for (double t = 1.0; t < 6000.0; t += 1.0) {
     max_dev = std::max(max_dev, angle_between(m.at(t).q_RB, orbit.at(t).q_RB) * kRadToDeg);
-    const Eigen::Vector3d a = (m.at(t + 0.5).omega_RB_B_rad_s - m.at(t - 0.5).omega_RB_B_rad_s) / 1.0;
+    const Eigen::Vector3d a = (m.at(t + 0.5).omega_BR_B_rad_s - m.at(t - 0.5).omega_BR_B_rad_s) / 1.0;
     max_accel = std::max(max_accel, a.norm() * kRadToDeg);
   }
   // Three Euler angles each within ±A: total deviation ≤ √3·A; and the motion is really there

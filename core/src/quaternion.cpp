@@ -36,8 +36,8 @@ Eigen::Vector3d quat_log(const Quaternion& q_in) {
   return (angle / s) * v;
 }
 
-Quaternion propagate(const Quaternion& q_RB, const Eigen::Vector3d& omega_B_rad_s, double dt_s) {
-  return (q_RB * quat_exp(omega_B_rad_s * dt_s)).normalized();
+Quaternion propagate(const Quaternion& q_RB, const Eigen::Vector3d& omega_BR_B_rad_s, double dt_s) {
+  return (q_RB * quat_exp(omega_BR_B_rad_s * dt_s)).normalized();
 }
 
 double angle_between(const Quaternion& a, const Quaternion& b) {

@@ -256,7 +256,7 @@ void Pipeline::Impl::publish_attitude() {
     }
   }
   auto& a = result_.attitude;
-  a.omega_B_rad_s = attitude_.omega_BR_B();
+  a.omega_BR_B_rad_s = attitude_.omega_BR_B();
   a.stamp_ns = frame_.now_ns;
   a.q_RB = attitude_.q_RB();
   a.sigma_rad = attitude_.sigma_rad();

@@ -14,7 +14,7 @@ void append_attitude_row(std::string& out, double time_s, const fdi::AttitudeEst
   }
   for (int i = 0; i < 3; ++i) {
     out += ',';
-    append_double(out, attitude.omega_B_rad_s[i] * kRadToDeg);
+    append_double(out, attitude.omega_BR_B_rad_s[i] * kRadToDeg);
   }
   out += ',';
   append_double(out, attitude.sigma_rad.norm() * kRadToDeg);  // 1σ of the total error angle

@@ -14,6 +14,7 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "dds_common.hpp"
+#include "tetra/core/units.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
@@ -120,7 +121,7 @@ int cmd_command(int argc, char** argv) {
   if (!data) return report("command", data.error());
   if (auto s = waitset->attach(data->handle(), kEvent); !s) return report("command", s.error());
 
-  const std::int64_t give_up = monotonic_ns() + static_cast<std::int64_t>(timeout_s * 1e9);
+  const std::int64_t give_up = monotonic_ns() + seconds_to_ns(timeout_s);
   std::vector<std::intptr_t> triggered;
   bool sent = false;
   for (;;) {

@@ -119,9 +119,9 @@ std::string health_json(const std::string& unit, const UnitView& view, std::int6
     const auto q = to_wxyz(a.q_RB);
     out << ", \"attitude\": {\"time_s\": " << json_number(ns_to_seconds(a.stamp_ns)) << ", \"q\": ["
         << json_number(q[0]) << ", " << json_number(q[1]) << ", " << json_number(q[2]) << ", "
-        << json_number(q[3]) << "], \"rate_dps\": [" << json_number(a.omega_B_rad_s.x() * kRadToDeg) << ", "
-        << json_number(a.omega_B_rad_s.y() * kRadToDeg) << ", "
-        << json_number(a.omega_B_rad_s.z() * kRadToDeg)
+        << json_number(q[3]) << "], \"rate_dps\": [" << json_number(a.omega_BR_B_rad_s.x() * kRadToDeg)
+        << ", " << json_number(a.omega_BR_B_rad_s.y() * kRadToDeg) << ", "
+        << json_number(a.omega_BR_B_rad_s.z() * kRadToDeg)
         << "], \"sigma_deg\": " << json_number(a.sigma_rad.maxCoeff() * kRadToDeg) << ", \"mode\": \""
         << fdi::to_string(a.mode) << "\", \"rate_hz\": " << json_number(view.attitude_rate_hz) << "}";
   }
@@ -159,9 +159,10 @@ std::string dashboard_block(const std::string& unit, const UnitView& view, std::
     const auto q = to_wxyz(a.q_RB);
     out << "  attitude q = (" << fixed(q[0], 6) << ", " << fixed(q[1], 6) << ", " << fixed(q[2], 6) << ", "
         << fixed(q[3], 6) << ")  σ " << fixed(a.sigma_rad.maxCoeff() * kRadToDeg, 4) << " deg   rate ("
-        << fixed(a.omega_B_rad_s.x() * kRadToDeg, 4) << ", " << fixed(a.omega_B_rad_s.y() * kRadToDeg, 4)
-        << ", " << fixed(a.omega_B_rad_s.z() * kRadToDeg, 4) << ") deg/s   "
-        << fixed(view.attitude_rate_hz, 1) << " Hz\n";
+        << fixed(a.omega_BR_B_rad_s.x() * kRadToDeg, 4) << ", "
+        << fixed(a.omega_BR_B_rad_s.y() * kRadToDeg, 4) << ", "
+        << fixed(a.omega_BR_B_rad_s.z() * kRadToDeg, 4) << ") deg/s   " << fixed(view.attitude_rate_hz, 1)
+        << " Hz\n";
   } else {
     out << "  attitude: none received\n";
   }
@@ -208,10 +209,9 @@ int cmd_monitor(int argc, char** argv) {
   const bool tty = isatty(STDOUT_FILENO) != 0;
   const auto wanted = [&](const std::string& unit) { return unit_filter.empty() || unit == unit_filter; };
   const std::int64_t start = monotonic_ns();
-  const std::int64_t period_ns = static_cast<std::int64_t>(period_s * 1e9);
-  const std::int64_t stop_at =
-      duration_s > 0 ? start + static_cast<std::int64_t>(duration_s * 1e9) : INT64_MAX;
-  const std::int64_t give_up_at = start + static_cast<std::int64_t>(timeout_s * 1e9);
+  const std::int64_t period_ns = seconds_to_ns(period_s);
+  const std::int64_t stop_at = duration_s > 0 ? start + seconds_to_ns(duration_s) : INT64_MAX;
+  const std::int64_t give_up_at = start + seconds_to_ns(timeout_s);
   std::int64_t next_refresh = start + period_ns;
   std::int64_t last_refresh = start;
   std::vector<std::intptr_t> triggered;
@@ -288,7 +288,7 @@ int cmd_monitor(int argc, char** argv) {
         return kExitFailure;
       }
     } else if (now >= next_refresh) {
-      const double dt = static_cast<double>(now - last_refresh) * 1e-9;
+      const double dt = ns_to_seconds(now - last_refresh);
       for (auto& [unit, view] : units) {
         view.attitude_rate_hz =
             static_cast<double>(view.attitudes_received - view.attitudes_at_last_refresh) / dt;

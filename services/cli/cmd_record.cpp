@@ -110,10 +110,9 @@ int cmd_record(int argc, char** argv) {
     assembly = config->assembler(config->calibration.gyro_count());
   } else {
     assembly.gyro_count = gyros;
-    assembly.nominal_period_ns = static_cast<std::int64_t>(1e9 / rate_hz + 0.5);
-    assembly.tolerance_ns = tolerance_s >= 0 ? static_cast<std::int64_t>(tolerance_s * 1e9 + 0.5)
-                                             : assembly.nominal_period_ns / 4;
-    assembly.max_latency_ns = static_cast<std::int64_t>(max_latency_s * 1e9 + 0.5);
+    assembly.nominal_period_ns = seconds_to_ns(1.0 / rate_hz);
+    assembly.tolerance_ns = tolerance_s >= 0 ? seconds_to_ns(tolerance_s) : assembly.nominal_period_ns / 4;
+    assembly.max_latency_ns = seconds_to_ns(max_latency_s);
   }
   auto assembler = service::EpochAssembler::create(assembly);
   if (!assembler) return report("record", assembler.error());
@@ -192,8 +191,7 @@ int cmd_record(int argc, char** argv) {
   bool writers_seen = false;
   std::int64_t idle_since = -1;  // [ns] local time the gyro writers went away; -1: not idle
   const std::int64_t start = monotonic_ns();
-  const std::int64_t stop_at =
-      duration_s > 0 ? start + static_cast<std::int64_t>(duration_s * 1e9) : INT64_MAX;
+  const std::int64_t stop_at = duration_s > 0 ? start + seconds_to_ns(duration_s) : INT64_MAX;
   std::vector<std::intptr_t> triggered;
 
   auto write_epochs = [&]() -> Status {

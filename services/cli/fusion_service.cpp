@@ -6,6 +6,7 @@
 
 #include "cli_common.hpp"
 #include "dds_common.hpp"
+#include "tetra/core/units.hpp"
 #include "tetra/dds/convert.hpp"
 
 namespace tetra::cli {
@@ -193,7 +194,7 @@ Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered,
               "fusion: a GyroSample writer offers incompatible QoS: deadline (policy id {}; its deadline "
               "must "
               "be at most {} s: sample_rate_hz and speed must match the sensor's)",
-              policy, static_cast<double>(deadline_ns_) * 1e-9);
+              policy, ns_to_seconds(deadline_ns_));
         } else {
           spdlog::warn("fusion: a GyroSample writer offers incompatible QoS: {} (policy id {}; docs/dds.md)",
                        dds::qos_policy_name(policy), policy);
@@ -428,7 +429,7 @@ Status FusionService::publish_health(std::int64_t now_ns, bool force) {
   } else {
     last_health_ = health;
   }
-  next_health_ns_ = now_ns + static_cast<std::int64_t>(config_.health_period_s * 1e9);
+  next_health_ns_ = now_ns + seconds_to_ns(config_.health_period_s);
   return ok_status();
 }
 

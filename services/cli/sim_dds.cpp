@@ -87,12 +87,12 @@ Result<SimDdsScore> run_sim_dds(sim::Simulator& simulator, const SimDdsOptions& 
     ++score.epochs_published;
     if (auto s = take_attitudes(); !s) return s.error();
     if (on_progress && monotonic_ns() >= next_progress) {
-      score.wall_s = static_cast<double>(monotonic_ns() - start) * 1e-9;
+      score.wall_s = ns_to_seconds(monotonic_ns() - start);
       on_progress(score);
       next_progress += 1'000'000'000;
     }
   }
-  score.wall_s = static_cast<double>(monotonic_ns() - start) * 1e-9;
+  score.wall_s = ns_to_seconds(monotonic_ns() - start);
   // The last attitudes: wait (briefly) for the one of the last epoch.
   link.wait_for_acks();
   const std::int64_t final_wait = monotonic_ns() + 2'000'000'000;

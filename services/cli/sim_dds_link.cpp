@@ -2,6 +2,7 @@
 
 #include "cli_common.hpp"
 #include "dds_common.hpp"
+#include "tetra/core/units.hpp"
 #include "tetra/dds/convert.hpp"
 
 namespace tetra::cli {
@@ -19,9 +20,9 @@ Result<std::unique_ptr<SimDdsLink>> SimDdsLink::open(const std::string& unit, do
   auto topics = dds::Topics::create(*participant);
   if (!topics) return topics.error();
   // The deadline offered is 3 periods of the wall-clock rate (none when unpaced).
-  const auto period =
-      options.speed > 0 ? std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / (rate_hz * options.speed)))
-                        : std::chrono::nanoseconds(0);
+  const auto period = options.speed > 0
+                          ? std::chrono::nanoseconds(seconds_to_ns(1.0 / (rate_hz * options.speed)))
+                          : std::chrono::nanoseconds(0);
   dds::Qos gyro_qos = dds::gyro_sample_qos(period);
   gyro_qos.no_autodispose();
   auto gyro_writer = dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, gyro_qos);
@@ -63,7 +64,7 @@ Status SimDdsLink::wait_for_readers(const SimDdsOptions& options) {
   if (shutdown_ != nullptr) const_cast<dds::ShutdownSignal*>(shutdown_)->set_guard(guard_->handle());
 
   // Wait for the readers (the service, a recorder) so that the first samples are not lost.
-  const std::int64_t give_up = monotonic_ns() + static_cast<std::int64_t>(options.wait_timeout_s * 1e9);
+  const std::int64_t give_up = monotonic_ns() + seconds_to_ns(options.wait_timeout_s);
   for (;;) {
     std::uint32_t status = 0;
     (void)dds_take_status(gyro_writer_.handle(), &status, DDS_PUBLICATION_MATCHED_STATUS);
@@ -96,8 +97,7 @@ Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
     bool service_seen = false;
     bool service_hears = false;
     const std::int64_t first_give_up = monotonic_ns() + 1'000'000'000;
-    const std::int64_t hears_give_up =
-        monotonic_ns() + static_cast<std::int64_t>(options.wait_timeout_s * 1e9);
+    const std::int64_t hears_give_up = monotonic_ns() + seconds_to_ns(options.wait_timeout_s);
     std::vector<std::intptr_t> fired;
     for (;;) {
       auto taken = health_reader->take([&](const tetra_Health& h, const dds_sample_info_t&) {

@@ -46,8 +46,8 @@ bool ClosedLoopSimulator::next(SimEpoch& out) {
   out.stamp_ns = stamp_ns(k_);
   out.time_s = time_s(k_);
   out.truth_q_RB = state_.q_NB;
-  out.truth_omega_B_rad_s = state_.omega_BN_B_rad_s;
-  out.sensed_omega_B_rad_s = state_.omega_BN_B_rad_s;
+  out.truth_omega_BR_B_rad_s = state_.omega_BN_B_rad_s;
+  out.omega_BN_B_rad_s = state_.omega_BN_B_rad_s;
   package_.sample(state_.omega_BN_B_rad_s * kRadToDeg, out.time_s, out.raw_V, out.present);
   out.reference_q_RB = package_.reference(k_, state_.q_NB);
   awaiting_control_ = true;

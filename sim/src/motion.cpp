@@ -105,8 +105,8 @@ MotionState TruthMotion::at(double t_s) const {
         chain.rotate(Eigen::Vector3d::UnitY(), rate * t_s, rate);
       }
       state.q_RB = chain.q;
-      state.omega_RB_B_rad_s = chain.omega;
-      state.omega_B_rad_s = chain.omega + chain.q.conjugate() * earth_rate_L_rad_s_;
+      state.omega_BR_B_rad_s = chain.omega;
+      state.omega_BN_B_rad_s = chain.omega + chain.q.conjugate() * earth_rate_L_rad_s_;
       return state;
     }
     case MotionKind::kOrbit:
@@ -136,8 +136,8 @@ MotionState TruthMotion::at(double t_s) const {
         }
       }
       state.q_RB = chain.q;
-      state.omega_RB_B_rad_s = chain.omega;
-      state.omega_B_rad_s = chain.omega;
+      state.omega_BR_B_rad_s = chain.omega;
+      state.omega_BN_B_rad_s = chain.omega;
       return state;
     }
   }

@@ -53,9 +53,9 @@ bool Simulator::next(SimEpoch& out) {
   out.stamp_ns = stamp_ns;
   out.time_s = t_s;
   out.truth_q_RB = truth.q_RB;
-  out.truth_omega_B_rad_s = truth.omega_RB_B_rad_s;
-  out.sensed_omega_B_rad_s = truth.omega_B_rad_s;
-  package_.sample(truth.omega_B_rad_s * kRadToDeg, t_s, out.raw_V, out.present);
+  out.truth_omega_BR_B_rad_s = truth.omega_BR_B_rad_s;
+  out.omega_BN_B_rad_s = truth.omega_BN_B_rad_s;
+  package_.sample(truth.omega_BN_B_rad_s * kRadToDeg, t_s, out.raw_V, out.present);
   out.reference_q_RB = package_.reference(k_, truth.q_RB);
   ++k_;
   return true;
@@ -143,8 +143,8 @@ Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options
     if (truth) {
       truth->time_s.push_back(epoch.time_s);
       truth->q_RB.push_back(epoch.truth_q_RB);
-      truth->omega_B_rad_s.push_back(epoch.truth_omega_B_rad_s);
-      truth->sensed_omega_B_rad_s.push_back(epoch.sensed_omega_B_rad_s);
+      truth->omega_BR_B_rad_s.push_back(epoch.truth_omega_BR_B_rad_s);
+      truth->omega_BN_B_rad_s.push_back(epoch.omega_BN_B_rad_s);
     }
   }
   return log;
@@ -169,7 +169,7 @@ class TruthWriter {
     }
     for (int a = 0; a < 3; ++a) {
       buffer_ += ',';
-      append_double(buffer_, e.truth_omega_B_rad_s[a] * kRadToDeg + 0.0);
+      append_double(buffer_, e.truth_omega_BR_B_rad_s[a] * kRadToDeg + 0.0);
     }
     buffer_ += '\n';
     if (buffer_.size() > (1u << 20)) return flush();

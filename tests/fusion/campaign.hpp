@@ -77,7 +77,7 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
       }
     }
     if (!r.accepted) continue;
-    if (!first) run.angle_y_deg += r.attitude.omega_B_rad_s.y() * kRadToDeg * (se.time_s - last_t);
+    if (!first) run.angle_y_deg += r.attitude.omega_BR_B_rad_s.y() * kRadToDeg * (se.time_s - last_t);
     first = false;
     last_t = se.time_s;
     run.final_mode = r.attitude.mode;

@@ -257,7 +257,7 @@ TEST(Pipeline, MissingSampleSwitchesToThreeGyroSolution) {
     const auto& r = p->step(e);
     if (k == 0) continue;
     EXPECT_EQ(r.attitude.gyros, k % 2 == 1 ? 0b1011U : 0b1111U);
-    EXPECT_LT((r.attitude.omega_B_rad_s * kRadToDeg - s.rate_dps(s.time_s())).norm(), 6 * 1.3e-4);
+    EXPECT_LT((r.attitude.omega_BR_B_rad_s * kRadToDeg - s.rate_dps(s.time_s())).norm(), 6 * 1.3e-4);
     EXPECT_TRUE(r.events.empty());
   }
 }

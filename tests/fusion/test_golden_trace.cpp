@@ -227,7 +227,7 @@ void hash_epoch(Fnv& h, const fdi::StepResult& r, const fdi::Health& health) {
     h.add(a.q_RB.x());
     h.add(a.q_RB.y());
     h.add(a.q_RB.z());
-    for (int i = 0; i < 3; ++i) h.add(a.omega_B_rad_s[i]);
+    for (int i = 0; i < 3; ++i) h.add(a.omega_BR_B_rad_s[i]);
     for (int i = 0; i < 3; ++i) h.add(a.sigma_rad[i]);
     h.add(static_cast<std::uint64_t>(a.mode));
     h.add(static_cast<std::uint64_t>(a.gyros));

@@ -128,7 +128,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         TETRA_FUZZ_CHECK(std::isfinite(q.w()) && std::isfinite(q.x()) && std::isfinite(q.y()) &&
                          std::isfinite(q.z()));
         TETRA_FUZZ_CHECK(std::abs(q.norm() - 1.0) < 1e-6);
-        TETRA_FUZZ_CHECK(!result.attitude.omega_B_rad_s.hasNaN());
+        TETRA_FUZZ_CHECK(!result.attitude.omega_BR_B_rad_s.hasNaN());
         TETRA_FUZZ_CHECK(!result.attitude.sigma_rad.hasNaN());
         TETRA_FUZZ_CHECK((result.attitude.gyros >> n) == 0);
       }

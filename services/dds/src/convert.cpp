@@ -70,7 +70,7 @@ Status to_wire(const std::string& unit, const fdi::AttitudeEstimate& attitude, t
   const auto q = to_wxyz(attitude.q_RB);
   for (std::size_t i = 0; i < 4; ++i) out.q_RB[i] = q[i];
   for (int i = 0; i < 3; ++i) {
-    out.omega_B_rad_s[i] = attitude.omega_B_rad_s[i];
+    out.omega_BR_B_rad_s[i] = attitude.omega_BR_B_rad_s[i];
     out.sigma_rad[i] = attitude.sigma_rad[i];
   }
   out.mode = to_wire(attitude.mode);
@@ -83,7 +83,7 @@ fdi::AttitudeEstimate from_wire(const tetra_Attitude& in) {
   out.stamp_ns = in.stamp_ns;
   out.q_RB = from_wxyz(in.q_RB[0], in.q_RB[1], in.q_RB[2], in.q_RB[3]);
   for (int i = 0; i < 3; ++i) {
-    out.omega_B_rad_s[i] = in.omega_B_rad_s[i];
+    out.omega_BR_B_rad_s[i] = in.omega_BR_B_rad_s[i];
     out.sigma_rad[i] = in.sigma_rad[i];
   }
   out.mode = from_wire(in.mode);

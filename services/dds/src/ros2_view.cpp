@@ -148,9 +148,9 @@ Status Ros2View::publish(const fdi::AttitudeEstimate& attitude) {
   imu.header = ros2_header(attitude.stamp_ns, settings_.names.frame_id);
   imu.orientation = q;
   set_covariance(imu.orientation_covariance, attitude.sigma_rad.cwiseAbs2().asDiagonal().toDenseMatrix());
-  imu.angular_velocity.x = attitude.omega_B_rad_s.x();
-  imu.angular_velocity.y = attitude.omega_B_rad_s.y();
-  imu.angular_velocity.z = attitude.omega_B_rad_s.z();
+  imu.angular_velocity.x = attitude.omega_BR_B_rad_s.x();
+  imu.angular_velocity.y = attitude.omega_BR_B_rad_s.y();
+  imu.angular_velocity.z = attitude.omega_BR_B_rad_s.z();
   if (!rate_covariance_ || rate_covariance_->first != attitude.gyros) {  // only when the gyros in use change
     rate_covariance_.emplace(attitude.gyros,
                              rate_covariance(settings_.calibration, attitude.gyros, settings_.sample_rate_hz,

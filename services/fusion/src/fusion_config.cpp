@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "tetra/core/input_files.hpp"
+#include "tetra/core/units.hpp"
 #include "tetra/core/yaml_reader.hpp"
 
 namespace tetra::service {
@@ -15,7 +16,7 @@ namespace tetra::service {
 namespace {
 
 std::int64_t to_ns(double seconds) {
-  return static_cast<std::int64_t>(std::llround(seconds * 1e9));
+  return seconds_to_ns(seconds);
 }
 
 }  // namespace
@@ -130,8 +131,7 @@ std::string describe(const FusionConfig& config) {
       << "calibration: " << config.calibration_path << " (" << config.calibration.gyro_count()
       << " gyros, method " << config.calibration.method << ")\n"
       << "sample_rate_hz: " << config.sample_rate_hz << '\n'
-      << "speed: " << config.speed << " (deadline " << static_cast<double>(config.deadline_ns()) * 1e-9
-      << " s)\n"
+      << "speed: " << config.speed << " (deadline " << ns_to_seconds(config.deadline_ns()) << " s)\n"
       << "tolerance_s: "
       << (config.tolerance_s ? std::to_string(*config.tolerance_s)
                              : "a quarter period (" + std::to_string(0.25 / config.sample_rate_hz) + ")")

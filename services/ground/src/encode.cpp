@@ -103,7 +103,7 @@ json attitude_json(const std::string& unit, const fdi::AttitudeEstimate& a, std:
           {"sensor_time_s", ns_to_seconds(a.stamp_ns)},
           {"q", json::array({q[0], q[1], q[2], q[3]})},
           {"euler_deg", {{"roll", e.roll_deg}, {"pitch", e.pitch_deg}, {"yaw", e.yaw_deg}}},
-          {"rate_dps", vector_deg(a.omega_B_rad_s)},
+          {"rate_dps", vector_deg(a.omega_BR_B_rad_s)},
           {"sigma_deg", vector_deg(a.sigma_rad)},
           {"mode", fdi::to_string(a.mode)},
           {"gyros_used", a.gyros}};

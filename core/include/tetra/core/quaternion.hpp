@@ -36,7 +36,7 @@ Quaternion quat_exp(const Eigen::Vector3d& rotvec_rad);
 Eigen::Vector3d quat_log(const Quaternion& q);
 
 //! One exact propagation step: q_RB(t+Δt) = q_RB(t) ⊗ exp(ω_B Δt), renormalized.
-Quaternion propagate(const Quaternion& q_RB, const Eigen::Vector3d& omega_B_rad_s, double dt_s);
+Quaternion propagate(const Quaternion& q_RB, const Eigen::Vector3d& omega_BR_B_rad_s, double dt_s);
 
 //! [rad] Angle of the rotation between two attitudes, in [0, π].
 double angle_between(const Quaternion& a, const Quaternion& b);

@@ -152,7 +152,7 @@ struct Health {
 struct AttitudeEstimate {
   std::int64_t stamp_ns = 0;
   Quaternion q_RB = Quaternion::Identity();  //!< body → reference
-  Eigen::Vector3d omega_B_rad_s =
+  Eigen::Vector3d omega_BR_B_rad_s =
       Eigen::Vector3d::Zero();  //!< rate used for propagation (Earth rate removed in ground mode)
   Eigen::Vector3d sigma_rad = Eigen::Vector3d::Zero();  //!< 1σ attitude uncertainty per body axis
   Mode mode = Mode::kNominal;
