@@ -153,14 +153,16 @@ double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) cons
   return std::sqrt(sum_sq / (n - 2)) / (std::sqrt(6.0) * sigma_sample);
 }
 
-void GyroSeries::check(std::int64_t now_ns, GyroMask excluded, double period_s, Isolations& out) {
+void GyroSeries::check(std::int64_t now_ns, GyroMask excluded, double period_s, double sqrt_period,
+                       Isolations& out) {
   for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
     if (!has_gyro(excluded, id))
-      (void)check_one(id, tracks_[static_cast<std::size_t>(id - 1)], now_ns, period_s, out);
+      (void)check_one(id, tracks_[static_cast<std::size_t>(id - 1)], now_ns, period_s, sqrt_period, out);
   }
 }
 
-bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_s, Isolations& out) {
+bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_s, double sqrt_period,
+                           Isolations& out) {
   auto found = [&](FaultKind kind, Evidence evidence, double statistic) {
     out.push_back({id, kind, evidence, DetectionTest::kSignature, statistic});
     return true;
@@ -172,7 +174,6 @@ bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_
   if (t.repeat_count >= config_.stuck_repeat_count)
     return found(FaultKind::kStuck, t.last_raw == 0.0 ? Evidence::kZero : Evidence::kRepeated,
                  t.repeat_count);
-  const double sqrt_period = std::sqrt(period_s);
   if (t.d2_since_eval >= kNoiseEvalEvery && period_s > 0.0) {
     t.d2_since_eval = 0;
     const double r = noise_ratio(id, sqrt_period);

@@ -36,7 +36,7 @@ class GyroSeries {
   //! series.
   void ingest(const Epoch& epoch, EpochFrame& frame, Counters& counters);
   //! The signatures of every gyro not in `excluded`; isolations appended to `out` in gyro order.
-  void check(std::int64_t now_ns, GyroMask excluded, double period_s, Isolations& out);
+  void check(std::int64_t now_ns, GyroMask excluded, double period_s, double sqrt_period, Isolations& out);
 
   //! A confirmed one-epoch outlier that went away: a spike of gyro `id`.
   void record_spike(int id, std::int64_t now_ns);
@@ -78,7 +78,7 @@ class GyroSeries {
   void ingest_sample(Track& t, double raw, double y);
   //! The last `n` second differences of `t` into the scratch buffer.
   double* recent(const Track& t, int n) const;
-  bool check_one(int id, Track& t, std::int64_t now_ns, double period_s, Isolations& out);
+  bool check_one(int id, Track& t, std::int64_t now_ns, double period_s, double sqrt_period, Isolations& out);
 
   std::vector<GyroConstants> constants_;
   const PipelineConfig& config_;

@@ -188,7 +188,7 @@ void Pipeline::Impl::detect() {
 }
 
 void Pipeline::Impl::seek_evidence(const Epoch& epoch) {
-  series_.check(frame_.now_ns, gyro_set_.excluded(), subsets_.period_s(), found_);
+  series_.check(frame_.now_ns, gyro_set_.excluded(), subsets_.period_s(), subsets_.sqrt_period(), found_);
   isolate_all(found_);
   if (epoch.reference_q_RB && subsets_.ready()) {
     const auto finding =
@@ -247,11 +247,13 @@ void Pipeline::Impl::publish_attitude() {
     // A gyro isolated during this epoch leaves the published set: the rate is the one of the gyros published.
     if (frame_.usable != measured_) attitude_.measure(sol, frame_);
     if (frame_.dt_s > 0.0) {
-      const Subset& active = subsets_.get(gyro_set_.active());
+      // The active set's subset only when needed: for the bound of an open episode, or the noise of a lost
+      // rate.
+      const bool episode = isolator_.episode().active;
+      const Subset* active = episode || !sol.observable ? &subsets_.get(gyro_set_.active()) : nullptr;
       const Eigen::Vector3d bound =
-          isolator_.episode().active
-              ? fault_rate_bound(active, detector_.parity_ema(), subsets_.sqrt_period())
-              : Eigen::Vector3d::Zero();
+          episode ? fault_rate_bound(*active, detector_.parity_ema(), subsets_.sqrt_period())
+                  : Eigen::Vector3d::Zero();
       attitude_.propagate(frame_, sol, active, bound);
     }
   }

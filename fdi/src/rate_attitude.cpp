@@ -56,7 +56,7 @@ bool RateAttitude::measure_unprepared(const GyroGeometry& geometry, const EpochF
   return true;
 }
 
-void RateAttitude::propagate(const EpochFrame& frame, const Subset& sol, const Subset& fallback,
+void RateAttitude::propagate(const EpochFrame& frame, const Subset& sol, const Subset* fallback,
                              const Eigen::Vector3d& fault_bound_rad_s) {
   Eigen::Vector3d bound = fault_bound_rad_s;
   if (!sol.observable) {
@@ -67,7 +67,7 @@ void RateAttitude::propagate(const EpochFrame& frame, const Subset& sol, const S
   } else {
     lost_since_ns_ = -1;
   }
-  const Subset& noise = sol.observable ? sol : fallback;
+  const Subset& noise = sol.observable ? sol : *fallback;
   (void)propagator_.step(0.5 * (omega_prev_ + omega_meas_), frame.dt_s, noise.arw_sq_rad2_s,
                          noise.bias_sigma_rad_s, bound);  // trapezoid
 }

@@ -30,9 +30,9 @@ class RateAttitude {
   void measure(const Subset& s, const EpochFrame& frame);
   //! Before the sample period is known (first epoch): the estimate straight from the geometry.
   bool measure_unprepared(const GyroGeometry& geometry, const EpochFrame& frame);
-  //! Propagates over the epoch with `sol` the solution's subset (`fallback`: the active set's, when `sol` is
-  //! not observable) and `fault_bound_rad_s` the bound of an unresolved fault.
-  void propagate(const EpochFrame& frame, const Subset& sol, const Subset& fallback,
+  //! Propagates over the epoch with `sol` the solution's subset (`fallback`: the active set's, used only when
+  //! `sol` is not observable) and `fault_bound_rad_s` the bound of an unresolved fault.
+  void propagate(const EpochFrame& frame, const Subset& sol, const Subset* fallback,
                  const Eigen::Vector3d& fault_bound_rad_s);
   //! Ends the epoch: the published rate and the previous rate for the next trapezoid.
   void finish_epoch() { omega_prev_ = omega_meas_; }

@@ -28,9 +28,7 @@ void SubsetCache::prepare(double period_s) {
   }
 }
 
-const Subset& SubsetCache::get(GyroMask mask) {
-  auto it = subsets_.find(mask);
-  if (it != subsets_.end()) return it->second;
+const Subset& SubsetCache::insert(GyroMask mask) {
   Subset& s = subsets_[mask];
   build(s, mask);
   return s;
@@ -39,10 +37,6 @@ const Subset& SubsetCache::get(GyroMask mask) {
 const Subset* SubsetCache::find(GyroMask mask) const {
   const auto it = subsets_.find(mask);
   return it == subsets_.end() ? nullptr : &it->second;
-}
-
-bool SubsetCache::observable(GyroMask mask) {
-  return ready() ? get(mask).observable : tetra::gyro_count(mask) >= 3;
 }
 
 void SubsetCache::build(Subset& s, GyroMask mask) const {
@@ -91,28 +85,6 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
     s.glt_accept = chi2_threshold(1e-3, s.dof - 1);
     s.glt_reject = chi2_threshold(config.glt_false_alarm_probability, s.dof - 1);
   }
-}
-
-double apply_parity(const Subset& s, GyroMask mask, const double* v, double scale, double* p) {
-  const int n = static_cast<int>(s.parity.cols());
-  double sum_sq = 0.0;
-  for (int r = 0; r < s.dof; ++r) {
-    double acc = 0.0;
-    for (int i = 0; i < n; ++i) {
-      if (has_gyro(mask, i + 1)) acc += s.parity(r, i) * v[i];
-    }
-    p[r] = acc * scale;
-    sum_sq += p[r] * p[r];
-  }
-  return sum_sq;
-}
-
-Eigen::Vector3d apply_pinv(const Eigen::Matrix3Xd& pinv, GyroMask mask, const double* v) {
-  Eigen::Vector3d w = Eigen::Vector3d::Zero();
-  for (Eigen::Index i = 0; i < pinv.cols(); ++i) {
-    if (has_gyro(mask, static_cast<int>(i) + 1)) w += pinv.col(i) * v[i];
-  }
-  return w;
 }
 
 }  // namespace tetra::fdi::detail

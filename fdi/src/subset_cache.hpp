@@ -43,15 +43,19 @@ class SubsetCache {
   double sqrt_period() const { return sqrt_period_; }
 
   //! The subset's constants, built on first use (only once `ready()`).
-  const Subset& get(GyroMask mask);
+  const Subset& get(GyroMask mask) {
+    const auto it = subsets_.find(mask);
+    return it != subsets_.end() ? it->second : insert(mask);
+  }
   //! The subset's constants if built already, else null.
   const Subset* find(GyroMask mask) const;
   //! Without a sample period, the full-rank test alone (at least 3 gyros spanning 3-D).
-  bool observable(GyroMask mask);
+  bool observable(GyroMask mask) { return ready() ? get(mask).observable : tetra::gyro_count(mask) >= 3; }
   const GyroGeometry& geometry() const { return geometry_; }
   int gyro_count() const { return geometry_.gyro_count(); }
 
  private:
+  const Subset& insert(GyroMask mask);
   void build(Subset& s, GyroMask mask) const;
 
   GyroGeometry geometry_;             //!< weighted by N_i
@@ -63,8 +67,27 @@ class SubsetCache {
 };
 
 //! p_r = scale·Σ_{i∈mask} W(r, i)·v_i for the subset's d rows; returns Σ p_r². The one parity kernel.
-double apply_parity(const Subset& s, GyroMask mask, const double* v, double scale, double* p);
+inline double apply_parity(const Subset& s, GyroMask mask, const double* v, double scale, double* p) {
+  const int n = static_cast<int>(s.parity.cols());
+  double sum_sq = 0.0;
+  for (int r = 0; r < s.dof; ++r) {
+    double acc = 0.0;
+    for (int i = 0; i < n; ++i) {
+      if (has_gyro(mask, i + 1)) acc += s.parity(r, i) * v[i];
+    }
+    p[r] = acc * scale;
+    sum_sq += p[r] * p[r];
+  }
+  return sum_sq;
+}
+
 //! ω = Σ_{i∈mask} H*(:, i)·v_i. The one rate kernel.
-Eigen::Vector3d apply_pinv(const Eigen::Matrix3Xd& pinv, GyroMask mask, const double* v);
+inline Eigen::Vector3d apply_pinv(const Eigen::Matrix3Xd& pinv, GyroMask mask, const double* v) {
+  Eigen::Vector3d w = Eigen::Vector3d::Zero();
+  for (Eigen::Index i = 0; i < pinv.cols(); ++i) {
+    if (has_gyro(mask, static_cast<int>(i) + 1)) w += pinv.col(i) * v[i];
+  }
+  return w;
+}
 
 }  // namespace tetra::fdi::detail

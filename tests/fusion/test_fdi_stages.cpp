@@ -128,7 +128,7 @@ TEST(GyroSeries, SignaturesNameTheGyroAndItsKind) {
     if (k >= 200) e.raw[2] = 0.25;   // gyro 3 stuck from 20 s
     frame.now_ns = e.stamp_ns;
     series.ingest(e, frame, counters);
-    series.check(frame.now_ns, 0, kPeriod, found);
+    series.check(frame.now_ns, 0, kPeriod, std::sqrt(kPeriod), found);
     if (k == 99) ratio = series.noise_ratio(1, std::sqrt(kPeriod));
     for (const auto& iso : found) {
       if (iso.gyro == 2) {
@@ -312,7 +312,7 @@ TEST(RateAttitude, ConstantRatePropagatesExactly) {
   for (int k = 1; k <= 600; ++k) {
     frame.now_ns = seconds_to_ns(k * kPeriod);
     attitude.measure(s, frame);
-    attitude.propagate(frame, s, s, Eigen::Vector3d::Zero());
+    attitude.propagate(frame, s, &s, Eigen::Vector3d::Zero());
     attitude.finish_epoch();
   }
   EXPECT_LT(angle_between(attitude.q_RB(), quat_exp(omega * 60.0)), 1e-12);
