@@ -40,7 +40,7 @@ void Isolator::record(const EpochFrame& frame) {
   const auto slot = static_cast<std::size_t>(frame.index % kHistory);
   hist_ns_[slot] = frame.now_ns;
   std::copy(frame.y_rad_s.begin(), frame.y_rad_s.end(),
-            hist_y_.begin() + static_cast<std::ptrdiff_t>(slot * n_));
+            hist_y_.begin() + static_cast<std::ptrdiff_t>(slot * static_cast<std::size_t>(n_)));
   hist_valid_[slot] = frame.valid;
 }
 
