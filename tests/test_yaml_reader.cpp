@@ -78,5 +78,19 @@ TEST(YamlReader, SyntaxErrorsCarryTheLine) {
   }
 }
 
+TEST(YamlReader, OneDocumentAndNoHangOnMalformedText) {
+  // A second document is refused with its line; the inputs the fuzzers found hanging yaml-cpp's LoadAll (a
+  // lone comma, ",][") come back at once (ctest's timeout is the bound).
+  const YamlReader yaml{"d.yaml"};
+  const auto two = yaml.load("a: 1\n---\nb: 2\n");
+  ASSERT_FALSE(two.ok());
+  EXPECT_NE(two.error().message.find("d.yaml:2: a second YAML document"), std::string::npos)
+      << two.error().message;
+  EXPECT_FALSE(yaml.load("a: 1\n...\nb: 2\n").ok());
+  EXPECT_TRUE(yaml.load("---\na: 1\n...\n").ok());
+  EXPECT_TRUE(yaml.load("# comment\n---\na: 1\n").ok());
+  for (const char* text : {",", ",][", ",# "}) (void)yaml.load(text);
+}
+
 }  // namespace
 }  // namespace tetra

@@ -1,6 +1,8 @@
 #include "tetra/core/yaml_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string_view>
 #include <vector>
 
 #include "tetra/core/csv.hpp"
@@ -61,15 +63,45 @@ Status YamlReader::check_unique_keys(const YAML::Node& node, const std::string& 
   return ok_status();
 }
 
-Result<YAML::Node> YamlReader::load(const std::string& text) const {
-  try {
-    std::vector<YAML::Node> docs = YAML::LoadAll(text);
-    if (docs.empty()) return YAML::Node();
-    if (docs.size() > 1) {
-      return error(docs[1], "", "a second YAML document ('---'): a file holds exactly one");
+namespace {
+
+// 1-based line of a second document in `text` (a "---" line after content, or content after a "..." line),
+// or 0. Found in the text because yaml-cpp 0.7's LoadAll never returns on some malformed input (a lone ",").
+int second_document_line(const std::string& text) {
+  bool content = false;
+  bool ended = false;
+  int line_no = 0;
+  for (std::size_t begin = 0; begin < text.size();) {
+    const std::size_t end = std::min(text.find('\n', begin), text.size());
+    const std::string_view line(text.data() + begin, end - begin);
+    begin = end + 1;
+    ++line_no;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string_view::npos || line[first] == '#' || line[0] == '%') continue;
+    const bool marker = line.substr(0, 3) == "---" && (line.size() == 3 || line[3] == ' ' || line[3] == '\r');
+    const bool end_marker =
+        line.substr(0, 3) == "..." && (line.size() == 3 || line[3] == ' ' || line[3] == '\r');
+    if ((marker && content) || (ended && !end_marker)) return line_no;
+    if (end_marker) {
+      ended = content;
+      continue;
     }
-    if (Status st = check_unique_keys(docs[0], ""); !st) return st.error();
-    return docs[0];
+    if (!marker || line.find_first_not_of(" \t\r", 3) != std::string_view::npos) content = true;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Result<YAML::Node> YamlReader::load(const std::string& text) const {
+  if (const int line = second_document_line(text); line > 0) {
+    return bad_input(source_ + ":" + std::to_string(line) +
+                     ": a second YAML document ('---'): a file holds exactly one");
+  }
+  try {
+    YAML::Node doc = YAML::Load(text);
+    if (Status st = check_unique_keys(doc, ""); !st) return st.error();
+    return doc;
   } catch (const YAML::Exception& e) {
     return error(e, "");
   }
