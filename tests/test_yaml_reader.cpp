@@ -32,7 +32,7 @@ TEST(YamlReader, NumbersMustBeFiniteNumbers) {
   EXPECT_EQ(y.error().message, "n.yaml:2: g.y: 'abc' is not a number");
   const auto z = yaml.number(root["z"], "z");
   ASSERT_FALSE(z.ok());
-  EXPECT_EQ(z.error().message, "n.yaml:3: z: must be finite");
+  EXPECT_EQ(z.error().message, "n.yaml:3: z: '.inf' is not a number");  // plain decimal numbers only
   const auto w = yaml.number(root["w"], "w");
   ASSERT_FALSE(w.ok());
   EXPECT_EQ(w.error().message, "n.yaml:4: w: '?' is not a number");

@@ -1,8 +1,8 @@
 // tetra record -o LOG.csv — the gyro and reference streams of one unit on DDS, written as a
 // replayable gyro log (docs/interfaces.md §2.2). Epochs are assembled exactly as `tetra fusion` does (same
 // assembler, same settings when given the service's --config), so `tetra replay` of the log sees
-// the epochs the service saw. Optionally also the service's Attitude (§2.4) and FdiEvents (§2.5).
-// Stops on SIGINT/SIGTERM, after --duration, or with --until-idle when the gyro writers are gone.
+// the epochs the service saw. Optionally also the service's Attitude (docs/interfaces.md §2.4) and FdiEvents
+// (§2.5). Stops on SIGINT/SIGTERM, after --duration, or with --until-idle when the gyro writers are gone.
 
 #include <algorithm>
 #include <iostream>

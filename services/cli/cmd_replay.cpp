@@ -1,5 +1,5 @@
 // tetra replay — the whole fusion pipeline offline: gyro log in; attitude (docs/interfaces.md §2.4) and FDI
-// events (§2.5) out; a summary on stderr. The same Pipeline object serves the DDS service.
+// events (docs/interfaces.md §2.5) out; a summary on stderr. The same Pipeline object serves the DDS service.
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -50,8 +50,7 @@ Result<Quaternion> parse_quaternion(const std::string& text) {
 int cmd_replay(int argc, char** argv) {
   CLI::App app{
       "Run the fusion and fault-detection pipeline over a gyro log (docs/interfaces.md §2.2): writes the "
-      "attitude "
-      "(§2.4) and the FDI events (§2.5); prints a summary on stderr.",
+      "attitude (§2.4) and the FDI events (§2.5); prints a summary on stderr.",
       "replay"};
   std::string log_path;
   std::string cal_path;

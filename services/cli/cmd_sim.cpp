@@ -84,26 +84,35 @@ int cmd_sim(int argc, char** argv) {
                  "default: the seed paper's unit");
   app.add_option("--out,-o", out_path, "output log (- = standard output; turntable: the default)");
   app.add_option("--truth", truth_path, "truth file: time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps");
-  auto* opt_rate = app.add_option("--rate-hz", rate_hz, "[Hz] gyro sampling rate");
-  auto* opt_minutes = app.add_option("--minutes", minutes, "[min] duration (not for turntable)");
+  auto* opt_rate =
+      app.add_option("--rate-hz", rate_hz, "[Hz] gyro sampling rate")->check(CLI::PositiveNumber);
+  auto* opt_minutes =
+      app.add_option("--minutes", minutes, "[min] duration (not for turntable)")->check(CLI::PositiveNumber);
   auto* opt_lat =
       app.add_option("--latitude", latitude_deg, "[deg] geodetic latitude (turntable, static, lab-orbit)")
           ->check(CLI::Range(-90.0, 90.0));
   app.add_option("--fault", fault_texts,
                  "gyro=N,kind=K,at=S[,size=X][,until=S] (repeatable; docs/interfaces.md §2.7)");
-  auto* opt_ref = app.add_option("--reference-hz", reference_hz, "[Hz] attitude reference rate (0 = none)");
+  auto* opt_ref = app.add_option("--reference-hz", reference_hz, "[Hz] attitude reference rate (0 = none)")
+                      ->check(CLI::NonNegativeNumber);
   auto* opt_ref_noise =
-      app.add_option("--reference-noise", reference_noise_arcsec, "[arcsec] reference 1-sigma per axis");
+      app.add_option("--reference-noise", reference_noise_arcsec, "[arcsec] reference 1-sigma per axis")
+          ->check(CLI::NonNegativeNumber);
   auto* opt_acs_amp = app.add_option("--acs-amplitude", acs_amplitude_deg,
                                      "[deg] orbit/slews: attitude-control motion amplitude (0 = none)");
   auto* opt_acs_acc =
-      app.add_option("--acs-accel", acs_accel_dps2, "[deg/s^2] orbit/slews: its peak acceleration");
+      app.add_option("--acs-accel", acs_accel_dps2, "[deg/s^2] orbit/slews: its peak acceleration")
+          ->check(CLI::PositiveNumber);
   auto* opt_period =
-      app.add_option("--orbit-period", orbit_period_min, "[min] orbit/slews: orbit period (one pitch turn)");
-  auto* opt_jitter = app.add_option("--jitter", jitter_s, "[s] sample-time jitter, uniform +-");
+      app.add_option("--orbit-period", orbit_period_min, "[min] orbit/slews: orbit period (one pitch turn)")
+          ->check(CLI::PositiveNumber);
+  auto* opt_jitter = app.add_option("--jitter", jitter_s, "[s] sample-time jitter, uniform +-")
+                         ->check(CLI::NonNegativeNumber);
   auto* opt_drop =
-      app.add_option("--drop", drop_probability, "probability that a gyro sample is not delivered");
-  auto* opt_range = app.add_option("--range", range_dps, "[deg/s] measuring range (saturation)");
+      app.add_option("--drop", drop_probability, "probability that a gyro sample is not delivered")
+          ->check(CLI::Range(0.0, 1.0));
+  auto* opt_range = app.add_option("--range", range_dps, "[deg/s] measuring range (saturation)")
+                        ->check(CLI::PositiveNumber);
   auto* opt_table = app.add_option("--table-rate", plan.table_rate_dps, "[deg/s] turntable: gimbal rate")
                         ->capture_default_str();
   auto* opt_revs = app.add_option("--revolutions", plan.revolutions, "turntable: revolutions per sequence")

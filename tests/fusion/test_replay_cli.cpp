@@ -50,7 +50,9 @@ TEST(ReplayCli, WritesAttitudeAndEventsAndSummary) {
   const auto r = run_tetra("replay " + log + " --calibration " + cal + " --attitude " + dir.file("att.csv") +
                            " --events " + dir.file("ev.jsonl"));
   ASSERT_EQ(r.exit_status, 0) << r.err;
-  const std::string text = test::read_file(dir.file("att.csv"));
+  const std::string file = test::read_file(dir.file("att.csv"));
+  EXPECT_EQ(file.rfind("# tetra_version=", 0), 0U);  // provenance first
+  const std::string text = file.substr(file.find("\ntime_s") + 1);
   EXPECT_EQ(text.substr(0, text.find('\n')), "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros");
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1001);  // header + one row per epoch
   EXPECT_NE(text.find(",NOMINAL,1234\n"), std::string::npos);
@@ -153,7 +155,8 @@ TEST(ReplayCli, SeedExperimentFromTheCommandLine) {
     EXPECT_EQ(r.exit_status, 0) << r.err;
     std::istringstream in(test::read_file(dir.file("att.csv")));
     std::string line;
-    std::getline(in, line);  // header
+    while (std::getline(in, line) && line.rfind("time_s", 0) != 0) {
+    }  // provenance comments, then the header
     double sum = 0.0;
     double last_t = -1.0;
     while (std::getline(in, line)) {

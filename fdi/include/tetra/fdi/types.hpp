@@ -38,7 +38,8 @@ const char* to_string(FaultKind kind);  // "none", "bias", ..., "unknown"
 std::optional<FaultKind> fault_kind_from_string(std::string_view text);
 
 //! detected, isolated, unisolated (detected and the data cannot tell which gyro), reconfigured,
-//! cleared, lost; and command (acknowledgement of an operator command — an addition to §2.5).
+//! cleared, lost; and command (acknowledgement of an operator command — an addition to docs/interfaces.md
+//! §2.5).
 enum class EventType : std::uint8_t {
   kDetected,
   kIsolated,
