@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev
   cyclonedds-dev cyclonedds-tools
   libgtest-dev libgmock-dev libbenchmark-dev
+  libhdf5-dev                                 # HDF5 gyro logs
   gnuplot-nox
   clang libclang-rt-14-dev openssl iproute2   # reliability tests: fuzzers (clang), DDS Security PKI, netns
 )
