@@ -20,6 +20,7 @@
 #include "allan_internal.hpp"
 #include "tetra/core/allan.hpp"
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/gyro_log_prefetch.hpp"
 
 namespace tetra::allan {
 
@@ -116,7 +117,7 @@ Error out_of_memory(const std::string& source) {
 }
 
 // Reads the log once, keeping the times and each wanted gyro's rate (calibrated when asked).
-Status read_columns(GyroLogReader& reader, const LogAllanOptions& options, bool calibrate, Columns& c) {
+Status read_columns(GyroLogPrefetcher& reader, const LogAllanOptions& options, bool calibrate, Columns& c) {
   const auto ng = static_cast<std::size_t>(c.header.gyro_count);
   c.rate.resize(c.ids.size());
   c.invalid.assign(c.ids.size(), 0);
@@ -246,8 +247,10 @@ Result<LogAllan> analyze_gyro_log_file(const std::string& path, const LogAllanOp
   const auto ids = gyro_ids(options, log.gyro_count);
   const bool cal_short = calibrate && options.calibration->gyro_count() < log.gyro_count;
   if (ids && !cal_short) c.ids = *ids;
-  if (Status st = read_columns(**reader, options, calibrate, c); !st) return st.error();
-  reader->reset();
+  {
+    GyroLogPrefetcher prefetch(std::move(reader.value()));  // parsing overlaps storing the columns
+    if (Status st = read_columns(prefetch, options, calibrate, c); !st) return st.error();
+  }
 
   LogAllan out;
   out.epochs = c.time_s.size();
