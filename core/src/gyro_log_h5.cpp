@@ -19,7 +19,8 @@ namespace {
 
 constexpr const char* kFormat = "tetra gyro log";
 constexpr int kVersion = 1;
-constexpr hsize_t kChunkRows = 65536;  // rows per chunk and per block read or written
+constexpr hsize_t kChunkRows = 65536;  // rows per chunk, and per block written
+constexpr hsize_t kBlockRows = 16384;  // rows per block read (a quarter chunk: the chunk cache keeps it)
 constexpr unsigned kDeflateLevel = 1;  // fast: the noise in gyro values barely compresses anyway
 constexpr std::array<const char*, 4> kRefNames = {"ref_qw", "ref_qx", "ref_qy", "ref_qz"};
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -309,7 +310,7 @@ Status H5Reader::check_block(const GyroLog& block, hsize_t first) const {
 
 Result<bool> H5Reader::next(GyroLog& block) {
   if (row_ >= rows_) return false;
-  const hsize_t count = std::min(kChunkRows, rows_ - row_);
+  const hsize_t count = std::min(kBlockRows, rows_ - row_);
   const auto n = static_cast<std::size_t>(count);
   const auto ng = static_cast<std::size_t>(header_.gyro_count);
   block.source = header_.source;

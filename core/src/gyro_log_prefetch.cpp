@@ -17,6 +17,13 @@ GyroLogPrefetcher::~GyroLogPrefetcher() {
 void GyroLogPrefetcher::run() {
   while (true) {
     Item item;
+    {
+      const std::lock_guard lock(mutex_);
+      if (!spare_.empty()) {
+        item.block = std::move(spare_.back());
+        spare_.pop_back();
+      }
+    }
     item.more = reader_->next(item.block);
     fraction_.store(reader_->fraction_read(), std::memory_order_relaxed);
     const bool last = !item.more || !*item.more;
@@ -37,10 +44,14 @@ Result<bool> GyroLogPrefetcher::next(GyroLog& block) {
   queue_.pop_front();
   // The end (or an error) stays at the head, so every later call returns it again.
   const bool last = !item.more || !*item.more;
-  if (last) queue_.push_front(Item{item.more, GyroLog{}});
+  if (last) {
+    queue_.push_front(Item{item.more, GyroLog{}});
+  } else {
+    if (spare_.size() < kDepth) spare_.push_back(std::move(block));
+    block = std::move(item.block);
+  }
   lock.unlock();
   changed_.notify_all();
-  if (!last) block = std::move(item.block);
   return item.more;
 }
 

@@ -9,6 +9,7 @@
 #include <mutex>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/result.hpp"
@@ -27,7 +28,8 @@ class GyroLogPrefetcher {
   ~GyroLogPrefetcher();
 
   const GyroLog& header() const { return reader_->header(); }
-  //! As GyroLogReader::next, in the same order, with the same errors.
+  //! As GyroLogReader::next, in the same order, with the same errors. The block passed in goes back to
+  //! the worker to be filled again (its buffers are reused: no allocation per block).
   Result<bool> next(GyroLog& block);
   //! Fraction of the log read by the worker so far.
   double fraction_read() const { return fraction_.load(std::memory_order_relaxed); }
@@ -43,6 +45,7 @@ class GyroLogPrefetcher {
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Item> queue_;
+  std::vector<GyroLog> spare_;  // blocks handed back, to be refilled
   bool stop_ = false;
   std::atomic<double> fraction_{0.0};
   std::thread worker_;
