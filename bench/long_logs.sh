@@ -4,7 +4,7 @@
 #   replay:  orbit logs at 100 Hz, 4 gyros, 1 Hz reference: 30, 120 and 360 min (REPLAY_MINUTES)
 #   allan:   static logs at 100 Hz, 4 gyros: 2, 4 and 8 h (ALLAN_HOURS)
 # Each row: command, format, epochs, wall seconds, epochs per second, peak RSS [MB].
-# usage: bench/long_logs.sh [BUILD_DIR=build]   (needs tetra and make_allan_log built; several GB of /tmp)
+# usage: bench/long_logs.sh [BUILD_DIR=build]   (needs tetra, make_allan_log and read_log built; ~1 GB of /tmp)
 # BIG=1 adds Allan of 24 h x 1 kHz x 4 gyros from HDF5 (a 3 GB HDF5 file, generated on the way).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -43,6 +43,9 @@ for m in $REPLAY_MINUTES; do
   n=$(epochs_of "$log")
   row convert csv2h5 "$n" -- "$T" convert "$log" "$work/orbit_$m.h5"
   for f in csv h5; do
+    echo "read    $f     $("$build/bench/read_log" "$work/orbit_$m.$f" blocks)"
+  done
+  for f in csv h5; do
     row replay "$f" "$n" -- "$T" replay "$work/orbit_$m.$f" --calibration "$work/cal.yaml" \
       --attitude "$work/att.csv" --events "$work/ev.jsonl"
   done
@@ -55,16 +58,16 @@ for h in $ALLAN_HOURS; do
   n=$(epochs_of "$log")
   "$T" convert "$log" "$work/static_$h.h5"
   for f in csv h5; do
+    echo "read    $f     $("$build/bench/read_log" "$work/static_$h.$f" blocks)"
+  done
+  for f in csv h5; do
     row allan "$f" "$n" -- "$T" allan "$work/static_$h.$f" --calibration "$log.cal.yaml" --json "$work/a.json"
   done
   rm -f "$work/static_$h.csv" "$work/static_$h.h5"
 done
 
 if [ "${BIG:-0}" = 1 ]; then
-  log="$work/static_24h_1k.csv"
+  log="$work/static_24h_1k.h5"
   "$build/bench/make_allan_log" "$log" 24 1000 1 >/dev/null
-  "$T" convert "$log" "$work/static_24h_1k.h5"
-  n=$(epochs_of "$log")
-  rm -f "$log"
-  row allan h5 "$n" -- "$T" allan "$work/static_24h_1k.h5" --calibration "$log.cal.yaml" --json "$work/a.json"
+  row allan h5 86400000 -- "$T" allan "$log" --calibration "$log.cal.yaml" --json "$work/a.json"
 fi
