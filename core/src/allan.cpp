@@ -495,24 +495,33 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
     return gyro;
   };
 
-  // The gyros are independent: analyse them on up to two threads (the work per gyro is O(n) per τ
-  // and identical in any order, so the results do not depend on the thread count).
-  std::vector<std::optional<Result<GyroAllan>>> results(ids.size());
+  if (Status st = analyse_gyros(
+          ids.size(), [&](std::size_t i) { return analyse_one(ids[i]); }, out.gyros);
+      !st)
+    return st.error();
+  return out;
+}
+
+// The gyros are independent: analyse them on up to two threads (the work per gyro is O(n) per τ and
+// identical in any order, so the results do not depend on the thread count).
+Status analyse_gyros(std::size_t count, const std::function<Result<GyroAllan>(std::size_t)>& analyse,
+                     std::vector<GyroAllan>& out) {
+  std::vector<std::optional<Result<GyroAllan>>> results(count);
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
-    for (std::size_t i = next++; i < ids.size(); i = next++) results[i] = analyse_one(ids[i]);
+    for (std::size_t i = next++; i < count; i = next++) results[i] = analyse(i);
   };
   const std::size_t threads =
-      std::min<std::size_t>({2, ids.size(), std::max(1U, std::thread::hardware_concurrency())});
+      std::min<std::size_t>({2, count, std::max(1U, std::thread::hardware_concurrency())});
   std::vector<std::thread> pool;
   for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();
   for (std::thread& t : pool) t.join();
   for (auto& r : results) {
     if (!*r) return r->error();
-    out.gyros.push_back(std::move(r->value()));
+    out.push_back(std::move(r->value()));
   }
-  return out;
+  return ok_status();
 }
 
 }  // namespace tetra::allan

@@ -33,4 +33,9 @@ Result<AllanResult> finish_series(std::size_t samples, std::size_t present_sampl
                                   const std::vector<AvarPoint>& all, const std::vector<std::size_t>& runs,
                                   double tau0_s, const AllanOptions& options);
 
+//! Runs `analyse(i)` for i = 0..count−1 on up to two threads; appends the results to `out` in order,
+//! or returns the first error in that order.
+Status analyse_gyros(std::size_t count, const std::function<Result<GyroAllan>(std::size_t)>& analyse,
+                     std::vector<GyroAllan>& out);
+
 }  // namespace tetra::allan

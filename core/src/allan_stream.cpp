@@ -278,35 +278,20 @@ Result<LogAllan> analyze_gyro_log_file(const std::string& path, const LogAllanOp
   out.tau0_s = grid->tau0_s;
   out.missing_epochs = grid->missing_epochs;
 
-  std::vector<std::optional<Result<GyroAllan>>> results(c.ids.size());
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    for (std::size_t j = next++; j < c.ids.size(); j = next++) {
-      auto r = analyse_column(c.rate[j], *grid, options.allan, log.source);
-      if (!r) {
-        results[j] = Result<GyroAllan>(
-            bad_input(log.source + ": gyro " + std::to_string(c.ids[j]) + ": " + r.error().message +
-                      (c.ids.size() > 1 ? " (--gyro N analyses the others alone)" : "")));
-        continue;
-      }
-      GyroAllan gyro;
-      gyro.id = c.ids[j];
-      gyro.invalid = c.invalid[j];
-      gyro.absent = grid->slots - c.delivered[j] - c.invalid[j];
-      gyro.result = std::move(r.value());
-      results[j] = std::move(gyro);
+  auto analyse_one = [&](std::size_t j) -> Result<GyroAllan> {
+    auto r = analyse_column(c.rate[j], *grid, options.allan, log.source);
+    if (!r) {
+      return bad_input(log.source + ": gyro " + std::to_string(c.ids[j]) + ": " + r.error().message +
+                       (c.ids.size() > 1 ? " (--gyro N analyses the others alone)" : ""));
     }
+    GyroAllan gyro;
+    gyro.id = c.ids[j];
+    gyro.invalid = c.invalid[j];
+    gyro.absent = grid->slots - c.delivered[j] - c.invalid[j];
+    gyro.result = std::move(r.value());
+    return gyro;
   };
-  const std::size_t threads =
-      std::min<std::size_t>({2, c.ids.size(), std::max(1U, std::thread::hardware_concurrency())});
-  std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
-  for (auto& r : results) {
-    if (!*r) return r->error();
-    out.gyros.push_back(std::move(r->value()));
-  }
+  if (Status st = analyse_gyros(c.ids.size(), analyse_one, out.gyros); !st) return st.error();
   return out;
 }
 
