@@ -194,7 +194,8 @@ AttitudeRows read_attitude(const std::string& path) {
   AttitudeRows rows;
   std::istringstream in(read_file(path));
   std::string line;
-  std::getline(in, line);  // header
+  while (std::getline(in, line) && line.rfind("time_s", 0) != 0) {
+  }  // provenance comments, then the header
   while (std::getline(in, line)) {
     std::array<double, 9> v{};
     std::istringstream cells(line);

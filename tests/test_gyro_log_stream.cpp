@@ -232,6 +232,12 @@ TEST(GyroLogHdf5, BadFilesGiveOneLineErrors) {
   r = read_gyro_log(dir.file("nan.h5"));
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().message, dir.file("nan.h5") + ": dataset 'time_s' row 2: time must be a finite number");
+  // A truncated file (an interrupted copy): one line, exit 2.
+  const std::string whole = test::read_file(write_log(dir.file("whole.h5"), 70000, false));
+  test::write_file(dir.file("cut.h5"), whole.substr(0, whole.size() / 2));
+  r = read_gyro_log(dir.file("cut.h5"));
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().message, dir.file("cut.h5") + ": cannot open as HDF5");
   const auto cli = test::run_tetra("replay " + dir.file("nan.h5") + " --calibration x.yaml --attitude " +
                                    dir.file("a.csv") + " --events " + dir.file("e.jsonl"));
   EXPECT_EQ(cli.exit_status, 2);
