@@ -14,6 +14,7 @@ packages=(
   libeigen3-dev libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev
   cyclonedds-dev cyclonedds-tools
   libcpp-httplib-dev nlohmann-json3-dev       # tetra ground: HTTP server, JSON
+  libhdf5-dev                                 # HDF5 gyro logs
   help2man                                    # man pages from the --help texts (cmake --install)
 )
 # Node.js and npm for web/ (Debian's nodejs and npm, unless a node with npm is already installed).

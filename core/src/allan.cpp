@@ -2,6 +2,8 @@
 // The noise fit is in allan_fit.cpp, the reports in allan_report.cpp.
 #include "tetra/core/allan.hpp"
 
+#include "allan_internal.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <charconv>
@@ -132,41 +134,54 @@ Result<std::vector<std::int64_t>> averaging_factors(const TauSpec& spec, std::si
 
 Result<SamplingGrid> uniform_grid(std::span<const double> time_s, double tolerance, const std::string& source,
                                   std::span<const std::size_t> lines) {
+  return uniform_grid_lines(time_s, tolerance, source, [&](std::size_t row) -> std::optional<std::size_t> {
+    if (row < lines.size()) return lines[row];
+    return std::nullopt;
+  });
+}
+
+Result<SamplingGrid> uniform_grid_lines(
+    std::span<const double> time_s, double tolerance, const std::string& source,
+    const std::function<std::optional<std::size_t>(std::size_t)>& line_of) {
   const std::size_t n = time_s.size();
   auto where = [&](std::size_t row) {
-    return source + ":" +
-           (row < lines.size() ? std::to_string(lines[row]) : "row " + std::to_string(row + 1)) + ": ";
+    const auto line = line_of(row);
+    return source + ":" + (line ? std::to_string(*line) : "row " + std::to_string(row + 1)) + ": ";
   };
   if (n < 2) {
     return bad_input(source + ": " + std::to_string(n) + " sample" + (n == 1 ? "" : "s") +
                      ": an Allan variance needs at least 2");
   }
-  std::vector<double> steps(n - 1);
-  for (std::size_t r = 0; r + 1 < n; ++r) {
-    steps[r] = time_s[r + 1] - time_s[r];
-    if (!(steps[r] > 0.0)) {
-      return bad_input(where(r + 1) + "column 'time_s': time " + format_number(time_s[r + 1]) +
-                       " s does not increase (previous " + format_number(time_s[r]) + " s)");
-    }
-  }
-  std::vector<double> sorted = steps;
-  const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
-  std::nth_element(sorted.begin(), mid, sorted.end());
+  // One temporary (the steps, reordered for the median); the steps are recomputed afterwards.
+  auto step = [&](std::size_t r) { return time_s[r + 1] - time_s[r]; };
   SamplingGrid grid;
-  grid.tau0_s = *mid;
+  {
+    std::vector<double> sorted(n - 1);
+    for (std::size_t r = 0; r + 1 < n; ++r) {
+      sorted[r] = step(r);
+      if (!(sorted[r] > 0.0)) {
+        return bad_input(where(r + 1) + "column 'time_s': time " + format_number(time_s[r + 1]) +
+                         " s does not increase (previous " + format_number(time_s[r]) + " s)");
+      }
+    }
+    const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+    std::nth_element(sorted.begin(), mid, sorted.end());
+    grid.tau0_s = *mid;
+  }
   grid.slot.resize(n);
   std::size_t slot = 0;
   for (std::size_t r = 0; r < n; ++r) {
     if (r > 0) {
-      const double k = std::round(steps[r - 1] / grid.tau0_s);
-      if (k < 1.0 || std::abs(steps[r - 1] - k * grid.tau0_s) > tolerance * grid.tau0_s) {
-        return bad_input(where(r) + "column 'time_s': time step " + format_number(steps[r - 1]) +
+      const double dt = step(r - 1);
+      const double k = std::round(dt / grid.tau0_s);
+      if (k < 1.0 || std::abs(dt - k * grid.tau0_s) > tolerance * grid.tau0_s) {
+        return bad_input(where(r) + "column 'time_s': time step " + format_number(dt) +
                          " s is not a whole multiple of the sampling interval " + format_number(grid.tau0_s) +
                          " s (median) within " + format_number(100.0 * tolerance) +
                          " %: non-uniform sampling");
       }
       if (k > static_cast<double>(4 * n)) {
-        return bad_input(where(r) + "column 'time_s': time jumps by " + format_number(steps[r - 1]) +
+        return bad_input(where(r) + "column 'time_s': time jumps by " + format_number(dt) +
                          " s, more than the whole record at the sampling interval " +
                          format_number(grid.tau0_s) + " s");
       }
@@ -218,8 +233,12 @@ std::vector<AvarPoint> overlapping_avar(std::span<const double> rate, std::span<
     x[i + 1] = static_cast<double>(acc);
     cum[i + 1] = c;
   }
-  const bool complete = count == n;
+  return avar_from_angle(x.data(), count == n ? nullptr : cum.data(), n, tau0_s, m_values);
+}
 
+std::vector<AvarPoint> avar_from_angle(const double* x, const std::uint32_t* cum, std::size_t n,
+                                       double tau0_s, std::span<const std::int64_t> m_values) {
+  const bool complete = cum == nullptr;
   std::vector<AvarPoint> out;
   out.reserve(m_values.size());
   for (const std::int64_t m_signed : m_values) {
@@ -239,9 +258,9 @@ std::vector<AvarPoint> overlapping_avar(std::span<const double> rate, std::span<
       // Four partial sums: independent chains the CPU can overlap (the order is fixed, so results
       // are reproducible).
       double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-      const double* xa = x.data();
-      const double* xb = x.data() + m;
-      const double* xc = x.data() + 2 * m;
+      const double* xa = x;
+      const double* xb = x + m;
+      const double* xc = x + 2 * m;
       std::size_t i = 0;
       for (; i + 3 <= last; i += 4) {
         const double d0 = xc[i] - 2.0 * xb[i] + xa[i];
@@ -345,27 +364,45 @@ bool classify(std::vector<AdevPoint>& points, const NoiseFit& fit) {
 
 }  // namespace
 
-Result<AllanResult> analyze_series(std::span<const double> rate, std::span<const std::uint8_t> present,
-                                   double tau0_s, const AllanOptions& options) {
+Status check_series_options(double tau0_s, const AllanOptions& options) {
   if (!(options.confidence > 0.0 && options.confidence < 1.0)) {
     return bad_input("confidence level " + format_number(options.confidence) + " is not between 0 and 1");
   }
   if (!(tau0_s > 0.0) || !std::isfinite(tau0_s)) {
     return bad_input("sampling interval " + format_number(tau0_s) + " s is not positive");
   }
-  AllanResult result;
-  result.tau0_s = tau0_s;
-  result.samples = rate.size();
-  for (std::size_t i = 0; i < rate.size(); ++i) {
-    if ((present.empty() || present[i] != 0) && std::isfinite(rate[i])) ++result.present_samples;
-  }
-  if (result.present_samples < 2) {
-    return bad_input(std::to_string(result.present_samples) +
+  return ok_status();
+}
+
+Status check_present_samples(std::size_t present_samples) {
+  if (present_samples < 2) {
+    return bad_input(std::to_string(present_samples) +
                      " valid sample(s): an Allan variance needs at least 2");
   }
+  return ok_status();
+}
+
+Result<AllanResult> analyze_series(std::span<const double> rate, std::span<const std::uint8_t> present,
+                                   double tau0_s, const AllanOptions& options) {
+  if (Status st = check_series_options(tau0_s, options); !st) return st.error();
+  std::size_t present_samples = 0;
+  for (std::size_t i = 0; i < rate.size(); ++i) {
+    if ((present.empty() || present[i] != 0) && std::isfinite(rate[i])) ++present_samples;
+  }
+  if (Status st = check_present_samples(present_samples); !st) return st.error();
   auto ms = averaging_factors(options.taus, rate.size(), tau0_s);
   if (!ms) return ms.error();
-  std::vector<AvarPoint> all = overlapping_avar(rate, present, tau0_s, *ms);
+  const std::vector<AvarPoint> all = overlapping_avar(rate, present, tau0_s, *ms);
+  return finish_series(rate.size(), present_samples, all, valid_runs(rate, present), tau0_s, options);
+}
+
+Result<AllanResult> finish_series(std::size_t samples, std::size_t present_samples,
+                                  const std::vector<AvarPoint>& all, const std::vector<std::size_t>& runs,
+                                  double tau0_s, const AllanOptions& options) {
+  AllanResult result;
+  result.tau0_s = tau0_s;
+  result.samples = samples;
+  result.present_samples = present_samples;
   std::vector<AvarPoint> avar;
   for (const AvarPoint& p : all) {
     if (p.terms > 0 && std::isfinite(p.avar)) {
@@ -386,7 +423,6 @@ Result<AllanResult> analyze_series(std::span<const double> rate, std::span<const
   // White rate noise and weights from the measured variances first; then the noise types and the
   // weights of the fitted model (iteratively reweighted: weights from the measured values favour
   // points that happen to fall low), for a fixed number of passes.
-  const std::vector<std::size_t> runs = valid_runs(rate, present);
   set_intervals(result.points, avar, runs, options.confidence, false);
   result.fit = fit_noise_terms(result.points);
   for (int pass = 0; pass < 4; ++pass) {
@@ -405,6 +441,7 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
   out.epochs = log.epochs();
   const bool calibrate = !log.units_dps && options.calibration != nullptr;
   out.units = (log.units_dps || calibrate) ? "deg/s" : "V";
+  out.log_units_dps = log.units_dps;
   if (calibrate && options.calibration->gyro_count() < log.gyro_count) {
     return bad_input(log.source + ": the log has " + std::to_string(log.gyro_count) +
                      " gyros but the calibration only " + std::to_string(options.calibration->gyro_count()));
@@ -462,24 +499,33 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
     return gyro;
   };
 
-  // The gyros are independent: analyse them on up to two threads (the work per gyro is O(n) per τ
-  // and identical in any order, so the results do not depend on the thread count).
-  std::vector<std::optional<Result<GyroAllan>>> results(ids.size());
+  if (Status st = analyse_gyros(
+          ids.size(), [&](std::size_t i) { return analyse_one(ids[i]); }, out.gyros);
+      !st)
+    return st.error();
+  return out;
+}
+
+// The gyros are independent: analyse them on up to two threads (the work per gyro is O(n) per τ and
+// identical in any order, so the results do not depend on the thread count).
+Status analyse_gyros(std::size_t count, const std::function<Result<GyroAllan>(std::size_t)>& analyse,
+                     std::vector<GyroAllan>& out) {
+  std::vector<std::optional<Result<GyroAllan>>> results(count);
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
-    for (std::size_t i = next++; i < ids.size(); i = next++) results[i] = analyse_one(ids[i]);
+    for (std::size_t i = next++; i < count; i = next++) results[i] = analyse(i);
   };
   const std::size_t threads =
-      std::min<std::size_t>({2, ids.size(), std::max(1U, std::thread::hardware_concurrency())});
+      std::min<std::size_t>({2, count, std::max(1U, std::thread::hardware_concurrency())});
   std::vector<std::thread> pool;
   for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(worker);
   worker();
   for (std::thread& t : pool) t.join();
   for (auto& r : results) {
     if (!*r) return r->error();
-    out.gyros.push_back(std::move(r->value()));
+    out.push_back(std::move(r->value()));
   }
-  return out;
+  return ok_status();
 }
 
 }  // namespace tetra::allan

@@ -51,7 +51,9 @@ std::string unescape_meta(std::string_view value) {
   return out;
 }
 
-void parse_metadata(std::string_view comment, CsvTable& table) {
+}  // namespace
+
+void parse_metadata_comment(std::string_view comment, Metadata& metadata) {
   // comment without the '#': tokens "key=value" separated by blanks or commas.
   std::size_t i = 0;
   while (i < comment.size()) {
@@ -61,13 +63,11 @@ void parse_metadata(std::string_view comment, CsvTable& table) {
     const std::string_view token = comment.substr(i, j - i);
     const std::size_t eq = token.find('=');
     if (eq != std::string_view::npos && eq > 0) {
-      table.metadata.emplace_back(std::string(token.substr(0, eq)), unescape_meta(token.substr(eq + 1)));
+      metadata.emplace_back(std::string(token.substr(0, eq)), unescape_meta(token.substr(eq + 1)));
     }
     i = j;
   }
 }
-
-}  // namespace
 
 bool parse_number(std::string_view s, double& out) {
   if (!s.empty() && s.front() == '+') s.remove_prefix(1);
@@ -124,7 +124,8 @@ Status parse_lines(std::string_view text, std::size_t& pos, std::size_t& line_no
     const std::string_view content = trim(line);
     if (content.empty()) continue;
     if (content.front() == '#') {
-      parse_metadata(content.substr(1), t);
+      parse_metadata_comment(content.substr(1), t.metadata);
+      t.comments.emplace_back(content.substr(1));
       continue;
     }
 
@@ -250,11 +251,99 @@ Result<CsvTable> parse_csv(std::string_view text, std::string source) {
   if (!head_status) return head_status.error();
   if (!tail_status) return tail_status.error();
   t.metadata.insert(t.metadata.end(), tail.metadata.begin(), tail.metadata.end());
+  t.comments.insert(t.comments.end(), tail.comments.begin(), tail.comments.end());
   t.cells.insert(t.cells.end(), tail.cells.begin(), tail.cells.end());
   t.empty.insert(t.empty.end(), tail.empty.begin(), tail.empty.end());
   t.lines.insert(t.lines.end(), tail.lines.begin(), tail.lines.end());
   t.rows += tail.rows;
   return t;
+}
+
+CsvStreamReader::~CsvStreamReader() {
+  if (file_ != nullptr) std::fclose(file_);
+}
+
+namespace {
+constexpr std::size_t kStreamChunkBytes = std::size_t{1} << 20;
+}  // namespace
+
+Status CsvStreamReader::refill() {
+  text_.erase(0, pos_);
+  pos_ = 0;
+  if (text_.size() > kMaxLineBytes) {  // what is left is one unfinished line
+    return bad_input(header_.source + ":" + std::to_string(line_no_ + 1) + ": line longer than " +
+                     std::to_string(kMaxLineBytes) + " bytes");
+  }
+  const std::size_t old = text_.size();
+  text_.resize(old + kStreamChunkBytes);
+  const std::size_t got = std::fread(text_.data() + old, 1, kStreamChunkBytes, file_);
+  text_.resize(old + got);
+  if (got < kStreamChunkBytes) {
+    if (std::ferror(file_) != 0) return failure(header_.source + ": read error");
+    eof_ = true;
+  }
+  return ok_status();
+}
+
+Status CsvStreamReader::open(const std::string& path) {
+  if (file_ != nullptr) return failure(path + ": reader already open");
+  header_ = CsvTable{};
+  header_.source = path;
+  if (Status s = check_input(path, kMaxStreamedLogBytes, false); !s) return s;
+  file_ = std::fopen(path.c_str(), "rb");
+  if (file_ == nullptr) return bad_input(path + ": cannot open: " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(::fileno(file_), &st) == 0 && S_ISREG(st.st_mode))
+    total_ = static_cast<std::uint64_t>(st.st_size);
+  bool have_header = false;
+  bool first = true;
+  while (!have_header) {
+    if (eof_) {
+      return bad_input(header_.source + ":" + std::to_string(line_no_ + 1) + ": empty file: no header line");
+    }
+    if (Status s = refill(); !s) return s;
+    if (first && text_.size() >= 3 && std::memcmp(text_.data(), "\xEF\xBB\xBF", 3) == 0) pos_ = 3;
+    first = false;
+    // Whole lines only, unless the file ends here.
+    const std::size_t last_nl = text_.rfind('\n');
+    const std::size_t end =
+        eof_ ? text_.size() : (last_nl == std::string::npos || last_nl < pos_ ? pos_ : last_nl + 1);
+    const std::string_view whole(text_.data(), end);
+    const std::size_t before = pos_;
+    if (Status s = parse_lines(whole, pos_, line_no_, header_, have_header, true); !s) return s;
+    pos_ = std::min(pos_, end);
+    consumed_ += pos_ - before;
+  }
+  return ok_status();
+}
+
+Result<bool> CsvStreamReader::next(CsvTable& block) {
+  if (file_ == nullptr) return failure("CSV stream reader is not open");
+  block.source = header_.source;
+  block.metadata = header_.metadata;
+  block.comments.clear();
+  block.columns = header_.columns;
+  block.header_line = header_.header_line;
+  block.rows = 0;
+  block.cells.clear();
+  block.empty.clear();
+  block.lines.clear();
+  bool have_header = true;
+  while (true) {
+    const std::size_t last_nl = text_.rfind('\n');
+    const std::size_t end =
+        eof_ ? text_.size() : (last_nl == std::string::npos || last_nl < pos_ ? pos_ : last_nl + 1);
+    if (end > pos_) {
+      const std::string_view whole(text_.data(), end);
+      const std::size_t before = pos_;
+      if (Status s = parse_lines(whole, pos_, line_no_, block, have_header, false); !s) return s.error();
+      pos_ = std::min(pos_, end);
+      consumed_ += pos_ - before;
+      if (block.rows > 0) return true;
+    }
+    if (eof_) return false;
+    if (Status s = refill(); !s) return s.error();
+  }
 }
 
 Result<std::string> read_text_file(const std::string& path) {

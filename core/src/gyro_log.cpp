@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 
+#include "gyro_log_h5.hpp"
 #include "tetra/core/csv.hpp"
 
 namespace tetra {
@@ -19,6 +20,7 @@ Result<GyroLog> from_table(CsvTable&& t) {
   GyroLog log;
   log.source = t.source;
   log.metadata = std::move(t.metadata);
+  log.comments = std::move(t.comments);
   const std::string head = t.source + ":" + std::to_string(t.header_line) + ": header: ";
 
   const auto time_col = t.find_column("time_s");
@@ -110,7 +112,56 @@ Result<GyroLog> from_table(CsvTable&& t) {
   return log;
 }
 
+// CSV logs block by block: each block of rows goes through from_table, so every check and message is
+// the whole-file reader's. Units must not change after the header (a block cannot see later comments).
+class CsvGyroLogReader final : public GyroLogReader {
+ public:
+  Status open(const std::string& path) {
+    if (Status s = csv_.open(path); !s) return s;
+    CsvTable head = csv_.header();
+    auto log = from_table(std::move(head));
+    if (!log) return log.error();
+    header_ = std::move(log.value());
+    return ok_status();
+  }
+  Result<bool> next(GyroLog& block) override {
+    auto more = csv_.next(table_);
+    if (!more || !*more) return more;
+    auto log = from_table(std::move(table_));
+    if (!log) return log.error();
+    if (log->units_dps != header_.units_dps) {
+      return bad_input(header_.source + ":" + std::to_string(log->lines.front()) +
+                       ": metadata 'units' changes after the header: put it before the header line");
+    }
+    block = std::move(log.value());
+    return true;
+  }
+  double fraction_read() const override {
+    return csv_.bytes_total() == 0
+               ? 0.0
+               : static_cast<double>(csv_.bytes_read()) / static_cast<double>(csv_.bytes_total());
+  }
+
+ private:
+  CsvStreamReader csv_;
+  CsvTable table_;
+};
+
 }  // namespace
+
+bool is_hdf5_path(const std::string& path) {
+  auto ends_with = [&](std::string_view ext) {
+    return path.size() >= ext.size() && path.compare(path.size() - ext.size(), ext.size(), ext) == 0;
+  };
+  return ends_with(".h5") || ends_with(".hdf5");
+}
+
+Result<std::unique_ptr<GyroLogReader>> GyroLogReader::open(const std::string& path) {
+  if (is_hdf5_path(path)) return open_gyro_log_h5_reader(path);
+  auto reader = std::make_unique<CsvGyroLogReader>();
+  if (Status s = reader->open(path); !s) return s.error();
+  return std::unique_ptr<GyroLogReader>(std::move(reader));
+}
 
 Result<GyroLog> parse_gyro_log(std::string_view text, std::string source) {
   auto table = parse_csv(text, std::move(source));
@@ -119,32 +170,72 @@ Result<GyroLog> parse_gyro_log(std::string_view text, std::string source) {
 }
 
 Result<GyroLog> read_gyro_log(const std::string& path) {
+  if (is_hdf5_path(path)) return read_gyro_log_h5(path);
   auto table = read_csv(path);
   if (!table) return table.error();
   return from_table(std::move(table.value()));
 }
 
+GyroLogWriter::GyroLogWriter() = default;
+
 GyroLogWriter::~GyroLogWriter() = default;
 
 Status GyroLogWriter::open(const std::string& path, int gyro_count, bool with_reference, bool units_dps,
                            const std::vector<std::pair<std::string, std::string>>& comments) {
-  if (out_ != nullptr) return failure(out_->path() + ": writer already open");
-  own_ = std::make_unique<RunFiles>();
-  auto out = own_->add(path, "output");
+  auto out = open_own(path);
   if (!out) return out.error();
   return open(**out, gyro_count, with_reference, units_dps, comments);
 }
 
 Status GyroLogWriter::open(OutputFile& out, int gyro_count, bool with_reference, bool units_dps,
                            const std::vector<std::pair<std::string, std::string>>& comments) {
+  // The comment lines as they are written: text after '#', values escaped by append_metadata.
+  std::vector<std::string> lines;
+  if (units_dps) lines.emplace_back(" units=dps");
+  for (const auto& [k, v] : comments) {
+    std::string line;
+    append_metadata(line, k, v);
+    lines.push_back(line.substr(1, line.size() - 2));  // without '#' and the newline
+  }
+  return open_output(out, gyro_count, with_reference, lines);
+}
+
+Status GyroLogWriter::open_like(const std::string& path, const GyroLog& header) {
+  auto out = open_own(path);
+  if (!out) return out.error();
+  return open_like(**out, header);
+}
+
+Status GyroLogWriter::open_like(OutputFile& out, const GyroLog& header) {
+  return open_output(out, header.gyro_count, header.has_reference, header.comments);
+}
+
+Result<OutputFile*> GyroLogWriter::open_own(const std::string& path) {
+  if (out_ != nullptr) return failure(out_->path() + ": writer already open");
+  own_ = std::make_unique<RunFiles>();
+  return own_->add(path, "output");
+}
+
+Status GyroLogWriter::open_output(OutputFile& out, int gyro_count, bool with_reference,
+                                  const std::vector<std::string>& comments) {
   if (out_ != nullptr) return failure(out_->path() + ": writer already open");
   if (gyro_count < 1) return bad_input(out.path() + ": a gyro log needs at least one gyro column");
+  if (is_hdf5_path(out.path())) {
+    auto file_path = out.library_path();
+    if (!file_path) return file_path.error();
+    h5_ = std::make_unique<GyroLogH5Writer>();
+    if (Status s = h5_->open(*file_path, out.path(), gyro_count, with_reference, comments); !s) {
+      h5_.reset();
+      return s;
+    }
+    out_ = &out;
+    return ok_status();
+  }
   out_ = &out;
   gyro_count_ = gyro_count;
   with_reference_ = with_reference;
   buffer_.clear();
-  if (units_dps) buffer_ += "# units=dps\n";
-  for (const auto& [k, v] : comments) append_metadata(buffer_, k, v);
+  for (const std::string& c : comments) buffer_ += "#" + c + "\n";
   buffer_ += "time_s";
   for (int i = 1; i <= gyro_count; ++i) buffer_ += ",g" + std::to_string(i);
   if (with_reference) buffer_ += ",ref_qw,ref_qx,ref_qy,ref_qz";
@@ -156,6 +247,7 @@ Status GyroLogWriter::write(double time_s, std::span<const double> values,
                             std::span<const std::uint8_t> present,
                             const std::optional<std::array<double, 4>>& reference_wxyz) {
   if (out_ == nullptr) return failure("gyro log writer is not open");
+  if (h5_) return h5_->write(time_s, values, present, reference_wxyz);
   if (values.size() != static_cast<std::size_t>(gyro_count_) || present.size() != values.size()) {
     return failure(out_->path() + ": epoch has the wrong number of gyro values");
   }
@@ -183,7 +275,13 @@ Status GyroLogWriter::flush() {
 
 Status GyroLogWriter::close() {
   if (out_ == nullptr) return failure("gyro log writer is not open");
-  const Status flushed = flush();
+  Status flushed = ok_status();
+  if (h5_) {
+    flushed = h5_->close();
+    h5_.reset();
+  } else {
+    flushed = flush();
+  }
   out_ = nullptr;
   if (!flushed) return flushed;
   if (own_) {

@@ -50,6 +50,9 @@ Result<std::string> read_input(const std::string& path, std::size_t max_bytes) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return bad_input(path + ": cannot open: " + std::strerror(errno));
   std::string data;
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && static_cast<std::size_t>(st.st_size) <= max_bytes)
+    data.reserve(static_cast<std::size_t>(st.st_size));  // one allocation for a regular file
   char buf[1 << 16];
   while (true) {
     const ssize_t n = ::read(fd, buf, sizeof buf);

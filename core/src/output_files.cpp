@@ -90,6 +90,15 @@ Status OutputFile::write(std::string_view data) {
   return write_all(fd_, data, path_);
 }
 
+Result<std::string> OutputFile::library_path() const {
+  if (stream_) {
+    return bad_input(label_ + " " + path_ + ": needs a regular file (it is written with seeks), not " +
+                     (path_ == "-" ? "standard output" : "a device or FIFO"));
+  }
+  if (fd_ < 0) return failure(path_ + ": output is closed");
+  return temp_;
+}
+
 Status OutputFile::sync() {
   if (stream_ || fd_ < 0) return ok_status();
   const bool synced = ::fsync(fd_) == 0;
@@ -120,6 +129,12 @@ void OutputFile::discard() {
   fd_ = -1;
   if (!stream_ && !committed_ && !temp_.empty()) ::unlink(temp_.c_str());
   temp_.clear();
+}
+
+Status BufferedOutput::flush() {
+  if (Status st = out_.write(buffer_); !st) return st;
+  buffer_.clear();
+  return ok_status();
 }
 
 RunFiles::~RunFiles() = default;

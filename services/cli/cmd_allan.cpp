@@ -139,7 +139,8 @@ int cmd_allan(int argc, char** argv) {
   double confidence = allan::kOneSigmaConfidence;
   double dt_tolerance = 0.05;
   app.add_option("log", log_path,
-                 "gyro log (docs/interfaces.md §2.2): time_s,g1..gN; volts, or deg/s with '# units=dps'")
+                 "gyro log (CSV, or HDF5 when named .h5; docs/formats.md): time_s,g1..gN; volts, or deg/s "
+                 "with '# units=dps'")
       ->required();
   app.add_option("--calibration", cal_path, "calibration YAML: volts become deg/s as (g - bias)/scale");
   app.add_flag("--update-calibration", update_cal,
@@ -210,17 +211,7 @@ int cmd_allan(int argc, char** argv) {
   // one-line reason of a failure (the exit-status contract).
   const bool progress = ::isatty(STDERR_FILENO) != 0;
   const auto t0 = Clock::now();
-  if (progress) std::cerr << "tetra allan: reading " << log_path << "\n";
-  auto log = read_gyro_log(log_path);
-  if (!log) return report(cmd, log.error());
-  if (progress) {
-    std::cerr << "tetra allan: " << log->epochs() << " epochs x " << log->gyro_count << " gyros read in "
-              << sci(seconds_since(t0)) << " s; analysing\n";
-  }
-  if (log->units_dps && cal) {
-    std::cerr << "tetra allan: the log is already in deg/s; the calibration is used only for "
-                 "--update-calibration\n";
-  }
+  if (progress) std::cerr << "tetra allan: reading and analysing " << log_path << "\n";
 
   allan::LogAllanOptions options;
   options.allan.taus = *tau_spec;
@@ -228,15 +219,20 @@ int cmd_allan(int argc, char** argv) {
   options.dt_tolerance = dt_tolerance;
   options.gyros = gyros;
   options.calibration = cal ? &*cal : nullptr;
-  auto analysis = allan::analyze_gyro_log(*log, options);
+  // The log is read block by block, never whole (docs/allan.md: memory).
+  auto analysis = allan::analyze_gyro_log_file(log_path, options);
   if (!analysis) return report(cmd, analysis.error());
+  if (analysis->log_units_dps && cal) {
+    std::cerr << "tetra allan: the log is already in deg/s; the calibration is used only for "
+                 "--update-calibration\n";
+  }
   if (progress) std::cerr << "tetra allan: analysed in " << sci(seconds_since(t0)) << " s total\n";
 
   std::cout << log_path << ": " << analysis->epochs << " epochs";
   if (analysis->missing_epochs > 0)
     std::cout << " (+" << analysis->missing_epochs << " missing epochs as gaps)";
   std::cout << ", sampling interval " << num(analysis->tau0_s) << " s (from the time column)"
-            << (cal && !log->units_dps ? ", calibrated with " + cal_path : std::string()) << "\n\n";
+            << (cal && !analysis->log_units_dps ? ", calibrated with " + cal_path : std::string()) << "\n\n";
   std::cout << allan::format_table(*analysis);
 
   const auto meta = provenance_metadata(provenance(files.input_paths()));

@@ -63,7 +63,7 @@ int cmd_record(int argc, char** argv) {
   double duration_s = 0.0;
   bool until_idle = false;
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
-  app.add_option("-o,--out", out_path, "gyro log to write (CSV, docs/interfaces.md §2.2)")->required();
+  app.add_option("-o,--out", out_path, "gyro log to write (CSV, or HDF5 when named .h5)")->required();
   app.add_option("--unit", unit, "the unit to record (default: the first one seen)");
   app.add_option("--config", config_path, "take unit, gyro count and assembly settings from a fusion config");
   app.add_option("--gyros", gyros, "number of gyros N (columns g1..gN)")

@@ -12,9 +12,11 @@
 #include "cli_common.hpp"
 #include "command_log.hpp"
 #include "commands.hpp"
+#include "progress.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/gyro_log_prefetch.hpp"
 #include "tetra/core/output_files.hpp"
 #include "tetra/core/provenance.hpp"
 #include "tetra/core/units.hpp"
@@ -45,6 +47,68 @@ Result<Quaternion> parse_quaternion(const std::string& text) {
   return quat.normalized();
 }
 
+struct Replayed {
+  std::size_t epochs = 0;                   // epochs read
+  std::map<std::string, int> event_counts;  // per event type
+};
+
+// The pipeline over the log as it is read, block by block; attitude rows and events are appended to
+// the outputs as they come, so memory does not grow with the log's length.
+// Recorded operator commands are applied where the service obeyed them: after the last epoch before
+// their stamp, each acknowledgement written before that epoch's own events.
+Result<Replayed> replay_log(GyroLogPrefetcher& log, fdi::Pipeline& pipeline,
+                            const std::vector<RecordedCommand>& commands, BufferedOutput& att,
+                            BufferedOutput& events) {
+  const int n = log.header().gyro_count;
+  const auto ng = static_cast<std::size_t>(n);
+  std::size_t next_command = 0;
+  auto apply_commands_before = [&](std::int64_t stamp_ns, bool all) {
+    for (; next_command < commands.size() && (all || commands[next_command].stamp_ns < stamp_ns);
+         ++next_command) {
+      events.buffer() += fdi::to_json(apply(pipeline, commands[next_command]), n);
+      events.buffer() += '\n';
+    }
+  };
+  Replayed out;
+  fdi::Epoch epoch;
+  epoch.raw.resize(ng);
+  epoch.present.resize(ng);
+  Progress progress("tetra replay", "epochs");
+  GyroLog block;
+  while (true) {
+    auto more = log.next(block);
+    if (!more) return more.error();
+    if (!*more) break;
+    for (std::size_t k = 0; k < block.epochs(); ++k) {
+      epoch.stamp_ns = seconds_to_ns(block.time_s[k]);
+      for (std::size_t i = 0; i < ng; ++i) {
+        epoch.raw[i] = block.values[k * ng + i];
+        epoch.present[i] = block.present[k * ng + i] != 0 ? 1 : 0;
+      }
+      apply_commands_before(epoch.stamp_ns, false);
+      epoch.reference_q_RB.reset();
+      if (block.has_reference && block.reference_present[k] != 0)
+        epoch.reference_q_RB = from_wxyz(block.reference_wxyz[k]);
+      const auto& r = pipeline.step(epoch);
+      for (const auto& e : r.events) {
+        events.buffer() += fdi::to_json(e, n);
+        events.buffer() += '\n';
+        ++out.event_counts[fdi::to_string(e.type)];
+      }
+      if (!r.accepted) continue;
+      append_attitude_row(att.buffer(), block.time_s[k], r.attitude, n);  // the log's own time, bit for bit
+    }
+    out.epochs += block.epochs();
+    if (auto st = att.maybe_flush(); !st) return st.error();
+    if (auto st = events.maybe_flush(); !st) return st.error();
+    progress.update(log.fraction_read(), out.epochs);
+  }
+  // Commands after the last epoch: acknowledged (their other effects would show on a next epoch).
+  apply_commands_before(0, true);
+  progress.finish();
+  return out;
+}
+
 }  // namespace
 
 int cmd_replay(int argc, char** argv) {
@@ -59,7 +123,7 @@ int cmd_replay(int argc, char** argv) {
   std::string events_path;
   std::optional<double> latitude_deg;
   std::string initial_q;
-  app.add_option("LOG", log_path, "gyro log (CSV)")->required();
+  app.add_option("LOG", log_path, "gyro log (CSV, or HDF5 when named .h5)")->required();
   app.add_option("--calibration", cal_path, "calibration file (YAML, docs/interfaces.md §2.3)")->required();
   app.add_option("--latitude", latitude_deg,
                  "[deg] ground-test mode: remove the Earth rate at this geodetic latitude")
@@ -102,21 +166,22 @@ int cmd_replay(int argc, char** argv) {
 
   auto cal = read_calibration(cal_path);
   if (!cal) return report("replay", cal.error());
-  auto log = read_gyro_log(log_path);
-  if (!log) return report("replay", log.error());
+  auto opened = GyroLogReader::open(log_path);
+  if (!opened) return report("replay", opened.error());
+  GyroLogPrefetcher log(std::move(opened.value()));
+  const GyroLog& head = log.header();
   std::vector<RecordedCommand> commands;
   if (!commands_path.empty()) {
     auto c = read_command_log(commands_path);
     if (!c) return report("replay", c.error());
     commands = std::move(c).value();
   }
-  std::size_t next_command = 0;
-  if (log->gyro_count != cal->gyro_count()) {
-    return report("replay", bad_input(log_path + ": the log has " + std::to_string(log->gyro_count) +
+  if (head.gyro_count != cal->gyro_count()) {
+    return report("replay", bad_input(log_path + ": the log has " + std::to_string(head.gyro_count) +
                                       " gyro columns, the calibration " + cal_path + " has " +
                                       std::to_string(cal->gyro_count()) + " gyros"));
   }
-  config.raw_units_dps = log->units_dps;
+  config.raw_units_dps = head.units_dps;
   if (auto st = fdi::validate(config); !st) return report("replay", st.error());
   auto pipeline = fdi::Pipeline::create(*cal, config);
   if (!pipeline) {
@@ -126,55 +191,19 @@ int cmd_replay(int argc, char** argv) {
   if (verbose) {
     std::fprintf(stderr, "tetra replay: configuration\n%s", fdi::describe(config).c_str());
   }
-  const int n = log->gyro_count;
-  std::string att;
-  att.reserve(log->epochs() * 160 + 1024);
+  BufferedOutput att(**attitude_out);
+  BufferedOutput events(**events_out);
   for (const auto& [key, value] : provenance_metadata(provenance(files.input_paths())))
-    append_metadata(att, key, value);
-  att += kAttitudeHeader;
-  std::string events;
-  std::map<std::string, int> event_counts;
-  fdi::Epoch epoch;
-  epoch.raw.resize(static_cast<std::size_t>(n));
-  epoch.present.resize(static_cast<std::size_t>(n));
-  // Progress on stderr for long logs (a 100-min 10 Hz orbit takes about 0.1 s and prints nothing).
-  const std::size_t progress_every = log->epochs() >= 2'000'000 ? log->epochs() / 10 : 0;
-  for (std::size_t k = 0; k < log->epochs(); ++k) {
-    if (progress_every != 0 && k != 0 && k % progress_every == 0) {
-      std::fprintf(stderr, "tetra replay: %zu%% (%zu epochs)\n", 100 * k / log->epochs(), k);
-    }
-    epoch.stamp_ns = seconds_to_ns(log->time_s[k]);
-    for (int i = 0; i < n; ++i) {
-      epoch.raw[static_cast<std::size_t>(i)] = log->value(k, i);
-      epoch.present[static_cast<std::size_t>(i)] = log->is_present(k, i) ? 1 : 0;
-    }
-    // Commands the service obeyed after the last epoch before this one: the same place in the stream.
-    // Each acknowledgement is written where the service published it: before the epoch's own events.
-    for (; next_command < commands.size() && commands[next_command].stamp_ns < epoch.stamp_ns;
-         ++next_command) {
-      events += fdi::to_json(apply(*pipeline, commands[next_command]), n);
-      events += '\n';
-    }
-    epoch.reference_q_RB.reset();
-    if (log->has_reference && log->reference_present[k] != 0)
-      epoch.reference_q_RB = from_wxyz(log->reference_wxyz[k]);
-    const auto& r = pipeline->step(epoch);
-    for (const auto& e : r.events) {
-      events += fdi::to_json(e, n);
-      events += '\n';
-      ++event_counts[fdi::to_string(e.type)];
-    }
-    if (!r.accepted) continue;
-    append_attitude_row(att, log->time_s[k], r.attitude, n);  // the log's own time, bit for bit
-  }
-  // Commands after the last epoch: acknowledged (their other effects would show on a next epoch).
-  for (; next_command < commands.size(); ++next_command) {
-    events += fdi::to_json(apply(*pipeline, commands[next_command]), n);
-    events += '\n';
-  }
-  if (auto st = (*attitude_out)->write(att); !st) return report("replay", st.error());
-  if (auto st = (*events_out)->write(events); !st) return report("replay", st.error());
+    append_metadata(att.buffer(), key, value);
+  att.buffer() += kAttitudeHeader;
+  auto replayed = replay_log(log, *pipeline, commands, att, events);
+  if (!replayed) return report("replay", replayed.error());
+  if (auto st = att.flush(); !st) return report("replay", st.error());
+  if (auto st = events.flush(); !st) return report("replay", st.error());
   if (auto st = files.commit(); !st) return report("replay", st.error());
+  const std::size_t epochs_read = replayed->epochs;
+  const std::map<std::string, int>& event_counts = replayed->event_counts;
+  const int n = head.gyro_count;
 
   if (verbose) std::fprintf(stderr, "tetra replay: thresholds\n%s", pipeline->describe_thresholds().c_str());
   const auto& h = pipeline->health();
@@ -197,7 +226,7 @@ int cmd_replay(int argc, char** argv) {
       "  samples: %llu accepted, %llu invalid, %llu absent, %llu outliers left out (%llu spikes)\n"
       "  events: %s\n"
       "  final mode: %s, gyros used: %s, excluded: %s\n",
-      log->epochs(), static_cast<unsigned long long>(c.epochs_accepted),
+      epochs_read, static_cast<unsigned long long>(c.epochs_accepted),
       static_cast<unsigned long long>(c.epochs_rejected_time),
       static_cast<unsigned long long>(c.epochs_rejected_shape),
       static_cast<unsigned long long>(c.samples_accepted), static_cast<unsigned long long>(c.samples_invalid),

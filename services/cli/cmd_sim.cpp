@@ -82,7 +82,10 @@ int cmd_sim(int argc, char** argv) {
   app.add_option("--unit", unit_path,
                  "calibration YAML of the simulated unit (the as-built truth, with its noise: sections); "
                  "default: the seed paper's unit");
-  app.add_option("--out,-o", out_path, "output log (- = standard output; turntable: the default)");
+  app.add_option(
+      "--out,-o", out_path,
+      "output log: CSV, or HDF5 when named .h5 (- = standard output, CSV only; turntable: CSV, the "
+      "default)");
   app.add_option("--truth", truth_path, "truth file: time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps");
   auto* opt_rate =
       app.add_option("--rate-hz", rate_hz, "[Hz] gyro sampling rate")->check(CLI::PositiveNumber);

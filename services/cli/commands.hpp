@@ -8,6 +8,7 @@ int cmd_calibrate(int argc, char** argv);
 int cmd_allan(int argc, char** argv);
 int cmd_sim(int argc, char** argv);
 int cmd_replay(int argc, char** argv);
+int cmd_convert(int argc, char** argv);
 int cmd_fusion(int argc, char** argv);
 int cmd_monitor(int argc, char** argv);
 int cmd_command(int argc, char** argv);

@@ -174,6 +174,7 @@ struct LogAllanOptions {
 
 struct LogAllan {
   std::string units;               //!< "deg/s" or "V"
+  bool log_units_dps = false;      //!< the log itself was in deg/s ("# units=dps")
   double tau0_s = 0.0;             //!< [s]
   std::size_t epochs = 0;          //!< rows in the log
   std::size_t missing_epochs = 0;  //!< grid slots without a row
@@ -182,6 +183,12 @@ struct LogAllan {
 
 //! Analyses the gyros of a log. The error names the file (and line, where one is at fault).
 Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& options);
+
+//! The same analysis, with the same results bit for bit, of a log file (CSV or HDF5) read block by
+//! block: at most about 14 bytes per sample (the rate of each gyro as a double, turned into its
+//! cumulative sum in place; the times; the grid slots), gyros analysed two at a time. The blocks and
+//! arrays are anonymous memory mappings given back to the system as soon as they are consumed.
+Result<LogAllan> analyze_gyro_log_file(const std::string& path, const LogAllanOptions& options);
 
 // --- reports -----------------------------------------------------------------------------------
 

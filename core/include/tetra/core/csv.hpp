@@ -8,6 +8,7 @@
 #include <charconv>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -26,12 +27,13 @@ std::optional<std::string> last_meta(const Metadata& metadata, std::string_view 
 struct CsvTable {
   std::string source;                                         //!< file name used in messages
   std::vector<std::pair<std::string, std::string>> metadata;  //!< "# key=value" comments, in order
-  std::vector<std::string> columns;                           //!< header names, trimmed
-  std::size_t header_line = 0;                                //!< 1-based line of the header
-  std::size_t rows = 0;                                       //!< number of data rows
-  std::vector<double> cells;        //!< row-major rows×columns; NaN where empty or "nan"
-  std::vector<std::uint8_t> empty;  //!< row-major; 1 where the cell was empty
-  std::vector<std::size_t> lines;   //!< 1-based file line of each data row
+  std::vector<std::string> comments;  //!< text after the '#' of each comment line, in order
+  std::vector<std::string> columns;   //!< header names, trimmed
+  std::size_t header_line = 0;        //!< 1-based line of the header
+  std::size_t rows = 0;               //!< number of data rows
+  std::vector<double> cells;          //!< row-major rows×columns; NaN where empty or "nan"
+  std::vector<std::uint8_t> empty;    //!< row-major; 1 where the cell was empty
+  std::vector<std::size_t> lines;     //!< 1-based file line of each data row
 
   std::size_t column_count() const { return columns.size(); }
   //! Index of a column by exact name, or nullopt.
@@ -52,11 +54,46 @@ inline constexpr std::size_t kMaxColumns = 1024;
 bool parse_number(std::string_view text, double& out);
 //! A finite plain decimal number (as parse_number, without nan and inf), or nullopt.
 std::optional<double> parse_decimal(std::string_view text);
+//! Adds the "key=value" tokens of a comment's text (after the '#') to `metadata`.
+void parse_metadata_comment(std::string_view comment, Metadata& metadata);
 
 //! Parses a whole table from text; `source` names it in messages.
 Result<CsvTable> parse_csv(std::string_view text, std::string source);
 //! Reads and parses a file (a regular file or a FIFO of at most kMaxTableBytes).
 Result<CsvTable> read_csv(const std::string& path);
+
+//! Reads a table as it goes, with memory bounded by one block of text (about 1 MB) whatever the file's
+//! length: the header and the comments before it on open(), then the rows block by block. Messages
+//! and line numbers are those of read_csv. Comment lines between rows add their metadata to the
+//! block they appear in (blocks start from the metadata before the header).
+class CsvStreamReader {
+ public:
+  CsvStreamReader() = default;
+  CsvStreamReader(const CsvStreamReader&) = delete;
+  CsvStreamReader& operator=(const CsvStreamReader&) = delete;
+  ~CsvStreamReader();
+
+  //! Opens `path` and reads up to the header line.
+  Status open(const std::string& path);
+  //! Source, metadata before the header, columns and header line; no rows.
+  const CsvTable& header() const { return header_; }
+  //! Replaces `block` by the header's columns and the next rows (at least one). False at the end.
+  Result<bool> next(CsvTable& block);
+  //! Bytes consumed so far and the file's size (0 when unknown, e.g. a pipe): for progress.
+  std::uint64_t bytes_read() const { return consumed_; }
+  std::uint64_t bytes_total() const { return total_; }
+
+ private:
+  Status refill();
+  std::FILE* file_ = nullptr;
+  std::string text_;     // unparsed text; whole lines are parsed from pos_
+  std::size_t pos_ = 0;  // first unparsed byte of text_
+  std::size_t line_no_ = 0;
+  bool eof_ = false;
+  std::uint64_t consumed_ = 0;
+  std::uint64_t total_ = 0;
+  CsvTable header_;
+};
 
 //! Reads a whole file into a string (error names the file; at most kMaxTableBytes, see read_input).
 Result<std::string> read_text_file(const std::string& path);

@@ -24,7 +24,8 @@ namespace tetra {
 struct GyroLog {
   std::string source;                                         //!< file name used in messages
   std::vector<std::pair<std::string, std::string>> metadata;  //!< "# key=value" comments, in order
-  int gyro_count = 0;                                         //!< N, columns g1..gN
+  std::vector<std::string> comments;  //!< text after the '#' of each comment line, in order
+  int gyro_count = 0;                 //!< N, columns g1..gN
   bool units_dps = false;             //!< values already rates [deg/s] ("# units=dps"), else [V]
   std::vector<double> time_s;         //!< [s] per epoch
   std::vector<double> values;         //!< [V or deg/s] epochs×N row-major; NaN where absent/invalid
@@ -44,14 +45,42 @@ struct GyroLog {
   std::optional<std::string> meta(const std::string& key) const;
 };
 
+//! Reads a whole gyro log: CSV, or HDF5 when the name ends in ".h5" or ".hdf5" (docs/formats.md).
 Result<GyroLog> read_gyro_log(const std::string& path);
 Result<GyroLog> parse_gyro_log(std::string_view text, std::string source);
 
-//! Streams a gyro log to disk. Numbers are written in shortest round-trip form: the same inputs give
-//! byte-identical files.
+//! True when `path` names an HDF5 gyro log (".h5" or ".hdf5").
+bool is_hdf5_path(const std::string& path);
+
+//! Reads a gyro log block by block, memory bounded by one block whatever the log's length. Blocks are
+//! GyroLog values holding a slice of the epochs (same metadata and columns; `lines` are file lines of
+//! a CSV, 1-based rows of an HDF5 log). Errors are those of read_gyro_log.
+class GyroLogReader {
+ public:
+  virtual ~GyroLogReader() = default;
+  //! Opens a CSV or HDF5 log (by the name's extension) and reads its header.
+  static Result<std::unique_ptr<GyroLogReader>> open(const std::string& path);
+  //! Source, metadata, gyro count, units and reference flag; no epochs.
+  const GyroLog& header() const { return header_; }
+  //! Replaces `block`'s epochs by the next ones (at least one). False at the end of the log.
+  virtual Result<bool> next(GyroLog& block) = 0;
+  //! Fraction of the log read so far, in [0, 1] (0 when unknown).
+  virtual double fraction_read() const = 0;
+  //! Epochs in the whole log when known before reading it (HDF5), else 0.
+  virtual std::size_t epochs_hint() const { return 0; }
+
+ protected:
+  GyroLog header_;
+};
+
+class GyroLogH5Writer;
+
+//! Streams a gyro log into an output of the output layer (OutputFile: written as it goes into its
+//! temporary file): CSV, or HDF5 when the name ends in ".h5" or ".hdf5".
+//! Numbers are written in shortest round-trip form: the same inputs give byte-identical files.
 class GyroLogWriter {
  public:
-  GyroLogWriter() = default;
+  GyroLogWriter();
   GyroLogWriter(const GyroLogWriter&) = delete;
   GyroLogWriter& operator=(const GyroLogWriter&) = delete;
   ~GyroLogWriter();
@@ -63,16 +92,24 @@ class GyroLogWriter {
   //! Writes into an output of a larger run; close() flushes, the run's RunFiles::commit() commits.
   Status open(OutputFile& out, int gyro_count, bool with_reference, bool units_dps,
               const std::vector<std::pair<std::string, std::string>>& comments = {});
+  //! Opens an output for a log shaped like `header` (gyro count, reference columns), with its comment
+  //! lines as they are: a log read and written again is the same file when tetra wrote it.
+  Status open_like(const std::string& path, const GyroLog& header);
+  Status open_like(OutputFile& out, const GyroLog& header);
   //! One epoch. `present[i] == 0` writes an empty cell; NaN writes "nan".
   Status write(double time_s, std::span<const double> values, std::span<const std::uint8_t> present,
                const std::optional<std::array<double, 4>>& reference_wxyz = std::nullopt);
-  //! Flushes (and, when opened by path, renames into place).
+  //! Flushes and closes (and, when opened by path, commits: fsync and rename into place).
   Status close();
 
  private:
+  Result<OutputFile*> open_own(const std::string& path);
+  Status open_output(OutputFile& out, int gyro_count, bool with_reference,
+                     const std::vector<std::string>& comments);
   Status flush();
-  std::unique_ptr<RunFiles> own_;
+  std::unique_ptr<RunFiles> own_;  // a run of its own (the open() taking a path)
   OutputFile* out_ = nullptr;
+  std::unique_ptr<GyroLogH5Writer> h5_;  // set while an HDF5 log is open
   std::string buffer_;
   int gyro_count_ = 0;
   bool with_reference_ = false;

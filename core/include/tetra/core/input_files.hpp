@@ -13,6 +13,11 @@ namespace tetra {
 
 //! [bytes] largest CSV table read (a 24 h, 100 Hz log of four gyros is about 0.6 GB).
 inline constexpr std::size_t kMaxTableBytes = std::size_t{1} << 30;
+//! [bytes] largest gyro log read block by block (GyroLogReader, CsvStreamReader): memory stays one
+//! block whatever the length; a 24 h, 1 kHz log of four gyros is about 6 GB as CSV.
+inline constexpr std::size_t kMaxStreamedLogBytes = std::size_t{1} << 40;
+//! [bytes] longest line of a CSV read block by block (a row of kMaxColumns numbers is ~25 kB).
+inline constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
 //! [bytes] largest YAML file read (calibrations, scenarios and configurations are a few kB).
 inline constexpr std::size_t kMaxYamlBytes = std::size_t{1} << 20;
 

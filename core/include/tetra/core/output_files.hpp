@@ -44,8 +44,13 @@ class OutputFile {
   const std::string& path() const { return path_; }
   //! True for standard output, devices and FIFOs (written straight, never replaced).
   bool is_stream() const { return stream_; }
-  //! Appends `data`; an Error names the path (a full disk, a closed pipe).
+  //! Appends `data`; an Error names the path (a full disk, a closed pipe). Called as often as
+  //! needed: a streaming output writes as it goes into the temporary file, committed at the end.
   Status write(std::string_view data);
+  //! The temporary file, for a library that writes the file by name itself (HDF5): it writes there
+  //! (and closes the file) before RunFiles::commit(), which fsyncs and renames it as any output.
+  //! Bad input naming the option for standard output, a device or a FIFO (such a library seeks).
+  Result<std::string> library_path() const;
 
  private:
   friend class RunFiles;
@@ -61,6 +66,25 @@ class OutputFile {
   int fd_ = -1;
   bool stream_ = false;
   bool committed_ = false;
+};
+
+//! A text output written as it is produced (replay's attitude and events): appends to a buffer that
+//! goes out to the OutputFile (its temporary file) once it holds about 1 MB, so memory is bounded
+//! whatever the output's length; the run's RunFiles::commit() renames it into place.
+class BufferedOutput {
+ public:
+  explicit BufferedOutput(OutputFile& out) : out_(out) {}
+  //! The buffer to append to; call maybe_flush() after appending.
+  std::string& buffer() { return buffer_; }
+  //! Writes the buffer out once it holds more than about 1 MB.
+  Status maybe_flush() { return buffer_.size() > kFlushBytes ? flush() : ok_status(); }
+  //! Writes the buffer out.
+  Status flush();
+
+ private:
+  static constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
+  OutputFile& out_;
+  std::string buffer_;
 };
 
 //! The inputs and outputs of one run.

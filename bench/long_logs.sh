@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Long logs (docs/formats.md, docs/allan.md): time and peak RSS against the log's length, CSV and HDF5,
+# for `tetra replay`, `tetra allan`, `tetra convert` and reading alone.
+#   replay:  orbit logs at 100 Hz, 4 gyros, 1 Hz reference: 30, 120 and 360 min (REPLAY_MINUTES)
+#   allan:   static logs at 100 Hz, 4 gyros: 2, 4 and 8 h (ALLAN_HOURS)
+# Each row: command, format, epochs, wall seconds, epochs per second, peak RSS [MB].
+# usage: bench/long_logs.sh [BUILD_DIR=build]   (needs tetra, make_allan_log and read_log built; ~1 GB of /tmp)
+# BIG=1 adds Allan of 24 h x 1 kHz x 4 gyros from HDF5 (a 3 GB HDF5 file, generated on the way).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build}
+T="$build/tetra"
+work=$(mktemp -d /tmp/tetra-long-logs-XXXXXX)
+trap 'rm -rf "$work"' EXIT
+REPLAY_MINUTES=${REPLAY_MINUTES:-"30 120 360"}
+ALLAN_HOURS=${ALLAN_HOURS:-"2 4 8"}
+
+echo "load: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
+printf '%-8s %-5s %10s %8s %12s %10s\n' command fmt epochs wall_s epochs_per_s peak_MB
+row() {  # NAME FMT EPOCHS -- CMD...
+  local name=$1 fmt=$2 epochs=$3
+  shift 4
+  /usr/bin/time -f "%e %M" -o "$work/time.txt" "$@" >/dev/null 2>"$work/err.txt" || { cat "$work/err.txt"; exit 1; }
+  read -r wall kb <"$work/time.txt"
+  awk -v n="$name" -v f="$fmt" -v e="$epochs" -v w="$wall" -v k="$kb" \
+    'BEGIN { printf "%-8s %-5s %10d %8.2f %12.0f %10.1f\n", n, f, e, w, (w > 0 ? e / w : 0), k / 1024 }'
+}
+epochs_of() { grep -vc '^#' "$1" | awk '{ print $1 - 1 }'; }
+
+cat >"$work/cal.yaml" <<'YAML'
+unit: seed-as-built
+method: seed-tables-4-5
+gyros:
+  - {id: 1, scale_factor_V_per_dps: 0.0730, bias_V: 0.0002, axis: [0.55526, -0.00146, 0.83167], noise: {arw_dps_rtHz: 3.0e-5}}
+  - {id: 2, scale_factor_V_per_dps: 0.0785, bias_V: 0.0004, axis: [0.42638, 0.78516, -0.44914], noise: {arw_dps_rtHz: 3.0e-5}}
+  - {id: 3, scale_factor_V_per_dps: 0.0880, bias_V: 0.0002, axis: [0.51389, -0.74179, -0.43088], noise: {arw_dps_rtHz: 3.0e-5}}
+  - {id: 4, scale_factor_V_per_dps: 0.0775, bias_V: -0.0003, axis: [0.99999, -0.00094, 0.00065], noise: {arw_dps_rtHz: 3.0e-5}}
+YAML
+
+for m in $REPLAY_MINUTES; do
+  log="$work/orbit_$m.csv"
+  "$T" sim orbit --seed 3 --rate-hz 100 --minutes "$m" --reference-hz 1 -o "$log" >/dev/null 2>&1
+  n=$(epochs_of "$log")
+  row convert csv2h5 "$n" -- "$T" convert "$log" "$work/orbit_$m.h5"
+  for f in csv h5; do
+    echo "read    $f     $("$build/bench/read_log" "$work/orbit_$m.$f" blocks)"
+  done
+  for f in csv h5; do
+    row replay "$f" "$n" -- "$T" replay "$work/orbit_$m.$f" --calibration "$work/cal.yaml" \
+      --attitude "$work/att.csv" --events "$work/ev.jsonl"
+  done
+  rm -f "$work/orbit_$m.csv" "$work/orbit_$m.h5"
+done
+
+for h in $ALLAN_HOURS; do
+  log="$work/static_$h.csv"
+  "$build/bench/make_allan_log" "$log" "$h" 100 1 >/dev/null
+  n=$(epochs_of "$log")
+  "$T" convert "$log" "$work/static_$h.h5"
+  for f in csv h5; do
+    echo "read    $f     $("$build/bench/read_log" "$work/static_$h.$f" blocks)"
+  done
+  for f in csv h5; do
+    row allan "$f" "$n" -- "$T" allan "$work/static_$h.$f" --calibration "$log.cal.yaml" --json "$work/a.json"
+  done
+  rm -f "$work/static_$h.csv" "$work/static_$h.h5"
+done
+
+if [ "${BIG:-0}" = 1 ]; then
+  log="$work/static_24h_1k.h5"
+  "$build/bench/make_allan_log" "$log" 24 1000 1 >/dev/null
+  row allan h5 86400000 -- "$T" allan "$log" --calibration "$log.cal.yaml" --json "$work/a.json"
+fi

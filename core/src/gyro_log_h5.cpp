@@ -1,0 +1,565 @@
+// HDF5 gyro logs: layout in docs/formats.md. One thread at a time uses the HDF5 library here.
+#include "gyro_log_h5.hpp"
+
+#include <hdf5.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+
+#include "tetra/core/csv.hpp"
+#include "tetra/core/input_files.hpp"
+
+namespace tetra {
+
+namespace {
+
+constexpr const char* kFormat = "tetra gyro log";
+constexpr int kVersion = 1;
+constexpr hsize_t kChunkRows = 65536;  // rows per chunk, and per block written
+constexpr hsize_t kBlockRows = 16384;  // rows per block read (a quarter chunk: the chunk cache keeps it)
+constexpr unsigned kDeflateLevel = 1;  // fast: the noise in gyro values barely compresses anyway
+constexpr std::array<const char*, 4> kRefNames = {"ref_qw", "ref_qx", "ref_qy", "ref_qz"};
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Owns an HDF5 identifier.
+class Handle {
+ public:
+  Handle() = default;
+  Handle(hid_t id, herr_t (*closer)(hid_t)) : id_(id), closer_(closer) {}
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  Handle(Handle&& o) noexcept : id_(o.id_), closer_(o.closer_) { o.id_ = H5I_INVALID_HID; }
+  Handle& operator=(Handle&& o) noexcept {
+    if (this != &o) {
+      reset();
+      id_ = o.id_;
+      closer_ = o.closer_;
+      o.id_ = H5I_INVALID_HID;
+    }
+    return *this;
+  }
+  ~Handle() { reset(); }
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+  hid_t release() {
+    const hid_t id = id_;
+    id_ = H5I_INVALID_HID;
+    return id;
+  }
+  void reset() {
+    if (id_ >= 0 && closer_ != nullptr) closer_(id_);
+    id_ = H5I_INVALID_HID;
+  }
+
+ private:
+  hid_t id_ = H5I_INVALID_HID;
+  herr_t (*closer_)(hid_t) = nullptr;
+};
+
+// The library prints its error stack on stderr by default; tetra reports one line of its own.
+void silence_hdf5() {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
+
+std::string gyro_name(std::size_t index0) {
+  return "g" + std::to_string(index0 + 1);
+}
+
+// --- attributes ---------------------------------------------------------------------------------
+
+Handle string_type() {
+  Handle t(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(t.get(), H5T_VARIABLE);
+  H5Tset_cset(t.get(), H5T_CSET_UTF8);
+  return t;
+}
+
+bool write_string_attribute(hid_t obj, const char* name, const std::vector<std::string>& values,
+                            bool scalar) {
+  Handle type = string_type();
+  const hsize_t n = values.size();
+  Handle space(scalar ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, nullptr), H5Sclose);
+  Handle attr(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attr.valid()) return false;
+  std::vector<const char*> ptrs;
+  for (const std::string& v : values) ptrs.push_back(v.c_str());
+  return H5Awrite(attr.get(), type.get(), ptrs.data()) >= 0;
+}
+
+bool write_int_attribute(hid_t obj, const char* name, int value) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle attr(H5Acreate2(obj, name, H5T_STD_I32LE, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  return attr.valid() && H5Awrite(attr.get(), H5T_NATIVE_INT, &value) >= 0;
+}
+
+// Strings of a string attribute (scalar or 1-D; variable or fixed length), or nullopt when absent or
+// not strings.
+std::optional<std::vector<std::string>> read_string_attribute(hid_t obj, const char* name) {
+  if (H5Aexists(obj, name) <= 0) return std::nullopt;
+  Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  Handle ftype(H5Aget_type(attr.get()), H5Tclose);
+  if (H5Tget_class(ftype.get()) != H5T_STRING) return std::nullopt;
+  Handle space(H5Aget_space(attr.get()), H5Sclose);
+  const hssize_t count = H5Sget_simple_extent_npoints(space.get());
+  if (count < 0) return std::nullopt;
+  const auto n = static_cast<std::size_t>(count);
+  std::vector<std::string> out;
+  if (H5Tis_variable_str(ftype.get()) > 0) {
+    Handle mtype = string_type();
+    std::vector<char*> ptrs(n, nullptr);
+    if (H5Aread(attr.get(), mtype.get(), ptrs.data()) < 0) return std::nullopt;
+    for (char* p : ptrs) out.emplace_back(p == nullptr ? "" : p);
+    H5Dvlen_reclaim(mtype.get(), space.get(), H5P_DEFAULT, ptrs.data());
+  } else {
+    const std::size_t size = H5Tget_size(ftype.get());
+    Handle mtype(H5Tcopy(H5T_C_S1), H5Tclose);
+    H5Tset_size(mtype.get(), size);
+    std::vector<char> buf(n * size + 1, '\0');
+    if (H5Aread(attr.get(), mtype.get(), buf.data()) < 0) return std::nullopt;
+    for (std::size_t i = 0; i < n; ++i) {
+      const char* s = buf.data() + i * size;
+      out.emplace_back(s, strnlen(s, size));
+    }
+  }
+  return out;
+}
+
+std::optional<long long> read_int_attribute(hid_t obj, const char* name) {
+  if (H5Aexists(obj, name) <= 0) return std::nullopt;
+  Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  Handle ftype(H5Aget_type(attr.get()), H5Tclose);
+  if (H5Tget_class(ftype.get()) != H5T_INTEGER) return std::nullopt;
+  long long v = 0;
+  if (H5Aread(attr.get(), H5T_NATIVE_LLONG, &v) < 0) return std::nullopt;
+  return v;
+}
+
+// --- reading ------------------------------------------------------------------------------------
+
+struct Dataset {
+  std::string name;
+  Handle id;
+  hsize_t cols = 1;  // second dimension of a 2-D dataset
+};
+
+class H5Reader final : public GyroLogReader {
+ public:
+  Status open(const std::string& path);
+  Result<bool> next(GyroLog& block) override;
+  double fraction_read() const override {
+    return rows_ == 0 ? 1.0 : static_cast<double>(row_) / static_cast<double>(rows_);
+  }
+  std::size_t epochs_hint() const override { return static_cast<std::size_t>(rows_); }
+
+ private:
+  Result<Dataset> open_dataset(const char* name, int rank, hsize_t cols);
+  Status read_rows(const Dataset& d, hsize_t first, hsize_t count, hid_t mem_type, void* out) const;
+  Status read_header();
+  std::string where(const std::string& dataset, std::size_t row) const {
+    return header_.source + ": dataset '" + dataset + "' row " + std::to_string(row + 1) + ": ";
+  }
+  Status check_block(const GyroLog& block, hsize_t first) const;
+
+  Handle file_;
+  Dataset time_;
+  std::vector<Dataset> gyros_;
+  Dataset present_;
+  std::array<Dataset, 4> ref_{};
+  Dataset ref_present_;
+  hsize_t rows_ = 0;
+  hsize_t row_ = 0;
+  std::vector<double> column_;  // one dataset's block, reused
+};
+
+Result<Dataset> H5Reader::open_dataset(const char* name, int rank, hsize_t cols) {
+  const std::string& src = header_.source;
+  if (H5Lexists(file_.get(), name, H5P_DEFAULT) <= 0) {
+    return bad_input(src + ": dataset '" + name + "' is missing (docs/formats.md)");
+  }
+  Dataset d;
+  d.name = name;
+  d.id = Handle(H5Dopen2(file_.get(), name, H5P_DEFAULT), H5Dclose);
+  if (!d.id.valid()) return bad_input(src + ": dataset '" + name + "' cannot be opened");
+  Handle space(H5Dget_space(d.id.get()), H5Sclose);
+  std::array<hsize_t, 2> dims{};
+  const int got = H5Sget_simple_extent_ndims(space.get());
+  if (got != rank || H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) < 0) {
+    return bad_input(src + ": dataset '" + name + "' has " + std::to_string(got) +
+                     " dimension(s), expected " + std::to_string(rank));
+  }
+  if (rank == 2 && dims[1] != cols) {
+    return bad_input(src + ": dataset '" + name + "' has " + std::to_string(dims[1]) + " columns, expected " +
+                     std::to_string(cols));
+  }
+  Handle type(H5Dget_type(d.id.get()), H5Tclose);
+  const H5T_class_t cls = H5Tget_class(type.get());
+  if (cls != H5T_FLOAT && cls != H5T_INTEGER) {
+    return bad_input(src + ": dataset '" + name + "' is not numeric");
+  }
+  if (name != std::string("time_s") && dims[0] != rows_) {
+    return bad_input(src + ": dataset '" + name + "' has " + std::to_string(dims[0]) +
+                     " rows, 'time_s' has " + std::to_string(rows_));
+  }
+  if (name == std::string("time_s")) rows_ = dims[0];
+  d.cols = cols;
+  return d;
+}
+
+Status H5Reader::read_rows(const Dataset& d, hsize_t first, hsize_t count, hid_t mem_type, void* out) const {
+  Handle fspace(H5Dget_space(d.id.get()), H5Sclose);
+  const std::array<hsize_t, 2> start{first, 0};
+  const std::array<hsize_t, 2> size{count, d.cols};
+  const int rank = H5Sget_simple_extent_ndims(fspace.get());
+  H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, size.data(), nullptr);
+  Handle mspace(H5Screate_simple(rank, size.data(), nullptr), H5Sclose);
+  if (H5Dread(d.id.get(), mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, out) < 0) {
+    return bad_input(header_.source + ": dataset '" + d.name + "': cannot read rows " +
+                     std::to_string(first + 1) + ".." + std::to_string(first + count) + " (damaged file?)");
+  }
+  return ok_status();
+}
+
+Status H5Reader::read_header() {
+  const std::string& src = header_.source;
+  const hid_t root = file_.get();
+  const auto format = read_string_attribute(root, "format");
+  if (!format || format->size() != 1 || format->front() != kFormat) {
+    return bad_input(src + ": attribute 'format' is not '" + kFormat +
+                     "': not a tetra gyro log (docs/formats.md)");
+  }
+  const auto version = read_int_attribute(root, "version");
+  if (!version || *version != kVersion) {
+    return bad_input(src + ": attribute 'version': expected " + std::to_string(kVersion));
+  }
+  const auto count = read_int_attribute(root, "gyro_count");
+  if (!count || *count < 1 || *count > 4096) {
+    return bad_input(src + ": attribute 'gyro_count': expected an integer from 1 to 4096");
+  }
+  header_.gyro_count = static_cast<int>(*count);
+  const auto units = read_string_attribute(root, "units");
+  if (!units || units->size() != 1 || (units->front() != "V" && units->front() != "dps")) {
+    return bad_input(src + ": attribute 'units': expected 'V' or 'dps'");
+  }
+  header_.units_dps = units->front() == "dps";
+  // The metadata is read from the comment lines, as from a CSV's ("metadata" is for other readers).
+  if (const auto comments = read_string_attribute(root, "comments")) {
+    header_.comments = *comments;
+    for (const std::string& c : *comments) parse_metadata_comment(c, header_.metadata);
+  }
+  return ok_status();
+}
+
+Status H5Reader::open(const std::string& path) {
+  silence_hdf5();
+  header_.source = path;
+  if (Status s = check_input(path, kMaxStreamedLogBytes, true); !s) return s;
+  if (H5Fis_hdf5(path.c_str()) <= 0) return bad_input(path + ": not an HDF5 file");
+  file_ = Handle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!file_.valid()) return bad_input(path + ": cannot open as HDF5");
+  if (Status s = read_header(); !s) return s;
+  const auto ng = static_cast<hsize_t>(header_.gyro_count);
+  auto time = open_dataset("time_s", 1, 1);
+  if (!time) return time.error();
+  time_ = std::move(time.value());
+  for (std::size_t g = 0; g < ng; ++g) {
+    auto d = open_dataset(gyro_name(g).c_str(), 1, 1);
+    if (!d) return d.error();
+    gyros_.push_back(std::move(d.value()));
+  }
+  auto present = open_dataset("present", 2, ng);
+  if (!present) return present.error();
+  present_ = std::move(present.value());
+  int refs = 0;
+  for (const char* name : kRefNames) refs += H5Lexists(file_.get(), name, H5P_DEFAULT) > 0 ? 1 : 0;
+  if (refs != 0 && refs != 4) {
+    return bad_input(path + ": reference datasets must be all of ref_qw,ref_qx,ref_qy,ref_qz");
+  }
+  header_.has_reference = refs == 4;
+  if (header_.has_reference) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      auto d = open_dataset(kRefNames[k], 1, 1);
+      if (!d) return d.error();
+      ref_[k] = std::move(d.value());
+    }
+    auto rp = open_dataset("ref_present", 1, 1);
+    if (!rp) return rp.error();
+    ref_present_ = std::move(rp.value());
+  }
+  return ok_status();
+}
+
+Status H5Reader::check_block(const GyroLog& block, hsize_t first) const {
+  for (std::size_t r = 0; r < block.epochs(); ++r) {
+    if (!std::isfinite(block.time_s[r])) {
+      return bad_input(where("time_s", first + r) + "time must be a finite number");
+    }
+    if (block.has_reference && block.reference_present[r] != 0) {
+      const auto& q = block.reference_wxyz[r];
+      const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) {
+        return bad_input(where("ref_qw", first + r) + "reference quaternion is not of unit norm");
+      }
+    }
+  }
+  return ok_status();
+}
+
+Result<bool> H5Reader::next(GyroLog& block) {
+  if (row_ >= rows_) return false;
+  const hsize_t count = std::min(kBlockRows, rows_ - row_);
+  const auto n = static_cast<std::size_t>(count);
+  const auto ng = static_cast<std::size_t>(header_.gyro_count);
+  block.source = header_.source;
+  block.metadata = header_.metadata;
+  block.comments = header_.comments;
+  block.gyro_count = header_.gyro_count;
+  block.units_dps = header_.units_dps;
+  block.has_reference = header_.has_reference;
+  block.time_s.resize(n);
+  block.values.resize(n * ng);
+  block.present.resize(n * ng);
+  block.lines.resize(n);
+  for (std::size_t r = 0; r < n; ++r) block.lines[r] = static_cast<std::size_t>(row_) + r + 1;
+  if (Status s = read_rows(time_, row_, count, H5T_NATIVE_DOUBLE, block.time_s.data()); !s) return s.error();
+  if (Status s = read_rows(present_, row_, count, H5T_NATIVE_UINT8, block.present.data()); !s)
+    return s.error();
+  column_.resize(n);
+  for (std::size_t g = 0; g < ng; ++g) {
+    if (Status s = read_rows(gyros_[g], row_, count, H5T_NATIVE_DOUBLE, column_.data()); !s) return s.error();
+    for (std::size_t r = 0; r < n; ++r) {
+      std::uint8_t& p = block.present[r * ng + g];
+      p = p != 0 ? 1 : 0;
+      block.values[r * ng + g] = p != 0 ? column_[r] : kNaN;  // as an empty CSV cell
+    }
+  }
+  block.reference_wxyz.clear();
+  block.reference_present.clear();
+  if (block.has_reference) {
+    block.reference_wxyz.resize(n);
+    block.reference_present.resize(n);
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (Status s = read_rows(ref_[k], row_, count, H5T_NATIVE_DOUBLE, column_.data()); !s) return s.error();
+      for (std::size_t r = 0; r < n; ++r) block.reference_wxyz[r][k] = column_[r];
+    }
+    if (Status s = read_rows(ref_present_, row_, count, H5T_NATIVE_UINT8, block.reference_present.data()); !s)
+      return s.error();
+    for (std::size_t r = 0; r < n; ++r) {
+      std::uint8_t& p = block.reference_present[r];
+      p = p != 0 ? 1 : 0;
+      if (p == 0) block.reference_wxyz[r] = {kNaN, kNaN, kNaN, kNaN};
+    }
+  }
+  if (Status s = check_block(block, row_); !s) return s.error();
+  row_ += count;
+  return true;
+}
+
+template <class T>
+void append(std::vector<T>& to, const std::vector<T>& from) {
+  to.insert(to.end(), from.begin(), from.end());
+}
+
+}  // namespace
+
+Result<std::unique_ptr<GyroLogReader>> open_gyro_log_h5_reader(const std::string& path) {
+  auto reader = std::make_unique<H5Reader>();
+  if (Status s = reader->open(path); !s) return s.error();
+  return std::unique_ptr<GyroLogReader>(std::move(reader));
+}
+
+Result<GyroLog> read_gyro_log_h5(const std::string& path) {
+  auto reader = open_gyro_log_h5_reader(path);
+  if (!reader) return reader.error();
+  GyroLog log = (*reader)->header();
+  const std::size_t n = (*reader)->epochs_hint();
+  const auto ng = static_cast<std::size_t>(log.gyro_count);
+  // A whole log in memory holds no more values than the largest CSV table read whole (2 bytes a cell).
+  if (n > kMaxTableBytes / 2 / (ng + 1)) {
+    return bad_input(path + ": dataset 'time_s': " + std::to_string(n) + " rows of " + std::to_string(ng) +
+                     " gyros are more than a whole log read at once holds (" +
+                     std::to_string(kMaxTableBytes / 2) + " values)");
+  }
+  log.time_s.reserve(n);
+  log.values.reserve(n * ng);
+  log.present.reserve(n * ng);
+  log.lines.reserve(n);
+  GyroLog block;
+  while (true) {
+    auto more = (*reader)->next(block);
+    if (!more) return more.error();
+    if (!*more) break;
+    append(log.time_s, block.time_s);
+    append(log.values, block.values);
+    append(log.present, block.present);
+    append(log.lines, block.lines);
+    append(log.reference_wxyz, block.reference_wxyz);
+    append(log.reference_present, block.reference_present);
+  }
+  return log;
+}
+
+// --- writing ------------------------------------------------------------------------------------
+
+struct GyroLogH5Writer::Impl {
+  std::string path;  // the output's name, for messages
+  Handle file;
+  int gyro_count = 0;
+  bool with_reference = false;
+  hsize_t rows = 0;  // rows written to the file
+  // Rows buffered for the next chunk.
+  std::vector<double> time_s;
+  std::vector<std::vector<double>> gyro;  // per gyro
+  std::vector<std::uint8_t> present;      // rows×N
+  std::array<std::vector<double>, 4> ref;
+  std::vector<std::uint8_t> ref_present;
+
+  Status create_dataset(const char* name, hid_t type, hsize_t cols) const;
+  Status append_rows(const char* name, hid_t mem_type, const void* data, hsize_t count, hsize_t cols) const;
+  Status flush();
+};
+
+Status GyroLogH5Writer::Impl::create_dataset(const char* name, hid_t type, hsize_t cols) const {
+  const int rank = cols > 1 ? 2 : 1;
+  const std::array<hsize_t, 2> dims{0, cols};
+  const std::array<hsize_t, 2> max{H5S_UNLIMITED, cols};
+  const std::array<hsize_t, 2> chunk{kChunkRows, cols};
+  Handle space(H5Screate_simple(rank, dims.data(), max.data()), H5Sclose);
+  Handle plist(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_chunk(plist.get(), rank, chunk.data());
+  H5Pset_shuffle(plist.get());
+  H5Pset_deflate(plist.get(), kDeflateLevel);
+  Handle d(H5Dcreate2(file.get(), name, type, space.get(), H5P_DEFAULT, plist.get(), H5P_DEFAULT), H5Dclose);
+  if (!d.valid()) return failure(path + ": cannot create dataset '" + name + "'");
+  return ok_status();
+}
+
+Status GyroLogH5Writer::Impl::append_rows(const char* name, hid_t mem_type, const void* data, hsize_t count,
+                                          hsize_t cols) const {
+  Handle d(H5Dopen2(file.get(), name, H5P_DEFAULT), H5Dclose);
+  const int rank = cols > 1 ? 2 : 1;
+  const std::array<hsize_t, 2> new_dims{rows + count, cols};
+  if (!d.valid() || H5Dset_extent(d.get(), new_dims.data()) < 0) {
+    return failure(path + ": dataset '" + name + "': cannot extend");
+  }
+  Handle fspace(H5Dget_space(d.get()), H5Sclose);
+  const std::array<hsize_t, 2> start{rows, 0};
+  const std::array<hsize_t, 2> size{count, cols};
+  H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, size.data(), nullptr);
+  Handle mspace(H5Screate_simple(rank, size.data(), nullptr), H5Sclose);
+  if (H5Dwrite(d.get(), mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, data) < 0) {
+    return failure(path + ": dataset '" + name + "': write failed");
+  }
+  return ok_status();
+}
+
+Status GyroLogH5Writer::Impl::flush() {
+  const hsize_t count = time_s.size();
+  if (count == 0) return ok_status();
+  const auto ng = static_cast<hsize_t>(gyro_count);
+  if (Status s = append_rows("time_s", H5T_NATIVE_DOUBLE, time_s.data(), count, 1); !s) return s;
+  for (std::size_t g = 0; g < gyro.size(); ++g) {
+    if (Status s = append_rows(gyro_name(g).c_str(), H5T_NATIVE_DOUBLE, gyro[g].data(), count, 1); !s)
+      return s;
+    gyro[g].clear();
+  }
+  // A 2-D dataset of one column is still 2-D: rank follows the dataset, so write it as rows×1.
+  if (Status s = append_rows("present", H5T_NATIVE_UINT8, present.data(), count, ng); !s) return s;
+  if (with_reference) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (Status s = append_rows(kRefNames[k], H5T_NATIVE_DOUBLE, ref[k].data(), count, 1); !s) return s;
+      ref[k].clear();
+    }
+    if (Status s = append_rows("ref_present", H5T_NATIVE_UINT8, ref_present.data(), count, 1); !s) return s;
+    ref_present.clear();
+  }
+  rows += count;
+  time_s.clear();
+  present.clear();
+  return ok_status();
+}
+
+GyroLogH5Writer::GyroLogH5Writer() = default;
+
+GyroLogH5Writer::~GyroLogH5Writer() = default;
+
+Status GyroLogH5Writer::open(const std::string& file_path, const std::string& path, int gyro_count,
+                             bool with_reference, const std::vector<std::string>& comments) {
+  if (impl_ && impl_->file.valid()) return failure(path + ": writer already open");
+  if (gyro_count < 1) return bad_input(path + ": a gyro log needs at least one gyro column");
+  silence_hdf5();
+  impl_ = std::make_unique<Impl>();
+  Impl& w = *impl_;
+  w.path = path;
+  w.gyro_count = gyro_count;
+  w.with_reference = with_reference;
+  w.gyro.resize(static_cast<std::size_t>(gyro_count));
+  w.file = Handle(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+  if (!w.file.valid()) return failure(path + ": cannot write: " + std::strerror(errno));
+
+  Metadata metadata;
+  for (const std::string& c : comments) parse_metadata_comment(c, metadata);
+  std::vector<std::string> meta;
+  for (const auto& [k, v] : metadata) meta.push_back(k + "=" + v);
+  const auto meta_units = last_meta(metadata, "units");
+  const bool dps = meta_units && *meta_units == "dps";
+  const hid_t root = w.file.get();
+  bool ok = write_string_attribute(root, "format", {kFormat}, true) &&
+            write_int_attribute(root, "version", kVersion) &&
+            write_int_attribute(root, "gyro_count", gyro_count) &&
+            write_string_attribute(root, "units", {dps ? "dps" : "V"}, true);
+  if (ok && !comments.empty()) ok = write_string_attribute(root, "comments", comments, false);
+  if (ok && !meta.empty()) ok = write_string_attribute(root, "metadata", meta, false);
+  if (!ok) return failure(path + ": cannot write the attributes");
+
+  const auto ng = static_cast<hsize_t>(gyro_count);
+  if (Status s = w.create_dataset("time_s", H5T_IEEE_F64LE, 1); !s) return s;
+  for (std::size_t g = 0; g < w.gyro.size(); ++g) {
+    if (Status s = w.create_dataset(gyro_name(g).c_str(), H5T_IEEE_F64LE, 1); !s) return s;
+  }
+  if (Status s = w.create_dataset("present", H5T_STD_U8LE, ng); !s) return s;
+  if (with_reference) {
+    for (const char* name : kRefNames) {
+      if (Status s = w.create_dataset(name, H5T_IEEE_F64LE, 1); !s) return s;
+    }
+    if (Status s = w.create_dataset("ref_present", H5T_STD_U8LE, 1); !s) return s;
+  }
+  return ok_status();
+}
+
+Status GyroLogH5Writer::write(double time_s, std::span<const double> values,
+                              std::span<const std::uint8_t> present,
+                              const std::optional<std::array<double, 4>>& reference_wxyz) {
+  if (!impl_ || !impl_->file.valid()) return failure("gyro log writer is not open");
+  Impl& w = *impl_;
+  if (values.size() != static_cast<std::size_t>(w.gyro_count) || present.size() != values.size()) {
+    return failure(w.path + ": epoch has the wrong number of gyro values");
+  }
+  w.time_s.push_back(time_s);
+  for (std::size_t g = 0; g < values.size(); ++g) {
+    w.gyro[g].push_back(present[g] != 0 ? values[g] : kNaN);
+    w.present.push_back(present[g] != 0 ? 1 : 0);
+  }
+  if (w.with_reference) {
+    for (std::size_t k = 0; k < 4; ++k) w.ref[k].push_back(reference_wxyz ? (*reference_wxyz)[k] : kNaN);
+    w.ref_present.push_back(reference_wxyz ? 1 : 0);
+  }
+  if (w.time_s.size() >= kChunkRows) return w.flush();
+  return ok_status();
+}
+
+Status GyroLogH5Writer::close() {
+  if (!impl_ || !impl_->file.valid()) return failure("gyro log writer is not open");
+  Impl& w = *impl_;
+  const Status flushed = w.flush();
+  const bool closed = H5Fclose(w.file.release()) >= 0;
+  if (!flushed) return flushed;
+  if (!closed) return failure(w.path + ": write failed");
+  return ok_status();
+}
+
+}  // namespace tetra

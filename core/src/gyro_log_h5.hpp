@@ -1,0 +1,47 @@
+#pragma once
+// HDF5 gyro logs (docs/formats.md): the CSV's columns as chunked, compressed datasets and its metadata
+// as attributes. Private to tetra::core; reached through read_gyro_log, GyroLogReader and GyroLogWriter.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tetra/core/gyro_log.hpp"
+#include "tetra/core/result.hpp"
+
+namespace tetra {
+
+//! The whole log, as read_gyro_log.
+Result<GyroLog> read_gyro_log_h5(const std::string& path);
+//! A block reader, as GyroLogReader::open.
+Result<std::unique_ptr<GyroLogReader>> open_gyro_log_h5_reader(const std::string& path);
+
+//! Writes an HDF5 log into `file_path`: the temporary file of an OutputFile (OutputFile::library_path),
+//! committed with the run's other outputs (RunFiles::commit).
+class GyroLogH5Writer {
+ public:
+  GyroLogH5Writer();
+  GyroLogH5Writer(const GyroLogH5Writer&) = delete;
+  GyroLogH5Writer& operator=(const GyroLogH5Writer&) = delete;
+  ~GyroLogH5Writer();
+
+  //! `path` names the output in messages. `comments` are the CSV's comment lines (text after '#'), kept
+  //! verbatim; units are "dps" when their last "units" entry says so.
+  Status open(const std::string& file_path, const std::string& path, int gyro_count, bool with_reference,
+              const std::vector<std::string>& comments);
+  Status write(double time_s, std::span<const double> values, std::span<const std::uint8_t> present,
+               const std::optional<std::array<double, 4>>& reference_wxyz);
+  //! Flushes and closes the file (the run commits it).
+  Status close();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tetra
