@@ -29,8 +29,9 @@ Eigen::Vector3d AttitudePropagator::step(const Eigen::Vector3d& omega_meas_B_rad
   Eigen::Vector3d omega = omega_meas_B_rad_s - earth_rate_B();
   if (earth_rate_L_) {
     // Exact for rates constant over the step, each in its own frame: B turns at the measured rate in B, L at
-    // the Earth rate in L, so q_LB(t + Δt) = exp(−ω_e^L Δt) ⊗ q_LB(t) ⊗ exp(ω^B Δt). Evaluating the Earth rate
-    // in B once per step instead costs ½|ω_e||ω|Δt² per step (0.01° over the seed's 100-min run at 1.25 Hz).
+    // the Earth rate in L, so q_LB(t + Δt) = exp(−ω_e^L Δt) ⊗ q_LB(t) ⊗ exp(ω^B Δt). Evaluating the Earth
+    // rate in B once per step instead costs ½|ω_e||ω|Δt² per step (0.01° over the seed's 100-min run at 1.25
+    // Hz).
     q_RB_ = (quat_exp(-*earth_rate_L_ * dt_s) * propagate(q_RB_, omega_meas_B_rad_s, dt_s)).normalized();
   } else {
     q_RB_ = propagate(q_RB_, omega, dt_s);

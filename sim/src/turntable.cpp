@@ -131,7 +131,7 @@ Result<TurntableLog> simulate_turntable(const Calibration& unit, const Turntable
       const double inner_dot = seq.inner_rotates ? gimbal_rate_dps * kDegToRad : 0.0;
       const double outer_dot = seq.inner_rotates ? 0.0 : gimbal_rate_dps * kDegToRad;
       const Eigen::Vector3d omega_BN_B_rad_s = turntable_rate_B(inner_rad, inner_dot, outer_dot) +
-                                            turntable_earth_rate_B(inner_rad, outer_rad, latitude_rad);
+                                               turntable_earth_rate_B(inner_rad, outer_rad, latitude_rad);
       const Eigen::Vector3d omega_B_dps = omega_BN_B_rad_s * kRadToDeg;
 
       log.sequence.push_back(number);

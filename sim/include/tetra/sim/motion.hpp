@@ -67,7 +67,7 @@ struct MotionSpec {
 struct MotionState {
   Quaternion q_RB;                   //!< body → reference frame R (see above), unit norm
   Eigen::Vector3d omega_BR_B_rad_s;  //!< [rad/s] rate of B relative to R, in B (dq/dt = ½ q ⊗ ω)
-  Eigen::Vector3d omega_BN_B_rad_s;     //!< [rad/s] inertial rate of B, in B: what the gyros sense
+  Eigen::Vector3d omega_BN_B_rad_s;  //!< [rad/s] inertial rate of B, in B: what the gyros sense
 };
 
 //! Evaluates the truth motion at any time. Immutable once created; thread-safe to evaluate.

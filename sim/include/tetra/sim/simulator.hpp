@@ -39,8 +39,8 @@ struct SimEpoch {
   std::vector<std::uint8_t> present;         //!< per gyro: 0 = no sample delivered
   std::optional<Quaternion> reference_q_RB;  //!< attitude reference on its epochs
   Quaternion truth_q_RB;                     //!< true attitude, body → reference frame R
-  Eigen::Vector3d truth_omega_BR_B_rad_s;       //!< [rad/s] true rate of B relative to R, in B
-  Eigen::Vector3d omega_BN_B_rad_s;      //!< [rad/s] true inertial rate of B (incl. Earth rate)
+  Eigen::Vector3d truth_omega_BR_B_rad_s;    //!< [rad/s] true rate of B relative to R, in B
+  Eigen::Vector3d omega_BN_B_rad_s;          //!< [rad/s] true inertial rate of B (incl. Earth rate)
 };
 
 class Simulator {
@@ -79,9 +79,9 @@ std::vector<FaultSpec> all_faults(const Scenario& scenario, const SimOptions& op
 
 //! Ground truth of a simulated run, one entry per epoch.
 struct Truth {
-  std::vector<double> time_s;                         //!< [s]
-  std::vector<Quaternion> q_RB;                       //!< body → reference frame
-  std::vector<Eigen::Vector3d> omega_BR_B_rad_s;         //!< [rad/s] rate of B relative to R, in B
+  std::vector<double> time_s;                     //!< [s]
+  std::vector<Quaternion> q_RB;                   //!< body → reference frame
+  std::vector<Eigen::Vector3d> omega_BR_B_rad_s;  //!< [rad/s] rate of B relative to R, in B
   std::vector<Eigen::Vector3d> omega_BN_B_rad_s;  //!< [rad/s] inertial rate of B, in B
 };
 

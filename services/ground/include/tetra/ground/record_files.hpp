@@ -1,5 +1,5 @@
 #pragma once
-// History from `tetra record` files (docs/ground.md): the attitude CSV (INTERFACES §2.4) and the
+// History from `tetra record` files (docs/ground.md): the attitude CSV (docs/interfaces.md §2.4) and the
 // events or commands JSON lines in one folder, served as the stream's JSON objects. The files hold
 // sensor time only (no UTC), so rows are selected by `sensor_time_s`.
 
