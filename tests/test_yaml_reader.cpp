@@ -92,5 +92,16 @@ TEST(YamlReader, OneDocumentAndNoHangOnMalformedText) {
   for (const char* text : {",", ",][", ",# "}) (void)yaml.load(text);
 }
 
+TEST(YamlReader, TextMustBeUtf8) {
+  // Names round-trip through every writer only if they are text: a stray byte is refused by name and line.
+  const YamlReader yaml{"u.yaml"};
+  const auto doc = yaml.load("unit: tetr\xe1-1\nok: t\xc3\xa9tra\n");
+  ASSERT_TRUE(doc.ok());
+  const auto bad = yaml.text((*doc)["unit"], "unit");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().message, "u.yaml:1: unit: expected UTF-8 text");
+  EXPECT_EQ(yaml.text((*doc)["ok"], "ok").value(), "t\xc3\xa9tra");
+}
+
 }  // namespace
 }  // namespace tetra

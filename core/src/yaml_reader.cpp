@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/json.hpp"
 
 namespace tetra {
 
@@ -109,6 +110,7 @@ Result<YAML::Node> YamlReader::load(const std::string& text) const {
 
 Result<std::string> YamlReader::text(const YAML::Node& node, const std::string& what) const {
   if (!node.IsScalar()) return error(node, what, "expected a text value");
+  if (!is_valid_utf8(node.Scalar())) return error(node, what, "expected UTF-8 text");
   return node.Scalar();
 }
 
