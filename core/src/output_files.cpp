@@ -175,6 +175,17 @@ Status RunFiles::check_distinct(const OutputFile& out, const std::optional<FileI
   return ok_status();
 }
 
+Status RunFiles::add_outputs(std::initializer_list<OptionalOutput> outputs) {
+  for (const OptionalOutput& o : outputs) {
+    *o.slot = nullptr;
+    if (o.path.empty()) continue;
+    auto out = add(o.path, o.label);
+    if (!out) return out.error();
+    *o.slot = *out;
+  }
+  return ok_status();
+}
+
 Result<OutputFile*> RunFiles::add(const std::string& path, const std::string& label,
                                   const std::string& replaces_input) {
   auto out = std::unique_ptr<OutputFile>(new OutputFile());

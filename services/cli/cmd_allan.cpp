@@ -7,7 +7,6 @@
 #include <iostream>
 #include <optional>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "cli_common.hpp"
@@ -186,14 +185,12 @@ int cmd_allan(int argc, char** argv) {
   OutputFile* plot_out = nullptr;
   OutputFile* kalibr_out = nullptr;
   OutputFile* cal_out = nullptr;
-  for (auto [path, label, slot] :
-       {std::tuple{&csv_path, "--csv", &csv_out}, std::tuple{&json_path, "--json", &json_out},
-        std::tuple{&plot_path, "--plot", &plot_out}, std::tuple{&kalibr_path, "--kalibr", &kalibr_out}}) {
-    if (path->empty()) continue;
-    auto out = files.add(*path, label);
-    if (!out) return report(cmd, out.error());
-    *slot = *out;
-  }
+  if (Status s = files.add_outputs({{csv_path, "--csv", &csv_out},
+                                    {json_path, "--json", &json_out},
+                                    {plot_path, "--plot", &plot_out},
+                                    {kalibr_path, "--kalibr", &kalibr_out}});
+      !s)
+    return report(cmd, s.error());
   if (update_cal) {
     auto out = files.add(cal_path, "--update-calibration", cal_path);
     if (!out) return report(cmd, out.error());

@@ -8,7 +8,6 @@
 #include <iostream>
 #include <map>
 #include <string>
-#include <tuple>
 
 #include "attitude_csv.hpp"
 #include "cli_common.hpp"
@@ -92,15 +91,12 @@ int cmd_record(int argc, char** argv) {
   OutputFile* attitude_out = nullptr;
   OutputFile* events_out = nullptr;
   OutputFile* commands_out = nullptr;
-  for (auto [path, label, slot] :
-       {std::tuple{&out_path, "--out", &log_out}, std::tuple{&attitude_path, "--attitude", &attitude_out},
-        std::tuple{&events_path, "--events", &events_out},
-        std::tuple{&commands_path, "--commands", &commands_out}}) {
-    if (path->empty()) continue;
-    auto out = files.add(*path, label);
-    if (!out) return report("record", out.error());
-    *slot = *out;
-  }
+  if (Status s = files.add_outputs({{out_path, "--out", &log_out},
+                                    {attitude_path, "--attitude", &attitude_out},
+                                    {events_path, "--events", &events_out},
+                                    {commands_path, "--commands", &commands_out}});
+      !s)
+    return report("record", s.error());
 
   service::AssemblerConfig assembly;
   if (!config_path.empty()) {

@@ -14,6 +14,7 @@
 
 #include <sys/types.h>
 
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <string>
@@ -104,6 +105,14 @@ class RunFiles {
   //! place, e.g. `allan --update-calibration`).
   Result<OutputFile*> add(const std::string& path, const std::string& label,
                           const std::string& replaces_input = "");
+  //! An output option that may be absent: `path` empty leaves `*slot` null.
+  struct OptionalOutput {
+    const std::string& path;
+    const char* label;
+    OutputFile** slot;
+  };
+  //! add() for each output given; the first refusal is returned.
+  Status add_outputs(std::initializer_list<OptionalOutput> outputs);
   //! add() and write() in one step.
   Status put(const std::string& path, const std::string& label, std::string_view content);
   //! fsyncs every regular output, then renames each into place. Call once, when the run succeeded.
