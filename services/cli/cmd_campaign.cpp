@@ -1,4 +1,5 @@
-// tetra campaign SPEC.yaml — fault-injection campaigns over the closed loop (docs/campaign.md).
+// tetra campaign SPEC.yaml — fault-injection campaigns, closed or open loop, with the fusion pipeline in
+// process or in `tetra fusion` services over DDS (docs/campaign.md).
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,6 +15,7 @@
 
 #include <spdlog/fmt/fmt.h>
 
+#include "campaign_dds.hpp"
 #include "campaign_report.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
@@ -50,9 +52,14 @@ Result<std::set<std::size_t>> done_runs(const std::string& path) {
 
 //! A worker process: runs its share of the cases, one row per line on `fd` (each write below
 //! PIPE_BUF, so lines of several workers never interleave).
-[[noreturn]] void worker(const sim::CampaignSpec& spec, const std::vector<sim::CampaignCase>& cases, int fd) {
+[[noreturn]] void worker(const sim::CampaignSpec& spec, const std::vector<sim::CampaignCase>& cases, int fd,
+                         const std::string& out_dir) {
+  const sim::EstimatorFactory make =
+      spec.target == sim::CampaignTarget::kDds
+          ? dds_campaign_estimators(spec, (std::filesystem::path(out_dir) / "dds").string())
+          : sim::in_process_estimators(spec);
   for (const sim::CampaignCase& c : cases) {
-    auto row = sim::run_campaign_case(spec, c);
+    auto row = sim::run_campaign_case(spec, c, make);
     const std::string line = row ? sim::campaign_csv_row(*row) + "\n" : "error " + row.error().message + "\n";
     if (::write(fd, line.data(), line.size()) != static_cast<ssize_t>(line.size())) ::_exit(1);
   }
@@ -83,7 +90,8 @@ struct Progress {
 };
 
 Status run_pending(const sim::CampaignSpec& spec, const std::vector<sim::CampaignCase>& pending, int jobs,
-                   const std::string& runs_path, Progress& progress) {
+                   const std::string& out_dir, Progress& progress) {
+  const std::string runs_path = (std::filesystem::path(out_dir) / "runs.csv").string();
   int fds[2];
   if (::pipe(fds) != 0) return failure("cannot create a pipe");
   std::vector<pid_t> pids;
@@ -97,7 +105,7 @@ Status run_pending(const sim::CampaignSpec& spec, const std::vector<sim::Campaig
     if (pid < 0) return failure("cannot fork a worker");
     if (pid == 0) {
       ::close(fds[0]);
-      worker(spec, share, fds[1]);
+      worker(spec, share, fds[1], out_dir);
     }
     pids.push_back(pid);
   }
@@ -139,10 +147,12 @@ Status run_pending(const sim::CampaignSpec& spec, const std::vector<sim::Campaig
 
 int cmd_campaign(int argc, char** argv) {
   CLI::App app{
-      "Fault-injection campaign: closed-loop scenarios x fault kinds x gyros x onsets x sizes x seeds, run "
-      "in "
-      "parallel processes with the fusion pipeline in process; one row per run and a report with plots "
-      "(docs/campaign.md). Interrupted campaigns continue where they stopped.",
+      "Fault-injection campaign: scenarios x fault kinds x gyros x onsets x sizes x seeds, in parallel "
+      "processes; one row per run and a report with plots (docs/campaign.md). The spec selects closed loop "
+      "(`loop: closed`, the default: the controller steers with the estimate) or open loop (`loop: open`: "
+      "the scenarios' own motion), and the fusion pipeline in process (`target: in_process`, the default) "
+      "or one `tetra fusion` service per run over DDS in lockstep (`target: dds`, `domain: N`). "
+      "Interrupted campaigns continue where they stopped.",
       kName};
   std::string spec_path;
   std::string out_dir;
@@ -159,7 +169,9 @@ int cmd_campaign(int argc, char** argv) {
   auto spec = sim::read_campaign_spec(spec_path);
   if (!spec) return report(kName, spec.error());
   std::error_code ec;
-  std::filesystem::create_directories(out_dir, ec);
+  const bool over_dds = spec->target == sim::CampaignTarget::kDds;
+  std::filesystem::create_directories(
+      over_dds ? std::filesystem::path(out_dir) / "dds" : std::filesystem::path(out_dir), ec);
   if (ec) return report(kName, failure(out_dir + ": cannot create the folder"));
   const std::string runs_path = (std::filesystem::path(out_dir) / "runs.csv").string();
   auto done = done_runs(runs_path);
@@ -174,11 +186,15 @@ int cmd_campaign(int argc, char** argv) {
   for (const sim::CampaignCase& c : cases) {
     if (done->count(c.index) == 0) pending.push_back(c);
   }
-  std::cerr << "tetra campaign: " << cases.size() << " runs, " << cases.size() - pending.size()
-            << " already done, " << jobs << " jobs\n";
+  std::cerr << "tetra campaign: " << cases.size() << " runs ("
+            << (spec->loop == sim::CampaignLoop::kClosed ? "closed" : "open") << " loop, "
+            << (spec->target == sim::CampaignTarget::kDds
+                    ? "fusion services over DDS, domain " + std::to_string(spec->dds_domain)
+                    : std::string("pipeline in process"))
+            << "), " << cases.size() - pending.size() << " already done, " << jobs << " jobs\n";
   Progress progress{cases.size(), cases.size() - pending.size()};
   if (!pending.empty()) {
-    if (Status st = run_pending(*spec, pending, jobs, runs_path, progress); !st)
+    if (Status st = run_pending(*spec, pending, jobs, out_dir, progress); !st)
       return report(kName, st.error());
   }
   if (no_report) return kExitOk;

@@ -38,6 +38,9 @@ class SimDdsLink {
   bool stop_requested() const { return shutdown_ != nullptr && shutdown_->requested(); }
   //! Waits (up to 2 s) until the samples written are acknowledged.
   void wait_for_acks();
+  //! For more readers on the same participant (a campaign reads the FdiEvent and Health topics too).
+  const dds::Participant& participant() const { return participant_; }
+  const dds::Topics& topics() const { return topics_; }
 
  private:
   SimDdsLink(std::string unit, dds::Participant participant, dds::Topics topics,

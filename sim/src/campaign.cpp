@@ -1,7 +1,9 @@
 #include "tetra/sim/campaign.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
@@ -47,26 +49,61 @@ Status parse_kinds_and_sizes(const YamlReader& yaml, const YAML::Node& root, Cam
   return ok_status();
 }
 
+//! `scenarios:` files (relative to the spec) or built-in names; closed loop needs closed_loop sections.
+Status parse_scenarios(const YamlReader& yaml, const YAML::Node& root, const std::string& base_dir,
+                       CampaignSpec& spec) {
+  auto paths = list_of<std::string>(yaml, root, "scenarios");
+  if (!paths) return paths.error();
+  const std::vector<std::string> builtin = builtin_scenario_names();
+  for (std::size_t i = 0; i < paths->size(); ++i) {
+    std::filesystem::path path = (*paths)[i];
+    const bool is_builtin =
+        std::find(builtin.begin(), builtin.end(), (*paths)[i]) != builtin.end() && !path.has_extension();
+    if (path.is_relative() && !is_builtin) path = std::filesystem::path(base_dir) / path;
+    auto sc = is_builtin ? builtin_scenario((*paths)[i]) : read_scenario(path.string());
+    if (!sc) return yaml.error(root["scenarios"][i], "scenarios", sc.error().message);
+    if (spec.loop == CampaignLoop::kClosed && !sc->closed_loop)
+      return yaml.error(root["scenarios"][i], "scenarios",
+                        path.string() + " has no closed_loop section (or set loop: open)");
+    spec.scenario_paths.push_back(path.string());
+    spec.scenarios.push_back(std::move(sc.value()));
+  }
+  return ok_status();
+}
+
+//! `loop:`, `target:` and `domain:`.
+Status parse_mode(const YamlReader& yaml, const YAML::Node& root, CampaignSpec& spec) {
+  if (const YAML::Node loop = root["loop"]) {
+    const auto text = loop.as<std::string>();
+    if (text != "closed" && text != "open") return yaml.error(loop, "loop", "must be closed or open");
+    spec.loop = text == "open" ? CampaignLoop::kOpen : CampaignLoop::kClosed;
+  }
+  if (const YAML::Node target = root["target"]) {
+    const auto text = target.as<std::string>();
+    if (text != "in_process" && text != "dds")
+      return yaml.error(target, "target", "must be in_process or dds");
+    spec.target = text == "dds" ? CampaignTarget::kDds : CampaignTarget::kInProcess;
+  }
+  if (const YAML::Node domain = root["domain"]) {
+    if (spec.target != CampaignTarget::kDds)
+      return yaml.error(domain, "domain", "applies to target: dds only");
+    const int id = domain.as<int>();
+    if (id < 0 || id > 232) return yaml.error(domain, "domain", "must be a DDS domain id in 0..232");
+    spec.dds_domain = id;
+  }
+  return ok_status();
+}
+
 Result<CampaignSpec> parse_spec(const YAML::Node& root, const YamlReader& yaml, const std::string& base_dir) {
   if (Status st = yaml.check_keys(root,
                                   {"scenarios", "kinds", "gyros", "onsets_s", "sizes", "seeds", "duration_s",
-                                   "fault_free", "pipeline"},
+                                   "fault_free", "pipeline", "loop", "target", "domain"},
                                   "");
       !st)
     return st.error();
   CampaignSpec spec;
-  auto paths = list_of<std::string>(yaml, root, "scenarios");
-  if (!paths) return paths.error();
-  for (std::size_t i = 0; i < paths->size(); ++i) {
-    std::filesystem::path path = (*paths)[i];
-    if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
-    auto sc = read_scenario(path.string());
-    if (!sc) return yaml.error(root["scenarios"][i], "scenarios", sc.error().message);
-    if (!sc->closed_loop)
-      return yaml.error(root["scenarios"][i], "scenarios", path.string() + " has no closed_loop section");
-    spec.scenario_paths.push_back(path.string());
-    spec.scenarios.push_back(std::move(sc.value()));
-  }
+  if (Status st = parse_mode(yaml, root, spec); !st) return st.error();
+  if (Status st = parse_scenarios(yaml, root, base_dir, spec); !st) return st.error();
   if (Status st = parse_kinds_and_sizes(yaml, root, spec); !st) return st.error();
   auto gyros = list_of<int>(yaml, root, "gyros");
   if (!gyros) return gyros.error();
@@ -87,6 +124,7 @@ Result<CampaignSpec> parse_spec(const YAML::Node& root, const YamlReader& yaml, 
   auto pipeline = fdi::pipeline_config_from_yaml(root["pipeline"], yaml.source());
   if (!pipeline) return pipeline.error();
   spec.pipeline = pipeline.value();
+  spec.pipeline_yaml = root["pipeline"] ? YAML::Dump(root["pipeline"]) : "{}";
   return spec;
 }
 
@@ -103,6 +141,11 @@ std::string opt_text(const std::optional<double>& v) {
   std::string out;
   if (v) append_double(out, *v);
   return out;
+}
+
+//! NaN (not available) as an empty field.
+std::string num_text(double v) {
+  return opt_text(std::isnan(v) ? std::nullopt : std::optional<double>(v));
 }
 
 }  // namespace
@@ -184,45 +227,6 @@ std::optional<double> cusum_theory_delay_s(const Calibration& unit, const fdi::P
   return fdi::cusum_arl(delta, k, h) * dt_s;
 }
 
-Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCase& c) {
-  Scenario sc = spec.scenarios[c.scenario];
-  if (spec.duration_s) sc.duration_s = *spec.duration_s;
-  sc.faults.clear();
-  SimOptions options;
-  options.seed = c.seed;
-  if (c.fault) options.faults.push_back(*c.fault);
-  auto simulator = ClosedLoopSimulator::create(sc, options);
-  if (!simulator) return simulator.error();
-  auto estimator = PipelineEstimator::create(sc.unit, spec.pipeline, simulator->initial_q_NB());
-  if (!estimator) return estimator.error();
-  auto record = run_closed_loop(*simulator, *estimator);
-  if (!record) return record.error();
-  const PointingSummary summary = summarize(*record, *simulator);
-  CampaignRow row;
-  row.run = c.index;
-  row.scenario = std::filesystem::path(spec.scenario_paths[c.scenario]).filename().string();
-  row.kind = c.fault ? std::string(fault_kind_name(c.fault->kind)) : "none";
-  row.gyro = c.fault ? c.fault->gyro : 0;
-  row.onset_s = c.fault ? c.fault->at_s : 0.0;
-  row.size = c.fault ? c.fault->size : 0.0;
-  row.seed = c.seed;
-  row.fdi = summary.fdi;
-  if (c.fault && c.fault->kind == FaultKind::kBias) {
-    row.theory_delay_s =
-        cusum_theory_delay_s(sc.unit, spec.pipeline, sc.rate_hz, c.fault->gyro, c.fault->size);
-  }
-  row.final_knowledge_error_deg = summary.final_knowledge_error_deg;
-  row.final_sigma_deg = summary.final_sigma_deg;
-  row.pointing_max_before_deg = summary.segments.front().max_deg;
-  const PointingSegment& after = summary.segments.back();
-  row.pointing_rms_after_deg = after.rms_deg;
-  row.pointing_max_after_deg = after.max_deg;
-  row.recover_s = summary.segments.size() > 1 ? after.recover_s : std::optional<double>(0.0);
-  row.bound_deg = summary.bound_deg;
-  row.max_wheel_momentum_fraction = summary.max_wheel_momentum_fraction;
-  return row;
-}
-
 std::string campaign_csv_header() {
   return "run,scenario,kind,gyro,onset_s,size,seed,outcome,isolated_gyro,detection_delay_s,isolation_delay_s,"
          "theory_delay_s,false_alarms,fault_free_s,final_knowledge_error_deg,final_sigma_deg,"
@@ -242,14 +246,10 @@ std::string campaign_csv_row(const CampaignRow& r) {
          opt_text(r.theory_delay_s) + "," + std::to_string(r.fdi.false_alarms) + ",";
   for (double v : {r.fdi.fault_free_s, r.final_knowledge_error_deg, r.final_sigma_deg,
                    r.pointing_max_before_deg, r.pointing_rms_after_deg, r.pointing_max_after_deg}) {
-    append_double(out, v);
-    out += ',';
+    out += num_text(v) + ",";
   }
-  out += opt_text(r.recover_s) + ",";
-  append_double(out, r.bound_deg);
-  out += ',';
-  append_double(out, r.max_wheel_momentum_fraction);
-  out += ',';
+  out += opt_text(r.recover_s) + "," + num_text(r.bound_deg) + "," + num_text(r.max_wheel_momentum_fraction) +
+         ",";
   out += r.fdi.wrong_gyro ? std::to_string(*r.fdi.wrong_gyro) : std::string();
   out += "," + opt_text(r.fdi.wrong_at_s);
   return out;
@@ -263,7 +263,9 @@ Result<CampaignRow> parse_campaign_row(const std::string& line) {
   if (f.size() != 24)
     return bad_input("campaign row with " + std::to_string(f.size()) + " fields (24 expected)");
   try {
-    const auto num = [](const std::string& s) { return std::stod(s); };
+    const auto num = [](const std::string& s) {
+      return s.empty() ? std::numeric_limits<double>::quiet_NaN() : std::stod(s);
+    };
     const auto opt = [](const std::string& s) {
       return s.empty() ? std::nullopt : std::optional<double>(std::stod(s));
     };

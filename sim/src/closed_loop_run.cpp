@@ -90,6 +90,7 @@ Result<ClosedLoopRecord> run_closed_loop(ClosedLoopSimulator& simulator, Estimat
         record.max_wheel_momentum_fraction, simulator.state().h_wheels_Nms.cwiseAbs().maxCoeff() / h_max);
     record.series.push_back(std::move(sample));
   }
+  if (Status st = estimator.finish(record.events); !st) return st.error();
   record.counters = simulator.counters();
   record.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return record;

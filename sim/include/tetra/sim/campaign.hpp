@@ -1,23 +1,41 @@
 #pragma once
-// Fault-injection campaigns (`tetra campaign SPEC.yaml`, docs/campaign.md): a matrix of closed-loop
-// scenarios × fault kinds × gyros × onset times × sizes × seeds, each case one closed-loop run with
-// the fusion pipeline in process, each run one row of results.
+// Fault-injection campaigns (`tetra campaign SPEC.yaml`, docs/campaign.md): a matrix of scenarios ×
+// fault kinds × gyros × onset times × sizes × seeds, each case one run (closed loop: the controller
+// steers with the estimate; open loop: the scenario's own motion, the estimate only scored), each run
+// one row of results. The estimator is the fusion pipeline in process, or (made by the caller, e.g. a
+// `tetra fusion` service over DDS) anything behind sim::Estimator.
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "tetra/core/quaternion.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/config.hpp"
+#include "tetra/sim/closed_loop_run.hpp"
 #include "tetra/sim/fault.hpp"
 #include "tetra/sim/fdi_verdict.hpp"
 #include "tetra/sim/scenario.hpp"
 
 namespace tetra::sim {
 
+//! `loop:` what a run simulates.
+enum class CampaignLoop {
+  kClosed,  //!< the closed loop (the scenarios' closed_loop sections): pointing columns filled
+  kOpen,    //!< the scenarios' open-loop motion: no controller, pointing columns empty
+};
+
+//! `target:` where the fusion pipeline runs.
+enum class CampaignTarget {
+  kInProcess,  //!< in the campaign's worker processes
+  kDds,        //!< a `tetra fusion` service per run, over DDS in lockstep (services/cli/campaign_dds.hpp)
+};
+
 struct CampaignSpec {
-  std::vector<std::string> scenario_paths;  //!< closed-loop scenario files (resolved against the spec)
+  std::vector<std::string> scenario_paths;  //!< scenario files or built-in names (resolved against the spec)
   std::vector<Scenario> scenarios;          //!< read from them
   std::vector<FaultKind> kinds;
   std::vector<int> gyros;                                        //!< 1..N
@@ -27,6 +45,10 @@ struct CampaignSpec {
   std::optional<double> duration_s;  //!< overrides the scenarios' duration
   bool fault_free = false;           //!< also one fault-free run per scenario and seed (false alarms)
   fdi::PipelineConfig pipeline;      //!< the `pipeline:` map of the spec (defaults otherwise)
+  std::string pipeline_yaml;  //!< that map as YAML text ("{}" without one), for a service's configuration
+  CampaignLoop loop = CampaignLoop::kClosed;
+  CampaignTarget target = CampaignTarget::kInProcess;
+  int dds_domain = 0;  //!< `domain:` the DDS domain id (target dds)
 };
 
 //! Reads a campaign spec; errors name file, line and key.
@@ -43,6 +65,9 @@ struct CampaignCase {
 //! The cases in a fixed order (scenario, kind, gyro, onset, size, seed; fault-free runs first).
 std::vector<CampaignCase> expand_campaign(const CampaignSpec& spec);
 
+//! The scenario of a case as it runs: the spec's duration, the matrix's fault instead of its own.
+Scenario campaign_scenario(const CampaignSpec& spec, const CampaignCase& c);
+
 struct CampaignRow {
   std::size_t run = 0;
   std::string scenario;
@@ -53,6 +78,7 @@ struct CampaignRow {
   std::uint64_t seed = 0;
   FdiVerdict fdi;
   std::optional<double> theory_delay_s;  //!< [s] CUSUM's expected detection delay (bias faults)
+  // NaN (an empty CSV field): not available (no estimate; the pointing of an open-loop run).
   double final_knowledge_error_deg = 0.0;
   double final_sigma_deg = 0.0;
   double pointing_max_before_deg = 0.0;
@@ -63,8 +89,21 @@ struct CampaignRow {
   double max_wheel_momentum_fraction = 0.0;
 };
 
-//! Runs one case to its row.
+//! Makes the estimator of one run from the scenario as it runs and its true initial attitude.
+using EstimatorFactory = std::function<Result<std::unique_ptr<Estimator>>(
+    const Scenario& scenario, const CampaignCase& c, const Quaternion& initial_q_RB)>;
+//! The fusion pipeline in process, with the spec's configuration.
+EstimatorFactory in_process_estimators(const CampaignSpec& spec);
+
+//! Runs one case to its row, with the estimator `make` gives.
+Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCase& c,
+                                      const EstimatorFactory& make);
+//! Runs one case to its row with the pipeline in process.
 Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCase& c);
+
+//! The spec's `pipeline:` map with `initial_q_wxyz` set to `initial_q_RB` (every digit kept), as YAML
+//! text: a service configured with it starts where the in-process pipeline starts.
+std::string pipeline_yaml_from(const CampaignSpec& spec, const Quaternion& initial_q_RB);
 
 //! The CSV header and one row (the columns: docs/campaign.md).
 std::string campaign_csv_header();

@@ -34,6 +34,9 @@ class Estimator {
   virtual ~Estimator() = default;
   //! Takes epoch `epoch`'s samples; returns the latest estimate. Errors end the run.
   virtual Result<EstimatorOutput> estimate(const SimEpoch& epoch) = 0;
+  //! The run is over: appends the FDI events not yet returned (an estimator over DDS receives them
+  //! apart from the attitudes and waits here for the last ones). In process: nothing to add.
+  virtual Status finish(std::vector<fdi::FdiEvent>& /*events*/) { return ok_status(); }
 };
 
 //! The fusion pipeline in process (with `exclusion_enabled: false` in its configuration it reports isolations
