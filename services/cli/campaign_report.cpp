@@ -1,6 +1,7 @@
 #include "campaign_report.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -133,13 +134,18 @@ Status plot_delays(const std::vector<CampaignRow>& rows, const std::string& png)
   return run_gnuplot(dir->path(), png, 800, 600, body, "report");
 }
 
+//! A faulty closed-loop run (open-loop rows have no pointing columns).
+bool has_pointing(const CampaignRow& r) {
+  return r.kind != "none" && !std::isnan(r.pointing_max_after_deg);
+}
+
 Status plot_pointing(const std::vector<CampaignRow>& rows, const std::string& png) {
   auto dir = TempDir::create("tetra-campaign");
   if (!dir) return dir.error();
   std::vector<double> v;
   double bound = 0.0;
   for (const CampaignRow& r : rows) {
-    if (r.kind == "none") continue;
+    if (!has_pointing(r)) continue;
     v.push_back(r.pointing_max_after_deg);
     bound = r.bound_deg;
   }
@@ -204,7 +210,7 @@ std::string pointing_section(const std::vector<CampaignRow>& rows) {
   std::size_t within = 0;
   std::size_t not_recovered = 0;
   for (const CampaignRow& r : rows) {
-    if (r.kind == "none") continue;
+    if (!has_pointing(r)) continue;
     max_after.push_back(r.pointing_max_after_deg);
     bound = r.bound_deg;
     if (r.pointing_max_after_deg < r.bound_deg) ++within;
@@ -214,7 +220,7 @@ std::string pointing_section(const std::vector<CampaignRow>& rows) {
       ++not_recovered;
     }
   }
-  if (max_after.empty()) return "No faulty runs.\n";
+  if (max_after.empty()) return "No faulty closed-loop runs (open loop: nothing steers, no pointing).\n";
   return fmt::format(
       "Max pointing error after the fault [deg]: median {}, 90 % {}, 99 % {}, max {}. Within the bound ({} "
       "deg) "
@@ -262,11 +268,12 @@ Status write_campaign_report(const std::string& runs_csv, const std::string& out
       "hour.\n\n",
       false_alarms, g(fault_free_s / 3600.0),
       fault_free_s > 0.0 ? g(false_alarms / (fault_free_s / 3600.0)) : std::string("–"));
-  md += "## Pointing\n\n" + pointing_section(*rows) + "\n![pointing](pointing_cdf.png)\n";
+  const bool pointing = std::any_of(rows->begin(), rows->end(), has_pointing);
+  md += "## Pointing\n\n" + pointing_section(*rows) + (pointing ? "\n![pointing](pointing_cdf.png)\n" : "");
   if (Status s = write_text_file((dir / "report.md").string(), md); !s) return s;
   if (Status s = plot_delays(*rows, (dir / "delay_vs_theory.png").string()); !s) return s;
   if (Status s = plot_outcomes(*rows, (dir / "outcomes.png").string()); !s) return s;
-  return plot_pointing(*rows, (dir / "pointing_cdf.png").string());
+  return pointing ? plot_pointing(*rows, (dir / "pointing_cdf.png").string()) : ok_status();
 }
 
 }  // namespace tetra::cli
