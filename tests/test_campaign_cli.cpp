@@ -59,6 +59,30 @@ TEST(CampaignCli, RunsResumesAndReports) {
   EXPECT_EQ(resumed, rows) << "the resumed campaign has the same rows (runs are deterministic per seed)";
 }
 
+// Open loop (`loop: open`): the built-in orbit and slews scenarios' own motion, nothing steering. The faults
+// are isolated as in closed loop; the pointing columns are empty and the report says why.
+TEST(CampaignCli, OpenLoopCampaign) {
+  TempDir dir;
+  write_file(dir.file("spec.yaml"),
+             "loop: open\nscenarios: [orbit, slews]\nduration_s: 120\nkinds: [bias, stuck]\n"
+             "sizes: {bias: [0.01]}\ngyros: [2]\nonsets_s: [60]\nseeds: [1, 2]\nfault_free: true\n");
+  const std::string out = dir.file("out");
+  const auto run = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --jobs 2");
+  ASSERT_EQ(run.exit_status, 0) << run.err;
+  EXPECT_NE(run.err.find("open loop"), std::string::npos) << run.err;
+  const auto rows = lines_of(read_file(out + "/runs.csv"));
+  ASSERT_EQ(rows.size(), 13u);  // header + 2 scenarios × (2 fault-free + 2 kinds × 2 seeds)
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const bool fault_free = rows[i].find(",none,") != std::string::npos;
+    EXPECT_NE(rows[i].find(fault_free ? ",none," : ",right,2,"), std::string::npos) << rows[i];
+    // No pointing: the eight pointing and wheel columns before the last two are empty.
+    EXPECT_NE(rows[i].find(",,,,,,,,"), std::string::npos) << rows[i];
+  }
+  const std::string report = read_file(out + "/report.md");
+  EXPECT_NE(report.find("open loop: nothing steers"), std::string::npos) << report;
+  EXPECT_NE(report.find("## Wrong exclusions\n\nNone."), std::string::npos) << report;
+}
+
 TEST(CampaignCli, BadSpecNamesTheLine) {
   TempDir dir;
   write_file(dir.file("spec.yaml"),
@@ -68,6 +92,19 @@ TEST(CampaignCli, BadSpecNamesTheLine) {
   EXPECT_EQ(bad.exit_status, 2);
   EXPECT_NE(bad.err.find("spec.yaml:2"), std::string::npos) << bad.err;
   EXPECT_NE(bad.err.find("melted"), std::string::npos) << bad.err;
+  // A scenario without a closed_loop section in a closed-loop campaign; a domain without target dds.
+  write_file(dir.file("open.yaml"),
+             "scenarios: [orbit]\nkinds: [stuck]\ngyros: [1]\nonsets_s: [60]\nseeds: [1]\n");
+  const auto no_loop = run_tetra("campaign " + dir.file("open.yaml") + " --out " + dir.file("out"));
+  EXPECT_EQ(no_loop.exit_status, 2);
+  EXPECT_NE(no_loop.err.find("open.yaml:1"), std::string::npos) << no_loop.err;
+  EXPECT_NE(no_loop.err.find("loop: open"), std::string::npos) << no_loop.err;
+  write_file(dir.file("domain.yaml"),
+             "loop: open\nscenarios: [orbit]\nkinds: [stuck]\ngyros: [1]\n"
+             "onsets_s: [60]\nseeds: [1]\ndomain: 3\n");
+  const auto domain = run_tetra("campaign " + dir.file("domain.yaml") + " --out " + dir.file("out"));
+  EXPECT_EQ(domain.exit_status, 2);
+  EXPECT_NE(domain.err.find("domain.yaml:7"), std::string::npos) << domain.err;
   const auto open_loop = run_tetra("sim orbit --closed-loop");
   EXPECT_EQ(open_loop.exit_status, 2) << open_loop.err;
   EXPECT_NE(open_loop.err.find("closed_loop"), std::string::npos) << open_loop.err;
