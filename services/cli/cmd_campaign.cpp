@@ -159,7 +159,10 @@ int cmd_campaign(int argc, char** argv) {
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   bool no_report = false;
   app.add_option("SPEC", spec_path, "campaign spec YAML")->required();
-  app.add_option("--out,-o", out_dir, "output folder: runs.csv, report.md, plots")->required();
+  app.add_option(
+         "--out,-o", out_dir,
+         "output folder: runs.csv, report.md, plots (target dds: dds/, the services' files while they run)")
+      ->required();
   app.add_option("--jobs,-j", jobs, "worker processes (default: the number of cores)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();

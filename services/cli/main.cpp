@@ -32,7 +32,8 @@ constexpr Command kCommands[] = {
     {"record", tetra::cli::cmd_record, "record the gyro streams seen on DDS as a replayable gyro log"},
     {"ground", tetra::cli::cmd_ground, "the ground station in the browser: DDS to HTTP bridge, Open MCT"},
     {"demo", tetra::cli::cmd_demo, "simulator + service + monitor on loopback with a fault mid-run"},
-    {"campaign", tetra::cli::cmd_campaign, "fault-injection campaign over the closed loop, with a report"},
+    {"campaign", tetra::cli::cmd_campaign,
+     "fault-injection campaign, closed or open loop, in process or over DDS, with a report"},
 };
 
 void print_usage(std::FILE* out) {
