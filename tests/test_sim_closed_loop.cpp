@@ -7,6 +7,7 @@
 
 #include "test_support.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/sim/campaign.hpp"
 #include "tetra/sim/closed_loop.hpp"
 #include "tetra/sim/closed_loop_run.hpp"
 #include "tetra/sim/dynamics.hpp"
@@ -215,6 +216,37 @@ TEST(ClosedLoop, SameSeedSameRunBitForBit) {
     for (const PointingSample& s : record.series) errors_of_run.push_back(s.error_deg);
   }
   EXPECT_EQ(errors[0], errors[1]);
+}
+
+// The example specs: the in-process one (520 runs) and the DDS one (26 runs, domain 0).
+TEST(CampaignSpec, ExamplesReadWithTheirTargets) {
+  const auto local = read_campaign_spec(test::source_path("examples/campaign.yaml"));
+  ASSERT_TRUE(local) << local.error().message;
+  EXPECT_EQ(local->target, CampaignTarget::kInProcess);
+  EXPECT_EQ(local->loop, CampaignLoop::kClosed);
+  EXPECT_EQ(expand_campaign(*local).size(), 520u);
+  const auto wire = read_campaign_spec(test::source_path("examples/campaign_dds.yaml"));
+  ASSERT_TRUE(wire) << wire.error().message;
+  EXPECT_EQ(wire->target, CampaignTarget::kDds);
+  EXPECT_EQ(wire->dds_domain, 0);
+  EXPECT_EQ(expand_campaign(*wire).size(), 26u);
+}
+
+// A service configured with pipeline_yaml_from starts from the very initial attitude (every bit) and
+// keeps the spec's other keys.
+TEST(CampaignSpec, ServicePipelineKeepsTheInitialAttitudeExactly) {
+  test::TempDir dir;
+  test::write_file(dir.file("spec.yaml"),
+                   "scenarios: [orbit]\nloop: open\nkinds: [stuck]\ngyros: [1]\n"
+                   "onsets_s: [60]\nseeds: [1]\npipeline: {exclusion_enabled: false}\n");
+  const auto spec = read_campaign_spec(dir.file("spec.yaml"));
+  ASSERT_TRUE(spec) << spec.error().message;
+  const Quaternion q = canonical(quat_exp(Eigen::Vector3d(0.1, -0.2, 0.3)));
+  test::write_file(dir.file("service.yaml"), "pipeline:\n  " + pipeline_yaml_from(*spec, q) + "\n");
+  const auto config = fdi::read_pipeline_config(dir.file("service.yaml"));
+  ASSERT_TRUE(config) << config.error().message;
+  EXPECT_EQ(config->initial_q_RB.coeffs(), q.coeffs());
+  EXPECT_FALSE(config->exclusion_enabled);
 }
 
 TEST(ClosedLoopScenario, BadKeysNameTheLine) {
