@@ -158,7 +158,7 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
       const auto u = static_cast<std::size_t>(i);
       if (n_pre_[u] < 2 || n_post_[u] < 2) return -1;
       dw += h.pinv.col(i) * (mean_post_[u] - mean_pre_[u]);
-      const double sig = series.constants(i + 1).arw_rad_rts / subsets.sqrt_period();
+      const double sig = series.sample_sigma(i + 1, subsets.sqrt_period());
       var += h.pinv.col(i).squaredNorm() * sig * sig * (1.0 / n_pre_[u] + 1.0 / n_post_[u]);
     }
     return dw.norm() <= a_max * separation + config_.onset_sigma * std::sqrt(var) ? 1 : 0;

@@ -94,7 +94,7 @@ int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, con
     double var = 0.0;
     for (int i = 1; i <= static_cast<int>(tracks_.size()); ++i) {
       if (!has_gyro(h.mask, i)) continue;
-      const double sig = series.constants(i).arw_rad_rts / subsets.sqrt_period();
+      const double sig = series.sample_sigma(i, subsets.sqrt_period());
       var += h.pinv.col(i - 1).squaredNorm() * 2.0 * sig * sig;
     }
     bool ok = dw.norm() <= a_max * dt_max + config_.onset_sigma * std::sqrt(var);
