@@ -14,7 +14,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kNoiseEvalEvery = 10;  //!< [samples] the noise-level test runs this often
 constexpr double kNoiseExpectedMedian = 0.6744897501960817;  //!< median of |N(0,1)|
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kCoarseStepPerSigma = 0.1;  //!< a quantization step beyond this many σ makes repeats normal
+constexpr double kCoarseStepPerSigma = 0.1;
+constexpr double kQuietMotion = 2.0;  //!< [σ] motion level the noise-level test still tells from noise  //!< a quantization step beyond this many σ makes repeats normal
 }  // namespace
 
 Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const PipelineConfig& config) {
@@ -149,20 +150,24 @@ void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
     // The rate the others see along this gyro's axis, and its 1σ, over the current repeat run.
     const double rate = axis * apply_pinv(h.pinv, others, frame.y_rad_s.data());
     double var = 0.0;
+    double var_d2 = 0.0;
     for (int k = 1; k <= static_cast<int>(tracks_.size()); ++k) {
       if (!has_gyro(others, k)) continue;
       const double c = axis * h.pinv.col(k - 1);
       var += c * c * sample_sigma(k, sqrt_period) * sample_sigma(k, sqrt_period);
+      var_d2 += c * c * d2_sigma(k, sqrt_period) * d2_sigma(k, sqrt_period);
     }
     t.run_low = t.run_seen ? std::min(t.run_low, rate) : rate;
     t.run_high = t.run_seen ? std::max(t.run_high, rate) : rate;
     t.run_sigma = t.run_seen ? std::max(t.run_sigma, std::sqrt(var)) : std::sqrt(var);
     t.run_seen = true;
-    // The motion's second difference along the axis, when every other gyro has one this epoch.
+    // The motion's second difference along the axis, when every other gyro has one this epoch, in units of
+    // the others' own noise on it.
     if (t.d2_fresh && (fresh & others) == others) {
       const int w = config_.noise_window;
+      t.motion_sigma = std::sqrt(var_d2);
       t.m2[static_cast<std::size_t>((t.d2_head - 1 + w) % w)] =
-          std::abs(axis * apply_pinv(h.pinv, others, d2_all_.data()));
+          std::abs(axis * apply_pinv(h.pinv, others, d2_all_.data())) / t.motion_sigma;
     }
   }
 }
@@ -186,6 +191,17 @@ double GyroSeries::d2_sigma(int id, double sqrt_period) const {
   const double period = sqrt_period * sqrt_period;
   return std::sqrt(6.0 * c.arw_rad_rts * c.arw_rad_rts / period +
                    20.0 * c.quantization_rad * c.quantization_rad / (period * period));
+}
+
+bool GyroSeries::noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const {
+  // With four gyros a slew's jerk and one gyro's noise leave the same single residual: the gyro's own level
+  // tells them apart only while the motion is quiet. The motion the other gyros see along this axis (in units
+  // of their own noise on it, ≈ 1 at rest; ∞ when they could not see it) must be within kQuietMotion, and the
+  // gyro's level beyond the limit by more than that motion explains.
+  const double motion = noise_ratio(id, sqrt_period, 0, true);
+  if (!std::isfinite(motion) || motion > kQuietMotion) return false;
+  const double explained = std::max(0.0, motion - 1.0) * t.motion_sigma / d2_sigma(id, sqrt_period);
+  return r > config_.noise_high_ratio + explained;
 }
 
 bool GyroSeries::repeats_are_stuck(int id, const Track& t, double sqrt_period) const {
@@ -216,8 +232,8 @@ double GyroSeries::noise_ratio(int id, double sqrt_period, int last, bool motion
     buf = recent(ring, t, n);
   }
   std::nth_element(buf, buf + n / 2, buf + n);
-  // Gaussian Δ²y of level σ_Δ²: median |Δ²y| = 0.6745·σ_Δ².
-  return buf[n / 2] / (kNoiseExpectedMedian * d2_sigma(id, sqrt_period));
+  // Gaussian Δ²y of level σ_Δ²: median |Δ²y| = 0.6745·σ_Δ² (the motion's ring is already in its σ units).
+  return buf[n / 2] / (kNoiseExpectedMedian * (motion ? 1.0 : d2_sigma(id, sqrt_period)));
 }
 
 double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) const {
@@ -256,11 +272,8 @@ bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_
                  t.repeat_count);
   if (t.d2_since_eval >= kNoiseEvalEvery && period_s > 0.0) {
     t.d2_since_eval = 0;
-    // Noise: the gyro's own level beyond the limit by more than the motion the other gyros see along its axis
-    // explains (a slew's jerk is in every gyro's second differences; ∞ when the others could not see it).
     const double r = noise_ratio(id, sqrt_period);
-    const double motion = noise_ratio(id, sqrt_period, 0, true);
-    if (std::isfinite(r) && r > config_.noise_high_ratio + motion)
+    if (std::isfinite(r) && r > config_.noise_high_ratio && noise_beyond_motion(id, t, r, sqrt_period))
       return found(FaultKind::kNoise, Evidence::kNoiseLevel, r);
     if (std::isfinite(r) && r < config_.noise_low_ratio && !coarse(id, sqrt_period))
       return found(FaultKind::kStuck, Evidence::kVariance, r);

@@ -86,6 +86,7 @@ class GyroSeries {
     double run_high = 0.0;
     double run_sigma = 0.0;  //!< [rad/s] largest 1σ of that projection during the run
     bool run_seen = false;
+    double motion_sigma = 0.0;  //!< [rad/s] the others' noise on the motion's second difference (last seen)
     int d2_count = 0;
     int d2_head = 0;
     int d2_since_eval = 0;
@@ -98,6 +99,8 @@ class GyroSeries {
   double* recent(const std::vector<double>& ring, const Track& t, int n) const;
   //! Second-difference level [rad/s] of white noise (and quantization) that the noise ratios divide by.
   double d2_sigma(int id, double sqrt_period) const;
+  //! A noise level `r` that the motion the other gyros see cannot explain.
+  bool noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const;
   //! Repeated values that the motion the other gyros saw rules out for a healthy (quantized) gyro.
   bool repeats_are_stuck(int id, const Track& t, double sqrt_period) const;
   bool check_one(int id, Track& t, std::int64_t now_ns, double period_s, double sqrt_period, Isolations& out);
