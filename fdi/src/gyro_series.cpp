@@ -193,15 +193,20 @@ double GyroSeries::d2_sigma(int id, double sqrt_period) const {
                    20.0 * c.quantization_rad * c.quantization_rad / (period * period));
 }
 
+bool GyroSeries::motion_quiet(int id, double sqrt_period, int last) const {
+  const double motion = noise_ratio(id, sqrt_period, last, true);
+  return std::isfinite(motion) && motion <= kQuietMotion;
+}
+
 bool GyroSeries::noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const {
   // With four gyros a slew's jerk and one gyro's noise leave the same single residual: the gyro's own level
   // tells them apart only while the motion is quiet. The motion the other gyros see along this axis (in units
   // of their own noise on it, ≈ 1 at rest; ∞ when they could not see it) must be within kQuietMotion, and the
-  // gyro's level beyond the limit by more than that motion explains.
+  // gyro's level beyond the limit by more than that motion could hide: its level in the gyro's own σ units
+  // (the others' noise on it is large where their geometry is poor).
+  if (!motion_quiet(id, sqrt_period, 0)) return false;
   const double motion = noise_ratio(id, sqrt_period, 0, true);
-  if (!std::isfinite(motion) || motion > kQuietMotion) return false;
-  const double explained = std::max(0.0, motion - 1.0) * t.motion_sigma / d2_sigma(id, sqrt_period);
-  return r > config_.noise_high_ratio + explained;
+  return r > config_.noise_high_ratio + motion * t.motion_sigma / d2_sigma(id, sqrt_period);
 }
 
 bool GyroSeries::repeats_are_stuck(int id, const Track& t, double sqrt_period) const {

@@ -57,6 +57,9 @@ class GyroSeries {
   //! True when the quantization step of one sample is not small beside the white noise (> 0.1 σ): repeated
   //! values and a low second-difference level are then what a healthy gyro delivers.
   bool coarse(int id, double sqrt_period) const;
+  //! The motion the other gyros saw along gyro `id`'s axis over its last `last` second differences was quiet
+  //! enough for its noise level to mean noise (false when they could not see it).
+  bool motion_quiet(int id, double sqrt_period, int last) const;
   //! Identical raw values in a row of gyro `id`.
   int repeat_count(int id) const { return track(id).repeat_count; }
   bool absent(int id) const { return track(id).absent_since_ns >= 0; }

@@ -83,20 +83,23 @@ Verdict Isolator::decide(std::int64_t now_ns, std::int64_t index, GyroMask activ
     // estimate) are a stuck output; a noise increase also shifts window means, and its second differences
     // tell it apart.
     const bool repeated = series.repeat_count(culprit) >= 5;
-    const double r =
-        series.recent_noise_ratio(culprit, subsets.sqrt_period(),
-                                  static_cast<int>(std::max<std::int64_t>(index - episode_.onset_index, 20)));
+    const int last = static_cast<int>(std::max<std::int64_t>(index - episode_.onset_index, 20));
+    const double r = series.recent_noise_ratio(culprit, subsets.sqrt_period(), last);
+    // While the body moves, second differences carry its jerk: a raised level may be motion, not noise.
+    const bool quiet = series.motion_quiet(culprit, subsets.sqrt_period(), last);
+    const bool raised = std::isfinite(r) && r > 0.5 * config_.noise_high_ratio;
     FaultKind kind = FaultKind::kBias;
     if (repeated) {
       kind = FaultKind::kStuck;
-    } else if (std::isfinite(r) && r > config_.noise_high_ratio) {
+    } else if (raised && !quiet) {
+      kind = FaultKind::kUnknown;
+    } else if (raised && r > config_.noise_high_ratio) {
       kind = FaultKind::kNoise;
     } else if (evidence == Evidence::kGlt) {
       kind = classify_drift(culprit, index, active, subsets);
     }
     // A noise level neither normal nor clearly high: wait for more samples rather than guess the kind.
-    const bool ambiguous =
-        !repeated && std::isfinite(r) && r > 0.5 * config_.noise_high_ratio && r <= config_.noise_high_ratio;
+    const bool ambiguous = !repeated && raised && quiet && r <= config_.noise_high_ratio;
     if (ambiguous) return Verdict::kNone;
     found = {culprit, kind, evidence, episode_.test, episode_.statistic};
     return Verdict::kIsolated;
