@@ -15,7 +15,8 @@ constexpr int kNoiseEvalEvery = 10;  //!< [samples] the noise-level test runs th
 constexpr double kNoiseExpectedMedian = 0.6744897501960817;  //!< median of |N(0,1)|
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kCoarseStepPerSigma = 0.1;
-constexpr double kQuietMotion = 2.0;  //!< [σ] motion level the noise-level test still tells from noise  //!< a quantization step beyond this many σ makes repeats normal
+constexpr double kQuietMotion = 2.0;
+constexpr double kNormalLevel = 2.0;  //!< noise ratio of a gyro whose own second differences look normal  //!< [σ] motion level the noise-level test still tells from noise  //!< a quantization step beyond this many σ makes repeats normal
 }  // namespace
 
 Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const PipelineConfig& config) {
@@ -204,13 +205,27 @@ bool GyroSeries::noise_beyond_motion(int id, const Track& t, double r, double sq
   // of their own noise on it, ≈ 1 at rest; ∞ when they could not see it) must be within kQuietMotion, and the
   // gyro's level beyond the limit by more than that motion could hide: its level in the gyro's own σ units
   // (the others' noise on it is large where their geometry is poor).
-  if (!motion_quiet(id, sqrt_period, 0)) return false;
+  // Another gyro's raised level means motion or a second fault: neither leaves this gyro alone to blame.
+  if (!motion_quiet(id, sqrt_period, 0) || !others_normal(id, sqrt_period)) return false;
   const double motion = noise_ratio(id, sqrt_period, 0, true);
   return r > config_.noise_high_ratio + motion * t.motion_sigma / d2_sigma(id, sqrt_period);
 }
 
+bool GyroSeries::others_normal(int id, double sqrt_period) const {
+  for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
+    if (j == id || has_gyro(excluded_, j)) continue;
+    const double r = noise_ratio(j, sqrt_period);
+    if (!std::isfinite(r) || r > kNormalLevel) return false;
+  }
+  return true;
+}
+
 bool GyroSeries::repeats_are_stuck(int id, const Track& t, double sqrt_period) const {
   if (!coarse(id, sqrt_period)) return true;  // identical values of a finely quantized output: stuck
+  // Another gyro repeating too may be the stuck one, and its output is part of the motion the others see.
+  for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
+    if (j != id && !has_gyro(excluded_, j) && track(j).repeat_count >= config_.stuck_repeat_count) return false;
+  }
   // A healthy quantized gyro's sample is the mean rate over the sample period within one step: when the rate
   // the others see along its axis moved by two steps beyond their noise, its output must have changed.
   const double step = std::sqrt(12.0) * constants(id).quantization_rad / (sqrt_period * sqrt_period);
@@ -256,6 +271,7 @@ double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) cons
 
 void GyroSeries::check(std::int64_t now_ns, GyroMask excluded, double period_s, double sqrt_period,
                        Isolations& out) {
+  excluded_ = excluded;
   for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
     if (!has_gyro(excluded, id))
       (void)check_one(id, tracks_[static_cast<std::size_t>(id - 1)], now_ns, period_s, sqrt_period, out);

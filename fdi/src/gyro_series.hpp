@@ -104,6 +104,8 @@ class GyroSeries {
   double d2_sigma(int id, double sqrt_period) const;
   //! A noise level `r` that the motion the other gyros see cannot explain.
   bool noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const;
+  //! Every other gyro in use has a normal second-difference level.
+  bool others_normal(int id, double sqrt_period) const;
   //! Repeated values that the motion the other gyros saw rules out for a healthy (quantized) gyro.
   bool repeats_are_stuck(int id, const Track& t, double sqrt_period) const;
   bool check_one(int id, Track& t, std::int64_t now_ns, double period_s, double sqrt_period, Isolations& out);
@@ -112,6 +114,7 @@ class GyroSeries {
   const PipelineConfig& config_;
   std::vector<Track> tracks_;
   mutable std::vector<double> scratch_;
+  GyroMask excluded_ = 0;       //!< the gyros `check` leaves alone
   std::vector<double> d2_all_;  //!< this epoch's Δ²y of every gyro [rad/s]
 };
 
