@@ -16,7 +16,11 @@ constexpr double kNoiseExpectedMedian = 0.6744897501960817;  //!< median of |N(0
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kCoarseStepPerSigma = 0.1;
 constexpr double kQuietMotion = 2.0;
-constexpr double kNormalLevel = 2.0;  //!< noise ratio of a gyro whose own second differences look normal  //!< [σ] motion level the noise-level test still tells from noise  //!< a quantization step beyond this many σ makes repeats normal
+constexpr double kNormalLevel = 2.0;
+constexpr int kOtherRepeats =
+    3;  //!< [samples] another gyro's repeat run that leaves a coarse gyro's repeats unjudged  //!< noise
+        //!< ratio of a gyro whose own second differences look normal  //!< [σ] motion level the noise-level
+        //!< test still tells from noise  //!< a quantization step beyond this many σ makes repeats normal
 }  // namespace
 
 Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const PipelineConfig& config) {
@@ -187,7 +191,8 @@ bool GyroSeries::coarse(int id, double sqrt_period) const {
 }
 
 double GyroSeries::d2_sigma(int id, double sqrt_period) const {
-  // Δ²y of white noise has variance 6σ²; of the quantization error (e_k − e_{k−1})/T with var(e) = Q², 20Q²/T².
+  // Δ²y of white noise has variance 6σ²; of the quantization error (e_k − e_{k−1})/T with var(e) = Q²,
+  // 20Q²/T².
   const GyroConstants& c = constants(id);
   const double period = sqrt_period * sqrt_period;
   return std::sqrt(6.0 * c.arw_rad_rts * c.arw_rad_rts / period +
@@ -222,9 +227,10 @@ bool GyroSeries::others_normal(int id, double sqrt_period) const {
 
 bool GyroSeries::repeats_are_stuck(int id, const Track& t, double sqrt_period) const {
   if (!coarse(id, sqrt_period)) return true;  // identical values of a finely quantized output: stuck
-  // Another gyro repeating too may be the stuck one, and its output is part of the motion the others see.
+  // Another gyro repeating too (kOtherRepeats values: it may have just stuck) may be the stuck one, and its
+  // output is part of the motion the others see.
   for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
-    if (j != id && !has_gyro(excluded_, j) && track(j).repeat_count >= config_.stuck_repeat_count) return false;
+    if (j != id && !has_gyro(excluded_, j) && track(j).repeat_count >= kOtherRepeats) return false;
   }
   // A healthy quantized gyro's sample is the mean rate over the sample period within one step: when the rate
   // the others see along its axis moved by two steps beyond their noise, its output must have changed.

@@ -85,7 +85,7 @@ class GyroSeries {
     bool d2_fresh = false;   //!< d2_last belongs to this epoch
     std::vector<double> d2;  //!< ring of |Δ²y| [rad/s], size noise_window
     std::vector<double> m2;  //!< ring of |h·Δ²ω̂| the other gyros see [rad/s] (∞: not seen), aligned with d2
-    double run_low = 0.0;    //!< [rad/s] range of h·ω̂ of the other gyros during the current repeat run
+    double run_low = 0.0;  //!< [rad/s] range of h·ω̂ of the other gyros during the current repeat run
     double run_high = 0.0;
     double run_sigma = 0.0;  //!< [rad/s] largest 1σ of that projection during the run
     bool run_seen = false;

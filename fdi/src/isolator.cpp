@@ -17,7 +17,9 @@ Isolator::Isolator(int n_gyros, const PipelineConfig& config)
       mean_pre_(static_cast<std::size_t>(n_gyros), 0.0),
       mean_post_(static_cast<std::size_t>(n_gyros), 0.0),
       n_pre_(static_cast<std::size_t>(n_gyros), 0),
-      n_post_(static_cast<std::size_t>(n_gyros), 0) {
+      n_post_(static_cast<std::size_t>(n_gyros), 0),
+      drift_x_(kHistory, 0.0),
+      drift_t_(kHistory, 0.0) {
   // One scratch vector per parity dimension, so the GLT never resizes (allocates) one.
   for (int d = 0; d <= std::max(1, n_gyros - 3); ++d) {
     glt_mean_.push_back(Eigen::VectorXd::Zero(d));
@@ -209,17 +211,20 @@ int Isolator::glt_test(const Subset& s) const {
   return (accepted == 1 && rejected == members - 1) ? best : 0;
 }
 
-// Bias or ramp: fit p_j(τ) = c + b·τ to the parity projected on gyro j's direction over the history since the
-// onset (at most kHistory epochs): a step leaves b ≈ 0, a ramp a significant slope. Without parity (three
-// gyros) the data cannot tell: unknown.
+// Bias or ramp: the parity projected on gyro j's direction over the history kept (at most kHistory epochs,
+// the fault's onset inside it) is explained by a step f·[t ≥ t_m] or by a ramp r·(t − t_m)₊, each with its
+// best change time t_m. In units of the normalized parity, each fit removes G = (Σ x·u)²/Σ u² of the squared
+// sum (u the model's shape; a change time before the history gives a constant or a line a + b·t); the kind is
+// the model whose G is larger by kDriftMargin; an offset without a trend (slope below 3σ) is a bias that
+// began before the history; otherwise `unknown` (a step seen shortly after a ramp began fits both). Without
+// parity (three gyros) the data cannot tell: unknown.
 FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets) const {
   const Subset& s = subsets.get(active);
   if (!s.observable || s.dof < 1) return FaultKind::kUnknown;
   const double w_norm = s.parity.col(id - 1).norm();
-  const std::int64_t first = std::max<std::int64_t>(
-      {episode_.active ? episode_.onset_index : index - kHistory + 1, index - kHistory + 1, 0});
-  double n = 0.0, st = 0.0, sp = 0.0, stt = 0.0, stp = 0.0;
+  const std::int64_t first = std::max<std::int64_t>(index - kHistory + 1, 0);
   double p[kMaxGyros];
+  int n = 0;
   const std::int64_t t0 = time_of(first);
   for (std::int64_t k = first; k <= index; ++k) {
     const auto slot = static_cast<std::size_t>(k % kHistory);
@@ -227,19 +232,38 @@ FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, 
     (void)apply_parity(s, active, &hist_y_[slot * static_cast<std::size_t>(n_)], 1.0, p);
     double proj = 0.0;
     for (int r = 0; r < s.dof; ++r) proj += s.parity(r, id - 1) / w_norm * p[r] * subsets.sqrt_period();
-    const double t = ns_to_seconds(hist_ns_[slot] - t0);
-    n += 1.0;
-    st += t;
-    sp += proj;
-    stt += t * t;
-    stp += t * proj;
+    drift_x_[static_cast<std::size_t>(n)] = proj;
+    drift_t_[static_cast<std::size_t>(n)] = ns_to_seconds(hist_ns_[slot] - t0);
+    ++n;
   }
-  if (n < 20.0) return FaultKind::kUnknown;
-  const double sxx = stt - st * st / n;
-  if (sxx <= 0.0) return FaultKind::kUnknown;
-  const double slope = (stp - st * sp / n) / sxx;   // [σ/s]
-  const double slope_sigma = 1.0 / std::sqrt(sxx);  // unit noise of the normalized parity
-  return std::abs(slope) > 5.0 * slope_sigma ? FaultKind::kRamp : FaultKind::kBias;
+  if (n < 20) return FaultKind::kUnknown;
+  // Suffix sums from the change sample m on: Σx, Σx·t, Σt, Σt², count.
+  double sx = 0.0, sxt = 0.0, st = 0.0, stt = 0.0;
+  double g_step = 0.0, g_ramp = 0.0;
+  for (int m = n - 1; m >= 0; --m) {
+    const double x = drift_x_[static_cast<std::size_t>(m)];
+    const double t = drift_t_[static_cast<std::size_t>(m)];
+    sx += x;
+    sxt += x * t;
+    st += t;
+    stt += t * t;
+    const double count = n - m;
+    if (count < 3) continue;
+    g_step = std::max(g_step, sx * sx / count);
+    const double num = sxt - t * sx;                        // Σ x·(t_k − t_m)
+    const double den = stt - 2.0 * t * st + count * t * t;  // Σ (t_k − t_m)²
+    if (den > 0.0) g_ramp = std::max(g_ramp, num * num / den);
+  }
+  // A drift that began before the history: a constant (the step from m = 0) or a line a + b·t.
+  const double g_const = sx * sx / n;
+  const double sxx_t = stt - st * st / n;
+  const double slope_gain = sxx_t > 0.0 ? (sxt - st * sx / n) * (sxt - st * sx / n) / sxx_t : 0.0;
+  g_ramp = std::max(g_ramp, g_const + slope_gain);
+  if (g_step > g_ramp + kDriftMargin) return FaultKind::kBias;
+  if (g_ramp > g_step + kDriftMargin) return FaultKind::kRamp;
+  // An offset through the whole history with no trend in it (slope below 3σ): a bias that began before.
+  if (slope_gain < 9.0 && g_const > kDriftMargin) return FaultKind::kBias;
+  return FaultKind::kUnknown;
 }
 
 }  // namespace tetra::fdi::detail

@@ -66,8 +66,8 @@ Isolation OutlierGate::classify_step(int id, const EpochFrame& frame, const Gyro
   if (std::isfinite(r) && r > config_.noise_high_ratio) {
     // A raised level while the body moves may be its jerk: the step is certain, its kind is not.
     const bool quiet = series.motion_quiet(id, sqrt_period, config_.onset_confirm_epochs);
-    return {id, quiet ? FaultKind::kNoise : FaultKind::kUnknown, quiet ? Evidence::kNoiseLevel : Evidence::kOnset,
-            DetectionTest::kOnset, r};
+    return {id, quiet ? FaultKind::kNoise : FaultKind::kUnknown,
+            quiet ? Evidence::kNoiseLevel : Evidence::kOnset, DetectionTest::kOnset, r};
   }
   return {id, FaultKind::kBias, Evidence::kOnset, DetectionTest::kOnset, static_cast<double>(t.outlier_run)};
 }
