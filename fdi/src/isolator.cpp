@@ -136,6 +136,34 @@ double Isolator::window_means(std::int64_t b, std::int64_t e, std::vector<double
   return t_mean;
 }
 
+int Isolator::motion_within_bound(GyroMask mask, double separation_s, SubsetCache& subsets,
+                                  const GyroSeries& series) const {
+  const Subset& h = subsets.get(mask);
+  if (!h.observable) return -1;
+  Eigen::Vector3d dw = Eigen::Vector3d::Zero();
+  double var = 0.0;
+  for (int i = 0; i < n_; ++i) {
+    if (!has_gyro(mask, i + 1)) continue;
+    const auto u = static_cast<std::size_t>(i);
+    if (n_pre_[u] < 2 || n_post_[u] < 2) return -1;
+    dw += h.pinv.col(i) * (mean_post_[u] - mean_pre_[u]);
+    const double sig = series.sample_sigma(i + 1, subsets.sqrt_period());
+    var += h.pinv.col(i).squaredNorm() * sig * sig * (1.0 / n_pre_[u] + 1.0 / n_post_[u]);
+  }
+  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
+  return dw.norm() <= a_max * separation_s + config_.onset_sigma * std::sqrt(var) ? 1 : 0;
+}
+
+double Isolator::two_windows(std::int64_t b1, std::int64_t e1, std::int64_t b2, std::int64_t e2) {
+  std::fill(mean_pre_.begin(), mean_pre_.end(), 0.0);
+  std::fill(mean_post_.begin(), mean_post_.end(), 0.0);
+  std::fill(n_pre_.begin(), n_pre_.end(), 0);
+  std::fill(n_post_.begin(), n_post_.end(), 0);
+  const double t1 = window_means(b1, e1, mean_pre_, n_pre_);
+  const double t2 = window_means(b2, e2, mean_post_, n_post_);
+  return ns_to_seconds(time_of(b2) - time_of(b1)) + t2 - t1;
+}
+
 int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subsets,
                          const GyroSeries& series) {
   const std::int64_t k0 = episode_.onset_index;
@@ -144,36 +172,20 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
   const std::int64_t pre_end = k0 - gap;
   const std::int64_t post_end = std::min(index + 1, k0 + config_.onset_post_max_epochs);
   if (pre_begin < 0 || pre_begin <= index - kHistory || post_end - k0 < 20) return 0;
-  std::fill(mean_pre_.begin(), mean_pre_.end(), 0.0);
-  std::fill(mean_post_.begin(), mean_post_.end(), 0.0);
-  std::fill(n_pre_.begin(), n_pre_.end(), 0);
-  std::fill(n_post_.begin(), n_post_.end(), 0);
-  const double t_pre = window_means(pre_begin, pre_end, mean_pre_, n_pre_);
-  const double t_post = window_means(k0, post_end, mean_post_, n_post_);
-  const double separation = ns_to_seconds(time_of(k0) - time_of(pre_begin)) + t_post - t_pre;
-  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
-  // 1: the window means of `mask` are consistent with a possible motion; 0: not; −1: cannot judge.
-  auto consistent = [&](GyroMask mask) -> int {
-    const Subset& h = subsets.get(mask);
-    if (!h.observable) return -1;
-    Eigen::Vector3d dw = Eigen::Vector3d::Zero();
-    double var = 0.0;
-    for (int i = 0; i < n_; ++i) {
-      if (!has_gyro(mask, i + 1)) continue;
-      const auto u = static_cast<std::size_t>(i);
-      if (n_pre_[u] < 2 || n_post_[u] < 2) return -1;
-      dw += h.pinv.col(i) * (mean_post_[u] - mean_pre_[u]);
-      const double sig = series.sample_sigma(i + 1, subsets.sqrt_period());
-      var += h.pinv.col(i).squaredNorm() * sig * sig * (1.0 / n_pre_[u] + 1.0 / n_post_[u]);
-    }
-    return dw.norm() <= a_max * separation + config_.onset_sigma * std::sqrt(var) ? 1 : 0;
-  };
-  if (consistent(active) != 0) return 0;  // no abrupt change beyond motion: nothing to tell
+  // Every hypothesis below is judged against the acceleration bound. Before the onset the data are clean:
+  // when the body already turned faster than the bound there (a slew the bound does not cover), the true
+  // hypothesis may be the impossible one and a wrong one possible by chance. Nothing can be told.
+  const std::int64_t pre_mid = pre_begin + config_.onset_pre_epochs / 2;
+  if (motion_within_bound(active, two_windows(pre_begin, pre_mid, pre_mid, pre_end), subsets, series) == 0)
+    return 0;
+  const double separation = two_windows(pre_begin, pre_end, k0, post_end);
+  // All gyros consistent with a possible motion: no abrupt change beyond motion, nothing to tell.
+  if (motion_within_bound(active, separation, subsets, series) != 0) return 0;
   int count = 0;
   int culprit = 0;
   for (int j = 1; j <= n_; ++j) {
     if (!has_gyro(active, j)) continue;
-    const int c = consistent(without_gyro(active, j));
+    const int c = motion_within_bound(without_gyro(active, j), separation, subsets, series);
     if (c < 0) return 0;
     if (c == 1) {
       ++count;

@@ -64,6 +64,12 @@ class Isolator {
   //! [σ²] how much more of the parity one drift model must explain than the other (a 4σ difference)
   static constexpr double kDriftMargin = 16.0;
   int onset_test(std::int64_t index, GyroMask active, SubsetCache& subsets, const GyroSeries& series);
+  //! Means of two history windows [b1, e1) and [b2, e2) into the pre/post scratch; their separation [s].
+  double two_windows(std::int64_t b1, std::int64_t e1, std::int64_t b2, std::int64_t e2);
+  //! 1: the change between the two windows' means seen by `mask` is a possible motion (within the
+  //! acceleration bound over `separation_s` and the noise); 0: it is not; −1: cannot judge.
+  int motion_within_bound(GyroMask mask, double separation_s, SubsetCache& subsets,
+                          const GyroSeries& series) const;
   int glt_test(const Subset& s) const;
   //! Window means of each gyro's rate over history epochs [b, e); returns the mean time offset from b [s].
   double window_means(std::int64_t b, std::int64_t e, std::vector<double>& mean,
