@@ -234,6 +234,52 @@ TEST(IsolationAdversarial, FaultOnGyroFourDuringAGentleSlew) {
   EXPECT_TRUE(what.empty()) << what;
 }
 
+TEST(IsolationAdversarial, OnsetIsolationAtTheDefaults) {
+  // docs/fdi.md's onset figures, measured for the default acceleration bound (1e-3 deg/s²) and the orbit's
+  // (2e-4): bias steps on each gyro in the orbit with attitude-control motion, no reference, three seeds. A
+  // step is isolated by its onset only when it moves the rate beyond what the bound allows over the onset
+  // windows (a_max times about 4 s) — smaller steps end `unisolated`. Printed, and no wrong exclusion
+  // asserted.
+  std::string what;
+  for (const double a_max : {1e-3, 2e-4}) {
+    std::map<std::string, Tally> table;
+    for (const double size : {1e-3, 3e-3, 1e-2, 3e-2}) {
+      for (int gyro = 1; gyro <= 4; ++gyro) {
+        for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+          auto sc = sim::builtin_scenario("orbit");
+          ASSERT_TRUE(sc.ok());
+          sc->motion.acs.amplitude_deg = 0.04;
+          sc->motion.acs.peak_accel_dps2 = 1e-4;
+          sc->duration_s = 90.0;
+          sc->reference.rate_hz = 0.0;
+          sim::SimOptions so;
+          so.seed = seed;
+          so.faults = {fault(gyro, K::kBias, 60.0, size)};
+          fdi::PipelineConfig cfg;
+          cfg.max_angular_acceleration_dps2 = a_max;
+          const auto run = run_campaign(*sc, so, sc->unit, cfg);
+          char name[32];
+          std::snprintf(name, sizeof name, "bias %.0e", size);
+          auto& t = table[name];
+          ++t.runs;
+          if (!wrong_exclusions(run, so.faults).empty()) {
+            ++t.wrong;
+            what += std::string(name) + " gyro " + std::to_string(gyro) + ":\n" + test::describe(run);
+          } else if (run.isolated_gyro) {
+            ++t.isolated;
+            t.delays_s.push_back(*run.first_isolated_s - 60.0);
+          } else if (run.unisolated) {
+            ++t.unisolated;
+          }
+        }
+      }
+    }
+    std::printf("bias steps in orbit, max_angular_acceleration_dps2 = %g\n", a_max);
+    print_table(table);
+  }
+  EXPECT_TRUE(what.empty()) << what;
+}
+
 TEST(IsolationAdversarial, SignaturesWithThreeGyros) {
   // N = 3: no parity; only a gyro's own series can speak. Signature faults during slews: never a wrong gyro.
   std::string what;
