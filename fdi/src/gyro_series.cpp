@@ -200,7 +200,12 @@ double GyroSeries::d2_sigma(int id, double sqrt_period) const {
 }
 
 bool GyroSeries::motion_quiet(int id, double sqrt_period, int last) const {
-  const double motion = noise_ratio(id, sqrt_period, last, true);
+  // The whole window: its median, as the noise-level test. The last samples: their trimmed RMS, as the kind
+  // at isolation (a slew beginning within them must count, however few samples it has reached).
+  const Track& t = track(id);
+  const int n = std::min({last, t.d2_count, config_.noise_window});
+  const double motion =
+      last == 0 ? noise_ratio(id, sqrt_period, 0, true) : (n < 6 ? kNaN : trimmed_rms(t.m2, t, n));
   return std::isfinite(motion) && motion <= kQuietMotion;
 }
 
@@ -268,11 +273,15 @@ double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) cons
   const Track& t = track(id);
   const int n = std::min({last, t.d2_count, config_.noise_window});
   if (n < 6) return kNaN;
-  double* buf = recent(t.d2, t, n);
+  return trimmed_rms(t.d2, t, n) / d2_sigma(id, sqrt_period);
+}
+
+double GyroSeries::trimmed_rms(const std::vector<double>& ring, const Track& t, int n) const {
+  double* buf = recent(ring, t, n);
   std::sort(buf, buf + n);
   double sum_sq = 0.0;
   for (int k = 0; k < n - 2; ++k) sum_sq += buf[k] * buf[k];
-  return std::sqrt(sum_sq / (n - 2)) / d2_sigma(id, sqrt_period);
+  return std::sqrt(sum_sq / (n - 2));
 }
 
 void GyroSeries::check(std::int64_t now_ns, GyroMask excluded, double period_s, double sqrt_period,

@@ -57,8 +57,9 @@ class GyroSeries {
   //! True when the quantization step of one sample is not small beside the white noise (> 0.1 σ): repeated
   //! values and a low second-difference level are then what a healthy gyro delivers.
   bool coarse(int id, double sqrt_period) const;
-  //! The motion the other gyros saw along gyro `id`'s axis over its last `last` second differences was quiet
-  //! enough for its noise level to mean noise (false when they could not see it).
+  //! The motion the other gyros saw along gyro `id`'s axis was quiet enough for its noise level to mean noise
+  //! (false when they could not see it): over the window (`last` = 0, median) or its last `last` second
+  //! differences (trimmed RMS).
   bool motion_quiet(int id, double sqrt_period, int last) const;
   //! Identical raw values in a row of gyro `id`.
   int repeat_count(int id) const { return track(id).repeat_count; }
@@ -100,6 +101,8 @@ class GyroSeries {
   void ingest_sample(Track& t, double raw, double y);
   //! The last `n` second differences of `t` into the scratch buffer.
   double* recent(const std::vector<double>& ring, const Track& t, int n) const;
+  //! RMS of the last `n` values of `ring` without their two largest.
+  double trimmed_rms(const std::vector<double>& ring, const Track& t, int n) const;
   //! Second-difference level [rad/s] of white noise (and quantization) that the noise ratios divide by.
   double d2_sigma(int id, double sqrt_period) const;
   //! A noise level `r` that the motion the other gyros see cannot explain.
