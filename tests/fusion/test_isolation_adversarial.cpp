@@ -404,6 +404,8 @@ TEST(IsolationAdversarial, DriftKindForFourToSixGyros) {
       "drift kinds (isolated: right gyro with the true kind or unknown; wrong: another gyro or the "
       "other drift; delay over the runs labelled with the true kind)\n");
   print_table(table);
+  for (const auto& [name, t] : table)
+    std::printf("%s: true kind in %zu of %d\n", name.c_str(), t.delays_s.size(), t.runs);
   EXPECT_TRUE(what.empty()) << what;
 }
 
