@@ -55,6 +55,7 @@ GyroSeries::GyroSeries(std::vector<GyroConstants> constants, const PipelineConfi
   for (auto& t : tracks_) {
     t.d2.assign(static_cast<std::size_t>(config_.noise_window), 0.0);
     t.m2.assign(static_cast<std::size_t>(config_.noise_window), kInf);
+    t.view_coef.assign(tracks_.size(), 0.0);
   }
   scratch_.assign(static_cast<std::size_t>(std::max(config_.noise_window, 8)), 0.0);
   d2_all_.assign(tracks_.size(), 0.0);
@@ -64,9 +65,11 @@ void GyroSeries::reset() {
   for (auto& t : tracks_) {
     auto d2 = std::move(t.d2);
     auto m2 = std::move(t.m2);
+    auto coef = std::move(t.view_coef);
     t = Track{};
     t.d2 = std::move(d2);
     t.m2 = std::move(m2);
+    t.view_coef = std::move(coef);
   }
 }
 
@@ -138,7 +141,6 @@ void GyroSeries::record_spike(int id, std::int64_t now_ns) {
 void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
   if (!subsets.ready()) return;
   const double sqrt_period = subsets.sqrt_period();
-  const auto& axes = subsets.geometry().axes_B();
   GyroMask fresh = 0;
   for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
     const Track& t = track(id);
@@ -149,32 +151,55 @@ void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
     if (!has_gyro(frame.valid, id)) continue;
     Track& t = tracks_[static_cast<std::size_t>(id - 1)];
     const GyroMask others = without_gyro(frame.usable, id);
-    const Subset& h = subsets.get(others);
-    if (!h.observable) continue;  // the others cannot see the motion: no evidence either way
-    const Eigen::RowVector3d axis = axes.row(id - 1);
-    // The rate the others see along this gyro's axis, and its 1σ, over the current repeat run.
-    const double rate = axis * apply_pinv(h.pinv, others, frame.y_rad_s.data());
-    double var = 0.0;
-    double var_d2 = 0.0;
-    for (int k = 1; k <= static_cast<int>(tracks_.size()); ++k) {
-      if (!has_gyro(others, k)) continue;
-      const double c = axis * h.pinv.col(k - 1);
-      var += c * c * sample_sigma(k, sqrt_period) * sample_sigma(k, sqrt_period);
-      var_d2 += c * c * d2_sigma(k, sqrt_period) * d2_sigma(k, sqrt_period);
+    if (!motion_view(id, others, subsets)) continue;  // the others cannot see the motion: no evidence
+    // A coarse gyro's repeat run: the range of the rate the others see along its axis, and its 1σ.
+    if (coarse(id, sqrt_period)) {
+      const double rate = project(t, others, frame.y_rad_s.data());
+      t.run_low = t.run_seen ? std::min(t.run_low, rate) : rate;
+      t.run_high = t.run_seen ? std::max(t.run_high, rate) : rate;
+      t.run_sigma = t.run_seen ? std::max(t.run_sigma, t.view_rate_sigma) : t.view_rate_sigma;
+      t.run_seen = true;
     }
-    t.run_low = t.run_seen ? std::min(t.run_low, rate) : rate;
-    t.run_high = t.run_seen ? std::max(t.run_high, rate) : rate;
-    t.run_sigma = t.run_seen ? std::max(t.run_sigma, std::sqrt(var)) : std::sqrt(var);
-    t.run_seen = true;
     // The motion's second difference along the axis, when every other gyro has one this epoch, in units of
     // the others' own noise on it.
     if (t.d2_fresh && (fresh & others) == others) {
       const int w = config_.noise_window;
-      t.motion_sigma = std::sqrt(var_d2);
+      t.motion_sigma = t.view_d2_sigma;
       t.m2[static_cast<std::size_t>((t.d2_head - 1 + w) % w)] =
-          std::abs(axis * apply_pinv(h.pinv, others, d2_all_.data())) / t.motion_sigma;
+          std::abs(project(t, others, d2_all_.data())) / t.motion_sigma;
     }
   }
+}
+
+bool GyroSeries::motion_view(int id, GyroMask others, SubsetCache& subsets) {
+  Track& t = tracks_[static_cast<std::size_t>(id - 1)];
+  if (t.view_mask == others && t.view_period == subsets.sqrt_period()) return t.view_observable;
+  // The coefficients of h_i·H*_(others) and the noise they carry, once per set of others.
+  t.view_mask = others;
+  t.view_period = subsets.sqrt_period();
+  const Subset& h = subsets.get(others);
+  t.view_observable = h.observable;
+  if (!h.observable) return false;
+  const Eigen::RowVector3d axis = subsets.geometry().axes_B().row(id - 1);
+  double var = 0.0;
+  double var_d2 = 0.0;
+  for (int k = 1; k <= static_cast<int>(tracks_.size()); ++k) {
+    const double c = has_gyro(others, k) ? static_cast<double>(axis * h.pinv.col(k - 1)) : 0.0;
+    t.view_coef[static_cast<std::size_t>(k - 1)] = c;
+    var += c * c * sample_sigma(k, t.view_period) * sample_sigma(k, t.view_period);
+    var_d2 += c * c * d2_sigma(k, t.view_period) * d2_sigma(k, t.view_period);
+  }
+  t.view_rate_sigma = std::sqrt(var);
+  t.view_d2_sigma = std::sqrt(var_d2);
+  return true;
+}
+
+double GyroSeries::project(const Track& t, GyroMask others, const double* v) const {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < tracks_.size(); ++k) {
+    if (has_gyro(others, static_cast<int>(k) + 1)) sum += t.view_coef[k] * v[k];
+  }
+  return sum;
 }
 
 double GyroSeries::sample_sigma(int id, double sqrt_period) const {

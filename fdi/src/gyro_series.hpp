@@ -90,6 +90,12 @@ class GyroSeries {
     double run_high = 0.0;
     double run_sigma = 0.0;  //!< [rad/s] largest 1σ of that projection during the run
     bool run_seen = false;
+    GyroMask view_mask = ~GyroMask{0};  //!< the other gyros of the cached view (none yet)
+    double view_period = 0.0;           //!< [√s] the sample period's root it was made for
+    bool view_observable = false;
+    std::vector<double> view_coef;  //!< h_i·H*_(others), per gyro (0 outside the others)
+    double view_rate_sigma = 0.0;   //!< [rad/s] 1σ of the projected rate
+    double view_d2_sigma = 0.0;     //!< [rad/s] 1σ of the projected second difference
     double motion_sigma = 0.0;  //!< [rad/s] the others' noise on the motion's second difference (last seen)
     int d2_count = 0;
     int d2_head = 0;
@@ -105,6 +111,10 @@ class GyroSeries {
   double trimmed_rms(const std::vector<double>& ring, const Track& t, int n) const;
   //! Second-difference level [rad/s] of white noise (and quantization) that the noise ratios divide by.
   double d2_sigma(int id, double sqrt_period) const;
+  //! Caches gyro `id`'s view through `others` (coefficients and noise); false when they are not observable.
+  bool motion_view(int id, GyroMask others, SubsetCache& subsets);
+  //! h_i·H*_(others)·v with the cached coefficients of `t`.
+  double project(const Track& t, GyroMask others, const double* v) const;
   //! A noise level `r` that the motion the other gyros see cannot explain.
   bool noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const;
   //! Every other gyro in use has a normal second-difference level.
