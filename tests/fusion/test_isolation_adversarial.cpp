@@ -359,6 +359,44 @@ TEST(IsolationAdversarial, CoarselyQuantizedUnit) {
   EXPECT_TRUE(what.empty()) << what;
 }
 
+TEST(IsolationAdversarial, ScaleFaultAtNadirPointing) {
+  // +5 % scale factor on each gyro in the orbit (nadir pointing: the body turns about −Y at the orbit rate
+  // only), N = 5, 6, with and without reference. A gyro whose axis is nearly perpendicular to Y (gyros 1 and
+  // 4 of the seed unit: |h_y| ≈ 1e-3) sees almost no rate, so its scale error is ≈ 5e-5·0.06 deg/s — below
+  // any detector: missing it is physics. Printed per gyro; no wrong exclusion asserted.
+  std::string what;
+  for (int n = 5; n <= 6; ++n) {
+    for (bool reference : {false, true}) {
+      std::string line = "scale +5% at nadir, N=" + std::to_string(n) + (reference ? ", reference:" : ":");
+      for (int gyro = 1; gyro <= n; ++gyro) {
+        auto sc = sim::builtin_scenario("orbit");
+        ASSERT_TRUE(sc.ok());
+        sc->unit = test::unit_with(n);
+        sc->motion.acs.amplitude_deg = 0.04;
+        sc->motion.acs.peak_accel_dps2 = 1e-4;
+        sc->duration_s = 300.0;
+        sc->reference.rate_hz = reference ? 1.0 : 0.0;
+        sc->reference.noise_arcsec = 5.0;
+        sim::SimOptions so;
+        so.seed = static_cast<std::uint64_t>(gyro);
+        so.faults = {fault(gyro, K::kScale, 60.0, 0.05)};
+        fdi::PipelineConfig cfg;
+        cfg.max_angular_acceleration_dps2 = 2e-4;
+        const auto run = run_campaign(*sc, so, sc->unit, cfg);
+        const double h_y = sc->unit.gyros[static_cast<std::size_t>(gyro - 1)].axis_B.normalized().y();
+        char cell[64];
+        std::snprintf(cell, sizeof cell, " g%d(|h_y| %.3f) %s", gyro, std::abs(h_y),
+                      run.isolated_gyro ? "isolated" : (run.first_detected_s ? "detected" : "silent"));
+        line += cell;
+        const std::string wrong = wrong_exclusions(run, so.faults);
+        if (!wrong.empty()) what += line + "\n" + test::describe(run, n);
+      }
+      std::printf("%s\n", line.c_str());
+    }
+  }
+  EXPECT_TRUE(what.empty()) << what;
+}
+
 TEST(IsolationAdversarial, DriftKindForFourToSixGyros) {
   // Bias steps and ramps in orbit, N = 4, 5, 6, with the 1 Hz reference (N = 4 has no other way to isolate a
   // ramp): the kind reported with an isolation is the true one or `unknown`, never the other drift.
