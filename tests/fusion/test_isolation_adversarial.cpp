@@ -113,7 +113,7 @@ void print_table(const std::map<std::string, Tally>& table) {
 }
 
 TEST(IsolationAdversarial, AgileFaultFreeSlewsExcludeNothing) {
-  // 5 slews × N = 3..6 × reference or not × 6 seeds (both acceleration bounds): 240 runs, no exclusion
+  // 5 slews × N = 3..6 × reference or not × 12 seeds (both acceleration bounds): 480 runs, no exclusion
   // allowed, never LOST.
   int runs = 0;
   int detected = 0;
@@ -121,7 +121,7 @@ TEST(IsolationAdversarial, AgileFaultFreeSlewsExcludeNothing) {
   for (int n = 3; n <= 6; ++n) {
     for (const auto& slew : slews()) {
       for (bool reference : {false, true}) {
-        for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+        for (std::uint64_t seed = 1; seed <= 12; ++seed) {
           sim::SimOptions so;
           so.seed = seed;
           const auto run =
@@ -160,7 +160,7 @@ const std::vector<FaultCase>& fault_cases() {
 
 TEST(IsolationAdversarial, FaultsBeginningDuringSlewsNeverBlameAHealthyGyro) {
   // Every fault kind on every gyro, beginning a quarter into the slew, for N = 4..6 (N = 3 has no parity:
-  // only signatures, below), slews alternating over the cases, with and without reference, 4 seeds: 1560
+  // only signatures, below), slews alternating over the cases, with and without reference, 8 seeds: 3120
   // runs.
   std::map<std::string, Tally> table;
   std::string what;
@@ -169,7 +169,7 @@ TEST(IsolationAdversarial, FaultsBeginningDuringSlewsNeverBlameAHealthyGyro) {
     for (const auto& fc : fault_cases()) {
       for (int gyro = 1; gyro <= n; ++gyro) {
         for (bool reference : {false, true}) {
-          for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+          for (std::uint64_t seed = 1; seed <= 8; ++seed) {
             const auto& slew = slews()[static_cast<std::size_t>(case_index++) % slews().size()];
             const double at = kSlewStart_s + 0.25 * slew.duration_s;
             sim::SimOptions so;
