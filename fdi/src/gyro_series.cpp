@@ -13,6 +13,14 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kNoiseEvalEvery = 10;  //!< [samples] the noise-level test runs this often
 constexpr double kNoiseExpectedMedian = 0.6744897501960817;  //!< median of |N(0,1)|
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kCoarseStepPerSigma = 0.1;
+constexpr double kQuietMotion = 2.0;
+constexpr double kNormalLevel = 2.0;
+constexpr int kOtherRepeats =
+    3;  //!< [samples] another gyro's repeat run that leaves a coarse gyro's repeats unjudged  //!< noise
+        //!< ratio of a gyro whose own second differences look normal  //!< [σ] motion level the noise-level
+        //!< test still tells from noise  //!< a quantization step beyond this many σ makes repeats normal
 }  // namespace
 
 Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const PipelineConfig& config) {
@@ -29,6 +37,7 @@ Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const 
     c.arw_rad_rts = n_dps * kDegToRad;
     if (g.noise && g.noise->bias_instability_dps)
       c.bias_instability_rad_s = *g.noise->bias_instability_dps * kDegToRad;
+    if (g.noise && g.noise->quantization_deg) c.quantization_rad = *g.noise->quantization_deg * kDegToRad;
     const double s = config.raw_units_dps ? 1.0 : g.scale_factor_V_per_dps;
     c.scale_V_per_rad_s = s / kDegToRad;
     c.bias_V = config.raw_units_dps ? 0.0 : g.bias_V;
@@ -43,15 +52,24 @@ Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const 
 
 GyroSeries::GyroSeries(std::vector<GyroConstants> constants, const PipelineConfig& config)
     : constants_(std::move(constants)), config_(config), tracks_(constants_.size()) {
-  for (auto& t : tracks_) t.d2.assign(static_cast<std::size_t>(config_.noise_window), 0.0);
+  for (auto& t : tracks_) {
+    t.d2.assign(static_cast<std::size_t>(config_.noise_window), 0.0);
+    t.m2.assign(static_cast<std::size_t>(config_.noise_window), kInf);
+    t.view_coef.assign(tracks_.size(), 0.0);
+  }
   scratch_.assign(static_cast<std::size_t>(std::max(config_.noise_window, 8)), 0.0);
+  d2_all_.assign(tracks_.size(), 0.0);
 }
 
 void GyroSeries::reset() {
   for (auto& t : tracks_) {
     auto d2 = std::move(t.d2);
+    auto m2 = std::move(t.m2);
+    auto coef = std::move(t.view_coef);
     t = Track{};
     t.d2 = std::move(d2);
+    t.m2 = std::move(m2);
+    t.view_coef = std::move(coef);
   }
 }
 
@@ -68,6 +86,7 @@ void GyroSeries::ingest(const Epoch& epoch, EpochFrame& frame, Counters& counter
   frame.valid = 0;
   for (std::size_t u = 0; u < tracks_.size(); ++u) {
     auto& t = tracks_[u];
+    t.d2_fresh = false;
     if (epoch.present[u] == 0) {
       ++counters.samples_absent;
       if (t.absent_since_ns < 0) t.absent_since_ns = frame.now_ns;
@@ -96,10 +115,14 @@ void GyroSeries::ingest(const Epoch& epoch, EpochFrame& frame, Counters& counter
 
 void GyroSeries::ingest_sample(Track& t, double raw, double y) {
   t.repeat_count = (t.has_last_raw && raw == t.last_raw) ? t.repeat_count + 1 : 1;
+  if (t.repeat_count == 1) t.run_seen = false;
   t.has_last_raw = true;
   t.last_raw = raw;
   if (t.consecutive >= 2) {  // second difference Δ²y = y_k − 2y_{k−1} + y_{k−2}
-    t.d2[static_cast<std::size_t>(t.d2_head)] = std::abs(y - 2.0 * t.y1 + t.y2);
+    t.d2_last = y - 2.0 * t.y1 + t.y2;
+    t.d2_fresh = true;
+    t.d2[static_cast<std::size_t>(t.d2_head)] = std::abs(t.d2_last);
+    t.m2[static_cast<std::size_t>(t.d2_head)] = kInf;  // until observe_motion sees the others' motion
     t.d2_head = (t.d2_head + 1) % config_.noise_window;
     ++t.d2_count;
     ++t.d2_since_eval;
@@ -115,28 +138,158 @@ void GyroSeries::record_spike(int id, std::int64_t now_ns) {
   ++t.spike_n;
 }
 
-double* GyroSeries::recent(const Track& t, int n) const {
+void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
+  if (!subsets.ready()) return;
+  const double sqrt_period = subsets.sqrt_period();
+  GyroMask fresh = 0;
+  for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
+    const Track& t = track(id);
+    d2_all_[static_cast<std::size_t>(id - 1)] = t.d2_last;
+    if (t.d2_fresh && has_gyro(frame.usable, id)) fresh |= GyroMask{1} << static_cast<unsigned>(id - 1);
+  }
+  for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
+    if (!has_gyro(frame.valid, id)) continue;
+    Track& t = tracks_[static_cast<std::size_t>(id - 1)];
+    const GyroMask others = without_gyro(frame.usable, id);
+    if (!motion_view(id, others, subsets)) continue;  // the others cannot see the motion: no evidence
+    // A coarse gyro's repeat run: the range of the rate the others see along its axis, and its 1σ.
+    if (coarse(id, sqrt_period)) {
+      const double rate = project(t, others, frame.y_rad_s.data());
+      t.run_low = t.run_seen ? std::min(t.run_low, rate) : rate;
+      t.run_high = t.run_seen ? std::max(t.run_high, rate) : rate;
+      t.run_sigma = t.run_seen ? std::max(t.run_sigma, t.view_rate_sigma) : t.view_rate_sigma;
+      t.run_seen = true;
+    }
+    // The motion's second difference along the axis, when every other gyro has one this epoch, in units of
+    // the others' own noise on it.
+    if (t.d2_fresh && (fresh & others) == others) {
+      const int w = config_.noise_window;
+      t.motion_sigma = t.view_d2_sigma;
+      t.m2[static_cast<std::size_t>((t.d2_head - 1 + w) % w)] =
+          std::abs(project(t, others, d2_all_.data())) / t.motion_sigma;
+    }
+  }
+}
+
+bool GyroSeries::motion_view(int id, GyroMask others, SubsetCache& subsets) {
+  Track& t = tracks_[static_cast<std::size_t>(id - 1)];
+  if (t.view_mask == others && t.view_period == subsets.sqrt_period()) return t.view_observable;
+  // The coefficients of h_i·H*_(others) and the noise they carry, once per set of others.
+  t.view_mask = others;
+  t.view_period = subsets.sqrt_period();
+  const Subset& h = subsets.get(others);
+  t.view_observable = h.observable;
+  if (!h.observable) return false;
+  const Eigen::RowVector3d axis = subsets.geometry().axes_B().row(id - 1);
+  double var = 0.0;
+  double var_d2 = 0.0;
+  for (int k = 1; k <= static_cast<int>(tracks_.size()); ++k) {
+    const double c = has_gyro(others, k) ? static_cast<double>(axis * h.pinv.col(k - 1)) : 0.0;
+    t.view_coef[static_cast<std::size_t>(k - 1)] = c;
+    var += c * c * sample_sigma(k, t.view_period) * sample_sigma(k, t.view_period);
+    var_d2 += c * c * d2_sigma(k, t.view_period) * d2_sigma(k, t.view_period);
+  }
+  t.view_rate_sigma = std::sqrt(var);
+  t.view_d2_sigma = std::sqrt(var_d2);
+  return true;
+}
+
+double GyroSeries::project(const Track& t, GyroMask others, const double* v) const {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < tracks_.size(); ++k) {
+    if (has_gyro(others, static_cast<int>(k) + 1)) sum += t.view_coef[k] * v[k];
+  }
+  return sum;
+}
+
+double GyroSeries::sample_sigma(int id, double sqrt_period) const {
+  const GyroConstants& c = constants(id);
+  const double period = sqrt_period * sqrt_period;
+  return std::sqrt(c.arw_rad_rts * c.arw_rad_rts / period +
+                   2.0 * c.quantization_rad * c.quantization_rad / (period * period));
+}
+
+bool GyroSeries::coarse(int id, double sqrt_period) const {
+  const GyroConstants& c = constants(id);
+  const double step = std::sqrt(12.0) * c.quantization_rad / (sqrt_period * sqrt_period);
+  return step > kCoarseStepPerSigma * c.arw_rad_rts / sqrt_period;
+}
+
+double GyroSeries::d2_sigma(int id, double sqrt_period) const {
+  // Δ²y of white noise has variance 6σ²; of the quantization error (e_k − e_{k−1})/T with var(e) = Q²,
+  // 20Q²/T².
+  const GyroConstants& c = constants(id);
+  const double period = sqrt_period * sqrt_period;
+  return std::sqrt(6.0 * c.arw_rad_rts * c.arw_rad_rts / period +
+                   20.0 * c.quantization_rad * c.quantization_rad / (period * period));
+}
+
+bool GyroSeries::motion_quiet(int id, double sqrt_period, int last) const {
+  // The whole window: its median, as the noise-level test. The last samples: their trimmed RMS, as the kind
+  // at isolation (a slew beginning within them must count, however few samples it has reached).
+  const Track& t = track(id);
+  const int n = std::min({last, t.d2_count, config_.noise_window});
+  const double motion =
+      last == 0 ? noise_ratio(id, sqrt_period, 0, true) : (n < 6 ? kNaN : trimmed_rms(t.m2, t, n));
+  return std::isfinite(motion) && motion <= kQuietMotion;
+}
+
+bool GyroSeries::noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const {
+  // With four gyros a slew's jerk and one gyro's noise leave the same single residual: the gyro's own level
+  // tells them apart only while the motion is quiet. The motion the other gyros see along this axis (in units
+  // of their own noise on it, ≈ 1 at rest; ∞ when they could not see it) must be within kQuietMotion, and the
+  // gyro's level beyond the limit by more than that motion could hide: its level in the gyro's own σ units
+  // (the others' noise on it is large where their geometry is poor).
+  // Another gyro's raised level means motion or a second fault: neither leaves this gyro alone to blame.
+  if (!motion_quiet(id, sqrt_period, 0) || !others_normal(id, sqrt_period)) return false;
+  const double motion = noise_ratio(id, sqrt_period, 0, true);
+  return r > config_.noise_high_ratio + motion * t.motion_sigma / d2_sigma(id, sqrt_period);
+}
+
+bool GyroSeries::others_normal(int id, double sqrt_period) const {
+  for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
+    if (j == id || has_gyro(excluded_, j)) continue;
+    const double r = noise_ratio(j, sqrt_period);
+    if (!std::isfinite(r) || r > kNormalLevel) return false;
+  }
+  return true;
+}
+
+bool GyroSeries::repeats_are_stuck(int id, const Track& t, double sqrt_period) const {
+  if (!coarse(id, sqrt_period)) return true;  // identical values of a finely quantized output: stuck
+  // Another gyro repeating too (kOtherRepeats values: it may have just stuck) may be the stuck one, and its
+  // output is part of the motion the others see.
+  for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
+    if (j != id && !has_gyro(excluded_, j) && track(j).repeat_count >= kOtherRepeats) return false;
+  }
+  // A healthy quantized gyro's sample is the mean rate over the sample period within one step: when the rate
+  // the others see along its axis moved by two steps beyond their noise, its output must have changed.
+  const double step = std::sqrt(12.0) * constants(id).quantization_rad / (sqrt_period * sqrt_period);
+  return t.run_seen && t.run_high - t.run_low > 2.0 * step + 2.0 * config_.onset_sigma * t.run_sigma;
+}
+
+double* GyroSeries::recent(const std::vector<double>& ring, const Track& t, int n) const {
   const int w = config_.noise_window;
   double* buf = scratch_.data();
-  for (int k = 0; k < n; ++k) buf[k] = t.d2[static_cast<std::size_t>((t.d2_head - 1 - k + 2 * w) % w)];
+  for (int k = 0; k < n; ++k) buf[k] = ring[static_cast<std::size_t>((t.d2_head - 1 - k + 2 * w) % w)];
   return buf;
 }
 
-double GyroSeries::noise_ratio(int id, double sqrt_period, int last) const {
+double GyroSeries::noise_ratio(int id, double sqrt_period, int last, bool motion) const {
   const Track& t = track(id);
+  const std::vector<double>& ring = motion ? t.m2 : t.d2;
   const int w = config_.noise_window;
   const int n = last > 0 ? std::min({last, t.d2_count, w}) : std::min(t.d2_count, w);
   if (n < (last > 0 ? std::min(10, w) : w)) return kNaN;
   double* buf = scratch_.data();
   if (n == w) {
-    std::copy(t.d2.begin(), t.d2.end(), buf);  // the whole ring: order does not matter for a median
+    std::copy(ring.begin(), ring.end(), buf);  // the whole ring: order does not matter for a median
   } else {
-    buf = recent(t, n);
+    buf = recent(ring, t, n);
   }
   std::nth_element(buf, buf + n / 2, buf + n);
-  // Δ²y of white noise has variance 6σ²: median |Δ²y| = 0.6745·√6·σ.
-  const double sigma_sample = constants(id).arw_rad_rts / sqrt_period;
-  return buf[n / 2] / (kNoiseExpectedMedian * std::sqrt(6.0) * sigma_sample);
+  // Gaussian Δ²y of level σ_Δ²: median |Δ²y| = 0.6745·σ_Δ² (the motion's ring is already in its σ units).
+  return buf[n / 2] / (kNoiseExpectedMedian * (motion ? 1.0 : d2_sigma(id, sqrt_period)));
 }
 
 double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) const {
@@ -145,16 +298,20 @@ double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) cons
   const Track& t = track(id);
   const int n = std::min({last, t.d2_count, config_.noise_window});
   if (n < 6) return kNaN;
-  double* buf = recent(t, n);
+  return trimmed_rms(t.d2, t, n) / d2_sigma(id, sqrt_period);
+}
+
+double GyroSeries::trimmed_rms(const std::vector<double>& ring, const Track& t, int n) const {
+  double* buf = recent(ring, t, n);
   std::sort(buf, buf + n);
   double sum_sq = 0.0;
   for (int k = 0; k < n - 2; ++k) sum_sq += buf[k] * buf[k];
-  const double sigma_sample = constants(id).arw_rad_rts / sqrt_period;
-  return std::sqrt(sum_sq / (n - 2)) / (std::sqrt(6.0) * sigma_sample);
+  return std::sqrt(sum_sq / (n - 2));
 }
 
 void GyroSeries::check(std::int64_t now_ns, GyroMask excluded, double period_s, double sqrt_period,
                        Isolations& out) {
+  excluded_ = excluded;
   for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
     if (!has_gyro(excluded, id))
       (void)check_one(id, tracks_[static_cast<std::size_t>(id - 1)], now_ns, period_s, sqrt_period, out);
@@ -171,15 +328,15 @@ bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_
     return found(FaultKind::kDropout, Evidence::kTimeout, ns_to_seconds(now_ns - t.absent_since_ns));
   if (t.invalid_since_ns >= 0 && now_ns - t.invalid_since_ns >= seconds_to_ns(config_.invalid_timeout_s))
     return found(FaultKind::kInvalid, Evidence::kInvalid, ns_to_seconds(now_ns - t.invalid_since_ns));
-  if (t.repeat_count >= config_.stuck_repeat_count)
+  if (t.repeat_count >= config_.stuck_repeat_count && repeats_are_stuck(id, t, sqrt_period))
     return found(FaultKind::kStuck, t.last_raw == 0.0 ? Evidence::kZero : Evidence::kRepeated,
                  t.repeat_count);
   if (t.d2_since_eval >= kNoiseEvalEvery && period_s > 0.0) {
     t.d2_since_eval = 0;
     const double r = noise_ratio(id, sqrt_period);
-    if (std::isfinite(r) && r > config_.noise_high_ratio)
+    if (std::isfinite(r) && r > config_.noise_high_ratio && noise_beyond_motion(id, t, r, sqrt_period))
       return found(FaultKind::kNoise, Evidence::kNoiseLevel, r);
-    if (std::isfinite(r) && r < config_.noise_low_ratio)
+    if (std::isfinite(r) && r < config_.noise_low_ratio && !coarse(id, sqrt_period))
       return found(FaultKind::kStuck, Evidence::kVariance, r);
   }
   // Recurring spikes: enough confirmed one-epoch outliers within the window, the first one old enough for the

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "epoch_frame.hpp"
+#include "subset_cache.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/config.hpp"
@@ -23,6 +24,7 @@ struct GyroConstants {
   double bias_sigma_rad_s = 0.0;        //!< [rad/s] 1σ of the calibrated bias
   double scale_rel_sigma = 0.0;         //!< [-] 1σ relative scale factor error
   double bias_instability_rad_s = 0.0;  //!< [rad/s] B of the calibration's noise section (0 if absent)
+  double quantization_rad = 0.0;        //!< [rad] angle quantization Q of the noise section (0 if absent)
 };
 
 //! Per-gyro constants from the calibration; error names the gyro and field.
@@ -35,17 +37,30 @@ class GyroSeries {
   //! Validates and calibrates the epoch's samples into `frame` (y, raw, valid) and updates each gyro's
   //! series.
   void ingest(const Epoch& epoch, EpochFrame& frame, Counters& counters);
+  //! The body motion the other gyros see, for each gyro with a fresh second difference: its projection on
+  //! the gyro's axis (rate, and second difference) from the usable gyros without it. The noise-level and
+  //! repeated-value tests compare a gyro with what that motion explains.
+  void observe_motion(const EpochFrame& frame, SubsetCache& subsets);
   //! The signatures of every gyro not in `excluded`; isolations appended to `out` in gyro order.
   void check(std::int64_t now_ns, GyroMask excluded, double period_s, double sqrt_period, Isolations& out);
 
   //! A confirmed one-epoch outlier that went away: a spike of gyro `id`.
   void record_spike(int id, std::int64_t now_ns);
   //! Robust noise level / expected over the last `last` second differences (0: the whole window); NaN if too
-  //! few.
-  double noise_ratio(int id, double sqrt_period, int last = 0) const;
+  //! few. With `motion`, the same of the motion the other gyros see (∞ when they could not see it).
+  double noise_ratio(int id, double sqrt_period, int last = 0, bool motion = false) const;
   //! Trimmed RMS noise level / expected over the last `last` second differences (classification at
   //! isolation).
   double recent_noise_ratio(int id, double sqrt_period, int last) const;
+  //! [rad/s] 1σ of one sample: white noise N/√T and, with an angle quantization Q, its √2·Q/T.
+  double sample_sigma(int id, double sqrt_period) const;
+  //! True when the quantization step of one sample is not small beside the white noise (> 0.1 σ): repeated
+  //! values and a low second-difference level are then what a healthy gyro delivers.
+  bool coarse(int id, double sqrt_period) const;
+  //! The motion the other gyros saw along gyro `id`'s axis was quiet enough for its noise level to mean noise
+  //! (false when they could not see it): over the window (`last` = 0, median) or its last `last` second
+  //! differences (trimmed RMS).
+  bool motion_quiet(int id, double sqrt_period, int last) const;
   //! Identical raw values in a row of gyro `id`.
   int repeat_count(int id) const { return track(id).repeat_count; }
   bool absent(int id) const { return track(id).absent_since_ns >= 0; }
@@ -67,7 +82,21 @@ class GyroSeries {
     int consecutive = 0;     //!< valid samples in a row (up to 2)
     double y1 = 0.0;         //!< [rad/s] previous sample
     double y2 = 0.0;         //!< [rad/s] the one before
+    double d2_last = 0.0;    //!< [rad/s] signed Δ²y of this epoch
+    bool d2_fresh = false;   //!< d2_last belongs to this epoch
     std::vector<double> d2;  //!< ring of |Δ²y| [rad/s], size noise_window
+    std::vector<double> m2;  //!< ring of |h·Δ²ω̂| the other gyros see [rad/s] (∞: not seen), aligned with d2
+    double run_low = 0.0;  //!< [rad/s] range of h·ω̂ of the other gyros during the current repeat run
+    double run_high = 0.0;
+    double run_sigma = 0.0;  //!< [rad/s] largest 1σ of that projection during the run
+    bool run_seen = false;
+    GyroMask view_mask = ~GyroMask{0};  //!< the other gyros of the cached view (none yet)
+    double view_period = 0.0;           //!< [√s] the sample period's root it was made for
+    bool view_observable = false;
+    std::vector<double> view_coef;  //!< h_i·H*_(others), per gyro (0 outside the others)
+    double view_rate_sigma = 0.0;   //!< [rad/s] 1σ of the projected rate
+    double view_d2_sigma = 0.0;     //!< [rad/s] 1σ of the projected second difference
+    double motion_sigma = 0.0;  //!< [rad/s] the others' noise on the motion's second difference (last seen)
     int d2_count = 0;
     int d2_head = 0;
     int d2_since_eval = 0;
@@ -77,13 +106,29 @@ class GyroSeries {
   const Track& track(int id) const { return tracks_[static_cast<std::size_t>(id - 1)]; }
   void ingest_sample(Track& t, double raw, double y);
   //! The last `n` second differences of `t` into the scratch buffer.
-  double* recent(const Track& t, int n) const;
+  double* recent(const std::vector<double>& ring, const Track& t, int n) const;
+  //! RMS of the last `n` values of `ring` without their two largest.
+  double trimmed_rms(const std::vector<double>& ring, const Track& t, int n) const;
+  //! Second-difference level [rad/s] of white noise (and quantization) that the noise ratios divide by.
+  double d2_sigma(int id, double sqrt_period) const;
+  //! Caches gyro `id`'s view through `others` (coefficients and noise); false when they are not observable.
+  bool motion_view(int id, GyroMask others, SubsetCache& subsets);
+  //! h_i·H*_(others)·v with the cached coefficients of `t`.
+  double project(const Track& t, GyroMask others, const double* v) const;
+  //! A noise level `r` that the motion the other gyros see cannot explain.
+  bool noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const;
+  //! Every other gyro in use has a normal second-difference level.
+  bool others_normal(int id, double sqrt_period) const;
+  //! Repeated values that the motion the other gyros saw rules out for a healthy (quantized) gyro.
+  bool repeats_are_stuck(int id, const Track& t, double sqrt_period) const;
   bool check_one(int id, Track& t, std::int64_t now_ns, double period_s, double sqrt_period, Isolations& out);
 
   std::vector<GyroConstants> constants_;
   const PipelineConfig& config_;
   std::vector<Track> tracks_;
   mutable std::vector<double> scratch_;
+  GyroMask excluded_ = 0;       //!< the gyros `check` leaves alone
+  std::vector<double> d2_all_;  //!< this epoch's Δ²y of every gyro [rad/s]
 };
 
 }  // namespace tetra::fdi::detail

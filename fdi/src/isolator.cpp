@@ -17,7 +17,9 @@ Isolator::Isolator(int n_gyros, const PipelineConfig& config)
       mean_pre_(static_cast<std::size_t>(n_gyros), 0.0),
       mean_post_(static_cast<std::size_t>(n_gyros), 0.0),
       n_pre_(static_cast<std::size_t>(n_gyros), 0),
-      n_post_(static_cast<std::size_t>(n_gyros), 0) {
+      n_post_(static_cast<std::size_t>(n_gyros), 0),
+      drift_x_(kHistory, 0.0),
+      drift_t_(kHistory, 0.0) {
   // One scratch vector per parity dimension, so the GLT never resizes (allocates) one.
   for (int d = 0; d <= std::max(1, n_gyros - 3); ++d) {
     glt_mean_.push_back(Eigen::VectorXd::Zero(d));
@@ -83,20 +85,23 @@ Verdict Isolator::decide(std::int64_t now_ns, std::int64_t index, GyroMask activ
     // estimate) are a stuck output; a noise increase also shifts window means, and its second differences
     // tell it apart.
     const bool repeated = series.repeat_count(culprit) >= 5;
-    const double r =
-        series.recent_noise_ratio(culprit, subsets.sqrt_period(),
-                                  static_cast<int>(std::max<std::int64_t>(index - episode_.onset_index, 20)));
+    const int last = static_cast<int>(std::max<std::int64_t>(index - episode_.onset_index, 20));
+    const double r = series.recent_noise_ratio(culprit, subsets.sqrt_period(), last);
+    // While the body moves, second differences carry its jerk: a raised level may be motion, not noise.
+    const bool quiet = series.motion_quiet(culprit, subsets.sqrt_period(), last);
+    const bool raised = std::isfinite(r) && r > 0.5 * config_.noise_high_ratio;
     FaultKind kind = FaultKind::kBias;
     if (repeated) {
       kind = FaultKind::kStuck;
-    } else if (std::isfinite(r) && r > config_.noise_high_ratio) {
+    } else if (raised && !quiet) {
+      kind = FaultKind::kUnknown;
+    } else if (raised && r > config_.noise_high_ratio) {
       kind = FaultKind::kNoise;
     } else if (evidence == Evidence::kGlt) {
       kind = classify_drift(culprit, index, active, subsets);
     }
     // A noise level neither normal nor clearly high: wait for more samples rather than guess the kind.
-    const bool ambiguous =
-        !repeated && std::isfinite(r) && r > 0.5 * config_.noise_high_ratio && r <= config_.noise_high_ratio;
+    const bool ambiguous = !repeated && raised && quiet && r <= config_.noise_high_ratio;
     if (ambiguous) return Verdict::kNone;
     found = {culprit, kind, evidence, episode_.test, episode_.statistic};
     return Verdict::kIsolated;
@@ -131,6 +136,34 @@ double Isolator::window_means(std::int64_t b, std::int64_t e, std::vector<double
   return t_mean;
 }
 
+int Isolator::motion_within_bound(GyroMask mask, double separation_s, SubsetCache& subsets,
+                                  const GyroSeries& series) const {
+  const Subset& h = subsets.get(mask);
+  if (!h.observable) return -1;
+  Eigen::Vector3d dw = Eigen::Vector3d::Zero();
+  double var = 0.0;
+  for (int i = 0; i < n_; ++i) {
+    if (!has_gyro(mask, i + 1)) continue;
+    const auto u = static_cast<std::size_t>(i);
+    if (n_pre_[u] < 2 || n_post_[u] < 2) return -1;
+    dw += h.pinv.col(i) * (mean_post_[u] - mean_pre_[u]);
+    const double sig = series.sample_sigma(i + 1, subsets.sqrt_period());
+    var += h.pinv.col(i).squaredNorm() * sig * sig * (1.0 / n_pre_[u] + 1.0 / n_post_[u]);
+  }
+  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
+  return dw.norm() <= a_max * separation_s + config_.onset_sigma * std::sqrt(var) ? 1 : 0;
+}
+
+double Isolator::two_windows(std::int64_t b1, std::int64_t e1, std::int64_t b2, std::int64_t e2) {
+  std::fill(mean_pre_.begin(), mean_pre_.end(), 0.0);
+  std::fill(mean_post_.begin(), mean_post_.end(), 0.0);
+  std::fill(n_pre_.begin(), n_pre_.end(), 0);
+  std::fill(n_post_.begin(), n_post_.end(), 0);
+  const double t1 = window_means(b1, e1, mean_pre_, n_pre_);
+  const double t2 = window_means(b2, e2, mean_post_, n_post_);
+  return ns_to_seconds(time_of(b2) - time_of(b1)) + t2 - t1;
+}
+
 int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subsets,
                          const GyroSeries& series) {
   const std::int64_t k0 = episode_.onset_index;
@@ -139,36 +172,20 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
   const std::int64_t pre_end = k0 - gap;
   const std::int64_t post_end = std::min(index + 1, k0 + config_.onset_post_max_epochs);
   if (pre_begin < 0 || pre_begin <= index - kHistory || post_end - k0 < 20) return 0;
-  std::fill(mean_pre_.begin(), mean_pre_.end(), 0.0);
-  std::fill(mean_post_.begin(), mean_post_.end(), 0.0);
-  std::fill(n_pre_.begin(), n_pre_.end(), 0);
-  std::fill(n_post_.begin(), n_post_.end(), 0);
-  const double t_pre = window_means(pre_begin, pre_end, mean_pre_, n_pre_);
-  const double t_post = window_means(k0, post_end, mean_post_, n_post_);
-  const double separation = ns_to_seconds(time_of(k0) - time_of(pre_begin)) + t_post - t_pre;
-  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
-  // 1: the window means of `mask` are consistent with a possible motion; 0: not; −1: cannot judge.
-  auto consistent = [&](GyroMask mask) -> int {
-    const Subset& h = subsets.get(mask);
-    if (!h.observable) return -1;
-    Eigen::Vector3d dw = Eigen::Vector3d::Zero();
-    double var = 0.0;
-    for (int i = 0; i < n_; ++i) {
-      if (!has_gyro(mask, i + 1)) continue;
-      const auto u = static_cast<std::size_t>(i);
-      if (n_pre_[u] < 2 || n_post_[u] < 2) return -1;
-      dw += h.pinv.col(i) * (mean_post_[u] - mean_pre_[u]);
-      const double sig = series.constants(i + 1).arw_rad_rts / subsets.sqrt_period();
-      var += h.pinv.col(i).squaredNorm() * sig * sig * (1.0 / n_pre_[u] + 1.0 / n_post_[u]);
-    }
-    return dw.norm() <= a_max * separation + config_.onset_sigma * std::sqrt(var) ? 1 : 0;
-  };
-  if (consistent(active) != 0) return 0;  // no abrupt change beyond motion: nothing to tell
+  // Every hypothesis below is judged against the acceleration bound. Before the onset the data are clean:
+  // when the body already turned faster than the bound there (a slew the bound does not cover), the true
+  // hypothesis may be the impossible one and a wrong one possible by chance. Nothing can be told.
+  const std::int64_t pre_mid = pre_begin + config_.onset_pre_epochs / 2;
+  if (motion_within_bound(active, two_windows(pre_begin, pre_mid, pre_mid, pre_end), subsets, series) == 0)
+    return 0;
+  const double separation = two_windows(pre_begin, pre_end, k0, post_end);
+  // All gyros consistent with a possible motion: no abrupt change beyond motion, nothing to tell.
+  if (motion_within_bound(active, separation, subsets, series) != 0) return 0;
   int count = 0;
   int culprit = 0;
   for (int j = 1; j <= n_; ++j) {
     if (!has_gyro(active, j)) continue;
-    const int c = consistent(without_gyro(active, j));
+    const int c = motion_within_bound(without_gyro(active, j), separation, subsets, series);
     if (c < 0) return 0;
     if (c == 1) {
       ++count;
@@ -206,17 +223,20 @@ int Isolator::glt_test(const Subset& s) const {
   return (accepted == 1 && rejected == members - 1) ? best : 0;
 }
 
-// Bias or ramp: fit p_j(τ) = c + b·τ to the parity projected on gyro j's direction over the history since the
-// onset (at most kHistory epochs): a step leaves b ≈ 0, a ramp a significant slope. Without parity (three
-// gyros) the data cannot tell: unknown.
+// Bias or ramp: the parity projected on gyro j's direction over the history kept (at most kHistory epochs,
+// the fault's onset inside it) is explained by a step f·[t ≥ t_m] or by a ramp r·(t − t_m)₊, each with its
+// best change time t_m. In units of the normalized parity, each fit removes G = (Σ x·u)²/Σ u² of the squared
+// sum (u the model's shape; a change time before the history gives a constant or a line a + b·t); the kind is
+// the model whose G is larger by kDriftMargin; an offset without a trend (slope below 3σ) is a bias that
+// began before the history; otherwise `unknown` (a step seen shortly after a ramp began fits both). Without
+// parity (three gyros) the data cannot tell: unknown.
 FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets) const {
   const Subset& s = subsets.get(active);
   if (!s.observable || s.dof < 1) return FaultKind::kUnknown;
   const double w_norm = s.parity.col(id - 1).norm();
-  const std::int64_t first = std::max<std::int64_t>(
-      {episode_.active ? episode_.onset_index : index - kHistory + 1, index - kHistory + 1, 0});
-  double n = 0.0, st = 0.0, sp = 0.0, stt = 0.0, stp = 0.0;
+  const std::int64_t first = std::max<std::int64_t>(index - kHistory + 1, 0);
   double p[kMaxGyros];
+  int n = 0;
   const std::int64_t t0 = time_of(first);
   for (std::int64_t k = first; k <= index; ++k) {
     const auto slot = static_cast<std::size_t>(k % kHistory);
@@ -224,19 +244,38 @@ FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, 
     (void)apply_parity(s, active, &hist_y_[slot * static_cast<std::size_t>(n_)], 1.0, p);
     double proj = 0.0;
     for (int r = 0; r < s.dof; ++r) proj += s.parity(r, id - 1) / w_norm * p[r] * subsets.sqrt_period();
-    const double t = ns_to_seconds(hist_ns_[slot] - t0);
-    n += 1.0;
-    st += t;
-    sp += proj;
-    stt += t * t;
-    stp += t * proj;
+    drift_x_[static_cast<std::size_t>(n)] = proj;
+    drift_t_[static_cast<std::size_t>(n)] = ns_to_seconds(hist_ns_[slot] - t0);
+    ++n;
   }
-  if (n < 20.0) return FaultKind::kUnknown;
-  const double sxx = stt - st * st / n;
-  if (sxx <= 0.0) return FaultKind::kUnknown;
-  const double slope = (stp - st * sp / n) / sxx;   // [σ/s]
-  const double slope_sigma = 1.0 / std::sqrt(sxx);  // unit noise of the normalized parity
-  return std::abs(slope) > 5.0 * slope_sigma ? FaultKind::kRamp : FaultKind::kBias;
+  if (n < 20) return FaultKind::kUnknown;
+  // Suffix sums from the change sample m on: Σx, Σx·t, Σt, Σt², count.
+  double sx = 0.0, sxt = 0.0, st = 0.0, stt = 0.0;
+  double g_step = 0.0, g_ramp = 0.0;
+  for (int m = n - 1; m >= 0; --m) {
+    const double x = drift_x_[static_cast<std::size_t>(m)];
+    const double t = drift_t_[static_cast<std::size_t>(m)];
+    sx += x;
+    sxt += x * t;
+    st += t;
+    stt += t * t;
+    const double count = n - m;
+    if (count < 3) continue;
+    g_step = std::max(g_step, sx * sx / count);
+    const double num = sxt - t * sx;                        // Σ x·(t_k − t_m)
+    const double den = stt - 2.0 * t * st + count * t * t;  // Σ (t_k − t_m)²
+    if (den > 0.0) g_ramp = std::max(g_ramp, num * num / den);
+  }
+  // A drift that began before the history: a constant (the step from m = 0) or a line a + b·t.
+  const double g_const = sx * sx / n;
+  const double sxx_t = stt - st * st / n;
+  const double slope_gain = sxx_t > 0.0 ? (sxt - st * sx / n) * (sxt - st * sx / n) / sxx_t : 0.0;
+  g_ramp = std::max(g_ramp, g_const + slope_gain);
+  if (g_step > g_ramp + kDriftMargin) return FaultKind::kBias;
+  if (g_ramp > g_step + kDriftMargin) return FaultKind::kRamp;
+  // An offset through the whole history with no trend in it (slope below 3σ): a bias that began before.
+  if (slope_gain < 9.0 && g_const > kDriftMargin) return FaultKind::kBias;
+  return FaultKind::kUnknown;
 }
 
 }  // namespace tetra::fdi::detail

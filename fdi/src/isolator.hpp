@@ -49,7 +49,8 @@ class Isolator {
   //! Seeks evidence for the open episode. `found` is set with kIsolated.
   Verdict decide(std::int64_t now_ns, std::int64_t index, GyroMask active, SubsetCache& subsets,
                  const GyroSeries& series, Isolation& found);
-  //! Bias or ramp, from the parity projected on gyro `id` since the onset; unknown without parity.
+  //! Bias or ramp, from the parity projected on gyro `id` over the history (a step or a ramp from the best
+  //! change time); unknown when neither fits clearly better, or without parity.
   FaultKind classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets) const;
   //! Closes the episode (after a reconfiguration or an operator command).
   void close();
@@ -60,7 +61,15 @@ class Isolator {
 
  private:
   static constexpr int kHistory = 256;  //!< [epochs] history kept for the onset test
+  //! [σ²] how much more of the parity one drift model must explain than the other (a 4σ difference)
+  static constexpr double kDriftMargin = 16.0;
   int onset_test(std::int64_t index, GyroMask active, SubsetCache& subsets, const GyroSeries& series);
+  //! Means of two history windows [b1, e1) and [b2, e2) into the pre/post scratch; their separation [s].
+  double two_windows(std::int64_t b1, std::int64_t e1, std::int64_t b2, std::int64_t e2);
+  //! 1: the change between the two windows' means seen by `mask` is a possible motion (within the
+  //! acceleration bound over `separation_s` and the noise); 0: it is not; −1: cannot judge.
+  int motion_within_bound(GyroMask mask, double separation_s, SubsetCache& subsets,
+                          const GyroSeries& series) const;
   int glt_test(const Subset& s) const;
   //! Window means of each gyro's rate over history epochs [b, e); returns the mean time offset from b [s].
   double window_means(std::int64_t b, std::int64_t e, std::vector<double>& mean,
@@ -79,6 +88,8 @@ class Isolator {
   std::vector<std::int64_t> hist_ns_;
   std::vector<double> mean_pre_, mean_post_;
   std::vector<int> n_pre_, n_post_;
+  mutable std::vector<double> drift_x_;            //!< scratch of classify_drift: projected parity [σ]
+  mutable std::vector<double> drift_t_;            //!< [s] its times
   mutable std::vector<Eigen::VectorXd> glt_mean_;  //!< scratch per parity dimension (never resized)
   mutable std::vector<Eigen::VectorXd> glt_w_;
 };

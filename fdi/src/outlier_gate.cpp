@@ -22,6 +22,7 @@ void OutlierGate::restart() {
 
 void OutlierGate::reset() {
   for (auto& t : tracks_) t = Track{};
+  fast_motion_ = false;
 }
 
 void OutlierGate::update(EpochFrame& frame, SubsetCache& subsets, GyroSeries& series, Counters& counters,
@@ -63,9 +64,27 @@ Isolation OutlierGate::classify_step(int id, const EpochFrame& frame, const Gyro
   if (t.outlier_repeated)
     return {id, FaultKind::kStuck, zero ? Evidence::kZero : Evidence::kRepeated, DetectionTest::kOnset,
             static_cast<double>(t.outlier_run)};
-  if (std::isfinite(r) && r > config_.noise_high_ratio)
-    return {id, FaultKind::kNoise, Evidence::kNoiseLevel, DetectionTest::kOnset, r};
+  if (std::isfinite(r) && r > config_.noise_high_ratio) {
+    // A raised level while the body moves may be its jerk: the step is certain, its kind is not.
+    const bool quiet = series.motion_quiet(id, sqrt_period, config_.onset_confirm_epochs);
+    return {id, quiet ? FaultKind::kNoise : FaultKind::kUnknown,
+            quiet ? Evidence::kNoiseLevel : Evidence::kOnset, DetectionTest::kOnset, r};
+  }
   return {id, FaultKind::kBias, Evidence::kOnset, DetectionTest::kOnset, static_cast<double>(t.outlier_run)};
+}
+
+bool OutlierGate::possible_motion(const Subset& h, double dt_s, const GyroSeries& series,
+                                  const SubsetCache& subsets) const {
+  // The rate change the gyros of `h` imply since their last good samples, against a_max·Δt and its noise.
+  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
+  const Eigen::Vector3d dw = apply_pinv(h.pinv, h.mask, dy_.data());
+  double var = 0.0;
+  for (int i = 1; i <= static_cast<int>(tracks_.size()); ++i) {
+    if (!has_gyro(h.mask, i)) continue;
+    const double sig = series.sample_sigma(i, subsets.sqrt_period());
+    var += h.pinv.col(i - 1).squaredNorm() * 2.0 * sig * sig;
+  }
+  return dw.norm() <= a_max * dt_s + config_.onset_sigma * std::sqrt(var);
 }
 
 int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, const GyroSeries& series) {
@@ -82,22 +101,21 @@ int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, con
   }
   // Δp = √T·W·Δy/√2 (a difference of two samples has twice the variance).
   const double scale = subsets.sqrt_period() / std::sqrt(2.0);
-  if (apply_parity(s, avail, dy_.data(), scale, p_.data()) <= s.jump_threshold) return 0;
-  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
+  if (apply_parity(s, avail, dy_.data(), scale, p_.data()) <= s.jump_threshold) {
+    // No jump: this step's rate change is the body's own. Beyond the bound, the next step's cannot be judged.
+    fast_motion_ = !possible_motion(s, dt_max, series, subsets);
+    return 0;
+  }
+  // The body was turning faster than the bound allows on the last clean step: the true hypothesis may be the
+  // impossible one, and a wrong one possible by a fault cancelling the motion. No call.
+  if (fast_motion_) return 0;
   int consistent = 0;
   int culprit = 0;
   for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
     if (!has_gyro(avail, j)) continue;
     const Subset& h = subsets.get(without_gyro(avail, j));
     if (!h.observable) return 0;  // cannot judge: no outlier call
-    const Eigen::Vector3d dw = apply_pinv(h.pinv, h.mask, dy_.data());
-    double var = 0.0;
-    for (int i = 1; i <= static_cast<int>(tracks_.size()); ++i) {
-      if (!has_gyro(h.mask, i)) continue;
-      const double sig = series.constants(i).arw_rad_rts / subsets.sqrt_period();
-      var += h.pinv.col(i - 1).squaredNorm() * 2.0 * sig * sig;
-    }
-    bool ok = dw.norm() <= a_max * dt_max + config_.onset_sigma * std::sqrt(var);
+    bool ok = possible_motion(h, dt_max, series, subsets);
     if (ok && h.dof >= 1) ok = apply_parity(h, h.mask, dy_.data(), scale, p_.data()) <= h.jump_threshold;
     if (ok) {
       ++consistent;

@@ -38,13 +38,17 @@ class OutlierGate {
   };
   //! The single gyro whose jump explains the parity jump with a possible motion, or 0.
   int jump_culprit(const EpochFrame& frame, SubsetCache& subsets, const GyroSeries& series);
+  //! The rate change that the gyros of `h` imply over `dt_s` is within the acceleration bound and its noise.
+  bool possible_motion(const Subset& h, double dt_s, const GyroSeries& series,
+                       const SubsetCache& subsets) const;
   Isolation classify_step(int id, const EpochFrame& frame, const GyroSeries& series,
                           double sqrt_period) const;
 
   const PipelineConfig& config_;
   std::vector<Track> tracks_;
-  std::vector<double> dy_;  //!< [rad/s] change of each gyro since its last good sample
-  std::vector<double> p_;   //!< parity scratch
+  std::vector<double> dy_;    //!< [rad/s] change of each gyro since its last good sample
+  std::vector<double> p_;     //!< parity scratch
+  bool fast_motion_ = false;  //!< the last step without a jump turned the body beyond the acceleration bound
 };
 
 }  // namespace tetra::fdi::detail

@@ -133,6 +133,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   measured_ = ~GyroMask{0};
   if (subsets_.ready()) {
     reject_outliers();
+    series_.observe_motion(frame_, subsets_);
     detect();
   }
   reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B());

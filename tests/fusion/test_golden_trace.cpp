@@ -24,6 +24,7 @@
 
 #include <gtest/gtest.h>
 
+#include "campaign.hpp"
 #include "test_support.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/units.hpp"
@@ -76,23 +77,6 @@ void PrintTo(const GoldenScenario& g, std::ostream* os) {
   *os << g.name;
 }
 
-GyroCalibration extra_gyro(int id, const Eigen::Vector3d& axis, const Calibration& like) {
-  GyroCalibration g = like.gyros[0];
-  g.id = id;
-  g.scale_factor_V_per_dps = 0.08 + 0.001 * id;
-  g.bias_V = 1e-4 * id;
-  g.axis_B = axis.normalized();
-  return g;
-}
-
-Calibration unit_with(int n) {
-  Calibration cal = seed_as_built_unit();
-  if (n == 3) cal.gyros.resize(3);
-  if (n >= 5) cal.gyros.push_back(extra_gyro(5, Eigen::Vector3d(0.3, 0.5, -0.6), cal));
-  if (n >= 6) cal.gyros.push_back(extra_gyro(6, Eigen::Vector3d(-0.4, 0.7, 0.2), cal));
-  return cal;
-}
-
 sim::FaultSpec fault(int gyro, sim::FaultKind kind, double at, double size = 0.0,
                      std::optional<double> until = std::nullopt) {
   sim::FaultSpec f;
@@ -112,7 +96,7 @@ GoldenScenario base(const std::string& name, const std::string& builtin, double 
   EXPECT_TRUE(sc.ok()) << builtin;
   g.scenario = *sc;
   g.scenario.duration_s = duration_s;
-  g.scenario.unit = unit_with(n_gyros);
+  g.scenario.unit = test::unit_with(n_gyros);
   g.scenario.reference.rate_hz = reference_hz;
   if (reference_hz > 0.0) g.scenario.reference.noise_arcsec = 5.0;
   if (builtin == "orbit" || builtin == "slews") {
