@@ -241,15 +241,12 @@ TEST(CalibrationNoiseModel, MeanCovarianceMatchesADoubleSum) {
 }
 
 TEST(CalibrationNoiseModel, RejectsAModelOfAnotherSize) {
-  const Calibration unit = white_noise_unit();
   const sim::TurntablePlan plan;
-  auto log = sim::simulate_turntable(unit, plan, 3);
+  auto log = sim::simulate_turntable(white_noise_unit(), plan, 3);
   ASSERT_TRUE(log.ok());
-  auto motion = analyze_turntable(*log, plan.latitude_deg);
-  ASSERT_TRUE(motion.ok());
   CalibrationOptions options;
   options.noise.resize(3);
-  auto result = calibrate(*log, *motion, options);
+  auto result = calibrate(*log, analyze_turntable(*log, plan.latitude_deg).value(), options);
   ASSERT_FALSE(result.ok());
   EXPECT_NE(result.error().message.find("noise model has 3 gyros"), std::string::npos);
 }
