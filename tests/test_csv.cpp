@@ -81,5 +81,20 @@ TEST(GyroLog, RejectsMalformedLogs) {
   EXPECT_TRUE(dps->units_dps);
 }
 
+// Text columns (an attitude file's mode and gyros) are skipped, not parsed; every other cell stays strict.
+TEST(Csv, TextColumnsAreNotParsed) {
+  const std::string text = "t,mode,gyros,x\n1,NOMINAL,1;2;10,2\n2,,124,3\n";
+  const auto t = parse_csv(text, "a.csv", {"mode", "gyros"});
+  ASSERT_TRUE(t.ok()) << t.error().message;
+  ASSERT_EQ(t->rows, 2U);
+  EXPECT_TRUE(std::isnan(t->cell(0, 1)));
+  EXPECT_FALSE(t->is_empty(1, 1));
+  EXPECT_EQ(t->cell(1, 3), 3.0);
+  EXPECT_FALSE(parse_csv(text, "a.csv").ok());  // without: 'NOMINAL' is not a number
+  const auto bad = parse_csv("t,mode\nx,NOMINAL\n", "b.csv", {"mode"});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("b.csv:2: column 't'"), std::string::npos) << bad.error().message;
+}
+
 }  // namespace
 }  // namespace tetra

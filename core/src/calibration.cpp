@@ -8,6 +8,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include "tetra/core/correlated_noise.hpp"
 #include "tetra/core/frames.hpp"
 #include "tetra/core/units.hpp"
 
@@ -69,6 +70,32 @@ Eigen::MatrixXd sequence_sigma_of_mean(const TurntableLog& log, const TurntableM
     }
   }
   return sigma;
+}
+
+//! The time span of every sequence, each sample standing for ±half a sampling interval.
+std::vector<TimeInterval> sequence_intervals(const TurntableLog& log, const TurntableMotion& motion) {
+  std::vector<TimeInterval> spans;
+  for (const SequenceMotion& m : motion.sequences) {
+    const double first_s = log.time_s[m.first_row];
+    const double last_s = log.time_s[m.first_row + m.row_count - 1];
+    const double half_dt_s =
+        m.row_count > 1 ? 0.5 * (last_s - first_s) / static_cast<double>(m.row_count - 1) : 0.0;
+    spans.push_back({first_s - half_dt_s, last_s + half_dt_s});
+  }
+  return spans;
+}
+
+//! Covariance [V²] (M×M) of gyro i's sequence means from its correlated noise (none without a model).
+Eigen::MatrixXd correlated_sequence_covariance(const TurntableLog& log, const TurntableMotion& motion,
+                                               const CalibrationOptions& options, int gyro_index0,
+                                               double scale_V_per_dps) {
+  const auto m_count = idx(motion.sequences.size());
+  if (options.noise.empty()) return Eigen::MatrixXd::Zero(m_count, m_count);
+  const double start_s = log.time_s.front();
+  return scale_V_per_dps * scale_V_per_dps *
+         correlated_mean_covariance(sequence_intervals(log, motion),
+                                    options.noise[static_cast<std::size_t>(gyro_index0)],
+                                    options.bias_instability_correlation_s, start_s);
 }
 
 //! Fills a gyro's estimate from x = s·h and β with the 4×4 covariance of (x, β):
@@ -140,8 +167,9 @@ Result<CalibrationResult> calibrate_sixteen(const TurntableLog& log, const Turnt
   result.calibration.method =
       options.bias_model == BiasModel::kBody ? "sixteen-position" : "sixteen-position-seed-bias";
   for (int i = 0; i < n_gyros; ++i) {
-    const Eigen::VectorXd var = sigma_mean.col(i).array().square();
-    const Matrix4d cov = to_params * var.asDiagonal() * to_params.transpose();
+    Eigen::MatrixXd mean_cov = correlated_sequence_covariance(log, motion, options, i, x.row(i).norm());
+    mean_cov.diagonal() += sigma_mean.col(i).array().square().matrix();
+    const Matrix4d cov = to_params * mean_cov * to_params.transpose();
     result.calibration.gyros.push_back(to_gyro(i + 1, x.row(i).transpose(), bias(i), cov));
   }
   result.sequence_sigma_mean_V = sigma_mean;
@@ -187,10 +215,21 @@ Result<CalibrationResult> calibrate_batch(const TurntableLog& log, const Turntab
   result.calibration.unit = options.unit;
   result.calibration.latitude_deg = motion.latitude_deg;
   result.calibration.method = "batch";
+  // Correlated noise: nearly constant regressor within a sequence, so Aᵀ Σ A ≈ Āᵀ C Ā with Ā's rows
+  // n_j·(mean regressor of sequence j) and C the covariance of the sequence means.
+  Eigen::MatrixXd summed_regressor(idx(motion.sequences.size()), 4);
+  for (std::size_t j = 0; j < motion.sequences.size(); ++j) {
+    const SequenceMotion& m = motion.sequences[j];
+    const Eigen::Vector3d w_sum = m.rate_B_dps() * static_cast<double>(m.row_count);
+    summed_regressor.row(idx(j)) << w_sum.transpose(), static_cast<double>(m.row_count);
+  }
   Eigen::MatrixX3d x(n_gyros, 3);
   for (int i = 0; i < n_gyros; ++i) {
     x.row(i) = theta.col(i).head<3>().transpose();
-    const Matrix4d cov = (rss(i) / dof) * normal_inv;
+    const Eigen::MatrixXd mean_cov =
+        correlated_sequence_covariance(log, motion, options, i, theta.col(i).head<3>().norm());
+    const Matrix4d correlated = summed_regressor.transpose() * mean_cov * summed_regressor;
+    const Matrix4d cov = (rss(i) / dof) * normal_inv + normal_inv * correlated * normal_inv;
     result.calibration.gyros.push_back(to_gyro(i + 1, theta.col(i).head<3>(), theta(3, i), cov));
   }
   result.sequence_sigma_mean_V = sequence_sigma_of_mean(log, motion, x);
@@ -244,6 +283,13 @@ Result<CalibrationResult> calibrate(const TurntableLog& log, const TurntableMoti
                                     const CalibrationOptions& options) {
   if (motion.rate_B_dps.size() != log.rows() || motion.sequences.empty()) {
     return failure("calibrate: the motion was not derived from this log");
+  }
+  if (!options.noise.empty() && options.noise.size() != static_cast<std::size_t>(log.gyro_count)) {
+    return bad_input("the noise model has " + std::to_string(options.noise.size()) + " gyros, " + log.source +
+                     " has " + std::to_string(log.gyro_count));
+  }
+  if (!(options.bias_instability_correlation_s > 0.0)) {
+    return bad_input("the bias-instability correlation time must be positive");
   }
   auto result = options.method == CalibrationMethod::kSixteen ? calibrate_sixteen(log, motion, options)
                                                               : calibrate_batch(log, motion, options);

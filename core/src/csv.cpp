@@ -161,6 +161,12 @@ Status parse_lines(std::string_view text, std::size_t& pos, std::size_t& line_no
         t.columns.emplace_back(fields[i]);
       }
       t.header_line = line_no;
+      t.text_flag.assign(t.columns.size(), 0);
+      for (std::size_t i = 0; i < t.columns.size(); ++i) {
+        for (const std::string& name : t.text_columns) {
+          if (name == t.columns[i]) t.text_flag[i] = 1;
+        }
+      }
       have_header = true;
       if (header_only) return ok_status();
       continue;
@@ -173,6 +179,11 @@ Status parse_lines(std::string_view text, std::size_t& pos, std::size_t& line_no
     }
     for (std::size_t c = 0; c < fields.size(); ++c) {
       const std::string_view cell = fields[c];
+      if (c < t.text_flag.size() && t.text_flag[c] != 0) {
+        t.cells.push_back(std::numeric_limits<double>::quiet_NaN());
+        t.empty.push_back(0);
+        continue;
+      }
       if (cell.empty()) {
         t.cells.push_back(std::numeric_limits<double>::quiet_NaN());
         t.empty.push_back(1);
@@ -208,8 +219,13 @@ void reserve_rows(CsvTable& t, std::string_view body) {
 }  // namespace
 
 Result<CsvTable> parse_csv(std::string_view text, std::string source) {
+  return parse_csv(text, std::move(source), {});
+}
+
+Result<CsvTable> parse_csv(std::string_view text, std::string source, std::vector<std::string> text_columns) {
   CsvTable t;
   t.source = std::move(source);
+  t.text_columns = std::move(text_columns);
   if (text.size() >= 3 && std::memcmp(text.data(), "\xEF\xBB\xBF", 3) == 0) text.remove_prefix(3);
 
   std::size_t pos = 0;
@@ -236,6 +252,8 @@ Result<CsvTable> parse_csv(std::string_view text, std::string source) {
   tail.source = t.source;
   tail.columns = t.columns;
   tail.header_line = t.header_line;
+  tail.text_columns = t.text_columns;
+  tail.text_flag = t.text_flag;
   std::size_t tail_line_no = line_no + static_cast<std::size_t>(std::count(first.begin(), first.end(), '\n'));
   Status tail_status = ok_status();
   std::thread worker([&] {

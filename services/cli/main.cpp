@@ -25,6 +25,7 @@ constexpr Command kCommands[] = {
     {"allan", tetra::cli::cmd_allan, "Allan deviation and IEEE 952 noise terms of a gyro log"},
     {"sim", tetra::cli::cmd_sim, "simulate a unit: turntable, static, orbits, slews, faults"},
     {"replay", tetra::cli::cmd_replay, "run the fusion and fault-detection pipeline over a gyro log"},
+    {"score", tetra::cli::cmd_score, "attitude error, NEES and sigma bounds of an estimate against truth"},
     {"convert", tetra::cli::cmd_convert, "convert a gyro log between CSV and HDF5"},
     {"fusion", tetra::cli::cmd_fusion, "the fusion service on DDS"},
     {"monitor", tetra::cli::cmd_monitor, "ground monitoring of every unit on the DDS domain"},

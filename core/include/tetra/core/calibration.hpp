@@ -21,6 +21,10 @@
 //              the model within its sequence, / √n) propagated linearly through every step.
 //   kBatch   — one least-squares fit of g_i(t) = x_i · ω_B(t) + β_i over every sample; 1σ from the residual
 //              covariance σ̂²·(AᵀA)⁻¹ (white residuals assumed).
+// With a noise model (CalibrationOptions::noise) both 1σ also carry the correlated noise: the covariance
+// of the sequence means that bias instability and rate random walk cause (correlated over the whole log,
+// so it does not average down like white noise), propagated through the same linear maps. Without it,
+// a unit with bias instability gets 1σ several times too small (docs/calibration.md, "Are the 1σ honest?").
 // Both report, per gyro, the residual RMS over samples and over sequence means.
 
 #include <string>
@@ -85,6 +89,11 @@ struct CalibrationOptions {
   CalibrationMethod method = CalibrationMethod::kSixteen;
   BiasModel bias_model = BiasModel::kBody;  //!< used by kSixteen only
   std::string unit = "tetra-1";             //!< written to the calibration file
+  //! The unit's noise model per gyro (e.g. from `tetra allan`), for the 1σ only: empty = white noise
+  //! within a sequence assumed; otherwise one entry per gyro, whose bias instability B and rate random
+  //! walk K add the covariance of the sequence means they cause (correlated_noise.hpp).
+  std::vector<GyroNoise> noise;
+  double bias_instability_correlation_s = 100.0;  //!< [s] T_c of the Gauss–Markov model of B
 };
 
 //! How well a calibration explains the turntable data.

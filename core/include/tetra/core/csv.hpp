@@ -34,6 +34,10 @@ struct CsvTable {
   std::vector<double> cells;          //!< row-major rows×columns; NaN where empty or "nan"
   std::vector<std::uint8_t> empty;    //!< row-major; 1 where the cell was empty
   std::vector<std::size_t> lines;     //!< 1-based file line of each data row
+  //! Columns whose cells are text, not numbers (an attitude file's `mode`): not parsed, value NaN.
+  //! Set by parse_csv's text_columns; text_flag has one entry per column once the header is read.
+  std::vector<std::string> text_columns;
+  std::vector<std::uint8_t> text_flag;
 
   std::size_t column_count() const { return columns.size(); }
   //! Index of a column by exact name, or nullopt.
@@ -59,6 +63,8 @@ void parse_metadata_comment(std::string_view comment, Metadata& metadata);
 
 //! Parses a whole table from text; `source` names it in messages.
 Result<CsvTable> parse_csv(std::string_view text, std::string source);
+//! The same with the named columns kept as text (not parsed; their cells NaN, never "empty").
+Result<CsvTable> parse_csv(std::string_view text, std::string source, std::vector<std::string> text_columns);
 //! Reads and parses a file (a regular file or a FIFO of at most kMaxTableBytes).
 Result<CsvTable> read_csv(const std::string& path);
 

@@ -29,12 +29,14 @@
 #include <optional>
 
 #include "tetra/core/calibration_file.hpp"
+#include "tetra/core/correlated_noise.hpp"
 #include "tetra/sim/random.hpp"
 
 namespace tetra::sim {
 
-//! σ_GM / B: stationary σ of the Gauss–Markov process whose Allan peak equals 0.664·B.
-inline constexpr double kGaussMarkovSigmaPerB = 1.0760;
+//! σ_GM / B: stationary σ of the Gauss–Markov process whose Allan peak equals 0.664·B (shared with the
+//! calibration's noise model, tetra/core/correlated_noise.hpp).
+using tetra::kGaussMarkovSigmaPerB;
 //! τ / T_c at which the Allan deviation of a first-order Gauss–Markov process peaks.
 inline constexpr double kGaussMarkovPeakTauPerTc = 1.893;
 
