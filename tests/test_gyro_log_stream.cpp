@@ -175,6 +175,25 @@ TEST(GyroLogHdf5, ConvertRoundTripIsByteIdentical) {
   EXPECT_EQ(r.exit_status, 2);
 }
 
+// --compress (shuffle + deflate) changes the file, not what is read from it: same epochs, same round trip,
+// a smaller file (the test log's values are noise around 1.5 V: the exponent and sign bytes compress).
+TEST(GyroLogHdf5, CompressedLogsReadTheSame) {
+  TempDir dir;
+  const auto csv = write_log(dir.file("log.csv"), 70000, true);
+  auto r = test::run_tetra("convert " + csv + " " + dir.file("plain.h5"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  r = test::run_tetra("convert --compress " + csv + " " + dir.file("packed.h5"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_LT(std::filesystem::file_size(dir.file("packed.h5")),
+            std::filesystem::file_size(dir.file("plain.h5")));
+  auto plain = read_gyro_log(dir.file("plain.h5"));
+  ASSERT_TRUE(plain.ok()) << plain.error().message;
+  expect_same_log(read_by_blocks(dir.file("packed.h5")), *plain, true);
+  r = test::run_tetra("convert " + dir.file("packed.h5") + " " + dir.file("back.csv"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_EQ(test::read_file(dir.file("back.csv")), test::read_file(csv));
+}
+
 // Streaming outputs go through the output layer: a failed conversion leaves the old file byte-identical
 // and no temporary file behind; provenance lines (escaped values) survive CSV -> HDF5 -> CSV verbatim.
 TEST(GyroLogHdf5, ConvertGoesThroughTheOutputLayer) {
