@@ -1,5 +1,6 @@
 // Long logs: the block readers (CSV and HDF5) give what the whole-file reader gives, with the same
 // errors; HDF5 round trips; the streaming Allan analysis equals the whole-log one bit for bit.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -260,6 +261,47 @@ TEST(GyroLogHdf5, BadFilesGiveOneLineErrors) {
   const auto cli = test::run_tetra("replay " + dir.file("nan.h5") + " --calibration x.yaml --attitude " +
                                    dir.file("a.csv") + " --events " + dir.file("e.jsonl"));
   EXPECT_EQ(cli.exit_status, 2);
+}
+
+// The lines of a text after its comment lines (provenance differs between runs: inputs, time).
+std::string without_comments(const std::string& text) {
+  std::string out;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    if (text[pos] != '#') out.append(text, pos, end + 1 - pos);
+    pos = end + 1;
+  }
+  return out;
+}
+
+// Replay writes its attitude rows on a worker thread, in batches: a log of many batches (70 000 epochs,
+// 17 batches and a partial one) gives the same rows from CSV, HDF5 and compressed HDF5, one per accepted
+// epoch, and the same events.
+TEST(ReplayStream, AttitudeRowsAreTheSameFromEveryFormat) {
+  TempDir dir;
+  const auto csv = write_log(dir.file("log.csv"), 70000, true);
+  ASSERT_TRUE(write_calibration(dir.file("cal.yaml"), seed_as_built_unit()).ok());
+  auto r = test::run_tetra("convert " + csv + " " + dir.file("log.h5"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  r = test::run_tetra("convert --compress " + csv + " " + dir.file("z.h5"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  std::array<std::string, 3> attitude;
+  std::array<std::string, 3> events;
+  const std::array<std::string, 3> logs = {csv, dir.file("log.h5"), dir.file("z.h5")};
+  for (std::size_t k = 0; k < logs.size(); ++k) {
+    r = test::run_tetra("replay " + logs[k] + " --calibration " + dir.file("cal.yaml") + " --attitude " +
+                        dir.file("a.csv") + " --events " + dir.file("e.jsonl"));
+    ASSERT_EQ(r.exit_status, 0) << r.err;
+    attitude[k] = without_comments(test::read_file(dir.file("a.csv")));
+    events[k] = test::read_file(dir.file("e.jsonl"));
+  }
+  const auto rows = static_cast<std::size_t>(std::count(attitude[0].begin(), attitude[0].end(), '\n'));
+  EXPECT_EQ(rows, 70001U);  // the header and every epoch (times increase, none rejected)
+  EXPECT_EQ(attitude[1], attitude[0]);
+  EXPECT_EQ(attitude[2], attitude[0]);
+  EXPECT_EQ(events[1], events[0]);
+  EXPECT_EQ(events[2], events[0]);
 }
 
 void expect_same_allan(const allan::LogAllan& a, const allan::LogAllan& b) {
