@@ -21,8 +21,8 @@ namespace {
 constexpr const char* kFormat = "tetra gyro log";
 constexpr int kVersion = 1;
 constexpr hsize_t kChunkRows = 65536;  // rows per chunk, and per block written
-constexpr hsize_t kBlockRows =
-    32768;  // rows per block read: half a chunk, 2.5 MB for 4 gyros and a reference
+// Rows per block read: half a chunk (2.5 MB for 4 gyros and a reference).
+constexpr hsize_t kBlockRows = 32768;
 constexpr unsigned kDeflateLevel = 1;  // with compression: the noise in gyro values barely compresses anyway
 constexpr std::array<const char*, 4> kRefNames = {"ref_qw", "ref_qx", "ref_qy", "ref_qz"};
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
