@@ -14,6 +14,7 @@
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/gyro_log_prefetch.hpp"
+#include "tetra/core/turntable_log.hpp"
 
 namespace tetra {
 namespace {
@@ -261,6 +262,45 @@ TEST(GyroLogHdf5, BadFilesGiveOneLineErrors) {
   const auto cli = test::run_tetra("replay " + dir.file("nan.h5") + " --calibration x.yaml --attitude " +
                                    dir.file("a.csv") + " --events " + dir.file("e.jsonl"));
   EXPECT_EQ(cli.exit_status, 2);
+}
+
+// tetra calibrate reads its turntable log block by block: the same log as parsing the whole text, with
+// comment lines after the header and after the last row, and the same errors on the same lines.
+TEST(TurntableStream, BlocksGiveTheWholeTextsLog) {
+  TempDir dir;
+  auto r = test::run_tetra("sim turntable --rate-hz 200 -o " + dir.file("tt.csv"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  std::string text = test::read_file(dir.file("tt.csv"));
+  ASSERT_GT(text.size(), 3U << 20);  // several blocks
+  const std::size_t middle = text.find('\n', text.size() / 2) + 1;
+  text = text.substr(0, middle) + "# note=after the header\n" + text.substr(middle) + "# unit=late-name\n";
+  test::write_file(dir.file("tt2.csv"), text);
+  auto whole = parse_turntable_log(text, dir.file("tt2.csv"));
+  auto streamed = read_turntable_log(dir.file("tt2.csv"));
+  ASSERT_TRUE(whole.ok()) << whole.error().message;
+  ASSERT_TRUE(streamed.ok()) << streamed.error().message;
+  EXPECT_EQ(streamed->metadata, whole->metadata);
+  EXPECT_EQ(streamed->meta("unit"), "late-name");
+  EXPECT_EQ(streamed->gyro_count, whole->gyro_count);
+  EXPECT_EQ(streamed->sequence, whole->sequence);
+  EXPECT_TRUE(same_bits(streamed->time_s, whole->time_s));
+  EXPECT_TRUE(same_bits(streamed->inner_deg, whole->inner_deg));
+  EXPECT_TRUE(same_bits(streamed->outer_deg, whole->outer_deg));
+  EXPECT_TRUE(same_bits(streamed->g_V, whole->g_V));
+  EXPECT_EQ(streamed->lines, whole->lines);
+
+  // A time that repeats in a late block: the same message and line.
+  const std::size_t late = text.find('\n', text.size() * 3 / 4) + 1;
+  const std::size_t late_end = text.find('\n', late) + 1;
+  const std::string row = text.substr(late, late_end - late);
+  const std::string bad = text.substr(0, late_end) + row + text.substr(late_end);
+  test::write_file(dir.file("bad.csv"), bad);
+  auto bad_whole = parse_turntable_log(bad, dir.file("bad.csv"));
+  auto bad_streamed = read_turntable_log(dir.file("bad.csv"));
+  ASSERT_FALSE(bad_whole.ok());
+  ASSERT_FALSE(bad_streamed.ok());
+  EXPECT_EQ(bad_streamed.error().message, bad_whole.error().message);
+  EXPECT_NE(bad_streamed.error().message.find("time goes backwards or repeats"), std::string::npos);
 }
 
 // The lines of a text after its comment lines (provenance differs between runs: inputs, time).
