@@ -4,6 +4,7 @@
 # `tetra allan`, `tetra convert` and reading alone.
 #   replay:  orbit logs at 100 Hz, 4 gyros, 1 Hz reference: 30, 120 and 360 min (REPLAY_MINUTES)
 #   allan:   static logs at 100 Hz, 4 gyros: 2, 4 and 8 h (ALLAN_HOURS)
+#   calibr:  the simulated turntable plan at 250, 500 and 1000 Hz, 4 gyros (TURNTABLE_HZ)
 # Each row: command, format, epochs, wall seconds, epochs per second, CPU seconds (user + system, all
 # threads), peak RSS [MB]. Wall times depend on the machine's load (printed first); CPU seconds less so.
 # Reading rows: the best of 3 runs of bench/read_log.
@@ -74,6 +75,15 @@ for h in $ALLAN_HOURS; do
     row allan "$f" "$n" -- "$T" allan "$work/static_$h.$f" --calibration "$log.cal.yaml" --json "$work/a.json"
   done
   rm -f "$work/static_$h.csv" "$work/static_$h.h5" "$work/static_$h.h5z.h5"
+done
+
+# calibrate: the simulated turntable plan at 250, 500 and 1000 Hz (TURNTABLE_HZ)
+for hz in ${TURNTABLE_HZ:-250 500 1000}; do
+  log="$work/turntable_$hz.csv"
+  "$T" sim turntable --rate-hz "$hz" -o "$log" >/dev/null 2>&1
+  n=$(grep -v '^#' "$log" | tail -n +2 | wc -l)
+  row calibr csv "$n" -- "$T" calibrate "$log" -o "$work/cal_out.yaml"
+  rm -f "$log"
 done
 
 if [ "${BIG:-0}" = 1 ]; then
