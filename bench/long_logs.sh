@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
-# Long logs (docs/formats.md, docs/allan.md): time and peak RSS against the log's length, CSV and HDF5,
-# for `tetra replay`, `tetra allan`, `tetra convert` and reading alone.
+# Long logs (docs/formats.md, docs/allan.md): time and peak RSS against the log's length, CSV, HDF5
+# (uncompressed, the default) and HDF5 written with `convert --compress` (h5z), for `tetra replay`,
+# `tetra allan`, `tetra convert` and reading alone.
 #   replay:  orbit logs at 100 Hz, 4 gyros, 1 Hz reference: 30, 120 and 360 min (REPLAY_MINUTES)
 #   allan:   static logs at 100 Hz, 4 gyros: 2, 4 and 8 h (ALLAN_HOURS)
-# Each row: command, format, epochs, wall seconds, epochs per second, peak RSS [MB].
+#   calibr:  the simulated turntable plan at 250, 500 and 1000 Hz, 4 gyros (TURNTABLE_HZ)
+# Each row: command, format, epochs, wall seconds, epochs per second, CPU seconds (user + system, all
+# threads), peak RSS [MB]. Wall times depend on the machine's load (printed first); CPU seconds less so.
+# Reading rows: the best of 3 runs of bench/read_log.
 # usage: bench/long_logs.sh [BUILD_DIR=build]   (needs tetra, make_allan_log and read_log built; ~1 GB of /tmp)
-# BIG=1 adds Allan of 24 h x 1 kHz x 4 gyros from HDF5 (a 3 GB HDF5 file, generated on the way).
+# BIG=1 adds Allan of 24 h x 1 kHz x 4 gyros from HDF5 (a 3.8 GB HDF5 file, generated on the way).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -16,14 +20,19 @@ REPLAY_MINUTES=${REPLAY_MINUTES:-"30 120 360"}
 ALLAN_HOURS=${ALLAN_HOURS:-"2 4 8"}
 
 echo "load: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
-printf '%-8s %-5s %10s %8s %12s %10s\n' command fmt epochs wall_s epochs_per_s peak_MB
+printf '%-8s %-5s %10s %8s %12s %8s %10s\n' command fmt epochs wall_s epochs_per_s cpu_s peak_MB
 row() {  # NAME FMT EPOCHS -- CMD...
   local name=$1 fmt=$2 epochs=$3
   shift 4
-  /usr/bin/time -f "%e %M" -o "$work/time.txt" "$@" >/dev/null 2>"$work/err.txt" || { cat "$work/err.txt"; exit 1; }
-  read -r wall kb <"$work/time.txt"
-  awk -v n="$name" -v f="$fmt" -v e="$epochs" -v w="$wall" -v k="$kb" \
-    'BEGIN { printf "%-8s %-5s %10d %8.2f %12.0f %10.1f\n", n, f, e, w, (w > 0 ? e / w : 0), k / 1024 }'
+  /usr/bin/time -f "%e %U %S %M" -o "$work/time.txt" "$@" >/dev/null 2>"$work/err.txt" || { cat "$work/err.txt"; exit 1; }
+  read -r wall user sys kb <"$work/time.txt"
+  awk -v n="$name" -v f="$fmt" -v e="$epochs" -v w="$wall" -v c="$(awk -v u="$user" -v s="$sys" 'BEGIN { print u + s }')" -v k="$kb" \
+    'BEGIN { printf "%-8s %-5s %10d %8.2f %12.0f %8.2f %10.1f\n", n, f, e, w, (w > 0 ? e / w : 0), c, k / 1024 }'
+}
+read_rows() {  # LOG FMT: best of 3 block reads
+  local best
+  best=$(for _ in 1 2 3; do "$build/bench/read_log" "$1" blocks; done | awk '{ print $6, $3 }' | sort -n | head -1)
+  echo "$best" | awk -v f="$2" '{ printf "%-8s %-5s %10d %8.3f %12.0f\n", "read", f, $2, $1, $2 / $1 }'
 }
 epochs_of() { grep -vc '^#' "$1" | awk '{ print $1 - 1 }'; }
 
@@ -42,14 +51,15 @@ for m in $REPLAY_MINUTES; do
   "$T" sim orbit --seed 3 --rate-hz 100 --minutes "$m" --reference-hz 1 -o "$log" >/dev/null 2>&1
   n=$(epochs_of "$log")
   row convert csv2h5 "$n" -- "$T" convert "$log" "$work/orbit_$m.h5"
-  for f in csv h5; do
-    echo "read    $f     $("$build/bench/read_log" "$work/orbit_$m.$f" blocks)"
-  done
+  row convert csv2h5z "$n" -- "$T" convert --compress "$log" "$work/orbit_$m.h5z.h5"
+  read_rows "$log" csv
+  read_rows "$work/orbit_$m.h5" h5
+  read_rows "$work/orbit_$m.h5z.h5" h5z
   for f in csv h5; do
     row replay "$f" "$n" -- "$T" replay "$work/orbit_$m.$f" --calibration "$work/cal.yaml" \
       --attitude "$work/att.csv" --events "$work/ev.jsonl"
   done
-  rm -f "$work/orbit_$m.csv" "$work/orbit_$m.h5"
+  rm -f "$work/orbit_$m.csv" "$work/orbit_$m.h5" "$work/orbit_$m.h5z.h5"
 done
 
 for h in $ALLAN_HOURS; do
@@ -57,13 +67,23 @@ for h in $ALLAN_HOURS; do
   "$build/bench/make_allan_log" "$log" "$h" 100 1 >/dev/null
   n=$(epochs_of "$log")
   "$T" convert "$log" "$work/static_$h.h5"
-  for f in csv h5; do
-    echo "read    $f     $("$build/bench/read_log" "$work/static_$h.$f" blocks)"
-  done
+  "$T" convert --compress "$log" "$work/static_$h.h5z.h5"
+  read_rows "$log" csv
+  read_rows "$work/static_$h.h5" h5
+  read_rows "$work/static_$h.h5z.h5" h5z
   for f in csv h5; do
     row allan "$f" "$n" -- "$T" allan "$work/static_$h.$f" --calibration "$log.cal.yaml" --json "$work/a.json"
   done
-  rm -f "$work/static_$h.csv" "$work/static_$h.h5"
+  rm -f "$work/static_$h.csv" "$work/static_$h.h5" "$work/static_$h.h5z.h5"
+done
+
+# calibrate: the simulated turntable plan at 250, 500 and 1000 Hz (TURNTABLE_HZ)
+for hz in ${TURNTABLE_HZ:-250 500 1000}; do
+  log="$work/turntable_$hz.csv"
+  "$T" sim turntable --rate-hz "$hz" -o "$log" >/dev/null 2>&1
+  n=$(grep -v '^#' "$log" | tail -n +2 | wc -l)
+  row calibr csv "$n" -- "$T" calibrate "$log" -o "$work/cal_out.yaml"
+  rm -f "$log"
 done
 
 if [ "${BIG:-0}" = 1 ]; then

@@ -1,5 +1,6 @@
 // Long logs: the block readers (CSV and HDF5) give what the whole-file reader gives, with the same
 // errors; HDF5 round trips; the streaming Allan analysis equals the whole-log one bit for bit.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/gyro_log_prefetch.hpp"
+#include "tetra/core/turntable_log.hpp"
 
 namespace tetra {
 namespace {
@@ -175,6 +177,25 @@ TEST(GyroLogHdf5, ConvertRoundTripIsByteIdentical) {
   EXPECT_EQ(r.exit_status, 2);
 }
 
+// --compress (shuffle + deflate) changes the file, not what is read from it: same epochs, same round trip,
+// a smaller file (the test log's values are noise around 1.5 V: the exponent and sign bytes compress).
+TEST(GyroLogHdf5, CompressedLogsReadTheSame) {
+  TempDir dir;
+  const auto csv = write_log(dir.file("log.csv"), 70000, true);
+  auto r = test::run_tetra("convert " + csv + " " + dir.file("plain.h5"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  r = test::run_tetra("convert --compress " + csv + " " + dir.file("packed.h5"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_LT(std::filesystem::file_size(dir.file("packed.h5")),
+            std::filesystem::file_size(dir.file("plain.h5")));
+  auto plain = read_gyro_log(dir.file("plain.h5"));
+  ASSERT_TRUE(plain.ok()) << plain.error().message;
+  expect_same_log(read_by_blocks(dir.file("packed.h5")), *plain, true);
+  r = test::run_tetra("convert " + dir.file("packed.h5") + " " + dir.file("back.csv"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_EQ(test::read_file(dir.file("back.csv")), test::read_file(csv));
+}
+
 // Streaming outputs go through the output layer: a failed conversion leaves the old file byte-identical
 // and no temporary file behind; provenance lines (escaped values) survive CSV -> HDF5 -> CSV verbatim.
 TEST(GyroLogHdf5, ConvertGoesThroughTheOutputLayer) {
@@ -241,6 +262,86 @@ TEST(GyroLogHdf5, BadFilesGiveOneLineErrors) {
   const auto cli = test::run_tetra("replay " + dir.file("nan.h5") + " --calibration x.yaml --attitude " +
                                    dir.file("a.csv") + " --events " + dir.file("e.jsonl"));
   EXPECT_EQ(cli.exit_status, 2);
+}
+
+// tetra calibrate reads its turntable log block by block: the same log as parsing the whole text, with
+// comment lines after the header and after the last row, and the same errors on the same lines.
+TEST(TurntableStream, BlocksGiveTheWholeTextsLog) {
+  TempDir dir;
+  auto r = test::run_tetra("sim turntable --rate-hz 200 -o " + dir.file("tt.csv"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  std::string text = test::read_file(dir.file("tt.csv"));
+  ASSERT_GT(text.size(), 3U << 20);  // several blocks
+  const std::size_t middle = text.find('\n', text.size() / 2) + 1;
+  text = text.substr(0, middle) + "# note=after the header\n" + text.substr(middle) + "# unit=late-name\n";
+  test::write_file(dir.file("tt2.csv"), text);
+  auto whole = parse_turntable_log(text, dir.file("tt2.csv"));
+  auto streamed = read_turntable_log(dir.file("tt2.csv"));
+  ASSERT_TRUE(whole.ok()) << whole.error().message;
+  ASSERT_TRUE(streamed.ok()) << streamed.error().message;
+  EXPECT_EQ(streamed->metadata, whole->metadata);
+  EXPECT_EQ(streamed->meta("unit"), "late-name");
+  EXPECT_EQ(streamed->gyro_count, whole->gyro_count);
+  EXPECT_EQ(streamed->sequence, whole->sequence);
+  EXPECT_TRUE(same_bits(streamed->time_s, whole->time_s));
+  EXPECT_TRUE(same_bits(streamed->inner_deg, whole->inner_deg));
+  EXPECT_TRUE(same_bits(streamed->outer_deg, whole->outer_deg));
+  EXPECT_TRUE(same_bits(streamed->g_V, whole->g_V));
+  EXPECT_EQ(streamed->lines, whole->lines);
+
+  // A time that repeats in a late block: the same message and line.
+  const std::size_t late = text.find('\n', text.size() * 3 / 4) + 1;
+  const std::size_t late_end = text.find('\n', late) + 1;
+  const std::string row = text.substr(late, late_end - late);
+  const std::string bad = text.substr(0, late_end) + row + text.substr(late_end);
+  test::write_file(dir.file("bad.csv"), bad);
+  auto bad_whole = parse_turntable_log(bad, dir.file("bad.csv"));
+  auto bad_streamed = read_turntable_log(dir.file("bad.csv"));
+  ASSERT_FALSE(bad_whole.ok());
+  ASSERT_FALSE(bad_streamed.ok());
+  EXPECT_EQ(bad_streamed.error().message, bad_whole.error().message);
+  EXPECT_NE(bad_streamed.error().message.find("time goes backwards or repeats"), std::string::npos);
+}
+
+// The lines of a text after its comment lines (provenance differs between runs: inputs, time).
+std::string without_comments(const std::string& text) {
+  std::string out;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    if (text[pos] != '#') out.append(text, pos, end + 1 - pos);
+    pos = end + 1;
+  }
+  return out;
+}
+
+// Replay writes its attitude rows on a worker thread, in batches: a log of many batches (70 000 epochs,
+// 17 batches and a partial one) gives the same rows from CSV, HDF5 and compressed HDF5, one per accepted
+// epoch, and the same events.
+TEST(ReplayStream, AttitudeRowsAreTheSameFromEveryFormat) {
+  TempDir dir;
+  const auto csv = write_log(dir.file("log.csv"), 70000, true);
+  ASSERT_TRUE(write_calibration(dir.file("cal.yaml"), seed_as_built_unit()).ok());
+  auto r = test::run_tetra("convert " + csv + " " + dir.file("log.h5"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  r = test::run_tetra("convert --compress " + csv + " " + dir.file("z.h5"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  std::array<std::string, 3> attitude;
+  std::array<std::string, 3> events;
+  const std::array<std::string, 3> logs = {csv, dir.file("log.h5"), dir.file("z.h5")};
+  for (std::size_t k = 0; k < logs.size(); ++k) {
+    r = test::run_tetra("replay " + logs[k] + " --calibration " + dir.file("cal.yaml") + " --attitude " +
+                        dir.file("a.csv") + " --events " + dir.file("e.jsonl"));
+    ASSERT_EQ(r.exit_status, 0) << r.err;
+    attitude[k] = without_comments(test::read_file(dir.file("a.csv")));
+    events[k] = test::read_file(dir.file("e.jsonl"));
+  }
+  const auto rows = static_cast<std::size_t>(std::count(attitude[0].begin(), attitude[0].end(), '\n'));
+  EXPECT_EQ(rows, 70001U);  // the header and every epoch (times increase, none rejected)
+  EXPECT_EQ(attitude[1], attitude[0]);
+  EXPECT_EQ(attitude[2], attitude[0]);
+  EXPECT_EQ(events[1], events[0]);
+  EXPECT_EQ(events[2], events[0]);
 }
 
 void expect_same_allan(const allan::LogAllan& a, const allan::LogAllan& b) {

@@ -224,7 +224,7 @@ Status GyroLogWriter::open_output(OutputFile& out, int gyro_count, bool with_ref
     auto file_path = out.library_path();
     if (!file_path) return file_path.error();
     h5_ = std::make_unique<GyroLogH5Writer>();
-    if (Status s = h5_->open(*file_path, out.path(), gyro_count, with_reference, comments); !s) {
+    if (Status s = h5_->open(*file_path, out.path(), gyro_count, with_reference, comments, compress_); !s) {
       h5_.reset();
       return s;
     }

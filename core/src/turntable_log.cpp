@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/input_files.hpp"
 
 namespace tetra {
 
@@ -12,74 +13,115 @@ std::optional<std::string> TurntableLog::meta(const std::string& key) const {
 
 namespace {
 
-Result<TurntableLog> from_table(CsvTable&& t) {
-  TurntableLog log;
-  log.source = t.source;
-  log.metadata = t.metadata;
+// The columns of a turntable log, found in its header.
+struct Columns {
+  std::size_t fixed[4] = {};  // sequence, time_s, inner_deg, outer_deg
+  std::vector<std::size_t> gyro;
+};
+
+constexpr const char* kFixedNames[4] = {"sequence", "time_s", "inner_deg", "outer_deg"};
+
+Result<Columns> find_columns(const CsvTable& t) {
+  Columns c;
   const std::string head = t.source + ":" + std::to_string(t.header_line) + ": header: ";
-  std::size_t cols[4] = {};
-  const char* names[4] = {"sequence", "time_s", "inner_deg", "outer_deg"};
   for (int k = 0; k < 4; ++k) {
-    const auto c = t.find_column(names[k]);
-    if (!c) return bad_input(head + "missing column '" + names[k] + "'");
-    cols[k] = *c;
+    const auto col = t.find_column(kFixedNames[k]);
+    if (!col) return bad_input(head + "missing column '" + kFixedNames[k] + "'");
+    c.fixed[k] = *col;
   }
-  std::vector<std::size_t> gyro_cols;
   for (int id = 1;; ++id) {
-    const auto c = t.find_column("g" + std::to_string(id));
-    if (!c) break;
-    gyro_cols.push_back(*c);
+    const auto col = t.find_column("g" + std::to_string(id));
+    if (!col) break;
+    c.gyro.push_back(*col);
   }
-  if (gyro_cols.size() < 3) {
-    return bad_input(head + std::to_string(gyro_cols.size()) +
+  if (c.gyro.size() < 3) {
+    return bad_input(head + std::to_string(c.gyro.size()) +
                      " gyro columns (g1, g2, ...) found, calibration needs at least 3");
   }
-  if (4 + gyro_cols.size() != t.column_count()) {
+  if (4 + c.gyro.size() != t.column_count()) {
     for (const auto& name : t.columns) {
       bool known = false;
-      for (const char* n : names) known = known || name == n;
-      for (std::size_t g = 0; g < gyro_cols.size(); ++g) known = known || name == "g" + std::to_string(g + 1);
+      for (const char* n : kFixedNames) known = known || name == n;
+      for (std::size_t g = 0; g < c.gyro.size(); ++g) known = known || name == "g" + std::to_string(g + 1);
       if (!known) return bad_input(head + "unknown column '" + name + "'");
     }
   }
-  if (t.rows == 0) return bad_input(t.source + ": no data rows");
+  return c;
+}
 
-  log.gyro_count = static_cast<int>(gyro_cols.size());
-  const std::size_t n = t.rows;
-  const auto ng = gyro_cols.size();
-  log.sequence.resize(n);
-  log.time_s.resize(n);
-  log.inner_deg.resize(n);
-  log.outer_deg.resize(n);
-  log.g_V.resize(n * ng);
-  for (std::size_t r = 0; r < n; ++r) {
+// Checks the rows of `t` and appends them to `log` (times must increase across calls too).
+Status append_rows(const CsvTable& t, const Columns& c, TurntableLog& log) {
+  const auto ng = c.gyro.size();
+  for (std::size_t r = 0; r < t.rows; ++r) {
     for (std::size_t k = 0; k < 4; ++k) {
-      if (t.is_empty(r, cols[k]) || !std::isfinite(t.cell(r, cols[k]))) {
-        return bad_input(t.where(r, cols[k]) + "a finite number is required");
+      if (t.is_empty(r, c.fixed[k]) || !std::isfinite(t.cell(r, c.fixed[k]))) {
+        return bad_input(t.where(r, c.fixed[k]) + "a finite number is required");
       }
     }
-    const double seq = t.cell(r, cols[0]);
+    const double seq = t.cell(r, c.fixed[0]);
     if (seq != std::floor(seq) || seq < 1 || seq > 1e6) {
-      return bad_input(t.where(r, cols[0]) + "sequence must be a positive integer");
+      return bad_input(t.where(r, c.fixed[0]) + "sequence must be a positive integer");
     }
-    log.sequence[r] = static_cast<int>(seq);
-    log.time_s[r] = t.cell(r, cols[1]);
-    if (r > 0 && log.time_s[r] <= log.time_s[r - 1]) {
-      return bad_input(t.where(r, cols[1]) + "time goes backwards or repeats (" +
-                       std::to_string(log.time_s[r]) + " after " + std::to_string(log.time_s[r - 1]) + ")");
+    const double time_s = t.cell(r, c.fixed[1]);
+    if (!log.time_s.empty() && time_s <= log.time_s.back()) {
+      return bad_input(t.where(r, c.fixed[1]) + "time goes backwards or repeats (" + std::to_string(time_s) +
+                       " after " + std::to_string(log.time_s.back()) + ")");
     }
-    log.inner_deg[r] = t.cell(r, cols[2]);
-    log.outer_deg[r] = t.cell(r, cols[3]);
+    log.sequence.push_back(static_cast<int>(seq));
+    log.time_s.push_back(time_s);
+    log.inner_deg.push_back(t.cell(r, c.fixed[2]));
+    log.outer_deg.push_back(t.cell(r, c.fixed[3]));
     for (std::size_t g = 0; g < ng; ++g) {
-      const double v = t.cell(r, gyro_cols[g]);
-      if (t.is_empty(r, gyro_cols[g]) || !std::isfinite(v)) {
-        return bad_input(t.where(r, gyro_cols[g]) + "a finite voltage is required");
+      const double v = t.cell(r, c.gyro[g]);
+      if (t.is_empty(r, c.gyro[g]) || !std::isfinite(v)) {
+        return bad_input(t.where(r, c.gyro[g]) + "a finite voltage is required");
       }
-      log.g_V[r * ng + g] = v;
+      log.g_V.push_back(v);
     }
   }
-  log.lines = std::move(t.lines);
+  log.lines.insert(log.lines.end(), t.lines.begin(), t.lines.end());
+  return ok_status();
+}
+
+// The log's fields known from its header.
+TurntableLog empty_log(const CsvTable& header, const Columns& c) {
+  TurntableLog log;
+  log.source = header.source;
+  log.metadata = header.metadata;
+  log.gyro_count = static_cast<int>(c.gyro.size());
   return log;
+}
+
+Result<TurntableLog> from_table(CsvTable&& t) {
+  auto c = find_columns(t);
+  if (!c) return c.error();
+  if (t.rows == 0) return bad_input(t.source + ": no data rows");
+  TurntableLog log = empty_log(t, *c);
+  if (Status s = append_rows(t, *c, log); !s) return s.error();
+  return log;
+}
+
+// Comment lines found in a block, after those of the header (the whole file's order).
+void append_block_metadata(const CsvTable& block, std::size_t header_entries, TurntableLog& log) {
+  if (block.metadata.size() <= header_entries) return;
+  log.metadata.insert(log.metadata.end(),
+                      block.metadata.begin() + static_cast<std::ptrdiff_t>(header_entries),
+                      block.metadata.end());
+}
+
+// Room for the rows the file's size suggests after its first block (5 % spare), so the columns do not
+// grow by doubling (a copy, and up to twice the memory, at each step).
+void reserve_rows(const CsvStreamReader& reader, std::size_t first_rows, TurntableLog& log) {
+  if (reader.bytes_total() == 0 || reader.bytes_read() == 0 || first_rows == 0) return;
+  const double per_row = static_cast<double>(reader.bytes_read()) / static_cast<double>(first_rows);
+  const auto rows = static_cast<std::size_t>(1.05 * static_cast<double>(reader.bytes_total()) / per_row) + 1;
+  const auto ng = static_cast<std::size_t>(log.gyro_count);
+  log.sequence.reserve(rows);
+  log.time_s.reserve(rows);
+  log.inner_deg.reserve(rows);
+  log.outer_deg.reserve(rows);
+  log.g_V.reserve(rows * ng);
+  log.lines.reserve(rows);
 }
 
 }  // namespace
@@ -90,10 +132,32 @@ Result<TurntableLog> parse_turntable_log(std::string_view text, std::string sour
   return from_table(std::move(table.value()));
 }
 
+// Block by block: the file's text and its table of cells are never whole in memory, only the log's
+// columns (about 68 bytes a row with 4 gyros, against about 235 for the whole-file read). Same checks,
+// messages and lines as parse_turntable_log; the same size bound as a whole-file read.
 Result<TurntableLog> read_turntable_log(const std::string& path) {
-  auto table = read_csv(path);
-  if (!table) return table.error();
-  return from_table(std::move(table.value()));
+  if (Status s = check_input(path, kMaxTableBytes, false); !s) return s.error();
+  CsvStreamReader reader;
+  if (Status s = reader.open(path); !s) return s.error();
+  auto c = find_columns(reader.header());
+  if (!c) return c.error();
+  TurntableLog log = empty_log(reader.header(), *c);
+  const std::size_t header_entries = reader.header().metadata.size();
+  CsvTable block;
+  while (true) {
+    auto more = reader.next(block);
+    if (!more) return more.error();
+    append_block_metadata(block, header_entries, log);  // at the end: comment lines after the last row
+    if (!*more) break;
+    if (reader.bytes_read() > kMaxTableBytes) {  // a FIFO (a regular file was checked at opening)
+      return bad_input(path + ": is larger than the limit of " + std::to_string(kMaxTableBytes >> 30) +
+                       " GiB for this kind of file");
+    }
+    if (log.rows() == 0) reserve_rows(reader, block.rows, log);
+    if (Status s = append_rows(block, *c, log); !s) return s.error();
+  }
+  if (log.rows() == 0) return bad_input(log.source + ": no data rows");
+  return log;
 }
 
 std::string format_turntable_log(const TurntableLog& log) {

@@ -118,14 +118,7 @@ Status write_plot(OutputFile& png, const allan::LogAllan& analysis, double confi
   return png.write(*image);
 }
 
-}  // namespace
-
-int cmd_allan(int argc, char** argv) {
-  CLI::App app(
-      "Overlapping Allan deviation of each gyro of a log, with chi-squared confidence intervals "
-      "(NIST SP 1065), and the IEEE Std 952-1997 noise terms Q, N, B, K, R fitted by non-negative "
-      "weighted least squares; terms the data do not show are reported as NO (null).",
-      "allan");
+struct AllanOptions {
   std::string log_path;
   std::string cal_path;
   bool update_cal = false;
@@ -137,126 +130,166 @@ int cmd_allan(int argc, char** argv) {
   std::string kalibr_path;
   double confidence = allan::kOneSigmaConfidence;
   double dt_tolerance = 0.05;
-  app.add_option("log", log_path,
+};
+
+void add_options(CLI::App& app, AllanOptions& o) {
+  app.add_option("log", o.log_path,
                  "gyro log (CSV, or HDF5 when named .h5; docs/formats.md): time_s,g1..gN; volts, or deg/s "
                  "with '# units=dps'")
       ->required();
-  app.add_option("--calibration", cal_path, "calibration YAML: volts become deg/s as (g - bias)/scale");
-  app.add_flag("--update-calibration", update_cal,
+  app.add_option("--calibration", o.cal_path, "calibration YAML: volts become deg/s as (g - bias)/scale");
+  app.add_flag("--update-calibration", o.update_cal,
                "write the fitted terms into the calibration file's noise: sections (needs --calibration)");
-  app.add_option("--gyro", gyros, "analyse only this gyro (1..N); may be repeated");
-  app.add_option("--taus", taus,
+  app.add_option("--gyro", o.gyros, "analyse only this gyro (1..N); may be repeated");
+  app.add_option("--taus", o.taus,
                  "averaging times: default (about 10 per decade), octave, decade, all, or a list in seconds "
                  "like 0.1,1,10");
-  app.add_option("--csv", csv_path, "write gyro,tau_s,adev,adev_lo,adev_hi,n");
-  app.add_option("--json", json_path, "write the noise terms as JSON (null = not observed)");
-  app.add_option("--plot", plot_path, "write a log-log PNG plot (needs gnuplot)");
+  app.add_option("--csv", o.csv_path, "write gyro,tau_s,adev,adev_lo,adev_hi,n");
+  app.add_option("--json", o.json_path, "write the noise terms as JSON (null = not observed)");
+  app.add_option("--plot", o.plot_path, "write a log-log PNG plot (needs gnuplot)");
   app.add_option(
-      "--kalibr", kalibr_path,
+      "--kalibr", o.kalibr_path,
       "write Kalibr's imu.yaml: gyroscope noise density and random walk of the body axes, in rad/s "
       "(needs --calibration)");
-  app.add_option("--confidence", confidence,
+  app.add_option("--confidence", o.confidence,
                  "two-sided confidence level of the intervals (default 0.683 = 1 sigma)");
-  app.add_option("--dt-tolerance", dt_tolerance,
+  app.add_option("--dt-tolerance", o.dt_tolerance,
                  "allowed deviation of a time step from a whole multiple of the sampling interval, relative "
                  "(default 0.05)");
-  if (auto status = parse(app, argc, argv)) return *status;
+}
 
-  const std::string cmd = "allan";
-  if (update_cal && cal_path.empty())
-    return report(cmd, bad_input("--update-calibration needs --calibration CAL.yaml"));
-  if (!kalibr_path.empty() && cal_path.empty())
-    return report(cmd, bad_input("--kalibr needs --calibration CAL.yaml (the gyro axes)"));
-  if (!(dt_tolerance > 0.0 && dt_tolerance < 0.5)) {
-    return report(cmd,
-                  bad_input("--dt-tolerance " + num(dt_tolerance) + ": expected a fraction in (0, 0.5)"));
-  }
-  if (!(confidence > 0.0 && confidence < 1.0)) {
-    return report(cmd, bad_input("--confidence " + num(confidence) + ": expected a level in (0, 1)"));
-  }
-  auto tau_spec = allan::parse_tau_spec(taus);
-  if (!tau_spec) return report(cmd, tau_spec.error());
+// The options' combinations and ranges, and the averaging times parsed.
+Result<allan::TauSpec> check_options(const AllanOptions& o) {
+  if (o.update_cal && o.cal_path.empty())
+    return bad_input("--update-calibration needs --calibration CAL.yaml");
+  if (!o.kalibr_path.empty() && o.cal_path.empty())
+    return bad_input("--kalibr needs --calibration CAL.yaml (the gyro axes)");
+  if (!(o.dt_tolerance > 0.0 && o.dt_tolerance < 0.5))
+    return bad_input("--dt-tolerance " + num(o.dt_tolerance) + ": expected a fraction in (0, 0.5)");
+  if (!(o.confidence > 0.0 && o.confidence < 1.0))
+    return bad_input("--confidence " + num(o.confidence) + ": expected a level in (0, 1)");
+  return allan::parse_tau_spec(o.taus);
+}
 
-  RunFiles files;
-  files.add_input(log_path, "log");
-  if (!cal_path.empty()) files.add_input(cal_path, "--calibration");
-  OutputFile* csv_out = nullptr;
-  OutputFile* json_out = nullptr;
-  OutputFile* plot_out = nullptr;
-  OutputFile* kalibr_out = nullptr;
-  OutputFile* cal_out = nullptr;
-  if (Status s = files.add_outputs({{csv_path, "--csv", &csv_out},
-                                    {json_path, "--json", &json_out},
-                                    {plot_path, "--plot", &plot_out},
-                                    {kalibr_path, "--kalibr", &kalibr_out}});
+struct AllanOutputs {
+  OutputFile* csv = nullptr;
+  OutputFile* json = nullptr;
+  OutputFile* plot = nullptr;
+  OutputFile* kalibr = nullptr;
+  OutputFile* cal = nullptr;  // --update-calibration: the calibration file, replaced
+};
+
+Result<AllanOutputs> open_outputs(RunFiles& files, const AllanOptions& o) {
+  AllanOutputs out;
+  if (Status s = files.add_outputs({{o.csv_path, "--csv", &out.csv},
+                                    {o.json_path, "--json", &out.json},
+                                    {o.plot_path, "--plot", &out.plot},
+                                    {o.kalibr_path, "--kalibr", &out.kalibr}});
       !s)
-    return report(cmd, s.error());
-  if (update_cal) {
-    auto out = files.add(cal_path, "--update-calibration", cal_path);
-    if (!out) return report(cmd, out.error());
-    cal_out = *out;
+    return s.error();
+  if (o.update_cal) {
+    auto cal = files.add(o.cal_path, "--update-calibration", o.cal_path);
+    if (!cal) return cal.error();
+    out.cal = *cal;
   }
+  return out;
+}
 
-  std::optional<Calibration> cal;
-  if (!cal_path.empty()) {
-    auto c = read_calibration(cal_path);
-    if (!c) return report(cmd, c.error());
-    cal = std::move(c.value());
-  }
-
-  // Progress goes to stderr when a person is watching it; otherwise stderr carries only the
-  // one-line reason of a failure (the exit-status contract).
+// The log read block by block, never whole (docs/allan.md: memory). Progress goes to stderr when a
+// person is watching it; otherwise stderr carries only the one-line reason of a failure.
+Result<allan::LogAllan> analyse(const AllanOptions& o, const allan::TauSpec& taus, const Calibration* cal) {
   const bool progress = ::isatty(STDERR_FILENO) != 0;
   const auto t0 = Clock::now();
-  if (progress) std::cerr << "tetra allan: reading and analysing " << log_path << "\n";
-
+  if (progress) std::cerr << "tetra allan: reading and analysing " << o.log_path << "\n";
   allan::LogAllanOptions options;
-  options.allan.taus = *tau_spec;
-  options.allan.confidence = confidence;
-  options.dt_tolerance = dt_tolerance;
-  options.gyros = gyros;
-  options.calibration = cal ? &*cal : nullptr;
-  // The log is read block by block, never whole (docs/allan.md: memory).
-  auto analysis = allan::analyze_gyro_log_file(log_path, options);
-  if (!analysis) return report(cmd, analysis.error());
-  if (analysis->log_units_dps && cal) {
+  options.allan.taus = taus;
+  options.allan.confidence = o.confidence;
+  options.dt_tolerance = o.dt_tolerance;
+  options.gyros = o.gyros;
+  options.calibration = cal;
+  auto analysis = allan::analyze_gyro_log_file(o.log_path, options);
+  if (!analysis) return analysis;
+  if (analysis->log_units_dps && cal != nullptr) {
     std::cerr << "tetra allan: the log is already in deg/s; the calibration is used only for "
                  "--update-calibration\n";
   }
   if (progress) std::cerr << "tetra allan: analysed in " << sci(seconds_since(t0)) << " s total\n";
+  return analysis;
+}
 
-  std::cout << log_path << ": " << analysis->epochs << " epochs";
-  if (analysis->missing_epochs > 0)
-    std::cout << " (+" << analysis->missing_epochs << " missing epochs as gaps)";
-  std::cout << ", sampling interval " << num(analysis->tau0_s) << " s (from the time column)"
-            << (cal && !analysis->log_units_dps ? ", calibrated with " + cal_path : std::string()) << "\n\n";
-  std::cout << allan::format_table(*analysis);
+void print_report(const AllanOptions& o, const allan::LogAllan& analysis, bool calibrated) {
+  std::cout << o.log_path << ": " << analysis.epochs << " epochs";
+  if (analysis.missing_epochs > 0)
+    std::cout << " (+" << analysis.missing_epochs << " missing epochs as gaps)";
+  std::cout << ", sampling interval " << num(analysis.tau0_s) << " s (from the time column)"
+            << (calibrated && !analysis.log_units_dps ? ", calibrated with " + o.cal_path : std::string())
+            << "\n\n";
+  std::cout << allan::format_table(analysis);
+}
 
-  const auto meta = provenance_metadata(provenance(files.input_paths()));
-  if (csv_out) {
+Status write_outputs(const AllanOutputs& out, const allan::LogAllan& analysis,
+                     std::optional<Calibration>& cal, const Metadata& meta, double confidence) {
+  if (out.csv) {
     std::string text;
     for (const auto& [key, value] : meta) append_metadata(text, key, value);
-    if (Status s = csv_out->write(text + allan::format_csv(*analysis)); !s) return report(cmd, s.error());
+    if (Status s = out.csv->write(text + allan::format_csv(analysis)); !s) return s;
   }
-  if (json_out) {
-    if (Status s = json_out->write(allan::format_json(*analysis, meta)); !s) return report(cmd, s.error());
+  if (out.json) {
+    if (Status s = out.json->write(allan::format_json(analysis, meta)); !s) return s;
   }
-  if (plot_out) {
-    if (Status s = write_plot(*plot_out, *analysis, confidence); !s) return report(cmd, s.error());
+  if (out.plot) {
+    if (Status s = write_plot(*out.plot, analysis, confidence); !s) return s;
   }
-  if (kalibr_out) {
-    auto noise = allan::kalibr_gyro_noise(*analysis, *cal);
-    if (!noise) return report(cmd, noise.error());
+  if (out.kalibr) {
+    auto noise = allan::kalibr_gyro_noise(analysis, *cal);
+    if (!noise) return noise.error();
     const std::string rostopic = "/tetra/" + service::ros2_name(cal->unit) + "/imu";  // the ROS 2 view's
-    if (Status s = kalibr_out->write(allan::format_kalibr(*noise, rostopic)); !s)
-      return report(cmd, s.error());
+    if (Status s = out.kalibr->write(allan::format_kalibr(*noise, rostopic)); !s) return s;
   }
-  if (cal_out) {
-    if (Status s = allan::update_calibration_noise(*cal, *analysis); !s) return report(cmd, s.error());
-    if (Status s = write_calibration(*cal_out, *cal, meta); !s) return report(cmd, s.error());
+  if (out.cal) {
+    if (Status s = allan::update_calibration_noise(*cal, analysis); !s) return s;
+    if (Status s = write_calibration(*out.cal, *cal, meta); !s) return s;
   }
-  if (Status s = files.commit(); !s) return report(cmd, s.error());
-  if (cal_out) std::cerr << "tetra allan: noise terms written to " << cal_path << "\n";
+  return ok_status();
+}
+
+// Options checked, outputs opened, calibration read; the analysis; its report and files.
+Status run_allan(const AllanOptions& o) {
+  auto taus = check_options(o);
+  if (!taus) return taus.error();
+  RunFiles files;
+  files.add_input(o.log_path, "log");
+  if (!o.cal_path.empty()) files.add_input(o.cal_path, "--calibration");
+  auto out = open_outputs(files, o);
+  if (!out) return out.error();
+  std::optional<Calibration> cal;
+  if (!o.cal_path.empty()) {
+    auto c = read_calibration(o.cal_path);
+    if (!c) return c.error();
+    cal = std::move(c.value());
+  }
+  auto analysis = analyse(o, *taus, cal ? &*cal : nullptr);
+  if (!analysis) return analysis.error();
+  print_report(o, *analysis, cal.has_value());
+  const auto meta = provenance_metadata(provenance(files.input_paths()));
+  if (Status s = write_outputs(*out, *analysis, cal, meta, o.confidence); !s) return s;
+  if (Status s = files.commit(); !s) return s;
+  if (out->cal) std::cerr << "tetra allan: noise terms written to " << o.cal_path << "\n";
+  return ok_status();
+}
+
+}  // namespace
+
+int cmd_allan(int argc, char** argv) {
+  CLI::App app(
+      "Overlapping Allan deviation of each gyro of a log, with chi-squared confidence intervals "
+      "(NIST SP 1065), and the IEEE Std 952-1997 noise terms Q, N, B, K, R fitted by non-negative "
+      "weighted least squares; terms the data do not show are reported as NO (null).",
+      "allan");
+  AllanOptions options;
+  add_options(app, options);
+  if (auto status = parse(app, argc, argv)) return *status;
+  if (Status s = run_allan(options); !s) return report("allan", s.error());
   return kExitOk;
 }
 

@@ -150,13 +150,7 @@ void print_comparison(const TurntableMotion& motion, const CalibrationFit& refer
   std::cout << "\n\n";
 }
 
-}  // namespace
-
-int cmd_calibrate(int argc, char** argv) {
-  CLI::App app{
-      "Turntable calibration (seed eqs. 4-11): scale factor, bias and sensing axis of every gyro with their "
-      "1-sigma, from a turntable log (docs/interfaces.md §2.1). Body rates come from the encoder angles.",
-      kName};
+struct CalibrateOptions {
   std::string input;
   std::string output;
   std::optional<double> latitude_deg;
@@ -164,108 +158,148 @@ int cmd_calibrate(int argc, char** argv) {
   std::string bias_model_name = "body";
   std::string compare_path;
   std::string unit_name;
-  app.add_option("TURNTABLE.csv", input, "turntable log: sequence,time_s,inner_deg,outer_deg,g1..gN")
+};
+
+void add_options(CLI::App& app, CalibrateOptions& o) {
+  app.add_option("TURNTABLE.csv", o.input, "turntable log: sequence,time_s,inner_deg,outer_deg,g1..gN")
       ->required();
-  app.add_option("-o,--output", output,
+  app.add_option("-o,--output", o.output,
                  "calibration file to write (YAML, docs/interfaces.md §2.3; - for standard output)")
       ->required();
-  app.add_option("--latitude", latitude_deg,
+  app.add_option("--latitude", o.latitude_deg,
                  "[deg] geodetic latitude of the table (default: the file's '# latitude_deg=' comment)")
       ->check(CLI::Range(-90.0, 90.0));
   app.add_option(
-         "--method", method_name,
+         "--method", o.method_name,
          "sixteen: per-sequence means and pair differences (seed); batch: least squares over every sample")
       ->check(CLI::IsMember({"sixteen", "batch"}))
       ->capture_default_str();
-  app.add_option("--bias-model", bias_model_name,
+  app.add_option("--bias-model", o.bias_model_name,
                  "sixteen only. body: Earth rate projected into B per sequence; seed: the seed's eq. 11 "
                  "(lab-frame Earth rate, wrong while the body is rotated)")
       ->check(CLI::IsMember({"body", "seed"}))
       ->capture_default_str();
   app.add_option(
-      "--compare", compare_path,
+      "--compare", o.compare_path,
       "another calibration (e.g. examples/factory.yaml): print its per-sequence residuals beside the new "
       "one's (seed Fig. 4)");
-  app.add_option("--unit", unit_name,
+  app.add_option("--unit", o.unit_name,
                  "unit name for the calibration file (default: '# unit=' comment or tetra-1)");
-  if (auto status = parse(app, argc, argv)) return *status;
+}
 
+Result<CalibrationOptions> estimator_options(const CalibrateOptions& o) {
   CalibrationOptions options;
-  options.method = method_name == "batch" ? CalibrationMethod::kBatch : CalibrationMethod::kSixteen;
-  options.bias_model = bias_model_name == "seed" ? BiasModel::kSeed : BiasModel::kBody;
-  if (options.method == CalibrationMethod::kBatch && bias_model_name != "body") {
-    return report(
-        kName, bad_input("--bias-model applies to --method sixteen only (batch fits the bias per sample)"));
+  options.method = o.method_name == "batch" ? CalibrationMethod::kBatch : CalibrationMethod::kSixteen;
+  options.bias_model = o.bias_model_name == "seed" ? BiasModel::kSeed : BiasModel::kBody;
+  if (options.method == CalibrationMethod::kBatch && o.bias_model_name != "body") {
+    return bad_input("--bias-model applies to --method sixteen only (batch fits the bias per sample)");
   }
+  return options;
+}
 
-  RunFiles files;
-  files.add_input(input, "TURNTABLE.csv");
-  if (!compare_path.empty()) files.add_input(compare_path, "--compare");
-  auto out = files.add(output, "--output");
-  if (!out) return report(kName, out.error());
-
-  auto log = read_turntable_log(input);
-  if (!log) return report(kName, log.error());
-  auto latitude = latitude_from(*log, latitude_deg);
-  if (!latitude) return report(kName, latitude.error());
-  if (latitude_deg) {
-    if (const auto in_file = log->meta("latitude_deg")) {
-      std::cerr << "tetra calibrate: using --latitude " << *latitude_deg << " (the file says " << *in_file
+// The latitude (option or comment; a note on stderr when the option overrides the file's).
+Result<double> latitude_of(const TurntableLog& log, const CalibrateOptions& o) {
+  auto latitude = latitude_from(log, o.latitude_deg);
+  if (!latitude) return latitude;
+  if (o.latitude_deg) {
+    if (const auto in_file = log.meta("latitude_deg")) {
+      std::cerr << "tetra calibrate: using --latitude " << *o.latitude_deg << " (the file says " << *in_file
                 << ")\n";
     }
   }
-  options.unit = !unit_name.empty() ? unit_name : log->meta("unit").value_or("tetra-1");
+  return latitude;
+}
 
-  std::optional<Calibration> reference;
-  if (!compare_path.empty()) {
-    auto ref = read_calibration(compare_path);
-    if (!ref) return report(kName, ref.error());
-    if (ref->gyro_count() != log->gyro_count) {
-      return report(kName, bad_input(compare_path + ": has " + std::to_string(ref->gyro_count()) +
-                                     " gyros, " + input + " has " + std::to_string(log->gyro_count)));
-    }
-    reference = std::move(ref.value());
+// --compare: the other calibration, with as many gyros as the log.
+Result<std::optional<Calibration>> reference_of(const TurntableLog& log, const CalibrateOptions& o) {
+  if (o.compare_path.empty()) return std::optional<Calibration>{};
+  auto ref = read_calibration(o.compare_path);
+  if (!ref) return ref.error();
+  if (ref->gyro_count() != log.gyro_count) {
+    return bad_input(o.compare_path + ": has " + std::to_string(ref->gyro_count()) + " gyros, " + o.input +
+                     " has " + std::to_string(log.gyro_count));
   }
+  return std::optional<Calibration>(std::move(ref.value()));
+}
 
-  auto motion = analyze_turntable(*log, *latitude);
-  if (!motion) return report(kName, motion.error());
-  auto result = calibrate(*log, *motion, options);
-  if (!result) return report(kName, result.error());
+// With the seed's eq. 11 bias: how far it lies from the body-model bias.
+void print_seed_bias_difference(const TurntableLog& log, const TurntableMotion& motion,
+                                const CalibrationOptions& options, const CalibrationResult& result) {
+  CalibrationOptions body = options;
+  body.bias_model = BiasModel::kBody;
+  auto body_result = calibrate(log, motion, body);
+  if (!body_result) return;
+  std::cout << "Seed eq. 11 bias minus body-model bias [V]:";
+  for (int i = 0; i < log.gyro_count; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    std::cout << format("  g%d %+.3e", i + 1,
+                        result.calibration.gyros[k].bias_V - body_result->calibration.gyros[k].bias_V);
+  }
+  std::cout << "\n(eq. 11 subtracts the lab-frame Earth rate although the body is rotated; see "
+               "docs/calibration.md)\n\n";
+}
 
-  print_plan(*log, *motion);
-  print_estimates(*result, options, reference, compare_path);
+// The tables on standard output: plan, estimates, the comparison, the seed-bias note, what 1σ means.
+Status print_report(const TurntableLog& log, const TurntableMotion& motion, const CalibrationOptions& options,
+                    const CalibrationResult& result, const std::optional<Calibration>& reference,
+                    const std::string& reference_name) {
+  print_plan(log, motion);
+  print_estimates(result, options, reference, reference_name);
   if (reference) {
-    auto reference_fit = evaluate_calibration(*log, *motion, *reference);
-    if (!reference_fit) return report(kName, reference_fit.error());
-    print_comparison(*motion, *reference_fit, result->fit, compare_path, log->gyro_count);
+    auto reference_fit = evaluate_calibration(log, motion, *reference);
+    if (!reference_fit) return reference_fit.error();
+    print_comparison(motion, *reference_fit, result.fit, reference_name, log.gyro_count);
   }
-  if (options.method == CalibrationMethod::kSixteen && options.bias_model == BiasModel::kSeed) {
-    CalibrationOptions body = options;
-    body.bias_model = BiasModel::kBody;
-    if (auto body_result = calibrate(*log, *motion, body)) {
-      std::cout << "Seed eq. 11 bias minus body-model bias [V]:";
-      for (int i = 0; i < log->gyro_count; ++i) {
-        const auto k = static_cast<std::size_t>(i);
-        std::cout << format("  g%d %+.3e", i + 1,
-                            result->calibration.gyros[k].bias_V - body_result->calibration.gyros[k].bias_V);
-      }
-      std::cout << "\n(eq. 11 subtracts the lab-frame Earth rate although the body is rotated; see "
-                   "docs/calibration.md)\n\n";
-    }
-  }
-  std::cout
-      << "1-sigma: "
-      << (options.method == CalibrationMethod::kSixteen
-              ? "per-sequence standard deviation of the mean, propagated"
-              : "residual covariance of the fit")
-      << "; both assume white noise within a sequence, so correlated noise (bias instability, rate random "
-         "walk) makes them optimistic.\n";
+  if (options.method == CalibrationMethod::kSixteen && options.bias_model == BiasModel::kSeed)
+    print_seed_bias_difference(log, motion, options, result);
+  std::cout << "1-sigma: "
+            << (options.method == CalibrationMethod::kSixteen
+                    ? "per-sequence standard deviation of the mean, propagated"
+                    : "residual covariance of the fit")
+            << "; both assume white noise within a sequence, so correlated noise (bias instability, rate "
+               "random walk) makes them optimistic.\n";
+  return ok_status();
+}
 
+// Outputs opened, log read and interpreted, calibration estimated; report; file written and committed.
+Status run_calibrate(const CalibrateOptions& o) {
+  auto options = estimator_options(o);
+  if (!options) return options.error();
+  RunFiles files;
+  files.add_input(o.input, "TURNTABLE.csv");
+  if (!o.compare_path.empty()) files.add_input(o.compare_path, "--compare");
+  auto out = files.add(o.output, "--output");
+  if (!out) return out.error();
+  auto log = read_turntable_log(o.input);
+  if (!log) return log.error();
+  auto latitude = latitude_of(*log, o);
+  if (!latitude) return latitude.error();
+  options->unit = !o.unit_name.empty() ? o.unit_name : log->meta("unit").value_or("tetra-1");
+  auto reference = reference_of(*log, o);
+  if (!reference) return reference.error();
+  auto motion = analyze_turntable(*log, *latitude);
+  if (!motion) return motion.error();
+  auto result = calibrate(*log, *motion, *options);
+  if (!result) return result.error();
+  if (Status s = print_report(*log, *motion, *options, *result, *reference, o.compare_path); !s) return s;
   const auto meta = provenance_metadata(provenance(files.input_paths()));
-  if (auto written = write_calibration(**out, result->calibration, meta); !written)
-    return report(kName, written.error());
-  if (auto committed = files.commit(); !committed) return report(kName, committed.error());
-  std::cerr << "tetra calibrate: wrote " << output << "\n";
+  if (Status s = write_calibration(**out, result->calibration, meta); !s) return s;
+  if (Status s = files.commit(); !s) return s;
+  std::cerr << "tetra calibrate: wrote " << o.output << "\n";
+  return ok_status();
+}
+
+}  // namespace
+
+int cmd_calibrate(int argc, char** argv) {
+  CLI::App app{
+      "Turntable calibration (seed eqs. 4-11): scale factor, bias and sensing axis of every gyro with their "
+      "1-sigma, from a turntable log (docs/interfaces.md §2.1). Body rates come from the encoder angles.",
+      kName};
+  CalibrateOptions options;
+  add_options(app, options);
+  if (auto status = parse(app, argc, argv)) return *status;
+  if (Status s = run_calibrate(options); !s) return report(kName, s.error());
   return kExitOk;
 }
 

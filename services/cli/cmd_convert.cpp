@@ -13,7 +13,7 @@ namespace tetra::cli {
 
 namespace {
 
-Status convert(const std::string& in_path, const std::string& out_path) {
+Status convert(const std::string& in_path, const std::string& out_path, bool compress) {
   RunFiles files;
   files.add_input(in_path, "IN");
   auto out = files.add(out_path, "OUT");
@@ -22,6 +22,7 @@ Status convert(const std::string& in_path, const std::string& out_path) {
   if (!reader) return reader.error();
   const GyroLog& head = (*reader)->header();
   GyroLogWriter writer;
+  writer.set_hdf5_compression(compress);
   // The comment lines go over as they are (provenance included), so a round trip gives the same file.
   if (Status s = writer.open_like(**out, head); !s) return s;
   const auto ng = static_cast<std::size_t>(head.gyro_count);
@@ -54,8 +55,12 @@ int cmd_convert(int argc, char** argv) {
   std::string out_path;
   app.add_option("IN", in_path, "gyro log to read (CSV or HDF5)")->required();
   app.add_option("OUT", out_path, "gyro log to write (CSV or HDF5)")->required();
+  bool compress = false;
+  app.add_flag("--compress", compress,
+               "HDF5 output: shuffle + deflate every dataset (2-4x smaller, read about 5x slower; default: "
+               "chunked, uncompressed)");
   if (auto status = parse(app, argc, argv)) return *status;
-  if (Status s = convert(in_path, out_path); !s) return report("convert", s.error());
+  if (Status s = convert(in_path, out_path, compress); !s) return report("convert", s.error());
   return kExitOk;
 }
 

@@ -101,6 +101,9 @@ class GyroLogWriter {
                const std::optional<std::array<double, 4>>& reference_wxyz = std::nullopt);
   //! Flushes and closes (and, when opened by path, commits: fsync and rename into place).
   Status close();
+  //! HDF5 only, before open: shuffle + deflate every dataset (files 2-4x smaller, read about 5x slower).
+  //! Default off: chunked, uncompressed datasets. CSV output ignores it.
+  void set_hdf5_compression(bool compress) { compress_ = compress; }
 
  private:
   Result<OutputFile*> open_own(const std::string& path);
@@ -113,6 +116,7 @@ class GyroLogWriter {
   std::string buffer_;
   int gyro_count_ = 0;
   bool with_reference_ = false;
+  bool compress_ = false;
 };
 
 }  // namespace tetra

@@ -1,0 +1,113 @@
+#include "attitude_writer.hpp"
+
+#include <utility>
+
+#include "attitude_csv.hpp"
+
+namespace tetra::cli {
+
+namespace {
+constexpr std::size_t kWriteBytes = std::size_t{1} << 20;  // formatted text written in pieces of ~1 MB
+}  // namespace
+
+AttitudeWriter::AttitudeWriter(OutputFile& out, int n_gyros, std::string preamble)
+    : out_(out), n_gyros_(n_gyros), text_(std::move(preamble)), worker_([this] { run(); }) {
+  filling_.reserve(kBatchRows);
+}
+
+AttitudeWriter::~AttitudeWriter() {
+  {
+    const std::lock_guard lock(mutex_);
+    stop_ = true;
+    done_ = true;
+  }
+  changed_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+Status AttitudeWriter::error() const {
+  const std::lock_guard lock(mutex_);
+  return status_;
+}
+
+Status AttitudeWriter::add(double time_s, const fdi::AttitudeEstimate& attitude) {
+  filling_.push_back(Row{time_s, attitude});
+  if (filling_.size() < kBatchRows) return ok_status();
+  return hand_over();
+}
+
+// Queues the filled batch (waiting while kDepth batches are queued) and takes a spare one to fill.
+Status AttitudeWriter::hand_over() {
+  std::unique_lock lock(mutex_);
+  changed_.wait(lock, [this] { return queue_.size() < kDepth || !status_; });
+  if (!status_) return status_;
+  queue_.push_back(std::move(filling_));
+  filling_.clear();
+  if (!spare_.empty()) {
+    filling_ = std::move(spare_.back());
+    spare_.pop_back();
+  }
+  filling_.clear();
+  filling_.reserve(kBatchRows);
+  lock.unlock();
+  changed_.notify_all();
+  return ok_status();
+}
+
+Status AttitudeWriter::finish() {
+  if (!filling_.empty()) {
+    if (Status s = hand_over(); !s) return s;
+  }
+  {
+    const std::lock_guard lock(mutex_);
+    done_ = true;
+  }
+  changed_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  return error();
+}
+
+Status AttitudeWriter::write_batch(const Batch& batch) {
+  for (const Row& row : batch) {
+    append_attitude_row(text_, row.time_s, row.attitude, n_gyros_);
+    if (text_.size() < kWriteBytes) continue;
+    if (Status s = out_.write(text_); !s) return s;
+    text_.clear();
+  }
+  return ok_status();
+}
+
+void AttitudeWriter::run() {
+  while (true) {
+    Batch batch;
+    {
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [this] { return !queue_.empty() || done_; });
+      if (stop_ || queue_.empty()) break;
+      batch = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    changed_.notify_all();
+    const Status written = write_batch(batch);
+    const std::lock_guard lock(mutex_);
+    if (spare_.size() < kDepth) spare_.push_back(std::move(batch));
+    if (!written) {
+      status_ = written;
+      break;
+    }
+  }
+  {
+    const std::lock_guard lock(mutex_);
+    if (stop_ || !status_) {
+      changed_.notify_all();
+      return;
+    }
+  }
+  if (Status s = out_.write(text_); !s) {
+    const std::lock_guard lock(mutex_);
+    status_ = s;
+  }
+  text_.clear();
+}
+
+}  // namespace tetra::cli

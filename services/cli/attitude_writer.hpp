@@ -1,0 +1,64 @@
+#pragma once
+// Attitude rows (attitude_csv.hpp) formatted and written on a worker thread: formatting numbers in
+// shortest round-trip form and copying them into the file cost about twice the pipeline step, so the
+// caller hands over the estimates in batches and goes on. At most kDepth batches wait (bounded memory);
+// the file is the one append_attitude_row would give, byte for byte.
+
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tetra/core/output_files.hpp"
+#include "tetra/core/result.hpp"
+#include "tetra/fdi/types.hpp"
+
+namespace tetra::cli {
+
+class AttitudeWriter {
+ public:
+  static constexpr std::size_t kBatchRows = 4096;
+  static constexpr std::size_t kDepth = 2;
+
+  //! Writes `preamble` (comment lines and the header) first, then the rows as they come.
+  AttitudeWriter(OutputFile& out, int n_gyros, std::string preamble);
+  AttitudeWriter(const AttitudeWriter&) = delete;
+  AttitudeWriter& operator=(const AttitudeWriter&) = delete;
+  //! Stops the worker; rows not finished are dropped (the run failed).
+  ~AttitudeWriter();
+
+  //! One row stamped `time_s` [s]. A failed write of an earlier batch is returned here (or by finish()).
+  Status add(double time_s, const fdi::AttitudeEstimate& attitude);
+  //! Writes every row added and stops the worker; the first write error, if any.
+  Status finish();
+
+ private:
+  struct Row {
+    double time_s = 0.0;
+    fdi::AttitudeEstimate attitude;
+  };
+  using Batch = std::vector<Row>;
+
+  Status hand_over();
+  Status error() const;
+  void run();
+  Status write_batch(const Batch& batch);
+
+  OutputFile& out_;
+  const int n_gyros_;
+  std::string text_;  // worker: formatted rows not yet written
+  Batch filling_;     // caller: the batch being filled
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Batch> queue_;
+  std::vector<Batch> spare_;  // written batches, to be refilled (no allocation per batch)
+  Status status_ = ok_status();
+  bool done_ = false;  // no more batches will come
+  bool stop_ = false;  // drop what is left
+  std::thread worker_;
+};
+
+}  // namespace tetra::cli
