@@ -129,7 +129,8 @@ int cmd_replay(int argc, char** argv) {
                  "[deg] ground-test mode: remove the Earth rate at this geodetic latitude")
       ->check(CLI::Range(-90.0, 90.0));
   app.add_option("--initial-q", initial_q,
-                 "initial attitude w,x,y,z (relative to the lab frame in ground mode)");
+                 "initial attitude w,x,y,z (relative to the lab frame in ground mode), 1 sigma "
+                 "pipeline.initial_sigma_deg; the log's first reference sample, if any, sets it instead");
   app.add_option("--config", config_path, "YAML file with a 'pipeline:' map of thresholds (docs/fdi.md)");
   app.add_option("--attitude", attitude_path, "attitude output (CSV)")->required();
   app.add_option("--events", events_path, "FDI events output (JSON lines)")->required();
@@ -195,7 +196,7 @@ int cmd_replay(int argc, char** argv) {
   BufferedOutput events(**events_out);
   for (const auto& [key, value] : provenance_metadata(provenance(files.input_paths())))
     append_metadata(att.buffer(), key, value);
-  att.buffer() += kAttitudeHeader;
+  att.buffer() += attitude_header(pipeline->gyro_count());
   auto replayed = replay_log(log, *pipeline, commands, att, events);
   if (!replayed) return report("replay", replayed.error());
   if (auto st = att.flush(); !st) return report("replay", st.error());
