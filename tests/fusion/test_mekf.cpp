@@ -186,7 +186,9 @@ TEST(MekfFaults, RampIsolatedToTheRightGyroAndTheAttitudeRecovers) {
       const std::string what = std::string(sim::fault_kind_name(kind)) + " on gyro " + std::to_string(gyro);
       std::printf("%s: %zu isolation(s), final error %.2f arcsec, sigma %.2f arcsec\n", what.c_str(),
                   o.isolated.size(), o.final_error_arcsec, o.final_sigma_arcsec);
-      if (kind == sim::FaultKind::kRamp) ASSERT_EQ(o.isolated.size(), 1U) << what;
+      if (kind == sim::FaultKind::kRamp) {
+        ASSERT_EQ(o.isolated.size(), 1U) << what;
+      }
       for (const int g : o.isolated) EXPECT_EQ(g, gyro) << what;
       EXPECT_LE(o.final_error_arcsec, 3.0 * o.final_sigma_arcsec) << what;
     }
