@@ -45,6 +45,8 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       cross_(Eigen::Matrix3Xd::Zero(3, dim_ - 3)),
       joseph_(Eigen::MatrixXd::Zero(dim_, dim_)),
       gain_(Eigen::MatrixX3d::Zero(dim_, 3)),
+      ph_(Eigen::VectorXd::Zero(dim_)),
+      prior_var_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(gyros_.size()))),
       frozen_(gyros_.size(), 0) {
   reset(0.0);
 }
@@ -72,6 +74,7 @@ void Mekf::set_prior(int i) {
   P_(g_of(i), g_of(i)) = g.gm_sigma_rad_s * g.gm_sigma_rad_s;  // the simulator starts it stationary
   bias_[i] = 0.0;
   bias_[n_ + i] = 0.0;
+  prior_var_[i] = P_(c_of(i), c_of(i)) + P_(g_of(i), g_of(i));
 }
 
 void Mekf::decorrelate(int i) {
@@ -151,6 +154,7 @@ void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::V
     if (frozen_[static_cast<std::size_t>(i)] != 0) continue;
     const auto& g = gyros_[static_cast<std::size_t>(i)];
     P_(c_of(i), c_of(i)) += g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
+    prior_var_[i] += g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
     const double phi = decay_[n_ + i];
     P_(g_of(i), g_of(i)) += g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - phi * phi);
     bias_[n_ + i] *= phi;
@@ -194,6 +198,51 @@ ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quatern
   }
   symmetrize();
   return out;
+}
+
+Eigen::Vector3d Mekf::update_parity(const Eigen::MatrixXd& W, int d, GyroMask mask, double scale,
+                                    const double* p) {
+  Eigen::Vector3d correction = Eigen::Vector3d::Zero();
+  for (int r = 0; r < d; ++r) {
+    // h: ∂p_r/∂(c_i, g_i) = scale·W(r, i) for the gyros of the mask; R = 1.
+    double predicted = 0.0;
+    ph_.setZero();
+    for (int i = 0; i < n_; ++i) {
+      if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
+      const double h = scale * W(r, i);
+      predicted += h * (bias_[i] + bias_[n_ + i]);
+      ph_ += h * (P_.col(c_of(i)) + P_.col(g_of(i)));
+    }
+    double s = 1.0;
+    for (int i = 0; i < n_; ++i) {
+      if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
+      s += scale * W(r, i) * (ph_[c_of(i)] + ph_[g_of(i)]);
+    }
+    const double nu = p[r] - predicted;
+    // K = P·hᵀ/s; Joseph form for a scalar measurement, expanded: P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ.
+    for (Eigen::Index k = 0; k < dim_; ++k) {
+      const double kk = ph_[k] / s;
+      for (Eigen::Index j = 0; j < dim_; ++j) {
+        const double kj = ph_[j] / s;
+        P_(k, j) += -kk * ph_[j] - ph_[k] * kj + s * kk * kj;
+      }
+    }
+    correction += ph_.head<3>() * (nu / s);
+    bias_ += ph_.tail(dim_ - 3) * (nu / s);
+  }
+  symmetrize();
+  return correction;
+}
+
+double Mekf::bias_z(int id) const {
+  const double spread = prior_var_[id - 1];
+  return spread > 0.0 ? bias_rad_s(id) / std::sqrt(spread) : 0.0;
+}
+
+void Mekf::open_fault_hypothesis(double sigma_rad_s) {
+  for (int i = 0; i < n_; ++i) {
+    if (frozen_[static_cast<std::size_t>(i)] == 0) P_(c_of(i), c_of(i)) += sigma_rad_s * sigma_rad_s;
+  }
 }
 
 void Mekf::symmetrize() {

@@ -67,6 +67,20 @@ class Mekf {
   ReferenceUpdate update_reference(const Quaternion& q_est_RB, const Quaternion& q_ref_RB, double sigma_rad,
                                    double gate_chi2);
 
+  //! The epoch's normalized parity `p` (d rows, p = scale·W·y ~ N(0, I) without fault; W d×N over the gyros
+  //! of `mask`) as a measurement of the biases: with the reference it makes each gyro's bias observable.
+  //! Sequential scalar updates, Joseph form; returns the attitude correction δθ̂ to apply (q̂ ← q̂ ⊗ exp(δθ̂)).
+  Eigen::Vector3d update_parity(const Eigen::MatrixXd& W, int d, GyroMask mask, double scale,
+                                const double* p);
+
+  //! A fault of unknown gyro and size up to ~`sigma_rad_s` has appeared: every active gyro's slow bias state
+  //! gains that variance, so the measurements can put the step where it belongs.
+  void open_fault_hypothesis(double sigma_rad_s);
+
+  //! Gyro `id`'s bias estimate over its fault-free spread (the prior σ of c + g, which bounds the estimate's
+  //! own spread): |z| ≤ N(0, 1) in distribution while the model holds; a fault on the gyro drives it away.
+  double bias_z(int id) const;
+
   //! Gyro `id` (1..N) leaves the solution: its bias states keep their estimate and variance, uncorrelated
   //! with the rest, and stop evolving. `thaw` puts them back at their prior.
   void freeze(int id);
@@ -98,6 +112,8 @@ class Mekf {
   Eigen::Matrix3Xd cross_;     //!< 3×2N: U = A·Pθβ + G·Pββ (scratch)
   Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
   Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
+  Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
+  Eigen::VectorXd prior_var_;  //!< [rad²/s²] per gyro: the variance of c + g without any measurement
   std::vector<unsigned char> frozen_;
 };
 

@@ -186,6 +186,8 @@ void Pipeline::Impl::detect() {
     attitude_.add_bound(
         fault_rate_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()) *
         ns_to_seconds(frame_.now_ns - isolator_.episode().onset_ns));
+    attitude_.fault_opened(
+        fault_size_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()));
   }
   isolator_.alarmed(frame_.now_ns);
   detector_.restart_after_alarm();  // a persisting fault keeps raising alarms, a gone one stops
@@ -202,6 +204,13 @@ void Pipeline::Impl::seek_evidence(const Epoch& epoch) {
           isolator_.classify_drift(finding->gyro, frame_.index, gyro_set_.active(), subsets_);
       isolate({finding->gyro, finding->scale ? FaultKind::kScale : drift, Evidence::kReference,
                DetectionTest::kReference, finding->statistic});
+    } else if (isolator_.episode().active && attitude_.reference_aided()) {
+      // The filter's bias estimates (reference + parity make each gyro's observable): one gyro alone off.
+      if (const auto bias = reference_.filter_update(attitude_.filter(), gyro_set_.active())) {
+        const FaultKind drift =
+            isolator_.classify_drift(bias->gyro, frame_.index, gyro_set_.active(), subsets_);
+        isolate({bias->gyro, drift, Evidence::kReference, DetectionTest::kReference, bias->statistic});
+      }
     }
   }
   if (subsets_.ready()) decide_episode();
@@ -259,6 +268,9 @@ void Pipeline::Impl::publish_attitude(const Epoch& epoch) {
           episode ? fault_rate_bound(*active, detector_.parity_ema(), subsets_.sqrt_period())
                   : Eigen::Vector3d::Zero();
       attitude_.propagate(frame_, sol, active, bound);
+      // The epoch's parity, when it was computed over the gyros published, measures their biases.
+      if (frame_.usable == measured_ && sol.observable)
+        attitude_.parity(sol, detector_.parity(), subsets_.sqrt_period());
     }
   }
   // The reference sample, at this epoch's time, once the attitude is there too.

@@ -1,28 +1,47 @@
 #include "rate_attitude.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "tetra/core/allan_stats.hpp"
 #include "tetra/core/units.hpp"
 
 namespace tetra::fdi::detail {
 
+namespace {
+//! [rad/s] f_i = wᵢᵀp̄/|wᵢ|²: the fault on gyro i (column i of the subset's parity) that explains p̄.
+double single_gyro_fault(const Subset& s, Eigen::Index i, const Eigen::VectorXd& parity_ema,
+                         double sqrt_period) {
+  double wp = 0.0;
+  double ww = 0.0;
+  for (int r = 0; r < s.dof; ++r) {
+    const double w = s.parity(r, i) * sqrt_period;
+    wp += w * parity_ema[r];
+    ww += w * w;
+  }
+  return wp / ww;
+}
+}  // namespace
+
 Eigen::Vector3d fault_rate_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period) {
   Eigen::Vector3d bound = Eigen::Vector3d::Zero();
   if (s.dof < 1) return bound;
   for (Eigen::Index i = 0; i < s.pinv.cols(); ++i) {
     if (!has_gyro(s.mask, static_cast<int>(i) + 1)) continue;
-    double wp = 0.0;
-    double ww = 0.0;
-    for (int r = 0; r < s.dof; ++r) {
-      const double w = s.parity(r, i) * sqrt_period;
-      wp += w * parity_ema[r];
-      ww += w * w;
-    }
-    const double f = wp / ww;
+    const double f = single_gyro_fault(s, i, parity_ema, sqrt_period);
     bound = bound.cwiseMax((s.pinv.col(i) * f).cwiseAbs());
   }
   return bound;
+}
+
+double fault_size_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period) {
+  double f = 0.0;
+  if (s.dof < 1) return f;
+  for (Eigen::Index i = 0; i < s.pinv.cols(); ++i) {
+    if (has_gyro(s.mask, static_cast<int>(i) + 1))
+      f = std::max(f, std::abs(single_gyro_fault(s, i, parity_ema, sqrt_period)));
+  }
+  return f;
 }
 
 Eigen::Vector3d fault_angle_error(const Subset& s, int id, const Eigen::VectorXd& parity_ema,
@@ -78,6 +97,14 @@ Eigen::Vector3d RateAttitude::sigma_rad() const {
   const Eigen::Vector3d f = mekf_.attitude_sigma_rad();
   const Eigen::Vector3d b = propagator_.sigma_rad();  // the bound alone: its noise inputs are zero
   return (f.cwiseProduct(f) + b.cwiseProduct(b)).cwiseSqrt();
+}
+
+void RateAttitude::parity(const Subset& s, const Eigen::VectorXd& p, double sqrt_period) {
+  if (!reference_seen_ || s.dof < 1) return;
+  const Eigen::Vector3d dtheta = mekf_.update_parity(s.parity, s.dof, s.mask, sqrt_period, p.data());
+  const Eigen::Vector3d bound = propagator_.sigma_rad();  // the bound alone; kept across the attitude reset
+  propagator_.reset(propagator_.q_RB() * quat_exp(dtheta));
+  propagator_.add_bound(bound);
 }
 
 ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB) {

@@ -23,6 +23,9 @@ namespace tetra::fdi::detail {
 //! fault f_i = wᵢᵀp̄/|wᵢ|² (p̄ the parity EMA), which moves the estimate by H*(:, i)·f_i; the per-axis maximum.
 Eigen::Vector3d fault_rate_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period);
 
+//! [rad/s] the largest single-gyro fault size f_i = wᵢᵀp̄/|wᵢ|² over the gyros of the subset.
+double fault_size_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period);
+
 //! [rad] per axis: the angle error a fault on gyro `id` caused since `span_s` ago, from the parity EMA.
 Eigen::Vector3d fault_angle_error(const Subset& s, int id, const Eigen::VectorXd& parity_ema,
                                   double sqrt_period, double span_s);
@@ -52,6 +55,16 @@ class RateAttitude {
 
   //! A reference sample: the first one sets the attitude; later ones update the filter (gated).
   ReferenceUse reference(const Quaternion& q_ref_RB);
+  //! The epoch's normalized parity `p` over the subset `s` into the filter's biases — once a reference sample
+  //! has been seen (without one the attitude stays the gyros' alone).
+  void parity(const Subset& s, const Eigen::VectorXd& p, double sqrt_period);
+  bool reference_aided() const { return reference_seen_; }
+  //! A fault episode opened with fault size bound `sigma_rad_s`: with the reference, the filter's slow bias
+  //! states open up to take it (the reference and the parity then tell which gyro).
+  void fault_opened(double sigma_rad_s) {
+    if (reference_seen_) mekf_.open_fault_hypothesis(sigma_rad_s);
+  }
+
   //! Gyro `id` leaves the solution (its bias states freeze) or comes back (at its prior).
   void freeze(int id) { mekf_.freeze(id); }
   void thaw(int id) { mekf_.thaw(id); }

@@ -22,6 +22,39 @@ void ReferenceMonitor::reset() {
   snap_count_ = 0;
   run_gyro_ = 0;
   run_ = 0;
+  bias_run_gyro_ = 0;
+  bias_run_ = 0;
+}
+
+std::optional<ReferenceFinding> ReferenceMonitor::filter_update(const Mekf& filter, GyroMask active) {
+  const double threshold = config_.reference_threshold_sigma;
+  int flagged = 0, loud = 0, culprit = 0, members = 0;
+  double stat = 0.0;
+  for (int id = 1; id <= filter.gyro_count(); ++id) {
+    if (!has_gyro(active, id)) continue;
+    ++members;
+    const double z = std::abs(filter.bias_z(id));
+    if (z > threshold) {
+      ++flagged;
+      culprit = id;
+      stat = z;
+    } else if (z > 0.5 * threshold) {
+      ++loud;
+    }
+  }
+  if (flagged != 1 || loud != 0 || members < 3) {
+    bias_run_gyro_ = 0;
+    bias_run_ = 0;
+    return std::nullopt;
+  }
+  if (culprit != bias_run_gyro_) {
+    bias_run_gyro_ = culprit;
+    bias_run_ = 0;
+  }
+  if (++bias_run_ < config_.reference_confirm_count) return std::nullopt;
+  bias_run_gyro_ = 0;
+  bias_run_ = 0;
+  return ReferenceFinding{culprit, stat, false};
 }
 
 void ReferenceMonitor::integrate(const EpochFrame& frame, GyroMask excluded,

@@ -11,6 +11,7 @@
 
 #include "epoch_frame.hpp"
 #include "gyro_series.hpp"
+#include "mekf.hpp"
 #include "tetra/core/quaternion.hpp"
 #include "tetra/fdi/config.hpp"
 
@@ -34,6 +35,10 @@ class ReferenceMonitor {
   //! A reference sample: compares the last window; a confirmed single-gyro disagreement is returned.
   std::optional<ReferenceFinding> update(std::int64_t now_ns, const Quaternion& q_RB, GyroMask excluded,
                                          const GyroSeries& series);
+  //! During a fault episode, at a reference sample: the attitude filter's bias estimates. One active gyro's
+  //! bias beyond `reference_threshold_sigma` of its fault-free spread (Mekf::bias_z), every other within half
+  //! of it, at `reference_confirm_count` consecutive samples isolates it.
+  std::optional<ReferenceFinding> filter_update(const Mekf& filter, GyroMask active);
   //! The windows start again (a reinstated gyro's angle has a gap).
   void restart_windows() { snap_count_ = 0; }
   void reset();
@@ -64,6 +69,8 @@ class ReferenceMonitor {
   int snap_count_ = 0;              //!< total pushed
   int run_gyro_ = 0;                //!< gyro flagged alone by the last comparisons
   int run_ = 0;                     //!< how many in a row
+  int bias_run_gyro_ = 0;           //!< gyro flagged alone by the filter's last samples
+  int bias_run_ = 0;
 };
 
 }  // namespace tetra::fdi::detail
