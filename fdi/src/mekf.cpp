@@ -144,7 +144,7 @@ void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::V
   for (Eigen::Index j = 0; j < m; ++j) V += coupling_.col(j) * Ptb.col(j).transpose();
   Eigen::Matrix3d Ptt = V * A.transpose() + q_theta;
   for (Eigen::Index j = 0; j < m; ++j) Ptt += cross_.col(j) * coupling_.col(j).transpose();
-  P_.topLeftCorner<3, 3>() = Ptt;
+  P_.topLeftCorner<3, 3>() = 0.5 * (Ptt + Ptt.transpose());
   for (Eigen::Index k = 0; k < m; ++k) {
     P_.block<3, 1>(0, 3 + k) = cross_.col(k) * decay_[k];
     P_.block<1, 3>(3 + k, 0) = (cross_.col(k) * decay_[k]).transpose();
@@ -159,7 +159,7 @@ void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::V
     P_(g_of(i), g_of(i)) += g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - phi * phi);
     bias_[n_ + i] *= phi;
   }
-  symmetrize();
+  // Symmetric by construction but for the attitude block (symmetrized above).
 }
 
 void Mekf::add_attitude_variance(const Eigen::Vector3d& var_rad2) {
@@ -219,18 +219,20 @@ Eigen::Vector3d Mekf::update_parity(const Eigen::MatrixXd& W, int d, GyroMask ma
       s += scale * W(r, i) * (ph_[c_of(i)] + ph_[g_of(i)]);
     }
     const double nu = p[r] - predicted;
-    // K = P·hᵀ/s; Joseph form for a scalar measurement, expanded: P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ.
+    // K = P·hᵀ/s; Joseph form for a scalar measurement, expanded: P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ (symmetric
+    // term by term: one triangle computed, mirrored).
     for (Eigen::Index k = 0; k < dim_; ++k) {
       const double kk = ph_[k] / s;
-      for (Eigen::Index j = 0; j < dim_; ++j) {
+      for (Eigen::Index j = k; j < dim_; ++j) {
         const double kj = ph_[j] / s;
-        P_(k, j) += -kk * ph_[j] - ph_[k] * kj + s * kk * kj;
+        const double v = P_(k, j) - kk * ph_[j] - ph_[k] * kj + s * kk * kj;
+        P_(k, j) = v;
+        P_(j, k) = v;
       }
     }
     correction += ph_.head<3>() * (nu / s);
     bias_ += ph_.tail(dim_ - 3) * (nu / s);
   }
-  symmetrize();
   return correction;
 }
 
