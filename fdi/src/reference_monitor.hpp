@@ -24,6 +24,25 @@ struct ReferenceFinding {
   bool scale = false;      //!< the error follows the rotation during a slew: a scale-factor error
 };
 
+//! "One gyro alone beyond the threshold, every other below half of it, in `count` consecutive comparisons":
+//! the votes of one comparison (`begin`, `add` per gyro) and the run of comparisons that agree.
+class LoneGyro {
+ public:
+  void begin();
+  void add(int id, double z, double threshold);
+  //! The gyro flagged alone by this and the previous `count` − 1 comparisons (at least `min_members` gyros
+  //! compared), else 0; a confirmed gyro starts the run again.
+  int confirm(int count, int min_members);
+  double statistic() const { return stat_; }  //!< [σ] the flagged gyro's
+  void reset() { run_gyro_ = run_ = 0; }
+
+ private:
+  int flagged_ = 0, loud_ = 0, culprit_ = 0, members_ = 0;
+  double stat_ = 0.0;
+  int run_gyro_ = 0;  //!< gyro flagged alone by the last comparisons
+  int run_ = 0;       //!< how many in a row
+};
+
 class ReferenceMonitor {
  public:
   ReferenceMonitor(const Eigen::MatrixX3d& axes_B, const PipelineConfig& config);
@@ -67,10 +86,8 @@ class ReferenceMonitor {
   std::vector<double> snap_angle_;  //!< kSnapshots×N
   std::vector<double> snap_ref_;    //!< kSnapshots×N
   int snap_count_ = 0;              //!< total pushed
-  int run_gyro_ = 0;                //!< gyro flagged alone by the last comparisons
-  int run_ = 0;                     //!< how many in a row
-  int bias_run_gyro_ = 0;           //!< gyro flagged alone by the filter's last samples
-  int bias_run_ = 0;
+  LoneGyro windows_;                //!< the windows' comparisons
+  LoneGyro filter_;                 //!< the filter's bias estimates at reference samples
 };
 
 }  // namespace tetra::fdi::detail
