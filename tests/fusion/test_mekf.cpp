@@ -194,6 +194,38 @@ TEST(MekfFaults, BiasAndRampIsolatedToTheRightGyroAndTheAttitudeRecovers) {
   }
 }
 
+TEST(MekfGate, WildReferenceSamplesAreRejectedCountedAndAPersistentOffsetResetsTheAttitude) {
+  // Orbit with the 1 Hz, 5″ reference. Samples 30..34 s turned by 1° (χ² ≈ 1e8 ≫ the gate's 30.7): all five
+  // rejected, the attitude untouched by them (error < 30″, ~10σ of the 1.7″ steady state). From 60 s every
+  // sample is 1° off: after reference_gate_reset_count (10) rejections in a row the next sample sets the
+  // attitude.
+  auto sc = sim::builtin_scenario("orbit");
+  ASSERT_TRUE(sc.ok());
+  sc->duration_s = 90.0;
+  auto simulator = sim::Simulator::create(*sc, sim::SimOptions{3, {}});
+  ASSERT_TRUE(simulator.ok());
+  auto pipeline = fdi::Pipeline::create(sc->unit, fdi::PipelineConfig{});
+  ASSERT_TRUE(pipeline.ok());
+  const Quaternion off = quat_exp(Eigen::Vector3d(0.0, kDegToRad, 0.0));
+  sim::SimEpoch e;
+  double error_at_40_arcsec = -1.0;
+  std::uint64_t rejected_at_40 = 0;
+  while (simulator->next(e)) {
+    std::optional<Quaternion> ref = e.reference_q_RB;
+    if (ref && ((e.time_s >= 30.0 && e.time_s < 35.0) || e.time_s >= 60.0)) ref = *ref * off;
+    const auto& r = pipeline->step(fdi::Epoch{e.stamp_ns, e.raw_V, e.present, ref});
+    if (error_at_40_arcsec < 0.0 && e.time_s >= 40.0) {
+      error_at_40_arcsec = angle_between(r.attitude.q_RB, e.truth_q_RB) * kRadToDeg * 3600.0;
+      rejected_at_40 = pipeline->health().counters.reference_rejected;
+    }
+  }
+  const auto& c = pipeline->health().counters;
+  EXPECT_EQ(rejected_at_40, 5U);
+  EXPECT_LT(error_at_40_arcsec, 30.0);
+  EXPECT_EQ(c.reference_reinitialized, 1U);  // 60..68 s rejected, 69 s sets the attitude
+  EXPECT_EQ(c.reference_rejected, 5U + 9U);
+}
+
 // ---------------------------------------------------------------------------------------------
 // parts
 

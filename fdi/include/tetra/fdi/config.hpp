@@ -66,7 +66,7 @@ struct PipelineConfig {
   double bias_instability_correlation_s = 100.0;
   //! [-] probability that the χ² gate rejects a good reference sample (3 dof).
   double reference_gate_false_alarm_probability = 1.0e-6;
-  //! [-] this many reference samples rejected in a row set the attitude from the next one again.
+  //! [-] the last of this many reference samples in a row that the gate would reject sets the attitude.
   int reference_gate_reset_count = 10;
 };
 
