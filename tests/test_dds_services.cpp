@@ -206,8 +206,14 @@ AttitudeRows read_attitude(const std::string& path) {
     }
     std::string rest;
     std::getline(cells, rest);
+    // mode, gyros, sigma_x/y/z_deg; the bias columns after them are the filter's, which DDS Attitude does not
+    // carry (a recorder writes them nan; Health has the estimates).
+    std::size_t end = 0;
+    for (int commas = 0; end < rest.size(); ++end) {
+      if (rest[end] == ',' && ++commas == 5) break;
+    }
     rows.numbers.push_back(v);
-    rows.labels.push_back(rest);
+    rows.labels.push_back(rest.substr(0, end));
   }
   return rows;
 }

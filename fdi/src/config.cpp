@@ -54,6 +54,10 @@ const std::vector<KeyDef>& scalar_keys() {
       {"reference_confirm_count", &PipelineConfig::reference_confirm_count},
       {"glt_false_alarm_probability", &PipelineConfig::glt_false_alarm_probability},
       {"exclusion_enabled", &PipelineConfig::exclusion_enabled},
+      {"initial_sigma_deg", &PipelineConfig::initial_sigma_deg},
+      {"bias_instability_correlation_s", &PipelineConfig::bias_instability_correlation_s},
+      {"reference_gate_false_alarm_probability", &PipelineConfig::reference_gate_false_alarm_probability},
+      {"reference_gate_reset_count", &PipelineConfig::reference_gate_reset_count},
   };
   return keys;
 }
@@ -179,6 +183,14 @@ Status validate(const PipelineConfig& c) {
       {"reference_confirm_count", c.reference_confirm_count >= 1 && c.reference_confirm_count <= 100,
        "in [1, 100]"},
       {"glt_false_alarm_probability", probability(c.glt_false_alarm_probability), "in (0, 0.5)"},
+      {"initial_sigma_deg",
+       std::isfinite(c.initial_sigma_deg) && c.initial_sigma_deg >= 0.0 && c.initial_sigma_deg <= 180.0,
+       "in [0, 180]"},
+      {"bias_instability_correlation_s", positive(c.bias_instability_correlation_s), "> 0"},
+      {"reference_gate_false_alarm_probability", probability(c.reference_gate_false_alarm_probability),
+       "in (0, 0.5)"},
+      {"reference_gate_reset_count",
+       c.reference_gate_reset_count >= 1 && c.reference_gate_reset_count <= 1000, "in [1, 1000]"},
   };
   for (const auto& check : checks) {
     if (!check.ok) return bad_input(std::string("pipeline.") + check.name + ": must be " + check.rule);

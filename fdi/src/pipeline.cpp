@@ -5,7 +5,8 @@
 //   rate, parity ─ RateAttitude::measure, ParityDetector (χ², CUSUM)
 //   isolation    ─ GyroSeries::check (signatures), ReferenceMonitor, Isolator (onset, GLT)
 //   gyro set     ─ GyroSet (exclusions, latched) → mode
-//   attitude     ─ RateAttitude::propagate (trapezoid, uncertainty)
+//   attitude     ─ RateAttitude::propagate (trapezoid, filter covariance), RateAttitude::reference (filter
+//                  update with the epoch's reference sample)
 //
 // Each stage owns its state and resets it itself; the pipeline only orders them and turns their findings into
 // events. Steady state allocates nothing: every buffer is sized at creation (or when the sample period is
@@ -19,6 +20,7 @@
 #include "gyro_series.hpp"
 #include "gyro_set.hpp"
 #include "isolator.hpp"
+#include "mekf.hpp"
 #include "outlier_gate.hpp"
 #include "parity_detector.hpp"
 #include "rate_attitude.hpp"
@@ -53,12 +55,13 @@ class Pipeline::Impl {
         isolator_(n_, config_),
         reference_(cal.axes_B(), config_),
         gyro_set_(n_),
-        attitude_(config_) {
+        attitude_(config_, noise_models(cal, series_, config_)) {
     frame_.resize(n_);
     found_.reserve(static_cast<std::size_t>(n_));
     result_.events.reserve(32);
     pending_.reserve(16);
     health_.gyros.resize(static_cast<std::size_t>(n_));
+    result_.attitude.gyro_bias_rad_s.assign(static_cast<std::size_t>(n_), 0.0);
     if (config_.sample_period_s > 0.0) subsets_.prepare(config_.sample_period_s);
     reset();
   }
@@ -85,7 +88,8 @@ class Pipeline::Impl {
   void detect();
   void seek_evidence(const Epoch& epoch);
   void decide_episode();
-  void publish_attitude();
+  void publish_attitude(const Epoch& epoch);
+  void publish_filter();
 
   void isolate(const Isolation& iso);
   void isolate_all(Isolations& found);
@@ -139,7 +143,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B());
   seek_evidence(epoch);
   update_mode(frame_.now_ns);
-  publish_attitude();
+  publish_attitude(epoch);
   return result_;
 }
 
@@ -183,6 +187,8 @@ void Pipeline::Impl::detect() {
     attitude_.add_bound(
         fault_rate_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()) *
         ns_to_seconds(frame_.now_ns - isolator_.episode().onset_ns));
+    attitude_.fault_opened(
+        fault_size_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()));
   }
   isolator_.alarmed(frame_.now_ns);
   detector_.restart_after_alarm();  // a persisting fault keeps raising alarms, a gone one stops
@@ -199,6 +205,13 @@ void Pipeline::Impl::seek_evidence(const Epoch& epoch) {
           isolator_.classify_drift(finding->gyro, frame_.index, gyro_set_.active(), subsets_);
       isolate({finding->gyro, finding->scale ? FaultKind::kScale : drift, Evidence::kReference,
                DetectionTest::kReference, finding->statistic});
+    } else if (isolator_.episode().active && attitude_.reference_aided()) {
+      // The filter's bias estimates (reference + parity make each gyro's observable): one gyro alone off.
+      if (const auto bias = reference_.filter_update(attitude_.filter(), gyro_set_.active())) {
+        const FaultKind drift =
+            isolator_.classify_drift(bias->gyro, frame_.index, gyro_set_.active(), subsets_);
+        isolate({bias->gyro, drift, Evidence::kReference, DetectionTest::kReference, bias->statistic});
+      }
     }
   }
   if (subsets_.ready()) decide_episode();
@@ -235,7 +248,7 @@ void Pipeline::Impl::decide_episode() {
   }
 }
 
-void Pipeline::Impl::publish_attitude() {
+void Pipeline::Impl::publish_attitude(const Epoch& epoch) {
   frame_.usable &= gyro_set_.active();
   bool observable = false;
   if (!subsets_.ready()) {
@@ -256,8 +269,19 @@ void Pipeline::Impl::publish_attitude() {
           episode ? fault_rate_bound(*active, detector_.parity_ema(), subsets_.sqrt_period())
                   : Eigen::Vector3d::Zero();
       attitude_.propagate(frame_, sol, active, bound);
+      // The epoch's parity, when it was computed over the gyros published, measures their biases.
+      if (frame_.usable == measured_ && sol.observable)
+        attitude_.parity(sol, detector_.parity(), subsets_.sqrt_period());
     }
   }
+  // The reference sample, at this epoch's time, once the attitude is there too.
+  if (epoch.reference_q_RB) {
+    const ReferenceUse use = attitude_.reference(*epoch.reference_q_RB);
+    ++(use == ReferenceUse::kRejected ? health_.counters.reference_rejected
+                                      : health_.counters.reference_accepted);
+    if (use == ReferenceUse::kReinitialized) ++health_.counters.reference_reinitialized;
+  }
+  publish_filter();
   auto& a = result_.attitude;
   a.omega_BR_B_rad_s = attitude_.omega_BR_B();
   a.stamp_ns = frame_.now_ns;
@@ -267,6 +291,19 @@ void Pipeline::Impl::publish_attitude() {
   a.gyros = observable ? frame_.usable : GyroMask{0};
   health_.used = a.gyros;
   attitude_.finish_epoch();
+}
+
+void Pipeline::Impl::publish_filter() {
+  const Mekf& f = attitude_.filter();
+  auto& a = result_.attitude;
+  for (int id = 1; id <= n_; ++id) {
+    const auto i = static_cast<std::size_t>(id - 1);
+    a.gyro_bias_rad_s[i] = f.bias_rad_s(id);
+    auto& h = health_.gyros[i];
+    h.bias_rad_s = f.bias_rad_s(id);
+    h.bias_sigma_rad_s = f.bias_sigma_rad_s(id);
+  }
+  health_.reference_chi2 = attitude_.reference_chi2();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -307,6 +344,7 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   }
   emit(std::move(e));
   gyro_set_.exclude(iso.gyro, iso.kind);
+  attitude_.freeze(iso.gyro);
   restart_detectors();
   FdiEvent rc;
   rc.stamp_ns = now;
@@ -381,6 +419,7 @@ void Pipeline::Impl::reset() {
 // operator commands
 
 void Pipeline::Impl::reinstate(int id) {
+  if (gyro_set_.is_excluded(id)) attitude_.thaw(id);
   gyro_set_.reinstate(id);
   series_.forget_evidence(id);
   reference_.restart_windows();  // the reinstated gyro's angle has a gap: the reference windows start again
@@ -418,6 +457,7 @@ FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns, bool for
   if (!force && !subsets_.observable(without_gyro(gyro_set_.active(), id)))
     return acknowledge(verb, id, CommandOutcome::kRefusedUnobservable, false, stamp_ns);
   gyro_set_.exclude(id, FaultKind::kUnknown);
+  attitude_.freeze(id);
   return acknowledge(verb, id, CommandOutcome::kDone, true, stamp_ns);
 }
 

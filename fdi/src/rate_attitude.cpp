@@ -1,27 +1,47 @@
 #include "rate_attitude.hpp"
 
 #include <algorithm>
+#include <cmath>
 
+#include "tetra/core/allan_stats.hpp"
 #include "tetra/core/units.hpp"
 
 namespace tetra::fdi::detail {
+
+namespace {
+//! [rad/s] f_i = wᵢᵀp̄/|wᵢ|²: the fault on gyro i (column i of the subset's parity) that explains p̄.
+double single_gyro_fault(const Subset& s, Eigen::Index i, const Eigen::VectorXd& parity_ema,
+                         double sqrt_period) {
+  double wp = 0.0;
+  double ww = 0.0;
+  for (int r = 0; r < s.dof; ++r) {
+    const double w = s.parity(r, i) * sqrt_period;
+    wp += w * parity_ema[r];
+    ww += w * w;
+  }
+  return wp / ww;
+}
+}  // namespace
 
 Eigen::Vector3d fault_rate_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period) {
   Eigen::Vector3d bound = Eigen::Vector3d::Zero();
   if (s.dof < 1) return bound;
   for (Eigen::Index i = 0; i < s.pinv.cols(); ++i) {
     if (!has_gyro(s.mask, static_cast<int>(i) + 1)) continue;
-    double wp = 0.0;
-    double ww = 0.0;
-    for (int r = 0; r < s.dof; ++r) {
-      const double w = s.parity(r, i) * sqrt_period;
-      wp += w * parity_ema[r];
-      ww += w * w;
-    }
-    const double f = wp / ww;
+    const double f = single_gyro_fault(s, i, parity_ema, sqrt_period);
     bound = bound.cwiseMax((s.pinv.col(i) * f).cwiseAbs());
   }
   return bound;
+}
+
+double fault_size_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period) {
+  double f = 0.0;
+  if (s.dof < 1) return f;
+  for (Eigen::Index i = 0; i < s.pinv.cols(); ++i) {
+    if (has_gyro(s.mask, static_cast<int>(i) + 1))
+      f = std::max(f, std::abs(single_gyro_fault(s, i, parity_ema, sqrt_period)));
+  }
+  return f;
 }
 
 Eigen::Vector3d fault_angle_error(const Subset& s, int id, const Eigen::VectorXd& parity_ema,
@@ -33,17 +53,86 @@ Eigen::Vector3d fault_angle_error(const Subset& s, int id, const Eigen::VectorXd
   return s.pinv.col(id - 1) * f * span_s;
 }
 
-RateAttitude::RateAttitude(const PipelineConfig& config)
+std::vector<GyroNoiseModel> noise_models(const Calibration& cal, const GyroSeries& series,
+                                         const PipelineConfig& config) {
+  // σ_GM / B: the stationary σ of the first-order Gauss–Markov process whose Allan-deviation peak equals IEEE
+  // 952's bias-instability floor 0.664·B (the peak is 0.6174·σ_GM; the simulator's model, docs/sim.md).
+  constexpr double kGaussMarkovSigmaPerB = 1.0760;
+  std::vector<GyroNoiseModel> out(cal.gyros.size());
+  for (std::size_t i = 0; i < cal.gyros.size(); ++i) {
+    const GyroConstants& c = series.constants(static_cast<int>(i) + 1);
+    GyroNoiseModel& m = out[i];
+    m.arw_rad_rts = c.arw_rad_rts;
+    m.bias_sigma_rad_s = c.bias_sigma_rad_s;
+    m.gm_sigma_rad_s = kGaussMarkovSigmaPerB * c.bias_instability_rad_s;
+    m.gm_correlation_s = config.bias_instability_correlation_s;
+    const auto& noise = cal.gyros[i].noise;
+    if (noise && noise->rate_random_walk_dps_per_rts)
+      m.rrw_rad_s_rts = *noise->rate_random_walk_dps_per_rts * kDegToRad;
+  }
+  return out;
+}
+
+RateAttitude::RateAttitude(const PipelineConfig& config, std::vector<GyroNoiseModel> gyros)
     : config_(config),
       propagator_(config.initial_q_RB, config.latitude_deg
                                            ? std::optional<double>(*config.latitude_deg * kDegToRad)
-                                           : std::nullopt) {}
+                                           : std::nullopt),
+      mekf_(std::move(gyros)),
+      gate_chi2_(allan::chi2_quantile(1.0 - config.reference_gate_false_alarm_probability, 3.0)) {}
 
 void RateAttitude::reset(const Quaternion& q0_RB) {
   propagator_.reset(q0_RB);
+  mekf_.reset(config_.initial_sigma_deg * kDegToRad);
   omega_meas_.setZero();
   omega_prev_.setZero();
+  correction_.setZero();
   lost_since_ns_ = -1;
+  reference_seen_ = false;
+  rejected_run_ = 0;
+  last_chi2_ = 0.0;
+}
+
+Eigen::Vector3d RateAttitude::sigma_rad() const {
+  const Eigen::Vector3d f = mekf_.attitude_sigma_rad();
+  const Eigen::Vector3d b = propagator_.sigma_rad();  // the bound alone: its noise inputs are zero
+  return (f.cwiseProduct(f) + b.cwiseProduct(b)).cwiseSqrt();
+}
+
+void RateAttitude::parity(const Subset& s, const Eigen::VectorXd& p, double sqrt_period) {
+  if (!reference_seen_ || s.dof < 1) return;
+  const Eigen::Vector3d dtheta = mekf_.update_parity(s.parity, s.dof, s.mask, sqrt_period, p.data());
+  const Eigen::Vector3d bound = propagator_.sigma_rad();  // the bound alone; kept across the attitude reset
+  propagator_.reset(propagator_.q_RB() * quat_exp(dtheta));
+  propagator_.add_bound(bound);
+}
+
+ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB) {
+  const double sigma_ref = config_.reference_sigma_arcsec * kArcsecToRad;
+  if (!reference_seen_) {
+    // The first sample sets the attitude (replay and service alike): known to the reference's σ from now on.
+    reference_seen_ = true;
+    propagator_.reset(q_ref_RB);
+    mekf_.reset_attitude(sigma_ref);
+    return ReferenceUse::kInitialized;
+  }
+  // A bound (unresolved fault, lost rate) becomes a 1σ of the filter: the reference can then correct it.
+  const Eigen::Vector3d bound = propagator_.sigma_rad();
+  mekf_.add_attitude_variance(bound.cwiseProduct(bound));
+  propagator_.reset(propagator_.q_RB());
+  const ReferenceUpdate u = mekf_.update_reference(propagator_.q_RB(), q_ref_RB, sigma_ref, gate_chi2_);
+  last_chi2_ = u.chi2;
+  if (u.accepted) {
+    rejected_run_ = 0;
+    propagator_.reset(propagator_.q_RB() * quat_exp(u.correction_rad));
+    return ReferenceUse::kAccepted;
+  }
+  if (++rejected_run_ < config_.reference_gate_reset_count) return ReferenceUse::kRejected;
+  // Every recent sample disagrees: the estimate, not the reference, is wrong (e.g. after a lost rate).
+  rejected_run_ = 0;
+  propagator_.reset(q_ref_RB);
+  mekf_.reset_attitude(sigma_ref);
+  return ReferenceUse::kReinitialized;
 }
 
 void RateAttitude::measure(const Subset& s, const EpochFrame& frame) {
@@ -68,8 +157,13 @@ void RateAttitude::propagate(const EpochFrame& frame, const Subset& sol, const S
     lost_since_ns_ = -1;
   }
   const Subset& noise = sol.observable ? sol : *fallback;
-  (void)propagator_.step(0.5 * (omega_prev_ + omega_meas_), frame.dt_s, noise.arw_sq_rad2_s,
-                         noise.bias_sigma_rad_s, bound);  // trapezoid
+  // The rate as the filter sees it: the trapezoid of the estimates, less the bias estimates' projection
+  // (zero without a reference: then the attitude is the gyros' alone).
+  if (sol.observable) correction_ = mekf_.rate_correction(sol.pinv, sol.mask);
+  const Eigen::Vector3d omega = 0.5 * (omega_prev_ + omega_meas_) - correction_;
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  (void)propagator_.step(omega, frame.dt_s, zero, zero, bound);
+  mekf_.propagate(noise.pinv, noise.mask, omega, frame.dt_s);
 }
 
 }  // namespace tetra::fdi::detail

@@ -1,15 +1,20 @@
 #pragma once
-// Rate and attitude (docs/fdi.md, "Per epoch" 4 and 7, and "Attitude uncertainty"): the weighted
-// least-squares rate over the usable gyros, the trapezoid propagation of the attitude, and its per-axis
-// uncertainty — random, systematic, and the bound of an unresolved fault or of a lost rate.
+// Rate and attitude (docs/fdi.md, "Per epoch" 4 and 7, "Attitude filter" and "Attitude uncertainty"): the
+// weighted least-squares rate over the usable gyros corrected by the filter's bias estimates, the trapezoid
+// propagation of the attitude, the filter (mekf.hpp) that carries its covariance and takes the reference
+// samples, and the bound of an unresolved fault or of a lost rate (added to the filter's σ).
 
 #include <cstdint>
+#include <vector>
 
 #include <Eigen/Core>
 
 #include "epoch_frame.hpp"
+#include "gyro_series.hpp"
+#include "mekf.hpp"
 #include "subset_cache.hpp"
 #include "tetra/core/attitude.hpp"
+#include "tetra/core/calibration_file.hpp"
 #include "tetra/fdi/config.hpp"
 
 namespace tetra::fdi::detail {
@@ -18,13 +23,24 @@ namespace tetra::fdi::detail {
 //! fault f_i = wᵢᵀp̄/|wᵢ|² (p̄ the parity EMA), which moves the estimate by H*(:, i)·f_i; the per-axis maximum.
 Eigen::Vector3d fault_rate_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period);
 
+//! [rad/s] the largest single-gyro fault size f_i = wᵢᵀp̄/|wᵢ|² over the gyros of the subset.
+double fault_size_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period);
+
 //! [rad] per axis: the angle error a fault on gyro `id` caused since `span_s` ago, from the parity EMA.
 Eigen::Vector3d fault_angle_error(const Subset& s, int id, const Eigen::VectorXd& parity_ema,
                                   double sqrt_period, double span_s);
 
+//! The filter's noise model of every gyro: N and the calibration's bias σ from the pipeline's constants, K
+//! and B from the calibration's `noise:` section, T_c from the configuration.
+std::vector<GyroNoiseModel> noise_models(const Calibration& cal, const GyroSeries& series,
+                                         const PipelineConfig& config);
+
+//! What a reference sample did.
+enum class ReferenceUse { kInitialized, kAccepted, kRejected, kReinitialized };
+
 class RateAttitude {
  public:
-  RateAttitude(const PipelineConfig& config);
+  RateAttitude(const PipelineConfig& config, std::vector<GyroNoiseModel> gyros);
 
   //! The rate estimate of the usable gyros of `s` (kept when the subset is not observable).
   void measure(const Subset& s, const EpochFrame& frame);
@@ -37,6 +53,22 @@ class RateAttitude {
   //! Ends the epoch: the published rate and the previous rate for the next trapezoid.
   void finish_epoch() { omega_prev_ = omega_meas_; }
 
+  //! A reference sample: the first one sets the attitude; later ones update the filter (gated).
+  ReferenceUse reference(const Quaternion& q_ref_RB);
+  //! The epoch's normalized parity `p` over the subset `s` into the filter's biases — once a reference sample
+  //! has been seen (without one the attitude stays the gyros' alone).
+  void parity(const Subset& s, const Eigen::VectorXd& p, double sqrt_period);
+  bool reference_aided() const { return reference_seen_; }
+  //! A fault episode opened with fault size bound `sigma_rad_s`: with the reference, the filter's slow bias
+  //! states open up to take it (the reference and the parity then tell which gyro).
+  void fault_opened(double sigma_rad_s) {
+    if (reference_seen_) mekf_.open_fault_hypothesis(sigma_rad_s);
+  }
+
+  //! Gyro `id` leaves the solution (its bias states freeze) or comes back (at its prior).
+  void freeze(int id) { mekf_.freeze(id); }
+  void thaw(int id) { mekf_.thaw(id); }
+
   void add_bound(const Eigen::Vector3d& angle_rad) { propagator_.add_bound(angle_rad); }
   void reset(const Quaternion& q0_RB);
 
@@ -46,11 +78,21 @@ class RateAttitude {
   Eigen::Vector3d omega_BR_B() const { return omega_meas_ - propagator_.earth_rate_B(); }
   Eigen::Vector3d earth_rate_B() const { return propagator_.earth_rate_B(); }
   const Quaternion& q_RB() const { return propagator_.q_RB(); }
-  Eigen::Vector3d sigma_rad() const { return propagator_.sigma_rad(); }
+  //! [rad] 1σ per body axis: the filter's, with the bound of a fault or a lost rate in quadrature.
+  Eigen::Vector3d sigma_rad() const;
+  const Mekf& filter() const { return mekf_; }
+  //! The last reference sample's χ² (3 dof); 0 before any.
+  double reference_chi2() const { return last_chi2_; }
 
  private:
   const PipelineConfig& config_;
-  AttitudePropagator propagator_;
+  AttitudePropagator propagator_;  //!< the quaternion, and the bound (its noise inputs stay zero)
+  Mekf mekf_;
+  double gate_chi2_ = 0.0;                                //!< χ²₃ quantile of the reference gate
+  Eigen::Vector3d correction_ = Eigen::Vector3d::Zero();  //!< [rad/s] H*·b̂ of the last observable epoch
+  bool reference_seen_ = false;
+  int rejected_run_ = 0;  //!< reference samples rejected in a row
+  double last_chi2_ = 0.0;
   Eigen::Vector3d omega_prev_ = Eigen::Vector3d::Zero();  //!< [rad/s] previous epoch's estimate
   Eigen::Vector3d omega_meas_ = Eigen::Vector3d::Zero();  //!< [rad/s] last estimate (Earth rate included)
   std::int64_t lost_since_ns_ = -1;

@@ -20,8 +20,48 @@ ReferenceMonitor::ReferenceMonitor(const Eigen::MatrixX3d& axes_B, const Pipelin
 void ReferenceMonitor::reset() {
   for (auto& t : tracks_) t = Track{};
   snap_count_ = 0;
-  run_gyro_ = 0;
-  run_ = 0;
+  windows_.reset();
+  filter_.reset();
+}
+
+std::optional<ReferenceFinding> ReferenceMonitor::filter_update(const Mekf& filter, GyroMask active) {
+  filter_.begin();
+  for (int id = 1; id <= filter.gyro_count(); ++id) {
+    if (has_gyro(active, id)) filter_.add(id, std::abs(filter.bias_z(id)), config_.reference_threshold_sigma);
+  }
+  const int culprit = filter_.confirm(config_.reference_confirm_count, 3);
+  if (culprit == 0) return std::nullopt;
+  return ReferenceFinding{culprit, filter_.statistic(), false};
+}
+
+void LoneGyro::begin() {
+  flagged_ = loud_ = culprit_ = members_ = 0;
+  stat_ = 0.0;
+}
+
+void LoneGyro::add(int id, double z, double threshold) {
+  ++members_;
+  if (z > threshold) {
+    ++flagged_;
+    culprit_ = id;
+    stat_ = z;
+  } else if (z > 0.5 * threshold) {
+    ++loud_;
+  }
+}
+
+int LoneGyro::confirm(int count, int min_members) {
+  if (flagged_ != 1 || loud_ != 0 || members_ < min_members) {
+    reset();
+    return 0;
+  }
+  if (culprit_ != run_gyro_) {
+    run_gyro_ = culprit_;
+    run_ = 0;
+  }
+  if (++run_ < count) return 0;
+  reset();
+  return culprit_;
 }
 
 void ReferenceMonitor::integrate(const EpochFrame& frame, GyroMask excluded,
@@ -75,12 +115,10 @@ std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, co
   if (old < 0) return std::nullopt;
   const double span = ns_to_seconds(now_ns - snap_ns_[slot(old)]);
   const double sig_ref = config_.reference_sigma_arcsec * kArcsecToRad;
-  int flagged = 0, loud = 0, culprit = 0, members = 0;
-  double stat = 0.0;
+  windows_.begin();
   for (std::size_t i = 0; i < n_; ++i) {
     const int id = static_cast<int>(i) + 1;
     if (has_gyro(excluded, id)) continue;
-    ++members;
     const auto& t = tracks_[i];
     const GyroConstants& c = series.constants(id);
     const double rot = t.ref_angle_rad - snap_ref(old, static_cast<int>(i));
@@ -88,30 +126,13 @@ std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, co
     const double sig = std::sqrt(2.0 * sig_ref * sig_ref + c.arw_rad_rts * c.arw_rad_rts * span +
                                  std::pow((c.bias_sigma_rad_s + c.bias_instability_rad_s) * span, 2) +
                                  std::pow(c.scale_rel_sigma * rot, 2));
-    const double z = std::abs(err) / sig;
-    if (z > config_.reference_threshold_sigma) {
-      ++flagged;
-      culprit = id;
-      stat = z;
-    } else if (z > 0.5 * config_.reference_threshold_sigma) {
-      ++loud;
-    }
+    windows_.add(id, std::abs(err) / sig, config_.reference_threshold_sigma);
   }
   // One gyro alone beyond the threshold, the others quiet, in `reference_confirm_count` consecutive
   // comparisons (consecutive windows share no reference sample, so one wild reference sample cannot do it).
-  if (flagged != 1 || loud != 0 || members < 2) {
-    run_gyro_ = 0;
-    run_ = 0;
-    return std::nullopt;
-  }
-  if (culprit != run_gyro_) {
-    run_gyro_ = culprit;
-    run_ = 0;
-  }
-  if (++run_ < config_.reference_confirm_count) return std::nullopt;
-  run_gyro_ = 0;
-  run_ = 0;
-  return ReferenceFinding{culprit, stat, scale_significant(culprit, old)};
+  const int culprit = windows_.confirm(config_.reference_confirm_count, 2);
+  if (culprit == 0) return std::nullopt;
+  return ReferenceFinding{culprit, windows_.statistic(), scale_significant(culprit, old)};
 }
 
 bool ReferenceMonitor::scale_significant(int culprit, int old) const {

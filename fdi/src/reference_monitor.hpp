@@ -11,6 +11,7 @@
 
 #include "epoch_frame.hpp"
 #include "gyro_series.hpp"
+#include "mekf.hpp"
 #include "tetra/core/quaternion.hpp"
 #include "tetra/fdi/config.hpp"
 
@@ -21,6 +22,25 @@ struct ReferenceFinding {
   int gyro = 0;
   double statistic = 0.0;  //!< [σ] disagreement of the gyro
   bool scale = false;      //!< the error follows the rotation during a slew: a scale-factor error
+};
+
+//! "One gyro alone beyond the threshold, every other below half of it, in `count` consecutive comparisons":
+//! the votes of one comparison (`begin`, `add` per gyro) and the run of comparisons that agree.
+class LoneGyro {
+ public:
+  void begin();
+  void add(int id, double z, double threshold);
+  //! The gyro flagged alone by this and the previous `count` − 1 comparisons (at least `min_members` gyros
+  //! compared), else 0; a confirmed gyro starts the run again.
+  int confirm(int count, int min_members);
+  double statistic() const { return stat_; }  //!< [σ] the flagged gyro's
+  void reset() { run_gyro_ = run_ = 0; }
+
+ private:
+  int flagged_ = 0, loud_ = 0, culprit_ = 0, members_ = 0;
+  double stat_ = 0.0;
+  int run_gyro_ = 0;  //!< gyro flagged alone by the last comparisons
+  int run_ = 0;       //!< how many in a row
 };
 
 class ReferenceMonitor {
@@ -34,6 +54,10 @@ class ReferenceMonitor {
   //! A reference sample: compares the last window; a confirmed single-gyro disagreement is returned.
   std::optional<ReferenceFinding> update(std::int64_t now_ns, const Quaternion& q_RB, GyroMask excluded,
                                          const GyroSeries& series);
+  //! During a fault episode, at a reference sample: the attitude filter's bias estimates. One active gyro's
+  //! bias beyond `reference_threshold_sigma` of its fault-free spread (Mekf::bias_z), every other within half
+  //! of it, at `reference_confirm_count` consecutive samples isolates it.
+  std::optional<ReferenceFinding> filter_update(const Mekf& filter, GyroMask active);
   //! The windows start again (a reinstated gyro's angle has a gap).
   void restart_windows() { snap_count_ = 0; }
   void reset();
@@ -62,8 +86,8 @@ class ReferenceMonitor {
   std::vector<double> snap_angle_;  //!< kSnapshots×N
   std::vector<double> snap_ref_;    //!< kSnapshots×N
   int snap_count_ = 0;              //!< total pushed
-  int run_gyro_ = 0;                //!< gyro flagged alone by the last comparisons
-  int run_ = 0;                     //!< how many in a row
+  LoneGyro windows_;                //!< the windows' comparisons
+  LoneGyro filter_;                 //!< the filter's bias estimates at reference samples
 };
 
 }  // namespace tetra::fdi::detail

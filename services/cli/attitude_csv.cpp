@@ -22,7 +22,27 @@ void append_attitude_row(std::string& out, double time_s, const fdi::AttitudeEst
   out += fdi::to_string(attitude.mode);
   out += ',';
   out += gyros_cell(attitude.gyros, n_gyros);
+  for (int i = 0; i < 3; ++i) {
+    out += ',';
+    append_double(out, attitude.sigma_rad[i] * kRadToDeg);
+  }
+  const bool biases = static_cast<int>(attitude.gyro_bias_rad_s.size()) == n_gyros;
+  for (int i = 0; i < n_gyros; ++i) {
+    out += ',';
+    if (biases) {
+      append_double(out, attitude.gyro_bias_rad_s[static_cast<std::size_t>(i)] * kRadToDeg);
+    } else {
+      out += "nan";
+    }
+  }
   out += '\n';
+}
+
+std::string attitude_header(int n_gyros) {
+  std::string h =
+      "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros,sigma_x_deg,sigma_y_deg,sigma_z_deg";
+  for (int i = 1; i <= n_gyros; ++i) h += ",bias_" + std::to_string(i) + "_dps";
+  return h + "\n";
 }
 
 std::string gyros_cell(GyroMask mask, int n_gyros) {

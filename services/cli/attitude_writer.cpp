@@ -12,7 +12,7 @@ constexpr std::size_t kWriteBytes = std::size_t{1} << 20;  // formatted text wri
 
 AttitudeWriter::AttitudeWriter(OutputFile& out, int n_gyros, std::string preamble)
     : out_(out), n_gyros_(n_gyros), text_(std::move(preamble)), worker_([this] { run(); }) {
-  filling_.reserve(kBatchRows);
+  filling_.rows.reserve(kBatchRows);
 }
 
 AttitudeWriter::~AttitudeWriter() {
@@ -31,8 +31,11 @@ Status AttitudeWriter::error() const {
 }
 
 Status AttitudeWriter::add(double time_s, const fdi::AttitudeEstimate& attitude) {
-  filling_.push_back(Row{time_s, attitude});
-  if (filling_.size() < kBatchRows) return ok_status();
+  if (filling_.used == filling_.rows.size()) filling_.rows.emplace_back();
+  Row& row = filling_.rows[filling_.used++];
+  row.time_s = time_s;
+  row.attitude = attitude;
+  if (filling_.used < kBatchRows) return ok_status();
   return hand_over();
 }
 
@@ -42,20 +45,20 @@ Status AttitudeWriter::hand_over() {
   changed_.wait(lock, [this] { return queue_.size() < kDepth || !status_; });
   if (!status_) return status_;
   queue_.push_back(std::move(filling_));
-  filling_.clear();
+  filling_ = Batch{};
   if (!spare_.empty()) {
     filling_ = std::move(spare_.back());
     spare_.pop_back();
   }
-  filling_.clear();
-  filling_.reserve(kBatchRows);
+  filling_.used = 0;
+  filling_.rows.reserve(kBatchRows);
   lock.unlock();
   changed_.notify_all();
   return ok_status();
 }
 
 Status AttitudeWriter::finish() {
-  if (!filling_.empty()) {
+  if (filling_.used > 0) {
     if (Status s = hand_over(); !s) return s;
   }
   {
@@ -68,7 +71,8 @@ Status AttitudeWriter::finish() {
 }
 
 Status AttitudeWriter::write_batch(const Batch& batch) {
-  for (const Row& row : batch) {
+  for (std::size_t i = 0; i < batch.used; ++i) {
+    const Row& row = batch.rows[i];
     append_attitude_row(text_, row.time_s, row.attitude, n_gyros_);
     if (text_.size() < kWriteBytes) continue;
     if (Status s = out_.write(text_); !s) return s;

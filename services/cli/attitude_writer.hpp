@@ -40,7 +40,12 @@ class AttitudeWriter {
     double time_s = 0.0;
     fdi::AttitudeEstimate attitude;
   };
-  using Batch = std::vector<Row>;
+  // Rows are assigned in place (rows[used] = ...), never pushed: a refilled batch reuses each row's
+  // storage (the bias vector), so a batch costs no allocation after its first use.
+  struct Batch {
+    std::vector<Row> rows;
+    std::size_t used = 0;
+  };
 
   Status hand_over();
   Status error() const;

@@ -176,7 +176,7 @@ int cmd_record(int argc, char** argv) {
 
   GyroLogWriter log;
   bool log_open = false;
-  std::string attitude_text = kAttitudeHeader;
+  std::string attitude_text = attitude_header(n);
   std::map<std::uint64_t, std::string> event_lines;    // by event_seq: written in order
   std::map<std::uint64_t, std::string> command_lines;  // acknowledgements, by event_seq
   std::vector<fdi::Epoch> epochs;

@@ -67,7 +67,8 @@ void add_options(CLI::App& app, ReplayOptions& o) {
                  "[deg] ground-test mode: remove the Earth rate at this geodetic latitude")
       ->check(CLI::Range(-90.0, 90.0));
   app.add_option("--initial-q", o.initial_q,
-                 "initial attitude w,x,y,z (relative to the lab frame in ground mode)");
+                 "initial attitude w,x,y,z (relative to the lab frame in ground mode), 1 sigma "
+                 "pipeline.initial_sigma_deg; the log's first reference sample, if any, sets it instead");
   app.add_option("--config", o.config_path, "YAML file with a 'pipeline:' map of thresholds (docs/fdi.md)");
   app.add_option("--attitude", o.attitude_path, "attitude output (CSV)")->required();
   app.add_option("--events", o.events_path, "FDI events output (JSON lines)")->required();
@@ -254,7 +255,7 @@ Status run_replay(const ReplayOptions& o) {
   std::string preamble;
   for (const auto& [key, value] : provenance_metadata(provenance(files.input_paths())))
     append_metadata(preamble, key, value);
-  preamble += kAttitudeHeader;
+  preamble += attitude_header(n);
   AttitudeWriter att(**attitude_out, n, std::move(preamble));
   BufferedOutput events(**events_out);
   auto replayed = replay_log(*in->log, *pipeline, in->commands, att, events);

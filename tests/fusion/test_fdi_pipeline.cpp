@@ -78,9 +78,15 @@ std::string describe(const Outcome& o) {
 TEST(Pipeline, FaultFreeOrbitIsSilentAndAccurate) {
   // 100 min at 10 Hz. The attitude error is a random walk of N·√t per axis: 3e-5·√6000 ≈ 2.3e-3 deg, about
   // 1.6e-3 deg per axis after the 4-gyro averaging; 4σ of the total angle is the bound.
+  // The synthetic gyros are white noise only: the pipeline is told so (no bias instability B) and that the
+  // start is known (initial σ 0), so the filter's σ is the random walk alone.
   SynthOptions opt;
   opt.seed = 11;
-  const Outcome o = run({}, 6000.0, opt);
+  Calibration white = seed_as_built_unit();
+  for (auto& g : white.gyros) g.noise->bias_instability_dps.reset();
+  PipelineConfig cfg = campaign_config();
+  cfg.initial_sigma_deg = 0.0;
+  const Outcome o = run({}, 6000.0, opt, cfg, white);
   EXPECT_TRUE(o.events.empty()) << describe(o);
   EXPECT_EQ(o.final_mode, Mode::kNominal);
   EXPECT_LT(o.final_error_deg, 4.0 * o.final_sigma_deg);

@@ -297,7 +297,10 @@ TEST(RateAttitude, ConstantRatePropagatesExactly) {
   // q(t) = exp(ω t) for a constant rate (exact exponential map, trapezoid of equal rates): 600 steps leave
   // less than 1e-12 rad of rounding.
   Fixture f;
-  RateAttitude attitude(f.config);
+  f.config.initial_sigma_deg = 0.0;
+  std::vector<GyroNoiseModel> white(4);  // white noise only: the filter's σ is the ARW's
+  for (std::size_t i = 0; i < 4; ++i) white[i].arw_rad_rts = f.constants[i].arw_rad_rts;
+  RateAttitude attitude(f.config, white);
   attitude.reset(Quaternion::Identity());
   EpochFrame frame;
   frame.resize(4);
@@ -316,9 +319,10 @@ TEST(RateAttitude, ConstantRatePropagatesExactly) {
     attitude.finish_epoch();
   }
   EXPECT_LT(angle_between(attitude.q_RB(), quat_exp(omega * 60.0)), 1e-12);
-  // Random part of σ: N_a·√t per axis.
-  EXPECT_NEAR(attitude.sigma_rad()[0],
-              std::sqrt(s.arw_sq_rad2_s[0] * 60.0 + std::pow(s.bias_sigma_rad_s[0] * 60.0, 2)), 1e-12);
+  // σ² summed over the axes: Σ N_a²·t (the error covariance turns with the body, its trace does not; the
+  // process noise H*·diag(N²)·H*ᵀ has the trace of diag((HᵀR⁻¹H)⁻¹)). Relative 1e-12: rounding of 600 sums.
+  const double expect = s.arw_sq_rad2_s.sum() * 60.0;
+  EXPECT_NEAR(attitude.sigma_rad().squaredNorm(), expect, 1e-12 * expect);
 }
 
 }  // namespace

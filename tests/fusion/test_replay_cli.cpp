@@ -53,10 +53,13 @@ TEST(ReplayCli, WritesAttitudeAndEventsAndSummary) {
   const std::string file = test::read_file(dir.file("att.csv"));
   EXPECT_EQ(file.rfind("# tetra_version=", 0), 0U);  // provenance first
   const std::string text = file.substr(file.find("\ntime_s") + 1);
-  EXPECT_EQ(text.substr(0, text.find('\n')), "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros");
+  EXPECT_EQ(
+      text.substr(0, text.find('\n')),
+      "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros,sigma_x_deg,sigma_y_deg,sigma_z_deg,"
+      "bias_1_dps,bias_2_dps,bias_3_dps,bias_4_dps");
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1001);  // header + one row per epoch
-  EXPECT_NE(text.find(",NOMINAL,1234\n"), std::string::npos);
-  EXPECT_NE(text.find(",DEGRADED,134\n"), std::string::npos);
+  EXPECT_NE(text.find(",NOMINAL,1234,"), std::string::npos);
+  EXPECT_NE(text.find(",DEGRADED,134,"), std::string::npos);
   const std::string ev = test::read_file(dir.file("ev.jsonl"));
   EXPECT_NE(ev.find(R"("event": "isolated", "gyro": 2, "kind": "dropout")"), std::string::npos) << ev;
   EXPECT_NE(ev.find(R"("event": "reconfigured", "gyros": [1, 3, 4])"), std::string::npos) << ev;
@@ -82,7 +85,7 @@ TEST(ReplayCli, BadTimesAreCountedNotFatal) {
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.err.find("rejected: 3 time not increasing"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("1 invalid, 1 absent"), std::string::npos) << r.err;
-  EXPECT_NE(test::read_file(dir.file("att.csv")).find(",LOST,\n"),
+  EXPECT_NE(test::read_file(dir.file("att.csv")).find(",LOST,,"),
             std::string::npos);  // 2 usable gyros at 0.4 s
 }
 

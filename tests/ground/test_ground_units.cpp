@@ -218,6 +218,18 @@ TEST(CommandRequest, ValidatesEveryField) {
   EXPECT_FALSE(to_wire(*too_long, 1, wire).ok());
 }
 
+TEST(RecordFiles, AttitudeFilterColumnsAfterTheElevenAreReadPast) {
+  test::TempDir dir;
+  test::write_file(dir.file("att.csv"),
+                   "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros,sigma_x_deg,sigma_y_deg,"
+                   "sigma_z_deg,bias_1_dps,bias_2_dps,bias_3_dps\n"
+                   "0.1,1,0,0,0,0,0.06,0,0.001,NOMINAL,123,0.0005,0.0006,0.0007,1e-6,2e-6,3e-6\n");
+  auto att = read_record(dir.path().string(), "att.csv", 0.0, 1.0, 0);
+  ASSERT_TRUE(att.ok()) << att.error().message;
+  ASSERT_EQ(att->size(), 1U);
+  EXPECT_EQ((*att)[0]["gyros"], "123");
+}
+
 TEST(RecordFiles, AttitudeAndEventFilesAreServedBySensorTime) {
   test::TempDir dir;
   test::write_file(dir.file("att.csv"),

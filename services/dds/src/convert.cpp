@@ -101,6 +101,8 @@ Status to_wire(const std::string& unit, const fdi::Health& health, const service
   for (std::size_t i = 0; i < health.gyros.size(); ++i) {
     out.gyros[i].state = to_wire(health.gyros[i].state);
     out.gyros[i].kind = to_wire(health.gyros[i].kind);
+    out.gyros[i].bias_rad_s = health.gyros[i].bias_rad_s;
+    out.gyros[i].bias_sigma_rad_s = health.gyros[i].bias_sigma_rad_s;
   }
   out.msg.gyros._buffer = out.gyros.data();
   out.msg.gyros._length = static_cast<std::uint32_t>(health.gyros.size());
@@ -137,7 +139,8 @@ HealthView from_wire(const tetra_Health& in) {
   h.mode = from_wire(in.mode);
   h.used = in.used;
   for (std::uint32_t i = 0; i < in.gyros._length; ++i) {
-    h.gyros.push_back({from_wire(in.gyros._buffer[i].state), from_wire(in.gyros._buffer[i].kind)});
+    const tetra_GyroStatus& g = in.gyros._buffer[i];
+    h.gyros.push_back({from_wire(g.state), from_wire(g.kind), g.bias_rad_s, g.bias_sigma_rad_s});
   }
   h.parity_residual = in.parity_residual;
   h.chi2 = in.chi2;

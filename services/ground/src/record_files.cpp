@@ -27,7 +27,8 @@ std::vector<std::string> split(const std::string& line) {
 
 //! One attitude row as the stream's attitude object (without UTC), or an error naming the line.
 Result<json> attitude_row(const std::vector<std::string>& cells, const std::string& where) {
-  if (cells.size() != 11) return bad_input(where + ": expected 11 columns (" + kAttitudeHeader + ")");
+  // The 11 columns first; the attitude filter's per-axis sigma and bias columns may follow.
+  if (cells.size() < 11) return bad_input(where + ": expected at least 11 columns (" + kAttitudeHeader + ")");
   double v[9];
   for (std::size_t i = 0; i < 9; ++i) {
     char* end = nullptr;
@@ -67,7 +68,7 @@ Result<std::vector<json>> rows_of(const std::string& path, double start_s, doubl
   for (int number = 1; std::getline(in, line); ++number) {
     if (line.empty() || line[0] == '#') continue;
     if (!header_seen) {
-      if (line != kAttitudeHeader)
+      if (line.rfind(kAttitudeHeader, 0) != 0)
         return bad_input(path + ":" + std::to_string(number) + ": not an attitude file");
       header_seen = true;
       continue;

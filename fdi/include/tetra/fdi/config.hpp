@@ -58,6 +58,16 @@ struct PipelineConfig {
   //! report; for experiments that measure what exclusion is worth). The `isolated` event then says
   //! "gyro kept" and detection starts again; replay, the service and the closed-loop simulator alike.
   bool exclusion_enabled = true;
+
+  // --- attitude filter (docs/fdi.md, "Attitude filter")
+  //! [deg] 1σ per axis of `initial_q_wxyz` until a reference sample sets the attitude (0 only if set so).
+  double initial_sigma_deg = 0.1;
+  //! [s] correlation time T_c of the Gauss–Markov bias that models each gyro's bias instability B.
+  double bias_instability_correlation_s = 100.0;
+  //! [-] probability that the χ² gate rejects a good reference sample (3 dof).
+  double reference_gate_false_alarm_probability = 1.0e-6;
+  //! [-] the last of this many reference samples in a row that the gate would reject sets the attitude.
+  int reference_gate_reset_count = 10;
 };
 
 //! Parses a `pipeline:` YAML map (unknown keys are errors naming the line); `source` names the file.

@@ -123,17 +123,22 @@ const char* to_string(GyroState state);  // "ok", "absent", "invalid", "suspect"
 struct GyroHealth {
   GyroState state = GyroState::kOk;
   FaultKind kind = FaultKind::kNone;  //!< why it is excluded or suspect
+  double bias_rad_s = 0.0;            //!< [rad/s] the attitude filter's estimate of its bias (c + g)
+  double bias_sigma_rad_s = 0.0;      //!< [rad/s] 1σ of that estimate
 };
 
 struct Counters {
   std::uint64_t epochs_accepted = 0;
   std::uint64_t epochs_rejected_time = 0;  //!< time not increasing (duplicate, backward, out of order)
   std::uint64_t samples_accepted = 0;
-  std::uint64_t samples_invalid = 0;        //!< NaN, Inf or out of range
-  std::uint64_t samples_absent = 0;         //!< no sample delivered
-  std::uint64_t epochs_rejected_shape = 0;  //!< epoch with a sample count other than N
-  std::uint64_t samples_outlier = 0;        //!< valid samples left out for one epoch (spike or onset)
-  std::uint64_t spikes = 0;                 //!< confirmed one-epoch spikes (outliers that went away)
+  std::uint64_t samples_invalid = 0;          //!< NaN, Inf or out of range
+  std::uint64_t samples_absent = 0;           //!< no sample delivered
+  std::uint64_t epochs_rejected_shape = 0;    //!< epoch with a sample count other than N
+  std::uint64_t samples_outlier = 0;          //!< valid samples left out for one epoch (spike or onset)
+  std::uint64_t spikes = 0;                   //!< confirmed one-epoch spikes (outliers that went away)
+  std::uint64_t reference_accepted = 0;       //!< reference samples the attitude filter used
+  std::uint64_t reference_rejected = 0;       //!< reference samples its χ² gate rejected
+  std::uint64_t reference_reinitialized = 0;  //!< times a run of rejections set the attitude again
 };
 
 struct Health {
@@ -147,6 +152,7 @@ struct Health {
   double chi2_threshold = 0.0;
   double cusum_threshold = 0.0;
   Counters counters;
+  double reference_chi2 = 0.0;  //!< χ² (3 dof) of the last reference sample's innovation
 };
 
 //! The estimate published every accepted epoch (docs/interfaces.md §2.4).
@@ -157,7 +163,8 @@ struct AttitudeEstimate {
       Eigen::Vector3d::Zero();  //!< rate used for propagation (Earth rate removed in ground mode)
   Eigen::Vector3d sigma_rad = Eigen::Vector3d::Zero();  //!< 1σ attitude uncertainty per body axis
   Mode mode = Mode::kNominal;
-  GyroMask gyros = 0;  //!< gyros used
+  GyroMask gyros = 0;                   //!< gyros used
+  std::vector<double> gyro_bias_rad_s;  //!< [rad/s] size N: the filter's estimate of each gyro's bias
 };
 
 }  // namespace tetra::fdi

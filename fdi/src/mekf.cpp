@@ -1,0 +1,275 @@
+#include "mekf.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+namespace tetra::fdi::detail {
+
+namespace {
+Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+}  // namespace
+
+Eigen::Matrix3d rotation_integral(const Eigen::Vector3d& omega_rad_s, double dt_s) {
+  // ∫₀^Δt exp(−W u) du = I·Δt − (1 − cos θ)/|ω|²·W + (θ − sin θ)/|ω|³·W², θ = |ω|Δt, W = [ω×].
+  const Eigen::Matrix3d W = cross_matrix(omega_rad_s);
+  const double w = omega_rad_s.norm();
+  const double th = w * dt_s;
+  double a = 0.0;  // (1 − cos θ)/|ω|²
+  double b = 0.0;  // (θ − sin θ)/|ω|³
+  if (th < 1e-3) {
+    // Series to θ⁴ (relative truncation error < 1e-13 at θ = 1e-3).
+    const double dt2 = dt_s * dt_s;
+    a = dt2 * (0.5 - th * th / 24.0);
+    b = dt2 * dt_s * (1.0 / 6.0 - th * th / 120.0);
+  } else {
+    a = (1.0 - std::cos(th)) / (w * w);
+    b = (th - std::sin(th)) / (w * w * w);
+  }
+  return Eigen::Matrix3d::Identity() * dt_s - a * W + b * W * W;
+}
+
+Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
+    : gyros_(std::move(gyros)),
+      n_(static_cast<int>(gyros_.size())),
+      dim_(3 + 2 * static_cast<Eigen::Index>(gyros_.size())),
+      P_(Eigen::MatrixXd::Zero(dim_, dim_)),
+      bias_(Eigen::VectorXd::Zero(dim_ - 3)),
+      decay_(Eigen::VectorXd::Ones(dim_ - 3)),
+      coupling_(Eigen::Matrix3Xd::Zero(3, dim_ - 3)),
+      cross_(Eigen::Matrix3Xd::Zero(3, dim_ - 3)),
+      joseph_(Eigen::MatrixXd::Zero(dim_, dim_)),
+      gain_(Eigen::MatrixX3d::Zero(dim_, 3)),
+      ph_(Eigen::VectorXd::Zero(dim_)),
+      prior_var_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(gyros_.size()))),
+      frozen_(gyros_.size(), 0) {
+  reset(0.0);
+}
+
+void Mekf::reset(double attitude_sigma_rad) {
+  P_.setZero();
+  bias_.setZero();
+  for (int i = 0; i < n_; ++i) {
+    frozen_[static_cast<std::size_t>(i)] = 0;
+    set_prior(i);
+  }
+  P_.topLeftCorner<3, 3>().diagonal().setConstant(attitude_sigma_rad * attitude_sigma_rad);
+}
+
+void Mekf::reset_attitude(double attitude_sigma_rad) {
+  P_.topRows<3>().setZero();
+  P_.leftCols<3>().setZero();
+  P_.topLeftCorner<3, 3>().diagonal().setConstant(attitude_sigma_rad * attitude_sigma_rad);
+}
+
+void Mekf::set_prior(int i) {
+  decorrelate(i);
+  const auto& g = gyros_[static_cast<std::size_t>(i)];
+  P_(c_of(i), c_of(i)) = g.bias_sigma_rad_s * g.bias_sigma_rad_s;
+  P_(g_of(i), g_of(i)) = g.gm_sigma_rad_s * g.gm_sigma_rad_s;  // the simulator starts it stationary
+  bias_[i] = 0.0;
+  bias_[n_ + i] = 0.0;
+  prior_var_[i] = P_(c_of(i), c_of(i)) + P_(g_of(i), g_of(i));
+}
+
+void Mekf::decorrelate(int i) {
+  for (const Eigen::Index k : {c_of(i), g_of(i)}) {
+    const double keep = P_(k, k);
+    P_.row(k).setZero();
+    P_.col(k).setZero();
+    P_(k, k) = keep;
+  }
+  P_(c_of(i), g_of(i)) = 0.0;
+  P_(g_of(i), c_of(i)) = 0.0;
+}
+
+void Mekf::freeze(int id) {
+  if (id < 1 || id > n_) return;
+  decorrelate(id - 1);
+  frozen_[index(id)] = 1;
+}
+
+void Mekf::thaw(int id) {
+  if (id < 1 || id > n_) return;
+  frozen_[index(id)] = 0;
+  set_prior(id - 1);
+}
+
+Eigen::Vector3d Mekf::rate_correction(const Eigen::Matrix3Xd& pinv, GyroMask mask) const {
+  Eigen::Vector3d w = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n_; ++i) {
+    if (has_gyro(mask, i + 1)) w += pinv.col(i) * (bias_[i] + bias_[n_ + i]);
+  }
+  return w;
+}
+
+void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::Vector3d& omega_B_rad_s,
+                     double dt_s) {
+  if (!(dt_s > 0.0)) return;
+  const Eigen::Index m = dim_ - 3;
+  // Transition Φ = [[A, G], [0, D]]: A rotates the body-frame error by the step's rotation (exact),
+  // G = −Γ·H*·(bias states), Γ = ∫ A(u) du; D the bias models' own transitions.
+  const Eigen::Matrix3d A = quat_exp(omega_B_rad_s * dt_s).toRotationMatrix().transpose();
+  const Eigen::Matrix3d gamma = rotation_integral(omega_B_rad_s, dt_s);
+  Eigen::Matrix3d q_theta = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < n_; ++i) {
+    const auto& g = gyros_[static_cast<std::size_t>(i)];
+    const bool frozen = frozen_[static_cast<std::size_t>(i)] != 0;
+    const bool used = has_gyro(mask, i + 1) && !frozen;
+    const double phi = g.gm_sigma_rad_s > 0.0 ? std::exp(-dt_s / g.gm_correlation_s) : 1.0;
+    // The Gauss–Markov bias decays within the step: its mean over the step is κ·g, κ = T_c(1 − φ)/Δt.
+    const double kappa =
+        g.gm_sigma_rad_s > 0.0 ? g.gm_correlation_s * -std::expm1(-dt_s / g.gm_correlation_s) / dt_s : 1.0;
+    const Eigen::Vector3d col = used ? Eigen::Vector3d(-gamma * pinv.col(i)) : Eigen::Vector3d::Zero();
+    coupling_.col(i) = col;
+    coupling_.col(n_ + i) = col * kappa;
+    decay_[i] = 1.0;
+    decay_[n_ + i] = frozen ? 1.0 : phi;
+    if (used) q_theta += pinv.col(i) * pinv.col(i).transpose() * (g.arw_rad_rts * g.arw_rad_rts * dt_s);
+  }
+  // U = A·Pθβ + G·Pββ and V = A·Pθθ + G·Pβθ from the old P.
+  const auto Ptb = P_.block<3, Eigen::Dynamic>(0, 3, 3, m);
+  const auto Pbb = P_.block(3, 3, m, m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    Eigen::Vector3d u = A * Ptb.col(k);
+    for (Eigen::Index j = 0; j < m; ++j) u += coupling_.col(j) * Pbb(j, k);
+    cross_.col(k) = u;
+  }
+  Eigen::Matrix3d V = A * P_.topLeftCorner<3, 3>();
+  for (Eigen::Index j = 0; j < m; ++j) V += coupling_.col(j) * Ptb.col(j).transpose();
+  Eigen::Matrix3d Ptt = V * A.transpose() + q_theta;
+  for (Eigen::Index j = 0; j < m; ++j) Ptt += cross_.col(j) * coupling_.col(j).transpose();
+  P_.topLeftCorner<3, 3>() = 0.5 * (Ptt + Ptt.transpose());
+  for (Eigen::Index k = 0; k < m; ++k) {
+    P_.block<3, 1>(0, 3 + k) = cross_.col(k) * decay_[k];
+    P_.block<1, 3>(3 + k, 0) = (cross_.col(k) * decay_[k]).transpose();
+    for (Eigen::Index j = 0; j < m; ++j) P_(3 + j, 3 + k) *= decay_[j] * decay_[k];
+  }
+  for (int i = 0; i < n_; ++i) {
+    if (frozen_[static_cast<std::size_t>(i)] != 0) continue;
+    const auto& g = gyros_[static_cast<std::size_t>(i)];
+    P_(c_of(i), c_of(i)) += g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
+    prior_var_[i] += g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
+    const double phi = decay_[n_ + i];
+    P_(g_of(i), g_of(i)) += g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - phi * phi);
+    bias_[n_ + i] *= phi;
+  }
+  // Symmetric by construction but for the attitude block (symmetrized above).
+}
+
+void Mekf::add_attitude_variance(const Eigen::Vector3d& var_rad2) {
+  P_.topLeftCorner<3, 3>().diagonal() += var_rad2;
+}
+
+ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quaternion& q_ref_RB,
+                                       double sigma_rad, double gate_chi2) {
+  ReferenceUpdate out;
+  out.innovation_rad = quat_log(q_est_RB.conjugate() * q_ref_RB);
+  const double r = sigma_rad * sigma_rad;
+  const Eigen::Matrix3d S = P_.topLeftCorner<3, 3>() + Eigen::Matrix3d::Identity() * r;
+  const Eigen::LLT<Eigen::Matrix3d> llt(S);
+  if (llt.info() != Eigen::Success) return out;
+  out.chi2 = out.innovation_rad.dot(llt.solve(out.innovation_rad));
+  if (!(out.chi2 <= gate_chi2)) return out;
+  out.accepted = true;
+  // K = P·Hᵀ·S⁻¹ with H = [I₃ 0].
+  for (Eigen::Index k = 0; k < dim_; ++k)
+    gain_.row(k) = llt.solve(P_.block<1, 3>(k, 0).transpose()).transpose();
+  const Eigen::VectorXd::Index m = dim_ - 3;
+  for (Eigen::Index k = 0; k < m; ++k) {
+    int i = static_cast<int>(k % n_);
+    if (frozen_[static_cast<std::size_t>(i)] != 0) gain_.row(3 + k).setZero();
+  }
+  out.correction_rad = gain_.topRows<3>() * out.innovation_rad;
+  for (Eigen::Index k = 0; k < m; ++k) bias_[k] += gain_.row(3 + k).dot(out.innovation_rad);
+  // Joseph form: P ← (I − KH)·P·(I − KH)ᵀ + K·R·Kᵀ; (I − KH) differs from I in its first three columns only.
+  joseph_ = P_;
+  for (Eigen::Index k = 0; k < dim_; ++k)  // T = (I − KH)·P
+    joseph_.col(k).noalias() -= gain_ * P_.block<3, 1>(0, k);
+  for (Eigen::Index k = 0; k < dim_; ++k) {  // P = T·(I − KH)ᵀ + r·K·Kᵀ
+    const Eigen::Vector3d t = joseph_.block<1, 3>(k, 0).transpose();
+    for (Eigen::Index j = 0; j < dim_; ++j)
+      P_(k, j) = joseph_(k, j) - gain_.row(j).dot(t) + r * gain_.row(k).dot(gain_.row(j));
+  }
+  symmetrize();
+  return out;
+}
+
+Eigen::Vector3d Mekf::update_parity(const Eigen::MatrixXd& W, int d, GyroMask mask, double scale,
+                                    const double* p) {
+  Eigen::Vector3d correction = Eigen::Vector3d::Zero();
+  for (int r = 0; r < d; ++r) {
+    // h: ∂p_r/∂(c_i, g_i) = scale·W(r, i) for the gyros of the mask; R = 1.
+    double predicted = 0.0;
+    ph_.setZero();
+    for (int i = 0; i < n_; ++i) {
+      if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
+      const double h = scale * W(r, i);
+      predicted += h * (bias_[i] + bias_[n_ + i]);
+      ph_ += h * (P_.col(c_of(i)) + P_.col(g_of(i)));
+    }
+    double s = 1.0;
+    for (int i = 0; i < n_; ++i) {
+      if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
+      s += scale * W(r, i) * (ph_[c_of(i)] + ph_[g_of(i)]);
+    }
+    const double nu = p[r] - predicted;
+    // K = P·hᵀ/s; Joseph form for a scalar measurement, expanded: P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ (symmetric
+    // term by term: one triangle computed, mirrored).
+    for (Eigen::Index k = 0; k < dim_; ++k) {
+      const double kk = ph_[k] / s;
+      for (Eigen::Index j = k; j < dim_; ++j) {
+        const double kj = ph_[j] / s;
+        const double v = P_(k, j) - kk * ph_[j] - ph_[k] * kj + s * kk * kj;
+        P_(k, j) = v;
+        P_(j, k) = v;
+      }
+    }
+    correction += ph_.head<3>() * (nu / s);
+    bias_ += ph_.tail(dim_ - 3) * (nu / s);
+  }
+  return correction;
+}
+
+double Mekf::bias_z(int id) const {
+  const double spread = prior_var_[id - 1];
+  return spread > 0.0 ? bias_rad_s(id) / std::sqrt(spread) : 0.0;
+}
+
+void Mekf::open_fault_hypothesis(double sigma_rad_s) {
+  for (int i = 0; i < n_; ++i) {
+    if (frozen_[static_cast<std::size_t>(i)] == 0) P_(c_of(i), c_of(i)) += sigma_rad_s * sigma_rad_s;
+  }
+}
+
+void Mekf::symmetrize() {
+  for (Eigen::Index k = 0; k < dim_; ++k) {
+    for (Eigen::Index j = k + 1; j < dim_; ++j) {
+      const double v = 0.5 * (P_(k, j) + P_(j, k));
+      P_(k, j) = v;
+      P_(j, k) = v;
+    }
+  }
+}
+
+Eigen::Vector3d Mekf::attitude_sigma_rad() const {
+  return P_.topLeftCorner<3, 3>().diagonal().cwiseMax(0.0).cwiseSqrt();
+}
+
+double Mekf::bias_rad_s(int id) const {
+  const int i = id - 1;
+  return bias_[i] + bias_[n_ + i];
+}
+
+double Mekf::bias_sigma_rad_s(int id) const {
+  const int i = id - 1;
+  const double v = P_(c_of(i), c_of(i)) + P_(g_of(i), g_of(i)) + 2.0 * P_(c_of(i), g_of(i));
+  return std::sqrt(std::max(v, 0.0));
+}
+
+}  // namespace tetra::fdi::detail

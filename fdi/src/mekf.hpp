@@ -1,0 +1,123 @@
+#pragma once
+// The N-gyro multiplicative extended Kalman filter (docs/fdi.md, "Attitude filter"): the covariance of the
+// attitude error and of every gyro's bias, propagated exactly for the step and updated by attitude reference
+// samples (Joseph form, 3-dof χ² gate).
+//
+// State (3 + 2N), errors of the estimate:
+//   δθ      [rad]   attitude error in B: q_true = q̂ ⊗ exp(δθ)
+//   c_i     [rad/s] gyro i's slow bias: the calibration residual (1σ of the calibration) plus the rate random
+//                   walk K (a random walk: c_{k+1} = c_k + K·√Δt·n)
+//   g_i     [rad/s] gyro i's bias instability B: first-order Gauss–Markov, correlation time T_c,
+//                   stationary σ = 1.0760·B (the process whose Allan peak is IEEE 952's 0.664·B floor)
+// The gyro reads y_i = h_i·ω + c_i + g_i + n_i (n_i white, N_i); the rate is ω̂ = H*(y − ĉ − ĝ).
+//
+// The attitude itself (the quaternion) is the caller's: the filter returns the correction to apply.
+// Storage is sized once at creation; no step allocates.
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "tetra/core/geometry.hpp"
+#include "tetra/core/quaternion.hpp"
+
+namespace tetra::fdi::detail {
+
+//! One gyro's noise as the filter models it.
+struct GyroNoiseModel {
+  double arw_rad_rts = 0.0;         //!< [rad/√s] white rate noise N
+  double bias_sigma_rad_s = 0.0;    //!< [rad/s] 1σ of the calibrated bias (initial σ of c_i)
+  double rrw_rad_s_rts = 0.0;       //!< [rad/s/√s] rate random walk K (drives c_i)
+  double gm_sigma_rad_s = 0.0;      //!< [rad/s] stationary σ of g_i (1.0760·B)
+  double gm_correlation_s = 100.0;  //!< [s] T_c of g_i
+};
+
+//! The outcome of one reference sample.
+struct ReferenceUpdate {
+  bool accepted = false;
+  double chi2 = 0.0;                                         //!< zᵀS⁻¹z of the innovation (3 dof)
+  Eigen::Vector3d innovation_rad = Eigen::Vector3d::Zero();  //!< z = log(q̂* ⊗ q_ref)
+  Eigen::Vector3d correction_rad = Eigen::Vector3d::Zero();  //!< δθ̂: apply q̂ ← q̂ ⊗ exp(δθ̂)
+};
+
+class Mekf {
+ public:
+  explicit Mekf(std::vector<GyroNoiseModel> gyros);
+
+  //! Initial covariance: attitude σ [rad] per axis, biases at their prior; estimates zero; nothing frozen.
+  void reset(double attitude_sigma_rad);
+  //! A new attitude known to σ [rad] per axis (e.g. from a reference sample); biases keep their estimates,
+  //! their correlation with the attitude is dropped.
+  void reset_attitude(double attitude_sigma_rad);
+
+  //! The bias correction of the rate: H*(ĉ + ĝ) over the gyros of `mask` [rad/s].
+  Eigen::Vector3d rate_correction(const Eigen::Matrix3Xd& pinv, GyroMask mask) const;
+
+  //! One step of length `dt_s` with the rate `omega_B_rad_s` (the body's inertial rate as propagated) and the
+  //! rate solution `pinv` over the gyros of `mask`: Φ exact for the rotation, biases exact for their models.
+  void propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::Vector3d& omega_B_rad_s,
+                 double dt_s);
+
+  //! Adds a variance [rad²] per axis to the attitude (e.g. a bound turned into a 1σ before an update).
+  void add_attitude_variance(const Eigen::Vector3d& var_rad2);
+
+  //! A reference sample of the attitude, 1σ `sigma_rad` per axis; rejected (nothing changed) when the χ² of
+  //! its innovation exceeds `gate_chi2`. An accepted sample updates the biases itself; the caller applies
+  //! `correction_rad` to its quaternion.
+  ReferenceUpdate update_reference(const Quaternion& q_est_RB, const Quaternion& q_ref_RB, double sigma_rad,
+                                   double gate_chi2);
+
+  //! The epoch's normalized parity `p` (d rows, p = scale·W·y ~ N(0, I) without fault; W d×N over the gyros
+  //! of `mask`) as a measurement of the biases: with the reference it makes each gyro's bias observable.
+  //! Sequential scalar updates, Joseph form; returns the attitude correction δθ̂ to apply (q̂ ← q̂ ⊗ exp(δθ̂)).
+  Eigen::Vector3d update_parity(const Eigen::MatrixXd& W, int d, GyroMask mask, double scale,
+                                const double* p);
+
+  //! A fault of unknown gyro and size up to ~`sigma_rad_s` has appeared: every active gyro's slow bias state
+  //! gains that variance, so the measurements can put the step where it belongs.
+  void open_fault_hypothesis(double sigma_rad_s);
+
+  //! Gyro `id`'s bias estimate over its fault-free spread (the prior σ of c + g, which bounds the estimate's
+  //! own spread): |z| ≤ N(0, 1) in distribution while the model holds; a fault on the gyro drives it away.
+  double bias_z(int id) const;
+
+  //! Gyro `id` (1..N) leaves the solution: its bias states keep their estimate and variance, uncorrelated
+  //! with the rest, and stop evolving. `thaw` puts them back at their prior.
+  void freeze(int id);
+  void thaw(int id);
+  bool frozen(int id) const { return frozen_[index(id)] != 0; }
+
+  //! [rad] 1σ of the attitude error per body axis.
+  Eigen::Vector3d attitude_sigma_rad() const;
+  //! [rad/s] gyro `id`'s bias estimate (c + g) and its 1σ.
+  double bias_rad_s(int id) const;
+  double bias_sigma_rad_s(int id) const;
+  int gyro_count() const { return n_; }
+
+ private:
+  static std::size_t index(int id) { return static_cast<std::size_t>(id - 1); }
+  Eigen::Index c_of(int i) const { return 3 + i; }       //!< state index of c_i (i 0-based)
+  Eigen::Index g_of(int i) const { return 3 + n_ + i; }  //!< state index of g_i
+  void decorrelate(int i);
+  void set_prior(int i);
+  void symmetrize();
+
+  std::vector<GyroNoiseModel> gyros_;
+  int n_;
+  Eigen::Index dim_;           //!< 3 + 2N
+  Eigen::MatrixXd P_;          //!< covariance
+  Eigen::VectorXd bias_;       //!< [rad/s] ĉ (0..N−1) then ĝ (N..2N−1)
+  Eigen::VectorXd decay_;      //!< per bias state, the last step's transition (scratch)
+  Eigen::Matrix3Xd coupling_;  //!< 3×2N: ∂δθ/∂bias over the step (scratch)
+  Eigen::Matrix3Xd cross_;     //!< 3×2N: U = A·Pθβ + G·Pββ (scratch)
+  Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
+  Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
+  Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
+  Eigen::VectorXd prior_var_;  //!< [rad²/s²] per gyro: the variance of c + g without any measurement
+  std::vector<unsigned char> frozen_;
+};
+
+//! ∫₀^Δt exp(−[ω×]u) du in closed form (a series for small |ω|Δt).
+Eigen::Matrix3d rotation_integral(const Eigen::Vector3d& omega_rad_s, double dt_s);
+
+}  // namespace tetra::fdi::detail
