@@ -3,6 +3,10 @@
 // monitor, command): the participant, the six topics, readers and writers of a type on its topic, and
 // one waitset with the conditions it wakes on — samples arriving, communication statuses, guards, and
 // SIGINT/SIGTERM through a ShutdownSignal.
+//
+// Declare a session before the readers and writers made from it, so that they go first: deleting the
+// participant deletes every entity under it, and a reader takes its read conditions along (the session's
+// later delete of one finds it gone, which is harmless).
 
 #include <chrono>
 #include <cstdint>
