@@ -16,8 +16,7 @@
 #include "dds_common.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/dds/convert.hpp"
-#include "tetra/dds/entity.hpp"
-#include "tetra/dds/topics.hpp"
+#include "tetra/dds/session.hpp"
 #include "tetra/ground/command_request.hpp"
 #include "tetra/ground/command_tracker.hpp"
 
@@ -103,23 +102,15 @@ int cmd_command(int argc, char** argv) {
     return report("command", s.error());
   const std::string& unit = request.unit;
 
-  auto participant = dds::Participant::create(domain, unit);
-  if (!participant) return report("command", participant.error());
-  auto topics = dds::Topics::create(*participant);
-  if (!topics) return report("command", topics.error());
-  auto writer = dds::Writer<tetra_Command>::create(*participant, topics->command, dds::command_qos());
+  auto session = dds::Session::open(domain, unit);
+  if (!session) return report("command", session.error());
+  auto writer = session->writer<tetra_Command>(dds::command_qos());
   if (!writer) return report("command", writer.error());
-  auto events = dds::Reader<tetra_FdiEvent>::create(*participant, topics->event, dds::event_qos());
+  auto events = session->reader<tetra_FdiEvent>(dds::event_qos());
   if (!events) return report("command", events.error());
-  auto waitset = dds::WaitSet::create(*participant);
-  if (!waitset) return report("command", waitset.error());
-  if (dds_set_status_mask(writer->handle(), DDS_PUBLICATION_MATCHED_STATUS) < 0) {
-    return report("command", failure("cannot enable the publication-matched status"));
-  }
-  if (auto s = waitset->attach(writer->handle(), kMatched); !s) return report("command", s.error());
-  auto data = dds::Condition::data_available(events->handle());
-  if (!data) return report("command", data.error());
-  if (auto s = waitset->attach(data->handle(), kEvent); !s) return report("command", s.error());
+  if (auto s = session->watch_statuses(writer->handle(), DDS_PUBLICATION_MATCHED_STATUS, kMatched); !s)
+    return report("command", s.error());
+  if (auto s = session->watch_data(events->handle(), kEvent); !s) return report("command", s.error());
 
   const std::int64_t give_up = monotonic_ns() + seconds_to_ns(timeout_s);
   std::vector<std::intptr_t> triggered;
@@ -146,7 +137,7 @@ int cmd_command(int argc, char** argv) {
                 << timeout_s << " s\n";
       return kExitFailure;
     }
-    if (auto s = waitset->wait(std::chrono::nanoseconds(give_up - now), triggered); !s)
+    if (auto s = session->wait(std::chrono::nanoseconds(give_up - now), triggered); !s)
       return report("command", s.error());
     std::uint32_t status = 0;
     (void)dds_take_status(writer->handle(), &status, DDS_PUBLICATION_MATCHED_STATUS);

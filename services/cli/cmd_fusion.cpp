@@ -1,15 +1,15 @@
 // tetra fusion --config CFG.yaml — the fusion pipeline as a DDS service (docs/dds.md); the service
-// itself is FusionService (fusion_service.hpp).
+// itself is service::FusionService (tetra/service/fusion_service.hpp).
 
 #include <spdlog/spdlog.h>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "dds_common.hpp"
-#include "fusion_service.hpp"
 #include "tetra/dds/shutdown.hpp"
 #include "tetra/fdi/pipeline.hpp"
 #include "tetra/service/fusion_config.hpp"
+#include "tetra/service/fusion_service.hpp"
 
 namespace tetra::cli {
 
@@ -36,9 +36,10 @@ int cmd_fusion(int argc, char** argv) {
   if (!assembler) return report("fusion", assembler.error());
   spdlog::info("fusion: configuration from {}\n{}", config_path, service::describe(*config));
 
-  FusionService service(std::move(config).value(), std::move(pipeline).value(), std::move(assembler).value());
-  if (auto s = service.open(domain, shutdown); !s) return report("fusion", s.error());
-  if (auto s = service.run(shutdown); !s) return report("fusion", s.error());
+  service::FusionService service(std::move(config).value(), std::move(pipeline).value(),
+                                 std::move(assembler).value());
+  if (auto s = service.open(domain, &shutdown); !s) return report("fusion", s.error());
+  if (auto s = service.run(); !s) return report("fusion", s.error());
   spdlog::info("fusion: stopped");
   return kExitOk;
 }

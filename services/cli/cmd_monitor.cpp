@@ -177,11 +177,7 @@ std::string dashboard_block(const std::string& unit, const UnitView& view, std::
   return out.str();
 }
 
-}  // namespace
-
-int cmd_monitor(int argc, char** argv) {
-  dds::ShutdownSignal shutdown;
-  CLI::App app{"Ground monitoring: health, attitude and events of every unit on the DDS domain.", "monitor"};
+struct MonitorOptions {
   std::string unit_filter;
   bool jsonl = false;
   bool once = false;
@@ -189,129 +185,201 @@ int cmd_monitor(int argc, char** argv) {
   double duration_s = 0.0;
   double timeout_s = 5.0;
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
-  app.add_option("--unit", unit_filter, "show only this unit (default: every unit discovered)");
-  app.add_flag("--jsonl", jsonl, "JSON lines on stdout instead of the dashboard");
-  app.add_flag("--once", once, "print each unit's current health (and event history) and exit");
-  app.add_option("--period", period_s, "[s] refresh period (≤ 0.5: at least 2 Hz)")
+};
+
+void add_monitor_options(CLI::App& app, MonitorOptions& o) {
+  app.add_option("--unit", o.unit_filter, "show only this unit (default: every unit discovered)");
+  app.add_flag("--jsonl", o.jsonl, "JSON lines on stdout instead of the dashboard");
+  app.add_flag("--once", o.once, "print each unit's current health (and event history) and exit");
+  app.add_option("--period", o.period_s, "[s] refresh period (≤ 0.5: at least 2 Hz)")
       ->check(CLI::Range(0.01, 0.5));
-  app.add_option("--duration", duration_s, "[s] stop after this long (default: until SIGINT/SIGTERM)")
+  app.add_option("--duration", o.duration_s, "[s] stop after this long (default: until SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--timeout", timeout_s, "[s] with --once: give up when no unit answers within this")
+  app.add_option("--timeout", o.timeout_s, "[s] with --once: give up when no unit answers within this")
       ->check(CLI::PositiveNumber);
-  add_domain_option(app, domain);
-  if (auto exit = parse(app, argc, argv)) return *exit;
+  add_domain_option(app, o.domain);
+}
 
-  auto readers = ground::GroundReaders::open(domain, unit_filter, shutdown);
-  if (!readers) return report("monitor", readers.error());
+//! Every unit heard, as the readers deliver it.
+class MonitorState {
+ public:
+  explicit MonitorState(const MonitorOptions& options) : o_(options) {}
+  //! Takes Health, events (printed at once with --jsonl) and attitudes received at local time `received`.
+  Status take(const ground::GroundReaders& readers, std::int64_t received);
+  void update_links(std::int64_t now) {
+    for (auto& [unit, view] : units_) update_link(view, now);
+  }
+  //! --once: every matched Health writer has delivered, with each unit's complete event history.
+  bool complete(std::uint32_t health_writers) const;
+  //! Each unit's health, as JSON lines or dashboard blocks.
+  void print_units(std::int64_t now) const;
+  //! The dashboard (or JSON lines) of a refresh; attitude rates measured since the last one.
+  void refresh(std::int64_t now);
 
-  std::map<std::string, UnitView> units;
-  std::vector<dds::EventView> new_events;
-  const bool tty = isatty(STDOUT_FILENO) != 0;
-  const auto wanted = [&](const std::string& unit) { return unit_filter.empty() || unit == unit_filter; };
-  const std::int64_t start = monotonic_ns();
-  const std::int64_t period_ns = seconds_to_ns(period_s);
-  const std::int64_t stop_at = duration_s > 0 ? start + seconds_to_ns(duration_s) : INT64_MAX;
-  const std::int64_t give_up_at = start + seconds_to_ns(timeout_s);
-  std::int64_t next_refresh = start + period_ns;
-  std::int64_t last_refresh = start;
-  std::vector<std::intptr_t> triggered;
+ private:
+  bool wanted(const std::string& unit) const { return o_.unit_filter.empty() || unit == o_.unit_filter; }
+  Status take_events(const ground::GroundReaders& readers);
 
-  for (;;) {
-    const std::int64_t received = monotonic_ns();
-    auto h = readers->take_health(
-        [&](dds::HealthView&& view, std::int64_t) {
-          if (!wanted(view.unit)) return;
-          UnitView& unit = units[view.unit];
-          unit.health = std::move(view);
-          unit.health_received_ns = received;
-          unit.writer_alive = true;
-        },
-        [&](const std::string& unit) {
-          if (wanted(unit)) units[unit].writer_alive = false;
-        });
-    if (!h) return report("monitor", h.error());
-    new_events.clear();
-    auto e = readers->take_events([&](dds::EventView&& view, std::int64_t) {
-      if (wanted(view.unit)) new_events.push_back(std::move(view));
-    });
-    if (!e) return report("monitor", e.error());
-    std::sort(new_events.begin(), new_events.end(), [](const auto& a, const auto& b) {
-      return a.unit != b.unit ? a.unit < b.unit : a.event_seq < b.event_seq;
-    });
-    for (auto& ev : new_events) {
-      UnitView& view = units[ev.unit];
-      view.max_event_seq = std::max(view.max_event_seq, ev.event_seq);
-      const int n = view.health ? static_cast<int>(view.health->health.gyros.size()) : 4;
-      if (jsonl) std::cout << event_json(ev, n) << '\n';
-      view.events.push_back(ev);
-      if (view.events.size() > kRecentEvents) view.events.pop_front();
+  const MonitorOptions& o_;
+  std::map<std::string, UnitView> units_;
+  std::vector<dds::EventView> new_events_;
+  std::int64_t last_refresh_ = monotonic_ns();
+  bool tty_ = isatty(STDOUT_FILENO) != 0;
+};
+
+Status MonitorState::take(const ground::GroundReaders& readers, std::int64_t received) {
+  auto h = readers.take_health(
+      [&](dds::HealthView&& view, std::int64_t) {
+        if (!wanted(view.unit)) return;
+        UnitView& unit = units_[view.unit];
+        unit.health = std::move(view);
+        unit.health_received_ns = received;
+        unit.writer_alive = true;
+      },
+      [&](const std::string& unit) {
+        if (wanted(unit)) units_[unit].writer_alive = false;
+      });
+  if (!h) return h;
+  if (auto s = take_events(readers); !s) return s;
+  auto a =
+      readers.take_attitudes([&](const std::string& unit, fdi::AttitudeEstimate&& attitude, std::int64_t) {
+        if (!wanted(unit)) return;
+        UnitView& view = units_[unit];
+        view.attitude = attitude;
+        view.attitude_received_ns = received;
+        ++view.attitudes_received;
+      });
+  if (!a) return a;
+  if (o_.jsonl) std::cout.flush();
+  return ok_status();
+}
+
+Status MonitorState::take_events(const ground::GroundReaders& readers) {
+  new_events_.clear();
+  auto e = readers.take_events([&](dds::EventView&& view, std::int64_t) {
+    if (wanted(view.unit)) new_events_.push_back(std::move(view));
+  });
+  if (!e) return e;
+  std::sort(new_events_.begin(), new_events_.end(), [](const auto& a, const auto& b) {
+    return a.unit != b.unit ? a.unit < b.unit : a.event_seq < b.event_seq;
+  });
+  for (auto& ev : new_events_) {
+    UnitView& view = units_[ev.unit];
+    view.max_event_seq = std::max(view.max_event_seq, ev.event_seq);
+    const int n = view.health ? static_cast<int>(view.health->health.gyros.size()) : 4;
+    if (o_.jsonl) std::cout << event_json(ev, n) << '\n';
+    view.events.push_back(ev);
+    if (view.events.size() > kRecentEvents) view.events.pop_front();
+  }
+  return ok_status();
+}
+
+bool MonitorState::complete(std::uint32_t health_writers) const {
+  std::size_t complete = 0;
+  for (const auto& [unit, view] : units_) {
+    if (view.health && view.max_event_seq >= view.health->events_published) ++complete;
+  }
+  return complete > 0 && complete == units_.size() && (!o_.unit_filter.empty() || complete >= health_writers);
+}
+
+void MonitorState::print_units(std::int64_t now) const {
+  for (const auto& [unit, view] : units_) {
+    if (!view.health) continue;
+    if (o_.jsonl) {
+      std::cout << health_json(unit, view, now) << '\n';
+    } else {
+      std::cout << dashboard_block(unit, view, now);
     }
-    auto a =
-        readers->take_attitudes([&](const std::string& unit, fdi::AttitudeEstimate&& attitude, std::int64_t) {
-          if (!wanted(unit)) return;
-          UnitView& view = units[unit];
-          view.attitude = attitude;
-          view.attitude_received_ns = received;
-          ++view.attitudes_received;
-        });
-    if (!a) return report("monitor", a.error());
-    if (jsonl) std::cout.flush();
+  }
+}
 
+void MonitorState::refresh(std::int64_t now) {
+  const double dt = ns_to_seconds(now - last_refresh_);
+  for (auto& [unit, view] : units_) {
+    view.attitude_rate_hz =
+        static_cast<double>(view.attitudes_received - view.attitudes_at_last_refresh) / dt;
+    view.attitudes_at_last_refresh = view.attitudes_received;
+  }
+  last_refresh_ = now;
+  if (o_.jsonl) {
+    for (const auto& [unit, view] : units_) std::cout << health_json(unit, view, now) << '\n';
+  } else {
+    std::string screen = tty_ ? "\033[H\033[2J" : "";
+    screen += "tetra monitor — " + std::to_string(units_.size()) + " unit(s)\n";
+    for (const auto& [unit, view] : units_) screen += dashboard_block(unit, view, now);
+    std::cout << screen << (tty_ ? "" : "\n");
+  }
+  std::cout.flush();
+}
+
+//! --once: prints every unit's health once all have arrived; exit 1 when none did within --timeout.
+int monitor_once(const MonitorOptions& o, const ground::GroundReaders& readers,
+                 const dds::ShutdownSignal& shutdown) {
+  MonitorState state(o);
+  const std::int64_t start = monotonic_ns();
+  const std::int64_t give_up_at = start + seconds_to_ns(o.timeout_s);
+  const std::int64_t stop_at = o.duration_s > 0 ? start + seconds_to_ns(o.duration_s) : INT64_MAX;
+  std::vector<std::intptr_t> triggered;
+  while (!shutdown.requested()) {
+    if (auto s = state.take(readers, monotonic_ns()); !s) return report("monitor", s.error());
     const std::int64_t now = monotonic_ns();
-    for (auto& [unit, view] : units) update_link(view, now);
+    state.update_links(now);
     if (shutdown.requested()) break;
-    if (once) {
-      // Done when every matched Health writer has delivered and each unit's event history is complete.
-      auto matched = readers->health_writers();
-      if (!matched) return report("monitor", matched.error());
-      std::size_t complete = 0;
-      for (const auto& [unit, view] : units) {
-        if (view.health && view.max_event_seq >= view.health->events_published) ++complete;
-      }
-      const bool all_here =
-          complete > 0 && complete == units.size() && (!unit_filter.empty() || complete >= *matched);
-      if (all_here) {
-        for (const auto& [unit, view] : units) {
-          if (!view.health) continue;
-          if (jsonl) {
-            std::cout << health_json(unit, view, now) << '\n';
-          } else {
-            std::cout << dashboard_block(unit, view, now);
-          }
-        }
-        return kExitOk;
-      }
-      if (now >= give_up_at) {
-        std::cerr << "tetra monitor: no health from "
-                  << (unit_filter.empty() ? "any unit" : "unit " + unit_filter) << " within " << timeout_s
-                  << " s\n";
-        return kExitFailure;
-      }
-    } else if (now >= next_refresh) {
-      const double dt = ns_to_seconds(now - last_refresh);
-      for (auto& [unit, view] : units) {
-        view.attitude_rate_hz =
-            static_cast<double>(view.attitudes_received - view.attitudes_at_last_refresh) / dt;
-        view.attitudes_at_last_refresh = view.attitudes_received;
-      }
-      last_refresh = now;
-      next_refresh = now + period_ns;
-      if (jsonl) {
-        for (const auto& [unit, view] : units) std::cout << health_json(unit, view, now) << '\n';
-      } else {
-        std::string screen = tty ? "\033[H\033[2J" : "";
-        screen += "tetra monitor — " + std::to_string(units.size()) + " unit(s)\n";
-        for (const auto& [unit, view] : units) screen += dashboard_block(unit, view, now);
-        std::cout << screen << (tty ? "" : "\n");
-      }
-      std::cout.flush();
+    auto matched = readers.health_writers();
+    if (!matched) return report("monitor", matched.error());
+    if (state.complete(*matched)) {
+      state.print_units(now);
+      return kExitOk;
+    }
+    if (now >= give_up_at) {
+      std::cerr << "tetra monitor: no health from "
+                << (o.unit_filter.empty() ? "any unit" : "unit " + o.unit_filter) << " within " << o.timeout_s
+                << " s\n";
+      return kExitFailure;
     }
     if (now >= stop_at) break;
-    const std::int64_t wake = once ? give_up_at : std::min(next_refresh, stop_at);
-    if (auto s = readers->wait(std::chrono::nanoseconds(wake - now), triggered); !s)
+    if (auto s = readers.wait(std::chrono::nanoseconds(give_up_at - now), triggered); !s)
       return report("monitor", s.error());
   }
   return kExitOk;
+}
+
+//! The dashboard (or JSON lines) every --period until SIGINT/SIGTERM or --duration.
+int monitor_live(const MonitorOptions& o, const ground::GroundReaders& readers,
+                 const dds::ShutdownSignal& shutdown) {
+  MonitorState state(o);
+  const std::int64_t start = monotonic_ns();
+  const std::int64_t period_ns = seconds_to_ns(o.period_s);
+  const std::int64_t stop_at = o.duration_s > 0 ? start + seconds_to_ns(o.duration_s) : INT64_MAX;
+  std::int64_t next_refresh = start + period_ns;
+  std::vector<std::intptr_t> triggered;
+  for (;;) {
+    if (auto s = state.take(readers, monotonic_ns()); !s) return report("monitor", s.error());
+    const std::int64_t now = monotonic_ns();
+    state.update_links(now);
+    if (shutdown.requested()) break;
+    if (now >= next_refresh) {
+      state.refresh(now);
+      next_refresh = now + period_ns;
+    }
+    if (now >= stop_at) break;
+    if (auto s = readers.wait(std::chrono::nanoseconds(std::min(next_refresh, stop_at) - now), triggered); !s)
+      return report("monitor", s.error());
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int cmd_monitor(int argc, char** argv) {
+  dds::ShutdownSignal shutdown;
+  CLI::App app{"Ground monitoring: health, attitude and events of every unit on the DDS domain.", "monitor"};
+  MonitorOptions o;
+  add_monitor_options(app, o);
+  if (auto exit = parse(app, argc, argv)) return *exit;
+  auto readers = ground::GroundReaders::open(o.domain, o.unit_filter, shutdown);
+  if (!readers) return report("monitor", readers.error());
+  return o.once ? monitor_once(o, *readers, shutdown) : monitor_live(o, *readers, shutdown);
 }
 
 }  // namespace tetra::cli

@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 
 #include "tetra/core/json.hpp"
@@ -37,16 +36,6 @@ void add_domain_option(CLI::App& app, dds_domainid_t& domain) {
          "CDR encoding of this process's writers: xcdr1 (default; every DDS-XTypes reader accepts it) or "
          "xcdr2 (for XCDR2-only readers); its readers accept both")
       ->check(CLI::IsMember({"xcdr1", "xcdr2"}));
-}
-
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-std::int64_t wall_ns() {
-  return dds_time();
 }
 
 std::string self_executable() {

@@ -10,6 +10,8 @@
 #include <dds/dds.h>
 #include <CLI/CLI.hpp>
 
+#include "tetra/dds/clock.hpp"
+
 namespace tetra::cli {
 
 //! Adds `--domain ID` (default: DDS_DOMAIN_DEFAULT, i.e. the Cyclone configuration's, normally 0) and
@@ -17,11 +19,8 @@ namespace tetra::cli {
 //! `--data-representation xcdr1|xcdr2` (the encoding of the process's writers).
 void add_domain_option(CLI::App& app, dds_domainid_t& domain);
 
-//! [ns] local monotonic clock (for latency limits and periods; never on the wire).
-std::int64_t monotonic_ns();
-
-//! [ns] wall clock as DDS stamps it (source timestamps).
-std::int64_t wall_ns();
+using dds::monotonic_ns;
+using dds::wall_ns;
 
 //! Path of the running program (/proc/self/exe).
 std::string self_executable();

@@ -15,28 +15,25 @@ constexpr std::int64_t kDiscoverySettle_ns = 200'000'000;  //!< [ns] see wait_fo
 Result<std::unique_ptr<SimDdsLink>> SimDdsLink::open(const std::string& unit, double rate_hz,
                                                      const SimDdsOptions& options,
                                                      const dds::ShutdownSignal* shutdown) {
-  auto participant = dds::Participant::create(options.domain, unit);
-  if (!participant) return participant.error();
-  auto topics = dds::Topics::create(*participant);
-  if (!topics) return topics.error();
+  auto session = dds::Session::open(options.domain, unit);
+  if (!session) return session.error();
   // The deadline offered is 3 periods of the wall-clock rate (none when unpaced).
   const auto period = options.speed > 0
                           ? std::chrono::nanoseconds(seconds_to_ns(1.0 / (rate_hz * options.speed)))
                           : std::chrono::nanoseconds(0);
   dds::Qos gyro_qos = dds::gyro_sample_qos(period);
   gyro_qos.no_autodispose();
-  auto gyro_writer = dds::Writer<tetra_GyroSample>::create(*participant, topics->gyro_sample, gyro_qos);
+  auto gyro_writer = session->writer<tetra_GyroSample>(gyro_qos);
   if (!gyro_writer) return gyro_writer.error();
-  auto reference_writer =
-      dds::Writer<tetra_AttitudeReference>::create(*participant, topics->reference, dds::reference_qos());
+  auto reference_writer = session->writer<tetra_AttitudeReference>(dds::reference_qos());
   if (!reference_writer) return reference_writer.error();
   dds::Qos attitude_qos;
   attitude_qos.reliable().volatile_durability().keep_last(1024);  // score every epoch, not only the latest
-  auto attitude_reader = dds::Reader<tetra_Attitude>::create(*participant, topics->attitude, attitude_qos);
+  auto attitude_reader = session->reader<tetra_Attitude>(attitude_qos);
   if (!attitude_reader) return attitude_reader.error();
-  std::unique_ptr<SimDdsLink> link(new SimDdsLink(
-      unit, std::move(participant.value()), std::move(topics.value()), std::move(gyro_writer.value()),
-      std::move(reference_writer.value()), std::move(attitude_reader.value())));
+  std::unique_ptr<SimDdsLink> link(
+      new SimDdsLink(unit, std::move(session).value(), std::move(gyro_writer).value(),
+                     std::move(reference_writer).value(), std::move(attitude_reader).value()));
   link->shutdown_ = shutdown;
   if (auto s = dds::copy_bounded(link->sample_.unit, unit, "unit"); !s) return s.error();
   if (auto s = dds::copy_bounded(link->reference_.unit, unit, "unit"); !s) return s.error();
@@ -46,22 +43,12 @@ Result<std::unique_ptr<SimDdsLink>> SimDdsLink::open(const std::string& unit, do
 }
 
 Status SimDdsLink::wait_for_readers(const SimDdsOptions& options) {
-  auto waitset = dds::WaitSet::create(participant_);
-  if (!waitset) return waitset.error();
-  waitset_ = std::move(waitset.value());
-  auto data = dds::Condition::data_available(attitude_reader_.handle());
-  if (!data) return data.error();
-  data_ = std::move(data.value());
-  if (auto s = waitset_->attach(data_->handle(), kAttitude); !s) return s.error();
-  if (dds_set_status_mask(gyro_writer_.handle(), DDS_PUBLICATION_MATCHED_STATUS) < 0) {
-    return failure("DDS: cannot enable the publication-matched status");
-  }
-  if (auto s = waitset_->attach(gyro_writer_.handle(), kMatched); !s) return s.error();
-  auto guard = dds::Condition::guard(participant_);
+  if (auto s = session_.watch_data(attitude_reader_.handle(), kAttitude); !s) return s.error();
+  if (auto s = session_.watch_statuses(gyro_writer_.handle(), DDS_PUBLICATION_MATCHED_STATUS, kMatched); !s)
+    return s.error();
+  auto guard = session_.add_guard(kShutdown);
   if (!guard) return guard.error();
-  guard_ = std::move(guard.value());
-  if (auto s = waitset_->attach(guard_->handle(), kShutdown); !s) return s.error();
-  if (shutdown_ != nullptr) const_cast<dds::ShutdownSignal*>(shutdown_)->set_guard(guard_->handle());
+  if (shutdown_ != nullptr) const_cast<dds::ShutdownSignal*>(shutdown_)->set_guard((*guard)->handle());
 
   // Wait for the readers (the service, a recorder) so that the first samples are not lost.
   const std::int64_t give_up = monotonic_ns() + seconds_to_ns(options.wait_timeout_s);
@@ -77,7 +64,7 @@ Status SimDdsLink::wait_for_readers(const SimDdsOptions& options) {
       return failure("only " + std::to_string(*matched) + " of " + std::to_string(options.wait_readers) +
                      " GyroSample readers appeared within " + fixed(options.wait_timeout_s, 1) + " s");
     }
-    if (auto s = waitset_->wait(std::chrono::nanoseconds(give_up - now), triggered_); !s) return s.error();
+    if (auto s = session_.wait(std::chrono::nanoseconds(give_up - now), triggered_); !s) return s.error();
   }
   return ok_status();
 }
@@ -87,11 +74,11 @@ Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
   // be a moment after the writer has discovered the reader. So wait, when a service for this unit
   // exists (its Health arrives within a second), until its Health says it hears a GyroSample writer.
   if (options.wait_readers > 0) {
-    auto health_reader = dds::Reader<tetra_Health>::create(participant_, topics_.health, dds::health_qos());
+    auto health_reader = session_.reader<tetra_Health>(dds::health_qos());
     if (!health_reader) return health_reader.error();
     auto health_data = dds::Condition::data_available(health_reader->handle());
     if (!health_data) return health_data.error();
-    auto health_waitset = dds::WaitSet::create(participant_);
+    auto health_waitset = dds::WaitSet::create(session_.participant());
     if (!health_waitset) return health_waitset.error();
     if (auto s = health_waitset->attach(health_data->handle(), 1); !s) return s.error();
     bool service_seen = false;
@@ -115,10 +102,10 @@ Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
 
   // And (briefly) for the service's Attitude writer, so that the first epochs are scored too.
   if (options.wait_readers > 0) {
-    if (dds_set_status_mask(attitude_reader_.handle(), DDS_SUBSCRIPTION_MATCHED_STATUS) < 0) {
-      return failure("DDS: cannot enable the subscription-matched status");
-    }
-    if (auto s = waitset_->attach(attitude_reader_.handle(), kMatched); !s) return s.error();
+    if (auto s =
+            session_.watch_statuses(attitude_reader_.handle(), DDS_SUBSCRIPTION_MATCHED_STATUS, kMatched);
+        !s)
+      return s.error();
     const std::int64_t attitude_give_up = monotonic_ns() + 1'000'000'000;
     for (;;) {
       std::uint32_t status = 0;
@@ -127,7 +114,7 @@ Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
       if (!matched) return matched.error();
       const std::int64_t now = monotonic_ns();
       if (*matched > 0 || now >= attitude_give_up || stop_requested()) break;
-      if (auto s = waitset_->wait(std::chrono::nanoseconds(attitude_give_up - now), triggered_); !s)
+      if (auto s = session_.wait(std::chrono::nanoseconds(attitude_give_up - now), triggered_); !s)
         return s.error();
     }
   }
@@ -137,7 +124,7 @@ Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
   if (options.wait_readers > 1) {
     const std::int64_t settle_until = monotonic_ns() + kDiscoverySettle_ns;
     for (std::int64_t now = monotonic_ns(); now < settle_until && !stop_requested(); now = monotonic_ns()) {
-      if (auto s = waitset_->wait(std::chrono::nanoseconds(settle_until - now), triggered_); !s)
+      if (auto s = session_.wait(std::chrono::nanoseconds(settle_until - now), triggered_); !s)
         return s.error();
     }
   }
@@ -175,7 +162,7 @@ Status SimDdsLink::take_attitudes(const std::function<void(const fdi::AttitudeEs
 Status SimDdsLink::wait_until(std::int64_t until_ns) {
   const std::int64_t now = monotonic_ns();
   if (now >= until_ns || stop_requested()) return ok_status();
-  return waitset_->wait(std::chrono::nanoseconds(until_ns - now), triggered_);
+  return session_.wait(std::chrono::nanoseconds(until_ns - now), triggered_);
 }
 
 void SimDdsLink::wait_for_acks() {

@@ -14,8 +14,8 @@
 #include "sim_dds.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/dds/entity.hpp"
+#include "tetra/dds/session.hpp"
 #include "tetra/dds/shutdown.hpp"
-#include "tetra/dds/topics.hpp"
 #include "tetra/fdi/types.hpp"
 #include "tetra/sim/simulator.hpp"
 
@@ -39,16 +39,15 @@ class SimDdsLink {
   //! Waits (up to 2 s) until the samples written are acknowledged.
   void wait_for_acks();
   //! For more readers on the same participant (a campaign reads the FdiEvent and Health topics too).
-  const dds::Participant& participant() const { return participant_; }
-  const dds::Topics& topics() const { return topics_; }
+  const dds::Participant& participant() const { return session_.participant(); }
+  const dds::Topics& topics() const { return session_.topics(); }
 
  private:
-  SimDdsLink(std::string unit, dds::Participant participant, dds::Topics topics,
-             dds::Writer<tetra_GyroSample> gyro_writer, dds::Writer<tetra_AttitudeReference> reference_writer,
+  SimDdsLink(std::string unit, dds::Session session, dds::Writer<tetra_GyroSample> gyro_writer,
+             dds::Writer<tetra_AttitudeReference> reference_writer,
              dds::Reader<tetra_Attitude> attitude_reader)
       : unit_(std::move(unit)),
-        participant_(std::move(participant)),
-        topics_(std::move(topics)),
+        session_(std::move(session)),
         gyro_writer_(std::move(gyro_writer)),
         reference_writer_(std::move(reference_writer)),
         attitude_reader_(std::move(attitude_reader)) {}
@@ -56,14 +55,10 @@ class SimDdsLink {
   Status wait_for_service(const SimDdsOptions& options);
 
   std::string unit_;
-  dds::Participant participant_;
-  dds::Topics topics_;
+  dds::Session session_;
   dds::Writer<tetra_GyroSample> gyro_writer_;
   dds::Writer<tetra_AttitudeReference> reference_writer_;
   dds::Reader<tetra_Attitude> attitude_reader_;
-  std::optional<dds::WaitSet> waitset_;
-  std::optional<dds::Condition> data_;
-  std::optional<dds::Condition> guard_;
   const dds::ShutdownSignal* shutdown_ = nullptr;
   std::vector<std::intptr_t> triggered_;
   tetra_GyroSample sample_{};

@@ -12,39 +12,25 @@ constexpr int kAttitudeDepth = 64;  //!< samples per unit: 0.64 s of a 100 Hz se
 Result<GroundReaders> GroundReaders::open(dds_domainid_t domain, const std::string& unit,
                                           dds::ShutdownSignal& shutdown) {
   GroundReaders r;
-  if (auto s = assign(r.participant_, dds::Participant::create(domain, unit)); !s) return s.error();
-  if (auto s = assign(r.topics_, dds::Topics::create(*r.participant_)); !s) return s.error();
-  const auto& p = *r.participant_;
-  const auto& t = *r.topics_;
-  if (auto s = assign(r.health_, dds::Reader<tetra_Health>::create(p, t.health, dds::health_qos())); !s)
-    return s.error();
-  if (auto s = assign(r.event_, dds::Reader<tetra_FdiEvent>::create(p, t.event, dds::event_qos())); !s)
-    return s.error();
+  if (auto s = assign(r.session_, dds::Session::open(domain, unit)); !s) return s.error();
+  dds::Session& session = *r.session_;
+  if (auto s = assign(r.health_, session.reader<tetra_Health>(dds::health_qos())); !s) return s.error();
+  if (auto s = assign(r.event_, session.reader<tetra_FdiEvent>(dds::event_qos())); !s) return s.error();
   // A deeper history than the writer's keep-last 1: a busy ground thread still sees every epoch, so the
   // attitude it keeps is exactly one per attitude period (docs/ground.md).
   auto attitude_qos = dds::attitude_qos();
   attitude_qos.keep_last(kAttitudeDepth);
-  if (auto s = assign(r.attitude_, dds::Reader<tetra_Attitude>::create(p, t.attitude, attitude_qos)); !s)
-    return s.error();
-  if (auto s = assign(r.command_, dds::Writer<tetra_Command>::create(p, t.command, dds::command_qos())); !s)
-    return s.error();
-  if (auto s = assign(r.waitset_, dds::WaitSet::create(p)); !s) return s.error();
+  if (auto s = assign(r.attitude_, session.reader<tetra_Attitude>(attitude_qos)); !s) return s.error();
+  if (auto s = assign(r.command_, session.writer<tetra_Command>(dds::command_qos())); !s) return s.error();
   for (auto [reader, token] :
        {std::pair{r.health_->handle(), kHealthToken}, std::pair{r.event_->handle(), kEventToken},
         std::pair{r.attitude_->handle(), kAttitudeToken}}) {
-    auto condition = dds::Condition::data_available(reader);
-    if (!condition) return condition.error();
-    if (auto s = r.waitset_->attach(condition->handle(), token); !s) return s.error();
-    r.conditions_.push_back(std::move(condition).value());
+    if (auto s = session.watch_data(reader, token); !s) return s.error();
   }
   // Matched-writer changes wake the waitset too (a monitor --once counts the services it hears).
-  if (auto st = r.health_->enable_statuses(DDS_SUBSCRIPTION_MATCHED_STATUS); !st) return st.error();
-  if (auto st = r.waitset_->attach(r.health_->handle(), kHealthToken); !st) return st.error();
-  auto guard = dds::Condition::guard(p);
-  if (!guard) return guard.error();
-  if (auto s = r.waitset_->attach(guard->handle(), kShutdownToken); !s) return s.error();
-  shutdown.set_guard(guard->handle());
-  r.conditions_.push_back(std::move(guard).value());
+  if (auto s = session.watch_statuses(r.health_->handle(), DDS_SUBSCRIPTION_MATCHED_STATUS, kHealthToken); !s)
+    return s.error();
+  if (auto s = session.watch_shutdown(shutdown, kShutdownToken); !s) return s.error();
   return r;
 }
 
@@ -84,7 +70,7 @@ Status GroundReaders::take_attitudes(
 }
 
 Status GroundReaders::wait(std::chrono::nanoseconds timeout, std::vector<std::intptr_t>& triggered) const {
-  return waitset_->wait(timeout, triggered);
+  return session_->wait(timeout, triggered);
 }
 
 }  // namespace tetra::ground

@@ -9,7 +9,7 @@
 #include "tetra.h"  // generated from idl/tetra.idl
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/types.hpp"
-#include "tetra/service/epoch_assembler.hpp"
+#include "tetra/service_types/assembler_counters.hpp"
 
 namespace tetra::dds {
 

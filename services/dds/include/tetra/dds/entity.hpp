@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "tetra/core/result.hpp"
-#include "tetra/service/security_profile.hpp"
+#include "tetra/service_types/security_profile.hpp"
 
 namespace tetra::dds {
 

@@ -17,7 +17,6 @@
 #include "tetra/core/geometry.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/fdi/types.hpp"
-#include "tetra/service/ros2_view_config.hpp"
 
 namespace tetra::dds {
 
@@ -41,12 +40,19 @@ std::optional<Eigen::Matrix3d> rate_covariance(const Calibration& calibration, G
 std::uint8_t diagnostic_level(fdi::Mode mode);
 std::uint8_t diagnostic_level(fdi::GyroState state);
 
+//! The ROS 2 names of one unit's view, every default already filled in (docs/ros2.md).
+struct Ros2Names {
+  std::string name;                //!< ROS name of the unit: rt/tetra/NAME/...
+  std::string frame_id;            //!< the body frame (Imu, DiagnosticArray headers)
+  std::string reference_frame_id;  //!< the frame q_RB points into (QuaternionStamped header)
+};
+
 class Ros2View {
  public:
   struct Settings {
-    service::Ros2ViewConfig names;  //!< resolved (every default filled in)
-    std::string unit;               //!< hardware_id of the diagnostics
-    Calibration calibration;        //!< gyro axes and noise, for the rate covariance
+    Ros2Names names;
+    std::string unit;         //!< hardware_id of the diagnostics
+    Calibration calibration;  //!< gyro axes and noise, for the rate covariance
     double sample_rate_hz = 100.0;
     double default_arw_dps_rtHz = 3.0e-5;
   };

@@ -32,6 +32,7 @@
 #include "tetra/core/quaternion.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/types.hpp"
+#include "tetra/service_types/assembler_counters.hpp"
 
 namespace tetra::service {
 
@@ -44,20 +45,6 @@ struct AssemblerConfig {
 
 //! Validates: N in 1..32, period > 0, 0 ≤ tolerance < period / 2, latency > 0; errors name the field.
 Status validate(const AssemblerConfig& config);
-
-struct AssemblerCounters {
-  std::uint64_t epochs_emitted = 0;
-  std::uint64_t samples_late = 0;          //!< arrived after their epoch was emitted
-  std::uint64_t samples_duplicate = 0;     //!< sequence number repeated
-  std::uint64_t samples_out_of_order = 0;  //!< sequence number or stamp going backwards
-  std::uint64_t samples_gap = 0;           //!< sequence numbers skipped
-  std::uint64_t samples_unknown_gyro = 0;  //!< gyro id outside 1..N
-  std::uint64_t samples_other_unit = 0;    //!< other units' samples (counted by the caller)
-  std::uint64_t sensor_restarts = 0;       //!< time base restarted after every gyro went absent
-  std::uint64_t references_late = 0;       //!< references for epochs already emitted
-  std::uint64_t deadlines_missed = 0;      //!< counted by the caller through mark_absent()
-  std::uint64_t liveliness_lost = 0;       //!< counted by the caller through mark_absent()
-};
 
 enum class Verdict : std::uint8_t { kAccepted, kDuplicate, kOutOfOrder, kLate, kUnknownGyro };
 const char* to_string(Verdict verdict);

@@ -10,23 +10,15 @@
 //   permissions: permissions.p7s            # signed grants (the certificate's subject must have one)
 //
 // Relative paths are relative to the profile file. Every key is required; unknown keys are errors.
-// Plain data: services/dds turns it into participant QoS properties. No DDS header here.
+// The profile itself is plain data (tetra/service_types/security_profile.hpp): services/dds turns it
+// into participant QoS properties. No DDS header here.
 
 #include <string>
 
 #include "tetra/core/result.hpp"
+#include "tetra/service_types/security_profile.hpp"
 
 namespace tetra::service {
-
-struct SecurityProfile {
-  std::string identity_ca;           //!< PEM: identity certificate authority
-  std::string identity_certificate;  //!< PEM: this participant's identity, signed by identity_ca
-  std::string private_key;           //!< PEM: the identity's private key
-  std::string permissions_ca;        //!< PEM: permissions certificate authority
-  std::string governance;            //!< S/MIME-signed governance XML (.p7s)
-  std::string permissions;           //!< S/MIME-signed permissions XML (.p7s)
-  std::string source;                //!< the profile file, for messages
-};
 
 //! Parses a profile; relative paths are resolved against `base_dir`. Does not touch the files.
 Result<SecurityProfile> parse_security_profile(const std::string& yaml_text, const std::string& source,

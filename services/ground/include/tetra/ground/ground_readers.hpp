@@ -11,8 +11,8 @@
 #include "tetra/core/result.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
+#include "tetra/dds/session.hpp"
 #include "tetra/dds/shutdown.hpp"
-#include "tetra/dds/topics.hpp"
 
 namespace tetra::ground {
 
@@ -37,14 +37,11 @@ class GroundReaders {
 
  private:
   GroundReaders() = default;
-  std::optional<dds::Participant> participant_;
-  std::optional<dds::Topics> topics_;
+  std::optional<dds::Session> session_;
   std::optional<dds::Reader<tetra_Health>> health_;
   std::optional<dds::Reader<tetra_FdiEvent>> event_;
   std::optional<dds::Reader<tetra_Attitude>> attitude_;
   std::optional<dds::Writer<tetra_Command>> command_;
-  std::optional<dds::WaitSet> waitset_;
-  std::vector<dds::Condition> conditions_;
 };
 
 }  // namespace tetra::ground

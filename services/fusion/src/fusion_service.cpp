@@ -1,89 +1,80 @@
-#include "fusion_service.hpp"
+#include "tetra/service/fusion_service.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 
-#include "cli_common.hpp"
-#include "dds_common.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/dds/clock.hpp"
 #include "tetra/dds/convert.hpp"
+#include "tetra/dds/topics.hpp"
 
-namespace tetra::cli {
+namespace tetra::service {
 
 namespace {
 
-enum Token : std::intptr_t { kGyroData = 1, kGyroStatus, kReferenceData, kCommandData, kWake, kShutdown };
+enum Token : std::intptr_t { kGyroData = 1, kGyroStatus, kReferenceData, kCommandData, kWake, kStop };
+constexpr std::uint32_t kGyroStatuses = DDS_REQUESTED_DEADLINE_MISSED_STATUS |
+                                        DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
+                                        DDS_SUBSCRIPTION_MATCHED_STATUS;
 
 using dds::assign;
+using dds::monotonic_ns;
 
 }  // namespace
 
-Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal& shutdown) {
+Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal* shutdown) {
   deadline_ns_ = config_.deadline_ns();
-  if (auto s = assign(participant_, dds::Participant::create(domain, config_.unit)); !s) return s;
-  if (auto s = assign(topics_, dds::Topics::create(*participant_)); !s) return s;
-  const dds::Topics& t = *topics_;
-  if (auto s =
-          assign(gyro_reader_, dds::Reader<tetra_GyroSample>::create(
-                                   *participant_, t.gyro_sample,
-                                   dds::gyro_sample_reader_qos(std::chrono::nanoseconds(deadline_ns_ / 3))));
-      !s) {
-    return s;
-  }
-  if (auto s = assign(reference_reader_, dds::Reader<tetra_AttitudeReference>::create(
-                                             *participant_, t.reference, dds::reference_qos()));
-      !s)
-    return s;
-  if (auto s = assign(command_reader_,
-                      dds::Reader<tetra_Command>::create(*participant_, t.command, dds::command_qos()));
-      !s)
-    return s;
-  if (auto s = assign(attitude_writer_,
-                      dds::Writer<tetra_Attitude>::create(*participant_, t.attitude, dds::attitude_qos()));
-      !s)
-    return s;
-  if (auto s = assign(health_writer_,
-                      dds::Writer<tetra_Health>::create(*participant_, t.health, dds::health_qos()));
-      !s)
-    return s;
-  if (auto s = assign(event_writer_,
-                      dds::Writer<tetra_FdiEvent>::create(*participant_, t.event, dds::event_qos()));
-      !s)
-    return s;
-  if (config_.ros2.enabled) {
-    dds::Ros2View::Settings ros2{config_.ros2.resolved(config_.unit), config_.unit, config_.calibration,
-                                 config_.sample_rate_hz, config_.pipeline.default_arw_dps_rtHz};
-    if (auto s = assign(ros2_view_, dds::Ros2View::create(*participant_, std::move(ros2))); !s) return s;
-  }
-  if (auto s = gyro_reader_->enable_statuses(DDS_REQUESTED_DEADLINE_MISSED_STATUS |
-                                             DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
-                                             DDS_SUBSCRIPTION_MATCHED_STATUS);
-      !s)
-    return s;
+  shutdown_ = shutdown;
+  if (auto s = assign(session_, dds::Session::open(domain, config_.unit)); !s) return s;
+  if (auto s = open_endpoints(); !s) return s;
+  return open_waitset();
+}
 
-  if (auto s = assign(waitset_, dds::WaitSet::create(*participant_)); !s) return s;
-  auto attach_data = [&](dds_entity_t reader, Token token) -> Status {
-    auto condition = dds::Condition::data_available(reader);
-    if (!condition) return condition.error();
-    if (auto s = waitset_->attach(condition->handle(), token); !s) return s;
-    conditions_.push_back(std::move(condition).value());
-    return ok_status();
-  };
+Status FusionService::open_endpoints() {
+  const dds::Session& session = *session_;
+  const auto sample_period = std::chrono::nanoseconds(deadline_ns_ / 3);
+  if (auto s =
+          assign(gyro_reader_, session.reader<tetra_GyroSample>(dds::gyro_sample_reader_qos(sample_period)));
+      !s)
+    return s;
+  if (auto s = assign(reference_reader_, session.reader<tetra_AttitudeReference>(dds::reference_qos())); !s)
+    return s;
+  if (auto s = assign(command_reader_, session.reader<tetra_Command>(dds::command_qos())); !s) return s;
+  if (auto s = assign(attitude_writer_, session.writer<tetra_Attitude>(dds::attitude_qos())); !s) return s;
+  if (auto s = assign(health_writer_, session.writer<tetra_Health>(dds::health_qos())); !s) return s;
+  if (auto s = assign(event_writer_, session.writer<tetra_FdiEvent>(dds::event_qos())); !s) return s;
+  if (!config_.ros2.enabled) return ok_status();
+  const Ros2ViewConfig names = config_.ros2.resolved(config_.unit);
+  dds::Ros2View::Settings ros2{{names.name, names.frame_id, names.reference_frame_id},
+                               config_.unit,
+                               config_.calibration,
+                               config_.sample_rate_hz,
+                               config_.pipeline.default_arw_dps_rtHz};
+  return assign(ros2_view_, dds::Ros2View::create(session.participant(), std::move(ros2)));
+}
+
+Status FusionService::open_waitset() {
+  dds::Session& session = *session_;
   if (!listener_dispatch()) {
-    if (auto s = attach_data(gyro_reader_->handle(), kGyroData); !s) return s;
+    if (auto s = session.watch_data(gyro_reader_->handle(), kGyroData); !s) return s;
   }
-  if (auto s = attach_data(reference_reader_->handle(), kReferenceData); !s) return s;
-  if (auto s = attach_data(command_reader_->handle(), kCommandData); !s) return s;
-  if (auto s = waitset_->attach(gyro_reader_->handle(), kGyroStatus); !s) return s;
-  if (auto s = assign(wake_, dds::Condition::guard(*participant_)); !s) return s;
-  if (auto s = waitset_->attach(wake_->handle(), kWake); !s) return s;
-  auto guard = dds::Condition::guard(*participant_);
-  if (!guard) return guard.error();
-  if (auto s = waitset_->attach(guard->handle(), kShutdown); !s) return s;
-  shutdown.set_guard(guard->handle());
-  conditions_.push_back(std::move(guard).value());
+  if (auto s = session.watch_data(reference_reader_->handle(), kReferenceData); !s) return s;
+  if (auto s = session.watch_data(command_reader_->handle(), kCommandData); !s) return s;
+  if (auto s = session.watch_statuses(gyro_reader_->handle(), kGyroStatuses, kGyroStatus); !s) return s;
+  auto wake = session.add_guard(kWake);
+  if (!wake) return wake.error();
+  wake_ = *wake;
+  auto stop = session.add_guard(kStop);
+  if (!stop) return stop.error();
+  if (shutdown_ != nullptr) shutdown_->set_guard((*stop)->handle());
+  stop_.store(*stop);
   return ok_status();
+}
+
+void FusionService::request_stop() {
+  stop_requested_.store(true);
+  if (const dds::Condition* stop = stop_.load()) (void)stop->trigger();
 }
 
 void FusionService::on_gyro_data(dds_entity_t, void* self) {
@@ -102,7 +93,7 @@ void FusionService::stop_listener() {
   listening_ = false;
 }
 
-Status FusionService::run(const dds::ShutdownSignal& shutdown) {
+Status FusionService::run() {
   {
     const std::lock_guard lock(mutex_);
     started_ns_ = monotonic_ns();
@@ -115,24 +106,28 @@ Status FusionService::run(const dds::ShutdownSignal& shutdown) {
   }
   spdlog::info("fusion: unit {} running, {} gyros, {} Hz, gyro samples dispatched by the {}", config_.unit,
                n_gyros_, config_.sample_rate_hz, listener_dispatch() ? "listener" : "waitset");
-  Status status = loop(shutdown);
+  Status status = loop();
   stop_listener();  // before anything the listener uses goes away
   if (!status) return status;
-  spdlog::info("fusion: signal {} received, shutting down", shutdown.signal_number());
+  if (shutdown_ != nullptr && shutdown_->requested()) {
+    spdlog::info("fusion: signal {} received, shutting down", shutdown_->signal_number());
+  } else {
+    spdlog::info("fusion: stop requested, shutting down");
+  }
   const std::lock_guard lock(mutex_);
   return publish_health(monotonic_ns(), true);
 }
 
-Status FusionService::loop(const dds::ShutdownSignal& shutdown) {
+Status FusionService::loop() {
   std::vector<std::intptr_t> triggered;
   std::int64_t wake = 0;
   {
     const std::lock_guard lock(mutex_);
     wake = scheduled_wake_ns_ = next_wake_ns(monotonic_ns());
   }
-  while (!shutdown.requested()) {
-    if (auto s = waitset_->wait(std::chrono::nanoseconds(wake - monotonic_ns()), triggered); !s) return s;
-    if (shutdown.requested()) break;
+  while (!stopping()) {
+    if (auto s = session_->wait(std::chrono::nanoseconds(wake - monotonic_ns()), triggered); !s) return s;
+    if (stopping()) break;
     const std::lock_guard lock(mutex_);
     if (auto s = wake_->clear(); !s) return s;
     if (listener_error_) return *listener_error_;
@@ -165,42 +160,14 @@ std::int64_t FusionService::next_wake_ns(std::int64_t now_ns) const {
 
 Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered, std::int64_t now) {
   bool deadline_status = false;
-  bool command_data = false;
-  bool gyro_data = false;
   bool matched_changed = false;
-  for (const auto token : triggered) {
-    command_data = command_data || token == kCommandData;
-    gyro_data = gyro_data || token == kGyroData;
-    if (token == kGyroStatus) {
-      std::uint32_t status = 0;
-      (void)dds_take_status(gyro_reader_->handle(), &status,
-                            DDS_REQUESTED_DEADLINE_MISSED_STATUS | DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
-                                DDS_SUBSCRIPTION_MATCHED_STATUS);
-      deadline_status = (status & DDS_REQUESTED_DEADLINE_MISSED_STATUS) != 0;
-      if ((status & DDS_SUBSCRIPTION_MATCHED_STATUS) != 0) {
-        // A sensor (or simulator) came or went: say so in Health at once (a simulator waits for it).
-        auto matched = gyro_reader_->matched_writers();
-        if (!matched) return matched.error();
-        gyro_writers_ = *matched;
-        spdlog::info("fusion: {} GyroSample writer(s) matched", gyro_writers_);
-        matched_changed = true;
-      }
-      if ((status & DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS) != 0) {
-        dds_requested_incompatible_qos_status_t qos_status{};
-        (void)dds_get_requested_incompatible_qos_status(gyro_reader_->handle(), &qos_status);
-        const std::uint32_t policy = qos_status.last_policy_id;
-        if (policy == DDS_DEADLINE_QOS_POLICY_ID) {
-          spdlog::warn(
-              "fusion: a GyroSample writer offers incompatible QoS: deadline (policy id {}; its deadline "
-              "must "
-              "be at most {} s: sample_rate_hz and speed must match the sensor's)",
-              policy, ns_to_seconds(deadline_ns_));
-        } else {
-          spdlog::warn("fusion: a GyroSample writer offers incompatible QoS: {} (policy id {}; docs/dds.md)",
-                       dds::qos_policy_name(policy), policy);
-        }
-      }
-    }
+  const auto fired = [&](Token token) {
+    return std::find(triggered.begin(), triggered.end(), token) != triggered.end();
+  };
+  const bool command_data = fired(kCommandData);
+  const bool gyro_data = fired(kGyroData);
+  if (fired(kGyroStatus)) {
+    if (auto s = take_gyro_statuses(deadline_status, matched_changed); !s) return s;
   }
   if (gyro_data) {
     if (auto s = ingest(now); !s) return s;
@@ -214,6 +181,35 @@ Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered,
   if (auto s = process_epochs(now); !s) return s;
   if (command_data || newly_absent || matched_changed || now >= next_health_ns_) {
     if (auto s = publish_health(now, matched_changed); !s) return s;
+  }
+  return ok_status();
+}
+
+Status FusionService::take_gyro_statuses(bool& deadline_missed, bool& matched_changed) {
+  std::uint32_t status = 0;
+  (void)dds_take_status(gyro_reader_->handle(), &status, kGyroStatuses);
+  deadline_missed = (status & DDS_REQUESTED_DEADLINE_MISSED_STATUS) != 0;
+  if ((status & DDS_SUBSCRIPTION_MATCHED_STATUS) != 0) {
+    // A sensor (or simulator) came or went: say so in Health at once (a simulator waits for it).
+    auto matched = gyro_reader_->matched_writers();
+    if (!matched) return matched.error();
+    gyro_writers_ = *matched;
+    spdlog::info("fusion: {} GyroSample writer(s) matched", gyro_writers_);
+    matched_changed = true;
+  }
+  if ((status & DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS) != 0) {
+    dds_requested_incompatible_qos_status_t qos_status{};
+    (void)dds_get_requested_incompatible_qos_status(gyro_reader_->handle(), &qos_status);
+    const std::uint32_t policy = qos_status.last_policy_id;
+    if (policy == DDS_DEADLINE_QOS_POLICY_ID) {
+      spdlog::warn(
+          "fusion: a GyroSample writer offers incompatible QoS: deadline (policy id {}; its deadline must "
+          "be at most {} s: sample_rate_hz and speed must match the sensor's)",
+          policy, ns_to_seconds(deadline_ns_));
+    } else {
+      spdlog::warn("fusion: a GyroSample writer offers incompatible QoS: {} (policy id {}; docs/dds.md)",
+                   dds::qos_policy_name(policy), policy);
+    }
   }
   return ok_status();
 }
@@ -240,9 +236,9 @@ Status FusionService::take_gyro_samples(std::int64_t now_ns) {
         const int gyro = sample.gyro;
         const auto verdict = assembler_.add_sample(gyro, sample.seq, sample.stamp_ns, sample.raw, now_ns);
         if (gyro >= 1 && gyro <= n_gyros_) last_arrival_ns_[static_cast<std::size_t>(gyro - 1)] = now_ns;
-        if (verdict != service::Verdict::kAccepted) {
+        if (verdict != Verdict::kAccepted) {
           spdlog::debug("fusion: gyro {} seq {} stamp {} ns: {}", gyro, sample.seq, sample.stamp_ns,
-                        service::to_string(verdict));
+                        to_string(verdict));
         }
       },
       [&](const dds_sample_info_t& info) {
@@ -253,7 +249,7 @@ Status FusionService::take_gyro_samples(std::int64_t now_ns) {
             dds::from_wire(key.unit) == config_.unit) {
           if (!assembler_.absent(key.gyro))
             spdlog::warn("fusion: gyro {} has no live writer: absent", key.gyro);
-          assembler_.mark_absent(key.gyro, service::AbsentReason::kLiveliness);
+          assembler_.mark_absent(key.gyro, AbsentReason::kLiveliness);
         }
         dds_sample_free(&key, &tetra_GyroSample_desc, DDS_FREE_CONTENTS);
       });
@@ -348,7 +344,7 @@ bool FusionService::check_deadlines(std::int64_t now_ns, bool dds_reported) {
     if (now_ns - since >= deadline_ns_) {
       spdlog::warn("fusion: gyro {} silent for 3 sample periods{}: absent", g,
                    dds_reported ? " (DDS deadline)" : "");
-      assembler_.mark_absent(g, service::AbsentReason::kDeadline);
+      assembler_.mark_absent(g, AbsentReason::kDeadline);
       any = true;
     }
   }
@@ -433,4 +429,4 @@ Status FusionService::publish_health(std::int64_t now_ns, bool force) {
   return ok_status();
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::service

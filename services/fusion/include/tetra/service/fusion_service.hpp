@@ -1,15 +1,18 @@
 #pragma once
-// The fusion service of `tetra fusion` (docs/dds.md): the pipeline of `tetra replay` on DDS.
+// The fusion service of `tetra fusion` (docs/dds.md): the pipeline of `tetra replay` on DDS. A library:
+// the command runs it until SIGINT/SIGTERM, a test runs it in a thread and stops it with request_stop().
 //
 // Reads GyroSample, AttitudeReference and Command of its unit; writes Attitude (every accepted
 // epoch), Health (every `health_period_s` and on every change) and FdiEvent (pipeline events and
 // command acknowledgements). One waitset drives everything but the gyro samples themselves: the
 // reference and command readers, the gyro reader's statuses (deadline, liveliness, matches), the
-// latency limit of the oldest open epoch, silent gyros, the Health period, and SIGINT/SIGTERM.
+// latency limit of the oldest open epoch, silent gyros, the Health period, and a stop (request_stop()
+// or, when asked for, SIGINT/SIGTERM).
 // Gyro samples are handed to the same code by a data-available listener on Cyclone's receive thread
 // (`gyro_dispatch: listener`, the default: an epoch is fused and its Attitude written without a
 // thread wake-up) or by the waitset (`gyro_dispatch: waitset`). One mutex serializes the two threads.
 
+#include <atomic>
 #include <cstdint>
 #include <mutex>
 #include <optional>
@@ -20,19 +23,19 @@
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/ros2_view.hpp"
+#include "tetra/dds/session.hpp"
 #include "tetra/dds/shutdown.hpp"
-#include "tetra/dds/topics.hpp"
 #include "tetra/fdi/pipeline.hpp"
 #include "tetra/service/epoch_assembler.hpp"
 #include "tetra/service/fusion_config.hpp"
 
-namespace tetra::cli {
+namespace tetra::service {
 
-//! One unit's service: open() creates its DDS entities, run() serves until SIGINT/SIGTERM (or a
-//! DDS failure, returned as an error) and publishes a last Health.
+//! One unit's service: open() creates its DDS entities, run() serves until a stop (or a DDS failure,
+//! returned as an error) and publishes a last Health.
 class FusionService {
  public:
-  FusionService(service::FusionConfig config, fdi::Pipeline pipeline, service::EpochAssembler assembler)
+  FusionService(FusionConfig config, fdi::Pipeline pipeline, EpochAssembler assembler)
       : config_(std::move(config)),
         pipeline_(std::move(pipeline)),
         assembler_(std::move(assembler)),
@@ -42,20 +45,28 @@ class FusionService {
   FusionService(const FusionService&) = delete;
   FusionService& operator=(const FusionService&) = delete;
 
-  //! Participant, topics, readers, writers and the waitset on `domain`; `shutdown` gets its guard.
-  Status open(dds_domainid_t domain, dds::ShutdownSignal& shutdown);
-  //! Serves until `shutdown` is requested.
-  Status run(const dds::ShutdownSignal& shutdown);
+  //! Participant, topics, readers, writers and the waitset on `domain`. With `shutdown`, SIGINT and
+  //! SIGTERM stop run() too (it must outlive the service).
+  Status open(dds_domainid_t domain, dds::ShutdownSignal* shutdown = nullptr);
+  //! Serves until a stop is requested (request_stop(), or a signal through open()'s `shutdown`).
+  Status run();
+  //! Ends run() (from any thread; before run(), run() returns at once after its first Health).
+  void request_stop();
 
  private:
-  bool listener_dispatch() const { return config_.gyro_dispatch == service::GyroDispatch::kListener; }
+  bool listener_dispatch() const { return config_.gyro_dispatch == GyroDispatch::kListener; }
+  Status open_endpoints();
+  Status open_waitset();
+  bool stopping() const { return stop_requested_.load() || (shutdown_ != nullptr && shutdown_->requested()); }
   //! The gyro reader's listener, on Cyclone's receive thread.
   static void on_gyro_data(dds_entity_t reader, void* self);
   //! Removes the listener; returns once no callback runs (call without holding mutex_).
   void stop_listener();
-  Status loop(const dds::ShutdownSignal& shutdown);
+  Status loop();
   //! Everything a waitset wake-up calls for: statuses, samples, commands, deadlines, timers.
   Status handle_wakeup(const std::vector<std::intptr_t>& triggered, std::int64_t now_ns);
+  //! The gyro reader's statuses: sets `deadline_missed`, `matched_changed`.
+  Status take_gyro_statuses(bool& deadline_missed, bool& matched_changed);
   //! Takes gyro samples and references, and fuses the epochs they complete.
   Status ingest(std::int64_t now_ns);
   //! [ns] the next time the waitset thread has work without any sample arriving.
@@ -76,9 +87,9 @@ class FusionService {
 
   //! Serializes the waitset thread and the gyro listener: every member below is used under it.
   std::mutex mutex_;
-  service::FusionConfig config_;
+  FusionConfig config_;
   fdi::Pipeline pipeline_;
-  service::EpochAssembler assembler_;
+  EpochAssembler assembler_;
   int n_gyros_;
   std::int64_t deadline_ns_ = 0;  //!< [ns] 3 sample periods
   std::int64_t started_ns_ = 0;   //!< [ns] local time the service started
@@ -103,8 +114,9 @@ class FusionService {
   std::optional<Error> listener_error_;  //!< a failure inside the listener, for run() to return
   bool listening_ = false;
 
-  std::optional<dds::Participant> participant_;
-  std::optional<dds::Topics> topics_;
+  std::atomic<bool> stop_requested_{false};
+  dds::ShutdownSignal* shutdown_ = nullptr;  //!< SIGINT/SIGTERM stop run() too (optional)
+  std::optional<dds::Session> session_;
   std::optional<dds::Reader<tetra_GyroSample>> gyro_reader_;
   std::optional<dds::Reader<tetra_AttitudeReference>> reference_reader_;
   std::optional<dds::Reader<tetra_Command>> command_reader_;
@@ -112,9 +124,8 @@ class FusionService {
   std::optional<dds::Writer<tetra_Health>> health_writer_;
   std::optional<dds::Writer<tetra_FdiEvent>> event_writer_;
   std::optional<dds::Ros2View> ros2_view_;  //!< `ros2: enabled: true` (docs/ros2.md)
-  std::vector<dds::Condition> conditions_;
-  std::optional<dds::Condition> wake_;  //!< the listener wakes the waitset thread for an epoch's deadline
-  std::optional<dds::WaitSet> waitset_;
+  const dds::Condition* wake_ = nullptr;    //!< the listener wakes the waitset thread for an epoch's deadline
+  std::atomic<const dds::Condition*> stop_{nullptr};  //!< request_stop() wakes the waitset thread
 };
 
-}  // namespace tetra::cli
+}  // namespace tetra::service

@@ -1,0 +1,23 @@
+#pragma once
+// The epoch assembler's counters (services/fusion): plain data, below both the service and the DDS
+// layer, which puts them on the wire in Health (docs/dds.md, "Epoch assembly").
+
+#include <cstdint>
+
+namespace tetra::service {
+
+struct AssemblerCounters {
+  std::uint64_t epochs_emitted = 0;
+  std::uint64_t samples_late = 0;          //!< arrived after their epoch was emitted
+  std::uint64_t samples_duplicate = 0;     //!< sequence number repeated
+  std::uint64_t samples_out_of_order = 0;  //!< sequence number or stamp going backwards
+  std::uint64_t samples_gap = 0;           //!< sequence numbers skipped
+  std::uint64_t samples_unknown_gyro = 0;  //!< gyro id outside 1..N
+  std::uint64_t samples_other_unit = 0;    //!< other units' samples (counted by the caller)
+  std::uint64_t sensor_restarts = 0;       //!< time base restarted after every gyro went absent
+  std::uint64_t references_late = 0;       //!< references for epochs already emitted
+  std::uint64_t deadlines_missed = 0;      //!< counted by the caller through mark_absent()
+  std::uint64_t liveliness_lost = 0;       //!< counted by the caller through mark_absent()
+};
+
+}  // namespace tetra::service

@@ -1,0 +1,199 @@
+// The fusion service as a library (docs/dds.md): started in a thread of this process on a private
+// domain, fed simulated gyro samples over DDS, its Attitude checked against the simulator's truth,
+// then stopped with request_stop() — no process, no signal. Waits are on DDS conditions, each with a
+// generous upper bound that only turns a hang into a failure; nothing asserts on elapsed time.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <memory>
+#include <thread>
+
+#include "test_support.hpp"
+#include "tetra/core/calibration_file.hpp"
+#include "tetra/core/json.hpp"
+#include "tetra/core/units.hpp"
+#include "tetra/dds/clock.hpp"
+#include "tetra/dds/convert.hpp"
+#include "tetra/dds/session.hpp"
+#include "tetra/service/fusion_service.hpp"
+#include "tetra/sim/scenario.hpp"
+#include "tetra/sim/simulator.hpp"
+#include "tetra_process.hpp"
+
+namespace tetra::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+const bool kLoopback = use_loopback_dds();
+constexpr dds_domainid_t kDomain = 167;
+constexpr std::int64_t kWaitLimit_ns = 20'000'000'000;  //!< [ns] only turns a hang into a failure
+
+//! The static scenario's unit for 3 s at 100 Hz, and the service set up for it (its files in `dir`).
+struct Rig {
+  TempDir dir;
+  sim::Simulator simulator;
+  sim::SimEpoch first;
+
+  static sim::Simulator make_simulator() {
+    auto scenario = sim::builtin_scenario("static");
+    EXPECT_TRUE(scenario.ok());
+    scenario->duration_s = 3.0;
+    scenario->rate_hz = 100.0;
+    sim::SimOptions options;
+    options.seed = 7;
+    return std::move(sim::Simulator::create(*scenario, options)).value();
+  }
+  Rig() : simulator(make_simulator()) {
+    EXPECT_TRUE(simulator.next(first));
+    simulator.reset();
+  }
+
+  //! The service (not movable: it owns a mutex), on the heap.
+  Result<std::unique_ptr<service::FusionService>> make_service() {
+    EXPECT_TRUE(write_calibration(dir.file("cal.yaml"), simulator.scenario().unit).ok());
+    const auto q = to_wxyz(first.truth_q_RB);
+    std::string unit;
+    append_json_string(unit, simulator.scenario().unit.unit);
+    std::string q_text;
+    for (int i = 0; i < 4; ++i) {
+      q_text += (i ? ", " : "");
+      append_json_number(q_text, q[static_cast<std::size_t>(i)]);
+    }
+    write_file(dir.file("fusion.yaml"),
+               "unit: " + unit +
+                   "\ncalibration: cal.yaml\nsample_rate_hz: 100\nmax_latency_s: 0.05\n"
+                   "health_period_s: 0.2\npipeline:\n  initial_q_wxyz: [" +
+                   q_text + "]\n  sample_period_s: 0.01\n");
+    auto config = service::read_fusion_config(dir.file("fusion.yaml"));
+    if (!config) return config.error();
+    auto pipeline = fdi::Pipeline::create(config->calibration, config->pipeline);
+    if (!pipeline) return pipeline.error();
+    auto assembler = service::EpochAssembler::create(config->assembler(pipeline->gyro_count()));
+    if (!assembler) return assembler.error();
+    return std::make_unique<service::FusionService>(std::move(config).value(), std::move(pipeline).value(),
+                                                    std::move(assembler).value());
+  }
+};
+
+//! The sensor's and the ground's side: GyroSample writer, Health and Attitude readers.
+struct Peer {
+  dds::Session session;
+  dds::Writer<tetra_GyroSample> gyro;
+  dds::Reader<tetra_Health> health;
+  dds::Reader<tetra_Attitude> attitude;
+
+  static Peer open() {
+    auto session = std::move(dds::Session::open(kDomain)).value();
+    // The deadline the service requests: 3 periods of its 100 Hz.
+    auto gyro = std::move(session.writer<tetra_GyroSample>(dds::gyro_sample_qos(10ms))).value();
+    auto health = std::move(session.reader<tetra_Health>(dds::health_qos())).value();
+    dds::Qos deep;
+    deep.reliable().volatile_durability().keep_last(100000);
+    auto attitude = std::move(session.reader<tetra_Attitude>(deep)).value();
+    EXPECT_TRUE(session.watch_data(health.handle(), 1).ok());
+    EXPECT_TRUE(session.watch_data(attitude.handle(), 2).ok());
+    return Peer{std::move(session), std::move(gyro), std::move(health), std::move(attitude)};
+  }
+  //! Waits (on the waitset) until `done()` holds after `drain()`; false when the limit passes.
+  template <class Drain, class Done>
+  bool wait_until(Drain&& drain, Done&& done) {
+    const std::int64_t give_up = dds::monotonic_ns() + kWaitLimit_ns;
+    std::vector<std::intptr_t> triggered;
+    for (;;) {
+      drain();
+      if (done()) return true;
+      const std::int64_t now = dds::monotonic_ns();
+      if (now >= give_up) return false;
+      EXPECT_TRUE(session.wait(std::chrono::nanoseconds(give_up - now), triggered).ok());
+    }
+  }
+};
+
+TEST(FusionServiceLibrary, RunsInAThreadFusesSamplesFromDdsAndStopsOnRequest) {
+  ASSERT_TRUE(kLoopback);
+  Rig rig;
+  auto service = rig.make_service();
+  ASSERT_TRUE(service.ok()) << service.error().message;
+  ASSERT_TRUE((*service)->open(kDomain).ok());
+  Status run_status = ok_status();
+  std::thread thread([&] { run_status = (*service)->run(); });
+
+  Peer peer = Peer::open();
+  const std::string unit = rig.simulator.scenario().unit.unit;
+  // The service hears our writer (its Health says so) before the first sample: none is lost.
+  bool hears = false;
+  ASSERT_TRUE(peer.wait_until(
+      [&] {
+        (void)peer.health.take([&](const tetra_Health& h, const dds_sample_info_t&) {
+          hears = hears || (dds::from_wire(h.unit) == unit && h.gyro_writers > 0);
+        });
+      },
+      [&] { return hears; }));
+
+  // Publish every epoch (2 ms apart: faster than the 100 Hz the service expects, slower than its
+  // 30 ms deadline), keeping the truth to score the attitudes against.
+  std::map<std::int64_t, Quaternion> truth;
+  tetra_GyroSample sample{};
+  ASSERT_TRUE(dds::copy_bounded(sample.unit, unit, "unit").ok());
+  sim::SimEpoch epoch;
+  std::uint64_t k = 0;
+  while (rig.simulator.next(epoch)) {
+    truth[epoch.stamp_ns] = epoch.truth_q_RB;
+    ++k;
+    for (std::size_t g = 1; g <= epoch.present.size(); ++g) {
+      if (epoch.present[g - 1] == 0) continue;
+      sample.gyro = static_cast<std::uint16_t>(g);
+      sample.seq = k;
+      sample.stamp_ns = epoch.stamp_ns;
+      sample.raw = epoch.raw_V[g - 1];
+      ASSERT_TRUE(peer.gyro.write(sample).ok());
+    }
+    std::this_thread::sleep_for(2ms);
+  }
+  const std::int64_t last_stamp = epoch.stamp_ns;
+
+  // Attitude out: the last epoch's arrives, and every one received is the truth within 50 arcsec. The
+  // static unit's truth is fixed in R, while the service, not told its latitude, integrates the Earth's
+  // rate too: at most 15.04 arcsec/s × 3 s = 45.1 arcsec, plus 5 arcsec for the gyros' noise over 3 s.
+  // A wrong frame, sign or scale is degrees off.
+  std::size_t received = 0;
+  double worst_arcsec = 0.0;
+  bool last_seen = false;
+  ASSERT_TRUE(peer.wait_until(
+      [&] {
+        (void)peer.attitude.take([&](const tetra_Attitude& m, const dds_sample_info_t&) {
+          const auto estimate = dds::from_wire(m);
+          const auto it = truth.find(estimate.stamp_ns);
+          ASSERT_NE(it, truth.end()) << "an attitude for an epoch never published";
+          worst_arcsec =
+              std::max(worst_arcsec, angle_between(estimate.q_RB, it->second) * kRadToDeg * 3600.0);
+          ++received;
+          last_seen = last_seen || estimate.stamp_ns == last_stamp;
+        });
+      },
+      [&] { return last_seen; }));
+  // The Attitude writer keeps only its latest sample (docs/interfaces.md §4), so a reader may miss one
+  // under load; half is far below what loopback delivers and far above a service that stalls.
+  EXPECT_GT(received, truth.size() / 2) << "most epochs fused";
+  EXPECT_LT(worst_arcsec, 50.0);
+
+  (*service)->request_stop();
+  thread.join();
+  EXPECT_TRUE(run_status.ok()) << run_status.error().message;
+}
+
+TEST(FusionServiceLibrary, AStopRequestedBeforeRunEndsItAtOnce) {
+  ASSERT_TRUE(kLoopback);
+  Rig rig;
+  auto service = rig.make_service();
+  ASSERT_TRUE(service.ok()) << service.error().message;
+  ASSERT_TRUE((*service)->open(kDomain + 1).ok());
+  (*service)->request_stop();
+  EXPECT_TRUE((*service)->run().ok());
+}
+
+}  // namespace
+}  // namespace tetra::test
