@@ -31,7 +31,9 @@ struct PipelineConfig {
   double chi2_false_alarm_probability = 1.0e-9;  //!< [-] per epoch, instantaneous χ² test
   double cusum_min_fault_dps = 2.0e-4;  //!< [deg/s] smallest bias step on any gyro the CUSUM is sized for
   double cusum_arl0_epochs = 1.0e8;     //!< [epochs] in-control average run length (two-sided)
-  double clear_after_s = 30.0;          //!< [s] no alarm for this long ends a SUSPECT episode
+  //! [s] the rate random walk K of a gyro's `noise:` enters the detectors' reference noise as K·√horizon
+  double rate_random_walk_horizon_s = 3600.0;
+  double clear_after_s = 30.0;  //!< [s] no alarm for this long ends a SUSPECT episode
 
   // --- isolation
   double isolation_window_s = 5.0;                //!< [s] evidence is sought this long before `unisolated`

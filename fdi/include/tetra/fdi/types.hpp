@@ -39,7 +39,8 @@ std::optional<FaultKind> fault_kind_from_string(std::string_view text);
 
 //! detected, isolated, unisolated (detected and the data cannot tell which gyro), reconfigured,
 //! cleared, lost; and command (acknowledgement of an operator command — an addition to docs/interfaces.md
-//! §2.5).
+//! §2.5); fdi_unavailable / fdi_available: fault detection lost (no parity left and no recent reference) or
+//! back (docs/fdi.md, "Reconfiguration and modes").
 enum class EventType : std::uint8_t {
   kDetected,
   kIsolated,
@@ -47,7 +48,9 @@ enum class EventType : std::uint8_t {
   kReconfigured,
   kCleared,
   kLost,
-  kCommand
+  kCommand,
+  kFdiUnavailable,
+  kFdiAvailable
 };
 const char* to_string(EventType type);
 
@@ -147,6 +150,9 @@ struct Health {
   double chi2_threshold = 0.0;
   double cusum_threshold = 0.0;
   Counters counters;
+  //! false: a new fault cannot be detected (the gyros used leave no parity and no reference came within
+  //! reference_window_s); signatures of a single gyro (stuck, noise, dropout...) still run.
+  bool fdi_available = true;
 };
 
 //! The estimate published every accepted epoch (docs/interfaces.md §2.4).
@@ -157,7 +163,8 @@ struct AttitudeEstimate {
       Eigen::Vector3d::Zero();  //!< rate used for propagation (Earth rate removed in ground mode)
   Eigen::Vector3d sigma_rad = Eigen::Vector3d::Zero();  //!< 1σ attitude uncertainty per body axis
   Mode mode = Mode::kNominal;
-  GyroMask gyros = 0;  //!< gyros used
+  GyroMask gyros = 0;         //!< gyros used
+  bool fdi_available = true;  //!< as Health::fdi_available: false = a new fault would go unseen
 };
 
 }  // namespace tetra::fdi
