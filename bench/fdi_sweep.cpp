@@ -2,7 +2,10 @@
 // "Detection"): the simulator's default unit (bias instability B = 5e-6 deg/s) with N = 4, 5, 6 gyros,
 // straight into the pipeline in process, one-hour orbits on every thread.
 //
-//   fdi_sweep [--hours H] [--jobs J] [--delay-seeds S]
+//   fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS]
+//
+// --arl0 lowers the design in-control ARL (cusum_arl0_epochs) so that a sweep of a few hundred hours counts
+// enough false alarms to test the threshold computation itself (at the default 1e8, 1,000 h expect 0.4).
 //
 // Prints per N: false alarms (`detected` events) per 1,000 h against the design rate (1/ARL₀ of the CUSUM
 // plus the χ² per-epoch probability), and a table of detection delays of the documented faults against the
@@ -53,6 +56,8 @@ struct RunOutcome {
 };
 
 //! One simulated run of `duration_s` straight into a pipeline; counts `detected` events.
+double g_arl0 = fdi::PipelineConfig{}.cusum_arl0_epochs;  // set once by main before any thread starts
+
 RunOutcome run(int n, double duration_s, std::uint64_t seed, const std::vector<sim::FaultSpec>& faults) {
   RunOutcome out;
   auto sc = sim::builtin_scenario("orbit");
@@ -71,6 +76,7 @@ RunOutcome run(int n, double duration_s, std::uint64_t seed, const std::vector<s
   sim::SimEpoch se;
   if (!simulator->next(se)) return out;
   fdi::PipelineConfig config;
+  config.cusum_arl0_epochs = g_arl0;
   config.initial_q_RB = se.truth_q_RB;
   auto pipeline = fdi::Pipeline::create(sc->unit, config);
   if (!pipeline) {
@@ -116,7 +122,8 @@ struct Theory {
 
 Theory theory(int n) {
   const Calibration cal = unit_with(n);
-  const fdi::PipelineConfig config;
+  fdi::PipelineConfig config;
+  config.cusum_arl0_epochs = g_arl0;
   Eigen::VectorXd arw(n);
   Eigen::VectorXd wander(n);
   for (int i = 0; i < n; ++i) {
@@ -226,15 +233,24 @@ int main(int argc, char** argv) {
     const std::string arg = argv[a];
     if (arg == "--help" || arg == "-h") {
       std::printf(
-          "fdi_sweep [--hours H] [--jobs J] [--delay-seeds S]\n"
+          "fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS]\n"
           "  false alarms in H fault-free one-hour orbits per N = 4, 5, 6 (default 1000), then the "
           "detection\n"
-          "  delays of the documented faults (S seeds per fault and gyro, default 10), on J threads.\n");
+          "  delays of the documented faults (S seeds per fault and gyro, default 10), on J threads.\n"
+          "  --arl0: the CUSUM's design in-control ARL [epochs] (default 1e8).\n");
       return 0;
     }
     if (a + 1 >= argc) {
       std::fprintf(stderr, "fdi_sweep: option %s needs a value\n", arg.c_str());
       return 2;
+    }
+    if (arg == "--arl0") {
+      g_arl0 = std::atof(argv[++a]);
+      if (!(g_arl0 >= 10.0)) {
+        std::fprintf(stderr, "fdi_sweep: option --arl0 must be >= 10\n");
+        return 2;
+      }
+      continue;
     }
     const int value = std::atoi(argv[++a]);
     if (value < 0) {

@@ -389,9 +389,9 @@ TEST(Pipeline, GroundModeRemovesEarthRate) {
 }
 
 TEST(Pipeline, ThreeGyrosHaveNoParityButSignaturesStillIsolate) {
-  // Gyros 1–3 of the unit alone: no parity, so χ² and CUSUM are silent (10 min, one event: at the first epoch,
-  // `fdi_unavailable`, the user is told a new fault would go unseen); a stuck gyro is still isolated by its own
-  // series, and with two gyros left the attitude is LOST.
+  // Gyros 1–3 of the unit alone: no parity, so χ² and CUSUM are silent (10 min, one event: at the first
+  // epoch, `fdi_unavailable`, the user is told a new fault would go unseen); a stuck gyro is still isolated
+  // by its own series, and with two gyros left the attitude is LOST.
   Calibration cal = seed_as_built_unit();
   cal.gyros.resize(3);
   const Outcome quiet = run({}, 600.0, SynthOptions{}, campaign_config(), cal);
