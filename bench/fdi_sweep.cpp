@@ -115,6 +115,7 @@ struct Theory {
   int dof = 0;
   double k = 0.0;
   double h = 0.0;
+  double s = 0.0;  //!< [σ] bias wander per parity axis
   double chi2_p = 0.0;
   double arl0 = 0.0;
   std::vector<double> w_norm;  //!< |w_i|·√T [σ per rad/s]
@@ -135,7 +136,13 @@ Theory theory(int n) {
                                  wander);
   cache.prepare(1.0 / kRateHz);
   const auto& s = cache.get(all_gyros(n));
-  Theory t{s.dof, s.cusum_k, s.cusum_h, config.chi2_false_alarm_probability, config.cusum_arl0_epochs, {}};
+  Theory t{s.dof,
+           s.cusum_k,
+           s.cusum_h,
+           s.bias_wander_sigma,
+           config.chi2_false_alarm_probability,
+           config.cusum_arl0_epochs,
+           {}};
   for (int i = 0; i < n; ++i) t.w_norm.push_back(s.parity.col(i).norm() * cache.sqrt_period());
   return t;
 }
@@ -172,9 +179,10 @@ void false_alarm_sweep(int n, int hours, int jobs) {
   const double epochs_per_1000h = 1000.0 * 3600.0 * kRateHz;
   const double design = epochs_per_1000h * (1.0 / t.arl0 + t.chi2_p);
   std::printf(
-      "N=%d  %d h: %d detections (%d runs)  %.2f per 1000 h  design %.2f  ratio %.2f  (d=%d k=%.3f h=%.2f)\n",
+      "N=%d  %d h: %d detections (%d runs)  %.2f per 1000 h  design %.2f  ratio %.2f  (d=%d k=%.3f h=%.2f "
+      "s=%.3f)\n",
       n, hours, total, runs_with, 1000.0 * total / hours, design, 1000.0 * total / hours / design, t.dof, t.k,
-      t.h);
+      t.h, t.s);
   std::fflush(stdout);
 }
 
