@@ -72,9 +72,10 @@ namespace tetra::fdi {
 
 namespace {
 
-constexpr double kVectorOvershoot = 0.8;  // b − h for Crosier's statistic (detectors.hpp)
-constexpr int kArlSteps = 400;            // trapezoid steps of the ARL integral (relative error < 1e-3)
-constexpr int kBiasNodes = 32;            // nodes of the average over the parity bias, out to 6 s
+constexpr double kVectorOvershoot = 0.8;    // b − h for Crosier's statistic (detectors.hpp)
+constexpr double kScalarOvershoot = 1.166;  // b − h in Siegmund's formula
+constexpr int kArlSteps = 400;              // trapezoid steps of the ARL integral (relative error < 1e-3)
+constexpr int kBiasNodes = 32;              // nodes of the average over the parity bias, out to 6 s
 
 double int_pow(double x, int n) {
   double r = 1.0;
@@ -85,11 +86,6 @@ double int_pow(double x, int n) {
 //! Two-sided scalar CUSUM with the parity mean μ: both branches, 1/ARL = 1/ARL⁺ + 1/ARL⁻.
 double scalar_alarm_rate(double mu, double k, double h) {
   return 1.0 / cusum_arl(mu, k, h) + 1.0 / cusum_arl(-mu, k, h);
-}
-
-//! Density (unnormalized) of |μ| for μ ~ N(0, s² I_d) at r = x·s: x^{d−1} e^{−x²/2}.
-double chi_density(int dof, double x) {
-  return int_pow(x, dof - 1) * std::exp(-0.5 * x * x);
 }
 
 }  // namespace
@@ -118,15 +114,30 @@ double cusum_arl0_with_bias(int dof, double k, double h, double bias_sigma) {
   if (!(bias_sigma > 0.0)) {
     return dof <= 1 ? 1.0 / scalar_alarm_rate(0.0, k, h) : vector_cusum_arl(dof, k, h);
   }
-  // E[1/ARL] over |μ| = s·x, x ~ χ_d (d = 1: |N(0, 1)|, both branches), on a grid out to x = 6.
+  if (dof >= 2) {
+    // A mean μ speeds the escape through each direction û as a one-dimensional shift x = μ·û would speed one
+    // branch of Siegmund's CUSUM with the same b; x ~ N(0, s²) for every û.
+    const double h1 = h + kVectorOvershoot - kScalarOvershoot;  // Siegmund's formula with b = h + 0.8
+    const double arl_free = cusum_arl(0.0, k, h1);
+    double tilt = 0.0;
+    double weight = 0.0;
+    for (int j = -kBiasNodes; j <= kBiasNodes; ++j) {
+      const double x = 6.0 * j / kBiasNodes;
+      const double w = std::exp(-0.5 * x * x);
+      tilt += w * arl_free / cusum_arl(bias_sigma * x, k, h1);
+      weight += w;
+    }
+    return vector_cusum_arl(dof, k, h) * weight / tilt;
+  }
+  // d = 1: E[1/ARL] over |μ| = s·x, x ~ |N(0, 1)|, both branches of Siegmund's formula, on a grid out to x
+  // = 6.
   const double dx = 6.0 / kBiasNodes;
   double rate = 0.0;
   double weight = 0.0;
   for (int j = 0; j <= kBiasNodes; ++j) {
     const double x = (j + 0.5) * dx;
-    const double w = chi_density(dof, x);
-    const double mu = bias_sigma * x;
-    rate += w * (dof <= 1 ? scalar_alarm_rate(mu, k, h) : 1.0 / vector_cusum_arl(dof, k - mu, h));
+    const double w = std::exp(-0.5 * x * x);
+    rate += w * scalar_alarm_rate(bias_sigma * x, k, h);
     weight += w;
   }
   return weight / rate;

@@ -20,8 +20,12 @@
 //
 //   Reference noise with a slowly wandering bias (bias instability B, rate random walk K): the parity then
 //   carries a quasi-static mean μ ~ N(0, s² I_d) (s in σ units, see cusum_arl0_with_bias). Alarms come
-//   from the run length at each μ: 1/ARL₀ = E_μ[1/ARL(μ)], with ARL(μ) the formulas above with k − |μ| for
-//   k (d = 1: both branches, k ∓ μ). The threshold h is set so that this average meets the design.
+//   at the rate 1/ARL(μ) at each μ; the design holds for the average 1/ARL₀ = E_μ[1/ARL(μ)]:
+//     d = 1: both branches of Siegmund's formula, k ∓ μ, averaged over μ numerically;
+//     d ≥ 2: μ speeds the escape through each direction û as the shift x = μ·û speeds one branch of the
+//            scalar CUSUM with the same b, and x ~ N(0, s²) for every û, so
+//            1/ARL₀ = E_x[ARL(−k)/ARL(x − k)] / ARL_d(k, b)   (Siegmund's ARL with b = h + 0.8).
+//   The threshold h is set so that this average meets the design.
 
 namespace tetra::fdi {
 
