@@ -81,8 +81,8 @@ TEST(Thresholds, ScalarWithoutBiasIsTheTwoSidedSiegmundThreshold) {
 TEST(Thresholds, WanderingBiasRaisesTheThresholdToKeepTheDesignRate) {
   // A quasi-static parity mean N(0, 0.1² I) per 20 000-epoch block, ARL₀ = 1000 wanted. The threshold that
   // accounts for it gives the design rate within 25 % (counting noise ≈ 2 %, plus the approximations: ±10 %
-  // for the vector ARL, the scalar tilt of each escape direction for d = 2); the threshold that ignores the wander
-  // alarms ≥ 1.3× the design.
+  // for the vector ARL, the scalar tilt of each escape direction for d = 2); the threshold that ignores the
+  // wander alarms ≥ 1.3× the design.
   for (int dof : {1, 2}) {
     const double k = 0.44;
     const double s = 0.1;
