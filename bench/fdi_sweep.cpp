@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "../tests/fusion/units.hpp"
 #include "subset_cache.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/units.hpp"
@@ -30,25 +31,9 @@
 namespace {
 
 using namespace tetra;
+using test::unit_with;
 
 constexpr double kRateHz = 10.0;
-
-GyroCalibration extra_gyro(int id, const Eigen::Vector3d& axis, const Calibration& like) {
-  GyroCalibration g = like.gyros[0];
-  g.id = id;
-  g.scale_factor_V_per_dps = 0.08 + 0.001 * id;
-  g.bias_V = 1e-4 * id;
-  g.axis_B = axis.normalized();
-  return g;
-}
-
-//! The default unit with one or two more gyros (the golden trace's N = 5, 6 units).
-Calibration unit_with(int n) {
-  Calibration cal = seed_as_built_unit();
-  if (n >= 5) cal.gyros.push_back(extra_gyro(5, Eigen::Vector3d(0.3, 0.5, -0.6), cal));
-  if (n >= 6) cal.gyros.push_back(extra_gyro(6, Eigen::Vector3d(-0.4, 0.7, 0.2), cal));
-  return cal;
-}
 
 struct RunOutcome {
   int detections = 0;

@@ -29,9 +29,12 @@
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/pipeline.hpp"
 #include "tetra/sim/simulator.hpp"
+#include "units.hpp"
 
 namespace tetra {
 namespace {
+
+using test::unit_with;
 
 constexpr int kBlock = 100;  //!< epochs per hashed block
 
@@ -74,23 +77,6 @@ struct GoldenScenario {
 // Failure messages name the scenario, not its bytes.
 void PrintTo(const GoldenScenario& g, std::ostream* os) {
   *os << g.name;
-}
-
-GyroCalibration extra_gyro(int id, const Eigen::Vector3d& axis, const Calibration& like) {
-  GyroCalibration g = like.gyros[0];
-  g.id = id;
-  g.scale_factor_V_per_dps = 0.08 + 0.001 * id;
-  g.bias_V = 1e-4 * id;
-  g.axis_B = axis.normalized();
-  return g;
-}
-
-Calibration unit_with(int n) {
-  Calibration cal = seed_as_built_unit();
-  if (n == 3) cal.gyros.resize(3);
-  if (n >= 5) cal.gyros.push_back(extra_gyro(5, Eigen::Vector3d(0.3, 0.5, -0.6), cal));
-  if (n >= 6) cal.gyros.push_back(extra_gyro(6, Eigen::Vector3d(-0.4, 0.7, 0.2), cal));
-  return cal;
 }
 
 sim::FaultSpec fault(int gyro, sim::FaultKind kind, double at, double size = 0.0,
