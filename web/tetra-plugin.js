@@ -425,6 +425,9 @@ function TetraPlugin(options) {
       const parity = root.querySelector('#tetra-parity');
       parity.innerHTML = '';
       if (h) {
+        if (h.fdi_available === false) {
+          parity.appendChild(el('div', { class: 'tetra-na' }, 'fault detection NOT available: a new fault would go unseen'));
+        }
         if (!h.parity_available) {
           parity.appendChild(el('div', { class: 'tetra-na' }, 'parity, chi2, CUSUM: not available (fewer than four gyros)'));
         } else {

@@ -5,8 +5,9 @@
 
 namespace tetra::fdi::detail {
 
-ParityDetector::ParityDetector(int n_gyros) {
+ParityDetector::ParityDetector(int n_gyros, double nominal_window_s) : nominal_window_s_(nominal_window_s) {
   const Eigen::Index dmax = std::max(1, n_gyros - 3);
+  p_slow_ = Eigen::VectorXd::Zero(dmax);
   mcusum_ = Eigen::VectorXd::Zero(dmax);
   mc_sum_ = Eigen::VectorXd::Zero(dmax);
   p_ema_ = Eigen::VectorXd::Zero(dmax);
@@ -23,6 +24,15 @@ void ParityDetector::restart(std::int64_t next_index) {
   mc_n_ = 0;
   mc_start_ = next_index;
   p_ema_.setZero();
+  p_slow_.setZero();
+  slow_age_s_ = 0.0;
+}
+
+bool ParityDetector::parity_nominal(const Subset& s) const {
+  if (s.dof < 1 || slow_age_s_ < nominal_window_s_) return false;
+  const auto d = static_cast<Eigen::Index>(s.dof);
+  const double var = slow_var_ + s.bias_wander_sigma * s.bias_wander_sigma;
+  return p_slow_.head(d).squaredNorm() < s.nominal_threshold * var;
 }
 
 void ParityDetector::restart_after_alarm() {
@@ -49,9 +59,16 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
     mc_sum_.setZero();
     mc_n_ = 0;
     p_ema_.setZero();
+    p_slow_.setZero();
+    slow_age_s_ = 0.0;
   }
   const double alpha = std::min(1.0, frame.dt_s / 2.0);  // EMA time constant 2 s
   for (int r = 0; r < s.dof; ++r) p_ema_[r] += alpha * (p_[r] - p_ema_[r]);
+  // The slow mean: white unit-variance input gives an EMA of variance β/(2 − β) in steady state.
+  const double beta = std::min(1.0, frame.dt_s / nominal_window_s_);
+  for (int r = 0; r < s.dof; ++r) p_slow_[r] += beta * (p_[r] - p_slow_[r]);
+  slow_var_ = beta / (2.0 - beta);
+  slow_age_s_ += frame.dt_s;
   std::int64_t onset = d.onset_index;
   const double stat =
       s.dof == 1 ? scalar_cusum(p_[0], s, frame.index, onset) : vector_cusum(s, frame.index, onset);

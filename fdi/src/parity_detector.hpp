@@ -22,7 +22,9 @@ struct Detection {
 
 class ParityDetector {
  public:
-  explicit ParityDetector(int n_gyros);
+  //! `nominal_window_s`: time constant of the slow parity mean that tells when the evidence is back to
+  //! nominal.
+  explicit ParityDetector(int n_gyros, double nominal_window_s = 30.0);
 
   //! The epoch's parity over `frame.usable` (`s` its subset), the χ² test, and the CUSUM when every active
   //! gyro is usable. Writes the statistics into `health`.
@@ -37,6 +39,10 @@ class ParityDetector {
   const Eigen::VectorXd& parity() const { return p_; }
   //! 2-s EMA of the normalized parity.
   const Eigen::VectorXd& parity_ema() const { return p_ema_; }
+  //! The parity evidence is nominal: the slow mean (time constant `nominal_window_s`) of the full active
+  //! subset's parity lies within its noise and the wandering bias, |p̄|² < χ²_d(1 − 1e-3)·(var_EMA + s²).
+  //! False while the slow mean has not yet seen a full window since a restart.
+  bool parity_nominal(const Subset& s) const;
   //! Σ p and its count since the vector CUSUM last left zero (d ≥ 2).
   const Eigen::VectorXd& vector_sum() const { return mc_sum_; }
   int vector_count() const { return mc_n_; }
@@ -55,6 +61,10 @@ class ParityDetector {
   int mc_n_ = 0;
   std::int64_t mc_start_ = 0;
   Eigen::VectorXd p_ema_;
+  Eigen::VectorXd p_slow_;  //!< EMA of the parity with time constant nominal_window_s_
+  double nominal_window_s_ = 30.0;
+  double slow_var_ = 0.0;    //!< [σ²] per axis: variance of p_slow_ without fault
+  double slow_age_s_ = 0.0;  //!< [s] time the slow mean has run since it was last zeroed
   Eigen::VectorXd p_;
   Eigen::VectorXd dp_;  //!< scratch
 };

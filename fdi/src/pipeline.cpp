@@ -15,6 +15,7 @@
 #include "tetra/fdi/pipeline.hpp"
 
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "gyro_series.hpp"
@@ -40,6 +41,19 @@ Eigen::VectorXd bias_sigmas(const std::vector<GyroConstants>& constants) {
     b[static_cast<Eigen::Index>(i)] = constants[i].bias_sigma_rad_s;
   return b;
 }
+
+//! [rad/s] per gyro: 1σ of its slowly wandering bias from the `noise:` section (B, K), for the detectors.
+Eigen::VectorXd bias_wanders(const Calibration& cal, const PipelineConfig& config) {
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(cal.gyro_count());
+  for (Eigen::Index i = 0; i < w.size(); ++i) {
+    const auto& noise = cal.gyros[static_cast<std::size_t>(i)].noise;
+    if (!noise) continue;
+    const double b = noise->bias_instability_dps.value_or(0.0) * kDegToRad;
+    const double k = noise->rate_random_walk_dps_per_rts.value_or(0.0) * kDegToRad;
+    w[i] = bias_wander_sigma(b, k, config.rate_random_walk_horizon_s);
+  }
+  return w;
+}
 }  // namespace
 
 class Pipeline::Impl {
@@ -48,10 +62,10 @@ class Pipeline::Impl {
        std::vector<GyroConstants> constants)
       : config_(config),
         n_(cal.gyro_count()),
-        subsets_(std::move(geometry), bias_sigmas(constants), config_),
+        subsets_(std::move(geometry), bias_sigmas(constants), config_, bias_wanders(cal, config_)),
         series_(std::move(constants), config_),
         gate_(n_, config_),
-        detector_(n_),
+        detector_(n_, config_.clear_after_s),
         isolator_(n_, config_),
         reference_(cal.axes_B(), config_),
         gyro_set_(n_),
@@ -90,6 +104,7 @@ class Pipeline::Impl {
   void decide_episode();
   void publish_attitude(const Epoch& epoch);
   void publish_filter();
+  void update_fdi_available();
 
   void isolate(const Isolation& iso);
   void isolate_all(Isolations& found);
@@ -120,6 +135,7 @@ class Pipeline::Impl {
   GyroMask measured_ = 0;  //!< the gyros of this epoch's rate estimate so far
   bool has_time_ = false;
   std::int64_t last_ns_ = 0;
+  std::optional<std::int64_t> last_reference_ns_;  //!< the last epoch that carried an attitude reference
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -143,8 +159,31 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B());
   seek_evidence(epoch);
   update_mode(frame_.now_ns);
+  if (epoch.reference_q_RB) last_reference_ns_ = frame_.now_ns;
+  update_fdi_available();
   publish_attitude(epoch);
   return result_;
+}
+
+void Pipeline::Impl::update_fdi_available() {
+  // Fault detection needs parity among the active gyros or an attitude reference heard within its window.
+  const GyroMask active = gyro_set_.active();
+  const bool parity = subsets_.ready() ? subsets_.get(active).dof >= 1 : tetra::gyro_count(active) >= 4;
+  const bool reference =
+      last_reference_ns_ && frame_.now_ns - *last_reference_ns_ <= seconds_to_ns(config_.reference_window_s);
+  const bool available = parity || reference;
+  result_.attitude.fdi_available = available;
+  if (available == health_.fdi_available) return;
+  health_.fdi_available = available;
+  FdiEvent e;
+  e.stamp_ns = frame_.now_ns;
+  e.type = available ? EventType::kFdiAvailable : EventType::kFdiUnavailable;
+  e.gyros = active;
+  e.detail = available
+                 ? "fault detection available again"
+                 : "no parity left among the gyros used and no attitude reference: a new fault would go "
+                   "unseen";
+  emit(std::move(e));
 }
 
 bool Pipeline::Impl::accept(const Epoch& epoch) {
@@ -180,6 +219,10 @@ void Pipeline::Impl::detect() {
   const GyroMask active = gyro_set_.active();
   const Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), health_);
   if (d.cusum_ran) isolator_.accumulate(detector_.parity(), s.dof);
+  // An open episode ends only once the parity is back to nominal for clear_after_s: a fault whose CUSUM
+  // alarms grow sparse (a slow ramp near the reference k) keeps it open.
+  if (d.cusum_ran && !d.alarm && isolator_.episode().active && !detector_.parity_nominal(s))
+    isolator_.alarmed(frame_.now_ns);
   if (!d.alarm) return;
   if (isolator_.open(d, frame_.now_ns, frame_.index, s, detector_)) {
     emit_detected(d.test, d.statistic, frame_.now_ns);
@@ -205,8 +248,10 @@ void Pipeline::Impl::seek_evidence(const Epoch& epoch) {
           isolator_.classify_drift(finding->gyro, frame_.index, gyro_set_.active(), subsets_);
       isolate({finding->gyro, finding->scale ? FaultKind::kScale : drift, Evidence::kReference,
                DetectionTest::kReference, finding->statistic});
-    } else if (isolator_.episode().active && attitude_.reference_aided()) {
+    } else if (config_.filter_bias_isolation && isolator_.episode().active && attitude_.reference_aided()) {
       // The filter's bias estimates (reference + parity make each gyro's observable): one gyro alone off.
+      // Off by default: a fault that is not a bias (a spike, a scale error during a slew) spreads over the
+      // bias states and can put a healthy gyro's alone beyond the threshold (docs/fdi.md).
       if (const auto bias = reference_.filter_update(attitude_.filter(), gyro_set_.active())) {
         const FaultKind drift =
             isolator_.classify_drift(bias->gyro, frame_.index, gyro_set_.active(), subsets_);
@@ -407,6 +452,9 @@ void Pipeline::Impl::reset() {
   attitude_.reset(config_.initial_q_RB);
   has_time_ = false;
   last_ns_ = 0;
+  last_reference_ns_.reset();
+  health_.fdi_available = true;
+  result_.attitude.fdi_available = true;
   frame_.index = -1;
   health_.counters = Counters{};
   persistent_mode_ = Mode::kNominal;
@@ -505,6 +553,8 @@ std::string Pipeline::Impl::describe_thresholds() const {
   append_double(out, s->chi2_threshold);
   out += "\ncusum k (sigma): ";
   append_double(out, s->cusum_k);
+  out += "\nbias wander in the parity (sigma): ";
+  append_double(out, s->bias_wander_sigma);
   out += "\ncusum h (sigma): ";
   append_double(out, s->cusum_h);
   out += "\n";

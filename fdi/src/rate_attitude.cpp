@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "tetra/core/allan_stats.hpp"
+#include "tetra/core/correlated_noise.hpp"  // kGaussMarkovSigmaPerB
 #include "tetra/core/units.hpp"
 
 namespace tetra::fdi::detail {
@@ -55,9 +56,7 @@ Eigen::Vector3d fault_angle_error(const Subset& s, int id, const Eigen::VectorXd
 
 std::vector<GyroNoiseModel> noise_models(const Calibration& cal, const GyroSeries& series,
                                          const PipelineConfig& config) {
-  // σ_GM / B: the stationary σ of the first-order Gauss–Markov process whose Allan-deviation peak equals IEEE
-  // 952's bias-instability floor 0.664·B (the peak is 0.6174·σ_GM; the simulator's model, docs/sim.md).
-  constexpr double kGaussMarkovSigmaPerB = 1.0760;
+  // σ_GM = kGaussMarkovSigmaPerB·B: the Gauss–Markov process whose Allan peak is IEEE 952's 0.664·B floor.
   std::vector<GyroNoiseModel> out(cal.gyros.size());
   for (std::size_t i = 0; i < cal.gyros.size(); ++i) {
     const GyroConstants& c = series.constants(static_cast<int>(i) + 1);

@@ -10,9 +10,20 @@
 
 namespace tetra::fdi::detail {
 
+double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s) {
+  const double b = kBiasWanderPerB * bias_instability_rad_s;
+  const double k = rate_random_walk_rad_s_rts;
+  return std::sqrt(b * b + k * k * horizon_s);
+}
+
 SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s,
-                         const PipelineConfig& config)
-    : geometry_(std::move(geometry)), bias_sigma_rad_s_(std::move(bias_sigma_rad_s)), config_(&config) {
+                         const PipelineConfig& config, Eigen::VectorXd bias_wander_rad_s)
+    : geometry_(std::move(geometry)),
+      bias_sigma_rad_s_(std::move(bias_sigma_rad_s)),
+      bias_wander_rad_s_(std::move(bias_wander_rad_s)),
+      config_(&config) {
+  if (bias_wander_rad_s_.size() != geometry_.gyro_count())
+    bias_wander_rad_s_ = Eigen::VectorXd::Zero(gyro_count());
   subsets_.reserve(gyro_count() <= 8 ? 512 : 4096);
 }
 
@@ -37,6 +48,17 @@ const Subset& SubsetCache::insert(GyroMask mask) {
 const Subset* SubsetCache::find(GyroMask mask) const {
   const auto it = subsets_.find(mask);
   return it == subsets_.end() ? nullptr : &it->second;
+}
+
+double SubsetCache::parity_bias_sigma(const Subset& s, GyroMask mask) const {
+  // The wandering biases b move the parity by √T·W·b: per axis, the mean variance trace(W Σ_b Wᵀ)/d.
+  double var = 0.0;
+  for (Eigen::Index i = 0; i < s.parity.cols(); ++i) {
+    if (!has_gyro(mask, static_cast<int>(i) + 1)) continue;
+    const double b = bias_wander_rad_s_[i] * sqrt_period_;
+    var += s.parity.col(i).squaredNorm() * b * b;
+  }
+  return std::sqrt(var / s.dof);
 }
 
 void SubsetCache::build(Subset& s, GyroMask mask) const {
@@ -73,6 +95,7 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   const PipelineConfig& config = *config_;
   s.chi2_threshold = chi2_threshold(config.chi2_false_alarm_probability, s.dof);
   s.jump_threshold = chi2_threshold(config.jump_false_alarm_probability, s.dof);
+  s.nominal_threshold = chi2_threshold(1e-3, s.dof);
   // Smallest parity shift [σ] a step of cusum_min_fault_dps on any gyro of the subset produces.
   double min_col = std::numeric_limits<double>::infinity();
   for (int i = 0; i < n; ++i) {
@@ -80,7 +103,8 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   }
   const double delta = config.cusum_min_fault_dps * kDegToRad * min_col * sqrt_period_;
   s.cusum_k = 0.5 * delta;
-  s.cusum_h = cusum_threshold(s.cusum_k, config.cusum_arl0_epochs);
+  s.bias_wander_sigma = parity_bias_sigma(s, mask);
+  s.cusum_h = cusum_threshold(s.dof, s.cusum_k, config.cusum_arl0_epochs, s.bias_wander_sigma);
   if (s.dof >= 2) {
     s.glt_accept = chi2_threshold(1e-3, s.dof - 1);
     s.glt_reject = chi2_threshold(config.glt_false_alarm_probability, s.dof - 1);

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include "tetra/core/correlated_noise.hpp"  // kGaussMarkovSigmaPerB
 #include "tetra/core/geometry.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/config.hpp"
@@ -25,6 +26,8 @@ struct Subset {
   double jump_threshold = 0.0;       //!< one-epoch jump χ² threshold
   double cusum_k = 0.0;              //!< [σ] CUSUM reference
   double cusum_h = 0.0;              //!< [σ] CUSUM threshold
+  double bias_wander_sigma = 0.0;    //!< [σ] per parity axis: the slowly wandering bias (B, K) in the parity
+  double nominal_threshold = 0.0;    //!< χ²_d(1 − 1e-3): the slow parity mean back to nominal
   double glt_accept = 0.0;           //!< χ²_{d−1} quantile accepting a single-gyro hypothesis
   double glt_reject = 0.0;           //!< χ²_{d−1} quantile rejecting one
 };
@@ -32,8 +35,10 @@ struct Subset {
 class SubsetCache {
  public:
   //! `geometry` weighted by each gyro's white rate noise N_i [rad/√s]; `bias_sigma_rad_s`: 1σ of each
-  //! calibrated bias; `config` outlives the cache.
-  SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s, const PipelineConfig& config);
+  //! calibrated bias; `config` outlives the cache. `bias_wander_rad_s`: 1σ of each gyro's slowly wandering
+  //! bias (bias instability and rate random walk, `bias_wander_sigma`); empty = none.
+  SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s, const PipelineConfig& config,
+              Eigen::VectorXd bias_wander_rad_s = {});
 
   //! The sample period T is known: thresholds follow from it. Every subset is built now for N ≤ 8 (a missing
   //! sample then never allocates); for larger N the full set and its leave-one-out subsets.
@@ -57,14 +62,25 @@ class SubsetCache {
  private:
   const Subset& insert(GyroMask mask);
   void build(Subset& s, GyroMask mask) const;
+  //! [σ] per parity axis: the wandering biases seen in the subset's normalized parity.
+  double parity_bias_sigma(const Subset& s, GyroMask mask) const;
 
-  GyroGeometry geometry_;             //!< weighted by N_i
-  Eigen::VectorXd bias_sigma_rad_s_;  //!< [rad/s] per gyro
-  const PipelineConfig* config_;      //!< owned by the pipeline, outlives the cache
+  GyroGeometry geometry_;              //!< weighted by N_i
+  Eigen::VectorXd bias_sigma_rad_s_;   //!< [rad/s] per gyro
+  Eigen::VectorXd bias_wander_rad_s_;  //!< [rad/s] per gyro (zeros when none)
+  const PipelineConfig* config_;       //!< owned by the pipeline, outlives the cache
   double period_s_ = 0.0;
   double sqrt_period_ = 0.0;
   std::unordered_map<GyroMask, Subset> subsets_;
 };
+
+//! [rad/s] 1σ of a gyro's slowly wandering bias over the detectors' horizon: the stationary σ of the
+//! bias-instability process (kBiasWanderPerB·B) and the rate random walk over `horizon_s` (K·√horizon), in
+//! quadrature. B [rad/s], K [rad/s/√s].
+double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s);
+//! σ_b / B: the stationary σ of a first-order Gauss–Markov bias whose Allan deviation peaks at the IEEE 952
+//! floor 0.664·B (the simulator's bias-instability model, docs/sim.md).
+inline constexpr double kBiasWanderPerB = kGaussMarkovSigmaPerB;
 
 //! p_r = scale·Σ_{i∈mask} W(r, i)·v_i for the subset's d rows; returns Σ p_r². The one parity kernel.
 inline double apply_parity(const Subset& s, GyroMask mask, const double* v, double scale, double* p) {

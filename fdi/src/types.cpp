@@ -56,6 +56,10 @@ const char* to_string(EventType type) {
       return "lost";
     case EventType::kCommand:
       return "command";
+    case EventType::kFdiUnavailable:
+      return "fdi_unavailable";
+    case EventType::kFdiAvailable:
+      return "fdi_available";
   }
   return "command";
 }
@@ -208,6 +212,8 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
     case EventType::kReconfigured:
     case EventType::kCleared:
     case EventType::kLost:
+    case EventType::kFdiUnavailable:
+    case EventType::kFdiAvailable:
       out += ", \"gyros\": ";
       append_gyro_list(out, event.gyros, n_gyros);
       break;

@@ -10,6 +10,7 @@
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/pipeline.hpp"
 #include "tetra/sim/simulator.hpp"
+#include "units.hpp"  // test::unit_with: the seed unit with N = 3..6 gyros
 
 namespace tetra::test {
 
@@ -89,24 +90,6 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
     run.final_error_deg = angle_between(se.truth_q_RB, r.attitude.q_RB) * kRadToDeg;
   } while (simulator->next(se));
   return run;
-}
-
-//! The seed's as-built unit with N gyros: the first three of it (N = 3), all four, or with one or two extra
-//! gyros of the first gyro's noise along fixed skewed axes (N = 5, 6).
-inline Calibration unit_with(int n) {
-  auto extra_gyro = [](int id, const Eigen::Vector3d& axis, const Calibration& like) {
-    GyroCalibration g = like.gyros[0];
-    g.id = id;
-    g.scale_factor_V_per_dps = 0.08 + 0.001 * id;
-    g.bias_V = 1e-4 * id;
-    g.axis_B = axis.normalized();
-    return g;
-  };
-  Calibration cal = seed_as_built_unit();
-  if (n == 3) cal.gyros.resize(3);
-  if (n >= 5) cal.gyros.push_back(extra_gyro(5, Eigen::Vector3d(0.3, 0.5, -0.6), cal));
-  if (n >= 6) cal.gyros.push_back(extra_gyro(6, Eigen::Vector3d(-0.4, 0.7, 0.2), cal));
-  return cal;
 }
 
 inline std::string describe(const CampaignRun& run, int n_gyros = 4) {

@@ -192,6 +192,22 @@ TEST(Pipeline, RampsAreDetectedAndEndUnisolatedWithoutReference) {
   }
 }
 
+TEST(Pipeline, SlowRampStaysVisibleUntilTheEnd) {
+  // A ramp of 3e-7 deg/s² (reaching cusum_min_fault_dps after 667 s): its CUSUM alarms come sparse at first,
+  // but the episode holds while the slow parity mean is off nominal — never `cleared` while the fault grows,
+  // SUSPECT at the end with the true error inside sigma. Gyros 1 and 4 (the two parity responses).
+  for (int gyro : {1, 4}) {
+    SynthFault f{gyro, FaultKind::kRamp, false, 60.0, 3e-7};
+    SynthOptions opt;
+    opt.seed = 2100U + static_cast<std::uint64_t>(gyro);
+    const Outcome o = run(f, 60.0 + 1800.0, opt);
+    ASSERT_TRUE(o.detected_s.has_value()) << gyro;
+    for (const auto& e : o.events) EXPECT_NE(e.type, EventType::kCleared) << describe(o);
+    EXPECT_EQ(o.final_mode, Mode::kSuspect) << describe(o);
+    EXPECT_LT(o.final_error_deg, o.final_sigma_deg) << gyro;
+  }
+}
+
 TEST(Pipeline, ReferenceIsolatesBiasRampAndScale) {
   SynthOptions opt;
   opt.reference_period_s = 1.0;
@@ -277,8 +293,16 @@ TEST(Pipeline, OperatorCommandsExcludeReinstateReset) {
   EXPECT_EQ(ack.type, EventType::kCommand);
   EXPECT_EQ(ack.gyros, 0b1101U);
   const auto& r = p->step(s.next());
-  ASSERT_EQ(r.events.size(), 1U);  // the reconfiguration; the acknowledgement came back from exclude() alone
+  // The reconfiguration (the acknowledgement came back from exclude() alone), then: three gyros leave no
+  // parity and there is no reference, so fault detection is no longer available — said by event and flags.
+  ASSERT_EQ(r.events.size(), 2U);
   EXPECT_EQ(r.events[0].type, EventType::kReconfigured);
+  EXPECT_EQ(r.events[1].type, EventType::kFdiUnavailable);
+  EXPECT_EQ(fdi::to_json(r.events[1], 4).find(R"("event": "fdi_unavailable", "gyros": [1, 3, 4])") ==
+                std::string::npos,
+            false);
+  EXPECT_FALSE(r.attitude.fdi_available);
+  EXPECT_FALSE(p->health().fdi_available);
   EXPECT_EQ(r.attitude.mode, Mode::kDegraded);
   EXPECT_EQ(r.attitude.gyros, 0b1101U);
   EXPECT_EQ(p->exclude(9, 2).detail.find("rejected") != std::string::npos, true);
@@ -300,6 +324,8 @@ TEST(Pipeline, OperatorCommandsExcludeReinstateReset) {
   const auto& back = p->step(s.next());
   EXPECT_EQ(back.attitude.mode, Mode::kNominal);
   EXPECT_EQ(back.attitude.gyros, 0b1111U);
+  EXPECT_TRUE(back.attitude.fdi_available);
+  EXPECT_EQ(back.events.back().type, EventType::kFdiAvailable);
 }
 
 TEST(Pipeline, ExclusionIsLatchedAfterTheFaultGoes) {
@@ -369,12 +395,14 @@ TEST(Pipeline, GroundModeRemovesEarthRate) {
 }
 
 TEST(Pipeline, ThreeGyrosHaveNoParityButSignaturesStillIsolate) {
-  // Gyros 1–3 of the unit alone: no parity, so χ² and CUSUM are silent (10 min, no event); a stuck gyro is
-  // still isolated by its own series, and with two gyros left the attitude is LOST.
+  // Gyros 1–3 of the unit alone: no parity, so χ² and CUSUM are silent (10 min, one event: at the first
+  // epoch, `fdi_unavailable`, the user is told a new fault would go unseen); a stuck gyro is still isolated
+  // by its own series, and with two gyros left the attitude is LOST.
   Calibration cal = seed_as_built_unit();
   cal.gyros.resize(3);
   const Outcome quiet = run({}, 600.0, SynthOptions{}, campaign_config(), cal);
-  EXPECT_TRUE(quiet.events.empty()) << describe(quiet);
+  ASSERT_EQ(quiet.events.size(), 1U) << describe(quiet);
+  EXPECT_EQ(quiet.events[0].type, EventType::kFdiUnavailable);
   EXPECT_EQ(quiet.final_mode, Mode::kNominal);
   const Outcome o =
       run(SynthFault{2, FaultKind::kStuck, false, 60.0, 0.0}, 70.0, SynthOptions{}, campaign_config(), cal);

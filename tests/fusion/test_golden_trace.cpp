@@ -30,9 +30,12 @@
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/pipeline.hpp"
 #include "tetra/sim/simulator.hpp"
+#include "units.hpp"
 
 namespace tetra {
 namespace {
+
+using test::unit_with;
 
 constexpr int kBlock = 100;  //!< epochs per hashed block
 

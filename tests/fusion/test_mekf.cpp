@@ -159,6 +159,7 @@ FaultOutcome run_fault(const sim::FaultSpec& fault) {
   sc->faults = {fault};
   fdi::PipelineConfig config;
   config.max_angular_acceleration_dps2 = 2e-4;
+  config.filter_bias_isolation = true;  // the path under test (off by default: docs/fdi.md)
   auto simulator = sim::Simulator::create(*sc, sim::SimOptions{7, {}});
   auto pipeline = fdi::Pipeline::create(sc->unit, config);
   FaultOutcome o;

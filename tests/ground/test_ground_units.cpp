@@ -71,6 +71,14 @@ TEST(Encode, ParityFieldsAreNotAvailableWithFewerThanFourGyros) {
   EXPECT_TRUE(three["parity_residual"].is_null());
   EXPECT_EQ(three["gyros_used"], json::array({1, 2, 3}));
   EXPECT_DOUBLE_EQ(three["utc_ms"].get<double>(), 1'790'000'000'000.0);  // ns -> ms
+  // Fault detection availability is the pipeline's flag, carried as is (health and attitude).
+  EXPECT_TRUE(four["fdi_available"].get<bool>());
+  auto exhausted = health("u", 0b0111);
+  exhausted.health.fdi_available = false;
+  EXPECT_FALSE(health_json(exhausted, kUtc0_ns)["fdi_available"].get<bool>());
+  fdi::AttitudeEstimate a;
+  a.fdi_available = false;
+  EXPECT_FALSE(attitude_json("u", a, kUtc0_ns)["fdi_available"].get<bool>());
 }
 
 TEST(Encode, AcknowledgementCarriesTheAuditTrail) {

@@ -56,13 +56,14 @@ tetra_EventType to_wire(fdi::EventType type) {
 }
 fdi::EventType from_wire(tetra_EventType type) {
   const int value = static_cast<int>(type);
-  return value >= 0 && value <= static_cast<int>(fdi::EventType::kCommand)
+  return value >= 0 && value <= static_cast<int>(fdi::EventType::kFdiAvailable)
              ? static_cast<fdi::EventType>(value)
              : fdi::EventType::kCommand;
 }
 static_assert(static_cast<int>(tetra_FAULT_UNKNOWN) == static_cast<int>(fdi::FaultKind::kUnknown));
 static_assert(static_cast<int>(tetra_GYRO_EXCLUDED) == static_cast<int>(fdi::GyroState::kExcluded));
 static_assert(static_cast<int>(tetra_EVENT_COMMAND) == static_cast<int>(fdi::EventType::kCommand));
+static_assert(static_cast<int>(tetra_EVENT_FDI_AVAILABLE) == static_cast<int>(fdi::EventType::kFdiAvailable));
 
 Status to_wire(const std::string& unit, const fdi::AttitudeEstimate& attitude, tetra_Attitude& out) {
   if (auto status = copy_bounded(out.unit, unit, "unit"); !status) return status;
@@ -75,6 +76,7 @@ Status to_wire(const std::string& unit, const fdi::AttitudeEstimate& attitude, t
   }
   out.mode = to_wire(attitude.mode);
   out.gyros = attitude.gyros;
+  out.fdi_available = attitude.fdi_available;
   return ok_status();
 }
 
@@ -88,6 +90,7 @@ fdi::AttitudeEstimate from_wire(const tetra_Attitude& in) {
   }
   out.mode = from_wire(in.mode);
   out.gyros = in.gyros;
+  out.fdi_available = in.fdi_available;
   return out;
 }
 
@@ -113,6 +116,7 @@ Status to_wire(const std::string& unit, const fdi::Health& health, const service
   out.msg.cusum = health.cusum;
   out.msg.chi2_threshold = health.chi2_threshold;
   out.msg.cusum_threshold = health.cusum_threshold;
+  out.msg.fdi_available = health.fdi_available;
   tetra_SampleCounters& c = out.msg.counters;
   c.epochs_accepted = health.counters.epochs_accepted;
   c.epochs_rejected_time = health.counters.epochs_rejected_time;
@@ -147,6 +151,7 @@ HealthView from_wire(const tetra_Health& in) {
   h.cusum = in.cusum;
   h.chi2_threshold = in.chi2_threshold;
   h.cusum_threshold = in.cusum_threshold;
+  h.fdi_available = in.fdi_available;
   const tetra_SampleCounters& c = in.counters;
   h.counters.epochs_accepted = c.epochs_accepted;
   h.counters.epochs_rejected_time = c.epochs_rejected_time;

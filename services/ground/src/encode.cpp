@@ -83,6 +83,7 @@ json health_json(const dds::HealthView& view, std::int64_t utc_ns) {
           {"gyros_used", gyro_list(h.used, n)},
           {"gyros", gyros},
           {"parity_available", parity},
+          {"fdi_available", h.fdi_available},
           {"parity_residual", when_parity(h.parity_residual)},
           {"chi2", when_parity(h.chi2)},
           {"chi2_threshold", number(h.chi2_threshold)},
@@ -106,7 +107,8 @@ json attitude_json(const std::string& unit, const fdi::AttitudeEstimate& a, std:
           {"rate_dps", vector_deg(a.omega_BR_B_rad_s)},
           {"sigma_deg", vector_deg(a.sigma_rad)},
           {"mode", fdi::to_string(a.mode)},
-          {"gyros_used", a.gyros}};
+          {"gyros_used", a.gyros},
+          {"fdi_available", a.fdi_available}};
 }
 
 json event_json(const dds::EventView& view, int n_gyros, std::int64_t utc_ns) {

@@ -31,7 +31,9 @@ struct PipelineConfig {
   double chi2_false_alarm_probability = 1.0e-9;  //!< [-] per epoch, instantaneous χ² test
   double cusum_min_fault_dps = 2.0e-4;  //!< [deg/s] smallest bias step on any gyro the CUSUM is sized for
   double cusum_arl0_epochs = 1.0e8;     //!< [epochs] in-control average run length (two-sided)
-  double clear_after_s = 30.0;          //!< [s] no alarm for this long ends a SUSPECT episode
+  //! [s] the rate random walk K of a gyro's `noise:` enters the detectors' reference noise as K·√horizon
+  double rate_random_walk_horizon_s = 3600.0;
+  double clear_after_s = 30.0;  //!< [s] no alarm for this long ends a SUSPECT episode
 
   // --- isolation
   double isolation_window_s = 5.0;                //!< [s] evidence is sought this long before `unisolated`
@@ -58,6 +60,10 @@ struct PipelineConfig {
   //! report; for experiments that measure what exclusion is worth). The `isolated` event then says
   //! "gyro kept" and detection starts again; replay, the service and the closed-loop simulator alike.
   bool exclusion_enabled = true;
+  //! true: during a fault episode with a reference, one gyro's filter bias estimate alone beyond
+  //! reference_threshold_sigma isolates it. Off by default: a fault that is not a bias (spike, scale error
+  //! during a slew) or a coarsely quantized unit spreads over the bias states and can blame a healthy gyro.
+  bool filter_bias_isolation = false;
 
   // --- attitude filter (docs/fdi.md, "Attitude filter")
   //! [deg] 1σ per axis of `initial_q_wxyz` until a reference sample sets the attitude (0 only if set so).

@@ -39,7 +39,8 @@ std::optional<FaultKind> fault_kind_from_string(std::string_view text);
 
 //! detected, isolated, unisolated (detected and the data cannot tell which gyro), reconfigured,
 //! cleared, lost; and command (acknowledgement of an operator command — an addition to docs/interfaces.md
-//! §2.5).
+//! §2.5); fdi_unavailable / fdi_available: fault detection lost (no parity left and no recent reference) or
+//! back (docs/fdi.md, "Reconfiguration and modes").
 enum class EventType : std::uint8_t {
   kDetected,
   kIsolated,
@@ -47,7 +48,9 @@ enum class EventType : std::uint8_t {
   kReconfigured,
   kCleared,
   kLost,
-  kCommand
+  kCommand,
+  kFdiUnavailable,
+  kFdiAvailable
 };
 const char* to_string(EventType type);
 
@@ -153,6 +156,9 @@ struct Health {
   double cusum_threshold = 0.0;
   Counters counters;
   double reference_chi2 = 0.0;  //!< χ² (3 dof) of the last reference sample's innovation
+  //! false: a new fault cannot be detected (the gyros used leave no parity and no reference came within
+  //! reference_window_s); signatures of a single gyro (stuck, noise, dropout...) still run.
+  bool fdi_available = true;
 };
 
 //! The estimate published every accepted epoch (docs/interfaces.md §2.4).
@@ -165,6 +171,7 @@ struct AttitudeEstimate {
   Mode mode = Mode::kNominal;
   GyroMask gyros = 0;                   //!< gyros used
   std::vector<double> gyro_bias_rad_s;  //!< [rad/s] size N: the filter's estimate of each gyro's bias
+  bool fdi_available = true;            //!< as Health::fdi_available: false = a new fault would go unseen
 };
 
 }  // namespace tetra::fdi

@@ -1,0 +1,271 @@
+// Long fault-free sweep and detection delays of the fusion pipeline (bench/fdi_sweep.sh, docs/fdi.md
+// "Detection"): the simulator's default unit (bias instability B = 5e-6 deg/s) with N = 4, 5, 6 gyros,
+// straight into the pipeline in process, one-hour orbits on every thread.
+//
+//   fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS]
+//
+// --arl0 lowers the design in-control ARL (cusum_arl0_epochs) so that a sweep of a few hundred hours counts
+// enough false alarms to test the threshold computation itself (at the default 1e8, 1,000 h expect 0.4).
+//
+// Prints per N: false alarms (`detected` events) per 1,000 h against the design rate (1/ARL₀ of the CUSUM
+// plus the χ² per-epoch probability), and a table of detection delays of the documented faults against the
+// CUSUM theory of fdi/include/tetra/fdi/detectors.hpp.
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "../tests/fusion/units.hpp"
+#include "subset_cache.hpp"
+#include "tetra/core/calibration_file.hpp"
+#include "tetra/core/units.hpp"
+#include "tetra/fdi/detectors.hpp"
+#include "tetra/fdi/pipeline.hpp"
+#include "tetra/sim/simulator.hpp"
+
+namespace {
+
+using namespace tetra;
+using test::unit_with;
+
+constexpr double kRateHz = 10.0;
+
+struct RunOutcome {
+  int detections = 0;
+  double first_detected_s = -1.0;
+};
+
+//! One simulated run of `duration_s` straight into a pipeline; counts `detected` events.
+double g_arl0 = fdi::PipelineConfig{}.cusum_arl0_epochs;  // set once by main before any thread starts
+
+RunOutcome run(int n, double duration_s, std::uint64_t seed, const std::vector<sim::FaultSpec>& faults) {
+  RunOutcome out;
+  auto sc = sim::builtin_scenario("orbit");
+  if (!sc) return out;
+  sc->unit = unit_with(n);
+  sc->duration_s = duration_s;
+  sc->rate_hz = kRateHz;
+  sim::SimOptions so;
+  so.seed = seed;
+  so.faults = faults;
+  auto simulator = sim::Simulator::create(*sc, so);
+  if (!simulator) {
+    std::fprintf(stderr, "simulator: %s\n", simulator.error().message.c_str());
+    std::exit(1);
+  }
+  sim::SimEpoch se;
+  if (!simulator->next(se)) return out;
+  fdi::PipelineConfig config;
+  config.cusum_arl0_epochs = g_arl0;
+  config.initial_q_RB = se.truth_q_RB;
+  auto pipeline = fdi::Pipeline::create(sc->unit, config);
+  if (!pipeline) {
+    std::fprintf(stderr, "pipeline: %s\n", pipeline.error().message.c_str());
+    std::exit(1);
+  }
+  fdi::Epoch e;
+  do {
+    e.stamp_ns = se.stamp_ns;
+    e.raw = se.raw_V;
+    e.present = se.present;
+    for (const auto& ev : pipeline->step(e).events) {
+      if (ev.type != fdi::EventType::kDetected) continue;
+      ++out.detections;
+      if (out.first_detected_s < 0.0) out.first_detected_s = ns_to_seconds(ev.stamp_ns);
+    }
+  } while (simulator->next(se));
+  return out;
+}
+
+//! Runs `count` jobs over `threads` threads; job(i) must be thread-safe.
+template <typename Job>
+void parallel(int count, int threads, Job job) {
+  std::atomic<int> next{0};
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) {
+    pool.emplace_back([&] {
+      for (int i = next++; i < count; i = next++) job(i);
+    });
+  }
+  for (auto& th : pool) th.join();
+}
+
+//! The full set's subset constants (k, h, parity columns) as the pipeline builds them.
+struct Theory {
+  int dof = 0;
+  double k = 0.0;
+  double h = 0.0;
+  double s = 0.0;  //!< [σ] bias wander per parity axis
+  double chi2_p = 0.0;
+  double arl0 = 0.0;
+  std::vector<double> w_norm;  //!< |w_i|·√T [σ per rad/s]
+};
+
+Theory theory(int n) {
+  const Calibration cal = unit_with(n);
+  fdi::PipelineConfig config;
+  config.cusum_arl0_epochs = g_arl0;
+  Eigen::VectorXd arw(n);
+  Eigen::VectorXd wander(n);
+  for (int i = 0; i < n; ++i) {
+    arw[i] = *cal.gyros[static_cast<std::size_t>(i)].noise->arw_dps_rtHz * kDegToRad;
+    wander[i] = fdi::detail::bias_wander_sigma(
+        *cal.gyros[static_cast<std::size_t>(i)].noise->bias_instability_dps * kDegToRad, 0.0, 0.0);
+  }
+  fdi::detail::SubsetCache cache(*GyroGeometry::create(cal.axes_B(), arw), Eigen::VectorXd::Zero(n), config,
+                                 wander);
+  cache.prepare(1.0 / kRateHz);
+  const auto& s = cache.get(all_gyros(n));
+  Theory t{s.dof,
+           s.cusum_k,
+           s.cusum_h,
+           s.bias_wander_sigma,
+           config.chi2_false_alarm_probability,
+           config.cusum_arl0_epochs,
+           {}};
+  for (int i = 0; i < n; ++i) t.w_norm.push_back(s.parity.col(i).norm() * cache.sqrt_period());
+  return t;
+}
+
+//! [s] CUSUM delay of a step: ARL(δ − k) in epochs (Siegmund; Wald's (h + 1.166)/(δ − k) when large).
+double step_delay_s(const Theory& t, double delta) {
+  return fdi::cusum_arl(delta, t.k, t.h) / kRateHz;
+}
+
+//! [s] CUSUM delay of a ramp: the mean path S_n = max(0, S_{n−1} + c·n − k) reaching h.
+double ramp_delay_s(const Theory& t, double c) {
+  double s = 0.0;
+  for (int n = 1; n < 10'000'000; ++n) {
+    s = std::max(0.0, s + c * n - t.k);
+    if (s > t.h) return n / kRateHz;
+  }
+  return INFINITY;
+}
+
+void false_alarm_sweep(int n, int hours, int jobs) {
+  std::vector<int> detections(static_cast<std::size_t>(hours), 0);
+  parallel(hours, jobs, [&](int i) {
+    detections[static_cast<std::size_t>(i)] =
+        run(n, 3600.0, 1000003ULL * static_cast<std::uint64_t>(n) + static_cast<std::uint64_t>(i), {})
+            .detections;
+  });
+  int total = 0;
+  int runs_with = 0;
+  for (int d : detections) {
+    total += d;
+    runs_with += d > 0 ? 1 : 0;
+  }
+  const Theory t = theory(n);
+  const double epochs_per_1000h = 1000.0 * 3600.0 * kRateHz;
+  const double design = epochs_per_1000h * (1.0 / t.arl0 + t.chi2_p);
+  std::printf(
+      "N=%d  %d h: %d detections (%d runs)  %.2f per 1000 h  design %.2f  ratio %.2f  (d=%d k=%.3f h=%.2f "
+      "s=%.3f)\n",
+      n, hours, total, runs_with, 1000.0 * total / hours, design, 1000.0 * total / hours / design, t.dof, t.k,
+      t.h, t.s);
+  std::fflush(stdout);
+}
+
+struct DelayCase {
+  const char* name;
+  sim::FaultKind kind;
+  double size;
+};
+
+void delay_table(int n, int seeds, int jobs) {
+  const DelayCase cases[] = {{"bias +1e-3 deg/s", sim::FaultKind::kBias, 1e-3},
+                             {"bias +2e-4 deg/s", sim::FaultKind::kBias, 2e-4},
+                             {"ramp 1e-5 deg/s2", sim::FaultKind::kRamp, 1e-5}};
+  const Theory t = theory(n);
+  constexpr double kAt = 120.0;
+  for (const auto& c : cases) {
+    for (int g = 1; g <= n; ++g) {
+      std::vector<double> delay(static_cast<std::size_t>(seeds), -1.0);
+      parallel(seeds, jobs, [&](int s) {
+        sim::FaultSpec f;
+        f.gyro = g;
+        f.kind = c.kind;
+        f.at_s = kAt;
+        f.size = c.size;
+        const auto r = run(n, kAt + 120.0, 7000ULL + static_cast<std::uint64_t>(s), {f});
+        delay[static_cast<std::size_t>(s)] = r.first_detected_s < kAt ? -1.0 : r.first_detected_s - kAt;
+      });
+      double sum = 0.0;
+      int count = 0;
+      int early = 0;
+      for (double d : delay) {
+        if (d < 0.0) {
+          ++early;
+          continue;
+        }
+        sum += d;
+        ++count;
+      }
+      const double wi = t.w_norm[static_cast<std::size_t>(g - 1)] * c.size * kDegToRad;
+      const double th = c.kind == sim::FaultKind::kRamp ? ramp_delay_s(t, wi / kRateHz) : step_delay_s(t, wi);
+      const double mean = count > 0 ? sum / count : NAN;
+      std::printf("| %d | %s | %d | %.2f | %.2f | %.2f | %d/%d |\n", n, c.name, g, mean, th, mean / th, count,
+                  seeds);
+    }
+  }
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int hours = 1000;
+  int jobs = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  int delay_seeds = 10;
+  for (int a = 1; a < argc; ++a) {
+    const std::string arg = argv[a];
+    if (arg == "--help" || arg == "-h") {
+      std::printf(
+          "fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS]\n"
+          "  false alarms in H fault-free one-hour orbits per N = 4, 5, 6 (default 1000), then the "
+          "detection\n"
+          "  delays of the documented faults (S seeds per fault and gyro, default 10), on J threads.\n"
+          "  --arl0: the CUSUM's design in-control ARL [epochs] (default 1e8).\n");
+      return 0;
+    }
+    if (a + 1 >= argc) {
+      std::fprintf(stderr, "fdi_sweep: option %s needs a value\n", arg.c_str());
+      return 2;
+    }
+    if (arg == "--arl0") {
+      g_arl0 = std::atof(argv[++a]);
+      if (!(g_arl0 >= 10.0)) {
+        std::fprintf(stderr, "fdi_sweep: option --arl0 must be >= 10\n");
+        return 2;
+      }
+      continue;
+    }
+    const int value = std::atoi(argv[++a]);
+    if (value < 0) {
+      std::fprintf(stderr, "fdi_sweep: option %s must be >= 0\n", arg.c_str());
+      return 2;
+    }
+    if (arg == "--hours") {
+      hours = value;
+    } else if (arg == "--jobs") {
+      jobs = std::max(1, value);
+    } else if (arg == "--delay-seeds") {
+      delay_seeds = value;
+    } else {
+      std::fprintf(stderr, "fdi_sweep: unknown option %s\n", arg.c_str());
+      return 2;
+    }
+  }
+  for (int n = 4; n <= 6 && hours > 0; ++n) false_alarm_sweep(n, hours, jobs);
+  if (delay_seeds > 0) {
+    std::printf("\n| N | fault | gyro | mean delay [s] | theory [s] | ratio | detected after onset |\n");
+    std::printf("|---|---|---|---|---|---|---|\n");
+    for (int n = 4; n <= 6; ++n) delay_table(n, delay_seeds, jobs);
+  }
+  return 0;
+}
