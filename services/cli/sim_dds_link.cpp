@@ -1,5 +1,7 @@
 #include "sim_dds_link.hpp"
 
+#include <algorithm>
+
 #include "cli_common.hpp"
 #include "dds_common.hpp"
 #include "tetra/core/units.hpp"
@@ -46,6 +48,9 @@ Status SimDdsLink::wait_for_readers(const SimDdsOptions& options) {
   if (auto s = session_.watch_data(attitude_reader_.handle(), kAttitude); !s) return s.error();
   if (auto s = session_.watch_statuses(gyro_writer_.handle(), DDS_PUBLICATION_MATCHED_STATUS, kMatched); !s)
     return s.error();
+  if (auto s = session_.watch_statuses(reference_writer_.handle(), DDS_PUBLICATION_MATCHED_STATUS, kMatched);
+      !s)
+    return s.error();
   auto guard = session_.add_guard(kShutdown);
   if (!guard) return guard.error();
   if (shutdown_ != nullptr) const_cast<dds::ShutdownSignal*>(shutdown_)->set_guard((*guard)->handle());
@@ -55,9 +60,16 @@ Status SimDdsLink::wait_for_readers(const SimDdsOptions& options) {
   for (;;) {
     std::uint32_t status = 0;
     (void)dds_take_status(gyro_writer_.handle(), &status, DDS_PUBLICATION_MATCHED_STATUS);
+    (void)dds_take_status(reference_writer_.handle(), &status, DDS_PUBLICATION_MATCHED_STATUS);
     auto matched = gyro_writer_.matched_readers();
     if (!matched) return matched.error();
-    if (static_cast<int>(*matched) >= options.wait_readers) break;
+    // The reference reader too (the service's): the first reference sample sets the filter's attitude, so
+    // losing it to discovery would make the run depend on timing.
+    auto references = reference_writer_.matched_readers();
+    if (!references) return references.error();
+    if (static_cast<int>(*matched) >= options.wait_readers &&
+        static_cast<int>(*references) >= std::min(options.wait_readers, 1))
+      break;
     if (stop_requested()) return failure("interrupted while waiting for readers");
     const std::int64_t now = monotonic_ns();
     if (now >= give_up) {
@@ -131,12 +143,13 @@ Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
   return ok_status();
 }
 
-Status SimDdsLink::publish(const sim::SimEpoch& epoch, std::uint64_t k) {
+Status SimDdsLink::publish(const sim::SimEpoch& epoch, std::uint64_t k, bool reference_acked) {
   if (epoch.reference_q_RB) {
     reference_.stamp_ns = epoch.stamp_ns;
     const auto q = to_wxyz(*epoch.reference_q_RB);
     for (std::size_t i = 0; i < 4; ++i) reference_.q_RB[i] = q[i];
     if (auto s = reference_writer_.write(reference_); !s) return s.error();
+    if (reference_acked) (void)reference_writer_.wait_for_acks(std::chrono::seconds(2));
   }
   for (std::size_t g = 1; g <= epoch.present.size(); ++g) {
     if (epoch.present[g - 1] == 0) continue;  // not delivered (dropout)

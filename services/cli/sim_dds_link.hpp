@@ -29,7 +29,9 @@ class SimDdsLink {
                                                   const dds::ShutdownSignal* shutdown);
   //! Publishes one epoch: the reference first (the service has it when the epoch completes), then
   //! the gyro samples delivered, with sequence number `k`.
-  Status publish(const sim::SimEpoch& epoch, std::uint64_t k);
+  //! `reference_acked`: wait until the readers have the reference before the gyro samples go (lockstep: the
+  //! two topics have no common order, and a reference that came after its epoch's samples would be late).
+  Status publish(const sim::SimEpoch& epoch, std::uint64_t k, bool reference_acked = false);
   //! Takes the Attitude samples of this unit received so far, in order.
   Status take_attitudes(const std::function<void(const fdi::AttitudeEstimate&)>& on_attitude);
   //! Blocks until data arrives on the Attitude reader, a shutdown is requested or the monotonic
