@@ -48,6 +48,8 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       ph_(Eigen::VectorXd::Zero(dim_)),
       prior_var_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(gyros_.size()))),
       frozen_(gyros_.size(), 0) {
+  gm_phi_.assign(gyros_.size(), 1.0);  // sized once here: computing them never allocates
+  gm_kappa_.assign(gyros_.size(), 1.0);
   reset(0.0);
 }
 
@@ -117,14 +119,13 @@ void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::V
   const Eigen::Matrix3d A = quat_exp(omega_B_rad_s * dt_s).toRotationMatrix().transpose();
   const Eigen::Matrix3d gamma = rotation_integral(omega_B_rad_s, dt_s);
   Eigen::Matrix3d q_theta = Eigen::Matrix3d::Zero();
+  if (dt_s != gm_dt_s_) gauss_markov_transitions(dt_s);
   for (int i = 0; i < n_; ++i) {
     const auto& g = gyros_[static_cast<std::size_t>(i)];
     const bool frozen = frozen_[static_cast<std::size_t>(i)] != 0;
     const bool used = has_gyro(mask, i + 1) && !frozen;
-    const double phi = g.gm_sigma_rad_s > 0.0 ? std::exp(-dt_s / g.gm_correlation_s) : 1.0;
-    // The Gauss–Markov bias decays within the step: its mean over the step is κ·g, κ = T_c(1 − φ)/Δt.
-    const double kappa =
-        g.gm_sigma_rad_s > 0.0 ? g.gm_correlation_s * -std::expm1(-dt_s / g.gm_correlation_s) / dt_s : 1.0;
+    const double phi = gm_phi_[static_cast<std::size_t>(i)];
+    const double kappa = gm_kappa_[static_cast<std::size_t>(i)];
     const Eigen::Vector3d col = used ? Eigen::Vector3d(-gamma * pinv.col(i)) : Eigen::Vector3d::Zero();
     coupling_.col(i) = col;
     coupling_.col(n_ + i) = col * kappa;
@@ -160,6 +161,17 @@ void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::V
     bias_[n_ + i] *= phi;
   }
   // Symmetric by construction but for the attitude block (symmetrized above).
+}
+
+void Mekf::gauss_markov_transitions(double dt_s) {
+  for (std::size_t i = 0; i < gyros_.size(); ++i) {
+    const auto& g = gyros_[i];
+    gm_phi_[i] = g.gm_sigma_rad_s > 0.0 ? std::exp(-dt_s / g.gm_correlation_s) : 1.0;
+    // The Gauss–Markov bias decays within the step: its mean over the step is κ·g, κ = T_c(1 − φ)/Δt.
+    gm_kappa_[i] =
+        g.gm_sigma_rad_s > 0.0 ? g.gm_correlation_s * -std::expm1(-dt_s / g.gm_correlation_s) / dt_s : 1.0;
+  }
+  gm_dt_s_ = dt_s;
 }
 
 void Mekf::add_attitude_variance(const Eigen::Vector3d& var_rad2) {

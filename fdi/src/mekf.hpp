@@ -101,13 +101,19 @@ class Mekf {
   void decorrelate(int i);
   void set_prior(int i);
   void symmetrize();
+  void gauss_markov_transitions(double dt_s);
 
   std::vector<GyroNoiseModel> gyros_;
   int n_;
-  Eigen::Index dim_;           //!< 3 + 2N
-  Eigen::MatrixXd P_;          //!< covariance
-  Eigen::VectorXd bias_;       //!< [rad/s] ĉ (0..N−1) then ĝ (N..2N−1)
-  Eigen::VectorXd decay_;      //!< per bias state, the last step's transition (scratch)
+  Eigen::Index dim_;       //!< 3 + 2N
+  Eigen::MatrixXd P_;      //!< covariance
+  Eigen::VectorXd bias_;   //!< [rad/s] ĉ (0..N−1) then ĝ (N..2N−1)
+  Eigen::VectorXd decay_;  //!< per bias state, the last step's transition (scratch)
+  //! Per gyro, the Gauss–Markov transition φ = e^(−Δt/T_c) and step mean κ = T_c(1 − φ)/Δt, computed for
+  //! `gm_dt_s_` only (the step is nearly always the same: no exp per gyro per step).
+  std::vector<double> gm_phi_;
+  std::vector<double> gm_kappa_;
+  double gm_dt_s_ = -1.0;
   Eigen::Matrix3Xd coupling_;  //!< 3×2N: ∂δθ/∂bias over the step (scratch)
   Eigen::Matrix3Xd cross_;     //!< 3×2N: U = A·Pθβ + G·Pββ (scratch)
   Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
