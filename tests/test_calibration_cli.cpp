@@ -2,6 +2,7 @@
 // naming the file, the line and the problem. One test per case.
 #include <gtest/gtest.h>
 
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -272,6 +273,41 @@ TEST(CalibrateCli, HelpNamesEveryOption) {
   for (const char* option : {"--latitude", "--method", "--bias-model", "--compare", "--output"}) {
     EXPECT_NE(r.out.find(option), std::string::npos) << option;
   }
+}
+
+// --noise: the unit's bias instability widens the bias 1σ (the sequence means share it: docs/calibration.md),
+// the estimates themselves unchanged; a noise file without `noise:` sections is bad input naming it.
+TEST(CalibrateCli, NoiseModelWidensTheBiasSigmaOnly) {
+  test::TempDir dir;
+  std::string noisy = test::read_file(test::source_path("examples/factory.yaml"));
+  std::string with_noise;
+  std::istringstream lines(noisy);
+  for (std::string line; std::getline(lines, line);) {
+    with_noise += line + "\n";
+    if (line.find("axis:") != std::string::npos)
+      with_noise += "    noise: {arw_dps_rtHz: 3.0e-5, bias_instability_dps: 5.0e-6}\n";
+  }
+  test::write_file(dir.file("noise.yaml"), with_noise);
+  const std::string table = test::source_path("examples/turntable.csv");
+  const auto white = test::run_tetra("calibrate " + table + " -o " + dir.file("white.yaml"));
+  ASSERT_EQ(white.exit_status, 0) << white.err;
+  const auto model = test::run_tetra("calibrate " + table + " --noise " + dir.file("noise.yaml") + " -o " +
+                                     dir.file("model.yaml"));
+  ASSERT_EQ(model.exit_status, 0) << model.err;
+  EXPECT_NE(model.out.find("(--noise)"), std::string::npos) << model.out;
+  auto a = read_calibration(dir.file("white.yaml"));
+  auto b = read_calibration(dir.file("model.yaml"));
+  ASSERT_TRUE(a.ok() && b.ok());
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(a->gyros[i].bias_V, b->gyros[i].bias_V);  // the estimate is the same, bit for bit
+    EXPECT_GT(b->gyros[i].sigma->bias_V, a->gyros[i].sigma->bias_V);
+  }
+  const auto bad =
+      test::run_tetra("calibrate " + table + " --noise " + test::source_path("examples/factory.yaml") +
+                      " -o " + dir.file("bad.yaml"));
+  EXPECT_EQ(bad.exit_status, 2) << bad.err;
+  EXPECT_NE(bad.err.find("factory.yaml: gyro 1 has no 'noise:' section"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bad.yaml")));
 }
 
 }  // namespace

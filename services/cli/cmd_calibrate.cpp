@@ -158,6 +158,8 @@ struct CalibrateOptions {
   std::string bias_model_name = "body";
   std::string compare_path;
   std::string unit_name;
+  std::string noise_path;
+  double correlation_s = 100.0;
 };
 
 void add_options(CLI::App& app, CalibrateOptions& o) {
@@ -185,6 +187,14 @@ void add_options(CLI::App& app, CalibrateOptions& o) {
       "one's (seed Fig. 4)");
   app.add_option("--unit", o.unit_name,
                  "unit name for the calibration file (default: '# unit=' comment or tetra-1)");
+  app.add_option("--noise", o.noise_path,
+                 "calibration file whose gyros carry 'noise:' sections (e.g. from tetra allan "
+                 "--update-calibration): bias instability and rate random walk enter the 1-sigma "
+                 "(docs/calibration.md); without it the 1-sigma assume white noise");
+  app.add_option("--bias-instability-correlation", o.correlation_s,
+                 "[s] correlation time of the Gauss-Markov model of bias instability (with --noise)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
 }
 
 Result<CalibrationOptions> estimator_options(const CalibrateOptions& o) {
@@ -222,6 +232,25 @@ Result<std::optional<Calibration>> reference_of(const TurntableLog& log, const C
   return std::optional<Calibration>(std::move(ref.value()));
 }
 
+// --noise: one noise section per gyro of the log, from another calibration file.
+Status noise_model_of(const TurntableLog& log, const CalibrateOptions& o, CalibrationOptions& options) {
+  if (o.noise_path.empty()) return ok_status();
+  auto cal = read_calibration(o.noise_path);
+  if (!cal) return cal.error();
+  if (cal->gyro_count() != log.gyro_count) {
+    return bad_input(o.noise_path + ": has " + std::to_string(cal->gyro_count()) + " gyros, " + o.input +
+                     " has " + std::to_string(log.gyro_count));
+  }
+  options.noise.clear();
+  for (const auto& g : cal->gyros) {
+    if (!g.noise)
+      return bad_input(o.noise_path + ": gyro " + std::to_string(g.id) + " has no 'noise:' section");
+    options.noise.push_back(*g.noise);
+  }
+  options.bias_instability_correlation_s = o.correlation_s;
+  return ok_status();
+}
+
 // With the seed's eq. 11 bias: how far it lies from the body-model bias.
 void print_seed_bias_difference(const TurntableLog& log, const TurntableMotion& motion,
                                 const CalibrationOptions& options, const CalibrationResult& result) {
@@ -255,9 +284,14 @@ Status print_report(const TurntableLog& log, const TurntableMotion& motion, cons
   std::cout << "1-sigma: "
             << (options.method == CalibrationMethod::kSixteen
                     ? "per-sequence standard deviation of the mean, propagated"
-                    : "residual covariance of the fit")
-            << "; both assume white noise within a sequence, so correlated noise (bias instability, rate "
-               "random walk) makes them optimistic.\n";
+                    : "residual covariance of the fit");
+  if (options.noise.empty()) {
+    std::cout << "; white noise within a sequence assumed, so correlated noise (bias instability, rate "
+                 "random walk) makes them optimistic (--noise adds it).\n";
+  } else {
+    std::cout << ", plus the covariance of the sequence means from the gyros' bias instability and rate "
+                 "random walk (--noise).\n";
+  }
   return ok_status();
 }
 
@@ -268,6 +302,7 @@ Status run_calibrate(const CalibrateOptions& o) {
   RunFiles files;
   files.add_input(o.input, "TURNTABLE.csv");
   if (!o.compare_path.empty()) files.add_input(o.compare_path, "--compare");
+  if (!o.noise_path.empty()) files.add_input(o.noise_path, "--noise");
   auto out = files.add(o.output, "--output");
   if (!out) return out.error();
   auto log = read_turntable_log(o.input);
@@ -277,6 +312,7 @@ Status run_calibrate(const CalibrateOptions& o) {
   options->unit = !o.unit_name.empty() ? o.unit_name : log->meta("unit").value_or("tetra-1");
   auto reference = reference_of(*log, o);
   if (!reference) return reference.error();
+  if (Status s = noise_model_of(*log, o, *options); !s) return s;
   auto motion = analyze_turntable(*log, *latitude);
   if (!motion) return motion.error();
   auto result = calibrate(*log, *motion, *options);
