@@ -3,6 +3,7 @@
 // Preallocated once (size N); nothing here allocates per epoch.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "tetra/core/geometry.hpp"
@@ -18,6 +19,9 @@ struct EpochFrame {
   std::vector<double> raw;      //!< [V] (or [deg/s]) raw sample per gyro (valid samples only)
   GyroMask valid = 0;           //!< present and valid samples
   GyroMask usable = 0;          //!< valid, not excluded, not an outlier: the rate solution's subset
+  //! The epoch's attitude reference when it is a unit quaternion (finite, norm 1 within 1e-3; normalized):
+  //! anything else is left out and counted (Counters::reference_invalid).
+  std::optional<Quaternion> reference_q_RB;
 
   void resize(int n) {
     y_rad_s.assign(static_cast<std::size_t>(n), 0.0);

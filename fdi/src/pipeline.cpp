@@ -100,9 +100,9 @@ class Pipeline::Impl {
   bool accept(const Epoch& epoch);
   void reject_outliers();
   void detect();
-  void seek_evidence(const Epoch& epoch);
+  void seek_evidence();
   void decide_episode();
-  void publish_attitude(const Epoch& epoch);
+  void publish_attitude();
   void publish_filter();
   void update_fdi_available();
 
@@ -157,11 +157,11 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
     detect();
   }
   reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B());
-  seek_evidence(epoch);
+  seek_evidence();
   update_mode(frame_.now_ns);
-  if (epoch.reference_q_RB) last_reference_ns_ = frame_.now_ns;
+  if (frame_.reference_q_RB) last_reference_ns_ = frame_.now_ns;
   update_fdi_available();
-  publish_attitude(epoch);
+  publish_attitude();
   return result_;
 }
 
@@ -203,6 +203,15 @@ bool Pipeline::Impl::accept(const Epoch& epoch) {
   frame_.now_ns = epoch.stamp_ns;
   ++frame_.index;
   ++counters.epochs_accepted;
+  frame_.reference_q_RB.reset();
+  if (epoch.reference_q_RB) {
+    const Quaternion& q = *epoch.reference_q_RB;
+    const bool unit = q.coeffs().allFinite() && std::abs(q.norm() - 1.0) <= 1e-3;
+    if (unit)
+      frame_.reference_q_RB = q.normalized();
+    else
+      ++counters.reference_invalid;
+  }
   return true;
 }
 
@@ -237,12 +246,12 @@ void Pipeline::Impl::detect() {
   detector_.restart_after_alarm();  // a persisting fault keeps raising alarms, a gone one stops
 }
 
-void Pipeline::Impl::seek_evidence(const Epoch& epoch) {
+void Pipeline::Impl::seek_evidence() {
   series_.check(frame_.now_ns, gyro_set_.excluded(), subsets_.period_s(), subsets_.sqrt_period(), found_);
   isolate_all(found_);
-  if (epoch.reference_q_RB && subsets_.ready()) {
+  if (frame_.reference_q_RB && subsets_.ready()) {
     const auto finding =
-        reference_.update(frame_.now_ns, *epoch.reference_q_RB, gyro_set_.excluded(), series_);
+        reference_.update(frame_.now_ns, *frame_.reference_q_RB, gyro_set_.excluded(), series_);
     if (finding) {
       const FaultKind drift =
           isolator_.classify_drift(finding->gyro, frame_.index, gyro_set_.active(), subsets_);
@@ -293,7 +302,7 @@ void Pipeline::Impl::decide_episode() {
   }
 }
 
-void Pipeline::Impl::publish_attitude(const Epoch& epoch) {
+void Pipeline::Impl::publish_attitude() {
   frame_.usable &= gyro_set_.active();
   bool observable = false;
   if (!subsets_.ready()) {
@@ -320,8 +329,8 @@ void Pipeline::Impl::publish_attitude(const Epoch& epoch) {
     }
   }
   // The reference sample, at this epoch's time, once the attitude is there too.
-  if (epoch.reference_q_RB) {
-    const ReferenceUse use = attitude_.reference(*epoch.reference_q_RB);
+  if (frame_.reference_q_RB) {
+    const ReferenceUse use = attitude_.reference(*frame_.reference_q_RB);
     ++(use == ReferenceUse::kRejected ? health_.counters.reference_rejected
                                       : health_.counters.reference_accepted);
     if (use == ReferenceUse::kReinitialized) ++health_.counters.reference_reinitialized;

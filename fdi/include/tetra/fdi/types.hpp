@@ -142,6 +142,7 @@ struct Counters {
   std::uint64_t reference_accepted = 0;       //!< reference samples the attitude filter used
   std::uint64_t reference_rejected = 0;       //!< reference samples its χ² gate rejected
   std::uint64_t reference_reinitialized = 0;  //!< times a run of rejections set the attitude again
+  std::uint64_t reference_invalid = 0;  //!< reference samples left out: not finite or norm not 1 within 1e-3
 };
 
 struct Health {
