@@ -197,7 +197,7 @@ class Recording {
   int n_;
   GyroLogWriter log_;
   bool log_open_ = false;
-  std::string attitude_text_ = attitude_header(n_);  // after n_: members initialize in order
+  std::string attitude_text_ = attitude_header(n_);     // after n_: members initialize in order
   std::map<std::uint64_t, std::string> event_lines_;    // by event_seq: written in order
   std::map<std::uint64_t, std::string> command_lines_;  // acknowledgements, by event_seq
   std::vector<fdi::Epoch> epochs_;

@@ -92,6 +92,16 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
   return run;
 }
 
+//! A fault of `kind` on `gyro` from `at` [s] on, of `size` (its unit depends on the kind).
+inline sim::FaultSpec fault(int gyro, sim::FaultKind kind, double at, double size = 0.0) {
+  sim::FaultSpec f;
+  f.gyro = gyro;
+  f.kind = kind;
+  f.at_s = at;
+  f.size = size;
+  return f;
+}
+
 inline std::string describe(const CampaignRun& run, int n_gyros = 4) {
   std::string s;
   for (const auto& e : run.events) s += fdi::to_json(e, n_gyros) + "\n";

@@ -38,14 +38,7 @@ fdi::PipelineConfig orbit_config() {
   return c;
 }
 
-sim::FaultSpec fault(int gyro, sim::FaultKind kind, double at, double size = 0.0) {
-  sim::FaultSpec f;
-  f.gyro = gyro;
-  f.kind = kind;
-  f.at_s = at;
-  f.size = size;
-  return f;
-}
+using test::fault;
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());

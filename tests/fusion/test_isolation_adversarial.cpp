@@ -66,14 +66,7 @@ fdi::PipelineConfig config_for(std::uint64_t seed) {
   return c;
 }
 
-sim::FaultSpec fault(int gyro, K kind, double at, double size = 0.0) {
-  sim::FaultSpec f;
-  f.gyro = gyro;
-  f.kind = kind;
-  f.at_s = at;
-  f.size = size;
-  return f;
-}
+using test::fault;
 
 //! Exclusions of a gyro with no fault begun by then (the promise's violations), as text.
 std::string wrong_exclusions(const test::CampaignRun& run, const std::vector<sim::FaultSpec>& faults) {
