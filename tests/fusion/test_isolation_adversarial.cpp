@@ -68,6 +68,20 @@ fdi::PipelineConfig config_for(std::uint64_t seed) {
 
 using test::fault;
 
+//! The built-in orbit with N gyros, gentle attitude control (0.04°, 1e-4 deg/s²) and, at `reference_hz`, the
+//! 5″ reference.
+Result<sim::Scenario> quiet_orbit(int n, double duration_s, double reference_hz) {
+  auto sc = sim::builtin_scenario("orbit");
+  if (!sc) return sc;
+  sc->unit = test::unit_with(n);
+  sc->motion.acs.amplitude_deg = 0.04;
+  sc->motion.acs.peak_accel_dps2 = 1e-4;
+  sc->duration_s = duration_s;
+  sc->reference.rate_hz = reference_hz;
+  sc->reference.noise_arcsec = 5.0;
+  return sc;
+}
+
 //! Exclusions of a gyro with no fault begun by then (the promise's violations), as text.
 std::string wrong_exclusions(const test::CampaignRun& run, const std::vector<sim::FaultSpec>& faults) {
   std::string out;
@@ -362,14 +376,8 @@ TEST(IsolationAdversarial, ScaleFaultAtNadirPointing) {
     for (bool reference : {false, true}) {
       std::string line = "scale +5% at nadir, N=" + std::to_string(n) + (reference ? ", reference:" : ":");
       for (int gyro = 1; gyro <= n; ++gyro) {
-        auto sc = sim::builtin_scenario("orbit");
+        auto sc = quiet_orbit(n, 300.0, reference ? 1.0 : 0.0);
         ASSERT_TRUE(sc.ok());
-        sc->unit = test::unit_with(n);
-        sc->motion.acs.amplitude_deg = 0.04;
-        sc->motion.acs.peak_accel_dps2 = 1e-4;
-        sc->duration_s = 300.0;
-        sc->reference.rate_hz = reference ? 1.0 : 0.0;
-        sc->reference.noise_arcsec = 5.0;
         sim::SimOptions so;
         so.seed = static_cast<std::uint64_t>(gyro);
         so.faults = {fault(gyro, K::kScale, 60.0, 0.05)};
@@ -398,14 +406,8 @@ TEST(IsolationAdversarial, DriftKindForFourToSixGyros) {
   for (int n = 4; n <= 6; ++n) {
     for (const auto& [kind, size] : {std::pair{K::kBias, 5e-4}, std::pair{K::kRamp, 2e-5}}) {
       for (int gyro = 1; gyro <= n; ++gyro) {
-        auto sc = sim::builtin_scenario("orbit");
+        auto sc = quiet_orbit(n, 240.0, 1.0);
         ASSERT_TRUE(sc.ok());
-        sc->unit = test::unit_with(n);
-        sc->motion.acs.amplitude_deg = 0.04;
-        sc->motion.acs.peak_accel_dps2 = 1e-4;
-        sc->duration_s = 240.0;
-        sc->reference.rate_hz = 1.0;
-        sc->reference.noise_arcsec = 5.0;
         sim::SimOptions so;
         so.seed = static_cast<std::uint64_t>(40 + gyro);
         so.faults = {fault(gyro, kind, 60.0, size)};
