@@ -18,6 +18,7 @@
 #include <optional>
 #include <string>
 
+#include "bias_hypothesis.hpp"
 #include "gyro_series.hpp"
 #include "gyro_set.hpp"
 #include "isolator.hpp"
@@ -63,6 +64,7 @@ class Pipeline::Impl {
       : config_(config),
         n_(cal.gyro_count()),
         subsets_(std::move(geometry), bias_sigmas(constants), config_, bias_wanders(cal, config_)),
+        bias_check_(constants),
         series_(std::move(constants), config_),
         gate_(n_, config_),
         detector_(n_, config_.clear_after_s),
@@ -101,6 +103,7 @@ class Pipeline::Impl {
   void reject_outliers();
   void detect();
   void seek_evidence();
+  void isolate_filter_bias(const ReferenceFinding& bias);
   void decide_episode();
   void publish_attitude();
   void publish_filter();
@@ -118,6 +121,7 @@ class Pipeline::Impl {
   PipelineConfig config_;
   int n_;
   SubsetCache subsets_;
+  BiasHypothesis bias_check_;  //!< the fault-model check of the filter's bias states
   GyroSeries series_;
   OutlierGate gate_;
   ParityDetector detector_;
@@ -227,7 +231,10 @@ void Pipeline::Impl::detect() {
   measured_ = frame_.usable;
   const GyroMask active = gyro_set_.active();
   const Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), health_);
-  if (d.cusum_ran) isolator_.accumulate(detector_.parity(), s.dof);
+  if (d.cusum_ran) {
+    isolator_.accumulate(detector_.parity(), s.dof);
+    bias_check_.record(detector_.parity(), s);
+  }
   // An open episode ends only once the parity is back to nominal for clear_after_s: a fault whose CUSUM
   // alarms grow sparse (a slow ramp near the reference k) keeps it open.
   if (d.cusum_ran && !d.alarm && isolator_.episode().active && !detector_.parity_nominal(s))
@@ -259,16 +266,37 @@ void Pipeline::Impl::seek_evidence() {
                DetectionTest::kReference, finding->statistic});
     } else if (config_.filter_bias_isolation && isolator_.episode().active && attitude_.reference_aided()) {
       // The filter's bias estimates (reference + parity make each gyro's observable): one gyro alone off.
-      // Off by default: a fault that is not a bias (a spike, a scale error during a slew) spreads over the
-      // bias states and can put a healthy gyro's alone beyond the threshold (docs/fdi.md).
-      if (const auto bias = reference_.filter_update(attitude_.filter(), gyro_set_.active())) {
-        const FaultKind drift =
-            isolator_.classify_drift(bias->gyro, frame_.index, gyro_set_.active(), subsets_);
-        isolate({bias->gyro, drift, Evidence::kReference, DetectionTest::kReference, bias->statistic});
-      }
+      if (const auto bias = reference_.filter_update(attitude_.filter(), gyro_set_.active()))
+        isolate_filter_bias(*bias);
     }
+    bias_check_.close_bin(frame_.now_ns);
   }
   if (subsets_.ready()) decide_episode();
+}
+
+void Pipeline::Impl::isolate_filter_bias(const ReferenceFinding& bias) {
+  // A fault that is not a bias (a spike, a scale error during a slew, a coarsely quantized output) spreads
+  // over the bias states and can put a healthy gyro's alone beyond the threshold. So the gyro is isolated
+  // only when one single-gyro fault explains the episode's parity and reference records best, by a margin,
+  // of the sign of the filter's estimate, and still does in the latest half of the span (docs/fdi.md).
+  const GyroMask active = gyro_set_.active();
+  const Subset& s = subsets_.get(active);
+  const std::int64_t now = frame_.now_ns;
+  const double window_s = config_.reference_window_s;
+  const std::int64_t from = std::max(isolator_.episode().onset_ns, now - seconds_to_ns(window_s));
+  SpanDisagreement span;
+  if (!reference_.span(from, 0.5 * window_s, gyro_set_.excluded(), series_, span)) return;
+  const BiasFit fit = bias_check_.best(s, span, subsets_.sqrt_period());
+  if (fit.gyro != bias.gyro || fit.size_rad_s * attitude_.filter().bias_rad_s(bias.gyro) <= 0.0) return;
+  SpanDisagreement late;
+  const std::int64_t middle = span.start_ns + (now - span.start_ns) / 2;
+  if (!reference_.span(middle, 0.25 * window_s, gyro_set_.excluded(), series_, late) ||
+      !bias_check_.persists(fit.gyro, fit.size_rad_s, s, late, subsets_.sqrt_period()))
+    return;
+  const FaultKind kind = reference_.span_scale(fit.gyro, span)
+                             ? FaultKind::kScale
+                             : isolator_.classify_drift(fit.gyro, frame_.index, active, subsets_);
+  isolate({fit.gyro, kind, Evidence::kReference, DetectionTest::kReference, bias.statistic});
 }
 
 void Pipeline::Impl::decide_episode() {
@@ -457,6 +485,7 @@ void Pipeline::Impl::reset() {
   series_.reset();
   gate_.reset();
   reference_.reset();
+  bias_check_.reset();
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);
   has_time_ = false;

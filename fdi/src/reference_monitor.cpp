@@ -114,25 +114,60 @@ std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, co
   const int old = window_start(now_ns);
   if (old < 0) return std::nullopt;
   const double span = ns_to_seconds(now_ns - snap_ns_[slot(old)]);
-  const double sig_ref = config_.reference_sigma_arcsec * kArcsecToRad;
   windows_.begin();
   for (std::size_t i = 0; i < n_; ++i) {
     const int id = static_cast<int>(i) + 1;
     if (has_gyro(excluded, id)) continue;
     const auto& t = tracks_[i];
-    const GyroConstants& c = series.constants(id);
     const double rot = t.ref_angle_rad - snap_ref(old, static_cast<int>(i));
     const double err = (t.angle_rad - snap_angle(old, static_cast<int>(i))) - rot;
-    const double sig = std::sqrt(2.0 * sig_ref * sig_ref + c.arw_rad_rts * c.arw_rad_rts * span +
-                                 std::pow((c.bias_sigma_rad_s + c.bias_instability_rad_s) * span, 2) +
-                                 std::pow(c.scale_rel_sigma * rot, 2));
-    windows_.add(id, std::abs(err) / sig, config_.reference_threshold_sigma);
+    windows_.add(id, std::abs(err) / disagreement_sigma(series.constants(id), span, rot),
+                 config_.reference_threshold_sigma);
   }
   // One gyro alone beyond the threshold, the others quiet, in `reference_confirm_count` consecutive
   // comparisons (consecutive windows share no reference sample, so one wild reference sample cannot do it).
   const int culprit = windows_.confirm(config_.reference_confirm_count, 2);
   if (culprit == 0) return std::nullopt;
   return ReferenceFinding{culprit, windows_.statistic(), scale_significant(culprit, old)};
+}
+
+double ReferenceMonitor::disagreement_sigma(const GyroConstants& c, double span_s, double rot_rad) const {
+  // Two reference samples, white noise over the span, the calibrated bias and its instability acting over
+  // it, the calibrated scale factor on the rotation, and the angle quantization at both ends.
+  const double sig_ref = config_.reference_sigma_arcsec * kArcsecToRad;
+  return std::sqrt(2.0 * sig_ref * sig_ref + c.arw_rad_rts * c.arw_rad_rts * span_s +
+                   std::pow((c.bias_sigma_rad_s + c.bias_instability_rad_s) * span_s, 2) +
+                   std::pow(c.scale_rel_sigma * rot_rad, 2) + 2.0 * c.quantization_rad * c.quantization_rad);
+}
+
+bool ReferenceMonitor::span(std::int64_t from_ns, double min_span_s, GyroMask excluded,
+                            const GyroSeries& series, SpanDisagreement& out) const {
+  out.start = -1;
+  if (snap_count_ < 2) return false;
+  const int last = snap_count_ - 1;
+  int old = -1;
+  for (int k = std::max(0, snap_count_ - kSnapshots); k < last; ++k) {
+    if (snap_ns_[slot(k)] >= from_ns) {
+      old = k;
+      break;
+    }
+  }
+  if (old < 0) return false;
+  out.span_s = ns_to_seconds(snap_ns_[slot(last)] - snap_ns_[slot(old)]);
+  if (out.span_s < min_span_s) return false;
+  out.start = old;
+  out.start_ns = snap_ns_[slot(old)];
+  out.gyros = 0;
+  for (std::size_t i = 0; i < n_; ++i) {
+    const int id = static_cast<int>(i) + 1;
+    if (has_gyro(excluded, id)) continue;
+    const int g = static_cast<int>(i);
+    const double rot = snap_ref(last, g) - snap_ref(old, g);
+    out.err_rad[i] = (snap_angle(last, g) - snap_angle(old, g)) - rot;
+    out.sigma_rad[i] = disagreement_sigma(series.constants(id), out.span_s, rot);
+    out.gyros |= GyroMask{1} << i;
+  }
+  return true;
 }
 
 bool ReferenceMonitor::scale_significant(int culprit, int old) const {

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "bias_hypothesis.hpp"
 #include "epoch_frame.hpp"
 #include "gyro_series.hpp"
 #include "mekf.hpp"
@@ -58,6 +59,12 @@ class ReferenceMonitor {
   //! bias beyond `reference_threshold_sigma` of its fault-free spread (Mekf::bias_z), every other within half
   //! of it, at `reference_confirm_count` consecutive samples isolates it.
   std::optional<ReferenceFinding> filter_update(const Mekf& filter, GyroMask active);
+  //! Each active gyro's disagreement with the reference from the first snapshot at or after `from_ns` to the
+  //! last one (this sample's); false when that span is shorter than `min_span_s`.
+  bool span(std::int64_t from_ns, double min_span_s, GyroMask excluded, const GyroSeries& series,
+            SpanDisagreement& out) const;
+  //! Gyro `id`'s disagreement over `span` follows the rotation about its axis (a scale error, see `update`).
+  bool span_scale(int id, const SpanDisagreement& span) const { return scale_significant(id, span.start); }
   //! The windows start again (a reinstated gyro's angle has a gap).
   void restart_windows() { snap_count_ = 0; }
   void reset();
@@ -73,6 +80,8 @@ class ReferenceMonitor {
   //! Index of the oldest snapshot inside the window and at least half a window old, or −1.
   int window_start(std::int64_t now_ns) const;
   bool scale_significant(int culprit, int old) const;
+  //! [rad] 1σ of a healthy gyro's disagreement over `span_s` with rotation `rot_rad` about its axis.
+  double disagreement_sigma(const GyroConstants& c, double span_s, double rot_rad) const;
   double snap_angle(int k, int i) const { return snap_angle_[slot(k) * n_ + static_cast<std::size_t>(i)]; }
   double snap_ref(int k, int i) const { return snap_ref_[slot(k) * n_ + static_cast<std::size_t>(i)]; }
   static std::size_t slot(int k) { return static_cast<std::size_t>(k % kSnapshots); }

@@ -1,0 +1,85 @@
+#pragma once
+// The fault-model check behind the filter's bias states (docs/fdi.md, "Filter bias states"): before the gyro
+// whose bias estimate stands out alone is isolated, one single-gyro fault must explain both independent
+// records of the episode — the parity mean and every gyro's disagreement with the reference over the same
+// span — better than every other gyro's by a margin, and it must still be there in the latest half of the
+// span (a spike has gone by then). Neither record contains the body's motion: the parity is blind to it
+// (V·H = 0) and the reference measures it.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gyro_series.hpp"
+#include "subset_cache.hpp"
+#include "tetra/core/geometry.hpp"
+
+namespace tetra::fdi::detail {
+
+//! Each active gyro's disagreement with the reference over a span: its integrated angle less the rotation the
+//! reference saw about its axis, and the 1σ of that difference without a fault.
+struct SpanDisagreement {
+  int start = -1;             //!< the reference monitor's snapshot the span starts at (−1: none)
+  std::int64_t start_ns = 0;  //!< [ns] its time
+  double span_s = 0.0;        //!< [s] from it to the last snapshot
+  GyroMask gyros = 0;         //!< the gyros compared
+  std::array<double, kMaxGyros> err_rad{};
+  std::array<double, kMaxGyros> sigma_rad{};
+};
+
+//! The test's outcome for the best-fitting gyro.
+struct BiasFit {
+  int gyro = 0;             //!< 0: no gyro explains the records clearly
+  double size_rad_s = 0.0;  //!< the fault's mean rate over the span
+  double margin = 0.0;      //!< [σ²] of the best hypothesis over the runner-up
+};
+
+class BiasHypothesis {
+ public:
+  //! Per gyro, its calibrated bias's 1σ (a constant offset in the parity mean) and its angle quantization Q
+  //! (a rate error that telescopes in a mean).
+  explicit BiasHypothesis(const std::vector<GyroConstants>& constants);
+
+  //! The epoch's normalized parity `p` over the full active subset `s` (other epochs are not recorded).
+  void record(const Eigen::VectorXd& p, const Subset& s);
+  //! A reference sample at `now_ns` closes the parity bin since the previous sample, so that parity bins and
+  //! the reference monitor's snapshots share their boundaries.
+  void close_bin(std::int64_t now_ns);
+  void reset();
+
+  //! The single-gyro fault that explains the parity since `span.start_ns` and the reference disagreements
+  //! `span` jointly, if it beats every other gyro's by `kMargin` and its model is accepted; else gyro 0.
+  BiasFit best(const Subset& s, const SpanDisagreement& span, double sqrt_period) const;
+  //! Gyro `id`'s fault in the latest part of the records (`late`) is significant and of the sign `sign`.
+  bool persists(int id, double sign, const Subset& s, const SpanDisagreement& late, double sqrt_period) const;
+
+  //! [σ²] how much more of the records the best gyro must explain than any other (5σ).
+  static constexpr double kMargin = 25.0;
+  //! [σ²] how much of the latest half-span's records the gyro's fault must explain (4σ).
+  static constexpr double kPersist = 16.0;
+
+ private:
+  static constexpr int kBins = 512;  //!< as many as the reference monitor's snapshots
+  struct Bin {
+    std::int64_t end_ns = 0;
+    GyroMask mask = 0;
+    int count = 0;
+    std::array<double, kMaxGyros> sum{};
+  };
+  //! Parity mean over the bins ending in (from_ns, last], per axis variance; returns the epoch count.
+  int parity_mean(const Subset& s, std::int64_t from_ns, double sqrt_period) const;
+  //! Gain G = (aᵀV⁻¹x)²/(aᵀV⁻¹a) of gyro `i`'s fault over both records, and its size.
+  double gain(int i, const Subset& s, const SpanDisagreement& span, double sqrt_period, double& size) const;
+
+  std::vector<double> bias_sigma_rad_s_;
+  std::vector<double> quantization_rad_;
+  std::vector<Bin> bins_;
+  int bin_count_ = 0;
+  Bin open_;
+  mutable std::array<double, kMaxGyros> mean_{};  //!< scratch: parity mean
+  mutable std::array<double, kMaxGyros> var_{};   //!< scratch: its variance per axis
+};
+
+}  // namespace tetra::fdi::detail
