@@ -109,6 +109,22 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+//! One run into its fault's tally: a wrong exclusion (described into `what`), the faulty gyro isolated (with
+//! its delay from `at_s`), or `unisolated`.
+void tally(Tally& t, const test::CampaignRun& run, const std::vector<sim::FaultSpec>& faults, double at_s,
+           const std::string& label, int n, std::string& what) {
+  ++t.runs;
+  if (!wrong_exclusions(run, faults).empty()) {
+    ++t.wrong;
+    what += label + ":\n" + test::describe(run, n);
+  } else if (run.isolated_gyro) {
+    ++t.isolated;
+    t.delays_s.push_back(*run.first_isolated_s - at_s);
+  } else if (run.unisolated) {
+    ++t.unisolated;
+  }
+}
+
 void print_table(const std::map<std::string, Tally>& table) {
   std::printf("%-14s %6s %9s %11s %6s %12s %9s\n", "fault", "runs", "isolated", "unisolated", "wrong",
               "median delay", "max delay");
@@ -184,20 +200,10 @@ TEST(IsolationAdversarial, FaultsBeginningDuringSlewsNeverBlameAHealthyGyro) {
             so.faults = {fault(gyro, fc.kind, at, fc.size)};
             const auto run =
                 run_campaign(slew_scenario(n, slew, reference), so, test::unit_with(n), config_for(seed));
-            auto& t = table[fc.name];
-            ++t.runs;
-            const std::string wrong = wrong_exclusions(run, so.faults);
-            if (!wrong.empty()) {
-              ++t.wrong;
-              what += "N=" + std::to_string(n) + " " + fc.name + " gyro " + std::to_string(gyro) + " " +
-                      slew.name + (reference ? " ref" : "") + " seed " + std::to_string(seed) + ":\n" +
-                      test::describe(run, n);
-            } else if (run.isolated_gyro) {
-              ++t.isolated;
-              t.delays_s.push_back(*run.first_isolated_s - at);
-            } else if (run.unisolated) {
-              ++t.unisolated;
-            }
+            tally(table[fc.name], run, so.faults, at,
+                  "N=" + std::to_string(n) + " " + fc.name + " gyro " + std::to_string(gyro) + " " +
+                      slew.name + (reference ? " ref" : "") + " seed " + std::to_string(seed),
+                  n, what);
           }
         }
       }
@@ -442,17 +448,11 @@ TEST(IsolationAdversarial, DriftKindForFourToSixGyros) {
   EXPECT_TRUE(what.empty()) << what;
 }
 
-struct FilterCase {
-  const char* name;
-  K kind;
-  double size;
-};
-
 // Faults small enough that the reference windows leave them to the filter's bias states (a 3e-4 deg/s step
 // is 32″ over a 30 s window, below its 6σ), and the faults that are not biases and once made the bias states
 // blame a healthy gyro (a spike, a ±5 % scale during a slew).
-const std::vector<FilterCase>& filter_cases() {
-  static const std::vector<FilterCase> all = {
+const std::vector<FaultCase>& filter_cases() {
+  static const std::vector<FaultCase> all = {
       {"bias 3e-4", K::kBias, 3e-4},   {"bias -5e-4", K::kBias, -5e-4}, {"ramp 2e-5", K::kRamp, 2e-5},
       {"ramp -3e-6", K::kRamp, -3e-6}, {"spike 0.05", K::kSpike, 0.05}, {"scale +5%", K::kScale, 0.05},
       {"scale -5%", K::kScale, -0.05},
@@ -484,20 +484,10 @@ TEST(IsolationAdversarial, FilterBiasStatesNeverBlameAHealthyGyro) {
             fdi::PipelineConfig cfg = config_for(seed);
             cfg.filter_bias_isolation = key;
             const auto run = run_campaign(slew_scenario(n, slew, true, 120.0), so, test::unit_with(n), cfg);
-            auto& t = (key ? on : off)[fc.name];
-            ++t.runs;
-            const std::string wrong = wrong_exclusions(run, so.faults);
-            if (!wrong.empty()) {
-              ++t.wrong;
-              what += "N=" + std::to_string(n) + " " + fc.name + " gyro " + std::to_string(gyro) + " " +
-                      slew.name + " seed " + std::to_string(seed) + (key ? "" : " (key off)") + ":\n" +
-                      test::describe(run, n);
-            } else if (run.isolated_gyro) {
-              ++t.isolated;
-              t.delays_s.push_back(*run.first_isolated_s - at);
-            } else if (run.unisolated) {
-              ++t.unisolated;
-            }
+            tally((key ? on : off)[fc.name], run, so.faults, at,
+                  "N=" + std::to_string(n) + " " + fc.name + " gyro " + std::to_string(gyro) + " " +
+                      slew.name + " seed " + std::to_string(seed) + (key ? "" : " (key off)"),
+                  n, what);
           }
         }
       }
