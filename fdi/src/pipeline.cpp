@@ -284,6 +284,7 @@ void Pipeline::Impl::isolate_filter_bias(const ReferenceFinding& bias) {
   const std::int64_t now = frame_.now_ns;
   const double window_s = config_.reference_window_s;
   const std::int64_t from = std::max(isolator_.episode().onset_ns, now - seconds_to_ns(window_s));
+  reference_.filter_rearm(bias.gyro);  // until the check agrees, it is retried at every sample
   SpanDisagreement span;
   if (!reference_.span(from, 0.5 * window_s, gyro_set_.excluded(), series_, span)) return;
   const BiasFit fit = bias_check_.best(s, span, subsets_.sqrt_period());

@@ -36,6 +36,11 @@ class LoneGyro {
   int confirm(int count, int min_members);
   double statistic() const { return stat_; }  //!< [σ] the flagged gyro's
   void reset() { run_gyro_ = run_ = 0; }
+  //! A confirmed gyro that was not acted on: the next comparison that flags it alone confirms it again.
+  void rearm(int id, int count) {
+    run_gyro_ = id;
+    run_ = count - 1;
+  }
 
  private:
   int flagged_ = 0, loud_ = 0, culprit_ = 0, members_ = 0;
@@ -59,6 +64,9 @@ class ReferenceMonitor {
   //! bias beyond `reference_threshold_sigma` of its fault-free spread (Mekf::bias_z), every other within half
   //! of it, at `reference_confirm_count` consecutive samples isolates it.
   std::optional<ReferenceFinding> filter_update(const Mekf& filter, GyroMask active);
+  //! The filter's finding for `id` was not confirmed by the fault-model check: the next sample that flags
+  //! `id` alone is a finding again (the check is retried at every sample rather than after a new run).
+  void filter_rearm(int id) { filter_.rearm(id, config_.reference_confirm_count); }
   //! Each active gyro's disagreement with the reference from the first snapshot at or after `from_ns` to the
   //! last one (this sample's); false when that span is shorter than `min_span_s`.
   bool span(std::int64_t from_ns, double min_span_s, GyroMask excluded, const GyroSeries& series,
