@@ -7,6 +7,7 @@
 // pipeline.
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <string>
 #include <vector>
@@ -162,6 +163,14 @@ TEST(IsolationAdversarial, AgileFaultFreeSlewsExcludeNothing) {
   }
   std::printf("fault-free slews: %d runs, %d with a detection, none may exclude a gyro\n", runs, detected);
   EXPECT_TRUE(what.empty()) << what;
+}
+
+//! The seed count of the filter-bias cases: `fallback` in ctest, TETRA_FILTER_BIAS_SEEDS for a longer sweep
+//! (docs/fdi.md's 1,260-run figures: 12).
+std::uint64_t filter_bias_seeds(std::uint64_t fallback) {
+  const char* v = std::getenv("TETRA_FILTER_BIAS_SEEDS");
+  const long n = v != nullptr ? std::strtol(v, nullptr, 10) : 0;
+  return n > 0 ? static_cast<std::uint64_t>(n) : fallback;
 }
 
 struct FaultCase {
@@ -464,17 +473,18 @@ TEST(IsolationAdversarial, FilterBiasStatesNeverBlameAHealthyGyro) {
   // The filter's bias-state path (`filter_bias_isolation`, on by default) acts only with the reference and
   // after the windows have had their say. Every case above on every gyro, N = 4..6, beginning a quarter into
   // one of the five slews (from 5°/120 s to 10°/2 s) or in the quiet orbit, rotating over the runs, with the
-  // 1 Hz 5″ reference and 120 s after the slew to decide, 3 seeds: 315 runs, each also run with the key off
-  // to show what the path adds. No healthy gyro may be excluded.
+  // 1 Hz 5″ reference and 120 s after the slew to decide, 3 seeds (TETRA_FILTER_BIAS_SEEDS): 315 runs, each
+  // also run with the key off to show what the path adds. No healthy gyro may be excluded.
   std::vector<SlewCase> settings = slews();
   settings.push_back({"orbit", Eigen::Vector3d::UnitX(), 0.0, 60.0});
   std::map<std::string, Tally> on, off;
   std::string what;
+  const std::uint64_t seeds = filter_bias_seeds(3);
   int case_index = 0;
   for (int n = 4; n <= 6; ++n) {
     for (const auto& fc : filter_cases()) {
       for (int gyro = 1; gyro <= n; ++gyro) {
-        for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+        for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
           const auto& slew = settings[static_cast<std::size_t>(case_index++) % settings.size()];
           const double at = kSlewStart_s + 0.25 * slew.duration_s;
           sim::SimOptions so;
@@ -502,8 +512,9 @@ TEST(IsolationAdversarial, FilterBiasStatesNeverBlameAHealthyGyro) {
 
 TEST(IsolationAdversarial, FilterBiasStatesOnACoarselyQuantizedUnit) {
   // examples/sim/allan_unit.yaml with the 1 Hz reference (the bias states once blamed gyro 3 of this unit,
-  // fault-free, during a 30°/60 s slew): fault-free in every slew and the quiet orbit, 4 seeds — nothing may
-  // be excluded; and a 5e-4 deg/s bias step on each gyro — no other gyro may be.
+  // fault-free, during a 30°/60 s slew): fault-free in every slew and the quiet orbit, 8 seeds — nothing may
+  // be excluded; and a 5e-4 deg/s bias step on each gyro, 2 seeds — no other gyro may be (2k and k/2 seeds
+  // with TETRA_FILTER_BIAS_SEEDS = k).
   auto unit = read_calibration(test::source_path("examples/sim/allan_unit.yaml"));
   ASSERT_TRUE(unit.ok()) << unit.error().message;
   std::vector<SlewCase> settings = slews();
@@ -512,9 +523,10 @@ TEST(IsolationAdversarial, FilterBiasStatesOnACoarselyQuantizedUnit) {
   int isolated = 0;
   int runs = 0;
   int steps = 0;
+  const std::uint64_t seeds = filter_bias_seeds(4);
   for (std::size_t s = 0; s < settings.size(); ++s) {
     for (int gyro = 0; gyro <= 4; ++gyro) {
-      for (std::uint64_t seed = 1; seed <= (gyro == 0 ? 8U : 2U); ++seed) {
+      for (std::uint64_t seed = 1; seed <= (gyro == 0 ? 2 * seeds : seeds / 2); ++seed) {
         auto sc = slew_scenario(4, settings[s], true, 120.0);
         sc.unit = *unit;
         sim::SimOptions so;
