@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "bias_hypothesis.hpp"
 #include "gyro_series.hpp"
 #include "gyro_set.hpp"
 #include "isolator.hpp"
@@ -280,6 +281,69 @@ TEST(ReferenceMonitor, ADriftingGyroIsFoundAgainstTheReference) {
   EXPECT_EQ(finding->gyro, 2);
   EXPECT_FALSE(finding->scale);
   EXPECT_LE(found_at, 4 * f.config.reference_window_s);
+}
+
+//! 30 s of records at 10 Hz (a bin per 1 Hz reference sample) of a fault `fault_rad_s(t)` on gyro `id` with
+//! four gyros, noise-free: the parity of every epoch and each gyro's disagreement with the reference.
+SpanDisagreement fault_records(BiasHypothesis& check, const Subset& s, int id,
+                               double (*fault_rad_s)(double)) {
+  SpanDisagreement span;
+  span.start = 0;
+  span.span_s = 30.0;
+  span.gyros = 0b1111;
+  span.sigma_rad.fill(8.0 * kArcsecToRad);  // two 5″ reference samples and the gyro's noise, about
+  Eigen::VectorXd p(1);
+  for (int k = 1; k <= 300; ++k) {
+    std::vector<double> y(4, 0.0);
+    const double rate = fault_rad_s(k * kPeriod);
+    y[static_cast<std::size_t>(id - 1)] = rate;
+    double out[kMaxGyros];
+    (void)apply_parity(s, s.mask, y.data(), std::sqrt(kPeriod), out);
+    p[0] = out[0];
+    check.record(p, s);
+    span.err_rad[static_cast<std::size_t>(id - 1)] += rate * kPeriod;
+    if (k % 10 == 0) check.close_bin(seconds_to_ns(k * kPeriod));
+  }
+  return span;
+}
+
+TEST(BiasHypothesis, OneGyrosPersistingFaultIsToldAndAPassingOneIsNot) {
+  // Noise-free records of four gyros (d = 1: the parity fits every gyro alike, the reference tells them
+  // apart). A 5e-4 deg/s step on gyro 2 for the whole span: gyro 2 explains everything (54″ against 8″ on
+  // its own reference disagreement), every other gyro leaves that unexplained: margin ≫ 25. The same mean
+  // rate as a spike in the first second: still gyro 2's, but gone from the latest half: not persistent.
+  // Nothing at all: no gyro.
+  Fixture f;
+  const Subset& s = f.subsets->get(0b1111);
+  {
+    BiasHypothesis check(f.constants);
+    const auto span = fault_records(check, s, 2, [](double) { return 5e-4 * kDegToRad; });
+    const BiasFit fit = check.best(s, span, std::sqrt(kPeriod));
+    EXPECT_EQ(fit.gyro, 2);
+    EXPECT_NEAR(fit.size_rad_s, 5e-4 * kDegToRad, 1e-9);  // noise-free: the fit is exact to rounding
+    EXPECT_GT(fit.margin, BiasHypothesis::kMargin);
+    SpanDisagreement late = span;
+    late.start_ns = seconds_to_ns(15.0);
+    late.span_s = 15.0;
+    late.err_rad[1] = 5e-4 * kDegToRad * 15.0;
+    EXPECT_TRUE(check.persists(2, 1.0, s, late, std::sqrt(kPeriod)));
+    EXPECT_FALSE(check.persists(2, -1.0, s, late, std::sqrt(kPeriod)));  // the other sign
+  }
+  {
+    BiasHypothesis check(f.constants);
+    const auto span = fault_records(check, s, 2, [](double t) { return t <= 1.0 ? 0.015 * kDegToRad : 0.0; });
+    EXPECT_EQ(check.best(s, span, std::sqrt(kPeriod)).gyro, 2);
+    SpanDisagreement late = span;
+    late.start_ns = seconds_to_ns(15.0);
+    late.span_s = 15.0;
+    late.err_rad.fill(0.0);
+    EXPECT_FALSE(check.persists(2, 1.0, s, late, std::sqrt(kPeriod)));
+  }
+  {
+    BiasHypothesis check(f.constants);
+    const auto span = fault_records(check, s, 2, [](double) { return 0.0; });
+    EXPECT_EQ(check.best(s, span, std::sqrt(kPeriod)).gyro, 0);
+  }
 }
 
 TEST(GyroSet, ExclusionsAreLatchedUntilReinstated) {
