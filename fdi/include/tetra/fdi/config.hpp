@@ -61,8 +61,8 @@ struct PipelineConfig {
   //! "gyro kept" and detection starts again; replay, the service and the closed-loop simulator alike.
   bool exclusion_enabled = true;
   //! true: during a fault episode with a reference, one gyro's filter bias estimate alone beyond
-  //! reference_threshold_sigma isolates it, once a single-gyro fault of that gyro explains the episode's parity
-  //! and reference records better than every other gyro's by a margin and persists (docs/fdi.md).
+  //! reference_threshold_sigma isolates it, once a single-gyro fault of that gyro explains the episode's
+  //! parity and reference records better than every other gyro's by a margin and persists (docs/fdi.md).
   bool filter_bias_isolation = true;
 
   // --- attitude filter (docs/fdi.md, "Attitude filter")
