@@ -42,7 +42,7 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       bias_(Eigen::VectorXd::Zero(dim_ - 3)),
       decay_(Eigen::VectorXd::Ones(dim_ - 3)),
       coupling_(Eigen::Matrix3Xd::Zero(3, dim_ - 3)),
-      cross_(Eigen::Matrix3Xd::Zero(3, dim_ - 3)),
+      cross_rows_(Eigen::VectorXd::Zero(3 * (dim_ - 3))),
       joseph_(Eigen::MatrixXd::Zero(dim_, dim_)),
       gain_(Eigen::MatrixX3d::Zero(dim_, 3)),
       ph_(Eigen::VectorXd::Zero(dim_)),
@@ -113,7 +113,6 @@ Eigen::Vector3d Mekf::rate_correction(const Eigen::Matrix3Xd& pinv, GyroMask mas
 void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::Vector3d& omega_B_rad_s,
                      double dt_s) {
   if (!(dt_s > 0.0)) return;
-  const Eigen::Index m = dim_ - 3;
   // Transition Φ = [[A, G], [0, D]]: A rotates the body-frame error by the step's rotation (exact),
   // G = −Γ·H*·(bias states), Γ = ∫ A(u) du; D the bias models' own transitions.
   const Eigen::Matrix3d A = quat_exp(omega_B_rad_s * dt_s).toRotationMatrix().transpose();
@@ -133,24 +132,7 @@ void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::V
     decay_[n_ + i] = frozen ? 1.0 : phi;
     if (used) q_theta += pinv.col(i) * pinv.col(i).transpose() * (g.arw_rad_rts * g.arw_rad_rts * dt_s);
   }
-  // U = A·Pθβ + G·Pββ and V = A·Pθθ + G·Pβθ from the old P.
-  const auto Ptb = P_.block<3, Eigen::Dynamic>(0, 3, 3, m);
-  const auto Pbb = P_.block(3, 3, m, m);
-  for (Eigen::Index k = 0; k < m; ++k) {
-    Eigen::Vector3d u = A * Ptb.col(k);
-    for (Eigen::Index j = 0; j < m; ++j) u += coupling_.col(j) * Pbb(j, k);
-    cross_.col(k) = u;
-  }
-  Eigen::Matrix3d V = A * P_.topLeftCorner<3, 3>();
-  for (Eigen::Index j = 0; j < m; ++j) V += coupling_.col(j) * Ptb.col(j).transpose();
-  Eigen::Matrix3d Ptt = V * A.transpose() + q_theta;
-  for (Eigen::Index j = 0; j < m; ++j) Ptt += cross_.col(j) * coupling_.col(j).transpose();
-  P_.topLeftCorner<3, 3>() = 0.5 * (Ptt + Ptt.transpose());
-  for (Eigen::Index k = 0; k < m; ++k) {
-    P_.block<3, 1>(0, 3 + k) = cross_.col(k) * decay_[k];
-    P_.block<1, 3>(3 + k, 0) = (cross_.col(k) * decay_[k]).transpose();
-    for (Eigen::Index j = 0; j < m; ++j) P_(3 + j, 3 + k) *= decay_[j] * decay_[k];
-  }
+  propagate_covariance(A, q_theta);
   for (int i = 0; i < n_; ++i) {
     if (frozen_[static_cast<std::size_t>(i)] != 0) continue;
     const auto& g = gyros_[static_cast<std::size_t>(i)];
@@ -161,6 +143,59 @@ void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::V
     bias_[n_ + i] *= phi;
   }
   // Symmetric by construction but for the attitude block (symmetrized above).
+}
+
+void Mekf::propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta) {
+  // P ← Φ·P·Φᵀ + Q by blocks, every sum in the order of the textbook form (U, V below), each element's terms
+  // added in turn. P is exactly symmetric (every update writes both triangles alike), so Pββ's row j is read
+  // as its column j: U's rows are then built column by column of Pββ, contiguous and vectorizable.
+  const Eigen::Index m = dim_ - 3;
+  const Eigen::Index ld = dim_;
+  double* P = P_.data();
+  const double* c = coupling_.data();  // 3×m, column j = G's column j
+  double* u = cross_rows_.data();      // 3 rows of m: U = A·Pθβ + G·Pββ, row-major
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const Eigen::Vector3d a = A * Eigen::Map<const Eigen::Vector3d>(P + (3 + k) * ld);
+    u[k] = a.x();
+    u[m + k] = a.y();
+    u[2 * m + k] = a.z();
+  }
+  for (Eigen::Index j = 0; j < m; ++j) {
+    const double* pb = P + (3 + j) * ld + 3;  // Pββ(:, j) = Pββ(j, :)ᵀ
+    for (Eigen::Index r = 0; r < 3; ++r) {
+      const double cr = c[3 * j + r];
+      double* ur = u + r * m;
+      for (Eigen::Index k = 0; k < m; ++k) ur[k] += cr * pb[k];
+    }
+  }
+  // V = A·Pθθ + G·Pβθ; Pθθ ← V·Aᵀ + Qθ + U·Gᵀ, symmetrized.
+  Eigen::Matrix3d V = A * P_.topLeftCorner<3, 3>();
+  for (Eigen::Index j = 0; j < m; ++j) {
+    const double* ptb = P + (3 + j) * ld;  // Pθβ(:, j)
+    for (Eigen::Index b = 0; b < 3; ++b)
+      for (Eigen::Index r = 0; r < 3; ++r) V(r, b) += c[3 * j + r] * ptb[b];
+  }
+  Eigen::Matrix3d Ptt = V * A.transpose() + q_theta;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    for (Eigen::Index b = 0; b < 3; ++b)
+      for (Eigen::Index r = 0; r < 3; ++r) Ptt(r, b) += u[r * m + j] * c[3 * j + b];
+  }
+  P_.topLeftCorner<3, 3>() = 0.5 * (Ptt + Ptt.transpose());
+  // Pθβ ← U·D, Pββ ← D·Pββ·D (D diagonal: 1 for the slow biases, φ for the Gauss–Markov ones).
+  const double* d = decay_.data();
+  for (Eigen::Index k = 0; k < m; ++k) {
+    double* col = P + (3 + k) * ld;
+    for (Eigen::Index r = 0; r < 3; ++r) {
+      const double v = u[r * m + k] * d[k];
+      col[r] = v;
+      P[r * ld + 3 + k] = v;
+    }
+    for (Eigen::Index j = k; j < m; ++j) {
+      const double v = col[3 + j] * (d[j] * d[k]);
+      col[3 + j] = v;
+      P[(3 + j) * ld + 3 + k] = v;
+    }
+  }
 }
 
 void Mekf::gauss_markov_transitions(double dt_s) {
@@ -215,35 +250,42 @@ ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quatern
 Eigen::Vector3d Mekf::update_parity(const Eigen::MatrixXd& W, int d, GyroMask mask, double scale,
                                     const double* p) {
   Eigen::Vector3d correction = Eigen::Vector3d::Zero();
+  const Eigen::Index ld = dim_;
+  double* P = P_.data();
+  double* ph = ph_.data();
+  double* gain = gain_.data();  // its first column: K = P·hᵀ/s of the row (scratch)
   for (int r = 0; r < d; ++r) {
     // h: ∂p_r/∂(c_i, g_i) = scale·W(r, i) for the gyros of the mask; R = 1.
     double predicted = 0.0;
-    ph_.setZero();
+    std::fill(ph, ph + dim_, 0.0);
     for (int i = 0; i < n_; ++i) {
       if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
       const double h = scale * W(r, i);
       predicted += h * (bias_[i] + bias_[n_ + i]);
-      ph_ += h * (P_.col(c_of(i)) + P_.col(g_of(i)));
+      const double* pc = P + c_of(i) * ld;
+      const double* pg = P + g_of(i) * ld;
+      for (Eigen::Index k = 0; k < dim_; ++k) ph[k] += h * (pc[k] + pg[k]);
     }
     double s = 1.0;
     for (int i = 0; i < n_; ++i) {
       if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
-      s += scale * W(r, i) * (ph_[c_of(i)] + ph_[g_of(i)]);
+      s += scale * W(r, i) * (ph[c_of(i)] + ph[g_of(i)]);
     }
     const double nu = p[r] - predicted;
     // K = P·hᵀ/s; Joseph form for a scalar measurement, expanded: P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ (symmetric
-    // term by term: one triangle computed, mirrored).
+    // term by term: the lower triangle computed column by column, mirrored).
+    for (Eigen::Index k = 0; k < dim_; ++k) gain[k] = ph[k] / s;
     for (Eigen::Index k = 0; k < dim_; ++k) {
-      const double kk = ph_[k] / s;
-      for (Eigen::Index j = k; j < dim_; ++j) {
-        const double kj = ph_[j] / s;
-        const double v = P_(k, j) - kk * ph_[j] - ph_[k] * kj + s * kk * kj;
-        P_(k, j) = v;
-        P_(j, k) = v;
-      }
+      const double kk = gain[k];
+      const double phk = ph[k];
+      const double skk = s * kk;
+      double* col = P + k * ld;
+      for (Eigen::Index j = k; j < dim_; ++j) col[j] = col[j] - kk * ph[j] - phk * gain[j] + skk * gain[j];
+      for (Eigen::Index j = k + 1; j < dim_; ++j) P[j * ld + k] = col[j];
     }
-    correction += ph_.head<3>() * (nu / s);
-    bias_ += ph_.tail(dim_ - 3) * (nu / s);
+    const double gain_nu = nu / s;
+    for (Eigen::Index k = 0; k < 3; ++k) correction[k] += ph[k] * gain_nu;
+    for (Eigen::Index k = 3; k < dim_; ++k) bias_[k - 3] += ph[k] * gain_nu;
   }
   return correction;
 }

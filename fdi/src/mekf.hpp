@@ -102,6 +102,7 @@ class Mekf {
   void set_prior(int i);
   void symmetrize();
   void gauss_markov_transitions(double dt_s);
+  void propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta);
 
   std::vector<GyroNoiseModel> gyros_;
   int n_;
@@ -115,7 +116,7 @@ class Mekf {
   std::vector<double> gm_kappa_;
   double gm_dt_s_ = -1.0;
   Eigen::Matrix3Xd coupling_;  //!< 3×2N: ∂δθ/∂bias over the step (scratch)
-  Eigen::Matrix3Xd cross_;     //!< 3×2N: U = A·Pθβ + G·Pββ (scratch)
+  Eigen::VectorXd cross_rows_;  //!< 3×2N row-major: U = A·Pθβ + G·Pββ (scratch)
   Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
   Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
   Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
