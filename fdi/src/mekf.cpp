@@ -13,6 +13,91 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
   m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
   return m;
 }
+
+//! The arrays of one covariance step: P (3 + m square, column-major), G's columns (3×m), D's diagonal (m) and
+//! the scratch of U (3 rows of m).
+struct CovarianceStep {
+  double* P;
+  const double* coupling;
+  const double* decay;
+  double* u;
+};
+
+//! P ← Φ·P·Φᵀ + Qθ with Φ = [[A, G], [0, D]] over m = 2N bias states (`kM` > 0: m known at compile time).
+//! Every sum in the order of the textbook form (U, V below), each element's terms added in turn. P is exactly
+//! symmetric (every update writes both triangles alike), so Pββ's row j is read as its column j: U's rows are
+//! built column by column of Pββ, contiguous and vectorizable.
+template <int kM>
+void propagate_blocks(const CovarianceStep& s, Eigen::Index m_runtime, const Eigen::Matrix3d& A,
+                      const Eigen::Matrix3d& q_theta) {
+  const Eigen::Index m = kM > 0 ? kM : m_runtime;
+  const Eigen::Index ld = 3 + m;
+  double* P = s.P;
+  const double* c = s.coupling;
+  double* u = s.u;
+  // U = A·Pθβ + G·Pββ (3 rows of m).
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const Eigen::Vector3d a = A * Eigen::Map<const Eigen::Vector3d>(P + (3 + k) * ld);
+    u[k] = a.x();
+    u[m + k] = a.y();
+    u[2 * m + k] = a.z();
+  }
+  for (Eigen::Index j = 0; j < m; ++j) {
+    const double* pb = P + (3 + j) * ld + 3;  // Pββ(:, j) = Pββ(j, :)ᵀ
+    for (Eigen::Index r = 0; r < 3; ++r) {
+      const double cr = c[3 * j + r];
+      double* ur = u + r * m;
+      for (Eigen::Index k = 0; k < m; ++k) ur[k] += cr * pb[k];
+    }
+  }
+  // V = A·Pθθ + G·Pβθ; Pθθ ← V·Aᵀ + Qθ + U·Gᵀ, symmetrized.
+  Eigen::Matrix3d V =
+      A * Eigen::Map<const Eigen::Matrix3d, 0, Eigen::OuterStride<>>(P, Eigen::OuterStride<>(ld));
+  for (Eigen::Index j = 0; j < m; ++j) {
+    const double* ptb = P + (3 + j) * ld;  // Pθβ(:, j)
+    for (Eigen::Index b = 0; b < 3; ++b)
+      for (Eigen::Index r = 0; r < 3; ++r) V(r, b) += c[3 * j + r] * ptb[b];
+  }
+  Eigen::Matrix3d Ptt = V * A.transpose() + q_theta;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    for (Eigen::Index b = 0; b < 3; ++b)
+      for (Eigen::Index r = 0; r < 3; ++r) Ptt(r, b) += u[r * m + j] * c[3 * j + b];
+  }
+  Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>>(P, Eigen::OuterStride<>(ld)) =
+      0.5 * (Ptt + Ptt.transpose());
+  // Pθβ ← U·D, Pββ ← D·Pββ·D (D diagonal: 1 for the slow biases, φ for the Gauss–Markov ones).
+  const double* d = s.decay;
+  for (Eigen::Index k = 0; k < m; ++k) {
+    double* col = P + (3 + k) * ld;
+    for (Eigen::Index r = 0; r < 3; ++r) {
+      const double v = u[r * m + k] * d[k];
+      col[r] = v;
+      P[r * ld + 3 + k] = v;
+    }
+    for (Eigen::Index j = k; j < m; ++j) {
+      const double v = col[3 + j] * (d[j] * d[k]);
+      col[3 + j] = v;
+      P[(3 + j) * ld + 3 + k] = v;
+    }
+  }
+}
+//! The Joseph update of P (`dim` square, column-major; `kDim` > 0: known at compile time) by a scalar
+//! measurement of innovation variance `s` with P·hᵀ = `ph`; `gain` receives K = P·hᵀ/s. Expanded:
+//! P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ, symmetric term by term: the lower triangle computed column by column,
+//! mirrored.
+template <int kDim>
+void joseph_scalar(double* P, const double* ph, double* gain, double s, Eigen::Index dim_runtime) {
+  const Eigen::Index dim = kDim > 0 ? kDim : dim_runtime;
+  for (Eigen::Index k = 0; k < dim; ++k) gain[k] = ph[k] / s;
+  for (Eigen::Index k = 0; k < dim; ++k) {
+    const double kk = gain[k];
+    const double phk = ph[k];
+    const double skk = s * kk;
+    double* col = P + k * dim;
+    for (Eigen::Index j = k; j < dim; ++j) col[j] = col[j] - kk * ph[j] - phk * gain[j] + skk * gain[j];
+    for (Eigen::Index j = k + 1; j < dim; ++j) P[j * dim + k] = col[j];
+  }
+}
 }  // namespace
 
 Eigen::Matrix3d rotation_integral(const Eigen::Vector3d& omega_rad_s, double dt_s) {
@@ -146,55 +231,23 @@ void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::V
 }
 
 void Mekf::propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta) {
-  // P ← Φ·P·Φᵀ + Q by blocks, every sum in the order of the textbook form (U, V below), each element's terms
-  // added in turn. P is exactly symmetric (every update writes both triangles alike), so Pββ's row j is read
-  // as its column j: U's rows are then built column by column of Pββ, contiguous and vectorizable.
-  const Eigen::Index m = dim_ - 3;
-  const Eigen::Index ld = dim_;
-  double* P = P_.data();
-  const double* c = coupling_.data();  // 3×m, column j = G's column j
-  double* u = cross_rows_.data();      // 3 rows of m: U = A·Pθβ + G·Pββ, row-major
-  for (Eigen::Index k = 0; k < m; ++k) {
-    const Eigen::Vector3d a = A * Eigen::Map<const Eigen::Vector3d>(P + (3 + k) * ld);
-    u[k] = a.x();
-    u[m + k] = a.y();
-    u[2 * m + k] = a.z();
-  }
-  for (Eigen::Index j = 0; j < m; ++j) {
-    const double* pb = P + (3 + j) * ld + 3;  // Pββ(:, j) = Pββ(j, :)ᵀ
-    for (Eigen::Index r = 0; r < 3; ++r) {
-      const double cr = c[3 * j + r];
-      double* ur = u + r * m;
-      for (Eigen::Index k = 0; k < m; ++k) ur[k] += cr * pb[k];
-    }
-  }
-  // V = A·Pθθ + G·Pβθ; Pθθ ← V·Aᵀ + Qθ + U·Gᵀ, symmetrized.
-  Eigen::Matrix3d V = A * P_.topLeftCorner<3, 3>();
-  for (Eigen::Index j = 0; j < m; ++j) {
-    const double* ptb = P + (3 + j) * ld;  // Pθβ(:, j)
-    for (Eigen::Index b = 0; b < 3; ++b)
-      for (Eigen::Index r = 0; r < 3; ++r) V(r, b) += c[3 * j + r] * ptb[b];
-  }
-  Eigen::Matrix3d Ptt = V * A.transpose() + q_theta;
-  for (Eigen::Index j = 0; j < m; ++j) {
-    for (Eigen::Index b = 0; b < 3; ++b)
-      for (Eigen::Index r = 0; r < 3; ++r) Ptt(r, b) += u[r * m + j] * c[3 * j + b];
-  }
-  P_.topLeftCorner<3, 3>() = 0.5 * (Ptt + Ptt.transpose());
-  // Pθβ ← U·D, Pββ ← D·Pββ·D (D diagonal: 1 for the slow biases, φ for the Gauss–Markov ones).
-  const double* d = decay_.data();
-  for (Eigen::Index k = 0; k < m; ++k) {
-    double* col = P + (3 + k) * ld;
-    for (Eigen::Index r = 0; r < 3; ++r) {
-      const double v = u[r * m + k] * d[k];
-      col[r] = v;
-      P[r * ld + 3 + k] = v;
-    }
-    for (Eigen::Index j = k; j < m; ++j) {
-      const double v = col[3 + j] * (d[j] * d[k]);
-      col[3 + j] = v;
-      P[(3 + j) * ld + 3 + k] = v;
-    }
+  const CovarianceStep step{P_.data(), coupling_.data(), decay_.data(), cross_rows_.data()};
+  switch (n_) {  // the common sizes with their loop bounds known to the compiler (unrolled, vectorized)
+    case 3:
+      propagate_blocks<6>(step, 6, A, q_theta);
+      break;
+    case 4:
+      propagate_blocks<8>(step, 8, A, q_theta);
+      break;
+    case 5:
+      propagate_blocks<10>(step, 10, A, q_theta);
+      break;
+    case 6:
+      propagate_blocks<12>(step, 12, A, q_theta);
+      break;
+    default:
+      propagate_blocks<0>(step, dim_ - 3, A, q_theta);
+      break;
   }
 }
 
@@ -272,16 +325,22 @@ Eigen::Vector3d Mekf::update_parity(const Eigen::MatrixXd& W, int d, GyroMask ma
       s += scale * W(r, i) * (ph[c_of(i)] + ph[g_of(i)]);
     }
     const double nu = p[r] - predicted;
-    // K = P·hᵀ/s; Joseph form for a scalar measurement, expanded: P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ (symmetric
-    // term by term: the lower triangle computed column by column, mirrored).
-    for (Eigen::Index k = 0; k < dim_; ++k) gain[k] = ph[k] / s;
-    for (Eigen::Index k = 0; k < dim_; ++k) {
-      const double kk = gain[k];
-      const double phk = ph[k];
-      const double skk = s * kk;
-      double* col = P + k * ld;
-      for (Eigen::Index j = k; j < dim_; ++j) col[j] = col[j] - kk * ph[j] - phk * gain[j] + skk * gain[j];
-      for (Eigen::Index j = k + 1; j < dim_; ++j) P[j * ld + k] = col[j];
+    switch (dim_) {  // the common sizes with their loop bounds known to the compiler
+      case 9:
+        joseph_scalar<9>(P, ph, gain, s, 9);
+        break;
+      case 11:
+        joseph_scalar<11>(P, ph, gain, s, 11);
+        break;
+      case 13:
+        joseph_scalar<13>(P, ph, gain, s, 13);
+        break;
+      case 15:
+        joseph_scalar<15>(P, ph, gain, s, 15);
+        break;
+      default:
+        joseph_scalar<0>(P, ph, gain, s, dim_);
+        break;
     }
     const double gain_nu = nu / s;
     for (Eigen::Index k = 0; k < 3; ++k) correction[k] += ph[k] * gain_nu;

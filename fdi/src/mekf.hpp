@@ -115,12 +115,12 @@ class Mekf {
   std::vector<double> gm_phi_;
   std::vector<double> gm_kappa_;
   double gm_dt_s_ = -1.0;
-  Eigen::Matrix3Xd coupling_;  //!< 3×2N: ∂δθ/∂bias over the step (scratch)
+  Eigen::Matrix3Xd coupling_;   //!< 3×2N: ∂δθ/∂bias over the step (scratch)
   Eigen::VectorXd cross_rows_;  //!< 3×2N row-major: U = A·Pθβ + G·Pββ (scratch)
-  Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
-  Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
-  Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
-  Eigen::VectorXd prior_var_;  //!< [rad²/s²] per gyro: the variance of c + g without any measurement
+  Eigen::MatrixXd joseph_;      //!< (3+2N)² scratch of the Joseph update
+  Eigen::MatrixX3d gain_;       //!< (3+2N)×3 Kalman gain
+  Eigen::VectorXd ph_;          //!< (3+2N) P·hᵀ of a scalar update (scratch)
+  Eigen::VectorXd prior_var_;   //!< [rad²/s²] per gyro: the variance of c + g without any measurement
   std::vector<unsigned char> frozen_;
 };
 
