@@ -25,8 +25,8 @@ struct CovarianceStep {
 
 //! P ← Φ·P·Φᵀ + Qθ with Φ = [[A, G], [0, D]] over m = 2N bias states (`kM` > 0: m known at compile time).
 //! Every sum in the order of the textbook form (U, V below), each element's terms added in turn. P is exactly
-//! symmetric (every update writes both triangles alike), so Pββ's row j is read as its column j: U's rows are
-//! built column by column of Pββ, contiguous and vectorizable.
+//! symmetric (every update writes both triangles alike), so Pββ(j, k) is read as Pββ(k, j): U's columns k and
+//! k + 1 (m is even) from contiguous pairs.
 template <int kM>
 void propagate_blocks(const CovarianceStep& s, Eigen::Index m_runtime, const Eigen::Matrix3d& A,
                       const Eigen::Matrix3d& q_theta) {
@@ -35,20 +35,28 @@ void propagate_blocks(const CovarianceStep& s, Eigen::Index m_runtime, const Eig
   double* P = s.P;
   const double* c = s.coupling;
   double* u = s.u;
-  // U = A·Pθβ + G·Pββ (3 rows of m).
-  for (Eigen::Index k = 0; k < m; ++k) {
-    const Eigen::Vector3d a = A * Eigen::Map<const Eigen::Vector3d>(P + (3 + k) * ld);
-    u[k] = a.x();
-    u[m + k] = a.y();
-    u[2 * m + k] = a.z();
-  }
-  for (Eigen::Index j = 0; j < m; ++j) {
-    const double* pb = P + (3 + j) * ld + 3;  // Pββ(:, j) = Pββ(j, :)ᵀ
-    for (Eigen::Index r = 0; r < 3; ++r) {
-      const double cr = c[3 * j + r];
-      double* ur = u + r * m;
-      for (Eigen::Index k = 0; k < m; ++k) ur[k] += cr * pb[k];
+  // U = A·Pθβ + G·Pββ (3 rows of m), two columns at a time: their sums stay in registers over j.
+  for (Eigen::Index k = 0; k < m; k += 2) {
+    const double* p0 = P + (3 + k) * ld;
+    const Eigen::Vector3d a0 = A * Eigen::Map<const Eigen::Vector3d>(p0);
+    const Eigen::Vector3d a1 = A * Eigen::Map<const Eigen::Vector3d>(p0 + ld);
+    double u00 = a0.x(), u01 = a1.x(), u10 = a0.y(), u11 = a1.y(), u20 = a0.z(), u21 = a1.z();
+    for (Eigen::Index j = 0; j < m; ++j) {
+      const double* pb = P + (3 + j) * ld + 3 + k;  // Pββ(k, j), Pββ(k + 1, j) = Pββ(j, k), Pββ(j, k + 1)
+      const double* cj = c + 3 * j;
+      u00 += cj[0] * pb[0];
+      u01 += cj[0] * pb[1];
+      u10 += cj[1] * pb[0];
+      u11 += cj[1] * pb[1];
+      u20 += cj[2] * pb[0];
+      u21 += cj[2] * pb[1];
     }
+    u[k] = u00;
+    u[k + 1] = u01;
+    u[m + k] = u10;
+    u[m + k + 1] = u11;
+    u[2 * m + k] = u20;
+    u[2 * m + k + 1] = u21;
   }
   // V = A·Pθθ + G·Pβθ; Pθθ ← V·Aᵀ + Qθ + U·Gᵀ, symmetrized.
   Eigen::Matrix3d V =
