@@ -206,9 +206,15 @@ Eigen::Vector3d Mekf::rate_correction(const Eigen::Matrix3Xd& pinv, GyroMask mas
 void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::Vector3d& omega_B_rad_s,
                      double dt_s) {
   if (!(dt_s > 0.0)) return;
+  propagate(quat_exp(omega_B_rad_s * dt_s), pinv, mask, omega_B_rad_s, dt_s);
+}
+
+void Mekf::propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, GyroMask mask,
+                     const Eigen::Vector3d& omega_B_rad_s, double dt_s) {
+  if (!(dt_s > 0.0)) return;
   // Transition Φ = [[A, G], [0, D]]: A rotates the body-frame error by the step's rotation (exact),
   // G = −Γ·H*·(bias states), Γ = ∫ A(u) du; D the bias models' own transitions.
-  const Eigen::Matrix3d A = quat_exp(omega_B_rad_s * dt_s).toRotationMatrix().transpose();
+  const Eigen::Matrix3d A = rotation.toRotationMatrix().transpose();
   const Eigen::Matrix3d gamma = rotation_integral(omega_B_rad_s, dt_s);
   Eigen::Matrix3d q_theta = Eigen::Matrix3d::Zero();
   if (dt_s != gm_dt_s_) gauss_markov_transitions(dt_s);

@@ -57,6 +57,9 @@ class Mekf {
   //! rate solution `pinv` over the gyros of `mask`: Φ exact for the rotation, biases exact for their models.
   void propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::Vector3d& omega_B_rad_s,
                  double dt_s);
+  //! The same with the step's body rotation exp(½·ω·Δt) already at hand (`rotation`, from the propagator).
+  void propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, GyroMask mask,
+                 const Eigen::Vector3d& omega_B_rad_s, double dt_s);
 
   //! Adds a variance [rad²] per axis to the attitude (e.g. a bound turned into a 1σ before an update).
   void add_attitude_variance(const Eigen::Vector3d& var_rad2);

@@ -162,7 +162,7 @@ void RateAttitude::propagate(const EpochFrame& frame, const Subset& sol, const S
   const Eigen::Vector3d omega = 0.5 * (omega_prev_ + omega_meas_) - correction_;
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   (void)propagator_.step(omega, frame.dt_s, zero, zero, bound);
-  mekf_.propagate(noise.pinv, noise.mask, omega, frame.dt_s);
+  mekf_.propagate(propagator_.last_increment(), noise.pinv, noise.mask, omega, frame.dt_s);
 }
 
 }  // namespace tetra::fdi::detail

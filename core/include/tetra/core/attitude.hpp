@@ -41,15 +41,19 @@ class AttitudePropagator {
   void add_bound(const Eigen::Vector3d& angle_rad) { bound_rad_ += angle_rad.cwiseAbs(); }
 
   const Quaternion& q_RB() const { return q_RB_; }
+  //! The last step's body rotation exp(½ ω_B Δt) (ω_B the rate the step turned B by: the measured rate in
+  //! ground mode, the rate relative to R otherwise); identity before any step.
+  const Quaternion& last_increment() const { return increment_; }
   //! [rad] 1σ per body axis.
   Eigen::Vector3d sigma_rad() const;
 
  private:
-  Quaternion q_RB_;                              //!< body → reference (L in ground mode); unit norm
-  std::optional<Eigen::Vector3d> earth_rate_L_;  //!< [rad/s] set in ground-test mode
-  Eigen::Vector3d var_random_rad2_;              //!< [rad²]
-  Eigen::Vector3d systematic_rad_;               //!< [rad]
-  Eigen::Vector3d bound_rad_;                    //!< [rad]
+  Quaternion q_RB_;                                //!< body → reference (L in ground mode); unit norm
+  Quaternion increment_ = Quaternion::Identity();  //!< the last step's body rotation
+  std::optional<Eigen::Vector3d> earth_rate_L_;    //!< [rad/s] set in ground-test mode
+  Eigen::Vector3d var_random_rad2_;                //!< [rad²]
+  Eigen::Vector3d systematic_rad_;                 //!< [rad]
+  Eigen::Vector3d bound_rad_;                      //!< [rad]
 };
 
 }  // namespace tetra
