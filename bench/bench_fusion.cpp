@@ -10,6 +10,7 @@
 #include <benchmark/benchmark.h>
 
 #include "../tests/fusion/synth.hpp"
+#include "bench_clock.hpp"
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/fdi/pipeline.hpp"
 
@@ -76,8 +77,12 @@ int run_steps(long n, bool reference) {
   const auto epochs = make_epochs(static_cast<std::size_t>(n), reference ? 1.0 : 0.0);
   auto p = tetra::fdi::Pipeline::create(tetra::seed_as_built_unit(), tetra::fdi::PipelineConfig{});
   std::size_t events = 0;
+  // The thread's CPU time (not the wall clock): time spent descheduled by other processes is left out.
+  const std::int64_t t0_ns = tetra::bench::now_ns(CLOCK_THREAD_CPUTIME_ID);
   for (const auto& e : epochs) events += p->step(e).events.size();
-  std::cout << epochs.size() << " steps, " << events << " events\n";
+  const std::int64_t cpu_ns = tetra::bench::now_ns(CLOCK_THREAD_CPUTIME_ID) - t0_ns;
+  std::cout << epochs.size() << " steps, " << events << " events, "
+            << static_cast<double>(cpu_ns) / static_cast<double>(epochs.size()) << " ns CPU a step\n";
   return 0;
 }
 
