@@ -101,9 +101,7 @@ Eigen::Vector3d RateAttitude::sigma_rad() const {
 void RateAttitude::parity(const Subset& s, const Eigen::VectorXd& p, double sqrt_period) {
   if (!reference_seen_ || s.dof < 1) return;
   const Eigen::Vector3d dtheta = mekf_.update_parity(s.parity, s.dof, s.mask, sqrt_period, p.data());
-  const Eigen::Vector3d bound = propagator_.sigma_rad();  // the bound alone; kept across the attitude reset
-  propagator_.reset(propagator_.q_RB() * quat_exp(dtheta));
-  propagator_.add_bound(bound);
+  propagator_.rotate(quat_exp(dtheta));  // the bound (a fault's, a lost rate's) kept
 }
 
 ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB) {

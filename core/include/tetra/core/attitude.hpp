@@ -26,6 +26,9 @@ class AttitudePropagator {
   AttitudePropagator(const Quaternion& q0_RB, std::optional<double> latitude_rad);
 
   void reset(const Quaternion& q0_RB);
+  //! Turns the attitude by `dq_B` in B (q_RB ← q_RB ⊗ dq_B, normalized), e.g. a filter's correction; the
+  //! uncertainty is kept.
+  void rotate(const Quaternion& dq_B) { q_RB_ = (q_RB_ * dq_B).normalized(); }
 
   //! [rad/s] Earth rate in B at the current attitude; zero outside ground-test mode.
   Eigen::Vector3d earth_rate_B() const;
