@@ -305,12 +305,20 @@ ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quatern
   joseph_ = P_;
   for (Eigen::Index k = 0; k < dim_; ++k)  // T = (I − KH)·P
     joseph_.col(k).noalias() -= gain_ * P_.block<3, 1>(0, k);
-  for (Eigen::Index k = 0; k < dim_; ++k) {  // P = T·(I − KH)ᵀ + r·K·Kᵀ
-    const Eigen::Vector3d t = joseph_.block<1, 3>(k, 0).transpose();
-    for (Eigen::Index j = 0; j < dim_; ++j)
-      P_(k, j) = joseph_(k, j) - gain_.row(j).dot(t) + r * gain_.row(k).dot(gain_.row(j));
+  // P = T·(I − KH)ᵀ + r·K·Kᵀ, symmetrized: each pair (k, j) and (j, k) at once, the r·K·Kᵀ term shared.
+  for (Eigen::Index k = 0; k < dim_; ++k) {
+    const Eigen::Vector3d tk = joseph_.block<1, 3>(k, 0).transpose();
+    P_(k, k) = joseph_(k, k) - gain_.row(k).dot(tk) + r * gain_.row(k).dot(gain_.row(k));
+    for (Eigen::Index j = k + 1; j < dim_; ++j) {
+      const Eigen::Vector3d tj = joseph_.block<1, 3>(j, 0).transpose();
+      const double rkk = r * gain_.row(k).dot(gain_.row(j));
+      const double pkj = joseph_(k, j) - gain_.row(j).dot(tk) + rkk;
+      const double pjk = joseph_(j, k) - gain_.row(k).dot(tj) + rkk;
+      const double v = 0.5 * (pkj + pjk);
+      P_(k, j) = v;
+      P_(j, k) = v;
+    }
   }
-  symmetrize();
   return out;
 }
 
@@ -371,16 +379,6 @@ double Mekf::bias_z(int id) const {
 void Mekf::open_fault_hypothesis(double sigma_rad_s) {
   for (int i = 0; i < n_; ++i) {
     if (frozen_[static_cast<std::size_t>(i)] == 0) P_(c_of(i), c_of(i)) += sigma_rad_s * sigma_rad_s;
-  }
-}
-
-void Mekf::symmetrize() {
-  for (Eigen::Index k = 0; k < dim_; ++k) {
-    for (Eigen::Index j = k + 1; j < dim_; ++j) {
-      const double v = 0.5 * (P_(k, j) + P_(j, k));
-      P_(k, j) = v;
-      P_(j, k) = v;
-    }
   }
 }
 

@@ -103,7 +103,6 @@ class Mekf {
   Eigen::Index g_of(int i) const { return 3 + n_ + i; }  //!< state index of g_i
   void decorrelate(int i);
   void set_prior(int i);
-  void symmetrize();
   void gauss_markov_transitions(double dt_s);
   void propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta);
 
