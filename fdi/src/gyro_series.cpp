@@ -21,10 +21,8 @@ constexpr int kOtherRepeats =
     3;  //!< [samples] another gyro's repeat run that leaves a coarse gyro's repeats unjudged  //!< noise
         //!< ratio of a gyro whose own second differences look normal  //!< [σ] motion level the noise-level
         //!< test still tells from noise  //!< a quantization step beyond this many σ makes repeats normal
+}  // namespace
 
-//! The element of rank k (0-based) of a[0..n) (a is reordered): the value std::nth_element puts at a + k, by
-//! a quickselect whose partition has no data-dependent branch (nth_element's mispredicts on nearly every
-//! comparison of noise). Every value must be ordered (no NaN).
 double select_rank(double* a, int n, int k) {
   int lo = 0;
   int hi = n - 1;
@@ -48,7 +46,6 @@ double select_rank(double* a, int n, int k) {
   }
   return a[k];
 }
-}  // namespace
 
 Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const PipelineConfig& config) {
   std::vector<GyroConstants> out;
