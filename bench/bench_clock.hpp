@@ -1,5 +1,6 @@
 #pragma once
-// The monotonic clock of the DDS benchmark programs: now, and sleeping until an absolute time.
+// The clocks of the benchmark programs: now (monotonic, or a thread's CPU time), and sleeping until an
+// absolute time.
 
 #include <time.h>
 
@@ -7,10 +8,10 @@
 
 namespace tetra::bench {
 
-//! [ns] CLOCK_MONOTONIC.
-inline std::int64_t now_ns() {
+//! [ns] the clock `clock` (CLOCK_MONOTONIC unless told).
+inline std::int64_t now_ns(clockid_t clock = CLOCK_MONOTONIC) {
   timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
+  clock_gettime(clock, &ts);
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 

@@ -1,5 +1,8 @@
 // Cost of one pipeline step with 4 gyros and every detector (χ², CUSUM, jump test, signatures, reference).
 // Also writes the synthetic 10 Hz log used by bench/replay.sh: `bench_fusion --write-log PATH SECONDS`.
+// `bench_fusion --steps N REFERENCE` runs exactly N steps (REFERENCE 0 or 1) outside the benchmark loop: a
+// fixed workload for an instruction count that does not depend on the machine's load, e.g.
+//   valgrind --tool=callgrind --toggle-collect='tetra::fdi::Pipeline::step(*' bench_fusion --steps 60000 1
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -7,6 +10,7 @@
 #include <benchmark/benchmark.h>
 
 #include "../tests/fusion/synth.hpp"
+#include "bench_clock.hpp"
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/fdi/pipeline.hpp"
 
@@ -69,6 +73,19 @@ void BM_PipelineStepSuspect(benchmark::State& state) {
 }
 BENCHMARK(BM_PipelineStepSuspect);
 
+int run_steps(long n, bool reference) {
+  const auto epochs = make_epochs(static_cast<std::size_t>(n), reference ? 1.0 : 0.0);
+  auto p = tetra::fdi::Pipeline::create(tetra::seed_as_built_unit(), tetra::fdi::PipelineConfig{});
+  std::size_t events = 0;
+  // The thread's CPU time (not the wall clock): time spent descheduled by other processes is left out.
+  const std::int64_t t0_ns = tetra::bench::now_ns(CLOCK_THREAD_CPUTIME_ID);
+  for (const auto& e : epochs) events += p->step(e).events.size();
+  const std::int64_t cpu_ns = tetra::bench::now_ns(CLOCK_THREAD_CPUTIME_ID) - t0_ns;
+  std::cout << epochs.size() << " steps, " << events << " events, "
+            << static_cast<double>(cpu_ns) / static_cast<double>(epochs.size()) << " ns CPU a step\n";
+  return 0;
+}
+
 int write_log(const char* path, double seconds) {
   tetra::test::SynthOptions opt;
   tetra::test::Synth s(tetra::seed_as_built_unit(), opt);
@@ -86,6 +103,8 @@ int write_log(const char* path, double seconds) {
 
 int main(int argc, char** argv) {
   if (argc == 4 && std::strcmp(argv[1], "--write-log") == 0) return write_log(argv[2], std::atof(argv[3]));
+  if (argc == 4 && std::strcmp(argv[1], "--steps") == 0)
+    return run_steps(std::atol(argv[2]), std::atoi(argv[3]) != 0);
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

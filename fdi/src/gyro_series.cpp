@@ -23,6 +23,30 @@ constexpr int kOtherRepeats =
         //!< test still tells from noise  //!< a quantization step beyond this many σ makes repeats normal
 }  // namespace
 
+double select_rank(double* a, int n, int k) {
+  int lo = 0;
+  int hi = n - 1;
+  while (hi > lo) {
+    std::swap(a[lo + (hi - lo) / 2], a[hi]);  // the middle element as the pivot
+    const double pivot = a[hi];
+    int store = lo;  // a[lo, store) < pivot ≤ a[store, i)
+    for (int i = lo; i < hi; ++i) {
+      const double x = a[i];
+      a[i] = a[store];
+      a[store] = x;
+      store += static_cast<int>(x < pivot);
+    }
+    std::swap(a[store], a[hi]);
+    if (k == store) return a[k];
+    if (k < store) {
+      hi = store - 1;
+    } else {
+      lo = store + 1;
+    }
+  }
+  return a[k];
+}
+
 Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const PipelineConfig& config) {
   std::vector<GyroConstants> out;
   for (std::size_t i = 0; i < cal.gyros.size(); ++i) {
@@ -287,9 +311,17 @@ double GyroSeries::noise_ratio(int id, double sqrt_period, int last, bool motion
   } else {
     buf = recent(ring, t, n);
   }
-  std::nth_element(buf, buf + n / 2, buf + n);
+  bool ordered = true;
+  for (int k = 0; k < n; ++k) ordered &= !std::isnan(buf[k]);
+  double median = 0.0;
+  if (ordered) {
+    median = select_rank(buf, n, n / 2);
+  } else {
+    std::nth_element(buf, buf + n / 2, buf + n);
+    median = buf[n / 2];
+  }
   // Gaussian Δ²y of level σ_Δ²: median |Δ²y| = 0.6745·σ_Δ² (the motion's ring is already in its σ units).
-  return buf[n / 2] / (kNoiseExpectedMedian * (motion ? 1.0 : d2_sigma(id, sqrt_period)));
+  return median / (kNoiseExpectedMedian * (motion ? 1.0 : d2_sigma(id, sqrt_period)));
 }
 
 double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) const {

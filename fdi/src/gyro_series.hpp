@@ -30,6 +30,11 @@ struct GyroConstants {
 //! Per-gyro constants from the calibration; error names the gyro and field.
 Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const PipelineConfig& config);
 
+//! The element of rank k (0-based) of a[0..n) (a is reordered): the value std::nth_element puts at a + k, by
+//! a quickselect whose partition has no data-dependent branch (nth_element's mispredicts on nearly every
+//! comparison of noise). Every value must be ordered (no NaN).
+double select_rank(double* a, int n, int k);
+
 class GyroSeries {
  public:
   GyroSeries(std::vector<GyroConstants> constants, const PipelineConfig& config);

@@ -13,6 +13,99 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
   m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
   return m;
 }
+
+//! The arrays of one covariance step: P (3 + m square, column-major), G's columns (3×m), D's diagonal (m) and
+//! the scratch of U (3 rows of m).
+struct CovarianceStep {
+  double* P;
+  const double* coupling;
+  const double* decay;
+  double* u;
+};
+
+//! P ← Φ·P·Φᵀ + Qθ with Φ = [[A, G], [0, D]] over m = 2N bias states (`kM` > 0: m known at compile time).
+//! Every sum in the order of the textbook form (U, V below), each element's terms added in turn. P is exactly
+//! symmetric (every update writes both triangles alike), so Pββ(j, k) is read as Pββ(k, j): U's columns k and
+//! k + 1 (m is even) from contiguous pairs.
+template <int kM>
+void propagate_blocks(const CovarianceStep& s, Eigen::Index m_runtime, const Eigen::Matrix3d& A,
+                      const Eigen::Matrix3d& q_theta) {
+  const Eigen::Index m = kM > 0 ? kM : m_runtime;
+  const Eigen::Index ld = 3 + m;
+  double* P = s.P;
+  const double* c = s.coupling;
+  double* u = s.u;
+  // U = A·Pθβ + G·Pββ (3 rows of m), two columns at a time: their sums stay in registers over j.
+  for (Eigen::Index k = 0; k < m; k += 2) {
+    const double* p0 = P + (3 + k) * ld;
+    const Eigen::Vector3d a0 = A * Eigen::Map<const Eigen::Vector3d>(p0);
+    const Eigen::Vector3d a1 = A * Eigen::Map<const Eigen::Vector3d>(p0 + ld);
+    double u00 = a0.x(), u01 = a1.x(), u10 = a0.y(), u11 = a1.y(), u20 = a0.z(), u21 = a1.z();
+    for (Eigen::Index j = 0; j < m; ++j) {
+      const double* pb = P + (3 + j) * ld + 3 + k;  // Pββ(k, j), Pββ(k + 1, j) = Pββ(j, k), Pββ(j, k + 1)
+      const double* cj = c + 3 * j;
+      u00 += cj[0] * pb[0];
+      u01 += cj[0] * pb[1];
+      u10 += cj[1] * pb[0];
+      u11 += cj[1] * pb[1];
+      u20 += cj[2] * pb[0];
+      u21 += cj[2] * pb[1];
+    }
+    u[k] = u00;
+    u[k + 1] = u01;
+    u[m + k] = u10;
+    u[m + k + 1] = u11;
+    u[2 * m + k] = u20;
+    u[2 * m + k + 1] = u21;
+  }
+  // V = A·Pθθ + G·Pβθ; Pθθ ← V·Aᵀ + Qθ + U·Gᵀ, symmetrized.
+  Eigen::Matrix3d V =
+      A * Eigen::Map<const Eigen::Matrix3d, 0, Eigen::OuterStride<>>(P, Eigen::OuterStride<>(ld));
+  for (Eigen::Index j = 0; j < m; ++j) {
+    const double* ptb = P + (3 + j) * ld;  // Pθβ(:, j)
+    for (Eigen::Index b = 0; b < 3; ++b)
+      for (Eigen::Index r = 0; r < 3; ++r) V(r, b) += c[3 * j + r] * ptb[b];
+  }
+  Eigen::Matrix3d Ptt = V * A.transpose() + q_theta;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    for (Eigen::Index b = 0; b < 3; ++b)
+      for (Eigen::Index r = 0; r < 3; ++r) Ptt(r, b) += u[r * m + j] * c[3 * j + b];
+  }
+  Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>>(P, Eigen::OuterStride<>(ld)) =
+      0.5 * (Ptt + Ptt.transpose());
+  // Pθβ ← U·D, Pββ ← D·Pββ·D (D diagonal: 1 for the slow biases, φ for the Gauss–Markov ones).
+  const double* d = s.decay;
+  for (Eigen::Index k = 0; k < m; ++k) {
+    double* col = P + (3 + k) * ld;
+    for (Eigen::Index r = 0; r < 3; ++r) {
+      const double v = u[r * m + k] * d[k];
+      col[r] = v;
+      P[r * ld + 3 + k] = v;
+    }
+    for (Eigen::Index j = k; j < m; ++j) {
+      const double v = col[3 + j] * (d[j] * d[k]);
+      col[3 + j] = v;
+      P[(3 + j) * ld + 3 + k] = v;
+    }
+  }
+}
+//! The Joseph update of P (`dim` square, column-major; `kDim` > 0: known at compile time) by a scalar
+//! measurement of innovation variance `s` with P·hᵀ = `ph`; `gain` receives K = P·hᵀ/s. Expanded:
+//! P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ, symmetric term by term: the lower triangle computed column by column,
+//! mirrored.
+template <int kDim>
+void joseph_scalar(double* P, const double* ph, double* gain, double s, Eigen::Index dim_runtime) {
+  const Eigen::Index dim = kDim > 0 ? kDim : dim_runtime;
+  for (Eigen::Index k = 0; k < dim; ++k) gain[k] = ph[k] / s;
+  for (Eigen::Index k = 0; k < dim; ++k) {
+    const double kk = gain[k];
+    const double phk = ph[k];
+    const double skk = s * kk;
+    double* col = P + k * dim;
+    for (Eigen::Index j = k; j < dim; ++j) col[j] = col[j] - kk * ph[j] - phk * gain[j] + skk * gain[j];
+    for (Eigen::Index j = k + 1; j < dim; ++j) P[j * dim + k] = col[j];
+  }
+}
 }  // namespace
 
 Eigen::Matrix3d rotation_integral(const Eigen::Vector3d& omega_rad_s, double dt_s) {
@@ -42,7 +135,7 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       bias_(Eigen::VectorXd::Zero(dim_ - 3)),
       decay_(Eigen::VectorXd::Ones(dim_ - 3)),
       coupling_(Eigen::Matrix3Xd::Zero(3, dim_ - 3)),
-      cross_(Eigen::Matrix3Xd::Zero(3, dim_ - 3)),
+      cross_rows_(Eigen::VectorXd::Zero(3 * (dim_ - 3))),
       joseph_(Eigen::MatrixXd::Zero(dim_, dim_)),
       gain_(Eigen::MatrixX3d::Zero(dim_, 3)),
       ph_(Eigen::VectorXd::Zero(dim_)),
@@ -113,10 +206,15 @@ Eigen::Vector3d Mekf::rate_correction(const Eigen::Matrix3Xd& pinv, GyroMask mas
 void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::Vector3d& omega_B_rad_s,
                      double dt_s) {
   if (!(dt_s > 0.0)) return;
-  const Eigen::Index m = dim_ - 3;
+  propagate(quat_exp(omega_B_rad_s * dt_s), pinv, mask, omega_B_rad_s, dt_s);
+}
+
+void Mekf::propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, GyroMask mask,
+                     const Eigen::Vector3d& omega_B_rad_s, double dt_s) {
+  if (!(dt_s > 0.0)) return;
   // Transition Φ = [[A, G], [0, D]]: A rotates the body-frame error by the step's rotation (exact),
   // G = −Γ·H*·(bias states), Γ = ∫ A(u) du; D the bias models' own transitions.
-  const Eigen::Matrix3d A = quat_exp(omega_B_rad_s * dt_s).toRotationMatrix().transpose();
+  const Eigen::Matrix3d A = rotation.toRotationMatrix().transpose();
   const Eigen::Matrix3d gamma = rotation_integral(omega_B_rad_s, dt_s);
   Eigen::Matrix3d q_theta = Eigen::Matrix3d::Zero();
   if (dt_s != gm_dt_s_) gauss_markov_transitions(dt_s);
@@ -133,24 +231,7 @@ void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::V
     decay_[n_ + i] = frozen ? 1.0 : phi;
     if (used) q_theta += pinv.col(i) * pinv.col(i).transpose() * (g.arw_rad_rts * g.arw_rad_rts * dt_s);
   }
-  // U = A·Pθβ + G·Pββ and V = A·Pθθ + G·Pβθ from the old P.
-  const auto Ptb = P_.block<3, Eigen::Dynamic>(0, 3, 3, m);
-  const auto Pbb = P_.block(3, 3, m, m);
-  for (Eigen::Index k = 0; k < m; ++k) {
-    Eigen::Vector3d u = A * Ptb.col(k);
-    for (Eigen::Index j = 0; j < m; ++j) u += coupling_.col(j) * Pbb(j, k);
-    cross_.col(k) = u;
-  }
-  Eigen::Matrix3d V = A * P_.topLeftCorner<3, 3>();
-  for (Eigen::Index j = 0; j < m; ++j) V += coupling_.col(j) * Ptb.col(j).transpose();
-  Eigen::Matrix3d Ptt = V * A.transpose() + q_theta;
-  for (Eigen::Index j = 0; j < m; ++j) Ptt += cross_.col(j) * coupling_.col(j).transpose();
-  P_.topLeftCorner<3, 3>() = 0.5 * (Ptt + Ptt.transpose());
-  for (Eigen::Index k = 0; k < m; ++k) {
-    P_.block<3, 1>(0, 3 + k) = cross_.col(k) * decay_[k];
-    P_.block<1, 3>(3 + k, 0) = (cross_.col(k) * decay_[k]).transpose();
-    for (Eigen::Index j = 0; j < m; ++j) P_(3 + j, 3 + k) *= decay_[j] * decay_[k];
-  }
+  propagate_covariance(A, q_theta);
   for (int i = 0; i < n_; ++i) {
     if (frozen_[static_cast<std::size_t>(i)] != 0) continue;
     const auto& g = gyros_[static_cast<std::size_t>(i)];
@@ -161,6 +242,27 @@ void Mekf::propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::V
     bias_[n_ + i] *= phi;
   }
   // Symmetric by construction but for the attitude block (symmetrized above).
+}
+
+void Mekf::propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta) {
+  const CovarianceStep step{P_.data(), coupling_.data(), decay_.data(), cross_rows_.data()};
+  switch (n_) {  // the common sizes with their loop bounds known to the compiler (unrolled, vectorized)
+    case 3:
+      propagate_blocks<6>(step, 6, A, q_theta);
+      break;
+    case 4:
+      propagate_blocks<8>(step, 8, A, q_theta);
+      break;
+    case 5:
+      propagate_blocks<10>(step, 10, A, q_theta);
+      break;
+    case 6:
+      propagate_blocks<12>(step, 12, A, q_theta);
+      break;
+    default:
+      propagate_blocks<0>(step, dim_ - 3, A, q_theta);
+      break;
+  }
 }
 
 void Mekf::gauss_markov_transitions(double dt_s) {
@@ -203,47 +305,68 @@ ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quatern
   joseph_ = P_;
   for (Eigen::Index k = 0; k < dim_; ++k)  // T = (I − KH)·P
     joseph_.col(k).noalias() -= gain_ * P_.block<3, 1>(0, k);
-  for (Eigen::Index k = 0; k < dim_; ++k) {  // P = T·(I − KH)ᵀ + r·K·Kᵀ
-    const Eigen::Vector3d t = joseph_.block<1, 3>(k, 0).transpose();
-    for (Eigen::Index j = 0; j < dim_; ++j)
-      P_(k, j) = joseph_(k, j) - gain_.row(j).dot(t) + r * gain_.row(k).dot(gain_.row(j));
+  // P = T·(I − KH)ᵀ + r·K·Kᵀ, symmetrized: each pair (k, j) and (j, k) at once, the r·K·Kᵀ term shared.
+  for (Eigen::Index k = 0; k < dim_; ++k) {
+    const Eigen::Vector3d tk = joseph_.block<1, 3>(k, 0).transpose();
+    P_(k, k) = joseph_(k, k) - gain_.row(k).dot(tk) + r * gain_.row(k).dot(gain_.row(k));
+    for (Eigen::Index j = k + 1; j < dim_; ++j) {
+      const Eigen::Vector3d tj = joseph_.block<1, 3>(j, 0).transpose();
+      const double rkk = r * gain_.row(k).dot(gain_.row(j));
+      const double pkj = joseph_(k, j) - gain_.row(j).dot(tk) + rkk;
+      const double pjk = joseph_(j, k) - gain_.row(k).dot(tj) + rkk;
+      const double v = 0.5 * (pkj + pjk);
+      P_(k, j) = v;
+      P_(j, k) = v;
+    }
   }
-  symmetrize();
   return out;
 }
 
 Eigen::Vector3d Mekf::update_parity(const Eigen::MatrixXd& W, int d, GyroMask mask, double scale,
                                     const double* p) {
   Eigen::Vector3d correction = Eigen::Vector3d::Zero();
+  const Eigen::Index ld = dim_;
+  double* P = P_.data();
+  double* ph = ph_.data();
+  double* gain = gain_.data();  // its first column: K = P·hᵀ/s of the row (scratch)
   for (int r = 0; r < d; ++r) {
     // h: ∂p_r/∂(c_i, g_i) = scale·W(r, i) for the gyros of the mask; R = 1.
     double predicted = 0.0;
-    ph_.setZero();
+    std::fill(ph, ph + dim_, 0.0);
     for (int i = 0; i < n_; ++i) {
       if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
       const double h = scale * W(r, i);
       predicted += h * (bias_[i] + bias_[n_ + i]);
-      ph_ += h * (P_.col(c_of(i)) + P_.col(g_of(i)));
+      const double* pc = P + c_of(i) * ld;
+      const double* pg = P + g_of(i) * ld;
+      for (Eigen::Index k = 0; k < dim_; ++k) ph[k] += h * (pc[k] + pg[k]);
     }
     double s = 1.0;
     for (int i = 0; i < n_; ++i) {
       if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
-      s += scale * W(r, i) * (ph_[c_of(i)] + ph_[g_of(i)]);
+      s += scale * W(r, i) * (ph[c_of(i)] + ph[g_of(i)]);
     }
     const double nu = p[r] - predicted;
-    // K = P·hᵀ/s; Joseph form for a scalar measurement, expanded: P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ (symmetric
-    // term by term: one triangle computed, mirrored).
-    for (Eigen::Index k = 0; k < dim_; ++k) {
-      const double kk = ph_[k] / s;
-      for (Eigen::Index j = k; j < dim_; ++j) {
-        const double kj = ph_[j] / s;
-        const double v = P_(k, j) - kk * ph_[j] - ph_[k] * kj + s * kk * kj;
-        P_(k, j) = v;
-        P_(j, k) = v;
-      }
+    switch (dim_) {  // the common sizes with their loop bounds known to the compiler
+      case 9:
+        joseph_scalar<9>(P, ph, gain, s, 9);
+        break;
+      case 11:
+        joseph_scalar<11>(P, ph, gain, s, 11);
+        break;
+      case 13:
+        joseph_scalar<13>(P, ph, gain, s, 13);
+        break;
+      case 15:
+        joseph_scalar<15>(P, ph, gain, s, 15);
+        break;
+      default:
+        joseph_scalar<0>(P, ph, gain, s, dim_);
+        break;
     }
-    correction += ph_.head<3>() * (nu / s);
-    bias_ += ph_.tail(dim_ - 3) * (nu / s);
+    const double gain_nu = nu / s;
+    for (Eigen::Index k = 0; k < 3; ++k) correction[k] += ph[k] * gain_nu;
+    for (Eigen::Index k = 3; k < dim_; ++k) bias_[k - 3] += ph[k] * gain_nu;
   }
   return correction;
 }
@@ -256,16 +379,6 @@ double Mekf::bias_z(int id) const {
 void Mekf::open_fault_hypothesis(double sigma_rad_s) {
   for (int i = 0; i < n_; ++i) {
     if (frozen_[static_cast<std::size_t>(i)] == 0) P_(c_of(i), c_of(i)) += sigma_rad_s * sigma_rad_s;
-  }
-}
-
-void Mekf::symmetrize() {
-  for (Eigen::Index k = 0; k < dim_; ++k) {
-    for (Eigen::Index j = k + 1; j < dim_; ++j) {
-      const double v = 0.5 * (P_(k, j) + P_(j, k));
-      P_(k, j) = v;
-      P_(j, k) = v;
-    }
   }
 }
 

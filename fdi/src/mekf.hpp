@@ -57,6 +57,9 @@ class Mekf {
   //! rate solution `pinv` over the gyros of `mask`: Φ exact for the rotation, biases exact for their models.
   void propagate(const Eigen::Matrix3Xd& pinv, GyroMask mask, const Eigen::Vector3d& omega_B_rad_s,
                  double dt_s);
+  //! The same with the step's body rotation exp(½·ω·Δt) already at hand (`rotation`, from the propagator).
+  void propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, GyroMask mask,
+                 const Eigen::Vector3d& omega_B_rad_s, double dt_s);
 
   //! Adds a variance [rad²] per axis to the attitude (e.g. a bound turned into a 1σ before an update).
   void add_attitude_variance(const Eigen::Vector3d& var_rad2);
@@ -100,8 +103,8 @@ class Mekf {
   Eigen::Index g_of(int i) const { return 3 + n_ + i; }  //!< state index of g_i
   void decorrelate(int i);
   void set_prior(int i);
-  void symmetrize();
   void gauss_markov_transitions(double dt_s);
+  void propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta);
 
   std::vector<GyroNoiseModel> gyros_;
   int n_;
@@ -114,12 +117,12 @@ class Mekf {
   std::vector<double> gm_phi_;
   std::vector<double> gm_kappa_;
   double gm_dt_s_ = -1.0;
-  Eigen::Matrix3Xd coupling_;  //!< 3×2N: ∂δθ/∂bias over the step (scratch)
-  Eigen::Matrix3Xd cross_;     //!< 3×2N: U = A·Pθβ + G·Pββ (scratch)
-  Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
-  Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
-  Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
-  Eigen::VectorXd prior_var_;  //!< [rad²/s²] per gyro: the variance of c + g without any measurement
+  Eigen::Matrix3Xd coupling_;   //!< 3×2N: ∂δθ/∂bias over the step (scratch)
+  Eigen::VectorXd cross_rows_;  //!< 3×2N row-major: U = A·Pθβ + G·Pββ (scratch)
+  Eigen::MatrixXd joseph_;      //!< (3+2N)² scratch of the Joseph update
+  Eigen::MatrixX3d gain_;       //!< (3+2N)×3 Kalman gain
+  Eigen::VectorXd ph_;          //!< (3+2N) P·hᵀ of a scalar update (scratch)
+  Eigen::VectorXd prior_var_;   //!< [rad²/s²] per gyro: the variance of c + g without any measurement
   std::vector<unsigned char> frozen_;
 };
 

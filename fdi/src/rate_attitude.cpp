@@ -101,9 +101,7 @@ Eigen::Vector3d RateAttitude::sigma_rad() const {
 void RateAttitude::parity(const Subset& s, const Eigen::VectorXd& p, double sqrt_period) {
   if (!reference_seen_ || s.dof < 1) return;
   const Eigen::Vector3d dtheta = mekf_.update_parity(s.parity, s.dof, s.mask, sqrt_period, p.data());
-  const Eigen::Vector3d bound = propagator_.sigma_rad();  // the bound alone; kept across the attitude reset
-  propagator_.reset(propagator_.q_RB() * quat_exp(dtheta));
-  propagator_.add_bound(bound);
+  propagator_.rotate(quat_exp(dtheta));  // the bound (a fault's, a lost rate's) kept
 }
 
 ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB) {
@@ -162,7 +160,7 @@ void RateAttitude::propagate(const EpochFrame& frame, const Subset& sol, const S
   const Eigen::Vector3d omega = 0.5 * (omega_prev_ + omega_meas_) - correction_;
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   (void)propagator_.step(omega, frame.dt_s, zero, zero, bound);
-  mekf_.propagate(noise.pinv, noise.mask, omega, frame.dt_s);
+  mekf_.propagate(propagator_.last_increment(), noise.pinv, noise.mask, omega, frame.dt_s);
 }
 
 }  // namespace tetra::fdi::detail

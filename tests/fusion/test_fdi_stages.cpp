@@ -1,6 +1,8 @@
 // Each stage of the pipeline on its own (fdi/src/*.hpp): the invariants a stage promises, checked without the
 // rest of the pipeline around it. The whole pipeline is guarded by the golden trace (test_golden_trace.cpp).
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -150,6 +152,27 @@ TEST(GyroSeries, SignaturesNameTheGyroAndItsKind) {
   }
   EXPECT_TRUE(dropout && stuck);
   EXPECT_NEAR(ratio, 1.0, 0.3);
+}
+
+TEST(GyroSeries, SelectRankGivesTheValueNthElementGives) {
+  // The noise test's median: for any window, with ties and infinities, the same value as std::nth_element
+  // (exact equality: both return an element of the window, the one of that rank). 2,000 seeded windows.
+  std::mt19937_64 rng(15);
+  std::uniform_int_distribution<int> size(1, 40);
+  std::uniform_int_distribution<int> level(0, 6);  // few distinct values: many ties
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int n = size(rng);
+    std::vector<double> a(static_cast<std::size_t>(n));
+    for (double& x : a) {
+      const int l = level(rng);
+      x = l == 0 ? std::numeric_limits<double>::infinity() : (trial % 2 == 0 ? l : std::abs(noise(rng)));
+    }
+    std::vector<double> b = a;
+    const int k = n / 2;
+    std::nth_element(b.begin(), b.begin() + k, b.end());
+    EXPECT_EQ(tetra::fdi::detail::select_rank(a.data(), n, k), b[static_cast<std::size_t>(k)]) << "n " << n;
+  }
 }
 
 TEST(OutlierGate, ASpikeIsLeftOutForOneEpochAndCounted) {

@@ -26,6 +26,9 @@ class AttitudePropagator {
   AttitudePropagator(const Quaternion& q0_RB, std::optional<double> latitude_rad);
 
   void reset(const Quaternion& q0_RB);
+  //! Turns the attitude by `dq_B` in B (q_RB ← q_RB ⊗ dq_B, normalized), e.g. a filter's correction; the
+  //! uncertainty is kept.
+  void rotate(const Quaternion& dq_B) { q_RB_ = (q_RB_ * dq_B).normalized(); }
 
   //! [rad/s] Earth rate in B at the current attitude; zero outside ground-test mode.
   Eigen::Vector3d earth_rate_B() const;
@@ -41,15 +44,19 @@ class AttitudePropagator {
   void add_bound(const Eigen::Vector3d& angle_rad) { bound_rad_ += angle_rad.cwiseAbs(); }
 
   const Quaternion& q_RB() const { return q_RB_; }
+  //! The last step's body rotation exp(½ ω_B Δt) (ω_B the rate the step turned B by: the measured rate in
+  //! ground mode, the rate relative to R otherwise); identity before any step.
+  const Quaternion& last_increment() const { return increment_; }
   //! [rad] 1σ per body axis.
   Eigen::Vector3d sigma_rad() const;
 
  private:
-  Quaternion q_RB_;                              //!< body → reference (L in ground mode); unit norm
-  std::optional<Eigen::Vector3d> earth_rate_L_;  //!< [rad/s] set in ground-test mode
-  Eigen::Vector3d var_random_rad2_;              //!< [rad²]
-  Eigen::Vector3d systematic_rad_;               //!< [rad]
-  Eigen::Vector3d bound_rad_;                    //!< [rad]
+  Quaternion q_RB_;                                //!< body → reference (L in ground mode); unit norm
+  Quaternion increment_ = Quaternion::Identity();  //!< the last step's body rotation
+  std::optional<Eigen::Vector3d> earth_rate_L_;    //!< [rad/s] set in ground-test mode
+  Eigen::Vector3d var_random_rad2_;                //!< [rad²]
+  Eigen::Vector3d systematic_rad_;                 //!< [rad]
+  Eigen::Vector3d bound_rad_;                      //!< [rad]
 };
 
 }  // namespace tetra
