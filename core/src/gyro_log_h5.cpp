@@ -21,8 +21,8 @@ namespace {
 constexpr const char* kFormat = "tetra gyro log";
 constexpr int kVersion = 1;
 constexpr hsize_t kChunkRows = 65536;  // rows per chunk, and per block written
-// Rows per block read: half a chunk (2.5 MB for 4 gyros and a reference).
-constexpr hsize_t kBlockRows = 32768;
+// Rows per block read: one chunk (5 MB for 4 gyros and a reference), read whole when the file allows.
+constexpr hsize_t kBlockRows = kChunkRows;
 constexpr unsigned kDeflateLevel = 1;  // with compression: the noise in gyro values barely compresses anyway
 constexpr std::array<const char*, 4> kRefNames = {"ref_qw", "ref_qx", "ref_qy", "ref_qz"};
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -163,7 +163,44 @@ struct Dataset {
   std::string name;
   Handle id;
   hsize_t cols = 1;  // second dimension of a 2-D dataset
+  // Whole chunks of kBlockRows rows, unfiltered, stored as `raw_type` (a native type): read as raw
+  // bytes straight into the block (H5Dread_chunk), past HDF5's selection and copy. Else 0.
+  hsize_t raw_chunk_rows = 0;
+  hid_t raw_type = H5I_INVALID_HID;
 };
+
+// A dataset whose chunks are kBlockRows rows by `cols`, unfiltered, of a native double or byte type:
+// its chunks' raw bytes are the block's values (what open_dataset records in raw_chunk_rows).
+void find_raw_chunks(Dataset& d, int rank) {
+  Handle dcpl(H5Dget_create_plist(d.id.get()), H5Pclose);
+  if (!dcpl.valid() || H5Pget_layout(dcpl.get()) != H5D_CHUNKED || H5Pget_nfilters(dcpl.get()) != 0) return;
+  std::array<hsize_t, 2> chunk{};
+  if (H5Pget_chunk(dcpl.get(), rank, chunk.data()) != rank || chunk[0] != kBlockRows) return;
+  if (rank == 2 && chunk[1] != d.cols) return;
+  Handle type(H5Dget_type(d.id.get()), H5Tclose);
+  for (const hid_t native : {H5T_NATIVE_DOUBLE, H5T_NATIVE_UINT8}) {
+    if (H5Tequal(type.get(), native) > 0) {
+      d.raw_chunk_rows = chunk[0];
+      d.raw_type = native;
+    }
+  }
+}
+
+// Rows [first, first + count) as one whole chunk's raw bytes, when the dataset allows it (false: read
+// them through H5Dread).
+bool read_raw_chunk(const Dataset& d, hsize_t first, hsize_t count, hid_t mem_type, void* out) {
+  if (d.raw_chunk_rows == 0 || count != d.raw_chunk_rows || first % count != 0 || mem_type != d.raw_type) {
+    return false;
+  }
+  const std::array<hsize_t, 2> offset{first, 0};
+  hsize_t bytes = 0;
+  if (H5Dget_chunk_storage_size(d.id.get(), offset.data(), &bytes) < 0 ||
+      bytes != count * d.cols * H5Tget_size(mem_type)) {
+    return false;
+  }
+  std::uint32_t filters = 0;
+  return H5Dread_chunk(d.id.get(), H5P_DEFAULT, offset.data(), &filters, out) >= 0 && filters == 0;
+}
 
 class H5Reader final : public GyroLogReader {
  public:
@@ -229,10 +266,12 @@ Result<Dataset> H5Reader::open_dataset(const char* name, int rank, hsize_t cols)
   }
   if (name == std::string("time_s")) rows_ = dims[0];
   d.cols = cols;
+  find_raw_chunks(d, rank);
   return d;
 }
 
 Status H5Reader::read_rows(const Dataset& d, hsize_t first, hsize_t count, hid_t mem_type, void* out) const {
+  if (read_raw_chunk(d, first, count, mem_type, out)) return ok_status();
   Handle fspace(H5Dget_space(d.id.get()), H5Sclose);
   const std::array<hsize_t, 2> start{first, 0};
   const std::array<hsize_t, 2> size{count, d.cols};
@@ -363,12 +402,13 @@ Status H5Reader::read_gyros(GyroLog& block, hsize_t count) {
     if (Status s = read_rows(gyros_[g], row_, count, H5T_NATIVE_DOUBLE, columns_.data() + g * n); !s)
       return s;
   }
-  for (std::size_t r = 0; r < n; ++r) {
-    for (std::size_t g = 0; g < ng; ++g) {
-      std::uint8_t& p = block.present[r * ng + g];
-      p = p != 0 ? 1 : 0;
-      block.values[r * ng + g] = p != 0 ? columns_[g * n + r] : kNaN;
-    }
+  // Plain pointers, one gyro at a time: no store through a byte pointer that could alias the others.
+  std::uint8_t* present = block.present.data();
+  for (std::size_t k = 0; k < n * ng; ++k) present[k] = present[k] != 0 ? 1 : 0;
+  double* values = block.values.data();
+  for (std::size_t g = 0; g < ng; ++g) {
+    const double* column = columns_.data() + g * n;
+    for (std::size_t r = 0; r < n; ++r) values[r * ng + g] = present[r * ng + g] != 0 ? column[r] : kNaN;
   }
   return ok_status();
 }
@@ -382,12 +422,12 @@ Status H5Reader::read_reference(GyroLog& block, hsize_t count) {
   }
   if (Status s = read_rows(ref_present_, row_, count, H5T_NATIVE_UINT8, block.reference_present.data()); !s)
     return s;
+  std::uint8_t* present = block.reference_present.data();
+  std::array<double, 4>* wxyz = block.reference_wxyz.data();
+  const double* column = columns_.data();
   for (std::size_t r = 0; r < n; ++r) {
-    std::uint8_t& p = block.reference_present[r];
-    p = p != 0 ? 1 : 0;
-    block.reference_wxyz[r] =
-        p != 0 ? std::array<double, 4>{columns_[r], columns_[n + r], columns_[2 * n + r], columns_[3 * n + r]}
-               : std::array<double, 4>{kNaN, kNaN, kNaN, kNaN};
+    present[r] = present[r] != 0 ? 1 : 0;
+    for (std::size_t k = 0; k < 4; ++k) wxyz[r][k] = present[r] != 0 ? column[k * n + r] : kNaN;
   }
   return ok_status();
 }
