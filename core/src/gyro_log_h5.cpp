@@ -402,13 +402,15 @@ Status H5Reader::read_gyros(GyroLog& block, hsize_t count) {
     if (Status s = read_rows(gyros_[g], row_, count, H5T_NATIVE_DOUBLE, columns_.data() + g * n); !s)
       return s;
   }
-  // Plain pointers, one gyro at a time: no store through a byte pointer that could alias the others.
+  // Plain pointers, and no store through a byte pointer in the copy (it could alias every other one).
   std::uint8_t* present = block.present.data();
   for (std::size_t k = 0; k < n * ng; ++k) present[k] = present[k] != 0 ? 1 : 0;
   double* values = block.values.data();
-  for (std::size_t g = 0; g < ng; ++g) {
-    const double* column = columns_.data() + g * n;
-    for (std::size_t r = 0; r < n; ++r) values[r * ng + g] = present[r * ng + g] != 0 ? column[r] : kNaN;
+  const double* columns = columns_.data();
+  for (std::size_t r = 0; r < n; ++r) {  // the epochs written in order, the columns read side by side
+    for (std::size_t g = 0; g < ng; ++g) {
+      values[r * ng + g] = present[r * ng + g] != 0 ? columns[g * n + r] : kNaN;
+    }
   }
   return ok_status();
 }
