@@ -47,15 +47,18 @@ growth_table() {  # from the rows of row(): first and last size of every command
 read_rows() {  # LOG FMT: best of 3 block reads
   local best
   best=$(for _ in 1 2 3; do "$build/bench/read_log" "$1" blocks; done | awk '{ print $6, $3 }' | sort -n | head -1)
-  echo "$best" | awk -v f="$2" '{ printf "%-8s %-5s %10d %8.3f %12.0f\n", "read", f, $2, $1, $2 / $1 }' |
-    tee -a "$work/reads.txt"
+  echo "$best" | awk -v f="$2" '{ printf "%-8s %-5s %10d %8.3f %12.0f\n", "read", f, $2, $1, $2 / $1 }'
+  local stem
+  stem=$(basename "$1")
+  echo "${stem%%.*} $2 $best" >>"$work/reads.txt"  # log, format, seconds, epochs
 }
 read_ratios() {  # HDF5 read against CSV read of the same log
   echo
   echo "read: CSV seconds / HDF5 seconds for the same log (best of 3 each)"
-  awk '{ t[$3 " " $2] = $4; if ($2 == "csv") sizes[++n] = $3 }
-    END { for (i = 1; i <= n; ++i) { e = sizes[i]
-      printf "%10d epochs: h5 %5.1fx, h5z %5.1fx\n", e, t[e " csv"] / t[e " h5"], t[e " csv"] / t[e " h5z"] } }' \
+  awk '{ t[$1 " " $2] = $3; if ($2 == "csv") { logs[++n] = $1; epochs[$1] = $4 } }
+    END { for (i = 1; i <= n; ++i) { l = logs[i]
+      printf "%-10s %10d epochs: CSV %6.3f s, h5 %6.3f s (%5.1fx), h5z %6.3f s (%5.1fx)\n", l, epochs[l],
+        t[l " csv"], t[l " h5"], t[l " csv"] / t[l " h5"], t[l " h5z"], t[l " csv"] / t[l " h5z"] } }' \
     "$work/reads.txt"
 }
 epochs_of() { grep -vc '^#' "$1" | awk '{ print $1 - 1 }'; }
