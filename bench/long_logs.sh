@@ -19,6 +19,7 @@ build=${1:-build}
 T="$build/tetra"
 work=$(mktemp -d /tmp/tetra-long-logs-XXXXXX)
 trap 'rm -rf "$work"' EXIT
+touch "$work/rows.txt" "$work/reads.txt"
 REPLAY_MINUTES=${REPLAY_MINUTES:-"30 120 360"}
 ALLAN_HOURS=${ALLAN_HOURS:-"2 4 8"}
 

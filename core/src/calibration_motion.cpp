@@ -13,6 +13,7 @@
 #include "tetra/core/csv.hpp"
 #include "tetra/core/frames.hpp"
 #include "tetra/core/units.hpp"
+#include "turntable_log_internal.hpp"
 
 namespace tetra {
 
@@ -323,6 +324,86 @@ BodyRate body_rate(const SequenceMotion& m, double inner_deg, double outer_deg, 
           turntable_earth_rate_B(inner_rad, outer_rad, latitude_rad) * kRadToDeg};
 }
 
+namespace {
+
+constexpr std::size_t kRateBlockRows = 1024;  // rates written or read back at a time
+
+// Appends rates to the cache a block at a time; marks it failed (and unused) when it cannot write.
+class RateWriter {
+ public:
+  explicit RateWriter(BodyRateCache* cache) : cache_(cache) {
+    if (cache_ == nullptr || cache_->failed || cache_->file != nullptr) return;
+    auto file = turntable_detail::open_temporary_file("the body rates");
+    if (file) {
+      cache_->file = *file;
+    } else {
+      cache_->failed = true;
+    }
+  }
+  bool active() const { return cache_ != nullptr && !cache_->failed && cache_->file != nullptr; }
+  void add(const Eigen::Vector3d& w) {
+    buffer_.insert(buffer_.end(), w.data(), w.data() + 3);
+    if (buffer_.size() == 3 * kRateBlockRows) flush();
+  }
+  void finish() {
+    flush();
+    if (active() && std::fflush(cache_->file) == 0) cache_->ready = true;
+  }
+
+ private:
+  void flush() {
+    if (active() &&
+        std::fwrite(buffer_.data(), sizeof(double), buffer_.size(), cache_->file) != buffer_.size()) {
+      cache_->failed = true;
+    }
+    buffer_.clear();
+  }
+  BodyRateCache* cache_;
+  std::vector<double> buffer_;
+};
+
+// Moves `cursor` to the sequence (index into file_order) that holds `row`.
+void advance(const TurntableMotion& motion, const std::vector<std::size_t>& file_order,
+             const TurntableRow& row, std::size_t& cursor) {
+  while (cursor + 1 < file_order.size() && row.index >= motion.sequences[file_order[cursor + 1]].first_row) {
+    ++cursor;
+  }
+}
+
+// The cached rates read back beside the rows.
+Status replay_rates(const TurntableRows& rows, const std::vector<std::size_t>& file_order,
+                    const TurntableMotion& motion, BodyRateCache& cache, const RateRowVisitor& visit) {
+  if (std::fseek(cache.file, 0, SEEK_SET) != 0)
+    return failure(rows.source() + ": cannot read the body rates again");
+  std::vector<double> buffer(3 * kRateBlockRows);
+  std::size_t held = 0;
+  std::size_t next = 0;
+  bool short_read = false;
+  std::size_t cursor = 0;
+  Status read = rows.for_each([&](const TurntableRow& row) {
+    if (short_read) return;
+    if (next == held) {
+      const std::size_t want = std::min(kRateBlockRows, rows.rows() - row.index);
+      held = std::fread(buffer.data(), 3 * sizeof(double), want, cache.file);
+      next = 0;
+      if (held != want) {
+        short_read = true;
+        return;
+      }
+    }
+    advance(motion, file_order, row, cursor);
+    const Eigen::Vector3d w(buffer[3 * next], buffer[3 * next + 1], buffer[3 * next + 2]);
+    ++next;
+    visit(row, file_order[cursor], w);
+  });
+  if (!read) return read;
+  if (short_read)
+    return failure(rows.source() + ": cannot read the body rates again from the temporary file");
+  return ok_status();
+}
+
+}  // namespace
+
 Status for_each_rate_row(const TurntableRows& rows, const TurntableMotion& motion,
                          const RateRowVisitor& visit) {
   std::vector<std::size_t> file_order(motion.sequences.size());
@@ -330,16 +411,22 @@ Status for_each_rate_row(const TurntableRows& rows, const TurntableMotion& motio
   std::sort(file_order.begin(), file_order.end(), [&](std::size_t a, std::size_t b) {
     return motion.sequences[a].first_row < motion.sequences[b].first_row;
   });
+  BodyRateCache* cache = motion.rate_cache.get();
+  if (cache != nullptr && cache->ready) return replay_rates(rows, file_order, motion, *cache, visit);
+  RateWriter writer(cache);
   const double latitude_rad = motion.latitude_deg * kDegToRad;
   std::size_t cursor = 0;
-  return rows.for_each([&](const TurntableRow& row) {
-    while (cursor + 1 < file_order.size() &&
-           row.index >= motion.sequences[file_order[cursor + 1]].first_row) {
-      ++cursor;
-    }
+  Status read = rows.for_each([&](const TurntableRow& row) {
+    advance(motion, file_order, row, cursor);
     const std::size_t j = file_order[cursor];
-    visit(row, j, body_rate(motion.sequences[j], row.inner_deg, row.outer_deg, latitude_rad).total_dps());
+    const Eigen::Vector3d w =
+        body_rate(motion.sequences[j], row.inner_deg, row.outer_deg, latitude_rad).total_dps();
+    if (writer.active()) writer.add(w);
+    visit(row, j, w);
   });
+  if (!read) return read;
+  writer.finish();
+  return ok_status();
 }
 
 }  // namespace calibration_detail
@@ -362,6 +449,7 @@ Result<TurntableMotion> analyze_turntable(const TurntableRows& rows, double lati
   motion.latitude_deg = latitude_deg;
   motion.rows = rows.rows();
   motion.start_time_s = scan->start_time_s;
+  motion.rate_cache = std::make_shared<BodyRateCache>();
   if (Status s = collect_sequences(*scan, motion); !s) return s.error();
   if (Status s = check_pairs(rows.source(), *scan, motion, tolerances); !s) return s.error();
   if (Status s = check_excitation(rows.source(), motion); !s) return s.error();

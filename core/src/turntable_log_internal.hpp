@@ -3,6 +3,8 @@
 // and the pass-by-pass reader (turntable_rows.cpp). Private to tetra::core.
 
 #include <cstddef>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 #include "tetra/core/csv.hpp"
@@ -22,6 +24,10 @@ Result<Columns> find_columns(const CsvTable& t);
 //! Checks row `r` of `t`: every cell a finite number, the sequence a positive integer, the time after
 //! `previous_time_s` (none for the file's first row). Messages name the file, line and column.
 Status check_row(const CsvTable& t, const Columns& c, std::size_t r, const double* previous_time_s);
+
+//! An unnamed temporary binary file in $TMPDIR or /tmp, removed from its folder at once (freed when
+//! closed); `what` names its use in messages.
+Result<std::FILE*> open_temporary_file(const std::string& what);
 
 //! Comment lines found in a block after the `header_entries` of the header (the whole file's order).
 void append_block_metadata(const CsvTable& block, std::size_t header_entries, Metadata& metadata);

@@ -20,21 +20,6 @@ std::size_t record_size(int gyro_count) {
   return kFixedFields + static_cast<std::size_t>(gyro_count);
 }
 
-// An unnamed temporary file (removed from the folder at once, freed when closed) in $TMPDIR or /tmp.
-Result<std::FILE*> open_spill_file() {
-  const char* dir = std::getenv("TMPDIR");
-  std::string templ = std::string(dir != nullptr && *dir != '\0' ? dir : "/tmp") + "/tetra-turntable-XXXXXX";
-  const int fd = ::mkstemp(templ.data());
-  if (fd < 0) return failure(templ + ": cannot create a temporary file for the turntable rows");
-  ::unlink(templ.c_str());
-  std::FILE* f = ::fdopen(fd, "w+b");
-  if (f == nullptr) {
-    ::close(fd);
-    return failure(templ + ": cannot open the temporary file for the turntable rows");
-  }
-  return f;
-}
-
 // The record of row `r` of a checked block: line, sequence, time, angles, gyro outputs.
 void append_record(const CsvTable& t, const turntable_detail::Columns& c, std::size_t r,
                    std::vector<double>& out) {
@@ -44,6 +29,24 @@ void append_record(const CsvTable& t, const turntable_detail::Columns& c, std::s
 }
 
 }  // namespace
+
+namespace turntable_detail {
+
+Result<std::FILE*> open_temporary_file(const std::string& what) {
+  const char* dir = std::getenv("TMPDIR");
+  std::string templ = std::string(dir != nullptr && *dir != '\0' ? dir : "/tmp") + "/tetra-turntable-XXXXXX";
+  const int fd = ::mkstemp(templ.data());
+  if (fd < 0) return failure(templ + ": cannot create a temporary file for " + what);
+  ::unlink(templ.c_str());
+  std::FILE* f = ::fdopen(fd, "w+b");
+  if (f == nullptr) {
+    ::close(fd);
+    return failure(templ + ": cannot open the temporary file for " + what);
+  }
+  return f;
+}
+
+}  // namespace turntable_detail
 
 Status TurntableLogRows::for_each(const TurntableRowVisitor& visit) const {
   const auto ng = static_cast<std::size_t>(log_.gyro_count);
@@ -98,7 +101,7 @@ Status TurntableFileRows::open(const std::string& path) {
   CsvStreamReader reader;
   if (Status s = reader.open(path); !s) return s;
   metadata_ = reader.header().metadata;
-  auto spill = open_spill_file();
+  auto spill = turntable_detail::open_temporary_file("the turntable rows");
   if (!spill) return spill.error();
   spill_ = *spill;
   if (Status s = spill_rows(reader, metadata_.size()); !s) return s;

@@ -27,6 +27,7 @@
 // a unit with bias instability gets 1σ several times too small (docs/calibration.md, "Are the 1σ honest?").
 // Both report, per gyro, the residual RMS over samples and over sequence means.
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,8 @@ struct SequenceMotion {
 
 //! The log interpreted: sequences in plan order with their mean outputs. The body rate of a row is
 //! recomputed from its sequence's motion and its encoder angles when needed, never stored per row.
+struct BodyRateCache;  // calibration's own: the body rates once computed (core/src/calibration_rows.hpp)
+
 struct TurntableMotion {
   std::string source;                     //!< file name for messages
   double latitude_deg = 0.0;              //!< [deg]
@@ -83,6 +86,9 @@ struct TurntableMotion {
   double start_time_s = 0.0;              //!< [s] time of the log's first row
   std::vector<SequenceMotion> sequences;  //!< sorted by plan index; pairs (2k−1, 2k) adjacent
   Eigen::MatrixXd g_mean_V;               //!< [V] M×N mean output of every gyro over each sequence
+  //! The body rate of every row, written to a temporary file by the first pass that needs them and read
+  //! back by the later ones (24 bytes a row, on disk); shared by copies of the motion.
+  std::shared_ptr<BodyRateCache> rate_cache;
 };
 
 //! Interprets the encoder angles: groups rows by sequence (each sequence contiguous), unwraps angles,
