@@ -196,5 +196,26 @@ TEST(CalibrationStream, FileRowsGiveTheLogInMemorysResults) {
   EXPECT_NE(from_file.error().message.find("appears again"), std::string::npos) << from_file.error().message;
 }
 
+// Without a folder for its temporary file the log cannot be visited in passes: a failure (tetra calibrate
+// exits 1), not bad input, naming the folder.
+TEST(CalibrationStream, NoTemporaryFolderIsAFailureNamingIt) {
+  test::TempDir dir;
+  ASSERT_TRUE(write_turntable_log(dir.file("tt.csv"), simulated_log(true)).ok());
+  const char* before = std::getenv("TMPDIR");
+  const std::string saved = before != nullptr ? before : "";
+  setenv("TMPDIR", dir.file("missing").c_str(), 1);
+  TurntableFileRows rows;
+  const Status opened = rows.open(dir.file("tt.csv"));
+  if (before != nullptr) {
+    setenv("TMPDIR", saved.c_str(), 1);
+  } else {
+    unsetenv("TMPDIR");
+  }
+  ASSERT_FALSE(opened.ok());
+  EXPECT_EQ(opened.error().kind, ErrorKind::kFailure);
+  EXPECT_NE(opened.error().message.find(dir.file("missing")), std::string::npos) << opened.error().message;
+  EXPECT_NE(opened.error().message.find("cannot create a temporary file"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace tetra

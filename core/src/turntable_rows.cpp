@@ -3,7 +3,9 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include "tetra/core/input_files.hpp"
@@ -33,15 +35,19 @@ void append_record(const CsvTable& t, const turntable_detail::Columns& c, std::s
 namespace turntable_detail {
 
 Result<std::FILE*> open_temporary_file(const std::string& what) {
-  const char* dir = std::getenv("TMPDIR");
-  std::string templ = std::string(dir != nullptr && *dir != '\0' ? dir : "/tmp") + "/tetra-turntable-XXXXXX";
+  const char* env = std::getenv("TMPDIR");
+  const std::string dir = env != nullptr && *env != '\0' ? env : "/tmp";
+  std::string templ = dir + "/tetra-turntable-XXXXXX";
   const int fd = ::mkstemp(templ.data());
-  if (fd < 0) return failure(templ + ": cannot create a temporary file for " + what);
+  if (fd < 0) {
+    return failure(dir + ": cannot create a temporary file for " + what + " (" + std::strerror(errno) +
+                   "; TMPDIR names another folder)");
+  }
   ::unlink(templ.c_str());
   std::FILE* f = ::fdopen(fd, "w+b");
   if (f == nullptr) {
     ::close(fd);
-    return failure(templ + ": cannot open the temporary file for " + what);
+    return failure(dir + ": cannot open a temporary file for " + what);
   }
   return f;
 }
