@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "calibration_test_unit.hpp"
 #include "tetra/core/calibration.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/correlated_noise.hpp"
@@ -27,17 +28,7 @@ constexpr double kAxisTol = 1e-5;      // issue: axes to 1e-5 (per component of 
 constexpr double kBiasTol_V = 2e-6;    // issue: β to 2e-6 V
 constexpr double kSigmaBound = 4.0;    // issue: every error within 4σ
 
-//! The seed unit with white rate noise only (no bias instability), as the issue asks.
-Calibration white_noise_unit() {
-  Calibration unit = seed_as_built_unit();
-  for (auto& g : unit.gyros) {
-    GyroNoise noise;
-    noise.arw_dps_rtHz = 3e-5;
-    g.noise = noise;
-    g.sigma.reset();
-  }
-  return unit;
-}
+using test::white_noise_unit;
 
 struct SimulatedRun {
   CalibrationResult result;

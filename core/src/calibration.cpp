@@ -8,6 +8,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include "calibration_rows.hpp"
 #include "tetra/core/correlated_noise.hpp"
 #include "tetra/core/frames.hpp"
 #include "tetra/core/units.hpp"
@@ -23,61 +24,46 @@ Eigen::Index idx(std::size_t i) {
   return static_cast<Eigen::Index>(i);
 }
 
-//! Per-sequence means of every gyro (M×N) [V].
-Eigen::MatrixXd sequence_means(const TurntableLog& log, const TurntableMotion& motion) {
-  const int n_gyros = log.gyro_count;
-  Eigen::MatrixXd mean = Eigen::MatrixXd::Zero(idx(motion.sequences.size()), n_gyros);
-  for (std::size_t j = 0; j < motion.sequences.size(); ++j) {
-    const SequenceMotion& m = motion.sequences[j];
-    for (std::size_t r = m.first_row; r < m.first_row + m.row_count; ++r) {
-      for (int i = 0; i < n_gyros; ++i) mean(idx(j), i) += log.g(r, i);
-    }
-    mean.row(idx(j)) /= static_cast<double>(m.row_count);
-  }
-  return mean;
-}
-
 //! 1σ of each sequence mean (M×N) [V]: the scatter of g_i − x_i·ω_B about its own sequence mean
-//! (the deterministic rate signal removed), sample standard deviation / √n.
-Eigen::MatrixXd sequence_sigma_of_mean(const TurntableLog& log, const TurntableMotion& motion,
-                                       const Eigen::MatrixX3d& x) {
-  const int n_gyros = log.gyro_count;
+//! (the deterministic rate signal removed), sample standard deviation / √n. One pass.
+Result<Eigen::MatrixXd> sequence_sigma_of_mean(const TurntableRows& rows, const TurntableMotion& motion,
+                                               const Eigen::MatrixX3d& x) {
+  const int n_gyros = rows.gyro_count();
   const auto m_count = idx(motion.sequences.size());
+  // Shifted by each sequence's first residual so the sums do not lose precision.
+  Eigen::MatrixXd shift(m_count, n_gyros);
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(m_count, n_gyros);
+  Eigen::MatrixXd sum_sq = Eigen::MatrixXd::Zero(m_count, n_gyros);
+  Status read = calibration_detail::for_each_rate_row(
+      rows, motion, [&](const TurntableRow& row, std::size_t j, const Eigen::Vector3d& w) {
+        const auto jj = idx(j);
+        if (row.index == motion.sequences[j].first_row) {
+          for (int i = 0; i < n_gyros; ++i) shift(jj, i) = row.g_V[i] - x.row(i).dot(w);
+        }
+        for (int i = 0; i < n_gyros; ++i) {
+          const double e = row.g_V[i] - x.row(i).dot(w) - shift(jj, i);
+          sum(jj, i) += e;
+          sum_sq(jj, i) += e * e;
+        }
+      });
+  if (!read) return read.error();
   Eigen::MatrixXd sigma(m_count, n_gyros);
-  Eigen::VectorXd sum(n_gyros);
-  Eigen::VectorXd sum_sq(n_gyros);
-  for (std::size_t j = 0; j < motion.sequences.size(); ++j) {
-    const SequenceMotion& m = motion.sequences[j];
-    // Shift by the first row's value so the sums do not lose precision.
-    Eigen::VectorXd shift(n_gyros);
+  for (Eigen::Index j = 0; j < m_count; ++j) {
+    const double n = static_cast<double>(motion.sequences[static_cast<std::size_t>(j)].row_count);
     for (int i = 0; i < n_gyros; ++i) {
-      shift(i) = log.g(m.first_row, i) - x.row(i).dot(motion.rate_B_dps[m.first_row]);
-    }
-    sum.setZero();
-    sum_sq.setZero();
-    for (std::size_t r = m.first_row; r < m.first_row + m.row_count; ++r) {
-      const Eigen::Vector3d& w = motion.rate_B_dps[r];
-      for (int i = 0; i < n_gyros; ++i) {
-        const double e = log.g(r, i) - x.row(i).dot(w) - shift(i);
-        sum(i) += e;
-        sum_sq(i) += e * e;
-      }
-    }
-    const double n = static_cast<double>(m.row_count);
-    for (int i = 0; i < n_gyros; ++i) {
-      const double variance = std::max(0.0, (sum_sq(i) - sum(i) * sum(i) / n) / (n - 1.0));
-      sigma(idx(j), i) = std::sqrt(variance / n);
+      const double variance = std::max(0.0, (sum_sq(j, i) - sum(j, i) * sum(j, i) / n) / (n - 1.0));
+      sigma(j, i) = std::sqrt(variance / n);
     }
   }
   return sigma;
 }
 
 //! The time span of every sequence, each sample standing for ±half a sampling interval.
-std::vector<TimeInterval> sequence_intervals(const TurntableLog& log, const TurntableMotion& motion) {
+std::vector<TimeInterval> sequence_intervals(const TurntableMotion& motion) {
   std::vector<TimeInterval> spans;
   for (const SequenceMotion& m : motion.sequences) {
-    const double first_s = log.time_s[m.first_row];
-    const double last_s = log.time_s[m.first_row + m.row_count - 1];
+    const double first_s = m.first_time_s;
+    const double last_s = m.last_time_s;
     const double half_dt_s =
         m.row_count > 1 ? 0.5 * (last_s - first_s) / static_cast<double>(m.row_count - 1) : 0.0;
     spans.push_back({first_s - half_dt_s, last_s + half_dt_s});
@@ -86,14 +72,14 @@ std::vector<TimeInterval> sequence_intervals(const TurntableLog& log, const Turn
 }
 
 //! Covariance [V²] (M×M) of gyro i's sequence means from its correlated noise (none without a model).
-Eigen::MatrixXd correlated_sequence_covariance(const TurntableLog& log, const TurntableMotion& motion,
+Eigen::MatrixXd correlated_sequence_covariance(const TurntableMotion& motion,
                                                const CalibrationOptions& options, int gyro_index0,
                                                double scale_V_per_dps) {
   const auto m_count = idx(motion.sequences.size());
   if (options.noise.empty()) return Eigen::MatrixXd::Zero(m_count, m_count);
-  const double start_s = log.time_s.front();
+  const double start_s = motion.start_time_s;
   return scale_V_per_dps * scale_V_per_dps *
-         correlated_mean_covariance(sequence_intervals(log, motion),
+         correlated_mean_covariance(sequence_intervals(motion),
                                     options.noise[static_cast<std::size_t>(gyro_index0)],
                                     options.bias_instability_correlation_s, start_s);
 }
@@ -117,12 +103,12 @@ GyroCalibration to_gyro(int id, const Eigen::Vector3d& x, double bias_V, const M
   return g;
 }
 
-Result<CalibrationResult> calibrate_sixteen(const TurntableLog& log, const TurntableMotion& motion,
+Result<CalibrationResult> calibrate_sixteen(const TurntableRows& rows, const TurntableMotion& motion,
                                             const CalibrationOptions& options) {
-  const int n_gyros = log.gyro_count;
+  const int n_gyros = rows.gyro_count();
   const std::size_t m_count = motion.sequences.size();
   const std::size_t pairs = m_count / 2;
-  const Eigen::MatrixXd g_mean = sequence_means(log, motion);
+  const Eigen::MatrixXd& g_mean = motion.g_mean_V;
 
   // Eqs. 5–7: Δḡ = Ω x with Ω rows ω̄(2k−1) − ω̄(2k) (encoder-derived, Earth rate included).
   // x = Ω# Δḡ = Ω# S ḡ =: L ḡ, with S (P×M) the pair-difference operator.
@@ -155,7 +141,9 @@ Result<CalibrationResult> calibrate_sixteen(const TurntableLog& log, const Turnt
     x.row(i) = (to_x * g_mean.col(i)).transpose();
     bias(i) = to_bias.dot(g_mean.col(i));
   }
-  const Eigen::MatrixXd sigma_mean = sequence_sigma_of_mean(log, motion, x);
+  auto sigma_of_mean = sequence_sigma_of_mean(rows, motion, x);
+  if (!sigma_of_mean) return sigma_of_mean.error();
+  const Eigen::MatrixXd& sigma_mean = *sigma_of_mean;
 
   // Linear propagation: (x, β) = [L; cᵀ] ḡ_i with cov(ḡ_i) = diag(σ_mean²).
   Eigen::MatrixXd to_params(4, idx(m_count));
@@ -167,7 +155,7 @@ Result<CalibrationResult> calibrate_sixteen(const TurntableLog& log, const Turnt
   result.calibration.method =
       options.bias_model == BiasModel::kBody ? "sixteen-position" : "sixteen-position-seed-bias";
   for (int i = 0; i < n_gyros; ++i) {
-    Eigen::MatrixXd mean_cov = correlated_sequence_covariance(log, motion, options, i, x.row(i).norm());
+    Eigen::MatrixXd mean_cov = correlated_sequence_covariance(motion, options, i, x.row(i).norm());
     mean_cov.diagonal() += sigma_mean.col(i).array().square().matrix();
     const Matrix4d cov = to_params * mean_cov * to_params.transpose();
     result.calibration.gyros.push_back(to_gyro(i + 1, x.row(i).transpose(), bias(i), cov));
@@ -176,40 +164,56 @@ Result<CalibrationResult> calibrate_sixteen(const TurntableLog& log, const Turnt
   return result;
 }
 
-Result<CalibrationResult> calibrate_batch(const TurntableLog& log, const TurntableMotion& motion,
+// The normal equations of g_i = x_i·ω_B + β_i over every sample (regressor a = (ω_B, 1), the same for
+// every gyro: one normal matrix, N right-hand sides), the lower triangle of the matrix filled. One pass.
+Status accumulate_normal_equations(const TurntableRows& rows, const TurntableMotion& motion, Matrix4d& normal,
+                                   Eigen::Matrix<double, 4, Eigen::Dynamic>& rhs) {
+  const int n_gyros = rows.gyro_count();
+  normal.setZero();
+  rhs = Eigen::Matrix<double, 4, Eigen::Dynamic>::Zero(4, n_gyros);
+  return calibration_detail::for_each_rate_row(
+      rows, motion, [&](const TurntableRow& row, std::size_t, const Eigen::Vector3d& w) {
+        const Vector4d a(w.x(), w.y(), w.z(), 1.0);
+        normal.selfadjointView<Eigen::Lower>().rankUpdate(a);
+        for (int i = 0; i < n_gyros; ++i) rhs.col(i) += a * row.g_V[i];
+      });
+}
+
+// Residual sum of squares of every gyro about the fit θ (columns (x_i, β_i)). One pass.
+Result<Eigen::VectorXd> residual_sum_of_squares(const TurntableRows& rows, const TurntableMotion& motion,
+                                                const Eigen::Matrix<double, 4, Eigen::Dynamic>& theta) {
+  const int n_gyros = rows.gyro_count();
+  Eigen::VectorXd rss = Eigen::VectorXd::Zero(n_gyros);
+  Status read = calibration_detail::for_each_rate_row(
+      rows, motion, [&](const TurntableRow& row, std::size_t, const Eigen::Vector3d& w) {
+        for (int i = 0; i < n_gyros; ++i) {
+          const double e = row.g_V[i] - theta.col(i).head<3>().dot(w) - theta(3, i);
+          rss(i) += e * e;
+        }
+      });
+  if (!read) return read.error();
+  return rss;
+}
+
+Result<CalibrationResult> calibrate_batch(const TurntableRows& rows, const TurntableMotion& motion,
                                           const CalibrationOptions& options) {
-  const int n_gyros = log.gyro_count;
-  // Regressor a = (ω_B, 1) is the same for every gyro: one normal matrix, N right-hand sides.
-  Matrix4d normal = Matrix4d::Zero();
-  Eigen::Matrix<double, 4, Eigen::Dynamic> rhs = Eigen::Matrix<double, 4, Eigen::Dynamic>::Zero(4, n_gyros);
-  const std::size_t rows = log.rows();
-  for (const auto& m : motion.sequences) {
-    for (std::size_t r = m.first_row; r < m.first_row + m.row_count; ++r) {
-      const Eigen::Vector3d& w = motion.rate_B_dps[r];
-      const Vector4d a(w.x(), w.y(), w.z(), 1.0);
-      normal.selfadjointView<Eigen::Lower>().rankUpdate(a);
-      for (int i = 0; i < n_gyros; ++i) rhs.col(i) += a * log.g(r, i);
-    }
-  }
+  const int n_gyros = rows.gyro_count();
+  Matrix4d normal;
+  Eigen::Matrix<double, 4, Eigen::Dynamic> rhs;
+  if (Status s = accumulate_normal_equations(rows, motion, normal, rhs); !s) return s.error();
   normal = normal.selfadjointView<Eigen::Lower>();
   const Eigen::LDLT<Matrix4d> ldlt(normal);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) {
-    return bad_input(log.source +
+    return bad_input(rows.source() +
                      ": the batch fit is singular: the samples do not separate rates and biases");
   }
   const Eigen::Matrix<double, 4, Eigen::Dynamic> theta = ldlt.solve(rhs);
   const Matrix4d normal_inv = ldlt.solve(Matrix4d::Identity());
-
-  Eigen::VectorXd rss = Eigen::VectorXd::Zero(n_gyros);
-  for (std::size_t r = 0; r < rows; ++r) {
-    const Eigen::Vector3d& w = motion.rate_B_dps[r];
-    for (int i = 0; i < n_gyros; ++i) {
-      const double e = log.g(r, i) - theta.col(i).head<3>().dot(w) - theta(3, i);
-      rss(i) += e * e;
-    }
-  }
-  const double dof = static_cast<double>(rows) - 4.0;
-  if (dof < 1.0) return bad_input(log.source + ": too few rows for the batch fit");
+  auto rss_of = residual_sum_of_squares(rows, motion, theta);
+  if (!rss_of) return rss_of.error();
+  const Eigen::VectorXd& rss = *rss_of;
+  const double dof = static_cast<double>(rows.rows()) - 4.0;
+  if (dof < 1.0) return bad_input(rows.source() + ": too few rows for the batch fit");
 
   CalibrationResult result;
   result.calibration.unit = options.unit;
@@ -227,26 +231,27 @@ Result<CalibrationResult> calibrate_batch(const TurntableLog& log, const Turntab
   for (int i = 0; i < n_gyros; ++i) {
     x.row(i) = theta.col(i).head<3>().transpose();
     const Eigen::MatrixXd mean_cov =
-        correlated_sequence_covariance(log, motion, options, i, theta.col(i).head<3>().norm());
+        correlated_sequence_covariance(motion, options, i, theta.col(i).head<3>().norm());
     const Matrix4d correlated = summed_regressor.transpose() * mean_cov * summed_regressor;
     const Matrix4d cov = (rss(i) / dof) * normal_inv + normal_inv * correlated * normal_inv;
     result.calibration.gyros.push_back(to_gyro(i + 1, theta.col(i).head<3>(), theta(3, i), cov));
   }
-  result.sequence_sigma_mean_V = sequence_sigma_of_mean(log, motion, x);
+  auto sigma_mean = sequence_sigma_of_mean(rows, motion, x);
+  if (!sigma_mean) return sigma_mean.error();
+  result.sequence_sigma_mean_V = std::move(sigma_mean.value());
   return result;
 }
 
 }  // namespace
 
-Result<CalibrationFit> evaluate_calibration(const TurntableLog& log, const TurntableMotion& motion,
+Result<CalibrationFit> evaluate_calibration(const TurntableRows& rows, const TurntableMotion& motion,
                                             const Calibration& calibration) {
-  const int n_gyros = log.gyro_count;
+  const int n_gyros = rows.gyro_count();
   if (calibration.gyro_count() != n_gyros) {
     return bad_input("the calibration has " + std::to_string(calibration.gyro_count()) + " gyros, " +
-                     log.source + " has " + std::to_string(n_gyros));
+                     rows.source() + " has " + std::to_string(n_gyros));
   }
-  if (motion.rate_B_dps.size() != log.rows())
-    return failure("evaluate_calibration: motion does not match the log");
+  if (motion.rows != rows.rows()) return failure("evaluate_calibration: motion does not match the log");
   const Eigen::MatrixX3d axes = calibration.axes_B();
   Eigen::MatrixX3d x(n_gyros, 3);
   Eigen::VectorXd bias(n_gyros);
@@ -258,19 +263,19 @@ Result<CalibrationFit> evaluate_calibration(const TurntableLog& log, const Turnt
   const auto m_count = idx(motion.sequences.size());
   fit.sequence_residual_V = Eigen::MatrixXd::Zero(m_count, n_gyros);
   Eigen::VectorXd sum_sq = Eigen::VectorXd::Zero(n_gyros);
+  Status read = calibration_detail::for_each_rate_row(
+      rows, motion, [&](const TurntableRow& row, std::size_t j, const Eigen::Vector3d& w) {
+        for (int i = 0; i < n_gyros; ++i) {
+          const double e = row.g_V[i] - x.row(i).dot(w) - bias(i);
+          fit.sequence_residual_V(idx(j), i) += e;
+          sum_sq(i) += e * e;
+        }
+      });
+  if (!read) return read.error();
   std::size_t samples = 0;
   for (std::size_t j = 0; j < motion.sequences.size(); ++j) {
-    const SequenceMotion& m = motion.sequences[j];
-    for (std::size_t r = m.first_row; r < m.first_row + m.row_count; ++r) {
-      const Eigen::Vector3d& w = motion.rate_B_dps[r];
-      for (int i = 0; i < n_gyros; ++i) {
-        const double e = log.g(r, i) - x.row(i).dot(w) - bias(i);
-        fit.sequence_residual_V(idx(j), i) += e;
-        sum_sq(i) += e * e;
-      }
-    }
-    fit.sequence_residual_V.row(idx(j)) /= static_cast<double>(m.row_count);
-    samples += m.row_count;
+    fit.sequence_residual_V.row(idx(j)) /= static_cast<double>(motion.sequences[j].row_count);
+    samples += motion.sequences[j].row_count;
   }
   fit.sample_rms_V = (sum_sq / static_cast<double>(samples)).cwiseSqrt();
   fit.sequence_rms_V = (fit.sequence_residual_V.colwise().squaredNorm() / static_cast<double>(m_count))
@@ -279,32 +284,42 @@ Result<CalibrationFit> evaluate_calibration(const TurntableLog& log, const Turnt
   return fit;
 }
 
-Result<CalibrationResult> calibrate(const TurntableLog& log, const TurntableMotion& motion,
+Result<CalibrationFit> evaluate_calibration(const TurntableLog& log, const TurntableMotion& motion,
+                                            const Calibration& calibration) {
+  return evaluate_calibration(TurntableLogRows(log), motion, calibration);
+}
+
+Result<CalibrationResult> calibrate(const TurntableRows& rows, const TurntableMotion& motion,
                                     const CalibrationOptions& options) {
-  if (motion.rate_B_dps.size() != log.rows() || motion.sequences.empty()) {
+  if (motion.rows != rows.rows() || motion.sequences.empty()) {
     return failure("calibrate: the motion was not derived from this log");
   }
-  if (!options.noise.empty() && options.noise.size() != static_cast<std::size_t>(log.gyro_count)) {
-    return bad_input("the noise model has " + std::to_string(options.noise.size()) + " gyros, " + log.source +
-                     " has " + std::to_string(log.gyro_count));
+  if (!options.noise.empty() && options.noise.size() != static_cast<std::size_t>(rows.gyro_count())) {
+    return bad_input("the noise model has " + std::to_string(options.noise.size()) + " gyros, " +
+                     rows.source() + " has " + std::to_string(rows.gyro_count()));
   }
   if (!(options.bias_instability_correlation_s > 0.0)) {
     return bad_input("the bias-instability correlation time must be positive");
   }
-  auto result = options.method == CalibrationMethod::kSixteen ? calibrate_sixteen(log, motion, options)
-                                                              : calibrate_batch(log, motion, options);
+  auto result = options.method == CalibrationMethod::kSixteen ? calibrate_sixteen(rows, motion, options)
+                                                              : calibrate_batch(rows, motion, options);
   if (!result) return result;
   for (const auto& g : result->calibration.gyros) {
     if (!std::isfinite(g.scale_factor_V_per_dps) || g.scale_factor_V_per_dps <= 0.0 ||
         !std::isfinite(g.bias_V)) {
-      return bad_input(log.source + ": gyro " + std::to_string(g.id) +
+      return bad_input(rows.source() + ": gyro " + std::to_string(g.id) +
                        " has no usable estimate (its output does not follow the table rates)");
     }
   }
-  auto fit = evaluate_calibration(log, motion, result->calibration);
+  auto fit = evaluate_calibration(rows, motion, result->calibration);
   if (!fit) return fit.error();
   result->fit = std::move(fit.value());
   return result;
+}
+
+Result<CalibrationResult> calibrate(const TurntableLog& log, const TurntableMotion& motion,
+                                    const CalibrationOptions& options) {
+  return calibrate(TurntableLogRows(log), motion, options);
 }
 
 }  // namespace tetra

@@ -21,8 +21,8 @@ namespace {
 constexpr const char* kFormat = "tetra gyro log";
 constexpr int kVersion = 1;
 constexpr hsize_t kChunkRows = 65536;  // rows per chunk, and per block written
-// Rows per block read: half a chunk (2.5 MB for 4 gyros and a reference).
-constexpr hsize_t kBlockRows = 32768;
+// Rows per block read: half a chunk (2.8 MB for 4 gyros and a reference); a chunk read raw serves two.
+constexpr hsize_t kBlockRows = kChunkRows / 2;
 constexpr unsigned kDeflateLevel = 1;  // with compression: the noise in gyro values barely compresses anyway
 constexpr std::array<const char*, 4> kRefNames = {"ref_qw", "ref_qx", "ref_qy", "ref_qz"};
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -163,7 +163,56 @@ struct Dataset {
   std::string name;
   Handle id;
   hsize_t cols = 1;  // second dimension of a 2-D dataset
+  // Unfiltered chunks of `raw_chunk_rows` rows (a multiple of kBlockRows, at most kChunkRows) stored as
+  // `raw_type` (a native type): read whole as raw bytes into `chunk` (H5Dread_chunk, past HDF5's
+  // selection and copy), whence the blocks take their rows. Else raw_chunk_rows is 0.
+  hsize_t raw_chunk_rows = 0;
+  hid_t raw_type = H5I_INVALID_HID;
+  std::vector<unsigned char> chunk;
+  hsize_t chunk_first = std::numeric_limits<hsize_t>::max();  // first row of the chunk held
 };
+
+// Records in `d` whether its chunks can be read raw (see Dataset).
+void find_raw_chunks(Dataset& d, int rank) {
+  Handle dcpl(H5Dget_create_plist(d.id.get()), H5Pclose);
+  if (!dcpl.valid() || H5Pget_layout(dcpl.get()) != H5D_CHUNKED || H5Pget_nfilters(dcpl.get()) != 0) return;
+  std::array<hsize_t, 2> chunk{};
+  if (H5Pget_chunk(dcpl.get(), rank, chunk.data()) != rank || chunk[0] % kBlockRows != 0 || chunk[0] == 0 ||
+      chunk[0] > kChunkRows) {
+    return;
+  }
+  if (rank == 2 && chunk[1] != d.cols) return;
+  Handle type(H5Dget_type(d.id.get()), H5Tclose);
+  for (const hid_t native : {H5T_NATIVE_DOUBLE, H5T_NATIVE_UINT8}) {
+    if (H5Tequal(type.get(), native) > 0) {
+      d.raw_chunk_rows = chunk[0];
+      d.raw_type = native;
+    }
+  }
+}
+
+// The raw bytes of the chunk that holds rows [first, first + count) in d.chunk, when the dataset
+// allows it and they lie in one chunk (false: read them through H5Dread).
+bool load_raw_chunk(Dataset& d, hsize_t first, hsize_t count, hid_t mem_type) {
+  if (d.raw_chunk_rows == 0 || mem_type != d.raw_type ||
+      first / d.raw_chunk_rows != (first + count - 1) / d.raw_chunk_rows) {
+    return false;
+  }
+  const hsize_t chunk_first = first - first % d.raw_chunk_rows;
+  if (chunk_first == d.chunk_first) return true;
+  const std::array<hsize_t, 2> offset{chunk_first, 0};
+  const hsize_t expected = d.raw_chunk_rows * d.cols * H5Tget_size(mem_type);
+  hsize_t bytes = 0;
+  if (H5Dget_chunk_storage_size(d.id.get(), offset.data(), &bytes) < 0 || bytes != expected) return false;
+  d.chunk.resize(static_cast<std::size_t>(expected));
+  std::uint32_t filters = 0;
+  d.chunk_first = std::numeric_limits<hsize_t>::max();
+  if (H5Dread_chunk(d.id.get(), H5P_DEFAULT, offset.data(), &filters, d.chunk.data()) < 0 || filters != 0) {
+    return false;
+  }
+  d.chunk_first = chunk_first;
+  return true;
+}
 
 class H5Reader final : public GyroLogReader {
  public:
@@ -177,6 +226,7 @@ class H5Reader final : public GyroLogReader {
  private:
   Result<Dataset> open_dataset(const char* name, int rank, hsize_t cols);
   Status read_rows(const Dataset& d, hsize_t first, hsize_t count, hid_t mem_type, void* out) const;
+  Result<const void*> rows_of(Dataset& d, hsize_t count, hid_t mem_type, void* fallback);
   Status read_header();
   std::string where(const std::string& dataset, std::size_t row) const {
     return header_.source + ": dataset '" + dataset + "' row " + std::to_string(row + 1) + ": ";
@@ -194,7 +244,8 @@ class H5Reader final : public GyroLogReader {
   Dataset ref_present_;
   hsize_t rows_ = 0;
   hsize_t row_ = 0;
-  std::vector<double> columns_;  // the block's columns of one kind, side by side, reused
+  std::vector<double> columns_;  // the block's columns of one kind read by H5Dread, side by side, reused
+  std::vector<const double*> column_ptrs_;  // each gyro's rows of the block
 };
 
 Result<Dataset> H5Reader::open_dataset(const char* name, int rank, hsize_t cols) {
@@ -229,6 +280,7 @@ Result<Dataset> H5Reader::open_dataset(const char* name, int rank, hsize_t cols)
   }
   if (name == std::string("time_s")) rows_ = dims[0];
   d.cols = cols;
+  find_raw_chunks(d, rank);
   return d;
 }
 
@@ -351,24 +403,47 @@ void H5Reader::shape_block(GyroLog& block, std::size_t n) const {
   block.reference_present.resize(header_.has_reference ? n : 0);
 }
 
-// Time and presence straight into the block; the gyro columns side by side, then interleaved into
-// epochs (absent samples NaN, as an empty CSV cell).
+// The block's `count` rows of `d` from row_ on: in its raw chunk when it can be read so, else read into
+// `fallback` (room for them) through H5Dread.
+Result<const void*> H5Reader::rows_of(Dataset& d, hsize_t count, hid_t mem_type, void* fallback) {
+  if (load_raw_chunk(d, row_, count, mem_type)) {
+    const hsize_t offset = (row_ - d.chunk_first) * d.cols * H5Tget_size(mem_type);
+    return static_cast<const void*>(d.chunk.data() + offset);
+  }
+  if (Status s = read_rows(d, row_, count, mem_type, fallback); !s) return s.error();
+  return static_cast<const void*>(fallback);
+}
+
+// Copies `bytes` from `from` to `to` unless they are the same place.
+void copy_into(void* to, const void* from, std::size_t bytes) {
+  if (to != from) std::memcpy(to, from, bytes);
+}
+
+// Time and presence into the block; the gyro columns interleaved into epochs (absent samples NaN, as an
+// empty CSV cell).
 Status H5Reader::read_gyros(GyroLog& block, hsize_t count) {
   const auto n = static_cast<std::size_t>(count);
   const auto ng = static_cast<std::size_t>(header_.gyro_count);
-  if (Status s = read_rows(time_, row_, count, H5T_NATIVE_DOUBLE, block.time_s.data()); !s) return s;
-  if (Status s = read_rows(present_, row_, count, H5T_NATIVE_UINT8, block.present.data()); !s) return s;
+  auto time = rows_of(time_, count, H5T_NATIVE_DOUBLE, block.time_s.data());
+  if (!time) return time.error();
+  copy_into(block.time_s.data(), *time, n * sizeof(double));
+  auto flags = rows_of(present_, count, H5T_NATIVE_UINT8, block.present.data());
+  if (!flags) return flags.error();
+  copy_into(block.present.data(), *flags, n * ng);
   columns_.resize(n * ng);
+  column_ptrs_.resize(ng);
   for (std::size_t g = 0; g < ng; ++g) {
-    if (Status s = read_rows(gyros_[g], row_, count, H5T_NATIVE_DOUBLE, columns_.data() + g * n); !s)
-      return s;
+    auto column = rows_of(gyros_[g], count, H5T_NATIVE_DOUBLE, columns_.data() + g * n);
+    if (!column) return column.error();
+    column_ptrs_[g] = static_cast<const double*>(*column);
   }
-  for (std::size_t r = 0; r < n; ++r) {
-    for (std::size_t g = 0; g < ng; ++g) {
-      std::uint8_t& p = block.present[r * ng + g];
-      p = p != 0 ? 1 : 0;
-      block.values[r * ng + g] = p != 0 ? columns_[g * n + r] : kNaN;
-    }
+  // Plain pointers, and no store through a byte pointer in the copy (it could alias every other one).
+  std::uint8_t* present = block.present.data();
+  for (std::size_t k = 0; k < n * ng; ++k) present[k] = present[k] != 0 ? 1 : 0;
+  double* values = block.values.data();
+  const double* const* columns = column_ptrs_.data();
+  for (std::size_t r = 0; r < n; ++r) {  // the epochs written in order, the columns read side by side
+    for (std::size_t g = 0; g < ng; ++g) values[r * ng + g] = present[r * ng + g] != 0 ? columns[g][r] : kNaN;
   }
   return ok_status();
 }
@@ -377,17 +452,20 @@ Status H5Reader::read_gyros(GyroLog& block, hsize_t count) {
 Status H5Reader::read_reference(GyroLog& block, hsize_t count) {
   const auto n = static_cast<std::size_t>(count);
   columns_.resize(n * 4);
+  std::array<const double*, 4> column{};
   for (std::size_t k = 0; k < 4; ++k) {
-    if (Status s = read_rows(ref_[k], row_, count, H5T_NATIVE_DOUBLE, columns_.data() + k * n); !s) return s;
+    auto rows = rows_of(ref_[k], count, H5T_NATIVE_DOUBLE, columns_.data() + k * n);
+    if (!rows) return rows.error();
+    column[k] = static_cast<const double*>(*rows);
   }
-  if (Status s = read_rows(ref_present_, row_, count, H5T_NATIVE_UINT8, block.reference_present.data()); !s)
-    return s;
+  auto flags = rows_of(ref_present_, count, H5T_NATIVE_UINT8, block.reference_present.data());
+  if (!flags) return flags.error();
+  copy_into(block.reference_present.data(), *flags, n);
+  std::uint8_t* present = block.reference_present.data();
+  std::array<double, 4>* wxyz = block.reference_wxyz.data();
   for (std::size_t r = 0; r < n; ++r) {
-    std::uint8_t& p = block.reference_present[r];
-    p = p != 0 ? 1 : 0;
-    block.reference_wxyz[r] =
-        p != 0 ? std::array<double, 4>{columns_[r], columns_[n + r], columns_[2 * n + r], columns_[3 * n + r]}
-               : std::array<double, 4>{kNaN, kNaN, kNaN, kNaN};
+    present[r] = present[r] != 0 ? 1 : 0;
+    for (std::size_t k = 0; k < 4; ++k) wxyz[r][k] = present[r] != 0 ? column[k][r] : kNaN;
   }
   return ok_status();
 }

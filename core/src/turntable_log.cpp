@@ -4,6 +4,7 @@
 
 #include "tetra/core/csv.hpp"
 #include "tetra/core/input_files.hpp"
+#include "turntable_log_internal.hpp"
 
 namespace tetra {
 
@@ -11,15 +12,11 @@ std::optional<std::string> TurntableLog::meta(const std::string& key) const {
   return last_meta(metadata, key);
 }
 
+namespace turntable_detail {
+
 namespace {
-
-// The columns of a turntable log, found in its header.
-struct Columns {
-  std::size_t fixed[4] = {};  // sequence, time_s, inner_deg, outer_deg
-  std::vector<std::size_t> gyro;
-};
-
 constexpr const char* kFixedNames[4] = {"sequence", "time_s", "inner_deg", "outer_deg"};
+}  // namespace
 
 Result<Columns> find_columns(const CsvTable& t) {
   Columns c;
@@ -49,35 +46,52 @@ Result<Columns> find_columns(const CsvTable& t) {
   return c;
 }
 
+Status check_row(const CsvTable& t, const Columns& c, std::size_t r, const double* previous_time_s) {
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (t.is_empty(r, c.fixed[k]) || !std::isfinite(t.cell(r, c.fixed[k]))) {
+      return bad_input(t.where(r, c.fixed[k]) + "a finite number is required");
+    }
+  }
+  const double seq = t.cell(r, c.fixed[0]);
+  if (seq != std::floor(seq) || seq < 1 || seq > 1e6) {
+    return bad_input(t.where(r, c.fixed[0]) + "sequence must be a positive integer");
+  }
+  const double time_s = t.cell(r, c.fixed[1]);
+  if (previous_time_s != nullptr && time_s <= *previous_time_s) {
+    return bad_input(t.where(r, c.fixed[1]) + "time goes backwards or repeats (" + std::to_string(time_s) +
+                     " after " + std::to_string(*previous_time_s) + ")");
+  }
+  for (const std::size_t col : c.gyro) {
+    if (t.is_empty(r, col) || !std::isfinite(t.cell(r, col))) {
+      return bad_input(t.where(r, col) + "a finite voltage is required");
+    }
+  }
+  return ok_status();
+}
+
+void append_block_metadata(const CsvTable& block, std::size_t header_entries, Metadata& metadata) {
+  if (block.metadata.size() <= header_entries) return;
+  metadata.insert(metadata.end(), block.metadata.begin() + static_cast<std::ptrdiff_t>(header_entries),
+                  block.metadata.end());
+}
+
+}  // namespace turntable_detail
+
+namespace {
+
+using turntable_detail::Columns;
+using turntable_detail::find_columns;
+
 // Checks the rows of `t` and appends them to `log` (times must increase across calls too).
 Status append_rows(const CsvTable& t, const Columns& c, TurntableLog& log) {
-  const auto ng = c.gyro.size();
   for (std::size_t r = 0; r < t.rows; ++r) {
-    for (std::size_t k = 0; k < 4; ++k) {
-      if (t.is_empty(r, c.fixed[k]) || !std::isfinite(t.cell(r, c.fixed[k]))) {
-        return bad_input(t.where(r, c.fixed[k]) + "a finite number is required");
-      }
-    }
-    const double seq = t.cell(r, c.fixed[0]);
-    if (seq != std::floor(seq) || seq < 1 || seq > 1e6) {
-      return bad_input(t.where(r, c.fixed[0]) + "sequence must be a positive integer");
-    }
-    const double time_s = t.cell(r, c.fixed[1]);
-    if (!log.time_s.empty() && time_s <= log.time_s.back()) {
-      return bad_input(t.where(r, c.fixed[1]) + "time goes backwards or repeats (" + std::to_string(time_s) +
-                       " after " + std::to_string(log.time_s.back()) + ")");
-    }
-    log.sequence.push_back(static_cast<int>(seq));
-    log.time_s.push_back(time_s);
+    const double* previous_time_s = log.time_s.empty() ? nullptr : &log.time_s.back();
+    if (Status s = turntable_detail::check_row(t, c, r, previous_time_s); !s) return s;
+    log.sequence.push_back(static_cast<int>(t.cell(r, c.fixed[0])));
+    log.time_s.push_back(t.cell(r, c.fixed[1]));
     log.inner_deg.push_back(t.cell(r, c.fixed[2]));
     log.outer_deg.push_back(t.cell(r, c.fixed[3]));
-    for (std::size_t g = 0; g < ng; ++g) {
-      const double v = t.cell(r, c.gyro[g]);
-      if (t.is_empty(r, c.gyro[g]) || !std::isfinite(v)) {
-        return bad_input(t.where(r, c.gyro[g]) + "a finite voltage is required");
-      }
-      log.g_V.push_back(v);
-    }
+    for (const std::size_t col : c.gyro) log.g_V.push_back(t.cell(r, col));
   }
   log.lines.insert(log.lines.end(), t.lines.begin(), t.lines.end());
   return ok_status();
@@ -99,14 +113,6 @@ Result<TurntableLog> from_table(CsvTable&& t) {
   TurntableLog log = empty_log(t, *c);
   if (Status s = append_rows(t, *c, log); !s) return s.error();
   return log;
-}
-
-// Comment lines found in a block, after those of the header (the whole file's order).
-void append_block_metadata(const CsvTable& block, std::size_t header_entries, TurntableLog& log) {
-  if (block.metadata.size() <= header_entries) return;
-  log.metadata.insert(log.metadata.end(),
-                      block.metadata.begin() + static_cast<std::ptrdiff_t>(header_entries),
-                      block.metadata.end());
 }
 
 // Room for the rows the file's size suggests after its first block (5 % spare), so the columns do not
@@ -147,7 +153,8 @@ Result<TurntableLog> read_turntable_log(const std::string& path) {
   while (true) {
     auto more = reader.next(block);
     if (!more) return more.error();
-    append_block_metadata(block, header_entries, log);  // at the end: comment lines after the last row
+    turntable_detail::append_block_metadata(block, header_entries,
+                                            log.metadata);  // at the end: comment lines after the last row
     if (!*more) break;
     if (reader.bytes_read() > kMaxTableBytes) {  // a FIFO (a regular file was checked at opening)
       return bad_input(path + ": is larger than the limit of " + std::to_string(kMaxTableBytes >> 30) +

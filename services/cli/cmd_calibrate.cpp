@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -16,7 +17,7 @@
 #include "tetra/core/geometry.hpp"
 #include "tetra/core/output_files.hpp"
 #include "tetra/core/provenance.hpp"
-#include "tetra/core/turntable_log.hpp"
+#include "tetra/core/turntable_rows.hpp"
 #include "tetra/core/units.hpp"
 
 namespace tetra::cli {
@@ -32,21 +33,21 @@ std::string format(const char* fmt, Args... args) {
   return buf;
 }
 
-Result<double> latitude_from(const TurntableLog& log, const std::optional<double>& option_deg) {
+Result<double> latitude_from(const TurntableRows& log, const std::optional<double>& option_deg) {
   if (option_deg) return *option_deg;
   const auto text = log.meta("latitude_deg");
   if (!text) {
-    return bad_input(log.source +
+    return bad_input(log.source() +
                      ": no latitude: give --latitude DEG or a '# latitude_deg=DEG' comment line in the file");
   }
   const auto v = parse_decimal(*text);
-  if (!v) return bad_input(log.source + ": comment '# latitude_deg=" + *text + "' is not a decimal number");
+  if (!v) return bad_input(log.source() + ": comment '# latitude_deg=" + *text + "' is not a decimal number");
   if (std::abs(*v) > 90.0)
-    return bad_input(log.source + ": comment '# latitude_deg=" + *text + "' is outside [-90, 90] deg");
+    return bad_input(log.source() + ": comment '# latitude_deg=" + *text + "' is outside [-90, 90] deg");
   return *v;
 }
 
-void print_plan(const TurntableLog& log, const TurntableMotion& motion) {
+void print_plan(const TurntableRows& log, const TurntableMotion& motion) {
   std::cout
       << "Rotation plan derived from the encoders (cf. seed Table 3; body rate = table + Earth, mean)\n";
   std::cout << " seq  lines          gimbal   rate[deg/s]  turned[deg]  other gimbal[deg]"
@@ -59,7 +60,7 @@ void print_plan(const TurntableLog& log, const TurntableMotion& motion) {
                         m.rotating == Gimbal::kInner ? "outer" : "inner", m.fixed_angle_deg, w.x(), w.y(),
                         w.z());
   }
-  std::cout << format("(%zu rows, %d gyros, latitude %+.4f deg)\n\n", log.rows(), log.gyro_count,
+  std::cout << format("(%zu rows, %d gyros, latitude %+.4f deg)\n\n", log.rows(), log.gyro_count(),
                       motion.latitude_deg);
 }
 
@@ -208,7 +209,7 @@ Result<CalibrationOptions> estimator_options(const CalibrateOptions& o) {
 }
 
 // The latitude (option or comment; a note on stderr when the option overrides the file's).
-Result<double> latitude_of(const TurntableLog& log, const CalibrateOptions& o) {
+Result<double> latitude_of(const TurntableRows& log, const CalibrateOptions& o) {
   auto latitude = latitude_from(log, o.latitude_deg);
   if (!latitude) return latitude;
   if (o.latitude_deg) {
@@ -221,25 +222,25 @@ Result<double> latitude_of(const TurntableLog& log, const CalibrateOptions& o) {
 }
 
 // --compare: the other calibration, with as many gyros as the log.
-Result<std::optional<Calibration>> reference_of(const TurntableLog& log, const CalibrateOptions& o) {
+Result<std::optional<Calibration>> reference_of(const TurntableRows& log, const CalibrateOptions& o) {
   if (o.compare_path.empty()) return std::optional<Calibration>{};
   auto ref = read_calibration(o.compare_path);
   if (!ref) return ref.error();
-  if (ref->gyro_count() != log.gyro_count) {
+  if (ref->gyro_count() != log.gyro_count()) {
     return bad_input(o.compare_path + ": has " + std::to_string(ref->gyro_count()) + " gyros, " + o.input +
-                     " has " + std::to_string(log.gyro_count));
+                     " has " + std::to_string(log.gyro_count()));
   }
   return std::optional<Calibration>(std::move(ref.value()));
 }
 
 // --noise: one noise section per gyro of the log, from another calibration file.
-Status noise_model_of(const TurntableLog& log, const CalibrateOptions& o, CalibrationOptions& options) {
+Status noise_model_of(const TurntableRows& log, const CalibrateOptions& o, CalibrationOptions& options) {
   if (o.noise_path.empty()) return ok_status();
   auto cal = read_calibration(o.noise_path);
   if (!cal) return cal.error();
-  if (cal->gyro_count() != log.gyro_count) {
+  if (cal->gyro_count() != log.gyro_count()) {
     return bad_input(o.noise_path + ": has " + std::to_string(cal->gyro_count()) + " gyros, " + o.input +
-                     " has " + std::to_string(log.gyro_count));
+                     " has " + std::to_string(log.gyro_count()));
   }
   options.noise.clear();
   for (const auto& g : cal->gyros) {
@@ -252,14 +253,14 @@ Status noise_model_of(const TurntableLog& log, const CalibrateOptions& o, Calibr
 }
 
 // With the seed's eq. 11 bias: how far it lies from the body-model bias.
-void print_seed_bias_difference(const TurntableLog& log, const TurntableMotion& motion,
+void print_seed_bias_difference(const TurntableRows& log, const TurntableMotion& motion,
                                 const CalibrationOptions& options, const CalibrationResult& result) {
   CalibrationOptions body = options;
   body.bias_model = BiasModel::kBody;
   auto body_result = calibrate(log, motion, body);
   if (!body_result) return;
   std::cout << "Seed eq. 11 bias minus body-model bias [V]:";
-  for (int i = 0; i < log.gyro_count; ++i) {
+  for (int i = 0; i < log.gyro_count(); ++i) {
     const auto k = static_cast<std::size_t>(i);
     std::cout << format("  g%d %+.3e", i + 1,
                         result.calibration.gyros[k].bias_V - body_result->calibration.gyros[k].bias_V);
@@ -269,15 +270,15 @@ void print_seed_bias_difference(const TurntableLog& log, const TurntableMotion& 
 }
 
 // The tables on standard output: plan, estimates, the comparison, the seed-bias note, what 1σ means.
-Status print_report(const TurntableLog& log, const TurntableMotion& motion, const CalibrationOptions& options,
-                    const CalibrationResult& result, const std::optional<Calibration>& reference,
-                    const std::string& reference_name) {
+Status print_report(const TurntableRows& log, const TurntableMotion& motion,
+                    const CalibrationOptions& options, const CalibrationResult& result,
+                    const std::optional<Calibration>& reference, const std::string& reference_name) {
   print_plan(log, motion);
   print_estimates(result, options, reference, reference_name);
   if (reference) {
     auto reference_fit = evaluate_calibration(log, motion, *reference);
     if (!reference_fit) return reference_fit.error();
-    print_comparison(motion, *reference_fit, result.fit, reference_name, log.gyro_count);
+    print_comparison(motion, *reference_fit, result.fit, reference_name, log.gyro_count());
   }
   if (options.method == CalibrationMethod::kSixteen && options.bias_model == BiasModel::kSeed)
     print_seed_bias_difference(log, motion, options, result);
@@ -305,8 +306,8 @@ Status run_calibrate(const CalibrateOptions& o) {
   if (!o.noise_path.empty()) files.add_input(o.noise_path, "--noise");
   auto out = files.add(o.output, "--output");
   if (!out) return out.error();
-  auto log = read_turntable_log(o.input);
-  if (!log) return log.error();
+  auto log = std::make_unique<TurntableFileRows>();  // the rows are read again at each pass, never held
+  if (Status s = log->open(o.input); !s) return s;
   auto latitude = latitude_of(*log, o);
   if (!latitude) return latitude.error();
   options->unit = !o.unit_name.empty() ? o.unit_name : log->meta("unit").value_or("tetra-1");

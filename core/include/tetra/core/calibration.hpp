@@ -27,6 +27,7 @@
 // a unit with bias instability gets 1σ several times too small (docs/calibration.md, "Are the 1σ honest?").
 // Both report, per gyro, the residual RMS over samples and over sequence means.
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,7 @@
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/core/turntable_log.hpp"
+#include "tetra/core/turntable_rows.hpp"
 
 namespace tetra {
 
@@ -62,6 +64,8 @@ struct SequenceMotion {
   std::size_t row_count = 0;   //!< number of rows
   std::size_t first_line = 0;  //!< 1-based file lines of its first and last rows
   std::size_t last_line = 0;
+  double first_time_s = 0.0;  //!< [s] times of its first and last rows
+  double last_time_s = 0.0;
   Gimbal rotating = Gimbal::kInner;  //!< the gimbal that turns
   double rate_dps = 0.0;             //!< [deg/s] fitted rate of the rotating gimbal
   double turned_deg = 0.0;           //!< [deg] signed angle turned (last − first, unwrapped)
@@ -71,17 +75,28 @@ struct SequenceMotion {
   Eigen::Vector3d rate_B_dps() const { return table_rate_B_dps + earth_rate_B_dps; }  //!< [deg/s] ω̄_B
 };
 
-//! The log interpreted: sequences in plan order, and the body rate of every row.
+//! The log interpreted: sequences in plan order with their mean outputs. The body rate of a row is
+//! recomputed from its sequence's motion and its encoder angles when needed, never stored per row.
+struct BodyRateCache;  // calibration's own: the body rates once computed (core/src/calibration_rows.hpp)
+
 struct TurntableMotion {
-  std::string source;                       //!< file name for messages
-  double latitude_deg = 0.0;                //!< [deg]
-  std::vector<SequenceMotion> sequences;    //!< sorted by plan index; pairs (2k−1, 2k) adjacent
-  std::vector<Eigen::Vector3d> rate_B_dps;  //!< [deg/s] ω_B per log row (table + Earth rate)
+  std::string source;                     //!< file name for messages
+  double latitude_deg = 0.0;              //!< [deg]
+  std::size_t rows = 0;                   //!< rows of the log
+  double start_time_s = 0.0;              //!< [s] time of the log's first row
+  std::vector<SequenceMotion> sequences;  //!< sorted by plan index; pairs (2k−1, 2k) adjacent
+  Eigen::MatrixXd g_mean_V;               //!< [V] M×N mean output of every gyro over each sequence
+  //! The body rate of every row, written to a temporary file by the first pass that needs them and read
+  //! back by the later ones (24 bytes a row, on disk); shared by copies of the motion.
+  std::shared_ptr<BodyRateCache> rate_cache;
 };
 
 //! Interprets the encoder angles: groups rows by sequence (each sequence contiguous), unwraps angles,
 //! finds the rotating gimbal and its rate, checks pairs (2k−1, 2k: same gimbal, opposite rates, same
 //! fixed angle) and that the pairs excite all three body axes. Errors are bad input naming file and line.
+//! Three passes over the rows; memory proportional to the number of sequences, not of rows.
+Result<TurntableMotion> analyze_turntable(const TurntableRows& rows, double latitude_deg,
+                                          const TurntableTolerances& tolerances = {});
 Result<TurntableMotion> analyze_turntable(const TurntableLog& log, double latitude_deg,
                                           const TurntableTolerances& tolerances = {});
 
@@ -105,6 +120,9 @@ struct CalibrationFit {
 };
 
 //! Residuals of any calibration with the same number of gyros on the interpreted log.
+//! One pass over the rows.
+Result<CalibrationFit> evaluate_calibration(const TurntableRows& rows, const TurntableMotion& motion,
+                                            const Calibration& calibration);
 Result<CalibrationFit> evaluate_calibration(const TurntableLog& log, const TurntableMotion& motion,
                                             const Calibration& calibration);
 
@@ -115,7 +133,11 @@ struct CalibrationResult {
   Eigen::MatrixXd sequence_sigma_mean_V;
 };
 
-//! Calibrates from an interpreted log (the log itself supplies the samples).
+//! Calibrates from an interpreted log (the log itself supplies the samples): kSixteen from the sequence
+//! means and one pass for the scatter, kBatch in two passes (normal equations, then residuals); one more
+//! for the fit. Memory proportional to the number of sequences, not of rows.
+Result<CalibrationResult> calibrate(const TurntableRows& rows, const TurntableMotion& motion,
+                                    const CalibrationOptions& options);
 Result<CalibrationResult> calibrate(const TurntableLog& log, const TurntableMotion& motion,
                                     const CalibrationOptions& options);
 
