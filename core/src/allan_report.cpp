@@ -199,14 +199,14 @@ std::string format_table(const LogAllan& analysis) {
 
 Status update_calibration_noise(Calibration& cal, const LogAllan& analysis) {
   if (analysis.units != "deg/s") {
-    return bad_input(
-        "--update-calibration needs rates in deg/s: the noise terms of a volts log are not in the "
-        "calibration file's units");
+    return bad_input({kSubjectNoiseUpdate},
+                     "needs rates in deg/s: the noise terms of a volts log are not in the calibration "
+                     "file's units");
   }
   for (const GyroAllan& g : analysis.gyros) {
     if (g.id < 1 || g.id > cal.gyro_count()) {
-      return bad_input("--update-calibration: gyro " + std::to_string(g.id) +
-                       " is not in the calibration file");
+      return bad_input({kSubjectNoiseUpdate},
+                       "gyro " + std::to_string(g.id) + " is not in the calibration file");
     }
     GyroNoise noise;
     const NoiseFit& f = g.result.fit;
