@@ -33,8 +33,7 @@ void print_progress(double fraction) {
   std::cerr << "tetra sim: " << std::lround(fraction * 100.0) << " %\n";
 }
 
-// Options that override the scenario's values; each pointer tells whether its
-// option was given.
+// Options that override the scenario's values; each pointer tells whether its option was given.
 struct ScenarioOverrides {
   double rate_hz = 0.0;
   double minutes = 0.0;
@@ -142,8 +141,8 @@ bool is_turntable(const SimArgs& a) {
   return a.scenario_name == "turntable";
 }
 
-// The run's inputs recorded and its outputs opened (the turntable writes to
-// standard output by default and has no truth file).
+// The run's inputs recorded and its outputs opened (the turntable writes to standard output by default and
+// has no truth file).
 struct SimOutputs {
   OutputFile* log = nullptr;
   OutputFile* truth = nullptr;
@@ -187,8 +186,7 @@ int run_turntable(const Calibration& unit, const sim::TurntablePlan& plan, const
   return kExitOk;
 }
 
-// The turntable scenario: only its options apply; the plan and the model with
-// the options given.
+// The turntable scenario: only its options apply; the plan and the model with the options given.
 int run_turntable_scenario(SimArgs& a, const std::optional<Calibration>& unit, RunFiles& files,
                            OutputFile& out) {
   const ScenarioOverrides& o = a.over;
@@ -220,8 +218,7 @@ void apply_overrides(const ScenarioOverrides& o, sim::Scenario& sc) {
   if (o.range->count()) sc.model.range_dps = o.range_dps;
 }
 
-// Any other scenario: built in or read from a file, then the unit and the
-// options given.
+// Any other scenario: built in or read from a file, then the unit and the options given.
 Result<sim::Scenario> load_scenario(const SimArgs& a, const std::optional<Calibration>& unit) {
   for (const CLI::Option* opt : a.turntable_only) {
     if (opt->count()) return bad_input(opt->get_name() + " applies to the turntable scenario only");
@@ -268,8 +265,7 @@ int write_files(const SimArgs& a, const sim::Scenario& sc, const sim::SimOptions
   return kExitOk;
 }
 
-// Closed loop (in process or over DDS), the open loop published over DDS, or
-// the open loop to files.
+// Closed loop (in process or over DDS), the open loop published over DDS, or the open loop to files.
 int run_scenario(const SimArgs& a, const sim::Scenario& sc, const sim::SimOptions& options, RunFiles& files,
                  const SimOutputs& out) {
 #if TETRA_WITH_DDS
