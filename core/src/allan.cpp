@@ -104,8 +104,8 @@ Result<std::vector<std::int64_t>> averaging_factors(const TauSpec& spec, std::si
     case TauSpacing::kAll: {
       const double work = static_cast<double>(samples) * static_cast<double>(m_max);
       if (work > kAllTauWorkLimit) {
-        return bad_input({kSubjectTaus, "all"},
-                         "on " + std::to_string(samples) + " samples means " + std::to_string(m_max) +
+        return bad_input({kSubjectTaus},
+                         "'all' on " + std::to_string(samples) + " samples means " + std::to_string(m_max) +
                              " averaging times of O(n) each, too slow; use the default, octave, decade or a "
                              "list");
       }
