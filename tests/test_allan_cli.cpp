@@ -159,10 +159,19 @@ TEST(AllanCli, BadInputExitsTwoWithAReason) {
   expect_bad_input(test::run_tetra("allan " + dir.file("log.csv") + " --taus 0.1,-2"), "not positive");
   expect_bad_input(test::run_tetra("allan " + dir.file("log.csv") + " --taus 100"),
                    "exceeds half the record");
-  expect_bad_input(test::run_tetra("allan " + dir.file("log.csv") + " --gyro 5"), "--gyro 5");
+  expect_bad_input(test::run_tetra("allan " + dir.file("log.csv") + " --gyro 5"),
+                   "--gyro 5: the log has gyros 1..4");
+  expect_bad_input(test::run_tetra("allan " + dir.file("log.csv") + " --taus 0.1,x"), "--taus: 'x' is not");
   expect_bad_input(test::run_tetra("allan " + dir.file("log.csv") + " --update-calibration"),
                    "needs --calibration");
   expect_bad_input(test::run_tetra("allan " + dir.file("missing.csv")), "cannot open");
+  // The library names the argument (Error::subject); the command words it with its option.
+  expect_bad_input(test::run_tetra("allan " + dir.file("log.csv") + " --taus 100"), "allan: --taus: ");
+  test::write_file(dir.file("silent.csv"), "# units=dps\ntime_s,g1,g2\n0,1,\n0.1,1,\n0.2,1,\n0.3,1,\n");
+  expect_bad_input(
+      test::run_tetra("allan " + dir.file("silent.csv")),
+      "gyro 2: 0 valid sample(s): an Allan variance needs at least 2 (--gyro N analyses the others "
+      "alone)");
   EXPECT_EQ(test::run_tetra("allan --help").exit_status, 0);
 }
 

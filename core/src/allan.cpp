@@ -65,11 +65,13 @@ Result<TauSpec> parse_tau_spec(std::string_view text) {
     const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), tau);
     if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || !std::isfinite(tau)) {
       return bad_input(
-          "--taus: '" + std::string(item) +
-          "' is not an averaging time in seconds (expected octave, decade, all or a list like 0.1,1,10)");
+          {kSubjectTaus},
+          "'" + std::string(item) +
+              "' is not an averaging time in seconds (expected octave, decade, all or a list like "
+              "0.1,1,10)");
     }
     if (tau <= 0.0) {
-      return bad_input("--taus: averaging time " + std::string(item) + " s is not positive");
+      return bad_input({kSubjectTaus}, "averaging time " + std::string(item) + " s is not positive");
     }
     spec.list_s.push_back(tau);
     if (comma == std::string_view::npos) break;
@@ -102,9 +104,10 @@ Result<std::vector<std::int64_t>> averaging_factors(const TauSpec& spec, std::si
     case TauSpacing::kAll: {
       const double work = static_cast<double>(samples) * static_cast<double>(m_max);
       if (work > kAllTauWorkLimit) {
-        return bad_input(
-            "--taus all on " + std::to_string(samples) + " samples means " + std::to_string(m_max) +
-            " averaging times of O(n) each, too slow; use the default, octave, decade or a list");
+        return bad_input({kSubjectTaus},
+                         "'all' on " + std::to_string(samples) + " samples means " + std::to_string(m_max) +
+                             " averaging times of O(n) each, too slow; use the default, octave, decade or a "
+                             "list");
       }
       for (std::int64_t m = 1; m <= m_max; ++m) ms.push_back(m);
       break;
@@ -112,16 +115,18 @@ Result<std::vector<std::int64_t>> averaging_factors(const TauSpec& spec, std::si
     case TauSpacing::kList:
       for (const double tau : spec.list_s) {
         if (!(tau > 0.0))
-          return bad_input("--taus: averaging time " + format_number(tau) + " s is not positive");
+          return bad_input({kSubjectTaus}, "averaging time " + format_number(tau) + " s is not positive");
         const double m = std::round(tau / tau0_s);
         if (m < 1.0) {
-          return bad_input("--taus: averaging time " + format_number(tau) +
-                           " s is shorter than the sampling interval " + format_number(tau0_s) + " s");
+          return bad_input({kSubjectTaus}, "averaging time " + format_number(tau) +
+                                               " s is shorter than the sampling interval " +
+                                               format_number(tau0_s) + " s");
         }
         if (m > static_cast<double>(m_max)) {
-          return bad_input("--taus: averaging time " + format_number(tau) + " s exceeds half the record (" +
-                           format_number(static_cast<double>(m_max) * tau0_s) +
-                           " s): no Allan variance there");
+          return bad_input({kSubjectTaus}, "averaging time " + format_number(tau) +
+                                               " s exceeds half the record (" +
+                                               format_number(static_cast<double>(m_max) * tau0_s) +
+                                               " s): no Allan variance there");
         }
         ms.push_back(static_cast<std::int64_t>(m));
       }
@@ -446,18 +451,9 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
     return bad_input(log.source + ": the log has " + std::to_string(log.gyro_count) +
                      " gyros but the calibration only " + std::to_string(options.calibration->gyro_count()));
   }
-  std::vector<int> ids = options.gyros;
-  if (ids.empty()) {
-    for (int id = 1; id <= log.gyro_count; ++id) ids.push_back(id);
-  }
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  for (const int id : ids) {
-    if (id < 1 || id > log.gyro_count) {
-      return bad_input("--gyro " + std::to_string(id) + ": the log has gyros 1.." +
-                       std::to_string(log.gyro_count));
-    }
-  }
+  auto analysed = gyro_ids(options, log.gyro_count);
+  if (!analysed) return analysed.error();
+  const std::vector<int>& ids = *analysed;
   auto grid = uniform_grid(log.time_s, options.dt_tolerance, log.source, log.lines);
   if (!grid) return grid.error();
   out.tau0_s = grid->tau0_s;
@@ -492,9 +488,7 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
     for (const std::uint8_t p : present) delivered += p;
     gyro.absent = grid_ref.slots - delivered - gyro.invalid;
     auto result = analyze_series(rate, present, grid_ref.tau0_s, options.allan);
-    if (!result)
-      return bad_input(log.source + ": gyro " + std::to_string(id) + ": " + result.error().message +
-                       (ids.size() > 1 ? " (--gyro N analyses the others alone)" : ""));
+    if (!result) return gyro_error(result.error(), log.source, id, ids.size());
     gyro.result = std::move(result.value());
     return gyro;
   };
@@ -508,6 +502,27 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
 
 // The gyros are independent: analyse them on up to two threads (the work per gyro is O(n) per τ and
 // identical in any order, so the results do not depend on the thread count).
+Result<std::vector<int>> gyro_ids(const LogAllanOptions& options, int gyro_count) {
+  std::vector<int> ids = options.gyros;
+  if (ids.empty()) {
+    for (int id = 1; id <= gyro_count; ++id) ids.push_back(id);
+  }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  for (const int id : ids) {
+    if (id < 1 || id > gyro_count)
+      return bad_input({kSubjectGyros, std::to_string(id)},
+                       "the log has gyros 1.." + std::to_string(gyro_count));
+  }
+  return ids;
+}
+
+Error gyro_error(const Error& series_error, const std::string& source, int id, std::size_t analysed) {
+  ErrorSubject subject = series_error.subject;
+  if (subject.name.empty() && analysed > 1) subject.name = kSubjectOtherGyros;
+  return bad_input(std::move(subject), source + ": gyro " + std::to_string(id) + ": " + series_error.message);
+}
+
 Status analyse_gyros(std::size_t count, const std::function<Result<GyroAllan>(std::size_t)>& analyse,
                      std::vector<GyroAllan>& out) {
   std::vector<std::optional<Result<GyroAllan>>> results(count);

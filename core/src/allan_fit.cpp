@@ -1,7 +1,10 @@
 // Non-negative weighted least-squares fit of the IEEE Std 952 terms to an Allan curve.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -53,80 +56,92 @@ double NoiseFit::model_avar(double tau_s) const {
   return sum;
 }
 
-NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weights_from) {
-  NoiseFit fit;
-  // Rows scaled by √(edf/2)/σ²: the residual of a row is the error of the model in units of the
-  // standard deviation of the variance estimate (Var s² = 2σ⁴/edf for a χ² estimate). σ² is the
-  // previous fit's model where given, else the measured value.
+namespace {
+
+using Coefficients = std::array<double, kTermCount>;  // σ² coefficients Q², N², B², K², R²
+constexpr int kAllTerms = (1 << kTermCount) - 1;
+
+std::vector<const AdevPoint*> usable_points(std::span<const AdevPoint> points) {
   std::vector<const AdevPoint*> used;
   for (const AdevPoint& p : points) {
     if (p.terms > 0 && p.adev > 0.0 && std::isfinite(p.adev) && p.edf > 0.0) used.push_back(&p);
   }
+  return used;
+}
+
+// The weighted least-squares system a·c = b, its columns scaled to unit norm (col_norm: the scales).
+struct WeightedSystem {
+  Eigen::MatrixXd a;
+  Eigen::VectorXd b;
+  Eigen::VectorXd col_norm;
+};
+
+// Rows scaled by √(edf/2)/σ²: the residual of a row is the error of the model in units of the
+// standard deviation of the variance estimate (Var s² = 2σ⁴/edf for a χ² estimate). σ² is the
+// previous fit's model where given, else the measured value.
+WeightedSystem weighted_system(const std::vector<const AdevPoint*>& used, const NoiseFit* weights_from) {
   const auto rows = static_cast<Eigen::Index>(used.size());
-  fit.points_used = static_cast<int>(rows);
-  if (rows == 0) return fit;
-  Eigen::MatrixXd a(rows, kTermCount);
-  Eigen::VectorXd b(rows);
+  WeightedSystem sys{Eigen::MatrixXd(rows, kTermCount), Eigen::VectorXd(rows), Eigen::VectorXd(kTermCount)};
   for (Eigen::Index i = 0; i < rows; ++i) {
     const AdevPoint& p = *used[static_cast<std::size_t>(i)];
     const double avar = p.adev * p.adev;
     const double model = weights_from != nullptr ? weights_from->model_avar(p.tau_s) : 0.0;
     const double w = std::sqrt(0.5 * p.edf) / (model > 0.0 ? model : avar);
-    for (int k = 0; k < kTermCount; ++k) a(i, k) = w * term_basis(k, p.tau_s);
-    b(i) = w * avar;
+    for (int k = 0; k < kTermCount; ++k) sys.a(i, k) = w * term_basis(k, p.tau_s);
+    sys.b(i) = w * avar;
   }
   // Column scaling: the basis functions span many decades.
-  Eigen::VectorXd col_norm(kTermCount);
   for (int k = 0; k < kTermCount; ++k) {
-    col_norm(k) = a.col(k).norm();
-    if (col_norm(k) > 0.0) a.col(k) /= col_norm(k);
+    sys.col_norm(k) = sys.a.col(k).norm();
+    if (sys.col_norm(k) > 0.0) sys.a.col(k) /= sys.col_norm(k);
   }
+  return sys;
+}
 
-  // Exact NNLS for five unknowns: the optimum is the unconstrained least-squares solution on its own
-  // support, so the best feasible subset solution is the optimum. `allowed` limits the terms.
-  auto nnls = [&](int allowed) {
-    double best_cost = b.squaredNorm();
-    Eigen::VectorXd best = Eigen::VectorXd::Zero(kTermCount);
-    for (int mask = 1; mask < (1 << kTermCount); ++mask) {
-      if ((mask & ~allowed) != 0) continue;
-      std::vector<int> cols;
-      for (int k = 0; k < kTermCount; ++k) {
-        if ((mask & (1 << k)) != 0) cols.push_back(k);
-      }
-      const auto nc = static_cast<Eigen::Index>(cols.size());
-      if (nc > rows) continue;
-      Eigen::MatrixXd sub(rows, nc);
-      for (Eigen::Index j = 0; j < nc; ++j) sub.col(j) = a.col(cols[static_cast<std::size_t>(j)]);
-      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(sub);
-      if (qr.rank() < nc) continue;
-      const Eigen::VectorXd coef = qr.solve(b);
-      if ((coef.array() <= 0.0).any()) continue;
-      const double cost = (sub * coef - b).squaredNorm();
-      if (cost < best_cost) {
-        best_cost = cost;
-        best.setZero();
-        for (Eigen::Index j = 0; j < nc; ++j) best(cols[static_cast<std::size_t>(j)]) = coef(j);
-      }
-    }
-    // Back to σ² coefficients (Q², N², B², K², R²).
-    std::array<double, kTermCount> c{};
+// Exact NNLS for five unknowns: the optimum is the unconstrained least-squares solution on its own
+// support, so the best feasible subset solution is the optimum. `allowed` limits the terms.
+Coefficients nnls(const WeightedSystem& sys, int allowed) {
+  const Eigen::Index rows = sys.a.rows();
+  double best_cost = sys.b.squaredNorm();
+  Eigen::VectorXd best = Eigen::VectorXd::Zero(kTermCount);
+  for (int mask = 1; mask < (1 << kTermCount); ++mask) {
+    if ((mask & ~allowed) != 0) continue;
+    std::vector<int> cols;
     for (int k = 0; k < kTermCount; ++k) {
-      c[static_cast<std::size_t>(k)] = col_norm(k) > 0.0 ? std::max(0.0, best(k) / col_norm(k)) : 0.0;
+      if ((mask & (1 << k)) != 0) cols.push_back(k);
     }
-    return c;
-  };
-  auto model = [](const std::array<double, kTermCount>& c, double tau_s) {
-    double sum = 0.0;
-    for (int k = 0; k < kTermCount; ++k) sum += c[static_cast<std::size_t>(k)] * term_basis(k, tau_s);
-    return sum;
-  };
+    const auto nc = static_cast<Eigen::Index>(cols.size());
+    if (nc > rows) continue;
+    Eigen::MatrixXd sub(rows, nc);
+    for (Eigen::Index j = 0; j < nc; ++j) sub.col(j) = sys.a.col(cols[static_cast<std::size_t>(j)]);
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(sub);
+    if (qr.rank() < nc) continue;
+    const Eigen::VectorXd coef = qr.solve(sys.b);
+    if ((coef.array() <= 0.0).any()) continue;
+    const double cost = (sub * coef - sys.b).squaredNorm();
+    if (cost < best_cost) {
+      best_cost = cost;
+      best.setZero();
+      for (Eigen::Index j = 0; j < nc; ++j) best(cols[static_cast<std::size_t>(j)]) = coef(j);
+    }
+  }
+  // Back to σ² coefficients (Q², N², B², K², R²).
+  Coefficients c{};
+  for (int k = 0; k < kTermCount; ++k) {
+    c[static_cast<std::size_t>(k)] = sys.col_norm(k) > 0.0 ? std::max(0.0, best(k) / sys.col_norm(k)) : 0.0;
+  }
+  return c;
+}
 
-  constexpr int kAllTerms = (1 << kTermCount) - 1;
-  const std::array<double, kTermCount> coeff = nnls(kAllTerms);
-  for (int k = 0; k < kTermCount; ++k)
-    fit.value[static_cast<std::size_t>(k)] = std::sqrt(coeff[static_cast<std::size_t>(k)]);
+double model_of(const Coefficients& c, double tau_s) {
+  double sum = 0.0;
+  for (int k = 0; k < kTermCount; ++k) sum += c[static_cast<std::size_t>(k)] * term_basis(k, tau_s);
+  return sum;
+}
 
-  // Where each term dominates.
+// Where each term dominates (fit's dominant_from_s/to_s); returns the dominant term of each point (-1: none).
+std::vector<int> mark_dominant(const std::vector<const AdevPoint*>& used, const Coefficients& coeff,
+                               NoiseFit& fit) {
   std::vector<int> largest(used.size(), -1);
   for (std::size_t i = 0; i < used.size(); ++i) {
     double best = 0.0;
@@ -142,21 +157,41 @@ NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weig
     if (fit.dominant_from_s[kl] == 0.0) fit.dominant_from_s[kl] = used[i]->tau_s;
     fit.dominant_to_s[kl] = used[i]->tau_s;
   }
-  // Observed: the model re-fitted without the term leaves the 95 % confidence interval of the
-  // measured variance at some τ where the term dominates — the other terms cannot stand in for it.
+  return largest;
+}
+
+// Observed: the model re-fitted without the term leaves the 95 % confidence interval of the
+// measured variance at some τ where the term dominates — the other terms cannot stand in for it.
+void mark_observed(const WeightedSystem& sys, const std::vector<const AdevPoint*>& used,
+                   const std::vector<int>& largest, NoiseFit& fit) {
   for (int k = 0; k < kTermCount; ++k) {
     if (fit.dominant_from_s[static_cast<std::size_t>(k)] == 0.0) continue;
-    const std::array<double, kTermCount> without = nnls(kAllTerms & ~(1 << k));
+    const Coefficients without = nnls(sys, kAllTerms & ~(1 << k));
     for (std::size_t i = 0; i < used.size() && !fit.observed[static_cast<std::size_t>(k)]; ++i) {
       if (largest[i] != k) continue;
       const AdevPoint& p = *used[i];
       const double avar = p.adev * p.adev;
       const double lower95 = avar * p.edf / chi2_quantile(0.975, p.edf);
       const double upper95 = avar * p.edf / chi2_quantile(0.025, p.edf);
-      const double alt = model(without, p.tau_s);
+      const double alt = model_of(without, p.tau_s);
       if (alt < lower95 || alt > upper95) fit.observed[static_cast<std::size_t>(k)] = true;
     }
   }
+}
+
+}  // namespace
+
+NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weights_from) {
+  NoiseFit fit;
+  const std::vector<const AdevPoint*> used = usable_points(points);
+  fit.points_used = static_cast<int>(used.size());
+  if (used.empty()) return fit;
+  const WeightedSystem sys = weighted_system(used, weights_from);
+  const Coefficients coeff = nnls(sys, kAllTerms);
+  for (int k = 0; k < kTermCount; ++k)
+    fit.value[static_cast<std::size_t>(k)] = std::sqrt(coeff[static_cast<std::size_t>(k)]);
+  const std::vector<int> largest = mark_dominant(used, coeff, fit);
+  mark_observed(sys, used, largest, fit);
   return fit;
 }
 

@@ -33,6 +33,14 @@ Result<AllanResult> finish_series(std::size_t samples, std::size_t present_sampl
                                   const std::vector<AvarPoint>& all, const std::vector<std::size_t>& runs,
                                   double tau0_s, const AllanOptions& options);
 
+//! The ids analyze_gyro_log analyses (options.gyros sorted without repeats, or all), or the error
+//! for one not in the log.
+Result<std::vector<int>> gyro_ids(const LogAllanOptions& options, int gyro_count);
+
+//! The error of gyro `id` of the log `source` (one of `analysed` gyros) from the analysis of its
+//! series: the series' subject kept, else the other gyros named as a way round when there are some.
+Error gyro_error(const Error& series_error, const std::string& source, int id, std::size_t analysed);
+
 //! Runs `analyse(i)` for i = 0..count−1 on up to two threads; appends the results to `out` in order,
 //! or returns the first error in that order.
 Status analyse_gyros(std::size_t count, const std::function<Result<GyroAllan>(std::size_t)>& analyse,

@@ -32,7 +32,7 @@ const GyroCalibration* find_gyro(const Calibration& calibration, int id) {
 
 Result<KalibrGyroNoise> kalibr_gyro_noise(const LogAllan& analysis, const Calibration& calibration) {
   if (analysis.units != "deg/s") {
-    return bad_input("--kalibr needs rates: give --calibration for a log in volts");
+    return bad_input({kSubjectKalibr}, "needs rates in deg/s: a log in volts needs a calibration");
   }
   std::vector<Eigen::Vector3d> axes;
   std::vector<double> n_rad, k_rad;  // [rad/√s], [rad/s/√s]
@@ -40,12 +40,13 @@ Result<KalibrGyroNoise> kalibr_gyro_noise(const LogAllan& analysis, const Calibr
   for (const GyroAllan& g : analysis.gyros) {
     const GyroCalibration* cal = find_gyro(calibration, g.id);
     if (cal == nullptr)
-      return bad_input("--kalibr: gyro " + std::to_string(g.id) + " is not in the calibration");
+      return bad_input({kSubjectKalibr}, "gyro " + std::to_string(g.id) + " is not in the calibration");
     const auto n = g.result.fit.reported(kN);
     if (!n) {
       return failure(
-          "--kalibr: gyro " + std::to_string(g.id) +
-          ": angle random walk N not observed (the record's shortest averaging times do not show it)");
+          {kSubjectKalibr},
+          "gyro " + std::to_string(g.id) +
+              ": angle random walk N not observed (the record's shortest averaging times do not show it)");
     }
     const auto k = g.result.fit.reported(kK);
     k_everywhere = k_everywhere && k.has_value();
@@ -56,7 +57,7 @@ Result<KalibrGyroNoise> kalibr_gyro_noise(const LogAllan& analysis, const Calibr
   KalibrGyroNoise out;
   out.update_rate_hz = 1.0 / analysis.tau0_s;
   const auto density = body_axis_value(axes, n_rad);
-  if (!density) return bad_input("--kalibr: the analysed gyros' axes do not span three dimensions");
+  if (!density) return bad_input({kSubjectKalibr}, "the analysed gyros' axes do not span three dimensions");
   out.noise_density_rad_s_rtHz = *density;
   if (k_everywhere) out.random_walk_rad_s2_rtHz = body_axis_value(axes, k_rad);
   return out;

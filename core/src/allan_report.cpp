@@ -129,50 +129,43 @@ std::string format_json(const LogAllan& analysis,
   return out;
 }
 
-std::string format_table(const LogAllan& analysis) {
-  std::string out;
-  const auto units = term_units(analysis.units);
-  out += "Allan variance noise terms (IEEE Std 952-1997), units " + analysis.units +
-         ", tau0 = " + sci(analysis.tau0_s, 3) + " s; NO = not observed in these data\n";
-  const std::size_t w = 16;
+namespace {
+
+constexpr std::size_t kColumnWidth = 16;
+
+double unit_factor(int /*term*/) {
+  return 1.0;
+}
+
+// A header naming each term's units, then one row per gyro: the reported terms times factor(term), or NO.
+void append_term_table(std::string& out, const LogAllan& analysis,
+                       const std::array<std::string, kTermCount>& units, double (*factor)(int)) {
   out += pad("gyro", 6);
   for (int k = 0; k < kTermCount; ++k) {
-    out += pad(std::string(term_symbol(k)) + " [" + units[static_cast<std::size_t>(k)] + "]", w);
+    out += pad(std::string(term_symbol(k)) + " [" + units[static_cast<std::size_t>(k)] + "]", kColumnWidth);
   }
   out += '\n';
   for (const GyroAllan& g : analysis.gyros) {
     out += pad(std::to_string(g.id), 6);
     for (int k = 0; k < kTermCount; ++k) {
       const auto v = g.result.fit.reported(k);
-      out += pad(v ? sci(*v) : "NO", w);
+      out += pad(v ? sci(*v * factor(k)) : "NO", kColumnWidth);
     }
     out += '\n';
   }
+}
+
+void append_uncomputed(std::string& out, const LogAllan& analysis) {
   for (const GyroAllan& g : analysis.gyros) {
     if (g.result.uncomputed_tau_s.empty()) continue;
     out += "gyro " + std::to_string(g.id) + ": averaging times not computable (gaps leave no window):";
     for (const double tau_s : g.result.uncomputed_tau_s) out += " " + sci(tau_s, 3);
     out += " s\n";
   }
-  if (analysis.units == "deg/s") {
-    out += "\nIn customary units (bias instability B; the flat floor of the Allan deviation is 0.664 B)\n";
-    const std::array<std::string, kTermCount> customary = {"deg", "deg/√h", "deg/h", "deg/h/√h", "deg/h²"};
-    out += pad("gyro", 6);
-    for (int k = 0; k < kTermCount; ++k) {
-      out += pad(std::string(term_symbol(k)) + " [" + customary[static_cast<std::size_t>(k)] + "]", w);
-    }
-    out += '\n';
-    for (const GyroAllan& g : analysis.gyros) {
-      out += pad(std::to_string(g.id), 6);
-      for (int k = 0; k < kTermCount; ++k) {
-        const auto v = g.result.fit.reported(k);
-        out += pad(v ? sci(*v * customary_factor(k)) : "NO", w);
-      }
-      out += '\n';
-    }
-  } else {
-    out += "\n(customary units deg/√h, deg/h, ... need rates in deg/s: give --calibration CAL.yaml)\n";
-  }
+}
+
+// Per gyro: the data behind it and the τ range where each term dominates.
+void append_dominance(std::string& out, const LogAllan& analysis) {
   out += "\nWhere each term dominates the fitted curve (tau range) and the data behind each gyro:\n";
   for (const GyroAllan& g : analysis.gyros) {
     const AllanResult& r = g.result;
@@ -194,19 +187,36 @@ std::string format_table(const LogAllan& analysis) {
     }
     if (!any) out += "  no term could be fitted: the data cannot tell the noise terms\n";
   }
+}
+
+}  // namespace
+
+std::string format_table(const LogAllan& analysis) {
+  std::string out;
+  out += "Allan variance noise terms (IEEE Std 952-1997), units " + analysis.units +
+         ", tau0 = " + sci(analysis.tau0_s, 3) + " s; NO = not observed in these data\n";
+  append_term_table(out, analysis, term_units(analysis.units), unit_factor);
+  append_uncomputed(out, analysis);
+  if (analysis.units == "deg/s") {
+    out += "\nIn customary units (bias instability B; the flat floor of the Allan deviation is 0.664 B)\n";
+    append_term_table(out, analysis, {"deg", "deg/√h", "deg/h", "deg/h/√h", "deg/h²"}, customary_factor);
+  } else {
+    out += "\n(customary units deg/√h, deg/h, ... need rates in deg/s: give --calibration CAL.yaml)\n";
+  }
+  append_dominance(out, analysis);
   return out;
 }
 
 Status update_calibration_noise(Calibration& cal, const LogAllan& analysis) {
   if (analysis.units != "deg/s") {
-    return bad_input(
-        "--update-calibration needs rates in deg/s: the noise terms of a volts log are not in the "
-        "calibration file's units");
+    return bad_input({kSubjectNoiseUpdate},
+                     "needs rates in deg/s: the noise terms of a volts log are not in the calibration "
+                     "file's units");
   }
   for (const GyroAllan& g : analysis.gyros) {
     if (g.id < 1 || g.id > cal.gyro_count()) {
-      return bad_input("--update-calibration: gyro " + std::to_string(g.id) +
-                       " is not in the calibration file");
+      return bad_input({kSubjectNoiseUpdate},
+                       "gyro " + std::to_string(g.id) + " is not in the calibration file");
     }
     GyroNoise noise;
     const NoiseFit& f = g.result.fit;

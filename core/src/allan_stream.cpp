@@ -217,23 +217,6 @@ Result<AllanResult> analyse_column(ChunkedColumn& column, const SamplingGrid& gr
   return finish_series(n, count, all, runs, grid.tau0_s, options);
 }
 
-// The ids analyze_gyro_log would analyse, and its error for a bad one.
-Result<std::vector<int>> gyro_ids(const LogAllanOptions& options, int gyro_count) {
-  std::vector<int> ids = options.gyros;
-  if (ids.empty()) {
-    for (int id = 1; id <= gyro_count; ++id) ids.push_back(id);
-  }
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  for (const int id : ids) {
-    if (id < 1 || id > gyro_count) {
-      return bad_input("--gyro " + std::to_string(id) + ": the log has gyros 1.." +
-                       std::to_string(gyro_count));
-    }
-  }
-  return ids;
-}
-
 }  // namespace
 
 Result<LogAllan> analyze_gyro_log_file(const std::string& path, const LogAllanOptions& options) {
@@ -280,10 +263,7 @@ Result<LogAllan> analyze_gyro_log_file(const std::string& path, const LogAllanOp
 
   auto analyse_one = [&](std::size_t j) -> Result<GyroAllan> {
     auto r = analyse_column(c.rate[j], *grid, options.allan, log.source);
-    if (!r) {
-      return bad_input(log.source + ": gyro " + std::to_string(c.ids[j]) + ": " + r.error().message +
-                       (c.ids.size() > 1 ? " (--gyro N analyses the others alone)" : ""));
-    }
+    if (!r) return gyro_error(r.error(), log.source, c.ids[j], c.ids.size());
     GyroAllan gyro;
     gyro.id = c.ids[j];
     gyro.invalid = c.invalid[j];

@@ -102,8 +102,8 @@ double integrated_angle_deg(const AttitudeSeries& series, const Eigen::Vector3d&
 
 Result<AttitudeScore> score_attitude(const AttitudeSeries& attitude, const AttitudeSeries& truth,
                                      const ScoreOptions& options) {
-  if (!(std::abs(options.axis_B.norm() - 1.0) <= 1e-9)) return bad_input("--axis: not a unit vector");
-  if (!(options.time_tolerance_s >= 0.0)) return bad_input("--time-tolerance: must be ≥ 0");
+  if (!(std::abs(options.axis_B.norm() - 1.0) <= 1e-9)) return bad_input({"axis_B"}, "not a unit vector");
+  if (!(options.time_tolerance_s >= 0.0)) return bad_input({"time_tolerance_s"}, "must be ≥ 0");
   AttitudeScore score;
   score.per_axis_sigma = !attitude.sigma_B_deg.empty();
   score.nees_dof = score.per_axis_sigma ? 3 : 1;

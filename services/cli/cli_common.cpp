@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include <fmt/format.h>
+
 #include "tetra/core/csv.hpp"
 #include "tetra/core/provenance.hpp"
 
@@ -80,8 +82,17 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv) {
   return std::nullopt;
 }
 
-int report(const std::string& command, const Error& error) {
-  std::cerr << "tetra " << command << ": " << error.message << '\n';
+std::string user_message(const Error& error, std::initializer_list<SubjectOption> options) {
+  for (const SubjectOption& o : options) {
+    if (error.subject.name != o.subject) continue;
+    return one_line(fmt::format(fmt::runtime(o.format), fmt::arg("value", error.subject.value),
+                                fmt::arg("message", error.message)));
+  }
+  return describe(error);
+}
+
+int report(const std::string& command, const Error& error, std::initializer_list<SubjectOption> options) {
+  std::cerr << "tetra " << command << ": " << user_message(error, options) << '\n';
   return error.kind == ErrorKind::kBadInput ? kExitBadInput : kExitFailure;
 }
 

@@ -2,8 +2,10 @@
 // Shared plumbing of the `tetra` subcommands: argument parsing with CLI11 and the exit-status
 // contract (0 success, 2 bad usage or bad input with one line on stderr, 1 any other failure).
 
+#include <initializer_list>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 
@@ -19,7 +21,19 @@ inline constexpr int kExitBadInput = 2;
 //! stop now (help printed → 0, bad usage → 2), or nullopt to go on.
 std::optional<int> parse(CLI::App& app, int argc, char** argv);
 
-//! Prints "tetra SUB: message" on stderr; returns 2 for bad input, 1 otherwise.
-int report(const std::string& command, const Error& error);
+//! How a command words an Error about an argument of a library call (Error::subject): `format`
+//! names the command's option and may use {value} (the subject's value) and {message}, e.g.
+//! {"taus", "--taus: {message}"}, {"gyros", "--gyro {value}: {message}"}.
+struct SubjectOption {
+  std::string_view subject;
+  std::string_view format;
+};
+
+//! The error's one line for the user: worded by the entry for its subject, else in the library's
+//! words (describe()).
+std::string user_message(const Error& error, std::initializer_list<SubjectOption> options);
+
+//! Prints "tetra SUB: message" on stderr (user_message); returns 2 for bad input, 1 otherwise.
+int report(const std::string& command, const Error& error, std::initializer_list<SubjectOption> options = {});
 
 }  // namespace tetra::cli

@@ -289,7 +289,14 @@ int cmd_allan(int argc, char** argv) {
   AllanOptions options;
   add_options(app, options);
   if (auto status = parse(app, argc, argv)) return *status;
-  if (Status s = run_allan(options); !s) return report("allan", s.error());
+  if (Status s = run_allan(options); !s) {
+    return report("allan", s.error(),
+                  {{allan::kSubjectTaus, "--taus: {message}"},
+                   {allan::kSubjectGyros, "--gyro {value}: {message}"},
+                   {allan::kSubjectOtherGyros, "{message} (--gyro N analyses the others alone)"},
+                   {allan::kSubjectNoiseUpdate, "--update-calibration: {message}"},
+                   {allan::kSubjectKalibr, "--kalibr: {message}"}});
+  }
   return kExitOk;
 }
 

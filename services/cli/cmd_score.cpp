@@ -197,7 +197,10 @@ int cmd_score(int argc, char** argv) {
   auto truth = read_attitude_series(truth_path, false);
   if (!truth) return report(cmd, truth.error());
   auto score = score_attitude(*attitude, *truth, options);
-  if (!score) return report(cmd, score.error());
+  if (!score) {
+    return report(cmd, score.error(),
+                  {{"axis_B", "--axis: {message}"}, {"time_tolerance_s", "--time-tolerance: {message}"}});
+  }
 
   print_report(*score, att_path, truth_path, options, axis_name);
   if (json_out) {

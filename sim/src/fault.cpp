@@ -46,13 +46,63 @@ std::string_view fault_kind_name(FaultKind kind) {
   return "unknown";
 }
 
-Result<FaultSpec> parse_fault_spec(std::string_view text) {
-  const std::string where = "fault '" + std::string(text) + "': ";
+namespace {
+
+// The fields of a fault spec as read so far.
+struct FaultFields {
   FaultSpec fault;
   bool has_gyro = false;
   bool has_kind = false;
   bool has_at = false;
   std::optional<double> size;
+};
+
+Status read_gyro(std::string_view value, const std::string& where, FaultFields& f) {
+  int gyro = 0;
+  auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), gyro);
+  if (ec != std::errc() || ptr != value.data() + value.size() || gyro < 1) {
+    return bad_input(where + "gyro: expected a gyro number 1..N, got '" + std::string(value) + "'");
+  }
+  f.fault.gyro = gyro;
+  f.has_gyro = true;
+  return ok_status();
+}
+
+Status read_kind(std::string_view value, const std::string& where, FaultFields& f) {
+  const auto kind = fault_kind_from_name(value);
+  if (!kind) {
+    return bad_input(where + "kind: unknown kind '" + std::string(value) +
+                     "' (known: bias, ramp, scale, stuck, zero, noise, spike, dropout, invalid)");
+  }
+  f.fault.kind = *kind;
+  f.has_kind = true;
+  return ok_status();
+}
+
+// at, until or size.
+Status read_number(const std::string& key, std::string_view value, const std::string& where, FaultFields& f) {
+  const auto number = to_double(value);
+  if (!number) return bad_input(where + key + ": expected a finite number, got '" + std::string(value) + "'");
+  if (key == "at") {
+    f.fault.at_s = *number;
+    f.has_at = true;
+  } else if (key == "until") {
+    f.fault.until_s = *number;
+  } else {
+    f.size = *number;
+  }
+  return ok_status();
+}
+
+Status read_field(const std::string& key, std::string_view value, const std::string& where, FaultFields& f) {
+  if (key == "gyro") return read_gyro(value, where, f);
+  if (key == "kind") return read_kind(value, where, f);
+  if (key == "at" || key == "until" || key == "size") return read_number(key, value, where, f);
+  return bad_input(where + "unknown field '" + key + "' (fields: gyro, kind, at, size, until)");
+}
+
+// The comma-separated key=value fields, each key at most once.
+Status read_fields(std::string_view text, const std::string& where, FaultFields& f) {
   std::vector<std::string> seen;
   std::size_t pos = 0;
   while (pos <= text.size()) {
@@ -65,70 +115,56 @@ Result<FaultSpec> parse_fault_spec(std::string_view text) {
       return bad_input(where + "field '" + std::string(field) + "' is not key=value");
     }
     const std::string key(field.substr(0, eq));
-    const std::string_view value = field.substr(eq + 1);
     if (std::find(seen.begin(), seen.end(), key) != seen.end())
       return bad_input(where + key + ": given twice");
     seen.push_back(key);
-    if (key == "gyro") {
-      int gyro = 0;
-      auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), gyro);
-      if (ec != std::errc() || ptr != value.data() + value.size() || gyro < 1) {
-        return bad_input(where + "gyro: expected a gyro number 1..N, got '" + std::string(value) + "'");
-      }
-      fault.gyro = gyro;
-      has_gyro = true;
-    } else if (key == "kind") {
-      bool found = false;
-      for (const auto& [k, name] : kKinds) {
-        if (name == value) {
-          fault.kind = k;
-          found = true;
-        }
-      }
-      if (!found) {
-        return bad_input(where + "kind: unknown kind '" + std::string(value) +
-                         "' (known: bias, ramp, scale, stuck, zero, noise, spike, dropout, invalid)");
-      }
-      has_kind = true;
-    } else if (key == "at" || key == "until" || key == "size") {
-      const auto number = to_double(value);
-      if (!number)
-        return bad_input(where + key + ": expected a finite number, got '" + std::string(value) + "'");
-      if (key == "at") {
-        fault.at_s = *number;
-        has_at = true;
-      } else if (key == "until") {
-        fault.until_s = *number;
-      } else {
-        size = *number;
-      }
-    } else {
-      return bad_input(where + "unknown field '" + key + "' (fields: gyro, kind, at, size, until)");
-    }
+    if (Status st = read_field(key, field.substr(eq + 1), where, f); !st) return st;
     if (comma == text.size()) break;
   }
-  if (!has_gyro) return bad_input(where + "gyro is missing");
-  if (!has_kind) return bad_input(where + "kind is missing");
-  if (!has_at) return bad_input(where + "at is missing");
-  if (fault.at_s < 0.0) return bad_input(where + "at must not be negative");
-  if (fault.until_s && *fault.until_s <= fault.at_s) return bad_input(where + "until must be after at");
+  return ok_status();
+}
+
+// gyro, kind and at given; the times in order.
+Status check_required(const FaultFields& f, const std::string& where) {
+  if (!f.has_gyro) return bad_input(where + "gyro is missing");
+  if (!f.has_kind) return bad_input(where + "kind is missing");
+  if (!f.has_at) return bad_input(where + "at is missing");
+  if (f.fault.at_s < 0.0) return bad_input(where + "at must not be negative");
+  if (f.fault.until_s && *f.fault.until_s <= f.fault.at_s) return bad_input(where + "until must be after at");
+  return ok_status();
+}
+
+// A size exactly for the kinds that take one, in the kind's range; until not for a spike.
+Status check_size(FaultFields& f, const std::string& where) {
+  FaultSpec& fault = f.fault;
   if (kind_takes_size(fault.kind)) {
-    if (!size)
+    if (!f.size)
       return bad_input(where + "size is required for kind " + std::string(fault_kind_name(fault.kind)));
-    fault.size = *size;
+    fault.size = *f.size;
     if (fault.kind == FaultKind::kNoise && fault.size < 0.0) {
       return bad_input(where + "size: a noise multiplier must not be negative");
     }
     if (fault.kind == FaultKind::kScale && fault.size <= -1.0) {
       return bad_input(where + "size: a relative scale change must be above -1");
     }
-  } else if (size) {
+  } else if (f.size) {
     return bad_input(where + "size has no meaning for kind " + std::string(fault_kind_name(fault.kind)));
   }
   if (fault.kind == FaultKind::kSpike && fault.until_s) {
     return bad_input(where + "until has no meaning for a spike (one sample at 'at')");
   }
-  return fault;
+  return ok_status();
+}
+
+}  // namespace
+
+Result<FaultSpec> parse_fault_spec(std::string_view text) {
+  const std::string where = "fault '" + std::string(text) + "': ";
+  FaultFields f;
+  if (Status st = read_fields(text, where, f); !st) return st.error();
+  if (Status st = check_required(f, where); !st) return st.error();
+  if (Status st = check_size(f, where); !st) return st.error();
+  return f.fault;
 }
 
 std::string format_fault_spec(const FaultSpec& fault) {

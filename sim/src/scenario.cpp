@@ -40,7 +40,8 @@ Result<Slew> parse_slew(const YamlReader& yaml, const YAML::Node& s, const std::
   return slew;
 }
 
-Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, const std::string& base_dir) {
+// The built-in scenario named by key 'scenario', after the file's keys are checked.
+Result<Scenario> base_scenario(const YAML::Node& root, const YamlReader& yaml) {
   if (Status st = yaml.check_keys(root,
                                   {"scenario", "duration_s", "rate_hz", "latitude_deg", "pitch_rate_dps",
                                    "orbit_period_s", "acs", "slews", "reference", "unit", "gyro_model",
@@ -56,83 +57,119 @@ Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, cons
   if (!builtin) return yaml.error(base, "scenario", builtin.error().message);
   Scenario sc = builtin.value();
   sc.name = yaml.source();
-  if (Status st = maybe_numbers(yaml, root, "",
-                                {{"duration_s", &sc.duration_s},
-                                 {"rate_hz", &sc.rate_hz},
-                                 {"latitude_deg", &sc.motion.latitude_deg},
-                                 {"pitch_rate_dps", &sc.motion.pitch_rate_dps},
-                                 {"orbit_period_s", &sc.motion.orbit_period_s},
-                                 {"jitter_s", &sc.jitter_s},
-                                 {"drop_probability", &sc.drop_probability}});
+  return sc;
+}
+
+Status read_top_numbers(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
+  return maybe_numbers(yaml, root, "",
+                       {{"duration_s", &sc.duration_s},
+                        {"rate_hz", &sc.rate_hz},
+                        {"latitude_deg", &sc.motion.latitude_deg},
+                        {"pitch_rate_dps", &sc.motion.pitch_rate_dps},
+                        {"orbit_period_s", &sc.motion.orbit_period_s},
+                        {"jitter_s", &sc.jitter_s},
+                        {"drop_probability", &sc.drop_probability}});
+}
+
+Status read_acs(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
+  const YAML::Node acs = root["acs"];
+  if (!acs) return ok_status();
+  if (Status st = yaml.check_keys(acs, {"amplitude_deg", "peak_accel_dps2"}, "acs"); !st) return st;
+  return maybe_numbers(
+      yaml, acs, "acs",
+      {{"amplitude_deg", &sc.motion.acs.amplitude_deg}, {"peak_accel_dps2", &sc.motion.acs.peak_accel_dps2}});
+}
+
+Status read_slews(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
+  const YAML::Node slews = root["slews"];
+  if (!slews) return ok_status();
+  if (!slews.IsSequence()) return yaml.error(slews, "slews", "expected a list");
+  if (sc.motion.kind != MotionKind::kSlews)
+    return yaml.error(slews, "slews", "only the 'slews' scenario has slews");
+  sc.motion.slews.clear();
+  for (std::size_t i = 0; i < slews.size(); ++i) {
+    auto slew = parse_slew(yaml, slews[i], "slews[" + std::to_string(i) + "]");
+    if (!slew) return slew.error();
+    sc.motion.slews.push_back(*slew);
+  }
+  return ok_status();
+}
+
+Status read_reference(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
+  const YAML::Node ref = root["reference"];
+  if (!ref) return ok_status();
+  if (Status st = yaml.check_keys(ref, {"rate_hz", "noise_arcsec"}, "reference"); !st) return st;
+  return maybe_numbers(yaml, ref, "reference",
+                       {{"rate_hz", &sc.reference.rate_hz}, {"noise_arcsec", &sc.reference.noise_arcsec}});
+}
+
+Status read_gyro_model(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
+  const YAML::Node model = root["gyro_model"];
+  if (!model) return ok_status();
+  if (Status st = yaml.check_keys(model, {"bias_instability_correlation_s", "range_dps"}, "gyro_model"); !st)
+    return st;
+  if (Status st = maybe_number(yaml, model, "bias_instability_correlation_s", "gyro_model",
+                               sc.model.bias_instability_correlation_s);
       !st)
-    return st.error();
-  if (const YAML::Node acs = root["acs"]) {
-    if (Status st = yaml.check_keys(acs, {"amplitude_deg", "peak_accel_dps2"}, "acs"); !st) return st.error();
-    if (Status st = maybe_numbers(yaml, acs, "acs",
-                                  {{"amplitude_deg", &sc.motion.acs.amplitude_deg},
-                                   {"peak_accel_dps2", &sc.motion.acs.peak_accel_dps2}});
-        !st)
-      return st.error();
-  }
-  if (const YAML::Node slews = root["slews"]) {
-    if (!slews.IsSequence()) return yaml.error(slews, "slews", "expected a list");
-    if (sc.motion.kind != MotionKind::kSlews)
-      return yaml.error(slews, "slews", "only the 'slews' scenario has slews");
-    sc.motion.slews.clear();
-    for (std::size_t i = 0; i < slews.size(); ++i) {
-      auto slew = parse_slew(yaml, slews[i], "slews[" + std::to_string(i) + "]");
-      if (!slew) return slew.error();
-      sc.motion.slews.push_back(*slew);
-    }
-  }
-  if (const YAML::Node ref = root["reference"]) {
-    if (Status st = yaml.check_keys(ref, {"rate_hz", "noise_arcsec"}, "reference"); !st) return st.error();
-    if (Status st =
-            maybe_numbers(yaml, ref, "reference",
-                          {{"rate_hz", &sc.reference.rate_hz}, {"noise_arcsec", &sc.reference.noise_arcsec}});
-        !st)
-      return st.error();
-  }
-  if (const YAML::Node model = root["gyro_model"]) {
-    if (Status st = yaml.check_keys(model, {"bias_instability_correlation_s", "range_dps"}, "gyro_model");
-        !st)
-      return st.error();
-    if (Status st = maybe_number(yaml, model, "bias_instability_correlation_s", "gyro_model",
-                                 sc.model.bias_instability_correlation_s);
-        !st)
-      return st.error();
-    const auto range = yaml.optional_number(model, "range_dps", "gyro_model");
-    if (!range) return range.error();
-    if (*range) sc.model.range_dps = **range;
-  }
-  if (const YAML::Node unit = root["unit"]) {
-    auto unit_path = yaml.text(unit, "unit");
-    if (!unit_path) return unit_path.error();
-    std::filesystem::path path = *unit_path;
-    if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
-    auto cal = read_calibration(path.string());
-    if (!cal) return yaml.error(unit, "unit", cal.error().message);
-    sc.unit = std::move(cal.value());
-  }
-  if (const YAML::Node faults = root["faults"]) {
-    if (!faults.IsSequence()) return yaml.error(faults, "faults", "expected a list of fault specs");
-    for (std::size_t i = 0; i < faults.size(); ++i) {
-      auto spec = yaml.text(faults[i], "faults[" + std::to_string(i) + "]");
-      if (!spec) return spec.error();
-      auto fault = parse_fault_spec(*spec);
-      if (!fault) return yaml.error(faults[i], "faults[" + std::to_string(i) + "]", fault.error().message);
-      sc.faults.push_back(fault.value());
-    }
-  }
-  if (const YAML::Node loop = root["closed_loop"]) {
-    if (sc.motion.kind != MotionKind::kOrbit)
-      return yaml.error(loop, "closed_loop", "needs 'scenario: orbit' (the orbit the spacecraft flies)");
-    auto spec = parse_closed_loop(yaml, loop);
+    return st;
+  const auto range = yaml.optional_number(model, "range_dps", "gyro_model");
+  if (!range) return range.error();
+  if (*range) sc.model.range_dps = **range;
+  return ok_status();
+}
+
+// The unit's calibration file, relative to the scenario file's folder `base_dir`.
+Status read_unit(const YamlReader& yaml, const YAML::Node& root, const std::string& base_dir, Scenario& sc) {
+  const YAML::Node unit = root["unit"];
+  if (!unit) return ok_status();
+  auto unit_path = yaml.text(unit, "unit");
+  if (!unit_path) return unit_path.error();
+  std::filesystem::path path = *unit_path;
+  if (path.is_relative()) path = std::filesystem::path(base_dir) / path;
+  auto cal = read_calibration(path.string());
+  if (!cal) return yaml.error(unit, "unit", cal.error().message);
+  sc.unit = std::move(cal.value());
+  return ok_status();
+}
+
+Status read_faults(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
+  const YAML::Node faults = root["faults"];
+  if (!faults) return ok_status();
+  if (!faults.IsSequence()) return yaml.error(faults, "faults", "expected a list of fault specs");
+  for (std::size_t i = 0; i < faults.size(); ++i) {
+    auto spec = yaml.text(faults[i], "faults[" + std::to_string(i) + "]");
     if (!spec) return spec.error();
-    sc.closed_loop = std::move(spec.value());
+    auto fault = parse_fault_spec(*spec);
+    if (!fault) return yaml.error(faults[i], "faults[" + std::to_string(i) + "]", fault.error().message);
+    sc.faults.push_back(fault.value());
+  }
+  return ok_status();
+}
+
+Status read_closed_loop(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
+  const YAML::Node loop = root["closed_loop"];
+  if (!loop) return ok_status();
+  if (sc.motion.kind != MotionKind::kOrbit)
+    return yaml.error(loop, "closed_loop", "needs 'scenario: orbit' (the orbit the spacecraft flies)");
+  auto spec = parse_closed_loop(yaml, loop);
+  if (!spec) return spec.error();
+  sc.closed_loop = std::move(spec.value());
+  return ok_status();
+}
+
+// The built-in scenario, then each section of the file over it, in this order; then the ranges.
+Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, const std::string& base_dir) {
+  auto sc = base_scenario(root, yaml);
+  if (!sc) return sc.error();
+  for (auto* read_section : {read_top_numbers, read_acs, read_slews, read_reference, read_gyro_model}) {
+    if (Status st = read_section(yaml, root, *sc); !st) return st.error();
+  }
+  if (Status st = read_unit(yaml, root, base_dir, *sc); !st) return st.error();
+  for (auto* read_section : {read_faults, read_closed_loop}) {
+    if (Status st = read_section(yaml, root, *sc); !st) return st.error();
   }
   // Range checks with the line of the key where it exists.
-  if (Status st = validate_scenario(sc); !st) return yaml.error(root, "", st.error().message);
+  if (Status st = validate_scenario(*sc); !st) return yaml.error(root, "", st.error().message);
   return sc;
 }
 

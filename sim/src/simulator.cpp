@@ -191,11 +191,11 @@ class TruthWriter {
 Status write_simulation(Simulator& simulator, const std::string& log_path, const std::string& truth_path,
                         void (*progress)(double fraction)) {
   RunFiles files;
-  auto log = files.add(log_path, "--out");
+  auto log = files.add(log_path, "log");
   if (!log) return log.error();
   OutputFile* truth = nullptr;
   if (!truth_path.empty()) {
-    auto t = files.add(truth_path, "--truth");
+    auto t = files.add(truth_path, "truth");
     if (!t) return t.error();
     truth = *t;
   }

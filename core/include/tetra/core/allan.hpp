@@ -37,6 +37,18 @@
 
 namespace tetra::allan {
 
+// --- error subjects (Error::subject.name of this header's errors; a command maps them to options) ---
+
+inline constexpr const char* kSubjectTaus =
+    "taus";  //!< the averaging times (parse_tau_spec, AllanOptions::taus)
+inline constexpr const char* kSubjectGyros =
+    "gyros";  //!< LogAllanOptions::gyros; value: the id not in the log
+//! One gyro of several could not be analysed: the others can be, when analysed without it
+//! (LogAllanOptions::gyros); the message names the log and the gyro.
+inline constexpr const char* kSubjectOtherGyros = "other_gyros";
+inline constexpr const char* kSubjectNoiseUpdate = "noise_update";  //!< update_calibration_noise's output
+inline constexpr const char* kSubjectKalibr = "kalibr";  //!< kalibr_gyro_noise's output (allan_kalibr.hpp)
+
 // --- averaging times ---------------------------------------------------------------------------
 
 enum class TauSpacing {

@@ -87,8 +87,8 @@ struct AttitudeScore {
   double truth_angle_axis_deg = 0.0;  //!< [deg] the same from the truth
 };
 
-//! Scores `attitude` against `truth`. Bad input when no attitude row falls within the truth's time span
-//! or the axis is not a unit vector.
+//! Scores `attitude` against `truth`. Bad input when no attitude row falls within the truth's time span,
+//! or about an option (Error::subject "axis_B": not a unit vector; "time_tolerance_s": negative).
 Result<AttitudeScore> score_attitude(const AttitudeSeries& attitude, const AttitudeSeries& truth,
                                      const ScoreOptions& options = {});
 

@@ -91,7 +91,7 @@ Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options
 
 //! Runs the simulator to files: the gyro log (docs/interfaces.md §2.2) and, if `truth_path` is not empty,
 //! the truth (time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps: attitude body → R and rate of B relative to R).
-//! `progress` is called now and then with the fraction done.
+//! `progress` is called now and then with the fraction done. Errors name the outputs "log" and "truth".
 Status write_simulation(Simulator& simulator, const std::string& log_path, const std::string& truth_path,
                         void (*progress)(double fraction) = nullptr);
 //! The same into outputs of a larger run (the caller's RunFiles commits them); `extra_metadata` (e.g.
