@@ -44,7 +44,10 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
                                  double sqrt_period, Health& health) {
   Detection d;
   d.onset_index = frame.index;
-  const double chi2 = apply_parity(s, frame.usable, frame.y_rad_s.data(), sqrt_period, p_.data());
+  // The χ² sees one sample: with quantization its own whitening (white noise and quantization error).
+  double chi2 = apply_parity(s, frame.usable, frame.y_rad_s.data(), sqrt_period, p_.data());
+  if (s.quantized)
+    chi2 = apply_whitened(s.sample_parity, s.dof, frame.usable, frame.y_rad_s.data(), sqrt_period, dp_.data());
   health.chi2 = chi2;
   health.chi2_threshold = s.chi2_threshold;
   health.parity_residual = s.dof >= 1 ? std::sqrt(chi2) : 0.0;
@@ -67,7 +70,10 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   // The slow mean: white unit-variance input gives an EMA of variance β/(2 − β) in steady state.
   const double beta = std::min(1.0, frame.dt_s / nominal_window_s_);
   for (int r = 0; r < s.dof; ++r) p_slow_[r] += beta * (p_[r] - p_slow_[r]);
-  slow_var_ = beta / (2.0 - beta);
+  // Quantization: each sample's error term is a difference u_k − u_{k−1} (1σ of u: quantization_sigma), whose
+  // EMA telescopes to β²(1 + β(1 − β)²/(2 − β))·σ_u².
+  const double qs = s.quantization_sigma;
+  slow_var_ = beta / (2.0 - beta) + beta * beta * (1.0 + beta * (1.0 - beta) * (1.0 - beta) / (2.0 - beta)) * qs * qs;
   slow_age_s_ += frame.dt_s;
   std::int64_t onset = d.onset_index;
   const double stat =

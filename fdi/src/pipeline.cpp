@@ -41,19 +41,6 @@ Eigen::VectorXd bias_sigmas(const std::vector<GyroConstants>& constants) {
     b[static_cast<Eigen::Index>(i)] = constants[i].bias_sigma_rad_s;
   return b;
 }
-
-//! [rad/s] per gyro: 1σ of its slowly wandering bias from the `noise:` section (B, K), for the detectors.
-Eigen::VectorXd bias_wanders(const Calibration& cal, const PipelineConfig& config) {
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(cal.gyro_count());
-  for (Eigen::Index i = 0; i < w.size(); ++i) {
-    const auto& noise = cal.gyros[static_cast<std::size_t>(i)].noise;
-    if (!noise) continue;
-    const double b = noise->bias_instability_dps.value_or(0.0) * kDegToRad;
-    const double k = noise->rate_random_walk_dps_per_rts.value_or(0.0) * kDegToRad;
-    w[i] = bias_wander_sigma(b, k, config.rate_random_walk_horizon_s);
-  }
-  return w;
-}
 }  // namespace
 
 class Pipeline::Impl {
@@ -62,7 +49,7 @@ class Pipeline::Impl {
        std::vector<GyroConstants> constants)
       : config_(config),
         n_(cal.gyro_count()),
-        subsets_(std::move(geometry), bias_sigmas(constants), config_, bias_wanders(cal, config_)),
+        subsets_(std::move(geometry), bias_sigmas(constants), config_, detector_noise(cal, config_)),
         series_(std::move(constants), config_),
         gate_(n_, config_),
         detector_(n_, config_.clear_after_s),
