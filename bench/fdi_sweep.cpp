@@ -2,10 +2,11 @@
 // "Detection"): the simulator's default unit (bias instability B = 5e-6 deg/s) with N = 4, 5, 6 gyros,
 // straight into the pipeline in process, one-hour orbits on every thread.
 //
-//   fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS] [--unit CAL.yaml]
+//   fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS] [--unit CAL.yaml] [--quantization DEG]
 //
 // --unit replaces the default unit by a calibration file's (its own N only; e.g. the coarsely quantized
 // examples/sim/allan_unit.yaml): the simulator runs that unit and the pipeline reads the same file.
+// --quantization gives every gyro of the default unit an angle quantization Q [deg] (N = 4, 5, 6 quantized).
 //
 // --arl0 lowers the design in-control ARL (cusum_arl0_epochs) so that a sweep of a few hundred hours counts
 // enough false alarms to test the threshold computation itself (at the default 1e8, 1,000 h expect 0.4).
@@ -48,10 +49,20 @@ struct RunOutcome {
 //! One simulated run of `duration_s` straight into a pipeline; counts `detected` events.
 double g_arl0 = fdi::PipelineConfig{}.cusum_arl0_epochs;  // set once by main before any thread starts
 std::optional<Calibration> g_unit;                        // --unit; set once by main
+double g_quantization_deg = 0.0;                          // --quantization; set once by main
 
-//! The unit of the sweep with n gyros: --unit's (its own N), else the seed's as-built unit cut or extended.
+//! The unit of the sweep with n gyros: --unit's (its own N), else the seed's as-built unit cut or extended,
+//! with --quantization's angle quantization on every gyro.
 Calibration sweep_unit(int n) {
-  return g_unit ? *g_unit : unit_with(n);
+  if (g_unit) return *g_unit;
+  Calibration cal = unit_with(n);
+  if (g_quantization_deg > 0.0) {
+    for (auto& g : cal.gyros) {
+      if (!g.noise) g.noise = GyroNoise{};
+      g.noise->quantization_deg = g_quantization_deg;
+    }
+  }
+  return cal;
 }
 
 RunOutcome run(int n, double duration_s, std::uint64_t seed, const std::vector<sim::FaultSpec>& faults) {
@@ -234,11 +245,13 @@ int main(int argc, char** argv) {
     if (arg == "--help" || arg == "-h") {
       std::printf(
           "fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS] [--unit CAL.yaml]\n"
+          "          [--quantization DEG]\n"
           "  false alarms in H fault-free one-hour orbits per N = 4, 5, 6 (default 1000), then the "
           "detection\n"
           "  delays of the documented faults (S seeds per fault and gyro, default 10), on J threads.\n"
           "  --arl0: the CUSUM's design in-control ARL [epochs] (default 1e8).\n"
-          "  --unit: simulate and fuse this calibration file's unit instead (its own N only).\n");
+          "  --unit: simulate and fuse this calibration file's unit instead (its own N only).\n"
+          "  --quantization: angle quantization [deg] of every gyro of the default unit.\n");
       return 0;
     }
     if (a + 1 >= argc) {
@@ -249,6 +262,14 @@ int main(int argc, char** argv) {
       g_arl0 = std::atof(argv[++a]);
       if (!(g_arl0 >= 10.0)) {
         std::fprintf(stderr, "fdi_sweep: option --arl0 must be >= 10\n");
+        return 2;
+      }
+      continue;
+    }
+    if (arg == "--quantization") {
+      g_quantization_deg = std::atof(argv[++a]);
+      if (!(g_quantization_deg >= 0.0)) {
+        std::fprintf(stderr, "fdi_sweep: option --quantization must be >= 0\n");
         return 2;
       }
       continue;

@@ -207,6 +207,11 @@ double GyroSeries::sample_sigma(int id, double sqrt_period) const {
   return std::sqrt(sample_variance(c.arw_rad_rts, c.quantization_rad, sqrt_period * sqrt_period));
 }
 
+double GyroSeries::window_mean_variance(int id, double sqrt_period, int n) const {
+  const GyroConstants& c = constants(id);
+  return mean_variance(c.arw_rad_rts, c.quantization_rad, sqrt_period * sqrt_period, n);
+}
+
 double GyroSeries::difference_variance(int id, double sqrt_period) const {
   const GyroConstants& c = constants(id);
   return sample_difference_variance(c.arw_rad_rts, c.quantization_rad, sqrt_period * sqrt_period);

@@ -106,16 +106,23 @@ void SubsetCache::add_quantization(Subset& s, const Eigen::MatrixXd& v, GyroMask
   s.sample_parity = whiten(v, r_sample);
   s.jump_parity = whiten(v, r_jump);
   // A sum of samples carries the quantization error of its last sample minus that of the one before its
-  // first, W·(e_n − e_m)/√T with |e_i| ≤ √3·Q_i: its norm is at most 2U, U = Σ_i |W_i|·√3·Q_i/√T.
+  // first, W·(e_n − e_m)/√T, e_i uniform within ±√3·Q_i. The CUSUM lingers near h for many epochs, each with
+  // a fresh e_n, so the last term reaches its bound U = Σ_i |W_i|·√3·Q_i/√T; the first is one draw, whose
+  // effect on the crossing rate ∝ exp(−2k·h) is its moment generating function at 2k:
+  // Σ_i ln(sinh x_i / x_i)/(2k), x_i = 2k·|W_i|·√3·Q_i/√T. h is raised by their sum (|W_i|, the column's
+  // norm, bounds its projection on any direction for d ≥ 2).
   double u = 0.0;
+  double log_mgf = 0.0;
   double var = 0.0;
   for (int i = 0; i < gyro_count(); ++i) {
     if (!has_gyro(mask, i + 1)) continue;
-    const double q = quantization_rad_[i] / sqrt_period_;
-    u += s.parity.col(i).norm() * std::sqrt(3.0) * q;
-    var += s.parity.col(i).squaredNorm() * q * q;
+    const double bound = s.parity.col(i).norm() * std::sqrt(3.0) * quantization_rad_[i] / sqrt_period_;
+    const double x = 2.0 * s.cusum_k * bound;
+    u += bound;
+    if (x > 0.0) log_mgf += std::log(std::sinh(x) / x);
+    var += bound * bound / 3.0;
   }
-  s.quantization_margin = 2.0 * u;
+  s.quantization_margin = u + log_mgf / (2.0 * s.cusum_k);
   s.quantization_sigma = std::sqrt(var / s.dof);
 }
 
@@ -147,7 +154,6 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   const Eigen::MatrixXd v = *geometry_.parity_matrix(mask);
   const Eigen::VectorXd& arw = geometry_.sigma();
   s.parity = whiten(v, arw.cwiseProduct(arw));
-  add_quantization(s, v, mask);
   const PipelineConfig& config = *config_;
   s.chi2_threshold = chi2_threshold(config.chi2_false_alarm_probability, s.dof);
   s.jump_threshold = chi2_threshold(config.jump_false_alarm_probability, s.dof);
@@ -159,6 +165,7 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   }
   const double delta = config.cusum_min_fault_dps * kDegToRad * min_col * sqrt_period_;
   s.cusum_k = 0.5 * delta;
+  add_quantization(s, v, mask);
   s.bias_wander_sigma = parity_bias_sigma(s, mask);
   s.cusum_h = cusum_threshold(s.dof, s.cusum_k, config.cusum_arl0_epochs, s.bias_wander_sigma) +
               s.quantization_margin;

@@ -3,6 +3,7 @@
 // axis, the thresholds of the parity tests — computed once per subset, and the two kernels every stage uses
 // to apply them (docs/fdi.md, "Noise model and normalized parity").
 
+#include <cmath>
 #include <unordered_map>
 
 #include <Eigen/Core>
@@ -26,7 +27,7 @@ struct Subset {
                                   //!< the instantaneous χ²; equals `parity` without quantization
   Eigen::MatrixXd jump_parity;    //!< whitened by the noise of a one-sample difference: the jump test
   bool quantized = false;         //!< some gyro of the subset has an angle quantization
-  double quantization_margin = 0.0;  //!< [σ] 2·U: the most the telescoping quantization error adds to a sum
+  double quantization_margin = 0.0;  //!< [σ] what the CUSUM's h adds for the telescoping quantization error
   double quantization_sigma = 0.0;   //!< [σ] per parity axis: 1σ of one sample's quantization error term
   Eigen::Vector3d arw_sq_rad2_s;  //!< [rad²/s] N² per body axis of the rate estimate
   Eigen::Vector3d bias_sigma_rad_s;  //!< [rad/s] 1σ rate bias per body axis left by the calibration
@@ -55,6 +56,11 @@ DetectorNoise detector_noise(const Calibration& cal, const PipelineConfig& confi
 inline double sample_variance(double arw_rad_rts, double quantization_rad, double period_s) {
   return arw_rad_rts * arw_rad_rts / period_s +
          2.0 * quantization_rad * quantization_rad / (period_s * period_s);
+}
+//! [rad²/s²] variance of the mean of n consecutive samples: N²/(nT) and, the quantization errors telescoping
+//! to (e_n − e_0)/(nT), 2Q²/(nT)² (n = 1: `sample_variance`).
+inline double mean_variance(double arw_rad_rts, double quantization_rad, double period_s, double n) {
+  return sample_variance(arw_rad_rts / std::sqrt(n), quantization_rad / n, period_s);
 }
 //! [rad²/s²] variance of the difference of two consecutive samples: 2N²/T and, of the quantized angle's
 //! second difference (e_k − 2e_{k−1} + e_{k−2})/T, 6Q²/T².
@@ -97,7 +103,8 @@ class SubsetCache {
   double parity_bias_sigma(const Subset& s, GyroMask mask) const;
   //! L⁻¹V with L Lᵀ = V diag(r) Vᵀ: the parity V of the subset whitened by per-gyro variances r.
   Eigen::MatrixXd whiten(const Eigen::MatrixXd& v, const Eigen::VectorXd& r) const;
-  //! The quantization's sample and jump whitening, its margin and σ in the normalized parity (Subset).
+  //! The quantization's sample and jump whitening, its CUSUM margin (needs `cusum_k`) and σ in the
+  //! normalized parity (Subset).
   void add_quantization(Subset& s, const Eigen::MatrixXd& v, GyroMask mask) const;
 
   GyroGeometry geometry_;              //!< weighted by N_i
