@@ -148,8 +148,9 @@ int Isolator::motion_within_bound(GyroMask mask, double separation_s, SubsetCach
     if (n_pre_[u] < 2 || n_post_[u] < 2) return -1;
     dw += h.pinv.col(i) * (mean_post_[u] - mean_pre_[u]);
     if (h.quantized) {  // a window mean's quantization error telescopes
-      var += h.pinv.col(i).squaredNorm() * (series.window_mean_variance(i + 1, subsets.sqrt_period(), n_pre_[u]) +
-                                            series.window_mean_variance(i + 1, subsets.sqrt_period(), n_post_[u]));
+      var += h.pinv.col(i).squaredNorm() *
+             (series.window_mean_variance(i + 1, subsets.sqrt_period(), n_pre_[u]) +
+              series.window_mean_variance(i + 1, subsets.sqrt_period(), n_post_[u]));
     } else {
       const double sig = series.sample_sigma(i + 1, subsets.sqrt_period());
       var += h.pinv.col(i).squaredNorm() * sig * sig * (1.0 / n_pre_[u] + 1.0 / n_post_[u]);

@@ -87,6 +87,7 @@ class Pipeline::Impl {
   bool accept(const Epoch& epoch);
   void reject_outliers();
   void detect();
+  void level_changed(const Detection& d);
   void seek_evidence();
   void decide_episode();
   void publish_attitude();
@@ -220,7 +221,12 @@ void Pipeline::Impl::detect() {
   if (d.cusum_ran && !d.alarm && isolator_.episode().active && !detector_.parity_nominal(s))
     isolator_.alarmed(frame_.now_ns);
   if (!d.alarm) return;
+  if (d.test == DetectionTest::kLevel) {
+    level_changed(d);
+    return;
+  }
   if (isolator_.open(d, frame_.now_ns, frame_.index, s, detector_)) {
+    detector_.open_episode();
     emit_detected(d.test, d.statistic, frame_.now_ns);
     // The fault acted since its onset: widen the uncertainty for the time already spent.
     attitude_.add_bound(
@@ -231,6 +237,22 @@ void Pipeline::Impl::detect() {
   }
   isolator_.alarmed(frame_.now_ns);
   detector_.restart_after_alarm();  // a persisting fault keeps raising alarms, a gone one stops
+}
+
+void Pipeline::Impl::level_changed(const Detection& d) {
+  // A new fault during the open episode: a new detection, and the uncertainty widened as for the first
+  // (docs/fdi.md, "Detection"). The episode's isolation goes on as it was (a second onset inside a drift
+  // gave the onset test chances to blame a healthy gyro); the level test measures from the new level.
+  const GyroMask active = gyro_set_.active();
+  emit_detected(d.test, d.statistic, frame_.now_ns);
+  attitude_.add_bound(
+      fault_rate_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()) *
+      ns_to_seconds(frame_.now_ns - isolator_.time_of(std::max<std::int64_t>(d.onset_index, 0))));
+  attitude_.fault_opened(
+      fault_size_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()));
+  detector_.open_episode();
+  isolator_.alarmed(frame_.now_ns);
+  detector_.restart_after_alarm();
 }
 
 void Pipeline::Impl::seek_evidence() {

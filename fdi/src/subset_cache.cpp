@@ -1,5 +1,6 @@
 #include "subset_cache.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -9,6 +10,10 @@
 #include "tetra/fdi/detectors.hpp"
 
 namespace tetra::fdi::detail {
+
+namespace {
+constexpr double kLevelMarginSigma = 3.0;  //!< [σ of the held level] offset the level test's k absorbs
+}  // namespace
 
 double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s,
                          double rate_ramp_rad_s2) {
@@ -39,7 +44,8 @@ SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s
       quantization_rad_(std::move(noise.quantization_rad)),
       bias_wander_rad_s_(std::move(noise.bias_wander_rad_s)),
       config_(&config) {
-  if (quantization_rad_.size() != geometry_.gyro_count()) quantization_rad_ = Eigen::VectorXd::Zero(gyro_count());
+  if (quantization_rad_.size() != geometry_.gyro_count())
+    quantization_rad_ = Eigen::VectorXd::Zero(gyro_count());
   if (bias_wander_rad_s_.size() != geometry_.gyro_count())
     bias_wander_rad_s_ = Eigen::VectorXd::Zero(gyro_count());
   subsets_.reserve(gyro_count() <= 8 ? 512 : 4096);
@@ -168,6 +174,14 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   add_quantization(s, v, mask);
   s.bias_wander_sigma = parity_bias_sigma(s, mask);
   s.cusum_h = cusum_threshold(s.dof, s.cusum_k, config.cusum_arl0_epochs, s.bias_wander_sigma) +
+              s.quantization_margin;
+  // The held level (mean of M epochs over isolation_window_s) misses the episode's true level by N(0, 1/M)
+  // per axis, a constant offset for the level test: its reference k grows by kLevelMarginSigma/√M, which
+  // absorbs such an offset (a larger one, rarer than 3σ, only hastens the test's false alarms in that
+  // episode).
+  s.level_epochs = std::max(2, static_cast<int>(std::lround(config.isolation_window_s / period_s_)));
+  s.level_k = s.cusum_k + kLevelMarginSigma / std::sqrt(static_cast<double>(s.level_epochs));
+  s.level_h = cusum_threshold(s.dof, s.level_k, config.cusum_arl0_epochs, s.bias_wander_sigma) +
               s.quantization_margin;
   if (s.dof >= 2) {
     s.glt_accept = chi2_threshold(1e-3, s.dof - 1);

@@ -19,23 +19,26 @@ namespace tetra::fdi::detail {
 struct Subset {
   GyroMask mask = 0;
   bool observable = false;
-  int dof = 0;                    //!< parity dimension |S| − 3
-  Eigen::Matrix3Xd pinv;          //!< 3×N weighted pseudoinverse (zero columns outside S)
-  Eigen::MatrixXd parity;         //!< d×N normalized parity in 1/(rad/s) per √s: p = √T·W·y, whitened by the
-                                  //!< white noise N_i (the long-run noise every averaging test sees)
-  Eigen::MatrixXd sample_parity;  //!< the same whitened by the noise of one sample (N_i and quantization Q_i):
-                                  //!< the instantaneous χ²; equals `parity` without quantization
-  Eigen::MatrixXd jump_parity;    //!< whitened by the noise of a one-sample difference: the jump test
-  bool quantized = false;         //!< some gyro of the subset has an angle quantization
+  int dof = 0;             //!< parity dimension |S| − 3
+  Eigen::Matrix3Xd pinv;   //!< 3×N weighted pseudoinverse (zero columns outside S)
+  Eigen::MatrixXd parity;  //!< d×N normalized parity in 1/(rad/s) per √s: p = √T·W·y, whitened by the
+                           //!< white noise N_i (the long-run noise every averaging test sees)
+  Eigen::MatrixXd sample_parity;  //!< the same whitened by the noise of one sample (N_i and quantization
+                                  //!< Q_i): the instantaneous χ²; equals `parity` without quantization
+  Eigen::MatrixXd jump_parity;       //!< whitened by the noise of a one-sample difference: the jump test
+  bool quantized = false;            //!< some gyro of the subset has an angle quantization
   double quantization_margin = 0.0;  //!< [σ] what the CUSUM's h adds for the telescoping quantization error
   double quantization_sigma = 0.0;   //!< [σ] per parity axis: 1σ of one sample's quantization error term
-  Eigen::Vector3d arw_sq_rad2_s;  //!< [rad²/s] N² per body axis of the rate estimate
+  Eigen::Vector3d arw_sq_rad2_s;     //!< [rad²/s] N² per body axis of the rate estimate
   Eigen::Vector3d bias_sigma_rad_s;  //!< [rad/s] 1σ rate bias per body axis left by the calibration
   double chi2_threshold = 0.0;       //!< instantaneous χ² threshold
   double jump_threshold = 0.0;       //!< one-epoch jump χ² threshold
   double cusum_k = 0.0;              //!< [σ] CUSUM reference
   double cusum_h = 0.0;              //!< [σ] CUSUM threshold
   double bias_wander_sigma = 0.0;    //!< [σ] per parity axis: the slowly wandering bias (B, K) in the parity
+  int level_epochs = 1;              //!< epochs an episode's parity level is averaged over before it is held
+  double level_k = 0.0;              //!< [σ] reference of the CUSUM on the parity minus the held level
+  double level_h = 0.0;              //!< [σ] its threshold
   double nominal_threshold = 0.0;    //!< χ²_d(1 − 1e-3): the slow parity mean back to nominal
   double glt_accept = 0.0;           //!< χ²_{d−1} quantile accepting a single-gyro hypothesis
   double glt_reject = 0.0;           //!< χ²_{d−1} quantile rejecting one
