@@ -23,8 +23,8 @@ struct Subset {
   Eigen::Matrix3Xd pinv;   //!< 3×N weighted pseudoinverse (zero columns outside S)
   Eigen::MatrixXd parity;  //!< d×N normalized parity in 1/(rad/s) per √s: p = √T·W·y, whitened by the
                            //!< white noise N_i (the long-run noise every averaging test sees)
-  Eigen::MatrixXd sample_parity;  //!< the same whitened by the noise of one sample (N_i and quantization
-                                  //!< Q_i): the instantaneous χ²; equals `parity` without quantization
+  Eigen::MatrixXd sample_parity;     //!< the same whitened by the noise of one sample (N_i and quantization
+                                     //!< Q_i): the instantaneous χ²; equals `parity` without quantization
   Eigen::MatrixXd jump_parity;       //!< whitened by the noise of a one-sample difference: the jump test
   bool quantized = false;            //!< some gyro of the subset has an angle quantization
   double quantization_margin = 0.0;  //!< [σ] what the CUSUM's h adds for the telescoping quantization error
