@@ -245,9 +245,8 @@ void Pipeline::Impl::level_changed(const Detection& d) {
   // gave the onset test chances to blame a healthy gyro); the level test measures from the new level.
   const GyroMask active = gyro_set_.active();
   emit_detected(d.test, d.statistic, frame_.now_ns);
-  attitude_.add_bound(
-      fault_rate_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()) *
-      ns_to_seconds(frame_.now_ns - isolator_.time_of(std::max<std::int64_t>(d.onset_index, 0))));
+  attitude_.add_bound(fault_rate_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()) *
+                      ns_to_seconds(frame_.now_ns - isolator_.onset_time(d.onset_index, frame_.index)));
   attitude_.fault_opened(
       fault_size_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()));
   detector_.open_episode();
