@@ -2,7 +2,11 @@
 // "Detection"): the simulator's default unit (bias instability B = 5e-6 deg/s) with N = 4, 5, 6 gyros,
 // straight into the pipeline in process, one-hour orbits on every thread.
 //
-//   fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS]
+//   fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS] [--unit CAL.yaml] [--quantization DEG]
+//
+// --unit replaces the default unit by a calibration file's (its own N only; e.g. the coarsely quantized
+// examples/sim/allan_unit.yaml): the simulator runs that unit and the pipeline reads the same file.
+// --quantization gives every gyro of the default unit an angle quantization Q [deg] (N = 4, 5, 6 quantized).
 //
 // --arl0 lowers the design in-control ARL (cusum_arl0_epochs) so that a sweep of a few hundred hours counts
 // enough false alarms to test the threshold computation itself (at the default 1e8, 1,000 h expect 0.4).
@@ -16,11 +20,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "../tests/fusion/units.hpp"
+#include "gyro_series.hpp"
 #include "subset_cache.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/units.hpp"
@@ -42,12 +48,28 @@ struct RunOutcome {
 
 //! One simulated run of `duration_s` straight into a pipeline; counts `detected` events.
 double g_arl0 = fdi::PipelineConfig{}.cusum_arl0_epochs;  // set once by main before any thread starts
+std::optional<Calibration> g_unit;                        // --unit; set once by main
+double g_quantization_deg = 0.0;                          // --quantization; set once by main
+
+//! The unit of the sweep with n gyros: --unit's (its own N), else the seed's as-built unit cut or extended,
+//! with --quantization's angle quantization on every gyro.
+Calibration sweep_unit(int n) {
+  if (g_unit) return *g_unit;
+  Calibration cal = unit_with(n);
+  if (g_quantization_deg > 0.0) {
+    for (auto& g : cal.gyros) {
+      if (!g.noise) g.noise = GyroNoise{};
+      g.noise->quantization_deg = g_quantization_deg;
+    }
+  }
+  return cal;
+}
 
 RunOutcome run(int n, double duration_s, std::uint64_t seed, const std::vector<sim::FaultSpec>& faults) {
   RunOutcome out;
   auto sc = sim::builtin_scenario("orbit");
   if (!sc) return out;
-  sc->unit = unit_with(n);
+  sc->unit = sweep_unit(n);
   sc->duration_s = duration_s;
   sc->rate_hz = kRateHz;
   sim::SimOptions so;
@@ -107,18 +129,14 @@ struct Theory {
 };
 
 Theory theory(int n) {
-  const Calibration cal = unit_with(n);
+  const Calibration cal = sweep_unit(n);
   fdi::PipelineConfig config;
   config.cusum_arl0_epochs = g_arl0;
+  const auto constants = fdi::detail::gyro_constants(cal, config);
   Eigen::VectorXd arw(n);
-  Eigen::VectorXd wander(n);
-  for (int i = 0; i < n; ++i) {
-    arw[i] = *cal.gyros[static_cast<std::size_t>(i)].noise->arw_dps_rtHz * kDegToRad;
-    wander[i] = fdi::detail::bias_wander_sigma(
-        *cal.gyros[static_cast<std::size_t>(i)].noise->bias_instability_dps * kDegToRad, 0.0, 0.0);
-  }
+  for (int i = 0; i < n; ++i) arw[i] = (*constants)[static_cast<std::size_t>(i)].arw_rad_rts;
   fdi::detail::SubsetCache cache(*GyroGeometry::create(cal.axes_B(), arw), Eigen::VectorXd::Zero(n), config,
-                                 wander);
+                                 fdi::detail::detector_noise(cal, config));
   cache.prepare(1.0 / kRateHz);
   const auto& s = cache.get(all_gyros(n));
   Theory t{s.dof,
@@ -226,11 +244,14 @@ int main(int argc, char** argv) {
     const std::string arg = argv[a];
     if (arg == "--help" || arg == "-h") {
       std::printf(
-          "fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS]\n"
+          "fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS] [--unit CAL.yaml]\n"
+          "          [--quantization DEG]\n"
           "  false alarms in H fault-free one-hour orbits per N = 4, 5, 6 (default 1000), then the "
           "detection\n"
           "  delays of the documented faults (S seeds per fault and gyro, default 10), on J threads.\n"
-          "  --arl0: the CUSUM's design in-control ARL [epochs] (default 1e8).\n");
+          "  --arl0: the CUSUM's design in-control ARL [epochs] (default 1e8).\n"
+          "  --unit: simulate and fuse this calibration file's unit instead (its own N only).\n"
+          "  --quantization: angle quantization [deg] of every gyro of the default unit.\n");
       return 0;
     }
     if (a + 1 >= argc) {
@@ -243,6 +264,23 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "fdi_sweep: option --arl0 must be >= 10\n");
         return 2;
       }
+      continue;
+    }
+    if (arg == "--quantization") {
+      g_quantization_deg = std::atof(argv[++a]);
+      if (!(g_quantization_deg >= 0.0)) {
+        std::fprintf(stderr, "fdi_sweep: option --quantization must be >= 0\n");
+        return 2;
+      }
+      continue;
+    }
+    if (arg == "--unit") {
+      auto unit = read_calibration(argv[++a]);
+      if (!unit) {
+        std::fprintf(stderr, "%s\n", unit.error().message.c_str());
+        return 2;
+      }
+      g_unit = *unit;
       continue;
     }
     const int value = std::atoi(argv[++a]);
@@ -261,11 +299,13 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  for (int n = 4; n <= 6 && hours > 0; ++n) false_alarm_sweep(n, hours, jobs);
+  const int n_first = g_unit ? g_unit->gyro_count() : 4;
+  const int n_last = g_unit ? g_unit->gyro_count() : 6;
+  for (int n = n_first; n <= n_last && hours > 0; ++n) false_alarm_sweep(n, hours, jobs);
   if (delay_seeds > 0) {
     std::printf("\n| N | fault | gyro | mean delay [s] | theory [s] | ratio | detected after onset |\n");
     std::printf("|---|---|---|---|---|---|---|\n");
-    for (int n = 4; n <= 6; ++n) delay_table(n, delay_seeds, jobs);
+    for (int n = n_first; n <= n_last; ++n) delay_table(n, delay_seeds, jobs);
   }
   return 0;
 }

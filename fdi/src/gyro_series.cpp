@@ -228,9 +228,17 @@ double GyroSeries::project(const Track& t, GyroMask others, const double* v) con
 
 double GyroSeries::sample_sigma(int id, double sqrt_period) const {
   const GyroConstants& c = constants(id);
-  const double period = sqrt_period * sqrt_period;
-  return std::sqrt(c.arw_rad_rts * c.arw_rad_rts / period +
-                   2.0 * c.quantization_rad * c.quantization_rad / (period * period));
+  return std::sqrt(sample_variance(c.arw_rad_rts, c.quantization_rad, sqrt_period * sqrt_period));
+}
+
+double GyroSeries::window_mean_variance(int id, double sqrt_period, int n) const {
+  const GyroConstants& c = constants(id);
+  return mean_variance(c.arw_rad_rts, c.quantization_rad, sqrt_period * sqrt_period, n);
+}
+
+double GyroSeries::difference_variance(int id, double sqrt_period) const {
+  const GyroConstants& c = constants(id);
+  return sample_difference_variance(c.arw_rad_rts, c.quantization_rad, sqrt_period * sqrt_period);
 }
 
 bool GyroSeries::coarse(int id, double sqrt_period) const {

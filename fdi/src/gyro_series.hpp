@@ -59,6 +59,10 @@ class GyroSeries {
   double recent_noise_ratio(int id, double sqrt_period, int last) const;
   //! [rad/s] 1σ of one sample: white noise N/√T and, with an angle quantization Q, its √2·Q/T.
   double sample_sigma(int id, double sqrt_period) const;
+  //! [rad²/s²] variance of the mean of n consecutive samples (`mean_variance`).
+  double window_mean_variance(int id, double sqrt_period, int n) const;
+  //! [rad²/s²] variance of the difference of two consecutive samples (`sample_difference_variance`).
+  double difference_variance(int id, double sqrt_period) const;
   //! True when the quantization step of one sample is not small beside the white noise (> 0.1 σ): repeated
   //! values and a low second-difference level are then what a healthy gyro delivers.
   bool coarse(int id, double sqrt_period) const;

@@ -147,8 +147,14 @@ int Isolator::motion_within_bound(GyroMask mask, double separation_s, SubsetCach
     const auto u = static_cast<std::size_t>(i);
     if (n_pre_[u] < 2 || n_post_[u] < 2) return -1;
     dw += h.pinv.col(i) * (mean_post_[u] - mean_pre_[u]);
-    const double sig = series.sample_sigma(i + 1, subsets.sqrt_period());
-    var += h.pinv.col(i).squaredNorm() * sig * sig * (1.0 / n_pre_[u] + 1.0 / n_post_[u]);
+    if (h.quantized) {  // a window mean's quantization error telescopes
+      var += h.pinv.col(i).squaredNorm() *
+             (series.window_mean_variance(i + 1, subsets.sqrt_period(), n_pre_[u]) +
+              series.window_mean_variance(i + 1, subsets.sqrt_period(), n_post_[u]));
+    } else {
+      const double sig = series.sample_sigma(i + 1, subsets.sqrt_period());
+      var += h.pinv.col(i).squaredNorm() * sig * sig * (1.0 / n_pre_[u] + 1.0 / n_post_[u]);
+    }
   }
   const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
   return dw.norm() <= a_max * separation_s + config_.onset_sigma * std::sqrt(var) ? 1 : 0;
@@ -177,6 +183,12 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
   // hypothesis may be the impossible one and a wrong one possible by chance. Nothing can be told.
   const std::int64_t pre_mid = pre_begin + config_.onset_pre_epochs / 2;
   if (motion_within_bound(active, two_windows(pre_begin, pre_mid, pre_mid, pre_end), subsets, series) == 0)
+    return 0;
+  // After the onset a step is constant: the data since then, the fault included, must not show the body
+  // turning beyond the bound either. Otherwise a motion that began too gently to show before the onset may be
+  // what one gyro sees alone (its axis the only one that sees it, another stuck), and it is not a step.
+  const std::int64_t post_mid = k0 + (post_end - k0) / 2;
+  if (motion_within_bound(active, two_windows(k0, post_mid, post_mid, post_end), subsets, series) == 0)
     return 0;
   const double separation = two_windows(pre_begin, pre_end, k0, post_end);
   // All gyros consistent with a possible motion: no abrupt change beyond motion, nothing to tell.

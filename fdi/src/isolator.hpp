@@ -4,6 +4,7 @@
 // possible motion), the GLT for N ≥ 5, and the bias-or-ramp classification. It isolates only when exactly one
 // single-gyro hypothesis explains the data; otherwise the episode ends `unisolated` or `cleared`.
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -58,6 +59,10 @@ class Isolator {
   const Episode& episode() const { return episode_; }
   //! [ns] time of a history epoch.
   std::int64_t time_of(std::int64_t index) const;
+  //! [ns] time of epoch `onset_index`, or of the oldest epoch kept when it is older (`index`: this epoch).
+  std::int64_t onset_time(std::int64_t onset_index, std::int64_t index) const {
+    return time_of(std::max({onset_index, index - kHistory + 1, std::int64_t{0}}));
+  }
 
  private:
   static constexpr int kHistory = 256;  //!< [epochs] history kept for the onset test

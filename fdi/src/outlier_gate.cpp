@@ -81,8 +81,7 @@ bool OutlierGate::possible_motion(const Subset& h, double dt_s, const GyroSeries
   double var = 0.0;
   for (int i = 1; i <= static_cast<int>(tracks_.size()); ++i) {
     if (!has_gyro(h.mask, i)) continue;
-    const double sig = series.sample_sigma(i, subsets.sqrt_period());
-    var += h.pinv.col(i - 1).squaredNorm() * 2.0 * sig * sig;
+    var += h.pinv.col(i - 1).squaredNorm() * series.difference_variance(i, subsets.sqrt_period());
   }
   return dw.norm() <= a_max * dt_s + config_.onset_sigma * std::sqrt(var);
 }
@@ -99,9 +98,9 @@ int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, con
     dt_max = std::max(dt_max, ns_to_seconds(frame.now_ns - t.last_good_ns));
     dy_[static_cast<std::size_t>(id - 1)] = frame.y_rad_s[static_cast<std::size_t>(id - 1)] - t.last_good_y;
   }
-  // Δp = √T·W·Δy/√2 (a difference of two samples has twice the variance).
+  // Δp = √T·W·Δy/√2 (a difference of two samples has twice the variance; W whitens the difference's noise).
   const double scale = subsets.sqrt_period() / std::sqrt(2.0);
-  if (apply_parity(s, avail, dy_.data(), scale, p_.data()) <= s.jump_threshold) {
+  if (apply_whitened(s.jump_parity, s.dof, avail, dy_.data(), scale, p_.data()) <= s.jump_threshold) {
     // No jump: this step's rate change is the body's own. Beyond the bound, the next step's cannot be judged.
     fast_motion_ = !possible_motion(s, dt_max, series, subsets);
     return 0;
@@ -116,7 +115,8 @@ int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, con
     const Subset& h = subsets.get(without_gyro(avail, j));
     if (!h.observable) return 0;  // cannot judge: no outlier call
     bool ok = possible_motion(h, dt_max, series, subsets);
-    if (ok && h.dof >= 1) ok = apply_parity(h, h.mask, dy_.data(), scale, p_.data()) <= h.jump_threshold;
+    if (ok && h.dof >= 1)
+      ok = apply_whitened(h.jump_parity, h.dof, h.mask, dy_.data(), scale, p_.data()) <= h.jump_threshold;
     if (ok) {
       ++consistent;
       culprit = j;

@@ -5,11 +5,59 @@
 
 namespace tetra::fdi::detail {
 
-ParityDetector::ParityDetector(int n_gyros, double nominal_window_s) : nominal_window_s_(nominal_window_s) {
+Cusum::Cusum(Eigen::Index dmax)
+    : s_(Eigen::VectorXd::Zero(dmax)), sum_(Eigen::VectorXd::Zero(dmax)), dp_(Eigen::VectorXd::Zero(dmax)) {}
+
+void Cusum::clear(std::int64_t next_index) {
+  pos_ = neg_ = 0.0;
+  pos_start_ = neg_start_ = next_index;
+  s_.setZero();
+  sum_.setZero();
+  n_ = 0;
+  start_ = next_index;
+}
+
+void Cusum::zero() {
+  pos_ = neg_ = 0.0;
+  s_.setZero();
+}
+
+double Cusum::step(const Eigen::VectorXd& p, int d, double k, std::int64_t index, std::int64_t& onset) {
+  if (d == 1) {
+    if (pos_ <= 0.0) pos_start_ = index;
+    if (neg_ <= 0.0) neg_start_ = index;
+    pos_ = std::max(0.0, pos_ + p[0] - k);
+    neg_ = std::max(0.0, neg_ - p[0] - k);
+    onset = pos_ >= neg_ ? pos_start_ : neg_start_;
+    return std::max(pos_, neg_);
+  }
+  // Crosier's multivariate CUSUM: C = |S + p|; S ← 0 if C ≤ k, else (S + p)(1 − k/C).
+  const auto n = static_cast<Eigen::Index>(d);
+  if (s_.head(n).squaredNorm() == 0.0) {
+    start_ = index;
+    sum_.setZero();
+    n_ = 0;
+  }
+  dp_.head(n) = s_.head(n) + p.head(n);
+  const double c = dp_.head(n).norm();
+  if (c <= k) {
+    s_.setZero();
+  } else {
+    s_.head(n) = dp_.head(n) * (1.0 - k / c);
+  }
+  sum_.head(n) += p.head(n);
+  ++n_;
+  onset = start_;
+  return s_.head(n).norm();
+}
+
+ParityDetector::ParityDetector(int n_gyros, double nominal_window_s)
+    : cusum_(std::max(1, n_gyros - 3)),
+      level_cusum_(std::max(1, n_gyros - 3)),
+      nominal_window_s_(nominal_window_s) {
   const Eigen::Index dmax = std::max(1, n_gyros - 3);
+  level_ = Eigen::VectorXd::Zero(dmax);
   p_slow_ = Eigen::VectorXd::Zero(dmax);
-  mcusum_ = Eigen::VectorXd::Zero(dmax);
-  mc_sum_ = Eigen::VectorXd::Zero(dmax);
   p_ema_ = Eigen::VectorXd::Zero(dmax);
   p_ = Eigen::VectorXd::Zero(dmax);
   dp_ = Eigen::VectorXd::Zero(dmax);
@@ -17,15 +65,20 @@ ParityDetector::ParityDetector(int n_gyros, double nominal_window_s) : nominal_w
 
 void ParityDetector::restart(std::int64_t next_index) {
   cusum_mask_ = 0;
-  cusum_pos_ = cusum_neg_ = 0.0;
-  cusum_pos_start_ = cusum_neg_start_ = next_index;
-  mcusum_.setZero();
-  mc_sum_.setZero();
-  mc_n_ = 0;
-  mc_start_ = next_index;
+  cusum_.clear(next_index);
+  level_cusum_.clear(next_index);
+  level_alarm_ = false;
+  episode_ = false;
   p_ema_.setZero();
   p_slow_.setZero();
   slow_age_s_ = 0.0;
+}
+
+void ParityDetector::open_episode() {
+  episode_ = true;
+  level_held_ = false;
+  level_n_ = 0;
+  level_.setZero();
 }
 
 bool ParityDetector::parity_nominal(const Subset& s) const {
@@ -36,15 +89,22 @@ bool ParityDetector::parity_nominal(const Subset& s) const {
 }
 
 void ParityDetector::restart_after_alarm() {
-  cusum_pos_ = cusum_neg_ = 0.0;
-  mcusum_.setZero();
+  if (level_alarm_) {
+    level_cusum_.zero();
+  } else {
+    cusum_.zero();
+  }
 }
 
 Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroMask active,
                                  double sqrt_period, Health& health) {
   Detection d;
   d.onset_index = frame.index;
-  const double chi2 = apply_parity(s, frame.usable, frame.y_rad_s.data(), sqrt_period, p_.data());
+  // The χ² sees one sample: with quantization its own whitening (white noise and quantization error).
+  double chi2 = apply_parity(s, frame.usable, frame.y_rad_s.data(), sqrt_period, p_.data());
+  if (s.quantized)
+    chi2 =
+        apply_whitened(s.sample_parity, s.dof, frame.usable, frame.y_rad_s.data(), sqrt_period, dp_.data());
   health.chi2 = chi2;
   health.chi2_threshold = s.chi2_threshold;
   health.parity_residual = s.dof >= 1 ? std::sqrt(chi2) : 0.0;
@@ -52,12 +112,11 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   if (frame.usable != active || s.dof < 1) return d;
 
   d.cusum_ran = true;
-  if (cusum_mask_ != active) {  // a new gyro set: its CUSUM starts from zero
+  if (cusum_mask_ != active) {  // a new gyro set: its CUSUM starts from zero, any episode level with it
     cusum_mask_ = active;
-    cusum_pos_ = cusum_neg_ = 0.0;
-    mcusum_.setZero();
-    mc_sum_.setZero();
-    mc_n_ = 0;
+    cusum_.clear(frame.index);
+    level_cusum_.clear(frame.index);
+    episode_ = false;
     p_ema_.setZero();
     p_slow_.setZero();
     slow_age_s_ = 0.0;
@@ -67,50 +126,47 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   // The slow mean: white unit-variance input gives an EMA of variance β/(2 − β) in steady state.
   const double beta = std::min(1.0, frame.dt_s / nominal_window_s_);
   for (int r = 0; r < s.dof; ++r) p_slow_[r] += beta * (p_[r] - p_slow_[r]);
-  slow_var_ = beta / (2.0 - beta);
+  // Quantization: each sample's error term is a difference u_k − u_{k−1} (1σ of u: quantization_sigma), whose
+  // EMA telescopes to β²(1 + β(1 − β)²/(2 − β))·σ_u².
+  const double qs = s.quantization_sigma;
+  slow_var_ =
+      beta / (2.0 - beta) + beta * beta * (1.0 + beta * (1.0 - beta) * (1.0 - beta) / (2.0 - beta)) * qs * qs;
   slow_age_s_ += frame.dt_s;
   std::int64_t onset = d.onset_index;
-  const double stat =
-      s.dof == 1 ? scalar_cusum(p_[0], s, frame.index, onset) : vector_cusum(s, frame.index, onset);
+  const double stat = cusum_.step(p_, s.dof, s.cusum_k, frame.index, onset);
   health.cusum = stat;
   health.cusum_threshold = s.cusum_h;
+  if (level_change(s, frame.index, d)) {
+    level_alarm_ = true;
+    return d;
+  }
   if (stat > s.cusum_h && !d.alarm) {
     d.alarm = true;
     d.test = DetectionTest::kCusum;
     d.statistic = stat;
     d.onset_index = onset;
   }
+  level_alarm_ = false;
   return d;
 }
 
-double ParityDetector::scalar_cusum(double p, const Subset& s, std::int64_t index, std::int64_t& onset) {
-  if (cusum_pos_ <= 0.0) cusum_pos_start_ = index;
-  if (cusum_neg_ <= 0.0) cusum_neg_start_ = index;
-  cusum_pos_ = std::max(0.0, cusum_pos_ + p - s.cusum_k);
-  cusum_neg_ = std::max(0.0, cusum_neg_ - p - s.cusum_k);
-  onset = cusum_pos_ >= cusum_neg_ ? cusum_pos_start_ : cusum_neg_start_;
-  return std::max(cusum_pos_, cusum_neg_);
-}
-
-double ParityDetector::vector_cusum(const Subset& s, std::int64_t index, std::int64_t& onset) {
-  // Crosier's multivariate CUSUM: C = |S + p|; S ← 0 if C ≤ k, else (S + p)(1 − k/C).
-  const auto d = static_cast<Eigen::Index>(s.dof);
-  if (mcusum_.head(d).squaredNorm() == 0.0) {
-    mc_start_ = index;
-    mc_sum_.setZero();
-    mc_n_ = 0;
+bool ParityDetector::level_change(const Subset& s, std::int64_t index, Detection& d) {
+  if (!episode_) return false;
+  const auto dof = static_cast<Eigen::Index>(s.dof);
+  if (!level_held_) {
+    level_.head(dof) += p_.head(dof);
+    if (++level_n_ < s.level_epochs) return false;
+    level_.head(dof) /= static_cast<double>(level_n_);
+    level_held_ = true;
+    level_cusum_.clear(index + 1);
+    return false;
   }
-  dp_.head(d) = mcusum_.head(d) + p_.head(d);
-  const double c = dp_.head(d).norm();
-  if (c <= s.cusum_k) {
-    mcusum_.setZero();
-  } else {
-    mcusum_.head(d) = dp_.head(d) * (1.0 - s.cusum_k / c);
-  }
-  mc_sum_.head(d) += p_.head(d);
-  ++mc_n_;
-  onset = mc_start_;
-  return mcusum_.head(d).norm();
+  dp_.head(dof) = p_.head(dof) - level_.head(dof);
+  std::int64_t onset = index;
+  const double stat = level_cusum_.step(dp_, s.dof, s.level_k, index, onset);
+  if (stat <= s.level_h) return false;
+  d = {true, DetectionTest::kLevel, stat, onset, true};
+  return true;
 }
 
 }  // namespace tetra::fdi::detail

@@ -1,7 +1,9 @@
 #pragma once
 // Detection on the normalized parity (docs/fdi.md, "Detection"): the instantaneous χ² on every epoch's subset
 // that has parity, and the CUSUM — two-sided for d = 1, Crosier's vector form for d ≥ 2 — on the full active
-// subset only. Also keeps the 2-s EMA of the parity, the size estimate of an unresolved fault.
+// subset only. During an episode a second CUSUM runs on the parity minus the episode's held level: a new
+// fault while the first persists is a new detection (test `level`). Also keeps the 2-s EMA of the parity,
+// the size estimate of an unresolved fault.
 
 #include <cstdint>
 
@@ -20,20 +22,50 @@ struct Detection {
   bool cusum_ran = false;        //!< the CUSUM saw this epoch (full active subset present)
 };
 
+//! One CUSUM on d-dimensional normalized parity: two-sided for d = 1, Crosier's vector form for d ≥ 2, with
+//! its change-time estimate (where it last left zero) and, for d ≥ 2, Σ p since then.
+class Cusum {
+ public:
+  explicit Cusum(Eigen::Index dmax);
+  //! Statistic, sum and change times to zero; the next change time is epoch `next_index`.
+  void clear(std::int64_t next_index);
+  //! The statistic to zero (after an alarm).
+  void zero();
+  //! One epoch: the first d entries of p; returns the statistic, `onset` its change time.
+  double step(const Eigen::VectorXd& p, int d, double k, std::int64_t index, std::int64_t& onset);
+  const Eigen::VectorXd& sum() const { return sum_; }
+  int count() const { return n_; }
+
+ private:
+  double pos_ = 0.0;
+  double neg_ = 0.0;
+  std::int64_t pos_start_ = 0;
+  std::int64_t neg_start_ = 0;
+  Eigen::VectorXd s_;    //!< d ≥ 2: Crosier's vector statistic
+  Eigen::VectorXd sum_;  //!< Σ p since the vector statistic was last zero
+  Eigen::VectorXd dp_;   //!< scratch
+  int n_ = 0;
+  std::int64_t start_ = 0;
+};
+
 class ParityDetector {
  public:
   //! `nominal_window_s`: time constant of the slow parity mean that tells when the evidence is back to
   //! nominal.
   explicit ParityDetector(int n_gyros, double nominal_window_s = 30.0);
 
-  //! The epoch's parity over `frame.usable` (`s` its subset), the χ² test, and the CUSUM when every active
+  //! The epoch's parity over `frame.usable` (`s` its subset), the χ² test, and the CUSUMs when every active
   //! gyro is usable. Writes the statistics into `health`.
   Detection update(const EpochFrame& frame, const Subset& s, GyroMask active, double sqrt_period,
                    Health& health);
-  //! After an alarm: the CUSUM starts again from zero, so a persisting fault keeps alarming.
+  //! After an alarm: the CUSUM that raised it starts again from zero, so a persisting fault keeps alarming
+  //! (and the main CUSUM's alarms during an episode leave the level test running).
   void restart_after_alarm();
-  //! Everything back to zero; the next change time is epoch `next_index`.
+  //! Everything back to zero; the next change time is epoch `next_index`. Ends the episode's level.
   void restart(std::int64_t next_index);
+  //! An episode opened, or its level changed (a `level` detection): the level is the mean parity over the
+  //! next `Subset::level_epochs`, then held, and the level test runs on the parity minus it.
+  void open_episode();
 
   //! This epoch's normalized parity (first `dof` entries).
   const Eigen::VectorXd& parity() const { return p_; }
@@ -44,22 +76,21 @@ class ParityDetector {
   //! False while the slow mean has not yet seen a full window since a restart.
   bool parity_nominal(const Subset& s) const;
   //! Σ p and its count since the vector CUSUM last left zero (d ≥ 2).
-  const Eigen::VectorXd& vector_sum() const { return mc_sum_; }
-  int vector_count() const { return mc_n_; }
+  const Eigen::VectorXd& vector_sum() const { return cusum_.sum(); }
+  int vector_count() const { return cusum_.count(); }
 
  private:
-  double scalar_cusum(double p, const Subset& s, std::int64_t index, std::int64_t& onset);
-  double vector_cusum(const Subset& s, std::int64_t index, std::int64_t& onset);
+  //! The level test of an open episode: accumulate the level, then the CUSUM on p minus it.
+  bool level_change(const Subset& s, std::int64_t index, Detection& d);
 
   GyroMask cusum_mask_ = 0;
-  double cusum_pos_ = 0.0;
-  double cusum_neg_ = 0.0;
-  std::int64_t cusum_pos_start_ = 0;  //!< epoch where the branch last left zero
-  std::int64_t cusum_neg_start_ = 0;
-  Eigen::VectorXd mcusum_;  //!< d ≥ 2: Crosier's vector CUSUM
-  Eigen::VectorXd mc_sum_;  //!< Σ p since the vector CUSUM was last zero
-  int mc_n_ = 0;
-  std::int64_t mc_start_ = 0;
+  Cusum cusum_;
+  Cusum level_cusum_;
+  bool level_alarm_ = false;  //!< the last alarm was the level test's
+  bool episode_ = false;
+  bool level_held_ = false;
+  int level_n_ = 0;
+  Eigen::VectorXd level_;  //!< the episode's mean parity, summed then held
   Eigen::VectorXd p_ema_;
   Eigen::VectorXd p_slow_;  //!< EMA of the parity with time constant nominal_window_s_
   double nominal_window_s_ = 30.0;

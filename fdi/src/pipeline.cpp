@@ -42,19 +42,6 @@ Eigen::VectorXd bias_sigmas(const std::vector<GyroConstants>& constants) {
     b[static_cast<Eigen::Index>(i)] = constants[i].bias_sigma_rad_s;
   return b;
 }
-
-//! [rad/s] per gyro: 1σ of its slowly wandering bias from the `noise:` section (B, K), for the detectors.
-Eigen::VectorXd bias_wanders(const Calibration& cal, const PipelineConfig& config) {
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(cal.gyro_count());
-  for (Eigen::Index i = 0; i < w.size(); ++i) {
-    const auto& noise = cal.gyros[static_cast<std::size_t>(i)].noise;
-    if (!noise) continue;
-    const double b = noise->bias_instability_dps.value_or(0.0) * kDegToRad;
-    const double k = noise->rate_random_walk_dps_per_rts.value_or(0.0) * kDegToRad;
-    w[i] = bias_wander_sigma(b, k, config.rate_random_walk_horizon_s);
-  }
-  return w;
-}
 }  // namespace
 
 class Pipeline::Impl {
@@ -63,7 +50,7 @@ class Pipeline::Impl {
        std::vector<GyroConstants> constants)
       : config_(config),
         n_(cal.gyro_count()),
-        subsets_(std::move(geometry), bias_sigmas(constants), config_, bias_wanders(cal, config_)),
+        subsets_(std::move(geometry), bias_sigmas(constants), config_, detector_noise(cal, config_)),
         bias_check_(constants),
         series_(std::move(constants), config_),
         gate_(n_, config_),
@@ -102,6 +89,7 @@ class Pipeline::Impl {
   bool accept(const Epoch& epoch);
   void reject_outliers();
   void detect();
+  void level_changed(const Detection& d);
   void seek_evidence();
   void isolate_filter_bias(const ReferenceFinding& bias);
   void decide_episode();
@@ -240,7 +228,12 @@ void Pipeline::Impl::detect() {
   if (d.cusum_ran && !d.alarm && isolator_.episode().active && !detector_.parity_nominal(s))
     isolator_.alarmed(frame_.now_ns);
   if (!d.alarm) return;
+  if (d.test == DetectionTest::kLevel) {
+    level_changed(d);
+    return;
+  }
   if (isolator_.open(d, frame_.now_ns, frame_.index, s, detector_)) {
+    detector_.open_episode();
     emit_detected(d.test, d.statistic, frame_.now_ns);
     // The fault acted since its onset: widen the uncertainty for the time already spent.
     attitude_.add_bound(
@@ -251,6 +244,21 @@ void Pipeline::Impl::detect() {
   }
   isolator_.alarmed(frame_.now_ns);
   detector_.restart_after_alarm();  // a persisting fault keeps raising alarms, a gone one stops
+}
+
+void Pipeline::Impl::level_changed(const Detection& d) {
+  // A new fault during the open episode: a new detection, and the uncertainty widened as for the first
+  // (docs/fdi.md, "Detection"). The episode's isolation goes on as it was (a second onset inside a drift
+  // gave the onset test chances to blame a healthy gyro); the level test measures from the new level.
+  const GyroMask active = gyro_set_.active();
+  emit_detected(d.test, d.statistic, frame_.now_ns);
+  attitude_.add_bound(fault_rate_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()) *
+                      ns_to_seconds(frame_.now_ns - isolator_.onset_time(d.onset_index, frame_.index)));
+  attitude_.fault_opened(
+      fault_size_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()));
+  detector_.open_episode();
+  isolator_.alarmed(frame_.now_ns);
+  detector_.restart_after_alarm();
 }
 
 void Pipeline::Impl::seek_evidence() {

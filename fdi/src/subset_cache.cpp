@@ -1,5 +1,6 @@
 #include "subset_cache.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -10,18 +11,41 @@
 
 namespace tetra::fdi::detail {
 
-double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s) {
+namespace {
+constexpr double kLevelMarginSigma = 3.0;  //!< [σ of the held level] offset the level test's k absorbs
+}  // namespace
+
+double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s,
+                         double rate_ramp_rad_s2) {
   const double b = kBiasWanderPerB * bias_instability_rad_s;
   const double k = rate_random_walk_rad_s_rts;
-  return std::sqrt(b * b + k * k * horizon_s);
+  const double r = rate_ramp_rad_s2 * horizon_s;
+  return std::sqrt(b * b + k * k * horizon_s + r * r);
+}
+
+DetectorNoise detector_noise(const Calibration& cal, const PipelineConfig& config) {
+  DetectorNoise out{Eigen::VectorXd::Zero(cal.gyro_count()), Eigen::VectorXd::Zero(cal.gyro_count())};
+  for (Eigen::Index i = 0; i < out.quantization_rad.size(); ++i) {
+    const auto& noise = cal.gyros[static_cast<std::size_t>(i)].noise;
+    if (!noise) continue;
+    out.quantization_rad[i] = noise->quantization_deg.value_or(0.0) * kDegToRad;
+    const double b = noise->bias_instability_dps.value_or(0.0) * kDegToRad;
+    const double k = noise->rate_random_walk_dps_per_rts.value_or(0.0) * kDegToRad;
+    const double r = noise->rate_ramp_dps_per_s.value_or(0.0) * kDegToRad;
+    out.bias_wander_rad_s[i] = bias_wander_sigma(b, k, config.rate_random_walk_horizon_s, r);
+  }
+  return out;
 }
 
 SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s,
-                         const PipelineConfig& config, Eigen::VectorXd bias_wander_rad_s)
+                         const PipelineConfig& config, DetectorNoise noise)
     : geometry_(std::move(geometry)),
       bias_sigma_rad_s_(std::move(bias_sigma_rad_s)),
-      bias_wander_rad_s_(std::move(bias_wander_rad_s)),
+      quantization_rad_(std::move(noise.quantization_rad)),
+      bias_wander_rad_s_(std::move(noise.bias_wander_rad_s)),
       config_(&config) {
+  if (quantization_rad_.size() != geometry_.gyro_count())
+    quantization_rad_ = Eigen::VectorXd::Zero(gyro_count());
   if (bias_wander_rad_s_.size() != geometry_.gyro_count())
     bias_wander_rad_s_ = Eigen::VectorXd::Zero(gyro_count());
   subsets_.reserve(gyro_count() <= 8 ? 512 : 4096);
@@ -61,6 +85,53 @@ double SubsetCache::parity_bias_sigma(const Subset& s, GyroMask mask) const {
   return std::sqrt(var / s.dof);
 }
 
+Eigen::MatrixXd SubsetCache::whiten(const Eigen::MatrixXd& v, const Eigen::VectorXd& r) const {
+  const Eigen::Index n = r.size();
+  Eigen::MatrixXd rm = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) rm(i, i) = r[i];
+  const Eigen::MatrixXd cov = v * rm * v.transpose();
+  const Eigen::LLT<Eigen::MatrixXd> llt(cov);
+  return llt.matrixL().solve(v);
+}
+
+void SubsetCache::add_quantization(Subset& s, const Eigen::MatrixXd& v, GyroMask mask) const {
+  s.quantized = false;
+  for (int i = 0; i < gyro_count(); ++i) s.quantized |= has_gyro(mask, i + 1) && quantization_rad_[i] > 0.0;
+  s.sample_parity = s.parity;
+  s.jump_parity = s.parity;
+  s.quantization_margin = s.quantization_sigma = 0.0;
+  if (!s.quantized) return;
+  // R·T per gyro for one sample and for half a one-sample difference (p = √T·W·Δy/√2 in the jump test).
+  const Eigen::VectorXd& arw = geometry_.sigma();
+  Eigen::VectorXd r_sample(gyro_count());
+  Eigen::VectorXd r_jump(gyro_count());
+  for (int i = 0; i < gyro_count(); ++i) {
+    r_sample[i] = sample_variance(arw[i], quantization_rad_[i], period_s_) * period_s_;
+    r_jump[i] = 0.5 * sample_difference_variance(arw[i], quantization_rad_[i], period_s_) * period_s_;
+  }
+  s.sample_parity = whiten(v, r_sample);
+  s.jump_parity = whiten(v, r_jump);
+  // A sum of samples carries the quantization error of its last sample minus that of the one before its
+  // first, W·(e_n − e_m)/√T, e_i uniform within ±√3·Q_i. The CUSUM lingers near h for many epochs, each with
+  // a fresh e_n, so the last term reaches its bound U = Σ_i |W_i|·√3·Q_i/√T; the first is one draw, whose
+  // effect on the crossing rate ∝ exp(−2k·h) is its moment generating function at 2k:
+  // Σ_i ln(sinh x_i / x_i)/(2k), x_i = 2k·|W_i|·√3·Q_i/√T. h is raised by their sum (|W_i|, the column's
+  // norm, bounds its projection on any direction for d ≥ 2).
+  double u = 0.0;
+  double log_mgf = 0.0;
+  double var = 0.0;
+  for (int i = 0; i < gyro_count(); ++i) {
+    if (!has_gyro(mask, i + 1)) continue;
+    const double bound = s.parity.col(i).norm() * std::sqrt(3.0) * quantization_rad_[i] / sqrt_period_;
+    const double x = 2.0 * s.cusum_k * bound;
+    u += bound;
+    if (x > 0.0) log_mgf += std::log(std::sinh(x) / x);
+    var += bound * bound / 3.0;
+  }
+  s.quantization_margin = u + log_mgf / (2.0 * s.cusum_k);
+  s.quantization_sigma = std::sqrt(var / s.dof);
+}
+
 void SubsetCache::build(Subset& s, GyroMask mask) const {
   const int n = gyro_count();
   s.mask = mask;
@@ -81,17 +152,14 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   }
   s.dof = tetra::gyro_count(mask) - 3;
   if (s.dof < 1) {
-    s.parity = Eigen::MatrixXd::Zero(0, n);
+    s.parity = s.sample_parity = s.jump_parity = Eigen::MatrixXd::Zero(0, n);
     return;
   }
-  // Unit-weight parity V (V H = 0, V Vᵀ = I) whitened by the noise: cov(V y) = V R Vᵀ = L Lᵀ, W = L⁻¹ V.
+  // Unit-weight parity V (V H = 0, V Vᵀ = I) whitened by the white noise: cov(V y) = V R Vᵀ/T = L Lᵀ/T,
+  // W = L⁻¹ V, R = diag(N_i²) (p = √T·W·y ~ N(0, I) without quantization).
   const Eigen::MatrixXd v = *geometry_.parity_matrix(mask);
   const Eigen::VectorXd& arw = geometry_.sigma();
-  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(n, n);
-  for (int i = 0; i < n; ++i) r(i, i) = arw[i] * arw[i];
-  const Eigen::MatrixXd cov = v * r * v.transpose();
-  const Eigen::LLT<Eigen::MatrixXd> llt(cov);
-  s.parity = llt.matrixL().solve(v);
+  s.parity = whiten(v, arw.cwiseProduct(arw));
   const PipelineConfig& config = *config_;
   s.chi2_threshold = chi2_threshold(config.chi2_false_alarm_probability, s.dof);
   s.jump_threshold = chi2_threshold(config.jump_false_alarm_probability, s.dof);
@@ -103,8 +171,18 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   }
   const double delta = config.cusum_min_fault_dps * kDegToRad * min_col * sqrt_period_;
   s.cusum_k = 0.5 * delta;
+  add_quantization(s, v, mask);
   s.bias_wander_sigma = parity_bias_sigma(s, mask);
-  s.cusum_h = cusum_threshold(s.dof, s.cusum_k, config.cusum_arl0_epochs, s.bias_wander_sigma);
+  s.cusum_h = cusum_threshold(s.dof, s.cusum_k, config.cusum_arl0_epochs, s.bias_wander_sigma) +
+              s.quantization_margin;
+  // The held level (mean of M epochs over isolation_window_s) misses the episode's true level by N(0, 1/M)
+  // per axis, a constant offset for the level test: its reference k grows by kLevelMarginSigma/√M, which
+  // absorbs such an offset (a larger one, rarer than 3σ, only hastens the test's false alarms in that
+  // episode).
+  s.level_epochs = std::max(2, static_cast<int>(std::lround(config.isolation_window_s / period_s_)));
+  s.level_k = s.cusum_k + kLevelMarginSigma / std::sqrt(static_cast<double>(s.level_epochs));
+  s.level_h = cusum_threshold(s.dof, s.level_k, config.cusum_arl0_epochs, s.bias_wander_sigma) +
+              s.quantization_margin;
   if (s.dof >= 2) {
     s.glt_accept = chi2_threshold(1e-3, s.dof - 1);
     s.glt_reject = chi2_threshold(config.glt_false_alarm_probability, s.dof - 1);

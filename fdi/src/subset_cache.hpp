@@ -3,10 +3,12 @@
 // axis, the thresholds of the parity tests — computed once per subset, and the two kernels every stage uses
 // to apply them (docs/fdi.md, "Noise model and normalized parity").
 
+#include <cmath>
 #include <unordered_map>
 
 #include <Eigen/Core>
 
+#include "tetra/core/calibration_file.hpp"
 #include "tetra/core/correlated_noise.hpp"  // kGaussMarkovSigmaPerB
 #include "tetra/core/geometry.hpp"
 #include "tetra/core/result.hpp"
@@ -17,28 +19,66 @@ namespace tetra::fdi::detail {
 struct Subset {
   GyroMask mask = 0;
   bool observable = false;
-  int dof = 0;                    //!< parity dimension |S| − 3
-  Eigen::Matrix3Xd pinv;          //!< 3×N weighted pseudoinverse (zero columns outside S)
-  Eigen::MatrixXd parity;         //!< d×N normalized parity in 1/(rad/s) per √s: p = √T·W·y ~ N(0, I)
-  Eigen::Vector3d arw_sq_rad2_s;  //!< [rad²/s] N² per body axis of the rate estimate
+  int dof = 0;             //!< parity dimension |S| − 3
+  Eigen::Matrix3Xd pinv;   //!< 3×N weighted pseudoinverse (zero columns outside S)
+  Eigen::MatrixXd parity;  //!< d×N normalized parity in 1/(rad/s) per √s: p = √T·W·y, whitened by the
+                           //!< white noise N_i (the long-run noise every averaging test sees)
+  Eigen::MatrixXd sample_parity;     //!< the same whitened by the noise of one sample (N_i and quantization
+                                     //!< Q_i): the instantaneous χ²; equals `parity` without quantization
+  Eigen::MatrixXd jump_parity;       //!< whitened by the noise of a one-sample difference: the jump test
+  bool quantized = false;            //!< some gyro of the subset has an angle quantization
+  double quantization_margin = 0.0;  //!< [σ] what the CUSUM's h adds for the telescoping quantization error
+  double quantization_sigma = 0.0;   //!< [σ] per parity axis: 1σ of one sample's quantization error term
+  Eigen::Vector3d arw_sq_rad2_s;     //!< [rad²/s] N² per body axis of the rate estimate
   Eigen::Vector3d bias_sigma_rad_s;  //!< [rad/s] 1σ rate bias per body axis left by the calibration
   double chi2_threshold = 0.0;       //!< instantaneous χ² threshold
   double jump_threshold = 0.0;       //!< one-epoch jump χ² threshold
   double cusum_k = 0.0;              //!< [σ] CUSUM reference
   double cusum_h = 0.0;              //!< [σ] CUSUM threshold
   double bias_wander_sigma = 0.0;    //!< [σ] per parity axis: the slowly wandering bias (B, K) in the parity
+  int level_epochs = 1;              //!< epochs an episode's parity level is averaged over before it is held
+  double level_k = 0.0;              //!< [σ] reference of the CUSUM on the parity minus the held level
+  double level_h = 0.0;              //!< [σ] its threshold
   double nominal_threshold = 0.0;    //!< χ²_d(1 − 1e-3): the slow parity mean back to nominal
   double glt_accept = 0.0;           //!< χ²_{d−1} quantile accepting a single-gyro hypothesis
   double glt_reject = 0.0;           //!< χ²_{d−1} quantile rejecting one
 };
 
+//! What the detectors' reference noise takes from each gyro's `noise:` section beyond its white noise N_i
+//! (docs/fdi.md, "Noise model and normalized parity"). Empty vectors = none.
+struct DetectorNoise {
+  Eigen::VectorXd quantization_rad;   //!< [rad] angle quantization Q_i (0 if absent)
+  Eigen::VectorXd bias_wander_rad_s;  //!< [rad/s] 1σ of the slowly wandering bias (`bias_wander_sigma`)
+};
+//! The calibration's `noise:` sections as the detectors see them (Q; B, K and R over the configured horizon).
+DetectorNoise detector_noise(const Calibration& cal, const PipelineConfig& config);
+
+//! [rad²/s²] variance of one sample of a gyro with white noise N [rad/√s] and angle quantization Q [rad] at
+//! the sample period T [s]: N²/T + 2Q²/T² (a sample is (e_k − e_{k−1})/T of a quantized angle, var(e) = Q²).
+//! The one formula of a sample's noise, for every test.
+inline double sample_variance(double arw_rad_rts, double quantization_rad, double period_s) {
+  return arw_rad_rts * arw_rad_rts / period_s +
+         2.0 * quantization_rad * quantization_rad / (period_s * period_s);
+}
+//! [rad²/s²] variance of the mean of n consecutive samples: N²/(nT) and, the quantization errors telescoping
+//! to (e_n − e_0)/(nT), 2Q²/(nT)² (n = 1: `sample_variance`).
+inline double mean_variance(double arw_rad_rts, double quantization_rad, double period_s, double n) {
+  return sample_variance(arw_rad_rts / std::sqrt(n), quantization_rad / n, period_s);
+}
+//! [rad²/s²] variance of the difference of two consecutive samples: 2N²/T and, of the quantized angle's
+//! second difference (e_k − 2e_{k−1} + e_{k−2})/T, 6Q²/T².
+inline double sample_difference_variance(double arw_rad_rts, double quantization_rad, double period_s) {
+  return 2.0 * sample_variance(arw_rad_rts, quantization_rad, period_s) +
+         2.0 * quantization_rad * quantization_rad / (period_s * period_s);
+}
+
 class SubsetCache {
  public:
-  //! `geometry` weighted by each gyro's white rate noise N_i [rad/√s]; `bias_sigma_rad_s`: 1σ of each
-  //! calibrated bias; `config` outlives the cache. `bias_wander_rad_s`: 1σ of each gyro's slowly wandering
-  //! bias (bias instability and rate random walk, `bias_wander_sigma`); empty = none.
+  //! `geometry` weighted by each gyro's white rate noise N_i [rad/√s] (the rate estimate's weights);
+  //! `bias_sigma_rad_s`: 1σ of each calibrated bias; `config` outlives the cache. `noise`: quantization and
+  //! wandering bias per gyro, which the detectors' whitening adds once the sample period is known.
   SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s, const PipelineConfig& config,
-              Eigen::VectorXd bias_wander_rad_s = {});
+              DetectorNoise noise = {});
 
   //! The sample period T is known: thresholds follow from it. Every subset is built now for N ≤ 8 (a missing
   //! sample then never allocates); for larger N the full set and its leave-one-out subsets.
@@ -64,9 +104,15 @@ class SubsetCache {
   void build(Subset& s, GyroMask mask) const;
   //! [σ] per parity axis: the wandering biases seen in the subset's normalized parity.
   double parity_bias_sigma(const Subset& s, GyroMask mask) const;
+  //! L⁻¹V with L Lᵀ = V diag(r) Vᵀ: the parity V of the subset whitened by per-gyro variances r.
+  Eigen::MatrixXd whiten(const Eigen::MatrixXd& v, const Eigen::VectorXd& r) const;
+  //! The quantization's sample and jump whitening, its CUSUM margin (needs `cusum_k`) and σ in the
+  //! normalized parity (Subset).
+  void add_quantization(Subset& s, const Eigen::MatrixXd& v, GyroMask mask) const;
 
   GyroGeometry geometry_;              //!< weighted by N_i
   Eigen::VectorXd bias_sigma_rad_s_;   //!< [rad/s] per gyro
+  Eigen::VectorXd quantization_rad_;   //!< [rad] per gyro (zeros when none)
   Eigen::VectorXd bias_wander_rad_s_;  //!< [rad/s] per gyro (zeros when none)
   const PipelineConfig* config_;       //!< owned by the pipeline, outlives the cache
   double period_s_ = 0.0;
@@ -75,26 +121,33 @@ class SubsetCache {
 };
 
 //! [rad/s] 1σ of a gyro's slowly wandering bias over the detectors' horizon: the stationary σ of the
-//! bias-instability process (kBiasWanderPerB·B) and the rate random walk over `horizon_s` (K·√horizon), in
-//! quadrature. B [rad/s], K [rad/s/√s].
-double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s);
+//! bias-instability process (kBiasWanderPerB·B), the rate random walk over `horizon_s` (K·√horizon) and the
+//! rate ramp over it (R·horizon), in quadrature. B [rad/s], K [rad/s/√s], R [rad/s²].
+double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s,
+                         double rate_ramp_rad_s2 = 0.0);
 //! σ_b / B: the stationary σ of a first-order Gauss–Markov bias whose Allan deviation peaks at the IEEE 952
 //! floor 0.664·B (the simulator's bias-instability model, docs/sim.md).
 inline constexpr double kBiasWanderPerB = kGaussMarkovSigmaPerB;
 
-//! p_r = scale·Σ_{i∈mask} W(r, i)·v_i for the subset's d rows; returns Σ p_r². The one parity kernel.
-inline double apply_parity(const Subset& s, GyroMask mask, const double* v, double scale, double* p) {
-  const int n = static_cast<int>(s.parity.cols());
+//! p_r = scale·Σ_{i∈mask} W(r, i)·v_i for the first `dof` rows of W; returns Σ p_r². The one parity kernel.
+inline double apply_whitened(const Eigen::MatrixXd& w, int dof, GyroMask mask, const double* v, double scale,
+                             double* p) {
+  const int n = static_cast<int>(w.cols());
   double sum_sq = 0.0;
-  for (int r = 0; r < s.dof; ++r) {
+  for (int r = 0; r < dof; ++r) {
     double acc = 0.0;
     for (int i = 0; i < n; ++i) {
-      if (has_gyro(mask, i + 1)) acc += s.parity(r, i) * v[i];
+      if (has_gyro(mask, i + 1)) acc += w(r, i) * v[i];
     }
     p[r] = acc * scale;
     sum_sq += p[r] * p[r];
   }
   return sum_sq;
+}
+
+//! The subset's normalized parity (`Subset::parity`) of v.
+inline double apply_parity(const Subset& s, GyroMask mask, const double* v, double scale, double* p) {
+  return apply_whitened(s.parity, s.dof, mask, v, scale, p);
 }
 
 //! ω = Σ_{i∈mask} H*(:, i)·v_i. The one rate kernel.

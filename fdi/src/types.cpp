@@ -94,13 +94,15 @@ const char* to_string(DetectionTest test) {
       return "onset";
     case DetectionTest::kReference:
       return "reference";
+    case DetectionTest::kLevel:
+      return "level";
   }
   return "";
 }
 
 DetectionTest detection_test_from_string(std::string_view text) {
   for (auto t : {DetectionTest::kChi2, DetectionTest::kCusum, DetectionTest::kSignature,
-                 DetectionTest::kOnset, DetectionTest::kReference}) {
+                 DetectionTest::kOnset, DetectionTest::kReference, DetectionTest::kLevel}) {
     if (text == to_string(t)) return t;
   }
   return DetectionTest::kNone;

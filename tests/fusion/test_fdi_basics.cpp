@@ -78,6 +78,8 @@ TEST(Events, JsonLinesFollowTheContract) {
   FdiEvent d;
   d.stamp_ns = 1'800'400'000'000;
   d.type = EventType::kDetected;
+  EXPECT_EQ(detection_test_from_string(to_string(DetectionTest::kLevel)), DetectionTest::kLevel);
+  EXPECT_STREQ(to_string(DetectionTest::kLevel), "level");
   d.test = DetectionTest::kCusum;
   d.statistic = 14.25;
   EXPECT_EQ(to_json(d, 4),

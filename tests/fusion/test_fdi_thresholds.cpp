@@ -1,11 +1,14 @@
 // Thresholds of the parity detectors for their own dimension and for a wandering bias (detectors.hpp): the
 // approximations checked against simulation of the statistics themselves, at short ARLs that a test can run.
 #include <cmath>
+#include <cstdio>
+#include <optional>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "subset_cache.hpp"
+#include "tetra/core/calibration_file.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/detectors.hpp"
 
@@ -100,6 +103,79 @@ TEST(Thresholds, BiasWanderFromTheNoiseSection) {
   // Stationary σ of the bias-instability process (1.076·B) and K·√horizon in quadrature.
   EXPECT_DOUBLE_EQ(detail::bias_wander_sigma(5e-6, 0.0, 3600.0), 1.076 * 5e-6);
   EXPECT_NEAR(detail::bias_wander_sigma(0.0, 1e-7, 3600.0), 6e-6, 1e-18);
+}
+
+TEST(Thresholds, BiasWanderIncludesTheRateRamp) {
+  // R·horizon in quadrature: 1e-9 rad/s² over 3600 s.
+  EXPECT_NEAR(detail::bias_wander_sigma(0.0, 0.0, 3600.0, 1e-9), 3.6e-6, 1e-18);
+}
+
+//! The seed unit's subset cache (all four gyros) at 10 Hz with angle quantization `q_deg` on every gyro.
+struct QuantizedCache {
+  PipelineConfig config;
+  Calibration cal = seed_as_built_unit();
+  std::optional<detail::SubsetCache> cache;
+  QuantizedCache(double q_deg, double arl0) {
+    config.cusum_arl0_epochs = arl0;
+    Eigen::VectorXd arw(cal.gyro_count());
+    for (auto& g : cal.gyros) g.noise->quantization_deg = q_deg;
+    for (int i = 0; i < cal.gyro_count(); ++i) arw[i] = config.default_arw_dps_rtHz * kDegToRad;
+    cache.emplace(*GyroGeometry::create(cal.axes_B(), arw), Eigen::VectorXd::Zero(cal.gyro_count()), config,
+                  detail::detector_noise(cal, config));
+    cache->prepare(0.1);
+  }
+  const detail::Subset& all() { return cache->get(all_gyros(cal.gyro_count())); }
+};
+
+TEST(Thresholds, QuantizationLeavesTheSummedParityAndRaisesH) {
+  QuantizedCache plain(0.0, 1e8);
+  QuantizedCache coarse(6e-5, 1e8);
+  const auto& p = plain.all();
+  const auto& q = coarse.all();
+  EXPECT_FALSE(p.quantized);
+  EXPECT_EQ(p.quantization_margin, 0.0);
+  EXPECT_TRUE(p.sample_parity == p.parity);
+  // The averaging tests keep the white-noise whitening; one sample's (the χ²'s) is wider by the quantization.
+  EXPECT_TRUE(q.parity == p.parity);
+  EXPECT_LT(q.sample_parity.norm(), 0.2 * q.parity.norm());
+  EXPECT_GT(q.cusum_h, p.cusum_h + 10.0);
+}
+
+TEST(Thresholds, QuantizationMarginKeepsTheCusumWithinItsDesign) {
+  // The scalar CUSUM (N = 4) on the white-noise-whitened parity of quantized samples: white unit noise plus
+  // w·(e_k − e_{k−1})/√T, e_i uniform within ±√3·Q per gyro. With h raised by the margin the alarm rate must
+  // stay at or below the design 1/ARL₀ (ARL₀ = 1000 so that 2e6 epochs count ~2000 alarms at the design; the
+  // margin is a bound: measured far below). Tolerance: 2× the design (the acceptance).
+  QuantizedCache coarse(6e-5, 1000.0);
+  const auto& s = coarse.all();
+  const int n = coarse.cal.gyro_count();
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const double e_max = std::sqrt(3.0) * 6e-5 * kDegToRad / std::sqrt(0.1);
+  std::vector<double> e_prev(static_cast<std::size_t>(n), 0.0);
+  double pos = 0.0;
+  double neg = 0.0;
+  long alarms = 0;
+  constexpr long kEpochs = 2'000'000;
+  for (long t = 0; t < kEpochs; ++t) {
+    double x = normal(rng);
+    for (int i = 0; i < n; ++i) {
+      const double e = e_max * uniform(rng);
+      x += s.parity(0, i) * (e - e_prev[static_cast<std::size_t>(i)]);
+      e_prev[static_cast<std::size_t>(i)] = e;
+    }
+    pos = std::max(0.0, pos + x - s.cusum_k);
+    neg = std::max(0.0, neg - x - s.cusum_k);
+    if (std::max(pos, neg) > s.cusum_h) {
+      ++alarms;
+      pos = neg = 0.0;
+    }
+  }
+  const double rate = static_cast<double>(alarms) / kEpochs;
+  std::printf("quantized CUSUM: %ld alarms in %ld epochs, %.3g x the design (h %.2f, margin %.2f)\n", alarms,
+              kEpochs, rate * 1000.0, s.cusum_h, s.quantization_margin);
+  EXPECT_LE(rate, 2.0 / 1000.0);
 }
 
 }  // namespace

@@ -357,6 +357,44 @@ TEST(IsolationAdversarial, SuccessiveFaults) {
   EXPECT_TRUE(what.empty()) << what;
 }
 
+TEST(IsolationAdversarial, SecondFaultDuringAnOpenEpisode) {
+  // A 1e-3 deg/s bias on gyro 2 at 60 s that the onset test cannot isolate at the default acceleration bound
+  // (N = 4, no reference: the episode stays open, SUSPECT), then one on gyro 3 at 150 s: the second is a new
+  // detection (test `level`, within 10 s), and nothing is excluded that has no fault. Without the second
+  // fault the level test stays silent over the same 240 s (the first fault alone gives one detection).
+  constexpr int kSeeds = 6;
+  std::string what;
+  int level_detections = 0;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    for (bool second : {true, false}) {
+      auto sc = quiet_orbit(4, 240.0, 0.0);
+      ASSERT_TRUE(sc.ok());
+      sim::SimOptions so;
+      so.seed = static_cast<std::uint64_t>(100 + seed);
+      so.faults = {fault(2, K::kBias, 60.0, 1e-3)};
+      if (second) so.faults.push_back(fault(3, K::kBias, 150.0, 1e-3));
+      const auto run = run_campaign(*sc, so, sc->unit, fdi::PipelineConfig{});
+      int detected = 0;
+      bool level_in_time = false;
+      for (const auto& e : run.events) {
+        if (e.type != fdi::EventType::kDetected) continue;
+        ++detected;
+        const double t = ns_to_seconds(e.stamp_ns);
+        level_in_time |= e.test == fdi::DetectionTest::kLevel && t >= 150.0 && t <= 160.0;
+      }
+      level_detections += level_in_time ? 1 : 0;
+      const bool ok = second ? level_in_time : detected == 1;
+      const std::string wrong = wrong_exclusions(run, so.faults);
+      if (!ok || !wrong.empty())
+        what += "seed " + std::to_string(seed) + (second ? " two faults" : " one fault") + ":\n" +
+                test::describe(run);
+    }
+  }
+  std::printf("second fault during an open episode: detected as a level change in %d of %d runs\n",
+              level_detections, kSeeds);
+  EXPECT_TRUE(what.empty()) << what;
+}
+
 TEST(IsolationAdversarial, CoarselyQuantizedUnit) {
   // examples/sim/allan_unit.yaml: angle quantization 6e-5° (a sample step of 2e-3 deg/s at 10 Hz, twenty
   // times the white noise). Fault-free, at rest in orbit and during slews: repeated values are what such a

@@ -55,8 +55,9 @@ enum class EventType : std::uint8_t {
 const char* to_string(EventType type);
 
 //! The test that raised a detection (or triggered an isolation).
-enum class DetectionTest : std::uint8_t { kNone, kChi2, kCusum, kSignature, kOnset, kReference };
-const char* to_string(DetectionTest test);  // "", "chi2", "cusum", "signature", "onset", "reference"
+//! kLevel: the CUSUM on the parity minus an open episode's held level (a new fault during the episode).
+enum class DetectionTest : std::uint8_t { kNone, kChi2, kCusum, kSignature, kOnset, kReference, kLevel };
+const char* to_string(DetectionTest test);  // "", "chi2", "cusum", "signature", "onset", "reference", "level"
 //! The test named by `text` (as written by to_string); kNone for any other text.
 DetectionTest detection_test_from_string(std::string_view text);
 
