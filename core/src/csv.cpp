@@ -107,6 +107,82 @@ std::string CsvTable::where(std::size_t row, std::size_t col) const {
 
 namespace {
 
+// The comma-separated fields of `line`, each trimmed.
+inline void split_fields(std::string_view line, std::vector<std::string_view>& fields) {
+  fields.clear();
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    if (comma == std::string_view::npos) {
+      fields.push_back(trim(line.substr(start)));
+      return;
+    }
+    fields.push_back(trim(line.substr(start, comma - start)));
+    start = comma + 1;
+  }
+}
+
+// The header line: at most kMaxColumns named, distinct columns; marks the text columns.
+Status parse_header(const std::vector<std::string_view>& fields, std::size_t line_no, CsvTable& t) {
+  if (fields.size() > kMaxColumns) {
+    return bad_input(t.source + ":" + std::to_string(line_no) + ": header: " + std::to_string(fields.size()) +
+                     " columns, at most " + std::to_string(kMaxColumns) + " are read");
+  }
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    if (fields[i].empty()) {
+      return bad_input(t.source + ":" + std::to_string(line_no) + ": header: column " +
+                       std::to_string(i + 1) + " has no name");
+    }
+    for (std::size_t k = 0; k < i; ++k) {
+      if (fields[k] == fields[i]) {
+        return bad_input(t.source + ":" + std::to_string(line_no) + ": header: column '" +
+                         std::string(fields[i]) + "' appears twice");
+      }
+    }
+    t.columns.emplace_back(fields[i]);
+  }
+  t.header_line = line_no;
+  t.text_flag.assign(t.columns.size(), 0);
+  for (std::size_t i = 0; i < t.columns.size(); ++i) {
+    for (const std::string& name : t.text_columns) {
+      if (name == t.columns[i]) t.text_flag[i] = 1;
+    }
+  }
+  return ok_status();
+}
+
+// A data row: as many fields as the header; numbers, empty cells (NaN, flagged) or text columns' cells.
+Status parse_row(const std::vector<std::string_view>& fields, std::size_t line_no, CsvTable& t) {
+  if (fields.size() != t.columns.size()) {
+    return bad_input(t.source + ":" + std::to_string(line_no) + ": expected " +
+                     std::to_string(t.columns.size()) + " fields as in the header, found " +
+                     std::to_string(fields.size()));
+  }
+  for (std::size_t c = 0; c < fields.size(); ++c) {
+    const std::string_view cell = fields[c];
+    if (c < t.text_flag.size() && t.text_flag[c] != 0) {
+      t.cells.push_back(std::numeric_limits<double>::quiet_NaN());
+      t.empty.push_back(0);
+      continue;
+    }
+    if (cell.empty()) {
+      t.cells.push_back(std::numeric_limits<double>::quiet_NaN());
+      t.empty.push_back(1);
+      continue;
+    }
+    double v = 0.0;
+    if (!parse_number(cell, v)) {
+      return bad_input(t.source + ":" + std::to_string(line_no) + ": column '" + t.columns[c] + "': '" +
+                       std::string(cell.substr(0, 40)) + "' is not a number");
+    }
+    t.cells.push_back(v);
+    t.empty.push_back(0);
+  }
+  t.lines.push_back(line_no);
+  ++t.rows;
+  return ok_status();
+}
+
 // Parses the lines of text[pos..] into `t`, numbering them after `line_no`; `pos` and `line_no`
 // advance. The first non-comment line is the header (then stops if `header_only`); rows need it.
 Status parse_lines(std::string_view text, std::size_t& pos, std::size_t& line_no, CsvTable& t,
@@ -128,77 +204,14 @@ Status parse_lines(std::string_view text, std::size_t& pos, std::size_t& line_no
       t.comments.emplace_back(content.substr(1));
       continue;
     }
-
-    fields.clear();
-    std::size_t start = 0;
-    while (true) {
-      const std::size_t comma = line.find(',', start);
-      if (comma == std::string_view::npos) {
-        fields.push_back(trim(line.substr(start)));
-        break;
-      }
-      fields.push_back(trim(line.substr(start, comma - start)));
-      start = comma + 1;
-    }
-
-    if (!have_header) {
-      if (fields.size() > kMaxColumns) {
-        return bad_input(t.source + ":" + std::to_string(line_no) +
-                         ": header: " + std::to_string(fields.size()) + " columns, at most " +
-                         std::to_string(kMaxColumns) + " are read");
-      }
-      for (std::size_t i = 0; i < fields.size(); ++i) {
-        if (fields[i].empty()) {
-          return bad_input(t.source + ":" + std::to_string(line_no) + ": header: column " +
-                           std::to_string(i + 1) + " has no name");
-        }
-        for (std::size_t k = 0; k < i; ++k) {
-          if (fields[k] == fields[i]) {
-            return bad_input(t.source + ":" + std::to_string(line_no) + ": header: column '" +
-                             std::string(fields[i]) + "' appears twice");
-          }
-        }
-        t.columns.emplace_back(fields[i]);
-      }
-      t.header_line = line_no;
-      t.text_flag.assign(t.columns.size(), 0);
-      for (std::size_t i = 0; i < t.columns.size(); ++i) {
-        for (const std::string& name : t.text_columns) {
-          if (name == t.columns[i]) t.text_flag[i] = 1;
-        }
-      }
-      have_header = true;
-      if (header_only) return ok_status();
+    split_fields(line, fields);
+    if (have_header) {
+      if (Status s = parse_row(fields, line_no, t); !s) return s;
       continue;
     }
-
-    if (fields.size() != t.columns.size()) {
-      return bad_input(t.source + ":" + std::to_string(line_no) + ": expected " +
-                       std::to_string(t.columns.size()) + " fields as in the header, found " +
-                       std::to_string(fields.size()));
-    }
-    for (std::size_t c = 0; c < fields.size(); ++c) {
-      const std::string_view cell = fields[c];
-      if (c < t.text_flag.size() && t.text_flag[c] != 0) {
-        t.cells.push_back(std::numeric_limits<double>::quiet_NaN());
-        t.empty.push_back(0);
-        continue;
-      }
-      if (cell.empty()) {
-        t.cells.push_back(std::numeric_limits<double>::quiet_NaN());
-        t.empty.push_back(1);
-        continue;
-      }
-      double v = 0.0;
-      if (!parse_number(cell, v)) {
-        return bad_input(t.source + ":" + std::to_string(line_no) + ": column '" + t.columns[c] + "': '" +
-                         std::string(cell.substr(0, 40)) + "' is not a number");
-      }
-      t.cells.push_back(v);
-      t.empty.push_back(0);
-    }
-    t.lines.push_back(line_no);
-    ++t.rows;
+    if (Status s = parse_header(fields, line_no, t); !s) return s;
+    have_header = true;
+    if (header_only) return ok_status();
   }
   return ok_status();
 }

@@ -16,61 +16,89 @@ std::optional<std::string> GyroLog::meta(const std::string& key) const {
 
 namespace {
 
-Result<GyroLog> from_table(CsvTable&& t) {
-  GyroLog log;
-  log.source = t.source;
-  log.metadata = std::move(t.metadata);
-  log.comments = std::move(t.comments);
-  const std::string head = t.source + ":" + std::to_string(t.header_line) + ": header: ";
+// The columns of a gyro log's table: time, g1..gN contiguous from 1, optionally the four reference columns.
+struct LogColumns {
+  std::size_t time = 0;
+  std::vector<std::size_t> gyros;
+  std::array<std::size_t, 4> reference{};
+  bool has_reference = false;
+};
 
+Result<LogColumns> find_log_columns(const CsvTable& t, const std::string& head) {
+  LogColumns cols;
   const auto time_col = t.find_column("time_s");
   if (!time_col) return bad_input(head + "missing column 'time_s'");
-
-  // Gyro columns g1..gN, contiguous from 1.
-  std::vector<std::size_t> gyro_cols;
+  cols.time = *time_col;
   for (int id = 1;; ++id) {
     const auto c = t.find_column("g" + std::to_string(id));
     if (!c) break;
-    gyro_cols.push_back(*c);
+    cols.gyros.push_back(*c);
   }
-  if (gyro_cols.empty()) return bad_input(head + "no gyro columns (expected g1, g2, ...)");
-  log.gyro_count = static_cast<int>(gyro_cols.size());
-
+  if (cols.gyros.empty()) return bad_input(head + "no gyro columns (expected g1, g2, ...)");
   static constexpr std::array<const char*, 4> kRefNames = {"ref_qw", "ref_qx", "ref_qy", "ref_qz"};
-  std::array<std::size_t, 4> ref_cols{};
   int ref_found = 0;
   for (std::size_t k = 0; k < 4; ++k) {
     if (const auto c = t.find_column(kRefNames[k])) {
-      ref_cols[k] = *c;
+      cols.reference[k] = *c;
       ++ref_found;
     }
   }
   if (ref_found != 0 && ref_found != 4)
     return bad_input(head + "reference columns must be all of ref_qw,ref_qx,ref_qy,ref_qz");
-  log.has_reference = ref_found == 4;
+  cols.has_reference = ref_found == 4;
+  return cols;
+}
 
-  // Every column must be used: a typo must not pass silently (duplicates are refused by parse_csv).
+// Every column must be used: a typo must not pass silently (duplicates are refused by parse_csv).
+Status check_every_column_used(const CsvTable& t, const LogColumns& cols, const std::string& head) {
   std::vector<bool> used(t.column_count(), false);
-  used[*time_col] = true;
-  for (const std::size_t c : gyro_cols) used[c] = true;
-  if (log.has_reference) {
-    for (const std::size_t c : ref_cols) used[c] = true;
+  used[cols.time] = true;
+  for (const std::size_t c : cols.gyros) used[c] = true;
+  if (cols.has_reference) {
+    for (const std::size_t c : cols.reference) used[c] = true;
   }
   for (std::size_t c = 0; c < t.column_count(); ++c) {
     if (!used[c]) {
       return bad_input(head + "unknown column '" + t.columns[c] + "' (expected time_s, g1..g" +
-                       std::to_string(log.gyro_count) + ", optional ref_qw..ref_qz)");
+                       std::to_string(cols.gyros.size()) + ", optional ref_qw..ref_qz)");
     }
   }
+  return ok_status();
+}
 
+Status read_units(GyroLog& log, const std::string& source) {
   if (const auto units = log.meta("units")) {
     if (*units == "dps") {
       log.units_dps = true;
     } else if (*units != "V") {
-      return bad_input(t.source + ": metadata units='" + *units + "': expected 'V' or 'dps'");
+      return bad_input(source + ": metadata units='" + *units + "': expected 'V' or 'dps'");
     }
   }
+  return ok_status();
+}
 
+// Row r's reference quaternion: all four cells or none, of unit norm.
+Status read_reference_row(const CsvTable& t, const LogColumns& cols, std::size_t r, GyroLog& log) {
+  int filled = 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    filled += t.is_empty(r, cols.reference[k]) ? 0 : 1;
+    log.reference_wxyz[r][k] = t.cell(r, cols.reference[k]);
+  }
+  if (filled != 0 && filled != 4) {
+    return bad_input(t.where(r, cols.reference[0]) + "reference quaternion is partly empty");
+  }
+  if (filled == 4) {
+    const auto& q = log.reference_wxyz[r];
+    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) {
+      return bad_input(t.where(r, cols.reference[0]) + "reference quaternion is not of unit norm");
+    }
+  }
+  log.reference_present[r] = filled == 4 ? 1 : 0;
+  return ok_status();
+}
+
+Status read_rows(const CsvTable& t, const LogColumns& cols, GyroLog& log) {
   const std::size_t n = t.rows;
   const auto ng = static_cast<std::size_t>(log.gyro_count);
   log.time_s.resize(n);
@@ -81,33 +109,34 @@ Result<GyroLog> from_table(CsvTable&& t) {
     log.reference_present.resize(n);
   }
   for (std::size_t r = 0; r < n; ++r) {
-    if (t.is_empty(r, *time_col) || !std::isfinite(t.cell(r, *time_col))) {
-      return bad_input(t.where(r, *time_col) + "time must be a finite number");
+    if (t.is_empty(r, cols.time) || !std::isfinite(t.cell(r, cols.time))) {
+      return bad_input(t.where(r, cols.time) + "time must be a finite number");
     }
-    log.time_s[r] = t.cell(r, *time_col);
+    log.time_s[r] = t.cell(r, cols.time);
     for (std::size_t g = 0; g < ng; ++g) {
-      log.values[r * ng + g] = t.cell(r, gyro_cols[g]);
-      log.present[r * ng + g] = t.is_empty(r, gyro_cols[g]) ? 0 : 1;
+      log.values[r * ng + g] = t.cell(r, cols.gyros[g]);
+      log.present[r * ng + g] = t.is_empty(r, cols.gyros[g]) ? 0 : 1;
     }
     if (log.has_reference) {
-      int filled = 0;
-      for (std::size_t k = 0; k < 4; ++k) {
-        filled += t.is_empty(r, ref_cols[k]) ? 0 : 1;
-        log.reference_wxyz[r][k] = t.cell(r, ref_cols[k]);
-      }
-      if (filled != 0 && filled != 4) {
-        return bad_input(t.where(r, ref_cols[0]) + "reference quaternion is partly empty");
-      }
-      if (filled == 4) {
-        const auto& q = log.reference_wxyz[r];
-        const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-        if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) {
-          return bad_input(t.where(r, ref_cols[0]) + "reference quaternion is not of unit norm");
-        }
-      }
-      log.reference_present[r] = filled == 4 ? 1 : 0;
+      if (Status s = read_reference_row(t, cols, r, log); !s) return s;
     }
   }
+  return ok_status();
+}
+
+Result<GyroLog> from_table(CsvTable&& t) {
+  GyroLog log;
+  log.source = t.source;
+  log.metadata = std::move(t.metadata);
+  log.comments = std::move(t.comments);
+  const std::string head = t.source + ":" + std::to_string(t.header_line) + ": header: ";
+  auto cols = find_log_columns(t, head);
+  if (!cols) return cols.error();
+  log.gyro_count = static_cast<int>(cols->gyros.size());
+  log.has_reference = cols->has_reference;
+  if (Status s = check_every_column_used(t, *cols, head); !s) return s.error();
+  if (Status s = read_units(log, t.source); !s) return s.error();
+  if (Status s = read_rows(t, *cols, log); !s) return s.error();
   log.lines = std::move(t.lines);
   return log;
 }
