@@ -332,7 +332,11 @@ constexpr std::size_t kRateBlockRows = 1024;  // rates written or read back at a
 class RateWriter {
  public:
   explicit RateWriter(BodyRateCache* cache) : cache_(cache) {
-    if (cache_ == nullptr || cache_->failed || cache_->file != nullptr) return;
+    if (cache_ == nullptr || cache_->failed) return;
+    if (cache_->file != nullptr) {  // an earlier pass stopped part way: its rates are not all there
+      cache_->failed = true;
+      return;
+    }
     auto file = turntable_detail::open_temporary_file("the body rates");
     if (file) {
       cache_->file = *file;

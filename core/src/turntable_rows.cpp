@@ -1,6 +1,7 @@
 // Turntable logs visited in passes: a log in memory, or a file spilled once into a temporary binary file.
 #include "tetra/core/turntable_rows.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -38,7 +39,7 @@ Result<std::FILE*> open_temporary_file(const std::string& what) {
   const char* env = std::getenv("TMPDIR");
   const std::string dir = env != nullptr && *env != '\0' ? env : "/tmp";
   std::string templ = dir + "/tetra-turntable-XXXXXX";
-  const int fd = ::mkstemp(templ.data());
+  const int fd = ::mkostemp(templ.data(), O_CLOEXEC);
   if (fd < 0) {
     return failure(dir + ": cannot create a temporary file for " + what + " (" + std::strerror(errno) +
                    "; TMPDIR names another folder)");

@@ -81,6 +81,14 @@ void ParityDetector::open_episode() {
   level_.setZero();
 }
 
+void ParityDetector::close_episode(std::int64_t next_index) {
+  episode_ = false;
+  level_held_ = false;
+  level_n_ = 0;
+  level_alarm_ = false;
+  level_cusum_.clear(next_index);
+}
+
 bool ParityDetector::parity_nominal(const Subset& s) const {
   if (s.dof < 1 || slow_age_s_ < nominal_window_s_) return false;
   const auto d = static_cast<Eigen::Index>(s.dof);
@@ -127,10 +135,10 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   const double beta = std::min(1.0, frame.dt_s / nominal_window_s_);
   for (int r = 0; r < s.dof; ++r) p_slow_[r] += beta * (p_[r] - p_slow_[r]);
   // Quantization: each sample's error term is a difference u_k − u_{k−1} (1σ of u: quantization_sigma), whose
-  // EMA telescopes to β²(1 + β(1 − β)²/(2 − β))·σ_u².
+  // EMA telescopes: β·Σ_j (1 − β)^j (u_{k−j} − u_{k−j−1}) = β·u_k − β²·Σ_j (1 − β)^j u_{k−j−1}, of variance
+  // β²(1 + β/(2 − β))·σ_u² = 2β²/(2 − β)·σ_u².
   const double qs = s.quantization_sigma;
-  slow_var_ =
-      beta / (2.0 - beta) + beta * beta * (1.0 + beta * (1.0 - beta) * (1.0 - beta) / (2.0 - beta)) * qs * qs;
+  slow_var_ = beta / (2.0 - beta) + 2.0 * beta * beta / (2.0 - beta) * qs * qs;
   slow_age_s_ += frame.dt_s;
   std::int64_t onset = d.onset_index;
   const double stat = cusum_.step(p_, s.dof, s.cusum_k, frame.index, onset);

@@ -66,6 +66,9 @@ class ParityDetector {
   //! An episode opened, or its level changed (a `level` detection): the level is the mean parity over the
   //! next `Subset::level_epochs`, then held, and the level test runs on the parity minus it.
   void open_episode();
+  //! The episode ended (`cleared`): the level test stops until the next episode opens; its CUSUM's next
+  //! change time is epoch `next_index`.
+  void close_episode(std::int64_t next_index);
 
   //! This epoch's normalized parity (first `dof` entries).
   const Eigen::VectorXd& parity() const { return p_; }

@@ -328,6 +328,7 @@ void Pipeline::Impl::decide_episode() {
       break;
     }
     case Verdict::kCleared: {
+      detector_.close_episode(frame_.index + 1);  // no level test outside an episode
       FdiEvent c;
       c.stamp_ns = frame_.now_ns;
       c.type = EventType::kCleared;

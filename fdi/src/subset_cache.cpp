@@ -111,25 +111,38 @@ void SubsetCache::add_quantization(Subset& s, const Eigen::MatrixXd& v, GyroMask
   }
   s.sample_parity = whiten(v, r_sample);
   s.jump_parity = whiten(v, r_jump);
+  s.quantization_margin = quantization_margin(s, mask, s.cusum_k);
+  double var = 0.0;
+  for (int i = 0; i < gyro_count(); ++i) {
+    if (!has_gyro(mask, i + 1)) continue;
+    const double bound = quantization_bound(s, i);
+    var += bound * bound / 3.0;
+  }
+  s.quantization_sigma = std::sqrt(var / s.dof);
+}
+
+double SubsetCache::quantization_bound(const Subset& s, int i) const {
+  return s.parity.col(i).norm() * std::sqrt(3.0) * quantization_rad_[i] / sqrt_period_;
+}
+
+double SubsetCache::quantization_margin(const Subset& s, GyroMask mask, double k) const {
   // A sum of samples carries the quantization error of its last sample minus that of the one before its
   // first, W·(e_n − e_m)/√T, e_i uniform within ±√3·Q_i. The CUSUM lingers near h for many epochs, each with
   // a fresh e_n, so the last term reaches its bound U = Σ_i |W_i|·√3·Q_i/√T; the first is one draw, whose
   // effect on the crossing rate ∝ exp(−2k·h) is its moment generating function at 2k:
   // Σ_i ln(sinh x_i / x_i)/(2k), x_i = 2k·|W_i|·√3·Q_i/√T. h is raised by their sum (|W_i|, the column's
-  // norm, bounds its projection on any direction for d ≥ 2).
+  // norm, bounds its projection on any direction for d ≥ 2). Zero for a unit without quantization.
+  if (!s.quantized) return 0.0;
   double u = 0.0;
   double log_mgf = 0.0;
-  double var = 0.0;
   for (int i = 0; i < gyro_count(); ++i) {
     if (!has_gyro(mask, i + 1)) continue;
-    const double bound = s.parity.col(i).norm() * std::sqrt(3.0) * quantization_rad_[i] / sqrt_period_;
-    const double x = 2.0 * s.cusum_k * bound;
+    const double bound = quantization_bound(s, i);
+    const double x = 2.0 * k * bound;
     u += bound;
     if (x > 0.0) log_mgf += std::log(std::sinh(x) / x);
-    var += bound * bound / 3.0;
   }
-  s.quantization_margin = u + log_mgf / (2.0 * s.cusum_k);
-  s.quantization_sigma = std::sqrt(var / s.dof);
+  return u + log_mgf / (2.0 * k);
 }
 
 void SubsetCache::build(Subset& s, GyroMask mask) const {
@@ -182,7 +195,7 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   s.level_epochs = std::max(2, static_cast<int>(std::lround(config.isolation_window_s / period_s_)));
   s.level_k = s.cusum_k + kLevelMarginSigma / std::sqrt(static_cast<double>(s.level_epochs));
   s.level_h = cusum_threshold(s.dof, s.level_k, config.cusum_arl0_epochs, s.bias_wander_sigma) +
-              s.quantization_margin;
+              quantization_margin(s, mask, s.level_k);
   if (s.dof >= 2) {
     s.glt_accept = chi2_threshold(1e-3, s.dof - 1);
     s.glt_reject = chi2_threshold(config.glt_false_alarm_probability, s.dof - 1);

@@ -109,6 +109,10 @@ class SubsetCache {
   //! The quantization's sample and jump whitening, its CUSUM margin (needs `cusum_k`) and σ in the
   //! normalized parity (Subset).
   void add_quantization(Subset& s, const Eigen::MatrixXd& v, GyroMask mask) const;
+  //! [σ] gyro i's bound on the quantization term of a parity sum, |W_i|·√3·Q_i/√T.
+  double quantization_bound(const Subset& s, int i) const;
+  //! [σ] what a CUSUM of reference `k` adds to its h for the telescoping quantization error.
+  double quantization_margin(const Subset& s, GyroMask mask, double k) const;
 
   GyroGeometry geometry_;              //!< weighted by N_i
   Eigen::VectorXd bias_sigma_rad_s_;   //!< [rad/s] per gyro

@@ -395,6 +395,42 @@ TEST(IsolationAdversarial, SecondFaultDuringAnOpenEpisode) {
   EXPECT_TRUE(what.empty()) << what;
 }
 
+TEST(IsolationAdversarial, NoLevelTestOutsideAnEpisode) {
+  // A 1e-3 deg/s bias on gyro 2 from 60 to 120 s: detected, its episode ends (`cleared`) once the parity is
+  // back to nominal for clear_after_s. A bias on gyro 3 at 400 s is then a new episode, detected by the
+  // CUSUM: the level test belongs to an open episode only (a level test left running after `cleared` would
+  // alarm first, with test `level`, and outside any episode).
+  constexpr int kSeeds = 4;
+  std::string what;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    auto sc = quiet_orbit(4, 520.0, 0.0);
+    ASSERT_TRUE(sc.ok());
+    sim::SimOptions so;
+    so.seed = static_cast<std::uint64_t>(300 + seed);
+    auto first = fault(2, K::kBias, 60.0, 1e-3);
+    first.until_s = 120.0;
+    so.faults = {first, fault(3, K::kBias, 400.0, 1e-3)};
+    const auto run = run_campaign(*sc, so, sc->unit, fdi::PipelineConfig{});
+    bool cleared = false;
+    bool open = false;  // an episode is open: a level detection is allowed
+    bool ok = true;
+    int detected_after_clear = 0;
+    for (const auto& e : run.events) {
+      if (e.type == fdi::EventType::kCleared) cleared = true;
+      const bool closes = e.type == fdi::EventType::kCleared || e.type == fdi::EventType::kReconfigured ||
+                          e.type == fdi::EventType::kLost;
+      if (closes) open = false;
+      if (e.type != fdi::EventType::kDetected) continue;
+      if (e.test == fdi::DetectionTest::kLevel && !open) ok = false;
+      if (cleared) ++detected_after_clear;
+      open = true;
+    }
+    if (!ok || !cleared || detected_after_clear == 0 || !wrong_exclusions(run, so.faults).empty())
+      what += "seed " + std::to_string(seed) + ":\n" + test::describe(run);
+  }
+  EXPECT_TRUE(what.empty()) << what;
+}
+
 TEST(IsolationAdversarial, CoarselyQuantizedUnit) {
   // examples/sim/allan_unit.yaml: angle quantization 6e-5° (a sample step of 2e-3 deg/s at 10 Hz, twenty
   // times the white noise). Fault-free, at rest in orbit and during slews: repeated values are what such a
