@@ -14,6 +14,9 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kNoiseEvalEvery = 10;  //!< [samples] the noise-level test runs this often
 constexpr double kNoiseExpectedMedian = 0.6744897501960817;  //!< median of |N(0,1)|
 constexpr double kInf = std::numeric_limits<double>::infinity();
+//! [-] relative margin of the counting decision on the noise ratio: far above the few ulps of rounding in
+//! median/level, far below any meaningful change of the limits
+constexpr double kRatioMargin = 1e-9;
 constexpr double kCoarseStepPerSigma = 0.1;
 constexpr double kQuietMotion = 2.0;
 constexpr double kNormalLevel = 2.0;
@@ -332,6 +335,29 @@ double GyroSeries::noise_ratio(int id, double sqrt_period, int last, bool motion
   return median / (kNoiseExpectedMedian * (motion ? 1.0 : d2_sigma(id, sqrt_period)));
 }
 
+bool GyroSeries::noise_ratio_within(const Track& t, int id, double sqrt_period, double low,
+                                    double high) const {
+  // The median of the full window (rank m = w/2) exceeds a level a when at most m values are ≤ a, and is
+  // below b when more than m values are < b: counting decides without ordering. The levels are moved inward
+  // by kRatioMargin (relative) so that the rounding of median/level cannot put the ratio itself across a
+  // limit that the count put it inside.
+  const int w = config_.noise_window;
+  if (t.d2_count < w) return false;
+  const double level = kNoiseExpectedMedian * d2_sigma(id, sqrt_period);
+  const double above = low * level * (1.0 + kRatioMargin);
+  const double below = high * level * (1.0 - kRatioMargin);
+  int at_most_above = 0;
+  int under_below = 0;
+  bool ordered = true;
+  for (const double x : t.d2) {
+    at_most_above += static_cast<int>(x <= above);
+    under_below += static_cast<int>(x < below);
+    ordered &= !std::isnan(x);
+  }
+  const int m = w / 2;
+  return ordered && at_most_above <= m && under_below > m;
+}
+
 double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) const {
   // RMS of the last `last` second differences without their two largest (a step leaves exactly two), over
   // the expected √6·σ. Efficient on few samples, where the median is not.
@@ -373,11 +399,13 @@ bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_
                  t.repeat_count);
   if (t.d2_since_eval >= kNoiseEvalEvery && period_s > 0.0) {
     t.d2_since_eval = 0;
-    const double r = noise_ratio(id, sqrt_period);
-    if (std::isfinite(r) && r > config_.noise_high_ratio && noise_beyond_motion(id, t, r, sqrt_period))
-      return found(FaultKind::kNoise, Evidence::kNoiseLevel, r);
-    if (std::isfinite(r) && r < config_.noise_low_ratio && !coarse(id, sqrt_period))
-      return found(FaultKind::kStuck, Evidence::kVariance, r);
+    if (!noise_ratio_within(t, id, sqrt_period, config_.noise_low_ratio, config_.noise_high_ratio)) {
+      const double r = noise_ratio(id, sqrt_period);
+      if (std::isfinite(r) && r > config_.noise_high_ratio && noise_beyond_motion(id, t, r, sqrt_period))
+        return found(FaultKind::kNoise, Evidence::kNoiseLevel, r);
+      if (std::isfinite(r) && r < config_.noise_low_ratio && !coarse(id, sqrt_period))
+        return found(FaultKind::kStuck, Evidence::kVariance, r);
+    }
   }
   // Recurring spikes: enough confirmed one-epoch outliers within the window, the first one old enough for the
   // noise-level test to have spoken, and the gyro's noise level otherwise normal.

@@ -118,6 +118,10 @@ class GyroSeries {
   double* recent(const std::vector<double>& ring, const Track& t, int n) const;
   //! RMS of the last `n` values of `ring` without their two largest.
   double trimmed_rms(const std::vector<double>& ring, const Track& t, int n) const;
+  //! The window's noise ratio (`noise_ratio` over the whole window) is certainly within (low, high): decided
+  //! by counting the ring against the two limits, without the median. False when it may not be (then the
+  //! ratio itself decides).
+  bool noise_ratio_within(const Track& t, int id, double sqrt_period, double low, double high) const;
   //! Second-difference level [rad/s] of white noise (and quantization) that the noise ratios divide by.
   double d2_sigma(int id, double sqrt_period) const;
   //! Caches gyro `id`'s view through `others` (coefficients and noise); false when they are not observable.

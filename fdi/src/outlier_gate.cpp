@@ -2,16 +2,24 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "tetra/core/units.hpp"
 
 namespace tetra::fdi::detail {
 
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr int kCachedGyros = 8;  //!< up to this many gyros, the motion noise is kept per subset
+}  // namespace
+
 OutlierGate::OutlierGate(int n_gyros, const PipelineConfig& config)
     : config_(config),
       tracks_(static_cast<std::size_t>(n_gyros)),
       dy_(static_cast<std::size_t>(n_gyros), 0.0),
-      p_(static_cast<std::size_t>(std::max(1, n_gyros - 3)), 0.0) {}
+      p_(static_cast<std::size_t>(std::max(1, n_gyros - 3)), 0.0) {
+  if (n_gyros <= kCachedGyros) motion_noise_.assign(std::size_t{1} << static_cast<unsigned>(n_gyros), kNaN);
+}
 
 void OutlierGate::restart() {
   for (auto& t : tracks_) {
@@ -78,12 +86,25 @@ bool OutlierGate::possible_motion(const Subset& h, double dt_s, const GyroSeries
   // The rate change the gyros of `h` imply since their last good samples, against a_max·Δt and its noise.
   const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
   const Eigen::Vector3d dw = apply_pinv(h.pinv, h.mask, dy_.data());
+  return dw.norm() <= a_max * dt_s + motion_noise(h, series, subsets.sqrt_period());
+}
+
+double OutlierGate::motion_noise(const Subset& h, const GyroSeries& series, double sqrt_period) const {
+  const bool cached = h.mask < motion_noise_.size();
+  if (cached && sqrt_period == motion_noise_period_ && !std::isnan(motion_noise_[h.mask]))
+    return motion_noise_[h.mask];
   double var = 0.0;
   for (int i = 1; i <= static_cast<int>(tracks_.size()); ++i) {
     if (!has_gyro(h.mask, i)) continue;
-    var += h.pinv.col(i - 1).squaredNorm() * series.difference_variance(i, subsets.sqrt_period());
+    var += h.pinv.col(i - 1).squaredNorm() * series.difference_variance(i, sqrt_period);
   }
-  return dw.norm() <= a_max * dt_s + config_.onset_sigma * std::sqrt(var);
+  const double noise = config_.onset_sigma * std::sqrt(var);
+  if (cached) {
+    if (sqrt_period != motion_noise_period_) std::fill(motion_noise_.begin(), motion_noise_.end(), kNaN);
+    motion_noise_period_ = sqrt_period;
+    motion_noise_[h.mask] = noise;
+  }
+  return noise;
 }
 
 int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, const GyroSeries& series) {

@@ -41,13 +41,18 @@ class OutlierGate {
   //! The rate change that the gyros of `h` imply over `dt_s` is within the acceleration bound and its noise.
   bool possible_motion(const Subset& h, double dt_s, const GyroSeries& series,
                        const SubsetCache& subsets) const;
+  //! [rad/s] onset_sigma × 1σ of the rate change the gyros of `h` imply from their sample noise alone (kept
+  //! per subset and sample period).
+  double motion_noise(const Subset& h, const GyroSeries& series, double sqrt_period) const;
   Isolation classify_step(int id, const EpochFrame& frame, const GyroSeries& series,
                           double sqrt_period) const;
 
   const PipelineConfig& config_;
   std::vector<Track> tracks_;
-  std::vector<double> dy_;    //!< [rad/s] change of each gyro since its last good sample
-  std::vector<double> p_;     //!< parity scratch
+  std::vector<double> dy_;                    //!< [rad/s] change of each gyro since its last good sample
+  std::vector<double> p_;                     //!< parity scratch
+  mutable std::vector<double> motion_noise_;  //!< by subset mask (NaN: not yet computed); empty for N > 8
+  mutable double motion_noise_period_ = 0.0;  //!< [√s] the sample period's root they were computed for
   bool fast_motion_ = false;  //!< the last step without a jump turned the body beyond the acceleration bound
 };
 

@@ -99,13 +99,26 @@ void ReferenceMonitor::snapshot(std::int64_t now_ns, const Quaternion& q) {
   ++snap_count_;
 }
 
+int ReferenceMonitor::first_snapshot_from(std::int64_t from_ns, int end) const {
+  // Snapshot times rise strictly with k (accepted epochs only): a binary search over the kept ones.
+  int lo = std::max(0, snap_count_ - kSnapshots);
+  int hi = end;
+  while (lo < hi) {
+    const int mid = lo + (hi - lo) / 2;
+    if (snap_ns_[slot(mid)] < from_ns) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  return lo;
+}
+
 int ReferenceMonitor::window_start(std::int64_t now_ns) const {
   const std::int64_t window = seconds_to_ns(config_.reference_window_s);
-  for (int k = std::max(0, snap_count_ - kSnapshots); k < snap_count_ - 1; ++k) {
-    if (now_ns - snap_ns_[slot(k)] > window) continue;
-    return now_ns - snap_ns_[slot(k)] < window / 2 ? -1 : k;
-  }
-  return -1;
+  const int k = first_snapshot_from(now_ns - window, snap_count_ - 1);  // now − t_k ≤ window
+  if (k >= snap_count_ - 1) return -1;
+  return now_ns - snap_ns_[slot(k)] < window / 2 ? -1 : k;
 }
 
 std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, const Quaternion& q_RB,
@@ -145,14 +158,8 @@ bool ReferenceMonitor::span(std::int64_t from_ns, double min_span_s, GyroMask ex
   out.start = -1;
   if (snap_count_ < 2) return false;
   const int last = snap_count_ - 1;
-  int old = -1;
-  for (int k = std::max(0, snap_count_ - kSnapshots); k < last; ++k) {
-    if (snap_ns_[slot(k)] >= from_ns) {
-      old = k;
-      break;
-    }
-  }
-  if (old < 0) return false;
+  const int old = first_snapshot_from(from_ns, last);
+  if (old >= last) return false;
   out.span_s = ns_to_seconds(snap_ns_[slot(last)] - snap_ns_[slot(old)]);
   if (out.span_s < min_span_s) return false;
   out.start = old;

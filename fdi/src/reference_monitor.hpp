@@ -85,6 +85,8 @@ class ReferenceMonitor {
     double ref_angle_rad = 0.0;  //!< Σ h_i·log(q_{k−1}* q_k) over the reference's own increments
   };
   void snapshot(std::int64_t now_ns, const Quaternion& q);
+  //! Index of the first kept snapshot taken at or after `from_ns` among those before `end`, else `end`.
+  int first_snapshot_from(std::int64_t from_ns, int end) const;
   //! Index of the oldest snapshot inside the window and at least half a window old, or −1.
   int window_start(std::int64_t now_ns) const;
   bool scale_significant(int culprit, int old) const;

@@ -49,6 +49,7 @@ SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s
   if (bias_wander_rad_s_.size() != geometry_.gyro_count())
     bias_wander_rad_s_ = Eigen::VectorXd::Zero(gyro_count());
   subsets_.reserve(gyro_count() <= 8 ? 512 : 4096);
+  if (gyro_count() <= 8) by_mask_.assign(std::size_t{1} << static_cast<unsigned>(gyro_count()), nullptr);
 }
 
 void SubsetCache::prepare(double period_s) {
@@ -66,6 +67,7 @@ void SubsetCache::prepare(double period_s) {
 const Subset& SubsetCache::insert(GyroMask mask) {
   Subset& s = subsets_[mask];
   build(s, mask);
+  if (mask < by_mask_.size()) by_mask_[mask] = &s;
   return s;
 }
 

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <unordered_map>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -79,6 +80,11 @@ class SubsetCache {
   //! wandering bias per gyro, which the detectors' whitening adds once the sample period is known.
   SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s, const PipelineConfig& config,
               DetectorNoise noise = {});
+  // by_mask_ points into subsets_: a copy would point into the original.
+  SubsetCache(const SubsetCache&) = delete;
+  SubsetCache& operator=(const SubsetCache&) = delete;
+  SubsetCache(SubsetCache&&) noexcept = default;
+  SubsetCache& operator=(SubsetCache&&) noexcept = default;
 
   //! The sample period T is known: thresholds follow from it. Every subset is built now for N ≤ 8 (a missing
   //! sample then never allocates); for larger N the full set and its leave-one-out subsets.
@@ -89,6 +95,7 @@ class SubsetCache {
 
   //! The subset's constants, built on first use (only once `ready()`).
   const Subset& get(GyroMask mask) {
+    if (mask < by_mask_.size() && by_mask_[mask] != nullptr) return *by_mask_[mask];
     const auto it = subsets_.find(mask);
     return it != subsets_.end() ? it->second : insert(mask);
   }
@@ -122,6 +129,8 @@ class SubsetCache {
   double period_s_ = 0.0;
   double sqrt_period_ = 0.0;
   std::unordered_map<GyroMask, Subset> subsets_;
+  //! For N ≤ 8: each built subset by its mask (the map's elements never move), a lookup without hashing.
+  std::vector<const Subset*> by_mask_;
 };
 
 //! [rad/s] 1σ of a gyro's slowly wandering bias over the detectors' horizon: the stationary σ of the
