@@ -83,6 +83,7 @@ GyroSeries::GyroSeries(std::vector<GyroConstants> constants, const PipelineConfi
     t.d2.assign(static_cast<std::size_t>(config_.noise_window), 0.0);
     t.m2.assign(static_cast<std::size_t>(config_.noise_window), kInf);
     t.view_coef.assign(tracks_.size(), 0.0);
+    t.view_gyros.assign(tracks_.size(), 0);
   }
   scratch_.assign(static_cast<std::size_t>(std::max(config_.noise_window, 8)), 0.0);
   d2_all_.assign(tracks_.size(), 0.0);
@@ -93,10 +94,12 @@ void GyroSeries::reset() {
     auto d2 = std::move(t.d2);
     auto m2 = std::move(t.m2);
     auto coef = std::move(t.view_coef);
+    auto view_gyros = std::move(t.view_gyros);
     t = Track{};
     t.d2 = std::move(d2);
     t.m2 = std::move(m2);
     t.view_coef = std::move(coef);
+    t.view_gyros = std::move(view_gyros);
   }
 }
 
@@ -167,7 +170,6 @@ void GyroSeries::record_spike(int id, std::int64_t now_ns) {
 
 void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
   if (!subsets.ready()) return;
-  const double sqrt_period = subsets.sqrt_period();
   GyroMask fresh = 0;
   for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
     const Track& t = track(id);
@@ -180,8 +182,8 @@ void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
     const GyroMask others = without_gyro(frame.usable, id);
     if (!motion_view(id, others, subsets)) continue;  // the others cannot see the motion: no evidence
     // A coarse gyro's repeat run: the range of the rate the others see along its axis, and its 1σ.
-    if (coarse(id, sqrt_period)) {
-      const double rate = project(t, others, frame.y_rad_s.data());
+    if (t.view_coarse) {
+      const double rate = project(t, frame.y_rad_s.data());
       t.run_low = t.run_seen ? std::min(t.run_low, rate) : rate;
       t.run_high = t.run_seen ? std::max(t.run_high, rate) : rate;
       t.run_sigma = t.run_seen ? std::max(t.run_sigma, t.view_rate_sigma) : t.view_rate_sigma;
@@ -193,17 +195,24 @@ void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
       const int w = config_.noise_window;
       t.motion_sigma = t.view_d2_sigma;
       t.m2[static_cast<std::size_t>((t.d2_head - 1 + w) % w)] =
-          std::abs(project(t, others, d2_all_.data())) / t.motion_sigma;
+          std::abs(project(t, d2_all_.data())) / t.motion_sigma;
     }
   }
 }
 
 bool GyroSeries::motion_view(int id, GyroMask others, SubsetCache& subsets) {
-  Track& t = tracks_[static_cast<std::size_t>(id - 1)];
+  const Track& t = track(id);
   if (t.view_mask == others && t.view_period == subsets.sqrt_period()) return t.view_observable;
+  return make_view(id, others, subsets);
+}
+
+bool GyroSeries::make_view(int id, GyroMask others, SubsetCache& subsets) {
   // The coefficients of h_i·H*_(others) and the noise they carry, once per set of others.
+  Track& t = tracks_[static_cast<std::size_t>(id - 1)];
   t.view_mask = others;
   t.view_period = subsets.sqrt_period();
+  t.view_coarse = coarse(id, t.view_period);
+  t.view_count = 0;
   const Subset& h = subsets.get(others);
   t.view_observable = h.observable;
   if (!h.observable) return false;
@@ -213,6 +222,7 @@ bool GyroSeries::motion_view(int id, GyroMask others, SubsetCache& subsets) {
   for (int k = 1; k <= static_cast<int>(tracks_.size()); ++k) {
     const double c = has_gyro(others, k) ? static_cast<double>(axis * h.pinv.col(k - 1)) : 0.0;
     t.view_coef[static_cast<std::size_t>(k - 1)] = c;
+    if (has_gyro(others, k)) t.view_gyros[static_cast<std::size_t>(t.view_count++)] = k - 1;
     var += c * c * sample_sigma(k, t.view_period) * sample_sigma(k, t.view_period);
     var_d2 += c * c * d2_sigma(k, t.view_period) * d2_sigma(k, t.view_period);
   }
@@ -221,10 +231,11 @@ bool GyroSeries::motion_view(int id, GyroMask others, SubsetCache& subsets) {
   return true;
 }
 
-double GyroSeries::project(const Track& t, GyroMask others, const double* v) const {
+double GyroSeries::project(const Track& t, const double* v) const {
   double sum = 0.0;
-  for (std::size_t k = 0; k < tracks_.size(); ++k) {
-    if (has_gyro(others, static_cast<int>(k) + 1)) sum += t.view_coef[k] * v[k];
+  for (int j = 0; j < t.view_count; ++j) {
+    const auto k = static_cast<std::size_t>(t.view_gyros[static_cast<std::size_t>(j)]);
+    sum += t.view_coef[k] * v[k];
   }
   return sum;
 }

@@ -102,9 +102,12 @@ class GyroSeries {
     GyroMask view_mask = ~GyroMask{0};  //!< the other gyros of the cached view (none yet)
     double view_period = 0.0;           //!< [√s] the sample period's root it was made for
     bool view_observable = false;
+    bool view_coarse = false;       //!< `coarse` at the view's sample period
     std::vector<double> view_coef;  //!< h_i·H*_(others), per gyro (0 outside the others)
-    double view_rate_sigma = 0.0;   //!< [rad/s] 1σ of the projected rate
-    double view_d2_sigma = 0.0;     //!< [rad/s] 1σ of the projected second difference
+    std::vector<int> view_gyros;    //!< the others' indices (0-based, rising); the first view_count are used
+    int view_count = 0;
+    double view_rate_sigma = 0.0;  //!< [rad/s] 1σ of the projected rate
+    double view_d2_sigma = 0.0;    //!< [rad/s] 1σ of the projected second difference
     double motion_sigma = 0.0;  //!< [rad/s] the others' noise on the motion's second difference (last seen)
     int d2_count = 0;
     int d2_head = 0;
@@ -124,10 +127,12 @@ class GyroSeries {
   bool noise_ratio_within(const Track& t, int id, double sqrt_period, double low, double high) const;
   //! Second-difference level [rad/s] of white noise (and quantization) that the noise ratios divide by.
   double d2_sigma(int id, double sqrt_period) const;
-  //! Caches gyro `id`'s view through `others` (coefficients and noise); false when they are not observable.
+  //! Gyro `id`'s view through `others` (coefficients and noise), made when not cached; false when they are
+  //! not observable.
   bool motion_view(int id, GyroMask others, SubsetCache& subsets);
-  //! h_i·H*_(others)·v with the cached coefficients of `t`.
-  double project(const Track& t, GyroMask others, const double* v) const;
+  bool make_view(int id, GyroMask others, SubsetCache& subsets);
+  //! h_i·H*_(others)·v with the cached coefficients of `t` (summed over the others in rising order).
+  double project(const Track& t, const double* v) const;
   //! A noise level `r` that the motion the other gyros see cannot explain.
   bool noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const;
   //! Every other gyro in use has a normal second-difference level.
