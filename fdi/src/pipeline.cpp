@@ -76,7 +76,10 @@ class Pipeline::Impl {
   FdiEvent command_reset(std::int64_t stamp_ns);
   std::string describe_thresholds() const;
 
-  const Health& health() const { return health_; }
+  const Health& health() const {
+    publish_filter_health();
+    return health_;
+  }
   bool observable(GyroMask gyros) const { return subsets_.geometry().observable(gyros); }
   int gyro_count() const { return n_; }
   const PipelineConfig& config() const { return config_; }
@@ -95,6 +98,7 @@ class Pipeline::Impl {
   void decide_episode();
   void publish_attitude();
   void publish_filter();
+  void publish_filter_health() const;
   void update_fdi_available();
 
   void isolate(const Isolation& iso);
@@ -122,7 +126,11 @@ class Pipeline::Impl {
   Isolations found_;
   StepResult result_;
   std::vector<FdiEvent> pending_;  //!< what operator commands caused, emitted with the next step
-  Health health_;
+  //! Mutable for the filter's per-gyro fields, filled when read (publish_filter_health).
+  mutable Health health_;
+  //! The filter's per-gyro bias and its σ are due in health_: the filter moved since they were filled. Every
+  //! change of the filter outside a step fills them first, so they are always those of the last step's end.
+  mutable bool filter_health_due_ = false;
   Mode persistent_mode_ = Mode::kNominal;
   GyroMask measured_ = 0;  //!< the gyros of this epoch's rate estimate so far
   bool has_time_ = false;
@@ -388,14 +396,20 @@ void Pipeline::Impl::publish_attitude() {
 void Pipeline::Impl::publish_filter() {
   const Mekf& f = attitude_.filter();
   auto& a = result_.attitude;
+  for (int id = 1; id <= n_; ++id) a.gyro_bias_rad_s[static_cast<std::size_t>(id - 1)] = f.bias_rad_s(id);
+  health_.reference_chi2 = attitude_.reference_chi2();
+  filter_health_due_ = true;  // read far less often than a step runs
+}
+
+void Pipeline::Impl::publish_filter_health() const {
+  if (!filter_health_due_) return;
+  filter_health_due_ = false;
+  const Mekf& f = attitude_.filter();
   for (int id = 1; id <= n_; ++id) {
-    const auto i = static_cast<std::size_t>(id - 1);
-    a.gyro_bias_rad_s[i] = f.bias_rad_s(id);
-    auto& h = health_.gyros[i];
+    auto& h = health_.gyros[static_cast<std::size_t>(id - 1)];
     h.bias_rad_s = f.bias_rad_s(id);
     h.bias_sigma_rad_s = f.bias_sigma_rad_s(id);
   }
-  health_.reference_chi2 = attitude_.reference_chi2();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -492,6 +506,7 @@ void Pipeline::Impl::update_mode(std::int64_t now_ns) {
 }
 
 void Pipeline::Impl::reset() {
+  publish_filter_health();  // the health keeps the last step's filter
   series_.reset();
   gate_.reset();
   reference_.reset();
@@ -515,6 +530,7 @@ void Pipeline::Impl::reset() {
 // operator commands
 
 void Pipeline::Impl::reinstate(int id) {
+  publish_filter_health();  // the health keeps the last step's filter
   if (gyro_set_.is_excluded(id)) attitude_.thaw(id);
   gyro_set_.reinstate(id);
   series_.forget_evidence(id);
@@ -552,6 +568,7 @@ FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns, bool for
     return acknowledge(verb, id, CommandOutcome::kAlreadyExcluded, false, stamp_ns);
   if (!force && !subsets_.observable(without_gyro(gyro_set_.active(), id)))
     return acknowledge(verb, id, CommandOutcome::kRefusedUnobservable, false, stamp_ns);
+  publish_filter_health();  // the health keeps the last step's filter
   gyro_set_.exclude(id, FaultKind::kUnknown);
   attitude_.freeze(id);
   return acknowledge(verb, id, CommandOutcome::kDone, true, stamp_ns);
