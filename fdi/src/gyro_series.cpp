@@ -389,10 +389,17 @@ double GyroSeries::trimmed_rms(const std::vector<double>& ring, const Track& t, 
 void GyroSeries::check(std::int64_t now_ns, GyroMask excluded, double period_s, double sqrt_period,
                        Isolations& out) {
   excluded_ = excluded;
-  for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
-    if (!has_gyro(excluded, id))
-      (void)check_one(id, tracks_[static_cast<std::size_t>(id - 1)], now_ns, period_s, sqrt_period, out);
+  const int n = static_cast<int>(tracks_.size());
+  for (int id = 1; id <= n; ++id) {
+    Track& t = tracks_[static_cast<std::size_t>(id - 1)];
+    if (!has_gyro(excluded, id) && may_signal(t)) (void)check_one(id, t, now_ns, period_s, sqrt_period, out);
   }
+}
+
+bool GyroSeries::may_signal(const Track& t) const {
+  // The entry condition of each signature of check_one: most epochs meet none of them.
+  return t.absent_since_ns >= 0 || t.invalid_since_ns >= 0 || t.repeat_count >= config_.stuck_repeat_count ||
+         t.d2_since_eval >= kNoiseEvalEvery || t.spike_n >= config_.spike_count;
 }
 
 bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_s, double sqrt_period,

@@ -139,6 +139,8 @@ class GyroSeries {
   bool others_normal(int id, double sqrt_period) const;
   //! Repeated values that the motion the other gyros saw rules out for a healthy (quantized) gyro.
   bool repeats_are_stuck(int id, const Track& t, double sqrt_period) const;
+  //! Some signature of `t` may be due this epoch (false: check_one would find nothing and change nothing).
+  bool may_signal(const Track& t) const;
   bool check_one(int id, Track& t, std::int64_t now_ns, double period_s, double sqrt_period, Isolations& out);
 
   std::vector<GyroConstants> constants_;
