@@ -90,6 +90,7 @@ GyroSeries::GyroSeries(std::vector<GyroConstants> constants, const PipelineConfi
 }
 
 void GyroSeries::reset() {
+  fresh_ = 0;
   for (auto& t : tracks_) {
     auto d2 = std::move(t.d2);
     auto m2 = std::move(t.m2);
@@ -114,6 +115,7 @@ void GyroSeries::forget_evidence(int id) {
 void GyroSeries::ingest(const Epoch& epoch, EpochFrame& frame, Counters& counters) {
   const double max_rate = config_.max_abs_rate_dps * kDegToRad;
   frame.valid = 0;
+  fresh_ = 0;
   for (std::size_t u = 0; u < tracks_.size(); ++u) {
     auto& t = tracks_[u];
     t.d2_fresh = false;
@@ -140,6 +142,10 @@ void GyroSeries::ingest(const Epoch& epoch, EpochFrame& frame, Counters& counter
     frame.raw[u] = raw;
     frame.y_rad_s[u] = y;
     ingest_sample(t, raw, y);
+    if (t.d2_fresh) {
+      fresh_ |= GyroMask{1} << static_cast<unsigned>(u);
+      d2_all_[u] = t.d2_last;
+    }
   }
 }
 
@@ -170,12 +176,7 @@ void GyroSeries::record_spike(int id, std::int64_t now_ns) {
 
 void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
   if (!subsets.ready()) return;
-  GyroMask fresh = 0;
-  for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
-    const Track& t = track(id);
-    d2_all_[static_cast<std::size_t>(id - 1)] = t.d2_last;
-    if (t.d2_fresh && has_gyro(frame.usable, id)) fresh |= GyroMask{1} << static_cast<unsigned>(id - 1);
-  }
+  const GyroMask fresh = fresh_ & frame.usable;
   for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
     if (!has_gyro(frame.valid, id)) continue;
     Track& t = tracks_[static_cast<std::size_t>(id - 1)];

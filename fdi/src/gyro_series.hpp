@@ -148,7 +148,8 @@ class GyroSeries {
   std::vector<Track> tracks_;
   mutable std::vector<double> scratch_;
   GyroMask excluded_ = 0;       //!< the gyros `check` leaves alone
-  std::vector<double> d2_all_;  //!< this epoch's Δ²y of every gyro [rad/s]
+  std::vector<double> d2_all_;  //!< this epoch's Δ²y of every gyro of `fresh_` [rad/s]
+  GyroMask fresh_ = 0;          //!< the gyros with a second difference this epoch
 };
 
 }  // namespace tetra::fdi::detail
