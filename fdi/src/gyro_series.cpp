@@ -50,6 +50,20 @@ double select_rank(double* a, int n, int k) {
   return a[k];
 }
 
+bool rank_within(const double* a, int n, int k, double low, double high) {
+  // The element of rank k exceeds `low` when at most k values are ≤ low, and is below `high` when more than k
+  // values are < high.
+  int at_most_low = 0;
+  int under_high = 0;
+  bool ordered = true;
+  for (int i = 0; i < n; ++i) {
+    at_most_low += static_cast<int>(a[i] <= low);
+    under_high += static_cast<int>(a[i] < high);
+    ordered &= !std::isnan(a[i]);
+  }
+  return ordered && at_most_low <= k && under_high > k;
+}
+
 Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const PipelineConfig& config) {
   std::vector<GyroConstants> out;
   for (std::size_t i = 0; i < cal.gyros.size(); ++i) {
@@ -349,25 +363,13 @@ double GyroSeries::noise_ratio(int id, double sqrt_period, int last, bool motion
 
 bool GyroSeries::noise_ratio_within(const Track& t, int id, double sqrt_period, double low,
                                     double high) const {
-  // The median of the full window (rank m = w/2) exceeds a level a when at most m values are ≤ a, and is
-  // below b when more than m values are < b: counting decides without ordering. The levels are moved inward
-  // by kRatioMargin (relative) so that the rounding of median/level cannot put the ratio itself across a
-  // limit that the count put it inside.
+  // The limits on the ratio as limits on the median, moved inward by kRatioMargin (relative) so that the
+  // rounding of median/level cannot put the ratio itself across a limit that the median is inside of.
   const int w = config_.noise_window;
   if (t.d2_count < w) return false;
   const double level = kNoiseExpectedMedian * d2_sigma(id, sqrt_period);
-  const double above = low * level * (1.0 + kRatioMargin);
-  const double below = high * level * (1.0 - kRatioMargin);
-  int at_most_above = 0;
-  int under_below = 0;
-  bool ordered = true;
-  for (const double x : t.d2) {
-    at_most_above += static_cast<int>(x <= above);
-    under_below += static_cast<int>(x < below);
-    ordered &= !std::isnan(x);
-  }
-  const int m = w / 2;
-  return ordered && at_most_above <= m && under_below > m;
+  return rank_within(t.d2.data(), w, w / 2, low * level * (1.0 + kRatioMargin),
+                     high * level * (1.0 - kRatioMargin));
 }
 
 double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) const {

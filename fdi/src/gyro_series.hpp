@@ -35,6 +35,10 @@ Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const 
 //! comparison of noise). Every value must be ordered (no NaN).
 double select_rank(double* a, int n, int k);
 
+//! The element of rank k (0-based) of a[0..n) lies strictly between `low` and `high`: decided by counting,
+//! without ordering or changing a. False when it does not, or when some value is NaN.
+bool rank_within(const double* a, int n, int k, double low, double high);
+
 class GyroSeries {
  public:
   GyroSeries(std::vector<GyroConstants> constants, const PipelineConfig& config);
@@ -122,8 +126,8 @@ class GyroSeries {
   //! RMS of the last `n` values of `ring` without their two largest.
   double trimmed_rms(const std::vector<double>& ring, const Track& t, int n) const;
   //! The window's noise ratio (`noise_ratio` over the whole window) is certainly within (low, high): decided
-  //! by counting the ring against the two limits, without the median. False when it may not be (then the
-  //! ratio itself decides).
+  //! by `rank_within` on the ring, without the median. False when it may not be (then the ratio itself
+  //! decides).
   bool noise_ratio_within(const Track& t, int id, double sqrt_period, double low, double high) const;
   //! Second-difference level [rad/s] of white noise (and quantization) that the noise ratios divide by.
   double d2_sigma(int id, double sqrt_period) const;

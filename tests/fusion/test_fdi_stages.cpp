@@ -175,6 +175,41 @@ TEST(GyroSeries, SelectRankGivesTheValueNthElementGives) {
   }
 }
 
+TEST(GyroSeries, RankWithinDecidesAsTheValueOfThatRank) {
+  // The noise test's counting decision: for any window and limits, true exactly when the element of rank k
+  // lies strictly between them (no tolerance: a decision, compared with select_rank's value). Limits are
+  // drawn from the window's own values and their neighbouring doubles, where an off-by-one in the counts
+  // would show; many ties and infinities. 5,000 seeded windows.
+  std::mt19937_64 rng(12);
+  std::uniform_int_distribution<int> size(1, 40);
+  std::uniform_int_distribution<int> level(0, 6);
+  std::uniform_int_distribution<int> nudge(-1, 1);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  auto limit = [&](const std::vector<double>& a) {
+    const double x = a[std::uniform_int_distribution<std::size_t>(0, a.size() - 1)(rng)];
+    const int d = nudge(rng);
+    return d == 0 ? x : std::nextafter(x, d < 0 ? -std::numeric_limits<double>::infinity() : x + 1.0);
+  };
+  for (int trial = 0; trial < 5000; ++trial) {
+    const int n = size(rng);
+    std::vector<double> a(static_cast<std::size_t>(n));
+    for (double& x : a) {
+      const int l = level(rng);
+      x = l == 0 ? std::numeric_limits<double>::infinity() : (trial % 2 == 0 ? l : std::abs(noise(rng)));
+    }
+    const int k = n / 2;
+    double low = limit(a);
+    double high = limit(a);
+    if (low > high) std::swap(low, high);
+    std::vector<double> b = a;
+    const double v = tetra::fdi::detail::select_rank(b.data(), n, k);
+    EXPECT_EQ(tetra::fdi::detail::rank_within(a.data(), n, k, low, high), v > low && v < high)
+        << "n " << n << " low " << low << " high " << high << " value " << v;
+  }
+  const std::vector<double> with_nan = {1.0, std::numeric_limits<double>::quiet_NaN(), 2.0};
+  EXPECT_FALSE(tetra::fdi::detail::rank_within(with_nan.data(), 3, 1, 0.0, 10.0));  // undecided: NaN
+}
+
 TEST(OutlierGate, ASpikeIsLeftOutForOneEpochAndCounted) {
   Fixture f;
   GyroSeries series(f.constants, f.config);
