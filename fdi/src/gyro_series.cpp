@@ -17,13 +17,11 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 //! [-] relative margin of the counting decision on the noise ratio: far above the few ulps of rounding in
 //! median/level, far below any meaningful change of the limits
 constexpr double kRatioMargin = 1e-9;
-constexpr double kCoarseStepPerSigma = 0.1;
-constexpr double kQuietMotion = 2.0;
-constexpr double kNormalLevel = 2.0;
-constexpr int kOtherRepeats =
-    3;  //!< [samples] another gyro's repeat run that leaves a coarse gyro's repeats unjudged  //!< noise
-        //!< ratio of a gyro whose own second differences look normal  //!< [σ] motion level the noise-level
-        //!< test still tells from noise  //!< a quantization step beyond this many σ makes repeats normal
+constexpr double kCoarseStepPerSigma = 0.1;  //!< a quantization step beyond this many σ makes repeats normal
+constexpr double kQuietMotion = 2.0;  //!< [σ] motion level the noise-level test still tells from noise
+constexpr double kNormalLevel = 2.0;  //!< noise ratio of a gyro whose own second differences look normal
+//! [samples] another gyro's repeat run that leaves a coarse gyro's repeats unjudged
+constexpr int kOtherRepeats = 3;
 }  // namespace
 
 double select_rank(double* a, int n, int k) {
