@@ -106,7 +106,7 @@ TurntableLog empty_log(const CsvTable& header, const Columns& c) {
   return log;
 }
 
-Result<TurntableLog> from_table(CsvTable&& t) {
+Result<TurntableLog> turntable_from_table(CsvTable&& t) {
   auto c = find_columns(t);
   if (!c) return c.error();
   if (t.rows == 0) return bad_input(t.source + ": no data rows");
@@ -135,7 +135,7 @@ void reserve_rows(const CsvStreamReader& reader, std::size_t first_rows, Turntab
 Result<TurntableLog> parse_turntable_log(std::string_view text, std::string source) {
   auto table = parse_csv(text, std::move(source));
   if (!table) return table.error();
-  return from_table(std::move(table.value()));
+  return turntable_from_table(std::move(table.value()));
 }
 
 // Block by block: the file's text and its table of cells are never whole in memory, only the log's

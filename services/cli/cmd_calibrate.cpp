@@ -24,7 +24,7 @@ namespace tetra::cli {
 
 namespace {
 
-constexpr const char* kName = "calibrate";
+constexpr const char* kCalibrateName = "calibrate";
 
 template <class... Args>
 std::string format(const char* fmt, Args... args) {
@@ -332,11 +332,11 @@ int cmd_calibrate(int argc, char** argv) {
   CLI::App app{
       "Turntable calibration (seed eqs. 4-11): scale factor, bias and sensing axis of every gyro with their "
       "1-sigma, from a turntable log (docs/interfaces.md §2.1). Body rates come from the encoder angles.",
-      kName};
+      kCalibrateName};
   CalibrateOptions options;
   add_options(app, options);
   if (auto status = parse(app, argc, argv)) return *status;
-  if (Status s = run_calibrate(options); !s) return report(kName, s.error());
+  if (Status s = run_calibrate(options); !s) return report(kCalibrateName, s.error());
   return kExitOk;
 }
 

@@ -25,7 +25,7 @@ namespace tetra::cli {
 
 namespace {
 
-constexpr const char* kName = "campaign";
+constexpr const char* kCampaignName = "campaign";
 
 //! Run ids already in `runs.csv` (a torn last line, from an interrupted run, is dropped and redone).
 Result<std::set<std::size_t>> done_runs(const std::string& path) {
@@ -153,7 +153,7 @@ int cmd_campaign(int argc, char** argv) {
       "the scenarios' own motion), and the fusion pipeline in process (`target: in_process`, the default) "
       "or one `tetra fusion` service per run over DDS in lockstep (`target: dds`, `domain: N`). "
       "Interrupted campaigns continue where they stopped.",
-      kName};
+      kCampaignName};
   std::string spec_path;
   std::string out_dir;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -170,19 +170,19 @@ int cmd_campaign(int argc, char** argv) {
   if (auto status = parse(app, argc, argv)) return *status;
 
   auto spec = sim::read_campaign_spec(spec_path);
-  if (!spec) return report(kName, spec.error());
+  if (!spec) return report(kCampaignName, spec.error());
   std::error_code ec;
   const bool over_dds = spec->target == sim::CampaignTarget::kDds;
   std::filesystem::create_directories(
       over_dds ? std::filesystem::path(out_dir) / "dds" : std::filesystem::path(out_dir), ec);
-  if (ec) return report(kName, failure(out_dir + ": cannot create the folder"));
+  if (ec) return report(kCampaignName, failure(out_dir + ": cannot create the folder"));
   const std::string runs_path = (std::filesystem::path(out_dir) / "runs.csv").string();
   auto done = done_runs(runs_path);
-  if (!done) return report(kName, done.error());
+  if (!done) return report(kCampaignName, done.error());
   if (done->empty()) {
     std::ofstream header(runs_path, std::ios::trunc);
     header << sim::campaign_csv_header() << '\n';
-    if (!header) return report(kName, failure(runs_path + ": cannot write"));
+    if (!header) return report(kCampaignName, failure(runs_path + ": cannot write"));
   }
   const std::vector<sim::CampaignCase> cases = sim::expand_campaign(*spec);
   std::vector<sim::CampaignCase> pending;
@@ -198,10 +198,10 @@ int cmd_campaign(int argc, char** argv) {
   Progress progress{cases.size(), cases.size() - pending.size()};
   if (!pending.empty()) {
     if (Status st = run_pending(*spec, pending, jobs, out_dir, progress); !st)
-      return report(kName, st.error());
+      return report(kCampaignName, st.error());
   }
   if (no_report) return kExitOk;
-  if (Status st = write_campaign_report(runs_path, out_dir); !st) return report(kName, st.error());
+  if (Status st = write_campaign_report(runs_path, out_dir); !st) return report(kCampaignName, st.error());
   std::cerr << "tetra campaign: report -> " << (std::filesystem::path(out_dir) / "report.md").string()
             << '\n';
   return kExitOk;

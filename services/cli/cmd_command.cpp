@@ -23,7 +23,7 @@
 namespace tetra::cli {
 
 namespace {
-enum Token : std::intptr_t { kMatched = 1, kEvent };
+enum CommandToken : std::intptr_t { kCommandMatched = 1, kCommandEvent };
 
 //! The login name, for the audit trail when --operator is not given.
 std::string login_name() {
@@ -108,9 +108,9 @@ int cmd_command(int argc, char** argv) {
   if (!writer) return report("command", writer.error());
   auto events = session->reader<tetra_FdiEvent>(dds::event_qos());
   if (!events) return report("command", events.error());
-  if (auto s = session->watch_statuses(writer->handle(), DDS_PUBLICATION_MATCHED_STATUS, kMatched); !s)
+  if (auto s = session->watch_statuses(writer->handle(), DDS_PUBLICATION_MATCHED_STATUS, kCommandMatched); !s)
     return report("command", s.error());
-  if (auto s = session->watch_data(events->handle(), kEvent); !s) return report("command", s.error());
+  if (auto s = session->watch_data(events->handle(), kCommandEvent); !s) return report("command", s.error());
 
   const std::int64_t give_up = monotonic_ns() + seconds_to_ns(timeout_s);
   std::vector<std::intptr_t> triggered;

@@ -29,7 +29,7 @@ namespace tetra::cli {
 
 namespace {
 
-enum Token : std::intptr_t { kData = 1, kShutdown };
+enum RecordToken : std::intptr_t { kRecordData = 1, kRecordShutdown };
 constexpr std::int64_t kIdleGrace_ns = 2'000'000'000;     //!< [ns] wait for the service's last outputs
 constexpr std::int64_t kServiceWait_ns = 10'000'000'000;  //!< [ns] wait for the service's Attitude writer
 constexpr int kRecorderDepth = 4096;  //!< deeper reader histories than the writers': a burst loses nothing
@@ -145,11 +145,12 @@ Result<RecordLink> open_record_link(const RecordOptions& o, dds::ShutdownSignal&
     return s.error();
   for (dds_entity_t reader :
        {link.gyro->handle(), link.reference->handle(), link.attitude->handle(), link.event->handle()}) {
-    if (auto s = link.session.watch_data(reader, kData); !s) return s.error();
+    if (auto s = link.session.watch_data(reader, kRecordData); !s) return s.error();
   }
-  if (auto s = link.session.watch_statuses(link.gyro->handle(), DDS_SUBSCRIPTION_MATCHED_STATUS, kData); !s)
+  if (auto s = link.session.watch_statuses(link.gyro->handle(), DDS_SUBSCRIPTION_MATCHED_STATUS, kRecordData);
+      !s)
     return s.error();
-  if (auto s = link.session.watch_shutdown(shutdown, kShutdown); !s) return s.error();
+  if (auto s = link.session.watch_shutdown(shutdown, kRecordShutdown); !s) return s.error();
   return link;
 }
 

@@ -27,7 +27,7 @@ namespace tetra::cli {
 
 namespace {
 
-constexpr const char* kName = "sim";
+constexpr const char* kSimName = "sim";
 
 void print_progress(double fraction) {
   std::cerr << "tetra sim: " << std::lround(fraction * 100.0) << " %\n";
@@ -176,11 +176,11 @@ Result<std::optional<Calibration>> read_unit(const std::string& unit_path) {
 int run_turntable(const Calibration& unit, const sim::TurntablePlan& plan, const sim::GyroModelOptions& model,
                   std::uint64_t seed, RunFiles& files, OutputFile& out) {
   auto log = sim::simulate_turntable(unit, plan, seed, model);
-  if (!log) return report(kName, log.error());
+  if (!log) return report(kSimName, log.error());
   const auto meta = provenance_metadata(provenance(files.input_paths()));
   log->metadata.insert(log->metadata.end(), meta.begin(), meta.end());
-  if (Status st = out.write(format_turntable_log(*log)); !st) return report(kName, st.error());
-  if (Status st = files.commit(); !st) return report(kName, st.error());
+  if (Status st = out.write(format_turntable_log(*log)); !st) return report(kSimName, st.error());
+  if (Status st = files.commit(); !st) return report(kSimName, st.error());
   std::cerr << "tetra sim: turntable: " << log->rows() << " rows, " << unit.gyro_count() << " gyros"
             << (out.path() == "-" ? std::string() : " -> " + out.path()) << '\n';
   return kExitOk;
@@ -192,10 +192,10 @@ int run_turntable_scenario(SimArgs& a, const std::optional<Calibration>& unit, R
   const ScenarioOverrides& o = a.over;
   for (const CLI::Option* opt : {o.minutes_given, o.reference, o.reference_noise, o.acs_amplitude,
                                  o.acs_accel, o.period, o.jitter, o.drop}) {
-    if (opt->count()) return report(kName, bad_input("turntable: " + opt->get_name() + " does not apply"));
+    if (opt->count()) return report(kSimName, bad_input("turntable: " + opt->get_name() + " does not apply"));
   }
   if (!a.fault_texts.empty() || !a.truth_path.empty()) {
-    return report(kName, bad_input("turntable: --fault and --truth do not apply"));
+    return report(kSimName, bad_input("turntable: --fault and --truth do not apply"));
   }
   if (o.rate->count()) a.plan.rate_hz = o.rate_hz;
   if (o.latitude->count()) a.plan.latitude_deg = o.latitude_deg;
@@ -248,17 +248,17 @@ Result<sim::SimOptions> sim_options(const SimArgs& a) {
 // The open-loop run into the log (and truth) files.
 int write_files(const SimArgs& a, const sim::Scenario& sc, const sim::SimOptions& options, RunFiles& files,
                 const SimOutputs& out) {
-  if (out.log == nullptr) return report(kName, bad_input("--out LOG.csv is required (or --dds)"));
+  if (out.log == nullptr) return report(kSimName, bad_input("--out LOG.csv is required (or --dds)"));
   auto simulator = sim::Simulator::create(sc, options);
-  if (!simulator) return report(kName, simulator.error());
+  if (!simulator) return report(kSimName, simulator.error());
   const bool long_run = simulator->epoch_count() > 2'000'000;
   const auto meta = provenance_metadata(provenance(files.input_paths()));
   if (Status st =
           sim::write_simulation(*simulator, *out.log, out.truth, meta, long_run ? print_progress : nullptr);
       !st) {
-    return report(kName, st.error());
+    return report(kSimName, st.error());
   }
-  if (Status st = files.commit(); !st) return report(kName, st.error());
+  if (Status st = files.commit(); !st) return report(kSimName, st.error());
   std::cerr << "tetra sim: " << sc.name << ": " << simulator->epoch_count() << " epochs, "
             << simulator->gyro_count() << " gyros -> " << a.out_path
             << (a.truth_path.empty() ? std::string() : ", truth -> " + a.truth_path) << '\n';
@@ -275,7 +275,7 @@ int run_scenario(const SimArgs& a, const sim::Scenario& sc, const sim::SimOption
 #if TETRA_WITH_DDS
   if (a.dds.enabled) {
     auto simulator = sim::Simulator::create(sc, options);
-    if (!simulator) return report(kName, simulator.error());
+    if (!simulator) return report(kSimName, simulator.error());
     return sim_dds_main(*simulator, a.dds);
   }
 #endif
@@ -288,7 +288,7 @@ int cmd_sim(int argc, char** argv) {
   CLI::App app{
       "Simulate a gyro unit with known truth. SCENARIO: turntable, static, lab-orbit, orbit, slews, or a "
       "scenario YAML file (docs/sim.md). Options given here override the scenario's.",
-      kName};
+      kSimName};
   SimArgs a;
   add_run_options(app, a);
   add_scenario_options(app, a);
@@ -301,14 +301,14 @@ int cmd_sim(int argc, char** argv) {
 
   RunFiles files;
   auto out = open_files(a, files);
-  if (!out) return report(kName, out.error());
+  if (!out) return report(kSimName, out.error());
   auto unit = read_unit(a.unit_path);
-  if (!unit) return report(kName, unit.error());
+  if (!unit) return report(kSimName, unit.error());
   if (is_turntable(a)) return run_turntable_scenario(a, *unit, files, *out->log);
   auto scenario = load_scenario(a, *unit);
-  if (!scenario) return report(kName, scenario.error());
+  if (!scenario) return report(kSimName, scenario.error());
   auto options = sim_options(a);
-  if (!options) return report(kName, options.error());
+  if (!options) return report(kSimName, options.error());
   return run_scenario(a, *scenario, *options, files, *out);
 }
 

@@ -15,7 +15,7 @@ namespace tetra::cli {
 
 namespace {
 
-constexpr const char* kName = "sim";
+constexpr const char* kClosedLoopName = "sim";
 
 std::string dec(double value, int decimals) {
   return fmt::format("{:.{}f}", value, decimals);
@@ -141,39 +141,41 @@ int write_closed_loop_outputs(const sim::Scenario& scenario, const sim::ClosedLo
                               const sim::ClosedLoopRecord& record, const ClosedLoopCliOptions& options) {
   LoopRun run{record, sim::summarize(record, simulator)};
   print_summary("", run.summary, run.record);
-  if (Status st = write_outputs(scenario, options, run, nullptr); !st) return report(kName, st.error());
+  if (Status st = write_outputs(scenario, options, run, nullptr); !st)
+    return report(kClosedLoopName, st.error());
   return kExitOk;
 }
 
 int sim_closed_loop_main(const sim::Scenario& scenario, const sim::SimOptions& sim_options,
                          const ClosedLoopCliOptions& options) {
-  if (Status st = check_closed_loop_options(scenario, options, false); !st) return report(kName, st.error());
+  if (Status st = check_closed_loop_options(scenario, options, false); !st)
+    return report(kClosedLoopName, st.error());
   Calibration calibration = scenario.unit;
   if (!options.calibration_path.empty()) {
     auto read = read_calibration(options.calibration_path);
-    if (!read) return report(kName, read.error());
+    if (!read) return report(kClosedLoopName, read.error());
     calibration = std::move(read.value());
   }
   fdi::PipelineConfig config;
   if (!options.config_path.empty()) {
     auto read = fdi::read_pipeline_config(options.config_path);
-    if (!read) return report(kName, read.error());
+    if (!read) return report(kClosedLoopName, read.error());
     config = read.value();
   }
   if (options.no_exclusion) config.exclusion_enabled = false;
   auto run = run_once(scenario, sim_options, calibration, config);
-  if (!run) return report(kName, run.error());
+  if (!run) return report(kClosedLoopName, run.error());
   print_summary(options.compare_exclusion ? "with exclusion: " : "", run->summary, run->record);
   std::optional<LoopRun> without;
   if (options.compare_exclusion) {
     config.exclusion_enabled = false;
     auto second = run_once(scenario, sim_options, calibration, config);
-    if (!second) return report(kName, second.error());
+    if (!second) return report(kClosedLoopName, second.error());
     print_summary("without exclusion: ", second->summary, second->record);
     without = std::move(second.value());
   }
   if (Status st = write_outputs(scenario, options, *run, without ? &*without : nullptr); !st)
-    return report(kName, st.error());
+    return report(kClosedLoopName, st.error());
   return kExitOk;
 }
 

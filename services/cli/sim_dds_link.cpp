@@ -10,7 +10,7 @@
 namespace tetra::cli {
 
 namespace {
-enum Token : std::intptr_t { kAttitude = 1, kMatched, kShutdown };
+enum LinkToken : std::intptr_t { kLinkAttitude = 1, kLinkMatched, kLinkShutdown };
 constexpr std::int64_t kDiscoverySettle_ns = 200'000'000;  //!< [ns] see wait_for_service
 }  // namespace
 
@@ -45,13 +45,15 @@ Result<std::unique_ptr<SimDdsLink>> SimDdsLink::open(const std::string& unit, do
 }
 
 Status SimDdsLink::wait_for_readers(const SimDdsOptions& options) {
-  if (auto s = session_.watch_data(attitude_reader_.handle(), kAttitude); !s) return s.error();
-  if (auto s = session_.watch_statuses(gyro_writer_.handle(), DDS_PUBLICATION_MATCHED_STATUS, kMatched); !s)
-    return s.error();
-  if (auto s = session_.watch_statuses(reference_writer_.handle(), DDS_PUBLICATION_MATCHED_STATUS, kMatched);
+  if (auto s = session_.watch_data(attitude_reader_.handle(), kLinkAttitude); !s) return s.error();
+  if (auto s = session_.watch_statuses(gyro_writer_.handle(), DDS_PUBLICATION_MATCHED_STATUS, kLinkMatched);
       !s)
     return s.error();
-  auto guard = session_.add_guard(kShutdown);
+  if (auto s =
+          session_.watch_statuses(reference_writer_.handle(), DDS_PUBLICATION_MATCHED_STATUS, kLinkMatched);
+      !s)
+    return s.error();
+  auto guard = session_.add_guard(kLinkShutdown);
   if (!guard) return guard.error();
   if (shutdown_ != nullptr) const_cast<dds::ShutdownSignal*>(shutdown_)->set_guard((*guard)->handle());
 
@@ -115,7 +117,7 @@ Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
   // And (briefly) for the service's Attitude writer, so that the first epochs are scored too.
   if (options.wait_readers > 0) {
     if (auto s =
-            session_.watch_statuses(attitude_reader_.handle(), DDS_SUBSCRIPTION_MATCHED_STATUS, kMatched);
+            session_.watch_statuses(attitude_reader_.handle(), DDS_SUBSCRIPTION_MATCHED_STATUS, kLinkMatched);
         !s)
       return s.error();
     const std::int64_t attitude_give_up = monotonic_ns() + 1'000'000'000;

@@ -13,7 +13,7 @@ namespace tetra::cli {
 
 namespace {
 
-constexpr const char* kName = "sim";
+constexpr const char* kDdsLoopName = "sim";
 
 const dds::ShutdownSignal* g_shutdown = nullptr;
 
@@ -26,18 +26,18 @@ bool shutdown_requested() {
 int sim_dds_closed_loop_main(const sim::Scenario& scenario, const sim::SimOptions& sim_options,
                              const ClosedLoopCliOptions& loop_options, const SimDdsOptions& dds_options) {
   if (Status st = check_closed_loop_options(scenario, loop_options, true); !st)
-    return report(kName, st.error());
+    return report(kDdsLoopName, st.error());
   auto simulator = sim::ClosedLoopSimulator::create(scenario, sim_options);
-  if (!simulator) return report(kName, simulator.error());
+  if (!simulator) return report(kDdsLoopName, simulator.error());
   dds::ShutdownSignal shutdown;
   g_shutdown = &shutdown;
   const std::string unit = dds_options.unit.empty() ? scenario.unit.unit : dds_options.unit;
   auto link = SimDdsLink::open(unit, scenario.rate_hz, dds_options, &shutdown);
-  if (!link) return report(kName, link.error());
+  if (!link) return report(kDdsLoopName, link.error());
   DdsEstimator estimator(**link, !loop_options.real_time, dds_options.speed);
   auto record = sim::run_closed_loop(*simulator, estimator, shutdown_requested);
   g_shutdown = nullptr;
-  if (!record) return report(kName, record.error());
+  if (!record) return report(kDdsLoopName, record.error());
   record->fdi_events = false;  // the service's FdiEvent topic is not read here
   if (estimator.missing() > 0) {
     std::cout << "lockstep: " << estimator.missing() << " epochs without their Attitude within "
