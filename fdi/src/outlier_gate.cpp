@@ -9,7 +9,6 @@
 namespace tetra::fdi::detail {
 
 namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kCachedGyros = 8;  //!< up to this many gyros, the motion noise is kept per subset
 }  // namespace
 
@@ -18,7 +17,9 @@ OutlierGate::OutlierGate(int n_gyros, const PipelineConfig& config)
       tracks_(static_cast<std::size_t>(n_gyros)),
       dy_(static_cast<std::size_t>(n_gyros), 0.0),
       p_(static_cast<std::size_t>(std::max(1, n_gyros - 3)), 0.0) {
-  if (n_gyros <= kCachedGyros) motion_noise_.assign(std::size_t{1} << static_cast<unsigned>(n_gyros), kNaN);
+  if (n_gyros <= kCachedGyros)
+    motion_noise_.assign(std::size_t{1} << static_cast<unsigned>(n_gyros),
+                         std::numeric_limits<double>::quiet_NaN());
 }
 
 void OutlierGate::restart() {
@@ -100,7 +101,8 @@ double OutlierGate::motion_noise(const Subset& h, const GyroSeries& series, doub
   }
   const double noise = config_.onset_sigma * std::sqrt(var);
   if (cached) {
-    if (sqrt_period != motion_noise_period_) std::fill(motion_noise_.begin(), motion_noise_.end(), kNaN);
+    if (sqrt_period != motion_noise_period_)
+      std::fill(motion_noise_.begin(), motion_noise_.end(), std::numeric_limits<double>::quiet_NaN());
     motion_noise_period_ = sqrt_period;
     motion_noise_[h.mask] = noise;
   }
