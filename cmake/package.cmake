@@ -20,7 +20,7 @@ set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_RECOMMENDS "gnuplot-nox")  # tetra allan --plot
 # Headers and static libraries: what tetraConfig.cmake and tetra.pc ask for.
-set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libeigen3-dev (>= 3.3), libyaml-cpp-dev, pkg-config")
+set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libeigen3-dev (>= 3.3), libyaml-cpp-dev, libhdf5-dev, pkg-config")
 # Extended descriptions (the synopsis of both is CPACK_PACKAGE_DESCRIPTION_SUMMARY).
 set(CPACK_DEBIAN_RUNTIME_DESCRIPTION "The tetra program: turntable calibration, Allan deviation, simulation with faults, the fusion and
 fault-detection pipeline, and its DDS service and ground tools (Eclipse Cyclone DDS).")
