@@ -11,10 +11,10 @@ Quaternion open_loop_initial_q_RB(const Simulator& simulator) {
 }
 
 Result<OpenLoopRecord> run_open_loop(Simulator& simulator, Estimator& estimator) {
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
   OpenLoopRecord record;
-  record.final_knowledge_error_deg = kNaN;
-  record.final_sigma_deg = kNaN;
+  record.final_knowledge_error_deg = kUnknown;
+  record.final_sigma_deg = kUnknown;
   SimEpoch epoch;
   while (simulator.next(epoch)) {
     auto out = estimator.estimate(epoch);
