@@ -143,6 +143,9 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       frozen_(gyros_.size(), 0) {
   gm_phi_.assign(gyros_.size(), 1.0);  // sized once here: computing them never allocates
   gm_kappa_.assign(gyros_.size(), 1.0);
+  rrw_var_.assign(gyros_.size(), 0.0);
+  gm_var_.assign(gyros_.size(), 0.0);
+  step_pinv_ = Eigen::Matrix3Xd::Zero(3, n_);
   reset(0.0);
 }
 
@@ -153,6 +156,7 @@ void Mekf::reset(double attitude_sigma_rad) {
     frozen_[static_cast<std::size_t>(i)] = 0;
     set_prior(i);
   }
+  frozen_mask_ = 0;
   P_.topLeftCorner<3, 3>().diagonal().setConstant(attitude_sigma_rad * attitude_sigma_rad);
 }
 
@@ -187,11 +191,13 @@ void Mekf::freeze(int id) {
   if (id < 1 || id > n_) return;
   decorrelate(id - 1);
   frozen_[index(id)] = 1;
+  frozen_mask_ |= GyroMask{1} << static_cast<unsigned>(id - 1);
 }
 
 void Mekf::thaw(int id) {
   if (id < 1 || id > n_) return;
   frozen_[index(id)] = 0;
+  frozen_mask_ = without_gyro(frozen_mask_, id);
   set_prior(id - 1);
 }
 
@@ -216,32 +222,46 @@ void Mekf::propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, G
   // G = −Γ·H*·(bias states), Γ = ∫ A(u) du; D the bias models' own transitions.
   const Eigen::Matrix3d A = rotation.toRotationMatrix().transpose();
   const Eigen::Matrix3d gamma = rotation_integral(omega_B_rad_s, dt_s);
-  Eigen::Matrix3d q_theta = Eigen::Matrix3d::Zero();
-  if (dt_s != gm_dt_s_) gauss_markov_transitions(dt_s);
+  const GyroMask used = mask & ~frozen_mask_;
+  refresh_step_constants(pinv, used, dt_s);
   for (int i = 0; i < n_; ++i) {
-    const auto& g = gyros_[static_cast<std::size_t>(i)];
-    const bool frozen = frozen_[static_cast<std::size_t>(i)] != 0;
-    const bool used = has_gyro(mask, i + 1) && !frozen;
-    const double phi = gm_phi_[static_cast<std::size_t>(i)];
     const double kappa = gm_kappa_[static_cast<std::size_t>(i)];
-    const Eigen::Vector3d col = used ? Eigen::Vector3d(-gamma * pinv.col(i)) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d col =
+        has_gyro(used, i + 1) ? Eigen::Vector3d(-gamma * pinv.col(i)) : Eigen::Vector3d::Zero();
     coupling_.col(i) = col;
     coupling_.col(n_ + i) = col * kappa;
-    decay_[i] = 1.0;
-    decay_[n_ + i] = frozen ? 1.0 : phi;
-    if (used) q_theta += pinv.col(i) * pinv.col(i).transpose() * (g.arw_rad_rts * g.arw_rad_rts * dt_s);
   }
-  propagate_covariance(A, q_theta);
+  propagate_covariance(A, q_theta_);
   for (int i = 0; i < n_; ++i) {
     if (frozen_[static_cast<std::size_t>(i)] != 0) continue;
-    const auto& g = gyros_[static_cast<std::size_t>(i)];
-    P_(c_of(i), c_of(i)) += g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
-    prior_var_[i] += g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
-    const double phi = decay_[n_ + i];
-    P_(g_of(i), g_of(i)) += g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - phi * phi);
-    bias_[n_ + i] *= phi;
+    const auto k = static_cast<std::size_t>(i);
+    P_(c_of(i), c_of(i)) += rrw_var_[k];
+    prior_var_[i] += rrw_var_[k];
+    P_(g_of(i), g_of(i)) += gm_var_[k];
+    bias_[n_ + i] *= gm_phi_[k];
   }
   // Symmetric by construction but for the attitude block (symmetrized above).
+}
+
+void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, double dt_s) {
+  if (dt_s != gm_dt_s_) gauss_markov_transitions(dt_s);
+  if (dt_s == step_dt_s_ && used == step_used_ && frozen_mask_ == step_frozen_ && pinv.cols() == n_ &&
+      (pinv.array() == step_pinv_.array()).all())
+    return;
+  q_theta_.setZero();
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const bool frozen = frozen_[k] != 0;
+    decay_[i] = 1.0;
+    decay_[n_ + i] = frozen ? 1.0 : gm_phi_[k];
+    const auto& g = gyros_[k];
+    if (has_gyro(used, i + 1))
+      q_theta_ += pinv.col(i) * pinv.col(i).transpose() * (g.arw_rad_rts * g.arw_rad_rts * dt_s);
+  }
+  if (pinv.cols() == n_) step_pinv_ = pinv;  // sized at creation: no allocation
+  step_used_ = used;
+  step_frozen_ = frozen_mask_;
+  step_dt_s_ = dt_s;
 }
 
 void Mekf::propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta) {
@@ -272,6 +292,8 @@ void Mekf::gauss_markov_transitions(double dt_s) {
     // The Gauss–Markov bias decays within the step: its mean over the step is κ·g, κ = T_c(1 − φ)/Δt.
     gm_kappa_[i] =
         g.gm_sigma_rad_s > 0.0 ? g.gm_correlation_s * -std::expm1(-dt_s / g.gm_correlation_s) / dt_s : 1.0;
+    rrw_var_[i] = g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
+    gm_var_[i] = g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - gm_phi_[i] * gm_phi_[i]);
   }
   gm_dt_s_ = dt_s;
 }

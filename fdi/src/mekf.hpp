@@ -104,6 +104,7 @@ class Mekf {
   void decorrelate(int i);
   void set_prior(int i);
   void gauss_markov_transitions(double dt_s);
+  void refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, double dt_s);
   void propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta);
 
   std::vector<GyroNoiseModel> gyros_;
@@ -116,7 +117,18 @@ class Mekf {
   //! `gm_dt_s_` only (the step is nearly always the same: no exp per gyro per step).
   std::vector<double> gm_phi_;
   std::vector<double> gm_kappa_;
+  std::vector<double> rrw_var_;  //!< [rad²/s²] per gyro: K²·Δt, the slow bias's variance gain over a step
+  std::vector<double> gm_var_;  //!< [rad²/s²] per gyro: σ_GM²(1 − φ²), the Gauss–Markov's over a step
   double gm_dt_s_ = -1.0;
+  //! What a step keeps while the gyro set, the frozen set, the rate solution and Δt stay the same (nearly
+  //! always): the attitude's process noise Qθ = H*·diag(N²)·H*ᵀ·Δt and D (`decay_`). Recomputed when the key
+  //! (`step_pinv_`, `step_used_`, `step_frozen_`, `step_dt_s_`) changes.
+  Eigen::Matrix3d q_theta_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3Xd step_pinv_;
+  GyroMask step_used_ = 0;
+  GyroMask step_frozen_ = 0;
+  double step_dt_s_ = -1.0;
+  GyroMask frozen_mask_ = 0;    //!< the frozen gyros (bit i − 1: gyro i), as `frozen_`
   Eigen::Matrix3Xd coupling_;   //!< 3×2N: ∂δθ/∂bias over the step (scratch)
   Eigen::VectorXd cross_rows_;  //!< 3×2N row-major: U = A·Pθβ + G·Pββ (scratch)
   Eigen::MatrixXd joseph_;      //!< (3+2N)² scratch of the Joseph update
