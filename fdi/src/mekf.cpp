@@ -89,22 +89,36 @@ void propagate_blocks(const CovarianceStep& s, Eigen::Index m_runtime, const Eig
     }
   }
 }
-//! The Joseph update of P (`dim` square, column-major; `kDim` > 0: known at compile time) by a scalar
-//! measurement of innovation variance `s` with P·hᵀ = `ph`; `gain` receives K = P·hᵀ/s. Expanded:
-//! P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ, symmetric term by term: the lower triangle computed column by column,
-//! mirrored.
+//! One scalar measurement of the biases, R = 1, h = `h[i]` on gyro i's c and g (0: not measured), over P
+//! (`dim` square, column-major, n gyros; `kDim` > 0: known at compile time). With the optimal gain K = P·hᵀ/s
+//! the Joseph form expands to P − (P·hᵀ)(P·hᵀ)ᵀ/s: applied as P − u·uᵀ, u = P·hᵀ/√s, so both triangles round
+//! alike (u_j·u_k = u_k·u_j). Each variance is kept at or above P_kk/s, the exact result's lower bound
+//! ((P·hᵀ)_k² ≤ P_kk·h·P·hᵀ for P ≥ 0), which rounding could otherwise cross. `ph` receives P·hᵀ (before the
+//! update), `u` is scratch; returns s = h·P·hᵀ + 1 (not finite or ≤ 0: P unchanged).
 template <int kDim>
-void joseph_scalar(double* P, const double* ph, double* gain, double s, Eigen::Index dim_runtime) {
+double scalar_downdate(double* P_data, const double* h, int n, Eigen::Index dim_runtime, double* ph_data,
+                       double* u_data) {
+  using Matrix = Eigen::Matrix<double, kDim, kDim>;
+  using Vector = Eigen::Matrix<double, kDim, 1>;
   const Eigen::Index dim = kDim > 0 ? kDim : dim_runtime;
-  for (Eigen::Index k = 0; k < dim; ++k) gain[k] = ph[k] / s;
-  for (Eigen::Index k = 0; k < dim; ++k) {
-    const double kk = gain[k];
-    const double phk = ph[k];
-    const double skk = s * kk;
-    double* col = P + k * dim;
-    for (Eigen::Index j = k; j < dim; ++j) col[j] = col[j] - kk * ph[j] - phk * gain[j] + skk * gain[j];
-    for (Eigen::Index j = k + 1; j < dim; ++j) P[j * dim + k] = col[j];
+  Eigen::Map<Matrix> P(P_data, dim, dim);
+  Eigen::Map<Vector> ph(ph_data, dim);
+  Eigen::Map<Vector> u(u_data, dim);
+  ph.setZero();
+  for (int i = 0; i < n; ++i) {
+    if (h[i] != 0.0) ph += h[i] * (P.col(3 + i) + P.col(3 + n + i));
   }
+  double s = 1.0;
+  for (int i = 0; i < n; ++i) s += h[i] * (ph[3 + i] + ph[3 + n + i]);
+  if (!(s > 0.0) || !std::isfinite(s)) return s;
+  u = ph * (1.0 / std::sqrt(s));
+  const double inv_s = 1.0 / s;
+  for (Eigen::Index k = 0; k < dim; ++k) {
+    const double floor = P(k, k) * inv_s;
+    P.col(k) -= u * u[k];
+    P(k, k) = std::max(P(k, k), floor);
+  }
+  return s;
 }
 }  // namespace
 
@@ -139,6 +153,7 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       joseph_(Eigen::MatrixXd::Zero(dim_, dim_)),
       gain_(Eigen::MatrixX3d::Zero(dim_, 3)),
       ph_(Eigen::VectorXd::Zero(dim_)),
+      parity_h_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(gyros_.size()))),
       prior_var_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(gyros_.size()))),
       frozen_(gyros_.size(), 0) {
   gm_phi_.assign(gyros_.size(), 1.0);  // sized once here: computing them never allocates
@@ -347,46 +362,37 @@ ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quatern
 Eigen::Vector3d Mekf::update_parity(const Eigen::MatrixXd& W, int d, GyroMask mask, double scale,
                                     const double* p) {
   Eigen::Vector3d correction = Eigen::Vector3d::Zero();
-  const Eigen::Index ld = dim_;
-  double* P = P_.data();
+  const GyroMask used = mask & ~frozen_mask_;
+  double* h = parity_h_.data();
   double* ph = ph_.data();
-  double* gain = gain_.data();  // its first column: K = P·hᵀ/s of the row (scratch)
+  double* u = gain_.data();  // its first column (scratch)
   for (int r = 0; r < d; ++r) {
     // h: ∂p_r/∂(c_i, g_i) = scale·W(r, i) for the gyros of the mask; R = 1.
     double predicted = 0.0;
-    std::fill(ph, ph + dim_, 0.0);
     for (int i = 0; i < n_; ++i) {
-      if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
-      const double h = scale * W(r, i);
-      predicted += h * (bias_[i] + bias_[n_ + i]);
-      const double* pc = P + c_of(i) * ld;
-      const double* pg = P + g_of(i) * ld;
-      for (Eigen::Index k = 0; k < dim_; ++k) ph[k] += h * (pc[k] + pg[k]);
+      h[i] = has_gyro(used, i + 1) ? scale * W(r, i) : 0.0;
+      predicted += h[i] * (bias_[i] + bias_[n_ + i]);
     }
-    double s = 1.0;
-    for (int i = 0; i < n_; ++i) {
-      if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
-      s += scale * W(r, i) * (ph[c_of(i)] + ph[g_of(i)]);
-    }
-    const double nu = p[r] - predicted;
+    double s = 0.0;
     switch (dim_) {  // the common sizes with their loop bounds known to the compiler
       case 9:
-        joseph_scalar<9>(P, ph, gain, s, 9);
+        s = scalar_downdate<9>(P_.data(), h, n_, 9, ph, u);
         break;
       case 11:
-        joseph_scalar<11>(P, ph, gain, s, 11);
+        s = scalar_downdate<11>(P_.data(), h, n_, 11, ph, u);
         break;
       case 13:
-        joseph_scalar<13>(P, ph, gain, s, 13);
+        s = scalar_downdate<13>(P_.data(), h, n_, 13, ph, u);
         break;
       case 15:
-        joseph_scalar<15>(P, ph, gain, s, 15);
+        s = scalar_downdate<15>(P_.data(), h, n_, 15, ph, u);
         break;
       default:
-        joseph_scalar<0>(P, ph, gain, s, dim_);
+        s = scalar_downdate<Eigen::Dynamic>(P_.data(), h, n_, dim_, ph, u);
         break;
     }
-    const double gain_nu = nu / s;
+    if (!(s > 0.0) || !std::isfinite(s)) continue;
+    const double gain_nu = (p[r] - predicted) / s;
     for (Eigen::Index k = 0; k < 3; ++k) correction[k] += ph[k] * gain_nu;
     for (Eigen::Index k = 3; k < dim_; ++k) bias_[k - 3] += ph[k] * gain_nu;
   }

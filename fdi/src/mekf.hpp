@@ -72,7 +72,8 @@ class Mekf {
 
   //! The epoch's normalized parity `p` (d rows, p = scale·W·y ~ N(0, I) without fault; W d×N over the gyros
   //! of `mask`) as a measurement of the biases: with the reference it makes each gyro's bias observable.
-  //! Sequential scalar updates, Joseph form; returns the attitude correction δθ̂ to apply (q̂ ← q̂ ⊗ exp(δθ̂)).
+  //! Sequential scalar updates (the Joseph form with the optimal gain, expanded: P − P·hᵀ·h·P/s); returns the
+  //! attitude correction δθ̂ to apply (q̂ ← q̂ ⊗ exp(δθ̂)).
   Eigen::Vector3d update_parity(const Eigen::MatrixXd& W, int d, GyroMask mask, double scale,
                                 const double* p);
 
@@ -96,6 +97,8 @@ class Mekf {
   double bias_rad_s(int id) const;
   double bias_sigma_rad_s(int id) const;
   int gyro_count() const { return n_; }
+  //! The covariance (3 + 2N square: δθ, then c_1..c_N, then g_1..g_N).
+  const Eigen::MatrixXd& covariance() const { return P_; }
 
  private:
   static std::size_t index(int id) { return static_cast<std::size_t>(id - 1); }
@@ -134,6 +137,7 @@ class Mekf {
   Eigen::MatrixXd joseph_;      //!< (3+2N)² scratch of the Joseph update
   Eigen::MatrixX3d gain_;       //!< (3+2N)×3 Kalman gain
   Eigen::VectorXd ph_;          //!< (3+2N) P·hᵀ of a scalar update (scratch)
+  Eigen::VectorXd parity_h_;    //!< N: a parity row's h per gyro (scratch)
   Eigen::VectorXd prior_var_;   //!< [rad²/s²] per gyro: the variance of c + g without any measurement
   std::vector<unsigned char> frozen_;
 };
