@@ -14,81 +14,84 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
   return m;
 }
 
-//! The arrays of one covariance step: P (3 + m square, column-major), G's columns (3×m), D's diagonal (m) and
-//! the scratch of U (3 rows of m).
+//! The arrays of one covariance step over n gyros: P (3 + 2n square, column-major); C = −Γ·H* (3×n, a zero
+//! column for a gyro outside the solution); κ (n); D on the Gauss–Markov states, d (n, 1 when frozen), and
+//! d_j·d_k (n×n); scratch for R (3 + 2n rows of n) and X (3 + 2n rows of 3).
 struct CovarianceStep {
   double* P;
   const double* coupling;
+  const double* kappa;
   const double* decay;
-  double* u;
+  const double* decay2;
+  double* fold;
+  double* cross;
 };
 
-//! P ← Φ·P·Φᵀ + Qθ with Φ = [[A, G], [0, D]] over m = 2N bias states (`kM` > 0: m known at compile time).
-//! Every sum in the order of the textbook form (U, V below), each element's terms added in turn. P is exactly
-//! symmetric (every update writes both triangles alike), so Pββ(j, k) is read as Pββ(k, j): U's columns k and
-//! k + 1 (m is even) from contiguous pairs.
-template <int kM>
-void propagate_blocks(const CovarianceStep& s, Eigen::Index m_runtime, const Eigen::Matrix3d& A,
+//! P ← Φ·P·Φᵀ + Qθ with Φ = [[A, G], [0, D]] over n gyros (`kN` > 0: n known at compile time) and
+//! G = [C, C·diag(κ)] factored: G·Pβ: = C·R, R = Pc: + diag(κ)·Pg: (each gyro's two bias rows folded first).
+//!   X = A·Pθ: + C·R                      (3 rows: V = X(:, θ), U = X(:, β))
+//!   Pθθ ← V·Aᵀ + (Uc + Ug·diag(κ))·Cᵀ + Qθ, symmetrized;   Pθβ ← U·D;   Pββ ← D·Pββ·D
+//! R and X are formed transposed, as columns of P's length; P is read by columns (it is exactly symmetric:
+//! every update writes both triangles alike).
+template <int kN>
+void propagate_blocks(const CovarianceStep& s, int n_runtime, const Eigen::Matrix3d& A,
                       const Eigen::Matrix3d& q_theta) {
-  const Eigen::Index m = kM > 0 ? kM : m_runtime;
-  const Eigen::Index ld = 3 + m;
+  // Columns of P's length and of n as Eigen vectors of a size known at compile time: packed arithmetic.
+  constexpr int kColumn = kN > 0 ? 3 + 2 * kN : Eigen::Dynamic;
+  constexpr int kPerGyro = kN > 0 ? kN : Eigen::Dynamic;
+  using Column = Eigen::Matrix<double, kColumn, 1>;
+  using PerGyro = Eigen::Matrix<double, kPerGyro, 1>;
+  const int n = kN > 0 ? kN : n_runtime;
+  const Eigen::Index ld = 3 + 2 * n;
   double* P = s.P;
-  const double* c = s.coupling;
-  double* u = s.u;
-  // U = A·Pθβ + G·Pββ (3 rows of m), two columns at a time: their sums stay in registers over j.
-  for (Eigen::Index k = 0; k < m; k += 2) {
-    const double* p0 = P + (3 + k) * ld;
-    const Eigen::Vector3d a0 = A * Eigen::Map<const Eigen::Vector3d>(p0);
-    const Eigen::Vector3d a1 = A * Eigen::Map<const Eigen::Vector3d>(p0 + ld);
-    double u00 = a0.x(), u01 = a1.x(), u10 = a0.y(), u11 = a1.y(), u20 = a0.z(), u21 = a1.z();
-    for (Eigen::Index j = 0; j < m; ++j) {
-      const double* pb = P + (3 + j) * ld + 3 + k;  // Pββ(k, j), Pββ(k + 1, j) = Pββ(j, k), Pββ(j, k + 1)
-      const double* cj = c + 3 * j;
-      u00 += cj[0] * pb[0];
-      u01 += cj[0] * pb[1];
-      u10 += cj[1] * pb[0];
-      u11 += cj[1] * pb[1];
-      u20 += cj[2] * pb[0];
-      u21 += cj[2] * pb[1];
-    }
-    u[k] = u00;
-    u[k + 1] = u01;
-    u[m + k] = u10;
-    u[m + k + 1] = u11;
-    u[2 * m + k] = u20;
-    u[2 * m + k + 1] = u21;
+  const double* C = s.coupling;
+  const double* kappa = s.kappa;
+  const auto column = [ld](double* p) { return Eigen::Map<Column>(p, ld); };
+  // Rᵀ (ld × n): column i = P(:, c_i) + κ_i·P(:, g_i).
+  for (int i = 0; i < n; ++i)
+    column(s.fold + i * ld) = column(P + (3 + i) * ld) + kappa[i] * column(P + (3 + n + i) * ld);
+  // Xᵀ (ld × 3): column a = P(:, θ)·A(a, :)ᵀ + Rᵀ·C(a, :)ᵀ.
+  for (int a = 0; a < 3; ++a) {
+    auto xa = column(s.cross + a * ld);
+    xa = column(P) * A(a, 0) + column(P + ld) * A(a, 1) + column(P + 2 * ld) * A(a, 2);
+    for (int i = 0; i < n; ++i) xa += column(s.fold + i * ld) * C[3 * i + a];
   }
-  // V = A·Pθθ + G·Pβθ; Pθθ ← V·Aᵀ + Qθ + U·Gᵀ, symmetrized.
-  Eigen::Matrix3d V =
-      A * Eigen::Map<const Eigen::Matrix3d, 0, Eigen::OuterStride<>>(P, Eigen::OuterStride<>(ld));
-  for (Eigen::Index j = 0; j < m; ++j) {
-    const double* ptb = P + (3 + j) * ld;  // Pθβ(:, j)
-    for (Eigen::Index b = 0; b < 3; ++b)
-      for (Eigen::Index r = 0; r < 3; ++r) V(r, b) += c[3 * j + r] * ptb[b];
-  }
-  Eigen::Matrix3d Ptt = V * A.transpose() + q_theta;
-  for (Eigen::Index j = 0; j < m; ++j) {
-    for (Eigen::Index b = 0; b < 3; ++b)
-      for (Eigen::Index r = 0; r < 3; ++r) Ptt(r, b) += u[r * m + j] * c[3 * j + b];
-  }
-  Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>>(P, Eigen::OuterStride<>(ld)) =
-      0.5 * (Ptt + Ptt.transpose());
-  // Pθβ ← U·D, Pββ ← D·Pββ·D (D diagonal: 1 for the slow biases, φ for the Gauss–Markov ones).
-  const double* d = s.decay;
-  for (Eigen::Index k = 0; k < m; ++k) {
-    double* col = P + (3 + k) * ld;
-    for (Eigen::Index r = 0; r < 3; ++r) {
-      const double v = u[r * m + k] * d[k];
-      col[r] = v;
-      P[r * ld + 3 + k] = v;
+  const double* X = s.cross;
+  // S = Uc + Ug·diag(κ) (3×n, into R's storage), then Pθθ ← V·Aᵀ + S·Cᵀ + Qθ, symmetrized.
+  double* S = s.fold;
+  for (int a = 0; a < 3; ++a)
+    for (int i = 0; i < n; ++i) S[a * n + i] = X[a * ld + 3 + i] + kappa[i] * X[a * ld + 3 + n + i];
+  Eigen::Matrix3d Ptt;
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) {
+      double v = X[a * ld] * A(b, 0) + X[a * ld + 1] * A(b, 1) + X[a * ld + 2] * A(b, 2);
+      for (int i = 0; i < n; ++i) v += S[a * n + i] * C[3 * i + b];
+      Ptt(a, b) = v + q_theta(a, b);
     }
-    for (Eigen::Index j = k; j < m; ++j) {
-      const double v = col[3 + j] * (d[j] * d[k]);
-      col[3 + j] = v;
-      P[(3 + j) * ld + 3 + k] = v;
+  }
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) P[b * ld + a] = 0.5 * (Ptt(a, b) + Ptt(b, a));
+  // Pθβ ← U·D (1 on the slow biases, d on the Gauss–Markov ones), both triangles.
+  for (int j = 0; j < 2 * n; ++j) {
+    const double d = j < n ? 1.0 : s.decay[j - n];
+    for (int a = 0; a < 3; ++a) {
+      const double v = X[a * ld + 3 + j] * d;
+      P[(3 + j) * ld + a] = v;
+      P[a * ld + 3 + j] = v;
     }
+  }
+  // Pββ ← D·Pββ·D: the slow block unchanged, the mixed ones by d, the Gauss–Markov block by d_j·d_k.
+  const Eigen::Map<const PerGyro> d(s.decay, n);
+  for (int k = 0; k < n; ++k) {
+    Eigen::Map<PerGyro> c_rows_g(P + (3 + k) * ld + 3 + n, n);  // column c_k, rows g
+    Eigen::Map<PerGyro> g_rows_c(P + (3 + n + k) * ld + 3, n);  // column g_k, rows c
+    Eigen::Map<PerGyro> g_rows_g(P + (3 + n + k) * ld + 3 + n, n);
+    c_rows_g.array() *= d.array();
+    g_rows_c *= d[k];
+    g_rows_g.array() *= Eigen::Map<const PerGyro>(s.decay2 + k * n, n).array();
   }
 }
+
 //! One scalar measurement of the biases, R = 1, h = `h[i]` on gyro i's c and g (0: not measured), over P
 //! (`dim` square, column-major, n gyros; `kDim` > 0: known at compile time). With the optimal gain K = P·hᵀ/s
 //! the Joseph form expands to P − (P·hᵀ)(P·hᵀ)ᵀ/s: applied as P − u·uᵀ, u = P·hᵀ/√s, so both triangles round
@@ -147,9 +150,11 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       dim_(3 + 2 * static_cast<Eigen::Index>(gyros_.size())),
       P_(Eigen::MatrixXd::Zero(dim_, dim_)),
       bias_(Eigen::VectorXd::Zero(dim_ - 3)),
-      decay_(Eigen::VectorXd::Ones(dim_ - 3)),
-      coupling_(Eigen::Matrix3Xd::Zero(3, dim_ - 3)),
-      cross_rows_(Eigen::VectorXd::Zero(3 * (dim_ - 3))),
+      decay_(Eigen::VectorXd::Ones(n_)),
+      decay2_(Eigen::MatrixXd::Ones(n_, n_)),
+      coupling_(Eigen::Matrix3Xd::Zero(3, n_)),
+      fold_(Eigen::VectorXd::Zero(dim_ * n_)),
+      cross_(Eigen::VectorXd::Zero(dim_ * 3)),
       joseph_(Eigen::MatrixXd::Zero(dim_, dim_)),
       gain_(Eigen::MatrixX3d::Zero(dim_, 3)),
       ph_(Eigen::VectorXd::Zero(dim_)),
@@ -240,11 +245,10 @@ void Mekf::propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, G
   const GyroMask used = mask & ~frozen_mask_;
   refresh_step_constants(pinv, used, dt_s);
   for (int i = 0; i < n_; ++i) {
-    const double kappa = gm_kappa_[static_cast<std::size_t>(i)];
-    const Eigen::Vector3d col =
-        has_gyro(used, i + 1) ? Eigen::Vector3d(-gamma * pinv.col(i)) : Eigen::Vector3d::Zero();
-    coupling_.col(i) = col;
-    coupling_.col(n_ + i) = col * kappa;
+    if (has_gyro(used, i + 1))
+      coupling_.col(i).noalias() = -gamma * pinv.col(i);
+    else
+      coupling_.col(i).setZero();
   }
   propagate_covariance(A, q_theta_);
   for (int i = 0; i < n_; ++i) {
@@ -267,35 +271,36 @@ void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, d
   for (int i = 0; i < n_; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const bool frozen = frozen_[k] != 0;
-    decay_[i] = 1.0;
-    decay_[n_ + i] = frozen ? 1.0 : gm_phi_[k];
+    decay_[i] = frozen ? 1.0 : gm_phi_[k];
     const auto& g = gyros_[k];
     if (has_gyro(used, i + 1))
       q_theta_ += pinv.col(i) * pinv.col(i).transpose() * (g.arw_rad_rts * g.arw_rad_rts * dt_s);
   }
-  if (pinv.cols() == n_) step_pinv_ = pinv;  // sized at creation: no allocation
+  decay2_.noalias() = decay_ * decay_.transpose();  // d_j·d_k = d_k·d_j: the block stays exactly symmetric
+  if (pinv.cols() == n_) step_pinv_ = pinv;         // sized at creation: no allocation
   step_used_ = used;
   step_frozen_ = frozen_mask_;
   step_dt_s_ = dt_s;
 }
 
 void Mekf::propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta) {
-  const CovarianceStep step{P_.data(), coupling_.data(), decay_.data(), cross_rows_.data()};
+  const CovarianceStep step{P_.data(),      coupling_.data(), gm_kappa_.data(), decay_.data(),
+                            decay2_.data(), fold_.data(),     cross_.data()};
   switch (n_) {  // the common sizes with their loop bounds known to the compiler (unrolled, vectorized)
     case 3:
-      propagate_blocks<6>(step, 6, A, q_theta);
+      propagate_blocks<3>(step, 3, A, q_theta);
       break;
     case 4:
-      propagate_blocks<8>(step, 8, A, q_theta);
+      propagate_blocks<4>(step, 4, A, q_theta);
       break;
     case 5:
-      propagate_blocks<10>(step, 10, A, q_theta);
+      propagate_blocks<5>(step, 5, A, q_theta);
       break;
     case 6:
-      propagate_blocks<12>(step, 12, A, q_theta);
+      propagate_blocks<6>(step, 6, A, q_theta);
       break;
     default:
-      propagate_blocks<0>(step, dim_ - 3, A, q_theta);
+      propagate_blocks<0>(step, n_, A, q_theta);
       break;
   }
 }

@@ -115,7 +115,8 @@ class Mekf {
   Eigen::Index dim_;       //!< 3 + 2N
   Eigen::MatrixXd P_;      //!< covariance
   Eigen::VectorXd bias_;   //!< [rad/s] ĉ (0..N−1) then ĝ (N..2N−1)
-  Eigen::VectorXd decay_;  //!< per bias state, the last step's transition (scratch)
+  Eigen::VectorXd decay_;  //!< per gyro, its Gauss–Markov state's transition d over the step (1 when frozen)
+  Eigen::MatrixXd decay2_;  //!< d_j·d_k (N×N)
   //! Per gyro, the Gauss–Markov transition φ = e^(−Δt/T_c) and step mean κ = T_c(1 − φ)/Δt, computed for
   //! `gm_dt_s_` only (the step is nearly always the same: no exp per gyro per step).
   std::vector<double> gm_phi_;
@@ -124,21 +125,23 @@ class Mekf {
   std::vector<double> gm_var_;  //!< [rad²/s²] per gyro: σ_GM²(1 − φ²), the Gauss–Markov's over a step
   double gm_dt_s_ = -1.0;
   //! What a step keeps while the gyro set, the frozen set, the rate solution and Δt stay the same (nearly
-  //! always): the attitude's process noise Qθ = H*·diag(N²)·H*ᵀ·Δt and D (`decay_`). Recomputed when the key
+  //! always): the attitude's process noise Qθ = H*·diag(N²)·H*ᵀ·Δt and D (`decay_`, `decay2_`). Recomputed
+  //! when the key
   //! (`step_pinv_`, `step_used_`, `step_frozen_`, `step_dt_s_`) changes.
   Eigen::Matrix3d q_theta_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3Xd step_pinv_;
   GyroMask step_used_ = 0;
   GyroMask step_frozen_ = 0;
   double step_dt_s_ = -1.0;
-  GyroMask frozen_mask_ = 0;    //!< the frozen gyros (bit i − 1: gyro i), as `frozen_`
-  Eigen::Matrix3Xd coupling_;   //!< 3×2N: ∂δθ/∂bias over the step (scratch)
-  Eigen::VectorXd cross_rows_;  //!< 3×2N row-major: U = A·Pθβ + G·Pββ (scratch)
-  Eigen::MatrixXd joseph_;      //!< (3+2N)² scratch of the Joseph update
-  Eigen::MatrixX3d gain_;       //!< (3+2N)×3 Kalman gain
-  Eigen::VectorXd ph_;          //!< (3+2N) P·hᵀ of a scalar update (scratch)
-  Eigen::VectorXd parity_h_;    //!< N: a parity row's h per gyro (scratch)
-  Eigen::VectorXd prior_var_;   //!< [rad²/s²] per gyro: the variance of c + g without any measurement
+  GyroMask frozen_mask_ = 0;  //!< the frozen gyros (bit i − 1: gyro i), as `frozen_`
+  Eigen::Matrix3Xd coupling_;  //!< 3×N: C = −Γ·H*, ∂δθ/∂c_i over the step (on g_i: κ_i·C) (scratch)
+  Eigen::VectorXd fold_;       //!< (3+2N)×N: Rᵀ of the propagation (scratch)
+  Eigen::VectorXd cross_;      //!< (3+2N)×3: Xᵀ of the propagation (scratch)
+  Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
+  Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
+  Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
+  Eigen::VectorXd parity_h_;   //!< N: a parity row's h per gyro (scratch)
+  Eigen::VectorXd prior_var_;  //!< [rad²/s²] per gyro: the variance of c + g without any measurement
   std::vector<unsigned char> frozen_;
 };
 
