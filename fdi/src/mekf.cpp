@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>  // the 3×3 inverse
 
 namespace tetra::fdi::detail {
 
@@ -122,6 +123,36 @@ double scalar_downdate(double* P_data, const double* h, int n, Eigen::Index dim_
     P(k, k) = std::max(P(k, k), floor);
   }
   return s;
+}
+
+//! The Joseph update P ← (I − K·H)·P·(I − K·H)ᵀ + r·K·Kᵀ for H = [I₃ 0] (P `dim` square and T its scratch,
+//! K dim×3, column-major; `kDim` > 0: known at compile time), column by column: T = (I − K·H)·P =
+//! P − K·P(θ, :), then P(:, k) ← T(:, k) + (r·K − T(:, θ))·K(k, :)ᵀ; symmetrized (each pair averaged).
+template <int kDim>
+void joseph_reference(double* P_data, double* T_data, const double* K_data, double r,
+                      Eigen::Index dim_runtime) {
+  using Matrix = Eigen::Matrix<double, kDim, kDim>;
+  using Gain = Eigen::Matrix<double, kDim, 3>;
+  const Eigen::Index dim = kDim > 0 ? kDim : dim_runtime;
+  Eigen::Map<Matrix> P(P_data, dim, dim);
+  Eigen::Map<Matrix> T(T_data, dim, dim);
+  const Eigen::Map<const Gain> K(K_data, dim, 3);
+  for (Eigen::Index k = 0; k < dim; ++k)
+    T.col(k) = P.col(k) - K.col(0) * P(0, k) - K.col(1) * P(1, k) - K.col(2) * P(2, k);
+  // M = r·K − T(:, θ), kept in P's first three columns (T holds what they were).
+  for (Eigen::Index a = 0; a < 3; ++a) P.col(a) = r * K.col(a) - T.col(a);
+  for (Eigen::Index k = 3; k < dim; ++k)
+    P.col(k) = T.col(k) + P.col(0) * K(k, 0) + P.col(1) * K(k, 1) + P.col(2) * K(k, 2);
+  for (Eigen::Index k = 0; k < 3; ++k)  // the first three columns last: M is read above
+    T.col(k) += P.col(0) * K(k, 0) + P.col(1) * K(k, 1) + P.col(2) * K(k, 2);
+  P.leftCols(3) = T.leftCols(3);
+  for (Eigen::Index k = 0; k < dim; ++k) {
+    for (Eigen::Index j = k + 1; j < dim; ++j) {
+      const double v = 0.5 * (P(j, k) + P(k, j));
+      P(j, k) = v;
+      P(k, j) = v;
+    }
+  }
 }
 }  // namespace
 
@@ -333,33 +364,32 @@ ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quatern
   out.chi2 = out.innovation_rad.dot(llt.solve(out.innovation_rad));
   if (!(out.chi2 <= gate_chi2)) return out;
   out.accepted = true;
-  // K = P·Hᵀ·S⁻¹ with H = [I₃ 0].
-  for (Eigen::Index k = 0; k < dim_; ++k)
-    gain_.row(k) = llt.solve(P_.block<1, 3>(k, 0).transpose()).transpose();
-  const Eigen::VectorXd::Index m = dim_ - 3;
-  for (Eigen::Index k = 0; k < m; ++k) {
-    int i = static_cast<int>(k % n_);
-    if (frozen_[static_cast<std::size_t>(i)] != 0) gain_.row(3 + k).setZero();
+  // K = P·Hᵀ·S⁻¹ with H = [I₃ 0]; no gain on a frozen gyro's states.
+  const Eigen::Matrix3d S_inv = S.inverse();  // positive definite (the factorization above succeeded)
+  gain_.noalias() = P_.leftCols<3>() * S_inv;
+  for (int i = 0; i < n_; ++i) {
+    if (frozen_[static_cast<std::size_t>(i)] == 0) continue;
+    gain_.row(c_of(i)).setZero();
+    gain_.row(g_of(i)).setZero();
   }
   out.correction_rad = gain_.topRows<3>() * out.innovation_rad;
-  for (Eigen::Index k = 0; k < m; ++k) bias_[k] += gain_.row(3 + k).dot(out.innovation_rad);
-  // Joseph form: P ← (I − KH)·P·(I − KH)ᵀ + K·R·Kᵀ; (I − KH) differs from I in its first three columns only.
-  joseph_ = P_;
-  for (Eigen::Index k = 0; k < dim_; ++k)  // T = (I − KH)·P
-    joseph_.col(k).noalias() -= gain_ * P_.block<3, 1>(0, k);
-  // P = T·(I − KH)ᵀ + r·K·Kᵀ, symmetrized: each pair (k, j) and (j, k) at once, the r·K·Kᵀ term shared.
-  for (Eigen::Index k = 0; k < dim_; ++k) {
-    const Eigen::Vector3d tk = joseph_.block<1, 3>(k, 0).transpose();
-    P_(k, k) = joseph_(k, k) - gain_.row(k).dot(tk) + r * gain_.row(k).dot(gain_.row(k));
-    for (Eigen::Index j = k + 1; j < dim_; ++j) {
-      const Eigen::Vector3d tj = joseph_.block<1, 3>(j, 0).transpose();
-      const double rkk = r * gain_.row(k).dot(gain_.row(j));
-      const double pkj = joseph_(k, j) - gain_.row(j).dot(tk) + rkk;
-      const double pjk = joseph_(j, k) - gain_.row(k).dot(tj) + rkk;
-      const double v = 0.5 * (pkj + pjk);
-      P_(k, j) = v;
-      P_(j, k) = v;
-    }
+  for (Eigen::Index k = 3; k < dim_; ++k) bias_[k - 3] += gain_.row(k).dot(out.innovation_rad);
+  switch (dim_) {  // the common sizes with their loop bounds known to the compiler
+    case 9:
+      joseph_reference<9>(P_.data(), joseph_.data(), gain_.data(), r, 9);
+      break;
+    case 11:
+      joseph_reference<11>(P_.data(), joseph_.data(), gain_.data(), r, 11);
+      break;
+    case 13:
+      joseph_reference<13>(P_.data(), joseph_.data(), gain_.data(), r, 13);
+      break;
+    case 15:
+      joseph_reference<15>(P_.data(), joseph_.data(), gain_.data(), r, 15);
+      break;
+    default:
+      joseph_reference<Eigen::Dynamic>(P_.data(), joseph_.data(), gain_.data(), r, dim_);
+      break;
   }
   return out;
 }
