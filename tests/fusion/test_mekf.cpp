@@ -280,6 +280,55 @@ TEST(MekfParts, GateRejectsAWildReferenceAndCounts) {
   EXPECT_EQ(f.attitude_sigma_rad(), before);
 }
 
+TEST(MekfParts, PropagationIsTheTransitionOfTheModel) {
+  // A dense P (propagation while turning, a parity row), gyro 4 frozen and out of the solution; one step
+  // against P ← Φ·P·Φᵀ + Q built here in full from the model (docs/fdi.md, "Propagation"): within 1e-12 of
+  // P's largest entry (a few dozen roundings of 1.1e-16 each, mathematically equal).
+  fdi::detail::GyroNoiseModel g;
+  g.arw_rad_rts = 1e-6;
+  g.bias_sigma_rad_s = 1e-5;
+  g.gm_sigma_rad_s = 2e-6;
+  g.gm_correlation_s = 100.0;
+  g.rrw_rad_s_rts = 1e-7;
+  fdi::detail::Mekf f(std::vector<fdi::detail::GyroNoiseModel>(4, g));
+  f.reset(1e-4);
+  Eigen::Matrix3Xd pinv(3, 4);
+  pinv << 0.6, -0.2, 0.1, -0.5, 0.1, 0.7, -0.4, -0.4, 0.3, 0.2, 0.8, -0.3;
+  const Eigen::Vector3d omega(0.02, -0.05, 0.1);
+  const double dt = 0.1;
+  for (int k = 0; k < 50; ++k) f.propagate(pinv, 0b1111, omega, dt);
+  Eigen::MatrixXd W(1, 4);
+  W << 0.5, -0.3, 0.6, -0.55;
+  const double p = 0.7;
+  (void)f.update_parity(W, 1, 0b1111, 2e4, &p);
+  f.freeze(4);
+  Eigen::Matrix3Xd pinv3 = pinv;
+  pinv3.col(3).setZero();
+  const GyroMask mask = 0b0111;
+  const Eigen::MatrixXd P0 = f.covariance();
+  f.propagate(pinv3, mask, omega, dt);
+
+  const Eigen::Index dim = 11;
+  Eigen::MatrixXd Phi = Eigen::MatrixXd::Identity(dim, dim);
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(dim, dim);
+  Phi.topLeftCorner<3, 3>() = quat_exp(omega * dt).toRotationMatrix().transpose();
+  const Eigen::Matrix3d gamma = fdi::detail::rotation_integral(omega, dt);
+  const double phi = std::exp(-dt / g.gm_correlation_s);
+  const double kappa = g.gm_correlation_s * (1.0 - phi) / dt;
+  for (int i = 0; i < 4; ++i) {
+    if (!has_gyro(mask, i + 1)) continue;  // gyro 4: frozen, no coupling, no evolution, no noise
+    Phi.block<3, 1>(0, 3 + i) = -gamma * pinv3.col(i);
+    Phi.block<3, 1>(0, 7 + i) = -gamma * pinv3.col(i) * kappa;
+    Phi(7 + i, 7 + i) = phi;
+    Q.topLeftCorner<3, 3>() += pinv3.col(i) * pinv3.col(i).transpose() * g.arw_rad_rts * g.arw_rad_rts * dt;
+    Q(3 + i, 3 + i) = g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt;
+    Q(7 + i, 7 + i) = g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - phi * phi);
+  }
+  const Eigen::MatrixXd expect = Phi * P0 * Phi.transpose() + Q;
+  EXPECT_LT((f.covariance() - expect).cwiseAbs().maxCoeff(), 1e-12 * expect.cwiseAbs().maxCoeff());
+  EXPECT_TRUE(f.covariance() == f.covariance().transpose());  // both triangles written alike
+}
+
 TEST(MekfParts, ParityUpdateIsTheJosephFormAndKeepsVariancesNonNegative) {
   // A correlated P (a few propagation steps while turning), then one parity row: the filter's update against
   // the Joseph form P ← (I − K·h)·P·(I − K·h)ᵀ + K·Kᵀ (R = 1) computed here in full, within 1e-12 of P's
