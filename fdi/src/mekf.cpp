@@ -52,10 +52,19 @@ void propagate_blocks(const CovarianceStep& s, int n_runtime, const Eigen::Matri
   for (int i = 0; i < n; ++i)
     column(s.fold + i * ld) = column(P + (3 + i) * ld) + kappa[i] * column(P + (3 + n + i) * ld);
   // Xᵀ (ld × 3): column a = P(:, θ)·A(a, :)ᵀ + Rᵀ·C(a, :)ᵀ.
-  for (int a = 0; a < 3; ++a) {
-    auto xa = column(s.cross + a * ld);
+  const auto cross_column = [&](int a, auto& xa) {
     xa = column(P) * A(a, 0) + column(P + ld) * A(a, 1) + column(P + 2 * ld) * A(a, 2);
     for (int i = 0; i < n; ++i) xa += column(s.fold + i * ld) * C[3 * i + a];
+  };
+  for (int a = 0; a < 3; ++a) {
+    if constexpr (kN > 0) {  // summed in registers, stored once
+      Column xa;
+      cross_column(a, xa);
+      column(s.cross + a * ld) = xa;
+    } else {
+      auto xa = column(s.cross + a * ld);
+      cross_column(a, xa);
+    }
   }
   const double* X = s.cross;
   // S = Uc + Ug·diag(κ) (3×n, into R's storage), then Pθθ ← V·Aᵀ + S·Cᵀ + Qθ, symmetrized.
@@ -100,21 +109,32 @@ void propagate_blocks(const CovarianceStep& s, int n_runtime, const Eigen::Matri
 //! ((P·hᵀ)_k² ≤ P_kk·h·P·hᵀ for P ≥ 0), which rounding could otherwise cross. `ph` receives P·hᵀ (before the
 //! update), `u` is scratch; returns s = h·P·hᵀ + 1 (not finite or ≤ 0: P unchanged).
 template <int kDim>
-double scalar_downdate(double* P_data, const double* h, int n, Eigen::Index dim_runtime, double* ph_data,
-                       double* u_data) {
+double scalar_downdate(double* P_data, const double* h, int n_runtime, Eigen::Index dim_runtime,
+                       double* ph_data, double* u_data) {
   using Matrix = Eigen::Matrix<double, kDim, kDim>;
   using Vector = Eigen::Matrix<double, kDim, 1>;
   const Eigen::Index dim = kDim > 0 ? kDim : dim_runtime;
+  const int n = kDim > 0 ? (kDim - 3) / 2 : n_runtime;
   Eigen::Map<Matrix> P(P_data, dim, dim);
-  Eigen::Map<Vector> ph(ph_data, dim);
-  Eigen::Map<Vector> u(u_data, dim);
-  ph.setZero();
-  for (int i = 0; i < n; ++i) {
-    if (h[i] != 0.0) ph += h[i] * (P.col(3 + i) + P.col(3 + n + i));
+  const auto sum_ph = [&](auto& ph) {
+    ph.setZero();
+    for (int i = 0; i < n; ++i) {
+      if (h[i] != 0.0) ph += h[i] * (P.col(3 + i) + P.col(3 + n + i));
+    }
+  };
+  if constexpr (kDim > 0) {  // summed in registers, stored once
+    Vector ph;
+    sum_ph(ph);
+    Eigen::Map<Vector>(ph_data, dim) = ph;
+  } else {
+    Eigen::Map<Vector> ph(ph_data, dim);
+    sum_ph(ph);
   }
+  const Eigen::Map<const Vector> ph(ph_data, dim);
   double s = 1.0;
   for (int i = 0; i < n; ++i) s += h[i] * (ph[3 + i] + ph[3 + n + i]);
   if (!(s > 0.0) || !std::isfinite(s)) return s;
+  Eigen::Map<Vector> u(u_data, dim);
   u = ph * (1.0 / std::sqrt(s));
   const double inv_s = 1.0 / s;
   for (Eigen::Index k = 0; k < dim; ++k) {
