@@ -9,12 +9,6 @@
 namespace tetra::fdi::detail {
 
 namespace {
-Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
 //! The arrays of one covariance step over n gyros: P (3 + 2n square, column-major); C = −Γ·H* (3×n, a zero
 //! column for a gyro outside the solution); κ (n); D on the Gauss–Markov states, d (n, 1 when frozen), and
 //! d_j·d_k (n×n); scratch for R (3 + 2n rows of n) and X (3 + 2n rows of 3).
@@ -177,9 +171,10 @@ void joseph_reference(double* P_data, double* T_data, const double* K_data, doub
 }  // namespace
 
 Eigen::Matrix3d rotation_integral(const Eigen::Vector3d& omega_rad_s, double dt_s) {
-  // ∫₀^Δt exp(−W u) du = I·Δt − (1 − cos θ)/|ω|²·W + (θ − sin θ)/|ω|³·W², θ = |ω|Δt, W = [ω×].
-  const Eigen::Matrix3d W = cross_matrix(omega_rad_s);
-  const double w = omega_rad_s.norm();
+  // ∫₀^Δt exp(−W u) du = I·Δt − (1 − cos θ)/|ω|²·W + (θ − sin θ)/|ω|³·W², θ = |ω|Δt, W = [ω×];
+  // W² = ω·ωᵀ − |ω|²·I.
+  const double w2 = omega_rad_s.squaredNorm();
+  const double w = std::sqrt(w2);
   const double th = w * dt_s;
   double a = 0.0;  // (1 − cos θ)/|ω|²
   double b = 0.0;  // (θ − sin θ)/|ω|³
@@ -189,10 +184,19 @@ Eigen::Matrix3d rotation_integral(const Eigen::Vector3d& omega_rad_s, double dt_
     a = dt2 * (0.5 - th * th / 24.0);
     b = dt2 * dt_s * (1.0 / 6.0 - th * th / 120.0);
   } else {
-    a = (1.0 - std::cos(th)) / (w * w);
-    b = (th - std::sin(th)) / (w * w * w);
+    a = (1.0 - std::cos(th)) / w2;
+    b = (th - std::sin(th)) / (w2 * w);
   }
-  return Eigen::Matrix3d::Identity() * dt_s - a * W + b * W * W;
+  Eigen::Matrix3d gamma = (b * omega_rad_s) * omega_rad_s.transpose();
+  gamma.diagonal().array() += dt_s - b * w2;
+  const Eigen::Vector3d aw = a * omega_rad_s;  // −a·W off the diagonal
+  gamma(0, 1) += aw.z();
+  gamma(1, 0) -= aw.z();
+  gamma(0, 2) -= aw.y();
+  gamma(2, 0) += aw.y();
+  gamma(1, 2) += aw.x();
+  gamma(2, 1) -= aw.x();
+  return gamma;
 }
 
 Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
