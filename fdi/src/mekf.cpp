@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>  // the 3×3 inverse
@@ -9,6 +10,30 @@
 namespace tetra::fdi::detail {
 
 namespace {
+//! Calls `f` with std::integral_constant<int, n> for the common gyro counts (3..6: the kernels' loop bounds
+//! known to the compiler, unrolled and vectorized), with std::integral_constant<int, 0> (sizes at run time)
+//! otherwise.
+template <typename F>
+decltype(auto) with_gyro_count(int n, F&& f) {
+  switch (n) {
+    case 3:
+      return f(std::integral_constant<int, 3>{});
+    case 4:
+      return f(std::integral_constant<int, 4>{});
+    case 5:
+      return f(std::integral_constant<int, 5>{});
+    case 6:
+      return f(std::integral_constant<int, 6>{});
+    default:
+      return f(std::integral_constant<int, 0>{});
+  }
+}
+
+//! The state dimension 3 + 2N for a gyro count known at compile time (`kN` > 0), Eigen::Dynamic otherwise.
+constexpr int state_dim(int kN) {
+  return kN > 0 ? 3 + 2 * kN : Eigen::Dynamic;
+}
+
 //! The arrays of one covariance step over n gyros: P (3 + 2n square, column-major); C = −Γ·H* (3×n, a zero
 //! column for a gyro outside the solution); κ (n); D on the Gauss–Markov states, d (n, 1 when frozen), and
 //! d_j·d_k (n×n); scratch for R (3 + 2n rows of n) and X (3 + 2n rows of 3).
@@ -341,23 +366,7 @@ void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, d
 void Mekf::propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta) {
   const CovarianceStep step{P_.data(),      coupling_.data(), gm_kappa_.data(), decay_.data(),
                             decay2_.data(), fold_.data(),     cross_.data()};
-  switch (n_) {  // the common sizes with their loop bounds known to the compiler (unrolled, vectorized)
-    case 3:
-      propagate_blocks<3>(step, 3, A, q_theta);
-      break;
-    case 4:
-      propagate_blocks<4>(step, 4, A, q_theta);
-      break;
-    case 5:
-      propagate_blocks<5>(step, 5, A, q_theta);
-      break;
-    case 6:
-      propagate_blocks<6>(step, 6, A, q_theta);
-      break;
-    default:
-      propagate_blocks<0>(step, n_, A, q_theta);
-      break;
-  }
+  with_gyro_count(n_, [&](auto k) { propagate_blocks<decltype(k)::value>(step, n_, A, q_theta); });
 }
 
 void Mekf::gauss_markov_transitions(double dt_s) {
@@ -398,23 +407,9 @@ ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quatern
   }
   out.correction_rad = gain_.topRows<3>() * out.innovation_rad;
   for (Eigen::Index k = 3; k < dim_; ++k) bias_[k - 3] += gain_.row(k).dot(out.innovation_rad);
-  switch (dim_) {  // the common sizes with their loop bounds known to the compiler
-    case 9:
-      joseph_reference<9>(P_.data(), joseph_.data(), gain_.data(), r, 9);
-      break;
-    case 11:
-      joseph_reference<11>(P_.data(), joseph_.data(), gain_.data(), r, 11);
-      break;
-    case 13:
-      joseph_reference<13>(P_.data(), joseph_.data(), gain_.data(), r, 13);
-      break;
-    case 15:
-      joseph_reference<15>(P_.data(), joseph_.data(), gain_.data(), r, 15);
-      break;
-    default:
-      joseph_reference<Eigen::Dynamic>(P_.data(), joseph_.data(), gain_.data(), r, dim_);
-      break;
-  }
+  with_gyro_count(n_, [&](auto k) {
+    joseph_reference<state_dim(decltype(k)::value)>(P_.data(), joseph_.data(), gain_.data(), r, dim_);
+  });
   return out;
 }
 
@@ -432,24 +427,9 @@ Eigen::Vector3d Mekf::update_parity(const Eigen::MatrixXd& W, int d, GyroMask ma
       h[i] = has_gyro(used, i + 1) ? scale * W(r, i) : 0.0;
       predicted += h[i] * (bias_[i] + bias_[n_ + i]);
     }
-    double s = 0.0;
-    switch (dim_) {  // the common sizes with their loop bounds known to the compiler
-      case 9:
-        s = scalar_downdate<9>(P_.data(), h, n_, 9, ph, u);
-        break;
-      case 11:
-        s = scalar_downdate<11>(P_.data(), h, n_, 11, ph, u);
-        break;
-      case 13:
-        s = scalar_downdate<13>(P_.data(), h, n_, 13, ph, u);
-        break;
-      case 15:
-        s = scalar_downdate<15>(P_.data(), h, n_, 15, ph, u);
-        break;
-      default:
-        s = scalar_downdate<Eigen::Dynamic>(P_.data(), h, n_, dim_, ph, u);
-        break;
-    }
+    const double s = with_gyro_count(n_, [&](auto k) {
+      return scalar_downdate<state_dim(decltype(k)::value)>(P_.data(), h, n_, dim_, ph, u);
+    });
     if (!(s > 0.0) || !std::isfinite(s)) continue;
     const double gain_nu = (p[r] - predicted) / s;
     for (Eigen::Index k = 0; k < 3; ++k) correction[k] += ph[k] * gain_nu;
