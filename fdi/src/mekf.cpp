@@ -232,6 +232,7 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       bias_(Eigen::VectorXd::Zero(dim_ - 3)),
       decay_(Eigen::VectorXd::Ones(n_)),
       decay2_(Eigen::MatrixXd::Ones(n_, n_)),
+      bias_noise_(Eigen::VectorXd::Zero(2 * n_)),
       coupling_(Eigen::Matrix3Xd::Zero(3, n_)),
       fold_(Eigen::VectorXd::Zero(dim_ * n_)),
       cross_(Eigen::VectorXd::Zero(dim_ * 3)),
@@ -331,14 +332,9 @@ void Mekf::propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, G
       coupling_.col(i).setZero();
   }
   propagate_covariance(A, q_theta_);
-  for (int i = 0; i < n_; ++i) {
-    if (frozen_[static_cast<std::size_t>(i)] != 0) continue;
-    const auto k = static_cast<std::size_t>(i);
-    P_(c_of(i), c_of(i)) += rrw_var_[k];
-    prior_var_[i] += rrw_var_[k];
-    P_(g_of(i), g_of(i)) += gm_var_[k];
-    bias_[n_ + i] *= gm_phi_[k];
-  }
+  P_.diagonal().tail(2 * n_) += bias_noise_;  // zero on a frozen gyro's states
+  prior_var_ += bias_noise_.head(n_);
+  bias_.tail(n_).array() *= decay_.array();  // 1 on a frozen gyro
   // Symmetric by construction but for the attitude block (symmetrized above).
 }
 
@@ -352,6 +348,8 @@ void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, d
     const auto k = static_cast<std::size_t>(i);
     const bool frozen = frozen_[k] != 0;
     decay_[i] = frozen ? 1.0 : gm_phi_[k];
+    bias_noise_[i] = frozen ? 0.0 : rrw_var_[k];
+    bias_noise_[n_ + i] = frozen ? 0.0 : gm_var_[k];
     const auto& g = gyros_[k];
     if (has_gyro(used, i + 1))
       q_theta_ += pinv.col(i) * pinv.col(i).transpose() * (g.arw_rad_rts * g.arw_rad_rts * dt_s);

@@ -112,11 +112,9 @@ class Mekf {
 
   std::vector<GyroNoiseModel> gyros_;
   int n_;
-  Eigen::Index dim_;       //!< 3 + 2N
-  Eigen::MatrixXd P_;      //!< covariance
-  Eigen::VectorXd bias_;   //!< [rad/s] ĉ (0..N−1) then ĝ (N..2N−1)
-  Eigen::VectorXd decay_;  //!< per gyro, its Gauss–Markov state's transition d over the step (1 when frozen)
-  Eigen::MatrixXd decay2_;  //!< d_j·d_k (N×N)
+  Eigen::Index dim_;      //!< 3 + 2N
+  Eigen::MatrixXd P_;     //!< covariance
+  Eigen::VectorXd bias_;  //!< [rad/s] ĉ (0..N−1) then ĝ (N..2N−1)
   //! Per gyro, the Gauss–Markov transition φ = e^(−Δt/T_c) and step mean κ = T_c(1 − φ)/Δt, computed for
   //! `gm_dt_s_` only (the step is nearly always the same: no exp per gyro per step).
   std::vector<double> gm_phi_;
@@ -125,9 +123,13 @@ class Mekf {
   std::vector<double> gm_var_;  //!< [rad²/s²] per gyro: σ_GM²(1 − φ²), the Gauss–Markov's over a step
   double gm_dt_s_ = -1.0;
   //! What a step keeps while the gyro set, the frozen set, the rate solution and Δt stay the same (nearly
-  //! always): the attitude's process noise Qθ = H*·diag(N²)·H*ᵀ·Δt and D (`decay_`, `decay2_`). Recomputed
-  //! when the key
-  //! (`step_pinv_`, `step_used_`, `step_frozen_`, `step_dt_s_`) changes.
+  //! always), recomputed when the key (`step_pinv_`, `step_used_`, `step_frozen_`, `step_dt_s_`) changes:
+  //! the attitude's process noise Qθ = H*·diag(N²)·H*ᵀ·Δt; D on the Gauss–Markov states, d per gyro
+  //! (`decay_`, 1 when frozen) and d_j·d_k (`decay2_`, N×N); the bias states' variance gain over the step
+  //! (`bias_noise_` [rad²/s²], c then g, 0 when frozen).
+  Eigen::VectorXd decay_;
+  Eigen::MatrixXd decay2_;
+  Eigen::VectorXd bias_noise_;
   Eigen::Matrix3d q_theta_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3Xd step_pinv_;
   GyroMask step_used_ = 0;
