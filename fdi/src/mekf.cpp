@@ -57,7 +57,7 @@ template <int kN>
 void propagate_blocks(const CovarianceStep& s, int n_runtime, const Eigen::Matrix3d& A,
                       const Eigen::Matrix3d& q_theta) {
   // Columns of P's length and of n as Eigen vectors of a size known at compile time: packed arithmetic.
-  constexpr int kColumn = kN > 0 ? 3 + 2 * kN : Eigen::Dynamic;
+  constexpr int kColumn = state_dim(kN);
   constexpr int kPerGyro = kN > 0 ? kN : Eigen::Dynamic;
   using Column = Eigen::Matrix<double, kColumn, 1>;
   using PerGyro = Eigen::Matrix<double, kPerGyro, 1>;
