@@ -2,116 +2,204 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>  // the 3×3 inverse
 
 namespace tetra::fdi::detail {
 
 namespace {
-Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
+//! Calls `f` with std::integral_constant<int, n> for the common gyro counts (3..6: the kernels' loop bounds
+//! known to the compiler, unrolled and vectorized), with std::integral_constant<int, 0> (sizes at run time)
+//! otherwise.
+template <typename F>
+decltype(auto) with_gyro_count(int n, F&& f) {
+  switch (n) {
+    case 3:
+      return f(std::integral_constant<int, 3>{});
+    case 4:
+      return f(std::integral_constant<int, 4>{});
+    case 5:
+      return f(std::integral_constant<int, 5>{});
+    case 6:
+      return f(std::integral_constant<int, 6>{});
+    default:
+      return f(std::integral_constant<int, 0>{});
+  }
 }
 
-//! The arrays of one covariance step: P (3 + m square, column-major), G's columns (3×m), D's diagonal (m) and
-//! the scratch of U (3 rows of m).
+//! The state dimension 3 + 2N for a gyro count known at compile time (`kN` > 0), Eigen::Dynamic otherwise.
+constexpr int state_dim(int kN) {
+  return kN > 0 ? 3 + 2 * kN : Eigen::Dynamic;
+}
+
+//! The arrays of one covariance step over n gyros: P (3 + 2n square, column-major); C = −Γ·H* (3×n, a zero
+//! column for a gyro outside the solution); κ (n); D on the Gauss–Markov states, d (n, 1 when frozen), and
+//! d_j·d_k (n×n); scratch for R (3 + 2n rows of n) and X (3 + 2n rows of 3).
 struct CovarianceStep {
   double* P;
   const double* coupling;
+  const double* kappa;
   const double* decay;
-  double* u;
+  const double* decay2;
+  double* fold;
+  double* cross;
 };
 
-//! P ← Φ·P·Φᵀ + Qθ with Φ = [[A, G], [0, D]] over m = 2N bias states (`kM` > 0: m known at compile time).
-//! Every sum in the order of the textbook form (U, V below), each element's terms added in turn. P is exactly
-//! symmetric (every update writes both triangles alike), so Pββ(j, k) is read as Pββ(k, j): U's columns k and
-//! k + 1 (m is even) from contiguous pairs.
-template <int kM>
-void propagate_blocks(const CovarianceStep& s, Eigen::Index m_runtime, const Eigen::Matrix3d& A,
+//! P ← Φ·P·Φᵀ + Qθ with Φ = [[A, G], [0, D]] over n gyros (`kN` > 0: n known at compile time) and
+//! G = [C, C·diag(κ)] factored: G·Pβ: = C·R, R = Pc: + diag(κ)·Pg: (each gyro's two bias rows folded first).
+//!   X = A·Pθ: + C·R                      (3 rows: V = X(:, θ), U = X(:, β))
+//!   Pθθ ← V·Aᵀ + (Uc + Ug·diag(κ))·Cᵀ + Qθ, symmetrized;   Pθβ ← U·D;   Pββ ← D·Pββ·D
+//! R and X are formed transposed, as columns of P's length; P is read by columns (it is exactly symmetric:
+//! every update writes both triangles alike).
+template <int kN>
+void propagate_blocks(const CovarianceStep& s, int n_runtime, const Eigen::Matrix3d& A,
                       const Eigen::Matrix3d& q_theta) {
-  const Eigen::Index m = kM > 0 ? kM : m_runtime;
-  const Eigen::Index ld = 3 + m;
+  // Columns of P's length and of n as Eigen vectors of a size known at compile time: packed arithmetic.
+  constexpr int kColumn = state_dim(kN);
+  constexpr int kPerGyro = kN > 0 ? kN : Eigen::Dynamic;
+  using Column = Eigen::Matrix<double, kColumn, 1>;
+  using PerGyro = Eigen::Matrix<double, kPerGyro, 1>;
+  const int n = kN > 0 ? kN : n_runtime;
+  const Eigen::Index ld = 3 + 2 * n;
   double* P = s.P;
-  const double* c = s.coupling;
-  double* u = s.u;
-  // U = A·Pθβ + G·Pββ (3 rows of m), two columns at a time: their sums stay in registers over j.
-  for (Eigen::Index k = 0; k < m; k += 2) {
-    const double* p0 = P + (3 + k) * ld;
-    const Eigen::Vector3d a0 = A * Eigen::Map<const Eigen::Vector3d>(p0);
-    const Eigen::Vector3d a1 = A * Eigen::Map<const Eigen::Vector3d>(p0 + ld);
-    double u00 = a0.x(), u01 = a1.x(), u10 = a0.y(), u11 = a1.y(), u20 = a0.z(), u21 = a1.z();
-    for (Eigen::Index j = 0; j < m; ++j) {
-      const double* pb = P + (3 + j) * ld + 3 + k;  // Pββ(k, j), Pββ(k + 1, j) = Pββ(j, k), Pββ(j, k + 1)
-      const double* cj = c + 3 * j;
-      u00 += cj[0] * pb[0];
-      u01 += cj[0] * pb[1];
-      u10 += cj[1] * pb[0];
-      u11 += cj[1] * pb[1];
-      u20 += cj[2] * pb[0];
-      u21 += cj[2] * pb[1];
+  const double* C = s.coupling;
+  const double* kappa = s.kappa;
+  const auto column = [ld](double* p) { return Eigen::Map<Column>(p, ld); };
+  // Rᵀ (ld × n): column i = P(:, c_i) + κ_i·P(:, g_i).
+  for (int i = 0; i < n; ++i)
+    column(s.fold + i * ld) = column(P + (3 + i) * ld) + kappa[i] * column(P + (3 + n + i) * ld);
+  // Xᵀ (ld × 3): column a = P(:, θ)·A(a, :)ᵀ + Rᵀ·C(a, :)ᵀ.
+  const auto cross_column = [&](int a, auto& xa) {
+    xa = column(P) * A(a, 0) + column(P + ld) * A(a, 1) + column(P + 2 * ld) * A(a, 2);
+    for (int i = 0; i < n; ++i) xa += column(s.fold + i * ld) * C[3 * i + a];
+  };
+  for (int a = 0; a < 3; ++a) {
+    if constexpr (kN > 0) {  // summed in registers, stored once
+      Column xa;
+      cross_column(a, xa);
+      column(s.cross + a * ld) = xa;
+    } else {
+      auto xa = column(s.cross + a * ld);
+      cross_column(a, xa);
     }
-    u[k] = u00;
-    u[k + 1] = u01;
-    u[m + k] = u10;
-    u[m + k + 1] = u11;
-    u[2 * m + k] = u20;
-    u[2 * m + k + 1] = u21;
   }
-  // V = A·Pθθ + G·Pβθ; Pθθ ← V·Aᵀ + Qθ + U·Gᵀ, symmetrized.
-  Eigen::Matrix3d V =
-      A * Eigen::Map<const Eigen::Matrix3d, 0, Eigen::OuterStride<>>(P, Eigen::OuterStride<>(ld));
-  for (Eigen::Index j = 0; j < m; ++j) {
-    const double* ptb = P + (3 + j) * ld;  // Pθβ(:, j)
-    for (Eigen::Index b = 0; b < 3; ++b)
-      for (Eigen::Index r = 0; r < 3; ++r) V(r, b) += c[3 * j + r] * ptb[b];
-  }
-  Eigen::Matrix3d Ptt = V * A.transpose() + q_theta;
-  for (Eigen::Index j = 0; j < m; ++j) {
-    for (Eigen::Index b = 0; b < 3; ++b)
-      for (Eigen::Index r = 0; r < 3; ++r) Ptt(r, b) += u[r * m + j] * c[3 * j + b];
-  }
-  Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>>(P, Eigen::OuterStride<>(ld)) =
-      0.5 * (Ptt + Ptt.transpose());
-  // Pθβ ← U·D, Pββ ← D·Pββ·D (D diagonal: 1 for the slow biases, φ for the Gauss–Markov ones).
-  const double* d = s.decay;
-  for (Eigen::Index k = 0; k < m; ++k) {
-    double* col = P + (3 + k) * ld;
-    for (Eigen::Index r = 0; r < 3; ++r) {
-      const double v = u[r * m + k] * d[k];
-      col[r] = v;
-      P[r * ld + 3 + k] = v;
+  const double* X = s.cross;
+  // S = Uc + Ug·diag(κ) (3×n, into R's storage), then Pθθ ← V·Aᵀ + S·Cᵀ + Qθ, symmetrized.
+  double* S = s.fold;
+  for (int a = 0; a < 3; ++a)
+    for (int i = 0; i < n; ++i) S[a * n + i] = X[a * ld + 3 + i] + kappa[i] * X[a * ld + 3 + n + i];
+  Eigen::Matrix3d Ptt;
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) {
+      double v = X[a * ld] * A(b, 0) + X[a * ld + 1] * A(b, 1) + X[a * ld + 2] * A(b, 2);
+      for (int i = 0; i < n; ++i) v += S[a * n + i] * C[3 * i + b];
+      Ptt(a, b) = v + q_theta(a, b);
     }
-    for (Eigen::Index j = k; j < m; ++j) {
-      const double v = col[3 + j] * (d[j] * d[k]);
-      col[3 + j] = v;
-      P[(3 + j) * ld + 3 + k] = v;
+  }
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) P[b * ld + a] = 0.5 * (Ptt(a, b) + Ptt(b, a));
+  // Pθβ ← U·D (1 on the slow biases, d on the Gauss–Markov ones), both triangles.
+  for (int j = 0; j < 2 * n; ++j) {
+    const double d = j < n ? 1.0 : s.decay[j - n];
+    for (int a = 0; a < 3; ++a) {
+      const double v = X[a * ld + 3 + j] * d;
+      P[(3 + j) * ld + a] = v;
+      P[a * ld + 3 + j] = v;
     }
+  }
+  // Pββ ← D·Pββ·D: the slow block unchanged, the mixed ones by d, the Gauss–Markov block by d_j·d_k.
+  const Eigen::Map<const PerGyro> d(s.decay, n);
+  for (int k = 0; k < n; ++k) {
+    Eigen::Map<PerGyro> c_rows_g(P + (3 + k) * ld + 3 + n, n);  // column c_k, rows g
+    Eigen::Map<PerGyro> g_rows_c(P + (3 + n + k) * ld + 3, n);  // column g_k, rows c
+    Eigen::Map<PerGyro> g_rows_g(P + (3 + n + k) * ld + 3 + n, n);
+    c_rows_g.array() *= d.array();
+    g_rows_c *= d[k];
+    g_rows_g.array() *= Eigen::Map<const PerGyro>(s.decay2 + k * n, n).array();
   }
 }
-//! The Joseph update of P (`dim` square, column-major; `kDim` > 0: known at compile time) by a scalar
-//! measurement of innovation variance `s` with P·hᵀ = `ph`; `gain` receives K = P·hᵀ/s. Expanded:
-//! P − K(Ph)ᵀ − (Ph)Kᵀ + s·K·Kᵀ, symmetric term by term: the lower triangle computed column by column,
-//! mirrored.
+
+//! One scalar measurement of the biases, R = 1, h = `h[i]` on gyro i's c and g (0: not measured), over P
+//! (`dim` square, column-major, n gyros; `kDim` > 0: known at compile time). With the optimal gain K = P·hᵀ/s
+//! the Joseph form expands to P − (P·hᵀ)(P·hᵀ)ᵀ/s: applied as P − u·uᵀ, u = P·hᵀ/√s, so both triangles round
+//! alike (u_j·u_k = u_k·u_j). Each variance is kept at or above P_kk/s, the exact result's lower bound
+//! ((P·hᵀ)_k² ≤ P_kk·h·P·hᵀ for P ≥ 0), which rounding could otherwise cross. `ph` receives P·hᵀ (before the
+//! update), `u` is scratch; returns s = h·P·hᵀ + 1 (not finite or ≤ 0: P unchanged).
 template <int kDim>
-void joseph_scalar(double* P, const double* ph, double* gain, double s, Eigen::Index dim_runtime) {
+double scalar_downdate(double* P_data, const double* h, int n_runtime, Eigen::Index dim_runtime,
+                       double* ph_data, double* u_data) {
+  using Matrix = Eigen::Matrix<double, kDim, kDim>;
+  using Vector = Eigen::Matrix<double, kDim, 1>;
   const Eigen::Index dim = kDim > 0 ? kDim : dim_runtime;
-  for (Eigen::Index k = 0; k < dim; ++k) gain[k] = ph[k] / s;
+  const int n = kDim > 0 ? (kDim - 3) / 2 : n_runtime;
+  Eigen::Map<Matrix> P(P_data, dim, dim);
+  const auto sum_ph = [&](auto& ph) {
+    ph.setZero();
+    for (int i = 0; i < n; ++i) {
+      if (h[i] != 0.0) ph += h[i] * (P.col(3 + i) + P.col(3 + n + i));
+    }
+  };
+  if constexpr (kDim > 0) {  // summed in registers, stored once
+    Vector ph;
+    sum_ph(ph);
+    Eigen::Map<Vector>(ph_data, dim) = ph;
+  } else {
+    Eigen::Map<Vector> ph(ph_data, dim);
+    sum_ph(ph);
+  }
+  const Eigen::Map<const Vector> ph(ph_data, dim);
+  double s = 1.0;
+  for (int i = 0; i < n; ++i) s += h[i] * (ph[3 + i] + ph[3 + n + i]);
+  if (!(s > 0.0) || !std::isfinite(s)) return s;
+  Eigen::Map<Vector> u(u_data, dim);
+  u = ph * (1.0 / std::sqrt(s));
+  const double inv_s = 1.0 / s;
   for (Eigen::Index k = 0; k < dim; ++k) {
-    const double kk = gain[k];
-    const double phk = ph[k];
-    const double skk = s * kk;
-    double* col = P + k * dim;
-    for (Eigen::Index j = k; j < dim; ++j) col[j] = col[j] - kk * ph[j] - phk * gain[j] + skk * gain[j];
-    for (Eigen::Index j = k + 1; j < dim; ++j) P[j * dim + k] = col[j];
+    const double floor = P(k, k) * inv_s;
+    P.col(k) -= u * u[k];
+    P(k, k) = std::max(P(k, k), floor);
+  }
+  return s;
+}
+
+//! The Joseph update P ← (I − K·H)·P·(I − K·H)ᵀ + r·K·Kᵀ for H = [I₃ 0] (P `dim` square and T its scratch,
+//! K dim×3, column-major; `kDim` > 0: known at compile time), column by column: T = (I − K·H)·P =
+//! P − K·P(θ, :), then P(:, k) ← T(:, k) + (r·K − T(:, θ))·K(k, :)ᵀ; symmetrized (each pair averaged).
+template <int kDim>
+void joseph_reference(double* P_data, double* T_data, const double* K_data, double r,
+                      Eigen::Index dim_runtime) {
+  using Matrix = Eigen::Matrix<double, kDim, kDim>;
+  using Gain = Eigen::Matrix<double, kDim, 3>;
+  const Eigen::Index dim = kDim > 0 ? kDim : dim_runtime;
+  Eigen::Map<Matrix> P(P_data, dim, dim);
+  Eigen::Map<Matrix> T(T_data, dim, dim);
+  const Eigen::Map<const Gain> K(K_data, dim, 3);
+  for (Eigen::Index k = 0; k < dim; ++k)
+    T.col(k) = P.col(k) - K.col(0) * P(0, k) - K.col(1) * P(1, k) - K.col(2) * P(2, k);
+  // M = r·K − T(:, θ), kept in P's first three columns (T holds what they were).
+  for (Eigen::Index a = 0; a < 3; ++a) P.col(a) = r * K.col(a) - T.col(a);
+  for (Eigen::Index k = 3; k < dim; ++k)
+    P.col(k) = T.col(k) + P.col(0) * K(k, 0) + P.col(1) * K(k, 1) + P.col(2) * K(k, 2);
+  for (Eigen::Index k = 0; k < 3; ++k)  // the first three columns last: M is read above
+    T.col(k) += P.col(0) * K(k, 0) + P.col(1) * K(k, 1) + P.col(2) * K(k, 2);
+  P.leftCols(3) = T.leftCols(3);
+  for (Eigen::Index k = 0; k < dim; ++k) {
+    for (Eigen::Index j = k + 1; j < dim; ++j) {
+      const double v = 0.5 * (P(j, k) + P(k, j));
+      P(j, k) = v;
+      P(k, j) = v;
+    }
   }
 }
 }  // namespace
 
 Eigen::Matrix3d rotation_integral(const Eigen::Vector3d& omega_rad_s, double dt_s) {
-  // ∫₀^Δt exp(−W u) du = I·Δt − (1 − cos θ)/|ω|²·W + (θ − sin θ)/|ω|³·W², θ = |ω|Δt, W = [ω×].
-  const Eigen::Matrix3d W = cross_matrix(omega_rad_s);
-  const double w = omega_rad_s.norm();
+  // ∫₀^Δt exp(−W u) du = I·Δt − (1 − cos θ)/|ω|²·W + (θ − sin θ)/|ω|³·W², θ = |ω|Δt, W = [ω×];
+  // W² = ω·ωᵀ − |ω|²·I.
+  const double w2 = omega_rad_s.squaredNorm();
+  const double w = std::sqrt(w2);
   const double th = w * dt_s;
   double a = 0.0;  // (1 − cos θ)/|ω|²
   double b = 0.0;  // (θ − sin θ)/|ω|³
@@ -121,10 +209,19 @@ Eigen::Matrix3d rotation_integral(const Eigen::Vector3d& omega_rad_s, double dt_
     a = dt2 * (0.5 - th * th / 24.0);
     b = dt2 * dt_s * (1.0 / 6.0 - th * th / 120.0);
   } else {
-    a = (1.0 - std::cos(th)) / (w * w);
-    b = (th - std::sin(th)) / (w * w * w);
+    a = (1.0 - std::cos(th)) / w2;
+    b = (th - std::sin(th)) / (w2 * w);
   }
-  return Eigen::Matrix3d::Identity() * dt_s - a * W + b * W * W;
+  Eigen::Matrix3d gamma = (b * omega_rad_s) * omega_rad_s.transpose();
+  gamma.diagonal().array() += dt_s - b * w2;
+  const Eigen::Vector3d aw = a * omega_rad_s;  // −a·W off the diagonal
+  gamma(0, 1) += aw.z();
+  gamma(1, 0) -= aw.z();
+  gamma(0, 2) -= aw.y();
+  gamma(2, 0) += aw.y();
+  gamma(1, 2) += aw.x();
+  gamma(2, 1) -= aw.x();
+  return gamma;
 }
 
 Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
@@ -133,16 +230,23 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       dim_(3 + 2 * static_cast<Eigen::Index>(gyros_.size())),
       P_(Eigen::MatrixXd::Zero(dim_, dim_)),
       bias_(Eigen::VectorXd::Zero(dim_ - 3)),
-      decay_(Eigen::VectorXd::Ones(dim_ - 3)),
-      coupling_(Eigen::Matrix3Xd::Zero(3, dim_ - 3)),
-      cross_rows_(Eigen::VectorXd::Zero(3 * (dim_ - 3))),
+      decay_(Eigen::VectorXd::Ones(n_)),
+      decay2_(Eigen::MatrixXd::Ones(n_, n_)),
+      bias_noise_(Eigen::VectorXd::Zero(2 * n_)),
+      coupling_(Eigen::Matrix3Xd::Zero(3, n_)),
+      fold_(Eigen::VectorXd::Zero(dim_ * n_)),
+      cross_(Eigen::VectorXd::Zero(dim_ * 3)),
       joseph_(Eigen::MatrixXd::Zero(dim_, dim_)),
       gain_(Eigen::MatrixX3d::Zero(dim_, 3)),
       ph_(Eigen::VectorXd::Zero(dim_)),
+      parity_h_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(gyros_.size()))),
       prior_var_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(gyros_.size()))),
       frozen_(gyros_.size(), 0) {
   gm_phi_.assign(gyros_.size(), 1.0);  // sized once here: computing them never allocates
   gm_kappa_.assign(gyros_.size(), 1.0);
+  rrw_var_.assign(gyros_.size(), 0.0);
+  gm_var_.assign(gyros_.size(), 0.0);
+  step_pinv_ = Eigen::Matrix3Xd::Zero(3, n_);
   reset(0.0);
 }
 
@@ -153,6 +257,7 @@ void Mekf::reset(double attitude_sigma_rad) {
     frozen_[static_cast<std::size_t>(i)] = 0;
     set_prior(i);
   }
+  frozen_mask_ = 0;
   P_.topLeftCorner<3, 3>().diagonal().setConstant(attitude_sigma_rad * attitude_sigma_rad);
 }
 
@@ -187,11 +292,13 @@ void Mekf::freeze(int id) {
   if (id < 1 || id > n_) return;
   decorrelate(id - 1);
   frozen_[index(id)] = 1;
+  frozen_mask_ |= GyroMask{1} << static_cast<unsigned>(id - 1);
 }
 
 void Mekf::thaw(int id) {
   if (id < 1 || id > n_) return;
   frozen_[index(id)] = 0;
+  frozen_mask_ = without_gyro(frozen_mask_, id);
   set_prior(id - 1);
 }
 
@@ -216,53 +323,48 @@ void Mekf::propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, G
   // G = −Γ·H*·(bias states), Γ = ∫ A(u) du; D the bias models' own transitions.
   const Eigen::Matrix3d A = rotation.toRotationMatrix().transpose();
   const Eigen::Matrix3d gamma = rotation_integral(omega_B_rad_s, dt_s);
-  Eigen::Matrix3d q_theta = Eigen::Matrix3d::Zero();
-  if (dt_s != gm_dt_s_) gauss_markov_transitions(dt_s);
+  const GyroMask used = mask & ~frozen_mask_;
+  refresh_step_constants(pinv, used, dt_s);
   for (int i = 0; i < n_; ++i) {
-    const auto& g = gyros_[static_cast<std::size_t>(i)];
-    const bool frozen = frozen_[static_cast<std::size_t>(i)] != 0;
-    const bool used = has_gyro(mask, i + 1) && !frozen;
-    const double phi = gm_phi_[static_cast<std::size_t>(i)];
-    const double kappa = gm_kappa_[static_cast<std::size_t>(i)];
-    const Eigen::Vector3d col = used ? Eigen::Vector3d(-gamma * pinv.col(i)) : Eigen::Vector3d::Zero();
-    coupling_.col(i) = col;
-    coupling_.col(n_ + i) = col * kappa;
-    decay_[i] = 1.0;
-    decay_[n_ + i] = frozen ? 1.0 : phi;
-    if (used) q_theta += pinv.col(i) * pinv.col(i).transpose() * (g.arw_rad_rts * g.arw_rad_rts * dt_s);
+    if (has_gyro(used, i + 1))
+      coupling_.col(i).noalias() = -gamma * pinv.col(i);
+    else
+      coupling_.col(i).setZero();
   }
-  propagate_covariance(A, q_theta);
-  for (int i = 0; i < n_; ++i) {
-    if (frozen_[static_cast<std::size_t>(i)] != 0) continue;
-    const auto& g = gyros_[static_cast<std::size_t>(i)];
-    P_(c_of(i), c_of(i)) += g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
-    prior_var_[i] += g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
-    const double phi = decay_[n_ + i];
-    P_(g_of(i), g_of(i)) += g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - phi * phi);
-    bias_[n_ + i] *= phi;
-  }
+  propagate_covariance(A, q_theta_);
+  P_.diagonal().tail(2 * n_) += bias_noise_;  // zero on a frozen gyro's states
+  prior_var_ += bias_noise_.head(n_);
+  bias_.tail(n_).array() *= decay_.array();  // 1 on a frozen gyro
   // Symmetric by construction but for the attitude block (symmetrized above).
 }
 
-void Mekf::propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta) {
-  const CovarianceStep step{P_.data(), coupling_.data(), decay_.data(), cross_rows_.data()};
-  switch (n_) {  // the common sizes with their loop bounds known to the compiler (unrolled, vectorized)
-    case 3:
-      propagate_blocks<6>(step, 6, A, q_theta);
-      break;
-    case 4:
-      propagate_blocks<8>(step, 8, A, q_theta);
-      break;
-    case 5:
-      propagate_blocks<10>(step, 10, A, q_theta);
-      break;
-    case 6:
-      propagate_blocks<12>(step, 12, A, q_theta);
-      break;
-    default:
-      propagate_blocks<0>(step, dim_ - 3, A, q_theta);
-      break;
+void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, double dt_s) {
+  if (dt_s != gm_dt_s_) gauss_markov_transitions(dt_s);
+  if (dt_s == step_dt_s_ && used == step_used_ && frozen_mask_ == step_frozen_ && pinv.cols() == n_ &&
+      (pinv.array() == step_pinv_.array()).all())
+    return;
+  q_theta_.setZero();
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const bool frozen = frozen_[k] != 0;
+    decay_[i] = frozen ? 1.0 : gm_phi_[k];
+    bias_noise_[i] = frozen ? 0.0 : rrw_var_[k];
+    bias_noise_[n_ + i] = frozen ? 0.0 : gm_var_[k];
+    const auto& g = gyros_[k];
+    if (has_gyro(used, i + 1))
+      q_theta_ += pinv.col(i) * pinv.col(i).transpose() * (g.arw_rad_rts * g.arw_rad_rts * dt_s);
   }
+  decay2_.noalias() = decay_ * decay_.transpose();  // d_j·d_k = d_k·d_j: the block stays exactly symmetric
+  if (pinv.cols() == n_) step_pinv_ = pinv;         // sized at creation: no allocation
+  step_used_ = used;
+  step_frozen_ = frozen_mask_;
+  step_dt_s_ = dt_s;
+}
+
+void Mekf::propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta) {
+  const CovarianceStep step{P_.data(),      coupling_.data(), gm_kappa_.data(), decay_.data(),
+                            decay2_.data(), fold_.data(),     cross_.data()};
+  with_gyro_count(n_, [&](auto k) { propagate_blocks<decltype(k)::value>(step, n_, A, q_theta); });
 }
 
 void Mekf::gauss_markov_transitions(double dt_s) {
@@ -272,6 +374,8 @@ void Mekf::gauss_markov_transitions(double dt_s) {
     // The Gauss–Markov bias decays within the step: its mean over the step is κ·g, κ = T_c(1 − φ)/Δt.
     gm_kappa_[i] =
         g.gm_sigma_rad_s > 0.0 ? g.gm_correlation_s * -std::expm1(-dt_s / g.gm_correlation_s) / dt_s : 1.0;
+    rrw_var_[i] = g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
+    gm_var_[i] = g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - gm_phi_[i] * gm_phi_[i]);
   }
   gm_dt_s_ = dt_s;
 }
@@ -291,80 +395,41 @@ ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quatern
   out.chi2 = out.innovation_rad.dot(llt.solve(out.innovation_rad));
   if (!(out.chi2 <= gate_chi2)) return out;
   out.accepted = true;
-  // K = P·Hᵀ·S⁻¹ with H = [I₃ 0].
-  for (Eigen::Index k = 0; k < dim_; ++k)
-    gain_.row(k) = llt.solve(P_.block<1, 3>(k, 0).transpose()).transpose();
-  const Eigen::VectorXd::Index m = dim_ - 3;
-  for (Eigen::Index k = 0; k < m; ++k) {
-    int i = static_cast<int>(k % n_);
-    if (frozen_[static_cast<std::size_t>(i)] != 0) gain_.row(3 + k).setZero();
+  // K = P·Hᵀ·S⁻¹ with H = [I₃ 0]; no gain on a frozen gyro's states.
+  const Eigen::Matrix3d S_inv = S.inverse();  // positive definite (the factorization above succeeded)
+  gain_.noalias() = P_.leftCols<3>() * S_inv;
+  for (int i = 0; i < n_; ++i) {
+    if (frozen_[static_cast<std::size_t>(i)] == 0) continue;
+    gain_.row(c_of(i)).setZero();
+    gain_.row(g_of(i)).setZero();
   }
   out.correction_rad = gain_.topRows<3>() * out.innovation_rad;
-  for (Eigen::Index k = 0; k < m; ++k) bias_[k] += gain_.row(3 + k).dot(out.innovation_rad);
-  // Joseph form: P ← (I − KH)·P·(I − KH)ᵀ + K·R·Kᵀ; (I − KH) differs from I in its first three columns only.
-  joseph_ = P_;
-  for (Eigen::Index k = 0; k < dim_; ++k)  // T = (I − KH)·P
-    joseph_.col(k).noalias() -= gain_ * P_.block<3, 1>(0, k);
-  // P = T·(I − KH)ᵀ + r·K·Kᵀ, symmetrized: each pair (k, j) and (j, k) at once, the r·K·Kᵀ term shared.
-  for (Eigen::Index k = 0; k < dim_; ++k) {
-    const Eigen::Vector3d tk = joseph_.block<1, 3>(k, 0).transpose();
-    P_(k, k) = joseph_(k, k) - gain_.row(k).dot(tk) + r * gain_.row(k).dot(gain_.row(k));
-    for (Eigen::Index j = k + 1; j < dim_; ++j) {
-      const Eigen::Vector3d tj = joseph_.block<1, 3>(j, 0).transpose();
-      const double rkk = r * gain_.row(k).dot(gain_.row(j));
-      const double pkj = joseph_(k, j) - gain_.row(j).dot(tk) + rkk;
-      const double pjk = joseph_(j, k) - gain_.row(k).dot(tj) + rkk;
-      const double v = 0.5 * (pkj + pjk);
-      P_(k, j) = v;
-      P_(j, k) = v;
-    }
-  }
+  for (Eigen::Index k = 3; k < dim_; ++k) bias_[k - 3] += gain_.row(k).dot(out.innovation_rad);
+  with_gyro_count(n_, [&](auto k) {
+    joseph_reference<state_dim(decltype(k)::value)>(P_.data(), joseph_.data(), gain_.data(), r, dim_);
+  });
   return out;
 }
 
 Eigen::Vector3d Mekf::update_parity(const Eigen::MatrixXd& W, int d, GyroMask mask, double scale,
                                     const double* p) {
   Eigen::Vector3d correction = Eigen::Vector3d::Zero();
-  const Eigen::Index ld = dim_;
-  double* P = P_.data();
+  const GyroMask used = mask & ~frozen_mask_;
+  double* h = parity_h_.data();
   double* ph = ph_.data();
-  double* gain = gain_.data();  // its first column: K = P·hᵀ/s of the row (scratch)
+  double* u = gain_.data();  // its first column (scratch)
   for (int r = 0; r < d; ++r) {
     // h: ∂p_r/∂(c_i, g_i) = scale·W(r, i) for the gyros of the mask; R = 1.
     double predicted = 0.0;
-    std::fill(ph, ph + dim_, 0.0);
     for (int i = 0; i < n_; ++i) {
-      if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
-      const double h = scale * W(r, i);
-      predicted += h * (bias_[i] + bias_[n_ + i]);
-      const double* pc = P + c_of(i) * ld;
-      const double* pg = P + g_of(i) * ld;
-      for (Eigen::Index k = 0; k < dim_; ++k) ph[k] += h * (pc[k] + pg[k]);
+      h[i] = has_gyro(used, i + 1) ? scale * W(r, i) : 0.0;
+      predicted += h[i] * (bias_[i] + bias_[n_ + i]);
     }
-    double s = 1.0;
-    for (int i = 0; i < n_; ++i) {
-      if (!has_gyro(mask, i + 1) || frozen_[static_cast<std::size_t>(i)] != 0) continue;
-      s += scale * W(r, i) * (ph[c_of(i)] + ph[g_of(i)]);
-    }
-    const double nu = p[r] - predicted;
-    switch (dim_) {  // the common sizes with their loop bounds known to the compiler
-      case 9:
-        joseph_scalar<9>(P, ph, gain, s, 9);
-        break;
-      case 11:
-        joseph_scalar<11>(P, ph, gain, s, 11);
-        break;
-      case 13:
-        joseph_scalar<13>(P, ph, gain, s, 13);
-        break;
-      case 15:
-        joseph_scalar<15>(P, ph, gain, s, 15);
-        break;
-      default:
-        joseph_scalar<0>(P, ph, gain, s, dim_);
-        break;
-    }
-    const double gain_nu = nu / s;
+    const double s = with_gyro_count(n_, [&](auto k) {
+      return scalar_downdate<state_dim(decltype(k)::value)>(P_.data(), h, n_, dim_, ph, u);
+    });
+    if (!(s > 0.0) || !std::isfinite(s)) continue;
+    const double gain_nu = (p[r] - predicted) / s;
     for (Eigen::Index k = 0; k < 3; ++k) correction[k] += ph[k] * gain_nu;
     for (Eigen::Index k = 3; k < dim_; ++k) bias_[k - 3] += ph[k] * gain_nu;
   }

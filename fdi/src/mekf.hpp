@@ -72,7 +72,8 @@ class Mekf {
 
   //! The epoch's normalized parity `p` (d rows, p = scale·W·y ~ N(0, I) without fault; W d×N over the gyros
   //! of `mask`) as a measurement of the biases: with the reference it makes each gyro's bias observable.
-  //! Sequential scalar updates, Joseph form; returns the attitude correction δθ̂ to apply (q̂ ← q̂ ⊗ exp(δθ̂)).
+  //! Sequential scalar updates (the Joseph form with the optimal gain, expanded: P − P·hᵀ·h·P/s); returns the
+  //! attitude correction δθ̂ to apply (q̂ ← q̂ ⊗ exp(δθ̂)).
   Eigen::Vector3d update_parity(const Eigen::MatrixXd& W, int d, GyroMask mask, double scale,
                                 const double* p);
 
@@ -96,6 +97,8 @@ class Mekf {
   double bias_rad_s(int id) const;
   double bias_sigma_rad_s(int id) const;
   int gyro_count() const { return n_; }
+  //! The covariance (3 + 2N square: δθ, then c_1..c_N, then g_1..g_N).
+  const Eigen::MatrixXd& covariance() const { return P_; }
 
  private:
   static std::size_t index(int id) { return static_cast<std::size_t>(id - 1); }
@@ -104,25 +107,43 @@ class Mekf {
   void decorrelate(int i);
   void set_prior(int i);
   void gauss_markov_transitions(double dt_s);
+  void refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, double dt_s);
   void propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta);
 
   std::vector<GyroNoiseModel> gyros_;
   int n_;
-  Eigen::Index dim_;       //!< 3 + 2N
-  Eigen::MatrixXd P_;      //!< covariance
-  Eigen::VectorXd bias_;   //!< [rad/s] ĉ (0..N−1) then ĝ (N..2N−1)
-  Eigen::VectorXd decay_;  //!< per bias state, the last step's transition (scratch)
+  Eigen::Index dim_;      //!< 3 + 2N
+  Eigen::MatrixXd P_;     //!< covariance
+  Eigen::VectorXd bias_;  //!< [rad/s] ĉ (0..N−1) then ĝ (N..2N−1)
   //! Per gyro, the Gauss–Markov transition φ = e^(−Δt/T_c) and step mean κ = T_c(1 − φ)/Δt, computed for
   //! `gm_dt_s_` only (the step is nearly always the same: no exp per gyro per step).
   std::vector<double> gm_phi_;
   std::vector<double> gm_kappa_;
+  std::vector<double> rrw_var_;  //!< [rad²/s²] per gyro: K²·Δt, the slow bias's variance gain over a step
+  std::vector<double> gm_var_;  //!< [rad²/s²] per gyro: σ_GM²(1 − φ²), the Gauss–Markov's over a step
   double gm_dt_s_ = -1.0;
-  Eigen::Matrix3Xd coupling_;   //!< 3×2N: ∂δθ/∂bias over the step (scratch)
-  Eigen::VectorXd cross_rows_;  //!< 3×2N row-major: U = A·Pθβ + G·Pββ (scratch)
-  Eigen::MatrixXd joseph_;      //!< (3+2N)² scratch of the Joseph update
-  Eigen::MatrixX3d gain_;       //!< (3+2N)×3 Kalman gain
-  Eigen::VectorXd ph_;          //!< (3+2N) P·hᵀ of a scalar update (scratch)
-  Eigen::VectorXd prior_var_;   //!< [rad²/s²] per gyro: the variance of c + g without any measurement
+  //! What a step keeps while the gyro set, the frozen set, the rate solution and Δt stay the same (nearly
+  //! always), recomputed when the key (`step_pinv_`, `step_used_`, `step_frozen_`, `step_dt_s_`) changes:
+  //! the attitude's process noise Qθ = H*·diag(N²)·H*ᵀ·Δt; D on the Gauss–Markov states, d per gyro
+  //! (`decay_`, 1 when frozen) and d_j·d_k (`decay2_`, N×N); the bias states' variance gain over the step
+  //! (`bias_noise_` [rad²/s²], c then g, 0 when frozen).
+  Eigen::VectorXd decay_;
+  Eigen::MatrixXd decay2_;
+  Eigen::VectorXd bias_noise_;
+  Eigen::Matrix3d q_theta_ = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3Xd step_pinv_;
+  GyroMask step_used_ = 0;
+  GyroMask step_frozen_ = 0;
+  double step_dt_s_ = -1.0;
+  GyroMask frozen_mask_ = 0;  //!< the frozen gyros (bit i − 1: gyro i), as `frozen_`
+  Eigen::Matrix3Xd coupling_;  //!< 3×N: C = −Γ·H*, ∂δθ/∂c_i over the step (on g_i: κ_i·C) (scratch)
+  Eigen::VectorXd fold_;       //!< (3+2N)×N: Rᵀ of the propagation (scratch)
+  Eigen::VectorXd cross_;      //!< (3+2N)×3: Xᵀ of the propagation (scratch)
+  Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
+  Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
+  Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
+  Eigen::VectorXd parity_h_;   //!< N: a parity row's h per gyro (scratch)
+  Eigen::VectorXd prior_var_;  //!< [rad²/s²] per gyro: the variance of c + g without any measurement
   std::vector<unsigned char> frozen_;
 };
 
