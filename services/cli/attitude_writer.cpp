@@ -11,7 +11,12 @@ constexpr std::size_t kWriteBytes = std::size_t{1} << 20;  // formatted text wri
 }  // namespace
 
 AttitudeWriter::AttitudeWriter(OutputFile& out, int n_gyros, std::string preamble)
-    : out_(out), n_gyros_(n_gyros), text_(std::move(preamble)), worker_([this] { run(); }) {
+    : out_(out),
+      n_gyros_(n_gyros),
+      preamble_(std::move(preamble)),
+      text_(kWriteBytes + attitude_row_max_bytes(n_gyros), '\0'),
+      cells_(n_gyros),
+      worker_([this] { run(); }) {
   filling_.rows.reserve(kBatchRows);
 }
 
@@ -70,18 +75,33 @@ Status AttitudeWriter::finish() {
   return error();
 }
 
+// Rows are formatted straight into text_ (room for one more row past kWriteBytes), written out in
+// pieces of about kWriteBytes.
 Status AttitudeWriter::write_batch(const Batch& batch) {
   for (std::size_t i = 0; i < batch.used; ++i) {
     const Row& row = batch.rows[i];
-    append_attitude_row(text_, row.time_s, row.attitude, n_gyros_);
-    if (text_.size() < kWriteBytes) continue;
-    if (Status s = out_.write(text_); !s) return s;
-    text_.clear();
+    char* end = format_attitude_row(text_.data() + text_used_, row.time_s, row.attitude, n_gyros_,
+                                    cells_.cell(row.attitude.gyros));
+    text_used_ = static_cast<std::size_t>(end - text_.data());
+    if (text_used_ < kWriteBytes) continue;
+    if (Status s = write_text(); !s) return s;
   }
   return ok_status();
 }
 
+Status AttitudeWriter::write_text() {
+  const Status s = out_.write(std::string_view(text_.data(), text_used_));
+  text_used_ = 0;
+  return s;
+}
+
 void AttitudeWriter::run() {
+  if (Status s = out_.write(preamble_); !s) {
+    const std::lock_guard lock(mutex_);
+    status_ = s;
+    changed_.notify_all();
+    return;
+  }
   while (true) {
     Batch batch;
     {
@@ -107,11 +127,10 @@ void AttitudeWriter::run() {
       return;
     }
   }
-  if (Status s = out_.write(text_); !s) {
+  if (Status s = write_text(); !s) {
     const std::lock_guard lock(mutex_);
     status_ = s;
   }
-  text_.clear();
 }
 
 }  // namespace tetra::cli

@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "attitude_csv.hpp"
 #include "tetra/core/output_files.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/types.hpp"
@@ -51,11 +52,15 @@ class AttitudeWriter {
   Status error() const;
   void run();
   Status write_batch(const Batch& batch);
+  Status write_text();
 
   OutputFile& out_;
   const int n_gyros_;
-  std::string text_;  // worker: formatted rows not yet written
-  Batch filling_;     // caller: the batch being filled
+  std::string preamble_;       // worker: written first
+  std::string text_;           // worker: formatted rows not yet written, text_used_ bytes of it
+  std::size_t text_used_ = 0;  // (its size is fixed: one row's room past kWriteBytes)
+  GyrosCellCache cells_;       // worker
+  Batch filling_;              // caller: the batch being filled
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Batch> queue_;
