@@ -37,8 +37,8 @@ std::size_t attitude_row_max_bytes(int n_gyros) {
   return numbers * (kMaxDoubleChars + 1) + longest_mode_chars() + 1 + gyros_cell_chars + 1;
 }
 
-char* format_attitude_row(char* out, double time_s, const fdi::AttitudeEstimate& attitude, int n_gyros,
-                          std::string_view gyros) {
+char* format_attitude_row(char* out, double time_s, const fdi::AttitudeEstimate& attitude,
+                          std::span<const double> bias_rad_s, int n_gyros, std::string_view gyros) {
   char* p = format_double(out, time_s);
   for (const double c : to_wxyz(attitude.q_RB)) p = put_double(p, c);
   for (int i = 0; i < 3; ++i) p = put_double(p, attitude.omega_BR_B_rad_s[i] * kRadToDeg);
@@ -48,10 +48,10 @@ char* format_attitude_row(char* out, double time_s, const fdi::AttitudeEstimate&
   *p++ = ',';
   p = put(p, gyros);
   for (int i = 0; i < 3; ++i) p = put_double(p, attitude.sigma_rad[i] * kRadToDeg);
-  const bool biases = static_cast<int>(attitude.gyro_bias_rad_s.size()) == n_gyros;
+  const bool biases = static_cast<int>(bias_rad_s.size()) == n_gyros;
   for (int i = 0; i < n_gyros; ++i) {
     if (biases) {
-      p = put_double(p, attitude.gyro_bias_rad_s[static_cast<std::size_t>(i)] * kRadToDeg);
+      p = put_double(p, bias_rad_s[static_cast<std::size_t>(i)] * kRadToDeg);
     } else {
       p = put(p, ",nan");
     }
@@ -65,7 +65,8 @@ void append_attitude_row(std::string& out, double time_s, const fdi::AttitudeEst
   const std::size_t start = out.size();
   out.resize(start + attitude_row_max_bytes(n_gyros));
   const std::string cell = gyros_cell(attitude.gyros, n_gyros);
-  char* end = format_attitude_row(out.data() + start, time_s, attitude, n_gyros, cell);
+  char* end =
+      format_attitude_row(out.data() + start, time_s, attitude, attitude.gyro_bias_rad_s, n_gyros, cell);
   out.resize(static_cast<std::size_t>(end - out.data()));
 }
 

@@ -5,6 +5,7 @@
 // estimate).
 
 #include <cstddef>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -28,11 +29,12 @@ void append_attitude_row(std::string& out, double time_s, const fdi::AttitudeEst
 
 //! The most bytes one row of `n_gyros` gyros takes (newline included).
 std::size_t attitude_row_max_bytes(int n_gyros);
-//! The row append_attitude_row appends, written at `out` (room for attitude_row_max_bytes) with `gyros`
-//! (gyros_cell of the estimate's mask) as its gyros cell; returns the row's end. For a writer that
-//! formats rows straight into a buffer of its own.
-char* format_attitude_row(char* out, double time_s, const fdi::AttitudeEstimate& attitude, int n_gyros,
-                          std::string_view gyros);
+//! The row append_attitude_row appends, written at `out` (room for attitude_row_max_bytes), with
+//! `bias_rad_s` for the estimate's biases (written nan unless it holds N) and `gyros` (gyros_cell of the
+//! estimate's mask) as its gyros cell; returns the row's end. For a writer that formats rows straight
+//! into a buffer of its own.
+char* format_attitude_row(char* out, double time_s, const fdi::AttitudeEstimate& attitude,
+                          std::span<const double> bias_rad_s, int n_gyros, std::string_view gyros);
 
 //! gyros_cell of the last mask asked for, made again only when the mask changes (it seldom does).
 class GyrosCellCache {

@@ -1,5 +1,7 @@
 #include "attitude_writer.hpp"
 
+#include <algorithm>
+#include <span>
 #include <utility>
 
 #include "attitude_csv.hpp"
@@ -35,11 +37,26 @@ Status AttitudeWriter::error() const {
   return status_;
 }
 
+// The estimate's fields are copied into the batch's storage; its bias vector goes into the batch's flat
+// `biases` (N per row), so a row costs no allocation and no vector assignment.
 Status AttitudeWriter::add(double time_s, const fdi::AttitudeEstimate& attitude) {
-  if (filling_.used == filling_.rows.size()) filling_.rows.emplace_back();
-  Row& row = filling_.rows[filling_.used++];
+  if (filling_.used == filling_.rows.size()) {
+    filling_.rows.emplace_back();
+    filling_.biases.resize(filling_.rows.size() * static_cast<std::size_t>(n_gyros_));
+  }
+  const std::size_t k = filling_.used++;
+  Row& row = filling_.rows[k];
   row.time_s = time_s;
-  row.attitude = attitude;
+  row.attitude.q_RB = attitude.q_RB;
+  row.attitude.omega_BR_B_rad_s = attitude.omega_BR_B_rad_s;
+  row.attitude.sigma_rad = attitude.sigma_rad;
+  row.attitude.mode = attitude.mode;
+  row.attitude.gyros = attitude.gyros;
+  row.has_biases = static_cast<int>(attitude.gyro_bias_rad_s.size()) == n_gyros_;
+  if (row.has_biases) {
+    std::copy(attitude.gyro_bias_rad_s.begin(), attitude.gyro_bias_rad_s.end(),
+              filling_.biases.begin() + static_cast<std::ptrdiff_t>(k * static_cast<std::size_t>(n_gyros_)));
+  }
   if (filling_.used < kBatchRows) return ok_status();
   return hand_over();
 }
@@ -80,7 +97,10 @@ Status AttitudeWriter::finish() {
 Status AttitudeWriter::write_batch(const Batch& batch) {
   for (std::size_t i = 0; i < batch.used; ++i) {
     const Row& row = batch.rows[i];
-    char* end = format_attitude_row(text_.data() + text_used_, row.time_s, row.attitude, n_gyros_,
+    const auto n = static_cast<std::size_t>(n_gyros_);
+    const std::span<const double> biases =
+        row.has_biases ? std::span<const double>(batch.biases).subspan(i * n, n) : std::span<const double>();
+    char* end = format_attitude_row(text_.data() + text_used_, row.time_s, row.attitude, biases, n_gyros_,
                                     cells_.cell(row.attitude.gyros));
     text_used_ = static_cast<std::size_t>(end - text_.data());
     if (text_used_ < kWriteBytes) continue;

@@ -22,7 +22,7 @@ namespace tetra::cli {
 class AttitudeWriter {
  public:
   static constexpr std::size_t kBatchRows = 4096;
-  static constexpr std::size_t kDepth = 2;
+  static constexpr std::size_t kDepth = 4;
 
   //! Writes `preamble` (comment lines and the header) first, then the rows as they come.
   AttitudeWriter(OutputFile& out, int n_gyros, std::string preamble);
@@ -39,12 +39,14 @@ class AttitudeWriter {
  private:
   struct Row {
     double time_s = 0.0;
-    fdi::AttitudeEstimate attitude;
+    fdi::AttitudeEstimate attitude;  // its bias vector stays empty: the biases are the batch's
+    bool has_biases = false;         // the estimate carried N biases (else they are written nan)
   };
-  // Rows are assigned in place (rows[used] = ...), never pushed: a refilled batch reuses each row's
-  // storage (the bias vector), so a batch costs no allocation after its first use.
+  // Rows are assigned in place (rows[used] = ...), never pushed, and row k's biases are biases[k*N ..
+  // k*N+N): a refilled batch reuses its storage, so a batch costs no allocation after its first use.
   struct Batch {
     std::vector<Row> rows;
+    std::vector<double> biases;
     std::size_t used = 0;
   };
 
