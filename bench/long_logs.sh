@@ -84,6 +84,9 @@ for m in $REPLAY_MINUTES; do
   read_rows "$work/orbit_$m.h5" h5
   read_rows "$work/orbit_$m.h5z.h5" h5z
   for f in csv h5; do
+    # Every replay row starts alike: the previous row's outputs deleted just before (their page-cache
+    # pages free for this run's outputs; docs/formats.md, "Replay throughput", on fresh pages).
+    rm -f "$work/att.csv" "$work/ev.jsonl"
     row replay "$f" "$n" -- "$T" replay "$work/orbit_$m.$f" --calibration "$work/cal.yaml" \
       --attitude "$work/att.csv" --events "$work/ev.jsonl"
   done

@@ -5,7 +5,11 @@
 # prints the wall seconds, epochs per second, CPU seconds (user + system, all threads) and the load
 # average beside it (the machine's other work makes wall times longer: compare at the same load).
 # Every run writes the same output paths, replacing the previous run's files, as a user re-running a
-# replay does; the first run of each format is a warm-up and is not counted.
+# replay does; the first run of each format is a warm-up and is not counted. The row "FMT-new" is one
+# more run into a new output path after COLD_S seconds idle: on a virtual machine that hands free memory
+# back to its host, page-cache pages taken fresh cost several times those the last run just freed
+# (766 MB written with dd: ~2 s of system time fresh, ~0.2 s right after deleting a file as large), so a
+# first run into a new path can cost more system time than the repeated runs.
 # usage: bench/replay_throughput.sh [BUILD_DIR=build]   (MINUTES=360 RUNS=3; ~1.2 GB of /tmp)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,6 +17,7 @@ build=${1:-build}
 T="$build/tetra"
 MINUTES=${MINUTES:-360}
 RUNS=${RUNS:-3}
+COLD_S=${COLD_S:-20}
 work=$(mktemp -d /tmp/tetra-replay-throughput-XXXXXX)
 trap 'rm -rf "$work"' EXIT
 
@@ -30,9 +35,10 @@ YAML
 epochs=$(grep -vc '^#' "$work/orbit.csv" | awk '{ print $1 - 1 }')
 
 load() { cut -d' ' -f1 /proc/loadavg; }
-run() {  # FORMAT: one timed replay; prints "wall cpu load"
+run() {  # FORMAT [OUTPUT_STEM]: one timed replay; prints "wall cpu load"
+  local stem=${2:-$work/out}
   /usr/bin/time -f "%e %U %S" -o "$work/time.txt" "$T" replay "$work/orbit.$1" --calibration "$work/cal.yaml" \
-    --attitude "$work/att.csv" --events "$work/ev.jsonl" >/dev/null 2>"$work/err.txt" || { cat "$work/err.txt"; exit 1; }
+    --attitude "$stem.att.csv" --events "$stem.ev.jsonl" >/dev/null 2>"$work/err.txt" || { cat "$work/err.txt"; exit 1; }
   read -r wall user sys <"$work/time.txt"
   echo "$wall $(awk -v u="$user" -v s="$sys" 'BEGIN { print u + s }') $(load)"
 }
@@ -46,4 +52,8 @@ for f in h5 csv; do
   all=$(echo "$runs" | awk '{ printf "%s/%s/%s ", $1, $2, $3 }')
   echo "$best" | awk -v f="$f" -v e="$epochs" -v a="$all" \
     '{ printf "%-5s %8.2f %12.0f %8.2f %6.2f   %s\n", f, $1, ($1 > 0 ? e / $1 : 0), $2, $3, a }'
+  sleep "$COLD_S"
+  run "$f" "$work/new_$f" | awk -v f="$f-new" -v e="$epochs" \
+    '{ printf "%-5s %8.2f %12.0f %8.2f %6.2f\n", f, $1, ($1 > 0 ? e / $1 : 0), $2, $3 }'
+  rm -f "$work/new_$f".*
 done
