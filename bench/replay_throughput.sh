@@ -21,15 +21,7 @@ COLD_S=${COLD_S:-20}
 work=$(mktemp -d /tmp/tetra-replay-throughput-XXXXXX)
 trap 'rm -rf "$work"' EXIT
 
-cat >"$work/cal.yaml" <<'YAML'
-unit: seed-as-built
-method: seed-tables-4-5
-gyros:
-  - {id: 1, scale_factor_V_per_dps: 0.0730, bias_V: 0.0002, axis: [0.55526, -0.00146, 0.83167], noise: {arw_dps_rtHz: 3.0e-5}}
-  - {id: 2, scale_factor_V_per_dps: 0.0785, bias_V: 0.0004, axis: [0.42638, 0.78516, -0.44914], noise: {arw_dps_rtHz: 3.0e-5}}
-  - {id: 3, scale_factor_V_per_dps: 0.0880, bias_V: 0.0002, axis: [0.51389, -0.74179, -0.43088], noise: {arw_dps_rtHz: 3.0e-5}}
-  - {id: 4, scale_factor_V_per_dps: 0.0775, bias_V: -0.0003, axis: [0.99999, -0.00094, 0.00065], noise: {arw_dps_rtHz: 3.0e-5}}
-YAML
+cp bench/seed_as_built.yaml "$work/cal.yaml"  # the seed paper's unit as built
 "$T" sim orbit --seed 3 --rate-hz 100 --minutes "$MINUTES" --reference-hz 1 -o "$work/orbit.csv" >/dev/null 2>&1
 "$T" convert "$work/orbit.csv" "$work/orbit.h5" >/dev/null
 epochs=$(grep -vc '^#' "$work/orbit.csv" | awk '{ print $1 - 1 }')
