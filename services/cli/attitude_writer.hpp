@@ -1,8 +1,9 @@
 #pragma once
 // Attitude rows (attitude_csv.hpp) formatted and written on a worker thread: formatting numbers in
-// shortest round-trip form and copying them into the file cost about twice the pipeline step, so the
-// caller hands over the estimates in batches and goes on. At most kDepth batches wait (bounded memory);
-// the file is the one append_attitude_row would give, byte for byte.
+// shortest round-trip form and writing them to the file cost about three quarters of the pipeline step
+// (16 numbers a row; docs/formats.md, "Replay throughput"), so the caller hands over the estimates in
+// batches and goes on. At most kDepth batches wait (bounded memory); the file is the one
+// append_attitude_row would give, byte for byte.
 
 #include <condition_variable>
 #include <cstddef>
