@@ -42,6 +42,27 @@ TEST(OutputFiles, OutputEqualToAnInputIsRefusedThroughLinks) {
   EXPECT_EQ(read_file(dir.file("in.csv")), "data\n");
 }
 
+// A long output is sent to the disk and dropped from the page cache window by window as it is written
+// (8 MB windows): the committed file is every byte written, in order, whatever the pieces' sizes.
+TEST(OutputFiles, LongOutputWrittenBehindIsWhole) {
+  TempDir dir;
+  std::string expected;
+  {
+    RunFiles files;
+    auto out = files.add(dir.file("long.csv"), "--attitude");
+    ASSERT_TRUE(out.ok());
+    for (int piece = 0; expected.size() < (std::size_t{26} << 20); ++piece) {
+      // Pieces of 1 byte to ~1.3 MB, so window edges fall inside pieces.
+      const std::string text(static_cast<std::size_t>(1 + (piece * 7919) % 1300000),
+                             static_cast<char>('a' + piece % 26));
+      expected += text;
+      ASSERT_TRUE((*out)->write(text).ok());
+    }
+    ASSERT_TRUE(files.commit().ok());
+  }
+  EXPECT_TRUE(read_file(dir.file("long.csv")) == expected);
+}
+
 TEST(OutputFiles, TwoOutputsTheSameFileAreRefused) {
   TempDir dir;
   RunFiles files;

@@ -430,14 +430,17 @@ void append_metadata(std::string& out, std::string_view key, std::string_view va
   out += '\n';
 }
 
-void append_double(std::string& out, double value) {
+char* format_double(char* first, double value) {
   if (std::isnan(value)) {
-    out += "nan";
-    return;
+    constexpr std::string_view kNan = "nan";
+    return std::copy(kNan.begin(), kNan.end(), first);
   }
-  char buf[32];
-  const auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, value);
-  out.append(buf, ptr);
+  return std::to_chars(first, first + kMaxDoubleChars, value).ptr;
+}
+
+void append_double(std::string& out, double value) {
+  char buf[kMaxDoubleChars];
+  out.append(buf, format_double(buf, value));
 }
 
 void append_fixed(std::string& out, double value, int decimals) {

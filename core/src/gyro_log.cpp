@@ -124,19 +124,26 @@ Status read_rows(const CsvTable& t, const LogColumns& cols, GyroLog& log) {
   return ok_status();
 }
 
-Result<GyroLog> from_table(CsvTable&& t) {
-  GyroLog log;
+// The table's columns, units and rows into `log` (all but its metadata, comments and lines). `log`'s
+// vectors keep their storage: a block refilled from a table of the same size allocates nothing.
+Status fill_from_table(const CsvTable& t, GyroLog& log) {
   log.source = t.source;
-  log.metadata = std::move(t.metadata);
-  log.comments = std::move(t.comments);
   const std::string head = t.source + ":" + std::to_string(t.header_line) + ": header: ";
   auto cols = find_log_columns(t, head);
   if (!cols) return cols.error();
   log.gyro_count = static_cast<int>(cols->gyros.size());
   log.has_reference = cols->has_reference;
-  if (Status s = check_every_column_used(t, *cols, head); !s) return s.error();
-  if (Status s = read_units(log, t.source); !s) return s.error();
-  if (Status s = read_rows(t, *cols, log); !s) return s.error();
+  log.units_dps = false;
+  if (Status s = check_every_column_used(t, *cols, head); !s) return s;
+  if (Status s = read_units(log, t.source); !s) return s;
+  return read_rows(t, *cols, log);
+}
+
+Result<GyroLog> from_table(CsvTable&& t) {
+  GyroLog log;
+  log.metadata = std::move(t.metadata);
+  log.comments = std::move(t.comments);
+  if (Status s = fill_from_table(t, log); !s) return s.error();
   log.lines = std::move(t.lines);
   return log;
 }
@@ -153,16 +160,18 @@ class CsvGyroLogReader final : public GyroLogReader {
     header_ = std::move(log.value());
     return ok_status();
   }
+  // The table and the block are refilled in place (no allocation per block once they have grown).
   Result<bool> next(GyroLog& block) override {
     auto more = csv_.next(table_);
     if (!more || !*more) return more;
-    auto log = from_table(std::move(table_));
-    if (!log) return log.error();
-    if (log->units_dps != header_.units_dps) {
-      return bad_input(header_.source + ":" + std::to_string(log->lines.front()) +
+    block.metadata = table_.metadata;
+    block.comments = table_.comments;
+    if (Status s = fill_from_table(table_, block); !s) return s.error();
+    block.lines = table_.lines;
+    if (block.units_dps != header_.units_dps) {
+      return bad_input(header_.source + ":" + std::to_string(block.lines.front()) +
                        ": metadata 'units' changes after the header: put it before the header line");
     }
-    block = std::move(log.value());
     return true;
   }
   double fraction_read() const override {

@@ -87,7 +87,30 @@ Status OutputFile::write(std::string_view data) {
   if (fd_ < 0) return failure(path_ + ": output is closed");
   // Text printed through stdio or std::cout (synchronized with stdio) comes first on standard output.
   if (fd_ == STDOUT_FILENO) std::fflush(stdout);
-  return write_all(fd_, data, path_);
+  if (Status st = write_all(fd_, data, path_); !st) return st;
+  written_bytes_ += static_cast<off_t>(data.size());
+  if (!stream_) write_behind();
+  return ok_status();
+}
+
+// A long output is sent to the disk as it grows: each full window is queued for writing, and the
+// window before it, once on the disk, leaves the page cache. The cache then holds about two windows of
+// the file whatever its length, and its pages are reused window after window instead of fresh memory
+// being taken for every page of the file (on a virtual machine that returns free memory to its host,
+// fresh pages cost several times the copy). Errors are left to the fsync of sync(), which reports
+// them. Outputs shorter than a window are untouched.
+void OutputFile::write_behind() {
+  constexpr off_t kWindowBytes = off_t{8} << 20;
+  while (written_bytes_ - queued_bytes_ >= kWindowBytes) {
+    ::sync_file_range(fd_, queued_bytes_, kWindowBytes, SYNC_FILE_RANGE_WRITE);
+    if (queued_bytes_ >= kWindowBytes) {
+      const off_t previous = queued_bytes_ - kWindowBytes;
+      ::sync_file_range(fd_, previous, kWindowBytes,
+                        SYNC_FILE_RANGE_WAIT_BEFORE | SYNC_FILE_RANGE_WRITE | SYNC_FILE_RANGE_WAIT_AFTER);
+      ::posix_fadvise(fd_, previous, kWindowBytes, POSIX_FADV_DONTNEED);
+    }
+    queued_bytes_ += kWindowBytes;
+  }
 }
 
 Result<std::string> OutputFile::library_path() const {

@@ -1,41 +1,73 @@
 #include "attitude_csv.hpp"
 
+#include <algorithm>
+#include <cstring>
+
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"  // kRadToDeg
 
 namespace tetra::cli {
 
-void append_attitude_row(std::string& out, double time_s, const fdi::AttitudeEstimate& attitude,
-                         int n_gyros) {
-  append_double(out, time_s);
-  for (const double c : to_wxyz(attitude.q_RB)) {
-    out += ',';
-    append_double(out, c);
-  }
-  for (int i = 0; i < 3; ++i) {
-    out += ',';
-    append_double(out, attitude.omega_BR_B_rad_s[i] * kRadToDeg);
-  }
-  out += ',';
-  append_double(out, attitude.sigma_rad.norm() * kRadToDeg);  // 1σ of the total error angle
-  out += ',';
-  out += fdi::to_string(attitude.mode);
-  out += ',';
-  out += gyros_cell(attitude.gyros, n_gyros);
-  for (int i = 0; i < 3; ++i) {
-    out += ',';
-    append_double(out, attitude.sigma_rad[i] * kRadToDeg);
-  }
-  const bool biases = static_cast<int>(attitude.gyro_bias_rad_s.size()) == n_gyros;
+namespace {
+
+char* put(char* p, std::string_view text) {
+  std::memcpy(p, text.data(), text.size());
+  return p + text.size();
+}
+
+char* put_double(char* p, double value) {
+  *p++ = ',';
+  return format_double(p, value);
+}
+
+// The longest mode name to_string(Mode) gives.
+std::size_t longest_mode_chars() {
+  std::size_t longest = 0;
+  for (const auto mode : {fdi::Mode::kNominal, fdi::Mode::kDegraded, fdi::Mode::kSuspect, fdi::Mode::kLost})
+    longest = std::max(longest, std::strlen(fdi::to_string(mode)));
+  return longest;
+}
+
+}  // namespace
+
+std::size_t attitude_row_max_bytes(int n_gyros) {
+  const auto n = static_cast<std::size_t>(std::max(n_gyros, 0));
+  const std::size_t numbers = 12 + n;          // time, q (4), rate (3), sigma, sigma per axis (3), biases
+  const std::size_t gyros_cell_chars = 3 * n;  // at most two digits and a ';' per gyro
+  return numbers * (kMaxDoubleChars + 1) + longest_mode_chars() + 1 + gyros_cell_chars + 1;
+}
+
+char* format_attitude_row(char* out, double time_s, const fdi::AttitudeEstimate& attitude,
+                          std::span<const double> bias_rad_s, int n_gyros, std::string_view gyros) {
+  char* p = format_double(out, time_s);
+  for (const double c : to_wxyz(attitude.q_RB)) p = put_double(p, c);
+  for (int i = 0; i < 3; ++i) p = put_double(p, attitude.omega_BR_B_rad_s[i] * kRadToDeg);
+  p = put_double(p, attitude.sigma_rad.norm() * kRadToDeg);  // 1σ of the total error angle
+  *p++ = ',';
+  p = put(p, fdi::to_string(attitude.mode));
+  *p++ = ',';
+  p = put(p, gyros);
+  for (int i = 0; i < 3; ++i) p = put_double(p, attitude.sigma_rad[i] * kRadToDeg);
+  const bool biases = static_cast<int>(bias_rad_s.size()) == n_gyros;
   for (int i = 0; i < n_gyros; ++i) {
-    out += ',';
     if (biases) {
-      append_double(out, attitude.gyro_bias_rad_s[static_cast<std::size_t>(i)] * kRadToDeg);
+      p = put_double(p, bias_rad_s[static_cast<std::size_t>(i)] * kRadToDeg);
     } else {
-      out += "nan";
+      p = put(p, ",nan");
     }
   }
-  out += '\n';
+  *p++ = '\n';
+  return p;
+}
+
+void append_attitude_row(std::string& out, double time_s, const fdi::AttitudeEstimate& attitude,
+                         int n_gyros) {
+  const std::size_t start = out.size();
+  out.resize(start + attitude_row_max_bytes(n_gyros));
+  const std::string cell = gyros_cell(attitude.gyros, n_gyros);
+  char* end =
+      format_attitude_row(out.data() + start, time_s, attitude, attitude.gyro_bias_rad_s, n_gyros, cell);
+  out.resize(static_cast<std::size_t>(end - out.data()));
 }
 
 std::string attitude_header(int n_gyros) {
@@ -51,6 +83,15 @@ std::string gyros_cell(GyroMask mask, int n_gyros) {
     if (c == ',') c = ';';  // one CSV field for any N: "1;2;10"
   }
   return cell;
+}
+
+const std::string& GyrosCellCache::cell(GyroMask mask) {
+  if (!valid_ || mask != mask_) {
+    cell_ = gyros_cell(mask, n_gyros_);
+    mask_ = mask;
+    valid_ = true;
+  }
+  return cell_;
 }
 
 }  // namespace tetra::cli

@@ -1,5 +1,7 @@
 #include "attitude_writer.hpp"
 
+#include <algorithm>
+#include <span>
 #include <utility>
 
 #include "attitude_csv.hpp"
@@ -11,7 +13,12 @@ constexpr std::size_t kWriteBytes = std::size_t{1} << 20;  // formatted text wri
 }  // namespace
 
 AttitudeWriter::AttitudeWriter(OutputFile& out, int n_gyros, std::string preamble)
-    : out_(out), n_gyros_(n_gyros), text_(std::move(preamble)), worker_([this] { run(); }) {
+    : out_(out),
+      n_gyros_(n_gyros),
+      preamble_(std::move(preamble)),
+      text_(kWriteBytes + attitude_row_max_bytes(n_gyros), '\0'),
+      cells_(n_gyros),
+      worker_([this] { run(); }) {
   filling_.rows.reserve(kBatchRows);
 }
 
@@ -30,11 +37,26 @@ Status AttitudeWriter::error() const {
   return status_;
 }
 
+// The estimate's fields are copied into the batch's storage; its bias vector goes into the batch's flat
+// `biases` (N per row), so a row costs no allocation and no vector assignment.
 Status AttitudeWriter::add(double time_s, const fdi::AttitudeEstimate& attitude) {
-  if (filling_.used == filling_.rows.size()) filling_.rows.emplace_back();
-  Row& row = filling_.rows[filling_.used++];
+  if (filling_.used == filling_.rows.size()) {
+    filling_.rows.emplace_back();
+    filling_.biases.resize(filling_.rows.size() * static_cast<std::size_t>(n_gyros_));
+  }
+  const std::size_t k = filling_.used++;
+  Row& row = filling_.rows[k];
   row.time_s = time_s;
-  row.attitude = attitude;
+  row.attitude.q_RB = attitude.q_RB;
+  row.attitude.omega_BR_B_rad_s = attitude.omega_BR_B_rad_s;
+  row.attitude.sigma_rad = attitude.sigma_rad;
+  row.attitude.mode = attitude.mode;
+  row.attitude.gyros = attitude.gyros;
+  row.has_biases = static_cast<int>(attitude.gyro_bias_rad_s.size()) == n_gyros_;
+  if (row.has_biases) {
+    std::copy(attitude.gyro_bias_rad_s.begin(), attitude.gyro_bias_rad_s.end(),
+              filling_.biases.begin() + static_cast<std::ptrdiff_t>(k * static_cast<std::size_t>(n_gyros_)));
+  }
   if (filling_.used < kBatchRows) return ok_status();
   return hand_over();
 }
@@ -70,18 +92,36 @@ Status AttitudeWriter::finish() {
   return error();
 }
 
+// Rows are formatted straight into text_ (room for one more row past kWriteBytes), written out in
+// pieces of about kWriteBytes.
 Status AttitudeWriter::write_batch(const Batch& batch) {
   for (std::size_t i = 0; i < batch.used; ++i) {
     const Row& row = batch.rows[i];
-    append_attitude_row(text_, row.time_s, row.attitude, n_gyros_);
-    if (text_.size() < kWriteBytes) continue;
-    if (Status s = out_.write(text_); !s) return s;
-    text_.clear();
+    const auto n = static_cast<std::size_t>(n_gyros_);
+    const std::span<const double> biases =
+        row.has_biases ? std::span<const double>(batch.biases).subspan(i * n, n) : std::span<const double>();
+    char* end = format_attitude_row(text_.data() + text_used_, row.time_s, row.attitude, biases, n_gyros_,
+                                    cells_.cell(row.attitude.gyros));
+    text_used_ = static_cast<std::size_t>(end - text_.data());
+    if (text_used_ < kWriteBytes) continue;
+    if (Status s = write_text(); !s) return s;
   }
   return ok_status();
 }
 
+Status AttitudeWriter::write_text() {
+  const Status s = out_.write(std::string_view(text_.data(), text_used_));
+  text_used_ = 0;
+  return s;
+}
+
 void AttitudeWriter::run() {
+  if (Status s = out_.write(preamble_); !s) {
+    const std::lock_guard lock(mutex_);
+    status_ = s;
+    changed_.notify_all();
+    return;
+  }
   while (true) {
     Batch batch;
     {
@@ -107,11 +147,10 @@ void AttitudeWriter::run() {
       return;
     }
   }
-  if (Status s = out_.write(text_); !s) {
+  if (Status s = write_text(); !s) {
     const std::lock_guard lock(mutex_);
     status_ = s;
   }
-  text_.clear();
 }
 
 }  // namespace tetra::cli

@@ -112,6 +112,11 @@ Status write_text_file(const std::string& path, std::string_view content);
 void append_metadata(std::string& out, std::string_view key, std::string_view value);
 //! Appends the shortest decimal text that reads back to exactly `value` ("nan" for NaN).
 void append_double(std::string& out, double value);
+//! The most characters format_double writes ("-2.2250738585072014e-308").
+inline constexpr std::size_t kMaxDoubleChars = 24;
+//! append_double's text written at `first` (room for kMaxDoubleChars); returns its end. For a writer
+//! that formats many numbers into a buffer of its own.
+char* format_double(char* first, double value);
 //! Appends `value` in fixed notation with `decimals` digits after the point.
 void append_fixed(std::string& out, double value, int decimals);
 //! Appends an integer.

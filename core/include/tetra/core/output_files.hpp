@@ -58,13 +58,16 @@ class OutputFile {
   OutputFile() = default;
   Status sync();  // fsync and close the temporary file (regular outputs)
   Status rename_into_place();
-  void discard();  // removes an uncommitted temporary file
+  void discard();       // removes an uncommitted temporary file
+  void write_behind();  // a long regular output: written to the disk and dropped from the cache as it grows
 
   std::string path_;    // as given
   std::string label_;   // the option that named it ("--attitude"), for messages
   std::string target_;  // final path, symbolic links resolved
   std::string temp_;    // temporary file next to target_ (regular outputs)
   int fd_ = -1;
+  off_t written_bytes_ = 0;  // appended by write()
+  off_t queued_bytes_ = 0;   // handed to the disk by write_behind()
   bool stream_ = false;
   bool committed_ = false;
 };
