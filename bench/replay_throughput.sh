@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Whole-command replay throughput (docs/formats.md, "Replay throughput"): `tetra replay` of a simulated
 # 100 Hz orbit with 4 gyros and a 1 Hz reference (6 h = 2.16 M epochs by default), from CSV and from
-# HDF5, outputs included (the attitude CSV is ~355 B per epoch). Best of RUNS runs per format; each row
+# HDF5, outputs included (the attitude CSV is ~270 B per epoch). Best of RUNS runs per format; each row
 # prints the wall seconds, epochs per second, CPU seconds (user + system, all threads) and the load
 # average beside it (the machine's other work makes wall times longer: compare at the same load).
 # Every run writes the same output paths, replacing the previous run's files, as a user re-running a
