@@ -89,28 +89,37 @@ Status OutputFile::write(std::string_view data) {
   if (fd_ == STDOUT_FILENO) std::fflush(stdout);
   if (Status st = write_all(fd_, data, path_); !st) return st;
   written_bytes_ += static_cast<off_t>(data.size());
-  if (!stream_) write_behind();
-  return ok_status();
+  return stream_ ? ok_status() : write_behind();
 }
 
 // A long output is sent to the disk as it grows: each full window is queued for writing, and the
 // window before it, once on the disk, leaves the page cache. The cache then holds about two windows of
 // the file whatever its length, and its pages are reused window after window instead of fresh memory
 // being taken for every page of the file (on a virtual machine that returns free memory to its host,
-// fresh pages cost several times the copy). Errors are left to the fsync of sync(), which reports
-// them. Outputs shorter than a window are untouched.
-void OutputFile::write_behind() {
+// fresh pages cost several times the copy). Outputs shorter than a window are untouched. A write error
+// that waiting for a window reports is returned here: the kernel reports it once, to this wait, and a
+// later fsync would not see it again (the run then fails and the output is not committed).
+Status OutputFile::write_behind() {
   constexpr off_t kWindowBytes = off_t{8} << 20;
-  while (written_bytes_ - queued_bytes_ >= kWindowBytes) {
-    ::sync_file_range(fd_, queued_bytes_, kWindowBytes, SYNC_FILE_RANGE_WRITE);
+  while (write_behind_ && written_bytes_ - queued_bytes_ >= kWindowBytes) {
+    if (::sync_file_range(fd_, queued_bytes_, kWindowBytes, SYNC_FILE_RANGE_WRITE) != 0) {
+      if (errno != EINVAL && errno != ESPIPE && errno != ENOSYS)
+        return failure(path_ + ": cannot write: " + errno_text());
+      write_behind_ = false;  // a file system without it: the file is written as any other
+      break;
+    }
     if (queued_bytes_ >= kWindowBytes) {
       const off_t previous = queued_bytes_ - kWindowBytes;
-      ::sync_file_range(fd_, previous, kWindowBytes,
-                        SYNC_FILE_RANGE_WAIT_BEFORE | SYNC_FILE_RANGE_WRITE | SYNC_FILE_RANGE_WAIT_AFTER);
-      ::posix_fadvise(fd_, previous, kWindowBytes, POSIX_FADV_DONTNEED);
+      if (::sync_file_range(
+              fd_, previous, kWindowBytes,
+              SYNC_FILE_RANGE_WAIT_BEFORE | SYNC_FILE_RANGE_WRITE | SYNC_FILE_RANGE_WAIT_AFTER) != 0)
+        return failure(path_ + ": cannot write: " + errno_text());
+      ::posix_fadvise(fd_, previous, kWindowBytes,
+                      POSIX_FADV_DONTNEED);  // advice only: its result changes nothing
     }
     queued_bytes_ += kWindowBytes;
   }
+  return ok_status();
 }
 
 Result<std::string> OutputFile::library_path() const {

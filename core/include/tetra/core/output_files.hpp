@@ -58,8 +58,8 @@ class OutputFile {
   OutputFile() = default;
   Status sync();  // fsync and close the temporary file (regular outputs)
   Status rename_into_place();
-  void discard();       // removes an uncommitted temporary file
-  void write_behind();  // a long regular output: written to the disk and dropped from the cache as it grows
+  void discard();         // removes an uncommitted temporary file
+  Status write_behind();  // a long regular output: written to the disk and dropped from the cache as it grows
 
   std::string path_;    // as given
   std::string label_;   // the option that named it ("--attitude"), for messages
@@ -69,6 +69,7 @@ class OutputFile {
   off_t written_bytes_ = 0;  // appended by write()
   off_t queued_bytes_ = 0;   // handed to the disk by write_behind()
   bool stream_ = false;
+  bool write_behind_ = true;  // cleared where the file system does not support it
   bool committed_ = false;
 };
 
