@@ -40,7 +40,7 @@ Result<Eigen::Vector3d> parse_axis(const std::string& text) {
   return Eigen::Vector3d(v.normalized());
 }
 
-std::string fixed(double v, int decimals) {
+std::string fixed_or_na(double v, int decimals) {
   if (!std::isfinite(v)) return "n/a";
   std::string s;
   append_fixed(s, v, decimals);
@@ -48,7 +48,8 @@ std::string fixed(double v, int decimals) {
 }
 
 std::string percents(const std::array<double, 3>& f) {
-  return fixed(100.0 * f[0], 1) + " / " + fixed(100.0 * f[1], 1) + " / " + fixed(100.0 * f[2], 1) + " %";
+  return fixed_or_na(100.0 * f[0], 1) + " / " + fixed_or_na(100.0 * f[1], 1) + " / " +
+         fixed_or_na(100.0 * f[2], 1) + " %";
 }
 
 void print_errors(const AttitudeScore& s) {
@@ -70,8 +71,8 @@ void print_consistency(const AttitudeScore& s) {
   const std::string left_out =
       s.no_sigma_epochs ? " (" + std::to_string(s.no_sigma_epochs) + " with sigma 0 or nan left out)" : "";
   if (s.per_axis_sigma) {
-    std::cout << "  NEES, 3 dof (expectation 3): mean " << fixed(s.mean_nees, 3) << " over " << s.sigma_epochs
-              << " epochs" << left_out << '\n';
+    std::cout << "  NEES, 3 dof (expectation 3): mean " << fixed_or_na(s.mean_nees, 3) << " over "
+              << s.sigma_epochs << " epochs" << left_out << '\n';
     const char* axes[3] = {"x", "y", "z"};
     for (int k = 0; k < 3; ++k) {
       std::cout << "  within 1/2/3 sigma, " << axes[k] << ": "
@@ -79,7 +80,7 @@ void print_consistency(const AttitudeScore& s) {
                 << "   (Gaussian: 68.3 / 95.4 / 99.7 %)\n";
     }
   } else {
-    std::cout << "  normalized error |e|^2/sigma^2 (expectation 1): mean " << fixed(s.mean_nees, 3)
+    std::cout << "  normalized error |e|^2/sigma^2 (expectation 1): mean " << fixed_or_na(s.mean_nees, 3)
               << " over " << s.sigma_epochs << " epochs" << left_out << '\n';
   }
   std::cout << "  within 1/2/3 sigma, total angle: " << percents(s.within_total)
@@ -98,10 +99,10 @@ void print_report(const AttitudeScore& s, const std::string& att, const std::str
             << '\n';
   print_errors(s);
   print_consistency(s);
-  std::cout << "  integrated angle about " << axis_name << ": " << fixed(s.angle_axis_deg, 2)
-            << " deg (truth " << fixed(s.truth_angle_axis_deg, 2)
-            << " deg); about x, y, z: " << fixed(s.angle_B_deg(0), 2) << ", " << fixed(s.angle_B_deg(1), 2)
-            << ", " << fixed(s.angle_B_deg(2), 2) << " deg\n";
+  std::cout << "  integrated angle about " << axis_name << ": " << fixed_or_na(s.angle_axis_deg, 2)
+            << " deg (truth " << fixed_or_na(s.truth_angle_axis_deg, 2)
+            << " deg); about x, y, z: " << fixed_or_na(s.angle_B_deg(0), 2) << ", "
+            << fixed_or_na(s.angle_B_deg(1), 2) << ", " << fixed_or_na(s.angle_B_deg(2), 2) << " deg\n";
 }
 
 nlohmann::json vec(const Eigen::Vector3d& v) {
