@@ -1,6 +1,7 @@
 #include "attitude_writer.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <span>
 #include <utility>
 
@@ -116,7 +117,12 @@ Status AttitudeWriter::write_text() {
 }
 
 void AttitudeWriter::run() {
-  if (Status s = out_.write(preamble_); !s) {
+  // The preamble goes out with the first rows (a run that fails before them writes nothing, as on
+  // standard output a failed run should); one longer than the buffer is written at once.
+  if (preamble_.size() <= kWriteBytes) {
+    std::memcpy(text_.data(), preamble_.data(), preamble_.size());
+    text_used_ = preamble_.size();
+  } else if (Status s = out_.write(preamble_); !s) {
     const std::lock_guard lock(mutex_);
     status_ = s;
     changed_.notify_all();

@@ -129,6 +129,11 @@ TEST(ReplayCli, BadInputIsExitTwoNamingFileAndLine) {
     EXPECT_NE(r.err.find(c.expect), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
+  // Attitude to standard output: a run that fails writes nothing there, not even the header.
+  const auto piped = run_tetra("replay " + dir.file("text.csv") + " --calibration " + cal +
+                               " --attitude - --events " + dir.file("ev.jsonl"));
+  EXPECT_EQ(piped.exit_status, 2) << piped.err;
+  EXPECT_EQ(piped.out, "");
   const auto cfg = run_tetra("replay " + dir.file("ok.csv") + " --calibration " + cal + " --config " +
                              dir.file("cfg.yaml") + out);
   EXPECT_EQ(cfg.exit_status, 2);
