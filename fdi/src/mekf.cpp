@@ -66,7 +66,7 @@ void propagate_blocks(const CovarianceStep& s, int n_runtime, const Eigen::Matri
   double* P = s.P;
   const double* C = s.coupling;
   const double* kappa = s.kappa;
-  const auto column = [ld](double* p) { return Eigen::Map<Column>(p, ld); };
+  const auto column = [&](double* p) { return Eigen::Map<Column>(p, ld); };
   // Rᵀ (ld × n): column i = P(:, c_i) + κ_i·P(:, g_i).
   for (int i = 0; i < n; ++i)
     column(s.fold + i * ld) = column(P + (3 + i) * ld) + kappa[i] * column(P + (3 + n + i) * ld);
