@@ -622,6 +622,10 @@ std::string Pipeline::Impl::describe_thresholds() const {
   append_double(out, s->bias_wander_sigma);
   out += "\ncusum h (sigma): ";
   append_double(out, s->cusum_h);
+  out += "\nlevel test k (sigma, during an episode): ";
+  append_double(out, s->level_k);
+  out += "\nlevel test h (sigma): ";
+  append_double(out, s->level_h);
   out += "\n";
   return out;
 }

@@ -67,6 +67,23 @@ TEST(ReplayCli, WritesAttitudeAndEventsAndSummary) {
   EXPECT_NE(r.err.find("final mode: DEGRADED"), std::string::npos) << r.err;
 }
 
+// --verbose prints the thresholds the pipeline derived, each a positive number: the parity tests' and the
+// level test's that runs during an episode.
+TEST(ReplayCli, VerbosePrintsTheDerivedThresholds) {
+  TempDir dir;
+  const auto log = write_log(dir, "log.csv", 10.0);
+  const auto r = run_tetra("replay " + log + " --calibration " + write_cal(dir) + " --verbose --attitude " +
+                           dir.file("att.csv") + " --events " + dir.file("ev.jsonl"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  for (const std::string key : {"chi2 threshold: ", "cusum k (sigma): ", "cusum h (sigma): ",
+                                "level test k (sigma, during an episode): ", "level test h (sigma): "}) {
+    const auto at = r.err.find(key);
+    ASSERT_NE(at, std::string::npos) << key << " missing from:\n" << r.err;
+    const double value = std::stod(r.err.substr(at + key.size()));
+    EXPECT_GT(value, 0.0) << key;
+  }
+}
+
 TEST(ReplayCli, BadTimesAreCountedNotFatal) {
   TempDir dir;
   const auto cal = write_cal(dir);
