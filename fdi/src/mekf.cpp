@@ -240,8 +240,7 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       gain_(Eigen::MatrixX3d::Zero(dim_, 3)),
       ph_(Eigen::VectorXd::Zero(dim_)),
       parity_h_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(gyros_.size()))),
-      prior_var_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(gyros_.size()))),
-      frozen_(gyros_.size(), 0) {
+      prior_var_(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(gyros_.size()))) {
   gm_phi_.assign(gyros_.size(), 1.0);  // sized once here: computing them never allocates
   gm_kappa_.assign(gyros_.size(), 1.0);
   rrw_var_.assign(gyros_.size(), 0.0);
@@ -253,11 +252,8 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
 void Mekf::reset(double attitude_sigma_rad) {
   P_.setZero();
   bias_.setZero();
-  for (int i = 0; i < n_; ++i) {
-    frozen_[static_cast<std::size_t>(i)] = 0;
-    set_prior(i);
-  }
   frozen_mask_ = 0;
+  for (int i = 0; i < n_; ++i) set_prior(i);
   P_.topLeftCorner<3, 3>().diagonal().setConstant(attitude_sigma_rad * attitude_sigma_rad);
 }
 
@@ -291,13 +287,11 @@ void Mekf::decorrelate(int i) {
 void Mekf::freeze(int id) {
   if (id < 1 || id > n_) return;
   decorrelate(id - 1);
-  frozen_[index(id)] = 1;
   frozen_mask_ |= GyroMask{1} << static_cast<unsigned>(id - 1);
 }
 
 void Mekf::thaw(int id) {
   if (id < 1 || id > n_) return;
-  frozen_[index(id)] = 0;
   frozen_mask_ = without_gyro(frozen_mask_, id);
   set_prior(id - 1);
 }
@@ -346,7 +340,7 @@ void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, d
   q_theta_.setZero();
   for (int i = 0; i < n_; ++i) {
     const auto k = static_cast<std::size_t>(i);
-    const bool frozen = frozen_[k] != 0;
+    const bool frozen = has_gyro(frozen_mask_, i + 1);
     decay_[i] = frozen ? 1.0 : gm_phi_[k];
     bias_noise_[i] = frozen ? 0.0 : rrw_var_[k];
     bias_noise_[n_ + i] = frozen ? 0.0 : gm_var_[k];
@@ -399,7 +393,7 @@ ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quatern
   const Eigen::Matrix3d S_inv = S.inverse();  // positive definite (the factorization above succeeded)
   gain_.noalias() = P_.leftCols<3>() * S_inv;
   for (int i = 0; i < n_; ++i) {
-    if (frozen_[static_cast<std::size_t>(i)] == 0) continue;
+    if (!has_gyro(frozen_mask_, i + 1)) continue;
     gain_.row(c_of(i)).setZero();
     gain_.row(g_of(i)).setZero();
   }
@@ -443,7 +437,7 @@ double Mekf::bias_z(int id) const {
 
 void Mekf::open_fault_hypothesis(double sigma_rad_s) {
   for (int i = 0; i < n_; ++i) {
-    if (frozen_[static_cast<std::size_t>(i)] == 0) P_(c_of(i), c_of(i)) += sigma_rad_s * sigma_rad_s;
+    if (!has_gyro(frozen_mask_, i + 1)) P_(c_of(i), c_of(i)) += sigma_rad_s * sigma_rad_s;
   }
 }
 

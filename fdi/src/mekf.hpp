@@ -89,7 +89,7 @@ class Mekf {
   //! with the rest, and stop evolving. `thaw` puts them back at their prior.
   void freeze(int id);
   void thaw(int id);
-  bool frozen(int id) const { return frozen_[index(id)] != 0; }
+  bool frozen(int id) const { return has_gyro(frozen_mask_, id); }
 
   //! [rad] 1σ of the attitude error per body axis.
   Eigen::Vector3d attitude_sigma_rad() const;
@@ -101,7 +101,6 @@ class Mekf {
   const Eigen::MatrixXd& covariance() const { return P_; }
 
  private:
-  static std::size_t index(int id) { return static_cast<std::size_t>(id - 1); }
   Eigen::Index c_of(int i) const { return 3 + i; }       //!< state index of c_i (i 0-based)
   Eigen::Index g_of(int i) const { return 3 + n_ + i; }  //!< state index of g_i
   void decorrelate(int i);
@@ -135,7 +134,7 @@ class Mekf {
   GyroMask step_used_ = 0;
   GyroMask step_frozen_ = 0;
   double step_dt_s_ = -1.0;
-  GyroMask frozen_mask_ = 0;  //!< the frozen gyros (bit i − 1: gyro i), as `frozen_`
+  GyroMask frozen_mask_ = 0;  //!< the frozen gyros (bit i − 1: gyro i)
   Eigen::Matrix3Xd coupling_;  //!< 3×N: C = −Γ·H*, ∂δθ/∂c_i over the step (on g_i: κ_i·C) (scratch)
   Eigen::VectorXd fold_;       //!< (3+2N)×N: Rᵀ of the propagation (scratch)
   Eigen::VectorXd cross_;      //!< (3+2N)×3: Xᵀ of the propagation (scratch)
@@ -144,7 +143,6 @@ class Mekf {
   Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
   Eigen::VectorXd parity_h_;   //!< N: a parity row's h per gyro (scratch)
   Eigen::VectorXd prior_var_;  //!< [rad²/s²] per gyro: the variance of c + g without any measurement
-  std::vector<unsigned char> frozen_;
 };
 
 //! ∫₀^Δt exp(−[ω×]u) du in closed form (a series for small |ω|Δt).
