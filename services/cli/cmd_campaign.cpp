@@ -1,9 +1,14 @@
 // tetra campaign SPEC.yaml — fault-injection campaigns, closed or open loop, with the fusion pipeline in
 // process or in `tetra fusion` services over DDS (docs/campaign.md).
+#include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -26,6 +31,28 @@ namespace tetra::cli {
 namespace {
 
 constexpr const char* kCampaignName = "campaign";
+
+// SIGINT/SIGTERM: the workers are told to stop (each worker's `tetra fusion` services follow it, see
+// spawn_self), the rows already finished stay in runs.csv, and the same command continues the campaign.
+constexpr std::size_t kMaxWorkers = 1024;
+volatile std::sig_atomic_t g_stop_signal = 0;
+pid_t g_worker_pids[kMaxWorkers] = {};
+volatile std::sig_atomic_t g_worker_count = 0;
+
+extern "C" void campaign_on_signal(int sig) {
+  g_stop_signal = sig;
+  for (std::sig_atomic_t i = 0; i < g_worker_count; ++i) ::kill(g_worker_pids[i], SIGTERM);
+}
+
+//! Installs (or, with `install` false, removes) the handler for SIGINT and SIGTERM.
+void handle_stop_signals(bool install) {
+  struct sigaction action {};
+  action.sa_handler = install ? campaign_on_signal : SIG_DFL;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART;
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+}
 
 //! Run ids already in `runs.csv` (a torn last line, from an interrupted run, is dropped and redone).
 Result<std::set<std::size_t>> done_runs(const std::string& path) {
@@ -95,19 +122,26 @@ Status run_pending(const sim::CampaignSpec& spec, const std::vector<sim::Campaig
   int fds[2];
   if (::pipe(fds) != 0) return failure("cannot create a pipe");
   std::vector<pid_t> pids;
-  const auto n_jobs =
-      static_cast<std::size_t>(std::max(1, std::min<int>(jobs, static_cast<int>(pending.size()))));
-  for (std::size_t w = 0; w < n_jobs; ++w) {
+  const auto n_jobs = static_cast<std::size_t>(
+      std::max(1, std::min<int>({jobs, static_cast<int>(pending.size()), static_cast<int>(kMaxWorkers)})));
+  const pid_t parent = ::getpid();
+  for (std::size_t w = 0; w < n_jobs && g_stop_signal == 0; ++w) {
     std::vector<sim::CampaignCase> share;
     for (std::size_t i = w; i < pending.size(); i += n_jobs) share.push_back(pending[i]);
     std::cout.flush();
     const pid_t pid = ::fork();
     if (pid < 0) return failure("cannot fork a worker");
     if (pid == 0) {
+      handle_stop_signals(false);
+      ::prctl(PR_SET_PDEATHSIG, SIGTERM);  // a campaign killed outright takes its workers with it
+      if (::getppid() != parent) ::_exit(1);
       ::close(fds[0]);
       worker(spec, share, fds[1], out_dir);
     }
     pids.push_back(pid);
+    g_worker_pids[w] = pid;
+    g_worker_count = static_cast<std::sig_atomic_t>(w + 1);
+    if (g_stop_signal != 0) ::kill(pid, SIGTERM);  // the signal came between fork and the line above
   }
   ::close(fds[1]);
   std::FILE* in = ::fdopen(fds[0], "r");
@@ -134,10 +168,18 @@ Status run_pending(const sim::CampaignSpec& spec, const std::vector<sim::Campaig
   bool workers_ok = true;
   for (pid_t pid : pids) {
     int status = 0;
-    ::waitpid(pid, &status, 0);
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
     workers_ok = workers_ok && WIFEXITED(status) && WEXITSTATUS(status) == 0;
   }
+  g_worker_count = 0;
   progress.print(true);
+  if (g_stop_signal != 0) {
+    return failure(std::string("interrupted by ") + (g_stop_signal == SIGINT ? "SIGINT" : "SIGTERM") +
+                   ": workers stopped, " + std::to_string(progress.done_before + progress.done_now) + " of " +
+                   std::to_string(progress.total) + " runs in " + runs_path +
+                   "; the same command continues the campaign");
+  }
   if (!first_error.empty()) return failure("a run failed: " + first_error);
   if (!workers_ok || !out) return failure(runs_path + ": a worker failed or the file could not be written");
   return ok_status();
@@ -167,10 +209,19 @@ int cmd_campaign(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_flag("--no-report", no_report, "only the runs (no report, no plots)");
+  int domain = 0;
+  CLI::Option* domain_opt =
+      app.add_option("--domain", domain, "DDS domain of the services (target dds; overrides the spec's domain:)")
+          ->check(CLI::Range(0, 232));
   if (auto status = parse(app, argc, argv)) return *status;
 
   auto spec = sim::read_campaign_spec(spec_path);
   if (!spec) return report(kCampaignName, spec.error());
+  if (domain_opt->count() != 0) {
+    if (spec->target != sim::CampaignTarget::kDds)
+      return report(kCampaignName, bad_input("--domain applies to a campaign with target: dds only"));
+    spec->dds_domain = domain;
+  }
   std::error_code ec;
   const bool over_dds = spec->target == sim::CampaignTarget::kDds;
   std::filesystem::create_directories(
@@ -197,8 +248,10 @@ int cmd_campaign(int argc, char** argv) {
             << "), " << cases.size() - pending.size() << " already done, " << jobs << " jobs\n";
   Progress progress{cases.size(), cases.size() - pending.size()};
   if (!pending.empty()) {
-    if (Status st = run_pending(*spec, pending, jobs, out_dir, progress); !st)
-      return report(kCampaignName, st.error());
+    handle_stop_signals(true);
+    Status st = run_pending(*spec, pending, jobs, out_dir, progress);
+    handle_stop_signals(false);
+    if (!st) return report(kCampaignName, st.error());
   }
   if (no_report) return kExitOk;
   if (Status st = write_campaign_report(runs_path, out_dir); !st) return report(kCampaignName, st.error());

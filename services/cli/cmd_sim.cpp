@@ -65,7 +65,9 @@ struct SimArgs {
   std::string unit_path;
   std::string out_path;
   std::string truth_path;
-  std::vector<std::string> fault_texts;
+  std::string write_unit_path;  // --write-unit: the simulated unit as a calibration YAML, then stop
+  std::vector<std::string> fault_texts;      // --fault: replace the scenario's faults
+  std::vector<std::string> add_fault_texts;  // --add-fault: added to the scenario's faults
   ScenarioOverrides over;
   sim::TurntablePlan plan;
   std::vector<CLI::Option*> turntable_only;  // --table-rate, --revolutions, --order, --wrap
@@ -76,8 +78,10 @@ struct SimArgs {
 };
 
 void add_run_options(CLI::App& app, SimArgs& a) {
-  app.add_option("SCENARIO", a.scenario_name, "turntable | static | lab-orbit | orbit | slews | FILE.yaml")
-      ->required();
+  app.add_option("SCENARIO", a.scenario_name, "turntable | static | lab-orbit | orbit | slews | FILE.yaml");
+  app.add_option("--write-unit", a.write_unit_path,
+                 "write the simulated unit (the seed paper's as-built unit, or --unit's) as a calibration "
+                 "YAML to FILE and stop (no SCENARIO)");
   app.add_option("--seed", a.seed, "random seed; the same seed gives byte-identical output")
       ->capture_default_str();
   app.add_option("--unit", a.unit_path,
@@ -98,7 +102,10 @@ void add_scenario_options(CLI::App& app, SimArgs& a) {
       app.add_option("--latitude", o.latitude_deg, "[deg] geodetic latitude (turntable, static, lab-orbit)")
           ->check(CLI::Range(-90.0, 90.0));
   app.add_option("--fault", a.fault_texts,
-                 "gyro=N,kind=K,at=S[,size=X][,until=S] (repeatable; docs/interfaces.md §2.7)");
+                 "gyro=N,kind=K,at=S[,size=X][,until=S] (repeatable; docs/interfaces.md §2.7); replaces "
+                 "the scenario file's faults");
+  app.add_option("--add-fault", a.add_fault_texts,
+                 "a fault added to the scenario file's faults (and to --fault's), same syntax; repeatable");
   o.reference = app.add_option("--reference-hz", o.reference_hz, "[Hz] attitude reference rate (0 = none)")
                     ->check(CLI::NonNegativeNumber);
   o.reference_noise =
@@ -194,8 +201,8 @@ int run_turntable_scenario(SimArgs& a, const std::optional<Calibration>& unit, R
                                  o.acs_accel, o.period, o.jitter, o.drop}) {
     if (opt->count()) return report(kSimName, bad_input("turntable: " + opt->get_name() + " does not apply"));
   }
-  if (!a.fault_texts.empty() || !a.truth_path.empty()) {
-    return report(kSimName, bad_input("turntable: --fault and --truth do not apply"));
+  if (!a.fault_texts.empty() || !a.add_fault_texts.empty() || !a.truth_path.empty()) {
+    return report(kSimName, bad_input("turntable: --fault, --add-fault and --truth do not apply"));
   }
   if (o.rate->count()) a.plan.rate_hz = o.rate_hz;
   if (o.latitude->count()) a.plan.latitude_deg = o.latitude_deg;
@@ -228,16 +235,19 @@ Result<sim::Scenario> load_scenario(const SimArgs& a, const std::optional<Calibr
   if (!scenario) return scenario.error();
   if (unit) scenario->unit = *unit;
   apply_overrides(a.over, *scenario);
+  if (!a.fault_texts.empty()) scenario->faults.clear();  // the command line's faults replace the file's
   return scenario;
 }
 
 Result<sim::SimOptions> sim_options(const SimArgs& a) {
   sim::SimOptions options;
   options.seed = a.seed;
-  for (const std::string& text : a.fault_texts) {
-    auto fault = sim::parse_fault_spec(text);
-    if (!fault) return fault.error();
-    options.faults.push_back(fault.value());
+  for (const auto* texts : {&a.fault_texts, &a.add_fault_texts}) {
+    for (const std::string& text : *texts) {
+      auto fault = sim::parse_fault_spec(text);
+      if (!fault) return fault.error();
+      options.faults.push_back(fault.value());
+    }
   }
   if (a.loop.enabled && (!a.out_path.empty() || !a.truth_path.empty())) {
     return bad_input("--out and --truth do not apply with --closed-loop (see --pointing)");
@@ -282,12 +292,31 @@ int run_scenario(const SimArgs& a, const sim::Scenario& sc, const sim::SimOption
   return write_files(a, sc, options, files, out);
 }
 
+// --write-unit FILE: the unit a run would simulate, as a calibration file (examples/seed_unit.yaml).
+int write_unit(const SimArgs& a) {
+  if (!a.scenario_name.empty()) return report(kSimName, bad_input("--write-unit takes no SCENARIO"));
+  RunFiles files;
+  if (!a.unit_path.empty()) files.add_input(a.unit_path, "--unit");
+  auto out = files.add(a.write_unit_path, "--write-unit");
+  if (!out) return report(kSimName, out.error());
+  auto unit = read_unit(a.unit_path);
+  if (!unit) return report(kSimName, unit.error());
+  const Calibration cal = unit->has_value() ? **unit : seed_as_built_unit();
+  const auto meta = provenance_metadata(provenance(files.input_paths()));
+  if (Status st = write_calibration(**out, cal, meta); !st) return report(kSimName, st.error());
+  if (Status st = files.commit(); !st) return report(kSimName, st.error());
+  std::cerr << "tetra sim: unit '" << cal.unit << "', " << cal.gyro_count() << " gyros -> " << a.write_unit_path
+            << '\n';
+  return kExitOk;
+}
+
 }  // namespace
 
 int cmd_sim(int argc, char** argv) {
   CLI::App app{
       "Simulate a gyro unit with known truth. SCENARIO: turntable, static, lab-orbit, orbit, slews, or a "
-      "scenario YAML file (docs/sim.md). Options given here override the scenario's.",
+      "scenario YAML file (docs/sim.md). Options given here override the scenario's (--fault replaces its "
+      "faults, --add-fault adds to them).",
       kSimName};
   SimArgs a;
   add_run_options(app, a);
@@ -298,6 +327,8 @@ int cmd_sim(int argc, char** argv) {
   add_sim_dds_options(app, a.dds);
 #endif
   if (auto status = parse(app, argc, argv)) return *status;
+  if (!a.write_unit_path.empty()) return write_unit(a);
+  if (a.scenario_name.empty()) return report(kSimName, bad_input("SCENARIO is required (or --write-unit FILE)"));
 
   RunFiles files;
   auto out = open_files(a, files);

@@ -1,6 +1,7 @@
 #include "dds_common.hpp"
 
 #include <fcntl.h>
+#include <sys/prctl.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -51,9 +52,14 @@ int spawn_self(const std::vector<std::string>& args, const std::string& stdout_p
   std::vector<char*> argv;
   for (auto& a : storage) argv.push_back(a.data());
   argv.push_back(nullptr);
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid != 0) return pid;  // parent (or -1)
   // Child: signal mask and redirections, then exec. Only async-signal-safe calls from here on.
+  // The child is stopped (SIGTERM) when the process that started it ends, however it ends: a campaign
+  // worker or a demo killed by a signal leaves no service behind.
+  prctl(PR_SET_PDEATHSIG, SIGTERM);
+  if (getppid() != parent) _exit(127);  // it ended before the line above
   sigset_t set;
   sigemptyset(&set);
   sigprocmask(SIG_SETMASK, &set, nullptr);

@@ -26,7 +26,8 @@ using dds::wall_ns;
 std::string self_executable();
 
 //! Starts `self_executable() args...` as a child with SIGINT/SIGTERM unblocked; stdout/stderr
-//! go to the given files (empty: inherited). Returns the pid, or -1.
+//! go to the given files (empty: inherited); the child gets SIGTERM when the calling thread ends
+//! (PR_SET_PDEATHSIG: call it from the thread that outlives the child). Returns the pid, or -1.
 int spawn_self(const std::vector<std::string>& args, const std::string& stdout_path = "",
                const std::string& stderr_path = "");
 

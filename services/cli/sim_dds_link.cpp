@@ -1,11 +1,13 @@
 #include "sim_dds_link.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "cli_common.hpp"
 #include "dds_common.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/dds/convert.hpp"
+#include "tetra/dds/topics.hpp"
 
 namespace tetra::cli {
 
@@ -76,11 +78,30 @@ Status SimDdsLink::wait_for_readers(const SimDdsOptions& options) {
     const std::int64_t now = monotonic_ns();
     if (now >= give_up) {
       return failure("only " + std::to_string(*matched) + " of " + std::to_string(options.wait_readers) +
-                     " GyroSample readers appeared within " + fixed(options.wait_timeout_s, 1) + " s");
+                     " GyroSample readers appeared within " + fixed(options.wait_timeout_s, 1) + " s" +
+                     incompatible_readers_note());
     }
     if (auto s = session_.wait(std::chrono::nanoseconds(give_up - now), triggered_); !s) return s.error();
   }
   return ok_status();
+}
+
+std::string SimDdsLink::incompatible_readers_note() const {
+  // A reader that was discovered but refused this writer's QoS is counted on the writer's side.
+  for (const auto& [writer, topic] : {std::pair{gyro_writer_.handle(), "GyroSample"},
+                                      std::pair{reference_writer_.handle(), "AttitudeReference"}}) {
+    dds_offered_incompatible_qos_status_t st{};
+    if (dds_get_offered_incompatible_qos_status(writer, &st) != DDS_RETCODE_OK || st.total_count == 0) continue;
+    std::string note = "; " + std::to_string(st.total_count) + " " + topic +
+                       " reader(s) refused this writer's QoS: " + dds::qos_policy_name(st.last_policy_id) +
+                       " (policy id " + std::to_string(st.last_policy_id) + ")";
+    if (st.last_policy_id == DDS_DEADLINE_QOS_POLICY_ID) {
+      note += ", the reader asks for a shorter deadline than 3 periods of --rate-hz: run at the service's "
+              "sample_rate_hz";
+    }
+    return note + " (docs/troubleshooting.md)";
+  }
+  return {};
 }
 
 Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
