@@ -9,8 +9,9 @@ before a block may adjust how it runs (the reader does not see it):
                                                  one per line of the comment): shorter durations, a
                                                  bounded wait instead of an interactive one
     <!-- doc-test: dds -->                        the block talks DDS: it runs on the loopback
-                                                 configuration and on a domain of its own; `--domain 7`
-                                                 (any number) and ROS_DOMAIN_ID become that domain
+                                                 configuration and on a domain of its own (the default
+                                                 domain of CYCLONEDDS_URI); `--domain 7` (any number) and
+                                                 ROS_DOMAIN_ID=7 become that domain
     <!-- doc-test: timeout S -->                  give up after S seconds (default 60)
     <!-- doc-test: expect FILE -->                FILE must exist afterwards (besides those found below)
 
@@ -209,7 +210,13 @@ def main():
                 continue
             block_env = dict(env)
             if block.dds:
-                block_env["CYCLONEDDS_URI"] = "file://" + os.path.join(source, "config", "cyclonedds-loopback.xml")
+                # The loopback configuration with this block's domain as the default one, for the commands
+                # the block runs without --domain.
+                xml = open(os.path.join(source, "config", "cyclonedds-loopback.xml"), encoding="utf-8").read()
+                config = os.path.join(bin_dir, f"cyclonedds-{domain}.xml")
+                with open(config, "w", encoding="utf-8") as out:
+                    out.write(xml.replace('<Domain Id="any">', f'<Domain Id="{domain}">'))
+                block_env["CYCLONEDDS_URI"] = "file://" + config
                 block_env["ROS_DOMAIN_ID"] = str(domain)
                 domain += 1
             status, output, seconds = run_block(block, text, folder, block_env)
