@@ -12,6 +12,12 @@ install(FILES ${PROJECT_SOURCE_DIR}/idl/tetra.idl ${PROJECT_SOURCE_DIR}/idl/ros2
 install(FILES ${PROJECT_SOURCE_DIR}/config/cyclonedds-loopback.xml
         DESTINATION ${CMAKE_INSTALL_DATADIR}/tetra COMPONENT runtime)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples COMPONENT runtime)
+# The ground station's web application (tetra ground finds it at ../share/tetra/web beside the program),
+# with Open MCT's built files when `npm ci` has been run in web/ (otherwise tetra ground says so).
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/web/ DESTINATION ${CMAKE_INSTALL_DATADIR}/tetra/web COMPONENT runtime
+        PATTERN node_modules EXCLUDE)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/web/node_modules/openmct/dist/
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/tetra/web/node_modules/openmct/dist COMPONENT runtime OPTIONAL)
 install(FILES ${PROJECT_SOURCE_DIR}/packaging/bash-completion/tetra
         DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions COMPONENT runtime)
 

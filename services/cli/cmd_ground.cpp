@@ -11,10 +11,6 @@
 #include "tetra/ground/ground_bridge.hpp"
 #include "tetra/ground/http_api.hpp"
 
-#ifndef TETRA_WEB_DIR
-#define TETRA_WEB_DIR "web"
-#endif
-
 namespace tetra::cli {
 
 namespace {
@@ -41,13 +37,16 @@ int cmd_ground(int argc, char** argv) {
   dds::ShutdownSignal shutdown;
   CLI::App app{"Ground station in the browser: DDS to HTTP bridge and the Open MCT application.", "ground"};
   std::string listen = "127.0.0.1:8080";
-  std::string web_dir = TETRA_WEB_DIR;
+  std::string web_dir = default_web_dir();
   ground::StoreConfig store_config;
   ground::ServerConfig server_config;
   double command_timeout_s = 5.0;
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
   app.add_option("--listen", listen, "HOST:PORT to serve on (default loopback only; port 0: any free port)");
-  app.add_option("--web", web_dir, "the web application's directory (with node_modules/ from npm ci)");
+  app.add_option("--web", web_dir,
+                 "the web application's directory (with node_modules/ from npm ci); default: ../share/tetra/web "
+                 "beside the program when installed, else the source tree's web/")
+      ->capture_default_str();
   app.add_option("--records", server_config.records_dir,
                  "serve the attitude and event files of tetra record in this folder (/api/records)")
       ->check(CLI::ExistingDirectory);

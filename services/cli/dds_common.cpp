@@ -43,6 +43,18 @@ std::string self_executable() {
   return std::filesystem::read_symlink("/proc/self/exe").string();
 }
 
+#ifndef TETRA_WEB_DIR
+#define TETRA_WEB_DIR "web"
+#endif
+
+std::string default_web_dir() {
+  const std::filesystem::path installed =
+      std::filesystem::path(self_executable()).parent_path() / ".." / "share" / "tetra" / "web";
+  std::error_code ec;
+  if (std::filesystem::is_directory(installed, ec)) return installed.lexically_normal().string();
+  return TETRA_WEB_DIR;
+}
+
 int spawn_self(const std::vector<std::string>& args, const std::string& stdout_path,
                const std::string& stderr_path) {
   const std::string exe = self_executable();

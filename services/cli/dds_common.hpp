@@ -25,6 +25,10 @@ using dds::wall_ns;
 //! Path of the running program (/proc/self/exe).
 std::string self_executable();
 
+//! The ground station's web application: `../share/tetra/web` beside the program when it is installed
+//! (cmake --install), else the source tree's `web/` the program was built from.
+std::string default_web_dir();
+
 //! Starts `self_executable() args...` as a child with SIGINT/SIGTERM unblocked; stdout/stderr
 //! go to the given files (empty: inherited); the child gets SIGTERM when the calling thread ends
 //! (PR_SET_PDEATHSIG: call it from the thread that outlives the child). Returns the pid, or -1.

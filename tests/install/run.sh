@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The install test (ctest install_consumer): installs the build tree into a temporary prefix, then
-#  1. the installed program runs, its man pages and bash completion are in place;
+#  1. the installed program runs, its man pages (one per command), bash completion and web application
+#     are in place, and `tetra ground` finds the web application beside itself;
 #  2. tests/install (find_package(tetra), tetra::core/fdi/sim) configures, builds and runs against it;
 #  3. a program built with `pkg-config --cflags --libs tetra` alone compiles, links and runs.
 #   run.sh SOURCE_DIR BUILD_DIR WORK_DIR
@@ -21,6 +22,18 @@ for page in tetra tetra-calibrate tetra-allan tetra-sim tetra-replay tetra-fusio
 done
 [ -f "$prefix/share/bash-completion/completions/tetra" ] || { echo "install: no bash completion" >&2; exit 1; }
 [ -f "$prefix/share/tetra/idl/tetra.idl" ] || { echo "install: no IDL" >&2; exit 1; }
+# One man page per command `tetra help` lists, and tetra.1 (docs/install.md gives the count).
+commands=$("$prefix/bin/tetra" help | sed -n '/^commands:/,$p' | awk '/^  [a-z]/ && $1 != "help" {print $1}')
+for c in $commands; do
+  [ -n "$(find "$prefix" -path "*/man1/tetra-$c.1.gz")" ] || { echo "install: no man page for $c" >&2; exit 1; }
+done
+pages=$(find "$prefix" -path "*/man1/tetra*.1.gz" | wc -l)
+grep -q "its $pages man pages" "$src/docs/install.md" ||
+  { echo "install: $pages man pages installed; docs/install.md says otherwise" >&2; exit 1; }
+# The ground station's web application, found by the installed program beside itself.
+[ -f "$prefix/share/tetra/web/index.html" ] || { echo "install: no web application" >&2; exit 1; }
+"$prefix/bin/tetra" ground --help | grep -q -- "--web TEXT=$prefix/share/tetra/web" ||
+  { echo "install: tetra ground does not default to the installed web application" >&2; exit 1; }
 
 cmake -S "$src/tests/install" -B "$work/consumer" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release \
   >"$work/consumer-configure.log"
