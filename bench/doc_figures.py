@@ -8,6 +8,7 @@ GROUP:
                calibrate -> lab-orbit -> replay (own calibration, factory calibration) -> score
   closed-loop  docs/sim.md's closed-loop table and the stuck/ramp variants
                (examples/sim/closed_loop_nadir.yaml; --plot rewrites docs/closed_loop_exclusion.png)
+  allan        docs/allan.md's example (two hours of the simulated unit at rest, 100 Hz)
   demo         the length of `tetra demo` (README.md, docs/dds.md); wall clock, so never --check'ed
 
 --check compares each figure with the number the doc prints (the doc's text is searched with a pattern
@@ -143,6 +144,26 @@ CLOSED_LOOP_CHECKS = [  # relative tolerances
 ]
 
 
+def allan(d):
+    tetra("sim", "static", "--rate-hz", "100", "--minutes", "120", "-o", "static_2h.csv", cwd=d)
+    tetra("sim", "--write-unit", "cal.yaml", cwd=d)
+    out = tetra("allan", "static_2h.csv", "--calibration", "cal.yaml", cwd=d)
+    rows = re.findall(r"^([1-4])\s+NO\s+([\d.e+-]+)\s+([\d.e+-]+)\s+NO", out, re.M)[:4]
+    f = {f"{k}{g}": float(v) for g, n, b in rows for k, v in (("N", n), ("B", b))}
+    f["B_min"], f["B_max"] = min(f[f"B{g}"] for g in "1234"), max(f[f"B{g}"] for g in "1234")
+    print("gyro  N [deg/√s]  B [deg/s]")
+    for g in "1234":
+        print(f"{g}     {f['N' + g]:.2e}    {f['B' + g]:.2e}")
+    return f
+
+
+ALLAN_CHECKS = [  # printed to 3 digits: 0.2 % relative
+    ("docs/allan.md", r"R \[deg/s²\]\n1     NO              ([\d.e+-]+)        [\d.e+-]+        NO", "N1", 0.002, "3 digits"),
+    ("docs/allan.md", r"R \[deg/s²\]\n1     NO              [\d.e+-]+        ([\d.e+-]+)        NO", "B1", 0.002, "3 digits"),
+    ("docs/allan.md", r"B \(([\d.]+)[–-][\d.]+e-6 deg/s over", "B_min", 0.02, "2 digits, in units of 1e-6"),
+]
+
+
 def demo(d):
     start = time.monotonic()
     tetra("demo", cwd=d)
@@ -176,7 +197,7 @@ def main():
     ap.add_argument("--source", default=".")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--plot", action="store_true", help="closed-loop: rewrite docs/closed_loop_exclusion.png")
-    ap.add_argument("groups", nargs="+", choices=["seed", "closed-loop", "demo"])
+    ap.add_argument("groups", nargs="+", choices=["seed", "closed-loop", "allan", "demo"])
     ARGS = ap.parse_args()
     ARGS.tetra = os.path.abspath(ARGS.tetra)
     ARGS.source = os.path.abspath(ARGS.source)
@@ -190,6 +211,10 @@ def main():
             elif g == "closed-loop":
                 f = closed_loop(d)
                 bad += check(f, CLOSED_LOOP_CHECKS, True) if ARGS.check else 0
+            elif g == "allan":
+                f = allan(d)
+                f["B_min"] *= 1e6
+                bad += check(f, ALLAN_CHECKS, True) if ARGS.check else 0
             else:
                 demo(d)
     return 1 if bad else 0
