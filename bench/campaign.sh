@@ -17,5 +17,7 @@ runs=$(($(wc -l <"$out/runs.csv") - 1))
 echo "runs: $runs in $(echo "$end - $start" | bc) s wall (report and plots included)"
 wrong=$(awk -F, 'NR > 1 && $8 == "wrong"' "$out/runs.csv" | wc -l)
 echo "wrong exclusions: $wrong"
-sed -n '/## Isolation/,/## Wrong/p' "$out/report.md"
+# The report's sections docs/campaign.md quotes: outcomes, delays, false alarms, pointing.
+sed -n '/## Isolation/,/## Wrong/p; /## Detection/,/^CUSUM theory/p; /## False alarms/,/^0 detections\|per hour/p; /## Pointing/,/Recovered/p' \
+  "$out/report.md" | grep -v '^!\['
 [ "$wrong" -eq 0 ]
