@@ -9,7 +9,8 @@ GROUP:
   closed-loop  docs/sim.md's closed-loop table and the stuck/ramp variants
                (examples/sim/closed_loop_nadir.yaml; --plot rewrites docs/closed_loop_exclusion.png)
   allan        docs/allan.md's example (two hours of the simulated unit at rest, 100 Hz)
-  demo         the length of `tetra demo` (README.md, docs/dds.md); wall clock, so never --check'ed
+  demo-length  the length of `tetra demo` from its defaults (simulated seconds / speed), as the docs quote it
+  demo         the length of `tetra demo` measured (wall clock, so never --check'ed)
 
 --check compares each figure with the number the doc prints (the doc's text is searched with a pattern
 that must match exactly once) within the tolerance given beside it, and exits 1 on any difference. Every
@@ -164,6 +165,22 @@ ALLAN_CHECKS = [  # printed to 3 digits: 0.2 % relative
 ]
 
 
+def demo_length(d):
+    """The demo's length from its defaults (simulated seconds / speed): what the docs quote, not timed."""
+    out = tetra("demo", "--help", cwd=d)
+    seconds = num(r"--seconds [^=\n]*=([\d.]+)", out)
+    speed = num(r"--speed [^=\n]*=([\d.]+)", out)
+    print(f"tetra demo: {seconds:g} simulated s at {speed:g}x real time: {seconds / speed:g} s of wall clock")
+    return {"demo_s": seconds / speed, "demo_sim_s": seconds, "demo_speed": speed}
+
+
+DEMO_CHECKS = [  # the docs round to whole seconds; the measured run adds ~0.5 s of start-up and summary
+    ("README.md", r"then the demo's\s+(\d+) s:", "demo_s", 0.5, "whole seconds"),
+    ("README.md", r"s: (\d+) simulated seconds", "demo_sim_s", 0.5, "whole seconds"),
+    ("docs/dds.md", r"everything below in ~(\d+) s", "demo_s", 0.5, "whole seconds"),
+]
+
+
 def demo(d):
     start = time.monotonic()
     tetra("demo", cwd=d)
@@ -197,7 +214,7 @@ def main():
     ap.add_argument("--source", default=".")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--plot", action="store_true", help="closed-loop: rewrite docs/closed_loop_exclusion.png")
-    ap.add_argument("groups", nargs="+", choices=["seed", "closed-loop", "allan", "demo"])
+    ap.add_argument("groups", nargs="+", choices=["seed", "closed-loop", "allan", "demo-length", "demo"])
     ARGS = ap.parse_args()
     ARGS.tetra = os.path.abspath(ARGS.tetra)
     ARGS.source = os.path.abspath(ARGS.source)
@@ -215,6 +232,9 @@ def main():
                 f = allan(d)
                 f["B_min"] *= 1e6
                 bad += check(f, ALLAN_CHECKS, True) if ARGS.check else 0
+            elif g == "demo-length":
+                f = demo_length(d)
+                bad += check(f, DEMO_CHECKS, False) if ARGS.check else 0
             else:
                 demo(d)
     return 1 if bad else 0

@@ -346,7 +346,7 @@ int cmd_demo(int argc, char** argv) {
   dds::ShutdownSignal shutdown;
   CLI::App app{
       "Simulator + fusion service + monitor on a private loopback DDS domain, with a gyro failure "
-      "injected mid-run, and a summary. Takes about 30 s.",
+      "injected mid-run, and a summary. Takes about 20 s (--seconds / --speed).",
       "demo"};
   DemoOptions o;
   add_demo_options(app, o);
