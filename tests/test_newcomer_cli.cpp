@@ -65,7 +65,8 @@ int processes_mentioning(const std::string& text) {
     std::ifstream in(entry.path() / "cmdline");
     std::string cmdline((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     for (char& c : cmdline) c = c == '\0' ? ' ' : c;
-    if (cmdline.find(text) != std::string::npos && cmdline.find("test_newcomer_cli") == std::string::npos) ++n;
+    if (cmdline.find(text) != std::string::npos && cmdline.find("test_newcomer_cli") == std::string::npos)
+      ++n;
   }
   return n;
 }
@@ -112,8 +113,9 @@ TEST(FusionCli, ShippedServiceConfigurationIsAcceptedAndItsReadersTimeoutNamesTh
   TempDir dir;
   TetraProcess fusion({"fusion", "--config", source_path("examples/fusion_service.yaml"), "--domain", "226"},
                       dir.file("fusion.log"));
-  ASSERT_TRUE(eventually([&] { return read_file(dir.file("fusion.log")).find("running") != std::string::npos; }))
-      << read_file(dir.file("fusion.log"));
+  ASSERT_TRUE(eventually([&] {
+    return read_file(dir.file("fusion.log")).find("running") != std::string::npos;
+  })) << read_file(dir.file("fusion.log"));
   // The service expects 100 Hz (deadline 3 periods = 0.03 s); a sensor at 10 Hz offers 0.3 s: refused.
   const auto sim = run_tetra(
       "sim orbit --dds --dds-unit tetra-1 --domain 226 --minutes 0.1 --reference-hz 0 --wait-timeout 5");
@@ -125,9 +127,11 @@ TEST(FusionCli, ShippedServiceConfigurationIsAcceptedAndItsReadersTimeoutNamesTh
 
 TEST(CampaignCli, DomainOptionAppliesToDdsCampaignsOnly) {
   TempDir dir;
-  write_file(dir.file("c.yaml"), "loop: open\nscenarios: [orbit]\nduration_s: 60\nkinds: [stuck]\ngyros: [3]\n"
-                                 "onsets_s: [30]\nseeds: [1]\n");
-  const auto result = run_tetra("campaign " + dir.file("c.yaml") + " --out " + dir.file("out") + " --domain 5");
+  write_file(dir.file("c.yaml"),
+             "loop: open\nscenarios: [orbit]\nduration_s: 60\nkinds: [stuck]\ngyros: [3]\n"
+             "onsets_s: [30]\nseeds: [1]\n");
+  const auto result =
+      run_tetra("campaign " + dir.file("c.yaml") + " --out " + dir.file("out") + " --domain 5");
   EXPECT_EQ(result.exit_status, 2) << result.err;
   EXPECT_NE(result.err.find("--domain"), std::string::npos) << result.err;
 }
@@ -142,9 +146,9 @@ TEST(CampaignCli, SigtermStopsWorkersAndServicesAndTheSameCommandResumes) {
              "onsets_s: [20]\nseeds: [1]\ntarget: dds\ndomain: 3\n");
   const std::string out = dir.file("out");
   {
-    TetraProcess campaign({"campaign", dir.file("c.yaml"), "--out", out, "--jobs", "2", "--no-report",
-                           "--domain", "227"},
-                          dir.file("campaign.log"));
+    TetraProcess campaign(
+        {"campaign", dir.file("c.yaml"), "--out", out, "--jobs", "2", "--no-report", "--domain", "227"},
+        dir.file("campaign.log"));
     ASSERT_TRUE(eventually([&] { return processes_mentioning(out + "/dds/") >= 1; }))
         << read_file(dir.file("campaign.log"));
     EXPECT_EQ(campaign.signal_and_wait(SIGTERM), 1) << read_file(dir.file("campaign.log"));
@@ -155,8 +159,8 @@ TEST(CampaignCli, SigtermStopsWorkersAndServicesAndTheSameCommandResumes) {
   // The services get SIGTERM when their worker ends; allow them their orderly exit.
   EXPECT_TRUE(eventually([&] { return processes_mentioning(out) == 0; }, std::chrono::seconds(20)))
       << processes_mentioning(out) << " processes of the campaign are still running";
-  const auto resumed = run_tetra("campaign " + dir.file("c.yaml") + " --out " + out +
-                                 " --jobs 2 --no-report --domain 227");
+  const auto resumed =
+      run_tetra("campaign " + dir.file("c.yaml") + " --out " + out + " --jobs 2 --no-report --domain 227");
   ASSERT_EQ(resumed.exit_status, 0) << resumed.err;
   std::istringstream rows(read_file(out + "/runs.csv"));
   int n = 0;

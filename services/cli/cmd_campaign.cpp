@@ -211,7 +211,8 @@ int cmd_campaign(int argc, char** argv) {
   app.add_flag("--no-report", no_report, "only the runs (no report, no plots)");
   int domain = 0;
   CLI::Option* domain_opt =
-      app.add_option("--domain", domain, "DDS domain of the services (target dds; overrides the spec's domain:)")
+      app.add_option("--domain", domain,
+                     "DDS domain of the services (target dds; overrides the spec's domain:)")
           ->check(CLI::Range(0, 232));
   if (auto status = parse(app, argc, argv)) return *status;
 

@@ -43,9 +43,10 @@ int cmd_ground(int argc, char** argv) {
   double command_timeout_s = 5.0;
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
   app.add_option("--listen", listen, "HOST:PORT to serve on (default loopback only; port 0: any free port)");
-  app.add_option("--web", web_dir,
-                 "the web application's directory (with node_modules/ from npm ci); default: ../share/tetra/web "
-                 "beside the program when installed, else the source tree's web/")
+  app.add_option(
+         "--web", web_dir,
+         "the web application's directory (with node_modules/ from npm ci); default: ../share/tetra/web "
+         "beside the program when installed, else the source tree's web/")
       ->capture_default_str();
   app.add_option("--records", server_config.records_dir,
                  "serve the attitude and event files of tetra record in this folder (/api/records)")

@@ -65,8 +65,8 @@ struct SimArgs {
   std::string unit_path;
   std::string out_path;
   std::string truth_path;
-  std::string write_unit_path;  // --write-unit: the simulated unit as a calibration YAML, then stop
-  std::vector<std::string> fault_texts;      // --fault: replace the scenario's faults
+  std::string write_unit_path;           // --write-unit: the simulated unit as a calibration YAML, then stop
+  std::vector<std::string> fault_texts;  // --fault: replace the scenario's faults
   std::vector<std::string> add_fault_texts;  // --add-fault: added to the scenario's faults
   ScenarioOverrides over;
   sim::TurntablePlan plan;
@@ -305,8 +305,8 @@ int write_unit(const SimArgs& a) {
   const auto meta = provenance_metadata(provenance(files.input_paths()));
   if (Status st = write_calibration(**out, cal, meta); !st) return report(kSimName, st.error());
   if (Status st = files.commit(); !st) return report(kSimName, st.error());
-  std::cerr << "tetra sim: unit '" << cal.unit << "', " << cal.gyro_count() << " gyros -> " << a.write_unit_path
-            << '\n';
+  std::cerr << "tetra sim: unit '" << cal.unit << "', " << cal.gyro_count() << " gyros -> "
+            << a.write_unit_path << '\n';
   return kExitOk;
 }
 
@@ -328,7 +328,8 @@ int cmd_sim(int argc, char** argv) {
 #endif
   if (auto status = parse(app, argc, argv)) return *status;
   if (!a.write_unit_path.empty()) return write_unit(a);
-  if (a.scenario_name.empty()) return report(kSimName, bad_input("SCENARIO is required (or --write-unit FILE)"));
+  if (a.scenario_name.empty())
+    return report(kSimName, bad_input("SCENARIO is required (or --write-unit FILE)"));
 
   RunFiles files;
   auto out = open_files(a, files);

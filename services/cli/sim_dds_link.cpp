@@ -91,13 +91,15 @@ std::string SimDdsLink::incompatible_readers_note() const {
   for (const auto& [writer, topic] : {std::pair{gyro_writer_.handle(), "GyroSample"},
                                       std::pair{reference_writer_.handle(), "AttitudeReference"}}) {
     dds_offered_incompatible_qos_status_t st{};
-    if (dds_get_offered_incompatible_qos_status(writer, &st) != DDS_RETCODE_OK || st.total_count == 0) continue;
+    if (dds_get_offered_incompatible_qos_status(writer, &st) != DDS_RETCODE_OK || st.total_count == 0)
+      continue;
     std::string note = "; " + std::to_string(st.total_count) + " " + topic +
                        " reader(s) refused this writer's QoS: " + dds::qos_policy_name(st.last_policy_id) +
                        " (policy id " + std::to_string(st.last_policy_id) + ")";
     if (st.last_policy_id == DDS_DEADLINE_QOS_POLICY_ID) {
-      note += ", the reader asks for a shorter deadline than 3 periods of --rate-hz: run at the service's "
-              "sample_rate_hz";
+      note +=
+          ", the reader asks for a shorter deadline than 3 periods of --rate-hz: run at the service's "
+          "sample_rate_hz";
     }
     return note + " (docs/troubleshooting.md)";
   }
