@@ -300,6 +300,12 @@ check values "sim --orbit-period 1e-300" 2 "--orbit-period: '1e-300' must be fro
   sim orbit --minutes 0.1 --orbit-period 1e-300 -o s.csv
 check values "sim --minutes inf" 2 "^tetra sim: --minutes: 'inf' must be above 0 and at most 1e\+07 .{0,40}$" "" -- \
   sim orbit --minutes inf -o s.csv
+if "$TETRA" sim --help | grep -q -- '--speed'; then  # built with DDS
+  check values "sim --dds --speed 1e-300" 2 "--speed: '1e-300' must be 0 \(as fast as possible\) or at least 0.001" "" -- \
+    sim orbit --dds --speed 1e-300
+  check values "sim --dds --wait-timeout 1e300" 2 "--wait-timeout: '1e300' must be above 0 and at most 86400" "" -- \
+    sim orbit --dds --wait-timeout 1e300
+fi
 printf 'scenario: orbit\norbit_period_s: 1e-300\n' >period.yaml
 check values "scenario orbit_period_s 1e-300" 2 "period.yaml:2: orbit_period_s must be from 1200 to" "" -- \
   sim period.yaml --minutes 0.1 -o s.csv
