@@ -410,6 +410,25 @@ TEST(CampaignSpec, ImpossibleCasesAreRefusedUpFront) {
   EXPECT_NE(flat.error().message.find("c.yaml:2: scenarios[1] ("), std::string::npos) << flat.error().message;
   EXPECT_NE(flat.error().message.find("the fusion pipeline cannot run this unit"), std::string::npos)
       << flat.error().message;
+  // Gyro 1 without white noise: a noise fault on it has nothing to multiply.
+  test::write_file(
+      dir.file("quiet.yaml"),
+      "unit: quiet\ngyros:\n"
+      "  - {id: 1, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [1, 0, 0]}\n"
+      "  - {id: 2, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [0, 1, 0], noise: {arw_dps_rtHz: 3e-5}}\n"
+      "  - {id: 3, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [0, 0, 1], noise: {arw_dps_rtHz: 3e-5}}\n"
+      "  - {id: 4, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [0.6, 0.8, 0], noise: {arw_dps_rtHz: "
+      "3e-5}}\n");
+  test::write_file(dir.file("quiet_orbit.yaml"), "scenario: orbit\nunit: quiet.yaml\n");
+  test::write_file(dir.file("n.yaml"),
+                   "loop: open\nscenarios: [quiet_orbit.yaml]\nkinds: [stuck, noise]\n"
+                   "sizes: {noise: [10]}\ngyros: [2, 1]\nonsets_s: [60]\nseeds: [1]\n");
+  const auto quiet = read_campaign_spec(dir.file("n.yaml"));
+  ASSERT_FALSE(quiet);
+  EXPECT_NE(quiet.error().message.find("n.yaml:3: kinds[1]: cannot run on gyro 1 of scenarios[0] ("),
+            std::string::npos)
+      << quiet.error().message;
+  EXPECT_NE(quiet.error().message.find("has no white noise"), std::string::npos) << quiet.error().message;
 }
 
 // Inertia, torques and momenta out of their stated ranges are refused naming the key and its line.
