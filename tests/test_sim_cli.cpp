@@ -88,6 +88,11 @@ TEST(SimCli, BadInputExitsTwoWithOneClearLine) {
   TempDir dir;
   write_file(dir.file("bad.yaml"), "scenario: orbit\nrate_hz: 10\nreference: {hz: 1}\n");
   write_file(dir.file("badfault.yaml"), "scenario: orbit\nfaults: [\"gyro=1,kind=bias,at=1\"]\n");
+  write_file(dir.file("period.yaml"), "scenario: orbit\norbit_period_s: 1e-300\n");
+  write_file(dir.file("inertia.yaml"),
+             "scenario: orbit\nclosed_loop:\n  inertia_kg_m2: [1e300, 1e300, 1e300]\n");
+  write_file(dir.file("torque.yaml"),
+             "scenario: orbit\nclosed_loop:\n  disturbance: {constant_Nm: [1e300, 0, 0]}\n");
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"sim orbit --fault gyro=1,kind=melt,at=3 --out " + dir.file("x.csv"), "unknown kind 'melt'"},
       {"sim orbit --fault gyro=7,kind=zero,at=3 --out " + dir.file("x.csv"), "gyro 7 does not exist"},
@@ -106,6 +111,17 @@ TEST(SimCli, BadInputExitsTwoWithOneClearLine) {
       {"sim turntable --minutes 3", "--minutes does not apply"},
       {"sim orbit --wrap --out " + dir.file("x.csv"), "--wrap applies to the turntable scenario only"},
       {"sim orbit --unit " + dir.file("nounit.yaml") + " --out " + dir.file("x.csv"), "nounit.yaml"},
+      // Physical ranges (docs/sim.md, "Ranges"): these wrote all-NaN logs with exit 0.
+      {"sim orbit --acs-amplitude 1e300 --out " + dir.file("x.csv"),
+       "--acs-amplitude: '1e300' must be from 0 to 45"},
+      {"sim orbit --orbit-period 1e-300 --out " + dir.file("x.csv"),
+       "--orbit-period: '1e-300' must be from 20 to"},
+      {"sim orbit --minutes 1e7 --rate-hz 100 --out " + dir.file("x.csv"), "(with --rate-hz, --minutes)"},
+      {"sim " + dir.file("period.yaml") + " --out " + dir.file("x.csv"),
+       "period.yaml:2: orbit_period_s must be"},
+      {"sim " + dir.file("inertia.yaml") + " --closed-loop", "inertia.yaml:3: closed_loop: inertia_kg_m2"},
+      {"sim " + dir.file("torque.yaml") + " --closed-loop",
+       "torque.yaml:3: closed_loop: disturbance.constant_Nm[0]"},
   };
   for (const auto& [args, needle] : cases) {
     auto r = run_tetra(args);
@@ -114,6 +130,11 @@ TEST(SimCli, BadInputExitsTwoWithOneClearLine) {
     EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\n" << r.err;
   }
   EXPECT_FALSE(std::filesystem::exists(dir.file("x.csv")));
+  // An infinite duration: one short line (CLI11's own check printed a 300-digit bound).
+  const auto inf = run_tetra("sim orbit --minutes inf --out " + dir.file("x.csv"));
+  EXPECT_EQ(inf.exit_status, 2) << inf.err;
+  EXPECT_NE(inf.err.find("--minutes: 'inf' must be above 0 and at most 1e+07"), std::string::npos) << inf.err;
+  EXPECT_LT(inf.err.size(), 120u) << inf.err;
 }
 
 }  // namespace

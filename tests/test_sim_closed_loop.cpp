@@ -236,12 +236,12 @@ TEST(CampaignSpec, ExamplesReadWithTheirTargets) {
   ASSERT_TRUE(local) << local.error().message;
   EXPECT_EQ(local->target, CampaignTarget::kInProcess);
   EXPECT_EQ(local->loop, CampaignLoop::kClosed);
-  EXPECT_EQ(expand_campaign(*local).size(), 520u);
+  EXPECT_EQ(campaign_run_count(*local).value(), 520u);
   const auto wire = read_campaign_spec(test::source_path("examples/campaign_dds.yaml"));
   ASSERT_TRUE(wire) << wire.error().message;
   EXPECT_EQ(wire->target, CampaignTarget::kDds);
   EXPECT_EQ(wire->dds_domain, 0);
-  EXPECT_EQ(expand_campaign(*wire).size(), 26u);
+  EXPECT_EQ(campaign_run_count(*wire).value(), 26u);
 }
 
 // A service configured with pipeline_yaml_from starts from the very initial attitude (every bit) and
@@ -259,6 +259,227 @@ TEST(CampaignSpec, ServicePipelineKeepsTheInitialAttitudeExactly) {
   ASSERT_TRUE(config) << config.error().message;
   EXPECT_EQ(config->initial_q_RB.coeffs(), q.coeffs());
   EXPECT_FALSE(config->exclusion_enabled);
+}
+
+// Cases are made on demand (index → case) in the documented order: scenario, fault-free runs, kind, gyro,
+// onset, size, seed, checked against the nested loops that order describes.
+TEST(CampaignSpec, CasesAreMadeOnDemandInTheFixedOrder) {
+  test::TempDir dir;
+  test::write_file(
+      dir.file("spec.yaml"),
+      "loop: open\nscenarios: [orbit, slews]\nkinds: [bias, stuck]\nsizes: {bias: [0.01, 0.02]}\n"
+      "gyros: [2, 1]\nonsets_s: [60, 30]\nseeds: [7, 3]\nfault_free: true\n");
+  const auto spec = read_campaign_spec(dir.file("spec.yaml"));
+  ASSERT_TRUE(spec) << spec.error().message;
+  std::vector<CampaignCase> expected;
+  for (std::size_t s = 0; s < 2; ++s) {
+    for (std::uint64_t seed : {7u, 3u}) expected.push_back({expected.size(), s, std::nullopt, seed});
+    for (FaultKind kind : {FaultKind::kBias, FaultKind::kStuck}) {
+      for (int gyro : {2, 1}) {
+        for (double onset : {60.0, 30.0}) {
+          for (double size :
+               kind == FaultKind::kBias ? std::vector<double>{0.01, 0.02} : std::vector<double>{0.0}) {
+            for (std::uint64_t seed : {7u, 3u}) {
+              FaultSpec f;
+              f.kind = kind;
+              f.gyro = gyro;
+              f.at_s = onset;
+              f.size = size;
+              expected.push_back({expected.size(), s, f, seed});
+            }
+          }
+        }
+      }
+    }
+  }
+  ASSERT_EQ(campaign_run_count(*spec).value(), expected.size());  // 2 × (2 + 2·2·2·2 + 2·2·1·2) = 52
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    const CampaignCase c = campaign_case(*spec, i);
+    EXPECT_EQ(c.index, i);
+    EXPECT_EQ(c.scenario, expected[i].scenario) << i;
+    EXPECT_EQ(c.seed, expected[i].seed) << i;
+    ASSERT_EQ(c.fault.has_value(), expected[i].fault.has_value()) << i;
+    if (!c.fault) continue;
+    EXPECT_EQ(format_fault_spec(*c.fault), format_fault_spec(*expected[i].fault)) << i;
+  }
+}
+
+// A small spec describing an enormous matrix (20,000 onsets × 20,000 seeds: 218 KB) is refused before any
+// case exists, naming the lists and the product; the count itself never overflows.
+TEST(CampaignSpec, HugeMatrixIsRefusedBeforeExpansion) {
+  test::TempDir dir;
+  std::string onsets, seeds;
+  for (int i = 0; i < 20000; ++i) {
+    onsets += (i ? ", " : "") + std::to_string(i + 1);
+    seeds += (i ? ", " : "") + std::to_string(i);
+  }
+  test::write_file(dir.file("big.yaml"),
+                   "loop: open\nscenarios: [orbit]\nkinds: [stuck]\ngyros: [1]\nonsets_s: [" + onsets +
+                       "]\nseeds: [" + seeds + "]\nduration_s: 30000\n");
+  const auto big = read_campaign_spec(dir.file("big.yaml"));
+  ASSERT_FALSE(big);
+  EXPECT_EQ(big.error().message.find(dir.file("big.yaml") + ": the matrix has 400000000 runs ("), 0u)
+      << big.error().message;
+  for (const char* needle : {"onsets_s 20000", "seeds 20000", "more than 1000000"})
+    EXPECT_NE(big.error().message.find(needle), std::string::npos) << big.error().message;
+  // Far beyond 2^64 with a few lists (built in memory): still an error with the exact count, no wrap-around.
+  CampaignSpec spec;
+  spec.scenarios.resize(3);
+  spec.kinds = {FaultKind::kBias};
+  spec.gyros = {1, 2, 3, 4};
+  spec.onsets_s.resize(1'000'000);
+  spec.seeds.resize(1'000'000);
+  spec.sizes = {{FaultKind::kBias, std::vector<double>(1'000'000)}};
+  spec.fault_free = true;
+  const auto huge = campaign_run_count(spec);
+  ASSERT_FALSE(huge);
+  EXPECT_NE(huge.error().message.find("1.2e+19 runs"), std::string::npos) << huge.error().message;
+  spec.onsets_s.resize(10);
+  spec.seeds.resize(10);
+  spec.sizes[0].second.resize(10);
+  EXPECT_EQ(campaign_run_count(spec).value(), 3u * (10u + 4u * 10u * 10u * 10u));
+}
+
+// Every value of a spec is checked up front, its key named, its line given; nothing runs.
+TEST(CampaignSpec, EveryValueIsCheckedNamingTheKey) {
+  test::TempDir dir;
+  const std::string head = "loop: open\nscenarios: [orbit]\n";
+  const std::string rest = "gyros: [1]\nonsets_s: [60]\nseeds: [1]\n";
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {head + "kinds: [stuck]\ngyros: [1]\nonsets_s: [.nan]\nseeds: [1]\n",
+       "c.yaml:5: onsets_s[0]: '.nan' is not a number"},
+      {head + "kinds: [stuck]\ngyros: [1]\nonsets_s: [-10]\nseeds: [1]\n",
+       "c.yaml:5: onsets_s[0]: must not be negative"},
+      {head + "kinds: [bias]\nsizes: {bias: [.nan]}\n" + rest,
+       "c.yaml:4: sizes.bias[0]: '.nan' is not a number"},
+      {head + "kinds: [bias]\nsizes: {bias: [1e309]}\n" + rest, "c.yaml:4: sizes.bias[0]: "},
+      {head + "kinds: [noise]\nsizes: {noise: [-2]}\n" + rest,
+       "c.yaml:4: sizes.noise[0]: a noise multiplier"},
+      {head + "kinds: [stuck]\nsizes: {bias: [0.01]}\n" + rest,
+       "c.yaml:4: sizes.bias: kind bias is not in kinds"},
+      {head + "kinds: [stuck]\nsizes: {stuck: [1]}\n" + rest,
+       "c.yaml:4: sizes.stuck: kind stuck takes no size"},
+      {head + "kinds: [stuck]\ngyros: [1, 1]\nonsets_s: [60]\nseeds: [1]\n",
+       "c.yaml:4: gyros[1]: the same value as gyros[0]"},
+      {head + "kinds: [stuck, stuck]\n" + rest, "c.yaml:3: kinds[1]: the same value as kinds[0]"},
+      {head + "kinds: [stuck]\ngyros: [1]\nonsets_s: [60]\nseeds: [-1]\n",
+       "c.yaml:6: seeds[0]: expected a whole number from 0 to 18446744073709551615, got '-1'"},
+      {head + "kinds: [stuck]\n" + rest + "fault_free: maybe\n",
+       "c.yaml:7: fault_free: expected true or false, got 'maybe'"},
+      {head + "kinds: [stuck]\ngyros: [1.5]\nonsets_s: [60]\nseeds: [1]\n",
+       "c.yaml:4: gyros[0]: expected a whole number from 1 to 32, got '1.5'"},
+      {head + "kinds: [stuck]\ngyros: [5]\nonsets_s: [60]\nseeds: [1]\n",
+       "c.yaml:4: gyros[0]: gyro 5 does not exist in scenarios[0] (orbit)"},
+      {head + "kinds: [stuck]\ngyros: [1]\nonsets_s: [60, 7000]\nseeds: [1]\n",
+       "c.yaml:5: onsets_s[1]: 7000 s is at or after the end of scenarios[0] (orbit) (6000 s)"},
+      {head + "kinds: [stuck]\n" + rest + "duration_s: 1e300\n",
+       "c.yaml:7: duration_s: with scenarios[0] (orbit): duration_s must be above 0 and at most 6e+08 s"},
+      {head + "kinds: [stuck]\n" + rest + "duration_s: 30\n",
+       "c.yaml:5: onsets_s[0]: 60 s is at or after the end of scenarios[0] (orbit) (30 s, duration_s)"},
+      {"loop: [open]\nscenarios: [orbit]\nkinds: [stuck]\n" + rest, "c.yaml:1: loop: expected a text value"},
+      {head + "kinds: [stuck]\n" + rest + "target: dds\ndomain: 999\n",
+       "c.yaml:8: domain: expected a whole number from 0 to 232, got '999'"},
+      {head + "kinds: [stuck]\n" + rest + "seeds: [2]\n", "key 'seeds' appears twice"},
+  };
+  for (const auto& [text, needle] : bad) {
+    test::write_file(dir.file("c.yaml"), text);
+    const auto spec = read_campaign_spec(dir.file("c.yaml"));
+    ASSERT_FALSE(spec) << text;
+    EXPECT_NE(spec.error().message.find(needle), std::string::npos) << text << " -> " << spec.error().message;
+  }
+}
+
+// A case that cannot run is refused before the campaign starts, naming it: a scenario whose unit the
+// pipeline cannot fuse (coplanar axes), a noise fault on a gyro without white noise.
+TEST(CampaignSpec, ImpossibleCasesAreRefusedUpFront) {
+  test::TempDir dir;
+  test::write_file(
+      dir.file("flat.yaml"),
+      "unit: flat\ngyros:\n"
+      "  - {id: 1, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [1, 0, 0], noise: {arw_dps_rtHz: 3e-5}}\n"
+      "  - {id: 2, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [0, 1, 0], noise: {arw_dps_rtHz: 3e-5}}\n"
+      "  - {id: 3, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [0.6, 0.8, 0], noise: {arw_dps_rtHz: "
+      "3e-5}}\n"
+      "  - {id: 4, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [0.8, -0.6, 0]}\n");
+  test::write_file(dir.file("flat_orbit.yaml"), "scenario: orbit\nunit: flat.yaml\n");
+  test::write_file(dir.file("c.yaml"),
+                   "loop: open\nscenarios: [orbit, flat_orbit.yaml]\nkinds: [stuck]\n"
+                   "gyros: [1]\nonsets_s: [60]\nseeds: [1]\n");
+  const auto flat = read_campaign_spec(dir.file("c.yaml"));
+  ASSERT_FALSE(flat);
+  EXPECT_NE(flat.error().message.find("c.yaml:2: scenarios[1] ("), std::string::npos) << flat.error().message;
+  EXPECT_NE(flat.error().message.find("the fusion pipeline cannot run this unit"), std::string::npos)
+      << flat.error().message;
+  // Gyro 1 without white noise: a noise fault on it has nothing to multiply.
+  test::write_file(
+      dir.file("quiet.yaml"),
+      "unit: quiet\ngyros:\n"
+      "  - {id: 1, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [1, 0, 0]}\n"
+      "  - {id: 2, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [0, 1, 0], noise: {arw_dps_rtHz: 3e-5}}\n"
+      "  - {id: 3, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [0, 0, 1], noise: {arw_dps_rtHz: 3e-5}}\n"
+      "  - {id: 4, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: [0.6, 0.8, 0], noise: {arw_dps_rtHz: "
+      "3e-5}}\n");
+  test::write_file(dir.file("quiet_orbit.yaml"), "scenario: orbit\nunit: quiet.yaml\n");
+  test::write_file(dir.file("n.yaml"),
+                   "loop: open\nscenarios: [quiet_orbit.yaml]\nkinds: [stuck, noise]\n"
+                   "sizes: {noise: [10]}\ngyros: [2, 1]\nonsets_s: [60]\nseeds: [1]\n");
+  const auto quiet = read_campaign_spec(dir.file("n.yaml"));
+  ASSERT_FALSE(quiet);
+  EXPECT_NE(quiet.error().message.find("n.yaml:3: kinds[1]: cannot run on gyro 1 of scenarios[0] ("),
+            std::string::npos)
+      << quiet.error().message;
+  EXPECT_NE(quiet.error().message.find("has no white noise"), std::string::npos) << quiet.error().message;
+}
+
+// Inertia, torques and momenta out of their stated ranges are refused naming the key and its line.
+TEST(ClosedLoopScenario, RangesNameTheKey) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"  inertia_kg_m2: [1e-300, 1e-300, 1e-300]\n",
+       "x.yaml:3: closed_loop: inertia_kg_m2 principal moments must be from 1e-04 to 1e+09"},
+      {"  inertia_kg_m2: [1e300, 1e300, 1e300]\n",
+       "inertia_kg_m2 principal moments must be from 1e-04 to 1e+09"},
+      {"  inertia_kg_m2: [1, 1, 5]\n", "break the triangle inequality"},
+      {"  inertia_kg_m2: [[10, 1, 0], [0, 10, 0], [0, 0, 10]]\n", "inertia_kg_m2 must be symmetric"},
+      {"  inertia_kg_m2: [[10, 0, 0], [0, -10, 0], [0, 0, 10]]\n", "inertia_kg_m2 must be positive definite"},
+      {"  disturbance: {constant_Nm: [1e300, 0, 0]}\n",
+       "disturbance.constant_Nm[0] must be from -1000 to 1000"},
+      {"  disturbance: {periodic_Nm: [0, 0, -2e3]}\n",
+       "disturbance.periodic_Nm[2] must be from -1000 to 1000"},
+      {"  wheels: {max_momentum_Nms: 1e300}\n", "wheels.max_momentum_Nms must be above 0 and at most 1e+05"},
+      {"  wheels: {max_torque_Nm: 0}\n", "wheels.max_torque_Nm must be above 0"},
+      {"  controller: {bandwidth_hz: 1e300}\n", "controller.bandwidth_hz must be above 0 and at most 100"},
+      {"  initial_rate_error_dps: [1e300, 0, 0]\n",
+       "initial_rate_error_dps (its norm) must be from 0 to 360"},
+  };
+  for (const auto& [text, needle] : bad) {
+    const auto r = parse_scenario("scenario: orbit\nclosed_loop:\n" + text, "x.yaml");
+    ASSERT_FALSE(r) << text;
+    EXPECT_NE(r.error().message.find(needle), std::string::npos) << text << " -> " << r.error().message;
+  }
+}
+
+// An estimate that is not a number steers the spacecraft into a state that is not one: the run fails
+// with a clear message instead of summarizing NaN as a pointing error of 0.
+TEST(ClosedLoop, NonFiniteStateFailsTheRun) {
+  class NanEstimator final : public Estimator {
+   public:
+    Result<EstimatorOutput> estimate(const SimEpoch& epoch) override {
+      EstimatorOutput out;
+      fdi::AttitudeEstimate e;
+      e.stamp_ns = epoch.stamp_ns;
+      e.q_RB = Quaternion(NAN, NAN, NAN, NAN);
+      e.omega_BR_B_rad_s = Eigen::Vector3d::Constant(NAN);
+      out.latest = e;
+      return out;
+    }
+  };
+  auto sim = ClosedLoopSimulator::create(loop_scenario(quiet_spec(), 10.0), {}).value();
+  NanEstimator estimator;
+  const auto record = run_closed_loop(sim, estimator);
+  ASSERT_FALSE(record);
+  EXPECT_NE(record.error().message.find("closed loop: the spacecraft's state is not finite at t = "),
+            std::string::npos)
+      << record.error().message;
 }
 
 TEST(ClosedLoopScenario, BadKeysNameTheLine) {

@@ -52,6 +52,38 @@ TEST(YamlReader, NumbersMustBeFiniteNumbers) {
   EXPECT_FALSE(yaml.optional_number(root, "y", "").ok());
 }
 
+// Whole numbers, seeds and booleans say what they expect and what they got (yaml-cpp's as<T>() said only
+// "bad conversion"); a long value is cut in the message.
+TEST(YamlReader, TypedValuesNameTheTypeExpected) {
+  const YamlReader yaml{"t.yaml"};
+  const YAML::Node root =
+      YAML::Load("a: 7\nb: -1\nc: 1.5\nd: maybe\ne: 18446744073709551615\nf: [1]\ng: 0x10\n");
+  EXPECT_EQ(yaml.integer(root["a"], "a", 1, 32).value(), 7);
+  EXPECT_EQ(yaml.integer(root["b"], "b", 1, 32).error().message,
+            "t.yaml:2: b: expected a whole number from 1 to 32, got '-1'");
+  EXPECT_EQ(yaml.integer(root["c"], "c", 1, 32).error().message,
+            "t.yaml:3: c: expected a whole number from 1 to 32, got '1.5'");
+  EXPECT_EQ(yaml.integer(root["g"], "g", 0, 100).error().message,
+            "t.yaml:7: g: expected a whole number from 0 to 100, got '0x10'");
+  EXPECT_EQ(yaml.unsigned_integer(root["e"], "e").value(), UINT64_MAX);
+  EXPECT_EQ(yaml.unsigned_integer(root["b"], "seeds[0]").error().message,
+            "t.yaml:2: seeds[0]: expected a whole number from 0 to 18446744073709551615, got '-1'");
+  EXPECT_EQ(yaml.unsigned_integer(root["f"], "f").error().message,
+            "t.yaml:6: f: expected a whole number from 0 to 18446744073709551615, got a list or a mapping");
+  EXPECT_EQ(yaml.boolean(YAML::Load("true"), "x").value(), true);
+  EXPECT_EQ(yaml.boolean(root["d"], "fault_free").error().message,
+            "t.yaml:4: fault_free: expected true or false, got 'maybe'");
+  const YAML::Node long_value = YAML::Load("v: " + std::string(100, '9') + "\n");
+  EXPECT_EQ(yaml.integer(long_value["v"], "v", 0, 1).error().message,
+            "t.yaml:1: v: expected a whole number from 0 to 1, got '" + std::string(40, '9') + "...'");
+  try {
+    (void)root["d"].as<int>();
+    FAIL() << "yaml-cpp converted 'maybe' to an int";
+  } catch (const YAML::Exception& e) {
+    EXPECT_EQ(yaml.error(e, "k").message, "t.yaml:4: k: a value of the wrong type (bad conversion)");
+  }
+}
+
 TEST(YamlReader, Vector3NeedsThreeFiniteNumbers) {
   const YamlReader yaml{"v.yaml"};
   const YAML::Node root = YAML::Load("a: [1, -2, 0.5]\nb: [1, 2]\nc: [1, x, 3]\n");

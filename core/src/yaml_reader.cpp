@@ -1,6 +1,7 @@
 #include "tetra/core/yaml_reader.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <string_view>
 #include <vector>
@@ -22,7 +23,9 @@ Error YamlReader::error(const YAML::Node& node, const std::string& what, const s
 
 Error YamlReader::error(const YAML::Exception& e, const std::string& what) const {
   const int line = e.mark.line < 0 ? 0 : e.mark.line + 1;
-  return bad_input(source_ + ":" + std::to_string(line) + ": " + (what.empty() ? "" : what + ": ") + e.msg);
+  const bool conversion = e.msg.rfind("bad conversion", 0) == 0;
+  return bad_input(source_ + ":" + std::to_string(line) + ": " + (what.empty() ? "" : what + ": ") +
+                   (conversion ? "a value of the wrong type (bad conversion)" : e.msg));
 }
 
 namespace {
@@ -166,6 +169,55 @@ Result<std::optional<double>> YamlReader::optional_number(const YAML::Node& pare
   auto v = number(node, child(what, key));
   if (!v) return v.error();
   return std::optional<double>{*v};
+}
+
+namespace {
+
+// The whole scalar as a T, or nullopt (from_chars: no blanks, no '+', no hexadecimal, no fraction).
+template <class T>
+std::optional<T> whole_scalar(const YAML::Node& node) {
+  if (!node.IsScalar()) return std::nullopt;
+  const std::string& text = node.Scalar();
+  T value{};
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || ec != std::errc() || ptr != text.data() + text.size()) return std::nullopt;
+  return value;
+}
+
+// The value quoted for a message, at most 40 characters of it.
+std::string scalar_text(const YAML::Node& node) {
+  if (!node.IsScalar()) return "a list or a mapping";
+  const std::string& text = node.Scalar();
+  return "'" + (text.size() > 40 ? text.substr(0, 40) + "..." : text) + "'";
+}
+
+}  // namespace
+
+Result<std::int64_t> YamlReader::integer(const YAML::Node& node, const std::string& what, std::int64_t min,
+                                         std::int64_t max) const {
+  const auto v = whole_scalar<std::int64_t>(node);
+  if (!v || *v < min || *v > max) {
+    return error(node, what,
+                 "expected a whole number from " + std::to_string(min) + " to " + std::to_string(max) +
+                     ", got " + scalar_text(node));
+  }
+  return *v;
+}
+
+Result<std::uint64_t> YamlReader::unsigned_integer(const YAML::Node& node, const std::string& what) const {
+  const auto v = whole_scalar<std::uint64_t>(node);
+  if (!v) {
+    return error(
+        node, what,
+        "expected a whole number from 0 to " + std::to_string(UINT64_MAX) + ", got " + scalar_text(node));
+  }
+  return *v;
+}
+
+Result<bool> YamlReader::boolean(const YAML::Node& node, const std::string& what) const {
+  if (node.IsScalar() && (node.Scalar() == "true" || node.Scalar() == "false"))
+    return node.Scalar() == "true";
+  return error(node, what, "expected true or false, got " + scalar_text(node));
 }
 
 Result<Eigen::Vector3d> YamlReader::vector3(const YAML::Node& node, const std::string& what) const {

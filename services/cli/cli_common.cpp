@@ -60,6 +60,24 @@ void harden(CLI::App& app) {
 
 }  // namespace
 
+CLI::Validator number_in(double min, double max, bool above_min) {
+  const auto text_of = [](double v) {
+    std::string out;
+    append_double(out, v);
+    return out;
+  };
+  const std::string range =
+      (above_min ? "above " : "from ") + text_of(min) + (above_min ? " and at most " : " to ") + text_of(max);
+  return CLI::Validator(
+      [min, max, above_min, range](std::string& text) -> std::string {
+        const auto v = parse_decimal(text);
+        const bool ok = v && (above_min ? *v > min : *v >= min) && *v <= max;
+        const std::string shown = text.size() > 40 ? text.substr(0, 40) + "..." : text;
+        return ok ? std::string() : "'" + shown + "' must be " + range;
+      },
+      range, "in range");
+}
+
 std::optional<int> parse(CLI::App& app, int argc, char** argv) {
   harden(app);
   app.set_version_flag("--version", std::string("tetra ") + kVersion);

@@ -21,6 +21,11 @@ inline constexpr int kExitBadInput = 2;
 //! stop now (help printed → 0, bad usage → 2), or nullopt to go on.
 std::optional<int> parse(CLI::App& app, int argc, char** argv);
 
+//! A numeric option's range check, worded briefly: "'1e300' must be from 0 to 45" ("above MIN and at
+//! most MAX" with `above_min`); NaN and infinities fail (CLI11's Range and PositiveNumber let NaN through
+//! and print a 300-digit bound for an infinite one).
+CLI::Validator number_in(double min, double max, bool above_min = false);
+
 //! How a command words an Error about an argument of a library call (Error::subject): `format`
 //! names the command's option and may use {value} (the subject's value) and {message}, e.g.
 //! {"taus", "--taus: {message}"}, {"gyros", "--gyro {value}: {message}"}.

@@ -79,14 +79,14 @@ Result<std::set<std::size_t>> done_runs(const std::string& path) {
 
 //! A worker process: runs its share of the cases, one row per line on `fd` (each write below
 //! PIPE_BUF, so lines of several workers never interleave).
-[[noreturn]] void worker(const sim::CampaignSpec& spec, const std::vector<sim::CampaignCase>& cases, int fd,
+[[noreturn]] void worker(const sim::CampaignSpec& spec, const std::vector<std::size_t>& cases, int fd,
                          const std::string& out_dir) {
   const sim::EstimatorFactory make =
       spec.target == sim::CampaignTarget::kDds
           ? dds_campaign_estimators(spec, (std::filesystem::path(out_dir) / "dds").string())
           : sim::in_process_estimators(spec);
-  for (const sim::CampaignCase& c : cases) {
-    auto row = sim::run_campaign_case(spec, c, make);
+  for (std::size_t index : cases) {
+    auto row = sim::run_campaign_case(spec, sim::campaign_case(spec, index), make);
     const std::string line = row ? sim::campaign_csv_row(*row) + "\n" : "error " + row.error().message + "\n";
     if (::write(fd, line.data(), line.size()) != static_cast<ssize_t>(line.size())) ::_exit(1);
   }
@@ -116,7 +116,7 @@ struct Progress {
   }
 };
 
-Status run_pending(const sim::CampaignSpec& spec, const std::vector<sim::CampaignCase>& pending, int jobs,
+Status run_pending(const sim::CampaignSpec& spec, const std::vector<std::size_t>& pending, int jobs,
                    const std::string& out_dir, Progress& progress) {
   const std::string runs_path = (std::filesystem::path(out_dir) / "runs.csv").string();
   int fds[2];
@@ -126,7 +126,7 @@ Status run_pending(const sim::CampaignSpec& spec, const std::vector<sim::Campaig
       std::max(1, std::min<int>({jobs, static_cast<int>(pending.size()), static_cast<int>(kMaxWorkers)})));
   const pid_t parent = ::getpid();
   for (std::size_t w = 0; w < n_jobs && g_stop_signal == 0; ++w) {
-    std::vector<sim::CampaignCase> share;
+    std::vector<std::size_t> share;
     for (std::size_t i = w; i < pending.size(); i += n_jobs) share.push_back(pending[i]);
     std::cout.flush();
     const pid_t pid = ::fork();
@@ -236,18 +236,20 @@ int cmd_campaign(int argc, char** argv) {
     header << sim::campaign_csv_header() << '\n';
     if (!header) return report(kCampaignName, failure(runs_path + ": cannot write"));
   }
-  const std::vector<sim::CampaignCase> cases = sim::expand_campaign(*spec);
-  std::vector<sim::CampaignCase> pending;
-  for (const sim::CampaignCase& c : cases) {
-    if (done->count(c.index) == 0) pending.push_back(c);
+  // Bounded (read_campaign_spec): at most kMaxCampaignRuns indices; the cases are made one at a time.
+  const auto total = sim::campaign_run_count(*spec);
+  if (!total) return report(kCampaignName, total.error());
+  std::vector<std::size_t> pending;
+  for (std::size_t index = 0; index < *total; ++index) {
+    if (done->count(index) == 0) pending.push_back(index);
   }
-  std::cerr << "tetra campaign: " << cases.size() << " runs ("
+  std::cerr << "tetra campaign: " << *total << " runs ("
             << (spec->loop == sim::CampaignLoop::kClosed ? "closed" : "open") << " loop, "
             << (spec->target == sim::CampaignTarget::kDds
                     ? "fusion services over DDS, domain " + std::to_string(spec->dds_domain)
                     : std::string("pipeline in process"))
-            << "), " << cases.size() - pending.size() << " already done, " << jobs << " jobs\n";
-  Progress progress{cases.size(), cases.size() - pending.size()};
+            << "), " << *total - pending.size() << " already done, " << jobs << " jobs\n";
+  Progress progress{*total, *total - pending.size()};
   if (!pending.empty()) {
     handle_stop_signals(true);
     Status st = run_pending(*spec, pending, jobs, out_dir, progress);

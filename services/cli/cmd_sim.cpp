@@ -95,9 +95,11 @@ void add_run_options(CLI::App& app, SimArgs& a) {
 
 void add_scenario_options(CLI::App& app, SimArgs& a) {
   ScenarioOverrides& o = a.over;
-  o.rate = app.add_option("--rate-hz", o.rate_hz, "[Hz] gyro sampling rate")->check(CLI::PositiveNumber);
+  // The ranges are the scenario keys' (docs/sim.md, "Ranges"), checked here to name the option.
+  o.rate = app.add_option("--rate-hz", o.rate_hz, "[Hz] gyro sampling rate")
+               ->check(number_in(0.0, sim::kMaxRate_hz, true));
   o.minutes_given = app.add_option("--minutes", o.minutes, "[min] duration (not for turntable)")
-                        ->check(CLI::PositiveNumber);
+                        ->check(number_in(0.0, sim::kMaxDuration_s / 60.0, true));
   o.latitude =
       app.add_option("--latitude", o.latitude_deg, "[deg] geodetic latitude (turntable, static, lab-orbit)")
           ->check(CLI::Range(-90.0, 90.0));
@@ -110,21 +112,22 @@ void add_scenario_options(CLI::App& app, SimArgs& a) {
                     ->check(CLI::NonNegativeNumber);
   o.reference_noise =
       app.add_option("--reference-noise", o.reference_noise_arcsec, "[arcsec] reference 1-sigma per axis")
-          ->check(CLI::NonNegativeNumber);
+          ->check(number_in(0.0, sim::kMaxReferenceNoise_arcsec));
   o.acs_amplitude = app.add_option("--acs-amplitude", o.acs_amplitude_deg,
-                                   "[deg] orbit/slews: attitude-control motion amplitude (0 = none)");
+                                   "[deg] orbit/slews: attitude-control motion amplitude (0 = none)")
+                        ->check(number_in(0.0, sim::kMaxAcsAmplitude_deg));
   o.acs_accel =
       app.add_option("--acs-accel", o.acs_accel_dps2, "[deg/s^2] orbit/slews: its peak acceleration")
-          ->check(CLI::PositiveNumber);
+          ->check(number_in(0.0, sim::kMaxAcsAccel_dps2, true));
   o.period =
       app.add_option("--orbit-period", o.orbit_period_min, "[min] orbit/slews: orbit period (one pitch turn)")
-          ->check(CLI::PositiveNumber);
+          ->check(number_in(sim::kMinOrbitPeriod_s / 60.0, sim::kMaxOrbitPeriod_s / 60.0));
   o.jitter = app.add_option("--jitter", o.jitter_s, "[s] sample-time jitter, uniform +-")
                  ->check(CLI::NonNegativeNumber);
   o.drop = app.add_option("--drop", o.drop_probability, "probability that a gyro sample is not delivered")
                ->check(CLI::Range(0.0, 1.0));
   o.range = app.add_option("--range", o.range_dps, "[deg/s] measuring range (saturation)")
-                ->check(CLI::PositiveNumber);
+                ->check(number_in(0.0, sim::kMaxRange_dps, true));
 }
 
 void add_turntable_options(CLI::App& app, SimArgs& a) {
@@ -225,6 +228,16 @@ void apply_overrides(const ScenarioOverrides& o, sim::Scenario& sc) {
   if (o.range->count()) sc.model.range_dps = o.range_dps;
 }
 
+// The options given that change the scenario, for a message: " (with --minutes, --rate-hz)".
+std::string overrides_given(const ScenarioOverrides& o) {
+  std::string names;
+  for (const CLI::Option* opt : {o.rate, o.minutes_given, o.latitude, o.reference, o.reference_noise,
+                                 o.acs_amplitude, o.acs_accel, o.period, o.jitter, o.drop, o.range}) {
+    if (opt->count()) names += (names.empty() ? "" : ", ") + opt->get_name();
+  }
+  return names.empty() ? names : " (with " + names + ")";
+}
+
 // Any other scenario: built in or read from a file, then the unit and the options given.
 Result<sim::Scenario> load_scenario(const SimArgs& a, const std::optional<Calibration>& unit) {
   for (const CLI::Option* opt : a.turntable_only) {
@@ -236,6 +249,9 @@ Result<sim::Scenario> load_scenario(const SimArgs& a, const std::optional<Calibr
   if (unit) scenario->unit = *unit;
   apply_overrides(a.over, *scenario);
   if (!a.fault_texts.empty()) scenario->faults.clear();  // the command line's faults replace the file's
+  // Each option is in its own range; together (e.g. --minutes × --rate-hz) they may still not fit.
+  if (Status st = sim::validate_scenario(*scenario); !st)
+    return bad_input(st.error().message + overrides_given(a.over));
   return scenario;
 }
 

@@ -6,6 +6,7 @@
 #include "cli_common.hpp"
 #include "dds_common.hpp"
 #include "sim_dds_link.hpp"
+#include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
@@ -19,13 +20,22 @@ void add_sim_dds_options(CLI::App& app, SimDdsOptions& options) {
                "publish on DDS (GyroSample, AttitudeReference) instead of writing files, "
                "and score the Attitude received against the truth");
   app.add_option("--speed", options.speed,
-                 "--dds: 1 = real time, X = X times faster, 0 = as fast as possible")
-      ->check(CLI::NonNegativeNumber);
+                 "--dds: 1 = real time, X = X times faster, 0 = as fast as possible (at most 1e6)")
+      ->check(number_in(0.0, 1.0e6))
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {  // a slower clock than 1/1000 would overflow the pacing
+            const auto v = parse_decimal(text);
+            return v && *v > 0.0 && *v < 1e-3
+                       ? "'" + text + "' must be 0 (as fast as possible) or at least 0.001"
+                       : std::string();
+          },
+          "", "0 or at least 0.001"));
   app.add_option("--dds-unit", options.unit, "--dds: the unit's key on the wire (default: the unit's name)");
   app.add_option("--wait-readers", options.wait_readers, "--dds: gyro readers to wait for before publishing")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--wait-timeout", options.wait_timeout_s, "[s] --dds: how long to wait for them")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--wait-timeout", options.wait_timeout_s,
+                 "[s] --dds: how long to wait for them (at most a day)")
+      ->check(number_in(0.0, 86400.0, true));
   add_domain_option(app, options.domain);
 }
 

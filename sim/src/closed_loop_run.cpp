@@ -86,8 +86,19 @@ Result<ClosedLoopRecord> run_closed_loop(ClosedLoopSimulator& simulator, Estimat
     sample.wheel_torque_Nm = control.tau_wheels_Nm;
     sample.torque_limited = control.torque_limited;
     sample.momentum_limited = control.momentum_limited;
-    record.max_wheel_momentum_fraction = std::max(
-        record.max_wheel_momentum_fraction, simulator.state().h_wheels_Nms.cwiseAbs().maxCoeff() / h_max);
+    // A diverged state (within the ranges, a stiff case can still blow up) is a failure, never a number:
+    // NaN would pass unseen through max() and be reported as a pointing error of 0.
+    const BodyState& body = simulator.state();
+    if (!std::isfinite(sample.error_deg) || !body.q_NB.coeffs().allFinite() ||
+        !body.omega_BN_B_rad_s.allFinite() || !body.h_wheels_Nms.allFinite() ||
+        !control.tau_wheels_Nm.allFinite()) {
+      return failure(
+          "closed loop: the spacecraft's state is not finite at t = " + std::to_string(epoch.time_s) +
+          " s (the dynamics diverged: check inertia_kg_m2, the disturbances, the wheels and the "
+          "controller gains against dynamics_hz)");
+    }
+    record.max_wheel_momentum_fraction =
+        std::max(record.max_wheel_momentum_fraction, body.h_wheels_Nms.cwiseAbs().maxCoeff() / h_max);
     record.series.push_back(std::move(sample));
   }
   if (Status st = estimator.finish(record.events); !st) return st.error();

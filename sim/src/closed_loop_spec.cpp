@@ -1,10 +1,12 @@
 #include "tetra/sim/closed_loop_spec.hpp"
 
 #include <cmath>
+#include <tuple>
 
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Dense>
 
+#include "ranges.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/core/yaml_reader.hpp"
 #include "text.hpp"
@@ -187,42 +189,121 @@ Result<ClosedLoopSpec> parse_closed_loop(const YamlReader& yaml, const YAML::Nod
   if (node["pointing"]) {
     if (Status st = parse_pointing(yaml, node["pointing"], spec.pointing); !st) return st.error();
   }
-  if (Status st = validate_closed_loop(spec); !st) return yaml.error(node, what, st.error().message);
+  if (Status st = validate_closed_loop(spec); !st)
+    return yaml.error(node_named(node, st.error().message), what, st.error().message);
   return spec;
 }
 
-Status validate_closed_loop(const ClosedLoopSpec& s) {
-  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(s.inertia_kg_m2);
-  if (!s.inertia_kg_m2.allFinite() || !s.inertia_kg_m2.isApprox(s.inertia_kg_m2.transpose()) ||
-      eig.eigenvalues().minCoeff() <= 0.0) {
-    return bad_input("inertia_kg_m2 must be symmetric positive definite");
+namespace {
+
+// Symmetric (to 1e-9 of its largest element), principal moments within the bounds and obeying the
+// triangle inequality (each at most the sum of the other two, to 1e-9): a rigid body's inertia.
+Status check_inertia(const Eigen::Matrix3d& inertia) {
+  const std::string key = "inertia_kg_m2";
+  if (!inertia.allFinite()) return bad_input(key + " must be finite");
+  const double scale = inertia.cwiseAbs().maxCoeff();
+  if (!((inertia - inertia.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale))
+    return bad_input(key + " must be symmetric");
+  const Eigen::Vector3d m = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia).eigenvalues();
+  if (!(m.minCoeff() > 0.0)) return bad_input(key + " must be positive definite");
+  if (Status st = check_range(key + " principal moments", m.minCoeff(), kMinInertia_kg_m2, kMaxInertia_kg_m2,
+                              "kg·m^2");
+      !st)
+    return st;
+  if (Status st = check_range(key + " principal moments", m.maxCoeff(), kMinInertia_kg_m2, kMaxInertia_kg_m2,
+                              "kg·m^2");
+      !st)
+    return st;
+  // Eigenvalues in increasing order: the largest is the one that can break the inequality.
+  if (m[2] > (m[0] + m[1]) * (1.0 + 1e-9)) {
+    return bad_input(key + ": principal moments " + number_text(m[0]) + ", " + number_text(m[1]) + ", " +
+                     number_text(m[2]) + " break the triangle inequality (no rigid body has them)");
   }
-  if (!positive(s.dynamics_hz) || s.dynamics_hz > 1.0e5) return bad_input("dynamics_hz must be in (0, 1e5]");
-  if (!positive(s.pointing_bound_deg)) return bad_input("pointing_bound_deg must be positive");
-  if (!positive(s.wheels.max_torque_Nm) || !positive(s.wheels.max_momentum_Nms) ||
-      !positive(s.wheels.inertia_kg_m2))
-    return bad_input("wheels: max_torque_Nm, max_momentum_Nms and inertia_kg_m2 must be positive");
-  if (!(std::abs(s.wheels.pyramid_elevation_deg) > 1.0 && std::abs(s.wheels.pyramid_elevation_deg) < 89.0))
+  return ok_status();
+}
+
+// Every component of `v` within ±max.
+Status check_vector(const std::string& key, const Eigen::Vector3d& v, double max, const char* unit) {
+  for (int i = 0; i < 3; ++i) {
+    if (Status st = check_range(key + "[" + std::to_string(i) + "]", v[i], -max, max, unit); !st) return st;
+  }
+  return ok_status();
+}
+
+Status check_wheels_and_disturbance(const ClosedLoopSpec& s) {
+  const WheelSpec& w = s.wheels;
+  for (const auto& [key, value, max, unit] :
+       {std::tuple<const char*, double, double, const char*>{"wheels.max_torque_Nm", w.max_torque_Nm,
+                                                             kMaxWheelTorque_Nm, "N·m"},
+        {"wheels.max_momentum_Nms", w.max_momentum_Nms, kMaxWheelMomentum_Nms, "N·m·s"},
+        {"wheels.inertia_kg_m2", w.inertia_kg_m2, kMaxWheelInertia_kg_m2, "kg·m^2"}}) {
+    if (Status st = check_range(key, value, 0.0, max, unit, true); !st) return st;
+  }
+  if (!(std::abs(w.pyramid_elevation_deg) > 1.0 && std::abs(w.pyramid_elevation_deg) < 89.0))
     return bad_input("wheels.pyramid_elevation_deg must be between 1 and 89 deg");
-  const ControllerSpec& c = s.controller;
-  if (!positive(c.bandwidth_hz) || !positive(c.damping))
-    return bad_input("controller: bandwidth_hz and damping must be positive");
-  if (!std::isfinite(c.integral_time_s) || c.integral_time_s < 0.0)
-    return bad_input("controller.integral_time_s must not be negative");
-  if (!positive(c.hold_after_s) || !(c.safe_after_s >= c.hold_after_s))
-    return bad_input("controller: need 0 < hold_after_s <= safe_after_s");
-  if (!positive(s.pointing.max_rate_dps) || !positive(s.pointing.max_accel_dps2))
-    return bad_input("pointing: max_rate_dps and max_accel_dps2 must be positive");
+  if (Status st =
+          check_vector("disturbance.constant_Nm", s.disturbance.constant_Nm, kMaxDisturbance_Nm, "N·m");
+      !st)
+    return st;
+  return check_vector("disturbance.periodic_Nm", s.disturbance.periodic_Nm, kMaxDisturbance_Nm, "N·m");
+}
+
+Status check_controller(const ControllerSpec& c) {
+  if (Status st = check_range("controller.bandwidth_hz", c.bandwidth_hz, 0.0, kMaxBandwidth_hz, "Hz", true);
+      !st)
+    return st;
+  if (Status st = check_range("controller.damping", c.damping, 0.0, kMaxDamping, "", true); !st) return st;
+  if (Status st = check_range("controller.integral_time_s", c.integral_time_s, 0.0, kMaxControlTime_s, "s");
+      !st)
+    return st;
+  if (Status st = check_range("controller.hold_after_s", c.hold_after_s, 0.0, kMaxControlTime_s, "s", true);
+      !st)
+    return st;
+  if (!(c.safe_after_s >= c.hold_after_s && c.safe_after_s <= kMaxControlTime_s))
+    return bad_input("controller: need 0 < hold_after_s <= safe_after_s <= " +
+                     number_text(kMaxControlTime_s));
+  return ok_status();
+}
+
+Status check_pointing(const ClosedLoopSpec& s) {
+  const PointingSpec& p = s.pointing;
+  if (Status st =
+          check_range("pointing.max_rate_dps", p.max_rate_dps, 0.0, kMaxPointingRate_dps, "deg/s", true);
+      !st)
+    return st;
+  if (Status st = check_range("pointing.max_accel_dps2", p.max_accel_dps2, 0.0, kMaxPointingAccel_dps2,
+                              "deg/s^2", true);
+      !st)
+    return st;
   double previous_start = -INFINITY;
-  for (const PointingSlew& slew : s.pointing.slews) {
-    if (!std::isfinite(slew.angle_deg) || !std::isfinite(slew.start_s) || slew.start_s < previous_start)
-      return bad_input("pointing.slews: start_s must be finite and in order");
+  for (std::size_t i = 0; i < p.slews.size(); ++i) {
+    const PointingSlew& slew = p.slews[i];
+    const std::string key = "pointing.slews[" + std::to_string(i) + "]";
+    if (Status st = check_range(key + ".angle_deg", slew.angle_deg, -kMaxPointingAngle_deg,
+                                kMaxPointingAngle_deg, "deg");
+        !st)
+      return st;
+    if (!std::isfinite(slew.start_s) || slew.start_s < previous_start)
+      return bad_input(key + ".start_s must be finite and in order");
     previous_start = slew.start_s;
   }
-  if (!s.initial_error_deg.allFinite() || !s.initial_rate_error_dps.allFinite())
-    return bad_input("initial_error_deg and initial_rate_error_dps must be finite");
-  return ok_status();
+  if (Status st = check_range("pointing_bound_deg", s.pointing_bound_deg, 0.0, 180.0, "deg", true); !st)
+    return st;
+  if (Status st = check_range("initial_error_deg (its norm)", s.initial_error_deg.norm(), 0.0, 180.0, "deg");
+      !st)
+    return st;
+  return check_range("initial_rate_error_dps (its norm)", s.initial_rate_error_dps.norm(), 0.0,
+                     kMaxPointingRate_dps, "deg/s");
+}
+
+}  // namespace
+
+Status validate_closed_loop(const ClosedLoopSpec& s) {
+  if (Status st = check_inertia(s.inertia_kg_m2); !st) return st;
+  if (Status st = check_range("dynamics_hz", s.dynamics_hz, 0.0, 1.0e5, "Hz", true); !st) return st;
+  if (Status st = check_wheels_and_disturbance(s); !st) return st;
+  if (Status st = check_controller(s.controller); !st) return st;
+  return check_pointing(s);
 }
 
 }  // namespace tetra::sim

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tetra/core/csv.hpp"
+#include "text.hpp"
 
 namespace tetra::sim {
 
@@ -141,12 +142,8 @@ Status check_size(FaultFields& f, const std::string& where) {
     if (!f.size)
       return bad_input(where + "size is required for kind " + std::string(fault_kind_name(fault.kind)));
     fault.size = *f.size;
-    if (fault.kind == FaultKind::kNoise && fault.size < 0.0) {
-      return bad_input(where + "size: a noise multiplier must not be negative");
-    }
-    if (fault.kind == FaultKind::kScale && fault.size <= -1.0) {
-      return bad_input(where + "size: a relative scale change must be above -1");
-    }
+    if (Status st = check_fault_size(fault.kind, fault.size); !st)
+      return bad_input(where + "size: " + st.error().message);
   } else if (f.size) {
     return bad_input(where + "size has no meaning for kind " + std::string(fault_kind_name(fault.kind)));
   }
@@ -157,6 +154,14 @@ Status check_size(FaultFields& f, const std::string& where) {
 }
 
 }  // namespace
+
+Status check_fault_size(FaultKind kind, double size) {
+  if (!std::isfinite(size) || std::abs(size) > kMaxFaultSize)
+    return bad_input("must be finite and at most " + number_text(kMaxFaultSize) + " in magnitude");
+  if (kind == FaultKind::kNoise && size < 0.0) return bad_input("a noise multiplier must not be negative");
+  if (kind == FaultKind::kScale && size <= -1.0) return bad_input("a relative scale change must be above -1");
+  return ok_status();
+}
 
 Result<FaultSpec> parse_fault_spec(std::string_view text) {
   const std::string where = "fault '" + std::string(text) + "': ";

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ranges.hpp"
 #include "tetra/core/frames.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/sim/random.hpp"
@@ -41,31 +42,43 @@ std::string_view motion_kind_name(MotionKind kind) {
   return "unknown";
 }
 
-Result<TruthMotion> TruthMotion::create(const MotionSpec& spec, std::uint64_t seed) {
-  auto finite = [](double v) { return std::isfinite(v); };
-  if (!finite(spec.latitude_deg) || std::abs(spec.latitude_deg) > 90.0) {
-    return bad_input("motion: latitude_deg must be in [-90, 90]");
-  }
-  if (!finite(spec.pitch_rate_dps)) return bad_input("motion: pitch_rate_dps must be finite");
-  if (!finite(spec.orbit_period_s) || spec.orbit_period_s <= 0.0) {
-    return bad_input("motion: orbit_period_s must be positive");
-  }
-  if (!finite(spec.acs.amplitude_deg) || spec.acs.amplitude_deg < 0.0) {
-    return bad_input("motion: acs amplitude_deg must be zero (off) or positive");
-  }
-  if (spec.acs.amplitude_deg > 0.0 &&
-      (!finite(spec.acs.peak_accel_dps2) || spec.acs.peak_accel_dps2 <= 0.0)) {
-    return bad_input("motion: acs peak_accel_dps2 must be positive");
+Status validate_motion(const MotionSpec& spec) {
+  if (Status st = check_range("latitude_deg", spec.latitude_deg, -90.0, 90.0, "deg"); !st) return st;
+  if (Status st =
+          check_range("pitch_rate_dps", spec.pitch_rate_dps, -kMaxPitchRate_dps, kMaxPitchRate_dps, "deg/s");
+      !st)
+    return st;
+  if (Status st =
+          check_range("orbit_period_s", spec.orbit_period_s, kMinOrbitPeriod_s, kMaxOrbitPeriod_s, "s");
+      !st)
+    return st;
+  if (Status st = check_range("acs.amplitude_deg", spec.acs.amplitude_deg, 0.0, kMaxAcsAmplitude_deg, "deg");
+      !st)
+    return st;
+  if (spec.acs.amplitude_deg > 0.0) {
+    if (Status st = check_range("acs.peak_accel_dps2", spec.acs.peak_accel_dps2, 0.0, kMaxAcsAccel_dps2,
+                                "deg/s^2", true);
+        !st)
+      return st;
   }
   for (std::size_t i = 0; i < spec.slews.size(); ++i) {
     const Slew& s = spec.slews[i];
-    const std::string where = "motion: slew " + std::to_string(i + 1) + ": ";
+    const std::string where = "slews[" + std::to_string(i) + "].";
     if (!s.axis_B.allFinite() || s.axis_B.norm() < 1e-9)
       return bad_input(where + "axis must be a non-zero vector");
-    if (!finite(s.angle_deg) || !finite(s.start_s))
-      return bad_input(where + "angle and start must be finite");
-    if (!finite(s.duration_s) || s.duration_s <= 0.0) return bad_input(where + "duration must be positive");
+    if (Status st =
+            check_range(where + "angle_deg", s.angle_deg, -kMaxSlewAngle_deg, kMaxSlewAngle_deg, "deg");
+        !st)
+      return st;
+    if (!std::isfinite(s.start_s)) return bad_input(where + "start_s must be finite");
+    if (!std::isfinite(s.duration_s) || s.duration_s <= 0.0)
+      return bad_input(where + "duration_s must be positive");
   }
+  return ok_status();
+}
+
+Result<TruthMotion> TruthMotion::create(const MotionSpec& spec, std::uint64_t seed) {
+  if (Status st = validate_motion(spec); !st) return bad_input("motion: " + st.error().message);
   TruthMotion m;
   m.spec_ = spec;
   for (Slew& s : m.spec_.slews) s.axis_B.normalize();

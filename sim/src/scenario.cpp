@@ -9,6 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "ranges.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/input_files.hpp"
 #include "tetra/core/yaml_reader.hpp"
@@ -18,8 +19,6 @@
 namespace tetra::sim {
 
 namespace {
-
-constexpr double kMaxEpochs = 2.0e9;  // a guard against absurd durations × rates
 
 Result<Slew> parse_slew(const YamlReader& yaml, const YAML::Node& s, const std::string& what) {
   if (Status st = yaml.check_keys(s, {"axis", "angle_deg", "start_s", "duration_s"}, what); !st)
@@ -169,7 +168,8 @@ Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, cons
     if (Status st = read_section(yaml, root, *sc); !st) return st.error();
   }
   // Range checks with the line of the key where it exists.
-  if (Status st = validate_scenario(*sc); !st) return yaml.error(root, "", st.error().message);
+  if (Status st = validate_scenario(*sc); !st)
+    return yaml.error(node_named(root, st.error().message), "", st.error().message);
   return sc;
 }
 
@@ -238,36 +238,32 @@ Result<Scenario> read_scenario(const std::string& path) {
 
 Status validate_scenario(const Scenario& sc) {
   if (Status st = validate_calibration(sc.unit, "unit"); !st) return st;
-  if (!std::isfinite(sc.duration_s) || sc.duration_s <= 0.0) {
-    return bad_input("duration_s must be positive, got " + number_text(sc.duration_s));
-  }
-  if (!std::isfinite(sc.rate_hz) || sc.rate_hz <= 0.0) {
-    return bad_input("rate_hz must be positive, got " + number_text(sc.rate_hz));
-  }
+  if (Status st = check_range("duration_s", sc.duration_s, 0.0, kMaxDuration_s, "s", true); !st) return st;
+  if (Status st = check_range("rate_hz", sc.rate_hz, 0.0, kMaxRate_hz, "Hz", true); !st) return st;
   if (sc.duration_s * sc.rate_hz < 1.0 || sc.duration_s * sc.rate_hz > kMaxEpochs) {
     return bad_input("duration_s × rate_hz = " + number_text(sc.duration_s * sc.rate_hz) +
                      " epochs; need at least 1 and at most 2e9");
   }
+  if (Status st = validate_motion(sc.motion); !st) return st;
   if (!std::isfinite(sc.jitter_s) || sc.jitter_s < 0.0 || sc.jitter_s >= 0.5 / sc.rate_hz) {
     return bad_input("jitter_s must be in [0, half the sampling period), got " + number_text(sc.jitter_s));
   }
-  if (!std::isfinite(sc.drop_probability) || sc.drop_probability < 0.0 || sc.drop_probability > 1.0) {
-    return bad_input("drop_probability must be in [0, 1], got " + number_text(sc.drop_probability));
-  }
-  if (!std::isfinite(sc.reference.rate_hz) || sc.reference.rate_hz < 0.0 ||
-      sc.reference.rate_hz > sc.rate_hz) {
-    return bad_input("reference rate_hz must be in [0, rate_hz], got " + number_text(sc.reference.rate_hz));
-  }
-  if (!std::isfinite(sc.reference.noise_arcsec) || sc.reference.noise_arcsec < 0.0) {
-    return bad_input("reference noise_arcsec must not be negative, got " +
-                     number_text(sc.reference.noise_arcsec));
-  }
-  if (!std::isfinite(sc.model.bias_instability_correlation_s) ||
-      sc.model.bias_instability_correlation_s <= 0.0) {
-    return bad_input("gyro_model bias_instability_correlation_s must be positive");
-  }
-  if (sc.model.range_dps && (!std::isfinite(*sc.model.range_dps) || *sc.model.range_dps <= 0.0)) {
-    return bad_input("gyro_model range_dps must be positive");
+  if (Status st = check_range("drop_probability", sc.drop_probability, 0.0, 1.0, ""); !st) return st;
+  if (Status st = check_range("reference.rate_hz", sc.reference.rate_hz, 0.0, sc.rate_hz, "Hz"); !st)
+    return st;
+  if (Status st = check_range("reference.noise_arcsec", sc.reference.noise_arcsec, 0.0,
+                              kMaxReferenceNoise_arcsec, "arcsec");
+      !st)
+    return st;
+  if (Status st = check_range("gyro_model.bias_instability_correlation_s",
+                              sc.model.bias_instability_correlation_s, 0.0, kMaxCorrelation_s, "s", true);
+      !st)
+    return st;
+  if (sc.model.range_dps) {
+    if (Status st =
+            check_range("gyro_model.range_dps", *sc.model.range_dps, 0.0, kMaxRange_dps, "deg/s", true);
+        !st)
+      return st;
   }
   for (const FaultSpec& f : sc.faults) {
     if (f.gyro < 1 || f.gyro > sc.unit.gyro_count()) {

@@ -2,6 +2,8 @@
 // Reading optional scenario fields (private to tetra::sim): shared by the scenario and the
 // closed-loop sections.
 
+#include <algorithm>
+#include <cstdlib>
 #include <initializer_list>
 #include <string>
 #include <utility>
@@ -30,6 +32,32 @@ inline Status maybe_numbers(const YamlReader& yaml, const YAML::Node& parent, co
     if (Status st = maybe_number(yaml, parent, key, what, *out); !st) return st;
   }
   return ok_status();
+}
+
+// The node a range error names by its first word ("acs.amplitude_deg must ...", "slews[1].angle_deg ...",
+// "closed_loop: ..."): the deepest key of that path present in the file, else the root.
+inline YAML::Node node_named(const YAML::Node& root, const std::string& message) {
+  const std::string path = message.substr(0, message.find_first_of(" :"));
+  YAML::Node node(root);  // rebound with reset(): yaml-cpp's assignment would write into the tree
+  std::size_t begin = 0;
+  while (begin < path.size()) {
+    const std::size_t end = std::min(path.find_first_of(".[", begin), path.size());
+    const YAML::Node& here = node;
+    const YAML::Node next = here.IsMap() ? here[path.substr(begin, end - begin)] : YAML::Node();
+    if (!next) break;
+    node.reset(next);
+    begin = end + 1;
+    if (end < path.size() && path[end] == '[') {  // "slews[1]"
+      const std::size_t i = std::strtoul(path.c_str() + begin, nullptr, 10);
+      const YAML::Node& list = node;
+      if (!list.IsSequence() || i >= list.size()) break;
+      node.reset(list[i]);
+      begin = path.find(']', begin);
+      if (begin == std::string::npos) break;
+      begin += 2;
+    }
+  }
+  return node;
 }
 
 inline Result<Eigen::Vector3d> axis_from(const YamlReader& yaml, const YAML::Node& node,

@@ -230,6 +230,86 @@ check options "--initial-q hexadecimal" 2 "--initial-q" "" -- replay "$LOG" --ca
 check options "--dt-tolerance out of range" 2 "--dt-tolerance" "" -- allan "$LOG" --dt-tolerance 3
 check options "--gyro hexadecimal" 2 "--gyro" "" -- allan "$LOG" --gyro 0x1
 
+# --- values: bounded work, physical ranges ----------------------------------------------------------
+# A campaign spec (open loop, the built-in orbit) with its lines replaced: spec_with FILE 'YAML lines'.
+spec_with() { printf 'loop: open\nscenarios: [orbit]\n%b' "$2" >"$1"; }
+awk 'BEGIN { printf "loop: open\nscenarios: [orbit]\nkinds: [stuck]\ngyros: [1]\nduration_s: 30000\nonsets_s: [";
+  for (i = 1; i <= 20000; ++i) printf "%s%d", (i > 1 ? ", " : ""), i; printf "]\nseeds: [";
+  for (i = 0; i < 20000; ++i) printf "%s%d", (i > 0 ? ", " : ""), i; print "]" }' >bigspec.yaml
+check values "campaign: 20,000 onsets x 20,000 seeds (258 KB)" 2 \
+  "bigspec.yaml: the matrix has 400000000 runs .*onsets_s 20000.*seeds 20000.*more than 1000000" "" -- \
+  campaign bigspec.yaml --out camp
+spec_with nan_onset.yaml 'kinds: [stuck]\ngyros: [1]\nonsets_s: [.nan]\nseeds: [1]\n'
+check values "campaign: onsets_s [.nan]" 2 "nan_onset.yaml:5: onsets_s\[0\]: '.nan' is not a number" "" -- \
+  campaign nan_onset.yaml --out camp
+spec_with neg_onset.yaml 'kinds: [stuck]\ngyros: [1]\nonsets_s: [-10]\nseeds: [1]\n'
+check values "campaign: onsets_s [-10]" 2 "neg_onset.yaml:5: onsets_s\[0\]: must not be negative" "" -- \
+  campaign neg_onset.yaml --out camp
+spec_with late_onset.yaml 'kinds: [stuck]\ngyros: [1]\nonsets_s: [7000]\nseeds: [1]\n'
+check values "campaign: an onset after the end" 2 "late_onset.yaml:5: onsets_s\[0\]: 7000 s is at or after the end" "" -- \
+  campaign late_onset.yaml --out camp
+spec_with long.yaml 'kinds: [stuck]\ngyros: [1]\nonsets_s: [60]\nseeds: [1]\nduration_s: 1e300\n'
+check values "campaign: duration_s 1e300" 2 "long.yaml:7: duration_s: .*duration_s must be above 0" "" -- \
+  campaign long.yaml --out camp
+spec_with nan_size.yaml 'kinds: [bias]\nsizes: {bias: [.nan]}\ngyros: [1]\nonsets_s: [60]\nseeds: [1]\n'
+check values "campaign: sizes {bias: [.nan]}" 2 "nan_size.yaml:4: sizes.bias\[0\]: '.nan' is not a number" "" -- \
+  campaign nan_size.yaml --out camp
+spec_with big_size.yaml 'kinds: [bias]\nsizes: {bias: [1e309]}\ngyros: [1]\nonsets_s: [60]\nseeds: [1]\n'
+check values "campaign: sizes {bias: [1e309]}" 2 "big_size.yaml:4: sizes.bias\[0\]: " "" -- \
+  campaign big_size.yaml --out camp
+spec_with unrun_size.yaml 'kinds: [stuck]\nsizes: {bias: [0.01]}\ngyros: [1]\nonsets_s: [60]\nseeds: [1]\n'
+check values "campaign: sizes for a kind not run" 2 "unrun_size.yaml:4: sizes.bias: kind bias is not in kinds" "" -- \
+  campaign unrun_size.yaml --out camp
+spec_with dup_gyro.yaml 'kinds: [stuck]\ngyros: [1, 1]\nonsets_s: [60]\nseeds: [1]\n'
+check values "campaign: gyros [1, 1]" 2 "dup_gyro.yaml:4: gyros\[1\]: the same value as gyros\[0\]" "" -- \
+  campaign dup_gyro.yaml --out camp
+spec_with neg_seed.yaml 'kinds: [stuck]\ngyros: [1]\nonsets_s: [60]\nseeds: [-1]\n'
+check values "campaign: seeds [-1]" 2 "neg_seed.yaml:6: seeds\[0\]: expected a whole number from 0 to" "" -- \
+  campaign neg_seed.yaml --out camp
+spec_with maybe.yaml 'kinds: [stuck]\ngyros: [1]\nonsets_s: [60]\nseeds: [1]\nfault_free: maybe\n'
+check values "campaign: fault_free maybe" 2 "maybe.yaml:7: fault_free: expected true or false, got 'maybe'" "" -- \
+  campaign maybe.yaml --out camp
+printf 'unit: flat\ngyros:\n' >flat_unit.yaml
+for a in '[1, 0, 0]' '[0, 1, 0]' '[0.6, 0.8, 0]' '[0.8, -0.6, 0]'; do
+  printf '  - {id: %d, scale_factor_V_per_dps: 0.08, bias_V: 0, axis: %s, noise: {arw_dps_rtHz: 3e-5}}\n' \
+    "$(($(grep -c 'id:' flat_unit.yaml) + 1))" "$a" >>flat_unit.yaml
+done
+printf 'scenario: orbit\nunit: flat_unit.yaml\n' >flat_orbit.yaml
+spec_with flat.yaml 'kinds: [stuck]\ngyros: [1]\nonsets_s: [60]\nseeds: [1]\n'
+sed -i 's/^scenarios: .*/scenarios: [orbit, flat_orbit.yaml]/' flat.yaml
+check values "campaign: a scenario with coplanar gyro axes" 2 "flat.yaml:2: scenarios\[1\] .*pipeline cannot run" "" -- \
+  campaign flat.yaml --out camp
+printf 'scenario: orbit\nclosed_loop:\n  inertia_kg_m2: [1e-300, 1e-300, 1e-300]\n' >tiny_inertia.yaml
+check values "closed loop: inertia 1e-300" 2 "tiny_inertia.yaml:3: closed_loop: inertia_kg_m2 principal moments" "" -- \
+  sim tiny_inertia.yaml --closed-loop
+printf 'scenario: orbit\nclosed_loop:\n  inertia_kg_m2: [1e300, 1e300, 1e300]\n' >huge_inertia.yaml
+check values "closed loop: inertia 1e300" 2 "huge_inertia.yaml:3: closed_loop: inertia_kg_m2 principal moments" "" -- \
+  sim huge_inertia.yaml --closed-loop
+printf 'scenario: orbit\nclosed_loop:\n  inertia_kg_m2: [1, 1, 5]\n' >triangle.yaml
+check values "closed loop: inertia breaking the triangle inequality" 2 "triangle.yaml:3: .*triangle inequality" "" -- \
+  sim triangle.yaml --closed-loop
+printf 'scenario: orbit\nclosed_loop:\n  disturbance: {constant_Nm: [1e300, 0, 0]}\n' >torque.yaml
+check values "closed loop: a 1e300 disturbance" 2 "torque.yaml:3: closed_loop: disturbance.constant_Nm\[0\] must be" "" -- \
+  sim torque.yaml --closed-loop
+printf 'scenarios: [huge_inertia.yaml]\nkinds: [stuck]\ngyros: [1]\nonsets_s: [60]\nseeds: [1]\n' >inertia_spec.yaml
+check values "campaign: a scenario with inertia 1e300" 2 "inertia_spec.yaml:1: scenarios\[0\]: .*inertia_kg_m2" "" -- \
+  campaign inertia_spec.yaml --out camp
+check values "sim --acs-amplitude 1e300" 2 "--acs-amplitude: '1e300' must be from 0 to 45" "" -- \
+  sim orbit --minutes 0.1 --acs-amplitude 1e300 -o s.csv
+check values "sim --orbit-period 1e-300" 2 "--orbit-period: '1e-300' must be from 20 to" "" -- \
+  sim orbit --minutes 0.1 --orbit-period 1e-300 -o s.csv
+check values "sim --minutes inf" 2 "^tetra sim: --minutes: 'inf' must be above 0 and at most 1e\+07 .{0,40}$" "" -- \
+  sim orbit --minutes inf -o s.csv
+if "$TETRA" sim --help | grep -q -- '--speed'; then  # built with DDS
+  check values "sim --dds --speed 1e-300" 2 "--speed: '1e-300' must be 0 \(as fast as possible\) or at least 0.001" "" -- \
+    sim orbit --dds --speed 1e-300
+  check values "sim --dds --wait-timeout 1e300" 2 "--wait-timeout: '1e300' must be above 0 and at most 86400" "" -- \
+    sim orbit --dds --wait-timeout 1e300
+fi
+printf 'scenario: orbit\norbit_period_s: 1e-300\n' >period.yaml
+check values "scenario orbit_period_s 1e-300" 2 "period.yaml:2: orbit_period_s must be from 1200 to" "" -- \
+  sim period.yaml --minutes 0.1 -o s.csv
+
 # --- round trips -------------------------------------------------------------------------------------
 weird=$'odd "name" \\ with\nnewline, comma #hash'
 check roundtrip "calibrate --unit with quote, backslash, newline" 0 "" "weird.yaml" -- calibrate "$TT" -o weird.yaml --unit "$weird"

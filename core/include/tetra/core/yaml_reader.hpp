@@ -5,6 +5,7 @@
 // Every function returns a Result; none throws. Include this header only from a library that links
 // yaml-cpp itself (tetra::core keeps yaml-cpp private).
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -44,7 +45,8 @@ class YamlReader {
   Result<std::string> optional_text(const YAML::Node& parent, const std::string& key,
                                     const std::string& what) const;
 
-  //! A yaml-cpp exception (syntax error, bad conversion) as "FILE:LINE: what: message".
+  //! A yaml-cpp exception (syntax error, bad conversion) as "FILE:LINE: what: message" (a bad
+  //! conversion worded as "a value of the wrong type"; the typed readers above name the type expected).
   Error error(const YAML::Exception& e, const std::string& what) const;
 
   //! `map` must be a mapping whose keys are all in `allowed`; otherwise an Error naming the line of the
@@ -61,6 +63,15 @@ class YamlReader {
   //! parent[key] as a finite number, or nullopt when the key is absent or null.
   Result<std::optional<double>> optional_number(const YAML::Node& parent, const std::string& key,
                                                 const std::string& what) const;
+
+  //! A whole number (plain decimal digits, an optional '-') in [min, max]; otherwise "expected a whole
+  //! number from MIN to MAX, got 'TEXT'".
+  Result<std::int64_t> integer(const YAML::Node& node, const std::string& what, std::int64_t min,
+                               std::int64_t max) const;
+  //! A whole number from 0 to 2^64 - 1 (a seed); otherwise "expected a whole number from 0 to ..., got".
+  Result<std::uint64_t> unsigned_integer(const YAML::Node& node, const std::string& what) const;
+  //! true or false; otherwise "expected true or false, got 'TEXT'".
+  Result<bool> boolean(const YAML::Node& node, const std::string& what) const;
 
   //! A sequence of exactly three finite numbers, "[x, y, z]".
   Result<Eigen::Vector3d> vector3(const YAML::Node& node, const std::string& what) const;

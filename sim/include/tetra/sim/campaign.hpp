@@ -51,7 +51,10 @@ struct CampaignSpec {
   int dds_domain = 0;  //!< `domain:` the DDS domain id (target dds)
 };
 
-//! Reads a campaign spec; errors name file, line and key.
+//! Reads a campaign spec; errors name file, line and key. Every value is checked (types, ranges,
+//! duplicates, sizes only for the kinds run), the matrix's size is bounded (kMaxCampaignRuns) and
+//! every case is known to be able to run (each scenario with the pipeline, each onset before the end,
+//! each kind on each gyro) before anything runs.
 Result<CampaignSpec> read_campaign_spec(const std::string& path);
 
 //! One case of the matrix. No fault: a fault-free run.
@@ -62,8 +65,14 @@ struct CampaignCase {
   std::uint64_t seed = 1;
 };
 
-//! The cases in a fixed order (scenario, kind, gyro, onset, size, seed; fault-free runs first).
-std::vector<CampaignCase> expand_campaign(const CampaignSpec& spec);
+//! [runs] the largest campaign read (docs/campaign.md): a small spec can describe a matrix of any size.
+inline constexpr std::size_t kMaxCampaignRuns = 1'000'000;
+//! The number of runs: scenarios × (seeds if fault_free + Σ over kinds of gyros × onsets × sizes × seeds),
+//! computed without overflow; an error naming the lists' lengths above kMaxCampaignRuns (or for none).
+Result<std::size_t> campaign_run_count(const CampaignSpec& spec);
+//! Case `index` (< campaign_run_count) of the fixed order (scenario, kind, gyro, onset, size, seed;
+//! fault-free runs first), made on demand: a campaign never holds its cases in memory.
+CampaignCase campaign_case(const CampaignSpec& spec, std::size_t index);
 
 //! The scenario of a case as it runs: the spec's duration, the matrix's fault instead of its own.
 Scenario campaign_scenario(const CampaignSpec& spec, const CampaignCase& c);

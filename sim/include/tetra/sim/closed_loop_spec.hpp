@@ -84,6 +84,21 @@ struct ClosedLoopSpec {
   double pointing_bound_deg = 0.1;  //!< [deg] the stated pointing requirement (summary, recovery)
 };
 
+//! Ranges of the closed loop's numbers (docs/sim.md, "Closed loop"): a spacecraft from a 1U CubeSat
+//! (~2e-3 kg·m²) to a space station (~1e8 kg·m²), its actuators and its environment.
+inline constexpr double kMinInertia_kg_m2 = 1.0e-4;      //!< [kg·m²] smallest principal moment
+inline constexpr double kMaxInertia_kg_m2 = 1.0e9;       //!< [kg·m²] largest principal moment
+inline constexpr double kMaxWheelTorque_Nm = 1.0e3;      //!< [N·m] wheels.max_torque_Nm
+inline constexpr double kMaxWheelMomentum_Nms = 1.0e5;   //!< [N·m·s] wheels.max_momentum_Nms
+inline constexpr double kMaxWheelInertia_kg_m2 = 1.0e3;  //!< [kg·m²] wheels.inertia_kg_m2
+inline constexpr double kMaxDisturbance_Nm = 1.0e3;      //!< [N·m] each axis of constant_Nm, periodic_Nm
+inline constexpr double kMaxBandwidth_hz = 100.0;        //!< [Hz] controller.bandwidth_hz
+inline constexpr double kMaxDamping = 100.0;             //!< [-] controller.damping
+inline constexpr double kMaxControlTime_s = 1.0e9;       //!< [s] integral_time_s, hold_after_s, safe_after_s
+inline constexpr double kMaxPointingRate_dps = 360.0;  //!< [deg/s] pointing.max_rate_dps, initial rate error
+inline constexpr double kMaxPointingAccel_dps2 = 360.0;  //!< [deg/s²] pointing.max_accel_dps2
+inline constexpr double kMaxPointingAngle_deg = 3600.0;  //!< [deg] |angle_deg| of one pointing slew
+
 //! Parses the `closed_loop:` map; errors name file, line and key.
 Result<ClosedLoopSpec> parse_closed_loop(const YamlReader& yaml, const YAML::Node& node);
 //! Range checks; errors name the field.

@@ -42,6 +42,11 @@ std::string_view fault_kind_name(FaultKind kind);
 std::optional<FaultKind> fault_kind_from_name(std::string_view name);
 //! True for the kinds that need a size (bias, ramp, scale, noise, spike).
 bool kind_takes_size(FaultKind kind);
+//! [kind's unit] largest |size| of any kind (1e6 deg/s is far beyond any gyro's range).
+inline constexpr double kMaxFaultSize = 1.0e6;
+//! A size in its kind's range: finite, |size| ≤ kMaxFaultSize, a noise multiplier ≥ 0, a scale change
+//! above −1. The message reads after the size's name.
+Status check_fault_size(FaultKind kind, double size);
 
 //! True where the fault is active at time `t_s`.
 inline bool fault_active(const FaultSpec& fault, double t_s) {

@@ -63,6 +63,18 @@ struct MotionSpec {
   std::vector<Slew> slews;         //!< slews
 };
 
+//! Ranges of the motion's parameters (docs/sim.md, "Ranges"): beyond them the motion is not a physical
+//! one (or not representable in doubles: an orbit period of 1e-298 s turns every number into NaN).
+inline constexpr double kMaxPitchRate_dps = 1000.0;   //!< [deg/s] |pitch_rate_dps|
+inline constexpr double kMinOrbitPeriod_s = 1200.0;   //!< [s] 20 min (the lowest Earth orbit takes ~87 min)
+inline constexpr double kMaxOrbitPeriod_s = 6.0e7;    //!< [s] 1e6 min (about 1.9 years)
+inline constexpr double kMaxAcsAmplitude_deg = 45.0;  //!< [deg] an attitude-control deviation, not a slew
+inline constexpr double kMaxAcsAccel_dps2 = 100.0;    //!< [deg/s²]
+inline constexpr double kMaxSlewAngle_deg = 3600.0;   //!< [deg] |angle_deg| of one slew (10 turns)
+
+//! Checks the spec against the ranges above; errors name the scenario file's key.
+Status validate_motion(const MotionSpec& spec);
+
 //! Truth at one instant.
 struct MotionState {
   Quaternion q_RB;                   //!< body → reference frame R (see above), unit norm

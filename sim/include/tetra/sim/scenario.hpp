@@ -36,6 +36,15 @@ struct Scenario {
   std::optional<ClosedLoopSpec> closed_loop;  //!< closed loop: dynamics and control (closed_loop.hpp)
 };
 
+//! Ranges of a scenario's numbers besides the motion's (motion.hpp) and the closed loop's
+//! (closed_loop_spec.hpp); docs/sim.md, "Ranges".
+inline constexpr double kMaxDuration_s = 6.0e8;             //!< [s] 1e7 min (about 19 years)
+inline constexpr double kMaxRate_hz = 1.0e5;                //!< [Hz] gyro sampling rate
+inline constexpr double kMaxEpochs = 2.0e9;                 //!< duration_s × rate_hz
+inline constexpr double kMaxReferenceNoise_arcsec = 3.6e4;  //!< [arcsec] 10 deg
+inline constexpr double kMaxCorrelation_s = 1.0e9;          //!< [s] bias_instability_correlation_s
+inline constexpr double kMaxRange_dps = 1.0e6;              //!< [deg/s] gyro_model range_dps
+
 //! Names of the built-in scenarios (turntable is separate: see turntable.hpp).
 std::vector<std::string> builtin_scenario_names();
 //! A built-in scenario: static, lab-orbit, orbit, slews (defaults in docs/sim.md).
