@@ -89,6 +89,7 @@ Result<service::AssemblerConfig> assembly_settings(RecordOptions& o) {
   assembly.nominal_period_ns = seconds_to_ns(1.0 / o.rate_hz);
   assembly.tolerance_ns = o.tolerance_s >= 0 ? seconds_to_ns(o.tolerance_s) : assembly.nominal_period_ns / 4;
   assembly.max_latency_ns = seconds_to_ns(o.max_latency_s);
+  assembly.clock_window_ns = seconds_to_ns(service::default_clock_window_s(o.rate_hz));
   return assembly;
 }
 
@@ -370,7 +371,8 @@ int cmd_record(int argc, char** argv) {
   std::cerr << "tetra record: " << recording.epochs_written() << " epochs of unit "
             << (o.unit.empty() ? "(none seen)" : o.unit) << " written to " << o.out_path << " (late "
             << c.samples_late << ", duplicate " << c.samples_duplicate << ", out of order "
-            << c.samples_out_of_order << ", gap " << c.samples_gap << ")\n";
+            << c.samples_out_of_order << ", gap " << c.samples_gap << ", time outlier " << c.time_outlier
+            << ", sequence jump " << c.seq_discontinuity << ", restarts " << c.sensor_restarts << ")\n";
   return kExitOk;
 }
 
