@@ -469,6 +469,11 @@ TEST(DdsServices, GlitchingStampsAndSequenceNumbersFromAnotherProcessNeverBlindT
            h->counters.time_outlier + h->counters.seq_discontinuity == 9;
   })) << read_file(files.dir.file("fusion.log"));
   const auto& h = *health();
+  std::printf("[ figure ] glitches: time_outlier %llu, seq_discontinuity %llu; %zu Health checks after them, "
+              "%zu attitudes\n",
+              static_cast<unsigned long long>(h.counters.time_outlier),
+              static_cast<unsigned long long>(h.counters.seq_discontinuity), modes_after.size(),
+              observer.attitudes.size());
   EXPECT_GE(h.counters.time_outlier, 7U);
   EXPECT_EQ(h.counters.sensor_restarts, 0U);
   EXPECT_LT(h.counters.samples_gap, 1000U) << "no counter set to garbage by one sample";
