@@ -57,7 +57,7 @@ void add_record_options(CLI::App& app, RecordOptions& o) {
                  "take unit, gyro count and assembly settings from a fusion config");
   app.add_option("--gyros", o.gyros, "number of gyros N (columns g1..gN)")
       ->check(CLI::Range(1, dds::kMaxGyrosOnWire));
-  app.add_option("--rate", o.rate_hz, "[Hz] nominal sample rate")->check(CLI::PositiveNumber);
+  app.add_option("--rate", o.rate_hz, "[Hz] nominal sample rate")->check(CLI::Range(0.001, 100000.0));
   app.add_option("--tolerance", o.tolerance_s,
                  "[s] stamps this close form one epoch (default: a quarter period)")
       ->check(CLI::NonNegativeNumber);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "tetra/core/units.hpp"
+
 namespace tetra::service {
 
 namespace {
@@ -21,7 +23,9 @@ Status validate(const AssemblerConfig& config) {
   if (config.gyro_count < 1 || config.gyro_count > 32) {
     return bad_input("assembler: gyro_count " + std::to_string(config.gyro_count) + " is outside 1..32");
   }
-  if (config.nominal_period_ns <= 0) return bad_input("assembler: sample period must be positive");
+  if (config.nominal_period_ns <= 0 || config.nominal_period_ns > 1000 * kNanosPerSecond) {
+    return bad_input("assembler: the sample period must be in (0, 1000] s");
+  }
   if (config.tolerance_ns < 0 || 2 * config.tolerance_ns >= config.nominal_period_ns) {
     return bad_input("assembler: tolerance_s must be in [0, period/2)");
   }

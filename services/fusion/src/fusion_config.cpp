@@ -122,8 +122,8 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
 Status validate(const FusionConfig& config) {
   const std::string& s = config.source;
   if (auto status = check_unit_name(config.unit, s + ": unit"); !status) return status;
-  if (!(config.sample_rate_hz > 0.0 && config.sample_rate_hz <= 100000.0)) {
-    return bad_input(s + ": sample_rate_hz must be in (0, 100000]");
+  if (!(config.sample_rate_hz >= 0.001 && config.sample_rate_hz <= 100000.0)) {
+    return bad_input(s + ": sample_rate_hz must be in [0.001, 100000]");
   }
   if (!(config.speed > 0.0 && config.speed <= 1000.0)) return bad_input(s + ": speed must be in (0, 1000]");
   if (!(config.health_period_s > 0.0 && config.health_period_s <= 1.0)) {
