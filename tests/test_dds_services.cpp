@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -410,6 +411,85 @@ TEST(DdsServices, MalformedTrafficIsCountedNeverMixedNeverACrash) {
   EXPECT_EQ(observer.health.count("intruder"), 0U);  // nobody fuses the intruder's samples
   EXPECT_EQ(observer.attitude_units.count("intruder"), 0U);
   EXPECT_EQ(fusion.signal_and_wait(SIGINT), 0) << "the service survived and shut down cleanly";
+}
+
+TEST(DdsServices, GlitchingStampsAndSequenceNumbersFromAnotherProcessNeverBlindTheService) {
+  // A simulator feeds good samples; this process, a second writer on the same instances, publishes one
+  // of each glitch (docs/dds.md, "Epoch assembly"). 50 Hz: a 60 ms deadline, so a loaded machine's
+  // scheduling does not make gyros absent.
+  const dds_domainid_t domain = 197;
+  ServiceFiles files(50.0, 1.0);
+  Observer observer(domain);
+  TetraProcess fusion({"fusion", "--config", files.config, "--domain", d(domain)}, files.dir.file("fusion.log"));
+  TetraProcess sim({"sim", "static", "--dds", "--dds-unit", "tetra-1", "--domain", d(domain), "--rate-hz", "50",
+                    "--minutes", "1", "--speed", "1"},
+                   files.dir.file("sim.log"));
+  const auto health = [&]() -> const dds::HealthView* {
+    const auto it = observer.health.find("tetra-1");
+    return it == observer.health.end() ? nullptr : &it->second;
+  };
+  ASSERT_TRUE(observer.wait_until([&] {
+    const auto* h = health();
+    return h && h->health.mode == fdi::Mode::kNominal && h->health.counters.epochs_accepted > 25;
+  })) << read_file(files.dir.file("fusion.log"));
+  auto writer = dds::Writer<tetra_GyroSample>::create(observer.participant(), observer.topics().gyro_sample,
+                                                      dds::gyro_sample_qos(std::chrono::milliseconds(20)));
+  ASSERT_TRUE(writer.ok());
+  ASSERT_TRUE(observer.wait_until([&] { return *writer->matched_readers() >= 1; }));
+
+  const Calibration cal = seed_as_built_unit();
+  const auto glitch = [&](int gyro, std::uint64_t seq, std::int64_t stamp_ns) {
+    tetra_GyroSample m{};
+    EXPECT_TRUE(dds::copy_bounded(m.unit, "tetra-1", "unit").ok());
+    m.gyro = static_cast<std::uint16_t>(gyro);
+    m.seq = seq;
+    m.stamp_ns = stamp_ns;
+    m.raw = cal.gyros[static_cast<std::size_t>(gyro - 1)].bias_V;
+    EXPECT_TRUE(writer->write(m).ok());
+  };
+  observer.drain();
+  ASSERT_FALSE(observer.attitudes.empty());
+  const std::int64_t now_stamp = observer.attitudes.back().stamp_ns;  // the unit's time, about now
+  const std::uint64_t accepted_before = health()->health.counters.epochs_accepted;
+  const std::uint64_t deadlines_before = health()->counters.deadlines_missed;
+  constexpr std::int64_t kMillionSeconds = 1'000'000'000'000'000;
+  glitch(2, 1, std::numeric_limits<std::int64_t>::max());
+  glitch(3, 1, std::numeric_limits<std::int64_t>::min());
+  for (int g = 1; g <= 4; ++g) glitch(g, 1, now_stamp + kMillionSeconds);  // one epoch 1e6 s ahead
+  glitch(1, 1, now_stamp - kMillionSeconds);
+  glitch(4, std::numeric_limits<std::uint64_t>::max(), now_stamp + 20'000'000);  // plausible time
+  glitch(1, 1'000'000'000'000, now_stamp + 20'000'000);
+  observer.attitudes.clear();
+  // Health LOST not explained by a stall of the whole stream (a missed deadline: a loaded machine) would
+  // be the glitches blinding the unit.
+  int lost_unexplained = 0;
+  int lost_in_stall = 0;
+  // 7 time outliers; the two sequence numbers are discontinuities, or time outliers when this process
+  // was descheduled long enough for its "now" to fall out of the window: 9 in all, exactly.
+  ASSERT_TRUE(observer.wait_until([&] {
+    const auto* h = health();
+    if (h && h->health.mode == fdi::Mode::kLost) {
+      ++(h->counters.deadlines_missed > deadlines_before ? lost_in_stall : lost_unexplained);
+    }
+    return h && h->health.counters.epochs_accepted >= accepted_before + 100 &&
+           h->counters.time_outlier + h->counters.seq_discontinuity == 9 && h->health.mode == fdi::Mode::kNominal &&
+           h->health.used == 0xFU;
+  })) << read_file(files.dir.file("fusion.log"));
+  const auto& h = *health();
+  std::printf("[ figure ] glitches: time_outlier %llu, seq_discontinuity %llu; then %zu attitudes, Health LOST "
+              "seen %d times in stalls (deadlines missed %llu)\n",
+              static_cast<unsigned long long>(h.counters.time_outlier),
+              static_cast<unsigned long long>(h.counters.seq_discontinuity), observer.attitudes.size(),
+              lost_in_stall, static_cast<unsigned long long>(h.counters.deadlines_missed - deadlines_before));
+  EXPECT_GE(h.counters.time_outlier, 7U);
+  EXPECT_EQ(h.counters.sensor_restarts, 0U);
+  EXPECT_LT(h.counters.samples_gap, 1000U) << "no counter set to garbage by one sample";
+  EXPECT_EQ(h.health.mode, fdi::Mode::kNominal);
+  EXPECT_EQ(h.health.used, 0xFU);
+  EXPECT_GE(observer.attitudes.size(), 90U) << "attitude keeps flowing";
+  EXPECT_FALSE(observer.has_event(fdi::EventType::kIsolated));
+  EXPECT_EQ(lost_unexplained, 0) << read_file(files.dir.file("fusion.log"));
+  EXPECT_EQ(fusion.signal_and_wait(SIGINT), 0);
 }
 
 TEST(DdsServices, DefaultLivelinessWriterMatchesAndAnotherUnitIsWarnedAbout) {

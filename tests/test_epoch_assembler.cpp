@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
+#include "tetra/core/units.hpp"
 #include "tetra/service/epoch_assembler.hpp"
 
 namespace tetra::service {
@@ -13,6 +15,7 @@ namespace {
 constexpr std::int64_t kPeriod = 10'000'000;    // [ns] 100 Hz
 constexpr std::int64_t kTolerance = 1'000'000;  // [ns]
 constexpr std::int64_t kLatency = 20'000'000;   // [ns]
+constexpr std::int64_t kWindow = 100'000'000;   // [ns] the default clock window
 
 EpochAssembler make(int n = 4) {
   AssemblerConfig config;
@@ -222,6 +225,190 @@ TEST(EpochAssembler, ReferenceIsAttachedToTheEpochWithinTolerance) {
   EXPECT_EQ(a.counters().references_late, 1U);
 }
 
+// --- The unit's clock (docs/dds.md, "Epoch assembly"): one bad stamp or sequence number never blinds it.
+
+// Feeds epochs [from, to) of all four gyros at local time k·period, stamped k·period + stamp_offset
+// (speed 1); the sequence number is the stamp's period count + 1.
+void feed_flowing(EpochAssembler& a, int from, int to, std::vector<fdi::Epoch>& out, std::int64_t stamp_offset = 0) {
+  for (int k = from; k < to; ++k) {
+    const std::int64_t t = k * kPeriod;
+    const auto seq = static_cast<std::uint64_t>((t + stamp_offset) / kPeriod + 1);
+    for (int g = 1; g <= 4; ++g) {
+      EXPECT_EQ(a.add_sample(g, seq, t + stamp_offset, 0.0, t), Verdict::kAccepted)
+          << "epoch " << k << " gyro " << g;
+    }
+    a.poll(t, out);
+  }
+}
+
+TEST(EpochAssembler, AStampAtInt64MaxIsAnOutlierAndNeverMovesTheClock) {
+  auto a = make();
+  std::vector<fdi::Epoch> out;
+  feed_flowing(a, 0, 10, out);
+  EXPECT_EQ(a.add_sample(2, 11, std::numeric_limits<std::int64_t>::max(), 0.0, 10 * kPeriod),
+            Verdict::kTimeOutlier);
+  EXPECT_EQ(a.add_sample(3, 11, std::numeric_limits<std::int64_t>::min(), 0.0, 10 * kPeriod),
+            Verdict::kTimeOutlier);
+  feed_flowing(a, 11, 20, out);  // every later good epoch is accepted (sequence 11 skipped: gap 1 on gyros 2, 3)
+  ASSERT_EQ(out.size(), 19U);
+  EXPECT_EQ(out.back().stamp_ns, 19 * kPeriod);
+  EXPECT_EQ(a.counters().time_outlier, 2U);
+  EXPECT_EQ(a.counters().sensor_restarts, 0U);
+  EXPECT_EQ(a.counters().samples_late + a.counters().samples_out_of_order, 0U);
+}
+
+TEST(EpochAssembler, AnEpochAMillionSecondsAheadIsDroppedWhole) {
+  auto a = make();
+  std::vector<fdi::Epoch> out;
+  feed_flowing(a, 0, 10, out);
+  const std::int64_t ahead = 1'000'000 * kNanosPerSecond;
+  for (int g = 1; g <= 4; ++g) EXPECT_EQ(a.add_sample(g, 11, ahead, 0.0, 10 * kPeriod), Verdict::kTimeOutlier);
+  feed_flowing(a, 11, 20, out);
+  EXPECT_EQ(out.size(), 19U);
+  EXPECT_EQ(a.counters().time_outlier, 4U);
+  EXPECT_EQ(a.counters().sensor_restarts, 0U);  // one epoch on a new time base is no restart
+}
+
+TEST(EpochAssembler, TheWindowIsJudgedAgainstTheReceiveClock) {
+  auto a = make();
+  std::vector<fdi::Epoch> out;
+  feed_flowing(a, 0, 10, out);
+  // A stamp 0.1 s + 1 ns ahead of where the receive clock puts the unit: outlier; exactly 0.1 s: kept.
+  const std::int64_t now = 10 * kPeriod;
+  EXPECT_EQ(a.add_sample(1, 11, now + kWindow + 1, 0.0, now), Verdict::kTimeOutlier);
+  EXPECT_EQ(a.add_sample(1, 11, now + kWindow, 0.0, now), Verdict::kAccepted);
+  // After 5 s of silence the sensor is 5 s further on: accepted without any re-anchoring.
+  auto b = make();
+  feed_flowing(b, 0, 10, out);
+  for (int g = 1; g <= 4; ++g) b.mark_absent(g, AbsentReason::kDeadline);
+  const std::int64_t later = 10 * kPeriod + 5 * kNanosPerSecond;
+  for (int g = 1; g <= 4; ++g) EXPECT_EQ(b.add_sample(g, 511, later, 0.0, later), Verdict::kAccepted);
+  EXPECT_EQ(b.counters().time_outlier, 0U);
+  EXPECT_EQ(b.counters().samples_gap, 4U * 500U);  // 500 numbers per gyro, credible over 5 s
+  EXPECT_EQ(b.counters().sensor_restarts, 0U);
+}
+
+TEST(EpochAssembler, DelayedDeliveryNeverMakesAnOutlier) {
+  auto a = make();
+  std::vector<fdi::Epoch> out;
+  // A full reader history (64 samples per gyro) held up 2 s and taken at once, gyro by gyro (gyro 2's
+  // first sample lags gyro 1's newest by 63 periods), then on time again.
+  const std::int64_t batch_now = 2 * kNanosPerSecond;
+  for (int g = 1; g <= 4; ++g) {
+    for (int k = 0; k < 64; ++k) {
+      EXPECT_EQ(a.add_sample(g, static_cast<std::uint64_t>(k + 1), k * kPeriod, 0.0, batch_now),
+                Verdict::kAccepted);
+    }
+  }
+  a.poll(batch_now, out);
+  feed_flowing(a, 200, 210, out, -136 * kPeriod);  // stamps 64.. periods at local 2 s..: taken at once
+  EXPECT_EQ(out.size(), 74U);
+  EXPECT_EQ(a.counters().time_outlier, 0U);
+}
+
+TEST(EpochAssembler, SequenceNumberUint64MaxIsADiscontinuityNotAGap) {
+  auto a = make();
+  std::vector<fdi::Epoch> out;
+  feed_flowing(a, 0, 100, out);
+  // Seen from 100, 2^64-1 is 101 numbers back and 2^63 as far as can be: neither is credible.
+  const std::int64_t now = 100 * kPeriod;
+  EXPECT_EQ(a.add_sample(1, std::numeric_limits<std::uint64_t>::max(), now, 0.0, now), Verdict::kSeqDiscontinuity);
+  EXPECT_EQ(a.add_sample(2, std::uint64_t{1} << 63, now, 0.0, now), Verdict::kSeqDiscontinuity);
+  EXPECT_EQ(a.add_sample(3, 100'000, now, 0.0, now), Verdict::kSeqDiscontinuity);  // forward, 1 period later
+  feed_flowing(a, 100, 120, out);  // the gyros' own numbering goes on: nothing is out of order
+  EXPECT_EQ(out.size(), 120U);
+  EXPECT_EQ(a.counters().samples_gap, 0U);
+  EXPECT_EQ(a.counters().samples_out_of_order, 0U);
+  EXPECT_EQ(a.counters().seq_discontinuity, 3U);
+}
+
+TEST(EpochAssembler, SequenceNumbersWrapAround) {
+  auto a = make();
+  std::vector<fdi::Epoch> out;
+  const std::uint64_t start = std::numeric_limits<std::uint64_t>::max() - 1;  // ..., 2^64-2, 2^64-1, 0, 1, ...
+  for (int k = 0; k < 6; ++k) {
+    for (int g = 1; g <= 4; ++g) {
+      EXPECT_EQ(a.add_sample(g, start + static_cast<std::uint64_t>(k), k * kPeriod, 0.0, k * kPeriod),
+                Verdict::kAccepted);
+    }
+  }
+  EXPECT_EQ(a.add_sample(1, start + 3, 6 * kPeriod, 0.0, 6 * kPeriod), Verdict::kOutOfOrder);  // 1 after 3
+  EXPECT_EQ(a.counters().samples_gap, 0U);
+  EXPECT_EQ(a.counters().seq_discontinuity, 0U);
+}
+
+TEST(EpochAssembler, AGyroWhoseNumberingRestartsIsReanchoredOnItsSecondSample) {
+  auto a = make();
+  std::vector<fdi::Epoch> out;
+  feed_flowing(a, 0, 100, out);
+  // Gyro 3's writer restarts: numbers from 1 again while time goes on.
+  for (int g = 1; g <= 4; ++g) {
+    a.add_sample(g, g == 3 ? 1 : 101, 100 * kPeriod, 0.0, 100 * kPeriod);
+  }
+  EXPECT_EQ(a.counters().seq_discontinuity, 1U);
+  for (int g = 1; g <= 4; ++g) {
+    EXPECT_EQ(a.add_sample(g, g == 3 ? 2 : 102, 101 * kPeriod, 0.0, 101 * kPeriod), Verdict::kAccepted);
+  }
+  EXPECT_EQ(a.counters().samples_gap, 0U);
+}
+
+TEST(EpochAssembler, ASensorClockThatJumpsForGoodIsReanchoredAfterThreeSamplesPerGyro) {
+  auto a = make();
+  std::vector<fdi::Epoch> out;
+  feed_flowing(a, 0, 100, out);  // 1 s of time
+  // The sensor's clock restarts at 0 (sequence numbers too) without the stream pausing.
+  const std::int64_t local0 = 100 * kPeriod;
+  for (int k = 0; k < kRestartSamples; ++k) {
+    for (int g = 1; g <= 4; ++g) {
+      const Verdict v = a.add_sample(g, static_cast<std::uint64_t>(k + 1), k * kPeriod, 0.0, local0 + k * kPeriod);
+      const bool last = k == kRestartSamples - 1 && g == 4;  // the sample that confirms the new base
+      EXPECT_EQ(v, last ? Verdict::kAccepted : Verdict::kTimeOutlier) << k << " " << g;
+    }
+  }
+  EXPECT_EQ(a.counters().sensor_restarts, 1U);
+  EXPECT_EQ(a.counters().time_outlier, 4U * kRestartSamples - 1U);
+  out.clear();
+  for (int k = kRestartSamples; k < 10; ++k) {
+    for (int g = 1; g <= 4; ++g) {
+      EXPECT_EQ(a.add_sample(g, static_cast<std::uint64_t>(k + 1), k * kPeriod, 0.0, local0 + k * kPeriod),
+                Verdict::kAccepted);
+    }
+    a.poll(local0 + k * kPeriod, out);
+  }
+  ASSERT_FALSE(out.empty());
+  EXPECT_EQ(out.back().stamp_ns, 9 * kPeriod);
+  EXPECT_EQ(a.counters().samples_out_of_order + a.counters().samples_late, 0U);
+}
+
+TEST(EpochAssembler, OutliersInterleavedWithGoodSamplesNeverReanchor) {
+  auto a = make();
+  std::vector<fdi::Epoch> out;
+  // A hostile peer repeats a whole epoch 1e6 s ahead between every good epoch: it never takes over.
+  const std::int64_t ahead = 1'000'000 * kNanosPerSecond;
+  for (int k = 0; k < 20; ++k) {
+    feed_flowing(a, k, k + 1, out);
+    for (int g = 1; g <= 4; ++g) a.add_sample(g, 1000, ahead + k * kPeriod, 0.0, k * kPeriod);
+  }
+  EXPECT_EQ(out.size(), 20U);
+  EXPECT_EQ(a.counters().sensor_restarts, 0U);
+  EXPECT_EQ(a.counters().time_outlier, 80U);
+}
+
+TEST(EpochAssembler, AnOutlierFirstOfAllIsOutvotedByTheRealStream) {
+  auto a = make();
+  // The first sample ever is a glitch (stamp 1e6 s): the real stream re-anchors after 3 samples per gyro.
+  EXPECT_EQ(a.add_sample(1, 1, 1'000'000 * kNanosPerSecond, 0.0, 0), Verdict::kAccepted);
+  std::vector<fdi::Epoch> out;
+  for (int k = 0; k < 10; ++k) {
+    for (int g = 1; g <= 4; ++g) a.add_sample(g, static_cast<std::uint64_t>(k + 2), k * kPeriod, 0.0, k * kPeriod);
+    a.poll(k * kPeriod, out);
+  }
+  EXPECT_EQ(a.counters().sensor_restarts, 1U);
+  ASSERT_FALSE(out.empty());
+  EXPECT_EQ(out.back().stamp_ns, 9 * kPeriod);
+  EXPECT_EQ(out.back().present, (std::vector<std::uint8_t>{1, 1, 1, 1}));
+}
+
 TEST(EpochAssembler, InvalidSettingsAreRejectedByName) {
   AssemblerConfig config;
   config.tolerance_ns = config.nominal_period_ns / 2;  // would merge neighbouring epochs
@@ -234,6 +421,11 @@ TEST(EpochAssembler, InvalidSettingsAreRejectedByName) {
   config = AssemblerConfig{};
   config.max_latency_ns = 0;
   EXPECT_FALSE(EpochAssembler::create(config).ok());
+  config = AssemblerConfig{};
+  config.clock_window_ns = config.nominal_period_ns;  // under 2 periods
+  a = EpochAssembler::create(config);
+  ASSERT_FALSE(a.ok());
+  EXPECT_NE(a.error().message.find("clock_window_s"), std::string::npos);
 }
 
 }  // namespace

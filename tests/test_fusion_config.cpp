@@ -76,6 +76,41 @@ TEST_F(FusionConfigTest, BadValuesAreRejectedByName) {
   EXPECT_NE(missing.error().message.find("nowhere.yaml"), std::string::npos);
 }
 
+TEST_F(FusionConfigTest, UnitNameWithANewlineOrInvalidUtf8IsRefusedNamingTheKey) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"calibration: cal.yaml\nunit: \"tetra\\n1\"\n", "control character"},
+      {"calibration: cal.yaml\nunit: \"a\\tb\"\n", "control character"},
+      {"calibration: cal.yaml\nunit: \"bad\xff\"\n", "not valid UTF-8"},
+      {"calibration: cal.yaml\nunit: \"\"\n", "1 to 31 bytes"}};
+  for (const auto& [text, why] : cases) {
+    auto config = parse(text);
+    ASSERT_FALSE(config.ok()) << text;
+    EXPECT_EQ(config.error().kind, ErrorKind::kBadInput);
+    EXPECT_NE(config.error().message.find("f.yaml:2: unit"), std::string::npos) << config.error().message;
+    EXPECT_NE(config.error().message.find(why), std::string::npos) << config.error().message;
+  }
+  EXPECT_TRUE(parse("calibration: cal.yaml\nunit: \"Einheit-α\"\n").ok());  // UTF-8 text is fine
+}
+
+TEST_F(FusionConfigTest, ClockWindowDefaultsAndBounds) {
+  auto config = parse("calibration: cal.yaml\n");
+  ASSERT_TRUE(config.ok());
+  EXPECT_EQ(config->assembler(4).clock_window_ns, 100'000'000);  // 0.1 s at 100 Hz
+  EXPECT_EQ(config->assembler(4).speed, 1.0);
+  auto slow = parse("calibration: cal.yaml\nsample_rate_hz: 10\n");
+  ASSERT_TRUE(slow.ok());
+  EXPECT_EQ(slow->assembler(4).clock_window_ns, 400'000'000);  // 4 periods at 10 Hz
+  auto set = parse("calibration: cal.yaml\nclock_window_s: 0.5\n");
+  ASSERT_TRUE(set.ok());
+  EXPECT_EQ(set->assembler(4).clock_window_ns, 500'000'000);
+  for (const char* text : {"calibration: cal.yaml\nclock_window_s: 0.01\n", "calibration: cal.yaml\nclock_window_s: 1e300\n",
+                           "calibration: cal.yaml\nmax_latency_s: 1e300\n", "calibration: cal.yaml\ntolerance_s: -1e300\n"}) {
+    auto bad = parse(text);
+    ASSERT_FALSE(bad.ok()) << text;
+    EXPECT_EQ(bad.error().kind, ErrorKind::kBadInput);
+  }
+}
+
 TEST_F(FusionConfigTest, PipelineMapIsThePipelinesOwn) {
   auto config = parse("calibration: cal.yaml\npipeline:\n  initial_q_wxyz: [0, 1, 0, 0]\n");
   ASSERT_TRUE(config.ok()) << config.error().message;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "tetra/core/calibration_file.hpp"
+#include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/core/turntable_log.hpp"
@@ -23,6 +24,41 @@ TEST(ReliabilityParsers, GyroColumnNumberBeyondIntIsAnErrorNotACrash) {
   ASSERT_FALSE(log.ok());
   EXPECT_NE(log.error().message.find("huge.csv:1"), std::string::npos) << log.error().message;
   EXPECT_NE(log.error().message.find("g29999999999999999999999"), std::string::npos) << log.error().message;
+}
+
+TEST(ReliabilityParsers, TimesBeyondTheNanosecondRangeAreRefusedNamingTheLine) {
+  // 1e10 s does not fit 64-bit nanoseconds: every epoch after the first was rejected with exit 0.
+  const auto log = parse_gyro_log("time_s,g1\n10000000000.00,1\n10000000000.01,2\n", "big.csv");
+  ASSERT_FALSE(log.ok());
+  EXPECT_NE(log.error().message.find("big.csv:2: column 'time_s': time 1e+10 s is beyond"), std::string::npos)
+      << log.error().message;
+  EXPECT_TRUE(parse_gyro_log("time_s,g1\n8999999999.99,1\n8999999999.991,2\n", "ok.csv").ok());
+  EXPECT_TRUE(log_time_problem(-9.1e9).has_value());
+}
+
+TEST(ReliabilityParsers, DecimalCommaInAMetadataCommentStaysInTheValue) {
+  Metadata meta;
+  parse_metadata_comment(" latitude_deg=-23,2", meta);
+  ASSERT_EQ(meta.size(), 1U);
+  EXPECT_EQ(meta[0].second, "-23,2");  // its reader refuses it; it was read as -23
+  meta.clear();
+  parse_metadata_comment(" a=1,b=2 c=3", meta);  // commas between key=value pairs still separate them
+  ASSERT_EQ(meta.size(), 3U);
+  EXPECT_EQ(meta[0].second, "1");
+  EXPECT_EQ(meta[1].second, "2");
+}
+
+TEST(ReliabilityParsers, DenormalScaleFactorIsRefusedNamingTheKey) {
+  // 1e-320 is a denormal: its reciprocal overflows, and replay wrote NaN sigma rows with exit 0.
+  std::string text = format_calibration(seed_as_built_unit());
+  const std::size_t at = text.find("scale_factor_V_per_dps: ") + std::string("scale_factor_V_per_dps: ").size();
+  text.replace(at, text.find('\n', at) - at, "1e-320");
+  const auto cal = parse_calibration(text, "den.yaml");
+  ASSERT_FALSE(cal.ok());
+  EXPECT_NE(cal.error().message.find("gyros[0].scale_factor_V_per_dps: must be a number with magnitude in [1e-9, 1e9]"),
+            std::string::npos)
+      << cal.error().message;
+  EXPECT_NE(cal.error().message.find("den.yaml:"), std::string::npos);
 }
 
 TEST(ReliabilityParsers, DuplicateGyroColumnIsRejected) {

@@ -48,6 +48,15 @@ Calibration seed_as_built_unit() {
 
 namespace {
 
+//! A scale factor the conversion y = (g − bias) / scale keeps finite and meaningful: a normal number
+//! (no denormal such as 1e-320, whose reciprocal overflows) of magnitude within the stated bounds.
+bool plausible_scale_factor(double scale_V_per_dps) {
+  const double magnitude = std::abs(scale_V_per_dps);
+  return std::isfinite(magnitude) && magnitude >= kMinScaleFactor_V_per_dps && magnitude <= kMaxScaleFactor_V_per_dps;
+}
+
+const char* const kScaleFactorRange = "must be a number with magnitude in [1e-9, 1e9] V/(deg/s), not zero";
+
 Result<GyroCalibration> parse_gyro(const YamlReader& yaml, const YAML::Node& g, std::size_t index) {
   const std::string what = "gyros[" + std::to_string(index) + "]";
   if (Status st =
@@ -61,8 +70,8 @@ Result<GyroCalibration> parse_gyro(const YamlReader& yaml, const YAML::Node& g, 
   out.id = static_cast<int>(*id);
   const auto scale = yaml.required_number(g, "scale_factor_V_per_dps", what);
   if (!scale) return scale.error();
-  if (*scale == 0.0)
-    return yaml.error(g["scale_factor_V_per_dps"], what + ".scale_factor_V_per_dps", "must not be zero");
+  if (!plausible_scale_factor(*scale))
+    return yaml.error(g["scale_factor_V_per_dps"], what + ".scale_factor_V_per_dps", kScaleFactorRange);
   out.scale_factor_V_per_dps = *scale;
   const auto bias = yaml.required_number(g, "bias_V", what);
   if (!bias) return bias.error();
@@ -183,10 +192,9 @@ Status validate_calibration(const Calibration& cal, const std::string& source) {
       return bad_input(source + ": gyros[" + std::to_string(i) + "].id is " + std::to_string(g.id) +
                        ", expected " + std::to_string(i + 1) + " (ids 1..N in order)");
     }
-    if (!std::isfinite(g.scale_factor_V_per_dps) || g.scale_factor_V_per_dps == 0.0 ||
-        !std::isfinite(g.bias_V)) {
-      return bad_input(source + ": gyro " + std::to_string(g.id) +
-                       ": scale factor and bias must be finite, scale non-zero");
+    if (!plausible_scale_factor(g.scale_factor_V_per_dps) || !std::isfinite(g.bias_V)) {
+      return bad_input(source + ": gyro " + std::to_string(g.id) + ": bias must be finite, scale factor " +
+                       kScaleFactorRange);
     }
     if (std::abs(g.axis_B.norm() - 1.0) > 1e-9) {
       return bad_input(source + ": gyro " + std::to_string(g.id) + ": axis is not a unit vector");

@@ -60,8 +60,19 @@ void parse_metadata_comment(std::string_view comment, Metadata& metadata) {
     while (i < comment.size() && (comment[i] == ' ' || comment[i] == '\t' || comment[i] == ',')) ++i;
     std::size_t j = i;
     while (j < comment.size() && comment[j] != ' ' && comment[j] != '\t' && comment[j] != ',') ++j;
-    const std::string_view token = comment.substr(i, j - i);
+    std::string_view token = comment.substr(i, j - i);
     const std::size_t eq = token.find('=');
+    // tetra writes ',' in a value as %2C: a bare comma followed at once by text that is no "key="
+    // belongs to the value ("latitude_deg=-23,2", a decimal comma), so the value is read whole and
+    // refused by its reader, never cut to "-23".
+    while (eq != std::string_view::npos && j + 1 < comment.size() && comment[j] == ',' && comment[j + 1] != ' ' &&
+           comment[j + 1] != '\t' && comment[j + 1] != ',') {
+      std::size_t k = j + 1;
+      while (k < comment.size() && comment[k] != ' ' && comment[k] != '\t' && comment[k] != ',') ++k;
+      if (comment.substr(j + 1, k - j - 1).find('=') != std::string_view::npos) break;
+      j = k;
+      token = comment.substr(i, j - i);
+    }
     if (eq != std::string_view::npos && eq > 0) {
       metadata.emplace_back(std::string(token.substr(0, eq)), unescape_meta(token.substr(eq + 1)));
     }

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 
@@ -9,6 +10,16 @@
 #include "tetra/core/csv.hpp"
 
 namespace tetra {
+
+std::optional<std::string> log_time_problem(double time_s) {
+  if (!std::isfinite(time_s)) return std::string("time must be a finite number");
+  if (std::abs(time_s) <= kMaxLogTime_s) return std::nullopt;
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", time_s);
+  return std::string("time ") + text +
+         " s is beyond ±9e9 s (times become 64-bit nanoseconds): give times relative to an epoch, e.g. the first";
+}
+
 
 std::optional<std::string> GyroLog::meta(const std::string& key) const {
   return last_meta(metadata, key);
@@ -109,9 +120,8 @@ Status read_rows(const CsvTable& t, const LogColumns& cols, GyroLog& log) {
     log.reference_present.resize(n);
   }
   for (std::size_t r = 0; r < n; ++r) {
-    if (t.is_empty(r, cols.time) || !std::isfinite(t.cell(r, cols.time))) {
-      return bad_input(t.where(r, cols.time) + "time must be a finite number");
-    }
+    if (t.is_empty(r, cols.time)) return bad_input(t.where(r, cols.time) + "time must be a finite number");
+    if (auto why = log_time_problem(t.cell(r, cols.time))) return bad_input(t.where(r, cols.time) + *why);
     log.time_s[r] = t.cell(r, cols.time);
     for (std::size_t g = 0; g < ng; ++g) {
       log.values[r * ng + g] = t.cell(r, cols.gyros[g]);

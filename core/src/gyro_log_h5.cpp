@@ -369,9 +369,7 @@ Status H5Reader::open(const std::string& path) {
 
 Status H5Reader::check_block(const GyroLog& block, hsize_t first) const {
   for (std::size_t r = 0; r < block.epochs(); ++r) {
-    if (!std::isfinite(block.time_s[r])) {
-      return bad_input(where("time_s", first + r) + "time must be a finite number");
-    }
+    if (auto why = log_time_problem(block.time_s[r])) return bad_input(where("time_s", first + r) + *why);
     if (block.has_reference && block.reference_present[r] != 0) {
       const auto& q = block.reference_wxyz[r];
       const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);

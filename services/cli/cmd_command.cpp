@@ -81,7 +81,7 @@ int cmd_command(int argc, char** argv) {
   request.origin = "cli@" + host_name();
   double timeout_s = 5.0;
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
-  app.add_option("--unit", request.unit, "the unit to command")->required();
+  app.add_option("--unit", request.unit, "the unit to command")->required()->check(unit_name_check());
   app.add_option("action", action, "reset, exclude or reinstate")
       ->required()
       ->check(CLI::IsMember({"reset", "exclude", "reinstate"}));

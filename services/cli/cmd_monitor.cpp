@@ -111,7 +111,8 @@ std::string health_json(const std::string& unit, const UnitView& view, std::int6
         << ", \"samples_unknown_gyro\": " << c.samples_unknown_gyro
         << ", \"samples_other_unit\": " << c.samples_other_unit
         << ", \"deadlines_missed\": " << c.deadlines_missed << ", \"liveliness_lost\": " << c.liveliness_lost
-        << ", \"sensor_restarts\": " << c.sensor_restarts
+        << ", \"sensor_restarts\": " << c.sensor_restarts << ", \"time_outlier\": " << c.time_outlier
+        << ", \"seq_discontinuity\": " << c.seq_discontinuity
         << "}, \"events_published\": " << view.health->events_published;
   }
   if (view.attitude) {
@@ -171,7 +172,8 @@ std::string dashboard_block(const std::string& unit, const UnitView& view, std::
       << "  absent " << h.counters.samples_absent << "  late " << c.samples_late << "  duplicate "
       << c.samples_duplicate << "  out-of-order " << c.samples_out_of_order << "  gap " << c.samples_gap
       << "  unknown-gyro " << c.samples_unknown_gyro << "  other-unit " << c.samples_other_unit
-      << "  deadlines " << c.deadlines_missed << "  liveliness " << c.liveliness_lost << '\n';
+      << "  deadlines " << c.deadlines_missed << "  liveliness " << c.liveliness_lost << "  time-outlier "
+      << c.time_outlier << "  seq-jump " << c.seq_discontinuity << "  restarts " << c.sensor_restarts << '\n';
   out << "  recent events:" << (view.events.empty() ? " none\n" : "\n");
   for (const auto& e : view.events) out << "    " << fdi::to_json(e.event, n) << '\n';
   return out.str();

@@ -52,12 +52,12 @@ struct RecordOptions {
 
 void add_record_options(CLI::App& app, RecordOptions& o) {
   app.add_option("-o,--out", o.out_path, "gyro log to write (CSV, or HDF5 when named .h5)")->required();
-  app.add_option("--unit", o.unit, "the unit to record (default: the first one seen)");
+  app.add_option("--unit", o.unit, "the unit to record (default: the first one seen)")->check(unit_name_check());
   app.add_option("--config", o.config_path,
                  "take unit, gyro count and assembly settings from a fusion config");
   app.add_option("--gyros", o.gyros, "number of gyros N (columns g1..gN)")
       ->check(CLI::Range(1, dds::kMaxGyrosOnWire));
-  app.add_option("--rate", o.rate_hz, "[Hz] nominal sample rate")->check(CLI::PositiveNumber);
+  app.add_option("--rate", o.rate_hz, "[Hz] nominal sample rate")->check(CLI::Range(0.001, 100000.0));
   app.add_option("--tolerance", o.tolerance_s,
                  "[s] stamps this close form one epoch (default: a quarter period)")
       ->check(CLI::NonNegativeNumber);
@@ -89,6 +89,7 @@ Result<service::AssemblerConfig> assembly_settings(RecordOptions& o) {
   assembly.nominal_period_ns = seconds_to_ns(1.0 / o.rate_hz);
   assembly.tolerance_ns = o.tolerance_s >= 0 ? seconds_to_ns(o.tolerance_s) : assembly.nominal_period_ns / 4;
   assembly.max_latency_ns = seconds_to_ns(o.max_latency_s);
+  assembly.clock_window_ns = seconds_to_ns(service::default_clock_window_s(o.rate_hz));
   return assembly;
 }
 
@@ -370,7 +371,8 @@ int cmd_record(int argc, char** argv) {
   std::cerr << "tetra record: " << recording.epochs_written() << " epochs of unit "
             << (o.unit.empty() ? "(none seen)" : o.unit) << " written to " << o.out_path << " (late "
             << c.samples_late << ", duplicate " << c.samples_duplicate << ", out of order "
-            << c.samples_out_of_order << ", gap " << c.samples_gap << ")\n";
+            << c.samples_out_of_order << ", gap " << c.samples_gap << ", time outlier " << c.time_outlier
+            << ", sequence jump " << c.seq_discontinuity << ", restarts " << c.sensor_restarts << ")\n";
   return kExitOk;
 }
 

@@ -56,7 +56,7 @@ struct ReplayOptions {
   std::string events_path;
   std::string commands_path;
   std::optional<double> latitude_deg;
-  std::string initial_q;
+  std::optional<std::string> initial_q;
   bool verbose = false;
 };
 
@@ -87,8 +87,8 @@ Result<fdi::PipelineConfig> pipeline_config(const ReplayOptions& o) {
     config = *c;
   }
   if (o.latitude_deg) config.latitude_deg = *o.latitude_deg;
-  if (!o.initial_q.empty()) {
-    auto q = parse_quaternion(o.initial_q);
+  if (o.initial_q) {
+    auto q = parse_quaternion(*o.initial_q);
     if (!q) return q.error();
     config.initial_q_RB = *q;
   }

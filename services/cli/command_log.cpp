@@ -2,9 +2,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include <set>
 #include <sstream>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/gyro_log.hpp"
 #include "tetra/core/units.hpp"
 
 namespace tetra::cli {
@@ -14,11 +16,23 @@ namespace {
 using nlohmann::json;
 
 Result<RecordedCommand> parse_line(const std::string& line, const std::string& where) {
-  const json j = json::parse(line, nullptr, false);
+  // A key given twice is refused (JSON leaves its meaning open; the parser would keep the last).
+  std::set<std::string> keys;
+  std::string repeated;
+  const json::parser_callback_t note_keys = [&](int depth, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::key && depth == 1 && parsed.is_string() &&
+        !keys.insert(parsed.get<std::string>()).second && repeated.empty()) {
+      repeated = parsed.get<std::string>();
+    }
+    return true;
+  };
+  const json j = json::parse(line, note_keys, false);
   if (j.is_discarded() || !j.is_object()) return bad_input(where + ": not a JSON object");
+  if (!repeated.empty()) return bad_input(where + ": field '" + repeated + "' appears twice");
   RecordedCommand c;
   if (!j.contains("time_s") || !j["time_s"].is_number())
     return bad_input(where + ": field 'time_s' (number) missing");
+  if (auto why = log_time_problem(j["time_s"].get<double>())) return bad_input(where + ": field 'time_s': " + *why);
   c.stamp_ns = seconds_to_ns(j["time_s"].get<double>());
   if (!j.contains("command") || !j["command"].is_string())
     return bad_input(where + ": field 'command' missing");
@@ -26,9 +40,15 @@ Result<RecordedCommand> parse_line(const std::string& line, const std::string& w
   if (c.action != "reset" && c.action != "exclude" && c.action != "reinstate")
     return bad_input(where + ": field 'command' must be reset, exclude or reinstate");
   if (c.action != "reset") {
-    if (!j.contains("gyro") || !j["gyro"].is_number_integer())
-      return bad_input(where + ": field 'gyro' missing");
-    c.gyro = static_cast<int>(j["gyro"].get<std::int64_t>());
+    if (!j.contains("gyro")) return bad_input(where + ": field 'gyro' missing");
+    const json& gyro = j["gyro"];
+    if (!gyro.is_number_integer()) {
+      return bad_input(where + ": field 'gyro' must be a whole number (a gyro id 1..64), not " + gyro.dump());
+    }
+    if (gyro.get<double>() < 1 || gyro.get<double>() > 64) {
+      return bad_input(where + ": field 'gyro' " + gyro.dump() + " is outside 1..64");
+    }
+    c.gyro = static_cast<int>(gyro.get<std::int64_t>());
   }
   if (j.contains("force")) {
     if (!j["force"].is_boolean()) return bad_input(where + ": field 'force' must be true or false");

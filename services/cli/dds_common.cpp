@@ -9,10 +9,20 @@
 #include <filesystem>
 
 #include "tetra/core/json.hpp"
+#include "tetra/service/unit_name.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/service/security_profile.hpp"
 
 namespace tetra::cli {
+
+CLI::Validator unit_name_check() {
+  return CLI::Validator(
+      [](const std::string& name) {
+        const Status status = service::check_unit_name(name, "unit name");
+        return status ? std::string() : status.error().message;
+      },
+      "UNIT");
+}
 
 void add_domain_option(CLI::App& app, dds_domainid_t& domain) {
   domain = DDS_DOMAIN_DEFAULT;

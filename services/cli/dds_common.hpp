@@ -22,6 +22,10 @@ void add_domain_option(CLI::App& app, dds_domainid_t& domain);
 using dds::monotonic_ns;
 using dds::wall_ns;
 
+//! Checks a unit name option (tetra/service/unit_name.hpp: 1 to 31 bytes of UTF-8, no control
+//! characters); CLI11 names the option in the error.
+CLI::Validator unit_name_check();
+
 //! Path of the running program (/proc/self/exe).
 std::string self_executable();
 

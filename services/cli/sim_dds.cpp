@@ -30,7 +30,8 @@ void add_sim_dds_options(CLI::App& app, SimDdsOptions& options) {
                        : std::string();
           },
           "", "0 or at least 0.001"));
-  app.add_option("--dds-unit", options.unit, "--dds: the unit's key on the wire (default: the unit's name)");
+  app.add_option("--dds-unit", options.unit, "--dds: the unit's key on the wire (default: the unit's name)")
+      ->check(unit_name_check());
   app.add_option("--wait-readers", options.wait_readers, "--dds: gyro readers to wait for before publishing")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--wait-timeout", options.wait_timeout_s,

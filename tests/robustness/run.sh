@@ -212,6 +212,31 @@ grep -q 'latitude_deg=0x10' hexmeta.csv || sed -i '1i # latitude_deg=0x10' hexme
 sed -i '/^# latitude_deg=-/d' hexmeta.csv
 check csv "hexadecimal latitude comment" 2 "hexmeta.csv: comment '# latitude_deg=0x10'" "" -- calibrate hexmeta.csv -o c.yaml
 
+sed 's/^# latitude_deg=.*/# latitude_deg=-23,2/' "$TT" >commalat.csv
+grep -q 'latitude_deg=-23,2' commalat.csv || sed -i '1i # latitude_deg=-23,2' commalat.csv
+check csv "decimal comma in the latitude comment" 2 "commalat.csv: comment '# latitude_deg=-23,2' is not a decimal number" "" -- \
+  calibrate commalat.csv -o c.yaml
+awk -F, -v OFS=, '/^#/ || /^time_s/ { print; next } { $1 = sprintf("%.6f", $1 + 1e10); print }' "$LOG" >bigtime.csv
+check csv "times near 1e10 s" 2 "bigtime.csv:$first_row: column 'time_s': time 1e\+10 s is beyond" "" -- \
+  replay bigtime.csv --calibration "$CAL" --attitude a.csv --events e.jsonl
+cal_with '0,/scale_factor_V_per_dps:/s/scale_factor_V_per_dps: .*/scale_factor_V_per_dps: 1e-320/' denormal.yaml
+check yaml "denormal scale factor 1e-320" 2 "denormal.yaml:[0-9]+: gyros\[0\].scale_factor_V_per_dps: must be a number with magnitude" "" -- \
+  replay "$LOG" --calibration denormal.yaml --attitude a.csv --events e.jsonl
+printf '{"time_s": 1, "command": "exclude", "gyro": 2, "gyro": 3}\n' >dupcmd.jsonl
+check inputs "commands: a key twice" 2 "dupcmd.jsonl:1: field 'gyro' appears twice" "" -- \
+  replay "$LOG" --calibration "$CAL" --commands dupcmd.jsonl --attitude a.csv --events e.jsonl
+printf '{"time_s": 1, "command": "exclude", "gyro": 2.5}\n' >fraccmd.jsonl
+check inputs "commands: gyro 2.5" 2 "fraccmd.jsonl:1: field 'gyro' must be a whole number" "" -- \
+  replay "$LOG" --calibration "$CAL" --commands fraccmd.jsonl --attitude a.csv --events e.jsonl
+if "$TETRA" help fusion >/dev/null 2>&1; then  # a build with DDS
+printf 'unit: "tetra\\n1"\ncalibration: %s\n' "$CAL" >nlunit.yaml
+check yaml "fusion unit name with a newline" 2 "nlunit.yaml:1: unit: contains a control character" "" -- \
+  fusion --config nlunit.yaml
+printf 'unit: "tetra\xff"\ncalibration: %s\n' "$CAL" >utfunit.yaml
+check yaml "fusion unit name not UTF-8" 2 "utfunit.yaml:1: unit: is not valid UTF-8" "" -- \
+  fusion --config utfunit.yaml
+fi
+
 # --- command line ------------------------------------------------------------------------------------
 check options "help UNKNOWN" 2 "unknown command 'nosuch'" "" -- help nosuch
 check options "unknown command" 2 "unknown command 'nosuch'" "" -- nosuch
@@ -226,6 +251,10 @@ check options "negative --seed" 2 "--seed" "" -- sim static --minutes 0.1 --seed
 check options "overflowing --seed" 2 "--seed" "" -- sim static --minutes 0.1 --seed 99999999999999999999999 -o s.csv
 check options "fault field given twice" 2 "at: given twice" "" -- sim static --minutes 0.1 --fault gyro=1,kind=stuck,at=1,at=2 -o s.csv
 check options "fault after the run ends" 2 "after the end of the run" "" -- sim static --minutes 0.1 --fault gyro=1,kind=stuck,at=600 -o s.csv
+check options "--initial-q empty" 2 "--initial-q: expected four numbers" "" -- replay "$LOG" --calibration "$CAL" --initial-q '' --attitude a.csv --events e.jsonl
+"$TETRA" help fusion >/dev/null 2>&1 &&
+  check options "sim --dds-unit with a newline" 2 "--dds-unit: unit name: contains a control character" "" -- \
+    sim static --minutes 0.1 --dds --dds-unit $'a\nb'
 check options "--initial-q hexadecimal" 2 "--initial-q" "" -- replay "$LOG" --calibration "$CAL" --initial-q 0x1,0,0,0 --attitude a.csv --events e.jsonl
 check options "--dt-tolerance out of range" 2 "--dt-tolerance" "" -- allan "$LOG" --dt-tolerance 3
 check options "--gyro hexadecimal" 2 "--gyro" "" -- allan "$LOG" --gyro 0x1

@@ -132,6 +132,8 @@ Status to_wire(const std::string& unit, const fdi::Health& health, const service
   c.sensor_restarts = counters.sensor_restarts;
   c.deadlines_missed = counters.deadlines_missed;
   c.liveliness_lost = counters.liveliness_lost;
+  c.time_outlier = counters.time_outlier;
+  c.seq_discontinuity = counters.seq_discontinuity;
   return ok_status();
 }
 
@@ -170,6 +172,8 @@ HealthView from_wire(const tetra_Health& in) {
   out.health_period_s = in.health_period_s;
   out.counters.deadlines_missed = c.deadlines_missed;
   out.counters.liveliness_lost = c.liveliness_lost;
+  out.counters.time_outlier = c.time_outlier;
+  out.counters.seq_discontinuity = c.seq_discontinuity;
   return out;
 }
 

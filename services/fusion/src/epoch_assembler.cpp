@@ -4,17 +4,36 @@
 #include <cmath>
 #include <limits>
 
+#include "tetra/core/units.hpp"
+
 namespace tetra::service {
+
+namespace {
+
+//! Serial-number difference a − b (modulo 2^64, RFC 1982) as a signed number: wrap-around safe.
+std::int64_t serial_difference(std::uint64_t a, std::uint64_t b) {
+  const std::uint64_t d = a - b;
+  if (d <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) return static_cast<std::int64_t>(d);
+  return -static_cast<std::int64_t>(~d) - 1;  // d − 2^64, without an out-of-range conversion
+}
+
+}  // namespace
 
 Status validate(const AssemblerConfig& config) {
   if (config.gyro_count < 1 || config.gyro_count > 32) {
     return bad_input("assembler: gyro_count " + std::to_string(config.gyro_count) + " is outside 1..32");
   }
-  if (config.nominal_period_ns <= 0) return bad_input("assembler: sample period must be positive");
+  if (config.nominal_period_ns <= 0 || config.nominal_period_ns > 1000 * kNanosPerSecond) {
+    return bad_input("assembler: the sample period must be in (0, 1000] s");
+  }
   if (config.tolerance_ns < 0 || 2 * config.tolerance_ns >= config.nominal_period_ns) {
     return bad_input("assembler: tolerance_s must be in [0, period/2)");
   }
   if (config.max_latency_ns <= 0) return bad_input("assembler: max_latency_s must be positive");
+  if (config.clock_window_ns < 2 * config.nominal_period_ns || config.clock_window_ns > kStampLimit_ns) {
+    return bad_input("assembler: clock_window_s must be at least 2 sample periods");
+  }
+  if (!(config.speed >= 0.0 && config.speed <= 1000.0)) return bad_input("assembler: speed must be in [0, 1000]");
   return ok_status();
 }
 
@@ -30,6 +49,10 @@ const char* to_string(Verdict verdict) {
       return "late";
     case Verdict::kUnknownGyro:
       return "unknown gyro";
+    case Verdict::kTimeOutlier:
+      return "time outlier";
+    case Verdict::kSeqDiscontinuity:
+      return "sequence discontinuity";
   }
   return "?";
 }
@@ -42,24 +65,120 @@ Result<EpochAssembler> EpochAssembler::create(const AssemblerConfig& config) {
 EpochAssembler::EpochAssembler(const AssemblerConfig& config)
     : config_(config), gyros_(static_cast<std::size_t>(config.gyro_count)) {}
 
+double EpochAssembler::lead_ns(const Clock& clock, std::int64_t stamp_ns, std::int64_t now_ns) const {
+  if (!clock.ref_stamp_ns) return 0.0;
+  // Stamps are within ±kStampLimit_ns: their difference does not overflow.
+  return static_cast<double>(stamp_ns - *clock.ref_stamp_ns) -
+         config_.speed * static_cast<double>(now_ns - clock.ref_local_ns);
+}
+
+void EpochAssembler::observe(Clock& clock, std::int64_t stamp_ns, std::int64_t now_ns) const {
+  if (!clock.ref_stamp_ns || stamp_ns >= *clock.ref_stamp_ns) {
+    clock.ref_stamp_ns = stamp_ns;
+    clock.ref_local_ns = now_ns;
+  }
+}
+
+bool EpochAssembler::on_clock(const Clock& clock, std::optional<std::int64_t> last_stamp_ns, std::int64_t stamp_ns,
+                              std::int64_t now_ns) const {
+  if (lead_ns(clock, stamp_ns, now_ns) > static_cast<double>(config_.clock_window_ns)) return false;
+  const std::int64_t max_lag_ns = config_.clock_window_ns + kMaxLagPeriods * config_.nominal_period_ns;
+  if (clock.ref_stamp_ns && stamp_ns < *clock.ref_stamp_ns - max_lag_ns) return false;
+  return !last_stamp_ns || stamp_ns >= *last_stamp_ns - config_.clock_window_ns;
+}
+
+void EpochAssembler::forget_time_base() {
+  for (GyroTrack& g : gyros_) g = GyroTrack{{}, {}, {}, g.absent};
+  pending_.clear();
+  references_.clear();
+  last_emitted_ns_.reset();
+  clock_ = Clock{};
+  candidate_.reset();
+}
+
+bool EpochAssembler::confirm_new_clock(std::size_t index, std::int64_t stamp_ns, std::int64_t now_ns) {
+  const bool agrees = candidate_ && on_clock(*candidate_, candidate_->last_stamp_ns[index], stamp_ns, now_ns) &&
+                      (!candidate_->last_stamp_ns[index] || stamp_ns > *candidate_->last_stamp_ns[index]);
+  if (!agrees) {
+    candidate_ = Clock{};
+    candidate_->last_stamp_ns.assign(gyros_.size(), std::nullopt);
+    candidate_->samples.assign(gyros_.size(), 0);
+  }
+  Clock& candidate = *candidate_;
+  observe(candidate, stamp_ns, now_ns);
+  candidate.last_stamp_ns[index] = stamp_ns;
+  ++candidate.samples[index];
+  for (std::size_t i = 0; i < gyros_.size(); ++i) {
+    if (!gyros_[i].absent && candidate.samples[i] < kRestartSamples) {
+      ++counters_.time_outlier;
+      return false;
+    }
+  }
+  // Every gyro delivering agrees on the new time base and none was accepted on the old: re-anchor.
+  forget_time_base();
+  ++counters_.sensor_restarts;
+  return true;
+}
+
+Verdict EpochAssembler::check_seq(GyroTrack& track, std::uint64_t seq, std::int64_t stamp_ns) {
+  if (!track.last_seq) {
+    track.last_seq = seq;
+    return Verdict::kAccepted;
+  }
+  // A gap is credible up to 2 numbers per nominal period the stamp moved, plus the slack.
+  std::uint64_t credible = kSeqSlack;
+  if (track.last_stamp_ns && stamp_ns > *track.last_stamp_ns) {
+    credible += 2 * static_cast<std::uint64_t>((stamp_ns - *track.last_stamp_ns) / config_.nominal_period_ns);
+  }
+  const std::int64_t d = serial_difference(seq, *track.last_seq);
+  if (d == 0) {
+    ++counters_.samples_duplicate;
+    return Verdict::kDuplicate;
+  }
+  if (d > 0 && static_cast<std::uint64_t>(d) - 1 <= credible) {
+    counters_.samples_gap += static_cast<std::uint64_t>(d) - 1;
+    track.last_seq = seq;
+    track.jumped_seq.reset();
+    return Verdict::kAccepted;
+  }
+  if (d < 0 && d != std::numeric_limits<std::int64_t>::min() && static_cast<std::uint64_t>(-d) <= credible) {
+    ++counters_.samples_out_of_order;
+    return Verdict::kOutOfOrder;
+  }
+  // A jump no elapsed time explains: the numbering restarted (then the next sample continues from
+  // here) or this number is corrupt (then the next continues from the old one).
+  if (track.jumped_seq) {
+    const std::int64_t from_jump = serial_difference(seq, *track.jumped_seq);
+    if (from_jump > 0 && static_cast<std::uint64_t>(from_jump) <= kSeqSlack) {
+      track.last_seq = seq;
+      track.jumped_seq.reset();
+      return Verdict::kAccepted;
+    }
+  }
+  track.jumped_seq = seq;
+  ++counters_.seq_discontinuity;
+  return Verdict::kSeqDiscontinuity;
+}
+
 Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t stamp_ns, double raw,
                                    std::int64_t now_ns) {
   if (gyro_id < 1 || gyro_id > config_.gyro_count) {
     ++counters_.samples_unknown_gyro;
     return Verdict::kUnknownGyro;
   }
+  if (stamp_ns > kStampLimit_ns || stamp_ns < -kStampLimit_ns) {
+    ++counters_.time_outlier;
+    return Verdict::kTimeOutlier;
+  }
   const auto index = static_cast<std::size_t>(gyro_id - 1);
   const bool all_absent =
       std::all_of(gyros_.begin(), gyros_.end(), [](const GyroTrack& g) { return g.absent; });
   const GyroTrack& seen = gyros_[index];
-  const bool went_back =
-      (seen.last_seq && seq <= *seen.last_seq) || (seen.last_stamp_ns && stamp_ns <= *seen.last_stamp_ns);
+  const bool went_back = (seen.last_seq && serial_difference(seq, *seen.last_seq) <= 0) ||
+                         (seen.last_stamp_ns && stamp_ns <= *seen.last_stamp_ns);
   if (all_absent && went_back) {
     // The unit went silent and came back with a new time base: start afresh.
-    for (GyroTrack& g : gyros_) g = GyroTrack{};
-    pending_.clear();
-    references_.clear();
-    last_emitted_ns_.reset();
+    forget_time_base();
     ++counters_.sensor_restarts;
   }
   if (all_absent) {
@@ -68,18 +187,10 @@ Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t 
     for (GyroTrack& g : gyros_) g.absent = false;
   }
   GyroTrack& track = gyros_[index];
-  if (track.last_seq) {
-    if (seq == *track.last_seq) {
-      ++counters_.samples_duplicate;
-      return Verdict::kDuplicate;
-    }
-    if (seq < *track.last_seq) {
-      ++counters_.samples_out_of_order;
-      return Verdict::kOutOfOrder;
-    }
-    counters_.samples_gap += seq - *track.last_seq - 1;
+  if (!on_clock(clock_, track.last_stamp_ns, stamp_ns, now_ns) && !confirm_new_clock(index, stamp_ns, now_ns)) {
+    return Verdict::kTimeOutlier;
   }
-  track.last_seq = seq;
+  if (const Verdict verdict = check_seq(track, seq, stamp_ns); verdict != Verdict::kAccepted) return verdict;
   if (track.last_stamp_ns && stamp_ns <= *track.last_stamp_ns) {
     ++counters_.samples_out_of_order;
     return Verdict::kOutOfOrder;
@@ -90,6 +201,8 @@ Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t 
     return Verdict::kLate;
   }
   track.last_stamp_ns = stamp_ns;
+  observe(clock_, stamp_ns, now_ns);
+  candidate_.reset();  // a sample on the unit's clock: the outliers were not a new time base
 
   // Join the open epoch this stamp belongs to, or open a new one in stamp order.
   auto it = std::find_if(pending_.begin(), pending_.end(), [&](const Pending& p) {

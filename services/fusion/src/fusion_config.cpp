@@ -1,5 +1,6 @@
 #include "tetra/service/fusion_config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include "tetra/core/input_files.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/core/yaml_reader.hpp"
+#include "tetra/service/unit_name.hpp"
 
 namespace tetra::service {
 
@@ -25,12 +27,18 @@ std::int64_t FusionConfig::deadline_ns() const {
   return to_ns(3.0 / (sample_rate_hz * speed));
 }
 
+double default_clock_window_s(double sample_rate_hz) {
+  return std::min(std::max(kDefaultClockWindow_s, 4.0 / sample_rate_hz), 1e6);  // bounded: converted to ns
+}
+
 AssemblerConfig FusionConfig::assembler(int gyro_count) const {
   AssemblerConfig config;
   config.gyro_count = gyro_count;
   config.nominal_period_ns = to_ns(1.0 / sample_rate_hz);
   config.tolerance_ns = tolerance_s ? to_ns(*tolerance_s) : config.nominal_period_ns / 4;
   config.max_latency_ns = to_ns(max_latency_s);
+  config.clock_window_ns = to_ns(clock_window_s ? *clock_window_s : default_clock_window_s(sample_rate_hz));
+  config.speed = speed;
   return config;
 }
 
@@ -53,7 +61,7 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
   if (auto keys =
           reader.check_keys(root,
                             {"unit", "calibration", "sample_rate_hz", "speed", "tolerance_s", "max_latency_s",
-                             "health_period_s", "gyro_dispatch", "pipeline", "security", "ros2"},
+                             "clock_window_s", "health_period_s", "gyro_dispatch", "pipeline", "security", "ros2"},
                             "");
       !keys) {
     return keys.error();
@@ -63,6 +71,9 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
     const YAML::Node& value = item.second;
     if (key == "unit" || key == "calibration") {
       if (!value.IsScalar()) return bad_input(reader.at(value) + key + " must be text");
+      if (key == "unit") {
+        if (auto status = check_unit_name(value.Scalar(), reader.at(value) + "unit"); !status) return status.error();
+      }
       (key == "unit" ? config.unit : config.calibration_path) = value.Scalar();
     } else if (key == "gyro_dispatch") {
       const std::string text = value.IsScalar() ? value.Scalar() : std::string();
@@ -92,6 +103,7 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
       if (key == "speed") config.speed = *x;
       if (key == "tolerance_s") config.tolerance_s = *x;
       if (key == "max_latency_s") config.max_latency_s = *x;
+      if (key == "clock_window_s") config.clock_window_s = *x;
       if (key == "health_period_s") config.health_period_s = *x;
     }
   }
@@ -109,16 +121,27 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
 
 Status validate(const FusionConfig& config) {
   const std::string& s = config.source;
-  if (config.unit.empty() || config.unit.size() > 31)
-    return bad_input(s + ": unit must have 1 to 31 characters");
-  if (!(config.sample_rate_hz > 0.0 && config.sample_rate_hz <= 100000.0)) {
-    return bad_input(s + ": sample_rate_hz must be in (0, 100000]");
+  if (auto status = check_unit_name(config.unit, s + ": unit"); !status) return status;
+  if (!(config.sample_rate_hz >= 0.001 && config.sample_rate_hz <= 100000.0)) {
+    return bad_input(s + ": sample_rate_hz must be in [0.001, 100000]");
   }
   if (!(config.speed > 0.0 && config.speed <= 1000.0)) return bad_input(s + ": speed must be in (0, 1000]");
   if (!(config.health_period_s > 0.0 && config.health_period_s <= 1.0)) {
     return bad_input(s + ": health_period_s must be in (0, 1] (Health is published at least at 1 Hz)");
   }
   if (config.calibration.gyro_count() > 16) return bad_input(s + ": at most 16 gyros go on the wire");
+  // Before the assembler's settings are converted to integer nanoseconds.
+  const double period_s = 1.0 / config.sample_rate_hz;
+  if (config.tolerance_s && !(*config.tolerance_s >= 0.0 && *config.tolerance_s < period_s / 2)) {
+    return bad_input(s + ": tolerance_s must be in [0, period/2) = [0, " + std::to_string(period_s / 2) + ")");
+  }
+  if (!(config.max_latency_s > 0.0 && config.max_latency_s <= 60.0)) {
+    return bad_input(s + ": max_latency_s must be in (0, 60]");
+  }
+  if (config.clock_window_s && !(*config.clock_window_s >= 2 * period_s && *config.clock_window_s <= 3600.0)) {
+    return bad_input(s + ": clock_window_s must be in [2 sample periods, 3600] = [" + std::to_string(2 * period_s) +
+                     ", 3600]");
+  }
   if (auto status = validate(config.assembler(config.calibration.gyro_count())); !status) {
     return bad_input(s + ": " + status.error().message);
   }
@@ -137,6 +160,8 @@ std::string describe(const FusionConfig& config) {
                              : "a quarter period (" + std::to_string(0.25 / config.sample_rate_hz) + ")")
       << '\n'
       << "max_latency_s: " << config.max_latency_s << '\n'
+      << "clock_window_s: "
+      << (config.clock_window_s ? *config.clock_window_s : default_clock_window_s(config.sample_rate_hz)) << '\n'
       << "health_period_s: " << config.health_period_s << '\n'
       << "gyro_dispatch: " << (config.gyro_dispatch == GyroDispatch::kListener ? "listener" : "waitset")
       << '\n'

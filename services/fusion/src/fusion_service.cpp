@@ -258,7 +258,8 @@ Status FusionService::take_gyro_samples(std::int64_t now_ns) {
   if (was_silent && !assembler_.all_absent()) resumed_ns_ = now_ns;  // deadlines re-armed from now
   if (assembler_.counters().sensor_restarts != last_restarts_) {
     last_restarts_ = assembler_.counters().sensor_restarts;
-    spdlog::warn("fusion: sensor time restarted after the unit went silent: pipeline reset");
+    spdlog::warn("fusion: sensor time restarted (after silence, or every gyro moved to a new time base): "
+                 "pipeline reset");
     pipeline_.reset();
   }
   return ok_status();

@@ -42,7 +42,9 @@ json counters_json(const dds::HealthView& view) {
           {"samples_gap", c.samples_gap},
           {"deadlines_missed", c.deadlines_missed},
           {"liveliness_lost", c.liveliness_lost},
-          {"sensor_restarts", c.sensor_restarts}};
+          {"sensor_restarts", c.sensor_restarts},
+          {"time_outlier", c.time_outlier},
+          {"seq_discontinuity", c.seq_discontinuity}};
 }
 
 }  // namespace

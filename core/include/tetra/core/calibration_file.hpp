@@ -31,6 +31,10 @@ struct GyroNoise {
   std::optional<double> rate_ramp_dps_per_s;           //!< R [deg/s²]
 };
 
+//! [V/(deg/s)] bounds of a scale factor's magnitude (a denormal or absurd value is refused on reading).
+inline constexpr double kMinScaleFactor_V_per_dps = 1e-9;
+inline constexpr double kMaxScaleFactor_V_per_dps = 1e9;
+
 struct GyroCalibration {
   int id = 0;                                         //!< 1..N
   double scale_factor_V_per_dps = 0.0;                //!< s_i [V/(deg/s)]

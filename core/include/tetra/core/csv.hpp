@@ -58,7 +58,9 @@ inline constexpr std::size_t kMaxColumns = 1024;
 bool parse_number(std::string_view text, double& out);
 //! A finite plain decimal number (as parse_number, without nan and inf), or nullopt.
 std::optional<double> parse_decimal(std::string_view text);
-//! Adds the "key=value" tokens of a comment's text (after the '#') to `metadata`.
+//! Adds the "key=value" tokens of a comment's text (after the '#') to `metadata`. Tokens are separated
+//! by blanks or commas; a comma followed at once by text without '=' is part of the value (a decimal
+//! comma "-23,2" stays in the value, for its reader to refuse).
 void parse_metadata_comment(std::string_view comment, Metadata& metadata);
 
 //! Parses a whole table from text; `source` names it in messages.

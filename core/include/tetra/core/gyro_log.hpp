@@ -21,6 +21,11 @@
 
 namespace tetra {
 
+//! [s] the largest |time_s| a log may hold: time goes on as integer nanoseconds (int64, ±9.22e9 s).
+inline constexpr double kMaxLogTime_s = 9.0e9;
+//! Why `time_s` cannot be a log's time (not finite, or beyond ±kMaxLogTime_s), or nullopt.
+std::optional<std::string> log_time_problem(double time_s);
+
 struct GyroLog {
   std::string source;                                         //!< file name used in messages
   std::vector<std::pair<std::string, std::string>> metadata;  //!< "# key=value" comments, in order

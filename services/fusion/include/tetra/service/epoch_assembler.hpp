@@ -10,10 +10,28 @@
 //     later stamp: its sample for this epoch is lost), or is marked absent (deadline missed,
 //     liveliness lost); otherwise `max_latency_ns` of local time after it opened — a late or missing
 //     sample never stalls the output. Gyros without a sample are `present = 0` in the epoch;
-//   * per gyro, sequence numbers must increase by one: a repeat is a duplicate, a smaller one is out
-//     of order (both dropped), a jump counts the skipped numbers as a gap (the sample is kept);
-//     a stamp that does not increase is out of order (dropped); a sample for an epoch already
-//     emitted is late (dropped); a gyro id outside 1..N is unknown (dropped). All are counted;
+//   * each sample's stamp is judged against the unit's clock first (the rule below); a stamp far
+//     outside it is a time outlier (dropped, counted) and never moves the clock;
+//   * per gyro, sequence numbers are compared with wrap-around (serial-number) arithmetic and must
+//     increase: a repeat is a duplicate, a slightly smaller one is out of order (both dropped), a
+//     jump counts the skipped numbers as a gap (the sample is kept) when the stamp moved far enough
+//     for them (at most 2 per nominal period, + kSeqSlack); a larger jump either way is a sequence
+//     discontinuity (dropped, counted): the gyro's numbering is re-anchored only when its next sample
+//     continues from the new number. A stamp that does not increase is out of order (dropped); a
+//     sample for an epoch already emitted is late (dropped); a gyro id outside 1..N is unknown
+//     (dropped). All are counted;
+//   * the clock: a stamp beyond ±kStampLimit_ns is always an outlier. Otherwise the unit's clock is
+//     its newest accepted stamp carried forward by the receive clock (newest + speed · local time
+//     since it arrived); a stamp is an outlier when it leads that clock by more than
+//     `clock_window_ns`, lags the newest stamp by more than `clock_window_ns` + kMaxLagPeriods
+//     periods, or lags the same gyro's last accepted stamp by more than `clock_window_ns`. Samples of
+//     one writer are taken in order, so a delay never makes one lead by more than a period; a batch
+//     taken at once lags by at most the reader's history (64 samples);
+//   * a sensor clock that really jumped (forward or back) while samples flow: when every gyro not
+//     absent has delivered kRestartSamples outliers that agree with each other by the same rule, and
+//     no sample was accepted meanwhile, the assembler re-anchors on the new time base (as for a
+//     restart: counted in sensor_restarts; the caller resets its pipeline); a lone outlier, or
+//     outliers interleaved with good samples, never do;
 //   * when every gyro is absent and any sample arrives, the unit resumes: all gyros are waited for
 //     again (the caller re-arms their deadlines);
 //   * when every gyro is absent and a sample comes back with a sequence number or stamp at or before
@@ -41,12 +59,29 @@ struct AssemblerConfig {
   std::int64_t nominal_period_ns = 10'000'000;  //!< [ns] expected sample period (100 Hz)
   std::int64_t tolerance_ns = 1'000'000;        //!< [ns] stamps this close belong to one epoch; < period / 2
   std::int64_t max_latency_ns = 20'000'000;     //!< [ns] longest local wait for an epoch's missing samples
+  std::int64_t clock_window_ns = 100'000'000;   //!< [ns] how far a stamp may lead the unit's clock; >= 2 periods
+  double speed = 1.0;  //!< [-] sensor ns per local ns (a simulator X times real time: X); 0: the receive
+                       //!< clock is not used (the unit's newest stamp is its clock)
 };
 
-//! Validates: N in 1..32, period > 0, 0 ≤ tolerance < period / 2, latency > 0; errors name the field.
+constexpr std::int64_t kStampLimit_ns = std::int64_t{1} << 61;  //!< [ns] |stamp| beyond: outlier (73 years)
+constexpr std::int64_t kMaxLagPeriods = 128;  //!< twice the gyro reader's history (64 samples)
+constexpr int kRestartSamples = 3;      //!< agreeing outliers per gyro that re-anchor the clock
+constexpr std::uint64_t kSeqSlack = 16;  //!< sequence numbers a gap may skip beyond 2 per period
+
+//! Validates: N in 1..32, period > 0, 0 ≤ tolerance < period / 2, latency > 0, clock window ≥ 2 periods,
+//! speed in [0, 1000]; errors name the field.
 Status validate(const AssemblerConfig& config);
 
-enum class Verdict : std::uint8_t { kAccepted, kDuplicate, kOutOfOrder, kLate, kUnknownGyro };
+enum class Verdict : std::uint8_t {
+  kAccepted,
+  kDuplicate,
+  kOutOfOrder,
+  kLate,
+  kUnknownGyro,
+  kTimeOutlier,
+  kSeqDiscontinuity
+};
 const char* to_string(Verdict verdict);
 
 enum class AbsentReason : std::uint8_t { kDeadline, kLiveliness };
@@ -84,11 +119,32 @@ class EpochAssembler {
   };
   struct GyroTrack {
     std::optional<std::uint64_t> last_seq;
+    std::optional<std::uint64_t> jumped_seq;    //!< a discontinuous number, re-anchored if continued
     std::optional<std::int64_t> last_stamp_ns;  //!< [ns] latest accepted stamp
     bool absent = false;
   };
+  //! A clock: the newest stamp seen on it and its local arrival time, and per gyro the newest stamp. The unit's clock, and the candidate clock a run of outliers builds.
+  struct Clock {
+    std::optional<std::int64_t> ref_stamp_ns;  //!< [ns] the newest stamp
+    std::int64_t ref_local_ns = 0;             //!< [ns] local time it arrived
+    std::vector<std::optional<std::int64_t>> last_stamp_ns;  //!< [ns] per gyro (candidate only)
+    std::vector<int> samples;                                //!< per gyro (candidate only)
+  };
 
   explicit EpochAssembler(const AssemblerConfig& config);
+  //! [ns] how far `stamp_ns` at local `now_ns` leads `clock` (negative: it lags).
+  double lead_ns(const Clock& clock, std::int64_t stamp_ns, std::int64_t now_ns) const;
+  //! Moves `clock`'s reference to this sample if it is the newest.
+  void observe(Clock& clock, std::int64_t stamp_ns, std::int64_t now_ns) const;
+  //! True when the stamp is within the window of `clock` and of `last_stamp_ns` (that gyro's newest).
+  bool on_clock(const Clock& clock, std::optional<std::int64_t> last_stamp_ns, std::int64_t stamp_ns,
+                std::int64_t now_ns) const;
+  //! A time outlier: counted, and gathered into the candidate clock; re-anchors when it is confirmed.
+  bool confirm_new_clock(std::size_t index, std::int64_t stamp_ns, std::int64_t now_ns);
+  //! Forgets the time base (sequence numbers, stamps, open epochs, references); keeps absences.
+  void forget_time_base();
+  //! The sequence-number verdict (kAccepted: go on); counts gaps, duplicates, discontinuities.
+  Verdict check_seq(GyroTrack& track, std::uint64_t seq, std::int64_t stamp_ns);
   bool ready(const Pending& epoch, std::int64_t now_ns) const;
   void emit(Pending& epoch, std::vector<fdi::Epoch>& out);
 
@@ -97,6 +153,8 @@ class EpochAssembler {
   std::deque<Pending> pending_;                                 //!< sorted by stamp
   std::deque<std::pair<std::int64_t, Quaternion>> references_;  //!< sorted by stamp
   std::optional<std::int64_t> last_emitted_ns_;
+  Clock clock_;                     //!< the unit's clock
+  std::optional<Clock> candidate_;  //!< a new time base the outliers may be on
   AssemblerCounters counters_;
 };
 

@@ -22,6 +22,11 @@ enum class GyroDispatch {
   kWaitset,   //!< the service's waitset thread, woken by the gyro reader's read condition
 };
 
+constexpr double kDefaultClockWindow_s = 0.1;  //!< [s] (docs/dds.md, "Epoch assembly")
+
+//! [s] the clock window when none is configured: 0.1 s, or 4 sample periods if longer.
+double default_clock_window_s(double sample_rate_hz);
+
 struct FusionConfig {
   std::string unit = "tetra-1";   //!< key of every topic this service reads and writes
   std::string calibration_path;   //!< calibration YAML (relative paths: to the config file)
@@ -31,6 +36,8 @@ struct FusionConfig {
   std::optional<double>
       tolerance_s;               //!< [s] stamps this close belong to one epoch (< period/2); default period/4
   double max_latency_s = 0.02;   //!< [s] longest wait for an epoch's missing samples
+  std::optional<double> clock_window_s;  //!< [s] how far a stamp may lead the unit's clock; default
+                                         //!< kDefaultClockWindow_s or 4 periods, the larger
   double health_period_s = 0.5;  //!< [s] Health at least this often (and on every change)
   GyroDispatch gyro_dispatch = GyroDispatch::kListener;  //!< `gyro_dispatch: listener | waitset`
   fdi::PipelineConfig pipeline;                          //!< the `pipeline:` map
