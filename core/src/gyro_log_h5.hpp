@@ -19,7 +19,11 @@ namespace tetra {
 
 //! The whole log, as read_gyro_log.
 Result<GyroLog> read_gyro_log_h5(const std::string& path);
-//! A block reader, as GyroLogReader::open.
+//! The whole log from an in-memory image of an HDF5 file (`name` names it in messages), read in this
+//! process (no checking child; variable-length string attributes refused): for fuzzing the reader.
+Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, const std::string& name);
+//! A block reader, as GyroLogReader::open. The file is first checked in a child process
+//! (docs/formats.md, "HDF5 gyro log").
 Result<std::unique_ptr<GyroLogReader>> open_gyro_log_h5_reader(const std::string& path);
 
 //! Writes an HDF5 log into `file_path`: the temporary file of an OutputFile (OutputFile::library_path),
