@@ -436,6 +436,7 @@ Result<Dataset> H5Reader::open_dataset(const char* name, int rank, hsize_t cols)
   Handle space(H5Dget_space(d.id.get()), H5Sclose);
   std::array<hsize_t, 2> dims{};
   const int got = H5Sget_simple_extent_ndims(space.get());
+  if (got == 1 && rank == 2 && cols == 1) rank = 1;  // one gyro's 'present' as tetra wrote it before 2-D
   if (got != rank || H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) < 0) {
     return bad_input(src + ": dataset '" + name + "' has " + std::to_string(got) +
                      " dimension(s), expected " + std::to_string(rank));
@@ -904,8 +905,15 @@ struct GyroLogH5Writer::Impl {
   Status flush();
 };
 
+namespace {
+// 'present' is rows×N, 2-D even for one gyro (docs/formats.md); the other datasets are 1-D.
+int rank_of(const char* name) {
+  return std::strcmp(name, "present") == 0 ? 2 : 1;
+}
+}  // namespace
+
 Status GyroLogH5Writer::Impl::create_dataset(const char* name, hid_t type, hsize_t cols) const {
-  const int rank = cols > 1 ? 2 : 1;
+  const int rank = rank_of(name);
   const std::array<hsize_t, 2> dims{0, cols};
   const std::array<hsize_t, 2> max{H5S_UNLIMITED, cols};
   const std::array<hsize_t, 2> chunk{kChunkRows, cols};
@@ -924,7 +932,7 @@ Status GyroLogH5Writer::Impl::create_dataset(const char* name, hid_t type, hsize
 Status GyroLogH5Writer::Impl::append_rows(const char* name, hid_t mem_type, const void* data, hsize_t count,
                                           hsize_t cols) const {
   Handle d(H5Dopen2(file.get(), name, H5P_DEFAULT), H5Dclose);
-  const int rank = cols > 1 ? 2 : 1;
+  const int rank = rank_of(name);
   const std::array<hsize_t, 2> new_dims{rows + count, cols};
   if (!d.valid() || H5Dset_extent(d.get(), new_dims.data()) < 0) {
     return failure(path + ": dataset '" + name + "': cannot extend");
