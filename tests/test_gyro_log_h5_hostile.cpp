@@ -309,6 +309,10 @@ TEST(HostileH5, FuzzRegressionInputsEndInAValue) {
        std::filesystem::directory_iterator(test::source_path("tests/fuzz/corpus/gyro_log_h5"))) {
     ++files;
     const auto log = read_gyro_log(entry.path().string());
+    // regress_flip_*: 8 bytes flipped in a log of an earlier tetra (variable-length strings); each
+    // crashed libhdf5 in the process that read it (exit 139), two of them in the global heap (one,
+    // regress_flip_offset_928, reads memory it does not own and does not crash every time).
+    if (entry.path().filename().string().rfind("regress_flip", 0) == 0) EXPECT_FALSE(log.ok()) << entry.path();
     if (!log.ok()) {
       EXPECT_EQ(log.error().message.rfind(entry.path().string(), 0), 0U) << log.error().message;
     }
