@@ -376,12 +376,7 @@ bool load_raw_chunk(Dataset& d, hsize_t first, hsize_t count, hid_t mem_type) {
   return true;
 }
 
-// The header of a log as the checking child process sends it to its parent.
-struct H5Header {
-  int gyro_count = 0;
-  bool units_dps = false;
-  std::vector<std::string> comments;
-};
+using H5Header = GyroLogH5Header;
 
 class H5Reader final : public GyroLogReader {
  public:
@@ -868,7 +863,8 @@ Result<GyroLog> read_gyro_log_h5(const std::string& path) {
   return read_whole(**reader, path);
 }
 
-Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, const std::string& name) {
+Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, const std::string& name,
+                                       const GyroLogH5Header& header) {
   init_hdf5();
   if (bytes.empty()) return bad_input(name + ": not an HDF5 file");
   Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
@@ -880,7 +876,8 @@ Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, cons
   Handle file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, fapl.get()), H5Fclose);
   if (!file.valid()) return bad_input(name + ": cannot open as HDF5");
   H5Reader reader;
-  if (Status s = reader.open_file(std::move(file), name, nullptr, VariableStrings::kRefuse); !s) return s.error();
+  // As the process that opens a checked file: the header given, no attribute read.
+  if (Status s = reader.open_file(std::move(file), name, &header, VariableStrings::kRefuse); !s) return s.error();
   return read_whole(reader, name);
 }
 
