@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <hdf5.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -573,6 +574,33 @@ Status H5Reader::open_file(Handle file, const std::string& source, const H5Heade
 
 constexpr unsigned kProbeSeconds = 30;  // [s] longest the child may take to check a file
 
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define TETRA_H5_ASAN 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define TETRA_H5_ASAN 1
+#endif
+
+// libhdf5 sizes some buffers from the file before checking them (an object header claiming 5 GB): in
+// the child, such a malloc fails (an error, the file refused) instead of reserving gigabytes. The limit
+// is the child's address space at the fork plus kProbeExtraBytes. Not under AddressSanitizer, whose
+// shadow memory is terabytes of address space (there, its own allocation limit applies).
+void limit_child_memory() {
+#ifndef TETRA_H5_ASAN
+  constexpr rlim_t kProbeExtraBytes = rlim_t{2} << 30;  // [bytes] address space the child may add
+  std::FILE* statm = std::fopen("/proc/self/statm", "r");
+  unsigned long pages = 0;
+  const bool got = statm != nullptr && std::fscanf(statm, "%lu", &pages) == 1;
+  if (statm != nullptr) std::fclose(statm);
+  if (!got) return;
+  const auto now = static_cast<rlim_t>(pages) * static_cast<rlim_t>(::sysconf(_SC_PAGESIZE));
+  const struct rlimit limit {now + kProbeExtraBytes, now + kProbeExtraBytes};
+  ::setrlimit(RLIMIT_AS, &limit);
+#endif
+}
+
 std::string encode_header(const H5Header& h) {
   std::string out = "H" + std::to_string(h.gyro_count) + "\n" + (h.units_dps ? "dps" : "V") + "\n" +
                     std::to_string(h.comments.size()) + "\n";
@@ -647,6 +675,7 @@ Result<H5Header> probe_in_child(const std::string& path) {
   if (pid == 0) {
     ::close(fds[0]);
     ::alarm(kProbeSeconds);
+    limit_child_memory();
     const auto header = inspect_here(path);
     const std::string answer =
         header ? encode_header(*header)

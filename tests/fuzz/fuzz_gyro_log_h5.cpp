@@ -14,11 +14,13 @@
 #include "gyro_log_h5.hpp"
 
 // libhdf5 (Debian's, not instrumented) sizes some allocations from the file before it checks them and
-// handles a failed malloc as an error, as glibc's malloc fails such a size: let ASan's do the same
-// instead of aborting. It also loses a few hundred bytes on some error paths of a damaged file: those
+// handles a failed malloc as an error: the reader's checking child limits its address space so that
+// such a malloc fails there (docs/formats.md); here a malloc of more than 1 GiB fails the same way
+// (ASan returns null) instead of being reported as an out-of-memory. tetra's own allocations use new,
+// which throws, so one of them over 1 GiB is still a crash. It also loses a few hundred bytes on some error paths of a damaged file: those
 // leaks are not reported; every allocation of tetra's own code is still checked.
 extern "C" const char* __asan_default_options() {  // NOLINT(readability-identifier-naming)
-  return "allocator_may_return_null=1";
+  return "allocator_may_return_null=1:max_allocation_size_mb=1024";
 }
 extern "C" const char* __lsan_default_suppressions() {  // NOLINT(readability-identifier-naming)
   return "leak:libhdf5\n";
