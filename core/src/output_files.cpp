@@ -221,7 +221,7 @@ Status OutputFile::write_behind() {
 Result<std::string> OutputFile::library_path() const {
   if (stream_) {
     return bad_input(label_ + " " + path_ + ": needs a regular file (it is written with seeks), not " +
-                     (path_ == "-" ? "standard output" : "a device or FIFO"));
+                     (path_ == "-" ? "standard output" : "the null device"));
   }
   if (fd_ < 0) return failure(path_ + ": output is closed");
   return temp_;

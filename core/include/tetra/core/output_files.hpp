@@ -55,7 +55,7 @@ class OutputFile {
   Status write(std::string_view data);
   //! The temporary file, for a library that writes the file by name itself (HDF5): it writes there
   //! (and closes the file) before RunFiles::commit(), which fsyncs and renames it as any output.
-  //! Bad input naming the option for standard output, a device or a FIFO (such a library seeks).
+  //! Bad input naming the option for standard output or /dev/null (such a library seeks).
   Result<std::string> library_path() const;
 
  private:
