@@ -135,9 +135,10 @@ TEST(OutputFiles, FifosAndDevicesOtherThanDevNullAreRefused) {
   for (const std::string& path : {dir.file("fifo"), dir.file("to_fifo")}) {
     const auto fifo = files.add(path, "--attitude");  // returns at once: nothing opens the FIFO
     ASSERT_FALSE(fifo.ok());
-    EXPECT_EQ(fifo.error().message, "--attitude " + path +
-                                        ": is a FIFO: an output must be a regular file (`-` for standard output, "
-                                        "/dev/null to discard)");
+    EXPECT_EQ(fifo.error().message,
+              "--attitude " + path +
+                  ": is a FIFO: an output must be a regular file (`-` for standard output, "
+                  "/dev/null to discard)");
   }
   const auto full = files.add("/dev/full", "-o");
   ASSERT_FALSE(full.ok());
@@ -157,8 +158,8 @@ TEST(OutputFiles, WriteProtectedFileIsNeverReplaced) {
   RunFiles files;
   const auto out = files.add(dir.file("keep.csv"), "-o");
   ASSERT_FALSE(out.ok());
-  EXPECT_EQ(out.error().message,
-            "-o " + dir.file("keep.csv") + ": is write-protected (no write permission): it is never replaced");
+  EXPECT_EQ(out.error().message, "-o " + dir.file("keep.csv") +
+                                     ": is write-protected (no write permission): it is never replaced");
   EXPECT_FALSE(files.add(dir.file("keep.csv"), "--update", dir.file("keep.csv")).ok());
   EXPECT_FALSE(check_output_path(dir.file("keep.csv"), "campaign output").ok());
   EXPECT_EQ(read_file(dir.file("keep.csv")), "kept\n");

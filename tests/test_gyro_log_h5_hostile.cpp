@@ -49,7 +49,8 @@ void string_attribute(hid_t obj, const char* name, const std::vector<std::string
     H5Awrite(attr, type, ptrs.data());
   } else {
     std::vector<char> buf(n * size, '\0');
-    for (std::size_t i = 0; i < values.size(); ++i) std::memcpy(&buf[i * size], values[i].data(), values[i].size());
+    for (std::size_t i = 0; i < values.size(); ++i)
+      std::memcpy(&buf[i * size], values[i].data(), values[i].size());
     H5Awrite(attr, type, buf.data());
   }
   H5Aclose(attr);
@@ -150,8 +151,8 @@ TEST(HostileH5, FlippedGlobalHeapSizeIsAnErrorNotACrash) {
   const auto log = read_gyro_log(dir.file("heap.h5"));
   ASSERT_FALSE(log.ok());
   EXPECT_EQ(log.error().message.rfind(dir.file("heap.h5"), 0), 0U) << log.error().message;
-  for (const std::string& cmd : {"convert " + dir.file("heap.h5") + " " + dir.file("out.csv"),
-                                "allan " + dir.file("heap.h5")}) {
+  for (const std::string& cmd :
+       {"convert " + dir.file("heap.h5") + " " + dir.file("out.csv"), "allan " + dir.file("heap.h5")}) {
     expect_cli_refuses(cmd, "heap.h5");
   }
   EXPECT_FALSE(std::filesystem::exists(dir.file("out.csv")));
@@ -169,7 +170,8 @@ TEST(HostileH5, ThirtyLogsWithEightFlippedBytes) {
   for (int k = 0; k < 30; ++k) {
     std::string bytes = clean;
     const std::size_t at = rng() % (span - 8);
-    for (std::size_t i = 0; i < 8; ++i) bytes[at + i] = static_cast<char>(bytes[at + i] ^ static_cast<char>(1 + rng() % 255));
+    for (std::size_t i = 0; i < 8; ++i)
+      bytes[at + i] = static_cast<char>(bytes[at + i] ^ static_cast<char>(1 + rng() % 255));
     const std::string path = dir.file("flip" + std::to_string(k) + ".h5");
     test::write_file(path, bytes);
     const auto log = read_gyro_log(path);
@@ -178,7 +180,8 @@ TEST(HostileH5, ThirtyLogsWithEightFlippedBytes) {
       EXPECT_EQ(log.error().message.rfind(path, 0), 0U) << log.error().message;
     }
     const auto r = test::run_tetra("convert " + path + " " + dir.file("out.csv"));
-    EXPECT_TRUE(r.exit_status == 0 || r.exit_status == 2) << path << ": status " << r.exit_status << " " << r.err;
+    EXPECT_TRUE(r.exit_status == 0 || r.exit_status == 2)
+        << path << ": status " << r.exit_status << " " << r.err;
   }
   EXPECT_GT(refused, 0);
   for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
@@ -196,7 +199,8 @@ TEST(HostileH5, RowsDeclaredButNotWrittenAreRefused) {
   EXPECT_LT(std::filesystem::file_size(dir.file("huge.h5")), 64U * 1024);
   const auto log = read_gyro_log(dir.file("huge.h5"));
   ASSERT_FALSE(log.ok());
-  EXPECT_NE(log.error().message.find("huge.h5: dataset 'time_s': declares 1099511627776 rows"), std::string::npos)
+  EXPECT_NE(log.error().message.find("huge.h5: dataset 'time_s': declares 1099511627776 rows"),
+            std::string::npos)
       << log.error().message;
   h.declared_rows = 100000;  // fewer than a 7 KB file could hold raw, still not written
   write_log(dir.file("unwritten.h5"), h);
@@ -237,7 +241,8 @@ TEST(HostileH5, FilterTetraDoesNotWriteIsRefused) {
   write_log(dir.file("crc.h5"), h);
   const auto log = read_gyro_log(dir.file("crc.h5"));
   ASSERT_FALSE(log.ok());
-  EXPECT_NE(log.error().message.find("crc.h5: dataset 'g1': filter 3, which tetra does not read"), std::string::npos)
+  EXPECT_NE(log.error().message.find("crc.h5: dataset 'g1': filter 3, which tetra does not read"),
+            std::string::npos)
       << log.error().message;
 }
 
@@ -249,7 +254,8 @@ TEST(HostileH5, CommentWithLineBreakIsRefused) {
   write_log(dir.file("nl.h5"), h);
   const auto log = read_gyro_log(dir.file("nl.h5"));
   ASSERT_FALSE(log.ok());
-  EXPECT_EQ(log.error().message, dir.file("nl.h5") + ": attribute 'comments' entry 2 holds a line break (a comment is one line)");
+  EXPECT_EQ(log.error().message,
+            dir.file("nl.h5") + ": attribute 'comments' entry 2 holds a line break (a comment is one line)");
   expect_cli_refuses("convert " + dir.file("nl.h5") + " " + dir.file("out.csv"), "nl.h5");
   EXPECT_FALSE(std::filesystem::exists(dir.file("out.csv")));
 }
@@ -263,9 +269,10 @@ TEST(HostileH5, UnitsAttributeAndCommentsMustAgree) {
   write_log(dir.file("units.h5"), h);
   const auto log = read_gyro_log(dir.file("units.h5"));
   ASSERT_FALSE(log.ok());
-  EXPECT_EQ(log.error().message, dir.file("units.h5") +
-                                     ": attribute 'units' is 'V' but the comments say units=dps (the attribute "
-                                     "and the comments must agree)");
+  EXPECT_EQ(log.error().message,
+            dir.file("units.h5") +
+                ": attribute 'units' is 'V' but the comments say units=dps (the attribute "
+                "and the comments must agree)");
   h.units = "dps";
   write_log(dir.file("agree.h5"), h);
   const auto agree = read_gyro_log(dir.file("agree.h5"));
@@ -293,8 +300,9 @@ TEST(HostileH5, ManyCommentLinesRoundTrip) {
 // closing the half-written file again. No temporary file is left.
 TEST(HostileH5, FailedWriteExitsCleanly) {
   TempDir dir;
-  const auto r = test::run_shell("cd " + dir.path().string() + " && ulimit -f 200 && trap '' XFSZ && " +
-                                 std::string(TETRA_BINARY) + " sim static --minutes 2 --rate-hz 200 -o full.h5");
+  const auto r =
+      test::run_shell("cd " + dir.path().string() + " && ulimit -f 200 && trap '' XFSZ && " +
+                      std::string(TETRA_BINARY) + " sim static --minutes 2 --rate-hz 200 -o full.h5");
   EXPECT_EQ(r.exit_status, 1) << r.err;
   EXPECT_NE(r.err.find("full.h5: write failed"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("full.h5")));

@@ -107,7 +107,8 @@ bool write_string_attribute(hid_t obj, const char* name, const std::vector<std::
   Handle attr(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
   if (!attr.valid()) return false;
   std::vector<char> buf(values.size() * size, '\0');
-  for (std::size_t i = 0; i < values.size(); ++i) std::memcpy(buf.data() + i * size, values[i].data(), values[i].size());
+  for (std::size_t i = 0; i < values.size(); ++i)
+    std::memcpy(buf.data() + i * size, values[i].data(), values[i].size());
   return H5Awrite(attr.get(), type.get(), buf.data()) >= 0;
 }
 
@@ -133,7 +134,8 @@ Result<std::optional<std::vector<std::string>>> read_string_attribute(hid_t obj,
   Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
   Handle ftype(H5Aget_type(attr.get()), H5Tclose);
   Handle space(H5Aget_space(attr.get()), H5Sclose);
-  if (!attr.valid() || !ftype.valid() || !space.valid()) return bad_input(what + " cannot be read (damaged file?)");
+  if (!attr.valid() || !ftype.valid() || !space.valid())
+    return bad_input(what + " cannot be read (damaged file?)");
   if (H5Tget_class(ftype.get()) != H5T_STRING) return bad_input(what + " is not text");
   const hssize_t count = H5Sget_simple_extent_npoints(space.get());
   if (count < 0 || H5Sget_simple_extent_ndims(space.get()) > 1 ||
@@ -143,12 +145,14 @@ Result<std::optional<std::vector<std::string>>> read_string_attribute(hid_t obj,
   const auto n = static_cast<std::size_t>(count);
   std::vector<std::string> out;
   if (H5Tis_variable_str(ftype.get()) > 0) {
-    if (vlen == VariableStrings::kRefuse) return bad_input(what + ": variable-length strings are read only in a checked child process");
+    if (vlen == VariableStrings::kRefuse)
+      return bad_input(what + ": variable-length strings are read only in a checked child process");
     Handle mtype(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(mtype.get(), H5T_VARIABLE);
     H5Tset_cset(mtype.get(), H5Tget_cset(ftype.get()));  // libhdf5 converts no character set
     std::vector<char*> ptrs(n, nullptr);
-    if (H5Aread(attr.get(), mtype.get(), ptrs.data()) < 0) return bad_input(what + " cannot be read (damaged file?)");
+    if (H5Aread(attr.get(), mtype.get(), ptrs.data()) < 0)
+      return bad_input(what + " cannot be read (damaged file?)");
     std::size_t total = 0;
     for (char* p : ptrs) {
       const std::size_t len = p == nullptr ? 0 : strnlen(p, kMaxAttributeBytes + 1);
@@ -157,7 +161,8 @@ Result<std::optional<std::vector<std::string>>> read_string_attribute(hid_t obj,
       out.emplace_back(p == nullptr ? "" : p, len);
     }
     H5Dvlen_reclaim(mtype.get(), space.get(), H5P_DEFAULT, ptrs.data());
-    if (total > kMaxAttributeBytes) return bad_input(what + " is larger than " + std::to_string(kMaxAttributeBytes) + " bytes");
+    if (total > kMaxAttributeBytes)
+      return bad_input(what + " is larger than " + std::to_string(kMaxAttributeBytes) + " bytes");
   } else {
     const std::size_t size = H5Tget_size(ftype.get());
     if (size == 0 || size > kMaxAttributeBytes || n * size > kMaxAttributeBytes) {
@@ -168,7 +173,8 @@ Result<std::optional<std::vector<std::string>>> read_string_attribute(hid_t obj,
     H5Tset_strpad(mtype.get(), H5T_STR_NULLPAD);
     H5Tset_cset(mtype.get(), H5Tget_cset(ftype.get()));
     std::vector<char> buf(n * size + 1, '\0');
-    if (H5Aread(attr.get(), mtype.get(), buf.data()) < 0) return bad_input(what + " cannot be read (damaged file?)");
+    if (H5Aread(attr.get(), mtype.get(), buf.data()) < 0)
+      return bad_input(what + " cannot be read (damaged file?)");
     for (std::size_t i = 0; i < n; ++i) {
       const char* s = buf.data() + i * size;
       out.emplace_back(s, strnlen(s, size));
@@ -202,10 +208,11 @@ bool has_filters(hid_t dataset) {
 // The number types a dataset may be stored as (IEEE floats, integers of 8 to 64 bits, either byte
 // order): libhdf5 converts these with its own code; other number formats are refused.
 bool is_plain_number_type(hid_t type) {
-  const std::array<hid_t, 20> plain = {
-      H5T_IEEE_F32LE, H5T_IEEE_F32BE, H5T_IEEE_F64LE, H5T_IEEE_F64BE, H5T_STD_I8LE,  H5T_STD_I8BE,  H5T_STD_I16LE,
-      H5T_STD_I16BE,  H5T_STD_I32LE,  H5T_STD_I32BE,  H5T_STD_I64LE,  H5T_STD_I64BE, H5T_STD_U8LE,  H5T_STD_U8BE,
-      H5T_STD_U16LE,  H5T_STD_U16BE,  H5T_STD_U32LE,  H5T_STD_U32BE,  H5T_STD_U64LE, H5T_STD_U64BE};
+  const std::array<hid_t, 20> plain = {H5T_IEEE_F32LE, H5T_IEEE_F32BE, H5T_IEEE_F64LE, H5T_IEEE_F64BE,
+                                       H5T_STD_I8LE,   H5T_STD_I8BE,   H5T_STD_I16LE,  H5T_STD_I16BE,
+                                       H5T_STD_I32LE,  H5T_STD_I32BE,  H5T_STD_I64LE,  H5T_STD_I64BE,
+                                       H5T_STD_U8LE,   H5T_STD_U8BE,   H5T_STD_U16LE,  H5T_STD_U16BE,
+                                       H5T_STD_U32LE,  H5T_STD_U32BE,  H5T_STD_U64LE,  H5T_STD_U64BE};
   return std::any_of(plain.begin(), plain.end(), [&](hid_t t) { return H5Tequal(type, t) > 0; });
 }
 
@@ -230,7 +237,8 @@ Status check_storage(hid_t id, hid_t type, hsize_t rows, hsize_t cols, int rank,
   }
   const H5D_layout_t layout = H5Pget_layout(dcpl.get());
   if (layout != H5D_CHUNKED && layout != H5D_CONTIGUOUS && layout != H5D_COMPACT) {
-    return bad_input(what + ": a virtual or unknown storage layout, which tetra does not read (docs/formats.md)");
+    return bad_input(what +
+                     ": a virtual or unknown storage layout, which tetra does not read (docs/formats.md)");
   }
   const int nfilters = H5Pget_nfilters(dcpl.get());
   if (nfilters < 0) return bad_input(what + ": cannot read its filters (damaged file?)");
@@ -239,8 +247,8 @@ Status check_storage(hid_t id, hid_t type, hsize_t rows, hsize_t cols, int rank,
     std::size_t nvalues = 0;
     unsigned config = 0;
     std::array<char, 64> name{};
-    const H5Z_filter_t filter = H5Pget_filter2(dcpl.get(), static_cast<unsigned>(f), &flags, &nvalues, nullptr,
-                                               name.size(), name.data(), &config);
+    const H5Z_filter_t filter = H5Pget_filter2(dcpl.get(), static_cast<unsigned>(f), &flags, &nvalues,
+                                               nullptr, name.size(), name.data(), &config);
     if (filter != H5Z_FILTER_DEFLATE && filter != H5Z_FILTER_SHUFFLE) {
       return bad_input(what + ": filter " + std::to_string(filter) +
                        ", which tetra does not read (only deflate and shuffle; docs/formats.md)");
@@ -249,7 +257,8 @@ Status check_storage(hid_t id, hid_t type, hsize_t rows, hsize_t cols, int rank,
   const std::size_t type_size = H5Tget_size(type);
   hsize_t bytes = 0;  // declared
   if (type_size == 0 || __builtin_mul_overflow(rows, cols, &bytes) ||
-      __builtin_mul_overflow(bytes, hsize_t{type_size}, &bytes) || bytes > file_size * kMaxDeflateRatio + kMaxChunkBytes) {
+      __builtin_mul_overflow(bytes, hsize_t{type_size}, &bytes) ||
+      bytes > file_size * kMaxDeflateRatio + kMaxChunkBytes) {
     return bad_input(what + ": declares " + std::to_string(rows) + " rows, more than a file of " +
                      std::to_string(file_size) + " bytes can hold");
   }
@@ -301,7 +310,8 @@ Status check_storage(hid_t id, hid_t type, hsize_t rows, hsize_t cols, int rank,
       haddr_t addr = HADDR_UNDEF;
       hsize_t size = 0;
       if (H5Dget_chunk_info_by_coord(id, at.data(), &mask, &addr, &size) < 0 || addr == HADDR_UNDEF ||
-          addr > file_size || file_size - addr < size || mask != 0 || (nfilters == 0 && size != chunk_bytes)) {
+          addr > file_size || file_size - addr < size || mask != 0 ||
+          (nfilters == 0 && size != chunk_bytes)) {
         return bad_input(what + ": the chunk of row " + std::to_string(at[0] + 1) +
                          " is missing or lies outside the file (damaged file?)");
       }
@@ -443,7 +453,8 @@ Result<Dataset> H5Reader::open_dataset(const char* name, int rank, hsize_t cols)
   }
   Handle type(H5Dget_type(d.id.get()), H5Tclose);
   if (!type.valid() || !is_plain_number_type(type.get())) {
-    return bad_input(src + ": dataset '" + name + "' is not stored as plain numbers (IEEE floats or integers)");
+    return bad_input(src + ": dataset '" + name +
+                     "' is not stored as plain numbers (IEEE floats or integers)");
   }
   if (name != std::string("time_s") && dims[0] != rows_) {
     return bad_input(src + ": dataset '" + name + "' has " + std::to_string(dims[0]) +
@@ -596,7 +607,7 @@ void limit_child_memory() {
   if (statm != nullptr) std::fclose(statm);
   if (!got) return;
   const auto now = static_cast<rlim_t>(pages) * static_cast<rlim_t>(::sysconf(_SC_PAGESIZE));
-  const struct rlimit limit {now + kProbeExtraBytes, now + kProbeExtraBytes};
+  const struct rlimit limit { now + kProbeExtraBytes, now + kProbeExtraBytes };
   ::setrlimit(RLIMIT_AS, &limit);
 #endif
 }
@@ -653,7 +664,8 @@ Result<H5Header> inspect_here(const std::string& path) {
   Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   if (!file.valid()) return bad_input(path + ": cannot open as HDF5");
   H5Reader reader;
-  if (Status s = reader.open_file(std::move(file), path, nullptr, VariableStrings::kRead); !s) return s.error();
+  if (Status s = reader.open_file(std::move(file), path, nullptr, VariableStrings::kRead); !s)
+    return s.error();
   return reader.header_read();
 }
 
@@ -677,9 +689,10 @@ Result<H5Header> probe_in_child(const std::string& path) {
     ::alarm(kProbeSeconds);
     limit_child_memory();
     const auto header = inspect_here(path);
-    const std::string answer =
-        header ? encode_header(*header)
-               : std::string("E") + (header.error().kind == ErrorKind::kBadInput ? "b" : "f") + header.error().message;
+    const std::string answer = header ? encode_header(*header)
+                                      : std::string("E") +
+                                            (header.error().kind == ErrorKind::kBadInput ? "b" : "f") +
+                                            header.error().message;
     std::size_t done = 0;
     while (done < answer.size()) {
       const ssize_t n = ::write(fds[1], answer.data() + done, answer.size() - done);
@@ -707,7 +720,8 @@ Result<H5Header> probe_in_child(const std::string& path) {
       return bad_input(path + ": checking this HDF5 file took longer than " + std::to_string(kProbeSeconds) +
                        " s (damaged file?); nothing was read from it");
     }
-    return bad_input(path + ": damaged HDF5 file: the HDF5 library failed on it (" + strsignal(WTERMSIG(status)) +
+    return bad_input(path + ": damaged HDF5 file: the HDF5 library failed on it (" +
+                     strsignal(WTERMSIG(status)) +
                      ") in the process that checks files first; nothing was read from it");
   }
   return decode_answer(answer, path);
@@ -906,7 +920,8 @@ Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, cons
   if (!file.valid()) return bad_input(name + ": cannot open as HDF5");
   H5Reader reader;
   // As the process that opens a checked file: the header given, no attribute read.
-  if (Status s = reader.open_file(std::move(file), name, &header, VariableStrings::kRefuse); !s) return s.error();
+  if (Status s = reader.open_file(std::move(file), name, &header, VariableStrings::kRefuse); !s)
+    return s.error();
   return read_whole(reader, name);
 }
 

@@ -93,7 +93,8 @@ bool is_null_device(const struct stat& st) {
 // bits, ACLs, a read-only file system) and, for root (whom the kernel lets write anything), one with
 // at least one write bit: a write-protected file (chmod a-w) is never replaced, whoever runs.
 bool may_replace(const std::string& path, const struct stat& st) {
-  if (::geteuid() == 0) return (st.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH)) != 0 && ::access(path.c_str(), W_OK) == 0;
+  if (::geteuid() == 0)
+    return (st.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH)) != 0 && ::access(path.c_str(), W_OK) == 0;
   return ::access(path.c_str(), W_OK) == 0;
 }
 
@@ -369,7 +370,8 @@ Status check_output_path(const std::string& path, const std::string& label) {
   if (!followed) return bad_input(label + " " + followed.error().message);
   struct stat st {};
   if (::stat(followed->c_str(), &st) != 0) return ok_status();
-  if (const std::string why = refusal(*followed, st); !why.empty()) return bad_input(label + " " + path + ": " + why);
+  if (const std::string why = refusal(*followed, st); !why.empty())
+    return bad_input(label + " " + path + ": " + why);
   return ok_status();
 }
 

@@ -180,7 +180,8 @@ int cmd_campaign(int argc, char** argv) {
   const std::string runs_path = (std::filesystem::path(out_dir) / "runs.csv").string();
   // runs.csv is appended to in place (an interrupted campaign resumes): a FIFO or a write-protected
   // file is refused as any output is.
-  if (Status st = check_output_path(runs_path, "campaign output"); !st) return report(kCampaignName, st.error());
+  if (Status st = check_output_path(runs_path, "campaign output"); !st)
+    return report(kCampaignName, st.error());
   auto done = done_runs(runs_path);
   if (!done) return report(kCampaignName, done.error());
   if (done->empty()) {
