@@ -508,7 +508,7 @@ Status H5Reader::read_header(VariableStrings vlen) {
   if (!*units || (*units)->size() != 1 || ((*units)->front() != "V" && (*units)->front() != "dps")) {
     return bad_input(src + ": attribute 'units': expected 'V' or 'dps'");
   }
-  const auto comments = read_string_attribute(root, "comments", src, vlen);
+  auto comments = read_string_attribute(root, "comments", src, vlen);
   if (!comments) return comments.error();
   H5Header h;
   h.gyro_count = static_cast<int>(*count);
