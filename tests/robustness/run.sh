@@ -171,6 +171,19 @@ for sig in TERM INT; do
      for i in \$(seq 200); do ls -A | grep -q '^\\.sig_$sig.h5.tetra-' && break; sleep 0.05; done;
      kill -$sig \$p; wait \$p; st=\$?; test \$st -gt 128 && test \"\$(cat sig_$sig.h5)\" = previous && ! ls -A | grep -q tetra-"
 done
+# The same for convert and replay (a 400 000-row log: they run long enough to be signalled mid-write).
+"$TETRA" sim static --minutes 33.4 --rate-hz 200 -o long.csv 2>/dev/null || { echo "fixture: long log failed"; exit 1; }
+echo previous >sig_conv.h5
+echo previous >sig_att.csv
+check_sh outputs "SIGTERM during convert: no temporary file, previous output kept" \
+  "set -m; '$TETRA' convert long.csv sig_conv.h5 2>/dev/null & p=\$!;
+   for i in \$(seq 1000); do ls -A | grep -q '^\\.sig_conv.h5.tetra-' && break; sleep 0.01; done;
+   kill -TERM \$p; wait \$p; st=\$?; test \$st -gt 128 && test \"\$(cat sig_conv.h5)\" = previous && ! ls -A | grep -q tetra-"
+check_sh outputs "SIGINT during replay: no temporary file, previous outputs kept" \
+  "set -m; '$TETRA' replay long.csv --calibration $CAL --attitude sig_att.csv --events sig_ev.jsonl 2>/dev/null & p=\$!;
+   for i in \$(seq 1000); do ls -A | grep -q '^\\.sig_att.csv.tetra-' && break; sleep 0.01; done;
+   kill -INT \$p; wait \$p; st=\$?; test \$st -gt 128 && test \"\$(cat sig_att.csv)\" = previous && test ! -e sig_ev.jsonl && ! ls -A | grep -q tetra-"
+rm -f long.csv
 check_sh outputs "closed stdout (SIGPIPE): the file is still written" \
   "rm -f pipe_cal.yaml; '$TETRA' calibrate $TT -o pipe_cal.yaml 2>/dev/null | head -c 1 >/dev/null; grep -q gyros: pipe_cal.yaml; rc=\$?; rm -f pipe_cal.yaml; exit \$rc"
 check_sh outputs "a failed run leaves no temporary file" "! ls -A | grep -q '\.tetra-'"
