@@ -1,7 +1,10 @@
 // The input and output layers (docs/formats.md, "Inputs" and "Outputs"), strict numbers, metadata
 // escapes, JSON UTF-8 and the flicker-rate EDF at m = 1.
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <cmath>
 #include <filesystem>
@@ -120,6 +123,75 @@ TEST(OutputFiles, DevNullIsWrittenStraightNeverReplaced) {
   struct stat st {};
   ASSERT_EQ(::stat("/dev/null", &st), 0);
   EXPECT_TRUE(S_ISCHR(st.st_mode));
+}
+
+// A FIFO would block the run until a reader comes (and an HDF5 library cannot seek it); a device other
+// than /dev/null takes writes it does not keep. Both refused before anything is opened.
+TEST(OutputFiles, FifosAndDevicesOtherThanDevNullAreRefused) {
+  TempDir dir;
+  ASSERT_EQ(::mkfifo(dir.file("fifo").c_str(), 0600), 0);
+  std::filesystem::create_symlink(dir.file("fifo"), dir.file("to_fifo"));
+  RunFiles files;
+  for (const std::string& path : {dir.file("fifo"), dir.file("to_fifo")}) {
+    const auto fifo = files.add(path, "--attitude");  // returns at once: nothing opens the FIFO
+    ASSERT_FALSE(fifo.ok());
+    EXPECT_EQ(fifo.error().message,
+              "--attitude " + path +
+                  ": is a FIFO: an output must be a regular file (`-` for standard output, "
+                  "/dev/null to discard)");
+  }
+  const auto full = files.add("/dev/full", "-o");
+  ASSERT_FALSE(full.ok());
+  EXPECT_NE(full.error().message.find("-o /dev/full: is a character device"), std::string::npos);
+  EXPECT_FALSE(check_output_path(dir.file("fifo"), "campaign output").ok());
+  EXPECT_TRUE(check_output_path("/dev/null", "campaign output").ok());
+  EXPECT_TRUE(check_output_path(dir.file("new.csv"), "campaign output").ok());
+}
+
+// The rename of a temporary file would go around a file's write protection: a file without write
+// permission is refused instead, for root too (whom the kernel lets write anything) when no write bit
+// is set at all. Its contents and mode stay.
+TEST(OutputFiles, WriteProtectedFileIsNeverReplaced) {
+  TempDir dir;
+  write_file(dir.file("keep.csv"), "kept\n");
+  ASSERT_EQ(::chmod(dir.file("keep.csv").c_str(), 0444), 0);
+  RunFiles files;
+  const auto out = files.add(dir.file("keep.csv"), "-o");
+  ASSERT_FALSE(out.ok());
+  EXPECT_EQ(out.error().message, "-o " + dir.file("keep.csv") +
+                                     ": is write-protected (no write permission): it is never replaced");
+  EXPECT_FALSE(files.add(dir.file("keep.csv"), "--update", dir.file("keep.csv")).ok());
+  EXPECT_FALSE(check_output_path(dir.file("keep.csv"), "campaign output").ok());
+  EXPECT_EQ(read_file(dir.file("keep.csv")), "kept\n");
+  EXPECT_FALSE(has_temporary(dir));
+  ASSERT_EQ(::chmod(dir.file("keep.csv").c_str(), 0644), 0);
+  EXPECT_TRUE(files.add(dir.file("keep.csv"), "-o").ok());
+}
+
+// SIGINT, SIGTERM or SIGHUP during a run: the temporary files go, the previous output stays, and the
+// process still ends by the signal (a child process here, killing itself mid-write).
+TEST(OutputFiles, SignalRemovesTemporaryFilesAndKeepsThePreviousOutput) {
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    TempDir dir;
+    write_file(dir.file("out.csv"), "previous\n");
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {  // the signals at their default action, as gtest leaves them
+      RunFiles files;
+      auto a = files.add(dir.file("out.csv"), "-o");
+      auto b = files.add(dir.file("new.h5"), "--log");
+      if (!a.ok() || !b.ok() || !(*a)->write("partial").ok() || !has_temporary(dir)) ::_exit(3);
+      ::raise(sig);
+      ::_exit(4);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "signal " << sig << ": status " << status;
+    EXPECT_EQ(WTERMSIG(status), sig);
+    EXPECT_FALSE(has_temporary(dir)) << "signal " << sig;
+    EXPECT_EQ(read_file(dir.file("out.csv")), "previous\n");
+    EXPECT_FALSE(std::filesystem::exists(dir.file("new.h5")));
+  }
 }
 
 TEST(OutputFiles, FolderAndMissingFolderAreRefusedNamingTheOption) {

@@ -268,6 +268,12 @@ Status GyroLogWriter::open_output(OutputFile& out, int gyro_count, bool with_ref
                                   const std::vector<std::string>& comments) {
   if (out_ != nullptr) return failure(out_->path() + ": writer already open");
   if (gyro_count < 1) return bad_input(out.path() + ": a gyro log needs at least one gyro column");
+  for (std::size_t i = 0; i < comments.size(); ++i) {
+    if (comments[i].find_first_of("\n\r") != std::string::npos) {  // it would end the comment line
+      return bad_input(out.path() + ": comment " + std::to_string(i + 1) +
+                       " holds a line break (a comment is one line)");
+    }
+  }
   if (is_hdf5_path(out.path())) {
     auto file_path = out.library_path();
     if (!file_path) return file_path.error();

@@ -1,7 +1,11 @@
 // HDF5 gyro logs: layout in docs/formats.md. One thread at a time uses the HDF5 library here.
 #include "gyro_log_h5.hpp"
 
+#include <fcntl.h>
 #include <hdf5.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -62,9 +66,17 @@ class Handle {
   herr_t (*closer_)(hid_t) = nullptr;
 };
 
-// The library prints its error stack on stderr by default; tetra reports one line of its own.
-void silence_hdf5() {
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+// Once, before any other HDF5 call: the library's error stack is never printed (tetra reports one
+// line of its own, naming the file), and the library is not shut down at exit (after a failed write,
+// e.g. a full disk, its shutdown would close the half-written file again and may crash; the process
+// is ending and the temporary file is discarded anyway).
+void init_hdf5() {
+  static const bool done = [] {
+    H5dont_atexit();
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    return true;
+  }();
+  (void)done;
 }
 
 std::string gyro_name(std::size_t index0) {
@@ -73,23 +85,31 @@ std::string gyro_name(std::size_t index0) {
 
 // --- attributes ---------------------------------------------------------------------------------
 
-Handle string_type() {
+constexpr std::size_t kMaxAttributeBytes = std::size_t{16} << 20;  // [bytes] one string attribute read
+
+// Fixed-length UTF-8 strings of `size` bytes each (NUL-padded): stored in the attribute itself, so a
+// reader needs no global heap (variable-length strings live there; see read_string_attribute).
+Handle fixed_string_type(std::size_t size) {
   Handle t(H5Tcopy(H5T_C_S1), H5Tclose);
-  H5Tset_size(t.get(), H5T_VARIABLE);
+  H5Tset_size(t.get(), std::max<std::size_t>(size, 1));
+  H5Tset_strpad(t.get(), H5T_STR_NULLPAD);
   H5Tset_cset(t.get(), H5T_CSET_UTF8);
   return t;
 }
 
 bool write_string_attribute(hid_t obj, const char* name, const std::vector<std::string>& values,
                             bool scalar) {
-  Handle type = string_type();
+  std::size_t size = 1;
+  for (const std::string& v : values) size = std::max(size, v.size());
+  Handle type = fixed_string_type(size);
   const hsize_t n = values.size();
   Handle space(scalar ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, nullptr), H5Sclose);
   Handle attr(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
   if (!attr.valid()) return false;
-  std::vector<const char*> ptrs;
-  for (const std::string& v : values) ptrs.push_back(v.c_str());
-  return H5Awrite(attr.get(), type.get(), ptrs.data()) >= 0;
+  std::vector<char> buf(values.size() * size, '\0');
+  for (std::size_t i = 0; i < values.size(); ++i)
+    std::memcpy(buf.data() + i * size, values[i].data(), values[i].size());
+  return H5Awrite(attr.get(), type.get(), buf.data()) >= 0;
 }
 
 bool write_int_attribute(hid_t obj, const char* name, int value) {
@@ -98,43 +118,81 @@ bool write_int_attribute(hid_t obj, const char* name, int value) {
   return attr.valid() && H5Awrite(attr.get(), H5T_NATIVE_INT, &value) >= 0;
 }
 
-// Strings of a string attribute (scalar or 1-D; variable or fixed length), or nullopt when absent or
-// not strings.
-std::optional<std::vector<std::string>> read_string_attribute(hid_t obj, const char* name) {
-  if (H5Aexists(obj, name) <= 0) return std::nullopt;
+// Whether variable-length string attributes may be read. Their strings live in the file's global heap,
+// whose damaged sizes libhdf5 follows without checking (a flipped size crashes it): they are read only
+// in the child process that checks a file before it is opened (see probe_in_child).
+enum class VariableStrings { kRead, kRefuse };
+
+// Strings of a string attribute (scalar or 1-D; fixed or variable length): nullopt when absent, an
+// error when it is not strings or larger than kMaxAttributeBytes.
+Result<std::optional<std::vector<std::string>>> read_string_attribute(hid_t obj, const char* name,
+                                                                      const std::string& src,
+                                                                      VariableStrings vlen) {
+  using Strings = std::optional<std::vector<std::string>>;
+  if (H5Aexists(obj, name) <= 0) return Strings{};
+  const std::string what = src + ": attribute '" + name + "'";
   Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
   Handle ftype(H5Aget_type(attr.get()), H5Tclose);
-  if (H5Tget_class(ftype.get()) != H5T_STRING) return std::nullopt;
   Handle space(H5Aget_space(attr.get()), H5Sclose);
+  if (!attr.valid() || !ftype.valid() || !space.valid())
+    return bad_input(what + " cannot be read (damaged file?)");
+  if (H5Tget_class(ftype.get()) != H5T_STRING) return bad_input(what + " is not text");
   const hssize_t count = H5Sget_simple_extent_npoints(space.get());
-  if (count < 0) return std::nullopt;
+  if (count < 0 || H5Sget_simple_extent_ndims(space.get()) > 1 ||
+      static_cast<std::size_t>(count) > kMaxAttributeBytes / 8) {
+    return bad_input(what + " is not a list of strings of bounded size");
+  }
   const auto n = static_cast<std::size_t>(count);
   std::vector<std::string> out;
   if (H5Tis_variable_str(ftype.get()) > 0) {
-    Handle mtype = string_type();
+    if (vlen == VariableStrings::kRefuse)
+      return bad_input(what + ": variable-length strings are read only in a checked child process");
+    Handle mtype(H5Tcopy(H5T_C_S1), H5Tclose);
+    H5Tset_size(mtype.get(), H5T_VARIABLE);
+    H5Tset_cset(mtype.get(), H5Tget_cset(ftype.get()));  // libhdf5 converts no character set
     std::vector<char*> ptrs(n, nullptr);
-    if (H5Aread(attr.get(), mtype.get(), ptrs.data()) < 0) return std::nullopt;
-    for (char* p : ptrs) out.emplace_back(p == nullptr ? "" : p);
+    if (H5Aread(attr.get(), mtype.get(), ptrs.data()) < 0)
+      return bad_input(what + " cannot be read (damaged file?)");
+    std::size_t total = 0;
+    for (char* p : ptrs) {
+      const std::size_t len = p == nullptr ? 0 : strnlen(p, kMaxAttributeBytes + 1);
+      total += len;
+      if (total > kMaxAttributeBytes) break;
+      out.emplace_back(p == nullptr ? "" : p, len);
+    }
     H5Dvlen_reclaim(mtype.get(), space.get(), H5P_DEFAULT, ptrs.data());
+    if (total > kMaxAttributeBytes)
+      return bad_input(what + " is larger than " + std::to_string(kMaxAttributeBytes) + " bytes");
   } else {
     const std::size_t size = H5Tget_size(ftype.get());
+    if (size == 0 || size > kMaxAttributeBytes || n * size > kMaxAttributeBytes) {
+      return bad_input(what + " is larger than " + std::to_string(kMaxAttributeBytes) + " bytes");
+    }
     Handle mtype(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(mtype.get(), size);
+    H5Tset_strpad(mtype.get(), H5T_STR_NULLPAD);
+    H5Tset_cset(mtype.get(), H5Tget_cset(ftype.get()));
     std::vector<char> buf(n * size + 1, '\0');
-    if (H5Aread(attr.get(), mtype.get(), buf.data()) < 0) return std::nullopt;
+    if (H5Aread(attr.get(), mtype.get(), buf.data()) < 0)
+      return bad_input(what + " cannot be read (damaged file?)");
     for (std::size_t i = 0; i < n; ++i) {
       const char* s = buf.data() + i * size;
       out.emplace_back(s, strnlen(s, size));
     }
   }
-  return out;
+  return Strings{std::move(out)};
 }
 
+// A scalar integer attribute of at most 64 bits: nullopt when absent or of another kind.
 std::optional<long long> read_int_attribute(hid_t obj, const char* name) {
   if (H5Aexists(obj, name) <= 0) return std::nullopt;
   Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
   Handle ftype(H5Aget_type(attr.get()), H5Tclose);
-  if (H5Tget_class(ftype.get()) != H5T_INTEGER) return std::nullopt;
+  Handle space(H5Aget_space(attr.get()), H5Sclose);
+  if (!attr.valid() || !ftype.valid() || !space.valid() || H5Tget_class(ftype.get()) != H5T_INTEGER ||
+      H5Tget_size(ftype.get()) > 8 || H5Sget_simple_extent_npoints(space.get()) != 1) {
+    return std::nullopt;
+  }
   long long v = 0;
   if (H5Aread(attr.get(), H5T_NATIVE_LLONG, &v) < 0) return std::nullopt;
   return v;
@@ -145,6 +203,121 @@ std::optional<long long> read_int_attribute(hid_t obj, const char* name) {
 bool has_filters(hid_t dataset) {
   Handle dcpl(H5Dget_create_plist(dataset), H5Pclose);
   return !dcpl.valid() || H5Pget_nfilters(dcpl.get()) != 0;
+}
+
+// The number types a dataset may be stored as (IEEE floats, integers of 8 to 64 bits, either byte
+// order): libhdf5 converts these with its own code; other number formats are refused.
+bool is_plain_number_type(hid_t type) {
+  const std::array<hid_t, 20> plain = {H5T_IEEE_F32LE, H5T_IEEE_F32BE, H5T_IEEE_F64LE, H5T_IEEE_F64BE,
+                                       H5T_STD_I8LE,   H5T_STD_I8BE,   H5T_STD_I16LE,  H5T_STD_I16BE,
+                                       H5T_STD_I32LE,  H5T_STD_I32BE,  H5T_STD_I64LE,  H5T_STD_I64BE,
+                                       H5T_STD_U8LE,   H5T_STD_U8BE,   H5T_STD_U16LE,  H5T_STD_U16BE,
+                                       H5T_STD_U32LE,  H5T_STD_U32BE,  H5T_STD_U64LE,  H5T_STD_U64BE};
+  return std::any_of(plain.begin(), plain.end(), [&](hid_t t) { return H5Tequal(type, t) > 0; });
+}
+
+// [bytes] largest chunk read: tetra's own chunks are 65 536 rows of at most 4096 one-byte or one
+// 8-byte column, so 2 MiB per column and 256 MiB for the widest presence dataset.
+constexpr hsize_t kMaxChunkBytes = hsize_t{256} << 20;
+// Largest ratio deflate reaches (about 1032:1): a compressed dataset declares at most this many times
+// its stored bytes (plus one chunk), so a small file never stands for gigabytes of rows.
+constexpr hsize_t kMaxDeflateRatio = 1100;
+
+// The storage of dataset `id` (`rows`×`cols` elements of `type`) checked against the file's size
+// before anything is read or allocated: only what tetra writes (chunked, or contiguous or compact as
+// other writers make it; deflate and shuffle only; no external files, no virtual dataset), and every
+// row stored in the file (no unwritten chunk whose fill value a read would invent, no 2^40 rows in a
+// 7 KB file). `what` names the dataset in messages.
+Status check_storage(hid_t id, hid_t type, hsize_t rows, hsize_t cols, int rank, hsize_t file_size,
+                     const std::string& what) {
+  Handle dcpl(H5Dget_create_plist(id), H5Pclose);
+  if (!dcpl.valid()) return bad_input(what + ": cannot read its storage properties (damaged file?)");
+  if (H5Pget_external_count(dcpl.get()) != 0) {
+    return bad_input(what + ": stored in external files, which tetra does not read (docs/formats.md)");
+  }
+  const H5D_layout_t layout = H5Pget_layout(dcpl.get());
+  if (layout != H5D_CHUNKED && layout != H5D_CONTIGUOUS && layout != H5D_COMPACT) {
+    return bad_input(what +
+                     ": a virtual or unknown storage layout, which tetra does not read (docs/formats.md)");
+  }
+  const int nfilters = H5Pget_nfilters(dcpl.get());
+  if (nfilters < 0) return bad_input(what + ": cannot read its filters (damaged file?)");
+  for (int f = 0; f < nfilters; ++f) {
+    unsigned flags = 0;
+    std::size_t nvalues = 0;
+    unsigned config = 0;
+    std::array<char, 64> name{};
+    const H5Z_filter_t filter = H5Pget_filter2(dcpl.get(), static_cast<unsigned>(f), &flags, &nvalues,
+                                               nullptr, name.size(), name.data(), &config);
+    if (filter != H5Z_FILTER_DEFLATE && filter != H5Z_FILTER_SHUFFLE) {
+      return bad_input(what + ": filter " + std::to_string(filter) +
+                       ", which tetra does not read (only deflate and shuffle; docs/formats.md)");
+    }
+  }
+  const std::size_t type_size = H5Tget_size(type);
+  hsize_t bytes = 0;  // declared
+  if (type_size == 0 || __builtin_mul_overflow(rows, cols, &bytes) ||
+      __builtin_mul_overflow(bytes, hsize_t{type_size}, &bytes) ||
+      bytes > file_size * kMaxDeflateRatio + kMaxChunkBytes) {
+    return bad_input(what + ": declares " + std::to_string(rows) + " rows, more than a file of " +
+                     std::to_string(file_size) + " bytes can hold");
+  }
+  if (rows == 0) return ok_status();
+  const hsize_t stored = H5Dget_storage_size(id);
+  if (stored > file_size) return bad_input(what + ": its storage is larger than the file (damaged file?)");
+  if (layout == H5D_COMPACT) {
+    if (stored < bytes) return bad_input(what + ": rows declared but not stored (damaged file?)");
+    return ok_status();
+  }
+  if (layout == H5D_CONTIGUOUS) {
+    const haddr_t offset = H5Dget_offset(id);
+    if (stored != bytes || offset == HADDR_UNDEF || offset > file_size || file_size - offset < stored) {
+      return bad_input(what + ": " + std::to_string(rows) + " rows declared, " + std::to_string(stored) +
+                       " bytes stored at the file's offset " + std::to_string(offset) + " (damaged file?)");
+    }
+    return ok_status();
+  }
+  std::array<hsize_t, 2> chunk{};
+  if (H5Pget_chunk(dcpl.get(), rank, chunk.data()) != rank || chunk[0] == 0 || (rank == 2 && chunk[1] == 0)) {
+    return bad_input(what + ": cannot read its chunk shape (damaged file?)");
+  }
+  const hsize_t chunk_cols = rank == 2 ? chunk[1] : 1;
+  hsize_t chunk_bytes = 0;
+  if (__builtin_mul_overflow(chunk[0], chunk_cols, &chunk_bytes) ||
+      __builtin_mul_overflow(chunk_bytes, hsize_t{type_size}, &chunk_bytes) || chunk_bytes > kMaxChunkBytes) {
+    return bad_input(what + ": chunks of more than " + std::to_string(kMaxChunkBytes) + " bytes");
+  }
+  const hsize_t row_chunks = (rows - 1) / chunk[0] + 1;
+  const hsize_t col_chunks = (cols - 1) / chunk_cols + 1;
+  Handle space(H5Dget_space(id), H5Sclose);
+  hsize_t allocated = 0;
+  if (H5Dget_num_chunks(id, space.get(), &allocated) < 0 || allocated != row_chunks * col_chunks) {
+    return bad_input(what + ": " + std::to_string(rows) + " rows declared in " +
+                     std::to_string(row_chunks * col_chunks) + " chunks, " + std::to_string(allocated) +
+                     " written (damaged or unfinished file?)");
+  }
+  if (nfilters > 0 && bytes > stored * kMaxDeflateRatio + chunk_bytes) {
+    return bad_input(what + ": declares more rows than its compressed chunks can hold (damaged file?)");
+  }
+  if (nfilters == 0 && stored != allocated * chunk_bytes) {
+    return bad_input(what + ": its chunks are not all stored whole (damaged file?)");
+  }
+  // Every chunk in the file: found by its coordinates, within the file, with no filter skipped.
+  for (hsize_t r = 0; r < row_chunks; ++r) {
+    for (hsize_t c = 0; c < col_chunks; ++c) {
+      const std::array<hsize_t, 2> at{r * chunk[0], c * chunk_cols};
+      unsigned mask = 0;
+      haddr_t addr = HADDR_UNDEF;
+      hsize_t size = 0;
+      if (H5Dget_chunk_info_by_coord(id, at.data(), &mask, &addr, &size) < 0 || addr == HADDR_UNDEF ||
+          addr > file_size || file_size - addr < size || mask != 0 ||
+          (nfilters == 0 && size != chunk_bytes)) {
+        return bad_input(what + ": the chunk of row " + std::to_string(at[0] + 1) +
+                         " is missing or lies outside the file (damaged file?)");
+      }
+    }
+  }
+  return ok_status();
 }
 
 // An unfiltered dataset read with no chunk cache: HDF5 then reads the rows straight from the file into
@@ -214,9 +387,16 @@ bool load_raw_chunk(Dataset& d, hsize_t first, hsize_t count, hid_t mem_type) {
   return true;
 }
 
+using H5Header = GyroLogH5Header;
+
 class H5Reader final : public GyroLogReader {
  public:
+  // A file by name: checked first in a child process (probe_in_child), then opened here.
   Status open(const std::string& path);
+  // The file already open as `file` (`file_size` bytes), read in this process: its header is read
+  // here when `known` is null (variable-length strings then as `vlen` says).
+  Status open_file(Handle file, const std::string& source, const H5Header* known, VariableStrings vlen);
+  H5Header header_read() const { return {header_.gyro_count, header_.units_dps, header_.comments}; }
   Result<bool> next(GyroLog& block) override;
   double fraction_read() const override {
     return rows_ == 0 ? 1.0 : static_cast<double>(row_) / static_cast<double>(rows_);
@@ -227,7 +407,8 @@ class H5Reader final : public GyroLogReader {
   Result<Dataset> open_dataset(const char* name, int rank, hsize_t cols);
   Status read_rows(const Dataset& d, hsize_t first, hsize_t count, hid_t mem_type, void* out) const;
   Result<const void*> rows_of(Dataset& d, hsize_t count, hid_t mem_type, void* fallback);
-  Status read_header();
+  Status read_header(VariableStrings vlen);
+  Status use_header(const H5Header& h);
   std::string where(const std::string& dataset, std::size_t row) const {
     return header_.source + ": dataset '" + dataset + "' row " + std::to_string(row + 1) + ": ";
   }
@@ -237,6 +418,7 @@ class H5Reader final : public GyroLogReader {
   Status read_reference(GyroLog& block, hsize_t count);
 
   Handle file_;
+  hsize_t file_size_ = 0;  // [bytes]
   Dataset time_;
   std::vector<Dataset> gyros_;
   Dataset present_;
@@ -257,10 +439,10 @@ Result<Dataset> H5Reader::open_dataset(const char* name, int rank, hsize_t cols)
   d.name = name;
   d.id = Handle(H5Dopen2(file_.get(), name, H5P_DEFAULT), H5Dclose);
   if (!d.id.valid()) return bad_input(src + ": dataset '" + name + "' cannot be opened");
-  if (!has_filters(d.id.get())) d.id = reopen_uncached(file_.get(), name, std::move(d.id));
   Handle space(H5Dget_space(d.id.get()), H5Sclose);
   std::array<hsize_t, 2> dims{};
   const int got = H5Sget_simple_extent_ndims(space.get());
+  if (got == 1 && rank == 2 && cols == 1) rank = 1;  // one gyro's 'present' as tetra wrote it before 2-D
   if (got != rank || H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) < 0) {
     return bad_input(src + ": dataset '" + name + "' has " + std::to_string(got) +
                      " dimension(s), expected " + std::to_string(rank));
@@ -270,15 +452,21 @@ Result<Dataset> H5Reader::open_dataset(const char* name, int rank, hsize_t cols)
                      std::to_string(cols));
   }
   Handle type(H5Dget_type(d.id.get()), H5Tclose);
-  const H5T_class_t cls = H5Tget_class(type.get());
-  if (cls != H5T_FLOAT && cls != H5T_INTEGER) {
-    return bad_input(src + ": dataset '" + name + "' is not numeric");
+  if (!type.valid() || !is_plain_number_type(type.get())) {
+    return bad_input(src + ": dataset '" + name +
+                     "' is not stored as plain numbers (IEEE floats or integers)");
   }
   if (name != std::string("time_s") && dims[0] != rows_) {
     return bad_input(src + ": dataset '" + name + "' has " + std::to_string(dims[0]) +
                      " rows, 'time_s' has " + std::to_string(rows_));
   }
+  if (Status s = check_storage(d.id.get(), type.get(), dims[0], cols, rank, file_size_,
+                               src + ": dataset '" + name + "'");
+      !s) {
+    return s.error();
+  }
   if (name == std::string("time_s")) rows_ = dims[0];
+  if (!has_filters(d.id.get())) d.id = reopen_uncached(file_.get(), name, std::move(d.id));
   d.cols = cols;
   find_raw_chunks(d, rank);
   return d;
@@ -298,11 +486,12 @@ Status H5Reader::read_rows(const Dataset& d, hsize_t first, hsize_t count, hid_t
   return ok_status();
 }
 
-Status H5Reader::read_header() {
+Status H5Reader::read_header(VariableStrings vlen) {
   const std::string& src = header_.source;
   const hid_t root = file_.get();
-  const auto format = read_string_attribute(root, "format");
-  if (!format || format->size() != 1 || format->front() != kFormat) {
+  const auto format = read_string_attribute(root, "format", src, vlen);
+  if (!format) return format.error();
+  if (!*format || (*format)->size() != 1 || (*format)->front() != kFormat) {
     return bad_input(src + ": attribute 'format' is not '" + kFormat +
                      "': not a tetra gyro log (docs/formats.md)");
   }
@@ -314,28 +503,53 @@ Status H5Reader::read_header() {
   if (!count || *count < 1 || *count > 4096) {
     return bad_input(src + ": attribute 'gyro_count': expected an integer from 1 to 4096");
   }
-  header_.gyro_count = static_cast<int>(*count);
-  const auto units = read_string_attribute(root, "units");
-  if (!units || units->size() != 1 || (units->front() != "V" && units->front() != "dps")) {
+  const auto units = read_string_attribute(root, "units", src, vlen);
+  if (!units) return units.error();
+  if (!*units || (*units)->size() != 1 || ((*units)->front() != "V" && (*units)->front() != "dps")) {
     return bad_input(src + ": attribute 'units': expected 'V' or 'dps'");
   }
-  header_.units_dps = units->front() == "dps";
-  // The metadata is read from the comment lines, as from a CSV's ("metadata" is for other readers).
-  if (const auto comments = read_string_attribute(root, "comments")) {
-    header_.comments = *comments;
-    for (const std::string& c : *comments) parse_metadata_comment(c, header_.metadata);
+  auto comments = read_string_attribute(root, "comments", src, vlen);
+  if (!comments) return comments.error();
+  H5Header h;
+  h.gyro_count = static_cast<int>(*count);
+  h.units_dps = (*units)->front() == "dps";
+  if (*comments) h.comments = std::move(**comments);
+  return use_header(h);
+}
+
+// The header into header_, with the checks every header gets (read here or sent by the child): each
+// comment is one line (it becomes a CSV comment line on conversion), and a 'units' entry among the
+// comments says what the 'units' attribute says (one rule: the attribute; a conflict is an error).
+Status H5Reader::use_header(const H5Header& h) {
+  const std::string& src = header_.source;
+  header_.gyro_count = h.gyro_count;
+  header_.units_dps = h.units_dps;
+  header_.comments = h.comments;
+  header_.metadata.clear();
+  for (std::size_t i = 0; i < h.comments.size(); ++i) {
+    if (h.comments[i].find_first_of("\n\r") != std::string::npos) {
+      return bad_input(src + ": attribute 'comments' entry " + std::to_string(i + 1) +
+                       " holds a line break (a comment is one line)");
+    }
+    // The metadata is read from the comment lines, as from a CSV's ("metadata" is for other readers).
+    parse_metadata_comment(h.comments[i], header_.metadata);
+  }
+  const std::string units = h.units_dps ? "dps" : "V";
+  if (const auto said = last_meta(header_.metadata, "units"); said && *said != units) {
+    return bad_input(src + ": attribute 'units' is '" + units + "' but the comments say units=" + *said +
+                     " (the attribute and the comments must agree)");
   }
   return ok_status();
 }
 
-Status H5Reader::open(const std::string& path) {
-  silence_hdf5();
-  header_.source = path;
-  if (Status s = check_input(path, kMaxStreamedLogBytes, true); !s) return s;
-  if (H5Fis_hdf5(path.c_str()) <= 0) return bad_input(path + ": not an HDF5 file");
-  file_ = Handle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-  if (!file_.valid()) return bad_input(path + ": cannot open as HDF5");
-  if (Status s = read_header(); !s) return s;
+Status H5Reader::open_file(Handle file, const std::string& source, const H5Header* known,
+                           VariableStrings vlen) {
+  header_.source = source;
+  file_ = std::move(file);
+  if (!file_.valid() || H5Fget_filesize(file_.get(), &file_size_) < 0) {
+    return bad_input(source + ": cannot open as HDF5");
+  }
+  if (Status s = known != nullptr ? use_header(*known) : read_header(vlen); !s) return s;
   const auto ng = static_cast<hsize_t>(header_.gyro_count);
   auto time = open_dataset("time_s", 1, 1);
   if (!time) return time.error();
@@ -351,7 +565,7 @@ Status H5Reader::open(const std::string& path) {
   int refs = 0;
   for (const char* name : kRefNames) refs += H5Lexists(file_.get(), name, H5P_DEFAULT) > 0 ? 1 : 0;
   if (refs != 0 && refs != 4) {
-    return bad_input(path + ": reference datasets must be all of ref_qw,ref_qx,ref_qy,ref_qz");
+    return bad_input(header_.source + ": reference datasets must be all of ref_qw,ref_qx,ref_qy,ref_qz");
   }
   header_.has_reference = refs == 4;
   if (header_.has_reference) {
@@ -365,6 +579,162 @@ Status H5Reader::open(const std::string& path) {
     ref_present_ = std::move(rp.value());
   }
   return ok_status();
+}
+
+// --- the checking child process ---------------------------------------------------------------------
+
+constexpr unsigned kProbeSeconds = 30;  // [s] longest the child may take to check a file
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define TETRA_H5_ASAN 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define TETRA_H5_ASAN 1
+#endif
+
+// libhdf5 sizes some buffers from the file before checking them (an object header claiming 5 GB): in
+// the child, such a malloc fails (an error, the file refused) instead of reserving gigabytes. The limit
+// is the child's address space at the fork plus kProbeExtraBytes. Not under AddressSanitizer, whose
+// shadow memory is terabytes of address space (there, its own allocation limit applies).
+void limit_child_memory() {
+#ifndef TETRA_H5_ASAN
+  constexpr rlim_t kProbeExtraBytes = rlim_t{2} << 30;  // [bytes] address space the child may add
+  std::FILE* statm = std::fopen("/proc/self/statm", "r");
+  unsigned long pages = 0;
+  const bool got = statm != nullptr && std::fscanf(statm, "%lu", &pages) == 1;
+  if (statm != nullptr) std::fclose(statm);
+  if (!got) return;
+  const auto now = static_cast<rlim_t>(pages) * static_cast<rlim_t>(::sysconf(_SC_PAGESIZE));
+  const struct rlimit limit { now + kProbeExtraBytes, now + kProbeExtraBytes };
+  ::setrlimit(RLIMIT_AS, &limit);
+#endif
+}
+
+std::string encode_header(const H5Header& h) {
+  std::string out = "H" + std::to_string(h.gyro_count) + "\n" + (h.units_dps ? "dps" : "V") + "\n" +
+                    std::to_string(h.comments.size()) + "\n";
+  for (const std::string& c : h.comments) out += std::to_string(c.size()) + "\n" + c;
+  return out;
+}
+
+// The child's answer: a header, or an error ("E", then 'b' bad input or 'f' failure, then the message).
+Result<H5Header> decode_answer(const std::string& text, const std::string& path) {
+  const Error garbled = failure(path + ": the process checking the file gave no answer");
+  if (text.size() >= 2 && text[0] == 'E') {
+    return Error{text.substr(2), text[1] == 'b' ? ErrorKind::kBadInput : ErrorKind::kFailure};
+  }
+  if (text.empty() || text[0] != 'H') return garbled;
+  std::size_t pos = 1;
+  auto number = [&](unsigned long long& v) {
+    const std::size_t end = text.find('\n', pos);
+    if (end == std::string::npos) return false;
+    try {
+      v = std::stoull(text.substr(pos, end - pos));
+    } catch (...) {
+      return false;
+    }
+    pos = end + 1;
+    return true;
+  };
+  H5Header h;
+  unsigned long long count = 0;
+  unsigned long long n = 0;
+  if (!number(count)) return garbled;
+  h.gyro_count = static_cast<int>(count);
+  const std::size_t end = text.find('\n', pos);
+  if (end == std::string::npos) return garbled;
+  h.units_dps = text.compare(pos, end - pos, "dps") == 0;
+  pos = end + 1;
+  if (!number(n)) return garbled;
+  for (unsigned long long i = 0; i < n; ++i) {
+    unsigned long long len = 0;
+    if (!number(len) || len > text.size() - pos) return garbled;
+    h.comments.push_back(text.substr(pos, len));
+    pos += len;
+  }
+  return h;
+}
+
+// The whole check of `path` in this process: open, header (variable-length strings included), every
+// dataset's shape, type and storage. What the child runs.
+Result<H5Header> inspect_here(const std::string& path) {
+  if (H5Fis_hdf5(path.c_str()) <= 0) return bad_input(path + ": not an HDF5 file");
+  Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!file.valid()) return bad_input(path + ": cannot open as HDF5");
+  H5Reader reader;
+  if (Status s = reader.open_file(std::move(file), path, nullptr, VariableStrings::kRead); !s)
+    return s.error();
+  return reader.header_read();
+}
+
+// libhdf5 trusts the sizes it reads from a file's metadata: some damage (a flipped size in the global
+// heap, where variable-length strings live) makes it read out of bounds and crash, and no check from
+// outside the library can see it first. So a file is first opened and checked whole (its metadata,
+// not its rows) in a child process, which sends the header back; a crash, a hang (kProbeSeconds) or
+// an error there is an error value here naming the file, and this process then opens only a file that
+// passed, reading no variable-length string itself.
+Result<H5Header> probe_in_child(const std::string& path) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) return failure(path + ": cannot create a pipe: " + std::strerror(errno));
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    return failure(path + ": cannot start the process that checks it: " + std::strerror(errno));
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    ::alarm(kProbeSeconds);
+    limit_child_memory();
+    const auto header = inspect_here(path);
+    const std::string answer = header ? encode_header(*header)
+                                      : std::string("E") +
+                                            (header.error().kind == ErrorKind::kBadInput ? "b" : "f") +
+                                            header.error().message;
+    std::size_t done = 0;
+    while (done < answer.size()) {
+      const ssize_t n = ::write(fds[1], answer.data() + done, answer.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      done += static_cast<std::size_t>(n);
+    }
+    ::_exit(0);  // no exit handlers: the parent's files and libraries are left as they are
+  }
+  ::close(fds[1]);
+  std::string answer;
+  std::array<char, 65536> buf{};
+  while (answer.size() <= kMaxAttributeBytes * 2) {
+    const ssize_t n = ::read(fds[0], buf.data(), buf.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    answer.append(buf.data(), static_cast<std::size_t>(n));
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFSIGNALED(status)) {
+    if (WTERMSIG(status) == SIGALRM) {
+      return bad_input(path + ": checking this HDF5 file took longer than " + std::to_string(kProbeSeconds) +
+                       " s (damaged file?); nothing was read from it");
+    }
+    return bad_input(path + ": damaged HDF5 file: the HDF5 library failed on it (" +
+                     strsignal(WTERMSIG(status)) +
+                     ") in the process that checks files first; nothing was read from it");
+  }
+  return decode_answer(answer, path);
+}
+
+Status H5Reader::open(const std::string& path) {
+  init_hdf5();
+  header_.source = path;
+  if (Status s = check_input(path, kMaxStreamedLogBytes, true); !s) return s;
+  const auto header = probe_in_child(path);
+  if (!header) return header.error();
+  Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  return open_file(std::move(file), path, &*header, VariableStrings::kRefuse);
 }
 
 Status H5Reader::check_block(const GyroLog& block, hsize_t first) const {
@@ -494,11 +864,12 @@ Result<std::unique_ptr<GyroLogReader>> open_gyro_log_h5_reader(const std::string
   return std::unique_ptr<GyroLogReader>(std::move(reader));
 }
 
-Result<GyroLog> read_gyro_log_h5(const std::string& path) {
-  auto reader = open_gyro_log_h5_reader(path);
-  if (!reader) return reader.error();
-  GyroLog log = (*reader)->header();
-  const std::size_t n = (*reader)->epochs_hint();
+namespace {
+
+// Every block of `reader` into one log.
+Result<GyroLog> read_whole(GyroLogReader& reader, const std::string& path) {
+  GyroLog log = reader.header();
+  const std::size_t n = reader.epochs_hint();
   const auto ng = static_cast<std::size_t>(log.gyro_count);
   // A whole log in memory holds no more values than the largest CSV table read whole (2 bytes a cell).
   if (n > kMaxTableBytes / 2 / (ng + 1)) {
@@ -512,7 +883,7 @@ Result<GyroLog> read_gyro_log_h5(const std::string& path) {
   log.lines.reserve(n);
   GyroLog block;
   while (true) {
-    auto more = (*reader)->next(block);
+    auto more = reader.next(block);
     if (!more) return more.error();
     if (!*more) break;
     append(log.time_s, block.time_s);
@@ -523,6 +894,33 @@ Result<GyroLog> read_gyro_log_h5(const std::string& path) {
     append(log.reference_present, block.reference_present);
   }
   return log;
+}
+
+}  // namespace
+
+Result<GyroLog> read_gyro_log_h5(const std::string& path) {
+  auto reader = open_gyro_log_h5_reader(path);
+  if (!reader) return reader.error();
+  return read_whole(**reader, path);
+}
+
+Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, const std::string& name,
+                                       const GyroLogH5Header& header) {
+  init_hdf5();
+  if (bytes.empty()) return bad_input(name + ": not an HDF5 file");
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  // The core driver on a copy of the image; nothing is written back.
+  if (!fapl.valid() || H5Pset_fapl_core(fapl.get(), std::size_t{1} << 16, 0) < 0 ||
+      H5Pset_file_image(fapl.get(), const_cast<std::uint8_t*>(bytes.data()), bytes.size()) < 0) {
+    return failure(name + ": cannot open the image");
+  }
+  Handle file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, fapl.get()), H5Fclose);
+  if (!file.valid()) return bad_input(name + ": cannot open as HDF5");
+  H5Reader reader;
+  // As the process that opens a checked file: the header given, no attribute read.
+  if (Status s = reader.open_file(std::move(file), name, &header, VariableStrings::kRefuse); !s)
+    return s.error();
+  return read_whole(reader, name);
 }
 
 // --- writing ------------------------------------------------------------------------------------
@@ -546,8 +944,15 @@ struct GyroLogH5Writer::Impl {
   Status flush();
 };
 
+namespace {
+// 'present' is rows×N, 2-D even for one gyro (docs/formats.md); the other datasets are 1-D.
+int rank_of(const char* name) {
+  return std::strcmp(name, "present") == 0 ? 2 : 1;
+}
+}  // namespace
+
 Status GyroLogH5Writer::Impl::create_dataset(const char* name, hid_t type, hsize_t cols) const {
-  const int rank = cols > 1 ? 2 : 1;
+  const int rank = rank_of(name);
   const std::array<hsize_t, 2> dims{0, cols};
   const std::array<hsize_t, 2> max{H5S_UNLIMITED, cols};
   const std::array<hsize_t, 2> chunk{kChunkRows, cols};
@@ -566,7 +971,7 @@ Status GyroLogH5Writer::Impl::create_dataset(const char* name, hid_t type, hsize
 Status GyroLogH5Writer::Impl::append_rows(const char* name, hid_t mem_type, const void* data, hsize_t count,
                                           hsize_t cols) const {
   Handle d(H5Dopen2(file.get(), name, H5P_DEFAULT), H5Dclose);
-  const int rank = cols > 1 ? 2 : 1;
+  const int rank = rank_of(name);
   const std::array<hsize_t, 2> new_dims{rows + count, cols};
   if (!d.valid() || H5Dset_extent(d.get(), new_dims.data()) < 0) {
     return failure(path + ": dataset '" + name + "': cannot extend");
@@ -616,7 +1021,7 @@ Status GyroLogH5Writer::open(const std::string& file_path, const std::string& pa
                              bool with_reference, const std::vector<std::string>& comments, bool compress) {
   if (impl_ && impl_->file.valid()) return failure(path + ": writer already open");
   if (gyro_count < 1) return bad_input(path + ": a gyro log needs at least one gyro column");
-  silence_hdf5();
+  init_hdf5();
   impl_ = std::make_unique<Impl>();
   Impl& w = *impl_;
   w.path = path;
@@ -624,7 +1029,13 @@ Status GyroLogH5Writer::open(const std::string& file_path, const std::string& pa
   w.with_reference = with_reference;
   w.compress = compress;
   w.gyro.resize(static_cast<std::size_t>(gyro_count));
-  w.file = Handle(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+  // Object headers of HDF5 1.8 on: a string attribute larger than 64 KiB (many comment lines) is then
+  // stored densely instead of failing.
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!fapl.valid() || H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18) < 0) {
+    return failure(path + ": cannot set up the HDF5 library");
+  }
+  w.file = Handle(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
   if (!w.file.valid()) return failure(path + ": cannot write: " + std::strerror(errno));
 
   Metadata metadata;

@@ -19,7 +19,20 @@ namespace tetra {
 
 //! The whole log, as read_gyro_log.
 Result<GyroLog> read_gyro_log_h5(const std::string& path);
-//! A block reader, as GyroLogReader::open.
+//! A log's header as its root attributes give it (the checking child process sends it to the process
+//! that then opens the file).
+struct GyroLogH5Header {
+  int gyro_count = 0;
+  bool units_dps = false;
+  std::vector<std::string> comments;
+};
+//! The whole log from an in-memory image of an HDF5 file (`name` names it in messages), read as the
+//! process that opens a file after the child checked it: with `header` as the child sent it, reading no
+//! attribute; every dataset's shape, type and storage checked, then the rows. For fuzzing that path.
+Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, const std::string& name,
+                                       const GyroLogH5Header& header);
+//! A block reader, as GyroLogReader::open. The file is first checked in a child process
+//! (docs/formats.md, "HDF5 gyro log").
 Result<std::unique_ptr<GyroLogReader>> open_gyro_log_h5_reader(const std::string& path);
 
 //! Writes an HDF5 log into `file_path`: the temporary file of an OutputFile (OutputFile::library_path),

@@ -17,7 +17,9 @@ std::string size_text(std::size_t bytes) {
   return std::to_string(bytes) + " bytes";
 }
 
-const char* kind_of(mode_t mode) {
+}  // namespace
+
+const char* file_kind(mode_t mode) {
   if (S_ISDIR(mode)) return "a folder";
   if (S_ISCHR(mode)) return "a character device";
   if (S_ISBLK(mode)) return "a block device";
@@ -26,15 +28,13 @@ const char* kind_of(mode_t mode) {
   return "not a regular file";
 }
 
-}  // namespace
-
 Status check_input(const std::string& path, std::size_t max_bytes, bool seekable) {
   if (path.empty()) return bad_input("empty input file name");
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return bad_input(path + ": cannot open: " + std::strerror(errno));
   const bool fifo_ok = !seekable && S_ISFIFO(st.st_mode);
   if (!S_ISREG(st.st_mode) && !fifo_ok) {
-    return bad_input(path + ": is " + kind_of(st.st_mode) + ", not a regular file" +
+    return bad_input(path + ": is " + file_kind(st.st_mode) + ", not a regular file" +
                      (S_ISFIFO(st.st_mode) ? " (this input is read more than once)" : ""));
   }
   if (S_ISREG(st.st_mode) && static_cast<std::size_t>(st.st_size) > max_bytes) {

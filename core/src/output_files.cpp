@@ -1,18 +1,115 @@
 #include "tetra/core/output_files.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <array>
+#include <atomic>
 #include <cerrno>
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
+#include "tetra/core/input_files.hpp"
+
 namespace tetra {
 
 namespace {
+
+// --- temporary files removed on SIGINT, SIGTERM and SIGHUP --------------------------------------
+// A fixed table the signal handler reads with lock-free atomics only: no allocation, no lock. A slot
+// is claimed (1), filled, then published (2); the handler unlinks the published slots of its own
+// process (a forked child inherits the table, never the files) and re-raises the signal with its
+// default action, so the process still ends as the signal says.
+struct TempSlot {
+  std::atomic<int> state{0};  // 0 free, 1 being filled, 2 live
+  pid_t owner = 0;
+  std::array<char, PATH_MAX> path{};
+};
+std::array<TempSlot, 64> g_temp_slots;
+
+extern "C" void remove_temporaries_and_reraise(int sig) {
+  const int saved_errno = errno;
+  const pid_t self = ::getpid();
+  for (TempSlot& slot : g_temp_slots) {
+    if (slot.state.load() == 2 && slot.owner == self) ::unlink(slot.path.data());
+  }
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);  // delivered when the handler returns (the signal is blocked while it runs)
+  errno = saved_errno;
+}
+
+// Installs the handler once, for each signal whose disposition is still the default: a command that
+// handles or blocks a signal itself (the DDS services wait for them in a thread) keeps its own way.
+void install_temp_removal() {
+  static std::atomic<bool> installed{false};
+  if (installed.exchange(true)) return;
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    if (::sigaction(sig, nullptr, &old) != 0 || (old.sa_flags & SA_SIGINFO) != 0 || old.sa_handler != SIG_DFL)
+      continue;
+    struct sigaction sa {};
+    sa.sa_handler = remove_temporaries_and_reraise;
+    sigemptyset(&sa.sa_mask);
+    ::sigaction(sig, &sa, nullptr);
+  }
+}
+
+// The slot now holding `path`, or -1 when the table is full or the path too long (the file is then
+// only removed by a normal exit or failure, as before).
+int register_temporary(const std::string& path) {
+  install_temp_removal();
+  if (path.size() >= PATH_MAX) return -1;
+  for (std::size_t i = 0; i < g_temp_slots.size(); ++i) {
+    TempSlot& slot = g_temp_slots[i];
+    int expected = 0;
+    if (!slot.state.compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(slot.path.data(), path.c_str(), path.size() + 1);
+    slot.owner = ::getpid();
+    slot.state.store(2);
+    return static_cast<int>(i);
+  }
+  return -1;
+}
+
+void unregister_temporary(int& slot) {
+  if (slot >= 0) g_temp_slots[static_cast<std::size_t>(slot)].state.store(0);
+  slot = -1;
+}
+
+// --- what may be an output ------------------------------------------------------------------------
+
+// True for the null device (/dev/null, or another name of it).
+bool is_null_device(const struct stat& st) {
+  struct stat null_st {};
+  return S_ISCHR(st.st_mode) && ::stat("/dev/null", &null_st) == 0 && S_ISCHR(null_st.st_mode) &&
+         st.st_rdev == null_st.st_rdev;
+}
+
+// An existing regular file the caller may replace: one the kernel lets it write (access(2): mode
+// bits, ACLs, a read-only file system) and, for root (whom the kernel lets write anything), one with
+// at least one write bit: a write-protected file (chmod a-w) is never replaced, whoever runs.
+bool may_replace(const std::string& path, const struct stat& st) {
+  if (::geteuid() == 0)
+    return (st.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH)) != 0 && ::access(path.c_str(), W_OK) == 0;
+  return ::access(path.c_str(), W_OK) == 0;
+}
+
+// Why an existing file cannot be an output (empty when it can): only regular files the caller may
+// write and the null device are; a FIFO, a socket or another device is refused before anything is
+// opened (opening a FIFO blocks until a reader comes).
+std::string refusal(const std::string& path, const struct stat& st) {
+  if (S_ISDIR(st.st_mode)) return "is a folder, not a file";
+  if (S_ISREG(st.st_mode)) {
+    return may_replace(path, st) ? "" : "is write-protected (no write permission): it is never replaced";
+  }
+  if (is_null_device(st)) return "";
+  return std::string("is ") + file_kind(st.st_mode) +
+         ": an output must be a regular file (`-` for standard output, /dev/null to discard)";
+}
 
 std::string errno_text() {
   return std::strerror(errno);
@@ -125,7 +222,7 @@ Status OutputFile::write_behind() {
 Result<std::string> OutputFile::library_path() const {
   if (stream_) {
     return bad_input(label_ + " " + path_ + ": needs a regular file (it is written with seeks), not " +
-                     (path_ == "-" ? "standard output" : "a device or FIFO"));
+                     (path_ == "-" ? "standard output" : "the null device"));
   }
   if (fd_ < 0) return failure(path_ + ": output is closed");
   return temp_;
@@ -147,6 +244,7 @@ Status OutputFile::rename_into_place() {
     return failure(path_ + ": cannot replace: " + errno_text());
   }
   committed_ = true;
+  unregister_temporary(temp_slot_);
   // The rename itself reaches the disk with the folder.
   const int dir = ::open(dir_of(target_).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir >= 0) {
@@ -160,6 +258,7 @@ void OutputFile::discard() {
   if (fd_ >= 0 && fd_ != STDOUT_FILENO) ::close(fd_);
   fd_ = -1;
   if (!stream_ && !committed_ && !temp_.empty()) ::unlink(temp_.c_str());
+  unregister_temporary(temp_slot_);
   temp_.clear();
 }
 
@@ -239,9 +338,7 @@ Result<OutputFile*> RunFiles::add(const std::string& path, const std::string& la
   const bool exists = ::stat(followed->c_str(), &st) == 0;
   std::optional<FileId> id;
   if (exists) {
-    if (S_ISDIR(st.st_mode)) return bad_input(who + ": is a folder, not a file");
-    if (!S_ISREG(st.st_mode) && !S_ISCHR(st.st_mode) && !S_ISFIFO(st.st_mode))
-      return bad_input(who + ": is neither a regular file, a character device nor a FIFO");
+    if (const std::string why = refusal(*followed, st); !why.empty()) return bad_input(who + ": " + why);
     id = FileId{st.st_dev, st.st_ino};
     out->stream_ = !S_ISREG(st.st_mode);
   }
@@ -258,11 +355,24 @@ Result<OutputFile*> RunFiles::add(const std::string& path, const std::string& la
     out->fd_ = ::mkstemp(templ.data());
     if (out->fd_ < 0) return bad_input(who + ": cannot create a file in " + *dir + ": " + errno_text());
     out->temp_ = templ;
+    out->temp_slot_ = register_temporary(templ);
     const mode_t mode = exists ? static_cast<mode_t>(st.st_mode & 07777) : new_file_mode();
     ::fchmod(out->fd_, mode);
   }
   outputs_.push_back(std::move(out));
   return outputs_.back().get();
+}
+
+Status check_output_path(const std::string& path, const std::string& label) {
+  if (path.empty()) return bad_input(label + ": empty file name");
+  if (path == "-") return ok_status();
+  auto followed = follow_links(path);
+  if (!followed) return bad_input(label + " " + followed.error().message);
+  struct stat st {};
+  if (::stat(followed->c_str(), &st) != 0) return ok_status();
+  if (const std::string why = refusal(*followed, st); !why.empty())
+    return bad_input(label + " " + path + ": " + why);
+  return ok_status();
 }
 
 Status RunFiles::put(const std::string& path, const std::string& label, std::string_view content) {

@@ -24,6 +24,7 @@
 #include "campaign_report.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "tetra/core/output_files.hpp"
 #include "tetra/sim/campaign.hpp"
 
 namespace tetra::cli {
@@ -229,6 +230,10 @@ int cmd_campaign(int argc, char** argv) {
       over_dds ? std::filesystem::path(out_dir) / "dds" : std::filesystem::path(out_dir), ec);
   if (ec) return report(kCampaignName, failure(out_dir + ": cannot create the folder"));
   const std::string runs_path = (std::filesystem::path(out_dir) / "runs.csv").string();
+  // runs.csv is appended to in place (an interrupted campaign resumes): a FIFO or a write-protected
+  // file is refused as any output is.
+  if (Status st = check_output_path(runs_path, "campaign output"); !st)
+    return report(kCampaignName, st.error());
   auto done = done_runs(runs_path);
   if (!done) return report(kCampaignName, done.error());
   if (done->empty()) {

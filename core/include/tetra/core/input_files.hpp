@@ -4,6 +4,8 @@
 // /dev/zero, a socket, a missing or unreadable file, and a size limit per kind so that memory and
 // time stay bounded for any input. Every error names the path.
 
+#include <sys/types.h>
+
 #include <cstddef>
 #include <string>
 
@@ -20,6 +22,9 @@ inline constexpr std::size_t kMaxStreamedLogBytes = std::size_t{1} << 40;
 inline constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
 //! [bytes] largest YAML file read (calibrations, scenarios and configurations are a few kB).
 inline constexpr std::size_t kMaxYamlBytes = std::size_t{1} << 20;
+
+//! What a file of mode `mode` is, for messages: "a folder", "a FIFO", "a character device", ...
+const char* file_kind(mode_t mode);
 
 //! Checks that `path` can be read as an input: a regular file of at most `max_bytes` (or a FIFO when
 //! `seekable` is false). Error (bad input) naming the path and what it is instead.

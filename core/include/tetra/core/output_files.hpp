@@ -7,8 +7,13 @@
 // - a regular file (or a path that does not exist yet) is written to a unique temporary file in the
 //   same folder and replaces the target only in commit(), after fsync: a run that fails leaves every
 //   pre-existing output byte-identical. A symbolic link is written through to its target;
-// - `-` (standard output), character devices (/dev/null) and FIFOs are written straight and never
-//   replaced;
+// - `-` (standard output) and the null device (/dev/null) are written straight and never replaced;
+//   a FIFO, a socket or any other device is refused before anything is opened (a FIFO would block
+//   until a reader comes: pipe standard output instead);
+// - an existing file without write permission is refused, never replaced around its protection
+//   (for root, whom the kernel lets write anything: a file with no write bit at all);
+// - the temporary files are removed on SIGINT, SIGTERM and SIGHUP (where the command left the signal
+//   at its default action): the signal then ends the process as it would have;
 // - a write error, EPIPE included, is an Error naming the path; nothing raises a signal (the
 //   command line ignores SIGPIPE).
 
@@ -43,14 +48,14 @@ class OutputFile {
 
   //! The path as the user gave it (for messages).
   const std::string& path() const { return path_; }
-  //! True for standard output, devices and FIFOs (written straight, never replaced).
+  //! True for standard output and /dev/null (written straight, never replaced).
   bool is_stream() const { return stream_; }
   //! Appends `data`; an Error names the path (a full disk, a closed pipe). Called as often as
   //! needed: a streaming output writes as it goes into the temporary file, committed at the end.
   Status write(std::string_view data);
   //! The temporary file, for a library that writes the file by name itself (HDF5): it writes there
   //! (and closes the file) before RunFiles::commit(), which fsyncs and renames it as any output.
-  //! Bad input naming the option for standard output, a device or a FIFO (such a library seeks).
+  //! Bad input naming the option for standard output or /dev/null (such a library seeks).
   Result<std::string> library_path() const;
 
  private:
@@ -71,6 +76,7 @@ class OutputFile {
   bool stream_ = false;
   bool write_behind_ = true;  // cleared where the file system does not support it
   bool committed_ = false;
+  int temp_slot_ = -1;  // the temporary file's entry in the table the signal handler removes
 };
 
 //! A text output written as it is produced (replay's attitude and events): appends to a buffer that
@@ -91,6 +97,11 @@ class BufferedOutput {
   OutputFile& out_;
   std::string buffer_;
 };
+
+//! The checks RunFiles::add makes of an existing file before opening it (regular and writable, or
+//! /dev/null), for an output written by other means (appended to, or by another process): bad input
+//! naming `label` and `path`. A path that does not exist yet passes.
+Status check_output_path(const std::string& path, const std::string& label);
 
 //! The inputs and outputs of one run.
 class RunFiles {
