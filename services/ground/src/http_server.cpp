@@ -165,13 +165,17 @@ struct Conn {
   std::size_t out_off = 0;
   std::shared_ptr<const std::string> body;
   std::size_t body_off = 0;
+  //! A stream's messages: shared by every stream (one copy however many streams hold it).
+  std::deque<std::shared_ptr<const std::string>> chunks;
+  std::size_t chunk_off = 0;    //!< written of chunks.front()
+  std::size_t chunk_bytes = 0;  //!< in chunks
   bool close_after = false;
   bool want_out = false;
   std::int64_t accepted_ns = 0;
   std::int64_t request_start_ns = 0;  //!< [ns] first byte of the request being read (0: none yet)
   std::int64_t activity_ns = 0;       //!< [ns] last byte read or written
   std::size_t pending() const {
-    return out.size() - out_off + (body ? body->size() - body_off : 0);
+    return out.size() - out_off + (body ? body->size() - body_off : 0) + chunk_bytes - chunk_off;
   }
 };
 
@@ -443,14 +447,32 @@ struct HttpServer::Impl {
 
   void flush(Conn& c, std::int64_t now) {
     while (c.pending() > 0) {
-      const bool from_out = c.out_off < c.out.size();
-      const char* data = from_out ? c.out.data() + c.out_off : c.body->data() + c.body_off;
-      const std::size_t n = from_out ? c.out.size() - c.out_off : c.body->size() - c.body_off;
+      const char* data = nullptr;
+      std::size_t n = 0;
+      std::size_t* advanced = nullptr;
+      if (c.out_off < c.out.size()) {
+        data = c.out.data() + c.out_off;
+        n = c.out.size() - c.out_off;
+        advanced = &c.out_off;
+      } else if (c.body && c.body_off < c.body->size()) {
+        data = c.body->data() + c.body_off;
+        n = c.body->size() - c.body_off;
+        advanced = &c.body_off;
+      } else {
+        data = c.chunks.front()->data() + c.chunk_off;
+        n = c.chunks.front()->size() - c.chunk_off;
+        advanced = &c.chunk_off;
+      }
       const long w = write_some(c, data, n);
       if (w == -1) break;
       if (w <= 0) return drop(c);
-      (from_out ? c.out_off : c.body_off) += static_cast<std::size_t>(w);
+      *advanced += static_cast<std::size_t>(w);
       c.activity_ns = now;
+      if (advanced == &c.chunk_off && c.chunk_off == c.chunks.front()->size()) {
+        c.chunk_bytes -= c.chunk_off;
+        c.chunk_off = 0;
+        c.chunks.pop_front();
+      }
     }
     if (c.out_off == c.out.size()) {
       c.out.clear();
@@ -471,7 +493,9 @@ struct HttpServer::Impl {
   }
 
   //! Appends the new stream messages (or a keep-alive comment) to every stream.
+  //! At most every 10 ms (1,000 streams cost one append each, and a write when their socket has room).
   void broadcast(std::int64_t now, bool messages_only = false) {
+    if (!messages_only && now - broadcast_ns < to_ns(0.01)) return;
     std::string text;
     const std::uint64_t last = feed.last();
     while (cursor < last && text.size() < (4U << 20)) {
@@ -484,17 +508,20 @@ struct HttpServer::Impl {
       text = ": keep-alive\n\n";
     }
     broadcast_ns = now;
+    const auto chunk = std::make_shared<const std::string>(std::move(text));
     std::vector<std::uint64_t> ids(streams.begin(), streams.end());
     for (const auto id : ids) {
       Conn& c = *conns.at(id);
-      if (c.pending() + text.size() > limits.stream_buffer_bytes) {
+      if (c.pending() + chunk->size() > limits.stream_buffer_bytes) {
         spdlog::warn("ground: event stream to {} closed: {} bytes not read (a slow reader; it may resume)",
                      c.remote, c.pending());
         drop(c);
         continue;
       }
-      c.out += text;
-      flush(c, now);
+      const bool was_waiting = c.want_out;  // its socket is full: EPOLLOUT will flush it
+      c.chunks.push_back(chunk);
+      c.chunk_bytes += chunk->size();
+      if (!was_waiting) flush(c, now);
     }
   }
 
@@ -543,8 +570,9 @@ struct HttpServer::Impl {
 
   void run() {
     std::vector<epoll_event> events(512);
+    int wait_ms = 100;
     while (!stopping) {
-      const int n = ::epoll_wait(epoll_fd, events.data(), static_cast<int>(events.size()), 100);
+      const int n = ::epoll_wait(epoll_fd, events.data(), static_cast<int>(events.size()), wait_ms);
       const std::int64_t now = io_now_ns();
       for (int i = 0; i < n; ++i) {
         const std::uint64_t id = events[static_cast<std::size_t>(i)].data.u64;
@@ -572,6 +600,7 @@ struct HttpServer::Impl {
       }
       collect_done();
       broadcast(now);
+      wait_ms = feed.last() > cursor ? 10 : 100;  // messages held back by the 10 ms pacing
       if (now - swept_ns > to_ns(0.1)) {
         swept_ns = now;
         sweep(now);

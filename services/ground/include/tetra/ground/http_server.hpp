@@ -56,7 +56,7 @@ struct HttpLimits {
   std::size_t max_streams = 1024;       //!< event streams held; beyond: 503 (logged)
   std::size_t max_head_bytes = 16384;   //!< request line and headers; beyond: 431
   std::size_t max_body_bytes = 65536;   //!< request body; beyond: 413
-  std::size_t stream_buffer_bytes = 1 << 20;  //!< per stream not yet written; beyond: the stream is closed
+  std::size_t stream_buffer_bytes = 256U << 10;  //!< per stream not yet written; beyond: the stream is closed
   std::size_t max_queued = 256;         //!< requests waiting for a worker; beyond: 503
   int workers = 4;                      //!< handler threads
   double request_timeout_s = 10.0;      //!< [s] a request must arrive whole within this
