@@ -399,8 +399,12 @@ function TetraPlugin(options) {
       const a = state.attitude;
       const link = state.link ? state.link.state : 'WAITING';
       const stale = link !== 'LIVE';
-      root.querySelector('#tetra-mode').textContent = h ? h.mode : 'no health yet';
-      root.querySelector('#tetra-mode').className = 'tetra-mode tetra-mode--' + (h ? h.mode : 'NONE');
+      const mode = h ? (h.waiting ? 'WAITING FOR GYROS' : h.mode) : 'no health yet';
+      root.querySelector('#tetra-mode').textContent = mode;
+      root.querySelector('#tetra-mode').className = 'tetra-mode tetra-mode--' + (h ? mode.split(' ')[0] : 'NONE');
+      root.querySelector('#tetra-silences').textContent = h
+        ? 'every gyro silent at once: ' + h.counters.unit_silences + ' times'
+        : '';
       const linkEl = root.querySelector('#tetra-link');
       // A lost service means stale data too: both words, so STALE is always there to see.
       linkEl.textContent = link === 'SERVICE LOST' ? 'STALE \u00b7 SERVICE LOST' : link;
@@ -516,7 +520,7 @@ function TetraPlugin(options) {
         '<div class="tetra-head"><span class="tetra-name"></span>' +
         '<span id="tetra-mode" class="tetra-mode"></span><span id="tetra-link" class="tetra-link"></span>' +
         '<span id="tetra-ages" class="tetra-ages"></span></div>' +
-        '<div id="tetra-time" class="tetra-time"></div>' +
+        '<div id="tetra-time" class="tetra-time"></div><div id="tetra-silences" class="tetra-time"></div>' +
         '<div class="tetra-grid"><section><h2>Gyros</h2><table class="tetra-table"><thead><tr><th>gyro</th>' +
         '<th>state</th><th>fault</th><th>solution</th><th>command</th></tr></thead><tbody id="tetra-gyros"></tbody>' +
         '</table><div class="tetra-commands"></div><div id="tetra-ack" class="tetra-ack"></div>' +

@@ -111,7 +111,7 @@ std::string health_json(const std::string& unit, const UnitView& view, std::int6
         << ", \"samples_unknown_gyro\": " << c.samples_unknown_gyro
         << ", \"samples_other_unit\": " << c.samples_other_unit
         << ", \"deadlines_missed\": " << c.deadlines_missed << ", \"liveliness_lost\": " << c.liveliness_lost
-        << ", \"sensor_restarts\": " << c.sensor_restarts
+        << ", \"sensor_restarts\": " << c.sensor_restarts << ", \"unit_silences\": " << c.unit_silences
         << "}, \"events_published\": " << view.health->events_published;
   }
   if (view.attitude) {

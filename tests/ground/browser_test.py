@@ -65,7 +65,9 @@ def serve_attack_page(page):
         def log_message(self, *args):
             pass
 
-    server = http.server.HTTPServer(("127.0.0.1", 0), Handler)
+    # A thread per connection: a connection the browser opens ahead and never uses holds no other.
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+    server.daemon_threads = True
     threading.Thread(target=server.serve_forever, daemon=True).start()
     return server
 
@@ -172,7 +174,8 @@ def main():
         driver.get(app)
         wait.until(ec.presence_of_element_located((By.ID, "tetra-mode")))
         wait.until(lambda d: OPERATOR in text_of(d, "tetra-operator"))
-        wait.until(lambda d: text_of(d, "tetra-mode") != "no health yet")
+        # The service has heard no gyro yet: it says it waits (not LOST).
+        wait.until(lambda d: text_of(d, "tetra-mode") == "WAITING FOR GYROS")
 
         step = "start the simulator"
         # 2 min of orbit at 50 Hz in real time, gyro 2 stuck from 10 s; stopped once the test is done.
@@ -249,10 +252,10 @@ def main():
                 print(f"--- {log}\n{text}", file=sys.stderr)
         return 1
     finally:
-        if attack is not None:
-            attack.shutdown()
         if driver is not None:
             driver.quit()
+        if attack is not None:
+            attack.shutdown()
         for child in children:
             if child.poll() is None:
                 child.send_signal(signal.SIGTERM)

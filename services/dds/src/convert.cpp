@@ -132,6 +132,7 @@ Status to_wire(const std::string& unit, const fdi::Health& health, const service
   c.sensor_restarts = counters.sensor_restarts;
   c.deadlines_missed = counters.deadlines_missed;
   c.liveliness_lost = counters.liveliness_lost;
+  c.unit_silences = counters.unit_silences;
   return ok_status();
 }
 
@@ -170,6 +171,7 @@ HealthView from_wire(const tetra_Health& in) {
   out.health_period_s = in.health_period_s;
   out.counters.deadlines_missed = c.deadlines_missed;
   out.counters.liveliness_lost = c.liveliness_lost;
+  out.counters.unit_silences = c.unit_silences;
   return out;
 }
 

@@ -18,6 +18,7 @@ struct AssemblerCounters {
   std::uint64_t references_late = 0;       //!< references for epochs already emitted
   std::uint64_t deadlines_missed = 0;      //!< counted by the caller through mark_absent()
   std::uint64_t liveliness_lost = 0;       //!< counted by the caller through mark_absent()
+  std::uint64_t unit_silences = 0;         //!< counted by the caller: every gyro silent at once
 };
 
 }  // namespace tetra::service
