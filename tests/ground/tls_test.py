@@ -35,7 +35,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--tetra", required=True)
     ap.add_argument("--source", required=True)
-    ap.add_argument("--domain", default="185")  # private to this test (tests/CMakeLists.txt)
+    ap.add_argument("--domain", default="186")  # private to this test (tests/CMakeLists.txt)
     args = ap.parse_args()
     os.environ["CYCLONEDDS_URI"] = "file://" + os.path.join(args.source, "config", "cyclonedds-loopback.xml")
     with tempfile.TemporaryDirectory() as tmp:
