@@ -205,11 +205,25 @@ TEST(GroundHttp, ParametersBodiesStreamsAndSlowClientsAreBounded) {
   config.no_auth = true;
   config.limits.max_streams = 3;
   config.limits.request_timeout_s = 0.5;
+  config.allow_origins = {"http://ground.example.org"};
   Ground g(config);
   ASSERT_TRUE(g.start().ok());
   const Reply session = g.request("GET", "/api/session");
   ASSERT_EQ(session.status, 200);
   EXPECT_EQ(session.data()["user"], "anonymous");
+  // --allow-origin adds a name; without a port it is the scheme's default, as a browser omits it.
+  const auto with_host = [&](const std::string& host) {
+    const int fd = connect_to(g.port());
+    const std::string req = "GET /api/units HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n";
+    (void)::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+    const int status = parse_reply(read_from(fd)).status;
+    ::close(fd);
+    return status;
+  };
+  EXPECT_EQ(with_host("ground.example.org"), 200);
+  EXPECT_EQ(with_host("ground.example.org:80"), 200);
+  EXPECT_EQ(with_host("ground.example.org:8443"), 403);
+  EXPECT_EQ(with_host("other.example.org"), 403);
 
   // A negative count was a loop without end: now a 400 naming the parameter.
   const Reply negative = g.request("GET", "/api/history?unit=u&kind=event&max=-1");

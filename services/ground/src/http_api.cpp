@@ -71,6 +71,15 @@ std::string host_port_of(std::string text) {
   return lower_case(text);
 }
 
+//! "HOST" without a port (a browser omits the scheme's default) as "HOST:80" or "HOST:443".
+std::string with_port(std::string host_port, bool tls) {
+  const auto colon = host_port.rfind(':');
+  const auto bracket = host_port.rfind(']');
+  if (!host_port.empty() && (colon == std::string::npos || (bracket != std::string::npos && colon < bracket)))
+    host_port += tls ? ":443" : ":80";
+  return host_port;
+}
+
 }  // namespace
 
 bool is_loopback_host(const std::string& host) {
@@ -114,7 +123,8 @@ Status GroundServer::start() {
   const std::string port = ":" + std::to_string(server_->port());
   for (const std::string& h : {config_.host, std::string("localhost"), std::string("127.0.0.1"), std::string("[::1]")})
     allowed_hosts_.insert(lower_case(h.find(':') != std::string::npos && h[0] != '[' ? "[" + h + "]" : h) + port);
-  for (const auto& extra : config_.allow_origins) allowed_hosts_.insert(host_port_of(extra));
+  for (const auto& extra : config_.allow_origins)
+    allowed_hosts_.insert(with_port(host_port_of(extra), !config_.tls.cert.empty()));
   store_.set_listener([server = server_.get()] { server->notify(); });
   if (config_.no_auth)
     spdlog::warn("ground: --no-auth: no accounts; whoever reaches {}{} may command (as 'anonymous')",
@@ -159,13 +169,14 @@ std::optional<Session> GroundServer::session_of(const HttpRequest& req) {
 HttpResponse GroundServer::handle(const HttpRequest& req) {
   // DNS rebinding: a name that resolves to this host is not enough, the browser must call it by a name
   // of the allow-list. A cross-site page: its Origin is not on the list.
-  const std::string host = lower_case(req.header("host"));
+  const std::string host = with_port(lower_case(req.header("host")), req.tls);
   if (allowed_hosts_.count(host) == 0)
     return refuse(req, 403, "Host '" + host + "' not allowed (--allow-origin adds one)", "");
   const std::string origin = req.header("origin");
   if (!origin.empty()) {
     const std::string scheme = req.tls ? "https://" : "http://";
-    if (origin.compare(0, scheme.size(), scheme) != 0 || allowed_hosts_.count(host_port_of(origin)) == 0)
+    if (origin.compare(0, scheme.size(), scheme) != 0 ||
+        allowed_hosts_.count(with_port(host_port_of(origin), req.tls)) == 0)
       return refuse(req, 403, "Origin '" + origin + "' not allowed", "");
   }
   if (req.method != "GET" && req.method != "POST") return error_reply(405, "GET or POST only");
