@@ -248,8 +248,9 @@ TEST(FusionServiceLibrary, SilenceOfEveryGyroIsReportedWithHysteresisNeverBefore
   EXPECT_EQ(seen[1].event.type, fdi::EventType::kCleared);
   EXPECT_EQ(stamps.count(seen[0].event.stamp_ns), 1U) << "a sensor time the unit never had";
   EXPECT_EQ(stamps.count(seen[1].event.stamp_ns), 1U) << "a sensor time the unit never had";
-  EXPECT_GE(silences, 2U);  // 3 once the last samples have gone silent too
-  EXPECT_LE(silences, 3U);
+  // The brief and the long silence, a third once the last samples have gone silent, and more on a loaded
+  // machine where the publishing loop stalls past the 30 ms deadline: each counted, none an event.
+  EXPECT_GE(silences, 2U);
   (*service)->request_stop();
   thread.join();
   EXPECT_TRUE(run_status.ok()) << run_status.error().message;

@@ -27,6 +27,7 @@ import time
 from selenium import webdriver
 from selenium.webdriver.chrome.options import Options
 from selenium.webdriver.chrome.service import Service
+from selenium.common.exceptions import StaleElementReferenceException
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support import expected_conditions as ec
 from selenium.webdriver.support.ui import WebDriverWait
@@ -111,7 +112,12 @@ def audit_lines(out):
 def command_from_page(driver, wait, button):
     """Clicks a command button, confirms it in the dialog, returns the acknowledgement's text."""
     driver.execute_script("document.getElementById('tetra-ack').textContent = ''")
-    driver.find_element(By.CSS_SELECTOR, f'button[data-command="{button}"]').click()
+
+    def click(d):  # the gyro table is rebuilt when a gyro changes: find the button again then
+        d.find_element(By.CSS_SELECTOR, f'button[data-command="{button}"]').click()
+        return True
+
+    wait.until(click)
     wait.until(ec.element_to_be_clickable((By.XPATH, "//button[contains(., 'Send command')]"))).click()
     wait.until(lambda d: text_of(d, "tetra-ack").startswith(("ACCEPTED", "REFUSED", "error")))
     return text_of(driver, "tetra-ack")
@@ -150,7 +156,7 @@ def main():
         # The browser first: on a loaded machine it takes seconds to start, and the page must see the
         # unit NOMINAL before the fault.
         driver = start_browser()
-        wait = WebDriverWait(driver, 60, poll_frequency=0.2)
+        wait = WebDriverWait(driver, 60, poll_frequency=0.2, ignored_exceptions=[StaleElementReferenceException])
 
         step = "start the ground station and the service"
         data = os.path.join(args.source, "tests", "ground", "data")
