@@ -234,6 +234,8 @@ def main():
         ground.kill()  # kill -9
         ground.wait()
         wait.until(lambda d: "GROUND LINK LOST" in text_of(d, "tetra-link"))
+        ages = text_of(driver, "tetra-ages")
+        wait.until(lambda d: text_of(d, "tetra-ages") != ages)  # the ages keep counting meanwhile
         driver.save_screenshot(os.path.join(args.out, "4_ground_lost.png"))
         ground = spawn(ground_argv, "ground2.log")
         wait.until(lambda d: text_of(d, "tetra-link") == "LIVE")
