@@ -36,7 +36,8 @@ def main():
     domain = ["--domain", args.domain]
     null = subprocess.DEVNULL
     children = [
-        subprocess.Popen([tetra, "ground", "--listen", f"127.0.0.1:{port}"] + domain, stdout=null, stderr=null),
+        subprocess.Popen([tetra, "ground", "--listen", f"127.0.0.1:{port}", "--no-auth"] + domain, stdout=null,
+                         stderr=null),
         subprocess.Popen([tetra, "fusion", "--config", os.path.join(data, "fusion.yaml")] + domain,
                          stdout=null, stderr=null),
         subprocess.Popen([tetra, "sim", "orbit", "--dds", "--dds-unit", UNIT, "--unit",

@@ -104,7 +104,7 @@ def main():
     os.environ["CYCLONEDDS_URI"] = "file://" + os.path.join(ROOT, "config", "cyclonedds-loopback.xml")
     port = free_port()
     ground = subprocess.Popen([os.path.join(args.build, "tetra"), "ground", "--listen", f"127.0.0.1:{port}",
-                               "--domain", args.domain, "--history", str(args.history)],
+                               "--no-auth", "--domain", args.domain, "--history", str(args.history)],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     time.sleep(1.0)
     stop = threading.Event()

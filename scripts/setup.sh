@@ -13,7 +13,8 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev
   cyclonedds-dev cyclonedds-tools
-  libcpp-httplib-dev nlohmann-json3-dev       # tetra ground: HTTP server, JSON
+  libcpp-httplib-dev nlohmann-json3-dev       # tetra ground: HTTP client of the tests, JSON
+  libsodium-dev libssl-dev                    # tetra ground: argon2id password hashes, TLS
   libhdf5-dev                                 # HDF5 gyro logs
   help2man                                    # man pages from the --help texts (cmake --install)
 )

@@ -1,7 +1,8 @@
 // The tetra plugin for Open MCT: an object tree per unit, realtime telemetry from the ground
 // station's event stream (/api/stream, server-sent events), history from /api/history, limits from
 // the service's own thresholds, a unit status view (the default display: mode, link state, gyro
-// states, parity/CUSUM against thresholds, sigma, attitude, events) and commands with confirmation.
+// states, parity/CUSUM against thresholds, sigma, attitude, events) and commands with confirmation, sent
+// as the signed-in operator with the session's CSRF token.
 /* exported TetraPlugin */
 /* global EventSource */
 // eslint-disable-next-line no-unused-vars
@@ -92,10 +93,25 @@ function TetraPlugin(options) {
   }
 
   // --- the ground station's REST and stream ----------------------------------------------------
+  // Without a session the ground answers 401: back to the sign-in page.
+  async function apiGet(path) {
+    const response = await fetch(base + path, { credentials: 'same-origin' });
+    if (response.status === 401) window.location.href = base + '/login.html';
+    return response;
+  }
+  // The signed-in operator and the session's CSRF token; read again whenever the stream (re)opens, so a
+  // restarted ground station's token is the one sent.
+  const session = { user: null, role: null, csrf: null, listeners: new Set() };
+  async function refreshSession() {
+    const response = await apiGet('/api/session');
+    if (!response.ok) return;
+    Object.assign(session, await response.json());
+    session.listeners.forEach((l) => l());
+  }
   let unitsCache = null;
   async function units() {
     if (!unitsCache) {
-      const response = await fetch(base + '/api/units');
+      const response = await apiGet('/api/units');
       unitsCache = await response.json();
       setTimeout(() => (unitsCache = null), 2000);
     }
@@ -123,7 +139,10 @@ function TetraPlugin(options) {
       streamState.connected = c;
       streamState.listeners.forEach((l) => l(c));
     };
-    source.onopen = () => setConnected(true);
+    source.onopen = () => {
+      setConnected(true);
+      refreshSession();
+    };
     source.onerror = () => setConnected(false);
   }
   function listen(type, fn) {
@@ -242,7 +261,7 @@ function TetraPlugin(options) {
         '&end=' +
         (opts.end || Date.now()) +
         '&max=2000';
-      const response = await fetch(url);
+      const response = await apiGet(url.slice(base.length));
       if (!response.ok) return [];
       const rows = await response.json();
       return rows.map((m) => datum(p, m));
@@ -269,15 +288,16 @@ function TetraPlugin(options) {
 
   // --- commands -------------------------------------------------------------------------------------
   function operatorId() {
-    return window.localStorage.getItem('tetra.operator') || 'operator';
+    return session.user || '?';
   }
   async function sendCommand(openmct, command) {
-    const body = Object.assign({ operator: operatorId() }, command);
     try {
+      if (!session.csrf) await refreshSession();
       const response = await fetch(base + '/api/command', {
         method: 'POST',
-        headers: { 'Content-Type': 'application/json' },
-        body: JSON.stringify(body)
+        credentials: 'same-origin',
+        headers: { 'Content-Type': 'application/json', 'X-CSRF-Token': session.csrf || '' },
+        body: JSON.stringify(command)
       });
       const answer = await response.json();
       if (!response.ok) {
@@ -338,8 +358,8 @@ function TetraPlugin(options) {
     const unit = domainObject.unit;
     const stops = [];
     let root = null;
-    const state = { health: null, attitude: null, link: null, events: [] };
-    const MAX_EVENTS = 50;
+    const state = { health: null, attitude: null, link: null, linkAt: 0, events: [], filter: '' };
+    const MAX_EVENTS = 500;
 
     function bar(label, value, limit) {
       const row = el('div', { class: 'tetra-bar' });
@@ -379,17 +399,24 @@ function TetraPlugin(options) {
       const a = state.attitude;
       const link = state.link ? state.link.state : 'WAITING';
       const stale = link !== 'LIVE';
-      root.querySelector('#tetra-mode').textContent = h ? h.mode : 'no health yet';
-      root.querySelector('#tetra-mode').className = 'tetra-mode tetra-mode--' + (h ? h.mode : 'NONE');
+      const mode = h ? (h.waiting ? 'WAITING FOR GYROS' : h.mode) : 'no health yet';
+      root.querySelector('#tetra-mode').textContent = mode;
+      root.querySelector('#tetra-mode').className = 'tetra-mode tetra-mode--' + (h ? mode.split(' ')[0] : 'NONE');
+      root.querySelector('#tetra-silences').textContent = h
+        ? 'every gyro silent at once: ' + h.counters.unit_silences + ' times'
+        : '';
       const linkEl = root.querySelector('#tetra-link');
       // A lost service means stale data too: both words, so STALE is always there to see.
       linkEl.textContent = link === 'SERVICE LOST' ? 'STALE \u00b7 SERVICE LOST' : link;
       linkEl.className = 'tetra-link tetra-link--' + link.replace(' ', '_');
+      // Ages keep counting from the last link message, also while the ground link is lost.
+      const since = (Date.now() - state.linkAt) / 1000;
+      const aged = (v) => (typeof v === 'number' ? v + since : v);
       root.querySelector('#tetra-ages').textContent = state.link
         ? 'health age ' +
-          fmt(state.link.health_age_s, 1) +
+          fmt(aged(state.link.health_age_s), 1) +
           ' s, attitude age ' +
-          fmt(state.link.attitude_age_s, 1) +
+          fmt(aged(state.link.attitude_age_s), 1) +
           ' s (stale after ' +
           fmt(state.link.stale_after_s, 1) +
           ' s)'
@@ -454,13 +481,25 @@ function TetraPlugin(options) {
         );
         att.appendChild(el('div', {}, utcText(a.utc_ms) + ' (sensor time ' + a.sensor_time_s.toFixed(3) + ' s)'));
       }
+      const filter = root.querySelector('#tetra-event-filter');
+      const kinds = Array.from(new Set(state.events.map((e) => e.event))).sort();
+      if (filter.dataset.kinds !== kinds.join(',')) {
+        filter.dataset.kinds = kinds.join(',');
+        filter.innerHTML = '';
+        filter.appendChild(el('option', { value: '' }, 'all kinds'));
+        kinds.forEach((k) => filter.appendChild(el('option', { value: k }, k)));
+        filter.value = kinds.includes(state.filter) ? state.filter : '';
+      }
       const events = root.querySelector('#tetra-events');
-      const eventKey = String(state.events.length) + '/' + (state.events.length ? state.events[state.events.length - 1].utc_ms : 0);
+      const eventKey =
+        state.filter + '/' + String(state.events.length) + '/' +
+        (state.events.length ? state.events[state.events.length - 1].utc_ms : 0);
       if (events.dataset.key === eventKey) return;
       events.dataset.key = eventKey;
       events.innerHTML = '';
       state.events
-        .slice()
+        .filter((e) => !state.filter || e.event === state.filter)
+        .slice(-100)
         .reverse()
         .forEach((e) => {
           const tr = el('tr', { class: 'tetra-event tetra-event--' + e.event });
@@ -481,20 +520,39 @@ function TetraPlugin(options) {
         '<div class="tetra-head"><span class="tetra-name"></span>' +
         '<span id="tetra-mode" class="tetra-mode"></span><span id="tetra-link" class="tetra-link"></span>' +
         '<span id="tetra-ages" class="tetra-ages"></span></div>' +
-        '<div id="tetra-time" class="tetra-time"></div>' +
+        '<div id="tetra-time" class="tetra-time"></div><div id="tetra-silences" class="tetra-time"></div>' +
         '<div class="tetra-grid"><section><h2>Gyros</h2><table class="tetra-table"><thead><tr><th>gyro</th>' +
         '<th>state</th><th>fault</th><th>solution</th><th>command</th></tr></thead><tbody id="tetra-gyros"></tbody>' +
         '</table><div class="tetra-commands"></div><div id="tetra-ack" class="tetra-ack"></div>' +
-        '<label class="tetra-operator">operator <input id="tetra-operator" size="12"/></label></section>' +
+        '<div>signed in as <span id="tetra-operator" class="tetra-operator"></span>' +
+        ' <button id="tetra-sign-out" class="c-button">Sign out</button></div></section>' +
         '<section><h2>Parity and CUSUM</h2><div id="tetra-parity"></div><h2>Attitude</h2>' +
         '<div id="tetra-attitude"></div></section></div>' +
-        '<section><h2>FDI events</h2><table class="tetra-table"><thead><tr><th>UTC</th><th>sensor time [s]</th>' +
+        '<section><div class="tetra-events-head"><h2>FDI events</h2><label>kind ' +
+        '<select id="tetra-event-filter"></select></label></div>' +
+        '<table class="tetra-table"><thead><tr><th>UTC</th><th>sensor time [s]</th>' +
         '<th>event</th><th>gyro</th><th>detail</th></tr></thead><tbody id="tetra-events"></tbody></table></section>';
       r.querySelector('.tetra-name').textContent = 'Unit ' + unit;
       r.querySelector('.tetra-commands').appendChild(commandButton('FDI reset', { unit, action: 'reset' }));
-      const op = r.querySelector('#tetra-operator');
-      op.value = operatorId();
-      op.addEventListener('change', () => window.localStorage.setItem('tetra.operator', op.value));
+      const showOperator = () => {
+        r.querySelector('#tetra-operator').textContent = session.user ? session.user + ' (' + session.role + ')' : '?';
+      };
+      session.listeners.add(showOperator);
+      stops.push(() => session.listeners.delete(showOperator));
+      showOperator();
+      r.querySelector('#tetra-event-filter').addEventListener('change', (e) => {
+        state.filter = e.target.value;
+        render();
+      });
+      r.querySelector('#tetra-sign-out').addEventListener('click', async () => {
+        await fetch(base + '/api/logout', {
+          method: 'POST',
+          credentials: 'same-origin',
+          headers: { 'Content-Type': 'application/json', 'X-CSRF-Token': session.csrf || '' },
+          body: '{}'
+        });
+        window.location.href = base + '/login.html';
+      });
       return r;
     }
 
@@ -515,7 +573,16 @@ function TetraPlugin(options) {
           })
         );
         stops.push(listen('attitude', (m) => m.unit === unit && ((state.attitude = m), render())));
-        stops.push(listen('link', (m) => m.unit === unit && ((state.link = m), render())));
+        stops.push(
+          listen('link', (m) => {
+            if (m.unit !== unit) return;
+            state.link = m;
+            state.linkAt = Date.now();
+            render();
+          })
+        );
+        const ticker = setInterval(render, 500);
+        stops.push(() => clearInterval(ticker));
         stops.push(
           listen('event', (m) => {
             if (m.unit !== unit) return;
@@ -532,14 +599,19 @@ function TetraPlugin(options) {
         };
         streamState.listeners.add(lost);
         stops.push(() => streamState.listeners.delete(lost));
-        fetch(base + '/api/history?unit=' + encodeURIComponent(unit) + '&kind=event&max=' + MAX_EVENTS)
-          .then((r) => (r.ok ? r.json() : []))
-          .then((rows) => {
-            const seen = new Set(state.events.map((e) => e.event_seq + '/' + e.utc_ms));
-            state.events = rows.filter((e) => !seen.has(e.event_seq + '/' + e.utc_ms)).concat(state.events);
-            state.events.sort((x, y) => x.utc_ms - y.utc_ms);
-            render();
-          });
+        // The event history; again after a reset of the stream (a restarted ground station, a gap).
+        const loadEvents = () =>
+          apiGet('/api/history?unit=' + encodeURIComponent(unit) + '&kind=event&max=' + MAX_EVENTS)
+            .then((r) => (r.ok ? r.json() : []))
+            .then((rows) => {
+              const seen = new Set(state.events.map((e) => e.event_seq + '/' + e.utc_ms));
+              state.events = rows.filter((e) => !seen.has(e.event_seq + '/' + e.utc_ms)).concat(state.events);
+              state.events.sort((x, y) => x.utc_ms - y.utc_ms);
+              if (state.events.length > MAX_EVENTS) state.events = state.events.slice(-MAX_EVENTS);
+              render();
+            });
+        stops.push(listen('reset', loadEvents));
+        loadEvents();
         render();
       },
       destroy() {
@@ -550,6 +622,7 @@ function TetraPlugin(options) {
   }
 
   return function install(openmct) {
+    refreshSession();
     openmct.objects.addRoot(id('units'), openmct.priority.HIGH);
     openmct.objects.addProvider(NS, objectProvider);
     openmct.types.addType('tetra.unit', {

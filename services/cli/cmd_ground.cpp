@@ -1,6 +1,7 @@
 // tetra ground — the ground station in the browser (docs/ground.md): a bridge from DDS (Health,
 // FdiEvent, Attitude of every unit) to browsers over HTTP (server-sent events, history, commands as
-// JSON POST), and the Open MCT application of web/. Loopback by default.
+// JSON POST), and the Open MCT application of web/. Loopback by default; operators sign in with the
+// accounts of --users (tetra ground passwd); --no-auth on loopback only.
 
 #include <iostream>
 
@@ -34,6 +35,7 @@ Status parse_listen(const std::string& text, std::string& host, int& port) {
 }  // namespace
 
 int cmd_ground(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "passwd") return cmd_ground_passwd(argc - 1, argv + 1);
   dds::ShutdownSignal shutdown;
   CLI::App app{"Ground station in the browser: DDS to HTTP bridge and the Open MCT application.", "ground"};
   std::string listen = "127.0.0.1:8080";
@@ -58,12 +60,35 @@ int cmd_ground(int argc, char** argv) {
       ->check(CLI::Range(0.1, 100.0));
   app.add_option("--command-timeout", command_timeout_s, "[s] wait this long for a command's acknowledgement")
       ->check(CLI::PositiveNumber);
+  app.add_option("--users", server_config.users_path,
+                 "operator accounts (tetra ground passwd USER --users FILE); required unless --no-auth")
+      ->check(CLI::ExistingFile);
+  app.add_option("--session-key", server_config.session_key_path,
+                 "the key sessions are signed with (default: the --users file's name + .session-key; created "
+                 "when absent)");
+  app.add_flag("--no-auth", server_config.no_auth,
+               "no accounts: whoever reaches the port commands as 'anonymous' (loopback addresses only; logged)");
+  app.add_option("--allow-origin", server_config.allow_origins,
+                 "another HOST:PORT browsers reach this ground as (a DNS name, a proxy); repeatable");
+  app.add_option("--tls-cert", server_config.tls.cert, "PEM certificate (chain): serve HTTPS")
+      ->check(CLI::ExistingFile);
+  app.add_option("--tls-key", server_config.tls.key, "PEM private key of --tls-cert")->check(CLI::ExistingFile);
+  app.add_option("--max-streams", server_config.limits.max_streams, "event streams held at once (beyond: 503)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   add_domain_option(app, domain);
   if (auto exit = parse(app, argc, argv)) return *exit;
+  if (server_config.no_auth && !server_config.users_path.empty())
+    return report("ground", bad_input("--no-auth and --users: one or the other"));
 
   server_config.web_dir = web_dir;
   if (auto s = parse_listen(listen, server_config.host, server_config.port); !s)
     return report("ground", s.error());
+  if (server_config.no_auth && !ground::is_loopback_host(server_config.host))
+    return report("ground", bad_input("--no-auth: only on a loopback address (--listen 127.0.0.1:PORT)"));
+  if (!server_config.no_auth && server_config.users_path.empty())
+    return report("ground", bad_input("--users FILE (tetra ground passwd USER --users FILE) or, on loopback "
+                                      "only, --no-auth"));
   auto readers = ground::GroundReaders::open(domain, "", shutdown);
   if (!readers) return report("ground", readers.error());
   ground::GroundStore store(store_config);
@@ -73,7 +98,8 @@ int cmd_ground(int argc, char** argv) {
       store, [&](const ground::CommandRequest& request) { return bridge.send(request, timeout); },
       server_config);
   if (auto s = server.start(); !s) return report("ground", s.error());
-  std::cout << "tetra ground: http://" << server_config.host << ':' << server.port() << "/" << std::endl;
+  std::cout << "tetra ground: " << (server_config.tls.cert.empty() ? "http" : "https") << "://"
+            << server_config.host << ':' << server.port() << "/" << std::endl;
   auto status = bridge.run(shutdown);
   server.stop();
   if (!status) return report("ground", status.error());

@@ -16,6 +16,7 @@ int cmd_record(int argc, char** argv);
 int cmd_demo(int argc, char** argv);
 int cmd_campaign(int argc, char** argv);
 int cmd_ground(int argc, char** argv);
+int cmd_ground_passwd(int argc, char** argv);
 int cmd_score(int argc, char** argv);
 
 }  // namespace tetra::cli

@@ -1,32 +1,76 @@
 #!/usr/bin/python3
-"""Real-browser test of the ground station (issue 16): headless Chromium driven by Selenium on the
-Open MCT application served by `tetra ground`, with `tetra fusion` and `tetra sim --dds` as processes.
+"""Real-browser test of the ground station: headless Chromium driven by Selenium on the Open MCT
+application served by `tetra ground` (with an accounts file made by `tetra ground passwd`), with
+`tetra fusion` and `tetra sim --dds` as processes.
 
-The page loads first (on a loaded machine a browser takes seconds to start), then the simulator
-starts: the page shows the unit NOMINAL; the simulator's fault (gyro 2 stuck at 10 s) makes it
-DEGRADED with gyro 2 excluded; a command issued from the page (reinstate gyro 2, confirmed in the
-dialog) is acknowledged; after `kill -9` of the fusion service the page shows STALE. Screenshots of
-each step are kept in --out. Waits are bounded (they only turn a hang into a failure); nothing is
-timed.
+The operator signs in on the sign-in page, then the simulator starts: the page shows the unit
+NOMINAL; the simulator's fault (gyro 2 stuck at 10 s) makes it DEGRADED with gyro 2 excluded; a
+command that would leave two gyros is REFUSED and a reinstate ACCEPTED, each confirmed in the dialog,
+and the event log shows both with the signed-in operator; a page of another origin (same site, so the
+session cookie goes with its requests) forges commands as a text/plain form POST, a no-cors fetch and
+a beacon: all refused (the ground's audit lines) and none obeyed; after `kill -9` of the ground station
+and its restart, the open page recovers without a reload; after `kill -9` of the fusion service it
+shows SERVICE LOST. Screenshots of each step are kept in --out. Waits are bounded (they only turn a
+hang into a failure); nothing is timed.
 """
 
 import argparse
+import http.server
 import os
 import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 
 from selenium import webdriver
 from selenium.webdriver.chrome.options import Options
 from selenium.webdriver.chrome.service import Service
+from selenium.common.exceptions import StaleElementReferenceException
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support import expected_conditions as ec
 from selenium.webdriver.support.ui import WebDriverWait
 
 
 UNIT = "ground-test"
+OPERATOR = "alice"
+PASSWORD = "browser-test-password"
+
+ATTACK = """<!doctype html><html><body>
+<iframe name="sink" style="display:none"></iframe>
+<form id="f" method="POST" enctype="text/plain" target="sink" action="{ground}/api/command">
+<input name='{{"unit":"{unit}","action":"exclude","gyro":3,"force":true,"pad":"' value='"}}'></form>
+<script>
+document.getElementById('f').submit();
+fetch('{ground}/api/command', {{method: 'POST', mode: 'no-cors', credentials: 'include',
+  headers: {{'Content-Type': 'text/plain'}},
+  body: JSON.stringify({{unit: '{unit}', action: 'exclude', gyro: 4, force: true}})}});
+navigator.sendBeacon('{ground}/api/command',
+  new Blob([JSON.stringify({{unit: '{unit}', action: 'reset'}})], {{type: 'text/plain'}}));
+document.title = 'attacked';
+</script></body></html>"""
+
+
+def serve_attack_page(page):
+    """A page of another origin (another port of the same host: same site, so the cookie goes too)."""
+    class Handler(http.server.BaseHTTPRequestHandler):
+        def do_GET(self):  # noqa: N802 - the library's name
+            body = page.encode()
+            self.send_response(200)
+            self.send_header("Content-Type", "text/html")
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, *args):
+            pass
+
+    # A thread per connection: a connection the browser opens ahead and never uses holds no other.
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+    server.daemon_threads = True
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    return server
 
 
 def free_port():
@@ -60,6 +104,25 @@ def text_of(driver, element_id):
     return driver.find_element(By.ID, element_id).text
 
 
+def audit_lines(out):
+    with open(os.path.join(out, "ground.log"), encoding="utf-8", errors="replace") as f:
+        return [line for line in f if "ground audit" in line]
+
+
+def command_from_page(driver, wait, button):
+    """Clicks a command button, confirms it in the dialog, returns the acknowledgement's text."""
+    driver.execute_script("document.getElementById('tetra-ack').textContent = ''")
+
+    def click(d):  # the gyro table is rebuilt when a gyro changes: find the button again then
+        d.find_element(By.CSS_SELECTOR, f'button[data-command="{button}"]').click()
+        return True
+
+    wait.until(click)
+    wait.until(ec.element_to_be_clickable((By.XPATH, "//button[contains(., 'Send command')]"))).click()
+    wait.until(lambda d: text_of(d, "tetra-ack").startswith(("ACCEPTED", "REFUSED", "error")))
+    return text_of(driver, "tetra-ack")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--tetra", required=True)
@@ -80,25 +143,45 @@ def main():
         return child
 
     driver = None
+    attack = None
+    step = "make the operator's account"
+    users = os.path.join(args.out, "users")
+    for stale in (users, users + ".session-key"):
+        if os.path.exists(stale):
+            os.unlink(stale)
+    subprocess.run([args.tetra, "ground", "passwd", OPERATOR, "--role", "commander", "--users", users,
+                    "--password-stdin"], input=PASSWORD + "\n", text=True, check=True, capture_output=True)
     step = "start the browser"
     try:
         # The browser first: on a loaded machine it takes seconds to start, and the page must see the
         # unit NOMINAL before the fault.
         driver = start_browser()
-        wait = WebDriverWait(driver, 60, poll_frequency=0.2)
+        wait = WebDriverWait(driver, 60, poll_frequency=0.2, ignored_exceptions=[StaleElementReferenceException])
 
         step = "start the ground station and the service"
         data = os.path.join(args.source, "tests", "ground", "data")
         domain = ["--domain", args.domain]
-        spawn([args.tetra, "ground", "--listen", f"127.0.0.1:{port}"] + domain, "ground.log")
+        ground_argv = [args.tetra, "ground", "--listen", f"127.0.0.1:{port}", "--users", users] + domain
+        ground = spawn(ground_argv, "ground.log")
         fusion = spawn([args.tetra, "fusion", "--config", os.path.join(data, "fusion.yaml")] + domain,
                        "fusion.log")
         assert http_ready(port, 30), "the ground station does not answer"
 
+        step = "sign in"
+        app = f"http://127.0.0.1:{port}/#/browse/tetra:units/tetra:unit~{UNIT}"
+        driver.get(app)
+        wait.until(ec.presence_of_element_located((By.ID, "tetra-login-form")))  # sent to the sign-in page
+        driver.find_element(By.ID, "tetra-user").send_keys(OPERATOR)
+        driver.find_element(By.ID, "tetra-password").send_keys(PASSWORD)
+        driver.find_element(By.ID, "tetra-sign-in").click()
+        wait.until(lambda d: "/login.html" not in d.current_url)
+
         step = "page loads"
-        driver.get(f"http://127.0.0.1:{port}/#/browse/tetra:units/tetra:unit~{UNIT}")
+        driver.get(app)
         wait.until(ec.presence_of_element_located((By.ID, "tetra-mode")))
-        wait.until(lambda d: text_of(d, "tetra-mode") != "no health yet")
+        wait.until(lambda d: OPERATOR in text_of(d, "tetra-operator"))
+        # The service has heard no gyro yet: it says it waits (not LOST).
+        wait.until(lambda d: text_of(d, "tetra-mode") == "WAITING FOR GYROS")
 
         step = "start the simulator"
         # 2 min of orbit at 50 Hz in real time, gyro 2 stuck from 10 s; stopped once the test is done.
@@ -117,28 +200,60 @@ def main():
         wait.until(lambda d: "excluded" in d.find_element(By.CSS_SELECTOR, 'tr[data-gyro="2"]').text)
         driver.save_screenshot(os.path.join(args.out, "2_degraded.png"))
 
-        step = "a command from the page is confirmed and acknowledged"
-        driver.find_element(By.CSS_SELECTOR, 'button[data-command="reinstate gyro 2"]').click()
-        confirm = wait.until(ec.element_to_be_clickable(
-            (By.XPATH, "//button[contains(., 'Send command')]")))
-        driver.save_screenshot(os.path.join(args.out, "3_confirm.png"))
-        confirm.click()
-        wait.until(lambda d: text_of(d, "tetra-ack").startswith(("ACCEPTED", "REFUSED")))
-        assert text_of(driver, "tetra-ack").startswith("ACCEPTED"), text_of(driver, "tetra-ack")
-        driver.save_screenshot(os.path.join(args.out, "4_acknowledged.png"))
+        step = "an exclude leaving two gyros is refused, a reinstate accepted, both as the operator"
+        refused = command_from_page(driver, wait, "exclude gyro 1")
+        assert refused.startswith("REFUSED"), refused
+        accepted = command_from_page(driver, wait, "reinstate gyro 2")
+        assert accepted.startswith("ACCEPTED"), accepted
+        wait.until(lambda d: f"[{OPERATOR} @ ground@127.0.0.1, refused]" in text_of(d, "tetra-events")
+                   and f"[{OPERATOR} @ ground@127.0.0.1, accepted]" in text_of(d, "tetra-events"))
+        driver.save_screenshot(os.path.join(args.out, "3_commands.png"))
 
-        step = "STALE after the service is killed"
+        step = "forged cross-site requests are refused and not obeyed"
+        commands_before = len([line for line in audit_lines(args.out) if f"audit: {OPERATOR} from" in line])
+        refused_before = len([line for line in audit_lines(args.out) if "refused POST /api/command" in line])
+        attack = serve_attack_page(ATTACK.format(ground=f"http://127.0.0.1:{port}", unit=UNIT))
+        driver.get(f"http://127.0.0.1:{attack.server_port}/attack.html")
+        wait.until(lambda d: d.title == "attacked")
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline:  # the three requests reach the ground and are refused
+            lines = audit_lines(args.out)
+            if len([line for line in lines if "refused POST /api/command" in line]) >= refused_before + 3:
+                break
+            time.sleep(0.2)
+        lines = audit_lines(args.out)
+        refused_now = [line for line in lines if "refused POST /api/command" in line][refused_before:]
+        assert len(refused_now) >= 3, "forged requests not all refused: " + "".join(refused_now)
+        commands_after = len([line for line in lines if f"audit: {OPERATOR} from" in line])
+        assert commands_after == commands_before, "a forged command was obeyed: " + "".join(lines[-5:])
+
+        step = "the page recovers after a restart of the ground station, without a reload"
+        driver.get(app)
+        wait.until(lambda d: text_of(d, "tetra-link") == "LIVE")
+        driver.execute_script("window.tetraNotReloaded = true")
+        ground.kill()  # kill -9
+        ground.wait()
+        wait.until(lambda d: "GROUND LINK LOST" in text_of(d, "tetra-link"))
+        ages = text_of(driver, "tetra-ages")
+        wait.until(lambda d: text_of(d, "tetra-ages") != ages)  # the ages keep counting meanwhile
+        driver.save_screenshot(os.path.join(args.out, "4_ground_lost.png"))
+        ground = spawn(ground_argv, "ground2.log")
+        wait.until(lambda d: text_of(d, "tetra-link") == "LIVE")
+        assert driver.execute_script("return window.tetraNotReloaded === true"), "the page was reloaded"
+        driver.save_screenshot(os.path.join(args.out, "5_recovered.png"))
+
+        step = "SERVICE LOST after the service is killed"
         fusion.kill()
         fusion.wait()
-        wait.until(lambda d: "STALE" in text_of(d, "tetra-link") or "LOST" in text_of(d, "tetra-link"))
-        driver.save_screenshot(os.path.join(args.out, "5_stale.png"))
+        wait.until(lambda d: "SERVICE LOST" in text_of(d, "tetra-link"))
+        driver.save_screenshot(os.path.join(args.out, "6_service_lost.png"))
         print("ground_browser: all steps passed; screenshots in", args.out)
         return 0
     except Exception as exc:  # noqa: BLE001 - report any failure with the step it happened in
         if driver is not None:
             driver.save_screenshot(os.path.join(args.out, "failed.png"))
         print(f"ground_browser: FAILED at step '{step}': {exc!r}", file=sys.stderr)
-        for log in ("ground.log", "fusion.log", "sim.log"):
+        for log in ("ground.log", "ground2.log", "fusion.log", "sim.log"):
             path = os.path.join(args.out, log)
             if os.path.exists(path):
                 text = open(path, encoding="utf-8", errors="replace").read()[-1500:]
@@ -147,6 +262,8 @@ def main():
     finally:
         if driver is not None:
             driver.quit()
+        if attack is not None:
+            attack.shutdown()
         for child in children:
             if child.poll() is None:
                 child.send_signal(signal.SIGTERM)

@@ -27,7 +27,8 @@ const bool kLoopback = use_loopback_dds();
 
 //! One server-sent event.
 struct Sse {
-  std::uint64_t id = 0;
+  std::uint64_t id = 0;  //!< the number after the server run's prefix ("<instance>-<n>")
+  std::string id_text;
   std::string event;
   json data;
 };
@@ -43,7 +44,10 @@ class SseParser {
       buffer_.erase(0, end + 2);
       std::string line;
       while (std::getline(block, line)) {
-        if (line.rfind("id: ", 0) == 0) e.id = std::stoull(line.substr(4));
+        if (line.rfind("id: ", 0) == 0) {
+          e.id_text = line.substr(4);
+          e.id = std::stoull(e.id_text.substr(e.id_text.find('-') + 1));
+        }
         if (line.rfind("event: ", 0) == 0) e.event = line.substr(7);
         if (line.rfind("data: ", 0) == 0) e.data = json::parse(line.substr(6), nullptr, false);
       }
@@ -57,14 +61,14 @@ class SseParser {
 
 //! Reads /api/stream (optionally resuming after `last_id`) until `done` holds or `limit` passes.
 std::vector<Sse> read_stream(int port, const std::function<bool(const std::vector<Sse>&)>& done,
-                             std::uint64_t last_id = 0, std::chrono::seconds limit = 60s) {
+                             const std::string& last_id = "", std::chrono::seconds limit = 60s) {
   httplib::Client client("127.0.0.1", port);
   client.set_read_timeout(5, 0);
   std::vector<Sse> events;
   SseParser parser;
   const auto give_up = std::chrono::steady_clock::now() + limit;
   httplib::Headers headers;
-  if (last_id != 0) headers.emplace("Last-Event-ID", std::to_string(last_id));
+  if (!last_id.empty()) headers.emplace("Last-Event-ID", last_id);
   (void)client.Get("/api/stream", headers, [&](const char* data, std::size_t n) {
     parser.feed(data, n, events);
     return !done(events) && std::chrono::steady_clock::now() < give_up;
@@ -91,10 +95,14 @@ bool health_with(const std::vector<Sse>& events, const std::string& mode) {
   return false;
 }
 
+//! A command as the page posts it: JSON with the session's CSRF token (--no-auth: one per run).
 json post_command(int port, const json& body, int& status) {
   httplib::Client client("127.0.0.1", port);
   client.set_read_timeout(10, 0);
-  auto res = client.Post("/api/command", body.dump(), "application/json");
+  auto session = client.Get("/api/session");
+  const json s = session ? json::parse(session->body, nullptr, false) : json();
+  httplib::Headers headers{{"X-CSRF-Token", s.is_object() ? s.value("csrf", "") : ""}};
+  auto res = client.Post("/api/command", headers, body.dump(), "application/json");
   status = res ? res->status : -1;
   return res ? json::parse(res->body, nullptr, false) : json();
 }
@@ -112,7 +120,7 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   auto fusion = std::make_unique<TetraProcess>(
       std::vector<std::string>{"fusion", "--config", dir.file("fusion.yaml"), "--domain", d},
       dir.file("fusion.log"));
-  TetraProcess ground({"ground", "--listen", "127.0.0.1:0", "--domain", d}, dir.file("ground.log"));
+  TetraProcess ground({"ground", "--listen", "127.0.0.1:0", "--no-auth", "--domain", d}, dir.file("ground.log"));
   const int port = ground_port(dir.file("ground.log"));
   ASSERT_GT(port, 0) << read_file(dir.file("ground.log"));
   // 40 s of orbit at 100 Hz, 4 times real time; gyro 2 stuck from 8 s (2 s of wall clock).
@@ -132,6 +140,7 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   ASSERT_TRUE(health_with(events, "DEGRADED")) << read_file(dir.file("fusion.log"));
   std::uint64_t attitude_count = 0;
   std::uint64_t last_id = 0;
+  std::string instance;
   for (const auto& e : events) {
     attitude_count += e.event == "attitude" ? 1 : 0;
     if (e.event == "attitude") {
@@ -139,14 +148,17 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
       EXPECT_TRUE(e.data["euler_deg"].contains("yaw"));
       EXPECT_GT(e.data["utc_ms"].get<double>(), 1.7e12);  // a UTC time (after 2023), not sensor time
     }
-    if (e.id != 0) last_id = e.id;
+    if (e.id != 0) {
+      last_id = e.id;
+      instance = e.id_text.substr(0, e.id_text.find('-') + 1);
+    }
   }
   EXPECT_GT(attitude_count, 5U);
   ASSERT_GT(last_id, 10U);
 
   // Resuming after an id gives the messages after it, in order.
   const auto resumed = read_stream(
-      port, [](const std::vector<Sse>& ev) { return ev.size() >= 3; }, last_id - 5, 10s);
+      port, [](const std::vector<Sse>& ev) { return ev.size() >= 3; }, instance + std::to_string(last_id - 5), 10s);
   ASSERT_GE(resumed.size(), 3U);
   EXPECT_EQ(resumed[0].id, last_id - 4);
   EXPECT_EQ(resumed[1].id, last_id - 3);
@@ -178,11 +190,11 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   // force, obeyed (the unit goes LOST); the FDI reset is accepted; a malformed request is a 400.
   int status = 0;
   json ack = post_command(
-      port, {{"unit", "tetra-1"}, {"action", "exclude"}, {"gyro", 1}, {"operator", "test"}}, status);
+      port, {{"unit", "tetra-1"}, {"action", "exclude"}, {"gyro", 1}}, status);
   ASSERT_EQ(status, 200) << ack.dump();
   EXPECT_FALSE(ack["accepted"].get<bool>()) << ack.dump();
   EXPECT_NE(ack["detail"].get<std::string>().find("refused"), std::string::npos) << ack.dump();
-  EXPECT_EQ(ack["operator"], "test");
+  EXPECT_EQ(ack["operator"], "anonymous");  // --no-auth: nobody signed in
   EXPECT_EQ(ack["origin"], "ground@127.0.0.1");
   const auto refused = run_tetra("command --unit tetra-1 exclude 3 --operator test --domain " + d);
   EXPECT_EQ(refused.exit_status, 1) << refused.out << refused.err;
@@ -192,7 +204,7 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   const auto forced = run_tetra("command --unit tetra-1 exclude 3 --force --operator test --domain " + d);
   EXPECT_EQ(forced.exit_status, 0) << forced.err << forced.out;
   EXPECT_NE(forced.out.find("\"force\": true"), std::string::npos) << forced.out;
-  ack = post_command(port, {{"unit", "tetra-1"}, {"action", "reset"}, {"operator", "test"}}, status);
+  ack = post_command(port, {{"unit", "tetra-1"}, {"action", "reset"}}, status);
   ASSERT_EQ(status, 200) << ack.dump();
   EXPECT_TRUE(ack["accepted"].get<bool>()) << ack.dump();
   (void)post_command(port, {{"unit", "tetra-1"}, {"action", "exclude"}}, status);
@@ -210,7 +222,7 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
         }
         return false;
       },
-      0, 20s);
+      "", 20s);
   bool stale = false;
   for (const auto& e : lost) stale = stale || (e.event == "link" && e.data.value("state", "") != "LIVE");
   EXPECT_TRUE(stale);

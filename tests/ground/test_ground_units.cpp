@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <thread>
 
 #include "test_support.hpp"
@@ -12,6 +14,9 @@
 #include "tetra/ground/command_tracker.hpp"
 #include "tetra/ground/encode.hpp"
 #include "tetra/ground/link_state.hpp"
+#include "tetra/ground/http_api.hpp"
+#include "tetra/ground/operators.hpp"
+#include "tetra/ground/query_params.hpp"
 #include "tetra/ground/record_files.hpp"
 #include "tetra/ground/ring_buffer.hpp"
 #include "tetra/ground/store.hpp"
@@ -200,7 +205,7 @@ TEST(CommandTracker, MatchesAnAcknowledgementByIdAndUnit) {
 }
 
 TEST(CommandRequest, ValidatesEveryField) {
-  auto ok = parse_command_request(R"({"unit":"u","action":"exclude","gyro":2,"force":true,"operator":"bob"})",
+  auto ok = parse_command_request(R"({"unit":"u","action":"exclude","gyro":2,"force":true})", "bob",
                                   "ground@127.0.0.1");
   ASSERT_TRUE(ok.ok());
   EXPECT_EQ(ok->kind, tetra_COMMAND_EXCLUDE);
@@ -209,19 +214,22 @@ TEST(CommandRequest, ValidatesEveryField) {
   ASSERT_TRUE(to_wire(*ok, 9, wire).ok());
   EXPECT_STREQ(wire.operator_id, "bob");
   EXPECT_STREQ(wire.origin, "ground@127.0.0.1");
+  // The operator is the signed-in user: a typed one is refused; so are unknown and repeated keys
+  // (the last of two "action" keys would otherwise win).
   for (const char* bad :
-       {"", "[]", R"({"action":"reset","operator":"x"})", R"({"unit":"u","action":"reset"})",
-        R"({"unit":"u","action":"explode","operator":"x"})",
-        R"({"unit":"u","action":"exclude","operator":"x"})",
-        R"({"unit":"u","action":"exclude","gyro":99,"operator":"x"})",
-        R"({"unit":"u","action":"exclude","gyro":"2","operator":"x"})",
-        R"({"unit":"u","action":"reset","gyro":1,"operator":"x"})",
-        R"({"unit":"u","action":"reset","force":"yes","operator":"x"})"}) {
-    EXPECT_FALSE(parse_command_request(bad, "o").ok()) << bad;
+       {"", "[]", R"({"action":"reset"})", R"({"unit":"u","action":"reset","operator":"x"})",
+        R"({"unit":"u","action":"explode"})", R"({"unit":"u","action":"exclude"})",
+        R"({"unit":"u","action":"exclude","gyro":99})", R"({"unit":"u","action":"exclude","gyro":"2"})",
+        R"({"unit":"u","action":"reset","gyro":1})", R"({"unit":"u","action":"reset","force":"yes"})",
+        R"({"unit":"u","action":"reset","action":"exclude","gyro":1})", R"({"unit":"u","action":"reset","x":1})"}) {
+    EXPECT_FALSE(parse_command_request(bad, "alice", "o").ok()) << bad;
   }
+  EXPECT_NE(parse_command_request(R"({"unit":"u","action":"reset","action":"exclude","gyro":1})", "a", "o")
+                .error()
+                .message.find("'action' given twice"),
+            std::string::npos);
   const std::string long_operator(40, 'x');
-  auto too_long =
-      parse_command_request(R"({"unit":"u","action":"reset","operator":")" + long_operator + "\"}", "o");
+  auto too_long = parse_command_request(R"({"unit":"u","action":"reset"})", long_operator, "o");
   ASSERT_TRUE(too_long.ok());
   EXPECT_FALSE(to_wire(*too_long, 1, wire).ok());
 }
@@ -258,6 +266,92 @@ TEST(RecordFiles, AttitudeAndEventFilesAreServedBySensorTime) {
   EXPECT_EQ((*ev)[0]["event"], "isolated");
   EXPECT_FALSE(read_record(dir.path().string(), "../etc/passwd", 0, 1, 0).ok());
   EXPECT_FALSE(read_record(dir.path().string(), "log.csv", 0, 1, 0).ok());
+}
+
+TEST(RecordFiles, NoLinkOutOfTheFolderNoNulNoServerPathInErrors) {
+  test::TempDir outside;
+  test::write_file(outside.file("secret.jsonl"), "{\"time_s\": 1, \"event\": \"secret\"}\n");
+  test::TempDir dir;
+  std::filesystem::create_symlink(outside.file("secret.jsonl"), dir.file("link.jsonl"));
+  test::write_file(dir.file("dup.jsonl"), "{\"time_s\": 1, \"event\": \"a\", \"event\": \"b\"}\n");
+  auto list = list_records(dir.path().string());
+  ASSERT_TRUE(list.ok());
+  EXPECT_EQ(list->dump().find("link"), std::string::npos) << list->dump();
+  const auto linked = read_record(dir.path().string(), "link.jsonl", 0, 10, 0);
+  ASSERT_FALSE(linked.ok());
+  EXPECT_EQ(linked.error().message.find(dir.path().string()), std::string::npos) << linked.error().message;
+  EXPECT_FALSE(read_record(dir.path().string(), std::string("dup.jsonl\0.csv", 14), 0, 10, 0).ok());
+  const auto dup = read_record(dir.path().string(), "dup.jsonl", 0, 10, 0);
+  ASSERT_FALSE(dup.ok());
+  EXPECT_EQ(dup.error().message, "dup.jsonl:1: key 'event' given twice");
+  const auto missing = read_record(dir.path().string(), "none.csv", 0, 10, 0);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.error().message.find('/'), std::string::npos) << missing.error().message;
+}
+
+TEST(QueryParams, EveryParameterIsValidatedAndNamed) {
+  using P = std::vector<std::pair<std::string, std::string>>;
+  auto q = QueryParams::of(P{{"max", "-1"}, {"start", "nan"}, {"end", "12.5"}}, {"max", "start", "end"});
+  ASSERT_TRUE(q.ok());
+  EXPECT_EQ(q->count("max", 5000, 1, 100000).error().message, "parameter 'max': an integer 1..100000");
+  EXPECT_EQ(q->number("start", 0).error().message, "parameter 'start': a finite number");
+  EXPECT_DOUBLE_EQ(*q->number("end", 0), 12.5);
+  EXPECT_EQ(*q->count("absent", 7, 1, 9), 7U);
+  EXPECT_FALSE(QueryParams::of(P{{"max", "1"}, {"max", "2"}}, {"max"}).ok());
+  EXPECT_EQ(QueryParams::of(P{{"evil", "1"}}, {"max"}).error().message, "parameter 'evil' unknown here");
+}
+
+TEST(Operators, AccountsPasswordsSessionsAndRoles) {
+  test::TempDir dir;
+  const std::string users = dir.file("users");
+  auto hash = hash_password("correct horse");
+  ASSERT_TRUE(hash.ok());
+  EXPECT_EQ(hash->rfind("$argon2id$", 0), 0U);
+  ASSERT_TRUE(set_account(users, {"alice", Role::kCommander, *hash}).ok());
+  ASSERT_TRUE(set_account(users, {"victor", Role::kViewer, *hash}).ok());
+  EXPECT_FALSE(set_account(users, {"bad name", Role::kViewer, *hash}).ok());
+  auto accounts = read_accounts(users);
+  ASSERT_TRUE(accounts.ok()) << accounts.error().message;
+  ASSERT_EQ(accounts->size(), 2U);
+  EXPECT_EQ(std::filesystem::status(users).permissions() & std::filesystem::perms::all,
+            std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  auto ops = Operators::open(users, dir.file("key"));
+  ASSERT_TRUE(ops.ok()) << ops.error().message;
+  EXPECT_FALSE(ops->login("alice", "wrong").has_value());
+  EXPECT_FALSE(ops->login("nobody", "correct horse").has_value());
+  ASSERT_TRUE(ops->login("alice", "correct horse").has_value());
+  const std::string token = ops->issue("alice", 1000, 3600);
+  auto s = ops->session(token, 2000);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->user, "alice");
+  EXPECT_EQ(s->role, Role::kCommander);
+  EXPECT_EQ(s->csrf.size(), 64U);
+  EXPECT_FALSE(ops->session(token, 5000).has_value());  // expired
+  std::string forged = token;
+  forged[0] = 'b';  // another user with alice's signature
+  EXPECT_FALSE(ops->session(forged, 2000).has_value());
+  // Signed with the key of its file: a restarted ground station still knows the session.
+  auto again = Operators::open(users, dir.file("key"));
+  ASSERT_TRUE(again.ok());
+  EXPECT_TRUE(again->session(token, 2000).has_value());
+  again->revoke(token);
+  EXPECT_FALSE(again->session(token, 2000).has_value());
+  // A role changed in the file applies to open sessions.
+  ASSERT_TRUE(set_account(users, {"alice", Role::kViewer, *hash}).ok());
+  std::filesystem::last_write_time(users, std::filesystem::file_time_type::clock::now() + std::chrono::seconds(5));
+  EXPECT_EQ(ops->session(token, 2000)->role, Role::kViewer);
+  test::write_file(dir.file("broken"), "alice:admin:$argon2id$x\n");
+  EXPECT_EQ(read_accounts(dir.file("broken")).error().message,
+            dir.file("broken") + ":1: role must be viewer or commander");
+}
+
+TEST(GroundServer, NoAuthOnlyOnLoopback) {
+  EXPECT_TRUE(is_loopback_host("127.0.0.1"));
+  EXPECT_TRUE(is_loopback_host("127.1.2.3"));
+  EXPECT_TRUE(is_loopback_host("localhost"));
+  EXPECT_TRUE(is_loopback_host("::1"));
+  EXPECT_FALSE(is_loopback_host("0.0.0.0"));
+  EXPECT_FALSE(is_loopback_host("192.168.1.2"));
 }
 
 }  // namespace

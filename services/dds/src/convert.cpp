@@ -134,6 +134,7 @@ Status to_wire(const std::string& unit, const fdi::Health& health, const service
   c.liveliness_lost = counters.liveliness_lost;
   c.time_outlier = counters.time_outlier;
   c.seq_discontinuity = counters.seq_discontinuity;
+  c.unit_silences = counters.unit_silences;
   return ok_status();
 }
 
@@ -174,6 +175,7 @@ HealthView from_wire(const tetra_Health& in) {
   out.counters.liveliness_lost = c.liveliness_lost;
   out.counters.time_outlier = c.time_outlier;
   out.counters.seq_discontinuity = c.seq_discontinuity;
+  out.counters.unit_silences = c.unit_silences;
   return out;
 }
 

@@ -177,7 +177,7 @@ Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered,
     if (auto s = take_commands(); !s) return s;
   }
   const bool newly_absent = check_deadlines(now, deadline_status);
-  if (auto s = report_silence(); !s) return s;
+  if (auto s = report_silence(now); !s) return s;
   if (auto s = process_epochs(now); !s) return s;
   if (command_data || newly_absent || matched_changed || now >= next_health_ns_) {
     if (auto s = publish_health(now, matched_changed); !s) return s;
@@ -219,7 +219,7 @@ Status FusionService::ingest(std::int64_t now_ns) {
   // already in its reader when the epoch completes (docs/dds.md).
   if (auto s = take_gyro_samples(now_ns); !s) return s;
   if (auto s = take_references(); !s) return s;
-  if (auto s = report_silence(); !s) return s;
+  if (auto s = report_silence(now_ns); !s) return s;
   return process_epochs(now_ns);
 }
 
@@ -321,15 +321,26 @@ Status FusionService::take_commands() {
   return ok_status();
 }
 
-Status FusionService::report_silence() {
-  // Every gyro silent, or the first sample after that: events, so the ground sees even a brief loss.
-  const bool silent = assembler_.all_absent();
-  if (silent == all_silent_) return ok_status();
-  all_silent_ = silent;
+Status FusionService::report_silence(std::int64_t now_ns) {
+  // Every gyro silent: counted in Health at once; a `lost` event once the silence has lasted
+  // kMinOutageReported_s, and then a `cleared` when samples come back (hysteresis: a loaded machine's
+  // brief gaps do not flood the event log). Before the first epoch the service is waiting, not lost.
+  const bool silent = fused_any_ && assembler_.all_absent();
+  if (silent && !all_silent_) {
+    all_silent_ = true;
+    silent_since_ns_ = now_ns;
+    ++unit_silences_;
+  }
+  if (!silent) all_silent_ = false;
+  const bool report_lost = all_silent_ && !lost_reported_ &&
+                           now_ns - silent_since_ns_ >= seconds_to_ns(kMinOutageReported_s);
+  const bool report_cleared = !all_silent_ && lost_reported_;
+  if (!report_lost && !report_cleared) return ok_status();
+  lost_reported_ = report_lost;
   fdi::FdiEvent event;
-  event.stamp_ns = pipeline_.health().stamp_ns;
-  event.type = silent ? fdi::EventType::kLost : fdi::EventType::kCleared;
-  event.detail = silent ? "all gyros silent" : "gyro samples back";
+  event.stamp_ns = pipeline_.health().stamp_ns;  // the last epoch fused: a time the unit had
+  event.type = report_lost ? fdi::EventType::kLost : fdi::EventType::kCleared;
+  event.detail = report_lost ? "all gyros silent" : "gyro samples back";
   for (int g = 1; g <= n_gyros_; ++g) {
     if (!assembler_.absent(g)) event.gyros |= GyroMask{1} << static_cast<unsigned>(g - 1);
   }
@@ -413,7 +424,9 @@ Status FusionService::publish_health(std::int64_t now_ns, bool force) {
                  mask_to_string(health.used, n_gyros_));
   }
   dds::WireHealth wire;
-  if (auto s = dds::to_wire(config_.unit, health, assembler_.counters(), wire); !s) return s;
+  service::AssemblerCounters counters = assembler_.counters();
+  counters.unit_silences = unit_silences_;
+  if (auto s = dds::to_wire(config_.unit, health, counters, wire); !s) return s;
   wire.msg.events_published = event_seq_;
   wire.msg.gyro_writers = gyro_writers_;
   wire.msg.health_period_s = config_.health_period_s;

@@ -4,22 +4,30 @@
 
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
+#include "tetra/ground/strict_json.hpp"
 
 namespace tetra::ground {
 
 using nlohmann::json;
 
-Result<CommandRequest> parse_command_request(const std::string& body, const std::string& origin) {
-  const json j = json::parse(body, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) return bad_input("command: the body is not a JSON object");
+Result<CommandRequest> parse_command_request(const std::string& body, const std::string& operator_id,
+                                             const std::string& origin) {
+  auto parsed = parse_strict_json(body);
+  if (!parsed) return bad_input("command: " + parsed.error().message);
+  const json& j = *parsed;
+  if (!j.is_object()) return bad_input("command: the body is not a JSON object");
+  for (const auto& item : j.items()) {
+    if (item.key() == "operator")
+      return bad_input("command: field 'operator' is not accepted: the operator is the signed-in user");
+    if (item.key() != "unit" && item.key() != "action" && item.key() != "gyro" && item.key() != "force")
+      return bad_input("command: field '" + item.key() + "' unknown (unit, action, gyro, force)");
+  }
   CommandRequest c;
   c.origin = origin;
+  c.operator_id = operator_id;
   if (!j.contains("unit") || !j["unit"].is_string() || j["unit"].get<std::string>().empty())
     return bad_input("command: field 'unit' (string) missing");
   c.unit = j["unit"].get<std::string>();
-  if (!j.contains("operator") || !j["operator"].is_string() || j["operator"].get<std::string>().empty())
-    return bad_input("command: field 'operator' (string, the operator's id) missing");
-  c.operator_id = j["operator"].get<std::string>();
   const std::string action =
       j.contains("action") && j["action"].is_string() ? j["action"].get<std::string>() : "";
   if (action == "reset") {

@@ -42,6 +42,7 @@ json counters_json(const dds::HealthView& view) {
           {"samples_gap", c.samples_gap},
           {"deadlines_missed", c.deadlines_missed},
           {"liveliness_lost", c.liveliness_lost},
+          {"unit_silences", c.unit_silences},
           {"sensor_restarts", c.sensor_restarts},
           {"time_outlier", c.time_outlier},
           {"seq_discontinuity", c.seq_discontinuity}};
@@ -82,6 +83,8 @@ json health_json(const dds::HealthView& view, std::int64_t utc_ns) {
           {"utc_ms", utc_ms(utc_ns)},
           {"sensor_time_s", ns_to_seconds(h.stamp_ns)},
           {"mode", fdi::to_string(h.mode)},
+          // No epoch fused yet: the service is waiting for its gyros (not lost; no sensor time yet).
+          {"waiting", h.counters.epochs_accepted == 0},
           {"gyros_used", gyro_list(h.used, n)},
           {"gyros", gyros},
           {"parity_available", parity},

@@ -1,12 +1,15 @@
 #include "tetra/ground/http_api.hpp"
 
+#include <arpa/inet.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
 #include <filesystem>
 
-#include "tetra/dds/topics.hpp"
 #include "tetra/ground/encode.hpp"
+#include "tetra/ground/query_params.hpp"
 #include "tetra/ground/record_files.hpp"
-// After Eigen (through the headers above): httplib.h brings <resolv.h>, whose `_res` macro breaks Eigen.
-#include <httplib.h>
+#include "tetra/ground/strict_json.hpp"
 
 namespace tetra::ground {
 
@@ -14,148 +17,340 @@ namespace {
 
 using nlohmann::json;
 
-//! The state of one browser's event stream between calls of the content provider.
-struct StreamCursor {
-  std::uint64_t after = 0;
-  bool fresh = true;  //!< no Last-Event-ID: send the current state first
-};
+constexpr const char* kCookie = "tetra_session";
+constexpr std::size_t kMaxCatchUp = 4096;  //!< a resume further behind gets a reset and the history
 
-void append_message(std::string& out, const StreamMessage& m) {
-  if (m.id != 0) out += "id: " + std::to_string(m.id) + '\n';
-  out += "event: " + m.event + "\ndata: " + m.data + "\n\n";
-}
-
-std::uint64_t last_event_id(const httplib::Request& req) {
-  std::string text = req.get_header_value("Last-Event-ID");
-  if (text.empty()) text = req.get_param_value("last_event_id");
-  if (text.empty()) return 0;
-  try {
-    return std::stoull(text);
-  } catch (const std::exception&) {
-    return 0;
-  }
-}
-
-void reply_json(httplib::Response& res, int status, const json& body) {
+HttpResponse json_reply(int status, const json& body) {
+  HttpResponse res;
   res.status = status;
-  res.set_header("Cache-Control", "no-store");
-  res.set_content(body.dump(), "application/json");
+  res.body = body.dump();
+  res.headers.emplace_back("Cache-Control", "no-store");
+  return res;
 }
 
-void reply_error(httplib::Response& res, int status, const std::string& message) {
-  reply_json(res, status, {{"error", message}});
+HttpResponse error_reply(int status, const std::string& message) {
+  return json_reply(status, {{"error", message}});
 }
 
-double number_param(const httplib::Request& req, const char* name, double fallback) {
-  if (!req.has_param(name)) return fallback;
-  try {
-    return std::stod(req.get_param_value(name));
-  } catch (const std::exception&) {
-    return fallback;
+std::string lower_case(std::string s) {
+  for (auto& ch : s) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return s;
+}
+
+std::int64_t utc_now_s() {
+  return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+//! The value of cookie `name` in a Cookie header ("" when absent).
+std::string cookie_value(const std::string& header, const std::string& name) {
+  std::size_t pos = 0;
+  while (pos < header.size()) {
+    auto end = header.find(';', pos);
+    if (end == std::string::npos) end = header.size();
+    std::string item = header.substr(pos, end - pos);
+    pos = end + 1;
+    const auto b = item.find_first_not_of(' ');
+    if (b == std::string::npos) continue;
+    item = item.substr(b);
+    if (item.compare(0, name.size() + 1, name + "=") == 0) return item.substr(name.size() + 1);
   }
+  return "";
+}
+
+bool is_json_type(const std::string& content_type) {
+  const std::string t = lower_case(content_type.substr(0, content_type.find(';')));
+  return t == "application/json";
+}
+
+//! "HOST:PORT" of an allow-list entry given as HOST:PORT or SCHEME://HOST:PORT.
+std::string host_port_of(std::string text) {
+  const auto scheme = text.find("://");
+  if (scheme != std::string::npos) text = text.substr(scheme + 3);
+  if (!text.empty() && text.back() == '/') text.pop_back();
+  return lower_case(text);
+}
+
+//! "HOST" without a port (a browser omits the scheme's default) as "HOST:80" or "HOST:443".
+std::string with_port(std::string host_port, bool tls) {
+  const auto colon = host_port.rfind(':');
+  const auto bracket = host_port.rfind(']');
+  if (!host_port.empty() && (colon == std::string::npos || (bracket != std::string::npos && colon < bracket)))
+    host_port += tls ? ":443" : ":80";
+  return host_port;
 }
 
 }  // namespace
 
+bool is_loopback_host(const std::string& host) {
+  if (host == "localhost" || host == "::1" || host == "[::1]") return true;
+  in_addr a{};
+  return ::inet_pton(AF_INET, host.c_str(), &a) == 1 && (ntohl(a.s_addr) >> 24U) == 127U;
+}
+
 GroundServer::GroundServer(GroundStore& store, SendCommand send, ServerConfig config)
-    : store_(store),
-      send_(std::move(send)),
-      config_(std::move(config)),
-      server_(std::make_unique<httplib::Server>()) {}
+    : store_(store), send_(std::move(send)), config_(std::move(config)) {}
 
 GroundServer::~GroundServer() {
   stop();
 }
 
 Status GroundServer::start() {
+  if (config_.no_auth && !is_loopback_host(config_.host))
+    return bad_input("--no-auth: only on a loopback address (--listen 127.0.0.1:PORT), not " + config_.host);
+  if (!config_.no_auth) {
+    if (config_.users_path.empty())
+      return bad_input("--users FILE (made by `tetra ground passwd`) or, on loopback only, --no-auth");
+    const std::string key = config_.session_key_path.empty() ? config_.users_path + ".session-key"
+                                                             : config_.session_key_path;
+    auto ops = Operators::open(config_.users_path, key);
+    if (!ops) return ops.error();
+    operators_.emplace(std::move(ops).value());
+  }
+  if (config_.tls.cert.empty() != config_.tls.key.empty())
+    return bad_input("--tls-cert and --tls-key go together");
+  if (!files_.mount("/", config_.web_dir)) return bad_input("--web " + config_.web_dir + ": no such directory");
   const std::filesystem::path openmct = std::filesystem::path(config_.web_dir) / "node_modules/openmct/dist";
-  if (!server_->set_mount_point("/", config_.web_dir)) {
-    return bad_input("--web " + config_.web_dir + ": no such directory");
-  }
-  if (!server_->set_mount_point("/openmct", openmct.string())) {
-    return failure(openmct.string() + " missing: run `npm ci` in " + config_.web_dir +
-                   " (scripts/setup.sh does)");
-  }
-  const int threads = config_.worker_threads;
-  server_->new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<std::size_t>(threads)); };
-  routes();
-  port_ = config_.port == 0 ? server_->bind_to_any_port(config_.host)
-                            : (server_->bind_to_port(config_.host, config_.port) ? config_.port : -1);
-  if (port_ <= 0) {
-    return failure("--listen " + config_.host + ":" + std::to_string(config_.port) + ": cannot bind");
-  }
-  thread_ = std::thread([this] { server_->listen_after_bind(); });
+  if (!files_.mount("/openmct/", openmct.string()))
+    return failure(openmct.string() + " missing: run `npm ci` in " + config_.web_dir + " (scripts/setup.sh does)");
+  instance_ = random_hex(4);
+  no_auth_csrf_ = random_hex(32);
+  StreamFeed feed{[this](std::uint64_t after, std::string& out) { return feed_next(after, out); },
+                  [this] { return store_.last_id(); }};
+  server_ = std::make_unique<HttpServer>([this](const HttpRequest& r) { return handle(r); }, std::move(feed),
+                                         config_.limits);
+  if (auto s = server_->start(config_.host, config_.port, config_.tls); !s) return s;
+  const std::string port = ":" + std::to_string(server_->port());
+  for (const std::string& h : {config_.host, std::string("localhost"), std::string("127.0.0.1"), std::string("[::1]")})
+    allowed_hosts_.insert(lower_case(h.find(':') != std::string::npos && h[0] != '[' ? "[" + h + "]" : h) + port);
+  for (const auto& extra : config_.allow_origins)
+    allowed_hosts_.insert(with_port(host_port_of(extra), !config_.tls.cert.empty()));
+  store_.set_listener([server = server_.get()] { server->notify(); });
+  if (config_.no_auth)
+    spdlog::warn("ground: --no-auth: no accounts; whoever reaches {}{} may command (as 'anonymous')",
+                 config_.host, port);
   return ok_status();
 }
 
 void GroundServer::stop() {
-  stopping_ = true;
+  store_.set_listener(nullptr);
   if (server_) server_->stop();
-  if (thread_.joinable()) thread_.join();
 }
 
-void GroundServer::routes() {
-  auto& s = *server_;
-  s.Get("/api/units", [this](const httplib::Request&, httplib::Response& res) {
-    reply_json(res, 200, store_.units_json(steady_now_ns()));
-  });
-  s.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-    reply_json(res, 200,
-               {{"last_event_id", store_.last_id()},
-                {"stream_dropped", store_.stream_dropped()},
-                {"units", store_.units_json(steady_now_ns())}});
-  });
-  s.Get("/api/history", [this](const httplib::Request& req, httplib::Response& res) {
-    const auto max_points = static_cast<std::size_t>(number_param(req, "max", 5000));
-    auto h = store_.history(req.get_param_value("unit"), req.get_param_value("kind"),
-                            number_param(req, "start", 0), number_param(req, "end", 1e300), max_points);
-    if (!h) return reply_error(res, 404, h.error().message);
-    reply_json(res, 200, *h);
-  });
-  s.Get("/api/records", [this](const httplib::Request& req, httplib::Response& res) {
-    if (config_.records_dir.empty()) return reply_error(res, 404, "no --records folder given");
-    auto r = req.has_param("file")
-                 ? read_record(config_.records_dir, req.get_param_value("file"),
-                               number_param(req, "start", -1e300), number_param(req, "end", 1e300),
-                               static_cast<std::size_t>(number_param(req, "max", 5000)))
-                 : list_records(config_.records_dir);
-    if (!r) return reply_error(res, 404, r.error().message);
-    reply_json(res, 200, *r);
-  });
-  s.Get("/api/stream", [this](const httplib::Request& req, httplib::Response& res) {
-    auto cursor = std::make_shared<StreamCursor>();
-    cursor->after = last_event_id(req);
-    cursor->fresh = cursor->after == 0;
-    res.set_header("Cache-Control", "no-cache");
-    res.set_header("X-Accel-Buffering", "no");  // nginx: pass events through unbuffered
-    res.set_chunked_content_provider(
-        "text/event-stream", [this, cursor](std::size_t, httplib::DataSink& sink) {
-          if (stopping_) return false;
-          std::string out;
-          if (cursor->fresh) {
-            cursor->fresh = false;
-            cursor->after = store_.last_id();
-            out += "retry: 1000\n\n";
-            for (const auto& m : store_.snapshot(steady_now_ns())) append_message(out, m);
-          }
-          const StreamRead read =
-              store_.read_stream(cursor->after, 512, std::chrono::milliseconds(config_.stream_wait_ms));
-          if (read.gap) out += "event: reset\ndata: {}\n\n";  // the browser reloads history
-          for (const auto& m : read.messages) {
-            append_message(out, m);
-            cursor->after = m.id;
-          }
-          if (out.empty()) out = ": keep-alive\n\n";
-          return !stopping_ && sink.write(out.data(), out.size());
-        });
-  });
-  s.Post("/api/command", [this](const httplib::Request& req, httplib::Response& res) {
-    auto request = parse_command_request(req.body, "ground@" + req.remote_addr);
-    if (!request) return reply_error(res, 400, request.error().message);
-    auto ack = send_(*request);
-    if (!ack) return reply_error(res, 504, ack.error().message);
-    reply_json(res, 200, ack_json(*ack, 16));
-  });
+void GroundServer::append_message(std::string& out, const StreamMessage& m) const {
+  if (m.id != 0) out += "id: " + instance_ + "-" + std::to_string(m.id) + '\n';
+  out += "event: " + m.event + "\ndata: " + m.data + "\n\n";
+}
+
+std::uint64_t GroundServer::feed_next(std::uint64_t after, std::string& out) const {
+  const StreamRead read = store_.read_stream(after, 512, std::chrono::milliseconds(0));
+  if (read.gap) out += "event: reset\ndata: {}\n\n";
+  for (const auto& m : read.messages) {
+    append_message(out, m);
+    after = m.id;
+  }
+  return after;
+}
+
+HttpResponse GroundServer::refuse(const HttpRequest& req, int status, const std::string& why,
+                                  const std::string& user) {
+  spdlog::warn("ground audit: refused {} {} from {} ({}): {}", req.method, req.path, req.remote_addr,
+               user.empty() ? "no session" : "user " + user, why);
+  return error_reply(status, why);
+}
+
+std::optional<Session> GroundServer::session_of(const HttpRequest& req) {
+  if (config_.no_auth) return Session{"anonymous", Role::kCommander, no_auth_csrf_};
+  const std::string token = cookie_value(req.header("cookie"), kCookie);
+  if (token.empty()) return std::nullopt;
+  return operators_->session(token, utc_now_s());
+}
+
+HttpResponse GroundServer::handle(const HttpRequest& req) {
+  // DNS rebinding: a name that resolves to this host is not enough, the browser must call it by a name
+  // of the allow-list. A cross-site page: its Origin is not on the list.
+  const std::string host = with_port(lower_case(req.header("host")), req.tls);
+  if (allowed_hosts_.count(host) == 0)
+    return refuse(req, 403, "Host '" + host + "' not allowed (--allow-origin adds one)", "");
+  const std::string origin = req.header("origin");
+  if (!origin.empty()) {
+    const std::string scheme = req.tls ? "https://" : "http://";
+    if (origin.compare(0, scheme.size(), scheme) != 0 ||
+        allowed_hosts_.count(with_port(host_port_of(origin), req.tls)) == 0)
+      return refuse(req, 403, "Origin '" + origin + "' not allowed", "");
+  }
+  if (req.method != "GET" && req.method != "POST") return error_reply(405, "GET or POST only");
+  if (req.method == "POST" && !is_json_type(req.header("content-type")))
+    return refuse(req, 415, "a POST must be application/json", "");
+  if (req.method == "POST" && req.path == "/api/login") return login(req);
+  if (req.method == "GET" && (req.path == "/login.html" || req.path == "/login.js" || req.path == "/tetra.css"))
+    return serve(req, std::nullopt);
+  const auto session = session_of(req);
+  if (!session) {
+    if (req.path.rfind("/api/", 0) == 0) return error_reply(401, "sign in first (/login.html)");
+    HttpResponse res;
+    res.status = 302;
+    res.content_type = "text/plain";
+    res.headers.emplace_back("Location", "/login.html");
+    return res;
+  }
+  if (req.method == "POST" && !same_secret(req.header("x-csrf-token"), session->csrf))
+    return refuse(req, 403, "the session's CSRF token is missing or wrong (X-CSRF-Token)", session->user);
+  return serve(req, session);
+}
+
+HttpResponse GroundServer::serve(const HttpRequest& req, const std::optional<Session>& session) {
+  if (req.method == "POST") {
+    if (req.path == "/api/command") return command(req, *session);
+    if (req.path == "/api/logout") {
+      if (operators_) operators_->revoke(cookie_value(req.header("cookie"), kCookie));
+      auto res = json_reply(200, {{"signed_out", session->user}});
+      res.headers.emplace_back("Set-Cookie", std::string(kCookie) + "=; Path=/; Max-Age=0; HttpOnly; SameSite=Strict");
+      return res;
+    }
+    return error_reply(404, "no such request");
+  }
+  const auto now = steady_now_ns();
+  if (req.path == "/api/session") {
+    return json_reply(200, {{"user", session->user},
+                            {"role", to_string(session->role)},
+                            {"csrf", session->csrf},
+                            {"auth", !config_.no_auth}});
+  }
+  if (req.path == "/api/units") {
+    if (!req.params.empty()) return error_reply(400, "parameter '" + req.params[0].first + "' unknown here");
+    return json_reply(200, store_.units_json(now));
+  }
+  if (req.path == "/api/status") {
+    return json_reply(200, {{"last_event_id", instance_ + "-" + std::to_string(store_.last_id())},
+                            {"stream_dropped", store_.stream_dropped()},
+                            {"streams", server_->open_streams()},
+                            {"units", store_.units_json(now)}});
+  }
+  if (req.path == "/api/history") return history(req);
+  if (req.path == "/api/records") return records(req);
+  if (req.path == "/api/stream") return stream(req);
+  if (req.path.rfind("/api/", 0) == 0) return error_reply(404, "no such request");
+  const auto file = files_.get(req.path);
+  if (!file) return error_reply(404, "no such file");
+  HttpResponse res;
+  res.content_type = file->content_type;
+  res.shared_body = file->content;
+  return res;
+}
+
+HttpResponse GroundServer::login(const HttpRequest& req) {
+  if (config_.no_auth) return error_reply(404, "--no-auth: no accounts to sign in to");
+  auto body = parse_strict_json(req.body);
+  if (!body || !body->is_object() || !(*body)["user"].is_string() || !(*body)["password"].is_string() ||
+      body->size() != 2)
+    return error_reply(400, "login: a JSON object {\"user\", \"password\"}");
+  const std::string user = (*body)["user"].get<std::string>();
+  std::unique_lock lock(login_mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return error_reply(503, "another sign-in is being checked: try again");
+  const auto account = operators_->login(user, (*body)["password"].get<std::string>());
+  lock.unlock();
+  if (!account) return refuse(req, 401, "user or password wrong", valid_user_name(user) ? user : "?");
+  const auto lifetime = static_cast<std::int64_t>(config_.session_lifetime_s);
+  const std::string token = operators_->issue(account->user, utc_now_s(), lifetime);
+  spdlog::info("ground audit: {} ({}) signed in from {}", account->user, to_string(account->role), req.remote_addr);
+  auto res = json_reply(200, {{"user", account->user},
+                              {"role", to_string(account->role)},
+                              {"csrf", operators_->csrf(token)}});
+  res.headers.emplace_back("Set-Cookie", std::string(kCookie) + "=" + token + "; Path=/; Max-Age=" +
+                                             std::to_string(lifetime) + "; HttpOnly; SameSite=Strict" +
+                                             (req.tls ? "; Secure" : ""));
+  return res;
+}
+
+HttpResponse GroundServer::command(const HttpRequest& req, const Session& session) {
+  if (session.role != Role::kCommander)
+    return refuse(req, 403, "the role viewer may not command", session.user);
+  auto request = parse_command_request(req.body, session.user, "ground@" + req.remote_addr);
+  if (!request) return refuse(req, 400, request.error().message, session.user);
+  if (commands_waiting_.fetch_add(1) >= config_.commands_in_flight) {
+    commands_waiting_.fetch_sub(1);
+    return refuse(req, 503, "other commands are waiting for their acknowledgement: try again", session.user);
+  }
+  auto ack = send_(*request);
+  commands_waiting_.fetch_sub(1);
+  const std::string what = std::string(request->kind == tetra_COMMAND_RESET     ? "reset"
+                                       : request->kind == tetra_COMMAND_EXCLUDE ? "exclude"
+                                                                                : "reinstate") +
+                           (request->gyro != 0 ? " gyro " + std::to_string(request->gyro) : "") +
+                           (request->force ? " force" : "");
+  if (!ack) {
+    spdlog::warn("ground audit: {} from {}: {} to {}: no acknowledgement ({})", session.user, req.remote_addr,
+                 what, request->unit, ack.error().message);
+    return error_reply(504, ack.error().message);
+  }
+  spdlog::info("ground audit: {} from {}: {} to {}: {} ({})", session.user, req.remote_addr, what,
+               request->unit, ack->event.refused() ? "refused" : "accepted", ack->event.detail);
+  return json_reply(200, ack_json(*ack, 16));
+}
+
+HttpResponse GroundServer::stream(const HttpRequest& req) {
+  auto q = QueryParams::of(req.params, {"last_event_id"});
+  if (!q) return error_reply(400, q.error().message);
+  std::string last = req.header("last-event-id");
+  if (last.empty()) last = q->text("last_event_id");
+  HttpResponse res;
+  res.stream = true;
+  res.stream_start = "retry: 1000\n\n";
+  const std::uint64_t newest = store_.last_id();
+  // Resume only an id of this run that the ring still holds; anything else (an id of an earlier run of
+  // the ground station, one from the future, too far behind) gets a reset and the current state.
+  std::uint64_t after = 0;
+  bool resume = false;
+  const std::string prefix = instance_ + "-";
+  if (last.compare(0, prefix.size(), prefix) == 0 && last.size() > prefix.size() && last.size() < prefix.size() + 20 &&
+      last.find_first_not_of("0123456789", prefix.size()) == std::string::npos) {
+    after = std::stoull(last.substr(prefix.size()));
+    resume = after <= newest && newest - after <= kMaxCatchUp &&
+             !store_.read_stream(after, 1, std::chrono::milliseconds(0)).gap;
+  }
+  if (!resume) {
+    if (!last.empty()) res.stream_start += "event: reset\ndata: {}\n\n";
+    after = newest;
+    for (const auto& m : store_.snapshot(steady_now_ns())) append_message(res.stream_start, m);
+  }
+  res.stream_after = after;
+  return res;
+}
+
+HttpResponse GroundServer::history(const HttpRequest& req) {
+  auto q = QueryParams::of(req.params, {"unit", "kind", "start", "end", "max"});
+  if (!q) return error_reply(400, q.error().message);
+  const auto start = q->number("start", 0);
+  const auto end = q->number("end", 1e300);
+  const auto max = q->count("max", 5000, 1, 100000);
+  for (const Error* e : {start ? nullptr : &start.error(), end ? nullptr : &end.error(), max ? nullptr : &max.error()}) {
+    if (e != nullptr) return error_reply(400, e->message);
+  }
+  if (!q->has("unit")) return error_reply(400, "parameter 'unit' missing");
+  auto h = store_.history(q->text("unit"), q->text("kind"), *start, *end, *max);
+  if (!h) return error_reply(h.error().message.rfind("history kind", 0) == 0 ? 400 : 404, h.error().message);
+  return json_reply(200, *h);
+}
+
+HttpResponse GroundServer::records(const HttpRequest& req) {
+  if (config_.records_dir.empty()) return error_reply(404, "no --records folder given");
+  auto q = QueryParams::of(req.params, {"file", "start", "end", "max"});
+  if (!q) return error_reply(400, q.error().message);
+  if (!q->has("file")) {
+    auto list = list_records(config_.records_dir);
+    if (!list) return error_reply(500, "the records folder cannot be read");
+    return json_reply(200, *list);
+  }
+  const auto start = q->number("start", -1e300);
+  const auto end = q->number("end", 1e300);
+  const auto max = q->count("max", 5000, 1, 100000);
+  for (const Error* e : {start ? nullptr : &start.error(), end ? nullptr : &end.error(), max ? nullptr : &max.error()}) {
+    if (e != nullptr) return error_reply(400, e->message);
+  }
+  auto r = read_record(config_.records_dir, q->text("file"), *start, *end, *max);
+  if (!r) return error_reply(404, r.error().message);
+  return json_reply(200, *r);
 }
 
 }  // namespace tetra::ground

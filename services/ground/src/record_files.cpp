@@ -8,6 +8,7 @@
 #include "tetra/core/csv.hpp"
 #include "tetra/core/quaternion.hpp"
 #include "tetra/ground/encode.hpp"
+#include "tetra/ground/strict_json.hpp"
 
 namespace tetra::ground {
 
@@ -48,18 +49,21 @@ Result<json> attitude_row(const std::vector<std::string>& cells, const std::stri
 }
 
 Result<json> event_row(const std::string& line, const std::string& where) {
-  json row = json::parse(line, nullptr, false);
-  if (row.is_discarded() || !row.is_object() || !row.contains("time_s") || !row["time_s"].is_number())
+  auto parsed = parse_strict_json(line);
+  if (!parsed) return bad_input(where + ": " + parsed.error().message);
+  json row = std::move(parsed).value();
+  if (!row.is_object() || !row.contains("time_s") || !row["time_s"].is_number())
     return bad_input(where + ": not an event (a JSON object with time_s)");
   row["type"] = "event";
   row["sensor_time_s"] = row["time_s"];
   return row;
 }
 
-//! The file's rows in [start_s, end_s].
-Result<std::vector<json>> rows_of(const std::string& path, double start_s, double end_s) {
+//! The file's rows in [start_s, end_s]; errors name the file by `name` (never the server's path).
+Result<std::vector<json>> rows_of(const std::string& path, const std::string& name, double start_s,
+                                  double end_s) {
   auto text = read_text_file(path);
-  if (!text) return text.error();
+  if (!text) return bad_input("record file '" + name + "': cannot be read");
   const bool csv = fs::path(path).extension() == ".csv";
   std::vector<json> rows;
   std::istringstream in(*text);
@@ -69,11 +73,11 @@ Result<std::vector<json>> rows_of(const std::string& path, double start_s, doubl
     if (line.empty() || line[0] == '#') continue;
     if (!header_seen) {
       if (line.rfind(kAttitudeHeader, 0) != 0)
-        return bad_input(path + ":" + std::to_string(number) + ": not an attitude file");
+        return bad_input(name + ":" + std::to_string(number) + ": not an attitude file");
       header_seen = true;
       continue;
     }
-    const std::string where = path + ":" + std::to_string(number);
+    const std::string where = name + ":" + std::to_string(number);
     auto row = csv ? attitude_row(split(line), where) : event_row(line, where);
     if (!row) return row.error();
     const double t = (*row)["sensor_time_s"].get<double>();
@@ -89,7 +93,10 @@ Result<json> list_records(const std::string& dir) {
   std::vector<json> files;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const auto ext = entry.path().extension();
-    if (!entry.is_regular_file() || (ext != ".csv" && ext != ".jsonl")) continue;
+    // A link is not listed (it may lead out of the folder), nor is a hidden file.
+    if (entry.is_symlink() || !entry.is_regular_file() || (ext != ".csv" && ext != ".jsonl") ||
+        entry.path().filename().string()[0] == '.')
+      continue;
     if (ext == ".csv") {
       auto text = read_text_file(entry.path().string());
       if (!text || text->find(kAttitudeHeader) == std::string::npos) continue;  // a gyro log, not attitude
@@ -97,16 +104,23 @@ Result<json> list_records(const std::string& dir) {
     files.push_back(
         {{"name", entry.path().filename().string()}, {"kind", ext == ".csv" ? "attitude" : "events"}});
   }
-  if (ec) return bad_input("--records " + dir + ": " + ec.message());
+  if (ec) return bad_input("the records folder cannot be read: " + ec.message());
   std::sort(files.begin(), files.end(), [](const json& a, const json& b) { return a["name"] < b["name"]; });
   return json(files);
 }
 
 Result<json> read_record(const std::string& dir, const std::string& name, double start_s, double end_s,
                          std::size_t max_points) {
-  if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
-    return bad_input("record file '" + name + "': a plain file name of the records folder");
-  auto rows = rows_of((fs::path(dir) / name).string(), start_s, end_s);
+  const fs::path path = fs::path(dir) / name;
+  const auto ext = path.extension();
+  std::error_code ec;
+  if (name.empty() || name.size() > 255 || name.find('/') != std::string::npos || name.find('\0') != std::string::npos ||
+      name[0] == '.' || (ext != ".csv" && ext != ".jsonl"))
+    return bad_input("record file '" + name + "': a plain .csv or .jsonl file name of the records folder");
+  // Never a link (it may lead out of the folder): the file itself must be a regular file.
+  if (!fs::is_regular_file(fs::symlink_status(path, ec)))
+    return bad_input("record file '" + name + "': no such file in the records folder");
+  auto rows = rows_of(path.string(), name, start_s, end_s);
   if (!rows) return rows.error();
   const std::size_t stride = max_points == 0 ? 1 : (rows->size() + max_points - 1) / max_points;
   json out = json::array();

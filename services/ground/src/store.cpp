@@ -41,6 +41,12 @@ int GroundStore::gyro_count(const Unit& u) const {
 void GroundStore::stream(const char* event, const json& data) {
   stream_.push({next_id_++, event, data.dump()});
   arrived_.notify_all();
+  if (listener_) listener_();
+}
+
+void GroundStore::set_listener(std::function<void()> listener) {
+  const std::lock_guard lock(mutex_);
+  listener_ = std::move(listener);
 }
 
 void GroundStore::add_health(const dds::HealthView& health, std::int64_t utc_ns, std::int64_t now_ns) {
@@ -189,7 +195,7 @@ Result<json> GroundStore::history(const std::string& name, const std::string& ki
         ring.partition_point([end_ms](const auto& item) { return utc_ms(item.utc_ns) <= end_ms; });
     if (last <= first) return;
     const std::size_t count = last - first;
-    const std::size_t stride = max_points == 0 ? 1 : (count + max_points - 1) / max_points;
+    const std::size_t stride = max_points == 0 ? 1 : std::max<std::size_t>(1, (count - 1) / max_points + 1);
     for (std::size_t i = first; i < last; i += stride) out.push_back(encode(ring[i]));
   };
   if (kind == "health") {

@@ -35,6 +35,8 @@ namespace tetra::service {
 //! returned as an error) and publishes a last Health.
 class FusionService {
  public:
+  //! [s] wall clock: every gyro silent this long is reported as a `lost` event (shorter: counted only).
+  static constexpr double kMinOutageReported_s = 2.0;
   FusionService(FusionConfig config, fdi::Pipeline pipeline, EpochAssembler assembler)
       : config_(std::move(config)),
         pipeline_(std::move(pipeline)),
@@ -80,7 +82,7 @@ class FusionService {
   Status process_epochs(std::int64_t now_ns);
   Status publish_event(const fdi::FdiEvent& event, std::uint64_t command_id, const dds::CommandAudit& audit);
   //! An event when every gyro has gone silent, and when samples come back.
-  Status report_silence();
+  Status report_silence(std::int64_t now_ns);
   Status publish_health(std::int64_t now_ns, bool force);
   //! The health to publish, into `out` (its storage is reused).
   void current_health(fdi::Health& out) const;
@@ -107,7 +109,10 @@ class FusionService {
   std::uint64_t event_seq_ = 0;
   std::uint32_t gyro_writers_ = 0;  //!< matched GyroSample writers (published in Health)
   std::uint64_t last_restarts_ = 0;
-  bool all_silent_ = false;  //!< every gyro absent (reported as an event)
+  bool all_silent_ = false;     //!< every gyro absent since silent_since_ns_ (after a first epoch)
+  bool lost_reported_ = false;  //!< the silence lasted kMinOutageReported_s: a `lost` event went out
+  std::int64_t silent_since_ns_ = 0;  //!< [ns] local monotonic time
+  std::uint64_t unit_silences_ = 0;   //!< outages of every gyro, in Health's counters
   bool fused_any_ = false;   //!< an epoch has been fused (commands are stamped with its time)
   std::vector<fdi::Epoch> epochs_;
   std::int64_t scheduled_wake_ns_ = 0;   //!< [ns] when the waitset thread wakes by itself next

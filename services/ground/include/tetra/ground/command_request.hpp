@@ -10,7 +10,8 @@
 
 namespace tetra::ground {
 
-//! An operator command as the browser posts it: {"unit", "action", "gyro", "force", "operator"}.
+//! An operator command as the browser posts it: {"unit", "action", "gyro", "force"}; the operator is
+//! the signed-in user, never a field of the request.
 struct CommandRequest {
   std::string unit;
   tetra_CommandKind kind = tetra_COMMAND_RESET;
@@ -19,8 +20,9 @@ struct CommandRequest {
   std::string operator_id;
   std::string origin;  //!< set by the server: "ground@<client address>"
 };
-//! Validates a POST body; errors name the field.
-Result<CommandRequest> parse_command_request(const std::string& body, const std::string& origin);
+//! Validates a POST body (no other keys, none twice); errors name the field.
+Result<CommandRequest> parse_command_request(const std::string& body, const std::string& operator_id,
+                                             const std::string& origin);
 
 //! The wire form; errors when a text is longer than the wire's bound.
 Status to_wire(const CommandRequest& request, std::uint64_t command_id, tetra_Command& out);

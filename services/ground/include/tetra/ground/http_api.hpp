@@ -1,23 +1,28 @@
 #pragma once
-// The ground station's HTTP server (docs/ground.md): the web application's files, the event stream
-// (server-sent events), history, the units' link states, and commands as JSON POST answered with the
-// service's acknowledgement. One thread per connection from a bounded pool.
+// The ground station's HTTP interface (docs/ground.md): sign-in and sessions, the web application's
+// files, the event stream (server-sent events), history, the units' link states, and commands as JSON
+// POST answered with the service's acknowledgement. Every request is checked before it is served:
+// its Host and Origin against an allow-list, a session (or the explicit --no-auth of loopback), and for
+// a state-changing request the JSON content type, the session's CSRF token and, for a command, the
+// commander role. Refusals are logged as audit lines.
 
 #include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
 #include <string>
-#include <thread>
+#include <vector>
 
 #include "tetra/core/result.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/ground/command_request.hpp"
+#include "tetra/ground/http_server.hpp"
+#include "tetra/ground/operators.hpp"
+#include "tetra/ground/static_files.hpp"
 #include "tetra/ground/store.hpp"
-
-namespace httplib {
-class Server;
-}
 
 namespace tetra::ground {
 
@@ -29,9 +34,18 @@ struct ServerConfig {
   int port = 8080;            //!< 0: any free port (see GroundServer::port())
   std::string web_dir;        //!< the web application (index.html, tetra-plugin.js, node_modules/openmct)
   std::string records_dir;    //!< `tetra record` files served by /api/records ("": none)
-  int worker_threads = 32;    //!< concurrent connections (each browser holds one for its stream)
-  int stream_wait_ms = 1000;  //!< [ms] a keep-alive comment at least this often on a quiet stream
+  std::string users_path;     //!< operator accounts (tetra ground passwd); "" only with no_auth
+  std::string session_key_path;  //!< the key sessions are signed with (created when absent)
+  bool no_auth = false;       //!< no accounts: everyone who reaches the port is commander "anonymous"
+  std::vector<std::string> allow_origins;  //!< more HOST:PORT a browser may reach the ground as
+  TlsFiles tls;
+  HttpLimits limits;
+  double session_lifetime_s = 12 * 3600.0;  //!< [s]
+  int commands_in_flight = 2;  //!< commands waiting for their acknowledgement at once; beyond: 503
 };
+
+//! True for 127.0.0.0/8, ::1 and "localhost".
+bool is_loopback_host(const std::string& host);
 
 class GroundServer {
  public:
@@ -40,21 +54,35 @@ class GroundServer {
   GroundServer(const GroundServer&) = delete;
   GroundServer& operator=(const GroundServer&) = delete;
 
-  //! Binds and starts serving on a thread of its own.
+  //! Checks the configuration, binds and starts serving on threads of its own.
   Status start();
-  //! Stops serving; open streams end within stream_wait_ms.
   void stop();
-  int port() const { return port_; }
+  int port() const { return server_ ? server_->port() : 0; }
 
  private:
-  void routes();
+  HttpResponse handle(const HttpRequest& req);
+  HttpResponse serve(const HttpRequest& req, const std::optional<Session>& session);
+  HttpResponse refuse(const HttpRequest& req, int status, const std::string& why, const std::string& user);
+  HttpResponse login(const HttpRequest& req);
+  HttpResponse command(const HttpRequest& req, const Session& session);
+  HttpResponse stream(const HttpRequest& req);
+  HttpResponse history(const HttpRequest& req);
+  HttpResponse records(const HttpRequest& req);
+  std::optional<Session> session_of(const HttpRequest& req);
+  std::uint64_t feed_next(std::uint64_t after, std::string& out) const;
+  void append_message(std::string& out, const StreamMessage& m) const;
+
   GroundStore& store_;
   SendCommand send_;
   ServerConfig config_;
-  std::unique_ptr<httplib::Server> server_;
-  std::thread thread_;
-  std::atomic<bool> stopping_{false};
-  int port_ = 0;
+  std::unique_ptr<HttpServer> server_;
+  std::optional<Operators> operators_;
+  StaticFiles files_;
+  std::set<std::string> allowed_hosts_;  //!< "host:port", lower case
+  std::string instance_;                 //!< this run's prefix of every event id
+  std::string no_auth_csrf_;
+  std::mutex login_mutex_;               //!< one password check at a time (64 MiB each)
+  std::atomic<int> commands_waiting_{0};
 };
 
 }  // namespace tetra::ground

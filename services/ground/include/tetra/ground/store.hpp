@@ -8,6 +8,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -76,6 +77,8 @@ class GroundStore {
                                  double end_ms, std::size_t max_points) const;
   //! Messages dropped from the stream ring, items dropped from the histories (bounded memory).
   std::size_t stream_dropped() const;
+  //! Called (under the store's lock: it must be quick) for every new stream message.
+  void set_listener(std::function<void()> listener);
 
  private:
   template <class T>
@@ -110,6 +113,7 @@ class GroundStore {
   std::map<std::string, Unit> units_;
   RingBuffer<StreamMessage> stream_;
   std::uint64_t next_id_ = 1;
+  std::function<void()> listener_;
 };
 
 }  // namespace tetra::ground

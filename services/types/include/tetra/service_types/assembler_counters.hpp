@@ -20,6 +20,7 @@ struct AssemblerCounters {
   std::uint64_t liveliness_lost = 0;       //!< counted by the caller through mark_absent()
   std::uint64_t time_outlier = 0;          //!< stamps far outside the unit's clock (dropped)
   std::uint64_t seq_discontinuity = 0;     //!< sequence numbers jumping further than time explains
+  std::uint64_t unit_silences = 0;         //!< counted by the caller: every gyro silent at once
 };
 
 }  // namespace tetra::service

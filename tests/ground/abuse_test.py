@@ -1,0 +1,206 @@
+#!/usr/bin/python3
+"""The ground station under abuse, through raw sockets: `tetra ground --no-auth --max-streams 1000`
+holds 1,000 open event streams and refuses the next with 503; 100 slow clients send their requests a
+byte a second; meanwhile the API answers every request (a socket timeout of 5 s only turns a hang into
+a failure); the slow clients are closed at the request deadline. Prints the API's latency and the
+ground's resident memory (figures for docs/ground.md; `--requests 1000` for the bench figure).
+Latency is reported, never a pass/fail condition.
+"""
+
+import argparse
+import os
+import re
+import resource
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+STREAMS = 1000
+SLOW = 100
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def rss_mib(pid):
+    with open(f"/proc/{pid}/status", encoding="ascii") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    return float("nan")
+
+
+def connect(port, timeout=5.0):
+    s = socket.create_connection(("127.0.0.1", port), timeout=timeout)
+    s.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    return s
+
+
+def status_of(sock):
+    head = b""
+    while b"\r\n" not in head:
+        chunk = sock.recv(4096)
+        if not chunk:
+            break
+        head += chunk
+    m = re.match(rb"HTTP/1\.1 (\d+)", head)
+    return int(m.group(1)) if m else -1
+
+
+def get(port, path):
+    """One GET on a new connection: (status, seconds)."""
+    start = time.perf_counter()
+    with connect(port) as s:
+        s.sendall(f"GET {path} HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n".encode())
+        data = b""
+        while True:
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            data += chunk
+    m = re.match(rb"HTTP/1\.1 (\d+)", data)
+    return (int(m.group(1)) if m else -1), time.perf_counter() - start
+
+
+def percentile(values, q):
+    v = sorted(values)
+    return v[min(len(v) - 1, int(q * len(v)))]
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--tetra", required=True)
+    ap.add_argument("--source", required=True)
+    ap.add_argument("--requests", type=int, default=100, help="API requests timed under load")
+    ap.add_argument("--domain", default="184")  # private to this test (tests/CMakeLists.txt)
+    ap.add_argument("--publisher", help="bench/ground_load_publisher: 10 units at 100 Hz stream while measured")
+    ap.add_argument("--spread", type=float, default=0.0, help="[s] spread the timed requests over this long")
+    args = ap.parse_args()
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    resource.setrlimit(resource.RLIMIT_NOFILE, (hard, hard))
+    os.environ["CYCLONEDDS_URI"] = "file://" + os.path.join(args.source, "config", "cyclonedds-loopback.xml")
+    port = free_port()
+    log_path = f"/tmp/tetra_abuse_{os.getpid()}.log"
+    log = open(log_path, "w")
+    ground = subprocess.Popen([args.tetra, "ground", "--listen", f"127.0.0.1:{port}", "--no-auth",
+                               "--max-streams", str(STREAMS), "--domain", args.domain],
+                              stdout=log, stderr=subprocess.STDOUT)
+    held = []
+    slow = []
+    publisher = None
+    if args.publisher:
+        publisher = subprocess.Popen([args.publisher, "--domain", args.domain, "--units", "10", "--rate", "100",
+                                      "--seconds", str(int(args.spread) + 120)],
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    stop = threading.Event()
+    failures = []
+    try:
+        for _ in range(300):
+            try:
+                connect(port, 1).close()
+                break
+            except OSError:
+                time.sleep(0.1)
+        rss_idle = rss_mib(ground.pid)
+
+        # 1,000 event streams, each read up to its status line only (then never read again).
+        for i in range(STREAMS):
+            s = connect(port)
+            s.sendall(f"GET /api/stream HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n".encode())
+            code = status_of(s)
+            if code != 200:
+                failures.append(f"stream {i + 1}: status {code}")
+                break
+            held.append(s)
+        beyond, _ = get(port, "/api/stream")
+        if beyond != 503:
+            failures.append(f"stream {STREAMS + 1}: status {beyond}, expected 503")
+
+        # 100 slow clients: a request a byte a second.
+        request = f"GET /api/units HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n".encode()
+        for _ in range(SLOW):
+            slow.append([connect(port, 30), 0])
+
+        def trickle():
+            while not stop.is_set():
+                for entry in slow:
+                    if entry[1] < len(request) - 1:
+                        try:
+                            entry[0].send(request[entry[1]:entry[1] + 1])
+                            entry[1] += 1
+                        except OSError:
+                            entry[1] = len(request)
+                stop.wait(1.0)
+
+        threading.Thread(target=trickle, daemon=True).start()
+        started_slow = time.monotonic()
+
+        # The API under that load.
+        latencies = []
+        for i in range(args.requests):
+            path = "/api/units" if i % 2 == 0 else "/api/history?unit=none&kind=event&max=10"
+            code, seconds = get(port, path)
+            if code not in (200, 404):
+                failures.append(f"{path}: status {code}")
+                break
+            latencies.append(seconds * 1000.0)
+            if args.spread:
+                time.sleep(args.spread / args.requests)
+        rss_held = rss_mib(ground.pid)
+        closed_slow_readers = open(log_path, encoding="utf-8", errors="replace").read().count("a slow reader")
+
+        # The slow clients are closed at the request deadline (10 s), never served.
+        stop_wait = started_slow + 25
+        closed = 0
+        for entry in slow:
+            entry[0].settimeout(max(0.1, stop_wait - time.monotonic()))
+            try:
+                data = entry[0].recv(4096)
+                closed += 1 if data == b"" or data.startswith(b"HTTP/1.1 408") else 0
+            except OSError:
+                pass
+        stop.set()
+        if closed != SLOW:
+            failures.append(f"{SLOW - closed} of {SLOW} slow clients not closed at the request deadline")
+        log.flush()
+        refused_logged = "refused (503)" in open(log_path, encoding="utf-8", errors="replace").read()
+        if not refused_logged:
+            failures.append("the refused stream is not in the ground's log")
+
+        if latencies:
+            p50, p99, worst = percentile(latencies, 0.5), percentile(latencies, 0.99), max(latencies)
+            print(f"ground_abuse: {len(held)} streams held, stream {STREAMS + 1} refused ({beyond}); {SLOW} slow "
+                  f"clients; {len(latencies)} API requests: p50 {p50:.1f} ms, p99 {p99:.1f} ms, max {worst:.1f} ms "
+                  f"({'within' if worst < 100 else 'NOT within'} 100 ms); resident {rss_idle:.1f} MiB idle, "
+                  f"{rss_held:.1f} MiB with the streams; {closed_slow_readers} unread streams closed at their buffer "
+                  f"bound; load average {os.getloadavg()[0]:.1f}")
+        if failures:
+            print("ground_abuse: FAILED: " + "; ".join(failures), file=sys.stderr)
+            print(open(log_path, encoding="utf-8", errors="replace").read()[-2000:], file=sys.stderr)
+            return 1
+        return 0
+    finally:
+        stop.set()
+        for s in held:
+            s.close()
+        for entry in slow:
+            entry[0].close()
+        if publisher is not None:
+            publisher.terminate()
+            publisher.wait()
+        ground.terminate()
+        try:
+            ground.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            ground.kill()
+        log.close()
+        os.unlink(log_path)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

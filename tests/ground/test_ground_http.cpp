@@ -1,0 +1,291 @@
+// The ground station's HTTP server in process, without DDS (a fake command sender), through raw
+// sockets: sign-in and roles, the cross-site defences (Host, Origin, content type, CSRF token), the
+// operator of a command being the signed-in user, validated parameters, the body limit, the bounded
+// number of streams, stream ids of the server's run, and the request deadline against slow clients.
+// Waits have generous bounds that only turn a hang into a failure; nothing asserts on elapsed time.
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "test_support.hpp"
+#include "tetra/ground/http_api.hpp"
+#include "tetra/ground/operators.hpp"
+
+namespace tetra::ground {
+namespace {
+
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+int connect_to(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  timeval tv{10, 0};  // a hang becomes a failure
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+//! Reads until the peer closes, `until` appears, or 10 s pass without data.
+std::string read_from(int fd, const std::string& until = "") {
+  std::string text;
+  char buf[4096];
+  for (;;) {
+    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    if (n <= 0) break;
+    text.append(buf, static_cast<std::size_t>(n));
+    if (!until.empty() && text.find(until) != std::string::npos) break;
+  }
+  return text;
+}
+
+struct Reply {
+  int status = 0;
+  std::string head;
+  std::string body;
+  json data() const { return json::parse(body, nullptr, false); }
+};
+
+Reply parse_reply(const std::string& text) {
+  Reply r;
+  const auto end = text.find("\r\n\r\n");
+  r.head = text.substr(0, end);
+  r.body = end == std::string::npos ? "" : text.substr(end + 4);
+  if (text.size() > 12) r.status = std::atoi(text.substr(9, 3).c_str());
+  return r;
+}
+
+class Ground {
+ public:
+  explicit Ground(ServerConfig config) : store_(StoreConfig{}) {
+    config.web_dir = std::string(TETRA_SOURCE_DIR) + "/web";
+    config.port = 0;
+    server_ = std::make_unique<GroundServer>(
+        store_,
+        [this](const CommandRequest& request) -> Result<dds::EventView> {
+          sent.push_back(request);
+          dds::EventView ack;
+          ack.unit = request.unit;
+          ack.command_id = 7;
+          ack.command.operator_id = request.operator_id;
+          ack.command.origin = request.origin;
+          ack.event.type = fdi::EventType::kCommand;
+          ack.event.detail = "done";
+          return ack;
+        },
+        std::move(config));
+  }
+  Status start() { return server_->start(); }
+  int port() const { return server_->port(); }
+  std::string host() const { return "127.0.0.1:" + std::to_string(port()); }
+  //! One request on its own connection; `headers` are whole lines with CRLF.
+  Reply request(const std::string& method, const std::string& path, const std::string& headers = "",
+                const std::string& body = "") const {
+    const int fd = connect_to(port());
+    std::string req = method + " " + path + " HTTP/1.1\r\nHost: " + host() + "\r\nConnection: close\r\n" +
+                      headers + "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body;
+    (void)::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+    Reply r = parse_reply(read_from(fd));
+    ::close(fd);
+    return r;
+  }
+  GroundStore& store() { return store_; }
+  std::vector<CommandRequest> sent;
+
+ private:
+  GroundStore store_;
+  std::unique_ptr<GroundServer> server_;
+};
+
+const std::string kJson = "Content-Type: application/json\r\n";
+
+TEST(GroundHttp, SignInRolesAndCrossSiteDefences) {
+  test::TempDir dir;
+  auto hash = hash_password("correct horse");
+  ASSERT_TRUE(hash.ok());
+  ASSERT_TRUE(set_account(dir.file("users"), {"alice", Role::kCommander, *hash}).ok());
+  ASSERT_TRUE(set_account(dir.file("users"), {"victor", Role::kViewer, *hash}).ok());
+  ServerConfig config;
+  config.users_path = dir.file("users");
+  Ground g(config);
+  ASSERT_TRUE(g.start().ok());
+
+  // No session: the API says 401, a page goes to the sign-in page.
+  EXPECT_EQ(g.request("GET", "/api/units").status, 401);
+  const Reply page = g.request("GET", "/");
+  EXPECT_EQ(page.status, 302);
+  EXPECT_NE(page.head.find("Location: /login.html"), std::string::npos);
+  EXPECT_EQ(g.request("GET", "/login.html").status, 200);
+  EXPECT_EQ(g.request("POST", "/api/login", kJson, R"({"user":"alice","password":"wrong"})").status, 401);
+
+  const auto sign_in = [&](const std::string& user) {
+    const Reply r = g.request("POST", "/api/login", kJson, R"({"user":")" + user + R"(","password":"correct horse"})");
+    EXPECT_EQ(r.status, 200) << r.body;
+    const auto at = r.head.find("Set-Cookie: tetra_session=");
+    EXPECT_NE(at, std::string::npos);
+    const std::string line = r.head.substr(at, r.head.find("\r\n", at) - at);
+    EXPECT_NE(line.find("; HttpOnly"), std::string::npos) << line;
+    EXPECT_NE(line.find("; SameSite=Strict"), std::string::npos) << line;
+    const std::string cookie = line.substr(12, line.find(';') - 12);
+    return std::make_pair("Cookie: " + cookie + "\r\n", r.data()["csrf"].get<std::string>());
+  };
+  const auto [alice, alice_csrf] = sign_in("alice");
+  const auto [victor, victor_csrf] = sign_in("victor");
+  const Reply session = g.request("GET", "/api/session", alice);
+  EXPECT_EQ(session.data()["user"], "alice");
+  EXPECT_EQ(session.data()["role"], "commander");
+
+  const std::string command = R"({"unit":"u","action":"reset"})";
+  const std::string alice_token = "X-CSRF-Token: " + alice_csrf + "\r\n";
+  // Forged requests as a cross-site page makes them: none reaches the unit.
+  EXPECT_EQ(g.request("POST", "/api/command", alice + "Content-Type: text/plain\r\n" + alice_token, command).status, 415);
+  EXPECT_EQ(g.request("POST", "/api/command", alice + kJson, command).status, 403);  // no token
+  EXPECT_EQ(g.request("POST", "/api/command", alice + kJson + "X-CSRF-Token: " + victor_csrf + "\r\n", command).status,
+            403);  // another session's token
+  EXPECT_EQ(g.request("POST", "/api/command", alice + kJson + alice_token + "Origin: http://evil.example\r\n", command)
+                .status,
+            403);
+  // DNS rebinding: the right address under another name.
+  {
+    const int fd = connect_to(g.port());
+    const std::string req = "GET /api/units HTTP/1.1\r\nHost: evil.example:" + std::to_string(g.port()) +
+                            "\r\nConnection: close\r\n" + alice + "\r\n";
+    (void)::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+    EXPECT_EQ(parse_reply(read_from(fd)).status, 403);
+    ::close(fd);
+  }
+  EXPECT_EQ(g.request("POST", "/api/command", victor + kJson + "X-CSRF-Token: " + victor_csrf + "\r\n", command).status,
+            403);  // a viewer
+  EXPECT_TRUE(g.sent.empty());
+
+  // The commander's command, with the operator the session's user (a typed one is refused).
+  EXPECT_EQ(g.request("POST", "/api/command", alice + kJson + alice_token, R"({"unit":"u","action":"reset","operator":"eve"})")
+                .status,
+            400);
+  const Reply ok = g.request("POST", "/api/command", alice + kJson + alice_token + "Origin: http://" + g.host() + "\r\n",
+                             command);
+  ASSERT_EQ(ok.status, 200) << ok.body;
+  ASSERT_EQ(g.sent.size(), 1U);
+  EXPECT_EQ(g.sent[0].operator_id, "alice");
+  EXPECT_EQ(g.sent[0].origin, "ground@127.0.0.1");
+  EXPECT_EQ(ok.data()["operator"], "alice");
+  EXPECT_EQ(ok.head.find("Access-Control"), std::string::npos);  // no CORS
+
+  // Signed out: the cookie no longer opens anything.
+  EXPECT_EQ(g.request("POST", "/api/logout", alice + kJson + alice_token, "{}").status, 200);
+  EXPECT_EQ(g.request("GET", "/api/units", alice).status, 401);
+}
+
+TEST(GroundHttp, NoAuthIsRefusedOffLoopbackAndNeedsNoAccounts) {
+  ServerConfig off;
+  off.no_auth = true;
+  off.host = "0.0.0.0";
+  Ground refused(off);
+  EXPECT_FALSE(refused.start().ok());
+  ServerConfig none;
+  Ground no_accounts(none);  // neither --users nor --no-auth
+  EXPECT_FALSE(no_accounts.start().ok());
+}
+
+TEST(GroundHttp, ParametersBodiesStreamsAndSlowClientsAreBounded) {
+  ServerConfig config;
+  config.no_auth = true;
+  config.limits.max_streams = 3;
+  config.limits.request_timeout_s = 0.5;
+  config.allow_origins = {"http://ground.example.org"};
+  Ground g(config);
+  ASSERT_TRUE(g.start().ok());
+  const Reply session = g.request("GET", "/api/session");
+  ASSERT_EQ(session.status, 200);
+  EXPECT_EQ(session.data()["user"], "anonymous");
+  // --allow-origin adds a name; without a port it is the scheme's default, as a browser omits it.
+  const auto with_host = [&](const std::string& host) {
+    const int fd = connect_to(g.port());
+    const std::string req = "GET /api/units HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n";
+    (void)::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+    const int status = parse_reply(read_from(fd)).status;
+    ::close(fd);
+    return status;
+  };
+  EXPECT_EQ(with_host("ground.example.org"), 200);
+  EXPECT_EQ(with_host("ground.example.org:80"), 200);
+  EXPECT_EQ(with_host("ground.example.org:8443"), 403);
+  EXPECT_EQ(with_host("other.example.org"), 403);
+
+  // A negative count was a loop without end: now a 400 naming the parameter.
+  const Reply negative = g.request("GET", "/api/history?unit=u&kind=event&max=-1");
+  EXPECT_EQ(negative.status, 400);
+  EXPECT_NE(negative.body.find("'max'"), std::string::npos) << negative.body;
+  EXPECT_EQ(g.request("GET", "/api/history?unit=u&kind=event&start=inf").status, 400);
+  EXPECT_EQ(g.request("GET", "/api/history?unit=u&kind=event&what=1").status, 400);
+  EXPECT_EQ(g.request("GET", "/api/records?file=a%00.csv").status, 400);
+
+  // A body beyond the limit is refused from its Content-Length, before it is read.
+  {
+    const int fd = connect_to(g.port());
+    const std::string req = "POST /api/command HTTP/1.1\r\nHost: " + g.host() +
+                            "\r\nContent-Type: application/json\r\nContent-Length: 268435456\r\n\r\n";
+    (void)::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+    EXPECT_EQ(parse_reply(read_from(fd)).status, 413);
+    ::close(fd);
+  }
+
+  // Streams: ids carry this run's instance; three held, the fourth refused with 503.
+  dds::HealthView h;
+  h.unit = "u";
+  h.health_period_s = 0.5;
+  g.store().add_health(h, 1'700'000'000'000'000'000, 1);
+  std::vector<int> streams;
+  std::string first;
+  for (int i = 0; i < 3; ++i) {
+    const int fd = connect_to(g.port());
+    const std::string req = "GET /api/stream HTTP/1.1\r\nHost: " + g.host() + "\r\n\r\n";
+    (void)::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+    const std::string text = read_from(fd, "event: link");
+    EXPECT_NE(text.find("200 OK"), std::string::npos) << text;
+    if (i == 0) first = text;
+    streams.push_back(fd);
+  }
+  EXPECT_EQ(g.request("GET", "/api/stream").status, 503);
+  EXPECT_EQ(g.request("GET", "/api/units").status, 200);  // the API still answers
+  g.store().add_health(h, 1'700'000'000'100'000'000, 2);
+  const std::string more = read_from(streams[0], "\n\n");
+  const auto id_at = more.find("id: ");
+  ASSERT_NE(id_at, std::string::npos) << more;
+  const std::string id = more.substr(id_at + 4, more.find('\n', id_at) - id_at - 4);
+  EXPECT_NE(id.find('-'), std::string::npos) << id;  // "<instance>-<n>"
+  for (const int fd : streams) ::close(fd);
+  std::this_thread::sleep_for(200ms);  // the server sees the closes
+
+  // A Last-Event-ID of another run (a restarted ground station): a reset and the current state.
+  const int fd = connect_to(g.port());
+  const std::string req = "GET /api/stream HTTP/1.1\r\nHost: " + g.host() + "\r\nLast-Event-ID: 0badf00d-99999\r\n\r\n";
+  (void)::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+  const std::string reset = read_from(fd, "event: link");
+  EXPECT_NE(reset.find("event: reset"), std::string::npos) << reset;
+  EXPECT_NE(reset.find("event: health"), std::string::npos) << reset;
+  ::close(fd);
+
+  // A client sending its request a byte at a time is closed at the request deadline.
+  const int slow = connect_to(g.port());
+  (void)::send(slow, "GET /api/u", 10, MSG_NOSIGNAL);
+  const std::string answer = read_from(slow);  // returns when the server closes (bounded: 10 s)
+  EXPECT_EQ(answer.find("200"), std::string::npos);
+  ::close(slow);
+}
+
+}  // namespace
+}  // namespace tetra::ground
