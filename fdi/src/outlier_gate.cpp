@@ -27,6 +27,9 @@ void OutlierGate::restart() {
     t.outlier_run = 0;
     t.has_last_good = false;
   }
+  // The last step judged may have had the removed gyro in it: no call until a clean step of the gyros now in
+  // use has shown the body within the bound.
+  fast_motion_ = true;
 }
 
 void OutlierGate::reset() {

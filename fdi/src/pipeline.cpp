@@ -36,6 +36,11 @@ namespace tetra::fdi {
 using namespace detail;
 
 namespace {
+//! What three gyros can no longer tell, said where the reconfiguration is (docs/fdi.md).
+constexpr const char* kThreeGyrosLeft =
+    "three gyros left: no parity; the jump, onset, noise-level and coarse repeated-value tests make no call; "
+    "invalid, dropout, stuck, zero, low variance and the reference go on";
+
 Eigen::VectorXd bias_sigmas(const std::vector<GyroConstants>& constants) {
   Eigen::VectorXd b(static_cast<Eigen::Index>(constants.size()));
   for (std::size_t i = 0; i < constants.size(); ++i)
@@ -452,10 +457,16 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   gyro_set_.exclude(iso.gyro, iso.kind);
   attitude_.freeze(iso.gyro);
   restart_detectors();
+  // The remaining gyros' tests restart from evidence the removed fault did not touch (docs/fdi.md, "One fault,
+  // one exclusion").
+  series_.restart_evidence();
+  reference_.restart_windows();
   FdiEvent rc;
   rc.stamp_ns = now;
   rc.gyros = gyro_set_.active();
   rc.type = subsets_.observable(rc.gyros) ? EventType::kReconfigured : EventType::kLost;
+  if (rc.type == EventType::kReconfigured && tetra::gyro_count(rc.gyros) == 3)
+    rc.detail = kThreeGyrosLeft;
   emit(std::move(rc));
   update_mode(now);
 }
@@ -571,6 +582,8 @@ FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns, bool for
   publish_filter_health();  // the health keeps the last step's filter
   gyro_set_.exclude(id, FaultKind::kUnknown);
   attitude_.freeze(id);
+  series_.restart_evidence();
+  reference_.restart_windows();
   return acknowledge(verb, id, CommandOutcome::kDone, true, stamp_ns);
 }
 

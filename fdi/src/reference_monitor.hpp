@@ -73,8 +73,14 @@ class ReferenceMonitor {
             SpanDisagreement& out) const;
   //! Gyro `id`'s disagreement over `span` follows the rotation about its axis (a scale error, see `update`).
   bool span_scale(int id, const SpanDisagreement& span) const { return scale_significant(id, span.start); }
-  //! The windows start again (a reinstated gyro's angle has a gap).
-  void restart_windows() { snap_count_ = 0; }
+  //! The windows and their runs of findings start again: a reinstated gyro's angle has a gap; after an
+  //! isolation, an angle may have integrated the rate estimate of the old set while its own sample was left out
+  //! as an outlier, and the findings so far were comparisons over that.
+  void restart_windows() {
+    snap_count_ = 0;
+    windows_.reset();
+    filter_.reset();
+  }
   void reset();
 
  private:
