@@ -14,6 +14,8 @@
 
 #include "tetra/fdi/pipeline.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -109,6 +111,8 @@ class Pipeline::Impl {
   void isolate(const Isolation& iso);
   void isolate_all(Isolations& found);
   void restart_detectors();
+  //! [ns] how long before a finding outside an episode its fault may have begun.
+  std::int64_t signature_span_ns() const;
   void update_mode(std::int64_t now_ns);
   void emit(FdiEvent event) { result_.events.push_back(std::move(event)); }
   void emit_detected(DetectionTest test, double statistic, std::int64_t now_ns);
@@ -246,6 +250,7 @@ void Pipeline::Impl::detect() {
     return;
   }
   if (isolator_.open(d, frame_.now_ns, frame_.index, s, detector_)) {
+    attitude_.hold_biases(isolator_.episode().onset_ns);  // before the filter opens them to the fault
     detector_.open_episode();
     emit_detected(d.test, d.statistic, frame_.now_ns);
     // The fault acted since its onset: widen the uncertainty for the time already spent.
@@ -342,6 +347,7 @@ void Pipeline::Impl::decide_episode() {
     }
     case Verdict::kCleared: {
       detector_.close_episode(frame_.index + 1);  // no level test outside an episode
+      attitude_.release_biases();
       FdiEvent c;
       c.stamp_ns = frame_.now_ns;
       c.type = EventType::kCleared;
@@ -385,6 +391,7 @@ void Pipeline::Impl::publish_attitude() {
     ++(use == ReferenceUse::kRejected ? health_.counters.reference_rejected
                                       : health_.counters.reference_accepted);
     if (use == ReferenceUse::kReinitialized) ++health_.counters.reference_reinitialized;
+    if (!isolator_.episode().active) attitude_.snapshot_biases(frame_.now_ns);
   }
   publish_filter();
   auto& a = result_.attitude;
@@ -428,13 +435,22 @@ void Pipeline::Impl::isolate_all(Isolations& found) {
 void Pipeline::Impl::isolate(const Isolation& iso) {
   if (gyro_set_.is_excluded(iso.gyro)) return;
   const std::int64_t now = frame_.now_ns;
-  if (!isolator_.episode().active) {
-    emit_detected(iso.test, iso.statistic, now);
-  } else if (subsets_.ready()) {
-    // The fault corrupted the rate from its onset until now: keep that in the attitude uncertainty.
-    attitude_.add_bound(fault_angle_error(subsets_.get(gyro_set_.active()), iso.gyro, detector_.parity_ema(),
-                                          subsets_.sqrt_period(),
-                                          ns_to_seconds(now - isolator_.episode().onset_ns)));
+  const bool episode = isolator_.episode().active;
+  if (!episode) emit_detected(iso.test, iso.statistic, now);
+  if (subsets_.ready()) {
+    // The fault corrupted the rate from its onset until now: keep that in the attitude uncertainty — the
+    // parity's mean fault over the span, and the sum of each kept epoch's (a fault that grew faster than the
+    // mean followed).
+    const GyroMask active = gyro_set_.active();
+    const std::int64_t span_epochs =
+        static_cast<std::int64_t>(std::ceil(ns_to_seconds(signature_span_ns()) / subsets_.period_s()));
+    const std::int64_t from = episode ? isolator_.episode().onset_index : frame_.index - span_epochs;
+    Eigen::Vector3d bound = isolator_.fault_angle(iso.gyro, from, frame_.index, active, subsets_);
+    if (episode)
+      bound = bound.cwiseMax(fault_angle_error(subsets_.get(active), iso.gyro, detector_.parity_ema(),
+                                               subsets_.sqrt_period(),
+                                               ns_to_seconds(now - isolator_.episode().onset_ns)));
+    attitude_.add_bound(bound);
   }
   FdiEvent e;
   e.stamp_ns = now;
@@ -456,6 +472,10 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   emit(std::move(e));
   gyro_set_.exclude(iso.gyro, iso.kind);
   attitude_.freeze(iso.gyro);
+  // What the fault leaked into the other gyros' bias states since its onset is undone (docs/fdi.md).
+  attitude_.repair_biases(gyro_set_.active(),
+                          isolator_.episode().active ? isolator_.episode().onset_ns : now - signature_span_ns(),
+                          now);
   restart_detectors();
   // The remaining gyros' tests restart from evidence the removed fault did not touch (docs/fdi.md, "One fault,
   // one exclusion").
@@ -475,6 +495,18 @@ void Pipeline::Impl::restart_detectors() {
   detector_.restart(frame_.index + 1);
   isolator_.close();
   gate_.restart();
+  attitude_.release_biases();
+}
+
+std::int64_t Pipeline::Impl::signature_span_ns() const {
+  // The longest a finding without an episode takes from its fault's onset: a timeout, the repeated values, the
+  // jump test's confirmation; one sample period more for the onset's own epoch.
+  const double period = subsets_.ready() ? subsets_.period_s() : 0.0;
+  const double span_s =
+      std::max({config_.dropout_timeout_s, config_.invalid_timeout_s, config_.stuck_repeat_count * period,
+                config_.onset_confirm_epochs * period}) +
+      period;
+  return seconds_to_ns(span_s);
 }
 
 void Pipeline::Impl::emit_detected(DetectionTest test, double statistic, std::int64_t now_ns) {

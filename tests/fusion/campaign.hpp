@@ -25,6 +25,7 @@ struct CampaignRun {
   double angle_y_deg = 0.0;                //!< Σ wy_dps·Δt (the seed's "angle")
   std::vector<double> time_s;              //!< per accepted epoch (when `keep_errors`)
   std::vector<Eigen::Vector3d> error_rad;  //!< log(q_true* ⊗ q_est) per accepted epoch
+  std::vector<Eigen::Vector3d> sigma_rad;  //!< the published 1σ per body axis, per accepted epoch
   double final_sigma_deg = 0.0;
   double final_error_deg = 0.0;
 };
@@ -85,6 +86,7 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
     if (options.keep_errors) {
       run.time_s.push_back(se.time_s);
       run.error_rad.push_back(quat_log(se.truth_q_RB.conjugate() * r.attitude.q_RB));
+      run.sigma_rad.push_back(r.attitude.sigma_rad);
     }
     run.final_sigma_deg = r.attitude.sigma_rad.norm() * kRadToDeg;
     run.final_error_deg = angle_between(se.truth_q_RB, r.attitude.q_RB) * kRadToDeg;
