@@ -88,6 +88,10 @@ class GyroSeries {
   //! that included the removed gyro). The gyros' own second differences, repeats, dropouts and invalid samples
   //! are kept: no other gyro is in them.
   void restart_evidence();
+  //! No epoch for a while (a gap): second differences do not straddle it.
+  void bridge_gap() {
+    for (auto& t : tracks_) t.consecutive = 0;
+  }
   void reset();
 
  private:

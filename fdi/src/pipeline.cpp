@@ -111,6 +111,7 @@ class Pipeline::Impl {
   void isolate(const Isolation& iso);
   void isolate_all(Isolations& found);
   void restart_detectors();
+  void gap();
   //! [ns] how long before a finding outside an episode its fault may have begun.
   std::int64_t signature_span_ns() const;
   void update_mode(std::int64_t now_ns);
@@ -156,6 +157,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   pending_.clear();
   result_.accepted = accept(epoch);
   if (!result_.accepted) return result_;
+  if (frame_.dt_s > config_.max_gap_s) gap();
   series_.ingest(epoch, frame_, health_.counters);
   isolator_.record(frame_);
   frame_.usable = frame_.valid & gyro_set_.active();
@@ -165,7 +167,8 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
     series_.observe_motion(frame_, subsets_);
     detect();
   }
-  reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B());
+  reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B(),
+                       subsets_.observable(frame_.usable));
   seek_evidence();
   update_mode(frame_.now_ns);
   if (frame_.reference_q_RB) last_reference_ns_ = frame_.now_ns;
@@ -507,6 +510,30 @@ std::int64_t Pipeline::Impl::signature_span_ns() const {
                 config_.onset_confirm_epochs * period}) +
       period;
   return seconds_to_ns(span_s);
+}
+
+void Pipeline::Impl::gap() {
+  // No epoch for dt: a fact of the data path, not of a gyro (docs/fdi.md, "Data path"). The rate between the
+  // two epochs is unknown but for the acceleration bound: the trapezoid over the gap can miss the angle by up to
+  // a_max·τ²/4 per axis (the rate leaving its chord at a_max and coming back). The tests whose evidence would
+  // straddle the gap start again on its far side.
+  const double tau = frame_.dt_s;
+  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
+  attitude_.add_bound(Eigen::Vector3d::Constant(0.25 * a_max * tau * tau));
+  series_.bridge_gap();
+  gate_.restart();
+  reference_.restart_windows();
+  FdiEvent e;
+  e.stamp_ns = frame_.now_ns;
+  e.type = EventType::kGap;
+  e.statistic = tau;
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "no epoch for %.6g s: attitude propagated across it, sigma widened by %.3g deg per axis "
+                "(max_angular_acceleration_dps2 * gap^2 / 4)",
+                tau, 0.25 * a_max * tau * tau * kRadToDeg);
+  e.detail = text;
+  emit(std::move(e));
 }
 
 void Pipeline::Impl::emit_detected(DetectionTest test, double statistic, std::int64_t now_ns) {

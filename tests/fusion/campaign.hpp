@@ -34,6 +34,8 @@ struct CampaignOptions {
   bool keep_errors = false;
   std::optional<int> exclude_from_start;  //!< operator exclusion before the first epoch
   double stop_after_s = 1e300;            //!< [s] stop the run early (log time)
+  double gap_from_s = 0.0;                //!< [s] epochs in [gap_from_s, gap_until_s) are not delivered
+  double gap_until_s = 0.0;
 };
 
 inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOptions& sim_options,
@@ -61,6 +63,7 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
   bool first = true;
   do {
     if (se.time_s > options.stop_after_s) break;
+    if (se.time_s >= options.gap_from_s && se.time_s < options.gap_until_s) continue;
     e.stamp_ns = se.stamp_ns;
     e.raw = se.raw_V;
     e.present = se.present;
