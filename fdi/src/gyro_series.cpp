@@ -124,6 +124,14 @@ void GyroSeries::forget_evidence(int id) {
   t.d2_since_eval = 0;
 }
 
+void GyroSeries::restart_evidence() {
+  for (auto& t : tracks_) {
+    std::fill(t.m2.begin(), t.m2.end(), kInf);  // unseen: the noise-level test makes no call on it
+    t.run_seen = false;
+    t.spike_n = 0;
+  }
+}
+
 void GyroSeries::ingest(const Epoch& epoch, EpochFrame& frame, Counters& counters) {
   const double max_rate = config_.max_abs_rate_dps * kDegToRad;
   frame.valid = 0;

@@ -82,6 +82,16 @@ class GyroSeries {
 
   //! A reinstated gyro starts its signature evidence afresh.
   void forget_evidence(int id);
+  //! After a reconfiguration: the evidence that the gyros' own samples do not carry alone restarts for every
+  //! gyro — the motion the others saw (each value was projected through the old set, the removed gyro in it),
+  //! a coarse gyro's repeat-run motion range, and the spike counts (each spike was judged against hypotheses
+  //! that included the removed gyro). The gyros' own second differences, repeats, dropouts and invalid samples
+  //! are kept: no other gyro is in them.
+  void restart_evidence();
+  //! No epoch for a while (a gap): second differences do not straddle it.
+  void bridge_gap() {
+    for (auto& t : tracks_) t.consecutive = 0;
+  }
   void reset();
 
  private:

@@ -290,4 +290,25 @@ FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, 
   return FaultKind::kUnknown;
 }
 
+Eigen::Vector3d Isolator::fault_angle(int id, std::int64_t from_index, std::int64_t index, GyroMask active,
+                                      SubsetCache& subsets) const {
+  // Each epoch's parity, fitted with a fault of gyro `id` alone: q = W·y = f·w (w its column), f = wᵀq/|w|².
+  // Its rate error H*(:, id)·f acted over the step to that epoch.
+  const Subset& s = subsets.get(active);
+  if (!s.observable || s.dof < 1 || !has_gyro(active, id)) return Eigen::Vector3d::Zero();
+  const auto w = s.parity.col(id - 1);  // a view: no copy
+  const double w2 = std::max(w.squaredNorm(), 1e-300);
+  double q[kMaxGyros];
+  double sum = 0.0;  // [rad] Σ |f_k|·Δt_k
+  for (std::int64_t k = std::max({from_index, index - kHistory + 2, std::int64_t{1}}); k <= index; ++k) {
+    const auto slot = static_cast<std::size_t>(k % kHistory);
+    if ((hist_valid_[slot] & active) != active) continue;
+    (void)apply_parity(s, active, &hist_y_[slot * static_cast<std::size_t>(n_)], 1.0, q);
+    double wq = 0.0;
+    for (int r = 0; r < s.dof; ++r) wq += w[r] * q[r];
+    sum += std::abs(wq / w2) * ns_to_seconds(hist_ns_[slot] - time_of(k - 1));
+  }
+  return s.pinv.col(id - 1).cwiseAbs() * sum;
+}
+
 }  // namespace tetra::fdi::detail

@@ -284,6 +284,52 @@ void Mekf::decorrelate(int i) {
   P_(g_of(i), c_of(i)) = 0.0;
 }
 
+void Mekf::save_biases(double* state) const {
+  const Eigen::Index m = 2 * n_;
+  Eigen::Map<Eigen::VectorXd>(state, m) = bias_;
+  Eigen::Map<Eigen::MatrixXd>(state + m, m, m) = P_.bottomRightCorner(m, m);
+}
+
+void Mekf::restore_biases(const double* state, GyroMask gyros, double elapsed_s) {
+  // The saved bias states propagated over `elapsed_s` with no measurement since: c a random walk, g a
+  // Gauss–Markov process (decay d = e^{−t/T_c}), i.e. the block D·B·D + Q; the attitude is not in it.
+  const Eigen::Index m = 2 * n_;
+  const Eigen::Map<const Eigen::MatrixXd> block(state + m, m, m);
+  auto restored = [&](int i) { return has_gyro(gyros, i + 1) && !frozen(i + 1); };
+  auto decay = [&](Eigen::Index k) {  // k: 0..2N−1, c then g
+    if (k < n_) return 1.0;
+    const auto& g = gyros_[static_cast<std::size_t>(k - n_)];
+    return g.gm_sigma_rad_s > 0.0 ? std::exp(-elapsed_s / g.gm_correlation_s) : 1.0;
+  };
+  for (int i = 0; i < n_; ++i) {  // every restored state loses its correlations first
+    if (!restored(i)) continue;
+    for (const Eigen::Index k : {c_of(i), g_of(i)}) {
+      P_.row(k).setZero();
+      P_.col(k).setZero();
+    }
+  }
+  for (Eigen::Index a = 0; a < m; ++a) {
+    if (!restored(static_cast<int>(a % n_))) continue;
+    bias_[a] = state[a] * decay(a);
+    for (Eigen::Index b = 0; b < m; ++b) {
+      if (restored(static_cast<int>(b % n_))) P_(3 + a, 3 + b) = decay(a) * block(a, b) * decay(b);
+    }
+  }
+  for (int i = 0; i < n_; ++i) {
+    if (!restored(i)) continue;
+    const auto& g = gyros_[static_cast<std::size_t>(i)];
+    P_(c_of(i), c_of(i)) += g.rrw_rad_s_rts * g.rrw_rad_s_rts * elapsed_s;
+    const double d = decay(n_ + i);
+    P_(g_of(i), g_of(i)) += g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - d * d);
+  }
+}
+
+void Mekf::restore_prior(GyroMask gyros) {
+  for (int i = 0; i < n_; ++i) {
+    if (has_gyro(gyros, i + 1) && !frozen(i + 1)) set_prior(i);
+  }
+}
+
 void Mekf::freeze(int id) {
   if (id < 1 || id > n_) return;
   decorrelate(id - 1);

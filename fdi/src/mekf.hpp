@@ -85,6 +85,17 @@ class Mekf {
   //! own spread): |z| ≤ N(0, 1) in distribution while the model holds; a fault on the gyro drives it away.
   double bias_z(int id) const;
 
+  //! The bias states (2N: c then g) and their covariance block (2N × 2N), into `state` (2N + 4N² values).
+  void save_biases(double* state) const;
+  //! The bias states of the unfrozen gyros of `gyros` back to `state` (a `save_biases` of `elapsed_s` ago):
+  //! estimates and their block of the covariance as saved, plus the process noise of `elapsed_s` (K²·t on c,
+  //! σ_GM²(1 − e^{−2t/T_c}) on g); their correlation with the attitude and the other states dropped.
+  void restore_biases(const double* state, GyroMask gyros, double elapsed_s);
+  //! The unfrozen gyros of `gyros` back at their prior (nothing saved to restore).
+  void restore_prior(GyroMask gyros);
+  //! Values `save_biases` writes.
+  Eigen::Index saved_size() const { return 2 * n_ + 4 * n_ * n_; }
+
   //! Gyro `id` (1..N) leaves the solution: its bias states keep their estimate and variance, uncorrelated
   //! with the rest, and stop evolving. `thaw` puts them back at their prior.
   void freeze(int id);

@@ -27,6 +27,9 @@ void OutlierGate::restart() {
     t.outlier_run = 0;
     t.has_last_good = false;
   }
+  // The last step judged may have had the removed gyro in it: no call until a clean step of the gyros now in
+  // use has shown the body within the bound.
+  fast_motion_ = true;
 }
 
 void OutlierGate::reset() {
@@ -114,10 +117,22 @@ int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, con
   const Subset& s = subsets.get(avail);
   if (!s.observable || s.dof < 1) return 0;
   double dt_max = 0.0;
+  std::int64_t since_ns = -1;
   for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
     if (!has_gyro(avail, id)) continue;
     const auto& t = tracks_[static_cast<std::size_t>(id - 1)];
     if (!t.has_last_good) return 0;
+    // Changes over different spans (a sample dropped since) differ by the body's own rate change over the
+    // difference — during a slew, a jump of the gyro that missed one. No call; the next step is not judged
+    // either until a step of equal spans has shown the body within the bound. (A gyro in an outlier run keeps
+    // its last good sample from before the run on purpose: a step is judged against it.)
+    if (t.outlier_run == 0) {
+      if (since_ns >= 0 && t.last_good_ns != since_ns) {
+        fast_motion_ = true;
+        return 0;
+      }
+      since_ns = t.last_good_ns;
+    }
     dt_max = std::max(dt_max, ns_to_seconds(frame.now_ns - t.last_good_ns));
     dy_[static_cast<std::size_t>(id - 1)] = frame.y_rad_s[static_cast<std::size_t>(id - 1)] - t.last_good_y;
   }

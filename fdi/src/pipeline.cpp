@@ -14,6 +14,8 @@
 
 #include "tetra/fdi/pipeline.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -36,6 +38,11 @@ namespace tetra::fdi {
 using namespace detail;
 
 namespace {
+//! What three gyros can no longer tell, said where the reconfiguration is (docs/fdi.md).
+constexpr const char* kThreeGyrosLeft =
+    "three gyros left: no parity; the jump, onset, noise-level and coarse repeated-value tests make no call; "
+    "invalid, dropout, stuck, zero, low variance and the reference go on";
+
 Eigen::VectorXd bias_sigmas(const std::vector<GyroConstants>& constants) {
   Eigen::VectorXd b(static_cast<Eigen::Index>(constants.size()));
   for (std::size_t i = 0; i < constants.size(); ++i)
@@ -104,6 +111,9 @@ class Pipeline::Impl {
   void isolate(const Isolation& iso);
   void isolate_all(Isolations& found);
   void restart_detectors();
+  void gap();
+  //! [ns] how long before a finding outside an episode its fault may have begun.
+  std::int64_t signature_span_ns() const;
   void update_mode(std::int64_t now_ns);
   void emit(FdiEvent event) { result_.events.push_back(std::move(event)); }
   void emit_detected(DetectionTest test, double statistic, std::int64_t now_ns);
@@ -147,6 +157,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   pending_.clear();
   result_.accepted = accept(epoch);
   if (!result_.accepted) return result_;
+  if (frame_.dt_s > config_.max_gap_s) gap();
   series_.ingest(epoch, frame_, health_.counters);
   isolator_.record(frame_);
   frame_.usable = frame_.valid & gyro_set_.active();
@@ -156,7 +167,8 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
     series_.observe_motion(frame_, subsets_);
     detect();
   }
-  reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B());
+  reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B(),
+                       subsets_.observable(frame_.usable));
   seek_evidence();
   update_mode(frame_.now_ns);
   if (frame_.reference_q_RB) last_reference_ns_ = frame_.now_ns;
@@ -241,6 +253,7 @@ void Pipeline::Impl::detect() {
     return;
   }
   if (isolator_.open(d, frame_.now_ns, frame_.index, s, detector_)) {
+    attitude_.hold_biases(isolator_.episode().onset_ns);  // before the filter opens them to the fault
     detector_.open_episode();
     emit_detected(d.test, d.statistic, frame_.now_ns);
     // The fault acted since its onset: widen the uncertainty for the time already spent.
@@ -337,6 +350,7 @@ void Pipeline::Impl::decide_episode() {
     }
     case Verdict::kCleared: {
       detector_.close_episode(frame_.index + 1);  // no level test outside an episode
+      attitude_.release_biases();
       FdiEvent c;
       c.stamp_ns = frame_.now_ns;
       c.type = EventType::kCleared;
@@ -380,6 +394,7 @@ void Pipeline::Impl::publish_attitude() {
     ++(use == ReferenceUse::kRejected ? health_.counters.reference_rejected
                                       : health_.counters.reference_accepted);
     if (use == ReferenceUse::kReinitialized) ++health_.counters.reference_reinitialized;
+    if (!isolator_.episode().active) attitude_.snapshot_biases(frame_.now_ns);
   }
   publish_filter();
   auto& a = result_.attitude;
@@ -423,13 +438,22 @@ void Pipeline::Impl::isolate_all(Isolations& found) {
 void Pipeline::Impl::isolate(const Isolation& iso) {
   if (gyro_set_.is_excluded(iso.gyro)) return;
   const std::int64_t now = frame_.now_ns;
-  if (!isolator_.episode().active) {
-    emit_detected(iso.test, iso.statistic, now);
-  } else if (subsets_.ready()) {
-    // The fault corrupted the rate from its onset until now: keep that in the attitude uncertainty.
-    attitude_.add_bound(fault_angle_error(subsets_.get(gyro_set_.active()), iso.gyro, detector_.parity_ema(),
-                                          subsets_.sqrt_period(),
-                                          ns_to_seconds(now - isolator_.episode().onset_ns)));
+  const bool episode = isolator_.episode().active;
+  if (!episode) emit_detected(iso.test, iso.statistic, now);
+  if (subsets_.ready()) {
+    // The fault corrupted the rate from its onset until now: keep that in the attitude uncertainty — the
+    // parity's mean fault over the span, and the sum of each kept epoch's (a fault that grew faster than the
+    // mean followed).
+    const GyroMask active = gyro_set_.active();
+    const std::int64_t span_epochs =
+        static_cast<std::int64_t>(std::ceil(ns_to_seconds(signature_span_ns()) / subsets_.period_s()));
+    const std::int64_t from = episode ? isolator_.episode().onset_index : frame_.index - span_epochs;
+    Eigen::Vector3d bound = isolator_.fault_angle(iso.gyro, from, frame_.index, active, subsets_);
+    if (episode)
+      bound = bound.cwiseMax(fault_angle_error(subsets_.get(active), iso.gyro, detector_.parity_ema(),
+                                               subsets_.sqrt_period(),
+                                               ns_to_seconds(now - isolator_.episode().onset_ns)));
+    attitude_.add_bound(bound);
   }
   FdiEvent e;
   e.stamp_ns = now;
@@ -451,11 +475,21 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   emit(std::move(e));
   gyro_set_.exclude(iso.gyro, iso.kind);
   attitude_.freeze(iso.gyro);
+  // What the fault leaked into the other gyros' bias states since its onset is undone (docs/fdi.md).
+  attitude_.repair_biases(gyro_set_.active(),
+                          isolator_.episode().active ? isolator_.episode().onset_ns : now - signature_span_ns(),
+                          now);
   restart_detectors();
+  // The remaining gyros' tests restart from evidence the removed fault did not touch (docs/fdi.md, "One fault,
+  // one exclusion").
+  series_.restart_evidence();
+  reference_.restart_windows();
   FdiEvent rc;
   rc.stamp_ns = now;
   rc.gyros = gyro_set_.active();
   rc.type = subsets_.observable(rc.gyros) ? EventType::kReconfigured : EventType::kLost;
+  if (rc.type == EventType::kReconfigured && tetra::gyro_count(rc.gyros) == 3)
+    rc.detail = kThreeGyrosLeft;
   emit(std::move(rc));
   update_mode(now);
 }
@@ -464,6 +498,42 @@ void Pipeline::Impl::restart_detectors() {
   detector_.restart(frame_.index + 1);
   isolator_.close();
   gate_.restart();
+  attitude_.release_biases();
+}
+
+std::int64_t Pipeline::Impl::signature_span_ns() const {
+  // The longest a finding without an episode takes from its fault's onset: a timeout, the repeated values, the
+  // jump test's confirmation; one sample period more for the onset's own epoch.
+  const double period = subsets_.ready() ? subsets_.period_s() : 0.0;
+  const double span_s =
+      std::max({config_.dropout_timeout_s, config_.invalid_timeout_s, config_.stuck_repeat_count * period,
+                config_.onset_confirm_epochs * period}) +
+      period;
+  return seconds_to_ns(span_s);
+}
+
+void Pipeline::Impl::gap() {
+  // No epoch for dt: a fact of the data path, not of a gyro (docs/fdi.md, "Data path"). The rate between the
+  // two epochs is unknown but for the acceleration bound: the trapezoid over the gap can miss the angle by up to
+  // a_max·τ²/4 per axis (the rate leaving its chord at a_max and coming back). The tests whose evidence would
+  // straddle the gap start again on its far side.
+  const double tau = frame_.dt_s;
+  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
+  attitude_.add_bound(Eigen::Vector3d::Constant(0.25 * a_max * tau * tau));
+  series_.bridge_gap();
+  gate_.restart();
+  reference_.restart_windows();
+  FdiEvent e;
+  e.stamp_ns = frame_.now_ns;
+  e.type = EventType::kGap;
+  e.statistic = tau;
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "no epoch for %.6g s: attitude propagated across it, sigma widened by %.3g deg per axis "
+                "(max_angular_acceleration_dps2 * gap^2 / 4)",
+                tau, 0.25 * a_max * tau * tau * kRadToDeg);
+  e.detail = text;
+  emit(std::move(e));
 }
 
 void Pipeline::Impl::emit_detected(DetectionTest test, double statistic, std::int64_t now_ns) {
@@ -571,6 +641,8 @@ FdiEvent Pipeline::Impl::command_exclude(int id, std::int64_t stamp_ns, bool for
   publish_filter_health();  // the health keeps the last step's filter
   gyro_set_.exclude(id, FaultKind::kUnknown);
   attitude_.freeze(id);
+  series_.restart_evidence();
+  reference_.restart_windows();
   return acknowledge(verb, id, CommandOutcome::kDone, true, stamp_ns);
 }
 

@@ -78,11 +78,13 @@ RateAttitude::RateAttitude(const PipelineConfig& config, std::vector<GyroNoiseMo
                                            ? std::optional<double>(*config.latitude_deg * kDegToRad)
                                            : std::nullopt),
       mekf_(std::move(gyros)),
+      snapshots_(mekf_),
       gate_chi2_(allan::chi2_quantile(1.0 - config.reference_gate_false_alarm_probability, 3.0)) {}
 
 void RateAttitude::reset(const Quaternion& q0_RB) {
   propagator_.reset(q0_RB);
   mekf_.reset(config_.initial_sigma_deg * kDegToRad);
+  snapshots_.reset();
   omega_meas_.setZero();
   omega_prev_.setZero();
   correction_.setZero();

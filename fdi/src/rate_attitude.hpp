@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "bias_snapshots.hpp"
 #include "epoch_frame.hpp"
 #include "gyro_series.hpp"
 #include "mekf.hpp"
@@ -65,6 +66,22 @@ class RateAttitude {
     if (reference_seen_) mekf_.open_fault_hypothesis(sigma_rad_s);
   }
 
+  //! With the reference: a copy of the filter's bias states (at most once a second, none while held).
+  void snapshot_biases(std::int64_t now_ns) {
+    if (reference_seen_) snapshots_.take(now_ns, mekf_);
+  }
+  //! A fault episode began at `onset_ns`: the copy before it is held for `repair_biases`.
+  void hold_biases(std::int64_t onset_ns) {
+    if (reference_seen_) snapshots_.hold(onset_ns);
+  }
+  void release_biases() { snapshots_.release(); }
+  //! After an isolation: the bias states of `gyros` go back to the held copy (or the newest before
+  //! `onset_ns`), propagated to `now_ns` — what the fault leaked into them is undone (docs/fdi.md).
+  void repair_biases(GyroMask gyros, std::int64_t onset_ns, std::int64_t now_ns) {
+    if (reference_seen_) snapshots_.restore(mekf_, gyros, onset_ns, now_ns);
+    snapshots_.release();
+  }
+
   //! Gyro `id` leaves the solution (its bias states freeze) or comes back (at its prior).
   void freeze(int id) { mekf_.freeze(id); }
   void thaw(int id) { mekf_.thaw(id); }
@@ -88,6 +105,7 @@ class RateAttitude {
   const PipelineConfig& config_;
   AttitudePropagator propagator_;  //!< the quaternion, and the bound (its noise inputs stay zero)
   Mekf mekf_;
+  BiasSnapshots snapshots_;  //!< the bias states before a fault, for their repair at its isolation
   double gate_chi2_ = 0.0;                                //!< χ²₃ quantile of the reference gate
   Eigen::Vector3d correction_ = Eigen::Vector3d::Zero();  //!< [rad/s] H*·b̂ of the last observable epoch
   bool reference_seen_ = false;

@@ -65,16 +65,17 @@ int LoneGyro::confirm(int count, int min_members) {
 }
 
 void ReferenceMonitor::integrate(const EpochFrame& frame, GyroMask excluded,
-                                 const Eigen::Vector3d& omega_meas_B_rad_s,
-                                 const Eigen::Vector3d& earth_B_rad_s) {
+                                 const Eigen::Vector3d& omega_meas_B_rad_s, const Eigen::Vector3d& earth_B_rad_s,
+                                 bool estimate_fresh) {
   // Samples are instantaneous rates at the sample time: the increment over (t_{k−1}, t_k] is the trapezoid.
   for (std::size_t u = 0; u < n_; ++u) {
     const int id = static_cast<int>(u) + 1;
     if (has_gyro(excluded, id)) continue;
     auto& t = tracks_[u];
     const auto row = static_cast<Eigen::Index>(u);
-    const double yi =
-        has_gyro(frame.usable, id) ? frame.y_rad_s[u] : axes_B_.row(row).dot(omega_meas_B_rad_s);
+    const bool own = has_gyro(frame.usable, id);
+    const double yi = own ? frame.y_rad_s[u] : axes_B_.row(row).dot(omega_meas_B_rad_s);
+    if (!own && !estimate_fresh) t.held_ns = frame.now_ns;
     if (frame.dt_s > 0.0)
       t.angle_rad += (0.5 * (t.prev_int_y + yi) - axes_B_.row(row).dot(earth_B_rad_s)) * frame.dt_s;
     t.prev_int_y = yi;
@@ -132,6 +133,7 @@ std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, co
     const int id = static_cast<int>(i) + 1;
     if (has_gyro(excluded, id)) continue;
     const auto& t = tracks_[i];
+    if (t.held_ns >= snap_ns_[slot(old)]) continue;  // its angle holds a stale rate over this window
     const double rot = t.ref_angle_rad - snap_ref(old, static_cast<int>(i));
     const double err = (t.angle_rad - snap_angle(old, static_cast<int>(i))) - rot;
     windows_.add(id, std::abs(err) / disagreement_sigma(series.constants(id), span, rot),
@@ -167,7 +169,7 @@ bool ReferenceMonitor::span(std::int64_t from_ns, double min_span_s, GyroMask ex
   out.gyros = 0;
   for (std::size_t i = 0; i < n_; ++i) {
     const int id = static_cast<int>(i) + 1;
-    if (has_gyro(excluded, id)) continue;
+    if (has_gyro(excluded, id) || tracks_[i].held_ns >= out.start_ns) continue;
     const int g = static_cast<int>(i);
     const double rot = snap_ref(last, g) - snap_ref(old, g);
     out.err_rad[i] = (snap_angle(last, g) - snap_angle(old, g)) - rot;

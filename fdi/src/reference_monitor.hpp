@@ -54,9 +54,11 @@ class ReferenceMonitor {
   ReferenceMonitor(const Eigen::MatrixX3d& axes_B, const PipelineConfig& config);
 
   //! Integrates each active gyro's angle up to this epoch (trapezoid; a gyro without a usable sample
-  //! contributes the rate estimate's projection), Earth rate `earth_B_rad_s` removed.
+  //! contributes the rate estimate's projection), Earth rate `earth_B_rad_s` removed. `estimate_fresh`: the
+  //! estimate is this epoch's (false: too few samples, the last one held) — a gyro that integrates a held
+  //! estimate is left out of every comparison whose span contains that epoch.
   void integrate(const EpochFrame& frame, GyroMask excluded, const Eigen::Vector3d& omega_meas_B_rad_s,
-                 const Eigen::Vector3d& earth_B_rad_s);
+                 const Eigen::Vector3d& earth_B_rad_s, bool estimate_fresh);
   //! A reference sample: compares the last window; a confirmed single-gyro disagreement is returned.
   std::optional<ReferenceFinding> update(std::int64_t now_ns, const Quaternion& q_RB, GyroMask excluded,
                                          const GyroSeries& series);
@@ -73,8 +75,14 @@ class ReferenceMonitor {
             SpanDisagreement& out) const;
   //! Gyro `id`'s disagreement over `span` follows the rotation about its axis (a scale error, see `update`).
   bool span_scale(int id, const SpanDisagreement& span) const { return scale_significant(id, span.start); }
-  //! The windows start again (a reinstated gyro's angle has a gap).
-  void restart_windows() { snap_count_ = 0; }
+  //! The windows and their runs of findings start again: a reinstated gyro's angle has a gap; after an
+  //! isolation, an angle may have integrated the rate estimate of the old set while its own sample was left out
+  //! as an outlier, and the findings so far were comparisons over that.
+  void restart_windows() {
+    snap_count_ = 0;
+    windows_.reset();
+    filter_.reset();
+  }
   void reset();
 
  private:
@@ -83,6 +91,7 @@ class ReferenceMonitor {
     double angle_rad = 0.0;      //!< ∫ (y_i − h_i·ω_e) dt (trapezoid)
     double prev_int_y = 0.0;     //!< [rad/s] rate integrated at the previous epoch
     double ref_angle_rad = 0.0;  //!< Σ h_i·log(q_{k−1}* q_k) over the reference's own increments
+    std::int64_t held_ns = -1;   //!< [ns] the last epoch whose angle increment used a held rate estimate
   };
   void snapshot(std::int64_t now_ns, const Quaternion& q);
   //! Index of the first kept snapshot taken at or after `from_ns` among those before `end`, else `end`.

@@ -60,6 +60,8 @@ const char* to_string(EventType type) {
       return "fdi_unavailable";
     case EventType::kFdiAvailable:
       return "fdi_available";
+    case EventType::kGap:
+      return "gap";
   }
   return "command";
 }
@@ -218,6 +220,10 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
     case EventType::kFdiAvailable:
       out += ", \"gyros\": ";
       append_gyro_list(out, event.gyros, n_gyros);
+      break;
+    case EventType::kGap:
+      out += ", \"length_s\": ";
+      append_double(out, event.statistic);
       break;
     case EventType::kCommand:
       out += ", \"gyro\": ";

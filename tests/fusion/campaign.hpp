@@ -25,6 +25,7 @@ struct CampaignRun {
   double angle_y_deg = 0.0;                //!< Σ wy_dps·Δt (the seed's "angle")
   std::vector<double> time_s;              //!< per accepted epoch (when `keep_errors`)
   std::vector<Eigen::Vector3d> error_rad;  //!< log(q_true* ⊗ q_est) per accepted epoch
+  std::vector<Eigen::Vector3d> sigma_rad;  //!< the published 1σ per body axis, per accepted epoch
   double final_sigma_deg = 0.0;
   double final_error_deg = 0.0;
 };
@@ -33,6 +34,8 @@ struct CampaignOptions {
   bool keep_errors = false;
   std::optional<int> exclude_from_start;  //!< operator exclusion before the first epoch
   double stop_after_s = 1e300;            //!< [s] stop the run early (log time)
+  double gap_from_s = 0.0;                //!< [s] epochs in [gap_from_s, gap_until_s) are not delivered
+  double gap_until_s = 0.0;
 };
 
 inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOptions& sim_options,
@@ -60,6 +63,7 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
   bool first = true;
   do {
     if (se.time_s > options.stop_after_s) break;
+    if (se.time_s >= options.gap_from_s && se.time_s < options.gap_until_s) continue;
     e.stamp_ns = se.stamp_ns;
     e.raw = se.raw_V;
     e.present = se.present;
@@ -85,6 +89,7 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
     if (options.keep_errors) {
       run.time_s.push_back(se.time_s);
       run.error_rad.push_back(quat_log(se.truth_q_RB.conjugate() * r.attitude.q_RB));
+      run.sigma_rad.push_back(r.attitude.sigma_rad);
     }
     run.final_sigma_deg = r.attitude.sigma_rad.norm() * kRadToDeg;
     run.final_error_deg = angle_between(se.truth_q_RB, r.attitude.q_RB) * kRadToDeg;

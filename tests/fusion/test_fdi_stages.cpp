@@ -331,7 +331,7 @@ TEST(ReferenceMonitor, ADriftingGyroIsFoundAgainstTheReference) {
     for (std::size_t i = 0; i < 4; ++i) frame.y_rad_s[i] = y[i];
     frame.usable = 0b1111;
     frame.now_ns = seconds_to_ns(t);
-    monitor.integrate(frame, 0, omega, Eigen::Vector3d::Zero());
+    monitor.integrate(frame, 0, omega, Eigen::Vector3d::Zero(), true);
     if (k % 10 == 0) finding = monitor.update(frame.now_ns, quat_exp(omega * t), 0, series);
     if (finding) found_at = t;
   }

@@ -56,7 +56,7 @@ tetra_EventType to_wire(fdi::EventType type) {
 }
 fdi::EventType from_wire(tetra_EventType type) {
   const int value = static_cast<int>(type);
-  return value >= 0 && value <= static_cast<int>(fdi::EventType::kFdiAvailable)
+  return value >= 0 && value <= static_cast<int>(fdi::EventType::kGap)
              ? static_cast<fdi::EventType>(value)
              : fdi::EventType::kCommand;
 }
@@ -64,6 +64,7 @@ static_assert(static_cast<int>(tetra_FAULT_UNKNOWN) == static_cast<int>(fdi::Fau
 static_assert(static_cast<int>(tetra_GYRO_EXCLUDED) == static_cast<int>(fdi::GyroState::kExcluded));
 static_assert(static_cast<int>(tetra_EVENT_COMMAND) == static_cast<int>(fdi::EventType::kCommand));
 static_assert(static_cast<int>(tetra_EVENT_FDI_AVAILABLE) == static_cast<int>(fdi::EventType::kFdiAvailable));
+static_assert(static_cast<int>(tetra_EVENT_GAP) == static_cast<int>(fdi::EventType::kGap));
 
 Status to_wire(const std::string& unit, const fdi::AttitudeEstimate& attitude, tetra_Attitude& out) {
   if (auto status = copy_bounded(out.unit, unit, "unit"); !status) return status;

@@ -44,6 +44,7 @@ struct PipelineConfig {
   double jump_false_alarm_probability = 1.0e-9;   //!< [-] per epoch, test of a one-epoch jump of the parity
   int onset_confirm_epochs = 10;           //!< [epochs] an outlier this persistent is a step, not a spike
   double dropout_timeout_s = 1.0;          //!< [s] absent this long → dropout
+  double max_gap_s = 2.0;                  //!< [s] no epoch for longer than this: a `gap` event
   double invalid_timeout_s = 1.0;          //!< [s] invalid this long → invalid
   int stuck_repeat_count = 10;             //!< [samples] identical raw values in a row → stuck
   int noise_window = 30;                   //!< [samples] window of the noise-level (2nd difference) test

@@ -40,7 +40,8 @@ std::optional<FaultKind> fault_kind_from_string(std::string_view text);
 //! detected, isolated, unisolated (detected and the data cannot tell which gyro), reconfigured,
 //! cleared, lost; and command (acknowledgement of an operator command — an addition to docs/interfaces.md
 //! §2.5); fdi_unavailable / fdi_available: fault detection lost (no parity left and no recent reference) or
-//! back (docs/fdi.md, "Reconfiguration and modes").
+//! back (docs/fdi.md, "Reconfiguration and modes"); gap: no epoch for longer than `max_gap_s` (statistic: its
+//! length [s]; docs/fdi.md, "Data path").
 enum class EventType : std::uint8_t {
   kDetected,
   kIsolated,
@@ -50,7 +51,8 @@ enum class EventType : std::uint8_t {
   kLost,
   kCommand,
   kFdiUnavailable,
-  kFdiAvailable
+  kFdiAvailable,
+  kGap
 };
 const char* to_string(EventType type);
 
