@@ -667,8 +667,10 @@ FdiEvent Pipeline::Impl::command_reinstate(int id, std::int64_t stamp_ns) {
 }
 
 FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
-  // FDI reset: every gyro reinstated, detectors and episode cleared; the attitude and time go on.
+  // FDI reset: every gyro reinstated, detectors and episode cleared, the reference judged afresh; the attitude
+  // and time go on.
   for (int id = 1; id <= n_; ++id) reinstate(id);
+  consistency_.reset();
   restart_detectors();
   update_mode(stamp_ns);
   FdiEvent ack;
