@@ -3,6 +3,7 @@
 // straight into the pipeline in process, one-hour orbits on every thread.
 //
 //   fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS] [--unit CAL.yaml] [--quantization DEG]
+//             [--reference 1]
 //
 // --unit replaces the default unit by a calibration file's (its own N only; e.g. the coarsely quantized
 // examples/sim/allan_unit.yaml): the simulator runs that unit and the pipeline reads the same file.
@@ -43,6 +44,7 @@ constexpr double kRateHz = 10.0;
 
 struct RunOutcome {
   int detections = 0;
+  int reference_rejections = 0;  //!< reference_rejected events (--reference 1)
   double first_detected_s = -1.0;
 };
 
@@ -50,6 +52,7 @@ struct RunOutcome {
 double g_arl0 = fdi::PipelineConfig{}.cusum_arl0_epochs;  // set once by main before any thread starts
 std::optional<Calibration> g_unit;                        // --unit; set once by main
 double g_quantization_deg = 0.0;                          // --quantization; set once by main
+bool g_reference = false;  // --reference 1: the orbit's 1 Hz, 5″ reference into the pipeline; set once by main
 
 //! The unit of the sweep with n gyros: --unit's (its own N), else the seed's as-built unit cut or extended,
 //! with --quantization's angle quantization on every gyro.
@@ -95,7 +98,9 @@ RunOutcome run(int n, double duration_s, std::uint64_t seed, const std::vector<s
     e.stamp_ns = se.stamp_ns;
     e.raw = se.raw_V;
     e.present = se.present;
+    if (g_reference) e.reference_q_RB = se.reference_q_RB;
     for (const auto& ev : pipeline->step(e).events) {
+      out.reference_rejections += ev.type == fdi::EventType::kReferenceRejected ? 1 : 0;
       if (ev.type != fdi::EventType::kDetected) continue;
       ++out.detections;
       if (out.first_detected_s < 0.0) out.first_detected_s = ns_to_seconds(ev.stamp_ns);
@@ -167,10 +172,12 @@ double ramp_delay_s(const Theory& t, double c) {
 
 void false_alarm_sweep(int n, int hours, int jobs) {
   std::vector<int> detections(static_cast<std::size_t>(hours), 0);
+  std::vector<int> rejections(static_cast<std::size_t>(hours), 0);
   parallel(hours, jobs, [&](int i) {
-    detections[static_cast<std::size_t>(i)] =
-        run(n, 3600.0, 1000003ULL * static_cast<std::uint64_t>(n) + static_cast<std::uint64_t>(i), {})
-            .detections;
+    const RunOutcome o =
+        run(n, 3600.0, 1000003ULL * static_cast<std::uint64_t>(n) + static_cast<std::uint64_t>(i), {});
+    detections[static_cast<std::size_t>(i)] = o.detections;
+    rejections[static_cast<std::size_t>(i)] = o.reference_rejections;
   });
   int total = 0;
   int runs_with = 0;
@@ -186,6 +193,13 @@ void false_alarm_sweep(int n, int hours, int jobs) {
       "s=%.3f)\n",
       n, hours, total, runs_with, 1000.0 * total / hours, design, 1000.0 * total / hours / design, t.dof, t.k,
       t.h, t.s);
+  if (g_reference) {
+    int rejected = 0;
+    for (int r : rejections) rejected += r;
+    std::printf("N=%d  %d h with the 1 Hz reference: %d reference rejections (design: %d tests at p = 1e-9 per "
+                "sample)\n",
+                n, hours, rejected, hours * 3600);
+  }
   std::fflush(stdout);
 }
 
@@ -245,13 +259,14 @@ int main(int argc, char** argv) {
     if (arg == "--help" || arg == "-h") {
       std::printf(
           "fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS] [--unit CAL.yaml]\n"
-          "          [--quantization DEG]\n"
+          "          [--quantization DEG] [--reference 1]\n"
           "  false alarms in H fault-free one-hour orbits per N = 4, 5, 6 (default 1000), then the "
           "detection\n"
           "  delays of the documented faults (S seeds per fault and gyro, default 10), on J threads.\n"
           "  --arl0: the CUSUM's design in-control ARL [epochs] (default 1e8).\n"
           "  --unit: simulate and fuse this calibration file's unit instead (its own N only).\n"
-          "  --quantization: angle quantization [deg] of every gyro of the default unit.\n");
+          "  --quantization: angle quantization [deg] of every gyro of the default unit.\n"
+          "  --reference 1: feed the orbit's 1 Hz, 5\" reference too and count reference rejections.\n");
       return 0;
     }
     if (a + 1 >= argc) {
@@ -294,6 +309,8 @@ int main(int argc, char** argv) {
       jobs = std::max(1, value);
     } else if (arg == "--delay-seeds") {
       delay_seeds = value;
+    } else if (arg == "--reference") {
+      g_reference = value != 0;
     } else {
       std::fprintf(stderr, "fdi_sweep: unknown option %s\n", arg.c_str());
       return 2;

@@ -23,6 +23,7 @@ fdi::AttitudeEstimate estimate(double x, int n_gyros, GyroMask mask) {
   a.mode = fdi::Mode::kDegraded;
   a.gyros = mask;
   for (int i = 0; i < n_gyros; ++i) a.gyro_bias_rad_s.push_back(x * (i + 1));
+  a.protection_level_rad = Eigen::Vector3d(2e-7, x, std::numeric_limits<double>::infinity());
   return a;
 }
 
@@ -54,6 +55,10 @@ std::string row_cell_by_cell(double time_s, const fdi::AttitudeEstimate& a, int 
       out += "nan";
     }
   }
+  for (int i = 0; i < 3; ++i) {  // the protection level, after the biases
+    out += ',';
+    append_double(out, a.protection_level_rad[i] * kRadToDeg);
+  }
   return out + "\n";
 }
 
@@ -71,7 +76,8 @@ TEST(AttitudeCsv, TenGyrosAndMissingBiases) {
   append_attitude_row(row, 1.5, a, 10);
   EXPECT_EQ(row, row_cell_by_cell(1.5, a, 10));
   EXPECT_NE(row.find(",1;2;10,"), std::string::npos) << row;
-  EXPECT_NE(row.find(",nan,nan,nan,nan,nan,nan,nan,nan,nan,nan\n"), std::string::npos) << row;
+  EXPECT_NE(row.find(",nan,nan,nan,nan,nan,nan,nan,nan,nan,nan,"), std::string::npos) << row;
+  EXPECT_NE(row.find(",inf\n"), std::string::npos) << row;  // no protection level: no parity
 }
 
 // The widest double text is kMaxDoubleChars long; a row of 32 gyros of such numbers fits the bound.
@@ -88,6 +94,7 @@ TEST(AttitudeCsv, WidestRowFitsTheBound) {
   a.mode = fdi::Mode::kDegraded;
   a.gyros = 0xFFFFFFFFu;
   a.gyro_bias_rad_s.assign(n, widest / kRadToDeg);
+  a.protection_level_rad = Eigen::Vector3d::Constant(widest / kRadToDeg);
   std::string row;
   append_attitude_row(row, widest, a, n);
   EXPECT_LE(row.size(), attitude_row_max_bytes(n));

@@ -61,6 +61,11 @@ const std::vector<KeyDef>& scalar_keys() {
       {"bias_instability_correlation_s", &PipelineConfig::bias_instability_correlation_s},
       {"reference_gate_false_alarm_probability", &PipelineConfig::reference_gate_false_alarm_probability},
       {"reference_gate_reset_count", &PipelineConfig::reference_gate_reset_count},
+      {"reference_check_window_s", &PipelineConfig::reference_check_window_s},
+      {"reference_bias_window_s", &PipelineConfig::reference_bias_window_s},
+      {"reference_check_false_alarm_probability", &PipelineConfig::reference_check_false_alarm_probability},
+      {"reference_reaccept_s", &PipelineConfig::reference_reaccept_s},
+      {"integrity_risk", &PipelineConfig::integrity_risk},
   };
   return keys;
 }
@@ -196,6 +201,12 @@ Status validate(const PipelineConfig& c) {
        "in (0, 0.5)"},
       {"reference_gate_reset_count",
        c.reference_gate_reset_count >= 1 && c.reference_gate_reset_count <= 1000, "in [1, 1000]"},
+      {"reference_check_window_s", positive(c.reference_check_window_s), "> 0"},
+      {"reference_bias_window_s", positive(c.reference_bias_window_s), "> 0"},
+      {"reference_check_false_alarm_probability", probability(c.reference_check_false_alarm_probability),
+       "in (0, 0.5)"},
+      {"reference_reaccept_s", std::isfinite(c.reference_reaccept_s) && c.reference_reaccept_s >= 0.0, ">= 0"},
+      {"integrity_risk", probability(c.integrity_risk), "in (0, 0.5)"},
   };
   for (const auto& check : checks) {
     if (!check.ok) return bad_input(std::string("pipeline.") + check.name + ": must be " + check.rule);

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -27,7 +28,9 @@
 #include "mekf.hpp"
 #include "outlier_gate.hpp"
 #include "parity_detector.hpp"
+#include "protection_level.hpp"
 #include "rate_attitude.hpp"
+#include "reference_consistency.hpp"
 #include "reference_monitor.hpp"
 #include "subset_cache.hpp"
 #include "tetra/core/csv.hpp"
@@ -65,7 +68,9 @@ class Pipeline::Impl {
         isolator_(n_, config_),
         reference_(cal.axes_B(), config_),
         gyro_set_(n_),
-        attitude_(config_, noise_models(cal, series_, config_)) {
+        attitude_(config_, noise_models(cal, series_, config_)),
+        consistency_(config_),
+        protection_(config_) {
     frame_.resize(n_);
     found_.reserve(static_cast<std::size_t>(n_));
     result_.events.reserve(32);
@@ -107,6 +112,7 @@ class Pipeline::Impl {
   void publish_filter();
   void publish_filter_health() const;
   void update_fdi_available();
+  void judge_reference();
 
   void isolate(const Isolation& iso);
   void isolate_all(Isolations& found);
@@ -131,6 +137,8 @@ class Pipeline::Impl {
   ReferenceMonitor reference_;
   GyroSet gyro_set_;
   RateAttitude attitude_;
+  ReferenceConsistency consistency_;  //!< the reference as a sensor that can fail
+  ProtectionLevel protection_;        //!< the integrity bound beside sigma
 
   EpochFrame frame_;
   Isolations found_;
@@ -145,7 +153,10 @@ class Pipeline::Impl {
   GyroMask measured_ = 0;  //!< the gyros of this epoch's rate estimate so far
   bool has_time_ = false;
   std::int64_t last_ns_ = 0;
-  std::optional<std::int64_t> last_reference_ns_;  //!< the last epoch that carried an attitude reference
+  std::optional<std::int64_t> last_reference_ns_;  //!< the last epoch that carried a usable reference
+  bool reference_usable_ = false;  //!< this epoch's reference sample passed the consistency tests
+  bool gyros_vouch_ = false;       //!< this epoch: parity among the gyros used, no episode, rate observable
+  std::optional<std::int64_t> reference_set_ns_;  //!< the last time a reference sample set the attitude
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -169,9 +180,10 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   }
   reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B(),
                        subsets_.observable(frame_.usable));
+  judge_reference();
   seek_evidence();
   update_mode(frame_.now_ns);
-  if (frame_.reference_q_RB) last_reference_ns_ = frame_.now_ns;
+  if (frame_.reference_q_RB && reference_usable_) last_reference_ns_ = frame_.now_ns;
   update_fdi_available();
   publish_attitude();
   return result_;
@@ -198,6 +210,58 @@ void Pipeline::Impl::update_fdi_available() {
   emit(std::move(e));
 }
 
+void Pipeline::Impl::judge_reference() {
+  // The reference sample is tested before anything uses it (docs/fdi.md, "Reference consistency"); the
+  // gyros vouch for their attitude when they leave parity, no episode is open and the rate is observable.
+  const GyroMask active = gyro_set_.active();
+  gyros_vouch_ = subsets_.ready() && subsets_.get(active).dof >= 1 && subsets_.get(frame_.usable).observable &&
+                 !isolator_.episode().active;
+  reference_usable_ = frame_.reference_q_RB.has_value();
+  if (!reference_usable_) {
+    if (last_reference_ns_ && frame_.now_ns - *last_reference_ns_ > seconds_to_ns(config_.reference_window_s))
+      consistency_.absent();
+    return;
+  }
+  Eigen::Vector3d z;
+  Eigen::Matrix3d S;
+  if (!subsets_.ready() || !attitude_.predict_reference(*frame_.reference_q_RB, frame_.dt_s, z, S)) return;
+  const ReferenceVerdict v =
+      consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_);
+  reference_usable_ = v.use;
+  if (v.rejected || v.reaccepted) {
+    FdiEvent e;
+    e.stamp_ns = frame_.now_ns;
+    e.type = v.rejected ? EventType::kReferenceRejected : EventType::kReferenceAccepted;
+    e.why = v.rejected ? *v.rejected : ReferenceCheck::kNone;
+    e.statistic = consistency_.windowed_nis();
+    e.detail = v.rejected ? "attitude reference inconsistent with the gyros: left out, sigma from the gyros"
+                          : "attitude reference consistent again: used";
+    emit(std::move(e));
+  }
+  if (v.rejected) {
+    attitude_.add_variance(v.contamination_rad2);
+    // An attitude the reference itself set a block ago or less rests on its samples alone: the rejecting
+    // sample's innovation, on every axis, bounds what they put in.
+    if (reference_set_ns_ && frame_.now_ns - *reference_set_ns_ <= seconds_to_ns(config_.reference_check_window_s))
+      attitude_.add_variance(Eigen::Vector3d::Constant(z.squaredNorm()));
+  }
+  // A jump is left to the gate (a lone wild sample, or ten in a row set the attitude): only the slower tests
+  // carry evidence of a gyro fault.
+  if (v.inconsistent && *v.inconsistent != ReferenceCheck::kJump && subsets_.get(active).dof < 1 &&
+      !isolator_.episode().active) {
+    // Redundancy exhausted: the reference or one of the gyros used is wrong and nothing tells which. The
+    // reference stays in use (it is the only check left), the fault is reported, and the filter's attitude
+    // and bias states open by what the innovation shows, so the reference can pull both back.
+    emit_detected(DetectionTest::kReference, consistency_.windowed_nis(), frame_.now_ns);
+    result_.events.back().why = *v.inconsistent;
+    result_.events.back().detail = std::string("attitude reference and gyros disagree (") +
+                                   to_string(*v.inconsistent) +
+                                   "); three gyros: the data cannot tell which, sigma and bias states widened";
+    attitude_.add_variance(z.cwiseProduct(z));
+    attitude_.fault_opened(z.norm() / config_.reference_check_window_s);
+  }
+}
+
 bool Pipeline::Impl::accept(const Epoch& epoch) {
   auto& counters = health_.counters;
   if (static_cast<int>(epoch.raw.size()) != n_ || static_cast<int>(epoch.present.size()) != n_) {
@@ -209,6 +273,7 @@ bool Pipeline::Impl::accept(const Epoch& epoch) {
     return false;
   }
   frame_.dt_s = has_time_ ? ns_to_seconds(epoch.stamp_ns - last_ns_) : 0.0;
+  if (!has_time_) protection_.anchor(epoch.stamp_ns);  // the start: the attitude known to its initial σ
   if (!subsets_.ready() && frame_.dt_s > 0.0) subsets_.prepare(frame_.dt_s);
   has_time_ = true;
   last_ns_ = epoch.stamp_ns;
@@ -285,7 +350,7 @@ void Pipeline::Impl::level_changed(const Detection& d) {
 void Pipeline::Impl::seek_evidence() {
   series_.check(frame_.now_ns, gyro_set_.excluded(), subsets_.period_s(), subsets_.sqrt_period(), found_);
   isolate_all(found_);
-  if (frame_.reference_q_RB && subsets_.ready()) {
+  if (frame_.reference_q_RB && reference_usable_ && subsets_.ready()) {
     const auto finding =
         reference_.update(frame_.now_ns, *frame_.reference_q_RB, gyro_set_.excluded(), series_);
     if (finding) {
@@ -389,8 +454,12 @@ void Pipeline::Impl::publish_attitude() {
     }
   }
   // The reference sample, at this epoch's time, once the attitude is there too.
-  if (frame_.reference_q_RB) {
-    const ReferenceUse use = attitude_.reference(*frame_.reference_q_RB);
+  if (frame_.reference_q_RB && !reference_usable_) ++health_.counters.reference_rejected;
+  if (frame_.reference_q_RB && reference_usable_) {
+    // Never set the attitude onto a reference that disagrees with gyros that vouch for theirs.
+    const ReferenceUse use = attitude_.reference(*frame_.reference_q_RB, !gyros_vouch_);
+    if (use != ReferenceUse::kRejected) protection_.anchor(frame_.now_ns);  // the error known again
+    if (use == ReferenceUse::kInitialized || use == ReferenceUse::kReinitialized) reference_set_ns_ = frame_.now_ns;
     ++(use == ReferenceUse::kRejected ? health_.counters.reference_rejected
                                       : health_.counters.reference_accepted);
     if (use == ReferenceUse::kReinitialized) ++health_.counters.reference_reinitialized;
@@ -402,6 +471,15 @@ void Pipeline::Impl::publish_attitude() {
   a.stamp_ns = frame_.now_ns;
   a.q_RB = attitude_.q_RB();
   a.sigma_rad = attitude_.sigma_rad();
+  if (!observable) {
+    a.protection_level_rad.setConstant(std::numeric_limits<double>::infinity());
+  } else if (subsets_.ready()) {
+    a.protection_level_rad = protection_.bound(subsets_.get(gyro_set_.active()), a.sigma_rad, frame_.now_ns,
+                                               subsets_.sqrt_period());
+  } else {
+    a.protection_level_rad = protection_.k_md() * a.sigma_rad;
+  }
+  health_.protection_level_rad = a.protection_level_rad;
   a.mode = observable ? persistent_mode_ : Mode::kLost;
   a.gyros = observable ? frame_.usable : GyroMask{0};
   health_.used = a.gyros;
@@ -413,6 +491,8 @@ void Pipeline::Impl::publish_filter() {
   auto& a = result_.attitude;
   for (int id = 1; id <= n_; ++id) a.gyro_bias_rad_s[static_cast<std::size_t>(id - 1)] = f.bias_rad_s(id);
   health_.reference_chi2 = attitude_.reference_chi2();
+  health_.reference_state = consistency_.state();
+  health_.reference_nis = consistency_.windowed_nis();
   filter_health_due_ = true;  // read far less often than a step runs
 }
 
@@ -499,6 +579,7 @@ void Pipeline::Impl::restart_detectors() {
   isolator_.close();
   gate_.restart();
   attitude_.release_biases();
+  consistency_.restart();
 }
 
 std::int64_t Pipeline::Impl::signature_span_ns() const {
@@ -580,12 +661,15 @@ void Pipeline::Impl::reset() {
   series_.reset();
   gate_.reset();
   reference_.reset();
+  consistency_.reset();
   bias_check_.reset();
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);
   has_time_ = false;
   last_ns_ = 0;
+  protection_.anchor(0);
   last_reference_ns_.reset();
+  reference_set_ns_.reset();
   health_.fdi_available = true;
   result_.attitude.fdi_available = true;
   frame_.index = -1;
@@ -655,8 +739,10 @@ FdiEvent Pipeline::Impl::command_reinstate(int id, std::int64_t stamp_ns) {
 }
 
 FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
-  // FDI reset: every gyro reinstated, detectors and episode cleared; the attitude and time go on.
+  // FDI reset: every gyro reinstated, detectors and episode cleared, the reference judged afresh; the attitude
+  // and time go on.
   for (int id = 1; id <= n_; ++id) reinstate(id);
+  consistency_.reset();
   restart_detectors();
   update_mode(stamp_ns);
   FdiEvent ack;

@@ -106,7 +106,22 @@ void RateAttitude::parity(const Subset& s, const Eigen::VectorXd& p, double sqrt
   propagator_.rotate(quat_exp(dtheta));  // the bound (a fault's, a lost rate's) kept
 }
 
-ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB) {
+bool RateAttitude::predict_reference(const Quaternion& q_ref_RB, double dt_s, Eigen::Vector3d& z,
+                                     Eigen::Matrix3d& S) const {
+  if (!reference_seen_) return false;
+  // The step propagate() will take: the trapezoid rate less the bias correction (the Earth rate's share is
+  // below a milliarcsecond over a step).
+  const Eigen::Vector3d omega = 0.5 * (omega_prev_ + omega_meas_) - correction_;
+  const Quaternion q_pred = propagator_.q_RB() * quat_exp(omega * dt_s);
+  z = quat_log(q_pred.conjugate() * q_ref_RB);
+  const double sigma_ref = config_.reference_sigma_arcsec * kArcsecToRad;
+  const Eigen::Vector3d bound = propagator_.sigma_rad();
+  S = mekf_.covariance().topLeftCorner<3, 3>();
+  S.diagonal() += bound.cwiseProduct(bound) + Eigen::Vector3d::Constant(sigma_ref * sigma_ref);
+  return true;
+}
+
+ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB, bool may_reinitialize) {
   const double sigma_ref = config_.reference_sigma_arcsec * kArcsecToRad;
   if (!reference_seen_) {
     // The first sample sets the attitude (replay and service alike): known to the reference's σ from now on.
@@ -126,7 +141,7 @@ ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB) {
     propagator_.reset(propagator_.q_RB() * quat_exp(u.correction_rad));
     return ReferenceUse::kAccepted;
   }
-  if (++rejected_run_ < config_.reference_gate_reset_count) return ReferenceUse::kRejected;
+  if (++rejected_run_ < config_.reference_gate_reset_count || !may_reinitialize) return ReferenceUse::kRejected;
   // Every recent sample disagrees: the estimate, not the reference, is wrong (e.g. after a lost rate).
   rejected_run_ = 0;
   propagator_.reset(q_ref_RB);

@@ -54,8 +54,13 @@ class RateAttitude {
   //! Ends the epoch: the published rate and the previous rate for the next trapezoid.
   void finish_epoch() { omega_prev_ = omega_meas_; }
 
-  //! A reference sample: the first one sets the attitude; later ones update the filter (gated).
-  ReferenceUse reference(const Quaternion& q_ref_RB);
+  //! A reference sample: the first one sets the attitude; later ones update the filter (gated). A run of
+  //! gate rejections sets the attitude again only when `may_reinitialize` (the gyros cannot vouch for theirs).
+  ReferenceUse reference(const Quaternion& q_ref_RB, bool may_reinitialize = true);
+  //! The innovation `z` [rad] a reference sample would have against the attitude propagated to this epoch
+  //! (the rate of this epoch, `dt_s`) and its covariance `S` [rad²]: the filter's attitude covariance, the
+  //! bound of a fault or lost rate, the reference's σ. False before the first sample.
+  bool predict_reference(const Quaternion& q_ref_RB, double dt_s, Eigen::Vector3d& z, Eigen::Matrix3d& S) const;
   //! The epoch's normalized parity `p` over the subset `s` into the filter's biases — once a reference sample
   //! has been seen (without one the attitude stays the gyros' alone).
   void parity(const Subset& s, const Eigen::VectorXd& p, double sqrt_period);
@@ -87,6 +92,8 @@ class RateAttitude {
   void thaw(int id) { mekf_.thaw(id); }
 
   void add_bound(const Eigen::Vector3d& angle_rad) { propagator_.add_bound(angle_rad); }
+  //! Adds a variance [rad²] per axis to the filter's attitude (e.g. what a rejected reference put in).
+  void add_variance(const Eigen::Vector3d& var_rad2) { mekf_.add_attitude_variance(var_rad2); }
   void reset(const Quaternion& q0_RB);
 
   //! [rad/s] last rate estimate, Earth rate included.

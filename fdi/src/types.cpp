@@ -62,8 +62,48 @@ const char* to_string(EventType type) {
       return "fdi_available";
     case EventType::kGap:
       return "gap";
+    case EventType::kReferenceRejected:
+      return "reference_rejected";
+    case EventType::kReferenceAccepted:
+      return "reference_accepted";
   }
   return "command";
+}
+
+const char* to_string(ReferenceState state) {
+  switch (state) {
+    case ReferenceState::kAbsent:
+      return "absent";
+    case ReferenceState::kAccepted:
+      return "accepted";
+    case ReferenceState::kRejected:
+      return "rejected";
+  }
+  return "absent";
+}
+
+const char* to_string(ReferenceCheck check) {
+  switch (check) {
+    case ReferenceCheck::kNone:
+      return "";
+    case ReferenceCheck::kNis:
+      return "nis";
+    case ReferenceCheck::kLag:
+      return "lag";
+    case ReferenceCheck::kBias:
+      return "bias";
+    case ReferenceCheck::kJump:
+      return "jump";
+  }
+  return "";
+}
+
+ReferenceCheck reference_check_from_string(std::string_view text) {
+  for (const ReferenceCheck c : {ReferenceCheck::kNis, ReferenceCheck::kLag, ReferenceCheck::kBias,
+                                 ReferenceCheck::kJump}) {
+    if (text == to_string(c)) return c;
+  }
+  return ReferenceCheck::kNone;
 }
 
 const char* to_string(GyroState state) {
@@ -211,6 +251,19 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
       if (event.test != DetectionTest::kNone) {
         out += ", \"test\": ";
         append_json_string(out, to_string(event.test));
+      }
+      break;
+    case EventType::kReferenceRejected:
+    case EventType::kReferenceAccepted:
+      if (event.why != ReferenceCheck::kNone) {
+        out += ", \"why\": ";
+        append_json_string(out, to_string(event.why));
+      }
+      out += ", \"statistic\": ";
+      if (std::isfinite(event.statistic)) {
+        append_double(out, event.statistic);
+      } else {
+        out += "null";
       }
       break;
     case EventType::kReconfigured:

@@ -32,7 +32,8 @@ std::size_t longest_mode_chars() {
 
 std::size_t attitude_row_max_bytes(int n_gyros) {
   const auto n = static_cast<std::size_t>(std::max(n_gyros, 0));
-  const std::size_t numbers = 12 + n;          // time, q (4), rate (3), sigma, sigma per axis (3), biases
+  // time, q (4), rate (3), sigma, sigma per axis (3), biases, protection level per axis (3)
+  const std::size_t numbers = 15 + n;
   const std::size_t gyros_cell_chars = 3 * n;  // at most two digits and a ';' per gyro
   return numbers * (kMaxDoubleChars + 1) + longest_mode_chars() + 1 + gyros_cell_chars + 1;
 }
@@ -56,6 +57,7 @@ char* format_attitude_row(char* out, double time_s, const fdi::AttitudeEstimate&
       p = put(p, ",nan");
     }
   }
+  for (int i = 0; i < 3; ++i) p = put_double(p, attitude.protection_level_rad[i] * kRadToDeg);
   *p++ = '\n';
   return p;
 }
@@ -74,7 +76,7 @@ std::string attitude_header(int n_gyros) {
   std::string h =
       "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros,sigma_x_deg,sigma_y_deg,sigma_z_deg";
   for (int i = 1; i <= n_gyros; ++i) h += ",bias_" + std::to_string(i) + "_dps";
-  return h + "\n";
+  return h + ",pl_x_deg,pl_y_deg,pl_z_deg\n";
 }
 
 std::string gyros_cell(GyroMask mask, int n_gyros) {

@@ -51,6 +51,7 @@ Status AttitudeWriter::add(double time_s, const fdi::AttitudeEstimate& attitude)
   row.attitude.q_RB = attitude.q_RB;
   row.attitude.omega_BR_B_rad_s = attitude.omega_BR_B_rad_s;
   row.attitude.sigma_rad = attitude.sigma_rad;
+  row.attitude.protection_level_rad = attitude.protection_level_rad;
   row.attitude.mode = attitude.mode;
   row.attitude.gyros = attitude.gyros;
   row.has_biases = static_cast<int>(attitude.gyro_bias_rad_s.size()) == n_gyros_;

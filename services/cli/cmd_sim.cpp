@@ -40,6 +40,9 @@ struct ScenarioOverrides {
   double latitude_deg = 0.0;
   double reference_hz = 0.0;
   double reference_noise_arcsec = 0.0;
+  double reference_latency_s = 0.0;
+  std::vector<double> reference_bias;   // arcsec, at s, ramp s
+  std::vector<double> reference_misid;  // deg, at s, duration s
   double acs_amplitude_deg = 0.0;
   double acs_accel_dps2 = 0.0;
   double jitter_s = 0.0;
@@ -51,6 +54,9 @@ struct ScenarioOverrides {
   CLI::Option* latitude = nullptr;
   CLI::Option* reference = nullptr;
   CLI::Option* reference_noise = nullptr;
+  CLI::Option* reference_latency = nullptr;
+  CLI::Option* reference_bias_given = nullptr;
+  CLI::Option* reference_misid_given = nullptr;
   CLI::Option* acs_amplitude = nullptr;
   CLI::Option* acs_accel = nullptr;
   CLI::Option* period = nullptr;
@@ -113,6 +119,20 @@ void add_scenario_options(CLI::App& app, SimArgs& a) {
   o.reference_noise =
       app.add_option("--reference-noise", o.reference_noise_arcsec, "[arcsec] reference 1-sigma per axis")
           ->check(number_in(0.0, sim::kMaxReferenceNoise_arcsec));
+  o.reference_latency =
+      app.add_option("--reference-latency", o.reference_latency_s,
+                     "[s] reference failure: each sample shows the attitude this long before its stamp")
+          ->check(CLI::Range(0.0, 10.0));
+  o.reference_bias_given =
+      app.add_option("--reference-bias", o.reference_bias,
+                     "ARCSEC,AT_S,RAMP_S: reference failure, a slow bias growing from AT_S to ARCSEC over RAMP_S")
+          ->delimiter(',')
+          ->expected(3);
+  o.reference_misid_given =
+      app.add_option("--reference-misid", o.reference_misid,
+                     "DEG,AT_S,DURATION_S: reference failure, mis-identified (turned by DEG) for DURATION_S")
+          ->delimiter(',')
+          ->expected(3);
   o.acs_amplitude = app.add_option("--acs-amplitude", o.acs_amplitude_deg,
                                    "[deg] orbit/slews: attitude-control motion amplitude (0 = none)")
                         ->check(number_in(0.0, sim::kMaxAcsAmplitude_deg));
@@ -200,8 +220,9 @@ int run_turntable(const Calibration& unit, const sim::TurntablePlan& plan, const
 int run_turntable_scenario(SimArgs& a, const std::optional<Calibration>& unit, RunFiles& files,
                            OutputFile& out) {
   const ScenarioOverrides& o = a.over;
-  for (const CLI::Option* opt : {o.minutes_given, o.reference, o.reference_noise, o.acs_amplitude,
-                                 o.acs_accel, o.period, o.jitter, o.drop}) {
+  for (const CLI::Option* opt :
+       {o.minutes_given, o.reference, o.reference_noise, o.reference_latency, o.reference_bias_given,
+        o.reference_misid_given, o.acs_amplitude, o.acs_accel, o.period, o.jitter, o.drop}) {
     if (opt->count()) return report(kSimName, bad_input("turntable: " + opt->get_name() + " does not apply"));
   }
   if (!a.fault_texts.empty() || !a.add_fault_texts.empty() || !a.truth_path.empty()) {
@@ -220,6 +241,17 @@ void apply_overrides(const ScenarioOverrides& o, sim::Scenario& sc) {
   if (o.latitude->count()) sc.motion.latitude_deg = o.latitude_deg;
   if (o.reference->count()) sc.reference.rate_hz = o.reference_hz;
   if (o.reference_noise->count()) sc.reference.noise_arcsec = o.reference_noise_arcsec;
+  if (o.reference_latency->count()) sc.reference.latency_s = o.reference_latency_s;
+  if (o.reference_bias.size() == 3) {
+    sc.reference.bias_arcsec = o.reference_bias[0];
+    sc.reference.bias_at_s = o.reference_bias[1];
+    sc.reference.bias_ramp_s = o.reference_bias[2];
+  }
+  if (o.reference_misid.size() == 3) {
+    sc.reference.misid_deg = o.reference_misid[0];
+    sc.reference.misid_at_s = o.reference_misid[1];
+    sc.reference.misid_duration_s = o.reference_misid[2];
+  }
   if (o.acs_amplitude->count()) sc.motion.acs.amplitude_deg = o.acs_amplitude_deg;
   if (o.acs_accel->count()) sc.motion.acs.peak_accel_dps2 = o.acs_accel_dps2;
   if (o.period->count()) sc.motion.orbit_period_s = o.orbit_period_min * 60.0;

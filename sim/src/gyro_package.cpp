@@ -1,5 +1,6 @@
 #include "tetra/sim/gyro_package.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -34,6 +35,7 @@ void GyroPackage::reset() {
   stuck_value_V_.assign(faults_.size(), std::nullopt);
   spike_done_.assign(faults_.size(), 0);
   last_reference_period_ = -1;
+  truth_history_.clear();
 }
 
 double GyroPackage::apply_faults(int i, double v, double t_s, bool& present) {
@@ -103,8 +105,38 @@ void GyroPackage::sample(const Eigen::Vector3d& sensed_dps, double t_s, std::vec
   }
 }
 
+namespace {
+//! [rad] the reference's deterministic error at time t: the slow bias and the mis-identification episode.
+Eigen::Vector3d reference_error_rad(const ReferenceOptions& r, double t_s) {
+  Eigen::Vector3d e = Eigen::Vector3d::Zero();
+  if (r.bias_arcsec != 0.0 && t_s >= r.bias_at_s) {
+    const double grown = r.bias_ramp_s > 0.0 ? std::min(1.0, (t_s - r.bias_at_s) / r.bias_ramp_s) : 1.0;
+    e += Eigen::Vector3d::Constant(r.bias_arcsec * kArcsecToRad * grown / std::sqrt(3.0));
+  }
+  if (r.misid_duration_s > 0.0 && t_s >= r.misid_at_s && t_s < r.misid_at_s + r.misid_duration_s)
+    e += Eigen::Vector3d(0.6, 0.8, 0.0) * (r.misid_deg * kDegToRad);
+  return e;
+}
+}  // namespace
+
 std::optional<Quaternion> GyroPackage::reference(std::size_t k, const Quaternion& truth_q_RB) {
   if (reference_options_.rate_hz <= 0.0) return std::nullopt;
+  const double t_s = static_cast<double>(k) / rate_hz_;
+  Quaternion seen = truth_q_RB;
+  bool before_first = false;  // a late reference has nothing to show before its latency has passed
+  if (reference_options_.latency_s > 0.0) {
+    // The truth latency_s ago, interpolated between the epochs around it (the first epoch before that).
+    const double t_seen = t_s - reference_options_.latency_s;
+    truth_history_.emplace_back(t_s, truth_q_RB);
+    while (truth_history_.size() > 2 && truth_history_[1].first <= t_seen) truth_history_.pop_front();
+    const auto& [t0, q0] = truth_history_.front();
+    before_first = t_seen < t0;
+    seen = q0;
+    if (truth_history_.size() > 1 && t_seen > t0) {
+      const auto& [t1, q1] = truth_history_[1];
+      seen = q0.slerp(std::min(1.0, (t_seen - t0) / (t1 - t0)), q1);
+    }
+  }
   // Reference period of the nominal epoch time (exact integer arithmetic where the rates allow).
   const auto period = static_cast<std::int64_t>(
       std::floor(static_cast<double>(k) * reference_options_.rate_hz / rate_hz_ + 1e-9));
@@ -113,7 +145,8 @@ std::optional<Quaternion> GyroPackage::reference(std::size_t k, const Quaternion
   const double sigma_rad = reference_options_.noise_arcsec * kArcsecToRad;
   Eigen::Vector3d error_rad;
   for (int a = 0; a < 3; ++a) error_rad[a] = sigma_rad * reference_rng_.normal();
-  return canonical(truth_q_RB * quat_exp(error_rad));
+  if (before_first) return std::nullopt;  // (its noise drawn all the same: the stream stays aligned)
+  return canonical(seen * quat_exp(error_rad + reference_error_rad(reference_options_, t_s)));
 }
 
 }  // namespace tetra::sim

@@ -97,9 +97,23 @@ Status read_slews(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) 
 Status read_reference(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
   const YAML::Node ref = root["reference"];
   if (!ref) return ok_status();
-  if (Status st = yaml.check_keys(ref, {"rate_hz", "noise_arcsec"}, "reference"); !st) return st;
+  ReferenceOptions& r = sc.reference;
+  if (Status st = yaml.check_keys(ref,
+                                  {"rate_hz", "noise_arcsec", "latency_s", "bias_arcsec", "bias_at_s",
+                                   "bias_ramp_s", "misid_deg", "misid_at_s", "misid_duration_s"},
+                                  "reference");
+      !st)
+    return st;
   return maybe_numbers(yaml, ref, "reference",
-                       {{"rate_hz", &sc.reference.rate_hz}, {"noise_arcsec", &sc.reference.noise_arcsec}});
+                       {{"rate_hz", &r.rate_hz},
+                        {"noise_arcsec", &r.noise_arcsec},
+                        {"latency_s", &r.latency_s},
+                        {"bias_arcsec", &r.bias_arcsec},
+                        {"bias_at_s", &r.bias_at_s},
+                        {"bias_ramp_s", &r.bias_ramp_s},
+                        {"misid_deg", &r.misid_deg},
+                        {"misid_at_s", &r.misid_at_s},
+                        {"misid_duration_s", &r.misid_duration_s}});
 }
 
 Status read_gyro_model(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
@@ -255,6 +269,18 @@ Status validate_scenario(const Scenario& sc) {
                               kMaxReferenceNoise_arcsec, "arcsec");
       !st)
     return st;
+  const ReferenceOptions& r = sc.reference;
+  if (!std::isfinite(r.latency_s) || r.latency_s < 0.0 || r.latency_s > 10.0)
+    return bad_input("reference latency_s must be in [0, 10], got " + number_text(r.latency_s));
+  for (const auto& [value, key] : {std::pair{r.bias_arcsec, "bias_arcsec"}, {r.bias_at_s, "bias_at_s"},
+                                   {r.misid_deg, "misid_deg"}, {r.misid_at_s, "misid_at_s"}}) {
+    if (!std::isfinite(value)) return bad_input(std::string("reference ") + key + " must be finite");
+  }
+  for (const auto& [value, key] :
+       {std::pair{r.bias_ramp_s, "bias_ramp_s"}, {r.misid_duration_s, "misid_duration_s"}}) {
+    if (!std::isfinite(value) || value < 0.0)
+      return bad_input(std::string("reference ") + key + " must not be negative, got " + number_text(value));
+  }
   if (Status st = check_range("gyro_model.bias_instability_correlation_s",
                               sc.model.bias_instability_correlation_s, 0.0, kMaxCorrelation_s, "s", true);
       !st)

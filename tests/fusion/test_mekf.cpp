@@ -203,36 +203,73 @@ TEST(MekfFaults, BiasAndRampIsolatedToTheRightGyroAndTheAttitudeRecovers) {
   }
 }
 
-TEST(MekfGate, WildReferenceSamplesAreRejectedCountedAndAPersistentOffsetResetsTheAttitude) {
-  // Orbit with the 1 Hz, 5″ reference. Samples 30..34 s turned by 1° (χ² ≈ 1e8 ≫ the gate's 30.7): all five
-  // rejected, the attitude untouched by them (error < 30″, ~10σ of the 1.7″ steady state). From 60 s every
-  // sample is 1° off: after reference_gate_reset_count (10) rejections in a row the next sample sets the
-  // attitude.
+namespace {
+struct GateRun {
+  double error_at_40_arcsec = -1.0;
+  double final_error_arcsec = 0.0;
+  double final_sigma_arcsec = 0.0;
+  fdi::Health health;
+  std::vector<fdi::FdiEvent> events;
+};
+
+//! Orbit with the 1 Hz, 5″ reference; samples 30..34 s and from 60 s on turned by 1° about y.
+GateRun run_wild_reference(bool three_gyros) {
+  GateRun out;
   auto sc = sim::builtin_scenario("orbit");
-  ASSERT_TRUE(sc.ok());
+  EXPECT_TRUE(sc.ok());
   sc->duration_s = 90.0;
   auto simulator = sim::Simulator::create(*sc, sim::SimOptions{3, {}});
-  ASSERT_TRUE(simulator.ok());
+  EXPECT_TRUE(simulator.ok());
   auto pipeline = fdi::Pipeline::create(sc->unit, fdi::PipelineConfig{});
-  ASSERT_TRUE(pipeline.ok());
+  EXPECT_TRUE(pipeline.ok());
+  if (three_gyros) (void)pipeline->exclude(4, 0);
   const Quaternion off = quat_exp(Eigen::Vector3d(0.0, kDegToRad, 0.0));
   sim::SimEpoch e;
-  double error_at_40_arcsec = -1.0;
-  std::uint64_t rejected_at_40 = 0;
   while (simulator->next(e)) {
     std::optional<Quaternion> ref = e.reference_q_RB;
     if (ref && ((e.time_s >= 30.0 && e.time_s < 35.0) || e.time_s >= 60.0)) ref = *ref * off;
     const auto& r = pipeline->step(fdi::Epoch{e.stamp_ns, e.raw_V, e.present, ref});
-    if (error_at_40_arcsec < 0.0 && e.time_s >= 40.0) {
-      error_at_40_arcsec = angle_between(r.attitude.q_RB, e.truth_q_RB) * kRadToDeg * 3600.0;
-      rejected_at_40 = pipeline->health().counters.reference_rejected;
-    }
+    for (const auto& ev : r.events) out.events.push_back(ev);
+    const double error_arcsec = angle_between(r.attitude.q_RB, e.truth_q_RB) * kRadToDeg * 3600.0;
+    if (out.error_at_40_arcsec < 0.0 && e.time_s >= 40.0) out.error_at_40_arcsec = error_arcsec;
+    out.final_error_arcsec = error_arcsec;
+    out.final_sigma_arcsec = r.attitude.sigma_rad.norm() * kRadToDeg * 3600.0;
   }
-  const auto& c = pipeline->health().counters;
-  EXPECT_EQ(rejected_at_40, 5U);
-  EXPECT_LT(error_at_40_arcsec, 30.0);
-  EXPECT_EQ(c.reference_reinitialized, 1U);  // 60..68 s rejected, 69 s sets the attitude
-  EXPECT_EQ(c.reference_rejected, 5U + 9U);
+  out.health = pipeline->health();
+  return out;
+}
+}  // namespace
+
+TEST(MekfGate, AReferenceTheGyrosContradictIsRejectedAndNeverSetsTheAttitude) {
+  // Four gyros vouch for their attitude (parity, no episode). Samples 30..34 s turned by 1° (NIS ≈ 1e8): the
+  // first is a `jump`, the reference is rejected and the attitude untouched (error < 30″, ~10σ of the 1.7″
+  // steady state). It would be used again after 30 s of consistent samples (from 65 s), but from 60 s every
+  // sample is 1° off: it stays rejected and, the gyros contradicting it, never sets the attitude; sigma comes
+  // from the gyros and covers the error.
+  const GateRun run = run_wild_reference(false);
+  EXPECT_LT(run.error_at_40_arcsec, 30.0);
+  EXPECT_EQ(run.health.counters.reference_reinitialized, 0U);
+  EXPECT_EQ(run.health.reference_state, fdi::ReferenceState::kRejected);
+  int rejected = 0;
+  for (const auto& ev : run.events) {
+    if (ev.type != fdi::EventType::kReferenceRejected) continue;
+    ++rejected;
+    EXPECT_EQ(ev.why, fdi::ReferenceCheck::kJump);
+    EXPECT_EQ(ev.stamp_ns, seconds_to_ns(30.0)) << fdi::to_json(ev, 4);
+  }
+  EXPECT_EQ(rejected, 1);
+  EXPECT_LT(run.final_error_arcsec, 3.0 * run.final_sigma_arcsec);  // 3σ: sigma honest on the gyros alone
+}
+
+TEST(MekfGate, WithThreeGyrosAPersistentOffsetStillResetsTheAttitude) {
+  // Three gyros leave no parity: they cannot vouch for their attitude, so a reference they disagree with is as
+  // likely right. The five wild samples are rejected by the gate (the attitude untouched); from 60 s after
+  // reference_gate_reset_count (10) rejections in a row the next sample sets the attitude (as before the
+  // reference had its own tests).
+  const GateRun run = run_wild_reference(true);
+  EXPECT_LT(run.error_at_40_arcsec, 30.0);
+  EXPECT_EQ(run.health.counters.reference_reinitialized, 1U);  // 60..68 s rejected, 69 s sets the attitude
+  EXPECT_EQ(run.health.counters.reference_rejected, 5U + 9U);
 }
 
 // ---------------------------------------------------------------------------------------------

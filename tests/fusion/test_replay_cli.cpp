@@ -56,7 +56,7 @@ TEST(ReplayCli, WritesAttitudeAndEventsAndSummary) {
   EXPECT_EQ(
       text.substr(0, text.find('\n')),
       "time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,mode,gyros,sigma_x_deg,sigma_y_deg,sigma_z_deg,"
-      "bias_1_dps,bias_2_dps,bias_3_dps,bias_4_dps");
+      "bias_1_dps,bias_2_dps,bias_3_dps,bias_4_dps,pl_x_deg,pl_y_deg,pl_z_deg");
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1001);  // header + one row per epoch
   EXPECT_NE(text.find(",NOMINAL,1234,"), std::string::npos);
   EXPECT_NE(text.find(",DEGRADED,134,"), std::string::npos);

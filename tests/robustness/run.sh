@@ -400,9 +400,9 @@ awk 'BEGIN {
 check roundtrip "sim with 10 gyros" 0 "" "ten.csv" -- sim static --minutes 0.1 --unit ten.yaml -o ten.csv
 check roundtrip "replay with 10 gyros" 0 "" "ten_att.csv ten_ev.jsonl" -- \
   replay ten.csv --calibration ten.yaml --attitude ten_att.csv --events ten_ev.jsonl
-# 11 columns, then sigma_x/y/z_deg and bias_1..10_dps: 24 fields a row.
+# 11 columns, then sigma_x/y/z_deg, bias_1..10_dps and pl_x/y/z_deg: 27 fields a row.
 check_sh roundtrip "attitude CSV: one gyros field for N = 10" \
-  "grep -v '^#' ten_att.csv | awk -F, 'NF != 24 { bad = 1 } END { exit bad }' && grep -q ',1;2;3;4;5;6;7;8;9;10,' ten_att.csv"
+  "grep -v '^#' ten_att.csv | awk -F, 'NF != 27 { bad = 1 } END { exit bad }' && grep -q ',1;2;3;4;5;6;7;8;9;10,' ten_att.csv"
 cp "$LOG" $'bad\xffname.csv'
 check roundtrip "invalid UTF-8 file name into JSON" 0 "" "n.json" -- allan $'bad\xffname.csv' --taus 1 --json n.json
 check_sh roundtrip "the JSON is valid UTF-8" "iconv -f UTF-8 -t UTF-8 n.json >/dev/null"

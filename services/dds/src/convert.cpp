@@ -56,7 +56,7 @@ tetra_EventType to_wire(fdi::EventType type) {
 }
 fdi::EventType from_wire(tetra_EventType type) {
   const int value = static_cast<int>(type);
-  return value >= 0 && value <= static_cast<int>(fdi::EventType::kGap)
+  return value >= 0 && value <= static_cast<int>(fdi::EventType::kReferenceAccepted)
              ? static_cast<fdi::EventType>(value)
              : fdi::EventType::kCommand;
 }
@@ -65,6 +65,9 @@ static_assert(static_cast<int>(tetra_GYRO_EXCLUDED) == static_cast<int>(fdi::Gyr
 static_assert(static_cast<int>(tetra_EVENT_COMMAND) == static_cast<int>(fdi::EventType::kCommand));
 static_assert(static_cast<int>(tetra_EVENT_FDI_AVAILABLE) == static_cast<int>(fdi::EventType::kFdiAvailable));
 static_assert(static_cast<int>(tetra_EVENT_GAP) == static_cast<int>(fdi::EventType::kGap));
+static_assert(static_cast<int>(tetra_EVENT_REFERENCE_ACCEPTED) ==
+              static_cast<int>(fdi::EventType::kReferenceAccepted));
+static_assert(static_cast<int>(tetra_REFERENCE_REJECTED) == static_cast<int>(fdi::ReferenceState::kRejected));
 
 Status to_wire(const std::string& unit, const fdi::AttitudeEstimate& attitude, tetra_Attitude& out) {
   if (auto status = copy_bounded(out.unit, unit, "unit"); !status) return status;
@@ -74,6 +77,7 @@ Status to_wire(const std::string& unit, const fdi::AttitudeEstimate& attitude, t
   for (int i = 0; i < 3; ++i) {
     out.omega_BR_B_rad_s[i] = attitude.omega_BR_B_rad_s[i];
     out.sigma_rad[i] = attitude.sigma_rad[i];
+    out.protection_level_rad[i] = attitude.protection_level_rad[i];
   }
   out.mode = to_wire(attitude.mode);
   out.gyros = attitude.gyros;
@@ -88,6 +92,7 @@ fdi::AttitudeEstimate from_wire(const tetra_Attitude& in) {
   for (int i = 0; i < 3; ++i) {
     out.omega_BR_B_rad_s[i] = in.omega_BR_B_rad_s[i];
     out.sigma_rad[i] = in.sigma_rad[i];
+    out.protection_level_rad[i] = in.protection_level_rad[i];
   }
   out.mode = from_wire(in.mode);
   out.gyros = in.gyros;
@@ -118,6 +123,9 @@ Status to_wire(const std::string& unit, const fdi::Health& health, const service
   out.msg.chi2_threshold = health.chi2_threshold;
   out.msg.cusum_threshold = health.cusum_threshold;
   out.msg.fdi_available = health.fdi_available;
+  out.msg.reference_state = static_cast<tetra_ReferenceState>(static_cast<int>(health.reference_state));
+  out.msg.reference_nis = health.reference_nis;
+  for (int i = 0; i < 3; ++i) out.msg.protection_level_rad[i] = health.protection_level_rad[i];
   tetra_SampleCounters& c = out.msg.counters;
   c.epochs_accepted = health.counters.epochs_accepted;
   c.epochs_rejected_time = health.counters.epochs_rejected_time;
@@ -156,6 +164,12 @@ HealthView from_wire(const tetra_Health& in) {
   h.chi2_threshold = in.chi2_threshold;
   h.cusum_threshold = in.cusum_threshold;
   h.fdi_available = in.fdi_available;
+  const int reference_state = static_cast<int>(in.reference_state);
+  h.reference_state = reference_state >= 0 && reference_state <= static_cast<int>(fdi::ReferenceState::kRejected)
+                          ? static_cast<fdi::ReferenceState>(reference_state)
+                          : fdi::ReferenceState::kAbsent;
+  h.reference_nis = in.reference_nis;
+  for (int i = 0; i < 3; ++i) h.protection_level_rad[i] = in.protection_level_rad[i];
   const tetra_SampleCounters& c = in.counters;
   h.counters.epochs_accepted = c.epochs_accepted;
   h.counters.epochs_rejected_time = c.epochs_rejected_time;
@@ -192,8 +206,11 @@ void copy_truncated(char (&dest)[N], const std::string& text) {
 Status to_wire(const EventView& view, tetra_FdiEvent& out) {
   if (auto status = copy_bounded(out.unit, view.unit, "unit"); !status) return status;
   const fdi::FdiEvent& e = view.event;
-  if (auto status = copy_bounded(out.test, std::string(fdi::to_string(e.test)), "event test"); !status)
-    return status;
+  // A reference event's test is why the reference was rejected (nis, lag, bias, jump).
+  const bool reference_event =
+      e.type == fdi::EventType::kReferenceRejected || e.type == fdi::EventType::kReferenceAccepted;
+  const std::string test = reference_event ? fdi::to_string(e.why) : fdi::to_string(e.test);
+  if (auto status = copy_bounded(out.test, test, "event test"); !status) return status;
   if (auto status = copy_bounded(out.evidence, std::string(fdi::to_string(e.evidence)), "event evidence");
       !status)
     return status;
@@ -247,6 +264,7 @@ EventView from_wire(const tetra_FdiEvent& in) {
   e.type = from_wire(in.type);
   if (in.gyro > 0) e.gyro = in.gyro;
   e.test = fdi::detection_test_from_string(from_wire(in.test));
+  if (e.type == fdi::EventType::kReferenceRejected) e.why = fdi::reference_check_from_string(from_wire(in.test));
   e.statistic = in.statistic;
   e.kind = from_wire(in.kind);
   e.evidence = fdi::evidence_from_string(from_wire(in.evidence));

@@ -89,6 +89,8 @@ json health_json(const dds::HealthView& view, std::int64_t utc_ns) {
           {"gyros", gyros},
           {"parity_available", parity},
           {"fdi_available", h.fdi_available},
+          {"reference_state", fdi::to_string(h.reference_state)},
+          {"reference_nis", number(h.reference_nis)},
           {"parity_residual", when_parity(h.parity_residual)},
           {"chi2", when_parity(h.chi2)},
           {"chi2_threshold", number(h.chi2_threshold)},
@@ -111,6 +113,7 @@ json attitude_json(const std::string& unit, const fdi::AttitudeEstimate& a, std:
           {"euler_deg", {{"roll", e.roll_deg}, {"pitch", e.pitch_deg}, {"yaw", e.yaw_deg}}},
           {"rate_dps", vector_deg(a.omega_BR_B_rad_s)},
           {"sigma_deg", vector_deg(a.sigma_rad)},
+          {"protection_level_deg", vector_deg(a.protection_level_rad)},
           {"mode", fdi::to_string(a.mode)},
           {"gyros_used", a.gyros},
           {"fdi_available", a.fdi_available}};

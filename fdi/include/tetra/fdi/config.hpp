@@ -75,6 +75,18 @@ struct PipelineConfig {
   double reference_gate_false_alarm_probability = 1.0e-6;
   //! [-] the last of this many reference samples in a row that the gate would reject sets the attitude.
   int reference_gate_reset_count = 10;
+
+  // --- the reference as a sensor that can fail (docs/fdi.md, "Reference consistency")
+  double reference_check_window_s = 30.0;  //!< [s] window of the NIS and lag tests of the reference
+  double reference_bias_window_s = 120.0;  //!< [s] window of the mean-innovation (bias) test
+  //! [-] per sample: the probability that a test of a good reference (with consistent gyros) fails
+  double reference_check_false_alarm_probability = 1.0e-9;
+  //! [s] a rejected reference is used again after its samples passed every test for this long
+  double reference_reaccept_s = 30.0;
+
+  // --- integrity (docs/fdi.md, "Protection level")
+  //! [-] probability that the attitude error exceeds the published protection level without an alarm
+  double integrity_risk = 1.0e-7;
 };
 
 //! Parses a `pipeline:` YAML map (unknown keys are errors naming the line); `source` names the file.

@@ -52,9 +52,25 @@ enum class EventType : std::uint8_t {
   kCommand,
   kFdiUnavailable,
   kFdiAvailable,
-  kGap
+  kGap,                //!< no epoch for longer than max_gap_s (statistic: the gap's length [s])
+  kReferenceRejected,  //!< the attitude reference failed a consistency test (why: ReferenceCheck)
+  kReferenceAccepted   //!< a rejected reference passed every test for reference_reaccept_s: used again
 };
 const char* to_string(EventType type);
+
+//! The attitude reference's state (docs/fdi.md, "Reference consistency").
+enum class ReferenceState : std::uint8_t {
+  kAbsent,    //!< no sample within reference_window_s (or none yet)
+  kAccepted,  //!< its samples update the filter
+  kRejected   //!< failed a test: its samples are left out until consistent again
+};
+const char* to_string(ReferenceState state);  // "absent", "accepted", "rejected"
+
+//! Why a reference was rejected.
+enum class ReferenceCheck : std::uint8_t { kNone, kNis, kLag, kBias, kJump };
+const char* to_string(ReferenceCheck check);  // "", "nis", "lag", "bias", "jump"
+//! The check named by `text` (as written by to_string); kNone for any other text.
+ReferenceCheck reference_check_from_string(std::string_view text);
 
 //! The test that raised a detection (or triggered an isolation).
 //! kLevel: the CUSUM on the parity minus an open episode's held level (a new fault during the episode).
@@ -114,6 +130,7 @@ struct FdiEvent {
   GyroMask gyros = 0;  //!< reconfigured / cleared / lost / command: the gyros used from now on
   std::optional<CommandVerb> command;              //!< command: the verb acknowledged
   CommandOutcome outcome = CommandOutcome::kDone;  //!< command: its outcome
+  ReferenceCheck why = ReferenceCheck::kNone;      //!< reference_rejected (and a `reference` detection): the test
   std::string detail;  //!< free text: e.g. the command acknowledged and its outcome
 
   //! command: refused (the outcome says why); nothing changed.
@@ -143,7 +160,7 @@ struct Counters {
   std::uint64_t samples_outlier = 0;          //!< valid samples left out for one epoch (spike or onset)
   std::uint64_t spikes = 0;                   //!< confirmed one-epoch spikes (outliers that went away)
   std::uint64_t reference_accepted = 0;       //!< reference samples the attitude filter used
-  std::uint64_t reference_rejected = 0;       //!< reference samples its χ² gate rejected
+  std::uint64_t reference_rejected = 0;  //!< reference samples its χ² gate rejected or left out (rejected)
   std::uint64_t reference_reinitialized = 0;  //!< times a run of rejections set the attitude again
   std::uint64_t reference_invalid = 0;  //!< reference samples left out: not finite or norm not 1 within 1e-3
 };
@@ -163,6 +180,11 @@ struct Health {
   //! false: a new fault cannot be detected (the gyros used leave no parity and no reference came within
   //! reference_window_s); signatures of a single gyro (stuck, noise, dropout...) still run.
   bool fdi_available = true;
+  ReferenceState reference_state = ReferenceState::kAbsent;  //!< the attitude reference's state
+  //! [-] the reference's windowed NIS per degree of freedom (≈ 1 when consistent; 0 before any sample)
+  double reference_nis = 0.0;
+  //! [rad] per body axis: the integrity bound beside sigma (AttitudeEstimate::protection_level_rad)
+  Eigen::Vector3d protection_level_rad = Eigen::Vector3d::Zero();
 };
 
 //! The estimate published every accepted epoch (docs/interfaces.md §2.4).
@@ -176,6 +198,9 @@ struct AttitudeEstimate {
   GyroMask gyros = 0;                   //!< gyros used
   std::vector<double> gyro_bias_rad_s;  //!< [rad/s] size N: the filter's estimate of each gyro's bias
   bool fdi_available = true;            //!< as Health::fdi_available: false = a new fault would go unseen
+  //! [rad] per body axis: the error a single-gyro fault below the detection threshold can have caused since
+  //! the last reference sample used (or the start), plus σ at integrity_risk; +∞ without parity (no integrity)
+  Eigen::Vector3d protection_level_rad = Eigen::Vector3d::Zero();
 };
 
 }  // namespace tetra::fdi

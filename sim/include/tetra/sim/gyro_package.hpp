@@ -6,6 +6,7 @@
 // draw the same seeded streams in the same order.
 
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <vector>
 
@@ -30,7 +31,8 @@ class GyroPackage {
   //! `present[i]` = 0 where gyro i delivered no sample (then raw_V[i] is NaN).
   void sample(const Eigen::Vector3d& sensed_dps, double t_s, std::vector<double>& raw_V,
               std::vector<std::uint8_t>& present);
-  //! The attitude reference of epoch `k` (none between reference periods): truth ⊗ exp(δθ).
+  //! The attitude reference of epoch `k` (none between reference periods): the truth `latency_s` earlier ⊗
+  //! exp(δθ + slow bias + mis-identification). Called for every epoch (it keeps the truth's recent past).
   std::optional<Quaternion> reference(std::size_t k, const Quaternion& truth_q_RB);
 
   const std::vector<FaultSpec>& faults() const { return faults_; }
@@ -54,6 +56,7 @@ class GyroPackage {
   std::vector<std::optional<double>> stuck_value_V_;  //!< per fault
   std::vector<std::uint8_t> spike_done_;              //!< per fault
   std::int64_t last_reference_period_ = -1;
+  std::deque<std::pair<double, Quaternion>> truth_history_;  //!< [s], q_RB: the last latency_s of truth
 };
 
 }  // namespace tetra::sim

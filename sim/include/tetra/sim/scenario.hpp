@@ -16,10 +16,19 @@
 
 namespace tetra::sim {
 
-//! Star-tracker-like attitude reference: q_RB ⊗ exp(δθ), δθ ~ N(0, σ²·I) per axis (in B).
+//! Star-tracker-like attitude reference: q_RB(t − latency) ⊗ exp(δθ + b(t) + m(t)), δθ ~ N(0, σ²·I) per axis
+//! (in B); b a slow (thermal) bias, m a mis-identification episode. The failure modes (latency, slow bias,
+//! mis-identification; a noisier reference is `noise_arcsec` itself) are off by default (docs/sim.md).
 struct ReferenceOptions {
   double rate_hz = 0.0;       //!< [Hz] 0 = no reference
   double noise_arcsec = 0.0;  //!< [arcsec] 1σ per axis
+  double latency_s = 0.0;     //!< [s] the sample shows the attitude this long before its time stamp
+  double bias_arcsec = 0.0;   //!< [arcsec] slow bias about (1, 1, 1)/√3 of B, reached after bias_ramp_s
+  double bias_at_s = 0.0;     //!< [s] the slow bias starts growing here
+  double bias_ramp_s = 0.0;   //!< [s] it grows linearly to bias_arcsec over this long (0: a step)
+  double misid_deg = 0.0;     //!< [deg] mis-identification: turned about (0.6, 0.8, 0) of B by this much...
+  double misid_at_s = 0.0;    //!< [s] ...from here...
+  double misid_duration_s = 0.0;  //!< [s] ...for this long (0: none)
 };
 
 struct Scenario {

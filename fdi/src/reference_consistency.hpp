@@ -1,0 +1,93 @@
+#pragma once
+// The attitude reference as a sensor that can fail (docs/fdi.md, "Reference consistency"). Every reference
+// sample's innovation against the gyro-propagated attitude, z with covariance S (the filter's attitude
+// covariance, any fault bound and the reference's configured σ), is tested before anything uses the sample:
+//
+//   jump  one sample:          zᵀS⁻¹z                        > χ²₃(1 − p)
+//   nis   the window's sum:    Σ zᵀS⁻¹z over m samples        > χ²_{3m}(1 − p)
+//   lag   z = a − ω·τ fitted over the window (a per-axis offset, τ common): τ̂²/var(τ̂) > χ²₁(1 − p)
+//   bias  the long window's weighted mean innovation: Σ_a (Σ z_a/S_aa)²/Σ 1/S_aa > χ²₃(1 − p)
+//
+// p = reference_check_false_alarm_probability per sample. Windows are consecutive blocks (the nis and lag
+// tests' of reference_check_window_s, the bias test's of reference_bias_window_s), each test evaluated at
+// every sample over its block so far. Without a gyro fault the innovations are white with covariance S (the
+// filter's model), so each statistic has the stated distribution; what a fault of the reference does to them
+// is in docs/fdi.md. A reference is judged only while the gyro solution is consistent (the caller's `judge`):
+// parity among the gyros used and no fault episode open. Then a failed test rejects the reference: its samples
+// are no longer used (sigma grows with the gyro propagation) until they pass every test for
+// reference_reaccept_s. Without judging, a failed test is reported (`inconsistent`) and nothing else changes.
+
+#include <cstdint>
+#include <optional>
+
+#include <Eigen/Core>
+
+#include "tetra/fdi/config.hpp"
+#include "tetra/fdi/types.hpp"
+
+namespace tetra::fdi::detail {
+
+//! What one reference sample's tests said.
+struct ReferenceVerdict {
+  bool use = true;                        //!< the sample may update the filter and the reference windows
+  std::optional<ReferenceCheck> rejected;  //!< the reference was rejected at this sample, and why
+  bool reaccepted = false;                 //!< the reference is used again from this sample on
+  //! A test failed while the gyros could not be judged (no parity or an open episode): the reference or a
+  //! gyro is wrong, and the data cannot tell which.
+  std::optional<ReferenceCheck> inconsistent;
+  Eigen::Vector3d contamination_rad2 = Eigen::Vector3d::Zero();  //!< rejected: what the used samples put in
+};
+
+class ReferenceConsistency {
+ public:
+  explicit ReferenceConsistency(const PipelineConfig& config);
+
+  void reset();    //!< absent, windows empty
+  void restart();  //!< windows empty (the gyro set changed, an episode ended); the state kept
+
+  //! One sample at `now_ns`: its innovation `z_rad` with covariance `S`, the body rate `omega_rad_s` at its
+  //! time, and whether the gyros are consistent enough to judge the reference.
+  ReferenceVerdict observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S,
+                           const Eigen::Vector3d& omega_rad_s, bool judge);
+  //! No sample for reference_window_s: absent (an accepted reference only; a rejected one stays rejected).
+  void absent() {
+    if (state_ == ReferenceState::kAccepted) state_ = ReferenceState::kAbsent;
+  }
+
+  ReferenceState state() const { return state_; }
+  //! The window's NIS per degree of freedom (Σ zᵀS⁻¹z / 3m: 1 for a consistent reference); 0 before any.
+  double windowed_nis() const { return nis_per_dof_; }
+
+ private:
+  //! The first test that fails over the blocks with this sample in, or none.
+  std::optional<ReferenceCheck> test(std::int64_t now_ns, const Eigen::Vector3d& z, const Eigen::Vector3d& w,
+                                     double nis, const Eigen::Vector3d& omega);
+  void restart_blocks(std::int64_t now_ns);
+
+  const PipelineConfig& config_;
+  double jump_chi2_ = 0.0;  //!< χ²₃(1 − p)
+  double lag_chi2_ = 0.0;   //!< χ²₁(1 − p)
+  double z_tail_ = 0.0;     //!< Φ⁻¹(1 − p), for the Wilson–Hilferty χ²_{3m} quantile
+  ReferenceState state_ = ReferenceState::kAbsent;
+  std::int64_t consistent_since_ns_ = 0;  //!< rejected: every sample since passed every test
+  double nis_per_dof_ = 0.0;
+  Eigen::Vector3d lag_offset_rad_ = Eigen::Vector3d::Zero();  //!< [rad] |ω̄·τ̂| of the block so far
+  double lag_s_ = 0.0;         //!< [s] τ̂ of the block so far
+  double lag_den_ = 0.0;       //!< [1/rad²·(rad/s)²] Σ_a Σw(ω − ω̄)² of the block so far: 1/var(τ̂)
+  double rejected_lag_s_ = 0.0;  //!< [s] |τ̂| when rejected for `lag` (0: another reason)
+  double reaccept_den_ = 0.0;    //!< rejected: Σ of lag_den_ over the blocks completed since consistent
+
+  // the nis and lag block (reference_check_window_s)
+  std::int64_t block_start_ns_ = -1;
+  int block_count_ = 0;
+  double block_nis_ = 0.0;
+  Eigen::Vector3d sw_, swo_, swz_, swoo_, swoz_;  //!< per axis Σw, Σwω, Σwz, Σwω², Σwωz (w = 1/S_aa)
+  Eigen::Vector3d szz_;                            //!< per axis Σz² of the samples used
+  Eigen::Vector3d sss_;                            //!< per axis ΣS_aa of the samples used
+  // the bias block (reference_bias_window_s)
+  std::int64_t bias_start_ns_ = -1;
+  int bias_count_ = 0;
+  Eigen::Vector3d bias_sw_, bias_swz_;
+};
+
+}  // namespace tetra::fdi::detail
