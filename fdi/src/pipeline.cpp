@@ -32,6 +32,7 @@
 #include "rate_attitude.hpp"
 #include "reference_consistency.hpp"
 #include "reference_monitor.hpp"
+#include "stamp_judge.hpp"
 #include "subset_cache.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"
@@ -151,6 +152,7 @@ class Pipeline::Impl {
   mutable bool filter_health_due_ = false;
   Mode persistent_mode_ = Mode::kNominal;
   GyroMask measured_ = 0;  //!< the gyros of this epoch's rate estimate so far
+  StampJudge clock_;  //!< the epoch time check: outliers dropped, forward jumps confirmed
   bool has_time_ = false;
   std::int64_t last_ns_ = 0;
   std::optional<std::int64_t> last_reference_ns_;  //!< the last epoch that carried a usable reference
@@ -268,13 +270,20 @@ bool Pipeline::Impl::accept(const Epoch& epoch) {
     ++counters.epochs_rejected_shape;
     return false;
   }
-  if (has_time_ && epoch.stamp_ns <= last_ns_) {
-    ++counters.epochs_rejected_time;  // duplicate, backward or out of order: the attitude is not advanced
-    return false;
+  switch (clock_.judge(epoch.stamp_ns)) {
+    case StampVerdict::kAccepted:
+      break;
+    case StampVerdict::kNotIncreasing:
+      ++counters.epochs_rejected_time;  // duplicate, backward or out of order: the attitude is not advanced
+      return false;
+    case StampVerdict::kOutlier:
+      ++counters.epochs_time_outlier;  // far from the stream's time: dropped, the time is not moved
+      return false;
   }
   frame_.dt_s = has_time_ ? ns_to_seconds(epoch.stamp_ns - last_ns_) : 0.0;
   if (!has_time_) protection_.anchor(epoch.stamp_ns);  // the start: the attitude known to its initial σ
   if (!subsets_.ready() && frame_.dt_s > 0.0) subsets_.prepare(frame_.dt_s);
+  if (!clock_.has_period() && subsets_.ready()) clock_.set_period(seconds_to_ns(subsets_.period_s()));
   has_time_ = true;
   last_ns_ = epoch.stamp_ns;
   frame_.now_ns = epoch.stamp_ns;
@@ -667,6 +676,7 @@ void Pipeline::Impl::reset() {
   attitude_.reset(config_.initial_q_RB);
   has_time_ = false;
   last_ns_ = 0;
+  clock_.reset();
   protection_.anchor(0);
   last_reference_ns_.reset();
   reference_set_ns_.reset();

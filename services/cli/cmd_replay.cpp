@@ -219,18 +219,31 @@ void print_summary(const fdi::Pipeline& pipeline, const Replayed& replayed, int 
     ev += (ev.empty() ? "" : ", ") + name + " " + std::to_string(count);
   std::fprintf(
       stderr,
-      "tetra replay: %zu epochs read, %llu accepted; rejected: %llu time not increasing, %llu wrong "
-      "sample count\n"
+      "tetra replay: %zu epochs read, %llu accepted; rejected: %llu time not increasing, %llu time "
+      "outliers, %llu wrong sample count\n"
       "  samples: %llu accepted, %llu invalid, %llu absent, %llu outliers left out (%llu spikes)\n"
       "  events: %s\n"
       "  final mode: %s, gyros used: %s, excluded: %s\n",
       replayed.epochs, static_cast<unsigned long long>(c.epochs_accepted),
       static_cast<unsigned long long>(c.epochs_rejected_time),
+      static_cast<unsigned long long>(c.epochs_time_outlier),
       static_cast<unsigned long long>(c.epochs_rejected_shape),
       static_cast<unsigned long long>(c.samples_accepted), static_cast<unsigned long long>(c.samples_invalid),
       static_cast<unsigned long long>(c.samples_absent), static_cast<unsigned long long>(c.samples_outlier),
       static_cast<unsigned long long>(c.spikes), ev.empty() ? "none" : ev.c_str(), fdi::to_string(h.mode),
       mask_to_string(h.used, n).c_str(), excluded.empty() ? "none" : excluded.c_str());
+  // Most of the log left out is never a quiet success: the exit status stays 0 (the outputs are what the
+  // pipeline made of the log), the warning says what was lost.
+  const std::uint64_t rejected = c.epochs_rejected_time + c.epochs_time_outlier + c.epochs_rejected_shape;
+  if (replayed.epochs > 0 && 2 * rejected > replayed.epochs) {
+    std::fprintf(stderr,
+                 "tetra replay: warning: %llu of %zu epochs rejected (%llu time not increasing, %llu time "
+                 "outliers, %llu wrong sample count): the attitude covers only part of the log\n",
+                 static_cast<unsigned long long>(rejected), replayed.epochs,
+                 static_cast<unsigned long long>(c.epochs_rejected_time),
+                 static_cast<unsigned long long>(c.epochs_time_outlier),
+                 static_cast<unsigned long long>(c.epochs_rejected_shape));
+  }
 }
 
 // Outputs, configuration, inputs, pipeline; the replay; the outputs committed; the summary.

@@ -1,6 +1,9 @@
 // `tetra replay` end to end: outputs per docs/interfaces.md §2.4, §2.5, the summary, and bad input (exit 2,
 // file and line named, or a counted rejection — never a crash).
 #include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstdio>
 #include <cmath>
 #include <sstream>
 
@@ -100,10 +103,98 @@ TEST(ReplayCli, BadTimesAreCountedNotFatal) {
   const auto r = run_tetra("replay " + dir.file("log.csv") + " --calibration " + cal + " --attitude " +
                            dir.file("att.csv") + " --events " + dir.file("ev.jsonl"));
   ASSERT_EQ(r.exit_status, 0) << r.err;
-  EXPECT_NE(r.err.find("rejected: 3 time not increasing"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("rejected: 3 time not increasing, 0 time outliers"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("1 invalid, 1 absent"), std::string::npos) << r.err;
   EXPECT_NE(test::read_file(dir.file("att.csv")).find(",LOST,,"),
             std::string::npos);  // 2 usable gyros at 0.4 s
+}
+
+// One mis-stamped row never blinds replay (docs/fdi.md, "Per epoch"): a row 1e6 s ahead and one 1e6 s behind
+// are time outliers, a duplicated row and one slightly backward are "time not increasing", a genuine 100 s
+// forward jump is followed after 3 agreeing rows (the first 2 counted as outliers) and is a gap. Every other
+// row is accepted, the attitude's time only increases and its rotation between rows stays within what the
+// body's rate explains.
+TEST(ReplayCli, MisStampedRowsAreTimeOutliersAndAGenuineJumpIsAGap) {
+  TempDir dir;
+  const auto clean = test::read_file(write_log(dir, "clean.csv", 60.0));  // 600 rows at 0.1 s
+  std::istringstream in(clean);
+  std::string line;
+  std::string text;
+  int row = 0;
+  auto with_time = [](const std::string& l, double t) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.9g", t);
+    return buf + l.substr(l.find(','));
+  };
+  while (std::getline(in, line)) {
+    const bool data = !line.empty() && (std::isdigit(static_cast<unsigned char>(line[0])) != 0);
+    if (!data) {
+      text += line + "\n";
+      continue;
+    }
+    const double t = std::stod(line.substr(0, line.find(',')));
+    const double shifted = row >= 500 ? t + 100.0 : t;  // the log's clock jumps 100 s for good at row 500
+    text += with_time(line, shifted) + "\n";
+    if (row == 100) text += with_time(line, t + 1.0e6) + "\n";  // one row 1e6 s ahead
+    if (row == 200) text += with_time(line, t - 1.0e6) + "\n";  // one row 1e6 s behind
+    if (row == 300) text += with_time(line, t) + "\n";          // a duplicated row
+    if (row == 400) text += with_time(line, t - 0.05) + "\n";   // a row slightly backward
+    ++row;
+  }
+  ASSERT_EQ(row, 600);
+  test::write_file(dir.file("glitch.csv"), text);
+  const auto r = run_tetra("replay " + dir.file("glitch.csv") + " --calibration " + write_cal(dir) +
+                           " --attitude " + dir.file("att.csv") + " --events " + dir.file("ev.jsonl"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.err.find("604 epochs read, 598 accepted; rejected: 2 time not increasing, 4 time outliers"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("final mode: NOMINAL, gyros used: 1234, excluded: none"), std::string::npos) << r.err;
+  const std::string ev = test::read_file(dir.file("ev.jsonl"));
+  EXPECT_NE(ev.find(R"("event": "gap")"), std::string::npos) << ev;
+  EXPECT_EQ(ev.find(R"("event": "isolated")"), std::string::npos) << ev;
+
+  // The attitude: 598 rows, time increasing, each rotation between rows within 0.07 deg/s (the synthetic body
+  // rate is 0.06 deg/s plus a 2e-3 deg/s motion) times the step, + 1e-3 deg for noise.
+  std::istringstream att(test::read_file(dir.file("att.csv")));
+  double last_t = -1.0;
+  Eigen::Quaterniond last_q = Eigen::Quaterniond::Identity();
+  int rows = 0;
+  while (std::getline(att, line)) {
+    if (line.empty() || std::isdigit(static_cast<unsigned char>(line[0])) == 0) continue;
+    std::array<double, 5> v{};
+    std::istringstream ls(line);
+    std::string cell;
+    for (double& x : v) {
+      std::getline(ls, cell, ',');
+      x = std::stod(cell);
+    }
+    const Eigen::Quaterniond q(v[1], v[2], v[3], v[4]);
+    if (rows > 0) {
+      ASSERT_GT(v[0], last_t) << line;
+      const double angle_deg = q.angularDistance(last_q) * 180.0 / M_PI;
+      EXPECT_LE(angle_deg, 0.07 * (v[0] - last_t) + 1e-3) << "at t = " << v[0];
+    }
+    last_t = v[0];
+    last_q = q;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 598);
+}
+
+// Most of a log rejected is never a quiet success: a warning line with the counts.
+TEST(ReplayCli, MostEpochsRejectedIsAWarning) {
+  TempDir dir;
+  std::string text = "time_s,g1,g2,g3,g4\n";
+  for (int k = 0; k < 10; ++k) text += "5.0,0.0002,0.0004,0.0002,-0.0003\n";  // one time, ten rows
+  test::write_file(dir.file("log.csv"), text);
+  const auto r = run_tetra("replay " + dir.file("log.csv") + " --calibration " + write_cal(dir) +
+                           " --attitude " + dir.file("att.csv") + " --events " + dir.file("ev.jsonl"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.err.find("tetra replay: warning: 9 of 10 epochs rejected (9 time not increasing, 0 time outliers"),
+            std::string::npos)
+      << r.err;
 }
 
 TEST(ReplayCli, BadInputIsExitTwoNamingFileAndLine) {

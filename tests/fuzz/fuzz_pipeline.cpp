@@ -56,6 +56,7 @@ double any_double(FuzzedDataProvider& in) {
 bool counters_not_less(const tetra::fdi::Counters& now, const tetra::fdi::Counters& before) {
   return now.epochs_accepted >= before.epochs_accepted &&
          now.epochs_rejected_time >= before.epochs_rejected_time &&
+         now.epochs_time_outlier >= before.epochs_time_outlier &&
          now.samples_accepted >= before.samples_accepted && now.samples_invalid >= before.samples_invalid &&
          now.samples_absent >= before.samples_absent;
 }

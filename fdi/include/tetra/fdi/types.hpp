@@ -153,6 +153,8 @@ struct GyroHealth {
 struct Counters {
   std::uint64_t epochs_accepted = 0;
   std::uint64_t epochs_rejected_time = 0;  //!< time not increasing (duplicate, backward, out of order)
+  //! epochs stamped far from the stream's time (beyond 1000 sample periods; docs/fdi.md, "Per epoch"): dropped
+  std::uint64_t epochs_time_outlier = 0;
   std::uint64_t samples_accepted = 0;
   std::uint64_t samples_invalid = 0;          //!< NaN, Inf or out of range
   std::uint64_t samples_absent = 0;           //!< no sample delivered
