@@ -66,6 +66,7 @@ const std::vector<KeyDef>& scalar_keys() {
       {"reference_check_false_alarm_probability", &PipelineConfig::reference_check_false_alarm_probability},
       {"reference_reaccept_s", &PipelineConfig::reference_reaccept_s},
       {"integrity_risk", &PipelineConfig::integrity_risk},
+      {"calibration_error_sigmas", &PipelineConfig::calibration_error_sigmas},
   };
   return keys;
 }
@@ -207,6 +208,10 @@ Status validate(const PipelineConfig& c) {
        "in (0, 0.5)"},
       {"reference_reaccept_s", std::isfinite(c.reference_reaccept_s) && c.reference_reaccept_s >= 0.0, ">= 0"},
       {"integrity_risk", probability(c.integrity_risk), "in (0, 0.5)"},
+      {"calibration_error_sigmas",
+       std::isfinite(c.calibration_error_sigmas) && c.calibration_error_sigmas >= 0.0 &&
+           c.calibration_error_sigmas <= 100.0,
+       "in [0, 100]"},
   };
   for (const auto& check : checks) {
     if (!check.ok) return bad_input(std::string("pipeline.") + check.name + ": must be " + check.rule);

@@ -303,7 +303,8 @@ void Pipeline::Impl::detect() {
   attitude_.measure(s, frame_);
   measured_ = frame_.usable;
   const GyroMask active = gyro_set_.active();
-  const Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), health_);
+  const double calibration = subsets_.calibration_bound(s, frame_.usable, attitude_.omega_meas_B());
+  const Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), calibration, health_);
   if (d.cusum_ran) {
     isolator_.accumulate(detector_.parity(), s.dof);
     bias_check_.record(detector_.parity(), s);

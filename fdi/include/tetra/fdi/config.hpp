@@ -87,6 +87,11 @@ struct PipelineConfig {
   // --- integrity (docs/fdi.md, "Protection level")
   //! [-] probability that the attitude error exceeds the published protection level without an alarm
   double integrity_risk = 1.0e-7;
+
+  // --- calibration uncertainty (docs/fdi.md, "Calibration uncertainty")
+  //! [-] multiple of the calibration file's stated 1σ (scale factors, axes) the parity tests tolerate: an
+  //! error of every scale factor and axis component within this many σ never raises the parity beyond its noise
+  double calibration_error_sigmas = 3.0;
 };
 
 //! Parses a `pipeline:` YAML map (unknown keys are errors naming the line); `source` names the file.
