@@ -35,6 +35,7 @@
 #include "subset_cache.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/fdi/noise_defaults.hpp"
 
 namespace tetra::fdi {
 
@@ -797,8 +798,10 @@ Pipeline::Pipeline(Pipeline&&) noexcept = default;
 Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
 Pipeline::~Pipeline() = default;
 
-Result<Pipeline> Pipeline::create(const Calibration& calibration, const PipelineConfig& config) {
-  if (auto st = validate_calibration(calibration, "calibration"); !st) return st.error();
+Result<Pipeline> Pipeline::create(const Calibration& stated, const PipelineConfig& config) {
+  if (auto st = validate_calibration(stated, "calibration"); !st) return st.error();
+  // A gyro whose noise is not stated runs on the conservative defaults (default_noise_warning says which).
+  const Calibration calibration = with_default_noise(stated, config);
   if (auto st = validate(config); !st) return st.error();
   auto constants = gyro_constants(calibration, config);
   if (!constants) return constants.error();

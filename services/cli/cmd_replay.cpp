@@ -22,6 +22,7 @@
 #include "tetra/core/provenance.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/config.hpp"
+#include "tetra/fdi/noise_defaults.hpp"
 #include "tetra/fdi/pipeline.hpp"
 
 namespace tetra::cli {
@@ -129,6 +130,8 @@ Result<fdi::Pipeline> make_pipeline(const ReplayOptions& o, const ReplayInputs& 
   if (auto st = fdi::validate(config); !st) return st.error();
   auto pipeline = fdi::Pipeline::create(in.cal, config);
   if (!pipeline) return bad_input(o.cal_path + ": " + pipeline.error().message);
+  if (const std::string w = fdi::default_noise_warning(in.cal, config); !w.empty())
+    std::fprintf(stderr, "tetra replay: warning: %s: %s\n", o.cal_path.c_str(), w.c_str());
   if (o.verbose) std::fprintf(stderr, "tetra replay: configuration\n%s", fdi::describe(config).c_str());
   return pipeline;
 }
