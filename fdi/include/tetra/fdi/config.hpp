@@ -26,7 +26,7 @@ struct PipelineConfig {
   double max_abs_raw_V = 10.0;   //!< [V] a raw sample beyond this is invalid
   double max_abs_rate_dps = 100.0;       //!< [deg/s] a calibrated rate beyond this is invalid
   double default_arw_dps_rtHz = 3.0e-5;  //!< [deg/√s] N of a gyro without `noise:` (seed Table 6)
-  //! [deg/s] B of a gyro without `noise: bias_instability_dps`: twice the seed's Table 6 level, conservative
+  //! [deg/s] B of a gyro without `noise:` section: twice the seed's Table 6 level, conservative
   double default_bias_instability_dps = 1.0e-5;
 
   // --- detection on the parity residual
