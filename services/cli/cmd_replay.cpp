@@ -130,8 +130,6 @@ Result<fdi::Pipeline> make_pipeline(const ReplayOptions& o, const ReplayInputs& 
   if (auto st = fdi::validate(config); !st) return st.error();
   auto pipeline = fdi::Pipeline::create(in.cal, config);
   if (!pipeline) return bad_input(o.cal_path + ": " + pipeline.error().message);
-  if (const std::string w = fdi::default_noise_warning(in.cal, config); !w.empty())
-    std::fprintf(stderr, "tetra replay: warning: %s: %s\n", o.cal_path.c_str(), w.c_str());
   if (o.verbose) std::fprintf(stderr, "tetra replay: configuration\n%s", fdi::describe(config).c_str());
   return pipeline;
 }
@@ -269,6 +267,9 @@ Status run_replay(const ReplayOptions& o) {
   if (o.verbose)
     std::fprintf(stderr, "tetra replay: thresholds\n%s", pipeline->describe_thresholds().c_str());
   print_summary(*pipeline, *replayed, n);
+  // Last, where it stays in view (and a run that fails says its one error line alone).
+  if (const std::string w = fdi::default_noise_warning(in->cal, *config); !w.empty())
+    std::fprintf(stderr, "tetra replay: warning: %s: %s\n", o.cal_path.c_str(), w.c_str());
   return ok_status();
 }
 
