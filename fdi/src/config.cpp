@@ -29,6 +29,7 @@ const std::vector<KeyDef>& scalar_keys() {
       {"max_abs_raw_V", &PipelineConfig::max_abs_raw_V},
       {"max_abs_rate_dps", &PipelineConfig::max_abs_rate_dps},
       {"default_arw_dps_rtHz", &PipelineConfig::default_arw_dps_rtHz},
+      {"default_bias_instability_dps", &PipelineConfig::default_bias_instability_dps},
       {"chi2_false_alarm_probability", &PipelineConfig::chi2_false_alarm_probability},
       {"cusum_min_fault_dps", &PipelineConfig::cusum_min_fault_dps},
       {"cusum_arl0_epochs", &PipelineConfig::cusum_arl0_epochs},
@@ -66,6 +67,7 @@ const std::vector<KeyDef>& scalar_keys() {
       {"reference_check_false_alarm_probability", &PipelineConfig::reference_check_false_alarm_probability},
       {"reference_reaccept_s", &PipelineConfig::reference_reaccept_s},
       {"integrity_risk", &PipelineConfig::integrity_risk},
+      {"calibration_error_sigmas", &PipelineConfig::calibration_error_sigmas},
   };
   return keys;
 }
@@ -164,6 +166,8 @@ Status validate(const PipelineConfig& c) {
       {"max_abs_raw_V", positive(c.max_abs_raw_V), "> 0"},
       {"max_abs_rate_dps", positive(c.max_abs_rate_dps), "> 0"},
       {"default_arw_dps_rtHz", positive(c.default_arw_dps_rtHz), "> 0"},
+      {"default_bias_instability_dps",
+       std::isfinite(c.default_bias_instability_dps) && c.default_bias_instability_dps >= 0.0, ">= 0"},
       {"chi2_false_alarm_probability", probability(c.chi2_false_alarm_probability), "in (0, 0.5)"},
       {"cusum_min_fault_dps", positive(c.cusum_min_fault_dps), "> 0"},
       {"cusum_arl0_epochs", std::isfinite(c.cusum_arl0_epochs) && c.cusum_arl0_epochs >= 10.0, ">= 10"},
@@ -207,6 +211,10 @@ Status validate(const PipelineConfig& c) {
        "in (0, 0.5)"},
       {"reference_reaccept_s", std::isfinite(c.reference_reaccept_s) && c.reference_reaccept_s >= 0.0, ">= 0"},
       {"integrity_risk", probability(c.integrity_risk), "in (0, 0.5)"},
+      {"calibration_error_sigmas",
+       std::isfinite(c.calibration_error_sigmas) && c.calibration_error_sigmas >= 0.0 &&
+           c.calibration_error_sigmas <= 100.0,
+       "in [0, 100]"},
   };
   for (const auto& check : checks) {
     if (!check.ok) return bad_input(std::string("pipeline.") + check.name + ": must be " + check.rule);

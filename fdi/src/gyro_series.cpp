@@ -84,6 +84,7 @@ Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const 
       c.bias_sigma_rad_s = g.sigma->bias_V / std::abs(g.scale_factor_V_per_dps) * kDegToRad;
       c.scale_rel_sigma = g.sigma->scale_factor_V_per_dps / std::abs(g.scale_factor_V_per_dps);
     }
+    if (g.sigma) c.axis_sigma = g.sigma->axis.cwiseAbs();
     out.push_back(c);
   }
   return out;

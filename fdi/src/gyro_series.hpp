@@ -23,6 +23,7 @@ struct GyroConstants {
   double arw_rad_rts = 0.0;             //!< [rad/√s] white rate noise N
   double bias_sigma_rad_s = 0.0;        //!< [rad/s] 1σ of the calibrated bias
   double scale_rel_sigma = 0.0;         //!< [-] 1σ relative scale factor error
+  Eigen::Vector3d axis_sigma = Eigen::Vector3d::Zero();  //!< [-] 1σ of each axis component
   double bias_instability_rad_s = 0.0;  //!< [rad/s] B of the calibration's noise section (0 if absent)
   double quantization_rad = 0.0;        //!< [rad] angle quantization Q of the noise section (0 if absent)
 };

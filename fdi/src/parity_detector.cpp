@@ -105,14 +105,18 @@ void ParityDetector::restart_after_alarm() {
 }
 
 Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroMask active,
-                                 double sqrt_period, Health& health) {
+                                 double sqrt_period, double calibration_bound, Health& health) {
   Detection d;
   d.onset_index = frame.index;
-  // The χ² sees one sample: with quantization its own whitening (white noise and quantization error).
-  double chi2 = apply_parity(s, frame.usable, frame.y_rad_s.data(), sqrt_period, p_.data());
+  // The χ² sees one sample: with quantization its own whitening (white noise and quantization error). Both
+  // leave out the calibration's rate-proportional term, bounded by `calibration_bound` in either whitening
+  // (the sample's columns are no longer than the white noise's).
+  double chi2 = shrink_by(p_.data(), s.dof, calibration_bound,
+                          apply_parity(s, frame.usable, frame.y_rad_s.data(), sqrt_period, p_.data()));
   if (s.quantized)
-    chi2 =
-        apply_whitened(s.sample_parity, s.dof, frame.usable, frame.y_rad_s.data(), sqrt_period, dp_.data());
+    chi2 = shrink_by(
+        dp_.data(), s.dof, calibration_bound,
+        apply_whitened(s.sample_parity, s.dof, frame.usable, frame.y_rad_s.data(), sqrt_period, dp_.data()));
   health.chi2 = chi2;
   health.chi2_threshold = s.chi2_threshold;
   health.parity_residual = s.dof >= 1 ? std::sqrt(chi2) : 0.0;

@@ -55,9 +55,10 @@ class ParityDetector {
   explicit ParityDetector(int n_gyros, double nominal_window_s = 30.0);
 
   //! The epoch's parity over `frame.usable` (`s` its subset), the χ² test, and the CUSUMs when every active
-  //! gyro is usable. Writes the statistics into `health`.
+  //! gyro is usable. Writes the statistics into `health`. `calibration_bound` [σ]: the bound on the parity's
+  //! calibration term at this epoch's rate (`SubsetCache::calibration_bound`), left out of the parity.
   Detection update(const EpochFrame& frame, const Subset& s, GyroMask active, double sqrt_period,
-                   Health& health);
+                   double calibration_bound, Health& health);
   //! After an alarm: the CUSUM that raised it starts again from zero, so a persisting fault keeps alarming
   //! (and the main CUSUM's alarms during an episode leave the level test running).
   void restart_after_alarm();

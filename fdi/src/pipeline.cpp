@@ -36,6 +36,7 @@
 #include "subset_cache.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/fdi/noise_defaults.hpp"
 
 namespace tetra::fdi {
 
@@ -312,7 +313,8 @@ void Pipeline::Impl::detect() {
   attitude_.measure(s, frame_);
   measured_ = frame_.usable;
   const GyroMask active = gyro_set_.active();
-  const Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), health_);
+  const double calibration = subsets_.calibration_bound(s, frame_.usable, attitude_.omega_meas_B());
+  const Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), calibration, health_);
   if (d.cusum_ran) {
     isolator_.accumulate(detector_.parity(), s.dof);
     bias_check_.record(detector_.parity(), s);
@@ -806,8 +808,10 @@ Pipeline::Pipeline(Pipeline&&) noexcept = default;
 Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
 Pipeline::~Pipeline() = default;
 
-Result<Pipeline> Pipeline::create(const Calibration& calibration, const PipelineConfig& config) {
-  if (auto st = validate_calibration(calibration, "calibration"); !st) return st.error();
+Result<Pipeline> Pipeline::create(const Calibration& stated, const PipelineConfig& config) {
+  if (auto st = validate_calibration(stated, "calibration"); !st) return st.error();
+  // A gyro whose noise is not stated runs on the conservative defaults (default_noise_warning says which).
+  const Calibration calibration = with_default_noise(stated, config);
   if (auto st = validate(config); !st) return st.error();
   auto constants = gyro_constants(calibration, config);
   if (!constants) return constants.error();

@@ -15,7 +15,8 @@ ReferenceMonitor::ReferenceMonitor(const Eigen::MatrixX3d& axes_B, const Pipelin
       snap_ns_(kSnapshots, 0),
       snap_q_(kSnapshots, Quaternion::Identity()),
       snap_angle_(static_cast<std::size_t>(kSnapshots) * n_, 0.0),
-      snap_ref_(static_cast<std::size_t>(kSnapshots) * n_, 0.0) {}
+      snap_ref_(static_cast<std::size_t>(kSnapshots) * n_, 0.0),
+      snap_theta_(kSnapshots, Eigen::Vector3d::Zero()) {}
 
 void ReferenceMonitor::reset() {
   for (auto& t : tracks_) t = Track{};
@@ -85,12 +86,15 @@ void ReferenceMonitor::integrate(const EpochFrame& frame, GyroMask excluded,
 void ReferenceMonitor::snapshot(std::int64_t now_ns, const Quaternion& q) {
   // The reference's rotation about each gyro axis, summed over its own increments: one increment spans one
   // reference period, so the non-commutativity of a long window (slews) does not enter.
+  Eigen::Vector3d theta = Eigen::Vector3d::Zero();
   if (snap_count_ > 0) {
     const Eigen::Vector3d inc_B = quat_log(snap_q_[slot(snap_count_ - 1)].conjugate() * q);
     for (std::size_t i = 0; i < n_; ++i)
       tracks_[i].ref_angle_rad += axes_B_.row(static_cast<Eigen::Index>(i)).dot(inc_B);
+    theta = snap_theta_[slot(snap_count_ - 1)] + inc_B;
   }
   const std::size_t s = slot(snap_count_);
+  snap_theta_[s] = theta;
   snap_ns_[s] = now_ns;
   snap_q_[s] = q;
   for (std::size_t i = 0; i < n_; ++i) {
@@ -135,7 +139,9 @@ std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, co
     const auto& t = tracks_[i];
     if (t.held_ns >= snap_ns_[slot(old)]) continue;  // its angle holds a stale rate over this window
     const double rot = t.ref_angle_rad - snap_ref(old, static_cast<int>(i));
-    const double err = (t.angle_rad - snap_angle(old, static_cast<int>(i))) - rot;
+    const double err = beyond_calibration(series.constants(id),
+                                          (t.angle_rad - snap_angle(old, static_cast<int>(i))) - rot, rot, old,
+                                          snap_count_ - 1);
     windows_.add(id, std::abs(err) / disagreement_sigma(series.constants(id), span, rot),
                  config_.reference_threshold_sigma);
   }
@@ -155,6 +161,17 @@ double ReferenceMonitor::disagreement_sigma(const GyroConstants& c, double span_
                    std::pow(c.scale_rel_sigma * rot_rad, 2) + 2.0 * c.quantization_rad * c.quantization_rad);
 }
 
+double ReferenceMonitor::beyond_calibration(const GyroConstants& c, double err, double rot, int old,
+                                           int last) const {
+  // As the parity's dead zone (docs/fdi.md, "Calibration uncertainty"): a scale factor off by ε and an axis off
+  // by δh add −ε·rot + δh·Θ to the disagreement; within e stated σ that is at most the bound below.
+  const Eigen::Vector3d theta = snap_theta_[slot(last)] - snap_theta_[slot(old)];
+  const double bound = config_.calibration_error_sigmas *
+                       (c.scale_rel_sigma * std::abs(rot) + c.axis_sigma.dot(theta.cwiseAbs()));
+  if (!(bound > 0.0)) return err;
+  return std::abs(err) <= bound ? 0.0 : err - std::copysign(bound, err);
+}
+
 bool ReferenceMonitor::span(std::int64_t from_ns, double min_span_s, GyroMask excluded,
                             const GyroSeries& series, SpanDisagreement& out) const {
   out.start = -1;
@@ -172,7 +189,8 @@ bool ReferenceMonitor::span(std::int64_t from_ns, double min_span_s, GyroMask ex
     if (has_gyro(excluded, id) || tracks_[i].held_ns >= out.start_ns) continue;
     const int g = static_cast<int>(i);
     const double rot = snap_ref(last, g) - snap_ref(old, g);
-    out.err_rad[i] = (snap_angle(last, g) - snap_angle(old, g)) - rot;
+    out.err_rad[i] =
+        beyond_calibration(series.constants(id), (snap_angle(last, g) - snap_angle(old, g)) - rot, rot, old, last);
     out.sigma_rad[i] = disagreement_sigma(series.constants(id), out.span_s, rot);
     out.gyros |= GyroMask{1} << i;
   }

@@ -101,6 +101,10 @@ class ReferenceMonitor {
   bool scale_significant(int culprit, int old) const;
   //! [rad] 1σ of a healthy gyro's disagreement over `span_s` with rotation `rot_rad` about its axis.
   double disagreement_sigma(const GyroConstants& c, double span_s, double rot_rad) const;
+  //! [rad] the disagreement `err` less the bound on what the gyro's scale factor and axis errors within
+  //! `calibration_error_sigmas` of their stated σ make of the rotation between snapshots `old` and `last`:
+  //! e·(σ_s·|rot| + Σ_j σ_h,j·|Θ_j|), Θ the reference's rotation in B (0 when |err| is below it).
+  double beyond_calibration(const GyroConstants& c, double err, double rot, int old, int last) const;
   double snap_angle(int k, int i) const { return snap_angle_[slot(k) * n_ + static_cast<std::size_t>(i)]; }
   double snap_ref(int k, int i) const { return snap_ref_[slot(k) * n_ + static_cast<std::size_t>(i)]; }
   static std::size_t slot(int k) { return static_cast<std::size_t>(k % kSnapshots); }
@@ -113,6 +117,7 @@ class ReferenceMonitor {
   std::vector<Quaternion> snap_q_;
   std::vector<double> snap_angle_;  //!< kSnapshots×N
   std::vector<double> snap_ref_;    //!< kSnapshots×N
+  std::vector<Eigen::Vector3d> snap_theta_;  //!< [rad] Σ of the reference's increments in B, per snapshot
   int snap_count_ = 0;              //!< total pushed
   LoneGyro windows_;                //!< the windows' comparisons
   LoneGyro filter_;                 //!< the filter's bias estimates at reference samples

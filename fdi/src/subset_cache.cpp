@@ -24,9 +24,17 @@ double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_
 }
 
 DetectorNoise detector_noise(const Calibration& cal, const PipelineConfig& config) {
-  DetectorNoise out{Eigen::VectorXd::Zero(cal.gyro_count()), Eigen::VectorXd::Zero(cal.gyro_count())};
-  for (Eigen::Index i = 0; i < out.quantization_rad.size(); ++i) {
-    const auto& noise = cal.gyros[static_cast<std::size_t>(i)].noise;
+  const Eigen::Index n = cal.gyro_count();
+  DetectorNoise out{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n),
+                    Eigen::Matrix3Xd::Zero(3, n)};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const GyroCalibration& g = cal.gyros[static_cast<std::size_t>(i)];
+    if (g.sigma) {  // a log already in deg/s has no scale factor to be wrong (`raw_units_dps`)
+      if (!config.raw_units_dps)
+        out.scale_rel_sigma[i] = g.sigma->scale_factor_V_per_dps / std::abs(g.scale_factor_V_per_dps);
+      out.axis_sigma.col(i) = g.sigma->axis.cwiseAbs();
+    }
+    const auto& noise = g.noise;
     if (!noise) continue;
     out.quantization_rad[i] = noise->quantization_deg.value_or(0.0) * kDegToRad;
     const double b = noise->bias_instability_dps.value_or(0.0) * kDegToRad;
@@ -43,11 +51,16 @@ SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s
       bias_sigma_rad_s_(std::move(bias_sigma_rad_s)),
       quantization_rad_(std::move(noise.quantization_rad)),
       bias_wander_rad_s_(std::move(noise.bias_wander_rad_s)),
+      scale_rel_sigma_(std::move(noise.scale_rel_sigma)),
+      axis_sigma_(std::move(noise.axis_sigma)),
       config_(&config) {
   if (quantization_rad_.size() != geometry_.gyro_count())
     quantization_rad_ = Eigen::VectorXd::Zero(gyro_count());
   if (bias_wander_rad_s_.size() != geometry_.gyro_count())
     bias_wander_rad_s_ = Eigen::VectorXd::Zero(gyro_count());
+  if (scale_rel_sigma_.size() != geometry_.gyro_count()) scale_rel_sigma_ = Eigen::VectorXd::Zero(gyro_count());
+  if (axis_sigma_.cols() != geometry_.gyro_count()) axis_sigma_ = Eigen::Matrix3Xd::Zero(3, gyro_count());
+  calibration_sigma_ = (scale_rel_sigma_.array() > 0.0).any() || (axis_sigma_.array() > 0.0).any();
   subsets_.reserve(gyro_count() <= 8 ? 512 : 4096);
   if (gyro_count() <= 8) by_mask_.assign(std::size_t{1} << static_cast<unsigned>(gyro_count()), nullptr);
 }
@@ -154,6 +167,7 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   s.pinv = Eigen::Matrix3Xd::Zero(3, n);
   s.arw_sq_rad2_s.setZero();
   s.bias_sigma_rad_s.setZero();
+  s.parity_col_norm = Eigen::VectorXd::Zero(n);
   if (!s.observable) return;
   s.pinv = *geometry_.pseudoinverse(mask);
   s.arw_sq_rad2_s = *geometry_.noise_variance_per_axis(mask);
@@ -175,6 +189,9 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   const Eigen::MatrixXd v = *geometry_.parity_matrix(mask);
   const Eigen::VectorXd& arw = geometry_.sigma();
   s.parity = whiten(v, arw.cwiseProduct(arw));
+  for (int i = 0; i < n; ++i) {
+    if (has_gyro(mask, i + 1)) s.parity_col_norm[i] = s.parity.col(i).norm();
+  }
   const PipelineConfig& config = *config_;
   s.chi2_threshold = chi2_threshold(config.chi2_false_alarm_probability, s.dof);
   s.jump_threshold = chi2_threshold(config.jump_false_alarm_probability, s.dof);

@@ -27,6 +27,7 @@ struct Subset {
   Eigen::MatrixXd sample_parity;     //!< the same whitened by the noise of one sample (N_i and quantization
                                      //!< Q_i): the instantaneous χ²; equals `parity` without quantization
   Eigen::MatrixXd jump_parity;       //!< whitened by the noise of a one-sample difference: the jump test
+  Eigen::VectorXd parity_col_norm;   //!< [1/(rad/s)·√s] |w_i| = |column i of `parity`| (0 outside S)
   bool quantized = false;            //!< some gyro of the subset has an angle quantization
   double quantization_margin = 0.0;  //!< [σ] what the CUSUM's h adds for the telescoping quantization error
   double quantization_sigma = 0.0;   //!< [σ] per parity axis: 1σ of one sample's quantization error term
@@ -50,6 +51,9 @@ struct Subset {
 struct DetectorNoise {
   Eigen::VectorXd quantization_rad;   //!< [rad] angle quantization Q_i (0 if absent)
   Eigen::VectorXd bias_wander_rad_s;  //!< [rad/s] 1σ of the slowly wandering bias (`bias_wander_sigma`)
+  //! The calibration's stated 1σ (`sigma:`), for the rate-proportional parity term ("Calibration uncertainty")
+  Eigen::VectorXd scale_rel_sigma;  //!< [-] 1σ of each scale factor relative to it (0 if absent)
+  Eigen::Matrix3Xd axis_sigma;      //!< [-] 1σ of each axis component (columns per gyro; 0 if absent)
 };
 //! The calibration's `noise:` sections as the detectors see them (Q; B, K and R over the configured horizon).
 DetectorNoise detector_noise(const Calibration& cal, const PipelineConfig& config);
@@ -106,6 +110,22 @@ class SubsetCache {
   const GyroGeometry& geometry() const { return geometry_; }
   int gyro_count() const { return geometry_.gyro_count(); }
 
+  //! [σ] bound on the normalized parity's calibration term at the body rate ω [rad/s] when every scale
+  //! factor and axis component of the subset's gyros is within `calibration_error_sigmas` of its stated 1σ:
+  //! e·√T·Σ_{i∈S} |w_i|·(σ_s,i·|h_i·ω| + Σ_j σ_h,ij·|ω_j|) (docs/fdi.md, "Calibration uncertainty").
+  //! 0 without stated σ.
+  double calibration_bound(const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s) const {
+    if (!calibration_sigma_ || s.dof < 1) return 0.0;
+    const Eigen::Vector3d w_abs = omega_rad_s.cwiseAbs();
+    double sum = 0.0;
+    for (int i = 0; i < gyro_count(); ++i) {
+      if (!has_gyro(mask, i + 1)) continue;
+      const double along = std::abs(geometry_.axes_B().row(i).dot(omega_rad_s));
+      sum += s.parity_col_norm[i] * (scale_rel_sigma_[i] * along + axis_sigma_.col(i).dot(w_abs));
+    }
+    return config_->calibration_error_sigmas * sqrt_period_ * sum;
+  }
+
  private:
   const Subset& insert(GyroMask mask);
   void build(Subset& s, GyroMask mask) const;
@@ -125,6 +145,9 @@ class SubsetCache {
   Eigen::VectorXd bias_sigma_rad_s_;   //!< [rad/s] per gyro
   Eigen::VectorXd quantization_rad_;   //!< [rad] per gyro (zeros when none)
   Eigen::VectorXd bias_wander_rad_s_;  //!< [rad/s] per gyro (zeros when none)
+  Eigen::VectorXd scale_rel_sigma_;    //!< [-] per gyro (zeros when none)
+  Eigen::Matrix3Xd axis_sigma_;        //!< [-] per gyro and component (zeros when none)
+  bool calibration_sigma_ = false;     //!< some scale factor or axis has a stated σ > 0
   const PipelineConfig* config_;       //!< owned by the pipeline, outlives the cache
   double period_s_ = 0.0;
   double sqrt_period_ = 0.0;
@@ -156,6 +179,16 @@ inline double apply_whitened(const Eigen::MatrixXd& w, int dof, GyroMask mask, c
     sum_sq += p[r] * p[r];
   }
   return sum_sq;
+}
+
+//! Moves p[0..dof) towards 0 by `bound` along its direction (0 when |p| ≤ bound); returns the new Σ p_r².
+//! A term of norm ≤ bound added to noise n then leaves |p| ≤ |n|: the calibration's dead zone.
+inline double shrink_by(double* p, int dof, double bound, double sum_sq) {
+  if (!(bound > 0.0)) return sum_sq;
+  const double norm = std::sqrt(sum_sq);
+  const double f = norm > bound ? 1.0 - bound / norm : 0.0;
+  for (int r = 0; r < dof; ++r) p[r] *= f;
+  return sum_sq * f * f;
 }
 
 //! The subset's normalized parity (`Subset::parity`) of v.

@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "dds_common.hpp"
 #include "tetra/dds/shutdown.hpp"
+#include "tetra/fdi/noise_defaults.hpp"
 #include "tetra/fdi/pipeline.hpp"
 #include "tetra/service/fusion_config.hpp"
 #include "tetra/service/fusion_service.hpp"
@@ -32,6 +33,8 @@ int cmd_fusion(int argc, char** argv) {
   if (config->security) dds::set_security_profile(config->security);
   auto pipeline = fdi::Pipeline::create(config->calibration, config->pipeline);
   if (!pipeline) return report("fusion", pipeline.error());
+  if (const std::string w = fdi::default_noise_warning(config->calibration, config->pipeline); !w.empty())
+    spdlog::warn("fusion: calibration: {}", w);
   auto assembler = service::EpochAssembler::create(config->assembler(pipeline->gyro_count()));
   if (!assembler) return report("fusion", assembler.error());
   spdlog::info("fusion: configuration from {}\n{}", config_path, service::describe(*config));

@@ -22,6 +22,7 @@
 #include "tetra/core/provenance.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/config.hpp"
+#include "tetra/fdi/noise_defaults.hpp"
 #include "tetra/fdi/pipeline.hpp"
 
 namespace tetra::cli {
@@ -279,6 +280,9 @@ Status run_replay(const ReplayOptions& o) {
   if (o.verbose)
     std::fprintf(stderr, "tetra replay: thresholds\n%s", pipeline->describe_thresholds().c_str());
   print_summary(*pipeline, *replayed, n);
+  // Last, where it stays in view (and a run that fails says its one error line alone).
+  if (const std::string w = fdi::default_noise_warning(in->cal, *config); !w.empty())
+    std::fprintf(stderr, "tetra replay: warning: %s: %s\n", o.cal_path.c_str(), w.c_str());
   return ok_status();
 }
 

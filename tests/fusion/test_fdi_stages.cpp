@@ -256,7 +256,7 @@ TEST(ParityDetector, CusumDetectsAShiftInTheoryTimeAndRestarts) {
   int alarm_at = -1;
   for (int k = 0; k < 100 && alarm_at < 0; ++k) {
     frame.index = k;
-    const Detection d = detector.update(frame, s, 0b1111, f.subsets->sqrt_period(), health);
+    const Detection d = detector.update(frame, s, 0b1111, f.subsets->sqrt_period(), 0.0, health);
     EXPECT_TRUE(d.cusum_ran);
     EXPECT_NEAR(health.parity_residual, 2.0, 1e-9);
     if (d.alarm) {
@@ -269,7 +269,7 @@ TEST(ParityDetector, CusumDetectsAShiftInTheoryTimeAndRestarts) {
   EXPECT_NEAR(alarm_at + 1, expected, 1.0);
   detector.restart_after_alarm();
   frame.index = 200;
-  EXPECT_FALSE(detector.update(frame, s, 0b1111, f.subsets->sqrt_period(), health).alarm);
+  EXPECT_FALSE(detector.update(frame, s, 0b1111, f.subsets->sqrt_period(), 0.0, health).alarm);
   EXPECT_NEAR(health.cusum, 2.0 - s.cusum_k, 1e-9);
 }
 

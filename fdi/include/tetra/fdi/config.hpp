@@ -26,6 +26,8 @@ struct PipelineConfig {
   double max_abs_raw_V = 10.0;   //!< [V] a raw sample beyond this is invalid
   double max_abs_rate_dps = 100.0;       //!< [deg/s] a calibrated rate beyond this is invalid
   double default_arw_dps_rtHz = 3.0e-5;  //!< [deg/√s] N of a gyro without `noise:` (seed Table 6)
+  //! [deg/s] B of a gyro without `noise:` section: twice the seed's Table 6 level, conservative
+  double default_bias_instability_dps = 1.0e-5;
 
   // --- detection on the parity residual
   double chi2_false_alarm_probability = 1.0e-9;  //!< [-] per epoch, instantaneous χ² test
@@ -87,6 +89,11 @@ struct PipelineConfig {
   // --- integrity (docs/fdi.md, "Protection level")
   //! [-] probability that the attitude error exceeds the published protection level without an alarm
   double integrity_risk = 1.0e-7;
+
+  // --- calibration uncertainty (docs/fdi.md, "Calibration uncertainty")
+  //! [-] multiple of the calibration file's stated 1σ (scale factors, axes) the parity tests tolerate: an
+  //! error of every scale factor and axis component within this many σ never raises the parity beyond its noise
+  double calibration_error_sigmas = 3.0;
 };
 
 //! Parses a `pipeline:` YAML map (unknown keys are errors naming the line); `source` names the file.
