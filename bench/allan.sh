@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Whole-command timing of `tetra allan` on the issue's benchmark: two hours at 100 Hz x 4 gyros
+# Whole-command timing of `tetra allan` on the benchmark log: two hours at 100 Hz x 4 gyros
 # (2.88 M samples) in volts, with a calibration — parsing, every tau of the default set (~10 per
 # decade, 53 taus from 0.01 s to 3600 s), EDF/chi-squared intervals and the noise fit.
 # Targets: < 1 s wall, < 200 MB resident.

@@ -1,4 +1,4 @@
-// Turntable calibration on the large case: 16 sequences × 10 min at 100 Hz (960 000 rows),
+// Turntable calibration on the large case: 16 sequences × 10 min at 100 Hz (960 000 rows),
 // seed unit, 6 deg/s. Measures reading the file, interpreting the encoders and both estimators.
 #include <benchmark/benchmark.h>
 

@@ -38,7 +38,7 @@ void BM_OrbitEpoch(benchmark::State& state) {
 }
 BENCHMARK(BM_OrbitEpoch);
 
-// The performance case without file output: 100 min at 100 Hz, 4 gyros, 1 Hz reference.
+// The performance case without file output: 100 min at 100 Hz, 4 gyros, 1 Hz reference.
 void BM_Orbit600kEpochsInMemory(benchmark::State& state) {
   const tetra::sim::Scenario sc = orbit_100hz();
   for (auto _ : state) {

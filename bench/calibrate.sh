@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Whole-command timing of the calibration's performance case (issue 2): 16 sequences × 10 min at
+# Whole-command timing of the calibration's performance case: 16 sequences × 10 min at
 # 100 Hz (960 000 rows, seed unit, 6 deg/s, 10 revolutions per sequence), CSV reading included.
 # Target: under 1 s wall. Usage: bench/calibrate.sh [BUILD_DIR]   (default: build).
 # Needs hyperfine; falls back to /usr/bin/time. Prints the machine load: on a shared machine, compare

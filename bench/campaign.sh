@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Whole-command timing of a fault-injection campaign (issue 17): examples/campaign.yaml, 520 closed-loop
+# Whole-command timing of a fault-injection campaign: examples/campaign.yaml, 520 closed-loop
 # runs of 10 min at 10 Hz with the fusion pipeline in process, on every core (--jobs = cores), and the
 # acceptance check that its outcome matrix has no wrong exclusion.
 # Usage: bench/campaign.sh [BUILD_DIR]   (default: build). Prints the load average beside the time.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Whole-command timing of the simulator's performance case (issue 4): a 100-min orbit at 100 Hz,
+# Whole-command timing of the simulator's performance case: a 100-min orbit at 100 Hz,
 # 4 gyros, 1 Hz attitude reference — 600 k epochs generated and written to a gyro log.
 # Usage: bench/sim_orbit.sh [BUILD_DIR]   (default: build). Needs hyperfine; falls back to /usr/bin/time.
 set -euo pipefail

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Soak (issue 7.4): the simulator at RATE Hz into `tetra fusion` for MINUTES in real time, on a private
+# Soak: the simulator at RATE Hz into `tetra fusion` for MINUTES in real time, on a private
 # loopback domain. Not a ctest test (it runs for an hour); docs/reliability.md has the figures.
 #   bench/soak.sh [MINUTES=60] [BUILD_DIR=build] [RATE_HZ=100]
 # Measures, and checks:

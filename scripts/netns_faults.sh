@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Multi-host faults (issue 7.5): simulator, fusion service and monitor each in its own network
+# Multi-host faults: simulator, fusion service and monitor each in its own network
 # namespace, joined by veth links to a bridge in a fourth namespace; Cyclone DDS configured for those
 # addresses (unicast discovery, no multicast). Faults injected by taking a link down on the bridge side:
 #   1. sensor link cut    -> the service sees its gyros absent -> LOST; restored -> NOMINAL again

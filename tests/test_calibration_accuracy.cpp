@@ -1,8 +1,8 @@
-// Calibration accuracy on simulated turntable data (issue 2 acceptance).
+// Calibration accuracy on simulated turntable data.
 //
 // Unit: the seed's as-built unit (Tables 4–5) with white rate noise only, N = 3e-5 deg/√s. Plan: seed
 // Table 3 geometry, 6 deg/s, one revolution per sequence, 10 Hz, latitude −23.2°. Both estimators must
-// recover s to 1e-5 relative, every axis component to 1e-5 and β to 2e-6 V (the issue's figures), and
+// recover s to 1e-5 relative, every axis component to 1e-5 and β to 2e-6 V (the figures), and
 // every error must lie within 4σ of the reported 1σ (|z| > 4 has probability 6e-5 per estimate for a
 // correct σ; the seeds are fixed, so a pass is reproducible). Variants: other sequence order, wrapped
 // encoder angles, 3 and 6 gyros, another latitude and table rate.
@@ -49,7 +49,7 @@ SimulatedRun calibrate_simulated(const Calibration& unit, const sim::TurntablePl
   return SimulatedRun{std::move(result.value()), std::move(motion.value())};
 }
 
-//! Checks every estimate against the truth: the issue's absolute tolerances and |error| ≤ 4σ.
+//! Checks every estimate against the truth: the absolute tolerances and |error| ≤ 4σ.
 void expect_recovers(const Calibration& truth, const Calibration& estimate, const std::string& what) {
   ASSERT_EQ(estimate.gyro_count(), truth.gyro_count()) << what;
   for (int i = 0; i < truth.gyro_count(); ++i) {

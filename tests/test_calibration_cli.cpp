@@ -1,4 +1,4 @@
-// `tetra calibrate` on bad input (issue 2 acceptance): exit status 2 and exactly one line on stderr
+// `tetra calibrate` on bad input: exit status 2 and exactly one line on stderr
 // naming the file, the line and the problem. One test per case.
 #include <gtest/gtest.h>
 
@@ -144,7 +144,7 @@ TEST(CalibrateCli, EmptyFile) {
   expect_bad_input("", "1", "empty file");
 }
 
-// Further checks of meaning, beyond the issue's list.
+// Further checks of meaning, beyond the list.
 TEST(CalibrateCli, PairTurningTheSameWay) {
   auto plan = seed_plan();
   plan[3].rate_dps = 6.0;  // sequence 4 (lines 21-26) repeats sequence 3's direction
@@ -191,7 +191,7 @@ TEST(CalibrateCli, PlanExcitingOnlyTwoAxes) {
   EXPECT_NE(r.err.find("excite only 2 independent body axes"), std::string::npos) << r.err;
 }
 
-// Not in the issue's list but part of the contract: no latitude anywhere is bad input.
+// Not in the list but part of the contract: no latitude anywhere is bad input.
 TEST(CalibrateCli, NoLatitude) {
   std::string text = turntable_text(seed_plan());
   text.erase(0, text.find('\n') + 1);
@@ -216,7 +216,7 @@ TEST(CalibrateCli, BiasModelOnlyWithSixteen) {
 }
 
 // The example data (seed unit with its Table 6 noise, 2 Hz): the command writes a calibration file that
-// reads back and is close to the unit that was simulated. Tolerances: the issue's figures (s 1e-5
+// reads back and is close to the unit that was simulated. Tolerances: the figures (s 1e-5
 // relative, axes 1e-5, β 2e-6 V); the example's noise (σ(β) ≈ 8e-8 V) is far below them.
 TEST(CalibrateCli, ExampleWithCompare) {
   test::TempDir dir;

@@ -1,4 +1,4 @@
-// tetra campaign on the command line (issue 17): rows, resuming after an interruption, the report,
+// tetra campaign on the command line: rows, resuming after an interruption, the report,
 // and errors naming the spec's line.
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// tetra campaign with `target: dds` (issue 17): each run against its own `tetra fusion` service over DDS
+// tetra campaign with `target: dds`: each run against its own `tetra fusion` service over DDS
 // in lockstep gives the very rows of the in-process campaign — every column, compared as text: the FDI
 // verdict (outcome, isolated gyro, delays, false alarms, wrong exclusions, read from the service's FdiEvent
 // topic) and the numbers (knowledge error, sigma, pointing), since the service runs the same pipeline on

@@ -1,4 +1,4 @@
-// The closed loop over DDS (issue 17): `tetra sim --closed-loop --dds` against a running `tetra fusion`.
+// The closed loop over DDS: `tetra sim --closed-loop --dds` against a running `tetra fusion`.
 // Lockstep gives the in-process loop's numbers bit for bit; real time at 100 Hz holds the pointing.
 // Each test uses its own domain id and kills what it starts; nothing asserts on elapsed time.
 

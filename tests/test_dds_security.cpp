@@ -1,4 +1,4 @@
-// DDS Security (issue 7.1): the demo PKI of scripts/security/make_pki.sh (units sec-1 and sec-2), its
+// DDS Security: the demo PKI of scripts/security/make_pki.sh (units sec-1 and sec-2), its
 // roles, and the promises — an unauthenticated participant sees nothing and injects nothing; a
 // sensor identity cannot write Command; an identity without the grant cannot write GyroSample; the
 // sensor of one unit cannot write GyroSample for another. Each test also shows the positive case, so

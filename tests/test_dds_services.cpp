@@ -1,4 +1,4 @@
-// Acceptance tests of the DDS services (issue 6): real Cyclone DDS on loopback, separate processes.
+// Acceptance tests of the DDS services: real Cyclone DDS on loopback, separate processes.
 // Every test uses its own domain id and kills what it starts (TetraProcess's destructor: SIGKILL).
 // Waits are on DDS conditions (waitsets) or process exits, each with a generous upper bound that
 // only turns a hang into a failure; nothing asserts on elapsed time.

@@ -1,4 +1,4 @@
-// Closed-loop simulation (issue 17): rigid-body dynamics, guidance, controller, and the loop closed
+// Closed-loop simulation: rigid-body dynamics, guidance, controller, and the loop closed
 // through the fusion pipeline in process, with and without exclusion of a faulty gyro.
 
 #include <gtest/gtest.h>

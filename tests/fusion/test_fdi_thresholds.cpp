@@ -145,7 +145,7 @@ TEST(Thresholds, QuantizationMarginKeepsTheCusumWithinItsDesign) {
   // The scalar CUSUM (N = 4) on the white-noise-whitened parity of quantized samples: white unit noise plus
   // w·(e_k − e_{k−1})/√T, e_i uniform within ±√3·Q per gyro. With h raised by the margin the alarm rate must
   // stay at or below the design 1/ARL₀ (ARL₀ = 1000 so that 2e6 epochs count ~2000 alarms at the design; the
-  // margin is a bound: measured far below). Tolerance: 2× the design (the acceptance).
+  // margin is a bound: measured far below). Tolerance: 2× the design (the acceptance line).
   QuantizedCache coarse(6e-5, 1000.0);
   const auto& s = coarse.all();
   const int n = coarse.cal.gyro_count();

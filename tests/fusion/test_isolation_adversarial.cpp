@@ -32,7 +32,7 @@ struct SlewCase {
   double duration_s;
 };
 
-// From the gentle 5° over 2 min to 30° in 10 s and beyond (peak rate 2Φ/T, peak acceleration
+// From a gentle 5° over 2 min to 30° in 10 s and beyond (peak rate 2Φ/T, peak acceleration
 // 2πΦ/T²: 0.08 deg/s and 2.2e-3 deg/s² ... 10 deg/s and 16 deg/s²).
 const std::vector<SlewCase>& slews() {
   static const std::vector<SlewCase> all = {

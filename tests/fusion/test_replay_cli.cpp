@@ -255,7 +255,7 @@ TEST(ReplayCli, BadInputIsExitTwoNamingFileAndLine) {
 TEST(ReplayCli, SeedExperimentFromTheCommandLine) {
   // The seed's experiment end to end: tetra sim turntable | tetra calibrate, then tetra sim lab-orbit |
   // tetra replay --latitude -23.2. The angle Σ wy·Δt over the run is ≈ 474° with the factory data sheet
-  // (measured 476.2°; ±3° covers what differs from the figure: Earth rate and noise, well below a
+  // (measured 476.2°; ±3° covers what differs from the seed paper's figure: Earth rate and noise, well below a
   // degree) and 360 ± 0.5° with the calibration `tetra calibrate` made from simulated turntable data of the
   // same unit.
   TempDir dir;

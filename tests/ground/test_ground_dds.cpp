@@ -1,4 +1,4 @@
-// Integration of the ground station (issue 16): simulator (sim --dds) + fusion service + tetra ground
+// Integration of the ground station: simulator (sim --dds) + fusion service + tetra ground
 // as separate processes on a private loopback domain; an HTTP client reads the event stream and the
 // history, and commands through POST. Waits have generous upper bounds that only turn a hang into a
 // failure; nothing asserts on elapsed time.
