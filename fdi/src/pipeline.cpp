@@ -54,6 +54,12 @@ Eigen::VectorXd bias_sigmas(const std::vector<GyroConstants>& constants) {
     b[static_cast<Eigen::Index>(i)] = constants[i].bias_sigma_rad_s;
   return b;
 }
+
+//! [ns] now − span, saturating at the earliest representable time (span ≥ 0).
+std::int64_t pipeline_time_before_ns(std::int64_t now_ns, std::int64_t span_ns) {
+  return now_ns >= std::numeric_limits<std::int64_t>::min() + span_ns ? now_ns - span_ns
+                                                                       : std::numeric_limits<std::int64_t>::min();
+}
 }  // namespace
 
 class Pipeline::Impl {
@@ -568,7 +574,7 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   attitude_.freeze(iso.gyro);
   // What the fault leaked into the other gyros' bias states since its onset is undone (docs/fdi.md).
   attitude_.repair_biases(gyro_set_.active(),
-                          isolator_.episode().active ? isolator_.episode().onset_ns : now - signature_span_ns(),
+                          isolator_.episode().active ? isolator_.episode().onset_ns : pipeline_time_before_ns(now, signature_span_ns()),
                           now);
   restart_detectors();
   // The remaining gyros' tests restart from evidence the removed fault did not touch (docs/fdi.md, "One fault,
@@ -601,7 +607,10 @@ std::int64_t Pipeline::Impl::signature_span_ns() const {
       std::max({config_.dropout_timeout_s, config_.invalid_timeout_s, config_.stuck_repeat_count * period,
                 config_.onset_confirm_epochs * period}) +
       period;
-  return seconds_to_ns(span_s);
+  // A span longer than any run (epochs days apart) means "since the start"; bounded so that its nanoseconds
+  // and now − span stay within int64 (fuzz_pipeline found 2.5e10 s).
+  constexpr double kMaxSpan_s = 1.0e8;
+  return seconds_to_ns(span_s < kMaxSpan_s ? span_s : kMaxSpan_s);
 }
 
 void Pipeline::Impl::gap() {
