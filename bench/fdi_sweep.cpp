@@ -52,7 +52,8 @@ struct RunOutcome {
 double g_arl0 = fdi::PipelineConfig{}.cusum_arl0_epochs;  // set once by main before any thread starts
 std::optional<Calibration> g_unit;                        // --unit; set once by main
 double g_quantization_deg = 0.0;                          // --quantization; set once by main
-bool g_reference = false;  // --reference 1: the orbit's 1 Hz, 5″ reference into the pipeline; set once by main
+bool g_reference =
+    false;  // --reference 1: the orbit's 1 Hz, 5″ reference into the pipeline; set once by main
 
 //! The unit of the sweep with n gyros: --unit's (its own N), else the seed's as-built unit cut or extended,
 //! with --quantization's angle quantization on every gyro.
@@ -196,9 +197,10 @@ void false_alarm_sweep(int n, int hours, int jobs) {
   if (g_reference) {
     int rejected = 0;
     for (int r : rejections) rejected += r;
-    std::printf("N=%d  %d h with the 1 Hz reference: %d reference rejections (design: %d tests at p = 1e-9 per "
-                "sample)\n",
-                n, hours, rejected, hours * 3600);
+    std::printf(
+        "N=%d  %d h with the 1 Hz reference: %d reference rejections (design: %d tests at p = 1e-9 per "
+        "sample)\n",
+        n, hours, rejected, hours * 3600);
   }
   std::fflush(stdout);
 }

@@ -420,9 +420,10 @@ TEST(DdsServices, GlitchingStampsAndSequenceNumbersFromAnotherProcessNeverBlindT
   const dds_domainid_t domain = 197;
   ServiceFiles files(50.0, 1.0);
   Observer observer(domain);
-  TetraProcess fusion({"fusion", "--config", files.config, "--domain", d(domain)}, files.dir.file("fusion.log"));
-  TetraProcess sim({"sim", "static", "--dds", "--dds-unit", "tetra-1", "--domain", d(domain), "--rate-hz", "50",
-                    "--minutes", "1", "--speed", "1"},
+  TetraProcess fusion({"fusion", "--config", files.config, "--domain", d(domain)},
+                      files.dir.file("fusion.log"));
+  TetraProcess sim({"sim", "static", "--dds", "--dds-unit", "tetra-1", "--domain", d(domain), "--rate-hz",
+                    "50", "--minutes", "1", "--speed", "1"},
                    files.dir.file("sim.log"));
   const auto health = [&]() -> const dds::HealthView* {
     const auto it = observer.health.find("tetra-1");
@@ -472,15 +473,16 @@ TEST(DdsServices, GlitchingStampsAndSequenceNumbersFromAnotherProcessNeverBlindT
       ++(h->counters.deadlines_missed > deadlines_before ? lost_in_stall : lost_unexplained);
     }
     return h && h->health.counters.epochs_accepted >= accepted_before + 100 &&
-           h->counters.time_outlier + h->counters.seq_discontinuity == 9 && h->health.mode == fdi::Mode::kNominal &&
-           h->health.used == 0xFU;
+           h->counters.time_outlier + h->counters.seq_discontinuity == 9 &&
+           h->health.mode == fdi::Mode::kNominal && h->health.used == 0xFU;
   })) << read_file(files.dir.file("fusion.log"));
   const auto& h = *health();
-  std::printf("[ figure ] glitches: time_outlier %llu, seq_discontinuity %llu; then %zu attitudes, Health LOST "
-              "seen %d times in stalls (deadlines missed %llu)\n",
-              static_cast<unsigned long long>(h.counters.time_outlier),
-              static_cast<unsigned long long>(h.counters.seq_discontinuity), observer.attitudes.size(),
-              lost_in_stall, static_cast<unsigned long long>(h.counters.deadlines_missed - deadlines_before));
+  std::printf(
+      "[ figure ] glitches: time_outlier %llu, seq_discontinuity %llu; then %zu attitudes, Health LOST "
+      "seen %d times in stalls (deadlines missed %llu)\n",
+      static_cast<unsigned long long>(h.counters.time_outlier),
+      static_cast<unsigned long long>(h.counters.seq_discontinuity), observer.attitudes.size(), lost_in_stall,
+      static_cast<unsigned long long>(h.counters.deadlines_missed - deadlines_before));
   EXPECT_GE(h.counters.time_outlier, 7U);
   EXPECT_EQ(h.counters.sensor_restarts, 0U);
   EXPECT_LT(h.counters.samples_gap, 1000U) << "no counter set to garbage by one sample";

@@ -229,7 +229,8 @@ TEST(EpochAssembler, ReferenceIsAttachedToTheEpochWithinTolerance) {
 
 // Feeds epochs [from, to) of all four gyros at local time k·period, stamped k·period + stamp_offset
 // (speed 1); the sequence number is the stamp's period count + 1.
-void feed_flowing(EpochAssembler& a, int from, int to, std::vector<fdi::Epoch>& out, std::int64_t stamp_offset = 0) {
+void feed_flowing(EpochAssembler& a, int from, int to, std::vector<fdi::Epoch>& out,
+                  std::int64_t stamp_offset = 0) {
   for (int k = from; k < to; ++k) {
     const std::int64_t t = k * kPeriod;
     const auto seq = static_cast<std::uint64_t>((t + stamp_offset) / kPeriod + 1);
@@ -249,7 +250,8 @@ TEST(EpochAssembler, AStampAtInt64MaxIsAnOutlierAndNeverMovesTheClock) {
             Verdict::kTimeOutlier);
   EXPECT_EQ(a.add_sample(3, 11, std::numeric_limits<std::int64_t>::min(), 0.0, 10 * kPeriod),
             Verdict::kTimeOutlier);
-  feed_flowing(a, 11, 20, out);  // every later good epoch is accepted (sequence 11 skipped: gap 1 on gyros 2, 3)
+  feed_flowing(a, 11, 20,
+               out);  // every later good epoch is accepted (sequence 11 skipped: gap 1 on gyros 2, 3)
   ASSERT_EQ(out.size(), 19U);
   EXPECT_EQ(out.back().stamp_ns, 19 * kPeriod);
   EXPECT_EQ(a.counters().time_outlier, 2U);
@@ -262,7 +264,8 @@ TEST(EpochAssembler, AnEpochAMillionSecondsAheadIsDroppedWhole) {
   std::vector<fdi::Epoch> out;
   feed_flowing(a, 0, 10, out);
   const std::int64_t ahead = 1'000'000 * kNanosPerSecond;
-  for (int g = 1; g <= 4; ++g) EXPECT_EQ(a.add_sample(g, 11, ahead, 0.0, 10 * kPeriod), Verdict::kTimeOutlier);
+  for (int g = 1; g <= 4; ++g)
+    EXPECT_EQ(a.add_sample(g, 11, ahead, 0.0, 10 * kPeriod), Verdict::kTimeOutlier);
   feed_flowing(a, 11, 20, out);
   EXPECT_EQ(out.size(), 19U);
   EXPECT_EQ(a.counters().time_outlier, 4U);
@@ -312,7 +315,8 @@ TEST(EpochAssembler, SequenceNumberUint64MaxIsADiscontinuityNotAGap) {
   feed_flowing(a, 0, 100, out);
   // Seen from 100, 2^64-1 is 101 numbers back and 2^63 as far as can be: neither is credible.
   const std::int64_t now = 100 * kPeriod;
-  EXPECT_EQ(a.add_sample(1, std::numeric_limits<std::uint64_t>::max(), now, 0.0, now), Verdict::kSeqDiscontinuity);
+  EXPECT_EQ(a.add_sample(1, std::numeric_limits<std::uint64_t>::max(), now, 0.0, now),
+            Verdict::kSeqDiscontinuity);
   EXPECT_EQ(a.add_sample(2, std::uint64_t{1} << 63, now, 0.0, now), Verdict::kSeqDiscontinuity);
   EXPECT_EQ(a.add_sample(3, 100'000, now, 0.0, now), Verdict::kSeqDiscontinuity);  // forward, 1 period later
   feed_flowing(a, 100, 120, out);  // the gyros' own numbering goes on: nothing is out of order
@@ -325,7 +329,8 @@ TEST(EpochAssembler, SequenceNumberUint64MaxIsADiscontinuityNotAGap) {
 TEST(EpochAssembler, SequenceNumbersWrapAround) {
   auto a = make();
   std::vector<fdi::Epoch> out;
-  const std::uint64_t start = std::numeric_limits<std::uint64_t>::max() - 1;  // ..., 2^64-2, 2^64-1, 0, 1, ...
+  const std::uint64_t start =
+      std::numeric_limits<std::uint64_t>::max() - 1;  // ..., 2^64-2, 2^64-1, 0, 1, ...
   for (int k = 0; k < 6; ++k) {
     for (int g = 1; g <= 4; ++g) {
       EXPECT_EQ(a.add_sample(g, start + static_cast<std::uint64_t>(k), k * kPeriod, 0.0, k * kPeriod),
@@ -360,7 +365,8 @@ TEST(EpochAssembler, ASensorClockThatJumpsForGoodIsReanchoredAfterThreeSamplesPe
   const std::int64_t local0 = 100 * kPeriod;
   for (int k = 0; k < kRestartSamples; ++k) {
     for (int g = 1; g <= 4; ++g) {
-      const Verdict v = a.add_sample(g, static_cast<std::uint64_t>(k + 1), k * kPeriod, 0.0, local0 + k * kPeriod);
+      const Verdict v =
+          a.add_sample(g, static_cast<std::uint64_t>(k + 1), k * kPeriod, 0.0, local0 + k * kPeriod);
       const bool last = k == kRestartSamples - 1 && g == 4;  // the sample that confirms the new base
       EXPECT_EQ(v, last ? Verdict::kAccepted : Verdict::kTimeOutlier) << k << " " << g;
     }
@@ -400,7 +406,8 @@ TEST(EpochAssembler, AnOutlierFirstOfAllIsOutvotedByTheRealStream) {
   EXPECT_EQ(a.add_sample(1, 1, 1'000'000 * kNanosPerSecond, 0.0, 0), Verdict::kAccepted);
   std::vector<fdi::Epoch> out;
   for (int k = 0; k < 10; ++k) {
-    for (int g = 1; g <= 4; ++g) a.add_sample(g, static_cast<std::uint64_t>(k + 2), k * kPeriod, 0.0, k * kPeriod);
+    for (int g = 1; g <= 4; ++g)
+      a.add_sample(g, static_cast<std::uint64_t>(k + 2), k * kPeriod, 0.0, k * kPeriod);
     a.poll(k * kPeriod, out);
   }
   EXPECT_EQ(a.counters().sensor_restarts, 1U);

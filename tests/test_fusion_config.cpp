@@ -103,8 +103,9 @@ TEST_F(FusionConfigTest, ClockWindowDefaultsAndBounds) {
   auto set = parse("calibration: cal.yaml\nclock_window_s: 0.5\n");
   ASSERT_TRUE(set.ok());
   EXPECT_EQ(set->assembler(4).clock_window_ns, 500'000'000);
-  for (const char* text : {"calibration: cal.yaml\nclock_window_s: 0.01\n", "calibration: cal.yaml\nclock_window_s: 1e300\n",
-                           "calibration: cal.yaml\nmax_latency_s: 1e300\n", "calibration: cal.yaml\ntolerance_s: -1e300\n"}) {
+  for (const char* text :
+       {"calibration: cal.yaml\nclock_window_s: 0.01\n", "calibration: cal.yaml\nclock_window_s: 1e300\n",
+        "calibration: cal.yaml\nmax_latency_s: 1e300\n", "calibration: cal.yaml\ntolerance_s: -1e300\n"}) {
     auto bad = parse(text);
     ASSERT_FALSE(bad.ok()) << text;
     EXPECT_EQ(bad.error().kind, ErrorKind::kBadInput);

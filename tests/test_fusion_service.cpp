@@ -206,8 +206,10 @@ TEST(FusionServiceLibrary, SilenceOfEveryGyroIsReportedWithHysteresisNeverBefore
   std::vector<dds::EventView> seen;
   std::uint64_t silences = 0;
   const auto drain = [&] {
-    (void)events.take([&](const tetra_FdiEvent& e, const dds_sample_info_t&) { seen.push_back(dds::from_wire(e)); });
-    (void)health.take([&](const tetra_Health& h, const dds_sample_info_t&) { silences = h.counters.unit_silences; });
+    (void)events.take(
+        [&](const tetra_FdiEvent& e, const dds_sample_info_t&) { seen.push_back(dds::from_wire(e)); });
+    (void)health.take(
+        [&](const tetra_Health& h, const dds_sample_info_t&) { silences = h.counters.unit_silences; });
   };
   std::this_thread::sleep_for(2500ms);  // no gyro heard yet: waiting, neither lost nor counted
   drain();

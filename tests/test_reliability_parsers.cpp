@@ -51,11 +51,13 @@ TEST(ReliabilityParsers, DecimalCommaInAMetadataCommentStaysInTheValue) {
 TEST(ReliabilityParsers, DenormalScaleFactorIsRefusedNamingTheKey) {
   // 1e-320 is a denormal: its reciprocal overflows, and replay wrote NaN sigma rows with exit 0.
   std::string text = format_calibration(seed_as_built_unit());
-  const std::size_t at = text.find("scale_factor_V_per_dps: ") + std::string("scale_factor_V_per_dps: ").size();
+  const std::size_t at =
+      text.find("scale_factor_V_per_dps: ") + std::string("scale_factor_V_per_dps: ").size();
   text.replace(at, text.find('\n', at) - at, "1e-320");
   const auto cal = parse_calibration(text, "den.yaml");
   ASSERT_FALSE(cal.ok());
-  EXPECT_NE(cal.error().message.find("gyros[0].scale_factor_V_per_dps: must be a number with magnitude in [1e-9, 1e9]"),
+  EXPECT_NE(cal.error().message.find(
+                "gyros[0].scale_factor_V_per_dps: must be a number with magnitude in [1e-9, 1e9]"),
             std::string::npos)
       << cal.error().message;
   EXPECT_NE(cal.error().message.find("den.yaml:"), std::string::npos);

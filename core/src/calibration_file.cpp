@@ -52,7 +52,8 @@ namespace {
 //! (no denormal such as 1e-320, whose reciprocal overflows) of magnitude within the stated bounds.
 bool plausible_scale_factor(double scale_V_per_dps) {
   const double magnitude = std::abs(scale_V_per_dps);
-  return std::isfinite(magnitude) && magnitude >= kMinScaleFactor_V_per_dps && magnitude <= kMaxScaleFactor_V_per_dps;
+  return std::isfinite(magnitude) && magnitude >= kMinScaleFactor_V_per_dps &&
+         magnitude <= kMaxScaleFactor_V_per_dps;
 }
 
 const char* const kScaleFactorRange = "must be a number with magnitude in [1e-9, 1e9] V/(deg/s), not zero";

@@ -65,8 +65,8 @@ void parse_metadata_comment(std::string_view comment, Metadata& metadata) {
     // tetra writes ',' in a value as %2C: a bare comma followed at once by text that is no "key="
     // belongs to the value ("latitude_deg=-23,2", a decimal comma), so the value is read whole and
     // refused by its reader, never cut to "-23".
-    while (eq != std::string_view::npos && j + 1 < comment.size() && comment[j] == ',' && comment[j + 1] != ' ' &&
-           comment[j + 1] != '\t' && comment[j + 1] != ',') {
+    while (eq != std::string_view::npos && j + 1 < comment.size() && comment[j] == ',' &&
+           comment[j + 1] != ' ' && comment[j + 1] != '\t' && comment[j + 1] != ',') {
       std::size_t k = j + 1;
       while (k < comment.size() && comment[k] != ' ' && comment[k] != '\t' && comment[k] != ',') ++k;
       if (comment.substr(j + 1, k - j - 1).find('=') != std::string_view::npos) break;

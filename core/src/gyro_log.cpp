@@ -17,9 +17,9 @@ std::optional<std::string> log_time_problem(double time_s) {
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", time_s);
   return std::string("time ") + text +
-         " s is beyond ±9e9 s (times become 64-bit nanoseconds): give times relative to an epoch, e.g. the first";
+         " s is beyond ±9e9 s (times become 64-bit nanoseconds): give times relative to an epoch, e.g. the "
+         "first";
 }
-
 
 std::optional<std::string> GyroLog::meta(const std::string& key) const {
   return last_meta(metadata, key);

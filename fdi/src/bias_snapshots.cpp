@@ -18,7 +18,8 @@ void BiasSnapshots::reset() {
 
 void BiasSnapshots::take(std::int64_t now_ns, const Mekf& filter) {
   if (holding_) return;
-  if (count_ > 0 && now_ns - stamp_ns_[static_cast<std::size_t>((count_ - 1) % kCopies)] < kSpacing_ns) return;
+  if (count_ > 0 && now_ns - stamp_ns_[static_cast<std::size_t>((count_ - 1) % kCopies)] < kSpacing_ns)
+    return;
   filter.save_biases(copy(count_));
   stamp_ns_[static_cast<std::size_t>(count_ % kCopies)] = now_ns;
   ++count_;
@@ -40,7 +41,8 @@ void BiasSnapshots::hold(std::int64_t onset_ns) {
 void BiasSnapshots::restore(Mekf& filter, GyroMask gyros, std::int64_t onset_ns, std::int64_t now_ns) {
   const int k = holding_ ? held_ : newest_before(onset_ns);
   if (k >= 0) {
-    filter.restore_biases(copy(k), gyros, ns_to_seconds(now_ns - stamp_ns_[static_cast<std::size_t>(k % kCopies)]));
+    filter.restore_biases(copy(k), gyros,
+                          ns_to_seconds(now_ns - stamp_ns_[static_cast<std::size_t>(k % kCopies)]));
   } else {
     filter.restore_prior(gyros);
   }

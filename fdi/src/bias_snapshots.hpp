@@ -25,12 +25,15 @@ class BiasSnapshots {
   //! `gyros` at `now_ns`; without such a copy they go back to their prior. Releases the hold.
   void restore(Mekf& filter, GyroMask gyros, std::int64_t onset_ns, std::int64_t now_ns);
   //! The episode ended without an isolation: copies are taken again.
-  void release() { held_ = -1; holding_ = false; }
+  void release() {
+    held_ = -1;
+    holding_ = false;
+  }
   bool holding() const { return holding_; }
   void reset();
 
  private:
-  static constexpr int kCopies = 64;                         //!< ring size
+  static constexpr int kCopies = 64;                          //!< ring size
   static constexpr std::int64_t kSpacing_ns = 1'000'000'000;  //!< [ns] at most one copy a second
   //! Index of the newest copy at or before `t_ns`, else −1.
   int newest_before(std::int64_t t_ns) const;
@@ -39,8 +42,8 @@ class BiasSnapshots {
   std::size_t size_;
   std::vector<double> data_;  //!< kCopies × size_
   std::vector<std::int64_t> stamp_ns_;
-  int count_ = 0;       //!< copies taken (ring index = count % kCopies)
-  int held_ = -1;       //!< the held copy's index, −1: none (then the prior)
+  int count_ = 0;         //!< copies taken (ring index = count % kCopies)
+  int held_ = -1;         //!< the held copy's index, −1: none (then the prior)
   bool holding_ = false;  //!< an episode is open: no new copies
 };
 

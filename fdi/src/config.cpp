@@ -209,7 +209,8 @@ Status validate(const PipelineConfig& c) {
       {"reference_bias_window_s", positive(c.reference_bias_window_s), "> 0"},
       {"reference_check_false_alarm_probability", probability(c.reference_check_false_alarm_probability),
        "in (0, 0.5)"},
-      {"reference_reaccept_s", std::isfinite(c.reference_reaccept_s) && c.reference_reaccept_s >= 0.0, ">= 0"},
+      {"reference_reaccept_s", std::isfinite(c.reference_reaccept_s) && c.reference_reaccept_s >= 0.0,
+       ">= 0"},
       {"integrity_risk", probability(c.integrity_risk), "in (0, 0.5)"},
       {"calibration_error_sigmas",
        std::isfinite(c.calibration_error_sigmas) && c.calibration_error_sigmas >= 0.0 &&

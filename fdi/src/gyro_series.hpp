@@ -18,11 +18,11 @@ namespace tetra::fdi::detail {
 
 //! What the calibration says of one gyro, in SI.
 struct GyroConstants {
-  double scale_V_per_rad_s = 1.0;       //!< [V/(rad/s)] (1 per rad/s·deg when the log is in deg/s)
-  double bias_V = 0.0;                  //!< [V]
-  double arw_rad_rts = 0.0;             //!< [rad/√s] white rate noise N
-  double bias_sigma_rad_s = 0.0;        //!< [rad/s] 1σ of the calibrated bias
-  double scale_rel_sigma = 0.0;         //!< [-] 1σ relative scale factor error
+  double scale_V_per_rad_s = 1.0;  //!< [V/(rad/s)] (1 per rad/s·deg when the log is in deg/s)
+  double bias_V = 0.0;             //!< [V]
+  double arw_rad_rts = 0.0;        //!< [rad/√s] white rate noise N
+  double bias_sigma_rad_s = 0.0;   //!< [rad/s] 1σ of the calibrated bias
+  double scale_rel_sigma = 0.0;    //!< [-] 1σ relative scale factor error
   Eigen::Vector3d axis_sigma = Eigen::Vector3d::Zero();  //!< [-] 1σ of each axis component
   double bias_instability_rad_s = 0.0;  //!< [rad/s] B of the calibration's noise section (0 if absent)
   double quantization_rad = 0.0;        //!< [rad] angle quantization Q of the noise section (0 if absent)
@@ -86,8 +86,8 @@ class GyroSeries {
   //! After a reconfiguration: the evidence that the gyros' own samples do not carry alone restarts for every
   //! gyro — the motion the others saw (each value was projected through the old set, the removed gyro in it),
   //! a coarse gyro's repeat-run motion range, and the spike counts (each spike was judged against hypotheses
-  //! that included the removed gyro). The gyros' own second differences, repeats, dropouts and invalid samples
-  //! are kept: no other gyro is in them.
+  //! that included the removed gyro). The gyros' own second differences, repeats, dropouts and invalid
+  //! samples are kept: no other gyro is in them.
   void restart_evidence();
   //! No epoch for a while (a gap): second differences do not straddle it.
   void bridge_gap() {

@@ -53,9 +53,9 @@ class Isolator {
   //! Bias or ramp, from the parity projected on gyro `id` over the history (a step or a ramp from the best
   //! change time); unknown when neither fits clearly better, or without parity.
   FaultKind classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets) const;
-  //! [rad] per axis: a bound of the attitude error a fault on gyro `id` caused from history epoch `from_index` to
-  //! `index` while in the solution of `active`: Σ |H*(:, id)|·|f_k|·Δt_k, f_k the fault the epoch's parity puts
-  //! on that gyro (every epoch of the full set kept in the history; zero without parity).
+  //! [rad] per axis: a bound of the attitude error a fault on gyro `id` caused from history epoch
+  //! `from_index` to `index` while in the solution of `active`: Σ |H*(:, id)|·|f_k|·Δt_k, f_k the fault the
+  //! epoch's parity puts on that gyro (every epoch of the full set kept in the history; zero without parity).
   Eigen::Vector3d fault_angle(int id, std::int64_t from_index, std::int64_t index, GyroMask active,
                               SubsetCache& subsets) const;
   //! Closes the episode (after a reconfiguration or an operator command).

@@ -22,9 +22,11 @@ std::string default_noise_warning(const Calibration& cal, const PipelineConfig& 
   }
   if (ids.empty()) return "";
   std::ostringstream out;
-  out << "no noise: section for gyro " << ids << "; running on the conservative defaults N = "
-      << config.default_arw_dps_rtHz << " deg/rt-s, B = " << config.default_bias_instability_dps
-      << " deg/s (pipeline default_arw_dps_rtHz, default_bias_instability_dps): sigma is honest only if the unit"
+  out << "no noise: section for gyro " << ids
+      << "; running on the conservative defaults N = " << config.default_arw_dps_rtHz
+      << " deg/rt-s, B = " << config.default_bias_instability_dps
+      << " deg/s (pipeline default_arw_dps_rtHz, default_bias_instability_dps): sigma is honest only if the "
+         "unit"
          " is no noisier; add the section from tetra allan";
   return out.str();
 }

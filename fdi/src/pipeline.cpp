@@ -57,8 +57,9 @@ Eigen::VectorXd bias_sigmas(const std::vector<GyroConstants>& constants) {
 
 //! [ns] now − span, saturating at the earliest representable time (span ≥ 0).
 std::int64_t pipeline_time_before_ns(std::int64_t now_ns, std::int64_t span_ns) {
-  return now_ns >= std::numeric_limits<std::int64_t>::min() + span_ns ? now_ns - span_ns
-                                                                       : std::numeric_limits<std::int64_t>::min();
+  return now_ns >= std::numeric_limits<std::int64_t>::min() + span_ns
+             ? now_ns - span_ns
+             : std::numeric_limits<std::int64_t>::min();
 }
 }  // namespace
 
@@ -159,7 +160,7 @@ class Pipeline::Impl {
   mutable bool filter_health_due_ = false;
   Mode persistent_mode_ = Mode::kNominal;
   GyroMask measured_ = 0;  //!< the gyros of this epoch's rate estimate so far
-  StampJudge clock_;  //!< the epoch time check: outliers dropped, forward jumps confirmed
+  StampJudge clock_;       //!< the epoch time check: outliers dropped, forward jumps confirmed
   bool has_time_ = false;
   std::int64_t last_ns_ = 0;
   std::optional<std::int64_t> last_reference_ns_;  //!< the last epoch that carried a usable reference
@@ -223,8 +224,8 @@ void Pipeline::Impl::judge_reference() {
   // The reference sample is tested before anything uses it (docs/fdi.md, "Reference consistency"); the
   // gyros vouch for their attitude when they leave parity, no episode is open and the rate is observable.
   const GyroMask active = gyro_set_.active();
-  gyros_vouch_ = subsets_.ready() && subsets_.get(active).dof >= 1 && subsets_.get(frame_.usable).observable &&
-                 !isolator_.episode().active;
+  gyros_vouch_ = subsets_.ready() && subsets_.get(active).dof >= 1 &&
+                 subsets_.get(frame_.usable).observable && !isolator_.episode().active;
   reference_usable_ = frame_.reference_q_RB.has_value();
   if (!reference_usable_) {
     if (last_reference_ns_ && frame_.now_ns - *last_reference_ns_ > seconds_to_ns(config_.reference_window_s))
@@ -234,8 +235,7 @@ void Pipeline::Impl::judge_reference() {
   Eigen::Vector3d z;
   Eigen::Matrix3d S;
   if (!subsets_.ready() || !attitude_.predict_reference(*frame_.reference_q_RB, frame_.dt_s, z, S)) return;
-  const ReferenceVerdict v =
-      consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_);
+  const ReferenceVerdict v = consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_);
   reference_usable_ = v.use;
   if (v.rejected || v.reaccepted) {
     FdiEvent e;
@@ -251,7 +251,8 @@ void Pipeline::Impl::judge_reference() {
     attitude_.add_variance(v.contamination_rad2);
     // An attitude the reference itself set a block ago or less rests on its samples alone: the rejecting
     // sample's innovation, on every axis, bounds what they put in.
-    if (reference_set_ns_ && frame_.now_ns - *reference_set_ns_ <= seconds_to_ns(config_.reference_check_window_s))
+    if (reference_set_ns_ &&
+        frame_.now_ns - *reference_set_ns_ <= seconds_to_ns(config_.reference_check_window_s))
       attitude_.add_variance(Eigen::Vector3d::Constant(z.squaredNorm()));
   }
   // A jump is left to the gate (a lone wild sample, or ten in a row set the attitude): only the slower tests
@@ -263,9 +264,9 @@ void Pipeline::Impl::judge_reference() {
     // and bias states open by what the innovation shows, so the reference can pull both back.
     emit_detected(DetectionTest::kReference, consistency_.windowed_nis(), frame_.now_ns);
     result_.events.back().why = *v.inconsistent;
-    result_.events.back().detail = std::string("attitude reference and gyros disagree (") +
-                                   to_string(*v.inconsistent) +
-                                   "); three gyros: the data cannot tell which, sigma and bias states widened";
+    result_.events.back().detail =
+        std::string("attitude reference and gyros disagree (") + to_string(*v.inconsistent) +
+        "); three gyros: the data cannot tell which, sigma and bias states widened";
     attitude_.add_variance(z.cwiseProduct(z));
     attitude_.fault_opened(z.norm() / config_.reference_check_window_s);
   }
@@ -476,7 +477,8 @@ void Pipeline::Impl::publish_attitude() {
     // Never set the attitude onto a reference that disagrees with gyros that vouch for theirs.
     const ReferenceUse use = attitude_.reference(*frame_.reference_q_RB, !gyros_vouch_);
     if (use != ReferenceUse::kRejected) protection_.anchor(frame_.now_ns);  // the error known again
-    if (use == ReferenceUse::kInitialized || use == ReferenceUse::kReinitialized) reference_set_ns_ = frame_.now_ns;
+    if (use == ReferenceUse::kInitialized || use == ReferenceUse::kReinitialized)
+      reference_set_ns_ = frame_.now_ns;
     ++(use == ReferenceUse::kRejected ? health_.counters.reference_rejected
                                       : health_.counters.reference_accepted);
     if (use == ReferenceUse::kReinitialized) ++health_.counters.reference_reinitialized;
@@ -574,19 +576,19 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   attitude_.freeze(iso.gyro);
   // What the fault leaked into the other gyros' bias states since its onset is undone (docs/fdi.md).
   attitude_.repair_biases(gyro_set_.active(),
-                          isolator_.episode().active ? isolator_.episode().onset_ns : pipeline_time_before_ns(now, signature_span_ns()),
+                          isolator_.episode().active ? isolator_.episode().onset_ns
+                                                     : pipeline_time_before_ns(now, signature_span_ns()),
                           now);
   restart_detectors();
-  // The remaining gyros' tests restart from evidence the removed fault did not touch (docs/fdi.md, "One fault,
-  // one exclusion").
+  // The remaining gyros' tests restart from evidence the removed fault did not touch (docs/fdi.md, "One
+  // fault, one exclusion").
   series_.restart_evidence();
   reference_.restart_windows();
   FdiEvent rc;
   rc.stamp_ns = now;
   rc.gyros = gyro_set_.active();
   rc.type = subsets_.observable(rc.gyros) ? EventType::kReconfigured : EventType::kLost;
-  if (rc.type == EventType::kReconfigured && tetra::gyro_count(rc.gyros) == 3)
-    rc.detail = kThreeGyrosLeft;
+  if (rc.type == EventType::kReconfigured && tetra::gyro_count(rc.gyros) == 3) rc.detail = kThreeGyrosLeft;
   emit(std::move(rc));
   update_mode(now);
 }
@@ -600,8 +602,8 @@ void Pipeline::Impl::restart_detectors() {
 }
 
 std::int64_t Pipeline::Impl::signature_span_ns() const {
-  // The longest a finding without an episode takes from its fault's onset: a timeout, the repeated values, the
-  // jump test's confirmation; one sample period more for the onset's own epoch.
+  // The longest a finding without an episode takes from its fault's onset: a timeout, the repeated values,
+  // the jump test's confirmation; one sample period more for the onset's own epoch.
   const double period = subsets_.ready() ? subsets_.period_s() : 0.0;
   const double span_s =
       std::max({config_.dropout_timeout_s, config_.invalid_timeout_s, config_.stuck_repeat_count * period,
@@ -615,9 +617,9 @@ std::int64_t Pipeline::Impl::signature_span_ns() const {
 
 void Pipeline::Impl::gap() {
   // No epoch for dt: a fact of the data path, not of a gyro (docs/fdi.md, "Data path"). The rate between the
-  // two epochs is unknown but for the acceleration bound: the trapezoid over the gap can miss the angle by up to
-  // a_max·τ²/4 per axis (the rate leaving its chord at a_max and coming back). The tests whose evidence would
-  // straddle the gap start again on its far side.
+  // two epochs is unknown but for the acceleration bound: the trapezoid over the gap can miss the angle by up
+  // to a_max·τ²/4 per axis (the rate leaving its chord at a_max and coming back). The tests whose evidence
+  // would straddle the gap start again on its far side.
   const double tau = frame_.dt_s;
   const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
   attitude_.add_bound(Eigen::Vector3d::Constant(0.25 * a_max * tau * tau));
@@ -760,8 +762,8 @@ FdiEvent Pipeline::Impl::command_reinstate(int id, std::int64_t stamp_ns) {
 }
 
 FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
-  // FDI reset: every gyro reinstated, detectors and episode cleared, the reference judged afresh; the attitude
-  // and time go on.
+  // FDI reset: every gyro reinstated, detectors and episode cleared, the reference judged afresh; the
+  // attitude and time go on.
   for (int id = 1; id <= n_; ++id) reinstate(id);
   consistency_.reset();
   restart_detectors();

@@ -18,8 +18,7 @@ ProtectionLevel::ProtectionLevel(const PipelineConfig& config)
 
 Eigen::Vector3d ProtectionLevel::bound(const Subset& s, const Eigen::Vector3d& sigma_rad, std::int64_t now_ns,
                                        double sqrt_period) const {
-  if (s.dof < 1 || !s.observable)
-    return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  if (s.dof < 1 || !s.observable) return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   const double period = sqrt_period * sqrt_period;
   const double t = std::max(0.0, ns_to_seconds(now_ns - anchor_ns_));
   const double reach = s.cusum_k * t + (s.cusum_h + kCusumOvershoot) * period;  // [σ·s]

@@ -1,6 +1,6 @@
 #pragma once
-// The integrity bound beside sigma (docs/fdi.md, "Protection level"): per body axis, the attitude error that a
-// single-gyro fault just below the detection threshold can have caused since the last point it could have
+// The integrity bound beside sigma (docs/fdi.md, "Protection level"): per body axis, the attitude error that
+// a single-gyro fault just below the detection threshold can have caused since the last point it could have
 // started, plus the filter's σ scaled to the integrity risk — as GNSS integrity monitoring (RAIM, ARAIM)
 // publishes a protection level beside its accuracy.
 //

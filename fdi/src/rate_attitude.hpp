@@ -55,12 +55,14 @@ class RateAttitude {
   void finish_epoch() { omega_prev_ = omega_meas_; }
 
   //! A reference sample: the first one sets the attitude; later ones update the filter (gated). A run of
-  //! gate rejections sets the attitude again only when `may_reinitialize` (the gyros cannot vouch for theirs).
+  //! gate rejections sets the attitude again only when `may_reinitialize` (the gyros cannot vouch for
+  //! theirs).
   ReferenceUse reference(const Quaternion& q_ref_RB, bool may_reinitialize = true);
   //! The innovation `z` [rad] a reference sample would have against the attitude propagated to this epoch
   //! (the rate of this epoch, `dt_s`) and its covariance `S` [rad²]: the filter's attitude covariance, the
   //! bound of a fault or lost rate, the reference's σ. False before the first sample.
-  bool predict_reference(const Quaternion& q_ref_RB, double dt_s, Eigen::Vector3d& z, Eigen::Matrix3d& S) const;
+  bool predict_reference(const Quaternion& q_ref_RB, double dt_s, Eigen::Vector3d& z,
+                         Eigen::Matrix3d& S) const;
   //! The epoch's normalized parity `p` over the subset `s` into the filter's biases — once a reference sample
   //! has been seen (without one the attitude stays the gyros' alone).
   void parity(const Subset& s, const Eigen::VectorXd& p, double sqrt_period);
@@ -113,7 +115,7 @@ class RateAttitude {
   AttitudePropagator propagator_;  //!< the quaternion, and the bound (its noise inputs stay zero)
   Mekf mekf_;
   BiasSnapshots snapshots_;  //!< the bias states before a fault, for their repair at its isolation
-  double gate_chi2_ = 0.0;                                //!< χ²₃ quantile of the reference gate
+  double gate_chi2_ = 0.0;   //!< χ²₃ quantile of the reference gate
   Eigen::Vector3d correction_ = Eigen::Vector3d::Zero();  //!< [rad/s] H*·b̂ of the last observable epoch
   bool reference_seen_ = false;
   int rejected_run_ = 0;  //!< reference samples rejected in a row

@@ -22,7 +22,8 @@ ReferenceConsistency::ReferenceConsistency(const PipelineConfig& config)
     : config_(config),
       jump_chi2_(allan::chi2_quantile(1.0 - config.reference_check_false_alarm_probability, 3.0)),
       lag_chi2_(allan::chi2_quantile(1.0 - config.reference_check_false_alarm_probability, 1.0)),
-      z_tail_(std::sqrt(allan::chi2_quantile(1.0 - 2.0 * config.reference_check_false_alarm_probability, 1.0))) {
+      z_tail_(
+          std::sqrt(allan::chi2_quantile(1.0 - 2.0 * config.reference_check_false_alarm_probability, 1.0))) {
   reset();
 }
 
@@ -141,7 +142,8 @@ ReferenceVerdict ReferenceConsistency::observe(std::int64_t now_ns, const Eigen:
     // Rejected: what the samples used in this block may have put in the attitude beyond what the filter
     // assumed is their innovations' second moment beyond the predicted one.
     if (used_count > 0) v.contamination_rad2 = (used_excess / used_count).cwiseMax(0.0);
-    if (*failed == ReferenceCheck::kLag) v.contamination_rad2 += lag_offset_rad_.cwiseProduct(lag_offset_rad_);
+    if (*failed == ReferenceCheck::kLag)
+      v.contamination_rad2 += lag_offset_rad_.cwiseProduct(lag_offset_rad_);
     state_ = ReferenceState::kRejected;
     v.use = false;
     v.rejected = failed;

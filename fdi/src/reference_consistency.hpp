@@ -13,8 +13,8 @@
 // every sample over its block so far. Without a gyro fault the innovations are white with covariance S (the
 // filter's model), so each statistic has the stated distribution; what a fault of the reference does to them
 // is in docs/fdi.md. A reference is judged only while the gyro solution is consistent (the caller's `judge`):
-// parity among the gyros used and no fault episode open. Then a failed test rejects the reference: its samples
-// are no longer used (sigma grows with the gyro propagation) until they pass every test for
+// parity among the gyros used and no fault episode open. Then a failed test rejects the reference: its
+// samples are no longer used (sigma grows with the gyro propagation) until they pass every test for
 // reference_reaccept_s. Without judging, a failed test is reported (`inconsistent`) and nothing else changes.
 
 #include <cstdint>
@@ -29,7 +29,7 @@ namespace tetra::fdi::detail {
 
 //! What one reference sample's tests said.
 struct ReferenceVerdict {
-  bool use = true;                        //!< the sample may update the filter and the reference windows
+  bool use = true;                         //!< the sample may update the filter and the reference windows
   std::optional<ReferenceCheck> rejected;  //!< the reference was rejected at this sample, and why
   bool reaccepted = false;                 //!< the reference is used again from this sample on
   //! A test failed while the gyros could not be judged (no parity or an open episode): the reference or a
@@ -72,8 +72,8 @@ class ReferenceConsistency {
   std::int64_t consistent_since_ns_ = 0;  //!< rejected: every sample since passed every test
   double nis_per_dof_ = 0.0;
   Eigen::Vector3d lag_offset_rad_ = Eigen::Vector3d::Zero();  //!< [rad] |ω̄·τ̂| of the block so far
-  double lag_s_ = 0.0;         //!< [s] τ̂ of the block so far
-  double lag_den_ = 0.0;       //!< [1/rad²·(rad/s)²] Σ_a Σw(ω − ω̄)² of the block so far: 1/var(τ̂)
+  double lag_s_ = 0.0;                                        //!< [s] τ̂ of the block so far
+  double lag_den_ = 0.0;  //!< [1/rad²·(rad/s)²] Σ_a Σw(ω − ω̄)² of the block so far: 1/var(τ̂)
   double rejected_lag_s_ = 0.0;  //!< [s] |τ̂| when rejected for `lag` (0: another reason)
   double reaccept_den_ = 0.0;    //!< rejected: Σ of lag_den_ over the blocks completed since consistent
 
@@ -82,8 +82,8 @@ class ReferenceConsistency {
   int block_count_ = 0;
   double block_nis_ = 0.0;
   Eigen::Vector3d sw_, swo_, swz_, swoo_, swoz_;  //!< per axis Σw, Σwω, Σwz, Σwω², Σwωz (w = 1/S_aa)
-  Eigen::Vector3d szz_;                            //!< per axis Σz² of the samples used
-  Eigen::Vector3d sss_;                            //!< per axis ΣS_aa of the samples used
+  Eigen::Vector3d szz_;                           //!< per axis Σz² of the samples used
+  Eigen::Vector3d sss_;                           //!< per axis ΣS_aa of the samples used
   // the bias block (reference_bias_window_s)
   std::int64_t bias_start_ns_ = -1;
   int bias_count_ = 0;

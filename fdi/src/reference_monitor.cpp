@@ -66,8 +66,8 @@ int LoneGyro::confirm(int count, int min_members) {
 }
 
 void ReferenceMonitor::integrate(const EpochFrame& frame, GyroMask excluded,
-                                 const Eigen::Vector3d& omega_meas_B_rad_s, const Eigen::Vector3d& earth_B_rad_s,
-                                 bool estimate_fresh) {
+                                 const Eigen::Vector3d& omega_meas_B_rad_s,
+                                 const Eigen::Vector3d& earth_B_rad_s, bool estimate_fresh) {
   // Samples are instantaneous rates at the sample time: the increment over (t_{k−1}, t_k] is the trapezoid.
   for (std::size_t u = 0; u < n_; ++u) {
     const int id = static_cast<int>(u) + 1;
@@ -139,9 +139,9 @@ std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, co
     const auto& t = tracks_[i];
     if (t.held_ns >= snap_ns_[slot(old)]) continue;  // its angle holds a stale rate over this window
     const double rot = t.ref_angle_rad - snap_ref(old, static_cast<int>(i));
-    const double err = beyond_calibration(series.constants(id),
-                                          (t.angle_rad - snap_angle(old, static_cast<int>(i))) - rot, rot, old,
-                                          snap_count_ - 1);
+    const double err =
+        beyond_calibration(series.constants(id), (t.angle_rad - snap_angle(old, static_cast<int>(i))) - rot,
+                           rot, old, snap_count_ - 1);
     windows_.add(id, std::abs(err) / disagreement_sigma(series.constants(id), span, rot),
                  config_.reference_threshold_sigma);
   }
@@ -162,9 +162,9 @@ double ReferenceMonitor::disagreement_sigma(const GyroConstants& c, double span_
 }
 
 double ReferenceMonitor::beyond_calibration(const GyroConstants& c, double err, double rot, int old,
-                                           int last) const {
-  // As the parity's dead zone (docs/fdi.md, "Calibration uncertainty"): a scale factor off by ε and an axis off
-  // by δh add −ε·rot + δh·Θ to the disagreement; within e stated σ that is at most the bound below.
+                                            int last) const {
+  // As the parity's dead zone (docs/fdi.md, "Calibration uncertainty"): a scale factor off by ε and an axis
+  // off by δh add −ε·rot + δh·Θ to the disagreement; within e stated σ that is at most the bound below.
   const Eigen::Vector3d theta = snap_theta_[slot(last)] - snap_theta_[slot(old)];
   const double bound = config_.calibration_error_sigmas *
                        (c.scale_rel_sigma * std::abs(rot) + c.axis_sigma.dot(theta.cwiseAbs()));
@@ -189,8 +189,8 @@ bool ReferenceMonitor::span(std::int64_t from_ns, double min_span_s, GyroMask ex
     if (has_gyro(excluded, id) || tracks_[i].held_ns >= out.start_ns) continue;
     const int g = static_cast<int>(i);
     const double rot = snap_ref(last, g) - snap_ref(old, g);
-    out.err_rad[i] =
-        beyond_calibration(series.constants(id), (snap_angle(last, g) - snap_angle(old, g)) - rot, rot, old, last);
+    out.err_rad[i] = beyond_calibration(series.constants(id),
+                                        (snap_angle(last, g) - snap_angle(old, g)) - rot, rot, old, last);
     out.sigma_rad[i] = disagreement_sigma(series.constants(id), out.span_s, rot);
     out.gyros |= GyroMask{1} << i;
   }

@@ -76,8 +76,8 @@ class ReferenceMonitor {
   //! Gyro `id`'s disagreement over `span` follows the rotation about its axis (a scale error, see `update`).
   bool span_scale(int id, const SpanDisagreement& span) const { return scale_significant(id, span.start); }
   //! The windows and their runs of findings start again: a reinstated gyro's angle has a gap; after an
-  //! isolation, an angle may have integrated the rate estimate of the old set while its own sample was left out
-  //! as an outlier, and the findings so far were comparisons over that.
+  //! isolation, an angle may have integrated the rate estimate of the old set while its own sample was left
+  //! out as an outlier, and the findings so far were comparisons over that.
   void restart_windows() {
     snap_count_ = 0;
     windows_.reset();
@@ -115,12 +115,12 @@ class ReferenceMonitor {
   std::vector<Track> tracks_;
   std::vector<std::int64_t> snap_ns_;
   std::vector<Quaternion> snap_q_;
-  std::vector<double> snap_angle_;  //!< kSnapshots×N
-  std::vector<double> snap_ref_;    //!< kSnapshots×N
+  std::vector<double> snap_angle_;           //!< kSnapshots×N
+  std::vector<double> snap_ref_;             //!< kSnapshots×N
   std::vector<Eigen::Vector3d> snap_theta_;  //!< [rad] Σ of the reference's increments in B, per snapshot
-  int snap_count_ = 0;              //!< total pushed
-  LoneGyro windows_;                //!< the windows' comparisons
-  LoneGyro filter_;                 //!< the filter's bias estimates at reference samples
+  int snap_count_ = 0;                       //!< total pushed
+  LoneGyro windows_;                         //!< the windows' comparisons
+  LoneGyro filter_;                          //!< the filter's bias estimates at reference samples
 };
 
 }  // namespace tetra::fdi::detail

@@ -1,9 +1,9 @@
 #pragma once
 // The epoch time check (docs/fdi.md, "Per epoch", step 1): each epoch's stamp judged against the stream's own
-// last accepted time. A stamp more than kWindowPeriods sample periods away from it is a time outlier: counted,
-// dropped, and it never moves the time. A forward jump is followed once kConfirmStamps stamps in a row agree
-// with it (each increasing, within the window of the one before): the last of them is accepted and the jump is
-// a gap. A stream's time never goes back: a stamp far behind is always an outlier.
+// last accepted time. A stamp more than kWindowPeriods sample periods away from it is a time outlier:
+// counted, dropped, and it never moves the time. A forward jump is followed once kConfirmStamps stamps in a
+// row agree with it (each increasing, within the window of the one before): the last of them is accepted and
+// the jump is a gap. A stream's time never goes back: a stamp far behind is always an outlier.
 
 #include <cstdint>
 #include <optional>
@@ -33,10 +33,10 @@ class StampJudge {
  private:
   std::int64_t window_ns() const;
 
-  std::int64_t period_ns_ = 0;              //!< [ns]
-  std::optional<std::int64_t> last_ns_;     //!< [ns] the last accepted stamp
+  std::int64_t period_ns_ = 0;                //!< [ns]
+  std::optional<std::int64_t> last_ns_;       //!< [ns] the last accepted stamp
   std::optional<std::int64_t> candidate_ns_;  //!< [ns] the newest stamp of a run of forward outliers
-  int candidate_count_ = 0;                 //!< stamps in that run
+  int candidate_count_ = 0;                   //!< stamps in that run
 };
 
 }  // namespace tetra::fdi::detail

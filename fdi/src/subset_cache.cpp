@@ -58,7 +58,8 @@ SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s
     quantization_rad_ = Eigen::VectorXd::Zero(gyro_count());
   if (bias_wander_rad_s_.size() != geometry_.gyro_count())
     bias_wander_rad_s_ = Eigen::VectorXd::Zero(gyro_count());
-  if (scale_rel_sigma_.size() != geometry_.gyro_count()) scale_rel_sigma_ = Eigen::VectorXd::Zero(gyro_count());
+  if (scale_rel_sigma_.size() != geometry_.gyro_count())
+    scale_rel_sigma_ = Eigen::VectorXd::Zero(gyro_count());
   if (axis_sigma_.cols() != geometry_.gyro_count()) axis_sigma_ = Eigen::Matrix3Xd::Zero(3, gyro_count());
   calibration_sigma_ = (scale_rel_sigma_.array() > 0.0).any() || (axis_sigma_.array() > 0.0).any();
   subsets_.reserve(gyro_count() <= 8 ? 512 : 4096);

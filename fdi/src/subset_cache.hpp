@@ -51,7 +51,8 @@ struct Subset {
 struct DetectorNoise {
   Eigen::VectorXd quantization_rad;   //!< [rad] angle quantization Q_i (0 if absent)
   Eigen::VectorXd bias_wander_rad_s;  //!< [rad/s] 1σ of the slowly wandering bias (`bias_wander_sigma`)
-  //! The calibration's stated 1σ (`sigma:`), for the rate-proportional parity term ("Calibration uncertainty")
+  //! The calibration's stated 1σ (`sigma:`), for the rate-proportional parity term ("Calibration
+  //! uncertainty")
   Eigen::VectorXd scale_rel_sigma;  //!< [-] 1σ of each scale factor relative to it (0 if absent)
   Eigen::Matrix3Xd axis_sigma;      //!< [-] 1σ of each axis component (columns per gyro; 0 if absent)
 };

@@ -66,14 +66,17 @@ int cmd_ground(int argc, char** argv) {
   app.add_option("--session-key", server_config.session_key_path,
                  "the key sessions are signed with (default: the --users file's name + .session-key; created "
                  "when absent)");
-  app.add_flag("--no-auth", server_config.no_auth,
-               "no accounts: whoever reaches the port commands as 'anonymous' (loopback addresses only; logged)");
+  app.add_flag(
+      "--no-auth", server_config.no_auth,
+      "no accounts: whoever reaches the port commands as 'anonymous' (loopback addresses only; logged)");
   app.add_option("--allow-origin", server_config.allow_origins,
                  "another HOST:PORT browsers reach this ground as (a DNS name, a proxy); repeatable");
   app.add_option("--tls-cert", server_config.tls.cert, "PEM certificate (chain): serve HTTPS")
       ->check(CLI::ExistingFile);
-  app.add_option("--tls-key", server_config.tls.key, "PEM private key of --tls-cert")->check(CLI::ExistingFile);
-  app.add_option("--max-streams", server_config.limits.max_streams, "event streams held at once (beyond: 503)")
+  app.add_option("--tls-key", server_config.tls.key, "PEM private key of --tls-cert")
+      ->check(CLI::ExistingFile);
+  app.add_option("--max-streams", server_config.limits.max_streams,
+                 "event streams held at once (beyond: 503)")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   add_domain_option(app, domain);

@@ -51,11 +51,13 @@ int cmd_ground_passwd(int argc, char** argv) {
 
   std::string password;
   if (from_stdin || !::isatty(STDIN_FILENO)) {
-    if (!from_stdin) return report("ground passwd", bad_input("standard input is not a terminal: --password-stdin"));
+    if (!from_stdin)
+      return report("ground passwd", bad_input("standard input is not a terminal: --password-stdin"));
     std::getline(std::cin, password);
   } else {
     password = ask_hidden("password for " + user + ": ");
-    if (ask_hidden("again: ") != password) return report("ground passwd", bad_input("the two passwords differ"));
+    if (ask_hidden("again: ") != password)
+      return report("ground passwd", bad_input("the two passwords differ"));
   }
   if (password.size() < 8) return report("ground passwd", bad_input("password: at least 8 characters"));
   auto hash = ground::hash_password(password);

@@ -112,8 +112,7 @@ std::string health_json(const std::string& unit, const UnitView& view, std::int6
         << ", \"samples_other_unit\": " << c.samples_other_unit
         << ", \"deadlines_missed\": " << c.deadlines_missed << ", \"liveliness_lost\": " << c.liveliness_lost
         << ", \"sensor_restarts\": " << c.sensor_restarts << ", \"time_outlier\": " << c.time_outlier
-        << ", \"seq_discontinuity\": " << c.seq_discontinuity
-        << ", \"unit_silences\": " << c.unit_silences
+        << ", \"seq_discontinuity\": " << c.seq_discontinuity << ", \"unit_silences\": " << c.unit_silences
         << "}, \"events_published\": " << view.health->events_published;
   }
   if (view.attitude) {

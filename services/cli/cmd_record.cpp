@@ -52,7 +52,8 @@ struct RecordOptions {
 
 void add_record_options(CLI::App& app, RecordOptions& o) {
   app.add_option("-o,--out", o.out_path, "gyro log to write (CSV, or HDF5 when named .h5)")->required();
-  app.add_option("--unit", o.unit, "the unit to record (default: the first one seen)")->check(unit_name_check());
+  app.add_option("--unit", o.unit, "the unit to record (default: the first one seen)")
+      ->check(unit_name_check());
   app.add_option("--config", o.config_path,
                  "take unit, gyro count and assembly settings from a fusion config");
   app.add_option("--gyros", o.gyros, "number of gyros N (columns g1..gN)")

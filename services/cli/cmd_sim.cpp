@@ -124,8 +124,9 @@ void add_scenario_options(CLI::App& app, SimArgs& a) {
                      "[s] reference failure: each sample shows the attitude this long before its stamp")
           ->check(CLI::Range(0.0, 10.0));
   o.reference_bias_given =
-      app.add_option("--reference-bias", o.reference_bias,
-                     "ARCSEC,AT_S,RAMP_S: reference failure, a slow bias growing from AT_S to ARCSEC over RAMP_S")
+      app.add_option(
+             "--reference-bias", o.reference_bias,
+             "ARCSEC,AT_S,RAMP_S: reference failure, a slow bias growing from AT_S to ARCSEC over RAMP_S")
           ->delimiter(',')
           ->expected(3);
   o.reference_misid_given =

@@ -32,7 +32,8 @@ Result<RecordedCommand> parse_line(const std::string& line, const std::string& w
   RecordedCommand c;
   if (!j.contains("time_s") || !j["time_s"].is_number())
     return bad_input(where + ": field 'time_s' (number) missing");
-  if (auto why = log_time_problem(j["time_s"].get<double>())) return bad_input(where + ": field 'time_s': " + *why);
+  if (auto why = log_time_problem(j["time_s"].get<double>()))
+    return bad_input(where + ": field 'time_s': " + *why);
   c.stamp_ns = seconds_to_ns(j["time_s"].get<double>());
   if (!j.contains("command") || !j["command"].is_string())
     return bad_input(where + ": field 'command' missing");

@@ -9,9 +9,9 @@
 #include <filesystem>
 
 #include "tetra/core/json.hpp"
-#include "tetra/service/unit_name.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/service/security_profile.hpp"
+#include "tetra/service/unit_name.hpp"
 
 namespace tetra::cli {
 

@@ -272,8 +272,10 @@ Status validate_scenario(const Scenario& sc) {
   const ReferenceOptions& r = sc.reference;
   if (!std::isfinite(r.latency_s) || r.latency_s < 0.0 || r.latency_s > 10.0)
     return bad_input("reference latency_s must be in [0, 10], got " + number_text(r.latency_s));
-  for (const auto& [value, key] : {std::pair{r.bias_arcsec, "bias_arcsec"}, {r.bias_at_s, "bias_at_s"},
-                                   {r.misid_deg, "misid_deg"}, {r.misid_at_s, "misid_at_s"}}) {
+  for (const auto& [value, key] : {std::pair{r.bias_arcsec, "bias_arcsec"},
+                                   {r.bias_at_s, "bias_at_s"},
+                                   {r.misid_deg, "misid_deg"},
+                                   {r.misid_at_s, "misid_at_s"}}) {
     if (!std::isfinite(value)) return bad_input(std::string("reference ") + key + " must be finite");
   }
   for (const auto& [value, key] :

@@ -105,11 +105,12 @@ std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
     if (r.latency_s > 0.0) meta.emplace_back("reference_latency_s", number_text(r.latency_s));
     if (r.bias_arcsec != 0.0)
       meta.emplace_back("reference_bias", number_text(r.bias_arcsec) + " arcsec from " +
-                                              number_text(r.bias_at_s) + " s over " + number_text(r.bias_ramp_s) +
-                                              " s");
+                                              number_text(r.bias_at_s) + " s over " +
+                                              number_text(r.bias_ramp_s) + " s");
     if (r.misid_duration_s > 0.0)
-      meta.emplace_back("reference_misid", number_text(r.misid_deg) + " deg from " + number_text(r.misid_at_s) +
-                                               " s for " + number_text(r.misid_duration_s) + " s");
+      meta.emplace_back("reference_misid", number_text(r.misid_deg) + " deg from " +
+                                               number_text(r.misid_at_s) + " s for " +
+                                               number_text(r.misid_duration_s) + " s");
   }
   if (scenario_.jitter_s > 0.0) meta.emplace_back("jitter_s", number_text(scenario_.jitter_s));
   if (scenario_.drop_probability > 0.0) {

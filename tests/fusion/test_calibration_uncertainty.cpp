@@ -1,6 +1,6 @@
 // Calibration uncertainty in the detectors (docs/fdi.md, "Calibration uncertainty"): a unit whose true scale
-// factors and axes differ from the calibration by up to twice the calibration's stated 1σ, flown through agile
-// slews (45° in 15 s), excludes no gyro and raises no parity detection; a real fault is still isolated.
+// factors and axes differ from the calibration by up to twice the calibration's stated 1σ, flown through
+// agile slews (45° in 15 s), excludes no gyro and raises no parity detection; a real fault is still isolated.
 // Scenarios run straight from the simulator into the pipeline (about 3 s of CPU).
 #include <cmath>
 #include <cstdio>
@@ -15,7 +15,8 @@
 namespace tetra {
 namespace {
 
-constexpr double kAxisSigma = 1e-3;   //!< [-] stated 1σ per axis component (the audit's 0.3–1 mrad, at its top)
+constexpr double kAxisSigma =
+    1e-3;  //!< [-] stated 1σ per axis component (the audit's 0.3–1 mrad, at its top)
 constexpr double kScaleSigma = 1e-3;  //!< [-] stated 1σ of each scale factor, relative
 
 //! The calibration that states σ: the true unit with each scale factor off by `errors`·σ (alternating sign)
@@ -97,8 +98,8 @@ TEST(CalibrationUncertainty, WithoutTheStatedSigmaTheSameErrorsAreDetected) {
   so.seed = 1;
   fdi::PipelineConfig config;
   config.calibration_error_sigmas = 0.0;
-  const auto run = test::run_campaign(slews(kAxes[0], false), so,
-                                      stated_calibration(test::unit_with(4), 2.0, 1), config);
+  const auto run =
+      test::run_campaign(slews(kAxes[0], false), so, stated_calibration(test::unit_with(4), 2.0, 1), config);
   EXPECT_GT(count(run, fdi::EventType::kDetected), 0) << test::describe(run);
 }
 
@@ -123,10 +124,10 @@ TEST(CalibrationUncertainty, ARealFaultIsStillIsolated) {
       so.seed = seed;
       const auto run = test::run_campaign(sc, so, stated_calibration(test::unit_with(4), 2.0, seed), {});
       bool wrong = !run.isolated_gyro || *run.isolated_gyro != c.gyro;
-      for (const auto& e : run.events)
-        wrong |= e.type == fdi::EventType::kIsolated && e.gyro != c.gyro;
-      if (wrong) what += "gyro " + std::to_string(c.gyro) + " seed " + std::to_string(seed) + ":\n" +
-                         test::describe(run);
+      for (const auto& e : run.events) wrong |= e.type == fdi::EventType::kIsolated && e.gyro != c.gyro;
+      if (wrong)
+        what +=
+            "gyro " + std::to_string(c.gyro) + " seed " + std::to_string(seed) + ":\n" + test::describe(run);
     }
   }
   EXPECT_TRUE(what.empty()) << what;

@@ -462,8 +462,9 @@ StampJudge judge_at(std::int64_t start_ns) {
 
 TEST(StampJudge, AStampFarAheadOrBehindIsAnOutlierAndNeverMovesTheTime) {
   StampJudge j = judge_at(0);
-  for (const std::int64_t glitch : {std::int64_t{1'000'000} * kNanosPerSecond, -std::int64_t{1'000'000} * kNanosPerSecond,
-                                    std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::min()}) {
+  for (const std::int64_t glitch :
+       {std::int64_t{1'000'000} * kNanosPerSecond, -std::int64_t{1'000'000} * kNanosPerSecond,
+        std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::min()}) {
     EXPECT_EQ(j.judge(glitch), StampVerdict::kOutlier) << glitch;
   }
   EXPECT_EQ(*j.last_ns(), 0);

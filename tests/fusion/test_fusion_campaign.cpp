@@ -23,7 +23,8 @@ sim::Scenario orbit(double duration_s, bool reference) {
   auto sc = sim::builtin_scenario("orbit");
   EXPECT_TRUE(sc.ok());
   sc->duration_s = duration_s;
-  // The attitude-control motion of the acceptance case: about 2e-3 deg/s, peak angular acceleration about 1e-4 deg/s².
+  // The attitude-control motion of the acceptance case: about 2e-3 deg/s, peak angular acceleration about
+  // 1e-4 deg/s².
   sc->motion.acs.amplitude_deg = 0.04;
   sc->motion.acs.peak_accel_dps2 = 1e-4;
   if (!reference) sc->reference.rate_hz = 0.0;

@@ -227,8 +227,10 @@ TEST(IsolationAdversarial, FaultsBeginningDuringSlewsNeverBlameAHealthyGyro) {
 //! each axis.
 const std::vector<SlewCase>& agile_slews() {
   static const std::vector<SlewCase> all = {
-      {"45deg/15s y", Eigen::Vector3d::UnitY(), 45.0, 15.0},  {"30deg/20s y", Eigen::Vector3d::UnitY(), 30.0, 20.0},
-      {"45deg/10s x", Eigen::Vector3d::UnitX(), 45.0, 10.0},  {"-45deg/10s y", Eigen::Vector3d::UnitY(), -45.0, 10.0},
+      {"45deg/15s y", Eigen::Vector3d::UnitY(), 45.0, 15.0},
+      {"30deg/20s y", Eigen::Vector3d::UnitY(), 30.0, 20.0},
+      {"45deg/10s x", Eigen::Vector3d::UnitX(), 45.0, 10.0},
+      {"-45deg/10s y", Eigen::Vector3d::UnitY(), -45.0, 10.0},
       {"45deg/10s z", Eigen::Vector3d::UnitZ(), 45.0, 10.0},
   };
   return all;
@@ -278,9 +280,10 @@ TEST(IsolationAdversarial, OneFaultNeverCostsASecondGyro) {
               so.faults = {fault(gyro, kind, at, size)};
               const auto run = run_campaign(slew_scenario(n, slew, reference, 60.0), so, test::unit_with(n),
                                             config_for(seed + static_cast<std::uint64_t>(case_index)));
-              const std::string label = "N=" + std::to_string(n) + " " + name + " gyro " + std::to_string(gyro) +
-                                        " at " + std::to_string(when) + " of " + slew.name +
-                                        (reference ? " ref" : "") + " seed " + std::to_string(seed);
+              const std::string label = "N=" + std::to_string(n) + " " + name + " gyro " +
+                                        std::to_string(gyro) + " at " + std::to_string(when) + " of " +
+                                        slew.name + (reference ? " ref" : "") + " seed " +
+                                        std::to_string(seed);
               tally(table[name], run, so.faults, at, label, n, what);
               if (run.final_mode == fdi::Mode::kLost || !second_exclusions(run).empty())
                 what += label + " (second exclusion or LOST):\n" + test::describe(run, n);
@@ -370,7 +373,8 @@ TEST(IsolationAdversarial, SigmaHonestAfterAReconfigurationWithAReference) {
                             "N=%d %s gyro %d at %.1f of %s seed %llu: %.1f %% within 3 sigma, NEES %.2f %.2f "
                             "%.2f, worst %.1f sigma, %.4f deg\n",
                             n, name, gyro, when, slew.name, static_cast<unsigned long long>(seed),
-                            100.0 * h.within, h.nees[0], h.nees[1], h.nees[2], h.worst_sigmas, h.worst_error_deg);
+                            100.0 * h.within, h.nees[0], h.nees[1], h.nees[2], h.worst_sigmas,
+                            h.worst_error_deg);
               what += line;
             }
           }
@@ -382,16 +386,18 @@ TEST(IsolationAdversarial, SigmaHonestAfterAReconfigurationWithAReference) {
                 nees_runs, nees[0], nees[1], nees[2]);
     if (nees.maxCoeff() > 2.0) what += "N=" + std::to_string(n) + ": mean per-axis NEES beyond 2\n";
   }
-  std::printf("fault in a slew with the reference: %d runs, %d correctly isolated; lowest within-3-sigma "
-              "%.1f %%\n",
-              runs, judged, 100.0 * lowest_within);
+  std::printf(
+      "fault in a slew with the reference: %d runs, %d correctly isolated; lowest within-3-sigma "
+      "%.1f %%\n",
+      runs, judged, 100.0 * lowest_within);
   EXPECT_TRUE(what.empty()) << what;
 }
 
 TEST(IsolationAdversarial, DataPathFaultsAreNotGyroFaults) {
   // Samples dropped at random (2 to 20 %) with ±5 ms time jitter during agile slews, the sample period
-  // configured (as a service with jitter sets it): a missing sample is a fact of the data path, never a gyro's
-  // onset or spike. Fault-free: nothing excluded, never LOST. N = 4..6, with and without the reference.
+  // configured (as a service with jitter sets it): a missing sample is a fact of the data path, never a
+  // gyro's onset or spike. Fault-free: nothing excluded, never LOST. N = 4..6, with and without the
+  // reference.
   const std::uint64_t seeds = one_fault_seeds(1);
   std::string what;
   int runs = 0, detected = 0;
@@ -412,11 +418,13 @@ TEST(IsolationAdversarial, DataPathFaultsAreNotGyroFaults) {
           ++runs;
           if (run.first_detected_s) ++detected;
           // LOST as a reconfiguration (an epoch with fewer than three samples is LOST for that epoch only).
-          const bool lost = std::any_of(run.events.begin(), run.events.end(),
-                                        [](const fdi::FdiEvent& e) { return e.type == fdi::EventType::kLost; });
+          const bool lost = std::any_of(run.events.begin(), run.events.end(), [](const fdi::FdiEvent& e) {
+            return e.type == fdi::EventType::kLost;
+          });
           if (!wrong_exclusions(run, {}).empty() || lost)
             what += "N=" + std::to_string(n) + " drop " + std::to_string(drop) + " " + slew.name +
-                    (reference ? " ref" : "") + " seed " + std::to_string(seed) + ":\n" + test::describe(run, n);
+                    (reference ? " ref" : "") + " seed " + std::to_string(seed) + ":\n" +
+                    test::describe(run, n);
         }
       }
     }
@@ -429,8 +437,8 @@ TEST(IsolationAdversarial, DataPathFaultsAreNotGyroFaults) {
 TEST(IsolationAdversarial, AGapIsAnEventAndWidensSigma) {
   // 30 s without any epoch, in the middle of an agile slew (the pipeline configured with the slew's peak
   // acceleration, 2πΦ/T²) or of the quiet orbit (the default bound): a `gap` event with its length, no
-  // exclusion, never LOST, and the attitude error inside 3σ at every epoch after the gap (the bound a_max·τ²/4
-  // per axis covers what the trapezoid across the gap can miss while the body keeps within a_max).
+  // exclusion, never LOST, and the attitude error inside 3σ at every epoch after the gap (the bound
+  // a_max·τ²/4 per axis covers what the trapezoid across the gap can miss while the body keeps within a_max).
   std::string what;
   int runs = 0;
   for (int n = 4; n <= 6; ++n) {
@@ -444,7 +452,8 @@ TEST(IsolationAdversarial, AGapIsAnEventAndWidensSigma) {
         if (orbit) {
           sc.motion.slews.clear();
         } else {
-          cfg.max_angular_acceleration_dps2 = 2.0 * kPi * std::abs(slew.angle_deg) / (slew.duration_s * slew.duration_s);
+          cfg.max_angular_acceleration_dps2 =
+              2.0 * kPi * std::abs(slew.angle_deg) / (slew.duration_s * slew.duration_s);
           from = kSlewStart_s + 0.5 * slew.duration_s;
         }
         sim::SimOptions so;
@@ -459,7 +468,8 @@ TEST(IsolationAdversarial, AGapIsAnEventAndWidensSigma) {
                                   (reference ? " ref" : "") + ":\n";
         const auto gap = std::find_if(run.events.begin(), run.events.end(),
                                       [](const fdi::FdiEvent& e) { return e.type == fdi::EventType::kGap; });
-        // The gap's length: from the last epoch before to the first after, 30 s plus one sample period (0.1 s).
+        // The gap's length: from the last epoch before to the first after, 30 s plus one sample period (0.1
+        // s).
         if (gap == run.events.end() || std::abs(gap->statistic - 30.1) > 0.01)
           what += label + "no gap event of 30.1 s\n" + test::describe(run, n);
         if (!wrong_exclusions(run, {}).empty() || run.final_mode == fdi::Mode::kLost)
@@ -467,9 +477,11 @@ TEST(IsolationAdversarial, AGapIsAnEventAndWidensSigma) {
         double worst = 0.0;
         for (std::size_t k = 0; k < run.time_s.size(); ++k) {
           if (run.time_s[k] < from) continue;
-          worst = std::max(worst, (run.error_rad[k].cwiseAbs().array() / run.sigma_rad[k].array()).maxCoeff());
+          worst =
+              std::max(worst, (run.error_rad[k].cwiseAbs().array() / run.sigma_rad[k].array()).maxCoeff());
         }
-        if (worst > 3.0) what += label + "error beyond 3 sigma after the gap: " + std::to_string(worst) + "\n";
+        if (worst > 3.0)
+          what += label + "error beyond 3 sigma after the gap: " + std::to_string(worst) + "\n";
       }
     }
   }

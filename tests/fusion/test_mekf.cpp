@@ -262,8 +262,8 @@ TEST(MekfGate, AReferenceTheGyrosContradictIsRejectedAndNeverSetsTheAttitude) {
 }
 
 TEST(MekfGate, WithThreeGyrosAPersistentOffsetStillResetsTheAttitude) {
-  // Three gyros leave no parity: they cannot vouch for their attitude, so a reference they disagree with is as
-  // likely right. The five wild samples are rejected by the gate (the attitude untouched); from 60 s after
+  // Three gyros leave no parity: they cannot vouch for their attitude, so a reference they disagree with is
+  // as likely right. The five wild samples are rejected by the gate (the attitude untouched); from 60 s after
   // reference_gate_reset_count (10) rejections in a row the next sample sets the attitude (as before the
   // reference had its own tests).
   const GateRun run = run_wild_reference(true);

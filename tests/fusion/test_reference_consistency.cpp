@@ -19,18 +19,18 @@ namespace {
 
 struct Outcome {
   std::vector<fdi::FdiEvent> events;
-  int rejected = 0;                 //!< reference_rejected events
+  int rejected = 0;  //!< reference_rejected events
   fdi::ReferenceCheck first_why = fdi::ReferenceCheck::kNone;
-  double first_rejected_s = -1.0;   //!< [s]
-  int within_3sigma = 0;            //!< (epoch, axis) with |e| ≤ 3σ, sampled every second from kSettle_s
+  double first_rejected_s = -1.0;  //!< [s]
+  int within_3sigma = 0;           //!< (epoch, axis) with |e| ≤ 3σ, sampled every second from kSettle_s
   int total = 0;
-  double worst_ratio = 0.0;         //!< largest |e|/σ over those samples
-  int beyond_protection = 0;        //!< sampled (epoch, axis) with |e| above the protection level
+  double worst_ratio = 0.0;             //!< largest |e|/σ over those samples
+  int beyond_protection = 0;            //!< sampled (epoch, axis) with |e| above the protection level
   double worst_protection_ratio = 0.0;  //!< largest |e|/PL
   double first_detected_s = -1.0;
-  int within_after = 0;             //!< as within_3sigma, after the first rejection or detection
+  int within_after = 0;  //!< as within_3sigma, after the first rejection or detection
   int total_after = 0;
-  double first_accepted_s = -1.0;   //!< [s] first reference_accepted
+  double first_accepted_s = -1.0;  //!< [s] first reference_accepted
   double final_error_arcsec = 0.0;
   fdi::Health health;
 };
@@ -43,7 +43,9 @@ sim::Scenario scenario(double duration_s, bool slew) {
   sc->duration_s = duration_s;
   sc->motion.slews.clear();
   // 30° about X in 20 s (1.5 deg/s), then −45° about Z in 15 s: agile motion a late reference cannot hide.
-  if (slew) sc->motion.slews = {{Eigen::Vector3d::UnitX(), 30.0, 60.0, 20.0}, {Eigen::Vector3d::UnitZ(), -45.0, 150.0, 15.0}};
+  if (slew)
+    sc->motion.slews = {{Eigen::Vector3d::UnitX(), 30.0, 60.0, 20.0},
+                        {Eigen::Vector3d::UnitZ(), -45.0, 150.0, 15.0}};
   return *sc;
 }
 
@@ -98,19 +100,22 @@ Outcome run(const sim::Scenario& sc, std::uint64_t seed) {
 
 std::string summary(const Outcome& o) {
   char text[256];
-  std::snprintf(text, sizeof text,
-                "rejected %d (first %s at %.1f s), within 3 sigma %.4f, worst %.1f sigma, final error %.2f arcsec, "
-                "reinitialized %llu, state %s, nis %.2f",
-                o.rejected, fdi::to_string(o.first_why), o.first_rejected_s,
-                o.total ? static_cast<double>(o.within_3sigma) / o.total : 1.0, o.worst_ratio, o.final_error_arcsec,
-                static_cast<unsigned long long>(o.health.counters.reference_reinitialized),
-                fdi::to_string(o.health.reference_state), o.health.reference_nis);
+  std::snprintf(
+      text, sizeof text,
+      "rejected %d (first %s at %.1f s), within 3 sigma %.4f, worst %.1f sigma, final error %.2f arcsec, "
+      "reinitialized %llu, state %s, nis %.2f",
+      o.rejected, fdi::to_string(o.first_why), o.first_rejected_s,
+      o.total ? static_cast<double>(o.within_3sigma) / o.total : 1.0, o.worst_ratio, o.final_error_arcsec,
+      static_cast<unsigned long long>(o.health.counters.reference_reinitialized),
+      fdi::to_string(o.health.reference_state), o.health.reference_nis);
   std::string s = text;
   for (const auto& e : o.events) s += "\n  " + fdi::to_json(e, 4);
   return s;
 }
 
-double fraction(int within, int total) { return total ? static_cast<double>(within) / total : 1.0; }
+double fraction(int within, int total) {
+  return total ? static_cast<double>(within) / total : 1.0;
+}
 
 // Tolerances: 97 % within 3σ is the campaign's criterion (99.73 % for a consistent Gaussian error; the
 // sampled epochs of one run are correlated, so a run's fraction scatters around it); times are the simulated

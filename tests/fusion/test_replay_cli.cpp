@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -192,8 +192,9 @@ TEST(ReplayCli, MostEpochsRejectedIsAWarning) {
   const auto r = run_tetra("replay " + dir.file("log.csv") + " --calibration " + write_cal(dir) +
                            " --attitude " + dir.file("att.csv") + " --events " + dir.file("ev.jsonl"));
   ASSERT_EQ(r.exit_status, 0) << r.err;
-  EXPECT_NE(r.err.find("tetra replay: warning: 9 of 10 epochs rejected (9 time not increasing, 0 time outliers"),
-            std::string::npos)
+  EXPECT_NE(
+      r.err.find("tetra replay: warning: 9 of 10 epochs rejected (9 time not increasing, 0 time outliers"),
+      std::string::npos)
       << r.err;
 }
 
@@ -255,8 +256,8 @@ TEST(ReplayCli, BadInputIsExitTwoNamingFileAndLine) {
 TEST(ReplayCli, SeedExperimentFromTheCommandLine) {
   // The seed's experiment end to end: tetra sim turntable | tetra calibrate, then tetra sim lab-orbit |
   // tetra replay --latitude -23.2. The angle Σ wy·Δt over the run is ≈ 474° with the factory data sheet
-  // (measured 476.2°; ±3° covers what differs from the seed paper's figure: Earth rate and noise, well below a
-  // degree) and 360 ± 0.5° with the calibration `tetra calibrate` made from simulated turntable data of the
+  // (measured 476.2°; ±3° covers what differs from the seed paper's figure: Earth rate and noise, well below
+  // a degree) and 360 ± 0.5° with the calibration `tetra calibrate` made from simulated turntable data of the
   // same unit.
   TempDir dir;
   ASSERT_EQ(run_tetra("sim turntable -o " + dir.file("tt.csv")).exit_status, 0);

@@ -120,7 +120,8 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   auto fusion = std::make_unique<TetraProcess>(
       std::vector<std::string>{"fusion", "--config", dir.file("fusion.yaml"), "--domain", d},
       dir.file("fusion.log"));
-  TetraProcess ground({"ground", "--listen", "127.0.0.1:0", "--no-auth", "--domain", d}, dir.file("ground.log"));
+  TetraProcess ground({"ground", "--listen", "127.0.0.1:0", "--no-auth", "--domain", d},
+                      dir.file("ground.log"));
   const int port = ground_port(dir.file("ground.log"));
   ASSERT_GT(port, 0) << read_file(dir.file("ground.log"));
   // 40 s of orbit at 100 Hz, 4 times real time; gyro 2 stuck from 8 s (2 s of wall clock).
@@ -158,7 +159,8 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
 
   // Resuming after an id gives the messages after it, in order.
   const auto resumed = read_stream(
-      port, [](const std::vector<Sse>& ev) { return ev.size() >= 3; }, instance + std::to_string(last_id - 5), 10s);
+      port, [](const std::vector<Sse>& ev) { return ev.size() >= 3; }, instance + std::to_string(last_id - 5),
+      10s);
   ASSERT_GE(resumed.size(), 3U);
   EXPECT_EQ(resumed[0].id, last_id - 4);
   EXPECT_EQ(resumed[1].id, last_id - 3);
@@ -189,8 +191,7 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   // which cannot determine the rate: refused, through POST and from the command line (exit 1); with
   // force, obeyed (the unit goes LOST); the FDI reset is accepted; a malformed request is a 400.
   int status = 0;
-  json ack = post_command(
-      port, {{"unit", "tetra-1"}, {"action", "exclude"}, {"gyro", 1}}, status);
+  json ack = post_command(port, {{"unit", "tetra-1"}, {"action", "exclude"}, {"gyro", 1}}, status);
   ASSERT_EQ(status, 200) << ack.dump();
   EXPECT_FALSE(ack["accepted"].get<bool>()) << ack.dump();
   EXPECT_NE(ack["detail"].get<std::string>().find("refused"), std::string::npos) << ack.dump();

@@ -132,7 +132,8 @@ TEST(GroundHttp, SignInRolesAndCrossSiteDefences) {
   EXPECT_EQ(g.request("POST", "/api/login", kJson, R"({"user":"alice","password":"wrong"})").status, 401);
 
   const auto sign_in = [&](const std::string& user) {
-    const Reply r = g.request("POST", "/api/login", kJson, R"({"user":")" + user + R"(","password":"correct horse"})");
+    const Reply r =
+        g.request("POST", "/api/login", kJson, R"({"user":")" + user + R"(","password":"correct horse"})");
     EXPECT_EQ(r.status, 200) << r.body;
     const auto at = r.head.find("Set-Cookie: tetra_session=");
     EXPECT_NE(at, std::string::npos);
@@ -151,11 +152,16 @@ TEST(GroundHttp, SignInRolesAndCrossSiteDefences) {
   const std::string command = R"({"unit":"u","action":"reset"})";
   const std::string alice_token = "X-CSRF-Token: " + alice_csrf + "\r\n";
   // Forged requests as a cross-site page makes them: none reaches the unit.
-  EXPECT_EQ(g.request("POST", "/api/command", alice + "Content-Type: text/plain\r\n" + alice_token, command).status, 415);
+  EXPECT_EQ(
+      g.request("POST", "/api/command", alice + "Content-Type: text/plain\r\n" + alice_token, command).status,
+      415);
   EXPECT_EQ(g.request("POST", "/api/command", alice + kJson, command).status, 403);  // no token
-  EXPECT_EQ(g.request("POST", "/api/command", alice + kJson + "X-CSRF-Token: " + victor_csrf + "\r\n", command).status,
-            403);  // another session's token
-  EXPECT_EQ(g.request("POST", "/api/command", alice + kJson + alice_token + "Origin: http://evil.example\r\n", command)
+  EXPECT_EQ(
+      g.request("POST", "/api/command", alice + kJson + "X-CSRF-Token: " + victor_csrf + "\r\n", command)
+          .status,
+      403);  // another session's token
+  EXPECT_EQ(g.request("POST", "/api/command", alice + kJson + alice_token + "Origin: http://evil.example\r\n",
+                      command)
                 .status,
             403);
   // DNS rebinding: the right address under another name.
@@ -167,16 +173,19 @@ TEST(GroundHttp, SignInRolesAndCrossSiteDefences) {
     EXPECT_EQ(parse_reply(read_from(fd)).status, 403);
     ::close(fd);
   }
-  EXPECT_EQ(g.request("POST", "/api/command", victor + kJson + "X-CSRF-Token: " + victor_csrf + "\r\n", command).status,
-            403);  // a viewer
+  EXPECT_EQ(
+      g.request("POST", "/api/command", victor + kJson + "X-CSRF-Token: " + victor_csrf + "\r\n", command)
+          .status,
+      403);  // a viewer
   EXPECT_TRUE(g.sent.empty());
 
   // The commander's command, with the operator the session's user (a typed one is refused).
-  EXPECT_EQ(g.request("POST", "/api/command", alice + kJson + alice_token, R"({"unit":"u","action":"reset","operator":"eve"})")
+  EXPECT_EQ(g.request("POST", "/api/command", alice + kJson + alice_token,
+                      R"({"unit":"u","action":"reset","operator":"eve"})")
                 .status,
             400);
-  const Reply ok = g.request("POST", "/api/command", alice + kJson + alice_token + "Origin: http://" + g.host() + "\r\n",
-                             command);
+  const Reply ok = g.request("POST", "/api/command",
+                             alice + kJson + alice_token + "Origin: http://" + g.host() + "\r\n", command);
   ASSERT_EQ(ok.status, 200) << ok.body;
   ASSERT_EQ(g.sent.size(), 1U);
   EXPECT_EQ(g.sent[0].operator_id, "alice");
@@ -272,7 +281,8 @@ TEST(GroundHttp, ParametersBodiesStreamsAndSlowClientsAreBounded) {
 
   // A Last-Event-ID of another run (a restarted ground station): a reset and the current state.
   const int fd = connect_to(g.port());
-  const std::string req = "GET /api/stream HTTP/1.1\r\nHost: " + g.host() + "\r\nLast-Event-ID: 0badf00d-99999\r\n\r\n";
+  const std::string req =
+      "GET /api/stream HTTP/1.1\r\nHost: " + g.host() + "\r\nLast-Event-ID: 0badf00d-99999\r\n\r\n";
   (void)::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
   const std::string reset = read_from(fd, "event: link");
   EXPECT_NE(reset.find("event: reset"), std::string::npos) << reset;

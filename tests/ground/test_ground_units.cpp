@@ -13,8 +13,8 @@
 #include "tetra/ground/command_request.hpp"
 #include "tetra/ground/command_tracker.hpp"
 #include "tetra/ground/encode.hpp"
-#include "tetra/ground/link_state.hpp"
 #include "tetra/ground/http_api.hpp"
+#include "tetra/ground/link_state.hpp"
 #include "tetra/ground/operators.hpp"
 #include "tetra/ground/query_params.hpp"
 #include "tetra/ground/record_files.hpp"
@@ -221,7 +221,8 @@ TEST(CommandRequest, ValidatesEveryField) {
         R"({"unit":"u","action":"explode"})", R"({"unit":"u","action":"exclude"})",
         R"({"unit":"u","action":"exclude","gyro":99})", R"({"unit":"u","action":"exclude","gyro":"2"})",
         R"({"unit":"u","action":"reset","gyro":1})", R"({"unit":"u","action":"reset","force":"yes"})",
-        R"({"unit":"u","action":"reset","action":"exclude","gyro":1})", R"({"unit":"u","action":"reset","x":1})"}) {
+        R"({"unit":"u","action":"reset","action":"exclude","gyro":1})",
+        R"({"unit":"u","action":"reset","x":1})"}) {
     EXPECT_FALSE(parse_command_request(bad, "alice", "o").ok()) << bad;
   }
   EXPECT_NE(parse_command_request(R"({"unit":"u","action":"reset","action":"exclude","gyro":1})", "a", "o")
@@ -338,7 +339,8 @@ TEST(Operators, AccountsPasswordsSessionsAndRoles) {
   EXPECT_FALSE(again->session(token, 2000).has_value());
   // A role changed in the file applies to open sessions.
   ASSERT_TRUE(set_account(users, {"alice", Role::kViewer, *hash}).ok());
-  std::filesystem::last_write_time(users, std::filesystem::file_time_type::clock::now() + std::chrono::seconds(5));
+  std::filesystem::last_write_time(users,
+                                   std::filesystem::file_time_type::clock::now() + std::chrono::seconds(5));
   EXPECT_EQ(ops->session(token, 2000)->role, Role::kViewer);
   test::write_file(dir.file("broken"), "alice:admin:$argon2id$x\n");
   EXPECT_EQ(read_accounts(dir.file("broken")).error().message,

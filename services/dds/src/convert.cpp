@@ -165,9 +165,10 @@ HealthView from_wire(const tetra_Health& in) {
   h.cusum_threshold = in.cusum_threshold;
   h.fdi_available = in.fdi_available;
   const int reference_state = static_cast<int>(in.reference_state);
-  h.reference_state = reference_state >= 0 && reference_state <= static_cast<int>(fdi::ReferenceState::kRejected)
-                          ? static_cast<fdi::ReferenceState>(reference_state)
-                          : fdi::ReferenceState::kAbsent;
+  h.reference_state =
+      reference_state >= 0 && reference_state <= static_cast<int>(fdi::ReferenceState::kRejected)
+          ? static_cast<fdi::ReferenceState>(reference_state)
+          : fdi::ReferenceState::kAbsent;
   h.reference_nis = in.reference_nis;
   for (int i = 0; i < 3; ++i) h.protection_level_rad[i] = in.protection_level_rad[i];
   const tetra_SampleCounters& c = in.counters;
@@ -264,7 +265,8 @@ EventView from_wire(const tetra_FdiEvent& in) {
   e.type = from_wire(in.type);
   if (in.gyro > 0) e.gyro = in.gyro;
   e.test = fdi::detection_test_from_string(from_wire(in.test));
-  if (e.type == fdi::EventType::kReferenceRejected) e.why = fdi::reference_check_from_string(from_wire(in.test));
+  if (e.type == fdi::EventType::kReferenceRejected)
+    e.why = fdi::reference_check_from_string(from_wire(in.test));
   e.statistic = in.statistic;
   e.kind = from_wire(in.kind);
   e.evidence = fdi::evidence_from_string(from_wire(in.evidence));

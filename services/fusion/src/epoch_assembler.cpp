@@ -13,7 +13,8 @@ namespace {
 //! Serial-number difference a − b (modulo 2^64, RFC 1982) as a signed number: wrap-around safe.
 std::int64_t serial_difference(std::uint64_t a, std::uint64_t b) {
   const std::uint64_t d = a - b;
-  if (d <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) return static_cast<std::int64_t>(d);
+  if (d <= static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+    return static_cast<std::int64_t>(d);
   return -static_cast<std::int64_t>(~d) - 1;  // d − 2^64, without an out-of-range conversion
 }
 
@@ -33,7 +34,8 @@ Status validate(const AssemblerConfig& config) {
   if (config.clock_window_ns < 2 * config.nominal_period_ns || config.clock_window_ns > kStampLimit_ns) {
     return bad_input("assembler: clock_window_s must be at least 2 sample periods");
   }
-  if (!(config.speed >= 0.0 && config.speed <= 1000.0)) return bad_input("assembler: speed must be in [0, 1000]");
+  if (!(config.speed >= 0.0 && config.speed <= 1000.0))
+    return bad_input("assembler: speed must be in [0, 1000]");
   return ok_status();
 }
 
@@ -79,8 +81,8 @@ void EpochAssembler::observe(Clock& clock, std::int64_t stamp_ns, std::int64_t n
   }
 }
 
-bool EpochAssembler::on_clock(const Clock& clock, std::optional<std::int64_t> last_stamp_ns, std::int64_t stamp_ns,
-                              std::int64_t now_ns) const {
+bool EpochAssembler::on_clock(const Clock& clock, std::optional<std::int64_t> last_stamp_ns,
+                              std::int64_t stamp_ns, std::int64_t now_ns) const {
   if (lead_ns(clock, stamp_ns, now_ns) > static_cast<double>(config_.clock_window_ns)) return false;
   const std::int64_t max_lag_ns = config_.clock_window_ns + kMaxLagPeriods * config_.nominal_period_ns;
   if (clock.ref_stamp_ns && stamp_ns < *clock.ref_stamp_ns - max_lag_ns) return false;
@@ -97,7 +99,8 @@ void EpochAssembler::forget_time_base() {
 }
 
 bool EpochAssembler::confirm_new_clock(std::size_t index, std::int64_t stamp_ns, std::int64_t now_ns) {
-  const bool agrees = candidate_ && on_clock(*candidate_, candidate_->last_stamp_ns[index], stamp_ns, now_ns) &&
+  const bool agrees = candidate_ &&
+                      on_clock(*candidate_, candidate_->last_stamp_ns[index], stamp_ns, now_ns) &&
                       (!candidate_->last_stamp_ns[index] || stamp_ns > *candidate_->last_stamp_ns[index]);
   if (!agrees) {
     candidate_ = Clock{};
@@ -187,7 +190,8 @@ Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t 
     for (GyroTrack& g : gyros_) g.absent = false;
   }
   GyroTrack& track = gyros_[index];
-  if (!on_clock(clock_, track.last_stamp_ns, stamp_ns, now_ns) && !confirm_new_clock(index, stamp_ns, now_ns)) {
+  if (!on_clock(clock_, track.last_stamp_ns, stamp_ns, now_ns) &&
+      !confirm_new_clock(index, stamp_ns, now_ns)) {
     return Verdict::kTimeOutlier;
   }
   if (const Verdict verdict = check_seq(track, seq, stamp_ns); verdict != Verdict::kAccepted) return verdict;

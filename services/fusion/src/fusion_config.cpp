@@ -58,11 +58,11 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
   if (!root.IsMap()) return bad_input(source + ": expected a YAML map of settings");
   FusionConfig config;
   config.source = source;
-  if (auto keys =
-          reader.check_keys(root,
-                            {"unit", "calibration", "sample_rate_hz", "speed", "tolerance_s", "max_latency_s",
-                             "clock_window_s", "health_period_s", "gyro_dispatch", "pipeline", "security", "ros2"},
-                            "");
+  if (auto keys = reader.check_keys(
+          root,
+          {"unit", "calibration", "sample_rate_hz", "speed", "tolerance_s", "max_latency_s", "clock_window_s",
+           "health_period_s", "gyro_dispatch", "pipeline", "security", "ros2"},
+          "");
       !keys) {
     return keys.error();
   }
@@ -72,7 +72,8 @@ Result<FusionConfig> parse_fusion_config(const std::string& yaml_text, const std
     if (key == "unit" || key == "calibration") {
       if (!value.IsScalar()) return bad_input(reader.at(value) + key + " must be text");
       if (key == "unit") {
-        if (auto status = check_unit_name(value.Scalar(), reader.at(value) + "unit"); !status) return status.error();
+        if (auto status = check_unit_name(value.Scalar(), reader.at(value) + "unit"); !status)
+          return status.error();
       }
       (key == "unit" ? config.unit : config.calibration_path) = value.Scalar();
     } else if (key == "gyro_dispatch") {
@@ -133,14 +134,16 @@ Status validate(const FusionConfig& config) {
   // Before the assembler's settings are converted to integer nanoseconds.
   const double period_s = 1.0 / config.sample_rate_hz;
   if (config.tolerance_s && !(*config.tolerance_s >= 0.0 && *config.tolerance_s < period_s / 2)) {
-    return bad_input(s + ": tolerance_s must be in [0, period/2) = [0, " + std::to_string(period_s / 2) + ")");
+    return bad_input(s + ": tolerance_s must be in [0, period/2) = [0, " + std::to_string(period_s / 2) +
+                     ")");
   }
   if (!(config.max_latency_s > 0.0 && config.max_latency_s <= 60.0)) {
     return bad_input(s + ": max_latency_s must be in (0, 60]");
   }
-  if (config.clock_window_s && !(*config.clock_window_s >= 2 * period_s && *config.clock_window_s <= 3600.0)) {
-    return bad_input(s + ": clock_window_s must be in [2 sample periods, 3600] = [" + std::to_string(2 * period_s) +
-                     ", 3600]");
+  if (config.clock_window_s &&
+      !(*config.clock_window_s >= 2 * period_s && *config.clock_window_s <= 3600.0)) {
+    return bad_input(s + ": clock_window_s must be in [2 sample periods, 3600] = [" +
+                     std::to_string(2 * period_s) + ", 3600]");
   }
   if (auto status = validate(config.assembler(config.calibration.gyro_count())); !status) {
     return bad_input(s + ": " + status.error().message);
@@ -161,7 +164,8 @@ std::string describe(const FusionConfig& config) {
       << '\n'
       << "max_latency_s: " << config.max_latency_s << '\n'
       << "clock_window_s: "
-      << (config.clock_window_s ? *config.clock_window_s : default_clock_window_s(config.sample_rate_hz)) << '\n'
+      << (config.clock_window_s ? *config.clock_window_s : default_clock_window_s(config.sample_rate_hz))
+      << '\n'
       << "health_period_s: " << config.health_period_s << '\n'
       << "gyro_dispatch: " << (config.gyro_dispatch == GyroDispatch::kListener ? "listener" : "waitset")
       << '\n'

@@ -258,8 +258,9 @@ Status FusionService::take_gyro_samples(std::int64_t now_ns) {
   if (was_silent && !assembler_.all_absent()) resumed_ns_ = now_ns;  // deadlines re-armed from now
   if (assembler_.counters().sensor_restarts != last_restarts_) {
     last_restarts_ = assembler_.counters().sensor_restarts;
-    spdlog::warn("fusion: sensor time restarted (after silence, or every gyro moved to a new time base): "
-                 "pipeline reset");
+    spdlog::warn(
+        "fusion: sensor time restarted (after silence, or every gyro moved to a new time base): "
+        "pipeline reset");
     pipeline_.reset();
   }
   return ok_status();
@@ -332,8 +333,8 @@ Status FusionService::report_silence(std::int64_t now_ns) {
     ++unit_silences_;
   }
   if (!silent) all_silent_ = false;
-  const bool report_lost = all_silent_ && !lost_reported_ &&
-                           now_ns - silent_since_ns_ >= seconds_to_ns(kMinOutageReported_s);
+  const bool report_lost =
+      all_silent_ && !lost_reported_ && now_ns - silent_since_ns_ >= seconds_to_ns(kMinOutageReported_s);
   const bool report_cleared = !all_silent_ && lost_reported_;
   if (!report_lost && !report_cleared) return ok_status();
   lost_reported_ = report_lost;

@@ -101,18 +101,20 @@ Status GroundServer::start() {
   if (!config_.no_auth) {
     if (config_.users_path.empty())
       return bad_input("--users FILE (made by `tetra ground passwd`) or, on loopback only, --no-auth");
-    const std::string key = config_.session_key_path.empty() ? config_.users_path + ".session-key"
-                                                             : config_.session_key_path;
+    const std::string key =
+        config_.session_key_path.empty() ? config_.users_path + ".session-key" : config_.session_key_path;
     auto ops = Operators::open(config_.users_path, key);
     if (!ops) return ops.error();
     operators_.emplace(std::move(ops).value());
   }
   if (config_.tls.cert.empty() != config_.tls.key.empty())
     return bad_input("--tls-cert and --tls-key go together");
-  if (!files_.mount("/", config_.web_dir)) return bad_input("--web " + config_.web_dir + ": no such directory");
+  if (!files_.mount("/", config_.web_dir))
+    return bad_input("--web " + config_.web_dir + ": no such directory");
   const std::filesystem::path openmct = std::filesystem::path(config_.web_dir) / "node_modules/openmct/dist";
   if (!files_.mount("/openmct/", openmct.string()))
-    return failure(openmct.string() + " missing: run `npm ci` in " + config_.web_dir + " (scripts/setup.sh does)");
+    return failure(openmct.string() + " missing: run `npm ci` in " + config_.web_dir +
+                   " (scripts/setup.sh does)");
   instance_ = random_hex(4);
   no_auth_csrf_ = random_hex(32);
   StreamFeed feed{[this](std::uint64_t after, std::string& out) { return feed_next(after, out); },
@@ -121,8 +123,10 @@ Status GroundServer::start() {
                                          config_.limits);
   if (auto s = server_->start(config_.host, config_.port, config_.tls); !s) return s;
   const std::string port = ":" + std::to_string(server_->port());
-  for (const std::string& h : {config_.host, std::string("localhost"), std::string("127.0.0.1"), std::string("[::1]")})
-    allowed_hosts_.insert(lower_case(h.find(':') != std::string::npos && h[0] != '[' ? "[" + h + "]" : h) + port);
+  for (const std::string& h :
+       {config_.host, std::string("localhost"), std::string("127.0.0.1"), std::string("[::1]")})
+    allowed_hosts_.insert(lower_case(h.find(':') != std::string::npos && h[0] != '[' ? "[" + h + "]" : h) +
+                          port);
   for (const auto& extra : config_.allow_origins)
     allowed_hosts_.insert(with_port(host_port_of(extra), !config_.tls.cert.empty()));
   store_.set_listener([server = server_.get()] { server->notify(); });
@@ -183,7 +187,8 @@ HttpResponse GroundServer::handle(const HttpRequest& req) {
   if (req.method == "POST" && !is_json_type(req.header("content-type")))
     return refuse(req, 415, "a POST must be application/json", "");
   if (req.method == "POST" && req.path == "/api/login") return login(req);
-  if (req.method == "GET" && (req.path == "/login.html" || req.path == "/login.js" || req.path == "/tetra.css"))
+  if (req.method == "GET" &&
+      (req.path == "/login.html" || req.path == "/login.js" || req.path == "/tetra.css"))
     return serve(req, std::nullopt);
   const auto session = session_of(req);
   if (!session) {
@@ -205,7 +210,8 @@ HttpResponse GroundServer::serve(const HttpRequest& req, const std::optional<Ses
     if (req.path == "/api/logout") {
       if (operators_) operators_->revoke(cookie_value(req.header("cookie"), kCookie));
       auto res = json_reply(200, {{"signed_out", session->user}});
-      res.headers.emplace_back("Set-Cookie", std::string(kCookie) + "=; Path=/; Max-Age=0; HttpOnly; SameSite=Strict");
+      res.headers.emplace_back("Set-Cookie",
+                               std::string(kCookie) + "=; Path=/; Max-Age=0; HttpOnly; SameSite=Strict");
       return res;
     }
     return error_reply(404, "no such request");
@@ -253,13 +259,13 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
   if (!account) return refuse(req, 401, "user or password wrong", valid_user_name(user) ? user : "?");
   const auto lifetime = static_cast<std::int64_t>(config_.session_lifetime_s);
   const std::string token = operators_->issue(account->user, utc_now_s(), lifetime);
-  spdlog::info("ground audit: {} ({}) signed in from {}", account->user, to_string(account->role), req.remote_addr);
-  auto res = json_reply(200, {{"user", account->user},
-                              {"role", to_string(account->role)},
-                              {"csrf", operators_->csrf(token)}});
-  res.headers.emplace_back("Set-Cookie", std::string(kCookie) + "=" + token + "; Path=/; Max-Age=" +
-                                             std::to_string(lifetime) + "; HttpOnly; SameSite=Strict" +
-                                             (req.tls ? "; Secure" : ""));
+  spdlog::info("ground audit: {} ({}) signed in from {}", account->user, to_string(account->role),
+               req.remote_addr);
+  auto res = json_reply(
+      200, {{"user", account->user}, {"role", to_string(account->role)}, {"csrf", operators_->csrf(token)}});
+  res.headers.emplace_back("Set-Cookie", std::string(kCookie) + "=" + token +
+                                             "; Path=/; Max-Age=" + std::to_string(lifetime) +
+                                             "; HttpOnly; SameSite=Strict" + (req.tls ? "; Secure" : ""));
   return res;
 }
 
@@ -303,7 +309,8 @@ HttpResponse GroundServer::stream(const HttpRequest& req) {
   std::uint64_t after = 0;
   bool resume = false;
   const std::string prefix = instance_ + "-";
-  if (last.compare(0, prefix.size(), prefix) == 0 && last.size() > prefix.size() && last.size() < prefix.size() + 20 &&
+  if (last.compare(0, prefix.size(), prefix) == 0 && last.size() > prefix.size() &&
+      last.size() < prefix.size() + 20 &&
       last.find_first_not_of("0123456789", prefix.size()) == std::string::npos) {
     after = std::stoull(last.substr(prefix.size()));
     resume = after <= newest && newest - after <= kMaxCatchUp &&
@@ -324,7 +331,8 @@ HttpResponse GroundServer::history(const HttpRequest& req) {
   const auto start = q->number("start", 0);
   const auto end = q->number("end", 1e300);
   const auto max = q->count("max", 5000, 1, 100000);
-  for (const Error* e : {start ? nullptr : &start.error(), end ? nullptr : &end.error(), max ? nullptr : &max.error()}) {
+  for (const Error* e :
+       {start ? nullptr : &start.error(), end ? nullptr : &end.error(), max ? nullptr : &max.error()}) {
     if (e != nullptr) return error_reply(400, e->message);
   }
   if (!q->has("unit")) return error_reply(400, "parameter 'unit' missing");
@@ -345,7 +353,8 @@ HttpResponse GroundServer::records(const HttpRequest& req) {
   const auto start = q->number("start", -1e300);
   const auto end = q->number("end", 1e300);
   const auto max = q->count("max", 5000, 1, 100000);
-  for (const Error* e : {start ? nullptr : &start.error(), end ? nullptr : &end.error(), max ? nullptr : &max.error()}) {
+  for (const Error* e :
+       {start ? nullptr : &start.error(), end ? nullptr : &end.error(), max ? nullptr : &max.error()}) {
     if (e != nullptr) return error_reply(400, e->message);
   }
   auto r = read_record(config_.records_dir, q->text("file"), *start, *end, *max);

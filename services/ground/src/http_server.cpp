@@ -38,26 +38,44 @@ std::int64_t io_now_ns() {
       .count();
 }
 
-std::int64_t to_ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
+std::int64_t to_ns(double s) {
+  return static_cast<std::int64_t>(s * 1e9);
+}
 
 const char* reason_phrase(int status) {
   switch (status) {
-    case 200: return "OK";
-    case 302: return "Found";
-    case 400: return "Bad Request";
-    case 401: return "Unauthorized";
-    case 403: return "Forbidden";
-    case 404: return "Not Found";
-    case 405: return "Method Not Allowed";
-    case 408: return "Request Timeout";
-    case 413: return "Payload Too Large";
-    case 415: return "Unsupported Media Type";
-    case 431: return "Request Header Fields Too Large";
-    case 500: return "Internal Server Error";
-    case 501: return "Not Implemented";
-    case 503: return "Service Unavailable";
-    case 504: return "Gateway Timeout";
-    default: return "Status";
+    case 200:
+      return "OK";
+    case 302:
+      return "Found";
+    case 400:
+      return "Bad Request";
+    case 401:
+      return "Unauthorized";
+    case 403:
+      return "Forbidden";
+    case 404:
+      return "Not Found";
+    case 405:
+      return "Method Not Allowed";
+    case 408:
+      return "Request Timeout";
+    case 413:
+      return "Payload Too Large";
+    case 415:
+      return "Unsupported Media Type";
+    case 431:
+      return "Request Header Fields Too Large";
+    case 500:
+      return "Internal Server Error";
+    case 501:
+      return "Not Implemented";
+    case 503:
+      return "Service Unavailable";
+    case 504:
+      return "Gateway Timeout";
+    default:
+      return "Status";
   }
 }
 
@@ -80,7 +98,9 @@ bool url_decode(const std::string& in, bool plus_is_space, std::string& out) {
     if (ch == '%') {
       if (i + 2 >= in.size()) return false;
       const auto hex = [](char h) {
-        return h >= '0' && h <= '9' ? h - '0' : (h >= 'a' && h <= 'f' ? h - 'a' + 10 : (h >= 'A' && h <= 'F' ? h - 'A' + 10 : -1));
+        return h >= '0' && h <= '9'
+                   ? h - '0'
+                   : (h >= 'a' && h <= 'f' ? h - 'a' + 10 : (h >= 'A' && h <= 'F' ? h - 'A' + 10 : -1));
       };
       const int hi = hex(in[i + 1]);
       const int lo = hex(in[i + 2]);
@@ -110,7 +130,8 @@ Result<HttpRequest> parse_head(const std::string& head, std::string& version) {
   if (version != "HTTP/1.1" && version != "HTTP/1.0") return bad_input("HTTP/1.0 or HTTP/1.1 only");
   if (target.empty() || target[0] != '/') return bad_input("the request target must be a path");
   const auto q = target.find('?');
-  if (!url_decode(target.substr(0, q), false, req.path)) return bad_input("path: bad percent-encoding or NUL");
+  if (!url_decode(target.substr(0, q), false, req.path))
+    return bad_input("path: bad percent-encoding or NUL");
   if (q != std::string::npos) {
     std::size_t start = q + 1;
     while (start <= target.size()) {
@@ -140,8 +161,8 @@ Result<HttpRequest> parse_head(const std::string& head, std::string& version) {
     const std::string value = trimmed(h.substr(colon + 1));
     auto [it, fresh] = req.headers.emplace(name, value);
     if (!fresh) {
-      static const std::unordered_set<std::string> single{"host", "content-length", "content-type", "origin",
-                                                          "x-csrf-token", "cookie", "transfer-encoding"};
+      static const std::unordered_set<std::string> single{
+          "host", "content-length", "content-type", "origin", "x-csrf-token", "cookie", "transfer-encoding"};
       if (single.count(name) != 0) return bad_input("header '" + name + "' given twice");
       it->second += ", " + value;
     }
@@ -294,7 +315,8 @@ struct HttpServer::Impl {
     for (;;) {
       sockaddr_storage addr{};
       socklen_t len = sizeof addr;
-      const int fd = ::accept4(listen_fd, reinterpret_cast<sockaddr*>(&addr), &len, SOCK_NONBLOCK | SOCK_CLOEXEC);
+      const int fd =
+          ::accept4(listen_fd, reinterpret_cast<sockaddr*>(&addr), &len, SOCK_NONBLOCK | SOCK_CLOEXEC);
       if (fd < 0) return;
       if (conns.size() >= limits.max_connections) {
         ::close(fd);
@@ -406,8 +428,9 @@ struct HttpServer::Impl {
         res.body = "{\"error\":\"too many event streams open\"}";
         keep_alive = false;
       } else {
-        std::string head = "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\n"
-                           "X-Accel-Buffering: no\r\n";
+        std::string head =
+            "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\n"
+            "X-Accel-Buffering: no\r\n";
         add_common_headers(head);
         for (const auto& [k, v] : res.headers) head += k + ": " + v + "\r\n";
         head += "\r\n";
@@ -639,7 +662,8 @@ struct HttpServer::Impl {
   }
 };
 
-HttpServer::HttpServer(Handler handler, StreamFeed feed, HttpLimits limits) : impl_(std::make_unique<Impl>()) {
+HttpServer::HttpServer(Handler handler, StreamFeed feed, HttpLimits limits)
+    : impl_(std::make_unique<Impl>()) {
   impl_->handler = std::move(handler);
   impl_->feed = std::move(feed);
   impl_->limits = limits;

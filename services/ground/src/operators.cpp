@@ -36,8 +36,8 @@ Status write_private(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".new" + std::to_string(::getpid());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) return failure(path + ": cannot write (" + tmp + ")");
-  const bool written = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) &&
-                       ::fsync(fd) == 0;
+  const bool written =
+      ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) && ::fsync(fd) == 0;
   ::close(fd);
   if (!written || ::rename(tmp.c_str(), path.c_str()) != 0) {
     ::unlink(tmp.c_str());
@@ -195,7 +195,8 @@ std::optional<Account> Operators::login(const std::string& user, const std::stri
     }
   }
   const std::string& hash = account ? account->hash : dummy_hash_;
-  const bool match = !hash.empty() && crypto_pwhash_str_verify(hash.c_str(), password.data(), password.size()) == 0;
+  const bool match =
+      !hash.empty() && crypto_pwhash_str_verify(hash.c_str(), password.data(), password.size()) == 0;
   return account && match ? account : std::nullopt;
 }
 

@@ -114,8 +114,8 @@ Result<json> read_record(const std::string& dir, const std::string& name, double
   const fs::path path = fs::path(dir) / name;
   const auto ext = path.extension();
   std::error_code ec;
-  if (name.empty() || name.size() > 255 || name.find('/') != std::string::npos || name.find('\0') != std::string::npos ||
-      name[0] == '.' || (ext != ".csv" && ext != ".jsonl"))
+  if (name.empty() || name.size() > 255 || name.find('/') != std::string::npos ||
+      name.find('\0') != std::string::npos || name[0] == '.' || (ext != ".csv" && ext != ".jsonl"))
     return bad_input("record file '" + name + "': a plain .csv or .jsonl file name of the records folder");
   // Never a link (it may lead out of the folder): the file itself must be a regular file.
   if (!fs::is_regular_file(fs::symlink_status(path, ec)))

@@ -12,13 +12,18 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string content_type_of(const fs::path& path) {
-  static const std::map<std::string, std::string> types{
-      {".html", "text/html; charset=utf-8"}, {".js", "text/javascript; charset=utf-8"},
-      {".css", "text/css; charset=utf-8"},   {".json", "application/json"},
-      {".map", "application/json"},          {".png", "image/png"},
-      {".svg", "image/svg+xml"},             {".ico", "image/x-icon"},
-      {".woff", "font/woff"},                {".woff2", "font/woff2"},
-      {".ttf", "font/ttf"},                  {".txt", "text/plain; charset=utf-8"}};
+  static const std::map<std::string, std::string> types{{".html", "text/html; charset=utf-8"},
+                                                        {".js", "text/javascript; charset=utf-8"},
+                                                        {".css", "text/css; charset=utf-8"},
+                                                        {".json", "application/json"},
+                                                        {".map", "application/json"},
+                                                        {".png", "image/png"},
+                                                        {".svg", "image/svg+xml"},
+                                                        {".ico", "image/x-icon"},
+                                                        {".woff", "font/woff"},
+                                                        {".woff2", "font/woff2"},
+                                                        {".ttf", "font/ttf"},
+                                                        {".txt", "text/plain; charset=utf-8"}};
   const auto it = types.find(path.extension().string());
   return it == types.end() ? "application/octet-stream" : it->second;
 }

@@ -92,7 +92,8 @@ struct PipelineConfig {
 
   // --- calibration uncertainty (docs/fdi.md, "Calibration uncertainty")
   //! [-] multiple of the calibration file's stated 1σ (scale factors, axes) the parity tests tolerate: an
-  //! error of every scale factor and axis component within this many σ never raises the parity beyond its noise
+  //! error of every scale factor and axis component within this many σ never raises the parity beyond its
+  //! noise
   double calibration_error_sigmas = 3.0;
 };
 

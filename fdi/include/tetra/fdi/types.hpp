@@ -130,8 +130,8 @@ struct FdiEvent {
   GyroMask gyros = 0;  //!< reconfigured / cleared / lost / command: the gyros used from now on
   std::optional<CommandVerb> command;              //!< command: the verb acknowledged
   CommandOutcome outcome = CommandOutcome::kDone;  //!< command: its outcome
-  ReferenceCheck why = ReferenceCheck::kNone;      //!< reference_rejected (and a `reference` detection): the test
-  std::string detail;  //!< free text: e.g. the command acknowledged and its outcome
+  ReferenceCheck why = ReferenceCheck::kNone;  //!< reference_rejected (and a `reference` detection): the test
+  std::string detail;                          //!< free text: e.g. the command acknowledged and its outcome
 
   //! command: refused (the outcome says why); nothing changed.
   bool refused() const { return type == EventType::kCommand && outcome != CommandOutcome::kDone; }
@@ -153,15 +153,16 @@ struct GyroHealth {
 struct Counters {
   std::uint64_t epochs_accepted = 0;
   std::uint64_t epochs_rejected_time = 0;  //!< time not increasing (duplicate, backward, out of order)
-  //! epochs stamped far from the stream's time (beyond 1000 sample periods; docs/fdi.md, "Per epoch"): dropped
+  //! epochs stamped far from the stream's time (beyond 1000 sample periods; docs/fdi.md, "Per epoch"):
+  //! dropped
   std::uint64_t epochs_time_outlier = 0;
   std::uint64_t samples_accepted = 0;
-  std::uint64_t samples_invalid = 0;          //!< NaN, Inf or out of range
-  std::uint64_t samples_absent = 0;           //!< no sample delivered
-  std::uint64_t epochs_rejected_shape = 0;    //!< epoch with a sample count other than N
-  std::uint64_t samples_outlier = 0;          //!< valid samples left out for one epoch (spike or onset)
-  std::uint64_t spikes = 0;                   //!< confirmed one-epoch spikes (outliers that went away)
-  std::uint64_t reference_accepted = 0;       //!< reference samples the attitude filter used
+  std::uint64_t samples_invalid = 0;        //!< NaN, Inf or out of range
+  std::uint64_t samples_absent = 0;         //!< no sample delivered
+  std::uint64_t epochs_rejected_shape = 0;  //!< epoch with a sample count other than N
+  std::uint64_t samples_outlier = 0;        //!< valid samples left out for one epoch (spike or onset)
+  std::uint64_t spikes = 0;                 //!< confirmed one-epoch spikes (outliers that went away)
+  std::uint64_t reference_accepted = 0;     //!< reference samples the attitude filter used
   std::uint64_t reference_rejected = 0;  //!< reference samples its χ² gate rejected or left out (rejected)
   std::uint64_t reference_reinitialized = 0;  //!< times a run of rejections set the attitude again
   std::uint64_t reference_invalid = 0;  //!< reference samples left out: not finite or norm not 1 within 1e-3
@@ -201,7 +202,8 @@ struct AttitudeEstimate {
   std::vector<double> gyro_bias_rad_s;  //!< [rad/s] size N: the filter's estimate of each gyro's bias
   bool fdi_available = true;            //!< as Health::fdi_available: false = a new fault would go unseen
   //! [rad] per body axis: the error a single-gyro fault below the detection threshold can have caused since
-  //! the last reference sample used (or the start), plus σ at integrity_risk; +∞ without parity (no integrity)
+  //! the last reference sample used (or the start), plus σ at integrity_risk; +∞ without parity (no
+  //! integrity)
   Eigen::Vector3d protection_level_rad = Eigen::Vector3d::Zero();
 };
 

@@ -59,15 +59,16 @@ struct AssemblerConfig {
   std::int64_t nominal_period_ns = 10'000'000;  //!< [ns] expected sample period (100 Hz)
   std::int64_t tolerance_ns = 1'000'000;        //!< [ns] stamps this close belong to one epoch; < period / 2
   std::int64_t max_latency_ns = 20'000'000;     //!< [ns] longest local wait for an epoch's missing samples
-  std::int64_t clock_window_ns = 100'000'000;   //!< [ns] how far a stamp may lead the unit's clock; >= 2 periods
+  std::int64_t clock_window_ns =
+      100'000'000;     //!< [ns] how far a stamp may lead the unit's clock; >= 2 periods
   double speed = 1.0;  //!< [-] sensor ns per local ns (a simulator X times real time: X); 0: the receive
                        //!< clock is not used (the unit's newest stamp is its clock)
 };
 
 constexpr std::int64_t kStampLimit_ns = std::int64_t{1} << 61;  //!< [ns] |stamp| beyond: outlier (73 years)
 constexpr std::int64_t kMaxLagPeriods = 128;  //!< twice the gyro reader's history (64 samples)
-constexpr int kRestartSamples = 3;      //!< agreeing outliers per gyro that re-anchor the clock
-constexpr std::uint64_t kSeqSlack = 16;  //!< sequence numbers a gap may skip beyond 2 per period
+constexpr int kRestartSamples = 3;            //!< agreeing outliers per gyro that re-anchor the clock
+constexpr std::uint64_t kSeqSlack = 16;       //!< sequence numbers a gap may skip beyond 2 per period
 
 //! Validates: N in 1..32, period > 0, 0 ≤ tolerance < period / 2, latency > 0, clock window ≥ 2 periods,
 //! speed in [0, 1000]; errors name the field.
@@ -123,10 +124,11 @@ class EpochAssembler {
     std::optional<std::int64_t> last_stamp_ns;  //!< [ns] latest accepted stamp
     bool absent = false;
   };
-  //! A clock: the newest stamp seen on it and its local arrival time, and per gyro the newest stamp. The unit's clock, and the candidate clock a run of outliers builds.
+  //! A clock: the newest stamp seen on it and its local arrival time, and per gyro the newest stamp. The
+  //! unit's clock, and the candidate clock a run of outliers builds.
   struct Clock {
-    std::optional<std::int64_t> ref_stamp_ns;  //!< [ns] the newest stamp
-    std::int64_t ref_local_ns = 0;             //!< [ns] local time it arrived
+    std::optional<std::int64_t> ref_stamp_ns;                //!< [ns] the newest stamp
+    std::int64_t ref_local_ns = 0;                           //!< [ns] local time it arrived
     std::vector<std::optional<std::int64_t>> last_stamp_ns;  //!< [ns] per gyro (candidate only)
     std::vector<int> samples;                                //!< per gyro (candidate only)
   };

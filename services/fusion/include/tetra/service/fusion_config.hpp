@@ -34,11 +34,11 @@ struct FusionConfig {
   double speed = 1.0;  //!< [-] sensor seconds per wall-clock second: 1 for a real sensor, X for a simulator X
                        //!< times faster
   std::optional<double>
-      tolerance_s;               //!< [s] stamps this close belong to one epoch (< period/2); default period/4
-  double max_latency_s = 0.02;   //!< [s] longest wait for an epoch's missing samples
+      tolerance_s;              //!< [s] stamps this close belong to one epoch (< period/2); default period/4
+  double max_latency_s = 0.02;  //!< [s] longest wait for an epoch's missing samples
   std::optional<double> clock_window_s;  //!< [s] how far a stamp may lead the unit's clock; default
                                          //!< kDefaultClockWindow_s or 4 periods, the larger
-  double health_period_s = 0.5;  //!< [s] Health at least this often (and on every change)
+  double health_period_s = 0.5;          //!< [s] Health at least this often (and on every change)
   GyroDispatch gyro_dispatch = GyroDispatch::kListener;  //!< `gyro_dispatch: listener | waitset`
   fdi::PipelineConfig pipeline;                          //!< the `pipeline:` map
   Calibration calibration;                               //!< read from calibration_path

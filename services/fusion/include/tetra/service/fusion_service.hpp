@@ -109,11 +109,11 @@ class FusionService {
   std::uint64_t event_seq_ = 0;
   std::uint32_t gyro_writers_ = 0;  //!< matched GyroSample writers (published in Health)
   std::uint64_t last_restarts_ = 0;
-  bool all_silent_ = false;     //!< every gyro absent since silent_since_ns_ (after a first epoch)
-  bool lost_reported_ = false;  //!< the silence lasted kMinOutageReported_s: a `lost` event went out
+  bool all_silent_ = false;           //!< every gyro absent since silent_since_ns_ (after a first epoch)
+  bool lost_reported_ = false;        //!< the silence lasted kMinOutageReported_s: a `lost` event went out
   std::int64_t silent_since_ns_ = 0;  //!< [ns] local monotonic time
   std::uint64_t unit_silences_ = 0;   //!< outages of every gyro, in Health's counters
-  bool fused_any_ = false;   //!< an epoch has been fused (commands are stamped with its time)
+  bool fused_any_ = false;            //!< an epoch has been fused (commands are stamped with its time)
   std::vector<fdi::Epoch> epochs_;
   std::int64_t scheduled_wake_ns_ = 0;   //!< [ns] when the waitset thread wakes by itself next
   std::optional<Error> listener_error_;  //!< a failure inside the listener, for run() to return

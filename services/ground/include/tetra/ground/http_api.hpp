@@ -31,12 +31,12 @@ using SendCommand = std::function<Result<dds::EventView>(const CommandRequest&)>
 
 struct ServerConfig {
   std::string host = "127.0.0.1";
-  int port = 8080;            //!< 0: any free port (see GroundServer::port())
-  std::string web_dir;        //!< the web application (index.html, tetra-plugin.js, node_modules/openmct)
-  std::string records_dir;    //!< `tetra record` files served by /api/records ("": none)
-  std::string users_path;     //!< operator accounts (tetra ground passwd); "" only with no_auth
+  int port = 8080;               //!< 0: any free port (see GroundServer::port())
+  std::string web_dir;           //!< the web application (index.html, tetra-plugin.js, node_modules/openmct)
+  std::string records_dir;       //!< `tetra record` files served by /api/records ("": none)
+  std::string users_path;        //!< operator accounts (tetra ground passwd); "" only with no_auth
   std::string session_key_path;  //!< the key sessions are signed with (created when absent)
-  bool no_auth = false;       //!< no accounts: everyone who reaches the port is commander "anonymous"
+  bool no_auth = false;          //!< no accounts: everyone who reaches the port is commander "anonymous"
   std::vector<std::string> allow_origins;  //!< more HOST:PORT a browser may reach the ground as
   TlsFiles tls;
   HttpLimits limits;
@@ -81,7 +81,7 @@ class GroundServer {
   std::set<std::string> allowed_hosts_;  //!< "host:port", lower case
   std::string instance_;                 //!< this run's prefix of every event id
   std::string no_auth_csrf_;
-  std::mutex login_mutex_;               //!< one password check at a time (64 MiB each)
+  std::mutex login_mutex_;  //!< one password check at a time (64 MiB each)
   std::atomic<int> commands_waiting_{0};
 };
 

@@ -21,9 +21,9 @@ namespace tetra::ground {
 
 struct HttpRequest {
   std::string method;
-  std::string path;  //!< decoded, without the query
+  std::string path;                                         //!< decoded, without the query
   std::vector<std::pair<std::string, std::string>> params;  //!< decoded query parameters, in order
-  std::map<std::string, std::string> headers;                //!< names in lower case
+  std::map<std::string, std::string> headers;               //!< names in lower case
   std::string body;
   std::string remote_addr;
   bool tls = false;
@@ -52,17 +52,17 @@ struct StreamFeed {
 };
 
 struct HttpLimits {
-  std::size_t max_connections = 4096;   //!< beyond: accepted and closed at once
-  std::size_t max_streams = 1024;       //!< event streams held; beyond: 503 (logged)
-  std::size_t max_head_bytes = 16384;   //!< request line and headers; beyond: 431
-  std::size_t max_body_bytes = 65536;   //!< request body; beyond: 413
+  std::size_t max_connections = 4096;            //!< beyond: accepted and closed at once
+  std::size_t max_streams = 1024;                //!< event streams held; beyond: 503 (logged)
+  std::size_t max_head_bytes = 16384;            //!< request line and headers; beyond: 431
+  std::size_t max_body_bytes = 65536;            //!< request body; beyond: 413
   std::size_t stream_buffer_bytes = 256U << 10;  //!< per stream not yet written; beyond: the stream is closed
-  std::size_t max_queued = 256;         //!< requests waiting for a worker; beyond: 503
-  int workers = 4;                      //!< handler threads
-  double request_timeout_s = 10.0;      //!< [s] a request must arrive whole within this
-  double idle_timeout_s = 30.0;         //!< [s] a kept-alive connection with no request is closed
-  double write_timeout_s = 10.0;        //!< [s] a response (or a stream) making no progress is closed
-  double keepalive_s = 1.0;             //!< [s] a comment line on a quiet stream at least this often
+  std::size_t max_queued = 256;                  //!< requests waiting for a worker; beyond: 503
+  int workers = 4;                               //!< handler threads
+  double request_timeout_s = 10.0;               //!< [s] a request must arrive whole within this
+  double idle_timeout_s = 30.0;                  //!< [s] a kept-alive connection with no request is closed
+  double write_timeout_s = 10.0;  //!< [s] a response (or a stream) making no progress is closed
+  double keepalive_s = 1.0;       //!< [s] a comment line on a quiet stream at least this often
 };
 
 struct TlsFiles {
