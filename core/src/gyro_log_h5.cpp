@@ -223,62 +223,40 @@ constexpr hsize_t kMaxChunkBytes = hsize_t{256} << 20;
 // its stored bytes (plus one chunk), so a small file never stands for gigabytes of rows.
 constexpr hsize_t kMaxDeflateRatio = 1100;
 
-// The storage of dataset `id` (`rows`×`cols` elements of `type`) checked against the file's size
-// before anything is read or allocated: only what tetra writes (chunked, or contiguous or compact as
-// other writers make it; deflate and shuffle only; no external files, no virtual dataset), and every
-// row stored in the file (no unwritten chunk whose fill value a read would invent, no 2^40 rows in a
-// 7 KB file). `what` names the dataset in messages.
-Status check_storage(hid_t id, hid_t type, hsize_t rows, hsize_t cols, int rank, hsize_t file_size,
-                     const std::string& what) {
-  Handle dcpl(H5Dget_create_plist(id), H5Pclose);
-  if (!dcpl.valid()) return bad_input(what + ": cannot read its storage properties (damaged file?)");
-  if (H5Pget_external_count(dcpl.get()) != 0) {
+// What tetra reads of a dataset's storage properties: no external files; chunked, contiguous or compact
+// (no virtual dataset); deflate and shuffle only. Sets the layout and the number of filters.
+Status check_storage_features(hid_t dcpl, const std::string& what, H5D_layout_t& layout, int& nfilters) {
+  if (H5Pget_external_count(dcpl) != 0) {
     return bad_input(what + ": stored in external files, which tetra does not read (docs/formats.md)");
   }
-  const H5D_layout_t layout = H5Pget_layout(dcpl.get());
+  layout = H5Pget_layout(dcpl);
   if (layout != H5D_CHUNKED && layout != H5D_CONTIGUOUS && layout != H5D_COMPACT) {
     return bad_input(what +
                      ": a virtual or unknown storage layout, which tetra does not read (docs/formats.md)");
   }
-  const int nfilters = H5Pget_nfilters(dcpl.get());
+  nfilters = H5Pget_nfilters(dcpl);
   if (nfilters < 0) return bad_input(what + ": cannot read its filters (damaged file?)");
   for (int f = 0; f < nfilters; ++f) {
     unsigned flags = 0;
     std::size_t nvalues = 0;
     unsigned config = 0;
     std::array<char, 64> name{};
-    const H5Z_filter_t filter = H5Pget_filter2(dcpl.get(), static_cast<unsigned>(f), &flags, &nvalues,
-                                               nullptr, name.size(), name.data(), &config);
+    const H5Z_filter_t filter = H5Pget_filter2(dcpl, static_cast<unsigned>(f), &flags, &nvalues, nullptr,
+                                               name.size(), name.data(), &config);
     if (filter != H5Z_FILTER_DEFLATE && filter != H5Z_FILTER_SHUFFLE) {
       return bad_input(what + ": filter " + std::to_string(filter) +
                        ", which tetra does not read (only deflate and shuffle; docs/formats.md)");
     }
   }
-  const std::size_t type_size = H5Tget_size(type);
-  hsize_t bytes = 0;  // declared
-  if (type_size == 0 || __builtin_mul_overflow(rows, cols, &bytes) ||
-      __builtin_mul_overflow(bytes, hsize_t{type_size}, &bytes) ||
-      bytes > file_size * kMaxDeflateRatio + kMaxChunkBytes) {
-    return bad_input(what + ": declares " + std::to_string(rows) + " rows, more than a file of " +
-                     std::to_string(file_size) + " bytes can hold");
-  }
-  if (rows == 0) return ok_status();
-  const hsize_t stored = H5Dget_storage_size(id);
-  if (stored > file_size) return bad_input(what + ": its storage is larger than the file (damaged file?)");
-  if (layout == H5D_COMPACT) {
-    if (stored < bytes) return bad_input(what + ": rows declared but not stored (damaged file?)");
-    return ok_status();
-  }
-  if (layout == H5D_CONTIGUOUS) {
-    const haddr_t offset = H5Dget_offset(id);
-    if (stored != bytes || offset == HADDR_UNDEF || offset > file_size || file_size - offset < stored) {
-      return bad_input(what + ": " + std::to_string(rows) + " rows declared, " + std::to_string(stored) +
-                       " bytes stored at the file's offset " + std::to_string(offset) + " (damaged file?)");
-    }
-    return ok_status();
-  }
+  return ok_status();
+}
+
+// Every chunk of a chunked dataset written, within the file, whole when unfiltered and with no filter
+// skipped; `bytes` are the rows' declared bytes and `stored` what the file holds for them.
+Status check_chunks(hid_t id, hid_t dcpl, hsize_t rows, hsize_t cols, int rank, std::size_t type_size,
+                    int nfilters, hsize_t bytes, hsize_t stored, hsize_t file_size, const std::string& what) {
   std::array<hsize_t, 2> chunk{};
-  if (H5Pget_chunk(dcpl.get(), rank, chunk.data()) != rank || chunk[0] == 0 || (rank == 2 && chunk[1] == 0)) {
+  if (H5Pget_chunk(dcpl, rank, chunk.data()) != rank || chunk[0] == 0 || (rank == 2 && chunk[1] == 0)) {
     return bad_input(what + ": cannot read its chunk shape (damaged file?)");
   }
   const hsize_t chunk_cols = rank == 2 ? chunk[1] : 1;
@@ -318,6 +296,43 @@ Status check_storage(hid_t id, hid_t type, hsize_t rows, hsize_t cols, int rank,
     }
   }
   return ok_status();
+}
+
+// The storage of dataset `id` (`rows`×`cols` elements of `type`) checked against the file's size
+// before anything is read or allocated: only what tetra writes (check_storage_features), and every
+// row stored in the file (no unwritten chunk whose fill value a read would invent, no 2^40 rows in a
+// 7 KB file). `what` names the dataset in messages.
+Status check_storage(hid_t id, hid_t type, hsize_t rows, hsize_t cols, int rank, hsize_t file_size,
+                     const std::string& what) {
+  Handle dcpl(H5Dget_create_plist(id), H5Pclose);
+  if (!dcpl.valid()) return bad_input(what + ": cannot read its storage properties (damaged file?)");
+  H5D_layout_t layout = H5D_LAYOUT_ERROR;
+  int nfilters = 0;
+  if (Status st = check_storage_features(dcpl.get(), what, layout, nfilters); !st) return st;
+  const std::size_t type_size = H5Tget_size(type);
+  hsize_t bytes = 0;  // declared
+  if (type_size == 0 || __builtin_mul_overflow(rows, cols, &bytes) ||
+      __builtin_mul_overflow(bytes, hsize_t{type_size}, &bytes) ||
+      bytes > file_size * kMaxDeflateRatio + kMaxChunkBytes) {
+    return bad_input(what + ": declares " + std::to_string(rows) + " rows, more than a file of " +
+                     std::to_string(file_size) + " bytes can hold");
+  }
+  if (rows == 0) return ok_status();
+  const hsize_t stored = H5Dget_storage_size(id);
+  if (stored > file_size) return bad_input(what + ": its storage is larger than the file (damaged file?)");
+  if (layout == H5D_COMPACT) {
+    if (stored < bytes) return bad_input(what + ": rows declared but not stored (damaged file?)");
+    return ok_status();
+  }
+  if (layout == H5D_CONTIGUOUS) {
+    const haddr_t offset = H5Dget_offset(id);
+    if (stored != bytes || offset == HADDR_UNDEF || offset > file_size || file_size - offset < stored) {
+      return bad_input(what + ": " + std::to_string(rows) + " rows declared, " + std::to_string(stored) +
+                       " bytes stored at the file's offset " + std::to_string(offset) + " (damaged file?)");
+    }
+    return ok_status();
+  }
+  return check_chunks(id, dcpl.get(), rows, cols, rank, type_size, nfilters, bytes, stored, file_size, what);
 }
 
 // An unfiltered dataset read with no chunk cache: HDF5 then reads the rows straight from the file into
