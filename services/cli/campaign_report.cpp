@@ -22,7 +22,8 @@ using sim::Outcome;
 constexpr Outcome kOutcomes[] = {Outcome::kRight, Outcome::kUnisolated, Outcome::kWrong, Outcome::kMissed,
                                  Outcome::kNone};
 
-Result<std::vector<CampaignRow>> read_rows(const std::string& path) {
+//! The rows of runs that finished, by run; those that ended in an error go to `errors`.
+Result<std::vector<CampaignRow>> read_rows(const std::string& path, std::vector<CampaignRow>& errors) {
   std::ifstream in(path);
   if (!in) return failure(path + ": cannot open");
   std::vector<CampaignRow> rows;
@@ -30,10 +31,12 @@ Result<std::vector<CampaignRow>> read_rows(const std::string& path) {
   std::getline(in, line);
   while (std::getline(in, line)) {
     auto row = sim::parse_campaign_row(line);
-    if (row) rows.push_back(*row);
+    if (row) (row->error.empty() ? rows : errors).push_back(*row);
   }
-  std::sort(rows.begin(), rows.end(),
-            [](const CampaignRow& a, const CampaignRow& b) { return a.run < b.run; });
+  for (auto* list : {&rows, &errors}) {
+    std::sort(list->begin(), list->end(),
+              [](const CampaignRow& a, const CampaignRow& b) { return a.run < b.run; });
+  }
   return rows;
 }
 
@@ -245,10 +248,22 @@ std::string wrong_section(const std::vector<CampaignRow>& rows) {
   return out.empty() ? "None.\n" : out;
 }
 
+//! Every run that ended in an error, with its case and message (not counted in the sections above).
+std::string error_section(const std::vector<CampaignRow>& errors) {
+  if (errors.empty()) return "None.\n";
+  std::string out = "| run | scenario | kind | gyro | onset_s | size | seed | error |\n|---|---|---|---|---|---|---|---|\n";
+  for (const CampaignRow& r : errors) {
+    out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", r.run, r.scenario, r.kind, r.gyro,
+                       g(r.onset_s), g(r.size), r.seed, r.error);
+  }
+  return out;
+}
+
 }  // namespace
 
 Status write_campaign_report(const std::string& runs_csv, const std::string& out_dir) {
-  auto rows = read_rows(runs_csv);
+  std::vector<CampaignRow> errors;
+  auto rows = read_rows(runs_csv, errors);
   if (!rows) return rows.error();
   int false_alarms = 0;
   double fault_free_s = 0.0;
@@ -257,7 +272,11 @@ Status write_campaign_report(const std::string& runs_csv, const std::string& out
     fault_free_s += r.fdi.fault_free_s;
   }
   const std::filesystem::path dir(out_dir);
-  std::string md = "# Campaign report\n\n" + std::to_string(rows->size()) + " runs (`runs.csv`).\n\n";
+  std::string md = "# Campaign report\n\n" + std::to_string(rows->size()) + " runs (`runs.csv`)" +
+                   (errors.empty() ? std::string()
+                                   : ", and " + std::to_string(errors.size()) +
+                                         " that ended in an error (\"Errors\", not counted below)") +
+                   ".\n\n";
   md += "## Isolation outcome (kind × gyro)\n\n" + outcome_matrix(*rows) + "\n![outcomes](outcomes.png)\n\n";
   md += "## Wrong exclusions\n\n" + wrong_section(*rows) + "\n";
   md += "## Detection and isolation delays\n\n" + delay_table(*rows) +
@@ -270,6 +289,7 @@ Status write_campaign_report(const std::string& runs_csv, const std::string& out
       fault_free_s > 0.0 ? g(false_alarms / (fault_free_s / 3600.0)) : std::string("–"));
   const bool pointing = std::any_of(rows->begin(), rows->end(), has_pointing);
   md += "## Pointing\n\n" + pointing_section(*rows) + (pointing ? "\n![pointing](pointing_cdf.png)\n" : "");
+  md += "\n## Errors\n\n" + error_section(errors);
   if (Status s = write_text_file((dir / "report.md").string(), md); !s) return s;
   if (Status s = plot_delays(*rows, (dir / "delay_vs_theory.png").string()); !s) return s;
   if (Status s = plot_outcomes(*rows, (dir / "outcomes.png").string()); !s) return s;

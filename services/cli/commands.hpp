@@ -15,6 +15,8 @@ int cmd_command(int argc, char** argv);
 int cmd_record(int argc, char** argv);
 int cmd_demo(int argc, char** argv);
 int cmd_campaign(int argc, char** argv);
+//! `tetra campaign merge OUT SHARD_DIRS...` (argv[0] is "merge").
+int cmd_campaign_merge(int argc, char** argv);
 int cmd_ground(int argc, char** argv);
 int cmd_ground_passwd(int argc, char** argv);
 int cmd_score(int argc, char** argv);

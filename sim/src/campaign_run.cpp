@@ -16,8 +16,8 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-//! The columns that describe the case (and the CUSUM theory for bias steps).
-CampaignRow case_row(const CampaignSpec& spec, const CampaignCase& c, const Scenario& sc) {
+//! The columns that describe the case.
+CampaignRow case_columns(const CampaignSpec& spec, const CampaignCase& c) {
   CampaignRow row;
   row.run = c.index;
   row.scenario = std::filesystem::path(spec.scenario_paths[c.scenario]).filename().string();
@@ -26,6 +26,12 @@ CampaignRow case_row(const CampaignSpec& spec, const CampaignCase& c, const Scen
   row.onset_s = c.fault ? c.fault->at_s : 0.0;
   row.size = c.fault ? c.fault->size : 0.0;
   row.seed = c.seed;
+  return row;
+}
+
+//! The columns that describe the case and the CUSUM theory for bias steps.
+CampaignRow case_row(const CampaignSpec& spec, const CampaignCase& c, const Scenario& sc) {
+  CampaignRow row = case_columns(spec, c);
   if (c.fault && c.fault->kind == FaultKind::kBias) {
     row.theory_delay_s =
         cusum_theory_delay_s(sc.unit, spec.pipeline, sc.rate_hz, c.fault->gyro, c.fault->size);
@@ -84,6 +90,16 @@ Result<CampaignRow> run_open(const CampaignSpec& spec, const CampaignCase& c, co
 }
 
 }  // namespace
+
+CampaignRow campaign_error_row(const CampaignSpec& spec, std::size_t index, const std::string& message) {
+  CampaignRow row = case_columns(spec, campaign_case(spec, index));
+  row.error = message.empty() ? "unknown error" : message;
+  for (char& ch : row.error) {
+    if (ch == ',') ch = ';';
+    if (ch == '\n' || ch == '\r') ch = ' ';
+  }
+  return row;
+}
 
 Scenario campaign_scenario(const CampaignSpec& spec, const CampaignCase& c) {
   Scenario sc = spec.scenarios[c.scenario];

@@ -96,6 +96,9 @@ struct CampaignRow {
   std::optional<double> recover_s;
   double bound_deg = 0.0;
   double max_wheel_momentum_fraction = 0.0;
+  //! Empty for a run that finished; otherwise why it did not (an error value, an exception, a crashed
+  //! or timed-out worker): the row then holds only the case's columns, `outcome` error, and this.
+  std::string error;
 };
 
 //! Makes the estimator of one run from the scenario as it runs and its true initial attitude.
@@ -103,6 +106,10 @@ using EstimatorFactory = std::function<Result<std::unique_ptr<Estimator>>(
     const Scenario& scenario, const CampaignCase& c, const Quaternion& initial_q_RB)>;
 //! The fusion pipeline in process, with the spec's configuration.
 EstimatorFactory in_process_estimators(const CampaignSpec& spec);
+
+//! The row of a case that did not run to its end: the case's columns and `message` (a single line:
+//! commas and line breaks become ';' and ' ', so the row stays one CSV line).
+CampaignRow campaign_error_row(const CampaignSpec& spec, std::size_t index, const std::string& message);
 
 //! Runs one case to its row, with the estimator `make` gives.
 Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCase& c,

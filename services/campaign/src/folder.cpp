@@ -1,0 +1,216 @@
+// A campaign's folder: the spec's hash and copy, the shard, and the rows of runs.csv.
+#include <openssl/evp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "folder.hpp"
+#include "tetra/core/csv.hpp"
+#include "tetra/core/input_files.hpp"
+#include "tetra/core/output_files.hpp"
+#include "tetra/campaign/runner.hpp"
+
+namespace tetra::campaign {
+
+namespace {
+
+std::string hex_sha256(const std::string& bytes) {
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  if (EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) != 1) return {};
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (unsigned int i = 0; i < length; ++i) {
+    out += kHex[digest[i] >> 4];
+    out += kHex[digest[i] & 0xf];
+  }
+  return out;
+}
+
+//! A whole number 1..max in `text`, or nullopt.
+std::optional<std::size_t> whole_number(const std::string& text, std::size_t max) {
+  if (text.empty() || text.size() > 7 || text.find_first_not_of("0123456789") != std::string::npos)
+    return std::nullopt;
+  const std::size_t v = std::stoul(text);
+  if (v < 1 || v > max) return std::nullopt;
+  return v;
+}
+
+}  // namespace
+
+Result<Shard> parse_shard(const std::string& text) {
+  const auto slash = text.find('/');
+  const std::string what = "--shard " + text + ": ";
+  if (slash == std::string::npos) return bad_input(what + "expected K/N, e.g. 1/4");
+  const auto n = whole_number(text.substr(slash + 1), sim::kMaxCampaignRuns);
+  if (!n) return bad_input(what + "N must be a whole number from 1 to " + std::to_string(sim::kMaxCampaignRuns));
+  const auto k = whole_number(text.substr(0, slash), *n);
+  if (!k) return bad_input(what + "K must be a whole number from 1 to N (" + std::to_string(*n) + ")");
+  return Shard{*k, *n};
+}
+
+std::string shard_text(const Shard& shard) { return std::to_string(shard.k) + "/" + std::to_string(shard.n); }
+
+double Progress::rate_per_s() const {
+  return elapsed_s > 0.0 && done_now > 0 ? static_cast<double>(done_now) / elapsed_s : 0.0;
+}
+
+double Progress::eta_s() const {
+  const double rate = rate_per_s();
+  if (rate <= 0.0) return -1.0;
+  return static_cast<double>(total - std::min(total, done_before + done_now)) / rate;
+}
+
+Result<std::string> campaign_spec_hash(const sim::CampaignSpec& spec, const std::string& spec_path) {
+  auto text = read_input(spec_path, kMaxYamlBytes);
+  if (!text) return text.error();
+  std::string canonical;
+  try {
+    YAML::Emitter out;
+    out << YAML::Load(*text);
+    canonical = out.c_str();
+  } catch (const YAML::Exception& e) {
+    return bad_input(spec_path + ": " + e.what());
+  }
+  for (const std::string& path : spec.scenario_paths) {
+    canonical += "\n--- scenario " + std::filesystem::path(path).filename().string() + "\n";
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) continue;  // a built-in scenario: its name
+    auto scenario = read_input(path, kMaxYamlBytes);
+    if (!scenario) return scenario.error();
+    canonical += *scenario;
+  }
+  return hex_sha256(canonical);
+}
+
+namespace folder {
+
+std::string path_in(const std::string& dir, const char* name) {
+  return (std::filesystem::path(dir) / name).string();
+}
+
+std::string manifest_text(const Shard& shard, std::size_t matrix_runs) {
+  return "shard " + shard_text(shard) + "\nruns " + std::to_string(matrix_runs) + "\n";
+}
+
+Result<Manifest> read_manifest(const std::string& dir) {
+  const std::string path = path_in(dir, kShardFile);
+  auto text = read_input(path, 4096);
+  if (!text) return text.error();
+  std::istringstream in(*text);
+  std::string shard_word, shard, runs_word, runs;
+  in >> shard_word >> shard >> runs_word >> runs;
+  auto parsed = parse_shard(shard);
+  const auto total = whole_number(runs, sim::kMaxCampaignRuns);
+  if (shard_word != "shard" || runs_word != "runs" || !parsed || !total)
+    return bad_input(path + ": not a campaign's shard file (expected 'shard K/N' and 'runs T')");
+  auto hash = read_input(path_in(dir, kHashFile), 4096);
+  if (!hash) return hash.error();
+  Manifest m;
+  m.shard = *parsed;
+  m.matrix_runs = *total;
+  m.spec_sha256 = hash->substr(0, hash->find('\n'));
+  return m;
+}
+
+Result<std::vector<Row>> read_rows(const std::string& runs_csv, bool drop_errors) {
+  std::vector<Row> rows;
+  std::ifstream in(runs_csv);
+  if (!in) return rows;
+  std::string line;
+  if (!std::getline(in, line)) return rows;
+  if (line != sim::campaign_csv_header())
+    return bad_input(runs_csv + ":1: not the header of a campaign of this version");
+  for (std::size_t number = 2; std::getline(in, line); ++number) {
+    auto row = sim::parse_campaign_row(line);
+    if (!row) continue;  // a torn line (an interrupted write): the run is done again
+    if (drop_errors && !row->error.empty()) continue;
+    rows.push_back(Row{row->run, !row->error.empty(), line});
+  }
+  std::stable_sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) { return a.run < b.run; });
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    if (rows[i].run == rows[i - 1].run)
+      return bad_input(runs_csv + ": run " + std::to_string(rows[i].run) + " twice");
+  }
+  return rows;
+}
+
+Status write_rows(const std::string& runs_csv, const std::vector<Row>& rows) {
+  std::string text = sim::campaign_csv_header() + "\n";
+  for (const Row& r : rows) text += r.line + "\n";
+  return write_text_file(runs_csv, text);
+}
+
+}  // namespace folder
+
+Result<std::vector<std::size_t>> prepare_folder(const sim::CampaignSpec& spec, const RunOptions& options,
+                                                RunSummary& summary) {
+  const std::string& dir = options.out_dir;
+  auto matrix_runs = sim::campaign_run_count(spec);
+  if (!matrix_runs) return matrix_runs.error();
+  auto hash = campaign_spec_hash(spec, options.spec_path);
+  if (!hash) return hash.error();
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return failure(dir + ": cannot create the folder");
+  summary.runs_csv = folder::path_in(dir, folder::kRunsFile);
+  // runs.csv is appended to in place (an interrupted campaign resumes): a FIFO or a write-protected
+  // file is refused as any output is.
+  if (Status st = check_output_path(summary.runs_csv, "campaign output"); !st) return st.error();
+  const std::string hash_path = folder::path_in(dir, folder::kHashFile);
+  const bool has_hash = std::filesystem::exists(hash_path, ec);
+  if (has_hash) {
+    auto manifest = folder::read_manifest(dir);
+    if (!manifest) return manifest.error();
+    if (manifest->spec_sha256 != *hash)
+      return bad_input(hash_path + ": this folder holds a campaign of another spec (its SHA-256 " +
+                       manifest->spec_sha256.substr(0, 12) + "… differs from " + options.spec_path + "'s " +
+                       hash->substr(0, 12) + "…): use another --out, or remove the folder to start over");
+    if (manifest->shard.k != options.shard.k || manifest->shard.n != options.shard.n)
+      return bad_input(folder::path_in(dir, folder::kShardFile) + ": this folder holds shard " +
+                       shard_text(manifest->shard) + ", not " + shard_text(options.shard) +
+                       ": use another --out");
+  } else if (std::filesystem::exists(summary.runs_csv, ec) &&
+             std::filesystem::file_size(summary.runs_csv, ec) > 0) {
+    return bad_input(summary.runs_csv + ": a campaign's rows without " + folder::kHashFile +
+                     " (its spec cannot be checked): use another --out");
+  }
+  auto rows = folder::read_rows(summary.runs_csv, true);
+  if (!rows) return rows.error();
+  for (const folder::Row& r : *rows) {
+    if (r.run >= *matrix_runs || !in_shard(options.shard, r.run))
+      return bad_input(summary.runs_csv + ": run " + std::to_string(r.run) + " is not a run of shard " +
+                       shard_text(options.shard) + " of this campaign");
+  }
+  // Without the torn line and the error rows (those runs are done again).
+  if (Status st = folder::write_rows(summary.runs_csv, *rows); !st) return st.error();
+  if (!has_hash) {
+    auto text = read_input(options.spec_path, kMaxYamlBytes);
+    if (!text) return text.error();
+    if (Status st = write_text_file(folder::path_in(dir, folder::kSpecCopy), *text); !st) return st.error();
+    if (Status st = write_text_file(folder::path_in(dir, folder::kShardFile),
+                                    folder::manifest_text(options.shard, *matrix_runs));
+        !st)
+      return st.error();
+    if (Status st = write_text_file(hash_path, *hash + "\n"); !st) return st.error();
+  }
+  std::vector<std::size_t> pending;
+  std::size_t next_done = 0;
+  summary.total = 0;
+  for (std::size_t index = options.shard.k - 1; index < *matrix_runs; index += options.shard.n) {
+    ++summary.total;
+    while (next_done < rows->size() && (*rows)[next_done].run < index) ++next_done;
+    if (next_done < rows->size() && (*rows)[next_done].run == index) continue;
+    pending.push_back(index);
+  }
+  summary.done_before = summary.total - pending.size();
+  return pending;
+}
+
+}  // namespace tetra::campaign

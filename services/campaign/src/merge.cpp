@@ -1,0 +1,98 @@
+// `tetra campaign merge`: the shards of one campaign into the folder a one-machine run writes.
+#include <algorithm>
+#include <filesystem>
+#include <map>
+
+#include "folder.hpp"
+#include "tetra/campaign/runner.hpp"
+#include "tetra/core/csv.hpp"
+#include "tetra/core/input_files.hpp"
+
+namespace tetra::campaign {
+
+namespace {
+
+bool same_folder(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return std::filesystem::equivalent(a, b, ec);
+}
+
+}  // namespace
+
+Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<std::string>& shard_dirs) {
+  if (shard_dirs.empty()) return bad_input("no shard folder given");
+  std::vector<folder::Manifest> manifests;
+  for (const std::string& dir : shard_dirs) {
+    if (same_folder(dir, out_dir)) return bad_input(dir + ": the merge's output is one of its shards");
+    auto m = folder::read_manifest(dir);
+    if (!m) return m.error();
+    manifests.push_back(*m);
+  }
+  const folder::Manifest& first = manifests.front();
+  std::map<std::size_t, std::string> shard_of_k;  // K → folder
+  for (std::size_t i = 0; i < manifests.size(); ++i) {
+    const folder::Manifest& m = manifests[i];
+    if (m.spec_sha256 != first.spec_sha256)
+      return bad_input(shard_dirs[i] + ": another spec than " + shard_dirs[0] + " (spec.sha256 " +
+                       m.spec_sha256.substr(0, 12) + "… against " + first.spec_sha256.substr(0, 12) + "…)");
+    if (m.shard.n != first.shard.n || m.matrix_runs != first.matrix_runs)
+      return bad_input(shard_dirs[i] + ": shard " + shard_text(m.shard) + " is of another split than " +
+                       shard_dirs[0] + "'s " + shard_text(first.shard));
+    if (auto [it, fresh] = shard_of_k.emplace(m.shard.k, shard_dirs[i]); !fresh)
+      return bad_input(shard_dirs[i] + ": shard " + shard_text(m.shard) + " again (also " + it->second +
+                       "): shards must be disjoint");
+  }
+  if (shard_of_k.size() != first.shard.n) {
+    std::string missing;
+    for (std::size_t k = 1; k <= first.shard.n && missing.size() < 200; ++k) {
+      if (shard_of_k.count(k) == 0) missing += (missing.empty() ? "" : ", ") + shard_text(Shard{k, first.shard.n});
+    }
+    return bad_input("shards missing (" + missing + "): the shards must cover every run");
+  }
+  std::vector<folder::Row> all;
+  all.reserve(first.matrix_runs);
+  for (std::size_t i = 0; i < manifests.size(); ++i) {
+    const std::string runs_csv = folder::path_in(shard_dirs[i], folder::kRunsFile);
+    auto rows = folder::read_rows(runs_csv, false);
+    if (!rows) return rows.error();
+    const Shard& shard = manifests[i].shard;
+    std::size_t expected = shard.k - 1;
+    for (const folder::Row& r : *rows) {
+      if (!in_shard(shard, r.run) || r.run >= first.matrix_runs)
+        return bad_input(runs_csv + ": run " + std::to_string(r.run) + " is not a run of shard " +
+                         shard_text(shard));
+      if (r.run != expected)
+        return bad_input(runs_csv + ": run " + std::to_string(expected) +
+                         " missing: the shard is not complete (run it again with the same command)");
+      expected += shard.n;
+    }
+    if (expected < first.matrix_runs)
+      return bad_input(runs_csv + ": run " + std::to_string(expected) +
+                       " missing: the shard is not complete (run it again with the same command)");
+    all.insert(all.end(), rows->begin(), rows->end());
+  }
+  if (auto old = folder::read_manifest(out_dir); old && old->spec_sha256 != first.spec_sha256)
+    return bad_input(folder::path_in(out_dir, folder::kHashFile) +
+                     ": the output folder holds a campaign of another spec: use another folder");
+  std::sort(all.begin(), all.end(), [](const folder::Row& a, const folder::Row& b) { return a.run < b.run; });
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) return failure(out_dir + ": cannot create the folder");
+  RunSummary summary;
+  summary.total = all.size();
+  summary.runs_csv = folder::path_in(out_dir, folder::kRunsFile);
+  for (const folder::Row& r : all) summary.errors += r.error ? 1 : 0;
+  if (Status st = folder::write_rows(summary.runs_csv, all); !st) return st.error();
+  auto spec_copy = read_input(folder::path_in(shard_dirs[0], folder::kSpecCopy), kMaxYamlBytes);
+  if (!spec_copy) return spec_copy.error();
+  if (Status st = write_text_file(folder::path_in(out_dir, folder::kSpecCopy), *spec_copy); !st) return st.error();
+  if (Status st = write_text_file(folder::path_in(out_dir, folder::kShardFile),
+                                  folder::manifest_text(Shard{1, 1}, first.matrix_runs));
+      !st)
+    return st.error();
+  if (Status st = write_text_file(folder::path_in(out_dir, folder::kHashFile), first.spec_sha256 + "\n"); !st)
+    return st.error();
+  return summary;
+}
+
+}  // namespace tetra::campaign
