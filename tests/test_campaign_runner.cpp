@@ -1,0 +1,205 @@
+// The campaign runner on the command line: a run that cannot run (a coplanar unit), hangs (longer than
+// --run-timeout) or loses its worker (kill -9) is an error row naming its case, and the campaign
+// completes with every row; a folder of another spec or shard is refused; shards merge into the files
+// of a one-machine campaign.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+
+namespace tetra::test {
+namespace {
+
+std::vector<std::string> rows_of(const std::string& path) {
+  std::vector<std::string> out;
+  std::stringstream in(read_file(path));
+  std::string line;
+  std::getline(in, line);  // the header
+  while (std::getline(in, line)) out.push_back(line);
+  return out;
+}
+
+std::vector<std::string> error_rows(const std::vector<std::string>& rows) {
+  std::vector<std::string> out;
+  std::copy_if(rows.begin(), rows.end(), std::back_inserter(out),
+               [](const std::string& r) { return r.find(",error,") != std::string::npos; });
+  return out;
+}
+
+//! Scenario files beside the spec: short.yaml (the closed-loop example, 2 min), long.yaml (the same,
+//! 1e5 s: several seconds a run) and flat.yaml (the same with a unit whose gyro axes are coplanar).
+void write_scenarios(const TempDir& dir) {
+  const std::string nadir = read_file(source_path("examples/sim/closed_loop_nadir.yaml"));
+  std::string base = nadir.substr(0, nadir.find("faults:")) + nadir.substr(nadir.find("closed_loop:"));
+  base.replace(base.find("duration_s: 2400"), 16, "duration_s: 120");
+  write_file(dir.file("short.yaml"), base);
+  std::string long_run = base;
+  long_run.replace(long_run.find("duration_s: 120"), 15, "duration_s: 100000");
+  write_file(dir.file("long.yaml"), long_run);
+  std::string flat_unit = "unit: flat\ngyros:\n";
+  const char* axes[] = {"[1, 0, 0]", "[0, 1, 0]", "[0.6, 0.8, 0]", "[0.8, -0.6, 0]"};
+  for (int i = 0; i < 4; ++i) {
+    flat_unit += "  - {id: " + std::to_string(i + 1) + ", scale_factor_V_per_dps: 0.08, bias_V: 0, axis: " +
+                 axes[i] + ", noise: {arw_dps_rtHz: 3e-5}}\n";
+  }
+  write_file(dir.file("flat_unit.yaml"), flat_unit);
+  std::string flat = base;
+  flat.replace(flat.find("scenario: orbit"), 15, "scenario: orbit\nunit: flat_unit.yaml");
+  write_file(dir.file("flat.yaml"), flat);
+}
+
+// 2 kinds × 2 gyros × 2 seeds + 2 fault-free = 10 runs of 2 min.
+void write_small_spec(const std::string& path, const std::string& seeds = "[1, 2]") {
+  write_file(path, "scenarios: [" + source_path("examples/sim/closed_loop_nadir.yaml") +
+                       "]\nduration_s: 120\nkinds: [bias, stuck]\nsizes: {bias: [0.01]}\ngyros: [1, 4]\n"
+                       "onsets_s: [60]\nseeds: " + seeds + "\nfault_free: true\n");
+}
+
+// The acceptance's case: a spec holding a coplanar scenario and a hung run completes, those rows errors.
+TEST(CampaignRunner, CoplanarUnitAndHungRunAreErrorRows) {
+  TempDir dir;
+  write_scenarios(dir);
+  write_file(dir.file("spec.yaml"),
+             "scenarios: [short.yaml, flat.yaml, long.yaml]\nkinds: [stuck]\ngyros: [1]\nonsets_s: [60]\n"
+             "seeds: [1]\nfault_free: true\n");
+  const std::string out = dir.file("out");
+  // 1 s: a long.yaml run takes several seconds even on an idle core, a short.yaml one about 0.01 s.
+  const auto run = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --jobs 2 --run-timeout 1");
+  ASSERT_EQ(run.exit_status, 0) << run.err;
+  const auto rows = rows_of(out + "/runs.csv");
+  ASSERT_EQ(rows.size(), 6u);  // 3 scenarios × (1 fault-free + 1 stuck), sorted by run
+  EXPECT_EQ(rows[0].rfind("0,short.yaml,none,0,0,0,1,none,", 0), 0u) << rows[0];
+  EXPECT_EQ(rows[1].rfind("1,short.yaml,stuck,1,60,0,1,right,", 0), 0u) << rows[1];
+  for (std::size_t i = 2; i < 4; ++i) {
+    EXPECT_EQ(rows[i].rfind(std::to_string(i) + ",flat.yaml,", 0), 0u) << rows[i];
+    EXPECT_NE(rows[i].find(",error,,,,,,,,,,,,,,,,,geometry: the gyro axes do not span three dimensions"),
+              std::string::npos)
+        << rows[i];
+  }
+  for (std::size_t i = 4; i < 6; ++i) {
+    EXPECT_EQ(rows[i].rfind(std::to_string(i) + ",long.yaml,", 0), 0u) << rows[i];
+    EXPECT_NE(rows[i].find(",error,,,,,,,,,,,,,,,,,timeout: no result after 1 s (--run-timeout)"),
+              std::string::npos)
+        << rows[i];
+  }
+  EXPECT_NE(run.err.find("4 of 6 runs ended in an error"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("runs/s"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("6/6 runs (4 errors)"), std::string::npos) << run.err;
+  const std::string report = read_file(out + "/report.md");
+  EXPECT_NE(report.find("2 runs (`runs.csv`), and 4 that ended in an error"), std::string::npos) << report;
+  EXPECT_NE(report.find("| 4 | long.yaml | none | 0 | 0 | 0 | 1 | timeout"), std::string::npos) << report;
+
+  // A resume runs the error rows again (a deterministic error comes back, a transient one may not).
+  const auto again = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out +
+                               " --jobs 2 --run-timeout 1 --no-report");
+  ASSERT_EQ(again.exit_status, 0) << again.err;
+  EXPECT_NE(again.err.find("2 already done"), std::string::npos) << again.err;
+  EXPECT_EQ(rows_of(out + "/runs.csv").size(), 6u);
+}
+
+// A worker killed with kill -9 in the middle of its run: that run is an error row, a new worker takes
+// the rest, every row is in and the progress says done only then.
+TEST(CampaignRunner, KilledWorkerIsAnErrorRowAndReplaced) {
+  TempDir dir;
+  write_scenarios(dir);
+  write_file(dir.file("spec.yaml"),
+             "scenarios: [long.yaml]\nduration_s: 3000\nkinds: [stuck]\ngyros: [1, 2]\nonsets_s: [60]\n"
+             "seeds: [1, 2, 3]\n");
+  const std::string out = dir.file("out");
+  // The first worker (the lowest pid among the campaign's children) is killed 0.3 s after it appears:
+  // a run of 3000 s takes about 0.1 s or more, and a worker is without a run only for the microseconds
+  // between its row and its next run index.
+  const auto run = run_shell("cd " + dir.path().string() + " && { " + TETRA_BINARY + " campaign spec.yaml --out " +
+                             out + " --jobs 2 --no-report 2>err.txt & p=$!; " +
+                             "for i in $(seq 100); do w=$(pgrep -P $p | sort -n | head -1); [ -n \"$w\" ] && break; "
+                             "sleep 0.05; done; sleep 0.3; kill -9 $w; wait $p; }");
+  ASSERT_EQ(run.exit_status, 0) << read_file(dir.file("err.txt"));
+  const auto rows = rows_of(out + "/runs.csv");
+  ASSERT_EQ(rows.size(), 6u) << read_file(out + "/runs.csv");
+  for (std::size_t i = 0; i < rows.size(); ++i) EXPECT_EQ(rows[i].rfind(std::to_string(i) + ",", 0), 0u);
+  const auto errors = error_rows(rows);
+  ASSERT_EQ(errors.size(), 1u) << read_file(out + "/runs.csv");
+  EXPECT_NE(errors[0].find("worker killed by signal 9"), std::string::npos) << errors[0];
+  const std::string err = read_file(dir.file("err.txt"));
+  EXPECT_NE(err.find("6/6 runs (1 error)"), std::string::npos) << err;
+  EXPECT_NE(err.find("done"), std::string::npos) << err;
+}
+
+TEST(CampaignRunner, ResumeRefusesAnotherSpecOrShard) {
+  TempDir dir;
+  write_small_spec(dir.file("spec.yaml"));
+  const std::string out = dir.file("out");
+  const auto first = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --no-report");
+  ASSERT_EQ(first.exit_status, 0) << first.err;
+  const std::string rows = read_file(out + "/runs.csv");
+  write_small_spec(dir.file("spec.yaml"), "[1, 3]");
+  const auto changed = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out);
+  EXPECT_EQ(changed.exit_status, 2);
+  EXPECT_NE(changed.err.find("spec.sha256: this folder holds a campaign of another spec"), std::string::npos)
+      << changed.err;
+  EXPECT_EQ(read_file(out + "/runs.csv"), rows) << "nothing touched";
+  // Comments and layout are not the spec: the same spec written otherwise continues the campaign.
+  write_file(dir.file("spec.yaml"), "# the same spec\n" + read_file(out + "/spec.yaml"));
+  const auto same = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --no-report");
+  EXPECT_EQ(same.exit_status, 0) << same.err;
+  EXPECT_NE(same.err.find("10 already done"), std::string::npos) << same.err;
+  const auto shard = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --shard 1/2");
+  EXPECT_EQ(shard.exit_status, 2);
+  EXPECT_NE(shard.err.find("shard.txt: this folder holds shard 1/1, not 1/2"), std::string::npos) << shard.err;
+  for (const char* bad : {"0/2", "3/2", "1", "a/b", "1/0"}) {
+    const auto r = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + dir.file("x") + " --shard " + bad);
+    EXPECT_EQ(r.exit_status, 2) << bad;
+    EXPECT_NE(r.err.find(std::string("--shard ") + bad + ":"), std::string::npos) << r.err;
+  }
+}
+
+// Three shards merge into the runs.csv and report.md of the campaign run whole, byte for byte; merge
+// refuses shards missing, twice, incomplete or of another spec.
+TEST(CampaignRunner, ShardsMergeToTheOneMachineFiles) {
+  TempDir dir;
+  write_small_spec(dir.file("spec.yaml"));
+  const std::string spec = dir.file("spec.yaml");
+  ASSERT_EQ(run_tetra("campaign " + spec + " --out " + dir.file("one") + " --jobs 2").exit_status, 0);
+  for (int k = 1; k <= 3; ++k) {
+    const auto r = run_tetra("campaign " + spec + " --out " + dir.file("s" + std::to_string(k)) + " --shard " +
+                             std::to_string(k) + "/3 --jobs 1");
+    ASSERT_EQ(r.exit_status, 0) << r.err;
+    EXPECT_NE(r.err.find(k == 1 ? "4 runs of shard 1/3" : "3 runs of shard"), std::string::npos) << r.err;
+  }
+  const std::string shards = dir.file("s1") + " " + dir.file("s2") + " " + dir.file("s3");
+  const auto merged = run_tetra("campaign merge " + dir.file("m") + " " + shards);
+  ASSERT_EQ(merged.exit_status, 0) << merged.err;
+  EXPECT_EQ(read_file(dir.file("m/runs.csv")), read_file(dir.file("one/runs.csv")));
+  EXPECT_EQ(read_file(dir.file("m/report.md")), read_file(dir.file("one/report.md")));
+  EXPECT_EQ(read_file(dir.file("m/spec.sha256")), read_file(dir.file("one/spec.sha256")));
+
+  const auto missing = run_tetra("campaign merge " + dir.file("m2") + " " + dir.file("s1") + " " + dir.file("s3"));
+  EXPECT_EQ(missing.exit_status, 2);
+  EXPECT_NE(missing.err.find("shards missing (2/3)"), std::string::npos) << missing.err;
+  const auto twice = run_tetra("campaign merge " + dir.file("m2") + " " + shards + " " + dir.file("s2"));
+  EXPECT_EQ(twice.exit_status, 2);
+  EXPECT_NE(twice.err.find("shard 2/3 again"), std::string::npos) << twice.err;
+  write_small_spec(dir.file("other.yaml"), "[1, 3]");
+  ASSERT_EQ(run_tetra("campaign " + dir.file("other.yaml") + " --out " + dir.file("o3") + " --shard 3/3")
+                .exit_status,
+            0);
+  const auto other = run_tetra("campaign merge " + dir.file("m2") + " " + dir.file("s1") + " " +
+                               dir.file("s2") + " " + dir.file("o3"));
+  EXPECT_EQ(other.exit_status, 2);
+  EXPECT_NE(other.err.find("another spec than"), std::string::npos) << other.err;
+  // Shard 3 with its last row torn off (an interrupted task): incomplete.
+  const std::string s3 = read_file(dir.file("s3/runs.csv"));
+  write_file(dir.file("s3/runs.csv"), s3.substr(0, s3.rfind('\n', s3.size() - 2) + 1));
+  const auto torn = run_tetra("campaign merge " + dir.file("m2") + " " + shards);
+  EXPECT_EQ(torn.exit_status, 2);
+  EXPECT_NE(torn.err.find("s3/runs.csv: run 8 missing: the shard is not complete"), std::string::npos)
+      << torn.err;
+}
+
+}  // namespace
+}  // namespace tetra::test
