@@ -17,7 +17,7 @@ int cmd_campaign_merge(int argc, char** argv) {
       "Merges the shards of a campaign (tetra campaign SPEC --shard K/N --out DIR_K): checks that they hold "
       "one spec (spec.sha256), are complete and disjoint and cover every run, then writes OUT/runs.csv "
       "sorted by run and the report, as one machine running the whole campaign writes them.",
-      "merge"};
+      "campaign merge"};
   std::string out_dir;
   std::vector<std::string> shard_dirs;
   bool no_report = false;
