@@ -67,8 +67,8 @@ int cmd_campaign(int argc, char** argv) {
                  "output folder: runs.csv, report.md, plots, spec.yaml, spec.sha256, shard.txt (target "
                  "dds: dds/, the services' files while they run)")
       ->required();
-  app.add_option("--jobs,-j", options.jobs, "worker processes (default: the number of cores)")
-      ->check(CLI::PositiveNumber)
+  app.add_option("--jobs,-j", options.jobs, "worker processes (default: the number of cores; at most 1024)")
+      ->check(CLI::Range(1, 1024))
       ->capture_default_str();
   app.add_option("--run-timeout", options.run_timeout_s,
                  "[s] a run without its row after this long is killed and is an error row")

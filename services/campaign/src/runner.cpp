@@ -259,7 +259,8 @@ class Pool {
       while (::waitpid(w.pid, &status, 0) < 0 && errno == EINTR) {
       }
       w.pid = -1;
-      if (w.run) error_row(*w.run, "worker " + death_text(status) + " during the run");
+      // Stopping (Ctrl-C reaches the workers too): the run is not an error, it is simply not done.
+      if (w.run && g_stop_signal == 0) error_row(*w.run, "worker " + death_text(status) + " during the run");
       close_fds(w);
       workers_.erase(workers_.begin() + static_cast<std::ptrdiff_t>(*it));
     }
