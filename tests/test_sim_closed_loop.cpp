@@ -433,6 +433,28 @@ TEST(CampaignSpec, ImpossibleCasesAreErrorsOrRefusedUpFront) {
   EXPECT_NE(quiet.error().message.find("has no white noise"), std::string::npos) << quiet.error().message;
 }
 
+// A run that did not finish is a row of its own: the case's columns, outcome error, the result columns
+// empty and the message in `error` on one CSV line (commas and line breaks replaced), read back as such.
+TEST(CampaignSpec, ErrorRowsRoundTripOnOneLine) {
+  test::TempDir dir;
+  test::write_file(dir.file("c.yaml"), "loop: open\nscenarios: [orbit]\nkinds: [stuck]\ngyros: [1]\n"
+                                       "onsets_s: [60]\nseeds: [7]\nfault_free: true\n");
+  const auto spec = read_campaign_spec(dir.file("c.yaml"));
+  ASSERT_TRUE(spec) << spec.error().message;
+  const std::string text = campaign_csv_row(campaign_error_row(*spec, 1, "bad, worse\nworst"));
+  EXPECT_EQ(text, "1,orbit,stuck,1,60,0,7,error,,,,,,,,,,,,,,,,,bad; worse worst");
+  const auto row = parse_campaign_row(text);
+  ASSERT_TRUE(row) << row.error().message;
+  EXPECT_EQ(row->run, 1u);
+  EXPECT_EQ(row->kind, "stuck");
+  EXPECT_EQ(row->seed, 7u);
+  EXPECT_EQ(row->error, "bad; worse worst");
+  EXPECT_EQ(campaign_csv_row(*row), text);
+  EXPECT_FALSE(parse_campaign_row("1,orbit,stuck,1,60,0,7,error,,,,,,,,,,,,,,,,,"));  // no message
+  // A finished run's row: `error` empty (the line ends with its comma), not an error when read back.
+  EXPECT_EQ(campaign_csv_header().substr(campaign_csv_header().rfind(',')), ",error");
+}
+
 // Inertia, torques and momenta out of their stated ranges are refused naming the key and its line.
 TEST(ClosedLoopScenario, RangesNameTheKey) {
   const std::vector<std::pair<std::string, std::string>> bad = {

@@ -255,8 +255,10 @@ Status check_cases(const CampaignSpec& spec, const YAML::Node& root, const YamlR
   return ok_status();
 }
 
-//! Fields of a row (campaign_csv_header): the error message is the last.
+//! Fields of a row (campaign_csv_header), and the index of `error` among them (columns appended after
+//! it keep it where it is).
 constexpr std::size_t kCampaignColumns = 25;
+constexpr std::size_t kErrorColumn = 24;
 
 std::string opt_text(const std::optional<double>& v) {
   std::string out;
@@ -430,7 +432,8 @@ std::string campaign_csv_row(const CampaignRow& r) {
   out += ',';
   append_double(out, r.size);
   out += "," + std::to_string(r.seed) + ",";
-  if (!r.error.empty()) return out + "error" + std::string(kCampaignColumns - 8, ',') + r.error;
+  // An error row: outcome `error`, the result columns empty, the message in `error` (column kErrorColumn).
+  if (!r.error.empty()) return out + "error" + std::string(kErrorColumn - 7, ',') + r.error;
   out += std::string(outcome_name(r.fdi.outcome)) + ",";
   out += r.fdi.isolated_gyro ? std::to_string(*r.fdi.isolated_gyro) : std::string();
   out += "," + opt_text(r.fdi.detection_delay_s) + "," + opt_text(r.fdi.isolation_delay_s) + "," +
@@ -470,11 +473,11 @@ Result<CampaignRow> parse_campaign_row(const std::string& line) {
     r.size = num(f[5]);
     r.seed = std::stoull(f[6]);
     if (f[7] == "error") {
-      if (f.back().empty()) return bad_input("campaign row: outcome error without its message");
-      r.error = f.back();
+      if (f[kErrorColumn].empty()) return bad_input("campaign row: outcome error without its message");
+      r.error = f[kErrorColumn];
       return r;
     }
-    if (!f.back().empty()) return bad_input("campaign row: an error message with outcome '" + f[7] + "'");
+    if (!f[kErrorColumn].empty()) return bad_input("campaign row: an error message with outcome '" + f[7] + "'");
     bool known = false;
     for (Outcome o :
          {Outcome::kNone, Outcome::kRight, Outcome::kWrong, Outcome::kUnisolated, Outcome::kMissed}) {
