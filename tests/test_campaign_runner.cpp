@@ -44,8 +44,9 @@ void write_scenarios(const TempDir& dir) {
   std::string flat_unit = "unit: flat\ngyros:\n";
   const char* axes[] = {"[1, 0, 0]", "[0, 1, 0]", "[0.6, 0.8, 0]", "[0.8, -0.6, 0]"};
   for (int i = 0; i < 4; ++i) {
-    flat_unit += "  - {id: " + std::to_string(i + 1) + ", scale_factor_V_per_dps: 0.08, bias_V: 0, axis: " +
-                 axes[i] + ", noise: {arw_dps_rtHz: 3e-5}}\n";
+    flat_unit += "  - {id: " + std::to_string(i + 1) +
+                 ", scale_factor_V_per_dps: 0.08, bias_V: 0, axis: " + axes[i] +
+                 ", noise: {arw_dps_rtHz: 3e-5}}\n";
   }
   write_file(dir.file("flat_unit.yaml"), flat_unit);
   std::string flat = base;
@@ -57,7 +58,8 @@ void write_scenarios(const TempDir& dir) {
 void write_small_spec(const std::string& path, const std::string& seeds = "[1, 2]") {
   write_file(path, "scenarios: [" + source_path("examples/sim/closed_loop_nadir.yaml") +
                        "]\nduration_s: 120\nkinds: [bias, stuck]\nsizes: {bias: [0.01]}\ngyros: [1, 4]\n"
-                       "onsets_s: [60]\nseeds: " + seeds + "\nfault_free: true\n");
+                       "onsets_s: [60]\nseeds: " +
+                       seeds + "\nfault_free: true\n");
 }
 
 // The acceptance's case: a spec holding a coplanar scenario and a hung run completes, those rows errors.
@@ -69,7 +71,8 @@ TEST(CampaignRunner, CoplanarUnitAndHungRunAreErrorRows) {
              "seeds: [1]\nfault_free: true\n");
   const std::string out = dir.file("out");
   // 1 s: a long.yaml run takes several seconds even on an idle core, a short.yaml one about 0.01 s.
-  const auto run = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --jobs 2 --run-timeout 1");
+  const auto run =
+      run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --jobs 2 --run-timeout 1");
   ASSERT_EQ(run.exit_status, 0) << run.err;
   const auto rows = rows_of(out + "/runs.csv");
   ASSERT_EQ(rows.size(), 6u);  // 3 scenarios × (1 fault-free + 1 stuck), sorted by run
@@ -77,8 +80,9 @@ TEST(CampaignRunner, CoplanarUnitAndHungRunAreErrorRows) {
   EXPECT_EQ(rows[1].rfind("1,short.yaml,stuck,1,60,0,1,right,", 0), 0u) << rows[1];
   for (std::size_t i = 2; i < 4; ++i) {
     EXPECT_EQ(rows[i].rfind(std::to_string(i) + ",flat.yaml,", 0), 0u) << rows[i];
-    EXPECT_NE(rows[i].find(",error,,,,,,,,,,,,,,,,,the fusion pipeline cannot run this unit: geometry: the gyro axes do not span "
-                            "three dimensions"),
+    EXPECT_NE(rows[i].find(",error,,,,,,,,,,,,,,,,,the fusion pipeline cannot run this unit: geometry: the "
+                           "gyro axes do not span "
+                           "three dimensions"),
               std::string::npos)
         << rows[i];
   }
@@ -115,10 +119,15 @@ TEST(CampaignRunner, KilledWorkerIsAnErrorRowAndReplaced) {
   // The first worker (the lowest pid among the campaign's children) is killed 0.3 s after it appears:
   // a run of 3000 s takes about 0.1 s or more, and a worker is without a run only for the microseconds
   // between its row and its next run index.
-  const auto run = run_shell("cd " + dir.path().string() + " && { " + TETRA_BINARY + " campaign spec.yaml --out " +
-                             out + " --jobs 2 --no-report 2>err.txt & p=$!; " +
-                             "for i in $(seq 100); do w=$(pgrep -P $p | sort -n | head -1); [ -n \"$w\" ] && break; "
-                             "sleep 0.05; done; sleep 0.3; kill -9 $w; wait $p; }");
+  // The children of a process from /proc (field 4 of stat is the parent's pid; no procps needed).
+  const std::string children =
+      "children() { for d in /proc/[0-9]*; do [ \"$(cut -d' ' -f4 $d/stat 2>/dev/null)\" = \"$1\" ] && "
+      "echo ${d#/proc/}; done; }; ";
+  const auto run =
+      run_shell(children + "cd " + dir.path().string() + " && { " + TETRA_BINARY +
+                " campaign spec.yaml --out " + out + " --jobs 2 --no-report 2>err.txt & p=$!; " +
+                "for i in $(seq 100); do w=$(children $p | sort -n | head -1); [ -n \"$w\" ] && break; "
+                "sleep 0.05; done; sleep 0.3; kill -9 $w; wait $p; }");
   ASSERT_EQ(run.exit_status, 0) << read_file(dir.file("err.txt"));
   const auto rows = rows_of(out + "/runs.csv");
   ASSERT_EQ(rows.size(), 6u) << read_file(out + "/runs.csv");
@@ -151,9 +160,11 @@ TEST(CampaignRunner, ResumeRefusesAnotherSpecOrShard) {
   EXPECT_NE(same.err.find("10 already done"), std::string::npos) << same.err;
   const auto shard = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --shard 1/2");
   EXPECT_EQ(shard.exit_status, 2);
-  EXPECT_NE(shard.err.find("shard.txt: this folder holds shard 1/1, not 1/2"), std::string::npos) << shard.err;
+  EXPECT_NE(shard.err.find("shard.txt: this folder holds shard 1/1, not 1/2"), std::string::npos)
+      << shard.err;
   for (const char* bad : {"0/2", "3/2", "1", "a/b", "1/0"}) {
-    const auto r = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + dir.file("x") + " --shard " + bad);
+    const auto r =
+        run_tetra("campaign " + dir.file("spec.yaml") + " --out " + dir.file("x") + " --shard " + bad);
     EXPECT_EQ(r.exit_status, 2) << bad;
     EXPECT_NE(r.err.find(std::string("--shard ") + bad + ":"), std::string::npos) << r.err;
   }
@@ -167,8 +178,8 @@ TEST(CampaignRunner, ShardsMergeToTheOneMachineFiles) {
   const std::string spec = dir.file("spec.yaml");
   ASSERT_EQ(run_tetra("campaign " + spec + " --out " + dir.file("one") + " --jobs 2").exit_status, 0);
   for (int k = 1; k <= 3; ++k) {
-    const auto r = run_tetra("campaign " + spec + " --out " + dir.file("s" + std::to_string(k)) + " --shard " +
-                             std::to_string(k) + "/3 --jobs 1");
+    const auto r = run_tetra("campaign " + spec + " --out " + dir.file("s" + std::to_string(k)) +
+                             " --shard " + std::to_string(k) + "/3 --jobs 1");
     ASSERT_EQ(r.exit_status, 0) << r.err;
     EXPECT_NE(r.err.find(k == 1 ? "4 runs of shard 1/3" : "3 runs of shard"), std::string::npos) << r.err;
   }
@@ -179,7 +190,8 @@ TEST(CampaignRunner, ShardsMergeToTheOneMachineFiles) {
   EXPECT_EQ(read_file(dir.file("m/report.md")), read_file(dir.file("one/report.md")));
   EXPECT_EQ(read_file(dir.file("m/spec.sha256")), read_file(dir.file("one/spec.sha256")));
 
-  const auto missing = run_tetra("campaign merge " + dir.file("m2") + " " + dir.file("s1") + " " + dir.file("s3"));
+  const auto missing =
+      run_tetra("campaign merge " + dir.file("m2") + " " + dir.file("s1") + " " + dir.file("s3"));
   EXPECT_EQ(missing.exit_status, 2);
   EXPECT_NE(missing.err.find("shards missing (2/3)"), std::string::npos) << missing.err;
   const auto twice = run_tetra("campaign merge " + dir.file("m2") + " " + shards + " " + dir.file("s2"));

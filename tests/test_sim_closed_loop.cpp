@@ -437,8 +437,9 @@ TEST(CampaignSpec, ImpossibleCasesAreErrorsOrRefusedUpFront) {
 // empty and the message in `error` on one CSV line (commas and line breaks replaced), read back as such.
 TEST(CampaignSpec, ErrorRowsRoundTripOnOneLine) {
   test::TempDir dir;
-  test::write_file(dir.file("c.yaml"), "loop: open\nscenarios: [orbit]\nkinds: [stuck]\ngyros: [1]\n"
-                                       "onsets_s: [60]\nseeds: [7]\nfault_free: true\n");
+  test::write_file(dir.file("c.yaml"),
+                   "loop: open\nscenarios: [orbit]\nkinds: [stuck]\ngyros: [1]\n"
+                   "onsets_s: [60]\nseeds: [7]\nfault_free: true\n");
   const auto spec = read_campaign_spec(dir.file("c.yaml"));
   ASSERT_TRUE(spec) << spec.error().message;
   const std::string text = campaign_csv_row(campaign_error_row(*spec, 1, "bad, worse\nworst"));

@@ -251,7 +251,8 @@ std::string wrong_section(const std::vector<CampaignRow>& rows) {
 //! Every run that ended in an error, with its case and message (not counted in the sections above).
 std::string error_section(const std::vector<CampaignRow>& errors) {
   if (errors.empty()) return "None.\n";
-  std::string out = "| run | scenario | kind | gyro | onset_s | size | seed | error |\n|---|---|---|---|---|---|---|---|\n";
+  std::string out =
+      "| run | scenario | kind | gyro | onset_s | size | seed | error |\n|---|---|---|---|---|---|---|---|\n";
   for (const CampaignRow& r : errors) {
     out += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", r.run, r.scenario, r.kind, r.gyro,
                        g(r.onset_s), g(r.size), r.seed, r.error);

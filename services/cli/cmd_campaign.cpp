@@ -39,7 +39,8 @@ void print_progress(const campaign::Progress& p) {
             << (p.errors ? fmt::format(" ({} error{})", p.errors, p.errors == 1 ? "" : "s") : std::string())
             << fmt::format(", {:.1f} runs/s, ", p.rate_per_s()) << duration_text(p.elapsed_s) << " elapsed, "
             << (p.final ? (all_in ? std::string("done") : std::string("stopped"))
-                        : (eta < 0.0 ? std::string("time left unknown") : "about " + duration_text(eta) + " left"))
+                        : (eta < 0.0 ? std::string("time left unknown")
+                                     : "about " + duration_text(eta) + " left"))
             << (isatty(2) && !p.final ? "   " : "\n") << std::flush;
 }
 
@@ -80,7 +81,8 @@ int cmd_campaign(int argc, char** argv) {
   app.add_flag("--no-report", no_report, "only the runs (no report, no plots)");
   int domain = 0;
   CLI::Option* domain_opt =
-      app.add_option("--domain", domain, "DDS domain of the services (target dds; overrides the spec's domain:)")
+      app.add_option("--domain", domain,
+                     "DDS domain of the services (target dds; overrides the spec's domain:)")
           ->check(CLI::Range(0, 232));
   if (auto status = parse(app, argc, argv)) return *status;
 
@@ -99,7 +101,9 @@ int cmd_campaign(int argc, char** argv) {
   const bool over_dds = spec->target == sim::CampaignTarget::kDds;
   const std::string dds_dir = (std::filesystem::path(options.out_dir) / "dds").string();
   if (over_dds) {
-    options.estimators = [dds_dir](const sim::CampaignSpec& s) { return dds_campaign_estimators(s, dds_dir); };
+    options.estimators = [dds_dir](const sim::CampaignSpec& s) {
+      return dds_campaign_estimators(s, dds_dir);
+    };
   }
   options.spec_path = spec_path;
   options.on_progress = print_progress;
@@ -112,8 +116,8 @@ int cmd_campaign(int argc, char** argv) {
     if (ec) return report(kCampaignName, failure(dds_dir + ": cannot create the folder"));
   }
   std::cerr << "tetra campaign: " << summary.total << " runs"
-            << (options.shard.n > 1 ? " of shard " + campaign::shard_text(options.shard) : std::string()) << " ("
-            << (spec->loop == sim::CampaignLoop::kClosed ? "closed" : "open") << " loop, "
+            << (options.shard.n > 1 ? " of shard " + campaign::shard_text(options.shard) : std::string())
+            << " (" << (spec->loop == sim::CampaignLoop::kClosed ? "closed" : "open") << " loop, "
             << (over_dds ? "fusion services over DDS, domain " + std::to_string(spec->dds_domain)
                          : std::string("pipeline in process"))
             << "), " << summary.done_before << " already done, " << options.jobs << " jobs\n";

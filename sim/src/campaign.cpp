@@ -477,7 +477,8 @@ Result<CampaignRow> parse_campaign_row(const std::string& line) {
       r.error = f[kErrorColumn];
       return r;
     }
-    if (!f[kErrorColumn].empty()) return bad_input("campaign row: an error message with outcome '" + f[7] + "'");
+    if (!f[kErrorColumn].empty())
+      return bad_input("campaign row: an error message with outcome '" + f[7] + "'");
     bool known = false;
     for (Outcome o :
          {Outcome::kNone, Outcome::kRight, Outcome::kWrong, Outcome::kUnisolated, Outcome::kMissed}) {

@@ -112,7 +112,8 @@ EstimatorFactory in_process_estimators(const CampaignSpec& spec) {
   return [config = spec.pipeline](const Scenario& sc, const CampaignCase&,
                                   const Quaternion& initial_q_RB) -> Result<std::unique_ptr<Estimator>> {
     auto estimator = PipelineEstimator::create(sc.unit, config, initial_q_RB);
-    if (!estimator) return bad_input("the fusion pipeline cannot run this unit: " + describe(estimator.error()));
+    if (!estimator)
+      return bad_input("the fusion pipeline cannot run this unit: " + describe(estimator.error()));
     return std::unique_ptr<Estimator>(std::make_unique<PipelineEstimator>(std::move(estimator.value())));
   };
 }

@@ -11,10 +11,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include "folder.hpp"
+#include "tetra/campaign/runner.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/input_files.hpp"
 #include "tetra/core/output_files.hpp"
-#include "tetra/campaign/runner.hpp"
 
 namespace tetra::campaign {
 
@@ -49,13 +49,16 @@ Result<Shard> parse_shard(const std::string& text) {
   const std::string what = "--shard " + text + ": ";
   if (slash == std::string::npos) return bad_input(what + "expected K/N, e.g. 1/4");
   const auto n = whole_number(text.substr(slash + 1), sim::kMaxCampaignRuns);
-  if (!n) return bad_input(what + "N must be a whole number from 1 to " + std::to_string(sim::kMaxCampaignRuns));
+  if (!n)
+    return bad_input(what + "N must be a whole number from 1 to " + std::to_string(sim::kMaxCampaignRuns));
   const auto k = whole_number(text.substr(0, slash), *n);
   if (!k) return bad_input(what + "K must be a whole number from 1 to N (" + std::to_string(*n) + ")");
   return Shard{*k, *n};
 }
 
-std::string shard_text(const Shard& shard) { return std::to_string(shard.k) + "/" + std::to_string(shard.n); }
+std::string shard_text(const Shard& shard) {
+  return std::to_string(shard.k) + "/" + std::to_string(shard.n);
+}
 
 double Progress::rate_per_s() const {
   return elapsed_s > 0.0 && done_now > 0 ? static_cast<double>(done_now) / elapsed_s : 0.0;

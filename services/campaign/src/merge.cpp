@@ -45,7 +45,8 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
   if (shard_of_k.size() != first.shard.n) {
     std::string missing;
     for (std::size_t k = 1; k <= first.shard.n && missing.size() < 200; ++k) {
-      if (shard_of_k.count(k) == 0) missing += (missing.empty() ? "" : ", ") + shard_text(Shard{k, first.shard.n});
+      if (shard_of_k.count(k) == 0)
+        missing += (missing.empty() ? "" : ", ") + shard_text(Shard{k, first.shard.n});
     }
     return bad_input("shards missing (" + missing + "): the shards must cover every run");
   }
@@ -85,7 +86,8 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
   if (Status st = folder::write_rows(summary.runs_csv, all); !st) return st.error();
   auto spec_copy = read_input(folder::path_in(shard_dirs[0], folder::kSpecCopy), kMaxYamlBytes);
   if (!spec_copy) return spec_copy.error();
-  if (Status st = write_text_file(folder::path_in(out_dir, folder::kSpecCopy), *spec_copy); !st) return st.error();
+  if (Status st = write_text_file(folder::path_in(out_dir, folder::kSpecCopy), *spec_copy); !st)
+    return st.error();
   if (Status st = write_text_file(folder::path_in(out_dir, folder::kShardFile),
                                   folder::manifest_text(Shard{1, 1}, first.matrix_runs));
       !st)

@@ -29,7 +29,9 @@ using Clock = std::chrono::steady_clock;
 
 volatile std::sig_atomic_t g_stop_signal = 0;
 
-extern "C" void campaign_runner_on_signal(int sig) { g_stop_signal = sig; }
+extern "C" void campaign_runner_on_signal(int sig) {
+  g_stop_signal = sig;
+}
 
 //! While it lives: SIGINT and SIGTERM ask the campaign to stop (poll returns early: no SA_RESTART);
 //! SIGPIPE is ignored (a write to a worker that just died is an error value, not the end).
@@ -107,9 +109,9 @@ std::string run_row(const sim::CampaignSpec& spec, std::size_t index, const sim:
   char line[32];
   while (in != nullptr && std::fgets(line, sizeof line, in) != nullptr) {
     const std::size_t index = std::strtoull(line, nullptr, 10);
-    const std::string row =
-        make_error.empty() ? run_row(spec, index, make)
-                           : sim::campaign_csv_row(sim::campaign_error_row(spec, index, make_error));
+    const std::string row = make_error.empty()
+                                ? run_row(spec, index, make)
+                                : sim::campaign_csv_row(sim::campaign_error_row(spec, index, make_error));
     if (!write_all(result_fd, row + "\n")) ::_exit(1);
   }
   ::_exit(0);
@@ -118,7 +120,8 @@ std::string run_row(const sim::CampaignSpec& spec, std::size_t index, const sim:
 //! "killed by signal 9 (Killed)" or "exited with status 3".
 std::string death_text(int status) {
   if (WIFSIGNALED(status))
-    return "killed by signal " + std::to_string(WTERMSIG(status)) + " (" + ::strsignal(WTERMSIG(status)) + ")";
+    return "killed by signal " + std::to_string(WTERMSIG(status)) + " (" + ::strsignal(WTERMSIG(status)) +
+           ")";
   if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
   return "ended";
 }

@@ -27,7 +27,9 @@ Result<Shard> parse_shard(const std::string& text);
 //! "K/N".
 std::string shard_text(const Shard& shard);
 //! Whether run `index` belongs to `shard`.
-inline bool in_shard(const Shard& shard, std::size_t index) { return index % shard.n == shard.k - 1; }
+inline bool in_shard(const Shard& shard, std::size_t index) {
+  return index % shard.n == shard.k - 1;
+}
 
 //! [s] the default per-run timeout: generous against a 10-minute closed-loop run's ~0.05 s (or a DDS
 //! run's few seconds); a run still going after it is a hung run.
