@@ -56,14 +56,14 @@ void handle_stop_signals(bool install) {
 }
 
 //! Run ids already in `runs.csv` (a torn last line, from an interrupted run, is dropped and redone).
-Result<std::set<std::size_t>> done_runs(const std::string& path) {
+Result<std::set<std::size_t>> done_runs(const std::string& path, const std::string& header) {
   std::set<std::size_t> done;
   std::ifstream in(path);
   if (!in) return done;
   std::string line;
   if (!std::getline(in, line)) return done;
-  if (line != sim::campaign_csv_header())
-    return bad_input(path + ":1: not the header of a campaign of this version");
+  if (line != header)
+    return bad_input(path + ":1: not the header of this campaign (another version, or other dispersions)");
   std::string kept = line + "\n";
   while (std::getline(in, line)) {
     auto row = sim::parse_campaign_row(line);
@@ -234,11 +234,11 @@ int cmd_campaign(int argc, char** argv) {
   // file is refused as any output is.
   if (Status st = check_output_path(runs_path, "campaign output"); !st)
     return report(kCampaignName, st.error());
-  auto done = done_runs(runs_path);
+  auto done = done_runs(runs_path, sim::campaign_csv_header(*spec));
   if (!done) return report(kCampaignName, done.error());
   if (done->empty()) {
     std::ofstream header(runs_path, std::ios::trunc);
-    header << sim::campaign_csv_header() << '\n';
+    header << sim::campaign_csv_header(*spec) << '\n';
     if (!header) return report(kCampaignName, failure(runs_path + ": cannot write"));
   }
   // Bounded (read_campaign_spec): at most kMaxCampaignRuns indices; the cases are made one at a time.
