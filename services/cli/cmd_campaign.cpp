@@ -262,7 +262,7 @@ int cmd_campaign(int argc, char** argv) {
     if (!st) return report(kCampaignName, st.error());
   }
   if (no_report) return kExitOk;
-  if (Status st = write_campaign_report(runs_path, out_dir); !st) return report(kCampaignName, st.error());
+  if (Status st = write_campaign_report(*spec, out_dir); !st) return report(kCampaignName, st.error());
   std::cerr << "tetra campaign: report -> " << (std::filesystem::path(out_dir) / "report.md").string()
             << '\n';
   return kExitOk;
