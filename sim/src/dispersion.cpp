@@ -121,9 +121,11 @@ Result<Distribution> parse_distribution(const YamlReader& yaml, const YAML::Node
   }
   if (!node.IsMap() || node.size() != 1)
     return yaml.error(node, what,
-                      "expected one of {normal: [mean, sigma]}, {uniform: [min, max]}, {truncated_normal: "
-                      "[mean, sigma, min, max]}, {log_uniform: [min, max]}, {choice: [...]}" +
-                          std::string(info.calibration ? ", calibration, {calibration: k}" : ""));
+                      info.domain == Domain::kChoice
+                          ? std::string("expected {choice: [...]}")
+                          : "expected one of {normal: [mean, sigma]}, {uniform: [min, max]}, {truncated_normal: "
+                            "[mean, sigma, min, max]}, {log_uniform: [min, max]}" +
+                                std::string(info.calibration ? ", calibration, {calibration: k}" : ""));
   const std::string form = node.begin()->first.IsScalar() ? node.begin()->first.Scalar() : "?";
   const YAML::Node v = node.begin()->second;
   const std::string at = what + "." + form;
