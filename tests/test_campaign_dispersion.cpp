@@ -10,6 +10,7 @@
 
 #include "tetra/sim/campaign.hpp"
 #include "tetra/sim/campaign_statistics.hpp"
+#include "tetra/sim/simulator.hpp"
 #include "test_support.hpp"
 
 namespace tetra::sim {
@@ -172,6 +173,43 @@ TEST(CampaignDispersion, RequirementsJudged) {
   EXPECT_EQ(fa.verdict, Verdict::kUndecided);
   // 29957 h are needed (2.9957/1e-4) at 1 h a run: 26958 more runs.
   EXPECT_EQ(fa.further_runs, 26958u);
+}
+
+}  // namespace
+}  // namespace tetra::sim
+
+namespace tetra::sim {
+namespace {
+
+// Star-tracker dropouts (reference.drop_probability): each sample left out independently, from a stream
+// of its own, so the samples delivered are exactly those of the run without dropouts.
+TEST(ReferenceDropouts, DeliveredSamplesAreThoseOfTheRunWithoutDropouts) {
+  const std::string base = "scenario: orbit\nduration_s: 200\nrate_hz: 10\nreference: {rate_hz: 1, noise_arcsec: 5";
+  auto full = parse_scenario(base + "}\n", "full.yaml");
+  auto dropping = parse_scenario(base + ", drop_probability: 0.5}\n", "drop.yaml");
+  ASSERT_TRUE(full && dropping) << (full ? dropping.error().message : full.error().message);
+  auto a = Simulator::create(*full, SimOptions{});
+  auto b = Simulator::create(*dropping, SimOptions{});
+  ASSERT_TRUE(a && b);
+  SimEpoch ea;
+  SimEpoch eb;
+  int references = 0;
+  int delivered = 0;
+  while (a->next(ea) && b->next(eb)) {
+    if (!ea.reference_q_RB) {
+      EXPECT_FALSE(eb.reference_q_RB);
+      continue;
+    }
+    ++references;
+    if (!eb.reference_q_RB) continue;
+    ++delivered;
+    EXPECT_EQ(ea.reference_q_RB->coeffs(), eb.reference_q_RB->coeffs());
+  }
+  EXPECT_EQ(references, 200);
+  // Binomial(200, 0.5): 1σ = 7.1; 100 ± 30 is 4.2σ.
+  EXPECT_NEAR(delivered, 100, 30);
+  const auto bad = parse_scenario(base + ", drop_probability: 1}\n", "bad.yaml");
+  EXPECT_TRUE(!bad || !validate_scenario(*bad)) << "a probability of 1 is refused";
 }
 
 }  // namespace

@@ -52,6 +52,7 @@ constexpr ParamInfo kParams[] = {
     {P::kReferenceNoiseArcsec, "reference.noise_arcsec", Shape::kScalar, Domain::kNonNegative, false},
     {P::kReferenceBiasArcsec, "reference.bias_arcsec", Shape::kScalar, Domain::kAny, false},
     {P::kReferenceLatencyS, "reference.latency_s", Shape::kScalar, Domain::kNonNegative, false},
+    {P::kReferenceDropProbability, "reference.drop_probability", Shape::kScalar, Domain::kProbability, false},
     {P::kDropProbability, "data.drop_probability", Shape::kScalar, Domain::kProbability, false},
     {P::kJitterS, "data.jitter_s", Shape::kScalar, Domain::kNonNegative, false},
     {P::kFaultOnsetS, "fault.onset_s", Shape::kScalar, Domain::kBounded, false},
@@ -307,7 +308,8 @@ Status check_dispersions(const YamlReader& yaml, const YAML::Node& node, const D
     if (spacecraft && !closed_loop) return yaml.error(at, what, "applies to a closed-loop campaign only");
     if (d.parameter == P::kJitterS && closed_loop)
       return yaml.error(at, what, "applies to an open-loop campaign only (no jitter in closed loop)");
-    const bool reference = d.parameter >= P::kReferenceNoiseArcsec && d.parameter <= P::kReferenceLatencyS;
+    const bool reference =
+        d.parameter >= P::kReferenceNoiseArcsec && d.parameter <= P::kReferenceDropProbability;
     if (reference && sc.reference.rate_hz <= 0.0)
       return yaml.error(at, what, name + " has no attitude reference to disperse");
     if (dist.kind == DistributionKind::kCalibration) {
@@ -446,6 +448,8 @@ Scenario dispersed_scenario(const Scenario& nominal, const DispersionSpec& spec,
       sc.reference.bias_ramp_s = 0.0;
     } else if (p == P::kReferenceLatencyS) {
       sc.reference.latency_s = v[0];
+    } else if (p == P::kReferenceDropProbability) {
+      sc.reference.drop_probability = v[0];
     } else if (p == P::kDropProbability) {
       sc.drop_probability = v[0];
     } else if (p == P::kJitterS) {

@@ -58,6 +58,7 @@ enum class DispersedParameter {
   kReferenceNoiseArcsec,    //!< reference.noise_arcsec: the value [arcsec]
   kReferenceBiasArcsec,     //!< reference.bias_arcsec: the value [arcsec] (from t = 0, a step)
   kReferenceLatencyS,       //!< reference.latency_s: the value [s]
+  kReferenceDropProbability,  //!< reference.drop_probability: the value (star-tracker dropouts)
   kDropProbability,         //!< data.drop_probability: the value
   kJitterS,                 //!< data.jitter_s: the value [s] (open loop)
   kFaultOnsetS,             //!< fault.onset_s: + δ [s] to the case's onset
