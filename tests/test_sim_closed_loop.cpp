@@ -273,7 +273,7 @@ TEST(CampaignSpec, CasesAreMadeOnDemandInTheFixedOrder) {
   ASSERT_TRUE(spec) << spec.error().message;
   std::vector<CampaignCase> expected;
   for (std::size_t s = 0; s < 2; ++s) {
-    for (std::uint64_t seed : {7u, 3u}) expected.push_back({expected.size(), s, std::nullopt, seed});
+    for (std::uint64_t seed : {7u, 3u}) expected.push_back({expected.size(), s, std::nullopt, seed, {}});
     for (FaultKind kind : {FaultKind::kBias, FaultKind::kStuck}) {
       for (int gyro : {2, 1}) {
         for (double onset : {60.0, 30.0}) {
@@ -285,7 +285,7 @@ TEST(CampaignSpec, CasesAreMadeOnDemandInTheFixedOrder) {
               f.gyro = gyro;
               f.at_s = onset;
               f.size = size;
-              expected.push_back({expected.size(), s, f, seed});
+              expected.push_back({expected.size(), s, f, seed, {}});
             }
           }
         }

@@ -31,7 +31,10 @@ int cmd_campaign_merge(int argc, char** argv) {
             << (merged->errors ? " (" + std::to_string(merged->errors) + " error rows)" : std::string())
             << " -> " << merged->runs_csv << '\n';
   if (no_report) return kExitOk;
-  if (Status st = write_campaign_report(merged->runs_csv, out_dir); !st) return report(kName, st.error());
+  auto options = campaign::folder_report_options(out_dir);
+  if (!options) return report(kName, options.error());
+  if (Status st = write_campaign_report(merged->runs_csv, out_dir, *options); !st)
+    return report(kName, st.error());
   std::cerr << "tetra campaign merge: report -> " << out_dir << "/report.md\n";
   return kExitOk;
 }

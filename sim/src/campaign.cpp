@@ -152,6 +152,41 @@ Status parse_mode(const YamlReader& yaml, const YAML::Node& root, CampaignSpec& 
   return ok_status();
 }
 
+//! `seeds: {first: F, count: C}`: the seeds F, F + 1, ..., F + C − 1 (a Monte Carlo campaign's runs).
+Result<std::vector<std::uint64_t>> seed_range(const YamlReader& yaml, const YAML::Node& node) {
+  if (Status st = yaml.check_keys(node, {"first", "count"}, "seeds"); !st) return st.error();
+  if (!node["first"] || !node["count"]) return yaml.error(node, "seeds", "expected {first: F, count: C}");
+  auto first = yaml.unsigned_integer(node["first"], "seeds.first");
+  if (!first) return first.error();
+  auto count = yaml.integer(node["count"], "seeds.count", 1, static_cast<std::int64_t>(kMaxCampaignRuns));
+  if (!count) return count.error();
+  if (*first > std::numeric_limits<std::uint64_t>::max() - static_cast<std::uint64_t>(*count - 1))
+    return yaml.error(node["count"], "seeds.count", "the last seed would pass 2^64 - 1");
+  std::vector<std::uint64_t> seeds(static_cast<std::size_t>(*count));
+  for (std::size_t i = 0; i < seeds.size(); ++i) seeds[i] = *first + i;
+  return seeds;
+}
+
+//! `requirements:` a list of "METRIC < BOUND at CONFIDENCE"; a kind named must be one the campaign runs.
+Status parse_requirements(const YamlReader& yaml, const YAML::Node& root, CampaignSpec& spec) {
+  const YAML::Node list = root["requirements"];
+  if (!list) return ok_status();
+  if (!list.IsSequence() || list.size() == 0) return yaml.error(list, "requirements", "expected a non-empty list");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string what = "requirements[" + std::to_string(i) + "]";
+    auto text = yaml.text(list[i], what);
+    if (!text) return text.error();
+    auto r = parse_requirement(*text);
+    if (!r) return yaml.error(list[i], what, r.error().message);
+    const auto kind = fault_kind_from_name(r->kind);
+    if (r->kind == "none" ? !spec.fault_free
+                          : kind && std::find(spec.kinds.begin(), spec.kinds.end(), *kind) == spec.kinds.end())
+      return yaml.error(list[i], what, "the campaign runs no " + r->kind + (r->kind == "none" ? " (fault_free: false)" : " fault"));
+    spec.requirements.push_back(*r);
+  }
+  return ok_status();
+}
+
 //! `gyros:`, `onsets_s:`, `seeds:`, `duration_s:` and `fault_free:`.
 Status parse_axes(const YamlReader& yaml, const YAML::Node& root, CampaignSpec& spec) {
   auto gyros = list_of<int>(yaml, root, "gyros", "gyros", [&](const YAML::Node& n, const std::string& w) {
@@ -168,11 +203,17 @@ Status parse_axes(const YamlReader& yaml, const YAML::Node& root, CampaignSpec& 
       });
   if (!onsets) return onsets.error();
   spec.onsets_s = *onsets;
-  auto seeds = list_of<std::uint64_t>(
-      yaml, root, "seeds", "seeds",
-      [&](const YAML::Node& n, const std::string& w) { return yaml.unsigned_integer(n, w); });
-  if (!seeds) return seeds.error();
-  spec.seeds = *seeds;
+  if (root["seeds"].IsMap()) {
+    auto seeds = seed_range(yaml, root["seeds"]);
+    if (!seeds) return seeds.error();
+    spec.seeds = *seeds;
+  } else {
+    auto seeds = list_of<std::uint64_t>(
+        yaml, root, "seeds", "seeds",
+        [&](const YAML::Node& n, const std::string& w) { return yaml.unsigned_integer(n, w); });
+    if (!seeds) return seeds.error();
+    spec.seeds = *seeds;
+  }
   if (root["duration_s"]) {
     auto d = yaml.number(root["duration_s"], "duration_s");
     if (!d) return d.error();
@@ -190,7 +231,8 @@ Status parse_axes(const YamlReader& yaml, const YAML::Node& root, CampaignSpec& 
 Result<CampaignSpec> parse_spec(const YAML::Node& root, const YamlReader& yaml, const std::string& base_dir) {
   if (Status st = yaml.check_keys(root,
                                   {"scenarios", "kinds", "gyros", "onsets_s", "sizes", "seeds", "duration_s",
-                                   "fault_free", "pipeline", "loop", "target", "domain"},
+                                   "fault_free", "pipeline", "loop", "target", "domain", "dispersions",
+                                   "requirements"},
                                   "");
       !st)
     return st.error();
@@ -199,6 +241,12 @@ Result<CampaignSpec> parse_spec(const YAML::Node& root, const YamlReader& yaml, 
   if (Status st = parse_scenarios(yaml, root, base_dir, spec); !st) return st.error();
   if (Status st = parse_kinds_and_sizes(yaml, root, spec); !st) return st.error();
   if (Status st = parse_axes(yaml, root, spec); !st) return st.error();
+  if (Status st = parse_requirements(yaml, root, spec); !st) return st.error();
+  if (root["dispersions"]) {
+    auto dispersions = parse_dispersions(yaml, root["dispersions"], spec.kinds, spec.gyros);
+    if (!dispersions) return dispersions.error();
+    spec.dispersions = *dispersions;
+  }
   auto pipeline = fdi::pipeline_config_from_yaml(root["pipeline"], yaml.source());
   if (!pipeline) return pipeline.error();
   spec.pipeline = pipeline.value();
@@ -221,6 +269,12 @@ Status check_cases(const CampaignSpec& spec, const YAML::Node& root, const YamlR
       const YAML::Node key = spec.duration_s ? root["duration_s"] : at;
       return yaml.error(key, spec.duration_s ? "duration_s" : name,
                         (spec.duration_s ? "with " + name + ": " : std::string()) + st.error().message);
+    }
+    if (!spec.dispersions.empty()) {
+      if (Status st = check_dispersions(yaml, root["dispersions"], spec.dispersions, sc, name,
+                                        spec.loop == CampaignLoop::kClosed, spec.onsets_s, spec.sizes);
+          !st)
+        return st;
     }
     for (std::size_t g = 0; g < spec.gyros.size(); ++g) {
       if (spec.gyros[g] > sc.unit.gyro_count())
@@ -310,6 +364,9 @@ std::size_t size_count(const CampaignSpec& spec, FaultKind kind) {
   return 1;
 }
 
+//! Case `index` of the matrix, before its dispersions.
+CampaignCase matrix_case(const CampaignSpec& spec, std::size_t index);
+
 //! Runs of one scenario, or nullopt above kMaxCampaignRuns.
 std::optional<std::size_t> runs_per_scenario(const CampaignSpec& spec) {
   std::optional<std::size_t> total = spec.fault_free ? spec.seeds.size() : 0;
@@ -353,6 +410,22 @@ Result<std::size_t> campaign_run_count(const CampaignSpec& spec) {
 }
 
 CampaignCase campaign_case(const CampaignSpec& spec, std::size_t index) {
+  CampaignCase c = matrix_case(spec, index);
+  if (spec.dispersions.empty()) return c;
+  c.draws = draw_dispersions(spec.dispersions, index, spec.scenarios[c.scenario].unit);
+  if (c.fault) c.fault = dispersed_fault(*c.fault, spec.dispersions, c.draws, spec.kinds, spec.sizes);
+  return c;
+}
+
+int CampaignSpec::max_gyro_count() const {
+  int n = 0;
+  for (const Scenario& sc : scenarios) n = std::max(n, sc.unit.gyro_count());
+  return n;
+}
+
+namespace {
+
+CampaignCase matrix_case(const CampaignSpec& spec, std::size_t index) {
   const std::size_t per_scenario = *runs_per_scenario(spec);
   CampaignCase c;
   c.index = index;
@@ -390,6 +463,8 @@ CampaignCase campaign_case(const CampaignSpec& spec, std::size_t index) {
   return c;  // not reached for index < campaign_run_count(spec)
 }
 
+}  // namespace
+
 std::optional<double> cusum_theory_delay_s(const Calibration& unit, const fdi::PipelineConfig& config,
                                            double rate_hz, int gyro, double size_dps) {
   const int n = unit.gyro_count();
@@ -425,6 +500,21 @@ std::string campaign_csv_header() {
          "max_wheel_momentum_fraction,wrong_gyro,wrong_at_s,error";
 }
 
+std::string campaign_csv_header(const CampaignSpec& spec) {
+  std::string out = campaign_csv_header();
+  for (const std::string& column : dispersion_columns(spec.dispersions, spec.max_gyro_count())) out += "," + column;
+  return out;
+}
+
+namespace {
+//! The dispersion columns' fields of a row, each after a comma (nothing without dispersions).
+std::string draw_fields(const CampaignRow& r) {
+  std::string out;
+  for (const std::string& field : r.draws) out += "," + field;
+  return out;
+}
+}  // namespace
+
 std::string campaign_csv_row(const CampaignRow& r) {
   std::string out = std::to_string(r.run) + "," + metadata_token(r.scenario) + "," + r.kind + "," +
                     std::to_string(r.gyro) + ",";
@@ -433,7 +523,7 @@ std::string campaign_csv_row(const CampaignRow& r) {
   append_double(out, r.size);
   out += "," + std::to_string(r.seed) + ",";
   // An error row: outcome `error`, the result columns empty, the message in `error` (column kErrorColumn).
-  if (!r.error.empty()) return out + "error" + std::string(kErrorColumn - 7, ',') + r.error;
+  if (!r.error.empty()) return out + "error" + std::string(kErrorColumn - 7, ',') + r.error + draw_fields(r);
   out += std::string(outcome_name(r.fdi.outcome)) + ",";
   out += r.fdi.isolated_gyro ? std::to_string(*r.fdi.isolated_gyro) : std::string();
   out += "," + opt_text(r.fdi.detection_delay_s) + "," + opt_text(r.fdi.isolation_delay_s) + "," +
@@ -446,6 +536,7 @@ std::string campaign_csv_row(const CampaignRow& r) {
          ",";
   out += r.fdi.wrong_gyro ? std::to_string(*r.fdi.wrong_gyro) : std::string();
   out += "," + opt_text(r.fdi.wrong_at_s) + ",";
+  return out + draw_fields(r);
   return out;
 }
 
@@ -454,9 +545,9 @@ Result<CampaignRow> parse_campaign_row(const std::string& line) {
   std::stringstream in(line);
   for (std::string field; std::getline(in, field, ',');) f.push_back(field);
   if (!line.empty() && line.back() == ',') f.emplace_back();
-  if (f.size() != kCampaignColumns)
+  if (f.size() < kCampaignColumns)
     return bad_input("campaign row with " + std::to_string(f.size()) + " fields (" +
-                     std::to_string(kCampaignColumns) + " expected)");
+                     std::to_string(kCampaignColumns) + " or more expected)");
   try {
     const auto num = [](const std::string& s) {
       return s.empty() ? std::numeric_limits<double>::quiet_NaN() : std::stod(s);
@@ -472,6 +563,7 @@ Result<CampaignRow> parse_campaign_row(const std::string& line) {
     r.onset_s = num(f[4]);
     r.size = num(f[5]);
     r.seed = std::stoull(f[6]);
+    r.draws.assign(f.begin() + static_cast<std::ptrdiff_t>(kCampaignColumns), f.end());
     if (f[7] == "error") {
       if (f[kErrorColumn].empty()) return bad_input("campaign row: outcome error without its message");
       r.error = f[kErrorColumn];

@@ -26,17 +26,26 @@ CampaignRow case_columns(const CampaignSpec& spec, const CampaignCase& c) {
   row.onset_s = c.fault ? c.fault->at_s : 0.0;
   row.size = c.fault ? c.fault->size : 0.0;
   row.seed = c.seed;
+  if (!spec.dispersions.empty())
+    row.draws = dispersion_fields(spec.dispersions, c.draws, spec.max_gyro_count(), spec.kinds);
   return row;
 }
 
 //! The columns that describe the case and the CUSUM theory for bias steps.
 CampaignRow case_row(const CampaignSpec& spec, const CampaignCase& c, const Scenario& sc) {
   CampaignRow row = case_columns(spec, c);
-  if (c.fault && c.fault->kind == FaultKind::kBias) {
-    row.theory_delay_s =
-        cusum_theory_delay_s(sc.unit, spec.pipeline, sc.rate_hz, c.fault->gyro, c.fault->size);
+  if (c.fault && c.fault->kind == FaultKind::kBias) {  // the pipeline's thresholds: its calibration
+    row.theory_delay_s = cusum_theory_delay_s(spec.scenarios[c.scenario].unit, spec.pipeline, sc.rate_hz,
+                                              c.fault->gyro, c.fault->size);
   }
   return row;
+}
+
+//! The scenario the estimator is made for: the run's, with the calibration the pipeline uses (the
+//! nominal unit) in place of the dispersed truth.
+Scenario pipeline_view(const CampaignSpec& spec, const CampaignCase& c, Scenario sc) {
+  sc.unit = spec.scenarios[c.scenario].unit;
+  return sc;
 }
 
 SimOptions case_options(const CampaignCase& c) {
@@ -50,7 +59,7 @@ Result<CampaignRow> run_closed(const CampaignSpec& spec, const CampaignCase& c, 
                                const EstimatorFactory& make) {
   auto simulator = ClosedLoopSimulator::create(sc, case_options(c));
   if (!simulator) return simulator.error();
-  auto estimator = make(sc, c, simulator->initial_q_NB());
+  auto estimator = make(pipeline_view(spec, c, sc), c, simulator->initial_q_NB());
   if (!estimator) return estimator.error();
   auto record = run_closed_loop(*simulator, **estimator);
   if (!record) return record.error();
@@ -74,7 +83,7 @@ Result<CampaignRow> run_open(const CampaignSpec& spec, const CampaignCase& c, co
   const SimOptions options = case_options(c);
   auto simulator = Simulator::create(sc, options);
   if (!simulator) return simulator.error();
-  auto estimator = make(sc, c, open_loop_initial_q_RB(*simulator));
+  auto estimator = make(pipeline_view(spec, c, sc), c, open_loop_initial_q_RB(*simulator));
   if (!estimator) return estimator.error();
   auto record = run_open_loop(*simulator, **estimator);
   if (!record) return record.error();
@@ -105,7 +114,7 @@ Scenario campaign_scenario(const CampaignSpec& spec, const CampaignCase& c) {
   Scenario sc = spec.scenarios[c.scenario];
   if (spec.duration_s) sc.duration_s = *spec.duration_s;
   sc.faults.clear();
-  return sc;
+  return c.draws.empty() ? sc : dispersed_scenario(sc, spec.dispersions, c.draws);
 }
 
 EstimatorFactory in_process_estimators(const CampaignSpec& spec) {

@@ -30,6 +30,7 @@ void GyroPackage::reset() {
     drop_rngs_.emplace_back(stream_seed(seed_, Stream::kDropped, i));
   }
   reference_rng_ = Rng(stream_seed(seed_, Stream::kReference, -1));
+  reference_drop_rng_ = Rng(stream_seed(seed_, Stream::kReferenceDrop, -1));
   last_output_V_.assign(static_cast<std::size_t>(n), 0.0);
   has_last_output_.assign(static_cast<std::size_t>(n), 0);
   stuck_value_V_.assign(faults_.size(), std::nullopt);
@@ -145,6 +146,8 @@ std::optional<Quaternion> GyroPackage::reference(std::size_t k, const Quaternion
   const double sigma_rad = reference_options_.noise_arcsec * kArcsecToRad;
   Eigen::Vector3d error_rad;
   for (int a = 0; a < 3; ++a) error_rad[a] = sigma_rad * reference_rng_.normal();
+  const double p_drop = reference_options_.drop_probability;
+  if (p_drop > 0.0 && reference_drop_rng_.uniform() < p_drop) return std::nullopt;  // drawn, not delivered
   if (before_first) return std::nullopt;  // (its noise drawn all the same: the stream stays aligned)
   return canonical(seen * quat_exp(error_rad + reference_error_rad(reference_options_, t_s)));
 }

@@ -100,7 +100,8 @@ Status read_reference(const YamlReader& yaml, const YAML::Node& root, Scenario& 
   ReferenceOptions& r = sc.reference;
   if (Status st = yaml.check_keys(ref,
                                   {"rate_hz", "noise_arcsec", "latency_s", "bias_arcsec", "bias_at_s",
-                                   "bias_ramp_s", "misid_deg", "misid_at_s", "misid_duration_s"},
+                                   "bias_ramp_s", "misid_deg", "misid_at_s", "misid_duration_s",
+                                   "drop_probability"},
                                   "reference");
       !st)
     return st;
@@ -113,7 +114,8 @@ Status read_reference(const YamlReader& yaml, const YAML::Node& root, Scenario& 
                         {"bias_ramp_s", &r.bias_ramp_s},
                         {"misid_deg", &r.misid_deg},
                         {"misid_at_s", &r.misid_at_s},
-                        {"misid_duration_s", &r.misid_duration_s}});
+                        {"misid_duration_s", &r.misid_duration_s},
+                        {"drop_probability", &r.drop_probability}});
 }
 
 Status read_gyro_model(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
@@ -272,6 +274,8 @@ Status validate_scenario(const Scenario& sc) {
   const ReferenceOptions& r = sc.reference;
   if (!std::isfinite(r.latency_s) || r.latency_s < 0.0 || r.latency_s > 10.0)
     return bad_input("reference latency_s must be in [0, 10], got " + number_text(r.latency_s));
+  if (!(r.drop_probability >= 0.0 && r.drop_probability < 1.0))
+    return bad_input("reference drop_probability must be in [0, 1), got " + number_text(r.drop_probability));
   for (const auto& [value, key] : {std::pair{r.bias_arcsec, "bias_arcsec"},
                                    {r.bias_at_s, "bias_at_s"},
                                    {r.misid_deg, "misid_deg"},

@@ -122,14 +122,24 @@ Result<Manifest> read_manifest(const std::string& dir) {
   return m;
 }
 
-Result<std::vector<Row>> read_rows(const std::string& runs_csv, bool drop_errors) {
+Result<std::string> read_header(const std::string& runs_csv) {
+  std::ifstream in(runs_csv);
+  std::string line;
+  if (!in || !std::getline(in, line)) return bad_input(runs_csv + ": cannot read its header");
+  const std::string base = sim::campaign_csv_header();
+  if (line.compare(0, base.size(), base) != 0 || (line.size() > base.size() && line[base.size()] != ','))
+    return bad_input(runs_csv + ":1: not the header of a campaign of this version");
+  return line;
+}
+
+Result<std::vector<Row>> read_rows(const std::string& runs_csv, const std::string& header, bool drop_errors) {
   std::vector<Row> rows;
   std::ifstream in(runs_csv);
   if (!in) return rows;
   std::string line;
   if (!std::getline(in, line)) return rows;
-  if (line != sim::campaign_csv_header())
-    return bad_input(runs_csv + ":1: not the header of a campaign of this version");
+  if (line != header)
+    return bad_input(runs_csv + ":1: not the header of this campaign (another version, or other dispersions)");
   for (std::size_t number = 2; std::getline(in, line); ++number) {
     auto row = sim::parse_campaign_row(line);
     if (!row) continue;  // a torn line (an interrupted write): the run is done again
@@ -144,8 +154,8 @@ Result<std::vector<Row>> read_rows(const std::string& runs_csv, bool drop_errors
   return rows;
 }
 
-Status write_rows(const std::string& runs_csv, const std::vector<Row>& rows) {
-  std::string text = sim::campaign_csv_header() + "\n";
+Status write_rows(const std::string& runs_csv, const std::string& header, const std::vector<Row>& rows) {
+  std::string text = header + "\n";
   for (const Row& r : rows) text += r.line + "\n";
   return write_text_file(runs_csv, text);
 }
@@ -184,7 +194,7 @@ Result<std::vector<std::size_t>> prepare_folder(const sim::CampaignSpec& spec, c
     return bad_input(summary.runs_csv + ": a campaign's rows without " + folder::kHashFile +
                      " (its spec cannot be checked): use another --out");
   }
-  auto rows = folder::read_rows(summary.runs_csv, true);
+  auto rows = folder::read_rows(summary.runs_csv, sim::campaign_csv_header(spec), true);
   if (!rows) return rows.error();
   for (const folder::Row& r : *rows) {
     if (r.run >= *matrix_runs || !in_shard(options.shard, r.run))
@@ -192,7 +202,7 @@ Result<std::vector<std::size_t>> prepare_folder(const sim::CampaignSpec& spec, c
                        shard_text(options.shard) + " of this campaign");
   }
   // Without the torn line and the error rows (those runs are done again).
-  if (Status st = folder::write_rows(summary.runs_csv, *rows); !st) return st.error();
+  if (Status st = folder::write_rows(summary.runs_csv, sim::campaign_csv_header(spec), *rows); !st) return st.error();
   if (!has_hash) {
     auto text = read_input(options.spec_path, kMaxYamlBytes);
     if (!text) return text.error();

@@ -33,9 +33,11 @@ struct Row {
   std::string line;
 };
 //! The rows of `runs_csv` by run (none when the file does not exist); a torn line is dropped, and with
-//! `drop_errors` the error rows too. A header of another version, or a run twice, is an error.
-Result<std::vector<Row>> read_rows(const std::string& runs_csv, bool drop_errors);
-//! Writes the header and `rows` in their order (atomically).
-Status write_rows(const std::string& runs_csv, const std::vector<Row>& rows);
+//! `drop_errors` the error rows too. A header other than `header`, or a run twice, is an error.
+Result<std::vector<Row>> read_rows(const std::string& runs_csv, const std::string& header, bool drop_errors);
+//! Writes `header` and `rows` in their order (atomically).
+Status write_rows(const std::string& runs_csv, const std::string& header, const std::vector<Row>& rows);
+//! The header line of `runs_csv`: this version's columns, then the spec's dispersion columns if any.
+Result<std::string> read_header(const std::string& runs_csv);
 
 }  // namespace tetra::campaign::folder

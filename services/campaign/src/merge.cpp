@@ -7,6 +7,9 @@
 #include "tetra/campaign/runner.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/input_files.hpp"
+#include "tetra/sim/requirement.hpp"
+
+#include <yaml-cpp/yaml.h>
 
 namespace tetra::campaign {
 
@@ -50,11 +53,14 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
     }
     return bad_input("shards missing (" + missing + "): the shards must cover every run");
   }
+  // The header (with the spec's dispersion columns) is the first shard's; every shard must have it.
+  auto header = folder::read_header(folder::path_in(shard_dirs[0], folder::kRunsFile));
+  if (!header) return header.error();
   std::vector<folder::Row> all;
   all.reserve(first.matrix_runs);
   for (std::size_t i = 0; i < manifests.size(); ++i) {
     const std::string runs_csv = folder::path_in(shard_dirs[i], folder::kRunsFile);
-    auto rows = folder::read_rows(runs_csv, false);
+    auto rows = folder::read_rows(runs_csv, *header, false);
     if (!rows) return rows.error();
     const Shard& shard = manifests[i].shard;
     std::size_t expected = shard.k - 1;
@@ -83,7 +89,7 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
   summary.total = all.size();
   summary.runs_csv = folder::path_in(out_dir, folder::kRunsFile);
   for (const folder::Row& r : all) summary.errors += r.error ? 1 : 0;
-  if (Status st = folder::write_rows(summary.runs_csv, all); !st) return st.error();
+  if (Status st = folder::write_rows(summary.runs_csv, *header, all); !st) return st.error();
   auto spec_copy = read_input(folder::path_in(shard_dirs[0], folder::kSpecCopy), kMaxYamlBytes);
   if (!spec_copy) return spec_copy.error();
   if (Status st = write_text_file(folder::path_in(out_dir, folder::kSpecCopy), *spec_copy); !st)
@@ -95,6 +101,28 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
   if (Status st = write_text_file(folder::path_in(out_dir, folder::kHashFile), first.spec_sha256 + "\n"); !st)
     return st.error();
   return summary;
+}
+
+Result<sim::CampaignReportOptions> folder_report_options(const std::string& dir) {
+  sim::CampaignReportOptions options;
+  auto header = folder::read_header(folder::path_in(dir, folder::kRunsFile));
+  if (!header) return header.error();
+  options.statistics = header->size() > sim::campaign_csv_header().size();
+  const std::string spec_path = folder::path_in(dir, folder::kSpecCopy);
+  auto text = read_input(spec_path, std::size_t{16} << 20);
+  if (!text) return text.error();
+  try {
+    const YAML::Node list = YAML::Load(*text)["requirements"];
+    if (!list) return options;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      auto r = sim::parse_requirement(list[i].as<std::string>());
+      if (!r) return bad_input(spec_path + ": requirements[" + std::to_string(i) + "]: " + r.error().message);
+      options.requirements.push_back(*r);
+    }
+  } catch (const YAML::Exception& e) {
+    return bad_input(spec_path + ": " + e.what());
+  }
+  return options;
 }
 
 }  // namespace tetra::campaign

@@ -365,12 +365,12 @@ Result<RunSummary> run_campaign(const sim::CampaignSpec& spec, const RunOptions&
     pool.report_progress(true);
   }
   // Every row in: runs.csv by run, the file whatever the number of workers or shards.
-  auto rows = folder::read_rows(summary.runs_csv, false);
+  auto rows = folder::read_rows(summary.runs_csv, sim::campaign_csv_header(spec), false);
   if (!rows) return rows.error();
   if (rows->size() != summary.total)
     return failure(summary.runs_csv + ": " + std::to_string(rows->size()) + " rows of " +
                    std::to_string(summary.total) + " runs after the campaign");
-  if (Status st = folder::write_rows(summary.runs_csv, *rows); !st) return st.error();
+  if (Status st = folder::write_rows(summary.runs_csv, sim::campaign_csv_header(spec), *rows); !st) return st.error();
   summary.errors = static_cast<std::size_t>(
       std::count_if(rows->begin(), rows->end(), [](const folder::Row& r) { return r.error; }));
   return summary;

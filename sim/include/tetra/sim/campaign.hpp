@@ -16,8 +16,10 @@
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/config.hpp"
 #include "tetra/sim/closed_loop_run.hpp"
+#include "tetra/sim/dispersion.hpp"
 #include "tetra/sim/fault.hpp"
 #include "tetra/sim/fdi_verdict.hpp"
+#include "tetra/sim/requirement.hpp"
 #include "tetra/sim/scenario.hpp"
 
 namespace tetra::sim {
@@ -49,6 +51,10 @@ struct CampaignSpec {
   CampaignLoop loop = CampaignLoop::kClosed;
   CampaignTarget target = CampaignTarget::kInProcess;
   int dds_domain = 0;  //!< `domain:` the DDS domain id (target dds)
+  DispersionSpec dispersions;             //!< `dispersions:` (none: every run the nominal truth)
+  std::vector<Requirement> requirements;  //!< `requirements:` judged by the report
+  //! The most gyros of any scenario (the rows' per-gyro dispersion columns).
+  int max_gyro_count() const;
 };
 
 //! Reads a campaign spec; errors name file, line and key. Every value is checked (types, ranges,
@@ -63,6 +69,7 @@ struct CampaignCase {
   std::size_t scenario = 0;        //!< index into spec.scenarios
   std::optional<FaultSpec> fault;  //!< the injected fault
   std::uint64_t seed = 1;
+  DispersionDraws draws;  //!< the run's dispersion draws (empty without dispersions)
 };
 
 //! [runs] the largest campaign read (docs/campaign.md): a small spec can describe a matrix of any size.
@@ -74,7 +81,8 @@ Result<std::size_t> campaign_run_count(const CampaignSpec& spec);
 //! fault-free runs first), made on demand: a campaign never holds its cases in memory.
 CampaignCase campaign_case(const CampaignSpec& spec, std::size_t index);
 
-//! The scenario of a case as it runs: the spec's duration, the matrix's fault instead of its own.
+//! The scenario of a case as it runs: the spec's duration, the matrix's fault instead of its own, the
+//! case's dispersions applied (its unit is then the true unit, not the calibration the pipeline uses).
 Scenario campaign_scenario(const CampaignSpec& spec, const CampaignCase& c);
 
 struct CampaignRow {
@@ -96,12 +104,14 @@ struct CampaignRow {
   std::optional<double> recover_s;
   double bound_deg = 0.0;
   double max_wheel_momentum_fraction = 0.0;
+  std::vector<std::string> draws;  //!< the dispersion columns' fields (campaigns with dispersions)
   //! Empty for a run that finished; otherwise why it did not (an error value, an exception, a crashed
   //! or timed-out worker): the row then holds only the case's columns, `outcome` error, and this.
   std::string error;
 };
 
-//! Makes the estimator of one run from the scenario as it runs and its true initial attitude.
+//! Makes the estimator of one run from the scenario as it runs (its `unit` the calibration the pipeline
+//! uses: the nominal unit, not a dispersed truth) and its true initial attitude.
 using EstimatorFactory = std::function<Result<std::unique_ptr<Estimator>>(
     const Scenario& scenario, const CampaignCase& c, const Quaternion& initial_q_RB)>;
 //! The fusion pipeline in process, with the spec's configuration.
@@ -121,8 +131,10 @@ Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCa
 //! text: a service configured with it starts where the in-process pipeline starts.
 std::string pipeline_yaml_from(const CampaignSpec& spec, const Quaternion& initial_q_RB);
 
-//! The CSV header and one row (the columns: docs/campaign.md).
+//! The CSV header and one row (the columns: docs/campaign.md); a spec with dispersions appends a
+//! column per drawn value (dispersion_columns).
 std::string campaign_csv_header();
+std::string campaign_csv_header(const CampaignSpec& spec);
 std::string campaign_csv_row(const CampaignRow& row);
 //! Parses a row written by campaign_csv_row (for resuming and the report); error on a torn line.
 Result<CampaignRow> parse_campaign_row(const std::string& line);

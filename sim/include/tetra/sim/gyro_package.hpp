@@ -32,7 +32,8 @@ class GyroPackage {
   void sample(const Eigen::Vector3d& sensed_dps, double t_s, std::vector<double>& raw_V,
               std::vector<std::uint8_t>& present);
   //! The attitude reference of epoch `k` (none between reference periods): the truth `latency_s` earlier ⊗
-  //! exp(δθ + slow bias + mis-identification). Called for every epoch (it keeps the truth's recent past).
+  //! exp(δθ + slow bias + mis-identification), none for a dropout (`drop_probability`). Called for every
+  //! epoch (it keeps the truth's recent past).
   std::optional<Quaternion> reference(std::size_t k, const Quaternion& truth_q_RB);
 
   const std::vector<FaultSpec>& faults() const { return faults_; }
@@ -50,6 +51,7 @@ class GyroPackage {
   GyroModelOptions model_;
   std::vector<GyroChannel> channels_;
   Rng reference_rng_;
+  Rng reference_drop_rng_;  //!< its own stream: dropouts leave the noise samples as they were
   std::vector<Rng> drop_rngs_;
   std::vector<double> last_output_V_;  //!< per gyro: last delivered value
   std::vector<std::uint8_t> has_last_output_;

@@ -34,6 +34,7 @@ enum class Stream : std::uint64_t {
   kJitter = 6,
   kReference = 7,
   kMotion = 8,
+  kReferenceDrop = 9,
 };
 
 //! Seed of the stream `stream` of gyro `gyro_index0` (use -1 for streams that belong to no gyro).

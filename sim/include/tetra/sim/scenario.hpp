@@ -18,7 +18,7 @@ namespace tetra::sim {
 
 //! Star-tracker-like attitude reference: q_RB(t − latency) ⊗ exp(δθ + b(t) + m(t)), δθ ~ N(0, σ²·I) per axis
 //! (in B); b a slow (thermal) bias, m a mis-identification episode. The failure modes (latency, slow bias,
-//! mis-identification; a noisier reference is `noise_arcsec` itself) are off by default (docs/sim.md).
+//! mis-identification, dropouts; a noisier reference is `noise_arcsec` itself) are off by default (docs/sim.md).
 struct ReferenceOptions {
   double rate_hz = 0.0;       //!< [Hz] 0 = no reference
   double noise_arcsec = 0.0;  //!< [arcsec] 1σ per axis
@@ -29,6 +29,7 @@ struct ReferenceOptions {
   double misid_deg = 0.0;     //!< [deg] mis-identification: turned about (0.6, 0.8, 0) of B by this much...
   double misid_at_s = 0.0;    //!< [s] ...from here...
   double misid_duration_s = 0.0;  //!< [s] ...for this long (0: none)
+  double drop_probability = 0.0;  //!< each reference sample independently not delivered (a dropout)
 };
 
 struct Scenario {

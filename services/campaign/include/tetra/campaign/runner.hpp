@@ -14,6 +14,7 @@
 
 #include "tetra/core/result.hpp"
 #include "tetra/sim/campaign.hpp"
+#include "tetra/sim/campaign_report.hpp"
 
 namespace tetra::campaign {
 
@@ -87,5 +88,10 @@ Result<std::string> campaign_spec_hash(const sim::CampaignSpec& spec, const std:
 //! together cover every run; then writes OUT/runs.csv sorted by run (the file a one-machine campaign
 //! writes), spec.yaml, spec.sha256 and shard.txt (1/1). OUT must not be one of the shards.
 Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<std::string>& shard_dirs);
+
+//! The report options of a campaign folder (a merge's output, which has no spec object): the statistics
+//! when runs.csv has dispersion columns, and the requirements of its spec.yaml — what
+//! sim::report_options gives for the spec itself, so a merged report equals a one-machine one.
+Result<sim::CampaignReportOptions> folder_report_options(const std::string& dir);
 
 }  // namespace tetra::campaign
