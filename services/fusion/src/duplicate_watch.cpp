@@ -6,14 +6,16 @@
 
 namespace tetra::service {
 
-Result<DuplicateWatch> DuplicateWatch::create(const dds::Session& session, std::string unit, int domain,
-                                              dds_entity_t own_health_writer) {
-  dds_instance_handle_t own = 0;
-  if (const dds_return_t rc = dds_get_instance_handle(own_health_writer, &own); rc < 0)
-    return failure("fusion: the Health writer's handle: " + std::string(dds_strretcode(rc)));
+Result<DuplicateWatch> DuplicateWatch::create(const dds::Session& session, std::string unit, int domain) {
   auto reader = session.reader<tetra_Health>(dds::health_qos());
   if (!reader) return reader.error();
-  return DuplicateWatch(std::move(reader).value(), std::move(unit), domain, own);
+  return DuplicateWatch(std::move(reader).value(), std::move(unit), domain);
+}
+
+Status DuplicateWatch::set_own_writer(dds_entity_t own_health_writer) {
+  if (const dds_return_t rc = dds_get_instance_handle(own_health_writer, &own_writer_); rc < 0)
+    return failure("fusion: the Health writer's handle: " + std::string(dds_strretcode(rc)));
+  return ok_status();
 }
 
 Status DuplicateWatch::check() const {

@@ -35,14 +35,14 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal* shutdown)
   deadline_ns_ = config_.deadline_ns();
   shutdown_ = shutdown;
   if (auto s = assign(session_, dds::Session::open(domain, config_.unit)); !s) return s;
-  if (auto s = open_endpoints(); !s) return s;
-  if (auto s = assign(duplicates_, DuplicateWatch::create(*session_, config_.unit, static_cast<int>(domain),
-                                                          health_writer_->handle()));
+  if (auto s = assign(duplicates_, DuplicateWatch::create(*session_, config_.unit, static_cast<int>(domain)));
       !s)
     return s;
   if (auto s = duplicates_->probe(session_->participant(), DuplicateWatch::kProbe, [this] { return stopping(); });
       !s)
     return s;
+  if (auto s = open_endpoints(); !s) return s;
+  if (auto s = duplicates_->set_own_writer(health_writer_->handle()); !s) return s;
   return open_waitset();
 }
 

@@ -28,10 +28,11 @@ class DuplicateWatch {
   //! 3–20 ms on loopback; check() catches one found later.
   static constexpr std::chrono::milliseconds kProbe{500};
 
-  //! A Health reader on `session` for `unit`; `own_health_writer` is the service's own writer (its
-  //! samples are not a duplicate).
-  static Result<DuplicateWatch> create(const dds::Session& session, std::string unit, int domain,
-                                       dds_entity_t own_health_writer);
+  //! A Health reader on `session` for `unit`. Create it, and probe, before the service's own readers and
+  //! writers: a newcomer that refuses has then matched nobody.
+  static Result<DuplicateWatch> create(const dds::Session& session, std::string unit, int domain);
+  //! The service's own Health writer, once created: its samples are not a duplicate.
+  Status set_own_writer(dds_entity_t own_health_writer);
   //! Waits up to `probe` for another writer's Health of the unit (`stop` ends the wait early), on a
   //! waitset of its own on `participant` (the one the reader was created on).
   Status probe(const dds::Participant& participant, std::chrono::nanoseconds probe,
@@ -41,14 +42,13 @@ class DuplicateWatch {
   dds_entity_t reader_handle() const { return reader_.handle(); }
 
  private:
-  DuplicateWatch(dds::Reader<tetra_Health> reader, std::string unit, int domain,
-                 dds_instance_handle_t own_writer)
-      : reader_(std::move(reader)), unit_(std::move(unit)), domain_(domain), own_writer_(own_writer) {}
+  DuplicateWatch(dds::Reader<tetra_Health> reader, std::string unit, int domain)
+      : reader_(std::move(reader)), unit_(std::move(unit)), domain_(domain) {}
 
   dds::Reader<tetra_Health> reader_;
   std::string unit_;
   int domain_;
-  dds_instance_handle_t own_writer_;
+  dds_instance_handle_t own_writer_ = 0;  //!< 0: none yet
 };
 
 }  // namespace tetra::service
