@@ -267,8 +267,9 @@ TEST(ClosedLoopScenario, OverlappingSlewsAreRefused) {
   const auto bad = parse_scenario(head + "      - {axis: x, angle_deg: 5, start_s: 60}\n", "x.yaml");
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("x.yaml:9"), std::string::npos) << bad.error().message;
-  EXPECT_NE(bad.error().message.find("pointing.slews[1].start_s 60 s: slews[0] is still under way until 75 s"),
-            std::string::npos)
+  EXPECT_NE(
+      bad.error().message.find("pointing.slews[1].start_s 60 s: slews[0] is still under way until 75 s"),
+      std::string::npos)
       << bad.error().message;
   EXPECT_TRUE(parse_scenario(head + "      - {axis: x, angle_deg: 5, start_s: 75}\n", "x.yaml"));
 }

@@ -61,8 +61,9 @@ void print_summary(const std::string& label, const sim::PointingSummary& s,
   std::cout << label << "wheels: max momentum " << dec(100.0 * s.max_wheel_momentum_fraction, 1)
             << " % of the limit, torque-limited " << dec(s.torque_limited_s, 1) << " s; control: hold "
             << s.counters.hold_epochs << " epochs, safe " << s.counters.safe_epochs << " epochs ("
-            << s.counters.safe_entries << " entries, " << s.counters.lost_epochs << " on a lost attitude); estimate age mean " << dec(s.mean_estimate_age_s, 4)
-            << " s, max " << dec(s.max_estimate_age_s, 3) << " s; estimates of their own epoch "
+            << s.counters.safe_entries << " entries, " << s.counters.lost_epochs
+            << " on a lost attitude); estimate age mean " << dec(s.mean_estimate_age_s, 4) << " s, max "
+            << dec(s.max_estimate_age_s, 3) << " s; estimates of their own epoch "
             << record.estimates_received << " of " << record.series.size() << "; run "
             << dec(record.wall_s, 2) << " s\n";
 }

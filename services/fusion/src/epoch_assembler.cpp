@@ -263,10 +263,9 @@ bool EpochAssembler::ready(const Pending& epoch, std::int64_t now_ns) const {
         track.last_stamp_ns && *track.last_stamp_ns > epoch.stamp_ns + config_.tolerance_ns;
     if (epoch.present[i] == 0 && !track.absent && !moved_past) return false;
   }
-  return !epoch.awaits_reference ||
-         std::any_of(references_.begin(), references_.end(), [&](const auto& r) {
-           return std::llabs(r.first - epoch.stamp_ns) <= config_.tolerance_ns;
-         });
+  return !epoch.awaits_reference || std::any_of(references_.begin(), references_.end(), [&](const auto& r) {
+    return std::llabs(r.first - epoch.stamp_ns) <= config_.tolerance_ns;
+  });
 }
 
 void EpochAssembler::emit(Pending& epoch, std::vector<fdi::Epoch>& out) {

@@ -38,7 +38,8 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal* shutdown)
   if (auto s = assign(duplicates_, DuplicateWatch::create(*session_, config_.unit, static_cast<int>(domain)));
       !s)
     return s;
-  if (auto s = duplicates_->probe(session_->participant(), DuplicateWatch::kProbe, [this] { return stopping(); });
+  if (auto s =
+          duplicates_->probe(session_->participant(), DuplicateWatch::kProbe, [this] { return stopping(); });
       !s)
     return s;
   if (auto s = open_endpoints(); !s) return s;

@@ -131,9 +131,9 @@ class FusionService {
   std::optional<dds::Writer<tetra_Attitude>> attitude_writer_;
   std::optional<dds::Writer<tetra_Health>> health_writer_;
   std::optional<dds::Writer<tetra_FdiEvent>> event_writer_;
-  std::optional<dds::Ros2View> ros2_view_;  //!< `ros2: enabled: true` (docs/ros2.md)
+  std::optional<dds::Ros2View> ros2_view_;    //!< `ros2: enabled: true` (docs/ros2.md)
   std::optional<DuplicateWatch> duplicates_;  //!< another service of this unit on the domain
-  const dds::Condition* wake_ = nullptr;    //!< the listener wakes the waitset thread for an epoch's deadline
+  const dds::Condition* wake_ = nullptr;  //!< the listener wakes the waitset thread for an epoch's deadline
   std::atomic<const dds::Condition*> stop_{nullptr};  //!< request_stop() wakes the waitset thread
 };
 
