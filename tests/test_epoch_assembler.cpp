@@ -239,8 +239,8 @@ TEST(EpochAssembler, AnEpochWhoseReferenceWasWrittenWaitsForIt) {
   ASSERT_EQ(out.size(), 1U);
   ASSERT_TRUE(out[0].reference_q_RB.has_value());
   EXPECT_EQ(out[0].reference_q_RB->w(), 0.5);
-  // A reference that never comes: the epoch goes at the latency limit, without one (and the reference,
-  // should it still come, is late and counted).
+  // A reference that never comes: the epoch goes at the latency limit, without one, and that is counted
+  // (references_late, on the wire within samples_late); should it still come, it is late and counted.
   for (int g = 1; g <= 4; ++g) EXPECT_EQ(a.add_sample(g, 2, kPeriod, g, kLatency, true), Verdict::kAccepted);
   out.clear();
   a.poll(2 * kLatency - 1, out);
@@ -248,8 +248,9 @@ TEST(EpochAssembler, AnEpochWhoseReferenceWasWrittenWaitsForIt) {
   a.poll(2 * kLatency, out);
   ASSERT_EQ(out.size(), 1U);
   EXPECT_FALSE(out[0].reference_q_RB.has_value());
-  a.add_reference(kPeriod, q);
   EXPECT_EQ(a.counters().references_late, 1U);
+  a.add_reference(kPeriod, q);
+  EXPECT_EQ(a.counters().references_late, 2U);
 }
 
 // --- The unit's clock (docs/dds.md, "Epoch assembly"): one bad stamp or sequence number never blinds it.

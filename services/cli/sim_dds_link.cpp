@@ -43,6 +43,7 @@ Result<std::unique_ptr<SimDdsLink>> SimDdsLink::open(const std::string& unit, do
   if (auto s = dds::copy_bounded(link->reference_.unit, unit, "unit"); !s) return s.error();
   if (auto s = link->wait_for_readers(options); !s) return s.error();
   if (auto s = link->wait_for_service(options); !s) return s.error();
+  if (auto s = link->prime_references(options); !s) return s.error();
   return link;
 }
 
@@ -165,6 +166,18 @@ Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
         return s.error();
     }
   }
+  return ok_status();
+}
+
+Status SimDdsLink::prime_references(const SimDdsOptions& options) {
+  // A volatile reader gets only what is written after it has discovered the writer. The service's Health
+  // says its gyro reader has; for its reference reader, a reference stamped before any epoch (attached
+  // to none) is written and its acknowledgement awaited: a reader acknowledges only a writer it knows.
+  if (options.wait_readers <= 0) return ok_status();
+  reference_.stamp_ns = -kNanosPerSecond;
+  reference_.q_RB[0] = 1.0;
+  if (auto s = reference_writer_.write(reference_); !s) return s.error();
+  (void)reference_writer_.wait_for_acks(std::chrono::seconds(2));
   return ok_status();
 }
 

@@ -55,6 +55,8 @@ class SimDdsLink {
         attitude_reader_(std::move(attitude_reader)) {}
   Status wait_for_readers(const SimDdsOptions& options);
   Status wait_for_service(const SimDdsOptions& options);
+  //! Makes sure the service's reference reader knows the reference writer before the first epoch.
+  Status prime_references(const SimDdsOptions& options);
   //! "; N GyroSample reader(s) refused this writer's QoS: deadline (…)" when a reader did not match, else "".
   std::string incompatible_readers_note() const;
 

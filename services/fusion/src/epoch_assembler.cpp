@@ -279,6 +279,8 @@ void EpochAssembler::emit(Pending& epoch, std::vector<fdi::Epoch>& out) {
   if (!references_.empty() && references_.front().first <= epoch.stamp_ns + config_.tolerance_ns) {
     result.reference_q_RB = references_.front().second;
     references_.pop_front();
+  } else if (epoch.awaits_reference) {
+    ++counters_.references_late;  // announced, and not in within max_latency_ns: the epoch goes without
   }
   last_emitted_ns_ = epoch.stamp_ns;
   ++counters_.epochs_emitted;
