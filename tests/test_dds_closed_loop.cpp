@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <chrono>
 #include <string>
+#include <thread>
 
 #include "test_support.hpp"
 #include "tetra/core/calibration_file.hpp"
@@ -78,6 +80,37 @@ TEST(DdsClosedLoop, RealTimeAt100HzHoldsThePointingBound) {
   EXPECT_LT(max_deg, 0.05) << run.out;
   EXPECT_NE(json.find("\"recovered\": true"), std::string::npos) << json;
   EXPECT_EQ(fusion.signal_and_wait(SIGTERM), 0);
+}
+
+// One service per unit on a domain: a second `tetra fusion` for a unit already served hears the first's
+// Health, refuses to start (exit 1, naming the unit and the domain) and writes nothing, so the first goes
+// on serving and a lockstep run against it still equals the in-process loop byte for byte.
+TEST(DdsClosedLoop, SecondServiceOfTheUnitIsRefused) {
+  const int domain = 213;
+  LoopFiles files(10.0, 60.0, 1.0);
+  TetraProcess first({"fusion", "--config", files.config, "--domain", std::to_string(domain)},
+                     files.dir.file("first.log"));
+  // Serving once it says so (after its own probe for another service): up to 30 s on a loaded machine.
+  for (int i = 0; i < 600 && read_file(files.dir.file("first.log")).find("running") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_NE(read_file(files.dir.file("first.log")).find("running"), std::string::npos);
+  TetraProcess second({"fusion", "--config", files.config, "--domain", std::to_string(domain)},
+                      files.dir.file("second.log"));
+  EXPECT_EQ(second.wait_exit(), 1);
+  const std::string refused = read_file(files.dir.file("second.log"));
+  EXPECT_NE(refused.find("another fusion service for unit 'tetra-loop' is running on domain " +
+                         std::to_string(domain)),
+            std::string::npos)
+      << refused;
+  EXPECT_EQ(refused.find("running, "), std::string::npos) << refused;  // it never served
+  const auto local =
+      run_tetra("sim " + files.scenario + " --closed-loop --pointing " + files.dir.file("local.csv"));
+  ASSERT_EQ(local.exit_status, 0) << local.err;
+  const auto wire = run_tetra("sim " + files.scenario + " --closed-loop --dds --domain " +
+                              std::to_string(domain) + " --pointing " + files.dir.file("wire.csv"));
+  ASSERT_EQ(wire.exit_status, 0) << wire.err << wire.out << read_file(files.dir.file("first.log"));
+  EXPECT_TRUE(read_file(files.dir.file("local.csv")) == read_file(files.dir.file("wire.csv")));
+  EXPECT_EQ(first.signal_and_wait(SIGTERM), 0);
 }
 
 }  // namespace

@@ -225,6 +225,34 @@ TEST(EpochAssembler, ReferenceIsAttachedToTheEpochWithinTolerance) {
   EXPECT_EQ(a.counters().references_late, 1U);
 }
 
+// A sample that says its reference was written holds the epoch until the reference is in, whichever of the
+// two streams arrives first (they have no common delivery order); without it, up to the latency limit only.
+TEST(EpochAssembler, AnEpochWhoseReferenceWasWrittenWaitsForIt) {
+  auto a = make();
+  const Quaternion q = from_wxyz(0.5, 0.5, 0.5, 0.5);
+  for (int g = 1; g <= 4; ++g) EXPECT_EQ(a.add_sample(g, 1, 0, g, 0, true), Verdict::kAccepted);
+  std::vector<fdi::Epoch> out;
+  a.poll(kLatency - 1, out);
+  EXPECT_TRUE(out.empty());  // every gyro in, the reference not yet
+  a.add_reference(500, q);   // within the tolerance of the epoch's stamp
+  a.poll(kLatency - 1, out);
+  ASSERT_EQ(out.size(), 1U);
+  ASSERT_TRUE(out[0].reference_q_RB.has_value());
+  EXPECT_EQ(out[0].reference_q_RB->w(), 0.5);
+  // A reference that never comes: the epoch goes at the latency limit, without one, and that is counted
+  // (references_late, on the wire within samples_late); should it still come, it is late and counted.
+  for (int g = 1; g <= 4; ++g) EXPECT_EQ(a.add_sample(g, 2, kPeriod, g, kLatency, true), Verdict::kAccepted);
+  out.clear();
+  a.poll(2 * kLatency - 1, out);
+  EXPECT_TRUE(out.empty());
+  a.poll(2 * kLatency, out);
+  ASSERT_EQ(out.size(), 1U);
+  EXPECT_FALSE(out[0].reference_q_RB.has_value());
+  EXPECT_EQ(a.counters().references_late, 1U);
+  a.add_reference(kPeriod, q);
+  EXPECT_EQ(a.counters().references_late, 2U);
+}
+
 // --- The unit's clock (docs/dds.md, "Epoch assembly"): one bad stamp or sequence number never blinds it.
 
 // Feeds epochs [from, to) of all four gyros at local time k·period, stamped k·period + stamp_offset

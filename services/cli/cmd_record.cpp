@@ -225,7 +225,7 @@ Status Recording::take_gyro_samples(const RecordLink& link, std::int64_t now) {
       std::cerr << "tetra record: recording unit " << o_.unit << '\n';
     }
     if (u != o_.unit) return;
-    (void)assembler_.add_sample(s.gyro, s.seq, s.stamp_ns, s.raw, now);
+    (void)assembler_.add_sample(s.gyro, s.seq, s.stamp_ns, s.raw, now, dds::reference_written(s));
   });
   if (!g) return g.error();
   auto r = link.reference->take([&](const tetra_AttitudeReference& s, const dds_sample_info_t&) {

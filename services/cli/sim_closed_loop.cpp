@@ -50,11 +50,8 @@ void print_summary(const std::string& label, const sim::PointingSummary& s,
             << " deg\n";
   for (const sim::PointingSegment& g : s.segments) {
     std::cout << label << "  " << g.label << " [" << dec(g.from_s, 1) << ", " << dec(g.to_s, 1) << ") s: rms "
-              << dec(g.rms_deg, 5) << " deg, max " << dec(g.max_deg, 5) << " deg";
-    if (&g != &s.segments.front()) {
-      std::cout << ", " << (g.recover_s ? "recovered after " + dec(*g.recover_s, 1) + " s" : "NOT recovered");
-    }
-    std::cout << '\n';
+              << dec(g.rms_deg, 5) << " deg, max " << dec(g.max_deg, 5) << " deg, "
+              << (g.recover_s ? "recovered after " + dec(*g.recover_s, 1) + " s" : "NOT recovered") << '\n';
   }
   if (record.fdi_events) {
     std::cout << label << "fdi: " << sim::outcome_name(s.fdi.outcome) << ", detection "
@@ -64,8 +61,9 @@ void print_summary(const std::string& label, const sim::PointingSummary& s,
   std::cout << label << "wheels: max momentum " << dec(100.0 * s.max_wheel_momentum_fraction, 1)
             << " % of the limit, torque-limited " << dec(s.torque_limited_s, 1) << " s; control: hold "
             << s.counters.hold_epochs << " epochs, safe " << s.counters.safe_epochs << " epochs ("
-            << s.counters.safe_entries << " entries); estimate age mean " << dec(s.mean_estimate_age_s, 4)
-            << " s, max " << dec(s.max_estimate_age_s, 3) << " s; estimates of their own epoch "
+            << s.counters.safe_entries << " entries, " << s.counters.lost_epochs
+            << " on a lost attitude); estimate age mean " << dec(s.mean_estimate_age_s, 4) << " s, max "
+            << dec(s.max_estimate_age_s, 3) << " s; estimates of their own epoch "
             << record.estimates_received << " of " << record.series.size() << "; run "
             << dec(record.wall_s, 2) << " s\n";
 }

@@ -8,7 +8,7 @@ Result<sim::EstimatorOutput> DdsEstimator::estimate(const sim::SimEpoch& epoch) 
   if (!lockstep_) {
     if (Status s = pace(epoch.stamp_ns); !s) return s.error();
   }
-  if (Status s = link_.publish(epoch, ++k_, lockstep_); !s) return s.error();
+  if (Status s = link_.publish(epoch, ++k_); !s) return s.error();
   if (Status s = take(); !s) return s.error();
   if (lockstep_) {
     const std::int64_t give_up = monotonic_ns() + kLockstepTimeout_ns;

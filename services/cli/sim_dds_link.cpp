@@ -43,6 +43,7 @@ Result<std::unique_ptr<SimDdsLink>> SimDdsLink::open(const std::string& unit, do
   if (auto s = dds::copy_bounded(link->reference_.unit, unit, "unit"); !s) return s.error();
   if (auto s = link->wait_for_readers(options); !s) return s.error();
   if (auto s = link->wait_for_service(options); !s) return s.error();
+  if (auto s = link->prime_references(options); !s) return s.error();
   return link;
 }
 
@@ -168,13 +169,24 @@ Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
   return ok_status();
 }
 
-Status SimDdsLink::publish(const sim::SimEpoch& epoch, std::uint64_t k, bool reference_acked) {
+Status SimDdsLink::prime_references(const SimDdsOptions& options) {
+  // A volatile reader gets only what is written after it has discovered the writer. The service's Health
+  // says its gyro reader has; for its reference reader, a reference stamped before any epoch (attached
+  // to none) is written and its acknowledgement awaited: a reader acknowledges only a writer it knows.
+  if (options.wait_readers <= 0) return ok_status();
+  reference_.stamp_ns = -kNanosPerSecond;
+  reference_.q_RB[0] = 1.0;
+  if (auto s = reference_writer_.write(reference_); !s) return s.error();
+  (void)reference_writer_.wait_for_acks(std::chrono::seconds(2));
+  return ok_status();
+}
+
+Status SimDdsLink::publish(const sim::SimEpoch& epoch, std::uint64_t k) {
   if (epoch.reference_q_RB) {
     reference_.stamp_ns = epoch.stamp_ns;
     const auto q = to_wxyz(*epoch.reference_q_RB);
     for (std::size_t i = 0; i < 4; ++i) reference_.q_RB[i] = q[i];
     if (auto s = reference_writer_.write(reference_); !s) return s.error();
-    if (reference_acked) (void)reference_writer_.wait_for_acks(std::chrono::seconds(2));
   }
   for (std::size_t g = 1; g <= epoch.present.size(); ++g) {
     if (epoch.present[g - 1] == 0) continue;  // not delivered (dropout)
@@ -182,18 +194,25 @@ Status SimDdsLink::publish(const sim::SimEpoch& epoch, std::uint64_t k, bool ref
     sample_.seq = k;  // the sensor's count: a dropped sample leaves a gap
     sample_.stamp_ns = epoch.stamp_ns;
     sample_.raw = epoch.raw_V[g - 1];
-    sample_.flags = 0;
+    sample_.flags = epoch.reference_q_RB ? dds::kGyroFlagReferenceWritten : 0u;
     if (auto s = gyro_writer_.write(sample_); !s) return s.error();
   }
   return ok_status();
 }
 
 Status SimDdsLink::take_attitudes(const std::function<void(const fdi::AttitudeEstimate&)>& on_attitude) {
-  auto taken = attitude_reader_.take([&](const tetra_Attitude& msg, const dds_sample_info_t&) {
+  bool second_writer = false;
+  auto taken = attitude_reader_.take([&](const tetra_Attitude& msg, const dds_sample_info_t& info) {
     if (dds::from_wire(msg.unit) != unit_) return;
-    on_attitude(dds::from_wire(msg));
+    if (attitude_writer_ == 0) attitude_writer_ = info.publication_handle;
+    if (info.publication_handle != attitude_writer_) second_writer = true;
+    if (!second_writer) on_attitude(dds::from_wire(msg));
   });
   if (!taken) return taken.error();
+  if (second_writer)
+    return failure("Attitude of unit " + unit_ +
+                   " from a second writer: two fusion services (or one restarted) serve this unit on the "
+                   "domain, and their estimates would mix");
   return ok_status();
 }
 

@@ -27,12 +27,12 @@ class SimDdsLink {
   static Result<std::unique_ptr<SimDdsLink>> open(const std::string& unit, double rate_hz,
                                                   const SimDdsOptions& options,
                                                   const dds::ShutdownSignal* shutdown);
-  //! Publishes one epoch: the reference first (the service has it when the epoch completes), then
-  //! the gyro samples delivered, with sequence number `k`.
-  //! `reference_acked`: wait until the readers have the reference before the gyro samples go (lockstep: the
-  //! two topics have no common order, and a reference that came after its epoch's samples would be late).
-  Status publish(const sim::SimEpoch& epoch, std::uint64_t k, bool reference_acked = false);
-  //! Takes the Attitude samples of this unit received so far, in order.
+  //! Publishes one epoch: the reference first, then the gyro samples delivered, with sequence number `k`;
+  //! with a reference, each sample carries dds::kGyroFlagReferenceWritten, so the service holds the
+  //! epoch until the reference is in (the two topics have no common delivery order), with no wait here.
+  Status publish(const sim::SimEpoch& epoch, std::uint64_t k);
+  //! Takes the Attitude samples of this unit received so far, in order; an error when they come from
+  //! more than one writer (two services of the unit).
   Status take_attitudes(const std::function<void(const fdi::AttitudeEstimate&)>& on_attitude);
   //! Blocks until data arrives on the Attitude reader, a shutdown is requested or the monotonic
   //! time `until_ns` passes.
@@ -55,6 +55,8 @@ class SimDdsLink {
         attitude_reader_(std::move(attitude_reader)) {}
   Status wait_for_readers(const SimDdsOptions& options);
   Status wait_for_service(const SimDdsOptions& options);
+  //! Makes sure the service's reference reader knows the reference writer before the first epoch.
+  Status prime_references(const SimDdsOptions& options);
   //! "; N GyroSample reader(s) refused this writer's QoS: deadline (…)" when a reader did not match, else "".
   std::string incompatible_readers_note() const;
 
@@ -65,6 +67,7 @@ class SimDdsLink {
   dds::Reader<tetra_Attitude> attitude_reader_;
   const dds::ShutdownSignal* shutdown_ = nullptr;
   std::vector<std::intptr_t> triggered_;
+  dds_instance_handle_t attitude_writer_ = 0;  //!< the one Attitude writer of this unit heard (0: none yet)
   tetra_GyroSample sample_{};
   tetra_AttitudeReference reference_{};
 };

@@ -72,7 +72,8 @@ Result<CampaignRow> run_closed(const CampaignSpec& spec, const CampaignCase& c, 
   const PointingSegment& after = summary.segments.back();
   row.pointing_rms_after_deg = after.rms_deg;
   row.pointing_max_after_deg = after.max_deg;
-  row.recover_s = summary.segments.size() > 1 ? after.recover_s : std::optional<double>(0.0);
+  // Recovered: every segment ends within the bound (a run that tumbles before its fault is not).
+  row.recover_s = summary.within_bound_after_recovery ? after.recover_s : std::nullopt;
   row.bound_deg = summary.bound_deg;
   row.max_wheel_momentum_fraction = summary.max_wheel_momentum_fraction;
   return row;

@@ -14,7 +14,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kRadPerSecToRpm = 60.0 / (2.0 * kPi);
 
 AttitudeKnowledge knowledge_of(const fdi::AttitudeEstimate& e) {
-  return {ns_to_seconds(e.stamp_ns), e.q_RB, e.omega_BR_B_rad_s};
+  return {ns_to_seconds(e.stamp_ns), e.q_RB, e.omega_BR_B_rad_s, e.mode != fdi::Mode::kLost};
 }
 
 PointingSample record_epoch(const ClosedLoopSimulator& sim, const SimEpoch& epoch,

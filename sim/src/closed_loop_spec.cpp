@@ -9,6 +9,7 @@
 #include "ranges.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/core/yaml_reader.hpp"
+#include "tetra/sim/guidance.hpp"
 #include "text.hpp"
 #include "yaml_fields.hpp"
 
@@ -275,7 +276,10 @@ Status check_pointing(const ClosedLoopSpec& s) {
                               "deg/s^2", true);
       !st)
     return st;
+  // Each slew's trapezoid keeps within max_rate_dps and max_accel_dps2 by itself; two under way at
+  // once would add their rates and accelerations, so a slew starts when the one before has ended.
   double previous_start = -INFINITY;
+  double previous_end = -INFINITY;
   for (std::size_t i = 0; i < p.slews.size(); ++i) {
     const PointingSlew& slew = p.slews[i];
     const std::string key = "pointing.slews[" + std::to_string(i) + "]";
@@ -285,7 +289,16 @@ Status check_pointing(const ClosedLoopSpec& s) {
       return st;
     if (!std::isfinite(slew.start_s) || slew.start_s < previous_start)
       return bad_input(key + ".start_s must be finite and in order");
+    if (slew.start_s < previous_end) {
+      return bad_input(key + ".start_s " + number_text(slew.start_s) + " s: slews[" + std::to_string(i - 1) +
+                       "] is still under way until " + number_text(previous_end) +
+                       " s (its trapezoid at max_rate_dps " + number_text(p.max_rate_dps) +
+                       " and max_accel_dps2 " + number_text(p.max_accel_dps2) +
+                       "); overlapping slews would add their rates and accelerations beyond those limits");
+    }
     previous_start = slew.start_s;
+    previous_end = slew.start_s + trapezoid_duration_s(slew.angle_deg * kDegToRad, p.max_rate_dps * kDegToRad,
+                                                       p.max_accel_dps2 * kDegToRad);
   }
   if (Status st = check_range("pointing_bound_deg", s.pointing_bound_deg, 0.0, 180.0, "deg", true); !st)
     return st;

@@ -41,7 +41,7 @@ Eigen::Vector3d AttitudeController::body_torque(const AttitudeKnowledge& k,
   const Eigen::Vector3d omega_ref_B = q_RB.conjugate() * ref.omega_RN_R_rad_s;
   const Eigen::Vector3d alpha_ref_B = q_RB.conjugate() * ref.alpha_RN_R_rad_s2;
   const Eigen::Vector3d d_omega = k.omega_BN_B_rad_s - omega_ref_B;
-  if (ki_per_s3_ > 0.0) integral_rad_s_ += theta * dt_s;
+  if (ki_per_s3_ > 0.0 && !last_limited_) integral_rad_s_ += theta * dt_s;  // frozen while limited
   const Eigen::Matrix3d& inertia = spec_.inertia_kg_m2;
   const Eigen::Vector3d& w = k.omega_BN_B_rad_s;
   const Eigen::Vector3d feedback =
@@ -73,8 +73,11 @@ ControlOutput AttitudeController::distribute(const Eigen::Vector3d& u_B_Nm,
 ControlOutput AttitudeController::command(double t_s, const std::optional<AttitudeKnowledge>& latest,
                                           const Eigen::VectorXd& h_wheels_Nms, double dt_s) {
   const double age_s = latest ? t_s - latest->time_s : INFINITY;
+  const bool lost = latest && !latest->attitude_known;
   const ControlState previous = state_;
-  if (age_s <= spec_.controller.hold_after_s) {
+  if (lost) {
+    state_ = ControlState::kSafe;  // whatever its age: an attitude nobody knows is never steered on
+  } else if (age_s <= spec_.controller.hold_after_s) {
     state_ = ControlState::kNormal;
   } else if (age_s <= spec_.controller.safe_after_s && previous != ControlState::kSafe) {
     state_ = ControlState::kHold;
@@ -89,15 +92,18 @@ ControlOutput AttitudeController::command(double t_s, const std::optional<Attitu
       ++counters_.normal_epochs;
       break;
     case ControlState::kHold:
-      out = distribute(last_torque_B_Nm_, h_wheels_Nms, dt_s);
+      out = distribute(last_torque_B_Nm_, h_wheels_Nms, dt_s);  // the integral is not advanced
       ++counters_.hold_epochs;
       break;
     case ControlState::kSafe:
       out.tau_wheels_Nm = Eigen::VectorXd::Zero(axes_B_.cols());
+      integral_rad_s_.setZero();
       if (previous != ControlState::kSafe) ++counters_.safe_entries;
       ++counters_.safe_epochs;
+      if (lost) ++counters_.lost_epochs;
       break;
   }
+  last_limited_ = out.torque_limited || out.momentum_limited;
   out.state = state_;
   return out;
 }

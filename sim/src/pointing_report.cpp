@@ -14,7 +14,7 @@ namespace tetra::sim {
 namespace {
 
 PointingSegment segment_of(const std::vector<PointingSample>& series, double from_s, double to_s,
-                           double bound_deg, double dt_s, bool after_fault) {
+                           double bound_deg, double dt_s) {
   PointingSegment seg;
   seg.from_s = from_s;
   seg.to_s = to_s;
@@ -38,12 +38,10 @@ PointingSegment segment_of(const std::vector<PointingSample>& series, double fro
   }
   seg.rms_deg = count ? std::sqrt(sum2 / static_cast<double>(count)) : 0.0;
   seg.estimated_rms_deg = est_count ? std::sqrt(est_sum2 / static_cast<double>(est_count)) : 0.0;
-  if (after_fault) {
-    if (!last_above_s) {
-      seg.recover_s = 0.0;
-    } else if (!ends_above) {
-      seg.recover_s = *last_above_s + dt_s - from_s;
-    }
+  if (!last_above_s) {
+    seg.recover_s = 0.0;
+  } else if (!ends_above) {
+    seg.recover_s = *last_above_s + dt_s - from_s;
   }
   return seg;
 }
@@ -82,7 +80,7 @@ PointingSummary summarize(const ClosedLoopRecord& record, const ClosedLoopSimula
   edges.push_back(INFINITY);
   for (std::size_t i = 0; i + 1 < edges.size(); ++i) {
     if (edges[i + 1] <= edges[i]) continue;
-    PointingSegment seg = segment_of(record.series, edges[i], edges[i + 1], s.bound_deg, dt_s, i > 0);
+    PointingSegment seg = segment_of(record.series, edges[i], edges[i + 1], s.bound_deg, dt_s);
     seg.to_s = std::min(seg.to_s, duration_s);
     if (i == 0) {
       seg.label = "before faults";
@@ -92,11 +90,11 @@ PointingSummary summarize(const ClosedLoopRecord& record, const ClosedLoopSimula
         if (!seg.label.empty()) seg.label += "; ";
         seg.label += format_fault_spec(f);
       }
-      if (!seg.recover_s) s.within_bound_after_recovery = false;
     }
+    if (!seg.recover_s) s.within_bound_after_recovery = false;  // every segment, the first too
     s.segments.push_back(seg);
   }
-  const PointingSegment all = segment_of(record.series, 0.0, INFINITY, s.bound_deg, dt_s, false);
+  const PointingSegment all = segment_of(record.series, 0.0, INFINITY, s.bound_deg, dt_s);
   s.rms_deg = all.rms_deg;
   s.max_deg = all.max_deg;
   if (!record.series.empty()) {
@@ -144,10 +142,8 @@ std::string summary_json(const PointingSummary& s, bool with_fdi) {
     append_json_number(out += ", \"rms_deg\": ", g.rms_deg);
     append_json_number(out += ", \"max_deg\": ", g.max_deg);
     append_json_number(out += ", \"estimated_rms_deg\": ", g.estimated_rms_deg);
-    if (i > 0) {
-      out += ", ";
-      add_optional(out, "recover_s", g.recover_s);
-    }
+    out += ", ";
+    add_optional(out, "recover_s", g.recover_s);
     out += '}';
   }
   out += "\n  ],\n  \"wheels\": {";
@@ -159,6 +155,7 @@ std::string summary_json(const PointingSummary& s, bool with_fdi) {
   append_json_number(out += ", \"hold_epochs\": ", static_cast<double>(s.counters.hold_epochs));
   append_json_number(out += ", \"safe_epochs\": ", static_cast<double>(s.counters.safe_epochs));
   append_json_number(out += ", \"safe_entries\": ", static_cast<double>(s.counters.safe_entries));
+  append_json_number(out += ", \"lost_epochs\": ", static_cast<double>(s.counters.lost_epochs));
   append_json_number(out += ", \"mean_estimate_age_s\": ", s.mean_estimate_age_s);
   append_json_number(out += ", \"max_estimate_age_s\": ", s.max_estimate_age_s);
   out += "},\n  \"fdi\": ";

@@ -164,7 +164,7 @@ Verdict EpochAssembler::check_seq(GyroTrack& track, std::uint64_t seq, std::int6
 }
 
 Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t stamp_ns, double raw,
-                                   std::int64_t now_ns) {
+                                   std::int64_t now_ns, bool reference_written) {
   if (gyro_id < 1 || gyro_id > config_.gyro_count) {
     ++counters_.samples_unknown_gyro;
     return Verdict::kUnknownGyro;
@@ -224,6 +224,7 @@ Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t 
   }
   it->raw[index] = raw;
   it->present[index] = 1;
+  it->awaits_reference = it->awaits_reference || reference_written;
   return Verdict::kAccepted;
 }
 
@@ -262,7 +263,9 @@ bool EpochAssembler::ready(const Pending& epoch, std::int64_t now_ns) const {
         track.last_stamp_ns && *track.last_stamp_ns > epoch.stamp_ns + config_.tolerance_ns;
     if (epoch.present[i] == 0 && !track.absent && !moved_past) return false;
   }
-  return true;
+  return !epoch.awaits_reference || std::any_of(references_.begin(), references_.end(), [&](const auto& r) {
+    return std::llabs(r.first - epoch.stamp_ns) <= config_.tolerance_ns;
+  });
 }
 
 void EpochAssembler::emit(Pending& epoch, std::vector<fdi::Epoch>& out) {
@@ -276,6 +279,8 @@ void EpochAssembler::emit(Pending& epoch, std::vector<fdi::Epoch>& out) {
   if (!references_.empty() && references_.front().first <= epoch.stamp_ns + config_.tolerance_ns) {
     result.reference_q_RB = references_.front().second;
     references_.pop_front();
+  } else if (epoch.awaits_reference) {
+    ++counters_.references_late;  // announced, and not in within max_latency_ns: the epoch goes without
   }
   last_emitted_ns_ = epoch.stamp_ns;
   ++counters_.epochs_emitted;

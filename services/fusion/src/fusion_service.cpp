@@ -13,7 +13,15 @@ namespace tetra::service {
 
 namespace {
 
-enum Token : std::intptr_t { kGyroData = 1, kGyroStatus, kReferenceData, kCommandData, kWake, kStop };
+enum Token : std::intptr_t {
+  kGyroData = 1,
+  kGyroStatus,
+  kReferenceData,
+  kCommandData,
+  kPeerHealth,
+  kWake,
+  kStop
+};
 constexpr std::uint32_t kGyroStatuses = DDS_REQUESTED_DEADLINE_MISSED_STATUS |
                                         DDS_REQUESTED_INCOMPATIBLE_QOS_STATUS |
                                         DDS_SUBSCRIPTION_MATCHED_STATUS;
@@ -27,7 +35,15 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal* shutdown)
   deadline_ns_ = config_.deadline_ns();
   shutdown_ = shutdown;
   if (auto s = assign(session_, dds::Session::open(domain, config_.unit)); !s) return s;
+  if (auto s = assign(duplicates_, DuplicateWatch::create(*session_, config_.unit, static_cast<int>(domain)));
+      !s)
+    return s;
+  if (auto s =
+          duplicates_->probe(session_->participant(), DuplicateWatch::kProbe, [this] { return stopping(); });
+      !s)
+    return s;
   if (auto s = open_endpoints(); !s) return s;
+  if (auto s = duplicates_->set_own_writer(health_writer_->handle()); !s) return s;
   return open_waitset();
 }
 
@@ -61,6 +77,7 @@ Status FusionService::open_waitset() {
   }
   if (auto s = session.watch_data(reference_reader_->handle(), kReferenceData); !s) return s;
   if (auto s = session.watch_data(command_reader_->handle(), kCommandData); !s) return s;
+  if (auto s = session.watch_data(duplicates_->reader_handle(), kPeerHealth); !s) return s;
   if (auto s = session.watch_statuses(gyro_reader_->handle(), kGyroStatuses, kGyroStatus); !s) return s;
   auto wake = session.add_guard(kWake);
   if (!wake) return wake.error();
@@ -164,6 +181,9 @@ Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered,
   const auto fired = [&](Token token) {
     return std::find(triggered.begin(), triggered.end(), token) != triggered.end();
   };
+  if (fired(kPeerHealth)) {
+    if (auto s = duplicates_->check(); !s) return s;
+  }
   const bool command_data = fired(kCommandData);
   const bool gyro_data = fired(kGyroData);
   if (fired(kGyroStatus)) {
@@ -234,7 +254,8 @@ Status FusionService::take_gyro_samples(std::int64_t now_ns) {
         }
         ++own_samples_;
         const int gyro = sample.gyro;
-        const auto verdict = assembler_.add_sample(gyro, sample.seq, sample.stamp_ns, sample.raw, now_ns);
+        const auto verdict = assembler_.add_sample(gyro, sample.seq, sample.stamp_ns, sample.raw, now_ns,
+                                                   dds::reference_written(sample));
         if (gyro >= 1 && gyro <= n_gyros_) last_arrival_ns_[static_cast<std::size_t>(gyro - 1)] = now_ns;
         if (verdict != Verdict::kAccepted) {
           spdlog::debug("fusion: gyro {} seq {} stamp {} ns: {}", gyro, sample.seq, sample.stamp_ns,

@@ -11,10 +11,19 @@
 // The reference is evaluated at the estimate's own time, so a late estimate is compared with where
 // the spacecraft should have been then.
 //
-// Stale or missing attitude, as flight software would handle it: an estimate older than
-// hold_after_s → the last command is held; older than safe_after_s (or none yet) → safe mode, wheel
-// torques zero (the body keeps its momentum). A fresh estimate resumes normal control. Epochs in
-// each state are counted.
+// Stale, missing or lost attitude, as flight software would handle it: an estimate older than
+// hold_after_s → the last command is held; older than safe_after_s (or none yet), or one whose
+// estimator says the attitude is lost (LOST: too few gyros left to determine it) → safe mode, wheel
+// torques zero (the body keeps its momentum: no torque is computed from an attitude or a rate nobody
+// knows). A fresh estimate that knows the attitude resumes normal control. Epochs in each state are
+// counted.
+//
+// Anti-windup: the integral of θ is frozen while the command is limited (scaled to the torque limit or
+// clipped at a wheel's momentum limit: conditional integration), not advanced in hold and cleared in
+// safe mode, so a saturated or interrupted period does not leave a charged integrator behind.
+// Momentum management (desaturation) is not modelled: a wheel at its momentum limit stops taking
+// torque in that direction (momentum_limited), the uncontrolled axis drifts under the disturbances,
+// and the run reports it (max_momentum_fraction, momentum_limited_s, recovered: false).
 
 #include <cstdint>
 #include <optional>
@@ -32,6 +41,7 @@ struct AttitudeKnowledge {
   double time_s = 0.0;                                         //!< [s] time the estimate refers to
   Quaternion q_NB = Quaternion::Identity();                    //!< estimated B → N
   Eigen::Vector3d omega_BN_B_rad_s = Eigen::Vector3d::Zero();  //!< [rad/s] estimated inertial rate
+  bool attitude_known = true;  //!< false: the estimator has lost the attitude (its mode LOST)
 };
 
 enum class ControlState : std::uint8_t { kNormal, kHold, kSafe };
@@ -49,6 +59,7 @@ struct ControlCounters {
   std::uint64_t hold_epochs = 0;
   std::uint64_t safe_epochs = 0;
   std::uint64_t safe_entries = 0;  //!< transitions into safe mode
+  std::uint64_t lost_epochs = 0;   //!< safe epochs because the estimate said the attitude was lost
 };
 
 class AttitudeController {
@@ -65,6 +76,8 @@ class AttitudeController {
   const Guidance& guidance() const { return guidance_; }
   //! [N·m] body torque of the last normal command (before the wheel limits).
   const Eigen::Vector3d& last_torque_B_Nm() const { return last_torque_B_Nm_; }
+  //! [rad·s] the integral of the attitude error (zero for PD).
+  const Eigen::Vector3d& integral_rad_s() const { return integral_rad_s_; }
 
  private:
   Eigen::Vector3d body_torque(const AttitudeKnowledge& k, const Eigen::VectorXd& h_wheels_Nms, double dt_s);
@@ -80,6 +93,7 @@ class AttitudeController {
   double ki_per_s3_;  //!< ω_n²/T_i (0 = PD)
   Eigen::Vector3d integral_rad_s_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d last_torque_B_Nm_ = Eigen::Vector3d::Zero();
+  bool last_limited_ = false;  //!< the previous command was torque- or momentum-limited
   ControlState state_ = ControlState::kSafe;
   ControlCounters counters_;
 };

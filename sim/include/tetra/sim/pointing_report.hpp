@@ -3,9 +3,10 @@
 // each fault, time to recover, wheel saturation, FDI verdict) as JSON, and the time series as CSV.
 //
 // Segments: [0, first onset), then [onset_i, onset_{i+1}) for each distinct fault onset in the run.
-// Time to recover after an onset: 0 when the pointing error never exceeds the bound in that segment;
-// otherwise the time from the onset to the end of the last epoch above the bound, provided the
-// segment ends below it (none = not recovered).
+// Time to recover in a segment: 0 when the pointing error never exceeds the bound in it; otherwise the
+// time from the segment's start to the end of the last epoch above the bound, provided the segment ends
+// below it (none = not recovered). The run is recovered when every segment is, the first one (no
+// fault yet) included: a fault-free run that ends off the bound (a tumble) is not recovered.
 
 #include <optional>
 #include <string>
@@ -43,7 +44,7 @@ struct PointingSummary {
   double mean_estimate_age_s = 0.0;  //!< [s] age of the estimate the controller used (epochs with one)
   double max_estimate_age_s = 0.0;   //!< [s]
   FdiVerdict fdi;
-  bool within_bound_after_recovery = true;  //!< every fault segment recovered
+  bool within_bound_after_recovery = true;  //!< every segment recovered (JSON "recovered")
 };
 
 PointingSummary summarize(const ClosedLoopRecord& record, const ClosedLoopSimulator& simulator);

@@ -14,6 +14,13 @@ inline constexpr int kReferenceDepth = 8;
 inline constexpr int kEventDepth = 256;  //!< events kept for late joiners, per unit
 inline constexpr int kCommandDepth = 16;
 inline constexpr int kMaxGyrosOnWire = tetra_MAX_GYROS;
+//! GyroSample.flags bit: an AttitudeReference with this sample's stamp was written before it (by the same
+//! publisher). A service holds the epoch until that reference is in (or its max_latency_s passes), so the
+//! two topics need no common delivery order and the publisher no acknowledgement wait.
+inline constexpr std::uint32_t kGyroFlagReferenceWritten = 0x8000'0000u;
+inline bool reference_written(const tetra_GyroSample& sample) {
+  return (sample.flags & kGyroFlagReferenceWritten) != 0;
+}
 inline constexpr std::chrono::milliseconds kWriterLease{1000};  //!< automatic liveliness of writers
 
 //! reliable / volatile / keep-last 64; deadline = 3 × `sample_period` (none if zero).

@@ -37,7 +37,10 @@
 //   * when every gyro is absent and a sample comes back with a sequence number or stamp at or before
 //     the last ones seen, the sensor restarted: the assembler forgets its time base (counted in
 //     sensor_restarts; the caller resets its pipeline too) and starts again from that sample;
-//   * attitude references are attached to the epoch whose stamp is within the tolerance of theirs.
+//   * attitude references are attached to the epoch whose stamp is within the tolerance of theirs. A
+//     sample that says a reference for its stamp was written (`reference_written`) makes its epoch
+//     wait for that reference too (within max_latency_ns like a sample), whatever order the two
+//     streams arrive in.
 // Times: stamps are sensor time [ns]; `now_ns` is the caller's local monotonic clock [ns].
 
 #include <cstdint>
@@ -92,7 +95,9 @@ class EpochAssembler {
   static Result<EpochAssembler> create(const AssemblerConfig& config);
 
   //! One gyro sample (raw may be NaN: that is for the pipeline to judge).
-  Verdict add_sample(int gyro_id, std::uint64_t seq, std::int64_t stamp_ns, double raw, std::int64_t now_ns);
+  //! `reference_written`: the sender wrote a reference for this stamp (the epoch waits for it).
+  Verdict add_sample(int gyro_id, std::uint64_t seq, std::int64_t stamp_ns, double raw, std::int64_t now_ns,
+                     bool reference_written = false);
   //! An attitude reference for the epoch at `stamp_ns`.
   void add_reference(std::int64_t stamp_ns, const Quaternion& q_RB);
   //! The gyro's stream stopped (deadline missed or liveliness lost): epochs no longer wait for it.
@@ -117,6 +122,7 @@ class EpochAssembler {
     std::int64_t opened_local_ns = 0;   //!< [ns] local time it was opened
     std::vector<double> raw;            //!< [V] per gyro
     std::vector<std::uint8_t> present;  //!< per gyro
+    bool awaits_reference = false;      //!< a sample said its reference was written
   };
   struct GyroTrack {
     std::optional<std::uint64_t> last_seq;

@@ -26,6 +26,7 @@
 #include "tetra/dds/session.hpp"
 #include "tetra/dds/shutdown.hpp"
 #include "tetra/fdi/pipeline.hpp"
+#include "tetra/service/duplicate_watch.hpp"
 #include "tetra/service/epoch_assembler.hpp"
 #include "tetra/service/fusion_config.hpp"
 
@@ -48,7 +49,9 @@ class FusionService {
   FusionService& operator=(const FusionService&) = delete;
 
   //! Participant, topics, readers, writers and the waitset on `domain`. With `shutdown`, SIGINT and
-  //! SIGTERM stop run() too (it must outlive the service).
+  //! SIGTERM stop run() too (it must outlive the service). Fails, before anything is written, when
+  //! another service of the unit answers on the domain (duplicate_watch.hpp); run() fails when one
+  //! appears later.
   Status open(dds_domainid_t domain, dds::ShutdownSignal* shutdown = nullptr);
   //! Serves until a stop is requested (request_stop(), or a signal through open()'s `shutdown`).
   Status run();
@@ -128,8 +131,9 @@ class FusionService {
   std::optional<dds::Writer<tetra_Attitude>> attitude_writer_;
   std::optional<dds::Writer<tetra_Health>> health_writer_;
   std::optional<dds::Writer<tetra_FdiEvent>> event_writer_;
-  std::optional<dds::Ros2View> ros2_view_;  //!< `ros2: enabled: true` (docs/ros2.md)
-  const dds::Condition* wake_ = nullptr;    //!< the listener wakes the waitset thread for an epoch's deadline
+  std::optional<dds::Ros2View> ros2_view_;    //!< `ros2: enabled: true` (docs/ros2.md)
+  std::optional<DuplicateWatch> duplicates_;  //!< another service of this unit on the domain
+  const dds::Condition* wake_ = nullptr;  //!< the listener wakes the waitset thread for an epoch's deadline
   std::atomic<const dds::Condition*> stop_{nullptr};  //!< request_stop() wakes the waitset thread
 };
 

@@ -15,7 +15,8 @@ struct AssemblerCounters {
   std::uint64_t samples_unknown_gyro = 0;  //!< gyro id outside 1..N
   std::uint64_t samples_other_unit = 0;    //!< other units' samples (counted by the caller)
   std::uint64_t sensor_restarts = 0;       //!< time base restarted (after silence, or re-anchored)
-  std::uint64_t references_late = 0;       //!< references for epochs already emitted
+  std::uint64_t references_late = 0;       //!< references for epochs already emitted, and announced ones
+                                           //!< (reference_written) their epoch went without
   std::uint64_t deadlines_missed = 0;      //!< counted by the caller through mark_absent()
   std::uint64_t liveliness_lost = 0;       //!< counted by the caller through mark_absent()
   std::uint64_t time_outlier = 0;          //!< stamps far outside the unit's clock (dropped)
