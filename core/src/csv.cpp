@@ -2,6 +2,7 @@
 
 #include "tetra/core/input_files.hpp"
 #include "tetra/core/output_files.hpp"
+#include "tetra/core/tdms.hpp"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -328,9 +329,10 @@ Status CsvStreamReader::refill() {
 }
 
 Status CsvStreamReader::open(const std::string& path) {
-  if (file_ != nullptr) return failure(path + ": reader already open");
+  if (file_ != nullptr || whole_) return failure(path + ": reader already open");
   header_ = CsvTable{};
   header_.source = path;
+  if (is_tdms_path(path)) return open_tdms(path);
   if (Status s = check_input(path, kMaxStreamedLogBytes, false); !s) return s;
   file_ = std::fopen(path.c_str(), "rb");
   if (file_ == nullptr) return bad_input(path + ": cannot open: " + std::strerror(errno));
@@ -359,8 +361,36 @@ Status CsvStreamReader::open(const std::string& path) {
   return ok_status();
 }
 
+Status CsvStreamReader::open_tdms(const std::string& path) {
+  auto table = read_tdms_table(path);
+  if (!table) return table.error();
+  whole_ = std::make_unique<CsvTable>(std::move(*table));
+  header_.metadata = whole_->metadata;
+  header_.comments = whole_->comments;
+  header_.columns = whole_->columns;
+  total_ = whole_->rows;
+  return ok_status();
+}
+
+// The next rows of a TDMS file's table (bytes_read/bytes_total then count rows).
+bool CsvStreamReader::next_tdms_rows(CsvTable& block) {
+  constexpr std::size_t kTdmsBlockRows = 65536;
+  const std::size_t n = std::min(kTdmsBlockRows, whole_->rows - whole_next_);
+  const std::size_t nc = whole_->columns.size();
+  const auto first = static_cast<std::ptrdiff_t>(whole_next_ * nc);
+  const auto last = static_cast<std::ptrdiff_t>((whole_next_ + n) * nc);
+  block.cells.assign(whole_->cells.begin() + first, whole_->cells.begin() + last);
+  block.empty.assign(whole_->empty.begin() + first, whole_->empty.begin() + last);
+  block.lines.assign(whole_->lines.begin() + static_cast<std::ptrdiff_t>(whole_next_),
+                     whole_->lines.begin() + static_cast<std::ptrdiff_t>(whole_next_ + n));
+  block.rows = n;
+  whole_next_ += n;
+  consumed_ = whole_next_;
+  return n > 0;
+}
+
 Result<bool> CsvStreamReader::next(CsvTable& block) {
-  if (file_ == nullptr) return failure("CSV stream reader is not open");
+  if (file_ == nullptr && !whole_) return failure("CSV stream reader is not open");
   block.source = header_.source;
   block.metadata = header_.metadata;
   block.comments.clear();
@@ -370,6 +400,7 @@ Result<bool> CsvStreamReader::next(CsvTable& block) {
   block.cells.clear();
   block.empty.clear();
   block.lines.clear();
+  if (whole_) return next_tdms_rows(block);
   bool have_header = true;
   while (true) {
     const std::size_t last_nl = text_.rfind('\n');
@@ -393,6 +424,7 @@ Result<std::string> read_text_file(const std::string& path) {
 }
 
 Result<CsvTable> read_csv(const std::string& path) {
+  if (is_tdms_path(path)) return read_tdms_table(path);
   // A regular file is parsed straight from a read-only mapping: no copy of the text in memory (a
   // 2 h, 100 Hz log is ~45 MB). Anything else (pipes, empty files) is read into a string.
   if (Status st = check_input(path, kMaxTableBytes, false); !st) return st.error();

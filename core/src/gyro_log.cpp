@@ -8,6 +8,7 @@
 
 #include "gyro_log_h5.hpp"
 #include "tetra/core/csv.hpp"
+#include "tetra/core/tdms.hpp"
 
 namespace tetra {
 
@@ -268,6 +269,9 @@ Status GyroLogWriter::open_output(OutputFile& out, int gyro_count, bool with_ref
                                   const std::vector<std::string>& comments) {
   if (out_ != nullptr) return failure(out_->path() + ": writer already open");
   if (gyro_count < 1) return bad_input(out.path() + ": a gyro log needs at least one gyro column");
+  if (is_tdms_path(out.path())) {
+    return bad_input(out.path() + ": tetra reads TDMS logs but does not write them: name the output .csv or .h5");
+  }
   for (std::size_t i = 0; i < comments.size(); ++i) {
     if (comments[i].find_first_of("\n\r") != std::string::npos) {  // it would end the comment line
       return bad_input(out.path() + ": comment " + std::to_string(i + 1) +

@@ -134,7 +134,7 @@ struct AllanOptions {
 
 void add_options(CLI::App& app, AllanOptions& o) {
   app.add_option("log", o.log_path,
-                 "gyro log (CSV, or HDF5 when named .h5; docs/formats.md): time_s,g1..gN; volts, or deg/s "
+                 "gyro log (CSV, HDF5 when named .h5, TDMS when named .tdms; docs/formats.md): time_s,g1..gN; volts, or deg/s "
                  "with '# units=dps'")
       ->required();
   app.add_option("--calibration", o.cal_path, "calibration YAML: volts become deg/s as (g - bias)/scale");

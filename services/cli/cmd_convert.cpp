@@ -47,13 +47,13 @@ Status convert(const std::string& in_path, const std::string& out_path, bool com
 
 int cmd_convert(int argc, char** argv) {
   CLI::App app{
-      "Convert a gyro log between CSV and HDF5 (docs/formats.md); each file's format follows its name: "
-      ".h5 or .hdf5 is HDF5, anything else CSV. CSV -> HDF5 -> CSV gives back a file written by tetra byte "
-      "for byte.",
+      "Convert a gyro log between CSV and HDF5, or from TDMS (docs/formats.md); each file's format follows its "
+      "name: .h5 or .hdf5 is HDF5, .tdms TDMS (read only), anything else CSV. CSV -> HDF5 -> CSV gives back a "
+      "file written by tetra byte for byte.",
       "convert"};
   std::string in_path;
   std::string out_path;
-  app.add_option("IN", in_path, "gyro log to read (CSV or HDF5)")->required();
+  app.add_option("IN", in_path, "gyro log to read (CSV, HDF5 or TDMS)")->required();
   app.add_option("OUT", out_path, "gyro log to write (CSV or HDF5)")->required();
   bool compress = false;
   app.add_flag("--compress", compress,

@@ -25,6 +25,12 @@ int cmd_command(int, char**) {
 int cmd_record(int, char**) {
   return unavailable("record");
 }
+int cmd_play(int, char**) {
+  return unavailable("play");
+}
+int cmd_ingest(int, char**) {
+  return unavailable("ingest");
+}
 int cmd_demo(int, char**) {
   return unavailable("demo");
 }

@@ -62,7 +62,7 @@ struct ReplayOptions {
 };
 
 void add_options(CLI::App& app, ReplayOptions& o) {
-  app.add_option("LOG", o.log_path, "gyro log (CSV, or HDF5 when named .h5)")->required();
+  app.add_option("LOG", o.log_path, "gyro log (CSV, HDF5 when named .h5, TDMS when named .tdms)")->required();
   app.add_option("--calibration", o.cal_path, "calibration file (YAML, docs/interfaces.md §2.3)")->required();
   app.add_option("--latitude", o.latitude_deg,
                  "[deg] ground-test mode: remove the Earth rate at this geodetic latitude")

@@ -13,6 +13,8 @@ int cmd_fusion(int argc, char** argv);
 int cmd_monitor(int argc, char** argv);
 int cmd_command(int argc, char** argv);
 int cmd_record(int argc, char** argv);
+int cmd_play(int argc, char** argv);
+int cmd_ingest(int argc, char** argv);
 int cmd_demo(int argc, char** argv);
 int cmd_campaign(int argc, char** argv);
 //! `tetra campaign merge OUT SHARD_DIRS...` (argv[0] is "merge").

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -67,13 +68,15 @@ void parse_metadata_comment(std::string_view comment, Metadata& metadata);
 Result<CsvTable> parse_csv(std::string_view text, std::string source);
 //! The same with the named columns kept as text (not parsed; their cells NaN, never "empty").
 Result<CsvTable> parse_csv(std::string_view text, std::string source, std::vector<std::string> text_columns);
-//! Reads and parses a file (a regular file or a FIFO of at most kMaxTableBytes).
+//! Reads and parses a file (a regular file or a FIFO of at most kMaxTableBytes). A TDMS file (".tdms")
+//! is read as the table its channels make (tetra/core/tdms.hpp, read_tdms_table).
 Result<CsvTable> read_csv(const std::string& path);
 
 //! Reads a table as it goes, with memory bounded by one block of text (about 1 MB) whatever the file's
 //! length: the header and the comments before it on open(), then the rows block by block. Messages
 //! and line numbers are those of read_csv. Comment lines between rows add their metadata to the
-//! block they appear in (blocks start from the metadata before the header).
+//! block they appear in (blocks start from the metadata before the header). A TDMS file (".tdms") is
+//! read whole on open (read_tdms_table) and served in blocks of rows; `lines` are then 1-based rows.
 class CsvStreamReader {
  public:
   CsvStreamReader() = default;
@@ -93,6 +96,8 @@ class CsvStreamReader {
 
  private:
   Status refill();
+  Status open_tdms(const std::string& path);
+  bool next_tdms_rows(CsvTable& block);
   std::FILE* file_ = nullptr;
   std::string text_;     // unparsed text; whole lines are parsed from pos_
   std::size_t pos_ = 0;  // first unparsed byte of text_
@@ -101,6 +106,8 @@ class CsvStreamReader {
   std::uint64_t consumed_ = 0;
   std::uint64_t total_ = 0;
   CsvTable header_;
+  std::unique_ptr<CsvTable> whole_;  // a TDMS file's table
+  std::size_t whole_next_ = 0;       // its next row
 };
 
 //! Reads a whole file into a string (error names the file; at most kMaxTableBytes, see read_input).

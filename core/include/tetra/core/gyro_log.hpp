@@ -50,7 +50,8 @@ struct GyroLog {
   std::optional<std::string> meta(const std::string& key) const;
 };
 
-//! Reads a whole gyro log: CSV, or HDF5 when the name ends in ".h5" or ".hdf5" (docs/formats.md).
+//! Reads a whole gyro log: CSV, HDF5 when the name ends in ".h5" or ".hdf5", TDMS when it ends in ".tdms"
+//! (read as the table its channels make, tetra/core/tdms.hpp; docs/formats.md).
 Result<GyroLog> read_gyro_log(const std::string& path);
 Result<GyroLog> parse_gyro_log(std::string_view text, std::string source);
 
@@ -63,7 +64,7 @@ bool is_hdf5_path(const std::string& path);
 class GyroLogReader {
  public:
   virtual ~GyroLogReader() = default;
-  //! Opens a CSV or HDF5 log (by the name's extension) and reads its header.
+  //! Opens a CSV, HDF5 or TDMS log (by the name's extension) and reads its header.
   static Result<std::unique_ptr<GyroLogReader>> open(const std::string& path);
   //! Source, metadata, gyro count, units and reference flag; no epochs.
   const GyroLog& header() const { return header_; }

@@ -1,0 +1,70 @@
+#pragma once
+// TDMS files (the NI "Technical Data Management Streaming" format 2.0, as LabVIEW writes it; docs/formats.md,
+// "TDMS"): a sequence of segments, each a 28-byte lead-in, optional metadata (objects with their raw data
+// index and properties, given in full or as updates of the previous segment's) and raw data (the channels'
+// values, contiguous or interleaved, in chunks). The reader keeps the numeric channels' values as doubles,
+// the file's and channels' properties as text. A malformed or hostile file is an Error naming the file,
+// the segment (1-based) and its byte offset; allocations are bounded by the file's own size.
+// The optional ".tdms_index" file is never needed (the .tdms holds the same metadata).
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tetra/core/csv.hpp"
+#include "tetra/core/result.hpp"
+
+namespace tetra {
+
+//! [bytes] largest TDMS file read (read whole; its numeric values then take at most 8 bytes each).
+inline constexpr std::size_t kMaxTdmsBytes = std::size_t{1} << 30;
+
+struct TdmsChannel {
+  std::string group;            //!< the group's name
+  std::string name;             //!< the channel's name
+  Metadata properties;          //!< the channel's properties as text, in order of first appearance
+  std::uint32_t type = 0;       //!< tdsDataType code of its raw data (0: it never had any)
+  bool numeric = false;         //!< integer, floating-point or boolean values (kept in `values`)
+  std::vector<double> values;   //!< [channel's unit] every value in file order (numeric channels)
+  std::size_t value_count = 0;  //!< values in the file (also for strings and timestamps, not kept)
+};
+
+struct TdmsFile {
+  std::string source;                 //!< file name used in messages
+  Metadata properties;                //!< the file object's ("/") properties as text, in order
+  std::vector<TdmsChannel> channels;  //!< in order of first appearance
+};
+
+//! True when `path` names a TDMS file (".tdms", any case).
+bool is_tdms_path(const std::string& path);
+
+//! Parses a TDMS file image; `source` names it in messages.
+Result<TdmsFile> parse_tdms(std::span<const std::uint8_t> bytes, const std::string& source);
+//! Reads and parses a file (a regular file or a FIFO of at most kMaxTdmsBytes).
+Result<TdmsFile> read_tdms(const std::string& path);
+
+//! Which TDMS channels and file properties make a table's columns and "# key=value" metadata when their
+//! names differ from the CSV's (docs/formats.md, "TDMS"). Empty: every channel is a column by its own name.
+struct TdmsChannelMap {
+  std::string source;  //!< the map file's name, for messages ("" when none)
+  //! column name ← channel name ("Channel", or "Group/Channel" where several groups hold the name)
+  std::vector<std::pair<std::string, std::string>> channels;
+  std::vector<std::pair<std::string, std::string>> properties;  //!< metadata key ← file property name
+};
+
+//! The channel map beside a TDMS log: "run.tdms" → "run.channels.yaml".
+std::string tdms_channel_map_path(const std::string& tdms_path);
+//! Parses a channel map (YAML: `channels:` and `properties:` mappings of text); `source` names it.
+Result<TdmsChannelMap> parse_tdms_channel_map(const std::string& text, const std::string& source);
+
+//! The table a CSV with the same columns and comments would give: columns = the mapped channels (every
+//! channel when the map has none), rows = their values (all columns of equal length, none empty), metadata
+//! and comment lines = the file's properties (renamed by the map), `lines` = 1-based rows.
+Result<CsvTable> tdms_to_table(const TdmsFile& file, const TdmsChannelMap& map);
+//! read_tdms + the channel map beside the file when there is one + tdms_to_table.
+Result<CsvTable> read_tdms_table(const std::string& path);
+
+}  // namespace tetra
