@@ -1,0 +1,140 @@
+#pragma once
+// The perturbation families' campaign (docs/fdi.md, "Perturbation families"): one generated run
+// (sim/perturbation_families.hpp) through the pipeline, judged against the promises — no exclusion of a gyro
+// without a fault begun, no exclusion in a fault-free run, never LOST from one fault, sigma honest per run —
+// and the figures of a family over many runs.
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+
+#include "campaign.hpp"
+#include "tetra/sim/perturbation_families.hpp"
+
+namespace tetra::test {
+
+//! Sigma's honesty is judged from here on [s]: the first reference sample (t = 0) or the initial attitude
+//! then holds, and a run's first seconds are the same in every family.
+inline constexpr double kHonestyFrom_s = 20.0;
+//! A run is honest when at least this share of its axis-epochs is within 3σ (a consistent Gaussian error
+//! gives 99.73 %; one run's epochs are correlated over tens of seconds, so its share scatters below that).
+inline constexpr double kMinWithin3Sigma = 0.97;
+//! ...and its per-axis NEES (mean e²/σ², 1 expected) is at most this.
+inline constexpr double kMaxNeesPerAxis = 2.0;
+
+struct FamilyVerdict {
+  bool wrong_exclusion = false;    //!< a gyro excluded before any fault of its own began
+  bool exclusion_no_fault = false;  //!< an exclusion in a run without any gyro fault
+  bool lost = false;                //!< `lost` event or final mode LOST
+  double within = 1.0;              //!< share of axis-epochs with |e| ≤ 3σ from kHonestyFrom_s
+  Eigen::Vector3d nees = Eigen::Vector3d::Zero();  //!< per-axis mean e²/σ² over the same epochs
+  double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
+  std::optional<double> flagged_after_s;           //!< [s] first detection or reference rejection after the
+                                                   //!< perturbation began
+  std::string events;                              //!< the run's events, for a failure report
+};
+
+inline double perturbation_start_s(const sim::PerturbedRun& r) {
+  double t = r.reference_fault_at_s >= 0.0 ? r.reference_fault_at_s : 1e300;
+  for (const auto& f : r.options.faults) t = std::min(t, f.at_s);
+  return t < 1e300 ? t : 0.0;
+}
+
+inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
+  fdi::PipelineConfig config;
+  if (r.sample_period_s > 0.0) config.sample_period_s = r.sample_period_s;
+  if (r.max_angular_acceleration_dps2 > 0.0) config.max_angular_acceleration_dps2 = r.max_angular_acceleration_dps2;
+  CampaignOptions options;
+  options.keep_errors = true;
+  options.gap_from_s = r.gap_from_s;
+  options.gap_until_s = r.gap_until_s;
+  const CampaignRun run = run_campaign(r.scenario, r.options, r.calibration, config, options);
+  FamilyVerdict v;
+  const int n = r.scenario.unit.gyro_count();
+  const double start = perturbation_start_s(r);
+  for (const auto& e : run.events) {
+    const double t = ns_to_seconds(e.stamp_ns);
+    if (e.type == fdi::EventType::kLost) v.lost = true;
+    if ((e.type == fdi::EventType::kDetected || e.type == fdi::EventType::kReferenceRejected) && t >= start &&
+        !v.flagged_after_s)
+      v.flagged_after_s = t - start;
+    if (e.type != fdi::EventType::kIsolated) continue;
+    if (r.options.faults.empty()) v.exclusion_no_fault = true;
+    const bool faulty = std::any_of(r.options.faults.begin(), r.options.faults.end(),
+                                    [&](const sim::FaultSpec& f) { return f.gyro == e.gyro && f.at_s <= t; });
+    if (!faulty) v.wrong_exclusion = true;
+  }
+  v.lost = v.lost || run.final_mode == fdi::Mode::kLost;
+  int epochs = 0;
+  int inside = 0;
+  for (std::size_t k = 0; k < run.time_s.size(); ++k) {
+    if (run.time_s[k] < kHonestyFrom_s) continue;
+    ++epochs;
+    for (int a = 0; a < 3; ++a) {
+      const double z = std::abs(run.error_rad[k][a]) / run.sigma_rad[k][a];
+      inside += z <= 3.0 ? 1 : 0;
+      v.nees[a] += z * z;
+      v.worst_sigmas = std::max(v.worst_sigmas, z);
+    }
+  }
+  if (epochs > 0) {
+    v.within = inside / (3.0 * epochs);
+    v.nees /= epochs;
+  }
+  v.events = describe(run, n);
+  return v;
+}
+
+//! A family's figures over its runs.
+struct FamilyFigures {
+  int runs = 0;
+  int wrong_exclusions = 0;
+  int exclusions_without_fault = 0;
+  int lost = 0;
+  int dishonest = 0;  //!< runs below kMinWithin3Sigma or above kMaxNeesPerAxis on an axis
+  double worst_within = 1.0;
+  double worst_nees = 0.0;
+  int flagged = 0;
+  double max_flag_delay_s = 0.0;
+  std::vector<double> flag_delays_s;
+  std::string failures;  //!< label, figures and events of every run that broke a promise
+};
+
+inline void add_run(FamilyFigures& f, const sim::PerturbedRun& r, const FamilyVerdict& v, bool lost_allowed) {
+  ++f.runs;
+  f.wrong_exclusions += v.wrong_exclusion ? 1 : 0;
+  f.exclusions_without_fault += v.exclusion_no_fault ? 1 : 0;
+  f.lost += v.lost ? 1 : 0;
+  const bool dishonest = v.within < kMinWithin3Sigma || v.nees.maxCoeff() > kMaxNeesPerAxis;
+  f.dishonest += dishonest ? 1 : 0;
+  f.worst_within = std::min(f.worst_within, v.within);
+  f.worst_nees = std::max(f.worst_nees, v.nees.maxCoeff());
+  if (v.flagged_after_s) {
+    ++f.flagged;
+    f.flag_delays_s.push_back(*v.flagged_after_s);
+    f.max_flag_delay_s = std::max(f.max_flag_delay_s, *v.flagged_after_s);
+  }
+  if (v.wrong_exclusion || v.exclusion_no_fault || (v.lost && !lost_allowed) || dishonest) {
+    char line[256];
+    std::snprintf(line, sizeof line, "  %.2f %% within 3 sigma, NEES %.2f %.2f %.2f, worst %.1f sigma%s%s%s\n",
+                  100.0 * v.within, v.nees[0], v.nees[1], v.nees[2], v.worst_sigmas,
+                  v.wrong_exclusion ? ", wrong exclusion" : "", v.exclusion_no_fault ? ", exclusion without fault" : "",
+                  v.lost ? ", LOST" : "");
+    f.failures += r.label + "\n" + line + v.events;
+  }
+}
+
+inline void print_figures_header() {
+  std::printf("%-26s %6s %6s %8s %5s %9s %9s %9s %8s %11s %11s\n", "family", "runs", "wrong", "no-fault", "LOST",
+              "dishonest", "worst<3s", "worstNEES", "flagged", "median flag", "max flag");
+}
+
+inline void print_figures(const std::string& name, FamilyFigures f) {
+  std::sort(f.flag_delays_s.begin(), f.flag_delays_s.end());
+  const double median = f.flag_delays_s.empty() ? 0.0 : f.flag_delays_s[f.flag_delays_s.size() / 2];
+  std::printf("%-26s %6d %6d %8d %5d %9d %8.2f%% %9.2f %8d %9.1f s %9.1f s\n", name.c_str(), f.runs,
+              f.wrong_exclusions, f.exclusions_without_fault, f.lost, f.dishonest, 100.0 * f.worst_within,
+              f.worst_nees, f.flagged, median, f.max_flag_delay_s);
+}
+
+}  // namespace tetra::test
