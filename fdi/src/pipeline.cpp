@@ -234,7 +234,9 @@ void Pipeline::Impl::judge_reference() {
   }
   Eigen::Vector3d z;
   Eigen::Matrix3d S;
-  if (!subsets_.ready() || !attitude_.predict_reference(*frame_.reference_q_RB, frame_.dt_s, z, S)) return;
+  if (!subsets_.ready() ||
+      !attitude_.predict_reference(*frame_.reference_q_RB, frame_.dt_s, subsets_.period_s(), z, S))
+    return;
   const ReferenceVerdict v = consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_);
   reference_usable_ = v.use;
   if (v.rejected || v.reaccepted) {
@@ -465,7 +467,7 @@ void Pipeline::Impl::publish_attitude() {
       const Eigen::Vector3d bound =
           episode ? fault_rate_bound(*active, detector_.parity_ema(), subsets_.sqrt_period())
                   : Eigen::Vector3d::Zero();
-      attitude_.propagate(frame_, sol, active, bound);
+      attitude_.propagate(frame_, sol, active, bound, subsets_.period_s());
       // The epoch's parity, when it was computed over the gyros published, measures their biases.
       if (frame_.usable == measured_ && sol.observable)
         attitude_.parity(sol, detector_.parity(), subsets_.sqrt_period());

@@ -17,17 +17,25 @@ constexpr std::array<std::string_view, kFamilyCount> kFamilyNames = {
     "fault-in-slew", "data-path", "gap", "reference", "calibration", "calibration-without-noise",
     "second-fault"};
 
-constexpr double kSlewStart_s = 30.0;  //!< [s] the detectors have a full history by then
+constexpr double kSlewStart_s = 30.0;                //!< [s] the detectors have a full history by then
 constexpr double kConfiguredReference_arcsec = 5.0;  //!< [arcsec] the star tracker's stated 1σ
+//! [s] every run goes on this long after its perturbation: sigma's honesty is judged per run, and a run's
+//! attitude error is correlated over tens of seconds with the reference, so a short run's NEES is a χ² of
+//! few degrees of freedom.
+constexpr double kAfter_s = 600.0;
 
 //! The draws of one run: a stream of its own, a function of (family, seed, index) alone.
 Rng family_rng(Family family, std::uint64_t seed, std::uint64_t index) {
-  return Rng(splitmix64(splitmix64(splitmix64(seed) ^ ((static_cast<std::uint64_t>(family) + 1) << 40)) ^
-                        index));
+  return Rng(
+      splitmix64(splitmix64(splitmix64(seed) ^ ((static_cast<std::uint64_t>(family) + 1) << 40)) ^ index));
 }
 
-double between(Rng& rng, double lo, double hi) { return lo + (hi - lo) * rng.uniform(); }
-int pick(Rng& rng, int count) { return static_cast<int>(rng.uniform() * count) % count; }
+double between(Rng& rng, double lo, double hi) {
+  return lo + (hi - lo) * rng.uniform();
+}
+int pick(Rng& rng, int count) {
+  return static_cast<int>(rng.uniform() * count) % count;
+}
 
 //! Body axis ±X, ±Y, ±Z by `which` (0…5).
 Eigen::Vector3d signed_axis(int which) {
@@ -84,20 +92,29 @@ std::string slew_text(const Slew& s) {
   return text;
 }
 
-std::string fault_text(const FaultSpec& f) { return format_fault_spec(f); }
+std::string fault_text(const FaultSpec& f) {
+  return format_fault_spec(f);
+}
 
 //! The fault kinds of a single fault in a slew: the audit's stuck and 0 V, a large and a small bias step,
 //! noise ×10, a fast ramp and a +5 % scale change.
 FaultSpec slew_fault(Rng& rng, int kind_index, int gyro, double at_s) {
   const double sign = rng.uniform() < 0.5 ? -1.0 : 1.0;
   switch (kind_index % 7) {
-    case 0: return make_fault(gyro, FaultKind::kStuck, at_s, 0.0);
-    case 1: return make_fault(gyro, FaultKind::kZero, at_s, 0.0);
-    case 2: return make_fault(gyro, FaultKind::kBias, at_s, sign * between(rng, 1e-2, 3e-2));
-    case 3: return make_fault(gyro, FaultKind::kBias, at_s, sign * between(rng, 1e-3, 3e-3));
-    case 4: return make_fault(gyro, FaultKind::kNoise, at_s, between(rng, 5.0, 10.0));
-    case 5: return make_fault(gyro, FaultKind::kRamp, at_s, sign * between(rng, 3e-4, 1e-3));
-    default: return make_fault(gyro, FaultKind::kScale, at_s, sign * between(rng, 0.02, 0.05));
+    case 0:
+      return make_fault(gyro, FaultKind::kStuck, at_s, 0.0);
+    case 1:
+      return make_fault(gyro, FaultKind::kZero, at_s, 0.0);
+    case 2:
+      return make_fault(gyro, FaultKind::kBias, at_s, sign * between(rng, 1e-2, 3e-2));
+    case 3:
+      return make_fault(gyro, FaultKind::kBias, at_s, sign * between(rng, 1e-3, 3e-3));
+    case 4:
+      return make_fault(gyro, FaultKind::kNoise, at_s, between(rng, 5.0, 10.0));
+    case 5:
+      return make_fault(gyro, FaultKind::kRamp, at_s, sign * between(rng, 3e-4, 1e-3));
+    default:
+      return make_fault(gyro, FaultKind::kScale, at_s, sign * between(rng, 0.02, 0.05));
   }
 }
 
@@ -109,7 +126,7 @@ PerturbedRun fault_in_slew(Rng& rng, std::uint64_t index) {
   const bool reference = index / 63 % 2 == 1;
   PerturbedRun r;
   const Slew slew = agile_slew(rng, pick(rng, 6));
-  r.scenario = base(n, reference, kSlewStart_s + slew.duration_s + (reference ? 120.0 : 60.0));
+  r.scenario = base(n, reference, kSlewStart_s + slew.duration_s + kAfter_s);
   r.scenario.motion.slews = {slew};
   const double at = kSlewStart_s + 0.5 * when * slew.duration_s;
   r.options.faults = {slew_fault(rng, kind, 1 + pick(rng, n), at)};
@@ -124,7 +141,7 @@ PerturbedRun data_path(Rng& rng, std::uint64_t index) {
   const bool reference = index / 3 % 2 == 1;
   PerturbedRun r;
   const Slew slew = agile_slew(rng, pick(rng, 6));
-  r.scenario = base(n, reference, kSlewStart_s + slew.duration_s + 60.0);
+  r.scenario = base(n, reference, kSlewStart_s + slew.duration_s + kAfter_s);
   r.scenario.motion.slews = {slew};
   r.scenario.drop_probability = between(rng, 0.0, 0.2);
   r.scenario.jitter_s = between(rng, 0.0, 0.005);
@@ -144,7 +161,7 @@ PerturbedRun gap(Rng& rng, std::uint64_t index) {
   PerturbedRun r;
   const Slew slew = agile_slew(rng, pick(rng, 6));
   const double length = between(rng, 10.0, 30.0);
-  r.scenario = base(n, reference, kSlewStart_s + slew.duration_s + length + 60.0);
+  r.scenario = base(n, reference, kSlewStart_s + slew.duration_s + length + kAfter_s);
   if (!orbit) {
     r.scenario.motion.slews = {slew};
     r.max_angular_acceleration_dps2 = peak_acceleration(slew);  // the bound the gap's widening rests on
@@ -166,7 +183,7 @@ PerturbedRun reference_failure(Rng& rng, std::uint64_t index) {
   // A slew about a random axis early in the run (a late reference shows only while the rate changes).
   Slew slew = agile_slew(rng, pick(rng, 6));
   slew.duration_s = between(rng, 10.0, 20.0);
-  r.scenario = base(n, true, 200.0);
+  r.scenario = base(n, true, 150.0 + kAfter_s);
   r.scenario.motion.slews = {slew};
   auto& ref = r.scenario.reference;
   char text[128] = "";
@@ -208,7 +225,9 @@ void maybe_fault(Rng& rng, std::uint64_t index, int n, const Slew& slew, Perturb
   if (index % 3 != 0) return;
   const int gyro = 1 + pick(rng, n);
   switch (index / 3 % 3) {
-    case 0: r.options.faults = {make_fault(gyro, FaultKind::kStuck, slew.start_s, 0.0)}; break;
+    case 0:
+      r.options.faults = {make_fault(gyro, FaultKind::kStuck, slew.start_s, 0.0)};
+      break;
     case 1:
       r.options.faults = {make_fault(gyro, FaultKind::kZero, slew.start_s + 0.5 * slew.duration_s, 0.0)};
       break;
@@ -228,7 +247,7 @@ PerturbedRun calibration(Rng& rng, std::uint64_t index, bool stated_noise) {
   Slew back = slew;
   back.angle_deg = -slew.angle_deg;
   back.start_s = slew.start_s + slew.duration_s + 30.0;
-  r.scenario = base(n, reference, back.start_s + back.duration_s + 60.0);
+  r.scenario = base(n, reference, back.start_s + back.duration_s + kAfter_s);
   r.scenario.motion.slews = {slew, back};
   char text[128];
   if (stated_noise) {
@@ -264,7 +283,7 @@ PerturbedRun second_fault(Rng& rng, std::uint64_t index) {
   PerturbedRun r;
   const double at = between(rng, 40.0, 80.0);
   const double sign = rng.uniform() < 0.5 ? -1.0 : 1.0;
-  r.scenario = base(kind == 3 ? 4 : 3, true, 400.0);
+  r.scenario = base(kind == 3 ? 4 : 3, true, 80.0 + kAfter_s);
   r.scenario.motion.kind = MotionKind::kOrbit;
   const int gyro = 1 + pick(rng, 3);
   switch (kind) {
@@ -274,11 +293,12 @@ PerturbedRun second_fault(Rng& rng, std::uint64_t index) {
     case 1:
       r.options.faults = {make_fault(gyro, FaultKind::kRamp, at, sign * between(rng, 1e-6, 1e-5))};
       break;
-    case 2: r.options.faults = {make_fault(gyro, FaultKind::kNoise, at, between(rng, 5.0, 10.0))}; break;
+    case 2:
+      r.options.faults = {make_fault(gyro, FaultKind::kNoise, at, between(rng, 5.0, 10.0))};
+      break;
     default: {
       const int other = 1 + (gyro % 3);  // two of gyros 1..3, both faulty: no parity left to see them
-      r.options.faults =
-          parity_cancelling(r.scenario.unit, gyro, other, sign * between(rng, 3e-4, 1e-3), at);
+      r.options.faults = parity_cancelling(r.scenario.unit, gyro, other, sign * between(rng, 3e-4, 1e-3), at);
       break;
     }
   }
@@ -290,7 +310,9 @@ PerturbedRun second_fault(Rng& rng, std::uint64_t index) {
 
 }  // namespace
 
-std::string_view family_name(Family family) { return kFamilyNames[static_cast<std::size_t>(family)]; }
+std::string_view family_name(Family family) {
+  return kFamilyNames[static_cast<std::size_t>(family)];
+}
 
 std::optional<Family> family_from_name(std::string_view name) {
   for (int i = 0; i < kFamilyCount; ++i)
@@ -306,12 +328,18 @@ std::vector<Family> all_families() {
 
 std::string_view reference_failure_name(ReferenceFailure failure) {
   switch (failure) {
-    case ReferenceFailure::kNone: return "none";
-    case ReferenceFailure::kLate: return "late";
-    case ReferenceFailure::kNoisy: return "noisy";
-    case ReferenceFailure::kBiasStep: return "bias-step";
-    case ReferenceFailure::kBiasRamp: return "bias-ramp";
-    case ReferenceFailure::kMisidentified: return "mis-identified";
+    case ReferenceFailure::kNone:
+      return "none";
+    case ReferenceFailure::kLate:
+      return "late";
+    case ReferenceFailure::kNoisy:
+      return "noisy";
+    case ReferenceFailure::kBiasStep:
+      return "bias-step";
+    case ReferenceFailure::kBiasRamp:
+      return "bias-ramp";
+    case ReferenceFailure::kMisidentified:
+      return "mis-identified";
   }
   return "none";
 }
@@ -353,17 +381,50 @@ Calibration stated_calibration(const Calibration& truth, double errors, double s
   return cal;
 }
 
+PerturbedRun unperturbed_twin(const PerturbedRun& run) {
+  PerturbedRun twin = run;
+  twin.label = "twin of " + run.label;
+  twin.options.faults.clear();
+  twin.scenario.faults.clear();
+  twin.scenario.drop_probability = 0.0;
+  twin.scenario.jitter_s = 0.0;
+  twin.gap_from_s = twin.gap_until_s = 0.0;
+  const double rate_hz = run.scenario.reference.rate_hz;
+  twin.scenario.reference = ReferenceOptions{};
+  twin.scenario.reference.rate_hz = rate_hz;
+  twin.scenario.reference.noise_arcsec = kConfiguredReference_arcsec;
+  twin.reference_failure = ReferenceFailure::kNone;
+  twin.reference_fault_at_s = -1.0;
+  twin.calibration = run.scenario.unit;
+  twin.stated_sigma_multiple = 0.0;
+  return twin;
+}
+
 PerturbedRun perturbed_run(Family family, std::uint64_t seed, std::uint64_t index) {
   Rng rng = family_rng(family, seed, index);
   PerturbedRun r;
   switch (family) {
-    case Family::kFaultInSlew: r = fault_in_slew(rng, index); break;
-    case Family::kDataPath: r = data_path(rng, index); break;
-    case Family::kGap: r = gap(rng, index); break;
-    case Family::kReference: r = reference_failure(rng, index); break;
-    case Family::kCalibration: r = calibration(rng, index, true); break;
-    case Family::kCalibrationWithoutNoise: r = calibration(rng, index, false); break;
-    case Family::kSecondFault: r = second_fault(rng, index); break;
+    case Family::kFaultInSlew:
+      r = fault_in_slew(rng, index);
+      break;
+    case Family::kDataPath:
+      r = data_path(rng, index);
+      break;
+    case Family::kGap:
+      r = gap(rng, index);
+      break;
+    case Family::kReference:
+      r = reference_failure(rng, index);
+      break;
+    case Family::kCalibration:
+      r = calibration(rng, index, true);
+      break;
+    case Family::kCalibrationWithoutNoise:
+      r = calibration(rng, index, false);
+      break;
+    case Family::kSecondFault:
+      r = second_fault(rng, index);
+      break;
   }
   if (r.calibration.gyros.empty()) r.calibration = r.scenario.unit;
   r.family = family;

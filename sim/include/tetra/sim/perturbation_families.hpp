@@ -23,11 +23,11 @@
 namespace tetra::sim {
 
 enum class Family {
-  kFaultInSlew,              //!< one gyro fault at a slew's start, middle or end (slews up to 45° in 10 s)
-  kDataPath,                 //!< fault-free, 0–20 % of samples dropped, time jitter up to ±5 ms
-  kGap,                      //!< fault-free, 10–30 s with no epoch delivered, mid-slew or in orbit
-  kReference,                //!< fault-free gyros, a late / noisy / biased / mis-identified star tracker
-  kCalibration,              //!< scale and axis errors up to 2× the calibration's stated 1σ (a fault in 1/3)
+  kFaultInSlew,  //!< one gyro fault at a slew's start, middle or end (slews up to 45° in 10 s)
+  kDataPath,     //!< fault-free, 0–20 % of samples dropped, time jitter up to ±5 ms
+  kGap,          //!< fault-free, 10–30 s with no epoch delivered, mid-slew or in orbit
+  kReference,    //!< fault-free gyros, a late / noisy / biased / mis-identified star tracker
+  kCalibration,  //!< scale and axis errors up to 2× the calibration's stated 1σ (a fault in 1/3)
   kCalibrationWithoutNoise,  //!< the fusion's calibration has no noise: section (a fault in 1/3)
   kSecondFault,              //!< three gyros and the reference, a fault on one of them (redundancy exhausted)
 };
@@ -45,14 +45,14 @@ std::string_view reference_failure_name(ReferenceFailure failure);
 //! One perturbed run: the truth to simulate and what the fusion is told.
 struct PerturbedRun {
   Family family = Family::kFaultInSlew;
-  std::string label;        //!< one line naming every draw (for a failure report)
-  Scenario scenario;        //!< truth: motion, unit, reference (with its failure), drops, jitter
-  SimOptions options;       //!< simulator seed and the gyro faults injected
-  Calibration calibration;  //!< what the fusion is given (the truth unit unless the family perturbs it)
-  double sample_period_s = 0.0;                //!< [s] the fusion's configured sample period; 0: from the data
+  std::string label;             //!< one line naming every draw (for a failure report)
+  Scenario scenario;             //!< truth: motion, unit, reference (with its failure), drops, jitter
+  SimOptions options;            //!< simulator seed and the gyro faults injected
+  Calibration calibration;       //!< what the fusion is given (the truth unit unless the family perturbs it)
+  double sample_period_s = 0.0;  //!< [s] the fusion's configured sample period; 0: from the data
   double max_angular_acceleration_dps2 = 0.0;  //!< [deg/s²] the fusion's bound; 0: its default
-  double gap_from_s = 0.0;   //!< [s] epochs in [gap_from_s, gap_until_s) are not delivered
-  double gap_until_s = 0.0;  //!< [s]
+  double gap_from_s = 0.0;                     //!< [s] epochs in [gap_from_s, gap_until_s) are not delivered
+  double gap_until_s = 0.0;                    //!< [s]
   ReferenceFailure reference_failure = ReferenceFailure::kNone;
   double reference_fault_at_s = -1.0;  //!< [s] when the reference failure begins (-1: none or from the start)
   double stated_sigma_multiple = 0.0;  //!< calibration family: the errors' size in stated 1σ (≤ 2)
@@ -69,5 +69,10 @@ Calibration stated_calibration(const Calibration& truth, double errors, double s
 
 //! The run `index` of `family` under `seed` (docs/fdi.md lists each family's draws).
 PerturbedRun perturbed_run(Family family, std::uint64_t seed, std::uint64_t index);
+
+//! The same run with its perturbation removed: same motion, unit, seed (so the same noise samples), no gyro
+//! fault, no drop, jitter or gap, a healthy reference at the stated 1σ, the fusion given the true unit. What
+//! the twin's sigma does is the fusion's fault-free character; what differs is the perturbation's doing.
+PerturbedRun unperturbed_twin(const PerturbedRun& run);
 
 }  // namespace tetra::sim
