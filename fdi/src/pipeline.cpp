@@ -22,6 +22,7 @@
 #include <string>
 
 #include "bias_hypothesis.hpp"
+#include "disagreement_trend.hpp"
 #include "gyro_series.hpp"
 #include "gyro_set.hpp"
 #include "isolator.hpp"
@@ -147,7 +148,8 @@ class Pipeline::Impl {
   GyroSet gyro_set_;
   RateAttitude attitude_;
   ReferenceConsistency consistency_;  //!< the reference as a sensor that can fail
-  ProtectionLevel protection_;        //!< the integrity bound beside sigma
+  DisagreementTrend trend_;     //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
+  ProtectionLevel protection_;  //!< the integrity bound beside sigma
 
   EpochFrame frame_;
   Isolations found_;
@@ -239,6 +241,9 @@ void Pipeline::Impl::judge_reference() {
     return;
   const ReferenceVerdict v = consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_);
   reference_usable_ = v.use;
+  if (v.rejected && *v.rejected != ReferenceCheck::kJump) trend_.start(frame_.now_ns);
+  if (v.reaccepted) trend_.stop();
+  if (consistency_.state() == ReferenceState::kRejected) trend_.add(frame_.now_ns, z, S.diagonal());
   if (v.rejected || v.reaccepted) {
     FdiEvent e;
     e.stamp_ns = frame_.now_ns;
@@ -492,6 +497,10 @@ void Pipeline::Impl::publish_attitude() {
   a.stamp_ns = frame_.now_ns;
   a.q_RB = attitude_.q_RB();
   a.sigma_rad = attitude_.sigma_rad();
+  if (trend_.active()) {
+    const Eigen::Vector3d d = trend_.bound(frame_.now_ns);
+    a.sigma_rad = (a.sigma_rad.cwiseProduct(a.sigma_rad) + d.cwiseProduct(d)).cwiseSqrt();
+  }
   if (!observable) {
     a.protection_level_rad.setConstant(std::numeric_limits<double>::infinity());
   } else if (subsets_.ready()) {
@@ -686,6 +695,7 @@ void Pipeline::Impl::reset() {
   gate_.reset();
   reference_.reset();
   consistency_.reset();
+  trend_.stop();
   bias_check_.reset();
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);
@@ -768,6 +778,7 @@ FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   // attitude and time go on.
   for (int id = 1; id <= n_; ++id) reinstate(id);
   consistency_.reset();
+  trend_.stop();
   restart_detectors();
   update_mode(stamp_ns);
   FdiEvent ack;

@@ -31,13 +31,44 @@ struct FamilyVerdict {
   double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
   std::optional<double> flagged_after_s;           //!< [s] first detection or reference rejection after the
                                                    //!< perturbation began
-  std::string events;                              //!< the run's events, for a failure report
+  //! Sigma meets the per-run criterion over the epochs from the first flag on: what the perturbation did
+  //! before anything could see it is the protection level's to bound, not sigma's (docs/fdi.md).
+  bool honest_after_flag = false;
+  std::string events;  //!< the run's events, for a failure report
 };
 
 inline double perturbation_start_s(const sim::PerturbedRun& r) {
   double t = r.reference_fault_at_s >= 0.0 ? r.reference_fault_at_s : 1e300;
   for (const auto& f : r.options.faults) t = std::min(t, f.at_s);
   return t < 1e300 ? t : 0.0;
+}
+
+//! Sigma's honesty over a run's epochs from `from_s` on.
+struct Honesty {
+  double within = 1.0;                             //!< share of axis-epochs with |e| ≤ 3σ
+  Eigen::Vector3d nees = Eigen::Vector3d::Zero();  //!< per-axis mean e²/σ²
+  double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
+};
+
+inline Honesty honesty(const CampaignRun& run, double from_s) {
+  Honesty h;
+  int epochs = 0;
+  int inside = 0;
+  for (std::size_t k = 0; k < run.time_s.size(); ++k) {
+    if (run.time_s[k] < from_s) continue;
+    ++epochs;
+    for (int a = 0; a < 3; ++a) {
+      const double z = std::abs(run.error_rad[k][a]) / run.sigma_rad[k][a];
+      inside += z <= 3.0 ? 1 : 0;
+      h.nees[a] += z * z;
+      h.worst_sigmas = std::max(h.worst_sigmas, z);
+    }
+  }
+  if (epochs > 0) {
+    h.within = inside / (3.0 * epochs);
+    h.nees /= epochs;
+  }
+  return h;
 }
 
 inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
@@ -66,27 +97,13 @@ inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
     if (!faulty) v.wrong_exclusion = true;
   }
   v.lost = v.lost || run.final_mode == fdi::Mode::kLost;
-  int epochs = 0;
-  int inside = 0;
-  for (std::size_t k = 0; k < run.time_s.size(); ++k) {
-    if (std::getenv("DBG_TRACE") && std::fmod(run.time_s[k] + 1e-3, 1.0) < 0.1 && run.time_s[k] > 25 &&
-        run.time_s[k] < 80)
-      std::printf("t %.2f err %.5f %.5f %.5f sig %.5f %.5f %.5f deg\n", run.time_s[k],
-                  run.error_rad[k][0] * kRadToDeg, run.error_rad[k][1] * kRadToDeg,
-                  run.error_rad[k][2] * kRadToDeg, run.sigma_rad[k][0] * kRadToDeg,
-                  run.sigma_rad[k][1] * kRadToDeg, run.sigma_rad[k][2] * kRadToDeg);
-    if (run.time_s[k] < kHonestyFrom_s) continue;
-    ++epochs;
-    for (int a = 0; a < 3; ++a) {
-      const double z = std::abs(run.error_rad[k][a]) / run.sigma_rad[k][a];
-      inside += z <= 3.0 ? 1 : 0;
-      v.nees[a] += z * z;
-      v.worst_sigmas = std::max(v.worst_sigmas, z);
-    }
-  }
-  if (epochs > 0) {
-    v.within = inside / (3.0 * epochs);
-    v.nees /= epochs;
+  const Honesty whole = honesty(run, kHonestyFrom_s);
+  v.within = whole.within;
+  v.nees = whole.nees;
+  v.worst_sigmas = whole.worst_sigmas;
+  if (v.flagged_after_s) {
+    const Honesty after = honesty(run, std::max(kHonestyFrom_s, start + *v.flagged_after_s));
+    v.honest_after_flag = after.within >= kMinWithin3Sigma && after.nees.maxCoeff() <= kMaxNeesPerAxis;
   }
   v.events = describe(run, n);
   return v;
@@ -98,10 +115,11 @@ struct FamilyFigures {
   int wrong_exclusions = 0;
   int exclusions_without_fault = 0;
   int lost = 0;
-  int dishonest = 0;       //!< runs failing the per-run criterion whose twin meets it
-  int twin_dishonest = 0;  //!< twins failing it (the fault-free character)
-  int below_within = 0;    //!< runs below kMinWithin3Sigma
-  int above_nees = 0;      //!< runs above kMaxNeesPerAxis on an axis
+  int dishonest = 0;         //!< runs failing the per-run criterion whose twin meets it
+  int twin_dishonest = 0;    //!< twins failing it (the fault-free character)
+  int honest_from_flag = 0;  //!< runs honest only from their first flag on (the perturbation unseen before)
+  int below_within = 0;      //!< runs below kMinWithin3Sigma
+  int above_nees = 0;        //!< runs above kMaxNeesPerAxis on an axis
   Eigen::Vector3d nees_sum = Eigen::Vector3d::Zero();  //!< Σ over the runs of each axis's NEES
   double worst_within = 1.0;
   double worst_nees = 0.0;
@@ -111,9 +129,9 @@ struct FamilyFigures {
   std::string failures;  //!< label, figures and events of every run that broke a promise
 };
 
-//! A run's sigma meets the per-run criterion.
+//! A run's sigma meets the per-run criterion over the whole run, or from an honest flag on.
 inline bool honest(const FamilyVerdict& v) {
-  return v.within >= kMinWithin3Sigma && v.nees.maxCoeff() <= kMaxNeesPerAxis;
+  return (v.within >= kMinWithin3Sigma && v.nees.maxCoeff() <= kMaxNeesPerAxis) || v.honest_after_flag;
 }
 
 //! One run and its unperturbed twin (sim::unperturbed_twin) into a family's figures. Sigma is charged to the
@@ -128,6 +146,8 @@ inline void add_run(FamilyFigures& f, const sim::PerturbedRun& r, const FamilyVe
   const bool dishonest = !honest(v) && honest(twin);
   f.dishonest += dishonest ? 1 : 0;
   f.twin_dishonest += honest(twin) ? 0 : 1;
+  f.honest_from_flag +=
+      (v.within < kMinWithin3Sigma || v.nees.maxCoeff() > kMaxNeesPerAxis) && v.honest_after_flag ? 1 : 0;
   f.below_within += v.within < kMinWithin3Sigma ? 1 : 0;
   f.above_nees += v.nees.maxCoeff() > kMaxNeesPerAxis ? 1 : 0;
   f.nees_sum += v.nees;
@@ -152,19 +172,20 @@ inline void add_run(FamilyFigures& f, const sim::PerturbedRun& r, const FamilyVe
 }
 
 inline void print_figures_header() {
-  std::printf("%-25s %5s %5s %8s %4s %9s %4s %6s %6s %8s %7s %16s %7s %11s %9s\n", "family", "runs", "wrong",
-              "no-fault", "LOST", "dishonest", "twin", "<97%", "NEES>2", "worst<3s", "worstNEES",
-              "mean NEES x y z", "flagged", "median flag", "max flag");
+  std::printf("%-25s %5s %5s %8s %4s %9s %4s %9s %6s %6s %8s %7s %16s %7s %11s %9s\n", "family", "runs",
+              "wrong", "no-fault", "LOST", "dishonest", "twin", "from flag", "<97%", "NEES>2", "worst<3s",
+              "worstNEES", "mean NEES x y z", "flagged", "median flag", "max flag");
 }
 
 inline void print_figures(const std::string& name, FamilyFigures f) {
   std::sort(f.flag_delays_s.begin(), f.flag_delays_s.end());
   const double median = f.flag_delays_s.empty() ? 0.0 : f.flag_delays_s[f.flag_delays_s.size() / 2];
   const Eigen::Vector3d mean = f.nees_sum / std::max(f.runs, 1);
-  std::printf("%-25s %5d %5d %8d %4d %9d %4d %6d %6d %7.2f%% %9.2f %5.2f %4.2f %4.2f %7d %9.1f s %7.1f s\n",
-              name.c_str(), f.runs, f.wrong_exclusions, f.exclusions_without_fault, f.lost, f.dishonest,
-              f.twin_dishonest, f.below_within, f.above_nees, 100.0 * f.worst_within, f.worst_nees, mean[0],
-              mean[1], mean[2], f.flagged, median, f.max_flag_delay_s);
+  std::printf(
+      "%-25s %5d %5d %8d %4d %9d %4d %9d %6d %6d %7.2f%% %9.2f %5.2f %4.2f %4.2f %7d %9.1f s %7.1f s\n",
+      name.c_str(), f.runs, f.wrong_exclusions, f.exclusions_without_fault, f.lost, f.dishonest,
+      f.twin_dishonest, f.honest_from_flag, f.below_within, f.above_nees, 100.0 * f.worst_within,
+      f.worst_nees, mean[0], mean[1], mean[2], f.flagged, median, f.max_flag_delay_s);
 }
 
 }  // namespace tetra::test
