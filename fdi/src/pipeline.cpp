@@ -469,9 +469,11 @@ void Pipeline::Impl::publish_attitude() {
       // rate.
       const bool episode = isolator_.episode().active;
       const Subset* active = episode || !sol.observable ? &subsets_.get(gyro_set_.active()) : nullptr;
+      // ...and the rate error the calibration's stated σ allows at this rate.
       const Eigen::Vector3d bound =
-          episode ? fault_rate_bound(*active, detector_.parity_ema(), subsets_.sqrt_period())
-                  : Eigen::Vector3d::Zero();
+          (episode ? fault_rate_bound(*active, detector_.parity_ema(), subsets_.sqrt_period())
+                   : Eigen::Vector3d::Zero()) +
+          subsets_.calibration_rate_bound(sol, frame_.usable, attitude_.omega_meas_B());
       attitude_.propagate(frame_, sol, active, bound, subsets_.period_s());
       // The epoch's parity, when it was computed over the gyros published, measures their biases.
       if (frame_.usable == measured_ && sol.observable)

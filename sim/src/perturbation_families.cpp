@@ -131,6 +131,9 @@ PerturbedRun fault_in_slew(Rng& rng, std::uint64_t index) {
   const double at = kSlewStart_s + 0.5 * when * slew.duration_s;
   r.options.faults = {slew_fault(rng, kind, 1 + pick(rng, n), at)};
   r.max_angular_acceleration_dps2 = rng.uniform() < 0.5 ? 2e-4 : 1e-3;
+  static constexpr std::array<const char*, 7> kKinds = {
+      "stuck", "zero", "bias 1e-2..3e-2", "bias 1e-3..3e-3", "noise", "ramp", "scale"};
+  r.case_name = std::string(kKinds[static_cast<std::size_t>(kind)]) + " at the " + kWhen[when];
   r.label = "N=" + std::to_string(n) + " " + fault_text(r.options.faults[0]) + " at the " + kWhen[when] +
             " of " + slew_text(slew) + (reference ? " ref" : "");
   return r;
@@ -150,6 +153,7 @@ PerturbedRun data_path(Rng& rng, std::uint64_t index) {
   char text[96];
   std::snprintf(text, sizeof text, " drop %.3f jitter %.4f s", r.scenario.drop_probability,
                 r.scenario.jitter_s);
+  r.case_name = reference ? "drops and jitter, reference" : "drops and jitter";
   r.label = "N=" + std::to_string(n) + " " + slew_text(slew) + text + (reference ? " ref" : "");
   return r;
 }
@@ -170,6 +174,7 @@ PerturbedRun gap(Rng& rng, std::uint64_t index) {
   r.gap_until_s = r.gap_from_s + length;
   char text[96];
   std::snprintf(text, sizeof text, " gap %.1f s from %.1f s", length, r.gap_from_s);
+  r.case_name = std::string(orbit ? "orbit" : "mid-slew") + (reference ? ", reference" : "");
   r.label = "N=" + std::to_string(n) + " " + (orbit ? std::string("orbit") : slew_text(slew)) + text +
             (reference ? " ref" : "");
   return r;
@@ -214,6 +219,7 @@ PerturbedRun reference_failure(Rng& rng, std::uint64_t index) {
                     ref.misid_at_s, ref.misid_duration_s);
       break;
   }
+  r.case_name = std::string(reference_failure_name(failure));
   r.label = "N=" + std::to_string(n) + " " + slew_text(slew) + " reference " +
             std::string(reference_failure_name(failure)) + ": " + text;
   return r;
@@ -236,6 +242,7 @@ void maybe_fault(Rng& rng, std::uint64_t index, int n, const Slew& slew, Perturb
       break;
   }
   r.label += " " + fault_text(r.options.faults[0]);
+  r.case_name = std::string(fault_kind_name(r.options.faults[0].kind));
 }
 
 PerturbedRun calibration(Rng& rng, std::uint64_t index, bool stated_noise) {
@@ -263,6 +270,7 @@ PerturbedRun calibration(Rng& rng, std::uint64_t index, bool stated_noise) {
     std::snprintf(text, sizeof text, " calibration without noise:");
   }
   r.label = "N=" + std::to_string(n) + " " + slew_text(slew) + " and back" + text + (reference ? " ref" : "");
+  r.case_name = "fault-free";
   maybe_fault(rng, index, n, slew, r);
   return r;
 }
@@ -302,6 +310,9 @@ PerturbedRun second_fault(Rng& rng, std::uint64_t index) {
       break;
     }
   }
+  static constexpr std::array<const char*, 4> kKinds = {"bias 3e-4..1e-3", "ramp 1e-6..1e-5", "noise x5..x10",
+                                                        "two biases cancelling in the parity"};
+  r.case_name = kKinds[static_cast<std::size_t>(kind)];
   r.label = std::string(kind == 3 ? "N=4, two biases cancelling in the parity:" : "N=3:");
   for (const auto& f : r.options.faults) r.label += " " + fault_text(f);
   r.label += " ref, orbit";

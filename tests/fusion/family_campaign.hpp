@@ -25,8 +25,10 @@ inline constexpr double kMaxNeesPerAxis = 2.0;
 struct FamilyVerdict {
   bool wrong_exclusion = false;     //!< a gyro excluded before any fault of its own began
   bool exclusion_no_fault = false;  //!< an exclusion in a run without any gyro fault
-  bool lost = false;                //!< `lost` event or final mode LOST
-  double within = 1.0;              //!< share of axis-epochs with |e| ≤ 3σ from kHonestyFrom_s
+  bool lost =
+      false;  //!< a `lost` event (exclusions left the rate unobservable; one epoch short of samples is not)
+  bool healthy_reference_rejected = false;  //!< `reference_rejected` of a reference without a failure
+  double within = 1.0;                      //!< share of axis-epochs with |e| ≤ 3σ from kHonestyFrom_s
   Eigen::Vector3d nees = Eigen::Vector3d::Zero();  //!< per-axis mean e²/σ² over the same epochs
   double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
   std::optional<double> flagged_after_s;           //!< [s] first detection or reference rejection after the
@@ -87,6 +89,8 @@ inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
   for (const auto& e : run.events) {
     const double t = ns_to_seconds(e.stamp_ns);
     if (e.type == fdi::EventType::kLost) v.lost = true;
+    if (e.type == fdi::EventType::kReferenceRejected && r.reference_failure == sim::ReferenceFailure::kNone)
+      v.healthy_reference_rejected = true;
     if ((e.type == fdi::EventType::kDetected || e.type == fdi::EventType::kReferenceRejected) && t >= start &&
         !v.flagged_after_s)
       v.flagged_after_s = t - start;
@@ -96,7 +100,6 @@ inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
                                     [&](const sim::FaultSpec& f) { return f.gyro == e.gyro && f.at_s <= t; });
     if (!faulty) v.wrong_exclusion = true;
   }
-  v.lost = v.lost || run.final_mode == fdi::Mode::kLost;
   const Honesty whole = honesty(run, kHonestyFrom_s);
   v.within = whole.within;
   v.nees = whole.nees;
@@ -115,8 +118,9 @@ struct FamilyFigures {
   int wrong_exclusions = 0;
   int exclusions_without_fault = 0;
   int lost = 0;
-  int dishonest = 0;         //!< runs failing the per-run criterion whose twin meets it
-  int twin_dishonest = 0;    //!< twins failing it (the fault-free character)
+  int healthy_reference_rejected = 0;  //!< runs whose healthy reference was rejected
+  int dishonest = 0;                   //!< runs failing the per-run criterion whose twin meets it
+  int twin_dishonest = 0;              //!< twins failing it (the fault-free character)
   int honest_from_flag = 0;  //!< runs honest only from their first flag on (the perturbation unseen before)
   int below_within = 0;      //!< runs below kMinWithin3Sigma
   int above_nees = 0;        //!< runs above kMaxNeesPerAxis on an axis
@@ -143,6 +147,7 @@ inline void add_run(FamilyFigures& f, const sim::PerturbedRun& r, const FamilyVe
   f.wrong_exclusions += v.wrong_exclusion ? 1 : 0;
   f.exclusions_without_fault += v.exclusion_no_fault ? 1 : 0;
   f.lost += v.lost ? 1 : 0;
+  f.healthy_reference_rejected += v.healthy_reference_rejected ? 1 : 0;
   const bool dishonest = !honest(v) && honest(twin);
   f.dishonest += dishonest ? 1 : 0;
   f.twin_dishonest += honest(twin) ? 0 : 1;
@@ -172,9 +177,9 @@ inline void add_run(FamilyFigures& f, const sim::PerturbedRun& r, const FamilyVe
 }
 
 inline void print_figures_header() {
-  std::printf("%-25s %5s %5s %8s %4s %9s %4s %9s %6s %6s %8s %7s %16s %7s %11s %9s\n", "family", "runs",
-              "wrong", "no-fault", "LOST", "dishonest", "twin", "from flag", "<97%", "NEES>2", "worst<3s",
-              "worstNEES", "mean NEES x y z", "flagged", "median flag", "max flag");
+  std::printf("%-36s %5s %5s %8s %4s %7s %9s %4s %9s %6s %6s %8s %7s %16s %7s %11s %9s\n", "family", "runs",
+              "wrong", "no-fault", "LOST", "ref-rej", "dishonest", "twin", "from flag", "<97%", "NEES>2",
+              "worst<3s", "worstNEES", "mean NEES x y z", "flagged", "median flag", "max flag");
 }
 
 inline void print_figures(const std::string& name, FamilyFigures f) {
@@ -182,10 +187,11 @@ inline void print_figures(const std::string& name, FamilyFigures f) {
   const double median = f.flag_delays_s.empty() ? 0.0 : f.flag_delays_s[f.flag_delays_s.size() / 2];
   const Eigen::Vector3d mean = f.nees_sum / std::max(f.runs, 1);
   std::printf(
-      "%-25s %5d %5d %8d %4d %9d %4d %9d %6d %6d %7.2f%% %9.2f %5.2f %4.2f %4.2f %7d %9.1f s %7.1f s\n",
-      name.c_str(), f.runs, f.wrong_exclusions, f.exclusions_without_fault, f.lost, f.dishonest,
-      f.twin_dishonest, f.honest_from_flag, f.below_within, f.above_nees, 100.0 * f.worst_within,
-      f.worst_nees, mean[0], mean[1], mean[2], f.flagged, median, f.max_flag_delay_s);
+      "%-36s %5d %5d %8d %4d %7d %9d %4d %9d %6d %6d %7.2f%% %9.2f %5.2f %4.2f %4.2f %7d %9.1f s %7.1f s\n",
+      name.c_str(), f.runs, f.wrong_exclusions, f.exclusions_without_fault, f.lost,
+      f.healthy_reference_rejected, f.dishonest, f.twin_dishonest, f.honest_from_flag, f.below_within,
+      f.above_nees, 100.0 * f.worst_within, f.worst_nees, mean[0], mean[1], mean[2], f.flagged, median,
+      f.max_flag_delay_s);
 }
 
 }  // namespace tetra::test

@@ -5,6 +5,7 @@
 // exclusion in a fault-free run, never LOST from one fault, and every run's sigma honest (≥ 97 % of
 // axis-epochs within 3σ, per-axis NEES ≤ 2). The figures are printed per family.
 #include <cstdlib>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -20,23 +21,25 @@ std::uint64_t env_count(const char* name, std::uint64_t fallback) {
   return n > 0 ? static_cast<std::uint64_t>(n) : fallback;
 }
 
-//! Runs `fallback` (or TETRA_FAMILY_RUNS) indices of `family`, prints its figures, returns them.
+//! Runs `fallback` (or TETRA_FAMILY_RUNS) indices of `family`, prints its figures and each case's, returns
+//! the family's.
 test::FamilyFigures run_family(sim::Family family, std::uint64_t fallback) {
   const std::uint64_t runs = env_count("TETRA_FAMILY_RUNS", fallback);
   const std::uint64_t seed = env_count("TETRA_FAMILY_SEED", 1);
   test::FamilyFigures f;
+  std::map<std::string, test::FamilyFigures> cases;
   for (std::uint64_t i = 0; i < runs; ++i) {
-    if (std::getenv("DBG_ONLY") && std::strtoul(std::getenv("DBG_ONLY"), nullptr, 10) != i) continue;
-    sim::PerturbedRun r = sim::perturbed_run(family, seed, i);
-    if (std::getenv("DBG_NOJITTER")) r.scenario.jitter_s = 0;
-    if (std::getenv("DBG_NODROP")) r.scenario.drop_probability = 0;
-    if (std::getenv("DBG_NOREF")) r.scenario.reference.rate_hz = 0;
+    const sim::PerturbedRun r = sim::perturbed_run(family, seed, i);
     // With three gyros (redundancy exhausted) or two faults, an exclusion leaves the rate unobservable.
     const bool lost_allowed = r.scenario.unit.gyro_count() - 1 < 3 || r.options.faults.size() > 1;
-    test::add_run(f, r, test::judge_run(r), test::judge_run(sim::unperturbed_twin(r)), lost_allowed);
+    const test::FamilyVerdict v = test::judge_run(r);
+    const test::FamilyVerdict twin = test::judge_run(sim::unperturbed_twin(r));
+    test::add_run(f, r, v, twin, lost_allowed);
+    test::add_run(cases[r.case_name], r, v, twin, lost_allowed);
   }
   test::print_figures_header();
   test::print_figures(std::string(sim::family_name(family)), f);
+  for (const auto& [name, c] : cases) test::print_figures("  " + name, c);
   return f;
 }
 

@@ -46,6 +46,7 @@ std::string_view reference_failure_name(ReferenceFailure failure);
 struct PerturbedRun {
   Family family = Family::kFaultInSlew;
   std::string label;             //!< one line naming every draw (for a failure report)
+  std::string case_name;         //!< the family's case of this run (fault kind, reference failure, ...)
   Scenario scenario;             //!< truth: motion, unit, reference (with its failure), drops, jitter
   SimOptions options;            //!< simulator seed and the gyro faults injected
   Calibration calibration;       //!< what the fusion is given (the truth unit unless the family perturbs it)
