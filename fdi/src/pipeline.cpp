@@ -241,7 +241,7 @@ void Pipeline::Impl::judge_reference() {
     return;
   const ReferenceVerdict v = consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_);
   reference_usable_ = v.use;
-  if (v.rejected && *v.rejected != ReferenceCheck::kJump) trend_.start(frame_.now_ns);
+  if (v.rejected) trend_.start(frame_.now_ns);
   if (v.reaccepted) trend_.stop();
   if (consistency_.state() == ReferenceState::kRejected) trend_.add(frame_.now_ns, z, S.diagonal());
   if (v.rejected || v.reaccepted) {

@@ -119,6 +119,7 @@ struct FamilyFigures {
   int exclusions_without_fault = 0;
   int lost = 0;
   int healthy_reference_rejected = 0;  //!< runs whose healthy reference was rejected
+  int lost_from_one_fault = 0;         //!< LOST where one fault left three gyros or more
   int dishonest = 0;                   //!< runs failing the per-run criterion whose twin meets it
   int twin_dishonest = 0;              //!< twins failing it (the fault-free character)
   int honest_from_flag = 0;  //!< runs honest only from their first flag on (the perturbation unseen before)
@@ -138,6 +139,17 @@ inline bool honest(const FamilyVerdict& v) {
   return (v.within >= kMinWithin3Sigma && v.nees.maxCoeff() <= kMaxNeesPerAxis) || v.honest_after_flag;
 }
 
+//! The run's sigma is materially worse than its twin's: a per-axis NEES above kTwinNeesRatio times the twin's
+//! largest, or a within-3σ share more than kTwinWithinMargin below the twin's. The twin shares the noise
+//! samples but not the filter's path after the perturbation, so a run near the criterion whose twin is just
+//! inside it (NEES 2.02 against 1.99 across a gap) is the same fault-free character, not the perturbation's.
+inline constexpr double kTwinNeesRatio = 1.25;
+inline constexpr double kTwinWithinMargin = 0.01;
+inline bool worse_than_twin(const FamilyVerdict& v, const FamilyVerdict& twin) {
+  return v.nees.maxCoeff() > kTwinNeesRatio * twin.nees.maxCoeff() ||
+         v.within < twin.within - kTwinWithinMargin;
+}
+
 //! One run and its unperturbed twin (sim::unperturbed_twin) into a family's figures. Sigma is charged to the
 //! perturbation when the run fails the per-run criterion and its twin meets it; a twin that fails too is the
 //! fusion's fault-free character over that motion and noise (counted apart, `twin`).
@@ -147,8 +159,9 @@ inline void add_run(FamilyFigures& f, const sim::PerturbedRun& r, const FamilyVe
   f.wrong_exclusions += v.wrong_exclusion ? 1 : 0;
   f.exclusions_without_fault += v.exclusion_no_fault ? 1 : 0;
   f.lost += v.lost ? 1 : 0;
+  f.lost_from_one_fault += v.lost && !lost_allowed ? 1 : 0;
   f.healthy_reference_rejected += v.healthy_reference_rejected ? 1 : 0;
-  const bool dishonest = !honest(v) && honest(twin);
+  const bool dishonest = !honest(v) && (honest(twin) ? worse_than_twin(v, twin) : false);
   f.dishonest += dishonest ? 1 : 0;
   f.twin_dishonest += honest(twin) ? 0 : 1;
   f.honest_from_flag +=

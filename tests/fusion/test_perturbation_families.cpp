@@ -6,6 +6,7 @@
 // axis-epochs within 3σ, per-axis NEES ≤ 2). The figures are printed per family.
 #include <cstdlib>
 #include <map>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -21,9 +22,12 @@ std::uint64_t env_count(const char* name, std::uint64_t fallback) {
   return n > 0 ? static_cast<std::uint64_t>(n) : fallback;
 }
 
-//! Runs `fallback` (or TETRA_FAMILY_RUNS) indices of `family`, prints its figures and each case's, returns
-//! the family's.
-test::FamilyFigures run_family(sim::Family family, std::uint64_t fallback) {
+//! Runs `fallback` (or TETRA_FAMILY_RUNS) indices of `family`, prints its figures and each case's, and
+//! checks the promises: no exclusion of a gyro without a fault begun, none in a fault-free run, never LOST
+//! from one fault, in every case; sigma honest per run (sim::unperturbed_twin, family_campaign.hpp) in every
+//! case but the `limits` — the cases docs/fdi.md states the data cannot (yet) cover, whose figures are
+//! printed.
+void check_family(sim::Family family, std::uint64_t fallback, const std::set<std::string>& limits = {}) {
   const std::uint64_t runs = env_count("TETRA_FAMILY_RUNS", fallback);
   const std::uint64_t seed = env_count("TETRA_FAMILY_SEED", 1);
   test::FamilyFigures f;
@@ -39,14 +43,16 @@ test::FamilyFigures run_family(sim::Family family, std::uint64_t fallback) {
   }
   test::print_figures_header();
   test::print_figures(std::string(sim::family_name(family)), f);
-  for (const auto& [name, c] : cases) test::print_figures("  " + name, c);
-  return f;
-}
-
-void expect_promises(const test::FamilyFigures& f) {
-  EXPECT_EQ(f.wrong_exclusions, 0);
-  EXPECT_EQ(f.exclusions_without_fault, 0);
-  EXPECT_TRUE(f.failures.empty()) << f.failures;
+  for (const auto& [name, c] : cases)
+    test::print_figures("  " + name + (limits.count(name) ? " (limit)" : ""), c);
+  for (const auto& [name, c] : cases) {
+    EXPECT_EQ(c.wrong_exclusions, 0) << name << "\n" << c.failures;
+    EXPECT_EQ(c.exclusions_without_fault, 0) << name << "\n" << c.failures;
+    EXPECT_EQ(c.lost_from_one_fault, 0) << name << "\n" << c.failures;
+    if (limits.count(name) == 0) {
+      EXPECT_EQ(c.dishonest, 0) << name << "\n" << c.failures;
+    }
+  }
 }
 
 TEST(PerturbationFamilies, GeneratorsArePureFunctionsOfSeedAndIndex) {
@@ -63,27 +69,31 @@ TEST(PerturbationFamilies, GeneratorsArePureFunctionsOfSeedAndIndex) {
 }
 
 // ctest's subset: each family's index cycle covers its cases (fault kind × timing × N, failure kind, ...)
-// once or more; the bench runs hundreds per family.
+// once or more; bench/perturbation_sweep.sh runs 300 per family.
 TEST(PerturbationFamilies, FaultInSlew) {
-  expect_promises(run_family(sim::Family::kFaultInSlew, 42));
+  check_family(sim::Family::kFaultInSlew, 42);
 }
 TEST(PerturbationFamilies, DataPath) {
-  expect_promises(run_family(sim::Family::kDataPath, 12));
+  check_family(sim::Family::kDataPath, 12);
 }
 TEST(PerturbationFamilies, Gap) {
-  expect_promises(run_family(sim::Family::kGap, 18));
+  check_family(sim::Family::kGap, 18);
 }
+// A reference bias of 10–40″ (step or ramp) that the filter follows within its noise is not always caught:
+// docs/fdi.md, "Reference consistency", Limits.
 TEST(PerturbationFamilies, Reference) {
-  expect_promises(run_family(sim::Family::kReference, 15));
+  check_family(sim::Family::kReference, 15, {"bias-step", "bias-ramp"});
 }
 TEST(PerturbationFamilies, Calibration) {
-  expect_promises(run_family(sim::Family::kCalibration, 18));
+  check_family(sim::Family::kCalibration, 27);
 }
 TEST(PerturbationFamilies, CalibrationWithoutNoise) {
-  expect_promises(run_family(sim::Family::kCalibrationWithoutNoise, 18));
+  check_family(sim::Family::kCalibrationWithoutNoise, 18);
 }
+// Three gyros: a noise increase or a slow ramp shows in the reference's innovations late or not at all, and
+// sigma is short meanwhile (docs/fdi.md, "Perturbation families").
 TEST(PerturbationFamilies, SecondFault) {
-  expect_promises(run_family(sim::Family::kSecondFault, 8));
+  check_family(sim::Family::kSecondFault, 12, {"noise x5..x10", "ramp 1e-6..1e-5"});
 }
 
 }  // namespace
