@@ -50,6 +50,7 @@ struct Honesty {
   double within = 1.0;                             //!< share of axis-epochs with |e| ≤ 3σ
   Eigen::Vector3d nees = Eigen::Vector3d::Zero();  //!< per-axis mean e²/σ²
   double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
+  double worst_error_deg = 0.0;                    //!< [deg] largest |e| of an axis
 };
 
 inline Honesty honesty(const CampaignRun& run, double from_s) {
@@ -64,6 +65,7 @@ inline Honesty honesty(const CampaignRun& run, double from_s) {
       inside += z <= 3.0 ? 1 : 0;
       h.nees[a] += z * z;
       h.worst_sigmas = std::max(h.worst_sigmas, z);
+      h.worst_error_deg = std::max(h.worst_error_deg, std::abs(run.error_rad[k][a]) * kRadToDeg);
     }
   }
   if (epochs > 0) {
