@@ -22,6 +22,7 @@
 #include <string>
 
 #include "bias_hypothesis.hpp"
+#include "disagreement_trend.hpp"
 #include "gyro_series.hpp"
 #include "gyro_set.hpp"
 #include "isolator.hpp"
@@ -147,7 +148,8 @@ class Pipeline::Impl {
   GyroSet gyro_set_;
   RateAttitude attitude_;
   ReferenceConsistency consistency_;  //!< the reference as a sensor that can fail
-  ProtectionLevel protection_;        //!< the integrity bound beside sigma
+  DisagreementTrend trend_;     //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
+  ProtectionLevel protection_;  //!< the integrity bound beside sigma
 
   EpochFrame frame_;
   Isolations found_;
@@ -234,9 +236,14 @@ void Pipeline::Impl::judge_reference() {
   }
   Eigen::Vector3d z;
   Eigen::Matrix3d S;
-  if (!subsets_.ready() || !attitude_.predict_reference(*frame_.reference_q_RB, frame_.dt_s, z, S)) return;
+  if (!subsets_.ready() ||
+      !attitude_.predict_reference(*frame_.reference_q_RB, frame_.dt_s, subsets_.period_s(), z, S))
+    return;
   const ReferenceVerdict v = consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_);
   reference_usable_ = v.use;
+  if (v.rejected) trend_.start(frame_.now_ns);
+  if (v.reaccepted) trend_.stop();
+  if (consistency_.state() == ReferenceState::kRejected) trend_.add(frame_.now_ns, z, S.diagonal());
   if (v.rejected || v.reaccepted) {
     FdiEvent e;
     e.stamp_ns = frame_.now_ns;
@@ -462,10 +469,12 @@ void Pipeline::Impl::publish_attitude() {
       // rate.
       const bool episode = isolator_.episode().active;
       const Subset* active = episode || !sol.observable ? &subsets_.get(gyro_set_.active()) : nullptr;
+      // ...and the rate error the calibration's stated σ allows at this rate.
       const Eigen::Vector3d bound =
-          episode ? fault_rate_bound(*active, detector_.parity_ema(), subsets_.sqrt_period())
-                  : Eigen::Vector3d::Zero();
-      attitude_.propagate(frame_, sol, active, bound);
+          (episode ? fault_rate_bound(*active, detector_.parity_ema(), subsets_.sqrt_period())
+                   : Eigen::Vector3d::Zero()) +
+          subsets_.calibration_rate_bound(sol, frame_.usable, attitude_.omega_meas_B());
+      attitude_.propagate(frame_, sol, active, bound, subsets_.period_s());
       // The epoch's parity, when it was computed over the gyros published, measures their biases.
       if (frame_.usable == measured_ && sol.observable)
         attitude_.parity(sol, detector_.parity(), subsets_.sqrt_period());
@@ -490,6 +499,10 @@ void Pipeline::Impl::publish_attitude() {
   a.stamp_ns = frame_.now_ns;
   a.q_RB = attitude_.q_RB();
   a.sigma_rad = attitude_.sigma_rad();
+  if (trend_.active()) {
+    const Eigen::Vector3d d = trend_.bound(frame_.now_ns);
+    a.sigma_rad = (a.sigma_rad.cwiseProduct(a.sigma_rad) + d.cwiseProduct(d)).cwiseSqrt();
+  }
   if (!observable) {
     a.protection_level_rad.setConstant(std::numeric_limits<double>::infinity());
   } else if (subsets_.ready()) {
@@ -684,6 +697,7 @@ void Pipeline::Impl::reset() {
   gate_.reset();
   reference_.reset();
   consistency_.reset();
+  trend_.stop();
   bias_check_.reset();
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);
@@ -766,6 +780,7 @@ FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   // attitude and time go on.
   for (int id = 1; id <= n_; ++id) reinstate(id);
   consistency_.reset();
+  trend_.stop();
   restart_detectors();
   update_mode(stamp_ns);
   FdiEvent ack;

@@ -10,6 +10,10 @@
 namespace tetra::fdi::detail {
 
 namespace {
+//! [s] how long the acceleration the gyros saw is remembered for a lost rate's bound: a slew's acceleration
+//! changes over seconds, and a few epochs without a rate are what drops and gaps make.
+constexpr double kAccelMemory_s = 5.0;
+
 //! [rad/s] f_i = wᵢᵀp̄/|wᵢ|²: the fault on gyro i (column i of the subset's parity) that explains p̄.
 double single_gyro_fault(const Subset& s, Eigen::Index i, const Eigen::VectorXd& parity_ema,
                          double sqrt_period) {
@@ -89,6 +93,9 @@ void RateAttitude::reset(const Quaternion& q0_RB) {
   omega_prev_.setZero();
   correction_.setZero();
   lost_since_ns_ = -1;
+  slope_prev_.setZero();
+  accel_seen_.setZero();
+  have_slope_ = false;
   reference_seen_ = false;
   rejected_run_ = 0;
   last_chi2_ = 0.0;
@@ -106,12 +113,19 @@ void RateAttitude::parity(const Subset& s, const Eigen::VectorXd& p, double sqrt
   propagator_.rotate(quat_exp(dtheta));  // the bound (a fault's, a lost rate's) kept
 }
 
-bool RateAttitude::predict_reference(const Quaternion& q_ref_RB, double dt_s, Eigen::Vector3d& z,
-                                     Eigen::Matrix3d& S) const {
+Eigen::Vector3d RateAttitude::curvature_rad_s(double dt_s, double period_s) const {
+  if (!have_slope_ || dt_s <= 0.0) return Eigen::Vector3d::Zero();
+  const Eigen::Vector3d slope = (omega_meas_ - omega_prev_) / dt_s;
+  return -(period_s * period_s / 12.0) * (slope - slope_prev_) / dt_s;
+}
+
+bool RateAttitude::predict_reference(const Quaternion& q_ref_RB, double dt_s, double period_s,
+                                     Eigen::Vector3d& z, Eigen::Matrix3d& S) const {
   if (!reference_seen_) return false;
-  // The step propagate() will take: the trapezoid rate less the bias correction (the Earth rate's share is
-  // below a milliarcsecond over a step).
-  const Eigen::Vector3d omega = 0.5 * (omega_prev_ + omega_meas_) - correction_;
+  // The step propagate() will take: the trapezoid rate with its curvature correction, less the bias
+  // correction (the Earth rate's share is below a milliarcsecond over a step).
+  const Eigen::Vector3d omega =
+      0.5 * (omega_prev_ + omega_meas_) + curvature_rad_s(dt_s, period_s) - correction_;
   const Quaternion q_pred = propagator_.q_RB() * quat_exp(omega * dt_s);
   z = quat_log(q_pred.conjugate() * q_ref_RB);
   const double sigma_ref = config_.reference_sigma_arcsec * kArcsecToRad;
@@ -161,21 +175,28 @@ bool RateAttitude::measure_unprepared(const GyroGeometry& geometry, const EpochF
 }
 
 void RateAttitude::propagate(const EpochFrame& frame, const Subset& sol, const Subset* fallback,
-                             const Eigen::Vector3d& fault_bound_rad_s) {
+                             const Eigen::Vector3d& fault_bound_rad_s, double period_s) {
   Eigen::Vector3d bound = fault_bound_rad_s;
   if (!sol.observable) {
-    // Rate unobservable: keep the last estimate and bound what the motion may have changed since.
+    // Rate unobservable: keep the last estimate and bound what the motion may have changed since, at the
+    // configured acceleration bound or at the acceleration the gyros saw just before, whichever is larger (a
+    // slew beyond the bound must not make the held rate's error look small).
     if (lost_since_ns_ < 0) lost_since_ns_ = frame.now_ns;
     const double t_lost = ns_to_seconds(frame.now_ns - lost_since_ns_) + frame.dt_s;
-    bound += Eigen::Vector3d::Constant(config_.max_angular_acceleration_dps2 * kDegToRad * t_lost);
+    bound += accel_seen_.cwiseMax(config_.max_angular_acceleration_dps2 * kDegToRad) * t_lost;
   } else {
     lost_since_ns_ = -1;
+    accel_seen_ = accel_seen_.cwiseProduct(Eigen::Vector3d::Constant(std::exp(-frame.dt_s / kAccelMemory_s)))
+                      .cwiseMax(((omega_meas_ - omega_prev_) / frame.dt_s).cwiseAbs());
   }
   const Subset& noise = sol.observable ? sol : *fallback;
-  // The rate as the filter sees it: the trapezoid of the estimates, less the bias estimates' projection
-  // (zero without a reference: then the attitude is the gyros' alone).
+  // The rate as the filter sees it: the trapezoid of the estimates with its curvature correction, less the
+  // bias estimates' projection (zero without a reference: then the attitude is the gyros' alone).
   if (sol.observable) correction_ = mekf_.rate_correction(sol.pinv, sol.mask);
-  const Eigen::Vector3d omega = 0.5 * (omega_prev_ + omega_meas_) - correction_;
+  const Eigen::Vector3d omega =
+      0.5 * (omega_prev_ + omega_meas_) + curvature_rad_s(frame.dt_s, period_s) - correction_;
+  slope_prev_ = (omega_meas_ - omega_prev_) / frame.dt_s;
+  have_slope_ = true;
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   (void)propagator_.step(omega, frame.dt_s, zero, zero, bound);
   mekf_.propagate(propagator_.last_increment(), noise.pinv, noise.mask, omega, frame.dt_s);

@@ -48,9 +48,10 @@ class RateAttitude {
   //! Before the sample period is known (first epoch): the estimate straight from the geometry.
   bool measure_unprepared(const GyroGeometry& geometry, const EpochFrame& frame);
   //! Propagates over the epoch with `sol` the solution's subset (`fallback`: the active set's, used only when
-  //! `sol` is not observable) and `fault_bound_rad_s` the bound of an unresolved fault.
+  //! `sol` is not observable), `fault_bound_rad_s` the bound of an unresolved fault and `period_s` the sample
+  //! period (the trapezoid's curvature correction, docs/fdi.md "Per epoch" 7).
   void propagate(const EpochFrame& frame, const Subset& sol, const Subset* fallback,
-                 const Eigen::Vector3d& fault_bound_rad_s);
+                 const Eigen::Vector3d& fault_bound_rad_s, double period_s);
   //! Ends the epoch: the published rate and the previous rate for the next trapezoid.
   void finish_epoch() { omega_prev_ = omega_meas_; }
 
@@ -61,7 +62,7 @@ class RateAttitude {
   //! The innovation `z` [rad] a reference sample would have against the attitude propagated to this epoch
   //! (the rate of this epoch, `dt_s`) and its covariance `S` [rad²]: the filter's attitude covariance, the
   //! bound of a fault or lost rate, the reference's σ. False before the first sample.
-  bool predict_reference(const Quaternion& q_ref_RB, double dt_s, Eigen::Vector3d& z,
+  bool predict_reference(const Quaternion& q_ref_RB, double dt_s, double period_s, Eigen::Vector3d& z,
                          Eigen::Matrix3d& S) const;
   //! The epoch's normalized parity `p` over the subset `s` into the filter's biases — once a reference sample
   //! has been seen (without one the attitude stays the gyros' alone).
@@ -97,6 +98,9 @@ class RateAttitude {
   //! Adds a variance [rad²] per axis to the filter's attitude (e.g. what a rejected reference put in).
   void add_variance(const Eigen::Vector3d& var_rad2) { mekf_.add_attitude_variance(var_rad2); }
   void reset(const Quaternion& q0_RB);
+  //! [rad/s] the trapezoid's curvature correction over the step `dt_s` to this epoch: −(T²/12)·(s_k −
+  //! s_{k−1})/Δt with s the rate's slope over a step and T `period_s` (zero before two steps).
+  Eigen::Vector3d curvature_rad_s(double dt_s, double period_s) const;
 
   //! [rad/s] last rate estimate, Earth rate included.
   const Eigen::Vector3d& omega_meas_B() const { return omega_meas_; }
@@ -122,6 +126,11 @@ class RateAttitude {
   double last_chi2_ = 0.0;
   Eigen::Vector3d omega_prev_ = Eigen::Vector3d::Zero();  //!< [rad/s] previous epoch's estimate
   Eigen::Vector3d omega_meas_ = Eigen::Vector3d::Zero();  //!< [rad/s] last estimate (Earth rate included)
+  Eigen::Vector3d slope_prev_ = Eigen::Vector3d::Zero();  //!< [rad/s²] the previous step's (ω_k − ω_{k−1})/Δt
+  bool have_slope_ = false;
+  //! [rad/s²] per axis: the largest |slope| of recent observable steps (decaying over kAccelMemory_s), so a
+  //! lost rate's bound covers the acceleration the gyros saw when it exceeds the configured bound.
+  Eigen::Vector3d accel_seen_ = Eigen::Vector3d::Zero();
   std::int64_t lost_since_ns_ = -1;
 };
 

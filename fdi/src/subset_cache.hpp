@@ -126,6 +126,22 @@ class SubsetCache {
     }
     return config_->calibration_error_sigmas * sqrt_period_ * sum;
   }
+  //! [rad/s] per body axis: the largest rate error the subset's scale factors and axes make at the body rate
+  //! ω [rad/s] when each is within `calibration_error_sigmas` (e) of its stated 1σ, the detectors' bound:
+  //! e·Σ_{i∈S} |H*(:, i)|·(σ_s,i·|h_i·ω| + Σ_j σ_h,ij·|ω_j|) (docs/fdi.md, "Calibration uncertainty"); the
+  //! attitude's sigma integrates it. Zero without stated σ.
+  Eigen::Vector3d calibration_rate_bound(const Subset& s, GyroMask mask,
+                                         const Eigen::Vector3d& omega_rad_s) const {
+    Eigen::Vector3d bound = Eigen::Vector3d::Zero();
+    if (!calibration_sigma_ || !s.observable) return bound;
+    const Eigen::Vector3d w_abs = omega_rad_s.cwiseAbs();
+    for (int i = 0; i < gyro_count(); ++i) {
+      if (!has_gyro(mask, i + 1)) continue;
+      const double along = std::abs(geometry_.axes_B().row(i).dot(omega_rad_s));
+      bound += s.pinv.col(i).cwiseAbs() * (scale_rel_sigma_[i] * along + axis_sigma_.col(i).dot(w_abs));
+    }
+    return config_->calibration_error_sigmas * bound;
+  }
 
  private:
   const Subset& insert(GyroMask mask);

@@ -11,6 +11,7 @@
 #include "campaign.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/fdi/noise_defaults.hpp"
+#include "tetra/sim/perturbation_families.hpp"
 
 namespace tetra {
 namespace {
@@ -19,29 +20,11 @@ constexpr double kAxisSigma =
     1e-3;  //!< [-] stated 1σ per axis component (the audit's 0.3–1 mrad, at its top)
 constexpr double kScaleSigma = 1e-3;  //!< [-] stated 1σ of each scale factor, relative
 
-//! The calibration that states σ: the true unit with each scale factor off by `errors`·σ (alternating sign)
-//! and each axis off by a perpendicular error whose largest component is `errors`·σ (direction from `seed`).
+//! The calibration that states σ (σ_s = kScaleSigma, σ_h = kAxisSigma): the true unit with each scale factor
+//! off by `errors`·σ (alternating sign) and each axis off by a perpendicular error whose largest component is
+//! `errors`·σ (direction from `seed`).
 Calibration stated_calibration(const Calibration& truth, double errors, std::uint64_t seed) {
-  Calibration cal = truth;
-  std::uint64_t state = seed * 0x9E3779B97F4A7C15ULL + 1;
-  const auto next = [&state] {  // a small LCG: directions only need to differ between seeds
-    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5;
-  };
-  for (auto& g : cal.gyros) {
-    const Eigen::Vector3d a = g.axis_B;
-    Eigen::Vector3d d(next(), next(), next());
-    d -= a * a.dot(d);
-    d *= errors * kAxisSigma / d.cwiseAbs().maxCoeff();
-    g.axis_B = (a + d).normalized();  // renormalizing moves it by O(σ²)
-    g.scale_factor_V_per_dps *= 1.0 + (g.id % 2 == 0 ? 1.0 : -1.0) * errors * kScaleSigma;
-    GyroSigma s;
-    s.scale_factor_V_per_dps = kScaleSigma * std::abs(g.scale_factor_V_per_dps);
-    s.bias_V = 1e-6;
-    s.axis = Eigen::Vector3d::Constant(kAxisSigma);
-    g.sigma = s;
-  }
-  return cal;
+  return sim::stated_calibration(truth, errors, kScaleSigma, kAxisSigma, seed);
 }
 
 sim::Scenario slews(const Eigen::Vector3d& axis_B, bool reference) {

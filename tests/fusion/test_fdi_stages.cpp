@@ -440,7 +440,7 @@ TEST(RateAttitude, ConstantRatePropagatesExactly) {
   for (int k = 1; k <= 600; ++k) {
     frame.now_ns = seconds_to_ns(k * kPeriod);
     attitude.measure(s, frame);
-    attitude.propagate(frame, s, &s, Eigen::Vector3d::Zero());
+    attitude.propagate(frame, s, &s, Eigen::Vector3d::Zero(), kPeriod);
     attitude.finish_epoch();
   }
   EXPECT_LT(angle_between(attitude.q_RB(), quat_exp(omega * 60.0)), 1e-12);

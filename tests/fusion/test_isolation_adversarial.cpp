@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "campaign.hpp"
+#include "family_campaign.hpp"  // test::honesty
 #include "test_support.hpp"
 #include "tetra/core/calibration_file.hpp"
 
@@ -297,36 +298,8 @@ TEST(IsolationAdversarial, OneFaultNeverCostsASecondGyro) {
   EXPECT_TRUE(what.empty()) << what;
 }
 
-//! Sigma's honesty over a run's epochs from `from_s` on: the share of axis-epochs with |e| ≤ 3σ and the
-//! per-axis NEES (mean e²/σ², 1 expected).
-struct Honesty {
-  double within = 1.0;
-  Eigen::Vector3d nees = Eigen::Vector3d::Zero();
-  double worst_sigmas = 0.0;  //!< largest |e|/σ of an axis
-  double worst_error_deg = 0.0;
-};
-
-Honesty honesty(const test::CampaignRun& run, double from_s) {
-  Honesty h;
-  int n = 0;
-  int inside = 0;
-  for (std::size_t k = 0; k < run.time_s.size(); ++k) {
-    if (run.time_s[k] < from_s) continue;
-    ++n;
-    for (int a = 0; a < 3; ++a) {
-      const double z = std::abs(run.error_rad[k][a]) / run.sigma_rad[k][a];
-      inside += z <= 3.0;
-      h.nees[a] += z * z;
-      h.worst_sigmas = std::max(h.worst_sigmas, z);
-      h.worst_error_deg = std::max(h.worst_error_deg, std::abs(run.error_rad[k][a]) * kRadToDeg);
-    }
-  }
-  if (n > 0) {
-    h.within = inside / (3.0 * n);
-    h.nees /= n;
-  }
-  return h;
-}
+using test::Honesty;
+using test::honesty;
 
 TEST(IsolationAdversarial, SigmaHonestAfterAReconfigurationWithAReference) {
   // With the 1 Hz reference, a fault during an agile slew: during SUSPECT the filter may push the fault into
