@@ -11,7 +11,7 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
-#include "gnuplot.hpp"
+#include "tetra/report/gnuplot.hpp"
 #include "tetra/core/allan.hpp"
 #include "tetra/core/allan_kalibr.hpp"
 #include "tetra/core/calibration_file.hpp"
@@ -53,7 +53,7 @@ std::string percent(double fraction) {
 // Log-log plot: per gyro a panel with the Allan deviation, its confidence band, the fitted curve and
 // the observed terms. Runs gnuplot (pngcairo, else png).
 Status write_plot(OutputFile& png, const allan::LogAllan& analysis, double confidence) {
-  auto temp = TempDir::create("tetra-allan");
+  auto temp = report::TempDir::create("tetra-allan");
   if (!temp) return failure("--plot: " + temp.error().message);
   const std::filesystem::path& dir = temp->path();
 
@@ -67,7 +67,7 @@ Status write_plot(OutputFile& png, const allan::LogAllan& analysis, double confi
       "{/Symbol t} [s]'\n";
   body += "set ylabel 'Allan deviation [" + analysis.units + "]'\n";
   body += "set multiplot layout " + std::to_string(rows) + "," + std::to_string(cols) + " title " +
-          gp_quote("tetra allan: overlapping Allan deviation, " + percent(confidence) +
+          report::gp_quote("tetra allan: overlapping Allan deviation, " + percent(confidence) +
                    " % confidence band, IEEE 952 fit") +
           "\n";
   const std::array<const char*, allan::kTermCount> colors = {"#9467bd", "#2ca02c", "#ff7f0e", "#d62728",
@@ -90,9 +90,9 @@ Status write_plot(OutputFile& png, const allan::LogAllan& analysis, double confi
       model += "+" + num(v * v) + "*b" + std::string(allan::term_symbol(k)) + "(x)";
     }
     model += ")";
-    body += "plot " + gp_quote(data_file) +
+    body += "plot " + report::gp_quote(data_file) +
             " using 1:3:4 with filledcurves lc rgb '#c6dbef' title 'confidence band', \\\n";
-    body += "  " + gp_quote(data_file) +
+    body += "  " + report::gp_quote(data_file) +
             " using 1:2 with linespoints pt 7 ps 0.5 lw 1.5 lc rgb '#1f4e9c' title 'ADEV', \\\n";
     body += "  " + model + " with lines lw 2 dt 2 lc rgb 'black' title 'fit'";
     for (int k = 0; k < allan::kTermCount; ++k) {
@@ -109,7 +109,7 @@ Status write_plot(OutputFile& png, const allan::LogAllan& analysis, double confi
       "bQ(t) = 3.0/(t*t)\nbN(t) = 1.0/t\nbB(t) = 2.0*log(2.0)/pi\nbK(t) = t/3.0\nbR(t) = t*t/2.0\n";
   // gnuplot writes into the temporary directory; the image reaches --plot through the output layer.
   const std::string png_path = (dir / "plot.png").string();
-  if (Status s = run_gnuplot(dir, png_path, static_cast<int>(cols * 640), static_cast<int>(rows * 480),
+  if (Status s = report::run_gnuplot(dir, png_path, static_cast<int>(cols * 640), static_cast<int>(rows * 480),
                              defs + body, "--plot");
       !s)
     return s;

@@ -9,7 +9,7 @@
 #include <map>
 #include <string>
 
-#include "attitude_csv.hpp"
+#include "tetra/report/attitude_csv.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "dds_common.hpp"
@@ -200,7 +200,7 @@ class Recording {
   int n_;
   GyroLogWriter log_;
   bool log_open_ = false;
-  std::string attitude_text_ = attitude_header(n_);     // after n_: members initialize in order
+  std::string attitude_text_ = report::attitude_header(n_);     // after n_: members initialize in order
   std::map<std::uint64_t, std::string> event_lines_;    // by event_seq: written in order
   std::map<std::uint64_t, std::string> command_lines_;  // acknowledgements, by event_seq
   std::vector<fdi::Epoch> epochs_;
@@ -240,7 +240,7 @@ Status Recording::take_outputs(const RecordLink& link) {
   auto a = link.attitude->take([&](const tetra_Attitude& s, const dds_sample_info_t&) {
     if (dds::from_wire(s.unit) != o_.unit) return;
     const auto attitude = dds::from_wire(s);
-    append_attitude_row(attitude_text_, ns_to_seconds(attitude.stamp_ns), attitude, n_);
+    report::append_attitude_row(attitude_text_, ns_to_seconds(attitude.stamp_ns), attitude, n_);
     last_attitude_ns_ = attitude.stamp_ns;
   });
   if (!a) return a.error();

@@ -1,5 +1,7 @@
 // tetra replay — the whole fusion pipeline offline: gyro log in; attitude (docs/interfaces.md §2.4) and FDI
 // events (docs/interfaces.md §2.5) out; a summary on stderr. The same Pipeline object serves the DDS service.
+#include <unistd.h>
+
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -8,12 +10,12 @@
 #include <sstream>
 #include <string>
 
-#include "attitude_csv.hpp"
-#include "attitude_writer.hpp"
+#include "tetra/report/attitude_csv.hpp"
+#include "tetra/report/attitude_writer.hpp"
 #include "cli_common.hpp"
-#include "command_log.hpp"
+#include "tetra/report/command_log.hpp"
 #include "commands.hpp"
-#include "progress.hpp"
+#include "tetra/report/progress.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
@@ -28,6 +30,10 @@
 namespace tetra::cli {
 
 namespace {
+
+using report::AttitudeWriter;
+using report::Progress;
+using report::RecordedCommand;
 
 Result<Quaternion> parse_quaternion(const std::string& text) {
   std::array<double, 4> q{};
@@ -111,7 +117,7 @@ Result<ReplayInputs> open_inputs(const ReplayOptions& o) {
   if (!opened) return opened.error();
   in.log = std::make_unique<GyroLogPrefetcher>(std::move(opened.value()));
   if (!o.commands_path.empty()) {
-    auto c = read_command_log(o.commands_path);
+    auto c = report::read_command_log(o.commands_path);
     if (!c) return c.error();
     in.commands = std::move(c).value();
   }
@@ -180,7 +186,7 @@ Result<Replayed> replay_log(GyroLogPrefetcher& log, fdi::Pipeline& pipeline,
   auto apply_commands_before = [&](std::int64_t stamp_ns, bool all) {
     for (; next_command < commands.size() && (all || commands[next_command].stamp_ns < stamp_ns);
          ++next_command) {
-      events.buffer() += fdi::to_json(apply(pipeline, commands[next_command]), n);
+      events.buffer() += fdi::to_json(report::apply(pipeline, commands[next_command]), n);
       events.buffer() += '\n';
     }
   };
@@ -188,7 +194,7 @@ Result<Replayed> replay_log(GyroLogPrefetcher& log, fdi::Pipeline& pipeline,
   fdi::Epoch epoch;
   epoch.raw.resize(static_cast<std::size_t>(n));
   epoch.present.resize(static_cast<std::size_t>(n));
-  Progress progress("tetra replay", "epochs");
+  Progress progress("tetra replay", "epochs", ::isatty(STDERR_FILENO) == 1 ? stderr : nullptr);
   GyroLog block;
   while (true) {
     auto more = log.next(block);
@@ -269,7 +275,7 @@ Status run_replay(const ReplayOptions& o) {
   std::string preamble;
   for (const auto& [key, value] : provenance_metadata(provenance(files.input_paths())))
     append_metadata(preamble, key, value);
-  preamble += attitude_header(n);
+  preamble += report::attitude_header(n);
   AttitudeWriter att(**attitude_out, n, std::move(preamble));
   BufferedOutput events(**events_out);
   auto replayed = replay_log(*in->log, *pipeline, in->commands, att, events);

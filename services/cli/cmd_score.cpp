@@ -11,7 +11,8 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
-#include "score_plot.hpp"
+#include "tetra/report/gnuplot.hpp"
+#include "tetra/report/score_plot.hpp"
 #include "tetra/core/attitude_score.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/output_files.hpp"
@@ -209,8 +210,9 @@ int cmd_score(int argc, char** argv) {
       return report(cmd, s.error());
   }
   if (plot_out) {
-    if (Status s = write_score_plot(*plot_out, *score, "tetra score: " + att_path + " - " + truth_path); !s)
-      return report(cmd, s.error());
+    if (Status s = report::write_score_plot(*plot_out, *score, "tetra score: " + att_path + " - " + truth_path);
+        !s)
+      return report(cmd, s.error(), {{report::kPlotSubject, "--plot: {message}"}});
   }
   if (Status s = files.commit(); !s) return report(cmd, s.error());
   return kExitOk;
