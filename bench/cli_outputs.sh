@@ -45,6 +45,15 @@ run sim_slews sim slews_custom.yaml --seed 5 --minutes 3 --rate-hz 5 --add-fault
   -o slews.csv --truth slews_truth.csv
 run sim_bad sim nowhere.yaml -o never.csv
 run sim_bad_fault sim orbit --fault gyro=9,kind=stuck,at=1 -o never.csv
+run sim_tt_minutes sim turntable --minutes 3 -o never.csv
+run sim_tt_fault sim turntable --fault gyro=1,kind=stuck,at=1 -o never.csv
+run sim_table_rate sim orbit --table-rate 3 -o never.csv
+run sim_too_long sim static --minutes 100000 --rate-hz 1000 -o never.csv
+run sim_no_out sim static --minutes 1
+run sim_loop_out sim orbit --closed-loop --minutes 1 -o never.csv
+run sim_unit_scenario sim orbit --write-unit never.yaml
+run sim_no_scenario sim
+run sim_same_file sim static --minutes 1 -o same.csv --truth same.csv
 
 # --- calibrate -------------------------------------------------------------------------------------
 run cal_sixteen calibrate turntable.csv -o cal.yaml
@@ -53,6 +62,9 @@ run cal_seed calibrate turntable.csv --bias-model seed --latitude -23 --unit u9 
 run cal_tt calibrate tt.csv -o cal_tt.yaml
 run cal_bad calibrate missing.csv -o x.yaml
 run cal_bad_combo calibrate turntable.csv --method batch --bias-model seed -o x.yaml
+run cal_compare_missing calibrate turntable.csv --compare missing.yaml -o x.yaml
+run cal_same calibrate turntable.csv -o turntable.csv
+run cal_no_noise calibrate turntable.csv --noise factory.yaml -o x.yaml
 
 # --- allan -----------------------------------------------------------------------------------------
 cp cal_tt.yaml cal_noise.yaml
@@ -62,6 +74,11 @@ run allan_update allan static.csv --calibration cal_noise.yaml --update-calibrat
 run allan_gyro allan static.csv --gyro 2 --gyro 4 --taus 0.1,1,10 --confidence 0.9 --csv allan_g.csv
 run allan_bad allan static.csv --taus nonsense
 run allan_bad_gyro allan static.csv --gyro 7
+run allan_no_cal allan static.csv --update-calibration
+run allan_kalibr_no_cal allan static.csv --kalibr never.yaml
+run allan_dt allan static.csv --dt-tolerance 0.7
+run allan_confidence allan static.csv --confidence 1.5
+run allan_same allan static.csv --csv static.csv
 run cal_noise calibrate turntable.csv --noise cal_noise.yaml -o cal_with_noise.yaml
 
 # --- replay ----------------------------------------------------------------------------------------
@@ -74,12 +91,19 @@ run replay_cmd replay orbit.csv --calibration unit.yaml --commands commands.json
   --events ev_cmd.jsonl
 run replay_slews replay slews.csv --calibration unit.yaml --attitude att_slews.csv --events ev_slews.jsonl
 run replay_bad replay orbit.csv --calibration missing.yaml --attitude x.csv --events x.jsonl
+run replay_q replay orbit.csv --calibration unit.yaml --initial-q 1,0,0 --attitude x.csv --events x.jsonl
+run replay_q_norm replay orbit.csv --calibration unit.yaml --initial-q 1,1,0,0 --attitude x.csv --events x.jsonl
+run replay_q_ok replay orbit.csv --calibration unit.yaml --initial-q 1,0,0,0 --latitude 45 \
+  --attitude att_q.csv --events ev_q.jsonl
+run replay_same replay orbit.csv --calibration unit.yaml --attitude orbit.csv --events x.jsonl
 
 # --- score -----------------------------------------------------------------------------------------
 run score_orbit score att.csv truth.csv --json score.json --plot score.png
 run score_slews score att_slews.csv slews_truth.csv --axis 0,1,1 --time-tolerance 1e-3
 run score_bad_axis score att.csv truth.csv --axis body
 run score_bad score att.csv missing.csv
+run score_zero_axis score att.csv truth.csv --axis 0,0,0
+run score_tolerance score att.csv truth.csv --time-tolerance -1
 
 # --- convert ---------------------------------------------------------------------------------------
 run convert_h5 convert orbit.csv orbit.h5
@@ -87,6 +111,7 @@ run convert_h5z convert static.csv static.h5 --compress
 run convert_back convert orbit.h5 orbit_back.csv
 run convert_backz convert static.h5 static_back.csv
 run convert_bad convert missing.csv x.h5
+run convert_same convert orbit.csv orbit.csv
 
 # Fingerprints: every file the runs left (inputs copied in included), the run time masked. HDF5 files
 # carry their objects' modification times in binary: they are fingerprinted by their size and by the CSV
