@@ -1,23 +1,18 @@
-// tetra sim SCENARIO — simulated gyro data with known truth (see docs/sim.md).
+// tetra sim SCENARIO — simulated gyro data with known truth (see docs/sim.md; tetra/report/sim_files.hpp).
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
-#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "sim_closed_loop.hpp"
-#include "tetra/core/calibration_file.hpp"
-#include "tetra/core/output_files.hpp"
-#include "tetra/core/provenance.hpp"
-#include "tetra/core/turntable_log.hpp"
-#include "tetra/sim/fault.hpp"
-#include "tetra/sim/scenario.hpp"
+#include "tetra/report/sim_files.hpp"
 #include "tetra/sim/simulator.hpp"
-#include "tetra/sim/turntable.hpp"
 #if TETRA_WITH_DDS
 #include "sim_dds.hpp"
 #include "sim_dds_loop.hpp"
@@ -163,200 +158,75 @@ void add_turntable_options(CLI::App& app, SimArgs& a) {
       app.add_flag("--wrap", a.plan.wrap_angles, "turntable: write encoder angles wrapped to (-180, 180]")};
 }
 
-bool looks_like_file(const std::string& scenario) {
-  const auto ext = std::filesystem::path(scenario).extension().string();
-  return ext == ".yaml" || ext == ".yml" || std::filesystem::exists(scenario);
+int report_sim(const Error& error) {
+  return report(kSimName, error,
+                {{report::kSubjectMissingOut, "--out LOG.csv is required (or --dds)"},
+                 {report::kSubjectClosedLoop, "--out and --truth do not apply with --closed-loop (see --pointing)"}});
 }
 
-bool is_turntable(const SimArgs& a) {
-  return a.scenario_name == "turntable";
-}
-
-// The run's inputs recorded and its outputs opened (the turntable writes to standard output by default and
-// has no truth file).
-struct SimOutputs {
-  OutputFile* log = nullptr;
-  OutputFile* truth = nullptr;
-};
-
-Result<SimOutputs> open_files(SimArgs& a, RunFiles& files) {
-  if (!a.unit_path.empty()) files.add_input(a.unit_path, "--unit");
-  if (looks_like_file(a.scenario_name)) files.add_input(a.scenario_name, "SCENARIO");
-  if (is_turntable(a) && a.out_path.empty()) a.out_path = "-";
-  SimOutputs out;
-  if (!a.out_path.empty()) {
-    auto log = files.add(a.out_path, "--out");
-    if (!log) return log.error();
-    out.log = *log;
-  }
-  if (!a.truth_path.empty() && !is_turntable(a)) {
-    auto truth = files.add(a.truth_path, "--truth");
-    if (!truth) return truth.error();
-    out.truth = *truth;
-  }
-  return out;
-}
-
-Result<std::optional<Calibration>> read_unit(const std::string& unit_path) {
-  if (unit_path.empty()) return std::optional<Calibration>();
-  auto read = read_calibration(unit_path);
-  if (!read) return read.error();
-  return std::optional<Calibration>(std::move(read.value()));
-}
-
-int run_turntable(const Calibration& unit, const sim::TurntablePlan& plan, const sim::GyroModelOptions& model,
-                  std::uint64_t seed, RunFiles& files, OutputFile& out) {
-  auto log = sim::simulate_turntable(unit, plan, seed, model);
-  if (!log) return report(kSimName, log.error());
-  const auto meta = provenance_metadata(provenance(files.input_paths()));
-  log->metadata.insert(log->metadata.end(), meta.begin(), meta.end());
-  if (Status st = out.write(format_turntable_log(*log)); !st) return report(kSimName, st.error());
-  if (Status st = files.commit(); !st) return report(kSimName, st.error());
-  std::cerr << "tetra sim: turntable: " << log->rows() << " rows, " << unit.gyro_count() << " gyros"
-            << (out.path() == "-" ? std::string() : " -> " + out.path()) << '\n';
-  return kExitOk;
-}
-
-// The turntable scenario: only its options apply; the plan and the model with the options given.
-int run_turntable_scenario(SimArgs& a, const std::optional<Calibration>& unit, RunFiles& files,
-                           OutputFile& out) {
+// The options given, as the report library's run options; messages name each by its option.
+report::SimRunOptions run_options(const SimArgs& a) {
+  report::SimRunOptions r;
+  r.scenario = a.scenario_name;
+  r.seed = a.seed;
+  r.unit_path = a.unit_path;
+  r.out_path = a.out_path;
+  r.truth_path = a.truth_path;
+  r.faults = a.fault_texts;
+  r.added_faults = a.add_fault_texts;
+  r.names = {{"command", "tetra sim"}, {"unit_path", "--unit"},  {"scenario", "SCENARIO"},
+             {"out_path", "--out"},    {"truth_path", "--truth"}, {"faults", "--fault"},
+             {"added_faults", "--add-fault"}};
   const ScenarioOverrides& o = a.over;
-  for (const CLI::Option* opt :
-       {o.minutes_given, o.reference, o.reference_noise, o.reference_latency, o.reference_bias_given,
-        o.reference_misid_given, o.acs_amplitude, o.acs_accel, o.period, o.jitter, o.drop}) {
-    if (opt->count()) return report(kSimName, bad_input("turntable: " + opt->get_name() + " does not apply"));
+  report::ScenarioOverrides& v = r.overrides;
+  const std::tuple<const CLI::Option*, std::optional<double>*, double, const char*> values[] = {
+      {o.rate, &v.rate_hz, o.rate_hz, "rate_hz"},
+      {o.minutes_given, &v.duration_min, o.minutes, "duration_min"},
+      {o.latitude, &v.latitude_deg, o.latitude_deg, "latitude_deg"},
+      {o.reference, &v.reference_hz, o.reference_hz, "reference_hz"},
+      {o.reference_noise, &v.reference_noise_arcsec, o.reference_noise_arcsec, "reference_noise_arcsec"},
+      {o.reference_latency, &v.reference_latency_s, o.reference_latency_s, "reference_latency_s"},
+      {o.acs_amplitude, &v.acs_amplitude_deg, o.acs_amplitude_deg, "acs_amplitude_deg"},
+      {o.acs_accel, &v.acs_accel_dps2, o.acs_accel_dps2, "acs_accel_dps2"},
+      {o.period, &v.orbit_period_min, o.orbit_period_min, "orbit_period_min"},
+      {o.jitter, &v.jitter_s, o.jitter_s, "jitter_s"},
+      {o.drop, &v.drop_probability, o.drop_probability, "drop_probability"},
+      {o.range, &v.range_dps, o.range_dps, "range_dps"}};
+  for (const auto& [option, value, given, argument] : values) {
+    if (option->count()) *value = given;
+    r.names[argument] = option->get_name();
   }
-  if (!a.fault_texts.empty() || !a.add_fault_texts.empty() || !a.truth_path.empty()) {
-    return report(kSimName, bad_input("turntable: --fault, --add-fault and --truth do not apply"));
+  if (o.reference_bias.size() == 3) v.reference_bias = {o.reference_bias[0], o.reference_bias[1], o.reference_bias[2]};
+  if (o.reference_misid.size() == 3)
+    v.reference_misid = {o.reference_misid[0], o.reference_misid[1], o.reference_misid[2]};
+  r.names["reference_bias"] = o.reference_bias_given->get_name();
+  r.names["reference_misid"] = o.reference_misid_given->get_name();
+  r.plan = a.plan;
+  const char* plan_arguments[] = {"table_rate_dps", "revolutions", "order", "wrap_angles"};
+  for (std::size_t k = 0; k < a.turntable_only.size(); ++k) {
+    if (a.turntable_only[k]->count()) r.plan_given.emplace_back(plan_arguments[k]);
+    r.names[plan_arguments[k]] = a.turntable_only[k]->get_name();
   }
-  if (o.rate->count()) a.plan.rate_hz = o.rate_hz;
-  if (o.latitude->count()) a.plan.latitude_deg = o.latitude_deg;
-  sim::GyroModelOptions model;
-  if (o.range->count()) model.range_dps = o.range_dps;
-  return run_turntable(unit ? *unit : seed_as_built_unit(), a.plan, model, a.seed, files, out);
+  r.closed_loop = a.loop.enabled;
+  r.progress = print_progress;
+  return r;
 }
 
-void apply_overrides(const ScenarioOverrides& o, sim::Scenario& sc) {
-  if (o.rate->count()) sc.rate_hz = o.rate_hz;
-  if (o.minutes_given->count()) sc.duration_s = o.minutes * 60.0;
-  if (o.latitude->count()) sc.motion.latitude_deg = o.latitude_deg;
-  if (o.reference->count()) sc.reference.rate_hz = o.reference_hz;
-  if (o.reference_noise->count()) sc.reference.noise_arcsec = o.reference_noise_arcsec;
-  if (o.reference_latency->count()) sc.reference.latency_s = o.reference_latency_s;
-  if (o.reference_bias.size() == 3) {
-    sc.reference.bias_arcsec = o.reference_bias[0];
-    sc.reference.bias_at_s = o.reference_bias[1];
-    sc.reference.bias_ramp_s = o.reference_bias[2];
-  }
-  if (o.reference_misid.size() == 3) {
-    sc.reference.misid_deg = o.reference_misid[0];
-    sc.reference.misid_at_s = o.reference_misid[1];
-    sc.reference.misid_duration_s = o.reference_misid[2];
-  }
-  if (o.acs_amplitude->count()) sc.motion.acs.amplitude_deg = o.acs_amplitude_deg;
-  if (o.acs_accel->count()) sc.motion.acs.peak_accel_dps2 = o.acs_accel_dps2;
-  if (o.period->count()) sc.motion.orbit_period_s = o.orbit_period_min * 60.0;
-  if (o.jitter->count()) sc.jitter_s = o.jitter_s;
-  if (o.drop->count()) sc.drop_probability = o.drop_probability;
-  if (o.range->count()) sc.model.range_dps = o.range_dps;
-}
-
-// The options given that change the scenario, for a message: " (with --minutes, --rate-hz)".
-std::string overrides_given(const ScenarioOverrides& o) {
-  std::string names;
-  for (const CLI::Option* opt : {o.rate, o.minutes_given, o.latitude, o.reference, o.reference_noise,
-                                 o.acs_amplitude, o.acs_accel, o.period, o.jitter, o.drop, o.range}) {
-    if (opt->count()) names += (names.empty() ? "" : ", ") + opt->get_name();
-  }
-  return names.empty() ? names : " (with " + names + ")";
-}
-
-// Any other scenario: built in or read from a file, then the unit and the options given.
-Result<sim::Scenario> load_scenario(const SimArgs& a, const std::optional<Calibration>& unit) {
-  for (const CLI::Option* opt : a.turntable_only) {
-    if (opt->count()) return bad_input(opt->get_name() + " applies to the turntable scenario only");
-  }
-  Result<sim::Scenario> scenario = looks_like_file(a.scenario_name) ? sim::read_scenario(a.scenario_name)
-                                                                    : sim::builtin_scenario(a.scenario_name);
-  if (!scenario) return scenario.error();
-  if (unit) scenario->unit = *unit;
-  apply_overrides(a.over, *scenario);
-  if (!a.fault_texts.empty()) scenario->faults.clear();  // the command line's faults replace the file's
-  // Each option is in its own range; together (e.g. --minutes × --rate-hz) they may still not fit.
-  if (Status st = sim::validate_scenario(*scenario); !st)
-    return bad_input(st.error().message + overrides_given(a.over));
-  return scenario;
-}
-
-Result<sim::SimOptions> sim_options(const SimArgs& a) {
-  sim::SimOptions options;
-  options.seed = a.seed;
-  for (const auto* texts : {&a.fault_texts, &a.add_fault_texts}) {
-    for (const std::string& text : *texts) {
-      auto fault = sim::parse_fault_spec(text);
-      if (!fault) return fault.error();
-      options.faults.push_back(fault.value());
-    }
-  }
-  if (a.loop.enabled && (!a.out_path.empty() || !a.truth_path.empty())) {
-    return bad_input("--out and --truth do not apply with --closed-loop (see --pointing)");
-  }
-  return options;
-}
-
-// The open-loop run into the log (and truth) files.
-int write_files(const SimArgs& a, const sim::Scenario& sc, const sim::SimOptions& options, RunFiles& files,
-                const SimOutputs& out) {
-  if (out.log == nullptr) return report(kSimName, bad_input("--out LOG.csv is required (or --dds)"));
-  auto simulator = sim::Simulator::create(sc, options);
+// Closed loop (in process or over DDS) or the open loop published over DDS, on the scenario prepared.
+int run_elsewhere(const SimArgs& a, const report::SimRunOptions& run) {
+  auto prepared = report::prepare_simulation(run);
+  if (!prepared) return report_sim(prepared.error());
+#if TETRA_WITH_DDS
+  if (a.loop.enabled && a.dds.enabled) return sim_dds_closed_loop_main(prepared->scenario, prepared->options, a.loop, a.dds);
+#endif
+  if (a.loop.enabled) return sim_closed_loop_main(prepared->scenario, prepared->options, a.loop);
+#if TETRA_WITH_DDS
+  auto simulator = sim::Simulator::create(prepared->scenario, prepared->options);
   if (!simulator) return report(kSimName, simulator.error());
-  const bool long_run = simulator->epoch_count() > 2'000'000;
-  const auto meta = provenance_metadata(provenance(files.input_paths()));
-  if (Status st =
-          sim::write_simulation(*simulator, *out.log, out.truth, meta, long_run ? print_progress : nullptr);
-      !st) {
-    return report(kSimName, st.error());
-  }
-  if (Status st = files.commit(); !st) return report(kSimName, st.error());
-  std::cerr << "tetra sim: " << sc.name << ": " << simulator->epoch_count() << " epochs, "
-            << simulator->gyro_count() << " gyros -> " << a.out_path
-            << (a.truth_path.empty() ? std::string() : ", truth -> " + a.truth_path) << '\n';
-  return kExitOk;
-}
-
-// Closed loop (in process or over DDS), the open loop published over DDS, or the open loop to files.
-int run_scenario(const SimArgs& a, const sim::Scenario& sc, const sim::SimOptions& options, RunFiles& files,
-                 const SimOutputs& out) {
-#if TETRA_WITH_DDS
-  if (a.loop.enabled && a.dds.enabled) return sim_dds_closed_loop_main(sc, options, a.loop, a.dds);
+  return sim_dds_main(*simulator, a.dds);
+#else
+  return kExitFailure;
 #endif
-  if (a.loop.enabled) return sim_closed_loop_main(sc, options, a.loop);
-#if TETRA_WITH_DDS
-  if (a.dds.enabled) {
-    auto simulator = sim::Simulator::create(sc, options);
-    if (!simulator) return report(kSimName, simulator.error());
-    return sim_dds_main(*simulator, a.dds);
-  }
-#endif
-  return write_files(a, sc, options, files, out);
-}
-
-// --write-unit FILE: the unit a run would simulate, as a calibration file (examples/seed_unit.yaml).
-int write_unit(const SimArgs& a) {
-  if (!a.scenario_name.empty()) return report(kSimName, bad_input("--write-unit takes no SCENARIO"));
-  RunFiles files;
-  if (!a.unit_path.empty()) files.add_input(a.unit_path, "--unit");
-  auto out = files.add(a.write_unit_path, "--write-unit");
-  if (!out) return report(kSimName, out.error());
-  auto unit = read_unit(a.unit_path);
-  if (!unit) return report(kSimName, unit.error());
-  const Calibration cal = unit->has_value() ? **unit : seed_as_built_unit();
-  const auto meta = provenance_metadata(provenance(files.input_paths()));
-  if (Status st = write_calibration(**out, cal, meta); !st) return report(kSimName, st.error());
-  if (Status st = files.commit(); !st) return report(kSimName, st.error());
-  std::cerr << "tetra sim: unit '" << cal.unit << "', " << cal.gyro_count() << " gyros -> "
-            << a.write_unit_path << '\n';
-  return kExitOk;
 }
 
 }  // namespace
@@ -376,21 +246,25 @@ int cmd_sim(int argc, char** argv) {
   add_sim_dds_options(app, a.dds);
 #endif
   if (auto status = parse(app, argc, argv)) return *status;
-  if (!a.write_unit_path.empty()) return write_unit(a);
+  if (!a.write_unit_path.empty()) {
+    if (!a.scenario_name.empty()) return report(kSimName, bad_input("--write-unit takes no SCENARIO"));
+    auto unit = report::write_simulated_unit(a.unit_path, a.write_unit_path,
+                                             {{"command", "tetra sim"}, {"unit_path", "--unit"},
+                                              {"out_path", "--write-unit"}},
+                                             std::cerr);
+    return unit ? kExitOk : report(kSimName, unit.error());
+  }
   if (a.scenario_name.empty())
     return report(kSimName, bad_input("SCENARIO is required (or --write-unit FILE)"));
-
-  RunFiles files;
-  auto out = open_files(a, files);
-  if (!out) return report(kSimName, out.error());
-  auto unit = read_unit(a.unit_path);
-  if (!unit) return report(kSimName, unit.error());
-  if (is_turntable(a)) return run_turntable_scenario(a, *unit, files, *out->log);
-  auto scenario = load_scenario(a, *unit);
-  if (!scenario) return report(kSimName, scenario.error());
-  auto options = sim_options(a);
-  if (!options) return report(kSimName, options.error());
-  return run_scenario(a, *scenario, *options, files, *out);
+  const report::SimRunOptions run = run_options(a);
+#if TETRA_WITH_DDS
+  const bool dds = a.dds.enabled;
+#else
+  const bool dds = false;
+#endif
+  if ((a.loop.enabled || dds) && run.scenario != "turntable") return run_elsewhere(a, run);
+  if (auto files = report::simulate_to_files(run, std::cerr); !files) return report_sim(files.error());
+  return kExitOk;
 }
 
 }  // namespace tetra::cli
