@@ -8,9 +8,9 @@
 
 #include <gtest/gtest.h>
 
-#include "tetra/report/attitude_csv.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/report/attitude_csv.hpp"
 
 namespace tetra::report {
 namespace {

@@ -19,7 +19,8 @@ void add_options(CLI::App& app, report::AllanReportOptions& o) {
                  "gyro log (CSV, or HDF5 when named .h5; docs/formats.md): time_s,g1..gN; volts, or deg/s "
                  "with '# units=dps'")
       ->required();
-  app.add_option("--calibration", o.calibration_path, "calibration YAML: volts become deg/s as (g - bias)/scale");
+  app.add_option("--calibration", o.calibration_path,
+                 "calibration YAML: volts become deg/s as (g - bias)/scale");
   app.add_flag("--update-calibration", o.update_calibration,
                "write the fitted terms into the calibration file's noise: sections (needs --calibration)");
   app.add_option("--gyro", o.gyros, "analyse only this gyro (1..N); may be repeated");
@@ -49,10 +50,14 @@ int cmd_allan(int argc, char** argv) {
       "weighted least squares; terms the data do not show are reported as NO (null).",
       "allan");
   report::AllanReportOptions options;
-  options.names = {{"command", "tetra allan"},          {"log_path", "log"},
-                   {"calibration_path", "--calibration"}, {"update_calibration", "--update-calibration"},
-                   {"csv_path", "--csv"},                 {"json_path", "--json"},
-                   {"plot_path", "--plot"},               {"kalibr_path", "--kalibr"}};
+  options.names = {{"command", "tetra allan"},
+                   {"log_path", "log"},
+                   {"calibration_path", "--calibration"},
+                   {"update_calibration", "--update-calibration"},
+                   {"csv_path", "--csv"},
+                   {"json_path", "--json"},
+                   {"plot_path", "--plot"},
+                   {"kalibr_path", "--kalibr"}};
   add_options(app, options);
   if (auto status = parse(app, argc, argv)) return *status;
   options.progress = ::isatty(STDERR_FILENO) != 0;

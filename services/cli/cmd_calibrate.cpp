@@ -79,11 +79,12 @@ int cmd_calibrate(int argc, char** argv) {
   o.unit = options.unit_name;
   o.noise_path = options.noise_path;
   o.bias_instability_correlation_s = options.correlation_s;
-  o.names = {{"command", "tetra calibrate"},  {"turntable_path", "TURNTABLE.csv"}, {"output_path", "--output"},
-             {"latitude_deg", "--latitude"},  {"compare_path", "--compare"},      {"noise_path", "--noise"}};
+  o.names = {{"command", "tetra calibrate"}, {"turntable_path", "TURNTABLE.csv"}, {"output_path", "--output"},
+             {"latitude_deg", "--latitude"}, {"compare_path", "--compare"},       {"noise_path", "--noise"}};
   if (auto result = report::write_calibration_report(o, std::cout, std::cerr); !result) {
-    return report("calibrate", result.error(),
-                  {{"bias_model", "--bias-model applies to --method sixteen only (batch fits the bias per sample)"}});
+    return report(
+        "calibrate", result.error(),
+        {{"bias_model", "--bias-model applies to --method sixteen only (batch fits the bias per sample)"}});
   }
   return kExitOk;
 }

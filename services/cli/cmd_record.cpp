@@ -9,7 +9,6 @@
 #include <map>
 #include <string>
 
-#include "tetra/report/attitude_csv.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "dds_common.hpp"
@@ -22,6 +21,7 @@
 #include "tetra/dds/session.hpp"
 #include "tetra/dds/shutdown.hpp"
 #include "tetra/ground/encode.hpp"
+#include "tetra/report/attitude_csv.hpp"
 #include "tetra/service/epoch_assembler.hpp"
 #include "tetra/service/fusion_config.hpp"
 
@@ -200,9 +200,9 @@ class Recording {
   int n_;
   GyroLogWriter log_;
   bool log_open_ = false;
-  std::string attitude_text_ = report::attitude_header(n_);     // after n_: members initialize in order
-  std::map<std::uint64_t, std::string> event_lines_;    // by event_seq: written in order
-  std::map<std::uint64_t, std::string> command_lines_;  // acknowledgements, by event_seq
+  std::string attitude_text_ = report::attitude_header(n_);  // after n_: members initialize in order
+  std::map<std::uint64_t, std::string> event_lines_;         // by event_seq: written in order
+  std::map<std::uint64_t, std::string> command_lines_;       // acknowledgements, by event_seq
   std::vector<fdi::Epoch> epochs_;
   std::vector<double> values_;
   std::optional<std::int64_t> last_epoch_ns_;

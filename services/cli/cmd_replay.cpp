@@ -15,7 +15,8 @@ namespace {
 
 void add_options(CLI::App& app, report::ReplayLogOptions& o) {
   app.add_option("LOG", o.log_path, "gyro log (CSV, or HDF5 when named .h5)")->required();
-  app.add_option("--calibration", o.calibration_path, "calibration file (YAML, docs/interfaces.md §2.3)")->required();
+  app.add_option("--calibration", o.calibration_path, "calibration file (YAML, docs/interfaces.md §2.3)")
+      ->required();
   app.add_option("--latitude", o.latitude_deg,
                  "[deg] ground-test mode: remove the Earth rate at this geodetic latitude")
       ->check(CLI::Range(-90.0, 90.0));
@@ -39,9 +40,12 @@ int cmd_replay(int argc, char** argv) {
       "attitude (§2.4) and the FDI events (§2.5); prints a summary on stderr.",
       "replay"};
   report::ReplayLogOptions options;
-  options.names = {{"command", "tetra replay"},          {"log_path", "LOG"},
-                   {"calibration_path", "--calibration"}, {"config_path", "--config"},
-                   {"commands_path", "--commands"},       {"attitude_path", "--attitude"},
+  options.names = {{"command", "tetra replay"},
+                   {"log_path", "LOG"},
+                   {"calibration_path", "--calibration"},
+                   {"config_path", "--config"},
+                   {"commands_path", "--commands"},
+                   {"attitude_path", "--attitude"},
                    {"events_path", "--events"}};
   add_options(app, options);
   if (auto status = parse(app, argc, argv)) return *status;

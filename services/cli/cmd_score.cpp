@@ -18,12 +18,16 @@ int cmd_score(int argc, char** argv) {
       "interpolated between its rows; rows outside the truth's time span are counted, not scored.",
       "score");
   report::ScoreReportOptions o;
-  o.names = {{"attitude_path", "ATT.csv"}, {"truth_path", "TRUTH.csv"}, {"plot_path", "--plot"},
+  o.names = {{"attitude_path", "ATT.csv"},
+             {"truth_path", "TRUTH.csv"},
+             {"plot_path", "--plot"},
              {"json_path", "--json"}};
-  app.add_option("ATT.csv", o.attitude_path, "attitude: time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,...")
+  app.add_option("ATT.csv", o.attitude_path,
+                 "attitude: time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps,sigma_deg,...")
       ->required();
   app.add_option("TRUTH.csv", o.truth_path, "truth: time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps")->required();
-  app.add_option("--plot", o.plot_path, "write the error per axis against +-3 sigma as a PNG (needs gnuplot)");
+  app.add_option("--plot", o.plot_path,
+                 "write the error per axis against +-3 sigma as a PNG (needs gnuplot)");
   app.add_option("--json", o.json_path, "write the figures as JSON");
   app.add_option("--axis", o.axis,
                  "axis of the integrated angle: x, y, z or a body vector a,b,c (default y, the seed's turn)");

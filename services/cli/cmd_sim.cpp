@@ -159,9 +159,10 @@ void add_turntable_options(CLI::App& app, SimArgs& a) {
 }
 
 int report_sim(const Error& error) {
-  return report(kSimName, error,
-                {{report::kSubjectMissingOut, "--out LOG.csv is required (or --dds)"},
-                 {report::kSubjectClosedLoop, "--out and --truth do not apply with --closed-loop (see --pointing)"}});
+  return report(
+      kSimName, error,
+      {{report::kSubjectMissingOut, "--out LOG.csv is required (or --dds)"},
+       {report::kSubjectClosedLoop, "--out and --truth do not apply with --closed-loop (see --pointing)"}});
 }
 
 // The options given, as the report library's run options; messages name each by its option.
@@ -174,8 +175,8 @@ report::SimRunOptions run_options(const SimArgs& a) {
   r.truth_path = a.truth_path;
   r.faults = a.fault_texts;
   r.added_faults = a.add_fault_texts;
-  r.names = {{"command", "tetra sim"}, {"unit_path", "--unit"},  {"scenario", "SCENARIO"},
-             {"out_path", "--out"},    {"truth_path", "--truth"}, {"faults", "--fault"},
+  r.names = {{"command", "tetra sim"},       {"unit_path", "--unit"},   {"scenario", "SCENARIO"},
+             {"out_path", "--out"},          {"truth_path", "--truth"}, {"faults", "--fault"},
              {"added_faults", "--add-fault"}};
   const ScenarioOverrides& o = a.over;
   report::ScenarioOverrides& v = r.overrides;
@@ -196,7 +197,8 @@ report::SimRunOptions run_options(const SimArgs& a) {
     if (option->count()) *value = given;
     r.names[argument] = option->get_name();
   }
-  if (o.reference_bias.size() == 3) v.reference_bias = {o.reference_bias[0], o.reference_bias[1], o.reference_bias[2]};
+  if (o.reference_bias.size() == 3)
+    v.reference_bias = {o.reference_bias[0], o.reference_bias[1], o.reference_bias[2]};
   if (o.reference_misid.size() == 3)
     v.reference_misid = {o.reference_misid[0], o.reference_misid[1], o.reference_misid[2]};
   r.names["reference_bias"] = o.reference_bias_given->get_name();
@@ -217,7 +219,8 @@ int run_elsewhere(const SimArgs& a, const report::SimRunOptions& run) {
   auto prepared = report::prepare_simulation(run);
   if (!prepared) return report_sim(prepared.error());
 #if TETRA_WITH_DDS
-  if (a.loop.enabled && a.dds.enabled) return sim_dds_closed_loop_main(prepared->scenario, prepared->options, a.loop, a.dds);
+  if (a.loop.enabled && a.dds.enabled)
+    return sim_dds_closed_loop_main(prepared->scenario, prepared->options, a.loop, a.dds);
 #endif
   if (a.loop.enabled) return sim_closed_loop_main(prepared->scenario, prepared->options, a.loop);
 #if TETRA_WITH_DDS
@@ -248,10 +251,9 @@ int cmd_sim(int argc, char** argv) {
   if (auto status = parse(app, argc, argv)) return *status;
   if (!a.write_unit_path.empty()) {
     if (!a.scenario_name.empty()) return report(kSimName, bad_input("--write-unit takes no SCENARIO"));
-    auto unit = report::write_simulated_unit(a.unit_path, a.write_unit_path,
-                                             {{"command", "tetra sim"}, {"unit_path", "--unit"},
-                                              {"out_path", "--write-unit"}},
-                                             std::cerr);
+    auto unit = report::write_simulated_unit(
+        a.unit_path, a.write_unit_path,
+        {{"command", "tetra sim"}, {"unit_path", "--unit"}, {"out_path", "--write-unit"}}, std::cerr);
     return unit ? kExitOk : report(kSimName, unit.error());
   }
   if (a.scenario_name.empty())

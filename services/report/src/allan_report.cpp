@@ -23,7 +23,6 @@ namespace tetra::report {
 
 namespace {
 
-
 using AllanClock = std::chrono::steady_clock;
 
 double seconds_since(AllanClock::time_point t0) {
@@ -74,7 +73,8 @@ Status write_allan_plot(OutputFile& png, const allan::LogAllan& analysis, double
     const std::string data_file = (dir / ("gyro" + std::to_string(g.id) + ".dat")).string();
     std::string data;
     for (const allan::AdevPoint& p : g.result.points) {
-      data += allan_num(p.tau_s) + ' ' + allan_num(p.adev) + ' ' + allan_num(p.adev_lo) + ' ' + allan_num(p.adev_hi) + '\n';
+      data += allan_num(p.tau_s) + ' ' + allan_num(p.adev) + ' ' + allan_num(p.adev_lo) + ' ' +
+              allan_num(p.adev_hi) + '\n';
     }
     if (Status s = write_text_file(data_file, data); !s) return s;
     const allan::NoiseFit& f = g.result.fit;
@@ -123,7 +123,8 @@ Result<allan::TauSpec> check_options(const AllanReportOptions& o) {
   if (!o.kalibr_path.empty() && o.calibration_path.empty())
     return bad_input(ErrorSubject("kalibr_path"), "needs calibration_path (the gyro axes)");
   if (!(o.dt_tolerance > 0.0 && o.dt_tolerance < 0.5))
-    return bad_input(ErrorSubject("dt_tolerance", allan_num(o.dt_tolerance)), "expected a fraction in (0, 0.5)");
+    return bad_input(ErrorSubject("dt_tolerance", allan_num(o.dt_tolerance)),
+                     "expected a fraction in (0, 0.5)");
   if (!(o.confidence > 0.0 && o.confidence < 1.0))
     return bad_input(ErrorSubject("confidence", allan_num(o.confidence)), "expected a level in (0, 1)");
   return allan::parse_tau_spec(o.taus);
@@ -159,8 +160,8 @@ Result<AllanOutputs> open_outputs(RunFiles& files, const AllanReportOptions& o) 
 
 // The log read block by block, never whole (docs/allan.md: memory). Progress goes to stderr when a
 // person is watching it; otherwise stderr carries only the one-line reason of a failure.
-Result<allan::LogAllan> analyse(const AllanReportOptions& o, const allan::TauSpec& taus, const Calibration* cal,
-                                std::ostream& err) {
+Result<allan::LogAllan> analyse(const AllanReportOptions& o, const allan::TauSpec& taus,
+                                const Calibration* cal, std::ostream& err) {
   const std::string command = name_of(o.names, "command");
   const auto t0 = AllanClock::now();
   if (o.progress) err << command << ": reading and analysing " << o.log_path << "\n";
@@ -183,11 +184,10 @@ Result<allan::LogAllan> analyse(const AllanReportOptions& o, const allan::TauSpe
 void print_allan(std::ostream& out, const AllanReportOptions& o, const allan::LogAllan& analysis,
                  bool calibrated) {
   out << o.log_path << ": " << analysis.epochs << " epochs";
-  if (analysis.missing_epochs > 0)
-    out << " (+" << analysis.missing_epochs << " missing epochs as gaps)";
+  if (analysis.missing_epochs > 0) out << " (+" << analysis.missing_epochs << " missing epochs as gaps)";
   out << ", sampling interval " << allan_num(analysis.tau0_s) << " s (from the time column)"
-            << (calibrated && !analysis.log_units_dps ? ", calibrated with " + o.calibration_path : std::string())
-            << "\n\n";
+      << (calibrated && !analysis.log_units_dps ? ", calibrated with " + o.calibration_path : std::string())
+      << "\n\n";
   out << allan::format_table(analysis);
 }
 
@@ -239,12 +239,12 @@ Result<AllanReport> write_allan_report(const AllanReportOptions& o, std::ostream
   const auto meta = provenance_metadata(provenance(files.input_paths()));
   if (Status s = write_outputs(*out, *analysis, cal, meta, o.confidence); !s) return s.error();
   if (Status s = files.commit(); !s) return s.error();
-  if (out->cal) err << name_of(o.names, "command") << ": noise terms written to " << o.calibration_path << "\n";
+  if (out->cal)
+    err << name_of(o.names, "command") << ": noise terms written to " << o.calibration_path << "\n";
   AllanReport result;
   result.analysis = std::move(analysis).value();
   result.calibration_updated = out->cal != nullptr;
   return result;
 }
-
 
 }  // namespace tetra::report

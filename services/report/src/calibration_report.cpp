@@ -21,7 +21,6 @@ namespace tetra::report {
 
 namespace {
 
-
 template <class... Args>
 std::string cal_format(const char* fmt, Args... args) {
   char buf[512];
@@ -45,28 +44,26 @@ Result<double> latitude_from(const TurntableRows& log, const std::optional<doubl
 }
 
 void print_plan(std::ostream& out, const TurntableRows& log, const TurntableMotion& motion) {
-  out
-      << "Rotation plan derived from the encoders (cf. seed Table 3; body rate = table + Earth, mean)\n";
+  out << "Rotation plan derived from the encoders (cf. seed Table 3; body rate = table + Earth, mean)\n";
   out << " seq  lines          gimbal   rate[deg/s]  turned[deg]  other gimbal[deg]"
-               "   omega_B x[deg/s]    y[deg/s]    z[deg/s]\n";
+         "   omega_B x[deg/s]    y[deg/s]    z[deg/s]\n";
   for (const auto& m : motion.sequences) {
     const Eigen::Vector3d w = m.rate_B_dps();
     const std::string lines = std::to_string(m.first_line) + "-" + std::to_string(m.last_line);
     out << cal_format(" %3d  %-13s  %-6s  %+11.5f  %+11.3f  %s %+9.4f   %+12.6f  %+10.6f  %+10.6f\n",
-                        m.sequence, lines.c_str(), to_string(m.rotating), m.rate_dps, m.turned_deg,
-                        m.rotating == Gimbal::kInner ? "outer" : "inner", m.fixed_angle_deg, w.x(), w.y(),
-                        w.z());
+                      m.sequence, lines.c_str(), to_string(m.rotating), m.rate_dps, m.turned_deg,
+                      m.rotating == Gimbal::kInner ? "outer" : "inner", m.fixed_angle_deg, w.x(), w.y(),
+                      w.z());
   }
   out << cal_format("(%zu rows, %d gyros, latitude %+.4f deg)\n\n", log.rows(), log.gyro_count(),
-                      motion.latitude_deg);
+                    motion.latitude_deg);
 }
 
 void print_estimates(std::ostream& out, const CalibrationResult& result, const CalibrationOptions& options,
                      const std::optional<Calibration>& reference, const std::string& reference_name) {
   const Calibration& cal = result.calibration;
   out << "Scale factors and biases (cf. seed Table 4), method " << to_string(options.method);
-  if (options.method == CalibrationMethod::kSixteen)
-    out << ", bias model " << to_string(options.bias_model);
+  if (options.method == CalibrationMethod::kSixteen) out << ", bias model " << to_string(options.bias_model);
   out << "\n";
   out << " gyro  scale[V/(deg/s)]    1-sigma";
   if (reference) out << "  diff wrt ref";
@@ -75,8 +72,7 @@ void print_estimates(std::ostream& out, const CalibrationResult& result, const C
   out << "   resid RMS[V]: samples  seq.means\n";
   for (int i = 0; i < cal.gyro_count(); ++i) {
     const auto& g = cal.gyros[static_cast<std::size_t>(i)];
-    out << cal_format(" %4d  %16.8f  %9.2e", g.id, g.scale_factor_V_per_dps,
-                        g.sigma->scale_factor_V_per_dps);
+    out << cal_format(" %4d  %16.8f  %9.2e", g.id, g.scale_factor_V_per_dps, g.sigma->scale_factor_V_per_dps);
     if (reference) {
       out << cal_format(
           "  %+12.6f",
@@ -96,7 +92,7 @@ void print_estimates(std::ostream& out, const CalibrationResult& result, const C
   for (int i = 0; i < cal.gyro_count(); ++i) {
     const auto& g = cal.gyros[static_cast<std::size_t>(i)];
     out << cal_format(" %4d  %+11.7f  %+11.7f  %+11.7f  %11.2e  %11.2e  %11.2e", g.id, g.axis_B.x(),
-                        g.axis_B.y(), g.axis_B.z(), g.sigma->axis.x(), g.sigma->axis.y(), g.sigma->axis.z());
+                      g.axis_B.y(), g.axis_B.z(), g.sigma->axis.x(), g.sigma->axis.y(), g.sigma->axis.z());
     if (reference) {
       const Eigen::Vector3d& h_ref = reference->gyros[static_cast<std::size_t>(i)].axis_B;
       const double angle_deg = std::atan2(g.axis_B.cross(h_ref).norm(), g.axis_B.dot(h_ref)) * kRadToDeg;
@@ -107,15 +103,14 @@ void print_estimates(std::ostream& out, const CalibrationResult& result, const C
   if (reference) {
     out << " " << reference_name << " axes:\n";
     for (const auto& g : reference->gyros) {
-      out << cal_format(" %4d  %+11.7f  %+11.7f  %+11.7f\n", g.id, g.axis_B.x(), g.axis_B.y(),
-                          g.axis_B.z());
+      out << cal_format(" %4d  %+11.7f  %+11.7f  %+11.7f\n", g.id, g.axis_B.x(), g.axis_B.y(), g.axis_B.z());
     }
   } else if (cal.gyro_count() == 4) {
     const auto nominal = nominal_tetrahedron_axes();
     out << " nominal tetrahedron:\n";
     for (int i = 0; i < 4; ++i) {
       out << cal_format(" %4d  %+11.7f  %+11.7f  %+11.7f\n", i + 1, nominal(i, 0), nominal(i, 1),
-                          nominal(i, 2));
+                        nominal(i, 2));
     }
   }
   out << "\n";
@@ -124,7 +119,7 @@ void print_estimates(std::ostream& out, const CalibrationResult& result, const C
 void print_comparison(std::ostream& out, const TurntableMotion& motion, const CalibrationFit& reference_fit,
                       const CalibrationFit& fit, const std::string& reference_name, int gyro_count) {
   out << "Mean residual per sequence [V], measured - predicted (cf. seed Fig. 4): '" << reference_name
-            << "' | new\n";
+      << "' | new\n";
   out << " seq";
   for (int i = 1; i <= gyro_count; ++i) out << cal_format("     g%d ref        g%d new  ", i, i);
   out << "\n";
@@ -133,7 +128,7 @@ void print_comparison(std::ostream& out, const TurntableMotion& motion, const Ca
     for (int i = 0; i < gyro_count; ++i) {
       const auto row = static_cast<Eigen::Index>(j);
       out << cal_format("  %+10.3e  %+10.3e ", reference_fit.sequence_residual_V(row, i),
-                          fit.sequence_residual_V(row, i));
+                        fit.sequence_residual_V(row, i));
     }
     out << "\n";
   }
@@ -153,7 +148,8 @@ Result<CalibrationOptions> estimator_options(const CalibrationReportOptions& o) 
   options.method = o.method;
   options.bias_model = o.bias_model;
   if (options.method == CalibrationMethod::kBatch && o.bias_model != BiasModel::kBody) {
-    return bad_input(ErrorSubject("bias_model"), "applies to method sixteen only (batch fits the bias per sample)");
+    return bad_input(ErrorSubject("bias_model"),
+                     "applies to method sixteen only (batch fits the bias per sample)");
   }
   return options;
 }
@@ -165,8 +161,8 @@ Result<double> latitude_of(const TurntableRows& log, const CalibrationReportOpti
   if (!latitude) return latitude;
   if (o.latitude_deg) {
     if (const auto in_file = log.meta("latitude_deg")) {
-      err << name_of(o.names, "command") << ": using " << option << " " << *o.latitude_deg << " (the file says "
-          << *in_file << ")\n";
+      err << name_of(o.names, "command") << ": using " << option << " " << *o.latitude_deg
+          << " (the file says " << *in_file << ")\n";
     }
   }
   return latitude;
@@ -178,20 +174,21 @@ Result<std::optional<Calibration>> reference_of(const TurntableRows& log, const 
   auto ref = read_calibration(o.compare_path);
   if (!ref) return ref.error();
   if (ref->gyro_count() != log.gyro_count()) {
-    return bad_input(o.compare_path + ": has " + std::to_string(ref->gyro_count()) + " gyros, " + o.turntable_path +
-                     " has " + std::to_string(log.gyro_count()));
+    return bad_input(o.compare_path + ": has " + std::to_string(ref->gyro_count()) + " gyros, " +
+                     o.turntable_path + " has " + std::to_string(log.gyro_count()));
   }
   return std::optional<Calibration>(std::move(ref.value()));
 }
 
 // --noise: one noise section per gyro of the log, from another calibration file.
-Status noise_model_of(const TurntableRows& log, const CalibrationReportOptions& o, CalibrationOptions& options) {
+Status noise_model_of(const TurntableRows& log, const CalibrationReportOptions& o,
+                      CalibrationOptions& options) {
   if (o.noise_path.empty()) return ok_status();
   auto cal = read_calibration(o.noise_path);
   if (!cal) return cal.error();
   if (cal->gyro_count() != log.gyro_count()) {
-    return bad_input(o.noise_path + ": has " + std::to_string(cal->gyro_count()) + " gyros, " + o.turntable_path +
-                     " has " + std::to_string(log.gyro_count()));
+    return bad_input(o.noise_path + ": has " + std::to_string(cal->gyro_count()) + " gyros, " +
+                     o.turntable_path + " has " + std::to_string(log.gyro_count()));
   }
   options.noise.clear();
   for (const auto& g : cal->gyros) {
@@ -214,16 +211,17 @@ void print_seed_bias_difference(std::ostream& out, const TurntableRows& log, con
   for (int i = 0; i < log.gyro_count(); ++i) {
     const auto k = static_cast<std::size_t>(i);
     out << cal_format("  g%d %+.3e", i + 1,
-                        result.calibration.gyros[k].bias_V - body_result->calibration.gyros[k].bias_V);
+                      result.calibration.gyros[k].bias_V - body_result->calibration.gyros[k].bias_V);
   }
   out << "\n(eq. 11 subtracts the lab-frame Earth rate although the body is rotated; see "
-               "docs/calibration.md)\n\n";
+         "docs/calibration.md)\n\n";
 }
 
 // The tables on standard output: plan, estimates, the comparison, the seed-bias note, what 1σ means.
 Status print_calibration_report(std::ostream& out, const TurntableRows& log, const TurntableMotion& motion,
-                    const CalibrationOptions& options, const CalibrationResult& result,
-                    const std::optional<Calibration>& reference, const std::string& reference_name) {
+                                const CalibrationOptions& options, const CalibrationResult& result,
+                                const std::optional<Calibration>& reference,
+                                const std::string& reference_name) {
   print_plan(out, log, motion);
   print_estimates(out, result, options, reference, reference_name);
   if (reference) {
@@ -234,15 +232,15 @@ Status print_calibration_report(std::ostream& out, const TurntableRows& log, con
   if (options.method == CalibrationMethod::kSixteen && options.bias_model == BiasModel::kSeed)
     print_seed_bias_difference(out, log, motion, options, result);
   out << "1-sigma: "
-            << (options.method == CalibrationMethod::kSixteen
-                    ? "per-sequence standard deviation of the mean, propagated"
-                    : "residual covariance of the fit");
+      << (options.method == CalibrationMethod::kSixteen
+              ? "per-sequence standard deviation of the mean, propagated"
+              : "residual covariance of the fit");
   if (options.noise.empty()) {
     out << "; white noise within a sequence assumed, so correlated noise (bias instability, rate "
-                 "random walk) makes them optimistic (--noise adds it).\n";
+           "random walk) makes them optimistic (--noise adds it).\n";
   } else {
     out << ", plus the covariance of the sequence means from the gyros' bias instability and rate "
-                 "random walk (--noise).\n";
+           "random walk (--noise).\n";
   }
   return ok_status();
 }
@@ -271,7 +269,8 @@ Result<CalibrationResult> write_calibration_report(const CalibrationReportOption
   if (!motion) return motion.error();
   auto result = calibrate(*log, *motion, *options);
   if (!result) return result.error();
-  if (Status s = print_calibration_report(out, *log, *motion, *options, *result, *reference, o.compare_path); !s)
+  if (Status s = print_calibration_report(out, *log, *motion, *options, *result, *reference, o.compare_path);
+      !s)
     return s.error();
   const auto meta = provenance_metadata(provenance(files.input_paths()));
   if (Status s = write_calibration(**cal_out, result->calibration, meta); !s) return s.error();
@@ -279,6 +278,5 @@ Result<CalibrationResult> write_calibration_report(const CalibrationReportOption
   err << name_of(o.names, "command") << ": wrote " << o.output_path << "\n";
   return result;
 }
-
 
 }  // namespace tetra::report

@@ -1,7 +1,7 @@
 #include "tetra/report/pointing_plot.hpp"
 
-#include "tetra/report/gnuplot.hpp"
 #include "tetra/core/csv.hpp"
+#include "tetra/report/gnuplot.hpp"
 
 namespace tetra::report {
 
@@ -31,7 +31,8 @@ std::string series_data(const sim::ClosedLoopRecord& record) {
 
 Status plot_pointing(const std::string& png_path, const std::vector<PlottedRun>& runs, double bound_deg,
                      const std::vector<double>& onsets_s, const std::string& title) {
-  if (runs.empty() || runs.front().record->series.empty()) return failure(ErrorSubject(kPlotSubject), "nothing to plot");
+  if (runs.empty() || runs.front().record->series.empty())
+    return failure(ErrorSubject(kPlotSubject), "nothing to plot");
   auto dir = TempDir::create("tetra-pointing");
   if (!dir) return failure(ErrorSubject(kPlotSubject), dir.error().message);
   std::vector<std::string> files;

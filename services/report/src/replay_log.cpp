@@ -100,8 +100,8 @@ Result<ReplayInputs> open_inputs(const ReplayLogOptions& o) {
   return in;
 }
 
-Result<fdi::Pipeline> make_pipeline(const ReplayLogOptions& o, const ReplayInputs& in, fdi::PipelineConfig config,
-                                    std::ostream& err) {
+Result<fdi::Pipeline> make_pipeline(const ReplayLogOptions& o, const ReplayInputs& in,
+                                    fdi::PipelineConfig config, std::ostream& err) {
   config.raw_units_dps = in.log->header().units_dps;
   if (auto st = fdi::validate(config); !st) return st.error();
   auto pipeline = fdi::Pipeline::create(in.cal, config);
@@ -144,8 +144,8 @@ Status replay_block(const GyroLog& block, fdi::Pipeline& pipeline, fdi::Epoch& e
 // Recorded operator commands are applied where the service obeyed them: after the last epoch before
 // their stamp, each acknowledgement written before that epoch's own events.
 Result<ReplayedLog> replay_blocks(GyroLogPrefetcher& log, fdi::Pipeline& pipeline,
-                            const std::vector<RecordedCommand>& commands, AttitudeWriter& att,
-                               BufferedOutput& events, std::FILE* terminal) {
+                                  const std::vector<RecordedCommand>& commands, AttitudeWriter& att,
+                                  BufferedOutput& events, std::FILE* terminal) {
   const int n = log.header().gyro_count;
   std::size_t next_command = 0;
   auto apply_commands_before = [&](std::int64_t stamp_ns, bool all) {
@@ -190,31 +190,35 @@ void print_summary(std::ostream& err, const std::string& command, const fdi::Pip
   std::string ev;
   for (const auto& [name, count] : replayed.event_counts)
     ev += (ev.empty() ? "" : ", ") + name + " " + std::to_string(count);
-  err << command << printf_text(
-      ": %zu epochs read, %llu accepted; rejected: %llu time not increasing, %llu time "
-      "outliers, %llu wrong sample count\n"
-      "  samples: %llu accepted, %llu invalid, %llu absent, %llu outliers left out (%llu spikes)\n"
-      "  events: %s\n"
-      "  final mode: %s, gyros used: %s, excluded: %s\n",
-      replayed.epochs, static_cast<unsigned long long>(c.epochs_accepted),
-      static_cast<unsigned long long>(c.epochs_rejected_time),
-      static_cast<unsigned long long>(c.epochs_time_outlier),
-      static_cast<unsigned long long>(c.epochs_rejected_shape),
-      static_cast<unsigned long long>(c.samples_accepted), static_cast<unsigned long long>(c.samples_invalid),
-      static_cast<unsigned long long>(c.samples_absent), static_cast<unsigned long long>(c.samples_outlier),
-      static_cast<unsigned long long>(c.spikes), ev.empty() ? "none" : ev.c_str(), fdi::to_string(h.mode),
-      mask_to_string(h.used, n).c_str(), excluded.empty() ? "none" : excluded.c_str());
+  err << command
+      << printf_text(
+             ": %zu epochs read, %llu accepted; rejected: %llu time not increasing, %llu time "
+             "outliers, %llu wrong sample count\n"
+             "  samples: %llu accepted, %llu invalid, %llu absent, %llu outliers left out (%llu spikes)\n"
+             "  events: %s\n"
+             "  final mode: %s, gyros used: %s, excluded: %s\n",
+             replayed.epochs, static_cast<unsigned long long>(c.epochs_accepted),
+             static_cast<unsigned long long>(c.epochs_rejected_time),
+             static_cast<unsigned long long>(c.epochs_time_outlier),
+             static_cast<unsigned long long>(c.epochs_rejected_shape),
+             static_cast<unsigned long long>(c.samples_accepted),
+             static_cast<unsigned long long>(c.samples_invalid),
+             static_cast<unsigned long long>(c.samples_absent),
+             static_cast<unsigned long long>(c.samples_outlier), static_cast<unsigned long long>(c.spikes),
+             ev.empty() ? "none" : ev.c_str(), fdi::to_string(h.mode), mask_to_string(h.used, n).c_str(),
+             excluded.empty() ? "none" : excluded.c_str());
   // Most of the log left out is never a quiet success: the exit status stays 0 (the outputs are what the
   // pipeline made of the log), the warning says what was lost.
   const std::uint64_t rejected = c.epochs_rejected_time + c.epochs_time_outlier + c.epochs_rejected_shape;
   if (replayed.epochs > 0 && 2 * rejected > replayed.epochs) {
-    err << command << printf_text(
-                 ": warning: %llu of %zu epochs rejected (%llu time not increasing, %llu time "
-                 "outliers, %llu wrong sample count): the attitude covers only part of the log\n",
-                 static_cast<unsigned long long>(rejected), replayed.epochs,
-                 static_cast<unsigned long long>(c.epochs_rejected_time),
-                 static_cast<unsigned long long>(c.epochs_time_outlier),
-                 static_cast<unsigned long long>(c.epochs_rejected_shape));
+    err << command
+        << printf_text(
+               ": warning: %llu of %zu epochs rejected (%llu time not increasing, %llu time "
+               "outliers, %llu wrong sample count): the attitude covers only part of the log\n",
+               static_cast<unsigned long long>(rejected), replayed.epochs,
+               static_cast<unsigned long long>(c.epochs_rejected_time),
+               static_cast<unsigned long long>(c.epochs_time_outlier),
+               static_cast<unsigned long long>(c.epochs_rejected_shape));
   }
 }
 
@@ -258,6 +262,5 @@ Result<ReplayedLog> replay_log(const ReplayLogOptions& o, std::ostream& err) {
   replayed->health = pipeline->health();
   return replayed;
 }
-
 
 }  // namespace tetra::report

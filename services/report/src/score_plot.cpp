@@ -4,9 +4,9 @@
 #include <cmath>
 #include <filesystem>
 
-#include "tetra/report/gnuplot.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/input_files.hpp"
+#include "tetra/report/gnuplot.hpp"
 
 namespace tetra::report {
 

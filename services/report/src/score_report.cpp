@@ -18,7 +18,6 @@ namespace tetra::report {
 
 namespace {
 
-
 //! "x", "y", "z" or three numbers "a,b,c" (normalized); bad input about kSubjectAxis otherwise.
 Result<Eigen::Vector3d> parse_axis(const std::string& text) {
   if (text == "x") return Eigen::Vector3d(Eigen::Vector3d::UnitX());
@@ -34,7 +33,8 @@ Result<Eigen::Vector3d> parse_axis(const std::string& text) {
     v(k) = *value;
     start = comma + 1;
   }
-  if (!(v.norm() > 0.0)) return bad_input(ErrorSubject(kSubjectAxis, text), "the zero vector has no direction");
+  if (!(v.norm() > 0.0))
+    return bad_input(ErrorSubject(kSubjectAxis, text), "the zero vector has no direction");
   return Eigen::Vector3d(v.normalized());
 }
 
@@ -69,38 +69,38 @@ void print_consistency(std::ostream& out, const AttitudeScore& s) {
   const std::string left_out =
       s.no_sigma_epochs ? " (" + std::to_string(s.no_sigma_epochs) + " with sigma 0 or nan left out)" : "";
   if (s.per_axis_sigma) {
-    out << "  NEES, 3 dof (expectation 3): mean " << fixed_or_na(s.mean_nees, 3) << " over "
-              << s.sigma_epochs << " epochs" << left_out << '\n';
+    out << "  NEES, 3 dof (expectation 3): mean " << fixed_or_na(s.mean_nees, 3) << " over " << s.sigma_epochs
+        << " epochs" << left_out << '\n';
     const char* axes[3] = {"x", "y", "z"};
     for (int k = 0; k < 3; ++k) {
       out << "  within 1/2/3 sigma, " << axes[k] << ": "
-                << percents({s.within_B[0](k), s.within_B[1](k), s.within_B[2](k)})
-                << "   (Gaussian: 68.3 / 95.4 / 99.7 %)\n";
+          << percents({s.within_B[0](k), s.within_B[1](k), s.within_B[2](k)})
+          << "   (Gaussian: 68.3 / 95.4 / 99.7 %)\n";
     }
   } else {
     out << "  normalized error |e|^2/sigma^2 (expectation 1): mean " << fixed_or_na(s.mean_nees, 3)
-              << " over " << s.sigma_epochs << " epochs" << left_out << '\n';
+        << " over " << s.sigma_epochs << " epochs" << left_out << '\n';
   }
   out << "  within 1/2/3 sigma, total angle: " << percents(s.within_total)
-            << "   (isotropic 3-D Gaussian: 60.8 / 99.3 / 100.0 %)\n";
+      << "   (isotropic 3-D Gaussian: 60.8 / 99.3 / 100.0 %)\n";
 }
 
 void print_score(std::ostream& out, const AttitudeScore& s, const std::string& att, const std::string& truth,
                  const ScoreOptions& o, const std::string& axis_name) {
   out << "tetra score: " << att << " against " << truth << '\n';
   out << "  epochs: " << s.epochs.size() << " scored (" << s.exact_matches << " at a truth row within "
-            << o.time_tolerance_s << " s, " << s.interpolated << " against truth interpolated between rows), "
-            << s.outside_truth << " outside the truth's time span\n";
+      << o.time_tolerance_s << " s, " << s.interpolated << " against truth interpolated between rows), "
+      << s.outside_truth << " outside the truth's time span\n";
   out << "  sigma: "
-            << (s.per_axis_sigma ? "per axis (sigma_x_deg, sigma_y_deg, sigma_z_deg)"
-                                 : "total sigma_deg (the file has no per-axis columns)")
-            << '\n';
+      << (s.per_axis_sigma ? "per axis (sigma_x_deg, sigma_y_deg, sigma_z_deg)"
+                           : "total sigma_deg (the file has no per-axis columns)")
+      << '\n';
   print_errors(out, s);
   print_consistency(out, s);
   out << "  integrated angle about " << axis_name << ": " << fixed_or_na(s.angle_axis_deg, 2)
-            << " deg (truth " << fixed_or_na(s.truth_angle_axis_deg, 2)
-            << " deg); about x, y, z: " << fixed_or_na(s.angle_B_deg(0), 2) << ", "
-            << fixed_or_na(s.angle_B_deg(1), 2) << ", " << fixed_or_na(s.angle_B_deg(2), 2) << " deg\n";
+      << " deg (truth " << fixed_or_na(s.truth_angle_axis_deg, 2)
+      << " deg); about x, y, z: " << fixed_or_na(s.angle_B_deg(0), 2) << ", "
+      << fixed_or_na(s.angle_B_deg(1), 2) << ", " << fixed_or_na(s.angle_B_deg(2), 2) << " deg\n";
 }
 
 nlohmann::json json_vec(const Eigen::Vector3d& v) {
@@ -114,7 +114,7 @@ nlohmann::json json_num(double v) {
 }
 
 std::string format_score_json(const AttitudeScore& s, const ScoreOptions& o, const std::string& axis_name,
-                        const std::vector<std::string>& inputs) {
+                              const std::vector<std::string>& inputs) {
   nlohmann::json j;
   nlohmann::json prov = nlohmann::json::object();
   for (const auto& [key, value] : provenance_metadata(provenance(inputs))) prov[key] = value;
@@ -167,8 +167,8 @@ Result<AttitudeScore> write_score_report(const ScoreReportOptions& o, std::ostre
   OutputFile* json_out = nullptr;
   const std::string plot_name = name_of(o.names, "plot_path");
   const std::string json_name = name_of(o.names, "json_path");
-  if (Status s = files.add_outputs({{o.plot_path, plot_name.c_str(), &plot_out},
-                                    {o.json_path, json_name.c_str(), &json_out}});
+  if (Status s = files.add_outputs(
+          {{o.plot_path, plot_name.c_str(), &plot_out}, {o.json_path, json_name.c_str(), &json_out}});
       !s)
     return s.error();
 

@@ -124,17 +124,18 @@ void apply_overrides(const ScenarioOverrides& o, sim::Scenario& sc) {
 // The overrides given that change the scenario, for a message: " (with --minutes, --rate-hz)".
 std::string overrides_given(const SimRunOptions& run) {
   const ScenarioOverrides& o = run.overrides;
-  const std::pair<bool, const char*> given[] = {{o.rate_hz.has_value(), "rate_hz"},
-                                                {o.duration_min.has_value(), "duration_min"},
-                                                {o.latitude_deg.has_value(), "latitude_deg"},
-                                                {o.reference_hz.has_value(), "reference_hz"},
-                                                {o.reference_noise_arcsec.has_value(), "reference_noise_arcsec"},
-                                                {o.acs_amplitude_deg.has_value(), "acs_amplitude_deg"},
-                                                {o.acs_accel_dps2.has_value(), "acs_accel_dps2"},
-                                                {o.orbit_period_min.has_value(), "orbit_period_min"},
-                                                {o.jitter_s.has_value(), "jitter_s"},
-                                                {o.drop_probability.has_value(), "drop_probability"},
-                                                {o.range_dps.has_value(), "range_dps"}};
+  const std::pair<bool, const char*> given[] = {
+      {o.rate_hz.has_value(), "rate_hz"},
+      {o.duration_min.has_value(), "duration_min"},
+      {o.latitude_deg.has_value(), "latitude_deg"},
+      {o.reference_hz.has_value(), "reference_hz"},
+      {o.reference_noise_arcsec.has_value(), "reference_noise_arcsec"},
+      {o.acs_amplitude_deg.has_value(), "acs_amplitude_deg"},
+      {o.acs_accel_dps2.has_value(), "acs_accel_dps2"},
+      {o.orbit_period_min.has_value(), "orbit_period_min"},
+      {o.jitter_s.has_value(), "jitter_s"},
+      {o.drop_probability.has_value(), "drop_probability"},
+      {o.range_dps.has_value(), "range_dps"}};
   std::string names;
   for (const auto& [is_given, argument] : given) {
     if (is_given) names += (names.empty() ? "" : ", ") + name_of(run.names, argument);
@@ -153,7 +154,8 @@ Result<sim::Scenario> load_scenario(const SimRunOptions& o, const std::optional<
   apply_overrides(o.overrides, *scenario);
   if (!o.faults.empty()) scenario->faults.clear();  // the run's faults replace the file's
   // Each override is in its own range; together (e.g. duration × rate) they may still not fit.
-  if (Status st = sim::validate_scenario(*scenario); !st) return bad_input(st.error().message + overrides_given(o));
+  if (Status st = sim::validate_scenario(*scenario); !st)
+    return bad_input(st.error().message + overrides_given(o));
   return scenario;
 }
 
@@ -202,7 +204,8 @@ Result<SimulatedFiles> simulate_to_files(const SimRunOptions& o, std::ostream& e
   if (!simulator) return simulator.error();
   const bool long_run = simulator->epoch_count() > 2'000'000;
   const auto meta = provenance_metadata(provenance(files.input_paths()));
-  if (Status st = sim::write_simulation(*simulator, *out->log, out->truth, meta, long_run ? o.progress : nullptr);
+  if (Status st =
+          sim::write_simulation(*simulator, *out->log, out->truth, meta, long_run ? o.progress : nullptr);
       !st)
     return st.error();
   if (Status st = files.commit(); !st) return st.error();

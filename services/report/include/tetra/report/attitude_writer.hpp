@@ -13,10 +13,10 @@
 #include <thread>
 #include <vector>
 
-#include "tetra/report/attitude_csv.hpp"
 #include "tetra/core/output_files.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/types.hpp"
+#include "tetra/report/attitude_csv.hpp"
 
 namespace tetra::report {
 

@@ -14,14 +14,14 @@
 namespace tetra::report {
 
 struct CalibrationReportOptions {
-  std::string turntable_path;            //!< turntable log: sequence,time_s,inner_deg,outer_deg,g1..gN
-  std::string output_path;               //!< calibration file to write ("-": standard output)
-  std::optional<double> latitude_deg;    //!< [deg] geodetic latitude; default: the log's latitude_deg comment
+  std::string turntable_path;          //!< turntable log: sequence,time_s,inner_deg,outer_deg,g1..gN
+  std::string output_path;             //!< calibration file to write ("-": standard output)
+  std::optional<double> latitude_deg;  //!< [deg] geodetic latitude; default: the log's latitude_deg comment
   CalibrationMethod method = CalibrationMethod::kSixteen;
   BiasModel bias_model = BiasModel::kBody;  //!< kSixteen only
-  std::string compare_path;              //!< another calibration, its residuals printed beside; empty: none
-  std::string unit;                      //!< unit name; default: the log's unit comment, else tetra-1
-  std::string noise_path;                //!< calibration whose gyros carry noise: sections; empty: none
+  std::string compare_path;  //!< another calibration, its residuals printed beside; empty: none
+  std::string unit;          //!< unit name; default: the log's unit comment, else tetra-1
+  std::string noise_path;    //!< calibration whose gyros carry noise: sections; empty: none
   double bias_instability_correlation_s = 100.0;  //!< [s] Gauss-Markov correlation time (with noise_path)
   //! How messages name the arguments (turntable_path, latitude_deg, ...) and the command ("command").
   ArgumentNames names;

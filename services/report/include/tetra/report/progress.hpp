@@ -4,8 +4,8 @@
 // pipes, files, tests).
 
 #include <chrono>
-#include <cstdio>
 #include <cstddef>
+#include <cstdio>
 #include <string>
 
 namespace tetra::report {

@@ -17,15 +17,15 @@
 namespace tetra::report {
 
 struct ReplayLogOptions {
-  std::string log_path;                //!< gyro log (CSV, or HDF5 when named .h5)
-  std::string calibration_path;        //!< calibration YAML (docs/interfaces.md §2.3)
-  std::string config_path;             //!< YAML with a 'pipeline:' map (docs/fdi.md); empty: defaults
-  std::string attitude_path;           //!< attitude rows to write (CSV)
-  std::string events_path;             //!< FDI events to write (JSON lines)
-  std::string commands_path;           //!< operator commands to re-apply (tetra record's); empty: none
-  std::optional<double> latitude_deg;  //!< [deg] ground-test mode: remove the Earth rate at this latitude
-  std::optional<std::string> initial_q;  //!< initial attitude "w,x,y,z"; none: the configuration's
-  bool verbose = false;                //!< the configuration and the derived thresholds on `err`
+  std::string log_path;                    //!< gyro log (CSV, or HDF5 when named .h5)
+  std::string calibration_path;            //!< calibration YAML (docs/interfaces.md §2.3)
+  std::string config_path;                 //!< YAML with a 'pipeline:' map (docs/fdi.md); empty: defaults
+  std::string attitude_path;               //!< attitude rows to write (CSV)
+  std::string events_path;                 //!< FDI events to write (JSON lines)
+  std::string commands_path;               //!< operator commands to re-apply (tetra record's); empty: none
+  std::optional<double> latitude_deg;      //!< [deg] ground-test mode: remove the Earth rate at this latitude
+  std::optional<std::string> initial_q;    //!< initial attitude "w,x,y,z"; none: the configuration's
+  bool verbose = false;                    //!< the configuration and the derived thresholds on `err`
   std::FILE* progress_terminal = nullptr;  //!< a terminal to draw the progress line on; nullptr: none
   //! How messages name the arguments (log_path, attitude_path, ...) and the command ("command").
   ArgumentNames names;

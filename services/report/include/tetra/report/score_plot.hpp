@@ -1,6 +1,6 @@
 #pragma once
-// The score's plot (`tetra score --plot`): the attitude error per body axis against its ±3σ envelope (the seed's Fig. 7,
-// right side), one panel per axis.
+// The score's plot (`tetra score --plot`): the attitude error per body axis against its ±3σ envelope (the
+// seed's Fig. 7, right side), one panel per axis.
 
 #include <string>
 

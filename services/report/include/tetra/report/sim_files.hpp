@@ -39,15 +39,15 @@ struct ScenarioOverrides {
 };
 
 struct SimRunOptions {
-  std::string scenario;      //!< turntable, static, lab-orbit, orbit, slews, or a scenario YAML file
-  std::uint64_t seed = 1;    //!< the same seed gives byte-identical output
-  std::string unit_path;     //!< calibration YAML of the simulated unit; empty: the seed paper's unit
-  std::string out_path;      //!< log to write ("-": standard output); turntable: default "-"
-  std::string truth_path;    //!< truth to write; empty: none (never for the turntable)
-  std::vector<std::string> faults;        //!< fault specs replacing the scenario's (docs/interfaces.md §2.7)
+  std::string scenario;             //!< turntable, static, lab-orbit, orbit, slews, or a scenario YAML file
+  std::uint64_t seed = 1;           //!< the same seed gives byte-identical output
+  std::string unit_path;            //!< calibration YAML of the simulated unit; empty: the seed paper's unit
+  std::string out_path;             //!< log to write ("-": standard output); turntable: default "-"
+  std::string truth_path;           //!< truth to write; empty: none (never for the turntable)
+  std::vector<std::string> faults;  //!< fault specs replacing the scenario's (docs/interfaces.md §2.7)
   std::vector<std::string> added_faults;  //!< fault specs added to the scenario's (and to `faults`)
   ScenarioOverrides overrides;
-  sim::TurntablePlan plan;                //!< the turntable scenario's plan
+  sim::TurntablePlan plan;  //!< the turntable scenario's plan
   //! The plan's arguments given (table_rate_dps, revolutions, order, wrap_angles): refused for any other
   //! scenario.
   std::vector<std::string> plan_given;
@@ -73,8 +73,8 @@ struct PreparedSimulation {
 Result<PreparedSimulation> prepare_simulation(const SimRunOptions& options);
 
 struct SimulatedFiles {
-  std::string scenario;     //!< the scenario's name
-  std::size_t epochs = 0;   //!< epochs simulated (turntable: rows)
+  std::string scenario;    //!< the scenario's name
+  std::size_t epochs = 0;  //!< epochs simulated (turntable: rows)
   int gyros = 0;
 };
 
