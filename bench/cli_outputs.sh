@@ -46,6 +46,11 @@ run sim_slews sim slews_custom.yaml --seed 5 --minutes 3 --rate-hz 5 --add-fault
 run sim_bad sim nowhere.yaml -o never.csv
 run sim_bad_fault sim orbit --fault gyro=9,kind=stuck,at=1 -o never.csv
 run sim_tt_minutes sim turntable --minutes 3 -o never.csv
+run sim_tt_plan sim turntable --wrap --order 1,2,5,6 --table-rate 3 --revolutions 2 --range 400 --latitude 10
+run sim_refs sim orbit --seed 6 --minutes 0.5 --reference-bias 5,10,20 --reference-misid 1,20,5 \
+  --reference-latency 0.2 --reference-noise 3 --orbit-period 95 -o refs.csv
+run sim_wrap_static sim static --wrap -o never.csv
+run sim_tt_refbias sim turntable --reference-bias 1,2,3
 run sim_tt_fault sim turntable --fault gyro=1,kind=stuck,at=1 -o never.csv
 run sim_table_rate sim orbit --table-rate 3 -o never.csv
 run sim_too_long sim static --minutes 100000 --rate-hz 1000 -o never.csv
