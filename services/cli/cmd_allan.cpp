@@ -8,7 +8,6 @@
 #include "commands.hpp"
 #include "tetra/core/allan.hpp"
 #include "tetra/report/allan_report.hpp"
-#include "tetra/report/gnuplot.hpp"
 
 namespace tetra::cli {
 
@@ -71,8 +70,7 @@ int cmd_allan(int argc, char** argv) {
                    {"update_calibration", "--update-calibration needs --calibration CAL.yaml"},
                    {"kalibr_path", "--kalibr needs --calibration CAL.yaml (the gyro axes)"},
                    {"dt_tolerance", "--dt-tolerance {value}: {message}"},
-                   {"confidence", "--confidence {value}: {message}"},
-                   {report::kPlotSubject, "--plot: {message}"}});
+                   {"confidence", "--confidence {value}: {message}"}});
   }
   return kExitOk;
 }

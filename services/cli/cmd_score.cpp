@@ -4,7 +4,6 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
-#include "tetra/report/gnuplot.hpp"
 #include "tetra/report/score_report.hpp"
 
 namespace tetra::cli {
@@ -38,8 +37,7 @@ int cmd_score(int argc, char** argv) {
     return report("score", score.error(),
                   {{report::kSubjectAxis, "--axis '{value}': {message}"},
                    {"axis_B", "--axis: {message}"},
-                   {"time_tolerance_s", "--time-tolerance: {message}"},
-                   {report::kPlotSubject, "--plot: {message}"}});
+                   {"time_tolerance_s", "--time-tolerance: {message}"}});
   }
   return kExitOk;
 }
