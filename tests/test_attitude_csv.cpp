@@ -1,5 +1,5 @@
-// Attitude rows (services/cli/attitude_csv.hpp) as replay's writer formats them straight into its buffer:
-// the same text as a row built cell by cell with append_double, within attitude_row_max_bytes for the
+// Attitude rows (tetra/report/attitude_csv.hpp) as replay's writer formats them straight into its
+// buffer: the same text as a row built cell by cell with append_double, within attitude_row_max_bytes for the
 // widest numbers, and the gyros cell cached per mask.
 #include <cmath>
 #include <limits>
@@ -8,11 +8,11 @@
 
 #include <gtest/gtest.h>
 
-#include "attitude_csv.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/report/attitude_csv.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 namespace {
 
 fdi::AttitudeEstimate estimate(double x, int n_gyros, GyroMask mask) {
@@ -113,4 +113,4 @@ TEST(AttitudeCsv, GyrosCellCacheFollowsTheMask) {
 }
 
 }  // namespace
-}  // namespace tetra::cli
+}  // namespace tetra::report

@@ -9,6 +9,7 @@
 
 #include "tetra/core/csv.hpp"
 #include "tetra/core/provenance.hpp"
+#include "tetra/report/gnuplot.hpp"
 
 namespace tetra::cli {
 
@@ -106,6 +107,8 @@ std::string user_message(const Error& error, std::initializer_list<SubjectOption
     return one_line(fmt::format(fmt::runtime(o.format), fmt::arg("value", error.subject.value),
                                 fmt::arg("message", error.message)));
   }
+  // Every command that plots names its PNG option --plot.
+  if (error.subject.name == report::kPlotSubject) return one_line("--plot: " + error.message);
   return describe(error);
 }
 

@@ -34,8 +34,8 @@ struct SubjectOption {
   std::string_view format;
 };
 
-//! The error's one line for the user: worded by the entry for its subject, else in the library's
-//! words (describe()).
+//! The error's one line for the user: worded by the entry for its subject, else (a plot's error,
+//! report::kPlotSubject) as --plot's, else in the library's words (describe()).
 std::string user_message(const Error& error, std::initializer_list<SubjectOption> options);
 
 //! Prints "tetra SUB: message" on stderr (user_message); returns 2 for bad input, 1 otherwise.

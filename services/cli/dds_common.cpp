@@ -97,26 +97,4 @@ int spawn_self(const std::vector<std::string>& args, const std::string& stdout_p
   _exit(127);
 }
 
-std::string fixed(double value, int decimals) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
-  return buffer;
-}
-
-}  // namespace tetra::cli
-
-namespace tetra::cli {
-
-std::string json_number(double value) {
-  std::string out;
-  append_json_number(out, value);
-  return out;
-}
-
-std::string json_string(const std::string& text) {
-  std::string out;
-  append_json_string(out, text);
-  return out;
-}
-
 }  // namespace tetra::cli

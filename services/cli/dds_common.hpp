@@ -1,6 +1,6 @@
 #pragma once
 // Plumbing shared by the DDS subcommands: the --domain option, the local clock, spawning
-// the program itself (demo), and small formatting helpers.
+// the program itself (demo), and the report library's formatting helpers (tetra/report/text.hpp).
 
 #include <chrono>
 #include <cstdint>
@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "tetra/dds/clock.hpp"
+#include "tetra/report/text.hpp"
 
 namespace tetra::cli {
 
@@ -39,16 +40,8 @@ std::string default_web_dir();
 int spawn_self(const std::vector<std::string>& args, const std::string& stdout_path = "",
                const std::string& stderr_path = "");
 
-//! "%.6f" style fixed formatting without iostreams state.
-std::string fixed(double value, int decimals);
-
-}  // namespace tetra::cli
-
-namespace tetra::cli {
-
-//! JSON number in shortest round-trip form; `null` for NaN and infinities.
-std::string json_number(double value);
-//! JSON string literal with escapes.
-std::string json_string(const std::string& text);
+using report::fixed;
+using report::json_number;
+using report::json_string;
 
 }  // namespace tetra::cli

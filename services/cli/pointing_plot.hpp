@@ -1,21 +1,12 @@
 #pragma once
-// PNG plot of closed-loop runs (gnuplot): pointing error (truth and estimated) against the bound,
-// with the fault onsets; wheel speeds and wheel torques of the first run.
+// The closed-loop pointing plot (tetra/report/pointing_plot.hpp) under the names `tetra sim --closed-loop`
+// uses. Its errors carry report::kPlotSubject (worded as --plot's by cli_common's report()).
 
-#include <string>
-#include <vector>
-
-#include "tetra/core/result.hpp"
-#include "tetra/sim/closed_loop_run.hpp"
+#include "tetra/report/pointing_plot.hpp"
 
 namespace tetra::cli {
 
-struct PlottedRun {
-  std::string label;                    //!< legend, e.g. "with exclusion"
-  const sim::ClosedLoopRecord* record;  //!< the run
-};
-
-Status plot_pointing(const std::string& png_path, const std::vector<PlottedRun>& runs, double bound_deg,
-                     const std::vector<double>& onsets_s, const std::string& title);
+using report::plot_pointing;
+using report::PlottedRun;
 
 }  // namespace tetra::cli

@@ -11,7 +11,7 @@
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/pipeline.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 
 struct RecordedCommand {
   std::int64_t stamp_ns = 0;  //!< [ns] sensor time of the last epoch the service had fused
@@ -26,4 +26,4 @@ Result<std::vector<RecordedCommand>> read_command_log(const std::string& path);
 //! Applies `command` to `pipeline` as the service did; returns the acknowledgement.
 fdi::FdiEvent apply(fdi::Pipeline& pipeline, const RecordedCommand& command);
 
-}  // namespace tetra::cli
+}  // namespace tetra::report

@@ -1,4 +1,4 @@
-#include "command_log.hpp"
+#include "tetra/report/command_log.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -9,7 +9,7 @@
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/units.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 
 namespace {
 
@@ -83,4 +83,4 @@ fdi::FdiEvent apply(fdi::Pipeline& pipeline, const RecordedCommand& command) {
   return pipeline.reset_command(command.stamp_ns);
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::report

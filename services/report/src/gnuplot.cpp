@@ -1,4 +1,4 @@
-#include "gnuplot.hpp"
+#include "tetra/report/gnuplot.hpp"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -6,7 +6,7 @@
 
 #include "tetra/core/csv.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 
 namespace {
 
@@ -46,7 +46,7 @@ TempDir::~TempDir() {
 }
 
 Status run_gnuplot(const std::filesystem::path& dir, const std::string& png_path, int width, int height,
-                   const std::string& body, const std::string& option) {
+                   const std::string& body, const std::string& subject) {
   const std::string size = std::to_string(width) + "," + std::to_string(height);
   for (const char* terminal : {"pngcairo", "png"}) {
     const std::string script_file = (dir / "plot.gp").string();
@@ -58,11 +58,11 @@ Status run_gnuplot(const std::filesystem::path& dir, const std::string& png_path
         std::system(("gnuplot " + shell_quote(script_file) + " 2>" + shell_quote(err_file)).c_str());
     if (rc == 0) return ok_status();
     if (rc == -1 || (WIFEXITED(rc) && WEXITSTATUS(rc) == 127)) {
-      return failure(option +
-                     ": gnuplot not found (install the Debian package gnuplot-nox; see scripts/setup.sh)");
+      return failure(ErrorSubject(subject),
+                     "gnuplot not found (install the Debian package gnuplot-nox; see scripts/setup.sh)");
     }
   }
-  return failure(option + ": gnuplot could not write " + png_path);
+  return failure(ErrorSubject(subject), "gnuplot could not write " + png_path);
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::report

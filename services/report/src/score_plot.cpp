@@ -1,14 +1,14 @@
-#include "score_plot.hpp"
+#include "tetra/report/score_plot.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 
-#include "gnuplot.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/input_files.hpp"
+#include "tetra/report/gnuplot.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 
 namespace {
 
@@ -53,7 +53,7 @@ std::string series_data(const AttitudeScore& score, const Scale& scale, double t
 
 Status write_score_plot(OutputFile& png, const AttitudeScore& score, const std::string& title) {
   auto temp = TempDir::create("tetra-score");
-  if (!temp) return failure("--plot: " + temp.error().message);
+  if (!temp) return failure(ErrorSubject(kPlotSubject), temp.error().message);
   const std::filesystem::path& dir = temp->path();
   const Scale scale = error_scale(score);
   const bool minutes = score.epochs.back().time_s - score.epochs.front().time_s > 1200.0;
@@ -81,10 +81,10 @@ Status write_score_plot(OutputFile& png, const AttitudeScore& score, const std::
   body += "unset multiplot\n";
   // gnuplot writes into the temporary directory; the image reaches --plot through the output layer.
   const std::string png_path = (dir / "plot.png").string();
-  if (Status s = run_gnuplot(dir, png_path, 1000, 900, body, "--plot"); !s) return s;
+  if (Status s = run_gnuplot(dir, png_path, 1000, 900, body, kPlotSubject); !s) return s;
   auto image = read_input(png_path, kMaxTableBytes);
-  if (!image) return failure("--plot: gnuplot wrote no image");
+  if (!image) return failure(ErrorSubject(kPlotSubject), "gnuplot wrote no image");
   return png.write(*image);
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::report

@@ -1,4 +1,4 @@
-#include "attitude_csv.hpp"
+#include "tetra/report/attitude_csv.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -6,7 +6,7 @@
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"  // kRadToDeg
 
-namespace tetra::cli {
+namespace tetra::report {
 
 namespace {
 
@@ -96,4 +96,4 @@ const std::string& GyrosCellCache::cell(GyroMask mask) {
   return cell_;
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::report

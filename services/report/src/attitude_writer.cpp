@@ -1,13 +1,13 @@
-#include "attitude_writer.hpp"
+#include "tetra/report/attitude_writer.hpp"
 
 #include <algorithm>
 #include <cstring>
 #include <span>
 #include <utility>
 
-#include "attitude_csv.hpp"
+#include "tetra/report/attitude_csv.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 
 namespace {
 constexpr std::size_t kWriteBytes = std::size_t{1} << 20;  // formatted text written in pieces of ~1 MB
@@ -160,4 +160,4 @@ void AttitudeWriter::run() {
   }
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::report

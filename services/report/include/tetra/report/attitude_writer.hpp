@@ -13,12 +13,12 @@
 #include <thread>
 #include <vector>
 
-#include "attitude_csv.hpp"
 #include "tetra/core/output_files.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/types.hpp"
+#include "tetra/report/attitude_csv.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 
 class AttitudeWriter {
  public:
@@ -74,4 +74,4 @@ class AttitudeWriter {
   std::thread worker_;
 };
 
-}  // namespace tetra::cli
+}  // namespace tetra::report

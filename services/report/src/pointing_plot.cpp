@@ -1,9 +1,9 @@
-#include "pointing_plot.hpp"
+#include "tetra/report/pointing_plot.hpp"
 
-#include "gnuplot.hpp"
 #include "tetra/core/csv.hpp"
+#include "tetra/report/gnuplot.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 
 namespace {
 
@@ -31,9 +31,10 @@ std::string series_data(const sim::ClosedLoopRecord& record) {
 
 Status plot_pointing(const std::string& png_path, const std::vector<PlottedRun>& runs, double bound_deg,
                      const std::vector<double>& onsets_s, const std::string& title) {
-  if (runs.empty() || runs.front().record->series.empty()) return failure("--plot: nothing to plot");
+  if (runs.empty() || runs.front().record->series.empty())
+    return failure(ErrorSubject(kPlotSubject), "nothing to plot");
   auto dir = TempDir::create("tetra-pointing");
-  if (!dir) return failure("--plot: " + dir.error().message);
+  if (!dir) return failure(ErrorSubject(kPlotSubject), dir.error().message);
   std::vector<std::string> files;
   for (std::size_t r = 0; r < runs.size(); ++r) {
     files.push_back((dir->path() / ("run" + std::to_string(r) + ".dat")).string());
@@ -70,7 +71,7 @@ Status plot_pointing(const std::string& png_path, const std::vector<PlottedRun>&
             " with lines title 'wheel " + std::to_string(w + 1) + "'";
   }
   body += "\nunset multiplot\n";
-  return run_gnuplot(dir->path(), png_path, 1100, 1000, body, "--plot");
+  return run_gnuplot(dir->path(), png_path, 1100, 1000, body, kPlotSubject);
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::report

@@ -12,7 +12,7 @@
 #include "tetra/core/geometry.hpp"
 #include "tetra/fdi/types.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 
 //! The header line (with its newline) for `n_gyros` gyros: the 11 columns every reader knows, then the
 //! filter's columns.
@@ -49,4 +49,4 @@ class GyrosCellCache {
   std::string cell_;
 };
 
-}  // namespace tetra::cli
+}  // namespace tetra::report
