@@ -1,5 +1,6 @@
 // tetra.Pipeline: the fusion and fault-detection pipeline, one epoch at a time (step) or a whole array of
 // epochs in C++ (run: no Python per epoch, the GIL released).
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <string>

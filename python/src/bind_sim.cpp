@@ -34,8 +34,8 @@ PyTruth to_python(sim::Truth&& t) {
   const std::size_t n = t.time_s.size();
   std::vector<double> q(4 * n), w(3 * n), wn(3 * n);
   for (std::size_t k = 0; k < n; ++k) {
-    const auto wxyz = to_wxyz(t.q_RB[k]);
-    for (std::size_t c = 0; c < 4; ++c) q[4 * k + c] = wxyz[c];
+    const auto wxyz = to_wxyz(canonical(t.q_RB[k]));  // as the truth file: normalized, w >= 0
+    for (std::size_t c = 0; c < 4; ++c) q[4 * k + c] = wxyz[c] + 0.0;  // + 0.0: no -0, as the file
     for (std::size_t a = 0; a < 3; ++a) {
       w[3 * k + a] = t.omega_BR_B_rad_s[k][static_cast<Eigen::Index>(a)];
       wn[3 * k + a] = t.omega_BN_B_rad_s[k][static_cast<Eigen::Index>(a)];
@@ -80,7 +80,9 @@ void bind_sim(py::module_& m) {
 
   py::class_<PyTruth>(m, "Truth", "The simulated truth, one row per epoch.")
       .def_readonly("time_s", &PyTruth::time_s, "[s] (n,)")
-      .def_readonly("q_RB_wxyz", &PyTruth::q_RB_wxyz, "True attitude body → reference (w, x, y, z), (n, 4).")
+      .def_readonly("q_RB_wxyz", &PyTruth::q_RB_wxyz,
+                    "True attitude body → reference (w, x, y, z), (n, 4), as `tetra sim --truth` writes it: "
+                    "normalized, w ≥ 0.")
       .def_readonly("omega_BR_B_rad_s", &PyTruth::omega_BR_B_rad_s, "[rad/s] rate of B relative to R, in B, (n, 3).")
       .def_readonly("omega_BN_B_rad_s", &PyTruth::omega_BN_B_rad_s, "[rad/s] inertial rate of B, in B, (n, 3).");
   py::class_<SimRun>(m, "SimRun", "A simulated run: the gyro log and the truth.")

@@ -6,6 +6,7 @@ The work is done by tetra's C++ libraries (tetra::core, tetra::fdi, tetra::sim) 
 
 Arrays: float64 C-contiguous arrays are read in place (no copy); any other real dtype or a strided view is
 converted once (one copy). Results are numpy arrays that own the library's memory (no copy either).
+numpy is imported when first needed (``import tetra`` alone does not need it).
 Errors: the library's messages raise ``tetra.BadInputError`` (bad input: a ValueError) or ``tetra.Error``
 (other failures); arguments of the wrong shape or dtype raise ValueError or TypeError naming the argument.
 """
@@ -15,8 +16,6 @@ import json
 import math
 import os
 from typing import Any, Mapping, Optional, Sequence, Union
-
-import numpy as np
 
 from . import _tetra
 from ._tetra import (
@@ -128,6 +127,7 @@ def allan(rate: Any, tau0_s: float, *, present: Any = None, taus: Taus = "defaul
     rate data (``tetra allan``'s analysis). ``rate``: shape (n,) — or (n, k) for k series, giving a list —
     in any unit (the terms come in it); NaN or ``present`` == 0 marks a sample not delivered. ``tau0_s``
     [s]: the sampling interval. ``taus``: 'default', 'octave', 'decade', 'all' or a list of τ [s]."""
+    import numpy as np
     t = _taus(taus)
     arr = np.asarray(rate)
     if arr.ndim == 2:
@@ -192,7 +192,7 @@ def log_frame(log: GyroLog):
     return pd.DataFrame(cols)
 
 
-def _truth_rate_dps(truth: Truth) -> np.ndarray:
+def _truth_rate_dps(truth: Truth):
     return truth.omega_BR_B_rad_s * _RAD_TO_DEG + 0.0  # as the truth file writes it (no -0)
 
 
@@ -244,8 +244,9 @@ class PipelineRun:
         return f"<tetra.PipelineRun epochs={self.epochs} accepted={len(self)} events={len(self.events)}>"
 
     @property
-    def mode_names(self) -> np.ndarray:
-        """The mode of each row as text (NOMINAL, DEGRADED, SUSPECT, LOST)."""
+    def mode_names(self):
+        """The mode of each row as text (NOMINAL, DEGRADED, SUSPECT, LOST), a numpy array."""
+        import numpy as np
         return np.asarray(MODE_NAMES, dtype=object)[self.mode]
 
     def attitude_frame(self):
@@ -303,6 +304,7 @@ class Pipeline:
         """One epoch: ``raw`` (N,) samples [V or deg/s] (NaN: invalid), ``present`` (N,) 0 where no sample
         was delivered, ``reference_wxyz`` (4,) an attitude reference or None. Returns a dict: accepted,
         attitude (a dict, None when the epoch was rejected) and events (list of dicts)."""
+        import numpy as np
         t = np.asarray([time_s], dtype=np.float64)
         r = np.asarray(raw, dtype=np.float64).reshape(1, -1)
         p = None if present is None else np.asarray(present).reshape(1, -1)
