@@ -6,11 +6,12 @@
 #  3. a program built with `pkg-config --cflags --libs tetra` alone compiles, links and runs;
 #  4. when the build has the Python package (TETRA_PYTHON), `import tetra` works from the prefix's
 #     lib/python3/dist-packages and runs the pipeline there.
-#   run.sh SOURCE_DIR BUILD_DIR WORK_DIR
+#   run.sh SOURCE_DIR BUILD_DIR WORK_DIR [PYTHON]    (PYTHON: the interpreter the module was built for)
 set -euo pipefail
 src=${1:?usage: run.sh SOURCE_DIR BUILD_DIR WORK_DIR}
 build=${2:?build dir}
 work=${3:?work dir}
+python=${4:-/usr/bin/python3}
 rm -rf "$work"
 mkdir -p "$work"
 prefix=$work/prefix
@@ -50,7 +51,7 @@ c++ -std=c++20 -O1 "$src/tests/install/pkgconfig.cpp" -o "$work/pkgconfig_consum
 if compgen -G "$build/python/tetra/_tetra*.so" >/dev/null; then
   site=$prefix/lib/python3/dist-packages
   [ -f "$site/tetra/__init__.pyi" ] || { echo "install: no type stubs in $site/tetra" >&2; exit 1; }
-  (cd "$work" && PYTHONPATH=$site python3 -c '
+  (cd "$work" && PYTHONPATH=$site "$python" -c '
 import sys, numpy as np, tetra
 assert tetra.__file__.startswith(sys.argv[1]), tetra.__file__
 cal = tetra.Calibration.seed_unit()
