@@ -28,13 +28,14 @@ out.mkdir(parents=True, exist_ok=True)
 # %% [markdown]
 # ## 1. Calibrate from a turntable log
 # The 16-sequence plan of the seed paper, simulated for the seed's unit (`tetra sim turntable`); the
-# calibration file it gives is what `tetra calibrate` writes.
+# calibration file it gives is what `tetra calibrate` writes. With the unit's noise model (`noise=`) the
+# 1-sigma include its bias instability (docs/calibration.md, "Are the 1σ honest?").
 
 # %%
-turntable = tetra.simulate_turntable(rate_hz=2.0, seed=1)
-calibrated = tetra.calibrate(turntable, method="sixteen")
-cal = calibrated.calibration
 truth_unit = tetra.Calibration.seed_unit()
+turntable = tetra.simulate_turntable(truth_unit, rate_hz=2.0, seed=1)
+calibrated = tetra.calibrate(turntable, method="sixteen", noise=truth_unit)
+cal = calibrated.calibration
 print("scale factor [V/(deg/s)]:", np.round(cal.scale_factor_V_per_dps, 6))
 print("error / 1-sigma:", np.round((cal.scale_factor_V_per_dps - truth_unit.scale_factor_V_per_dps)
                                     / cal.sigma_scale_factor_V_per_dps, 2))
