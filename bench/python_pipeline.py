@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Pipeline.run (the Python package) against `tetra replay` on the same 6-hour 100 Hz log (2.16 M epochs).
 
 Both run the same pipeline over the same epochs in the same run of this script: `tetra replay` reading the
@@ -64,7 +64,8 @@ def main():
     print(f"tetra replay (file in, attitude CSV and events out): {min(replay_s):.2f} s")
     print(f"tetra.read_gyro_log: {read_s:.2f} s")
     print(f"tetra.Pipeline.run (arrays in, arrays out):           {min(run_s):.2f} s")
-    print(f"ratio Pipeline.run / tetra replay: {min(run_s) / min(replay_s):.2f} (target <= 1.2)")
+    print(f"ratio Pipeline.run / tetra replay: {min(run_s) / min(replay_s):.2f} (target <= 1.2); "
+          f"with read_gyro_log: {(read_s + min(run_s)) / min(replay_s):.2f}")
 
 
 if __name__ == "__main__":
