@@ -1,6 +1,6 @@
 # `cpack -G DEB` in the build directory: tetra_VERSION_amd64.deb (the program, man pages, completion, IDL,
 # DDS configuration, examples), tetra-dev_VERSION_amd64.deb (libraries, headers, CMake and pkg-config
-# files) and, with TETRA_PYTHON, python3-tetra_VERSION_amd64.deb (the Python package, docs/python.md).
+# files) and, with the Python package built, python3-tetra_VERSION_amd64.deb (the Python package, docs/python.md).
 # Configure with -DCMAKE_INSTALL_PREFIX=/usr for Debian's paths (docs/install.md).
 set(CPACK_PACKAGE_NAME tetra)
 set(CPACK_PACKAGE_VENDOR "tetra")
@@ -12,7 +12,7 @@ set(CPACK_PACKAGING_INSTALL_PREFIX ${CMAKE_INSTALL_PREFIX})
 set(CPACK_GENERATOR DEB)
 set(CPACK_DEB_COMPONENT_INSTALL ON)
 set(CPACK_COMPONENTS_ALL runtime dev)
-if(TETRA_PYTHON)
+if(TETRA_BUILD_PYTHON)
   list(APPEND CPACK_COMPONENTS_ALL python)
 endif()
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
@@ -20,7 +20,7 @@ set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME tetra)
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME tetra-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
-if(TETRA_PYTHON)
+if(TETRA_BUILD_PYTHON)
   set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-tetra)
   set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
   # The module links the libraries statically; it needs Python and numpy, pandas for its frames.
