@@ -26,7 +26,8 @@ allan::TauSpec tau_spec(const std::variant<std::string, std::vector<double>>& ta
   spec.spacing = allan::TauSpacing::kList;
   spec.list_s = std::get<std::vector<double>>(taus);
   for (const double t : spec.list_s) {
-    if (!std::isfinite(t) || t <= 0.0) throw py::value_error("taus: every averaging time must be a positive number");
+    if (!std::isfinite(t) || t <= 0.0)
+      throw py::value_error("taus: every averaging time must be a positive number");
   }
   return spec;
 }
@@ -96,21 +97,28 @@ void bind_result(py::module_& m) {
       .def_readonly("samples", &allan::AllanResult::samples, "Rate samples on the grid (gaps included).")
       .def_readonly("present_samples", &allan::AllanResult::present_samples, "Samples delivered and finite.")
       .def_property_readonly(
-          "tau_s", [](const allan::AllanResult& r) { return point_column(r, [](const auto& p) { return p.tau_s; }); },
+          "tau_s",
+          [](const allan::AllanResult& r) { return point_column(r, [](const auto& p) { return p.tau_s; }); },
           "[s] averaging times.")
       .def_property_readonly(
-          "adev", [](const allan::AllanResult& r) { return point_column(r, [](const auto& p) { return p.adev; }); },
+          "adev",
+          [](const allan::AllanResult& r) { return point_column(r, [](const auto& p) { return p.adev; }); },
           "Overlapping Allan deviation [rate unit].")
       .def_property_readonly(
           "adev_lo",
-          [](const allan::AllanResult& r) { return point_column(r, [](const auto& p) { return p.adev_lo; }); },
+          [](const allan::AllanResult& r) {
+            return point_column(r, [](const auto& p) { return p.adev_lo; });
+          },
           "Lower confidence bound.")
       .def_property_readonly(
           "adev_hi",
-          [](const allan::AllanResult& r) { return point_column(r, [](const auto& p) { return p.adev_hi; }); },
+          [](const allan::AllanResult& r) {
+            return point_column(r, [](const auto& p) { return p.adev_hi; });
+          },
           "Upper confidence bound.")
       .def_property_readonly(
-          "edf", [](const allan::AllanResult& r) { return point_column(r, [](const auto& p) { return p.edf; }); },
+          "edf",
+          [](const allan::AllanResult& r) { return point_column(r, [](const auto& p) { return p.edf; }); },
           "Equivalent degrees of freedom.")
       .def_property_readonly(
           "terms",
@@ -136,7 +144,8 @@ void bind_result(py::module_& m) {
 void bind_log_allan(py::module_& m) {
   py::class_<allan::GyroAllan>(m, "GyroAllan", "One gyro of a log's analysis.")
       .def_readonly("id", &allan::GyroAllan::id, "1..N")
-      .def_readonly("absent", &allan::GyroAllan::absent, "Samples not delivered (empty cells, missing epochs).")
+      .def_readonly("absent", &allan::GyroAllan::absent,
+                    "Samples not delivered (empty cells, missing epochs).")
       .def_readonly("invalid", &allan::GyroAllan::invalid, "Samples delivered as NaN or infinite.")
       .def_readonly("result", &allan::GyroAllan::result, "Its tetra.AllanResult.");
   py::class_<allan::LogAllan>(m, "LogAllan", "The analysis of a log's gyros, as `tetra allan` makes it.")
@@ -178,7 +187,8 @@ void bind_allan(py::module_& m) {
         const DoubleArray y = doubles(rate, "rate", 0, Finite::kNanAllowed);
         MaskArray p;
         if (!present.is_none()) p = mask(present, "present", y.rows, 0);
-        if (!std::isfinite(tau0_s) || tau0_s <= 0.0) throw py::value_error("tau0_s: must be a positive number");
+        if (!std::isfinite(tau0_s) || tau0_s <= 0.0)
+          throw py::value_error("tau0_s: must be a positive number");
         allan::AllanOptions options;
         options.taus = tau_spec(taus);
         options.confidence = confidence;
@@ -186,7 +196,8 @@ void bind_allan(py::module_& m) {
         {
           py::gil_scoped_release release;
           const std::span<const std::uint8_t> present_span =
-              p.data != nullptr ? std::span<const std::uint8_t>(p.data, y.rows) : std::span<const std::uint8_t>();
+              p.data != nullptr ? std::span<const std::uint8_t>(p.data, y.rows)
+                                : std::span<const std::uint8_t>();
           r = allan::analyze_series(std::span<const double>(y.data, y.rows), present_span, tau0_s, options);
         }
         return take(std::move(r));

@@ -96,7 +96,8 @@ class ArrayTurntableRows final : public TurntableRows {
       throw py::value_error("sequence, inner_deg, outer_deg and g_V: expected one row per time_s (" +
                             std::to_string(n) + ")");
     }
-    if (g_.cols < 3) throw py::value_error("g_V: expected at least 3 gyro columns, got " + std::to_string(g_.cols));
+    if (g_.cols < 3)
+      throw py::value_error("g_V: expected at least 3 gyro columns, got " + std::to_string(g_.cols));
     for (std::size_t r = 0; r < n; ++r) {
       const double q = sequence_.data[r];
       if (q < 1.0 || q != std::floor(q) || q > 1e9)
@@ -160,11 +161,13 @@ double latitude_of(const TurntableRows& rows, const std::optional<double>& latit
   if (latitude_deg) return *latitude_deg;
   const auto text = rows.meta("latitude_deg");
   if (!text) {
-    throw py::value_error(rows.source() +
-                          ": no latitude: give latitude_deg= or a '# latitude_deg=DEG' comment line in the file");
+    throw py::value_error(
+        rows.source() +
+        ": no latitude: give latitude_deg= or a '# latitude_deg=DEG' comment line in the file");
   }
   const auto v = parse_decimal(*text);
-  if (!v) raise(bad_input(rows.source() + ": comment '# latitude_deg=" + *text + "' is not a decimal number"));
+  if (!v)
+    raise(bad_input(rows.source() + ": comment '# latitude_deg=" + *text + "' is not a decimal number"));
   return *v;
 }
 
@@ -175,8 +178,10 @@ struct Calibrated {
 
 Calibrated run_calibration(const TurntableRows& rows, const std::optional<double>& latitude_deg,
                            const std::string& method, const std::string& bias_model,
-                           const std::optional<std::string>& unit, const Calibration* noise, double correlation_s) {
-  CalibrationOptions options = calibration_options(method, bias_model, noise, correlation_s, rows.gyro_count());
+                           const std::optional<std::string>& unit, const Calibration* noise,
+                           double correlation_s) {
+  CalibrationOptions options =
+      calibration_options(method, bias_model, noise, correlation_s, rows.gyro_count());
   const double latitude = latitude_of(rows, latitude_deg);
   options.unit = unit ? *unit : rows.meta("unit").value_or("tetra-1");
   Result<TurntableMotion> motion = bad_input("");
@@ -205,16 +210,19 @@ py::array_t<double> vector(const Eigen::VectorXd& v) {
 }  // namespace
 
 void bind_calibration(py::module_& m) {
-  py::class_<Calibration>(m, "Calibration",
-                          "A gyro package's calibration (docs/interfaces.md §2.3): per gyro a scale factor "
-                          "[V/(deg/s)], a bias [V] and a unit sensing axis in the body frame B, with their 1σ "
-                          "and noise terms when known.")
+  py::class_<Calibration>(
+      m, "Calibration",
+      "A gyro package's calibration (docs/interfaces.md §2.3): per gyro a scale factor "
+      "[V/(deg/s)], a bias [V] and a unit sensing axis in the body frame B, with their 1σ "
+      "and noise terms when known.")
       .def_static(
           "read", [](const std::string& path) { return take(read_calibration(path)); }, "path"_a,
           "Reads a calibration file (YAML). Raises BadInputError naming the file, line and key.")
       .def_static(
           "from_yaml",
-          [](const std::string& text, const std::string& source) { return take(parse_calibration(text, source)); },
+          [](const std::string& text, const std::string& source) {
+            return take(parse_calibration(text, source));
+          },
           "text"_a, "source"_a = "<string>", "Parses calibration YAML; `source` names it in messages.")
       .def_static("from_arrays", &calibration_from_arrays, "scale_factor_V_per_dps"_a, "bias_V"_a, "axes_B"_a,
                   "unit"_a = "tetra-1", "method"_a = "python",
@@ -233,13 +241,17 @@ void bind_calibration(py::module_& m) {
       .def_readwrite("latitude_deg", &Calibration::latitude_deg, "[deg] where it was calibrated, or None.")
       .def_property_readonly("gyro_count", &Calibration::gyro_count, "N, the number of gyros.")
       .def_property_readonly(
-          "scale_factor_V_per_dps", [](const Calibration& c) { return per_gyro(c, [](const auto& g) { return g.scale_factor_V_per_dps; }); },
+          "scale_factor_V_per_dps",
+          [](const Calibration& c) {
+            return per_gyro(c, [](const auto& g) { return g.scale_factor_V_per_dps; });
+          },
           "[V/(deg/s)] scale factors, shape (N,).")
       .def_property_readonly(
           "bias_V", [](const Calibration& c) { return per_gyro(c, [](const auto& g) { return g.bias_V; }); },
           "[V] biases, shape (N,).")
       .def_property_readonly(
-          "axes_B", [](const Calibration& c) { return per_gyro_vec3(c, [](const auto& g) { return g.axis_B; }); },
+          "axes_B",
+          [](const Calibration& c) { return per_gyro_vec3(c, [](const auto& g) { return g.axis_B; }); },
           "Unit sensing axes in B, shape (N, 3).")
       .def_property_readonly(
           "sigma_scale_factor_V_per_dps",
@@ -272,8 +284,8 @@ void bind_calibration(py::module_& m) {
           "Per gyro, its noise terms (dict: quantization_deg, arw_dps_rtHz, bias_instability_dps, "
           "rate_random_walk_dps_per_rts, rate_ramp_dps_per_s; None = not observed), or None.")
       .def("__repr__", [](const Calibration& c) {
-        return "<tetra.Calibration unit='" + c.unit + "' method='" + c.method + "' gyros=" +
-               std::to_string(c.gyro_count()) + ">";
+        return "<tetra.Calibration unit='" + c.unit + "' method='" + c.method +
+               "' gyros=" + std::to_string(c.gyro_count()) + ">";
       });
 
   py::class_<Calibrated>(m, "CalibrationResult", "The outcome of tetra.calibrate.")
@@ -293,7 +305,8 @@ void bind_calibration(py::module_& m) {
           "sequence_sigma_mean_V", [](const Calibrated& r) { return matrix(r.result.sequence_sigma_mean_V); },
           "[V] M×N 1σ of each sequence mean.")
       .def_property_readonly(
-          "latitude_deg", [](const Calibrated& r) { return r.motion.latitude_deg; }, "[deg] the latitude used.")
+          "latitude_deg", [](const Calibrated& r) { return r.motion.latitude_deg; },
+          "[deg] the latitude used.")
       .def_property_readonly(
           "sequences", [](const Calibrated& r) { return r.motion.sequences.size(); },
           "The number of sequences of the rotation plan found in the log.");

@@ -14,9 +14,10 @@ namespace tetra::python {
 using namespace pybind11::literals;
 
 void bind_campaign(py::module_& m) {
-  py::class_<sim::CampaignSpec>(m, "CampaignSpec",
-                                "A campaign's matrix (docs/campaign.md): scenarios × kinds × gyros × onsets × "
-                                "sizes × seeds. Made by tetra.campaign_spec from a file or a dict.")
+  py::class_<sim::CampaignSpec>(
+      m, "CampaignSpec",
+      "A campaign's matrix (docs/campaign.md): scenarios × kinds × gyros × onsets × "
+      "sizes × seeds. Made by tetra.campaign_spec from a file or a dict.")
       .def_property_readonly(
           "runs", [](const sim::CampaignSpec& s) { return take(sim::campaign_run_count(s)); },
           "The number of runs of the matrix.")
@@ -24,11 +25,14 @@ void bind_campaign(py::module_& m) {
           "closed_loop", [](const sim::CampaignSpec& s) { return s.loop == sim::CampaignLoop::kClosed; },
           "True: closed loop (pointing columns filled); False: open loop.")
       .def_property_readonly(
-          "in_process", [](const sim::CampaignSpec& s) { return s.target == sim::CampaignTarget::kInProcess; },
+          "in_process",
+          [](const sim::CampaignSpec& s) { return s.target == sim::CampaignTarget::kInProcess; },
           "True when the spec's target is the pipeline in process (the only target Python runs).")
-      .def_readonly("scenario_paths", &sim::CampaignSpec::scenario_paths, "Scenario files or built-in names.");
+      .def_readonly("scenario_paths", &sim::CampaignSpec::scenario_paths,
+                    "Scenario files or built-in names.");
   m.def(
-      "_read_campaign_spec", [](const std::string& path) { return take(sim::read_campaign_spec(path)); }, "path"_a);
+      "_read_campaign_spec", [](const std::string& path) { return take(sim::read_campaign_spec(path)); },
+      "path"_a);
   m.def(
       "_parse_campaign_spec",
       [](const std::string& text, const std::string& source, const std::string& base_dir) {
@@ -40,7 +44,8 @@ void bind_campaign(py::module_& m) {
       "_campaign_rows",
       [](const sim::CampaignSpec& spec, const std::optional<std::vector<std::size_t>>& runs) {
         if (spec.target != sim::CampaignTarget::kInProcess)
-          throw py::value_error("target: Python runs campaigns in process only (`tetra campaign` runs target dds)");
+          throw py::value_error(
+              "target: Python runs campaigns in process only (`tetra campaign` runs target dds)");
         const std::size_t count = take(sim::campaign_run_count(spec));
         std::vector<std::size_t> indices;
         if (runs) {

@@ -36,15 +36,17 @@ PyGyroLog to_python(GyroLog&& log) {
 }
 
 void bind_logs(py::module_& m) {
-  py::class_<PyGyroLog>(m, "GyroLog",
-                        "A gyro log (docs/interfaces.md §2.2) as numpy arrays: what tetra.read_gyro_log reads "
-                        "and tetra.sim makes, and what Pipeline.run_log replays.")
+  py::class_<PyGyroLog>(
+      m, "GyroLog",
+      "A gyro log (docs/interfaces.md §2.2) as numpy arrays: what tetra.read_gyro_log reads "
+      "and tetra.sim makes, and what Pipeline.run_log replays.")
       .def_readonly("source", &PyGyroLog::source, "File name (or what made the log).")
       .def_readonly("metadata", &PyGyroLog::metadata, "The '# key=value' comment lines, in order.")
       .def_readonly("gyro_count", &PyGyroLog::gyro_count, "N, the gyro columns g1..gN.")
       .def_readonly("units_dps", &PyGyroLog::units_dps, "True: values are rates [deg/s]; False: volts.")
       .def_readonly("time_s", &PyGyroLog::time_s, "[s] epoch times, shape (n,).")
-      .def_readonly("values", &PyGyroLog::values, "[V or deg/s] samples, shape (n, N); NaN where absent or invalid.")
+      .def_readonly("values", &PyGyroLog::values,
+                    "[V or deg/s] samples, shape (n, N); NaN where absent or invalid.")
       .def_readonly("present", &PyGyroLog::present, "uint8 (n, N): 0 where no sample was delivered.")
       .def_readonly("reference_wxyz", &PyGyroLog::reference_wxyz,
                     "Attitude reference body → reference (w, x, y, z), shape (n, 4), NaN on epochs without "
@@ -66,7 +68,8 @@ void bind_logs(py::module_& m) {
         }
         return to_python(take(std::move(log)));
       },
-      "path"_a, "Reads a whole gyro log, CSV or HDF5 (.h5, .hdf5). Raises BadInputError naming file and line.");
+      "path"_a,
+      "Reads a whole gyro log, CSV or HDF5 (.h5, .hdf5). Raises BadInputError naming file and line.");
 }
 
 }  // namespace tetra::python

@@ -51,7 +51,8 @@ struct RunColumns {
     for (int i = 0; i < 3; ++i) sigma_B_deg.push_back(a.sigma_rad[i] * kRadToDeg);
     const bool biases = a.gyro_bias_rad_s.size() == ng;
     for (std::size_t i = 0; i < ng; ++i)
-      bias_dps.push_back(biases ? a.gyro_bias_rad_s[i] * kRadToDeg : std::numeric_limits<double>::quiet_NaN());
+      bias_dps.push_back(biases ? a.gyro_bias_rad_s[i] * kRadToDeg
+                                : std::numeric_limits<double>::quiet_NaN());
     for (int i = 0; i < 3; ++i) pl_deg.push_back(a.protection_level_rad[i] * kRadToDeg);
     mode.push_back(static_cast<std::uint8_t>(a.mode));
     fdi_available.push_back(a.fdi_available ? 1 : 0);
@@ -91,11 +92,12 @@ RunInputs run_inputs(const py::handle& time_s, const py::handle& raw, const py::
   if (!reference_wxyz.is_none()) {
     in.reference = doubles(reference_wxyz, "reference_wxyz", 4, Finite::kNanAllowed);
     if (in.reference.rows != rows) {
-      throw py::value_error("reference_wxyz: expected one row per time_s (" + std::to_string(rows) + "), got " +
-                            std::to_string(in.reference.rows));
+      throw py::value_error("reference_wxyz: expected one row per time_s (" + std::to_string(rows) +
+                            "), got " + std::to_string(in.reference.rows));
     }
     in.has_reference = true;
-    if (!reference_present.is_none()) in.reference_present = mask(reference_present, "reference_present", rows, 0);
+    if (!reference_present.is_none())
+      in.reference_present = mask(reference_present, "reference_present", rows, 0);
   } else if (!reference_present.is_none()) {
     throw py::value_error("reference_present: given without reference_wxyz");
   }
@@ -235,17 +237,21 @@ void bind_pipeline(py::module_& m) {
       .def_property_readonly("config", [](const PyPipeline& p) { return p.config; })
       .def("describe_thresholds", [](const PyPipeline& p) { return p.pipeline.describe_thresholds(); })
       .def("default_noise_warning",
-           [](const PyPipeline& p, const Calibration& cal) { return fdi::default_noise_warning(cal, p.config); })
+           [](const PyPipeline& p, const Calibration& cal) {
+             return fdi::default_noise_warning(cal, p.config);
+           })
       .def("reset", [](PyPipeline& p) { p.pipeline.reset(); })
       .def("health", [](const PyPipeline& p) { return health_dict(p.pipeline.health(), p.n); })
-      .def("exclude",
-           [](PyPipeline& p, int gyro, std::int64_t stamp_ns, bool force) {
-             return event_dict(p.pipeline.exclude(gyro, stamp_ns, force), p.n);
+      .def("exclude", [](PyPipeline& p, int gyro, std::int64_t stamp_ns,
+                         bool force) { return event_dict(p.pipeline.exclude(gyro, stamp_ns, force), p.n); })
+      .def("reinstate",
+           [](PyPipeline& p, int gyro, std::int64_t stamp_ns) {
+             return event_dict(p.pipeline.reinstate(gyro, stamp_ns), p.n);
            })
-      .def("reinstate", [](PyPipeline& p, int gyro,
-                           std::int64_t stamp_ns) { return event_dict(p.pipeline.reinstate(gyro, stamp_ns), p.n); })
       .def("reset_command",
-           [](PyPipeline& p, std::int64_t stamp_ns) { return event_dict(p.pipeline.reset_command(stamp_ns), p.n); })
+           [](PyPipeline& p, std::int64_t stamp_ns) {
+             return event_dict(p.pipeline.reset_command(stamp_ns), p.n);
+           })
       .def(
           "step",
           [](PyPipeline& p, const py::handle& time_s, const py::handle& raw, const py::object& present,
@@ -276,8 +282,9 @@ void bind_pipeline(py::module_& m) {
             return run_result(std::move(columns), p.n);
           },
           "time_s"_a, "raw"_a, "present"_a, "reference_wxyz"_a, "reference_present"_a);
-  m.attr("MODE_NAMES") = py::make_tuple(fdi::to_string(fdi::Mode::kNominal), fdi::to_string(fdi::Mode::kDegraded),
-                                        fdi::to_string(fdi::Mode::kSuspect), fdi::to_string(fdi::Mode::kLost));
+  m.attr("MODE_NAMES") =
+      py::make_tuple(fdi::to_string(fdi::Mode::kNominal), fdi::to_string(fdi::Mode::kDegraded),
+                     fdi::to_string(fdi::Mode::kSuspect), fdi::to_string(fdi::Mode::kLost));
   m.def(
       "_is_view",
       [](const py::handle& array) {

@@ -20,9 +20,9 @@ py::array_t<double> vec3(const Eigen::Vector3d& v) {
 
 // An attitude or truth series from arrays, checked as the file reader checks a file's rows (finite,
 // time increasing, quaternions of norm 1 within 1e-3, which are then normalized; sigma ≥ 0 or NaN).
-AttitudeSeries series_from_arrays(const std::string& source, const py::handle& time_s, const py::handle& q_wxyz,
-                                  const py::handle& rate_dps, const py::object& sigma_deg,
-                                  const py::object& sigma_B_deg) {
+AttitudeSeries series_from_arrays(const std::string& source, const py::handle& time_s,
+                                  const py::handle& q_wxyz, const py::handle& rate_dps,
+                                  const py::object& sigma_deg, const py::object& sigma_B_deg) {
   const DoubleArray t = doubles(time_s, "time_s", 0, Finite::kRequired);
   const DoubleArray q = doubles(q_wxyz, "q_RB_wxyz", 4, Finite::kRequired);
   const DoubleArray w = doubles(rate_dps, "omega_BR_B_dps", 3, Finite::kRequired);
@@ -44,7 +44,8 @@ AttitudeSeries series_from_arrays(const std::string& source, const py::handle& t
   }
   auto check_sigma = [&](double v, const char* name, std::size_t r) {
     if (std::isinf(v) || v < 0.0)
-      throw py::value_error(source + ": " + name + "[" + std::to_string(r) + "]: must be >= 0 (or NaN: not stated)");
+      throw py::value_error(source + ": " + name + "[" + std::to_string(r) +
+                            "]: must be >= 0 (or NaN: not stated)");
   };
   if (!sigma_deg.is_none()) {
     const DoubleArray sg = doubles(sigma_deg, "sigma_deg", 0, Finite::kNanAllowed);
@@ -78,33 +79,44 @@ void bind_score(py::module_& m) {
   m.def("_attitude_series", &series_from_arrays, "source"_a, "time_s"_a, "q_RB_wxyz"_a, "omega_BR_B_dps"_a,
         "sigma_deg"_a, "sigma_B_deg"_a);
 
-  py::class_<AttitudeScore>(m, "AttitudeScore",
-                            "The figures of `tetra score` (docs/score.md); angles in degrees, vectors per body "
-                            "axis x, y, z.")
-      .def_property_readonly("time_s",
-                             [](const AttitudeScore& s) {
-                               std::vector<double> v;
-                               for (const auto& e : s.epochs) v.push_back(e.time_s);
-                               return to_numpy(std::move(v));
-                             }, "[s] the scored attitude rows' times.")
-      .def_property_readonly("error_B_deg",
-                             [](const AttitudeScore& s) {
-                               std::vector<double> v;
-                               for (const auto& e : s.epochs) v.insert(v.end(), {e.error_B_deg.x(), e.error_B_deg.y(), e.error_B_deg.z()});
-                               return to_numpy(std::move(v), s.epochs.size(), 3);
-                             }, "[deg] error e_B per scored row, (m, 3).")
-      .def_property_readonly("sigma_B_deg",
-                             [](const AttitudeScore& s) {
-                               std::vector<double> v;
-                               for (const auto& e : s.epochs) v.insert(v.end(), {e.sigma_B_deg.x(), e.sigma_B_deg.y(), e.sigma_B_deg.z()});
-                               return to_numpy(std::move(v), s.epochs.size(), 3);
-                             }, "[deg] per-axis 1σ per scored row (NaN without per-axis columns), (m, 3).")
-      .def_property_readonly("sigma_deg",
-                             [](const AttitudeScore& s) {
-                               std::vector<double> v;
-                               for (const auto& e : s.epochs) v.push_back(e.sigma_deg);
-                               return to_numpy(std::move(v));
-                             }, "[deg] total 1σ per scored row.")
+  py::class_<AttitudeScore>(
+      m, "AttitudeScore",
+      "The figures of `tetra score` (docs/score.md); angles in degrees, vectors per body "
+      "axis x, y, z.")
+      .def_property_readonly(
+          "time_s",
+          [](const AttitudeScore& s) {
+            std::vector<double> v;
+            for (const auto& e : s.epochs) v.push_back(e.time_s);
+            return to_numpy(std::move(v));
+          },
+          "[s] the scored attitude rows' times.")
+      .def_property_readonly(
+          "error_B_deg",
+          [](const AttitudeScore& s) {
+            std::vector<double> v;
+            for (const auto& e : s.epochs)
+              v.insert(v.end(), {e.error_B_deg.x(), e.error_B_deg.y(), e.error_B_deg.z()});
+            return to_numpy(std::move(v), s.epochs.size(), 3);
+          },
+          "[deg] error e_B per scored row, (m, 3).")
+      .def_property_readonly(
+          "sigma_B_deg",
+          [](const AttitudeScore& s) {
+            std::vector<double> v;
+            for (const auto& e : s.epochs)
+              v.insert(v.end(), {e.sigma_B_deg.x(), e.sigma_B_deg.y(), e.sigma_B_deg.z()});
+            return to_numpy(std::move(v), s.epochs.size(), 3);
+          },
+          "[deg] per-axis 1σ per scored row (NaN without per-axis columns), (m, 3).")
+      .def_property_readonly(
+          "sigma_deg",
+          [](const AttitudeScore& s) {
+            std::vector<double> v;
+            for (const auto& e : s.epochs) v.push_back(e.sigma_deg);
+            return to_numpy(std::move(v));
+          },
+          "[deg] total 1σ per scored row.")
       .def_readonly("exact_matches", &AttitudeScore::exact_matches)
       .def_readonly("interpolated", &AttitudeScore::interpolated)
       .def_readonly("outside_truth", &AttitudeScore::outside_truth)
@@ -118,18 +130,23 @@ void bind_score(py::module_& m) {
       .def_readonly("no_sigma_epochs", &AttitudeScore::no_sigma_epochs)
       .def_readonly("nees_dof", &AttitudeScore::nees_dof)
       .def_readonly("mean_nees", &AttitudeScore::mean_nees)
-      .def_property_readonly("within_B",
-                             [](const AttitudeScore& s) {
-                               std::vector<double> v;
-                               for (const auto& w : s.within_B) v.insert(v.end(), {w.x(), w.y(), w.z()});
-                               return to_numpy(std::move(v), 3, 3);
-                             }, "Fractions within 1, 2, 3σ (rows) per axis (columns); NaN without per-axis σ.")
-      .def_property_readonly("within_total",
-                             [](const AttitudeScore& s) {
-                               return to_numpy(std::vector<double>(s.within_total.begin(), s.within_total.end()));
-                             }, "Fractions of the total angle within 1, 2, 3σ.")
+      .def_property_readonly(
+          "within_B",
+          [](const AttitudeScore& s) {
+            std::vector<double> v;
+            for (const auto& w : s.within_B) v.insert(v.end(), {w.x(), w.y(), w.z()});
+            return to_numpy(std::move(v), 3, 3);
+          },
+          "Fractions within 1, 2, 3σ (rows) per axis (columns); NaN without per-axis σ.")
+      .def_property_readonly(
+          "within_total",
+          [](const AttitudeScore& s) {
+            return to_numpy(std::vector<double>(s.within_total.begin(), s.within_total.end()));
+          },
+          "Fractions of the total angle within 1, 2, 3σ.")
       .def_property_readonly("angle_B_deg", [](const AttitudeScore& s) { return vec3(s.angle_B_deg); })
-      .def_property_readonly("truth_angle_B_deg", [](const AttitudeScore& s) { return vec3(s.truth_angle_B_deg); })
+      .def_property_readonly("truth_angle_B_deg",
+                             [](const AttitudeScore& s) { return vec3(s.truth_angle_B_deg); })
       .def_readonly("angle_axis_deg", &AttitudeScore::angle_axis_deg)
       .def_readonly("truth_angle_axis_deg", &AttitudeScore::truth_angle_axis_deg);
   m.def(

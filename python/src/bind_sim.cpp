@@ -58,7 +58,8 @@ void bind_sim(py::module_& m) {
       .def_readwrite("name", &sim::Scenario::name, "Built-in name or file name.")
       .def_readwrite("duration_s", &sim::Scenario::duration_s, "[s] length of the run.")
       .def_readwrite("rate_hz", &sim::Scenario::rate_hz, "[Hz] gyro sampling rate.")
-      .def_readwrite("unit", &sim::Scenario::unit, "The simulated unit's as-built truth (a tetra.Calibration).")
+      .def_readwrite("unit", &sim::Scenario::unit,
+                     "The simulated unit's as-built truth (a tetra.Calibration).")
       .def_property_readonly(
           "closed_loop", [](const sim::Scenario& s) { return s.closed_loop.has_value(); },
           "True when the scenario has a closed_loop section (campaigns only).")
@@ -68,7 +69,8 @@ void bind_sim(py::module_& m) {
       });
   m.def("builtin_scenarios", &sim::builtin_scenario_names, "Names of the built-in scenarios.");
   m.def(
-      "_builtin_scenario", [](const std::string& name) { return take(sim::builtin_scenario(name)); }, "name"_a);
+      "_builtin_scenario", [](const std::string& name) { return take(sim::builtin_scenario(name)); },
+      "name"_a);
   m.def(
       "_read_scenario", [](const std::string& path) { return take(sim::read_scenario(path)); }, "path"_a);
   m.def(
@@ -83,8 +85,10 @@ void bind_sim(py::module_& m) {
       .def_readonly("q_RB_wxyz", &PyTruth::q_RB_wxyz,
                     "True attitude body → reference (w, x, y, z), (n, 4), as `tetra sim --truth` writes it: "
                     "normalized, w ≥ 0.")
-      .def_readonly("omega_BR_B_rad_s", &PyTruth::omega_BR_B_rad_s, "[rad/s] rate of B relative to R, in B, (n, 3).")
-      .def_readonly("omega_BN_B_rad_s", &PyTruth::omega_BN_B_rad_s, "[rad/s] inertial rate of B, in B, (n, 3).");
+      .def_readonly("omega_BR_B_rad_s", &PyTruth::omega_BR_B_rad_s,
+                    "[rad/s] rate of B relative to R, in B, (n, 3).")
+      .def_readonly("omega_BN_B_rad_s", &PyTruth::omega_BN_B_rad_s,
+                    "[rad/s] inertial rate of B, in B, (n, 3).");
   py::class_<SimRun>(m, "SimRun", "A simulated run: the gyro log and the truth.")
       .def_readonly("log", &SimRun::log, "The gyro log (a tetra.GyroLog, volts).")
       .def_readonly("truth", &SimRun::truth, "The truth (a tetra.Truth).");
@@ -108,8 +112,8 @@ void bind_sim(py::module_& m) {
 
   m.def(
       "_simulate_turntable",
-      [](const Calibration& unit, double table_rate_dps, double revolutions, double rate_hz, double latitude_deg,
-         std::uint64_t seed) {
+      [](const Calibration& unit, double table_rate_dps, double revolutions, double rate_hz,
+         double latitude_deg, std::uint64_t seed) {
         sim::TurntablePlan plan;
         plan.table_rate_dps = table_rate_dps;
         plan.revolutions = revolutions;

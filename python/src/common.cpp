@@ -7,8 +7,8 @@ namespace tetra::python {
 
 namespace {
 
-PyObject* g_error = nullptr;        // tetra.Error
-PyObject* g_bad_input = nullptr;    // tetra.BadInputError
+PyObject* g_error = nullptr;      // tetra.Error
+PyObject* g_bad_input = nullptr;  // tetra.BadInputError
 
 std::string shape_text(const py::array& a) {
   std::string s = "(";
@@ -74,10 +74,11 @@ DoubleArray doubles(const py::handle& obj, const char* name, int cols, Finite fi
     const std::size_t n = out.rows * out.cols;
     for (std::size_t i = 0; i < n; ++i) {
       if (!std::isfinite(out.data[i])) {
-        const std::string where = ndim == 1 ? "[" + std::to_string(i) + "]"
-                                            : "[" + std::to_string(i / out.cols) + ", " +
-                                                  std::to_string(i % out.cols) + "]";
-        throw py::value_error(std::string(name) + where + ": " + (std::isnan(out.data[i]) ? "NaN" : "infinite") +
+        const std::string where =
+            ndim == 1 ? "[" + std::to_string(i) + "]"
+                      : "[" + std::to_string(i / out.cols) + ", " + std::to_string(i % out.cols) + "]";
+        throw py::value_error(std::string(name) + where + ": " +
+                              (std::isnan(out.data[i]) ? "NaN" : "infinite") +
                               " where a finite number is required");
       }
     }
