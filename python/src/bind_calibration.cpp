@@ -314,7 +314,7 @@ void bind_calibration(py::module_& m) {
   m.def(
       "_calibrate_file",
       [](const std::string& path, std::optional<double> latitude_deg, const std::string& method,
-         const std::string& bias_model, std::optional<std::string> unit, const Calibration* noise,
+         const std::string& bias_model, const std::optional<std::string>& unit, const Calibration* noise,
          double correlation_s) {
         TurntableFileRows rows;
         Status opened = ok_status();
@@ -330,7 +330,7 @@ void bind_calibration(py::module_& m) {
       "_calibrate_arrays",
       [](const py::handle& sequence, const py::handle& time_s, const py::handle& inner_deg,
          const py::handle& outer_deg, const py::handle& g_V, double latitude_deg, const std::string& method,
-         const std::string& bias_model, std::optional<std::string> unit, const Calibration* noise,
+         const std::string& bias_model, const std::optional<std::string>& unit, const Calibration* noise,
          double correlation_s) {
         const ArrayTurntableRows rows(sequence, time_s, inner_deg, outer_deg, g_V);
         return run_calibration(rows, latitude_deg, method, bias_model, unit, noise, correlation_s);

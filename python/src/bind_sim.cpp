@@ -94,7 +94,7 @@ void bind_sim(py::module_& m) {
       .def_readonly("truth", &SimRun::truth, "The truth (a tetra.Truth).");
   m.def(
       "_simulate",
-      [](sim::Scenario scenario, std::uint64_t seed) {
+      [](const sim::Scenario& scenario, std::uint64_t seed) {
         sim::SimOptions options;
         options.seed = seed;
         sim::Truth truth;
