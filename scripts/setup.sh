@@ -5,7 +5,8 @@
 #   setup.sh --test   that and what the test suite needs: GoogleTest, Google Benchmark, gnuplot (allan
 #                     --plot), clang (fuzzers), openssl (DDS Security PKI), iproute2 (netns tests), chromium
 #                     and selenium (the ground station's browser test), slurm-wlm and munge (the
-#                     campaign's Slurm test)
+#                     campaign's Slurm test), pybind11 and Python's numpy, pandas, pytest and matplotlib
+#                     (the Python package, its tests and example)
 # As root it runs apt-get; otherwise it prints the exact command to run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,6 +29,8 @@ if [ "${1:-}" = "--test" ]; then
     clang libclang-rt-14-dev openssl iproute2   # reliability tests: fuzzers (clang), DDS Security PKI, netns
     chromium chromium-driver python3-selenium    # the ground station's browser test
     slurm-wlm munge                              # the campaign over a single-node Slurm cluster
+    pybind11-dev python3-dev                     # the Python package tetra (docs/python.md)
+    python3-numpy python3-pandas python3-pytest python3-matplotlib  # its tests and notebook example
   )
 fi
 

@@ -131,17 +131,21 @@ Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const s
   return config;
 }
 
-Result<PipelineConfig> read_pipeline_config(const std::string& path) {
-  auto text = read_input(path, kMaxYamlBytes);
-  if (!text) return text.error();
-  const YamlReader yaml{path};
-  auto loaded = yaml.load(*text);
+Result<PipelineConfig> parse_pipeline_config(const std::string& yaml_text, const std::string& source) {
+  const YamlReader yaml{source};
+  auto loaded = yaml.load(yaml_text);
   if (!loaded) return loaded.error();
   const YAML::Node root = *loaded;
   if (!root || root.IsNull()) return PipelineConfig{};
-  if (!root.IsMap()) return bad_input(path + ": expected a mapping with a 'pipeline:' key");
+  if (!root.IsMap()) return bad_input(source + ": expected a mapping with a 'pipeline:' key");
   if (Status st = yaml.check_keys(root, {"pipeline"}, ""); !st) return st.error();
-  return pipeline_config_from_yaml(root["pipeline"], path);
+  return pipeline_config_from_yaml(root["pipeline"], source);
+}
+
+Result<PipelineConfig> read_pipeline_config(const std::string& path) {
+  auto text = read_input(path, kMaxYamlBytes);
+  if (!text) return text.error();
+  return parse_pipeline_config(*text, path);
 }
 
 Status validate(const PipelineConfig& c) {

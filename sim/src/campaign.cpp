@@ -328,16 +328,22 @@ std::string num_text(double v) {
 }  // namespace
 
 Result<CampaignSpec> read_campaign_spec(const std::string& path) {
-  const YamlReader yaml{path};
   auto text = read_input(path, kMaxYamlBytes);
   if (!text) return text.error();
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  return parse_campaign_spec(*text, path, parent.empty() ? "." : parent.string());
+}
+
+Result<CampaignSpec> parse_campaign_spec(const std::string& yaml_text, const std::string& source,
+                                         const std::string& base_dir) {
+  const std::string& path = source;
+  const YamlReader yaml{path};
   try {
-    auto loaded = yaml.load(*text);
+    auto loaded = yaml.load(yaml_text);
     if (!loaded) return loaded.error();
     const YAML::Node root = *loaded;
     if (!root || !root.IsMap()) return bad_input(path + ": expected a mapping (docs/campaign.md)");
-    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-    auto spec = parse_spec(root, yaml, parent.empty() ? "." : parent.string());
+    auto spec = parse_spec(root, yaml, base_dir);
     if (!spec) return spec.error();
     // The size first: a small spec may describe an enormous matrix, refused before any other work.
     if (auto runs = campaign_run_count(*spec); !runs) return bad_input(path + ": " + runs.error().message);

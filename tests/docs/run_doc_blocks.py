@@ -18,9 +18,10 @@ before a block may adjust how it runs (the reader does not see it):
 The blocks of one document run in order in one temporary folder (a later block may use an earlier one's
 files). The folder holds links to the repository's examples/, config/, scripts/, bench/, web/ and the
 build folder, so the paths the docs show work; `tetra` on PATH is the program built, and `build/tetra`
-is it too. A block fails on a non-zero exit status (bash -e, pipefail) or when a file it names as an
-output (-o, --out, --truth, --attitude, --events, --json, --plot, --summary, --pointing, --write-unit,
---kalibr, or an expect directive) is missing afterwards. Processes a block leaves in the
+is it too; `build/python` is the Python package built beside it (when it is). A block fails on a
+non-zero exit status (bash -e, pipefail) or when a file it names as an output (-o, --out, --truth,
+--attitude, --events, --json, --plot, --summary, --pointing, --write-unit, --kalibr, or an expect
+directive) is missing afterwards. Processes a block leaves in the
 background are stopped at its end.
 
 Usage: run_doc_blocks.py --tetra BUILD/tetra --source REPO [--domain-base N] [--only FILE] [--list]
@@ -193,6 +194,9 @@ def main():
                 os.symlink(os.path.join(source, name), os.path.join(folder, name))
         os.makedirs(os.path.join(folder, "build"))
         os.symlink(tetra, os.path.join(folder, "build", "tetra"))
+        python_package = os.path.join(os.path.dirname(tetra), "python")  # build/python (docs/python.md)
+        if os.path.isdir(python_package):
+            os.symlink(python_package, os.path.join(folder, "build", "python"))
         for block in blocks:
             label = block.name(source)
             if block.skip:

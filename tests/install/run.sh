@@ -3,12 +3,15 @@
 #  1. the installed program runs, its man pages (one per command), bash completion and web application
 #     are in place, and `tetra ground` finds the web application beside itself;
 #  2. tests/install (find_package(tetra), tetra::core/fdi/sim) configures, builds and runs against it;
-#  3. a program built with `pkg-config --cflags --libs tetra` alone compiles, links and runs.
-#   run.sh SOURCE_DIR BUILD_DIR WORK_DIR
+#  3. a program built with `pkg-config --cflags --libs tetra` alone compiles, links and runs;
+#  4. when the build has the Python package (TETRA_PYTHON), `import tetra` works from the prefix's
+#     lib/python3/dist-packages and runs the pipeline there.
+#   run.sh SOURCE_DIR BUILD_DIR WORK_DIR [PYTHON]    (PYTHON: the interpreter the module was built for)
 set -euo pipefail
 src=${1:?usage: run.sh SOURCE_DIR BUILD_DIR WORK_DIR}
 build=${2:?build dir}
 work=${3:?work dir}
+python=${4:-/usr/bin/python3}
 rm -rf "$work"
 mkdir -p "$work"
 prefix=$work/prefix
@@ -45,4 +48,15 @@ flags=$(PKG_CONFIG_PATH=$pc_dir pkg-config --cflags --libs tetra)
 # shellcheck disable=SC2086  # the flags are words
 c++ -std=c++20 -O1 "$src/tests/install/pkgconfig.cpp" -o "$work/pkgconfig_consumer" $flags
 "$work/pkgconfig_consumer"
+if compgen -G "$build/python/tetra/_tetra*.so" >/dev/null; then
+  site=$prefix/lib/python3/dist-packages
+  [ -f "$site/tetra/__init__.pyi" ] || { echo "install: no type stubs in $site/tetra" >&2; exit 1; }
+  (cd "$work" && PYTHONPATH=$site "$python" -c '
+import sys, numpy as np, tetra
+assert tetra.__file__.startswith(sys.argv[1]), tetra.__file__
+cal = tetra.Calibration.seed_unit()
+run = tetra.Pipeline(cal).run(np.arange(10) * 0.1, np.tile(cal.bias_V, (10, 1)))
+assert len(run) == 10
+' "$site") || { echo "install: import tetra from $site failed" >&2; exit 1; }
+fi
 echo "install: PASS ($prefix)"

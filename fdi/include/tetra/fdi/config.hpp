@@ -102,6 +102,8 @@ Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const s
 //! Reads a YAML file whose top level holds a `pipeline:` map (other top-level keys are ignored,
 //! so one file can configure the DDS service too).
 Result<PipelineConfig> read_pipeline_config(const std::string& path);
+//! The same from YAML text (e.g. a Python dict as JSON); `source` names it in messages.
+Result<PipelineConfig> parse_pipeline_config(const std::string& yaml_text, const std::string& source);
 //! Validates ranges; error names the field.
 Status validate(const PipelineConfig& config);
 //! Multi-line "key: value" echo of every field, for start-up logs.

@@ -62,6 +62,10 @@ struct CampaignSpec {
 //! every case is known to be able to run (each scenario with the pipeline, each onset before the end,
 //! each kind on each gyro) before anything runs.
 Result<CampaignSpec> read_campaign_spec(const std::string& path);
+//! The same from YAML text (e.g. a Python dict as JSON): `source` names it in messages, `base_dir` resolves
+//! the scenario files it names.
+Result<CampaignSpec> parse_campaign_spec(const std::string& yaml_text, const std::string& source,
+                                         const std::string& base_dir);
 
 //! One case of the matrix. No fault: a fault-free run.
 struct CampaignCase {

@@ -1,0 +1,421 @@
+"""tetra from Python: calibration, Allan analysis, simulation, the fusion and fault-detection pipeline,
+scoring and fault-injection campaigns of redundant gyro packages (docs/python.md).
+
+The work is done by tetra's C++ libraries (tetra::core, tetra::fdi, tetra::sim) through the module
+``tetra._tetra``; this package adds the Python conveniences (paths or arrays or dicts in, pandas frames out).
+
+Arrays: float64 C-contiguous arrays are read in place (no copy); any other real dtype or a strided view is
+converted once (one copy). Results are numpy arrays that own the library's memory (no copy either).
+numpy is imported when first needed (``import tetra`` alone does not need it).
+Errors: the library's messages raise ``tetra.BadInputError`` (bad input: a ValueError) or ``tetra.Error``
+(other failures); arguments of the wrong shape or dtype raise ValueError or TypeError naming the argument.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+from typing import Any, Mapping, Optional, Sequence, Union
+
+from . import _tetra
+from ._tetra import (
+    MODE_NAMES,
+    ONE_SIGMA_CONFIDENCE,
+    AllanResult,
+    AttitudeScore,
+    BadInputError,
+    Calibration,
+    CalibrationResult,
+    CampaignSpec,
+    Error,
+    GyroAllan,
+    GyroLog,
+    LogAllan,
+    NoiseFit,
+    PipelineConfig,
+    Scenario,
+    SimRun,
+    Truth,
+    builtin_scenarios,
+    read_gyro_log,
+)
+
+__version__ = _tetra.__version__
+
+__all__ = [
+    "AllanResult", "AttitudeScore", "BadInputError", "Calibration", "CalibrationResult", "CampaignResult",
+    "CampaignSpec", "Error", "GyroAllan", "GyroLog", "LogAllan", "MODE_NAMES", "NoiseFit", "ONE_SIGMA_CONFIDENCE",
+    "Pipeline", "PipelineConfig", "PipelineRun", "Scenario", "SimRun", "Truth", "allan", "allan_log",
+    "builtin_scenarios", "calibrate", "campaign", "campaign_spec", "log_frame", "pipeline_config",
+    "read_gyro_log", "scenario", "score", "sim", "simulate_turntable", "truth_frame",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+_RAD_TO_DEG = 180.0 / math.pi  # the libraries' kRadToDeg: the same double
+
+
+def _is_path(value: Any) -> bool:
+    return isinstance(value, (str, os.PathLike))
+
+
+def _yaml_text(mapping: Mapping[str, Any], what: str) -> str:
+    """A dict as YAML text (JSON is YAML): the library reads it as it reads a file."""
+    try:
+        return json.dumps(mapping, allow_nan=False)
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"{what}: the dict must hold only numbers, text, lists and dicts ({e})") from None
+
+
+# --- calibration ------------------------------------------------------------------------------------
+
+_TURNTABLE_KEYS = ("sequence", "time_s", "inner_deg", "outer_deg", "g_V")
+
+
+def calibrate(turntable: Union[PathLike, Mapping[str, Any]], *, latitude_deg: Optional[float] = None,
+              method: str = "sixteen", bias_model: str = "body", unit: Optional[str] = None,
+              noise: Optional[Calibration] = None,
+              bias_instability_correlation_s: float = 100.0) -> CalibrationResult:
+    """Turntable calibration (``tetra calibrate``): scale factor, bias and axis of every gyro with their 1σ.
+
+    ``turntable`` is a turntable log file (docs/interfaces.md §2.1; read a block at a time, as the command
+    reads it) or a mapping of arrays ``sequence`` (n,), ``time_s`` (n,), ``inner_deg`` (n,), ``outer_deg``
+    (n,) and ``g_V`` (n, N), read in place when float64 C-contiguous. ``latitude_deg`` [deg] defaults to the
+    file's ``# latitude_deg=`` comment (required with arrays). ``method``: 'sixteen' or 'batch';
+    ``bias_model``: 'body' or 'seed' (sixteen only). ``noise``: a calibration whose gyros carry ``noise:``
+    sections, for honest 1σ. The GIL is released while the library works.
+    """
+    if _is_path(turntable):
+        return _tetra._calibrate_file(os.fspath(turntable), latitude_deg, method, bias_model, unit, noise,
+                                      bias_instability_correlation_s)
+    if not isinstance(turntable, Mapping):
+        raise TypeError("turntable: expected a file name or a mapping of arrays " + ", ".join(_TURNTABLE_KEYS))
+    missing = [k for k in _TURNTABLE_KEYS if k not in turntable]
+    if missing:
+        raise ValueError("turntable: missing arrays " + ", ".join(missing))
+    if latitude_deg is None:
+        latitude_deg = turntable.get("latitude_deg")
+    if latitude_deg is None:
+        raise ValueError("latitude_deg: required with arrays (the latitude of the turntable [deg])")
+    return _tetra._calibrate_arrays(*(turntable[k] for k in _TURNTABLE_KEYS), float(latitude_deg), method,
+                                    bias_model, unit, noise, bias_instability_correlation_s)
+
+
+def simulate_turntable(unit: Optional[Calibration] = None, *, table_rate_dps: float = 6.0,
+                       revolutions: float = 1.0, rate_hz: float = 10.0, latitude_deg: float = -23.2,
+                       seed: int = 1) -> dict:
+    """The 16-sequence rotation plan of seed Table 3 simulated (``tetra sim turntable``) for ``unit`` (the
+    seed's unit as built by default): a dict of arrays ``sequence``, ``time_s``, ``inner_deg``,
+    ``outer_deg``, ``g_V`` (n, N), with ``latitude_deg``, ``metadata`` and ``text`` (the log file's text)."""
+    d = _tetra._simulate_turntable(unit if unit is not None else Calibration.seed_unit(), table_rate_dps,
+                                   revolutions, rate_hz, latitude_deg, seed)
+    d["latitude_deg"] = latitude_deg
+    return d
+
+
+# --- Allan ------------------------------------------------------------------------------------------
+
+Taus = Union[str, Sequence[float]]
+
+
+def _taus(taus: Taus) -> Union[str, list]:
+    return taus if isinstance(taus, str) else [float(t) for t in taus]
+
+
+def allan(rate: Any, tau0_s: float, *, present: Any = None, taus: Taus = "default",
+          confidence: float = ONE_SIGMA_CONFIDENCE) -> Union[AllanResult, list]:
+    """Overlapping Allan deviation, confidence intervals and the IEEE 952 noise terms of uniformly sampled
+    rate data (``tetra allan``'s analysis). ``rate``: shape (n,) — or (n, k) for k series, giving a list —
+    in any unit (the terms come in it); NaN or ``present`` == 0 marks a sample not delivered. ``tau0_s``
+    [s]: the sampling interval. ``taus``: 'default', 'octave', 'decade', 'all' or a list of τ [s]."""
+    import numpy as np
+    t = _taus(taus)
+    arr = np.asarray(rate)
+    if arr.ndim == 2:
+        pres = None if present is None else np.asarray(present)
+        return [_tetra._allan_series(np.ascontiguousarray(arr[:, j], dtype=np.float64), tau0_s,
+                                     None if pres is None else np.ascontiguousarray(pres[:, j]), t, confidence)
+                for j in range(arr.shape[1])]
+    return _tetra._allan_series(rate, tau0_s, present, t, confidence)
+
+
+def allan_log(path: PathLike, *, calibration: Optional[Calibration] = None,
+              gyros: Sequence[int] = (), taus: Taus = "default", confidence: float = ONE_SIGMA_CONFIDENCE,
+              dt_tolerance: float = 0.05) -> LogAllan:
+    """``tetra allan`` on a gyro log file (CSV or HDF5): every gyro (or ``gyros``), volts turned into deg/s
+    with ``calibration``. ``LogAllan.to_csv()``/``to_json()`` give the command's files."""
+    return _tetra._allan_log(os.fspath(path), calibration, list(gyros), _taus(taus), confidence, dt_tolerance)
+
+
+# --- simulation -------------------------------------------------------------------------------------
+
+def scenario(spec: Union[str, PathLike, Mapping[str, Any], Scenario], *, duration_s: Optional[float] = None,
+             rate_hz: Optional[float] = None, base_dir: Optional[PathLike] = None) -> Scenario:
+    """A scenario (docs/sim.md): a built-in name (``builtin_scenarios()``), a YAML file, or a dict with the
+    file's keys (``unit:`` paths resolved against ``base_dir``, the working directory by default)."""
+    if isinstance(spec, Scenario):
+        sc = spec
+    elif isinstance(spec, Mapping):
+        sc = _tetra._parse_scenario(_yaml_text(spec, "scenario"), "scenario dict",
+                                    os.fspath(base_dir) if base_dir is not None else os.getcwd())
+    elif isinstance(spec, str) and spec in builtin_scenarios():
+        sc = _tetra._builtin_scenario(spec)
+    elif _is_path(spec):
+        sc = _tetra._read_scenario(os.fspath(spec))
+    else:
+        raise TypeError("scenario: expected a built-in name, a file name, a dict or a tetra.Scenario")
+    if duration_s is not None:
+        sc.duration_s = float(duration_s)
+    if rate_hz is not None:
+        sc.rate_hz = float(rate_hz)
+    return sc
+
+
+def sim(spec: Union[str, PathLike, Mapping[str, Any], Scenario], *, seed: int = 1,
+        duration_s: Optional[float] = None, rate_hz: Optional[float] = None) -> SimRun:
+    """Simulates a scenario (``tetra sim``): its gyro log (``.log``, a GyroLog in volts, with reference
+    columns when the scenario has a reference) and its truth (``.truth``), as numpy arrays; the same seed
+    gives the same numbers, bit for bit, as ``tetra sim``'s files. ``log_frame``/``truth_frame`` make
+    pandas frames of them."""
+    return _tetra._simulate(scenario(spec, duration_s=duration_s, rate_hz=rate_hz), seed)
+
+
+def log_frame(log: GyroLog):
+    """A gyro log as a pandas DataFrame: time_s, g1..gN (NaN where absent), and qw, qx, qy, qz of the
+    reference (NaN where none) when the log has one."""
+    import pandas as pd
+    cols = {"time_s": log.time_s}
+    for i in range(log.gyro_count):
+        cols[f"g{i + 1}"] = log.values[:, i]
+    if log.reference_wxyz is not None:
+        for j, name in enumerate(("ref_qw", "ref_qx", "ref_qy", "ref_qz")):
+            cols[name] = log.reference_wxyz[:, j]
+    return pd.DataFrame(cols)
+
+
+def _truth_rate_dps(truth: Truth):
+    return truth.omega_BR_B_rad_s * _RAD_TO_DEG + 0.0  # as the truth file writes it (no -0)
+
+
+def truth_frame(truth: Truth):
+    """The truth as a pandas DataFrame with the columns of ``tetra sim --truth``:
+    time_s, qw, qx, qy, qz, wx_dps, wy_dps, wz_dps."""
+    import pandas as pd
+    w = _truth_rate_dps(truth)
+    q = truth.q_RB_wxyz
+    return pd.DataFrame({"time_s": truth.time_s, "qw": q[:, 0], "qx": q[:, 1], "qy": q[:, 2], "qz": q[:, 3],
+                         "wx_dps": w[:, 0], "wy_dps": w[:, 1], "wz_dps": w[:, 2]})
+
+
+# --- the pipeline -----------------------------------------------------------------------------------
+
+def pipeline_config(config: Union[None, PathLike, Mapping[str, Any], PipelineConfig] = None) -> PipelineConfig:
+    """The pipeline's configuration (docs/fdi.md): defaults (None), a YAML file with a ``pipeline:`` map, a
+    dict of that map's keys (e.g. ``{"latitude_deg": 45.0}``), or a PipelineConfig."""
+    if config is None:
+        return PipelineConfig()
+    if isinstance(config, PipelineConfig):
+        return config
+    if isinstance(config, Mapping):
+        return _tetra._parse_pipeline_config(_yaml_text({"pipeline": dict(config)}, "config"), "config dict")
+    if _is_path(config):
+        return _tetra._read_pipeline_config(os.fspath(config))
+    raise TypeError("config: expected None, a file name, a dict or a tetra.PipelineConfig")
+
+
+class PipelineRun:
+    """What ``Pipeline.run`` made of the epochs: one row per accepted epoch, in the units and with the
+    arithmetic of ``tetra replay --attitude`` (equal to that file's numbers to the last bit), and the events.
+
+    Arrays: ``time_s`` (m,), ``q_RB_wxyz`` (m, 4), ``omega_BR_B_dps`` (m, 3), ``sigma_deg`` (m,) (1σ of the
+    total angle), ``sigma_B_deg`` (m, 3), ``bias_dps`` (m, N), ``protection_level_B_deg`` (m, 3), ``mode``
+    (m,) uint8 indices into ``MODE_NAMES``, ``gyros`` (m,) uint32 masks (bit i−1: gyro i used),
+    ``fdi_available`` (m,) uint8. ``events``: dicts (type, gyro, test, ..., json: the line of
+    ``tetra replay --events``). ``epochs``: epochs given.
+    """
+
+    def __init__(self, d: dict, gyro_count: int):
+        self.__dict__.update(d)
+        self.gyro_count = gyro_count
+
+    def __len__(self) -> int:
+        return len(self.time_s)
+
+    def __repr__(self) -> str:
+        return f"<tetra.PipelineRun epochs={self.epochs} accepted={len(self)} events={len(self.events)}>"
+
+    @property
+    def mode_names(self):
+        """The mode of each row as text (NOMINAL, DEGRADED, SUSPECT, LOST), a numpy array."""
+        import numpy as np
+        return np.asarray(MODE_NAMES, dtype=object)[self.mode]
+
+    def attitude_frame(self):
+        """The rows as a pandas DataFrame with the columns of ``tetra replay --attitude`` (the gyros used as
+        the mask ``gyros_mask``)."""
+        import pandas as pd
+        cols = {"time_s": self.time_s}
+        for j, name in enumerate(("qw", "qx", "qy", "qz")):
+            cols[name] = self.q_RB_wxyz[:, j]
+        for j, name in enumerate(("wx_dps", "wy_dps", "wz_dps")):
+            cols[name] = self.omega_BR_B_dps[:, j]
+        cols["sigma_deg"] = self.sigma_deg
+        cols["mode"] = self.mode_names
+        cols["gyros_mask"] = self.gyros
+        for j, name in enumerate(("sigma_x_deg", "sigma_y_deg", "sigma_z_deg")):
+            cols[name] = self.sigma_B_deg[:, j]
+        for i in range(self.gyro_count):
+            cols[f"bias_{i + 1}_dps"] = self.bias_dps[:, i]
+        for j, name in enumerate(("pl_x_deg", "pl_y_deg", "pl_z_deg")):
+            cols[name] = self.protection_level_B_deg[:, j]
+        return pd.DataFrame(cols)
+
+    def events_frame(self):
+        """The events as a pandas DataFrame (one row per event; columns as the event dicts' keys)."""
+        import pandas as pd
+        return pd.DataFrame(self.events, columns=["stamp_ns", "time_s", "type", "gyro", "test", "statistic",
+                                                  "kind", "evidence", "gyros", "command", "outcome", "why",
+                                                  "detail", "json"])
+
+
+class Pipeline:
+    """The fusion and fault-detection pipeline (docs/fdi.md), the object ``tetra replay`` and the
+    ``tetra fusion`` service run: raw gyro epochs in; attitude, 1σ, mode and FDI events out.
+
+    ``calibration``: a Calibration (or a file name); ``config``: see ``pipeline_config``; ``units_dps``: the
+    samples are rates [deg/s] (a log with ``# units=dps``) rather than volts.
+    """
+
+    def __init__(self, calibration: Union[Calibration, PathLike],
+                 config: Union[None, PathLike, Mapping[str, Any], PipelineConfig] = None, *,
+                 units_dps: bool = False):
+        self.calibration = calibration if isinstance(calibration, Calibration) else Calibration.read(
+            os.fspath(calibration))
+        self._p = _tetra._Pipeline(self.calibration, pipeline_config(config), units_dps)
+
+    @property
+    def gyro_count(self) -> int:
+        return self._p.gyro_count
+
+    @property
+    def config(self) -> PipelineConfig:
+        return self._p.config
+
+    def step(self, time_s: float, raw: Any, present: Any = None, reference_wxyz: Any = None) -> dict:
+        """One epoch: ``raw`` (N,) samples [V or deg/s] (NaN: invalid), ``present`` (N,) 0 where no sample
+        was delivered, ``reference_wxyz`` (4,) an attitude reference or None. Returns a dict: accepted,
+        attitude (a dict, None when the epoch was rejected) and events (list of dicts)."""
+        import numpy as np
+        t = np.asarray([time_s], dtype=np.float64)
+        r = np.asarray(raw, dtype=np.float64).reshape(1, -1)
+        p = None if present is None else np.asarray(present).reshape(1, -1)
+        q = None if reference_wxyz is None else np.asarray(reference_wxyz, dtype=np.float64).reshape(1, -1)
+        return self._p.step(t, r, p, q)
+
+    def run(self, time_s: Any, raw: Any, present: Any = None, reference_wxyz: Any = None,
+            reference_present: Any = None) -> PipelineRun:
+        """Every epoch in C++ (no Python per epoch; the GIL released): ``time_s`` (n,), ``raw`` (n, N),
+        ``present`` (n, N) or None (all delivered), ``reference_wxyz`` (n, 4) with NaN rows where there is
+        no reference (or ``reference_present`` (n,)). float64 C-contiguous arrays are read in place."""
+        return PipelineRun(self._p.run(time_s, raw, present, reference_wxyz, reference_present), self.gyro_count)
+
+    def run_log(self, log: GyroLog) -> PipelineRun:
+        """``run`` over a GyroLog (``read_gyro_log``, ``sim(...).log``), as ``tetra replay`` runs a file."""
+        return self.run(log.time_s, log.values, log.present, log.reference_wxyz, log.reference_present)
+
+    def reset(self) -> None:
+        """Back to the initial state (all gyros reinstated, the configured initial attitude)."""
+        self._p.reset()
+
+    def health(self) -> dict:
+        """Mode, gyros used, per-gyro state, detector statistics and the counters."""
+        return self._p.health()
+
+    def exclude(self, gyro: int, stamp_ns: int, force: bool = False) -> dict:
+        """Operator command: leave gyro out; returns the acknowledgement event."""
+        return self._p.exclude(gyro, stamp_ns, force)
+
+    def reinstate(self, gyro: int, stamp_ns: int) -> dict:
+        """Operator command: use an excluded gyro again; returns the acknowledgement event."""
+        return self._p.reinstate(gyro, stamp_ns)
+
+    def reset_command(self, stamp_ns: int) -> dict:
+        """Operator command: reset; returns the acknowledgement event."""
+        return self._p.reset_command(stamp_ns)
+
+    def describe_thresholds(self) -> str:
+        """The thresholds derived from the configuration and the calibration (``tetra replay -v``)."""
+        return self._p.describe_thresholds()
+
+
+# --- score ------------------------------------------------------------------------------------------
+
+def _series(value: Any, with_sigma: bool, what: str):
+    if _is_path(value):
+        return _tetra._read_attitude_series(os.fspath(value), with_sigma)
+    if isinstance(value, PipelineRun):
+        return _tetra._attitude_series(what, value.time_s, value.q_RB_wxyz, value.omega_BR_B_dps,
+                                       value.sigma_deg, value.sigma_B_deg)
+    if isinstance(value, SimRun):
+        value = value.truth
+    if isinstance(value, Truth):
+        return _tetra._attitude_series(what, value.time_s, value.q_RB_wxyz, _truth_rate_dps(value), None, None)
+    if isinstance(value, Mapping):
+        return _tetra._attitude_series(what, value["time_s"], value["q_RB_wxyz"], value["omega_BR_B_dps"],
+                                       value.get("sigma_deg") if with_sigma else None,
+                                       value.get("sigma_B_deg") if with_sigma else None)
+    raise TypeError(f"{what}: expected a file name, a PipelineRun, a Truth/SimRun or a mapping of arrays")
+
+
+def score(attitude: Any, truth: Any, *, time_tolerance_s: float = 1e-6,
+          axis_B: Sequence[float] = (0.0, 1.0, 0.0)) -> AttitudeScore:
+    """``tetra score``: an attitude estimate (a ``tetra replay --attitude`` file, a PipelineRun, or a mapping
+    of time_s, q_RB_wxyz, omega_BR_B_dps, sigma_deg[, sigma_B_deg]) against the truth (a ``tetra sim
+    --truth`` file, a Truth or SimRun, or a mapping of time_s, q_RB_wxyz, omega_BR_B_dps)."""
+    return _tetra._score(_series(attitude, True, "attitude"), _series(truth, False, "truth"),
+                         float(time_tolerance_s), [float(a) for a in axis_B])
+
+
+# --- campaigns --------------------------------------------------------------------------------------
+
+def campaign_spec(spec: Union[PathLike, Mapping[str, Any], CampaignSpec], *,
+                  base_dir: Optional[PathLike] = None) -> CampaignSpec:
+    """A campaign spec (docs/campaign.md) from a YAML file or a dict with the file's keys (scenario files
+    resolved against ``base_dir``, the working directory by default); checked whole before anything runs."""
+    if isinstance(spec, CampaignSpec):
+        return spec
+    if isinstance(spec, Mapping):
+        return _tetra._parse_campaign_spec(_yaml_text(spec, "spec"), "campaign dict",
+                                           os.fspath(base_dir) if base_dir is not None else os.getcwd())
+    if _is_path(spec):
+        return _tetra._read_campaign_spec(os.fspath(spec))
+    raise TypeError("spec: expected a file name, a dict or a tetra.CampaignSpec")
+
+
+class CampaignResult:
+    """The rows of a campaign: ``rows`` (a pandas DataFrame with the columns of runs.csv) and ``csv`` (the
+    text of runs.csv for these runs, byte for byte what ``tetra campaign`` writes, in run order)."""
+
+    def __init__(self, csv: str):
+        import io
+
+        import pandas as pd
+        self.csv = csv
+        # round_trip: the rows' shortest round-trip numbers read back to the same doubles
+        self.rows = pd.read_csv(io.StringIO(csv), float_precision="round_trip",
+                                dtype={"scenario": str, "kind": str, "outcome": str})
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def __repr__(self) -> str:
+        return f"<tetra.CampaignResult runs={len(self.rows)}>"
+
+
+def campaign(spec: Union[PathLike, Mapping[str, Any], CampaignSpec], *, runs: Optional[Sequence[int]] = None,
+             base_dir: Optional[PathLike] = None) -> CampaignResult:
+    """Runs a campaign in process (``tetra campaign`` with ``target: in_process``), one run after the other
+    with the GIL released: every run of the matrix, or the run ids ``runs``. The report and its plots are
+    ``tetra campaign``'s."""
+    s = campaign_spec(spec, base_dir=base_dir)
+    lines = _tetra._campaign_rows(s, None if runs is None else [int(r) for r in runs])
+    return CampaignResult(_tetra._campaign_csv_header() + "\n" + "".join(line + "\n" for line in lines))
