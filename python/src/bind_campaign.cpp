@@ -39,7 +39,9 @@ void bind_campaign(py::module_& m) {
         return take(sim::parse_campaign_spec(text, source, base_dir));
       },
       "text"_a, "source"_a, "base_dir"_a);
-  m.def("_campaign_csv_header", &sim::campaign_csv_header);
+  m.def(
+      "_campaign_csv_header", [](const sim::CampaignSpec& spec) { return sim::campaign_csv_header(spec); },
+      "spec"_a);
   m.def(
       "_campaign_rows",
       [](const sim::CampaignSpec& spec, const std::optional<std::vector<std::size_t>>& runs) {

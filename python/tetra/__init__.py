@@ -418,4 +418,4 @@ def campaign(spec: Union[PathLike, Mapping[str, Any], CampaignSpec], *, runs: Op
     ``tetra campaign``'s."""
     s = campaign_spec(spec, base_dir=base_dir)
     lines = _tetra._campaign_rows(s, None if runs is None else [int(r) for r in runs])
-    return CampaignResult(_tetra._campaign_csv_header() + "\n" + "".join(line + "\n" for line in lines))
+    return CampaignResult(_tetra._campaign_csv_header(s) + "\n" + "".join(line + "\n" for line in lines))
