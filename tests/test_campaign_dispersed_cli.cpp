@@ -60,7 +60,8 @@ TEST(CampaignDispersedCli, RowsCarryTheDrawsAndTheReportJudgesTheRequirements) {
   // The same folder with another parameter dispersed: other columns, refused; runs.csv untouched.
   const std::string before = read_file(dir.file("b") + "/runs.csv");
   write_file(dir.file("spec.yaml"), dispersed_spec("{uniform: [0.5, 2]}\n  unit.bias_V: calibration"));
-  const auto other = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + dir.file("b") + " --no-report");
+  const auto other =
+      run_tetra("campaign " + dir.file("spec.yaml") + " --out " + dir.file("b") + " --no-report");
   EXPECT_EQ(other.exit_status, 2) << other.err;
   EXPECT_NE(other.err.find("runs.csv:1: not the header of this campaign"), std::string::npos) << other.err;
   EXPECT_EQ(read_file(dir.file("b") + "/runs.csv"), before);

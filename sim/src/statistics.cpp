@@ -8,8 +8,8 @@ namespace tetra::sim {
 namespace {
 
 constexpr double kNaNStat = std::numeric_limits<double>::quiet_NaN();
-constexpr double kTinyStat = 1e-300;        // keeps Lentz's denominators off zero
-constexpr double kEpsStat = 1e-16;          // a continued fraction or series has converged
+constexpr double kTinyStat = 1e-300;           // keeps Lentz's denominators off zero
+constexpr double kEpsStat = 1e-16;             // a continued fraction or series has converged
 constexpr int kMaxStatIterations = 1'000'000;  // far beyond what a campaign's counts need
 
 //! The continued fraction of I_x(a, b) (modified Lentz), valid for x < (a + 1)/(a + b + 2).
