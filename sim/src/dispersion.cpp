@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/geometry.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/core/yaml_reader.hpp"
 #include "tetra/sim/random.hpp"
