@@ -66,7 +66,7 @@ Result<std::set<std::size_t>> done_runs(const std::string& path, const std::stri
     return bad_input(path + ":1: not the header of this campaign (another version, or other dispersions)");
   std::string kept = line + "\n";
   while (std::getline(in, line)) {
-    auto row = sim::parse_campaign_row(line);
+    auto row = sim::parse_campaign_row(line, header);
     if (!row) continue;
     done.insert(row->run);
     kept += line + "\n";

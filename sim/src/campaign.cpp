@@ -529,6 +529,14 @@ std::string campaign_csv_row(const CampaignRow& r) {
   return out;
 }
 
+Result<CampaignRow> parse_campaign_row(const std::string& line, const std::string& header) {
+  const auto fields = std::count(line.begin(), line.end(), ',');
+  if (fields != std::count(header.begin(), header.end(), ','))
+    return bad_input("campaign row with " + std::to_string(fields + 1) + " fields (the header has " +
+                     std::to_string(std::count(header.begin(), header.end(), ',') + 1) + ")");
+  return parse_campaign_row(line);
+}
+
 Result<CampaignRow> parse_campaign_row(const std::string& line) {
   std::vector<std::string> f;
   std::stringstream in(line);

@@ -220,10 +220,10 @@ Result<std::vector<CampaignRow>> read_campaign_rows(const std::string& path) {
   std::ifstream in(path);
   if (!in) return failure(path + ": cannot open");
   std::vector<CampaignRow> rows;
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    auto row = parse_campaign_row(line);
+  std::string header;
+  std::getline(in, header);
+  for (std::string line; std::getline(in, line);) {
+    auto row = parse_campaign_row(line, header);
     if (row) rows.push_back(*row);
   }
   std::sort(rows.begin(), rows.end(),
