@@ -57,10 +57,18 @@ TEST(CampaignDispersedCli, RowsCarryTheDrawsAndTheReportJudgesTheRequirements) {
   EXPECT_NE(report.find("| `wrong_exclusion_rate < 1e-3 at 0.95` | 0 of 6 runs |"), std::string::npos);
   EXPECT_NE(report.find("not yet decidable | 2989 |"), std::string::npos) << report;  // 2995 − 6
   EXPECT_TRUE(std::filesystem::exists(dir.file("a") + "/detection_vs_size_bias.png"));
+  // A row torn among the draws' columns is redone on resume, to the same row.
+  const std::string complete = read_file(dir.file("b") + "/runs.csv");
+  write_file(dir.file("b") + "/runs.csv", complete.substr(0, complete.size() - 20));
+  const auto resumed = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + dir.file("b") + " --no-report");
+  ASSERT_EQ(resumed.exit_status, 0) << resumed.err;
+  EXPECT_NE(resumed.err.find("5 already done"), std::string::npos) << resumed.err;
+  EXPECT_EQ(sorted_lines(read_file(dir.file("b") + "/runs.csv")), rows);
   // The same folder with another parameter dispersed: other columns, refused; runs.csv untouched.
   const std::string before = read_file(dir.file("b") + "/runs.csv");
   write_file(dir.file("spec.yaml"), dispersed_spec("{uniform: [0.5, 2]}\n  unit.bias_V: calibration"));
-  const auto other = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + dir.file("b") + " --no-report");
+  const auto other =
+      run_tetra("campaign " + dir.file("spec.yaml") + " --out " + dir.file("b") + " --no-report");
   EXPECT_EQ(other.exit_status, 2) << other.err;
   EXPECT_NE(other.err.find("this folder holds a campaign of another spec"), std::string::npos) << other.err;
   EXPECT_EQ(read_file(dir.file("b") + "/runs.csv"), before);

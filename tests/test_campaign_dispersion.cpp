@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "test_support.hpp"
 #include "tetra/sim/campaign.hpp"
 #include "tetra/sim/campaign_statistics.hpp"
 #include "tetra/sim/simulator.hpp"
-#include "test_support.hpp"
 
 namespace tetra::sim {
 namespace {
@@ -40,8 +40,8 @@ TEST(CampaignDispersion, DrawsArePureFunctionsOfSeedAndRunAndAppliedToTheTruthOn
   ASSERT_EQ(campaign_run_count(*spec).value(), 4u + 2u * 2u * 4u);
   const CampaignCase a = campaign_case(*spec, 9);
   const CampaignCase again = campaign_case(*spec, 9);
-  EXPECT_EQ(a.draws, again.draws);                        // the same run, the same draws, bit for bit
-  EXPECT_NE(a.draws, campaign_case(*spec, 10).draws);     // another run, others
+  EXPECT_EQ(a.draws, again.draws);                     // the same run, the same draws, bit for bit
+  EXPECT_NE(a.draws, campaign_case(*spec, 10).draws);  // another run, others
   ASSERT_EQ(a.draws.size(), 4u);
   EXPECT_EQ(a.draws[0].size(), 4u);   // per gyro
   EXPECT_EQ(a.draws[1].size(), 12u);  // per gyro and component
@@ -84,7 +84,8 @@ TEST(CampaignDispersion, LawsAndTheCalibrationSigma) {
                                        "  fault.gyro: {choice: [2]}\n");
   ASSERT_TRUE(spec) << spec.error().message;
   const Calibration& unit = spec->scenarios[0].unit;
-  const double sigma_ppm = unit.gyros[0].sigma->scale_factor_V_per_dps / unit.gyros[0].scale_factor_V_per_dps * 1e6;
+  const double sigma_ppm =
+      unit.gyros[0].sigma->scale_factor_V_per_dps / unit.gyros[0].scale_factor_V_per_dps * 1e6;
   constexpr int kRuns = 4000;
   double sum2 = 0.0;
   double arw_sum = 0.0;
@@ -103,7 +104,8 @@ TEST(CampaignDispersion, LawsAndTheCalibrationSigma) {
   // The standard deviation of 4000 normal draws is within 2.2 % (1σ) of σ: 10 % is 4.5σ.
   EXPECT_NEAR(std::sqrt(sum2 / kRuns), sigma_ppm, 0.1 * sigma_ppm);
   // Mean of N(1, 0.5) truncated to [0.8, 1.1]: 0.9515 (from the closed form μ + σ(φ(α) − φ(β))/(Φ(β) −
-  // Φ(α))); the draws' standard deviation is 0.0861, so 16000 of them average within 6.8e-4 (1σ): 3e-3 is 4.4σ.
+  // Φ(α))); the draws' standard deviation is 0.0861, so 16000 of them average within 6.8e-4 (1σ): 3e-3
+  // is 4.4σ.
   EXPECT_NEAR(arw_sum / (4.0 * kRuns), 0.9515, 3e-3);
 }
 
@@ -115,15 +117,19 @@ TEST(CampaignDispersion, SpecErrorsNameTheLineAndKey) {
     std::string text;
   };
   const std::vector<Case> cases = {
-      {"dispersions:\n  seed: 1\n  unit.wobble: {normal: [0, 1]}\n", "spec.yaml:11", "dispersions.unit.wobble"},
+      {"dispersions:\n  seed: 1\n  unit.wobble: {normal: [0, 1]}\n", "spec.yaml:11",
+       "dispersions.unit.wobble"},
       {"dispersions:\n  unit.bias_V: {normal: [0, 1]}\n", "spec.yaml:10", "dispersions.seed"},
       {"dispersions:\n  seed: 1\n  fault.onset_s: {normal: [0, 1]}\n", "spec.yaml:11", "bounded"},
-      {"dispersions:\n  seed: 1\n  fault.onset_s: {uniform: [0, 600]}\n", "spec.yaml:11", "do not all lie in"},
-      {"dispersions:\n  seed: 1\n  unit.arw_factor: {normal: [1, 0.1]}\n", "spec.yaml:11", "must not be negative"},
+      {"dispersions:\n  seed: 1\n  fault.onset_s: {uniform: [0, 600]}\n", "spec.yaml:11",
+       "do not all lie in"},
+      {"dispersions:\n  seed: 1\n  unit.arw_factor: {normal: [1, 0.1]}\n", "spec.yaml:11",
+       "must not be negative"},
       {"dispersions:\n  seed: 1\n  fault.gyro: {choice: [3]}\n", "spec.yaml:11", "not in gyros"},
       {"dispersions:\n  seed: 1\n  unit.arw_factor: calibration\n", "spec.yaml:11", "no calibration"},
       {"dispersions:\n  seed: 1\n  data.jitter_s: {uniform: [0, 0.01]}\n", "spec.yaml:11", "open-loop"},
-      {"dispersions:\n  seed: 1\n  unit.bias_V: {uniform: [2, 1]}\n", "spec.yaml:11", "min must be below max"},
+      {"dispersions:\n  seed: 1\n  unit.bias_V: {uniform: [2, 1]}\n", "spec.yaml:11",
+       "min must be below max"},
       {"requirements: [wrong_exclusion_rate < 2 at 0.95]\n", "spec.yaml:9", "requirements[0]"},
       {"requirements: ['detection_rate[ramp] > 0.9 at 0.95']\n", "spec.yaml:9", "runs no ramp"},
       {"requirements: ['false_alarms_per_hour < 0.1 at 95']\n", "spec.yaml:9", "confidence"},
@@ -135,10 +141,10 @@ TEST(CampaignDispersion, SpecErrorsNameTheLineAndKey) {
     EXPECT_NE(spec.error().message.find(c.text), std::string::npos) << spec.error().message;
   }
   // The seed's unit states no 1σ: `calibration` is refused naming the gyro.
-  test::write_file(dir.file("nadir.yaml"),
-                   "scenarios: [" + test::source_path("examples/sim/closed_loop_nadir.yaml") +
-                       "]\nkinds: [stuck]\ngyros: [1]\nonsets_s: [100]\nseeds: [1]\n"
-                       "dispersions: {seed: 1, unit.axis: calibration}\n");
+  test::write_file(dir.file("nadir.yaml"), "scenarios: [" +
+                                               test::source_path("examples/sim/closed_loop_nadir.yaml") +
+                                               "]\nkinds: [stuck]\ngyros: [1]\nonsets_s: [100]\nseeds: [1]\n"
+                                               "dispersions: {seed: 1, unit.axis: calibration}\n");
   const auto nadir = read_campaign_spec(dir.file("nadir.yaml"));
   ASSERT_FALSE(nadir);
   EXPECT_NE(nadir.error().message.find("gyro 1 of scenarios[0]"), std::string::npos) << nadir.error().message;
@@ -184,7 +190,8 @@ namespace {
 // Star-tracker dropouts (reference.drop_probability): each sample left out independently, from a stream
 // of its own, so the samples delivered are exactly those of the run without dropouts.
 TEST(ReferenceDropouts, DeliveredSamplesAreThoseOfTheRunWithoutDropouts) {
-  const std::string base = "scenario: orbit\nduration_s: 200\nrate_hz: 10\nreference: {rate_hz: 1, noise_arcsec: 5";
+  const std::string base =
+      "scenario: orbit\nduration_s: 200\nrate_hz: 10\nreference: {rate_hz: 1, noise_arcsec: 5";
   auto full = parse_scenario(base + "}\n", "full.yaml");
   auto dropping = parse_scenario(base + ", drop_probability: 0.5}\n", "drop.yaml");
   ASSERT_TRUE(full && dropping) << (full ? dropping.error().message : full.error().message);

@@ -41,11 +41,11 @@ TEST(Statistics, ClopperPearsonMatchesExactBinomialBounds) {
     std::uint64_t k, n;
     double lower, upper;
   };
-  for (const Case& c : {Case{0, 10, 0, 0.30849710781876077}, Case{3, 10, 0.066739511177734495, 0.6524528500599972},
-                        Case{10, 10, 0.69150289218123928, 1}, Case{5, 100, 0.016431879182052161, 0.11283491110546276},
-                        Case{0, 1000, 0, 0.0036820838968656712},
-                        Case{17, 520, 0.01915753319572339, 0.05182865158347285},
-                        Case{1, 3000, 8.4392337175634131e-06, 0.001855799994491922}}) {
+  for (const Case& c :
+       {Case{0, 10, 0, 0.30849710781876077}, Case{3, 10, 0.066739511177734495, 0.6524528500599972},
+        Case{10, 10, 0.69150289218123928, 1}, Case{5, 100, 0.016431879182052161, 0.11283491110546276},
+        Case{0, 1000, 0, 0.0036820838968656712}, Case{17, 520, 0.01915753319572339, 0.05182865158347285},
+        Case{1, 3000, 8.4392337175634131e-06, 0.001855799994491922}}) {
     SCOPED_TRACE("k " + std::to_string(c.k) + " of n " + std::to_string(c.n));
     const Interval i = clopper_pearson(c.k, c.n, 0.95);
     expect_rel(i.lower, c.lower);
@@ -64,16 +64,17 @@ TEST(Statistics, GarwoodMatchesExactPoissonBoundsAndPublishedTables) {
     std::uint64_t k;
     double lower, upper;
   };
-  for (const Case& c : {Case{0, 0, 3.6888794541139354}, Case{1, 0.025317807984289897, 5.5716433909388972},
-                        Case{2, 0.24220927854396501, 7.22468766772396},
-                        Case{10, 4.7953886961324343, 18.390356042017778},
-                        Case{50, 37.110963737461866, 65.918766664336815}}) {
+  for (const Case& c :
+       {Case{0, 0, 3.6888794541139354}, Case{1, 0.025317807984289897, 5.5716433909388972},
+        Case{2, 0.24220927854396501, 7.22468766772396}, Case{10, 4.7953886961324343, 18.390356042017778},
+        Case{50, 37.110963737461866, 65.918766664336815}}) {
     SCOPED_TRACE("k " + std::to_string(c.k));
     const Interval i = garwood(c.k, 0.95);
     expect_rel(i.lower, c.lower);
     expect_rel(i.upper, c.upper);
   }
-  // Published (Garwood 1936; 4 significant digits): k = 0 → 3.689; k = 1 → 0.0253–5.572; k = 10 → 4.795–18.39.
+  // Published (Garwood 1936; 4 significant digits): k = 0 → 3.689; k = 1 → 0.0253–5.572; k = 10
+  // → 4.795–18.39.
   EXPECT_NEAR(garwood(0, 0.95).upper, 3.689, 5e-4);
   EXPECT_NEAR(garwood(1, 0.95).lower, 0.0253, 5e-5);
   EXPECT_NEAR(garwood(10, 0.95).upper, 18.39, 5e-3);

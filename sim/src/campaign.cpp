@@ -171,7 +171,8 @@ Result<std::vector<std::uint64_t>> seed_range(const YamlReader& yaml, const YAML
 Status parse_requirements(const YamlReader& yaml, const YAML::Node& root, CampaignSpec& spec) {
   const YAML::Node list = root["requirements"];
   if (!list) return ok_status();
-  if (!list.IsSequence() || list.size() == 0) return yaml.error(list, "requirements", "expected a non-empty list");
+  if (!list.IsSequence() || list.size() == 0)
+    return yaml.error(list, "requirements", "expected a non-empty list");
   for (std::size_t i = 0; i < list.size(); ++i) {
     const std::string what = "requirements[" + std::to_string(i) + "]";
     auto text = yaml.text(list[i], what);
@@ -179,9 +180,12 @@ Status parse_requirements(const YamlReader& yaml, const YAML::Node& root, Campai
     auto r = parse_requirement(*text);
     if (!r) return yaml.error(list[i], what, r.error().message);
     const auto kind = fault_kind_from_name(r->kind);
-    if (r->kind == "none" ? !spec.fault_free
-                          : kind && std::find(spec.kinds.begin(), spec.kinds.end(), *kind) == spec.kinds.end())
-      return yaml.error(list[i], what, "the campaign runs no " + r->kind + (r->kind == "none" ? " (fault_free: false)" : " fault"));
+    if (r->kind == "none"
+            ? !spec.fault_free
+            : kind && std::find(spec.kinds.begin(), spec.kinds.end(), *kind) == spec.kinds.end())
+      return yaml.error(
+          list[i], what,
+          "the campaign runs no " + r->kind + (r->kind == "none" ? " (fault_free: false)" : " fault"));
     spec.requirements.push_back(*r);
   }
   return ok_status();
@@ -229,11 +233,11 @@ Status parse_axes(const YamlReader& yaml, const YAML::Node& root, CampaignSpec& 
 }
 
 Result<CampaignSpec> parse_spec(const YAML::Node& root, const YamlReader& yaml, const std::string& base_dir) {
-  if (Status st = yaml.check_keys(root,
-                                  {"scenarios", "kinds", "gyros", "onsets_s", "sizes", "seeds", "duration_s",
-                                   "fault_free", "pipeline", "loop", "target", "domain", "dispersions",
-                                   "requirements"},
-                                  "");
+  if (Status st = yaml.check_keys(
+          root,
+          {"scenarios", "kinds", "gyros", "onsets_s", "sizes", "seeds", "duration_s", "fault_free",
+           "pipeline", "loop", "target", "domain", "dispersions", "requirements"},
+          "");
       !st)
     return st.error();
   CampaignSpec spec;
@@ -508,7 +512,8 @@ std::string campaign_csv_header() {
 
 std::string campaign_csv_header(const CampaignSpec& spec) {
   std::string out = campaign_csv_header();
-  for (const std::string& column : dispersion_columns(spec.dispersions, spec.max_gyro_count())) out += "," + column;
+  for (const std::string& column : dispersion_columns(spec.dispersions, spec.max_gyro_count()))
+    out += "," + column;
   return out;
 }
 
@@ -544,6 +549,14 @@ std::string campaign_csv_row(const CampaignRow& r) {
   out += "," + opt_text(r.fdi.wrong_at_s) + ",";
   return out + draw_fields(r);
   return out;
+}
+
+Result<CampaignRow> parse_campaign_row(const std::string& line, const std::string& header) {
+  const auto fields = std::count(line.begin(), line.end(), ',');
+  if (fields != std::count(header.begin(), header.end(), ','))
+    return bad_input("campaign row with " + std::to_string(fields + 1) + " fields (the header has " +
+                     std::to_string(std::count(header.begin(), header.end(), ',') + 1) + ")");
+  return parse_campaign_row(line);
 }
 
 Result<CampaignRow> parse_campaign_row(const std::string& line) {

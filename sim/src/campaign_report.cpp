@@ -12,8 +12,8 @@ namespace tetra::sim {
 
 namespace {
 
-constexpr Outcome kReportOutcomes[] = {Outcome::kRight, Outcome::kUnisolated, Outcome::kWrong, Outcome::kMissed,
-                                       Outcome::kNone};
+constexpr Outcome kReportOutcomes[] = {Outcome::kRight, Outcome::kUnisolated, Outcome::kWrong,
+                                       Outcome::kMissed, Outcome::kNone};
 
 std::string g(double v) {
   return report_number(v);
@@ -173,10 +173,10 @@ std::string pointing_section(const std::vector<CampaignRow>& rows) {
     }
   }
   if (max_after.empty()) return "No faulty closed-loop runs (open loop: nothing steers, no pointing).\n";
-  return "Max pointing error after the fault [deg]: median " + g(report_quantile(max_after, 0.5)) + ", 90 % " +
-         g(report_quantile(max_after, 0.9)) + ", 99 % " + g(report_quantile(max_after, 0.99)) + ", max " +
-         g(report_quantile(max_after, 1.0)) + ". Within the bound (" + g(bound) + " deg) throughout: " +
-         std::to_string(within) + " of " + std::to_string(max_after.size()) +
+  return "Max pointing error after the fault [deg]: median " + g(report_quantile(max_after, 0.5)) +
+         ", 90 % " + g(report_quantile(max_after, 0.9)) + ", 99 % " + g(report_quantile(max_after, 0.99)) +
+         ", max " + g(report_quantile(max_after, 1.0)) + ". Within the bound (" + g(bound) +
+         " deg) throughout: " + std::to_string(within) + " of " + std::to_string(max_after.size()) +
          " runs. Recovered below the bound by the end: " + std::to_string(recover.size()) + " (median time " +
          (recover.empty() ? std::string("–") : g(report_quantile(recover, 0.5))) +
          " s); not recovered: " + std::to_string(not_recovered) + ".\n";
@@ -191,8 +191,8 @@ std::string wrong_section(const std::vector<CampaignRow>& rows) {
                                                      ",at=" + g(r.onset_s) + ",size=" + g(r.size);
     out += "- run " + std::to_string(r.run) + ": " + r.scenario + " " + fault + ", seed " +
            std::to_string(r.seed) + " → healthy gyro " +
-           (r.fdi.wrong_gyro ? std::to_string(*r.fdi.wrong_gyro) : std::string("?")) + " isolated at t = " +
-           (r.fdi.wrong_at_s ? g(*r.fdi.wrong_at_s) : std::string("?")) + " s\n";
+           (r.fdi.wrong_gyro ? std::to_string(*r.fdi.wrong_gyro) : std::string("?")) +
+           " isolated at t = " + (r.fdi.wrong_at_s ? g(*r.fdi.wrong_at_s) : std::string("?")) + " s\n";
   }
   return out.empty() ? "None.\n" : out;
 }
@@ -220,13 +220,14 @@ Result<std::vector<CampaignRow>> read_campaign_rows(const std::string& path) {
   std::ifstream in(path);
   if (!in) return failure(path + ": cannot open");
   std::vector<CampaignRow> rows;
-  std::string line;
-  std::getline(in, line);
-  while (std::getline(in, line)) {
-    auto row = parse_campaign_row(line);
+  std::string header;
+  std::getline(in, header);
+  for (std::string line; std::getline(in, line);) {
+    auto row = parse_campaign_row(line, header);
     if (row) rows.push_back(*row);
   }
-  std::sort(rows.begin(), rows.end(), [](const CampaignRow& a, const CampaignRow& b) { return a.run < b.run; });
+  std::sort(rows.begin(), rows.end(),
+            [](const CampaignRow& a, const CampaignRow& b) { return a.run < b.run; });
   return rows;
 }
 
@@ -270,7 +271,8 @@ CampaignReport campaign_report(const std::vector<CampaignRow>& all_rows, const C
         "(fdi/include/tetra/fdi/detectors.hpp).\n\n![delays](delay_vs_theory.png)\n\n";
   md += "## False alarms\n\n" + std::to_string(false_alarms) + " detections before the fault onset in " +
         g(fault_free_s / 3600.0) + " h of fault-free flight: " +
-        (fault_free_s > 0.0 ? g(false_alarms / (fault_free_s / 3600.0)) : std::string("–")) + " per hour.\n\n";
+        (fault_free_s > 0.0 ? g(false_alarms / (fault_free_s / 3600.0)) : std::string("–")) +
+        " per hour.\n\n";
   const bool pointing = std::any_of(rows.begin(), rows.end(), has_pointing);
   md += "## Pointing\n\n" + pointing_section(rows) + (pointing ? "\n![pointing](pointing_cdf.png)\n" : "");
   md += "\n## Errors\n\n" + error_section(errors);

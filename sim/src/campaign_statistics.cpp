@@ -201,9 +201,9 @@ std::string false_alarm_section(const std::vector<CampaignRow>& rows) {
   const double hours = seconds / 3600.0;
   if (!(hours > 0.0)) return "### False alarms per hour\n\nNo fault-free flight.\n\n";
   const Interval i = garwood(k, kReportConfidence);
-  return "### False alarms per hour\n\n" + std::to_string(k) + " in " + num(hours) + " h: " +
-         num(static_cast<double>(k) / hours) + " per hour, 95 % interval [" + num(i.lower / hours) + ", " +
-         num(i.upper / hours) + "] per hour (Garwood, exact Poisson).\n\n";
+  return "### False alarms per hour\n\n" + std::to_string(k) + " in " + num(hours) +
+         " h: " + num(static_cast<double>(k) / hours) + " per hour, 95 % interval [" + num(i.lower / hours) +
+         ", " + num(i.upper / hours) + "] per hour (Garwood, exact Poisson).\n\n";
 }
 
 //! The bins of |size| of one kind's runs: each distinct size its own when there are at most kBins of
@@ -258,10 +258,11 @@ void size_curves(const std::vector<CampaignRow>& rows, CampaignReport& report) {
     md += "No fault kind with a size.\n\n";
     return;
   }
-  md += "Per kind, the runs binned by |size| (the kind's unit, docs/sim.md); probability of a detection and "
-        "of isolating the faulty gyro, with 95 % Clopper–Pearson intervals.\n\n"
-        "| kind | \\|size\\| | runs | detected | P(detect) 95 % | isolated | P(isolate) 95 % |\n"
-        "|---|---|---|---|---|---|---|\n";
+  md +=
+      "Per kind, the runs binned by |size| (the kind's unit, docs/sim.md); probability of a detection and "
+      "of isolating the faulty gyro, with 95 % Clopper–Pearson intervals.\n\n"
+      "| kind | \\|size\\| | runs | detected | P(detect) 95 % | isolated | P(isolate) 95 % |\n"
+      "|---|---|---|---|---|---|---|\n";
   for (const auto& [kind, runs] : by_kind) {
     const auto [bins, log] = size_bins(runs);
     ReportPlot plot{"detection_vs_size_" + kind + ".png", 800, 600, "", ""};

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/core/geometry.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/core/yaml_reader.hpp"
 #include "tetra/sim/random.hpp"
@@ -21,12 +22,12 @@ using P = DispersedParameter;
 enum class Shape { kPerGyro, kPerGyroXyz, kXyz, kScalar };
 //! What the support of a parameter's distribution must lie in.
 enum class Domain {
-  kAny,          //!< any real (normal allowed)
-  kNonNegative,  //!< [0, ∞): a noise factor, a noise, a latency
-  kProbability,  //!< [0, 1)
+  kAny,            //!< any real (normal allowed)
+  kNonNegative,    //!< [0, ∞): a noise factor, a noise, a latency
+  kProbability,    //!< [0, 1)
   kAboveMinus100,  //!< (−100, ∞) and bounded below: a percent change of inertia
-  kBounded,      //!< a finite support (checked against every scenario)
-  kChoice,       //!< choice only
+  kBounded,        //!< a finite support (checked against every scenario)
+  kChoice,         //!< choice only
 };
 
 struct ParamInfo {
@@ -75,9 +76,10 @@ std::string allowed_names() {
 }
 
 //! [numbers] of a distribution's list, as "what.kind: expected [a, b]" errors otherwise.
-Result<std::vector<double>> numbers_of(const YamlReader& yaml, const YAML::Node& list, const std::string& what,
-                                       std::size_t count, const char* form) {
-  if (!list.IsSequence() || list.size() != count) return yaml.error(list, what, std::string("expected ") + form);
+Result<std::vector<double>> numbers_of(const YamlReader& yaml, const YAML::Node& list,
+                                       const std::string& what, std::size_t count, const char* form) {
+  if (!list.IsSequence() || list.size() != count)
+    return yaml.error(list, what, std::string("expected ") + form);
   std::vector<double> out;
   for (std::size_t i = 0; i < count; ++i) {
     auto v = yaml.number(list[i], what + "[" + std::to_string(i) + "]");
@@ -93,8 +95,9 @@ std::string domain_problem(Domain domain, const Distribution& d) {
     case Domain::kAny:
       return "";
     case Domain::kNonNegative:
-      return d.min >= 0.0 ? "" : "its values must not be negative (use uniform, log_uniform or "
-                                 "truncated_normal with min >= 0)";
+      return d.min >= 0.0 ? ""
+                          : "its values must not be negative (use uniform, log_uniform or "
+                            "truncated_normal with min >= 0)";
     case Domain::kProbability:
       return d.min >= 0.0 && d.max < 1.0 ? "" : "its values must lie in [0, 1) (uniform or truncated_normal)";
     case Domain::kAboveMinus100:
@@ -110,9 +113,9 @@ std::string domain_problem(Domain domain, const Distribution& d) {
 }
 
 //! One distribution: `calibration`, {calibration: k}, {normal: [..]}, {uniform: [..]}, ...
-Result<Distribution> parse_distribution(const YamlReader& yaml, const YAML::Node& node, const std::string& what,
-                                        const ParamInfo& info, const std::vector<FaultKind>& kinds,
-                                        const std::vector<int>& gyros) {
+Result<Distribution> parse_distribution(const YamlReader& yaml, const YAML::Node& node,
+                                        const std::string& what, const ParamInfo& info,
+                                        const std::vector<FaultKind>& kinds, const std::vector<int>& gyros) {
   Distribution d;
   if (node.IsScalar() && node.Scalar() == "calibration") {
     if (!info.calibration) return yaml.error(node, what, "has no calibration 1σ (give a distribution)");
@@ -121,12 +124,13 @@ Result<Distribution> parse_distribution(const YamlReader& yaml, const YAML::Node
     return d;
   }
   if (!node.IsMap() || node.size() != 1)
-    return yaml.error(node, what,
-                      info.domain == Domain::kChoice
-                          ? std::string("expected {choice: [...]}")
-                          : "expected one of {normal: [mean, sigma]}, {uniform: [min, max]}, {truncated_normal: "
-                            "[mean, sigma, min, max]}, {log_uniform: [min, max]}" +
-                                std::string(info.calibration ? ", calibration, {calibration: k}" : ""));
+    return yaml.error(
+        node, what,
+        info.domain == Domain::kChoice
+            ? std::string("expected {choice: [...]}")
+            : "expected one of {normal: [mean, sigma]}, {uniform: [min, max]}, {truncated_normal: "
+              "[mean, sigma, min, max]}, {log_uniform: [min, max]}" +
+                  std::string(info.calibration ? ", calibration, {calibration: k}" : ""));
   const std::string form = node.begin()->first.IsScalar() ? node.begin()->first.Scalar() : "?";
   const YAML::Node v = node.begin()->second;
   const std::string at = what + "." + form;
@@ -174,14 +178,17 @@ Result<Distribution> parse_distribution(const YamlReader& yaml, const YAML::Node
         if (!name) return name.error();
         const auto kind = fault_kind_from_name(*name);
         const auto it = kind ? std::find(kinds.begin(), kinds.end(), *kind) : kinds.end();
-        if (it == kinds.end()) return yaml.error(v[i], item, "'" + *name + "' is not one of the spec's kinds");
+        if (it == kinds.end())
+          return yaml.error(v[i], item, "'" + *name + "' is not one of the spec's kinds");
         d.choices.push_back(static_cast<double>(it - kinds.begin()));
       } else {
         auto g = yaml.integer(v[i], item, 1, kMaxGyros);
         if (!g) return g.error();
         if (std::find(gyros.begin(), gyros.end(), static_cast<int>(*g)) == gyros.end())
-          return yaml.error(v[i], item, "gyro " + std::to_string(*g) + " is not in gyros (the gyros the "
-                                                                         "campaign checks)");
+          return yaml.error(v[i], item,
+                            "gyro " + std::to_string(*g) +
+                                " is not in gyros (the gyros the "
+                                "campaign checks)");
         d.choices.push_back(static_cast<double>(*g));
       }
     }
@@ -224,8 +231,8 @@ double draw(const Distribution& d, Rng& rng, double one_sigma) {
     case DistributionKind::kUniform:
       return d.min + (d.max - d.min) * rng.uniform();
     case DistributionKind::kTruncatedNormal:
-      return d.mean + d.sigma * truncated_standard_normal(rng, (d.min - d.mean) / d.sigma,
-                                                          (d.max - d.mean) / d.sigma);
+      return d.mean +
+             d.sigma * truncated_standard_normal(rng, (d.min - d.mean) / d.sigma, (d.max - d.mean) / d.sigma);
     case DistributionKind::kLogUniform:
       return std::exp(std::log(d.min) + (std::log(d.max) - std::log(d.min)) * rng.uniform());
     case DistributionKind::kCalibration:
@@ -315,16 +322,17 @@ Status check_dispersions(const YamlReader& yaml, const YAML::Node& node, const D
     if (dist.kind == DistributionKind::kCalibration) {
       for (const GyroCalibration& g : sc.unit.gyros) {
         if (!g.sigma)
-          return yaml.error(at, what,
-                            "gyro " + std::to_string(g.id) + " of " + name + " has no calibration 1σ (sigma:)");
+          return yaml.error(
+              at, what, "gyro " + std::to_string(g.id) + " of " + name + " has no calibration 1σ (sigma:)");
       }
     }
     if (d.parameter == P::kFaultOnsetS) {
       const auto [lo, hi] = std::minmax_element(onsets_s.begin(), onsets_s.end());
       if (*lo + dist.min < 0.0 || *hi + dist.max >= sc.duration_s)
         return yaml.error(at, what,
-                          "onsets from " + number_text(*lo + dist.min) + " to " + number_text(*hi + dist.max) +
-                              " s do not all lie in [0, " + number_text(sc.duration_s) + ") s of " + name);
+                          "onsets from " + number_text(*lo + dist.min) + " to " +
+                              number_text(*hi + dist.max) + " s do not all lie in [0, " +
+                              number_text(sc.duration_s) + ") s of " + name);
     }
     if (d.parameter == P::kFaultSizeFactor) {
       for (const auto& [kind, values] : sizes) {
@@ -354,7 +362,8 @@ DispersionDraws draw_dispersions(const DispersionSpec& spec, std::uint64_t run, 
         break;
       case Shape::kPerGyroXyz:
         for (const GyroCalibration& g : nominal.gyros) {
-          for (int c = 0; c < 3; ++c) values.push_back(draw(d.distribution, rng, calibration_sigma(d.parameter, g, c)));
+          for (int c = 0; c < 3; ++c)
+            values.push_back(draw(d.distribution, rng, calibration_sigma(d.parameter, g, c)));
         }
         break;
       case Shape::kXyz:
@@ -412,8 +421,9 @@ void disperse_spacecraft(ClosedLoopSpec& cl, P p, const std::vector<double>& v) 
     }
     case P::kInertiaAxesDeg: {
       const Eigen::Vector3d r = x * kDegToRad;
-      const Eigen::Matrix3d rot =
-          r.norm() > 0.0 ? Eigen::AngleAxisd(r.norm(), r.normalized()).toRotationMatrix() : Eigen::Matrix3d::Identity();
+      const Eigen::Matrix3d rot = r.norm() > 0.0
+                                      ? Eigen::AngleAxisd(r.norm(), r.normalized()).toRotationMatrix()
+                                      : Eigen::Matrix3d::Identity();
       cl.inertia_kg_m2 = rot * cl.inertia_kg_m2 * rot.transpose();
       break;
     }
@@ -430,7 +440,8 @@ void disperse_spacecraft(ClosedLoopSpec& cl, P p, const std::vector<double>& v) 
 
 }  // namespace
 
-Scenario dispersed_scenario(const Scenario& nominal, const DispersionSpec& spec, const DispersionDraws& draws) {
+Scenario dispersed_scenario(const Scenario& nominal, const DispersionSpec& spec,
+                            const DispersionDraws& draws) {
   Scenario sc = nominal;
   for (std::size_t i = 0; i < spec.parameters.size() && i < draws.size(); ++i) {
     const P p = spec.parameters[i].parameter;
@@ -513,8 +524,8 @@ std::vector<std::string> dispersion_columns(const DispersionSpec& spec, int gyro
   return out;
 }
 
-std::vector<std::string> dispersion_fields(const DispersionSpec& spec, const DispersionDraws& draws, int gyros,
-                                           const std::vector<FaultKind>& kinds) {
+std::vector<std::string> dispersion_fields(const DispersionSpec& spec, const DispersionDraws& draws,
+                                           int gyros, const std::vector<FaultKind>& kinds) {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < spec.parameters.size(); ++i) {
     const P p = spec.parameters[i].parameter;

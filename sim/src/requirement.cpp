@@ -12,8 +12,9 @@ namespace tetra::sim {
 namespace {
 
 constexpr RequirementMetric kMetrics[] = {
-    RequirementMetric::kRightRate,     RequirementMetric::kWrongRate,     RequirementMetric::kUnisolatedRate,
-    RequirementMetric::kMissedRate,    RequirementMetric::kDetectionRate, RequirementMetric::kIsolationRate,
+    RequirementMetric::kRightRate,          RequirementMetric::kWrongRate,
+    RequirementMetric::kUnisolatedRate,     RequirementMetric::kMissedRate,
+    RequirementMetric::kDetectionRate,      RequirementMetric::kIsolationRate,
     RequirementMetric::kWrongExclusionRate, RequirementMetric::kFalseAlarmsPerHour};
 
 //! A finite number written whole in `text`, or nullopt.
@@ -59,7 +60,8 @@ Result<Requirement> parse_requirement(const std::string& text) {
   std::istringstream in(text);
   std::vector<std::string> words;
   for (std::string w; in >> w;) words.push_back(w);
-  const std::string form = "expected 'METRIC < BOUND at CONFIDENCE' (or >), e.g. 'wrong_exclusion_rate < 1e-3 at 0.95'";
+  const std::string form =
+      "expected 'METRIC < BOUND at CONFIDENCE' (or >), e.g. 'wrong_exclusion_rate < 1e-3 at 0.95'";
   if (words.size() != 5 || words[3] != "at" || (words[1] != "<" && words[1] != ">")) return bad_input(form);
   Requirement r;
   r.text = text;

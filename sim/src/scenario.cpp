@@ -98,11 +98,11 @@ Status read_reference(const YamlReader& yaml, const YAML::Node& root, Scenario& 
   const YAML::Node ref = root["reference"];
   if (!ref) return ok_status();
   ReferenceOptions& r = sc.reference;
-  if (Status st = yaml.check_keys(ref,
-                                  {"rate_hz", "noise_arcsec", "latency_s", "bias_arcsec", "bias_at_s",
-                                   "bias_ramp_s", "misid_deg", "misid_at_s", "misid_duration_s",
-                                   "drop_probability"},
-                                  "reference");
+  if (Status st =
+          yaml.check_keys(ref,
+                          {"rate_hz", "noise_arcsec", "latency_s", "bias_arcsec", "bias_at_s", "bias_ramp_s",
+                           "misid_deg", "misid_at_s", "misid_duration_s", "drop_probability"},
+                          "reference");
       !st)
     return st;
   return maybe_numbers(yaml, ref, "reference",

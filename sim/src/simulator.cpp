@@ -111,7 +111,8 @@ std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
       meta.emplace_back("reference_misid", number_text(r.misid_deg) + " deg from " +
                                                number_text(r.misid_at_s) + " s for " +
                                                number_text(r.misid_duration_s) + " s");
-    if (r.drop_probability > 0.0) meta.emplace_back("reference_drop_probability", number_text(r.drop_probability));
+    if (r.drop_probability > 0.0)
+      meta.emplace_back("reference_drop_probability", number_text(r.drop_probability));
   }
   if (scenario_.jitter_s > 0.0) meta.emplace_back("jitter_s", number_text(scenario_.jitter_s));
   if (scenario_.drop_probability > 0.0) {

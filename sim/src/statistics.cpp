@@ -3,13 +3,15 @@
 #include <cmath>
 #include <limits>
 
+#include "tetra/core/allan_stats.hpp"
+
 namespace tetra::sim {
 
 namespace {
 
 constexpr double kNaNStat = std::numeric_limits<double>::quiet_NaN();
-constexpr double kTinyStat = 1e-300;        // keeps Lentz's denominators off zero
-constexpr double kEpsStat = 1e-16;          // a continued fraction or series has converged
+constexpr double kTinyStat = 1e-300;           // keeps Lentz's denominators off zero
+constexpr double kEpsStat = 1e-16;             // a continued fraction or series has converged
 constexpr int kMaxStatIterations = 1'000'000;  // far beyond what a campaign's counts need
 
 //! The continued fraction of I_x(a, b) (modified Lentz), valid for x < (a + 1)/(a + b + 2).
@@ -39,41 +41,6 @@ double beta_fraction(double x, double a, double b) {
     const double delta = d * c;
     f *= delta;
     if (std::abs(delta - 1.0) < kEpsStat) return f;
-  }
-  return kNaNStat;
-}
-
-//! The series of P(a, x) (for x < a + 1).
-double gamma_series(double a, double x) {
-  double term = 1.0 / a;
-  double sum = term;
-  for (int n = 1; n <= kMaxStatIterations; ++n) {
-    term *= x / (a + static_cast<double>(n));
-    sum += term;
-    if (std::abs(term) < std::abs(sum) * kEpsStat) {
-      return sum * std::exp(-x + a * std::log(x) - std::lgamma(a));
-    }
-  }
-  return kNaNStat;
-}
-
-//! The continued fraction of Q(a, x) = 1 − P(a, x) (modified Lentz, for x ≥ a + 1).
-double gamma_fraction(double a, double x) {
-  double b = x + 1.0 - a;
-  double c = 1.0 / kTinyStat;
-  double d = 1.0 / b;
-  double f = d;
-  for (int n = 1; n <= kMaxStatIterations; ++n) {
-    const double an = -static_cast<double>(n) * (static_cast<double>(n) - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < kTinyStat) d = kTinyStat;
-    c = b + an / c;
-    if (std::abs(c) < kTinyStat) c = kTinyStat;
-    d = 1.0 / d;
-    const double delta = d * c;
-    f *= delta;
-    if (std::abs(delta - 1.0) < kEpsStat) return std::exp(-x + a * std::log(x) - std::lgamma(a)) * f;
   }
   return kNaNStat;
 }
@@ -132,22 +99,10 @@ double beta_quantile(double p, double a, double b) {
   return bisect([&](double x) { return regularized_beta(x, a, b); }, p, 0.0, 1.0);
 }
 
-double regularized_gamma_p(double a, double x) {
-  if (!(a > 0.0) || std::isnan(x)) return kNaNStat;
-  if (x <= 0.0) return 0.0;
-  if (std::isinf(x)) return 1.0;
-  return x < a + 1.0 ? gamma_series(a, x) : 1.0 - gamma_fraction(a, x);
-}
-
 double gamma_quantile(double p, double a) {
   if (!(a > 0.0) || !(p >= 0.0 && p < 1.0)) return kNaNStat;
   if (p == 0.0) return 0.0;
-  double hi = std::max(1.0, a);
-  while (regularized_gamma_p(a, hi) < p) {
-    hi *= 2.0;
-    if (hi > 1e300) return kNaNStat;
-  }
-  return bisect([&](double x) { return regularized_gamma_p(a, x); }, p, 0.0, hi);
+  return 0.5 * allan::chi2_quantile(p, 2.0 * a);  // Gamma(a, 1) is χ²(2a)/2
 }
 
 double clopper_pearson_upper(std::uint64_t k, std::uint64_t n, double confidence) {

@@ -141,7 +141,7 @@ Result<std::vector<Row>> read_rows(const std::string& runs_csv, const std::strin
   if (line != header)
     return bad_input(runs_csv + ":1: not the header of this campaign (another version, or other dispersions)");
   for (std::size_t number = 2; std::getline(in, line); ++number) {
-    auto row = sim::parse_campaign_row(line);
+    auto row = sim::parse_campaign_row(line, header);
     if (!row) continue;  // a torn line (an interrupted write): the run is done again
     if (drop_errors && !row->error.empty()) continue;
     rows.push_back(Row{row->run, !row->error.empty(), line});

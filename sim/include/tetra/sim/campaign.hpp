@@ -142,6 +142,9 @@ std::string campaign_csv_header(const CampaignSpec& spec);
 std::string campaign_csv_row(const CampaignRow& row);
 //! Parses a row written by campaign_csv_row (for resuming and the report); error on a torn line.
 Result<CampaignRow> parse_campaign_row(const std::string& line);
+//! The same for a row under `header`: a row with fewer fields (torn among the dispersion columns) or
+//! more is an error too.
+Result<CampaignRow> parse_campaign_row(const std::string& line, const std::string& header);
 
 //! [s] expected CUSUM detection delay of a bias step `size_dps` on gyro `gyro` (1..N) for the
 //! pipeline's thresholds (k, h from the configuration and the calibration; fdi/detectors.hpp).

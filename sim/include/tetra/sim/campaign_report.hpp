@@ -16,15 +16,15 @@ namespace tetra::sim {
 //! One PNG plot: gnuplot commands that read their data from the file named by the gnuplot string
 //! variable `datafile` (the caller writes `data` to a file and sets the variable).
 struct ReportPlot {
-  std::string png;  //!< file name beside report.md
-  int width = 800;  //!< [px]
+  std::string png;   //!< file name beside report.md
+  int width = 800;   //!< [px]
   int height = 600;  //!< [px]
   std::string data;
   std::string body;
 };
 
 struct CampaignReport {
-  std::string markdown;            //!< report.md
+  std::string markdown;           //!< report.md
   std::vector<ReportPlot> plots;  //!< in the order report.md shows them; a plot without data is left out
 };
 

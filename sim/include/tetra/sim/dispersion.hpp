@@ -44,27 +44,27 @@ struct Distribution {
 
 //! What a dispersion applies to; the names in the spec are those of dispersion_parameter_name.
 enum class DispersedParameter {
-  kScaleFactorPpm,          //!< unit.scale_factor_ppm, per gyro: true s = s_cal·(1 + δ·1e-6)
-  kBiasV,                   //!< unit.bias_V, per gyro: true β = β_cal + δ [V]
-  kAxis,                    //!< unit.axis, per gyro and component: true h = (h_cal + δ)/|h_cal + δ|
-  kArwFactor,               //!< unit.arw_factor, per gyro: true N = N_cal·δ
-  kBiasInstabilityFactor,   //!< unit.bias_instability_factor, per gyro: true B = B_cal·δ
-  kRateRandomWalkFactor,    //!< unit.rate_random_walk_factor, per gyro: true K = K_cal·δ
-  kQuantizationFactor,      //!< unit.quantization_factor, per gyro: true Q = Q_cal·δ
-  kInertiaPercent,          //!< spacecraft.inertia_percent, per body axis: I ← S·I·S, S = diag(√(1 + δ/100))
-  kInertiaAxesDeg,          //!< spacecraft.inertia_axes_deg, a rotation vector [deg]: I ← R·I·Rᵀ
-  kDisturbanceConstantNm,   //!< disturbance.constant_Nm, per body axis: + δ [N·m]
-  kDisturbancePeriodicNm,   //!< disturbance.periodic_Nm, per body axis: + δ [N·m]
-  kReferenceNoiseArcsec,    //!< reference.noise_arcsec: the value [arcsec]
-  kReferenceBiasArcsec,     //!< reference.bias_arcsec: the value [arcsec] (from t = 0, a step)
-  kReferenceLatencyS,       //!< reference.latency_s: the value [s]
+  kScaleFactorPpm,         //!< unit.scale_factor_ppm, per gyro: true s = s_cal·(1 + δ·1e-6)
+  kBiasV,                  //!< unit.bias_V, per gyro: true β = β_cal + δ [V]
+  kAxis,                   //!< unit.axis, per gyro and component: true h = (h_cal + δ)/|h_cal + δ|
+  kArwFactor,              //!< unit.arw_factor, per gyro: true N = N_cal·δ
+  kBiasInstabilityFactor,  //!< unit.bias_instability_factor, per gyro: true B = B_cal·δ
+  kRateRandomWalkFactor,   //!< unit.rate_random_walk_factor, per gyro: true K = K_cal·δ
+  kQuantizationFactor,     //!< unit.quantization_factor, per gyro: true Q = Q_cal·δ
+  kInertiaPercent,  //!< spacecraft.inertia_percent, per body axis: I ← S·I·S, S = diag(√(1 + δ/100))
+  kInertiaAxesDeg,  //!< spacecraft.inertia_axes_deg, a rotation vector [deg]: I ← R·I·Rᵀ
+  kDisturbanceConstantNm,     //!< disturbance.constant_Nm, per body axis: + δ [N·m]
+  kDisturbancePeriodicNm,     //!< disturbance.periodic_Nm, per body axis: + δ [N·m]
+  kReferenceNoiseArcsec,      //!< reference.noise_arcsec: the value [arcsec]
+  kReferenceBiasArcsec,       //!< reference.bias_arcsec: the value [arcsec] (from t = 0, a step)
+  kReferenceLatencyS,         //!< reference.latency_s: the value [s]
   kReferenceDropProbability,  //!< reference.drop_probability: the value (star-tracker dropouts)
-  kDropProbability,         //!< data.drop_probability: the value
-  kJitterS,                 //!< data.jitter_s: the value [s] (open loop)
-  kFaultOnsetS,             //!< fault.onset_s: + δ [s] to the case's onset
-  kFaultSizeFactor,         //!< fault.size_factor: the case's size × δ
-  kFaultGyro,               //!< fault.gyro: the gyro (choice)
-  kFaultKind,               //!< fault.kind: the kind (choice), with its first size in `sizes:`
+  kDropProbability,           //!< data.drop_probability: the value
+  kJitterS,                   //!< data.jitter_s: the value [s] (open loop)
+  kFaultOnsetS,               //!< fault.onset_s: + δ [s] to the case's onset
+  kFaultSizeFactor,           //!< fault.size_factor: the case's size × δ
+  kFaultGyro,                 //!< fault.gyro: the gyro (choice)
+  kFaultKind,                 //!< fault.kind: the kind (choice), with its first size in `sizes:`
 };
 
 struct Dispersion {
@@ -73,7 +73,7 @@ struct Dispersion {
 };
 
 struct DispersionSpec {
-  std::uint64_t seed = 0;               //!< the campaign's dispersion seed
+  std::uint64_t seed = 0;              //!< the campaign's dispersion seed
   std::vector<Dispersion> parameters;  //!< in the spec's order (the rows' columns follow it)
   bool empty() const { return parameters.empty(); }
 };
@@ -94,7 +94,8 @@ using DispersionDraws = std::vector<std::vector<double>>;
 DispersionDraws draw_dispersions(const DispersionSpec& spec, std::uint64_t run, const Calibration& nominal);
 
 //! The scenario as the run's truth: unit, spacecraft, star tracker and data path dispersed.
-Scenario dispersed_scenario(const Scenario& nominal, const DispersionSpec& spec, const DispersionDraws& draws);
+Scenario dispersed_scenario(const Scenario& nominal, const DispersionSpec& spec,
+                            const DispersionDraws& draws);
 //! The sizes of the kinds that take one (the spec's `sizes:`).
 using KindSizes = std::vector<std::pair<FaultKind, std::vector<double>>>;
 //! The fault as the run's truth: onset, size, gyro and kind (a drawn kind with its first size in `sizes`).
@@ -110,7 +111,7 @@ Status check_dispersions(const YamlReader& yaml, const YAML::Node& node, const D
 
 //! The rows' column names for the draws (`gyros` the most gyros of any scenario) and one run's fields.
 std::vector<std::string> dispersion_columns(const DispersionSpec& spec, int gyros);
-std::vector<std::string> dispersion_fields(const DispersionSpec& spec, const DispersionDraws& draws, int gyros,
-                                           const std::vector<FaultKind>& kinds);
+std::vector<std::string> dispersion_fields(const DispersionSpec& spec, const DispersionDraws& draws,
+                                           int gyros, const std::vector<FaultKind>& kinds);
 
 }  // namespace tetra::sim

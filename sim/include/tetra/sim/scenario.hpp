@@ -18,7 +18,8 @@ namespace tetra::sim {
 
 //! Star-tracker-like attitude reference: q_RB(t − latency) ⊗ exp(δθ + b(t) + m(t)), δθ ~ N(0, σ²·I) per axis
 //! (in B); b a slow (thermal) bias, m a mis-identification episode. The failure modes (latency, slow bias,
-//! mis-identification, dropouts; a noisier reference is `noise_arcsec` itself) are off by default (docs/sim.md).
+//! mis-identification, dropouts; a noisier reference is `noise_arcsec` itself) are off by default
+//! (docs/sim.md).
 struct ReferenceOptions {
   double rate_hz = 0.0;       //!< [Hz] 0 = no reference
   double noise_arcsec = 0.0;  //!< [arcsec] 1σ per axis

@@ -1,7 +1,7 @@
 #pragma once
 // Confidence intervals for a campaign's rates (docs/campaign.md, "Statistics"): the exact
 // (Clopper–Pearson) binomial interval of a proportion, the exact (Garwood) Poisson interval of a count,
-// and the special functions they rest on (the regularized incomplete beta and gamma functions and their
+// and the special functions they rest on (the regularized incomplete beta function and the beta and gamma
 // quantiles). Every function is total: arguments outside their domain give NaN, never an abort.
 //
 //   Clopper–Pearson, k successes in n trials, confidence c (α = 1 − c), two-sided:
@@ -20,9 +20,8 @@ namespace tetra::sim {
 double regularized_beta(double x, double a, double b);
 //! x in [0, 1] with I_x(a, b) = p (bisection to adjacent doubles: full relative precision).
 double beta_quantile(double p, double a, double b);
-//! P(a, x), the regularized lower incomplete gamma function (the Gamma(a, 1) law's CDF at x), a > 0.
-double regularized_gamma_p(double a, double x);
-//! x ≥ 0 with P(a, x) = p.
+//! x ≥ 0 with P(a, x) = p, P the regularized lower incomplete gamma function (the Gamma(a, 1) law's CDF):
+//! half the χ² quantile with 2a degrees of freedom (tetra/core/allan_stats.hpp).
 double gamma_quantile(double p, double a);
 
 struct Interval {
