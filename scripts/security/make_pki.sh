@@ -133,8 +133,8 @@ XML
   for unit in "${units[@]}"; do
     grant "sensor-$unit" "tetra.$unit" "GyroSample AttitudeReference" "Attitude Health FdiEvent Command"
   done
-  # fusion: the service, of any unit
-  grant fusion "tetra.*" "Attitude Health FdiEvent" "GyroSample AttitudeReference Command"
+  # fusion: the service, of any unit (it reads Health too: a second service of its unit is refused)
+  grant fusion "tetra.*" "Attitude Health FdiEvent" "GyroSample AttitudeReference Command Health"
   # ground: monitor, command, record, of any unit
   grant ground "tetra.*" "Command" "GyroSample AttitudeReference Attitude Health FdiEvent"
   cat <<XML

@@ -19,7 +19,9 @@ class DdsEstimator final : public sim::Estimator {
   static constexpr std::int64_t kLockstepTimeout_ns = 2'000'000'000;
 
   DdsEstimator(SimDdsLink& link, bool lockstep, double speed)
-      : link_(link), lockstep_(lockstep), speed_(speed) {}
+      : link_(link), lockstep_(lockstep), speed_(speed) {
+    if (lockstep_) link_.require_one_attitude_writer();  // a second service would mix into the run
+  }
 
   Result<sim::EstimatorOutput> estimate(const sim::SimEpoch& epoch) override;
   //! Lockstep epochs whose Attitude did not come within the timeout.

@@ -25,12 +25,16 @@ Result<std::unique_ptr<SimDdsLink>> SimDdsLink::open(const std::string& unit, do
   const auto period = options.speed > 0
                           ? std::chrono::nanoseconds(seconds_to_ns(1.0 / (rate_hz * options.speed)))
                           : std::chrono::nanoseconds(0);
+  // The reference writer first: a participant's endpoints are announced in order on one reliable
+  // channel, so a service whose Health says it hears the gyro writer (wait_for_service) has discovered
+  // the reference writer too, and receives the first epoch's reference (a volatile reader gets only
+  // what is written after it has discovered the writer).
+  auto reference_writer = session->writer<tetra_AttitudeReference>(dds::reference_qos());
+  if (!reference_writer) return reference_writer.error();
   dds::Qos gyro_qos = dds::gyro_sample_qos(period);
   gyro_qos.no_autodispose();
   auto gyro_writer = session->writer<tetra_GyroSample>(gyro_qos);
   if (!gyro_writer) return gyro_writer.error();
-  auto reference_writer = session->writer<tetra_AttitudeReference>(dds::reference_qos());
-  if (!reference_writer) return reference_writer.error();
   dds::Qos attitude_qos;
   attitude_qos.reliable().volatile_durability().keep_last(1024);  // score every epoch, not only the latest
   auto attitude_reader = session->reader<tetra_Attitude>(attitude_qos);
@@ -43,7 +47,6 @@ Result<std::unique_ptr<SimDdsLink>> SimDdsLink::open(const std::string& unit, do
   if (auto s = dds::copy_bounded(link->reference_.unit, unit, "unit"); !s) return s.error();
   if (auto s = link->wait_for_readers(options); !s) return s.error();
   if (auto s = link->wait_for_service(options); !s) return s.error();
-  if (auto s = link->prime_references(options); !s) return s.error();
   return link;
 }
 
@@ -169,18 +172,6 @@ Status SimDdsLink::wait_for_service(const SimDdsOptions& options) {
   return ok_status();
 }
 
-Status SimDdsLink::prime_references(const SimDdsOptions& options) {
-  // A volatile reader gets only what is written after it has discovered the writer. The service's Health
-  // says its gyro reader has; for its reference reader, a reference stamped before any epoch (attached
-  // to none) is written and its acknowledgement awaited: a reader acknowledges only a writer it knows.
-  if (options.wait_readers <= 0) return ok_status();
-  reference_.stamp_ns = -kNanosPerSecond;
-  reference_.q_RB[0] = 1.0;
-  if (auto s = reference_writer_.write(reference_); !s) return s.error();
-  (void)reference_writer_.wait_for_acks(std::chrono::seconds(2));
-  return ok_status();
-}
-
 Status SimDdsLink::publish(const sim::SimEpoch& epoch, std::uint64_t k) {
   if (epoch.reference_q_RB) {
     reference_.stamp_ns = epoch.stamp_ns;
@@ -204,7 +195,7 @@ Status SimDdsLink::take_attitudes(const std::function<void(const fdi::AttitudeEs
   bool second_writer = false;
   auto taken = attitude_reader_.take([&](const tetra_Attitude& msg, const dds_sample_info_t& info) {
     if (dds::from_wire(msg.unit) != unit_) return;
-    if (attitude_writer_ == 0) attitude_writer_ = info.publication_handle;
+    if (attitude_writer_ == 0 || !one_attitude_writer_) attitude_writer_ = info.publication_handle;
     if (info.publication_handle != attitude_writer_) second_writer = true;
     if (!second_writer) on_attitude(dds::from_wire(msg));
   });

@@ -31,12 +31,14 @@ class SimDdsLink {
   //! with a reference, each sample carries dds::kGyroFlagReferenceWritten, so the service holds the
   //! epoch until the reference is in (the two topics have no common delivery order), with no wait here.
   Status publish(const sim::SimEpoch& epoch, std::uint64_t k);
-  //! Takes the Attitude samples of this unit received so far, in order; an error when they come from
-  //! more than one writer (two services of the unit).
+  //! Takes the Attitude samples of this unit received so far, in order; after
+  //! require_one_attitude_writer(), an error when they come from more than one writer (two services of
+  //! the unit, or one restarted: a lockstep run would mix them).
   Status take_attitudes(const std::function<void(const fdi::AttitudeEstimate&)>& on_attitude);
   //! Blocks until data arrives on the Attitude reader, a shutdown is requested or the monotonic
   //! time `until_ns` passes.
   Status wait_until(std::int64_t until_ns);
+  void require_one_attitude_writer() { one_attitude_writer_ = true; }
   bool stop_requested() const { return shutdown_ != nullptr && shutdown_->requested(); }
   //! Waits (up to 2 s) until the samples written are acknowledged.
   void wait_for_acks();
@@ -55,8 +57,6 @@ class SimDdsLink {
         attitude_reader_(std::move(attitude_reader)) {}
   Status wait_for_readers(const SimDdsOptions& options);
   Status wait_for_service(const SimDdsOptions& options);
-  //! Makes sure the service's reference reader knows the reference writer before the first epoch.
-  Status prime_references(const SimDdsOptions& options);
   //! "; N GyroSample reader(s) refused this writer's QoS: deadline (…)" when a reader did not match, else "".
   std::string incompatible_readers_note() const;
 
@@ -67,7 +67,8 @@ class SimDdsLink {
   dds::Reader<tetra_Attitude> attitude_reader_;
   const dds::ShutdownSignal* shutdown_ = nullptr;
   std::vector<std::intptr_t> triggered_;
-  dds_instance_handle_t attitude_writer_ = 0;  //!< the one Attitude writer of this unit heard (0: none yet)
+  dds_instance_handle_t attitude_writer_ = 0;  //!< the Attitude writer of this unit heard (0: none yet)
+  bool one_attitude_writer_ = false;           //!< another writer is an error (lockstep)
   tetra_GyroSample sample_{};
   tetra_AttitudeReference reference_{};
 };

@@ -35,16 +35,26 @@ Status FusionService::open(dds_domainid_t domain, dds::ShutdownSignal* shutdown)
   deadline_ns_ = config_.deadline_ns();
   shutdown_ = shutdown;
   if (auto s = assign(session_, dds::Session::open(domain, config_.unit)); !s) return s;
-  if (auto s = assign(duplicates_, DuplicateWatch::create(*session_, config_.unit, static_cast<int>(domain)));
-      !s)
-    return s;
-  if (auto s =
-          duplicates_->probe(session_->participant(), DuplicateWatch::kProbe, [this] { return stopping(); });
-      !s)
-    return s;
+  if (Status s = open_duplicate_watch(domain); !s) return s;
   if (auto s = open_endpoints(); !s) return s;
-  if (auto s = duplicates_->set_own_writer(health_writer_->handle()); !s) return s;
+  if (duplicates_) {
+    if (auto s = duplicates_->set_own_writer(health_writer_->handle()); !s) return s;
+  }
   return open_waitset();
+}
+
+Status FusionService::open_duplicate_watch(dds_domainid_t domain) {
+  auto watch = DuplicateWatch::create(*session_, config_.unit, static_cast<int>(domain));
+  if (!watch && config_.security) {
+    // A DDS Security identity granted no Health subscription (permissions made before the watch).
+    spdlog::warn(
+        "fusion: this identity may not subscribe to Health ({}): another service of unit {} would go "
+        "undetected; grant the fusion role Health (scripts/security/make_pki.sh)",
+        watch.error().message, config_.unit);
+    return ok_status();
+  }
+  if (auto s = assign(duplicates_, std::move(watch)); !s) return s;
+  return duplicates_->probe(session_->participant(), DuplicateWatch::kProbe, [this] { return stopping(); });
 }
 
 Status FusionService::open_endpoints() {
@@ -77,7 +87,9 @@ Status FusionService::open_waitset() {
   }
   if (auto s = session.watch_data(reference_reader_->handle(), kReferenceData); !s) return s;
   if (auto s = session.watch_data(command_reader_->handle(), kCommandData); !s) return s;
-  if (auto s = session.watch_data(duplicates_->reader_handle(), kPeerHealth); !s) return s;
+  if (duplicates_) {
+    if (auto s = session.watch_data(duplicates_->reader_handle(), kPeerHealth); !s) return s;
+  }
   if (auto s = session.watch_statuses(gyro_reader_->handle(), kGyroStatuses, kGyroStatus); !s) return s;
   auto wake = session.add_guard(kWake);
   if (!wake) return wake.error();
@@ -182,7 +194,7 @@ Status FusionService::handle_wakeup(const std::vector<std::intptr_t>& triggered,
     return std::find(triggered.begin(), triggered.end(), token) != triggered.end();
   };
   if (fired(kPeerHealth)) {
-    if (auto s = duplicates_->check(); !s) return s;
+    if (auto s = duplicates_ ? duplicates_->check() : ok_status(); !s) return s;
   }
   const bool command_data = fired(kCommandData);
   const bool gyro_data = fired(kGyroData);

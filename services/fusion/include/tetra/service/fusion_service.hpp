@@ -60,6 +60,8 @@ class FusionService {
 
  private:
   bool listener_dispatch() const { return config_.gyro_dispatch == GyroDispatch::kListener; }
+  //! The check for another service of the unit (duplicate_watch.hpp), before any endpoint exists.
+  Status open_duplicate_watch(dds_domainid_t domain);
   Status open_endpoints();
   Status open_waitset();
   bool stopping() const { return stop_requested_.load() || (shutdown_ != nullptr && shutdown_->requested()); }
