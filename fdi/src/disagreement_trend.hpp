@@ -2,9 +2,9 @@
 // While the reference is rejected, the data hold two explanations the single-fault argument cannot always
 // tell apart: the reference is wrong, or the gyros are, by a fault their parity does not see (two faults that
 // cancel in it, a common-mode error). The rejected samples' innovations against the gyro-propagated attitude
-// are that attitude's error under the second explanation. A weighted line fitted per axis over them, evaluated
-// now, plus three times the σ of that prediction, bounds it; the published sigma carries the bound in
-// quadrature until the reference is used again (docs/fdi.md, "Reference consistency"). Under the first
+// are that attitude's error under the second explanation. A weighted line fitted per axis over them,
+// evaluated now, plus three times the σ of that prediction, bounds it; the published sigma carries the bound
+// in quadrature until the reference is used again (docs/fdi.md, "Reference consistency"). Under the first
 // explanation the bound is only conservative. Every rejection starts it, a `jump` too: a fast enough drift of
 // the gyro attitude (two cancelling 1e-3 deg/s biases: 20″ in 6 s) first shows as one.
 

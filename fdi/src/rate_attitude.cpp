@@ -186,8 +186,12 @@ void RateAttitude::propagate(const EpochFrame& frame, const Subset& sol, const S
     bound += accel_seen_.cwiseMax(config_.max_angular_acceleration_dps2 * kDegToRad) * t_lost;
   } else {
     lost_since_ns_ = -1;
-    accel_seen_ = accel_seen_.cwiseProduct(Eigen::Vector3d::Constant(std::exp(-frame.dt_s / kAccelMemory_s)))
-                      .cwiseMax(((omega_meas_ - omega_prev_) / frame.dt_s).cwiseAbs());
+    if (frame.dt_s != accel_decay_dt_s_) {  // the step is nearly always the last one's: one exp per change
+      accel_decay_dt_s_ = frame.dt_s;
+      accel_decay_ = std::exp(-frame.dt_s / kAccelMemory_s);
+    }
+    accel_seen_ =
+        (accel_seen_ * accel_decay_).cwiseMax(((omega_meas_ - omega_prev_) / frame.dt_s).cwiseAbs());
   }
   const Subset& noise = sol.observable ? sol : *fallback;
   // The rate as the filter sees it: the trapezoid of the estimates with its curvature correction, less the

@@ -131,6 +131,8 @@ class RateAttitude {
   //! [rad/s²] per axis: the largest |slope| of recent observable steps (decaying over kAccelMemory_s), so a
   //! lost rate's bound covers the acceleration the gyros saw when it exceeds the configured bound.
   Eigen::Vector3d accel_seen_ = Eigen::Vector3d::Zero();
+  double accel_decay_dt_s_ = -1.0;  //!< [s] the step of accel_decay_
+  double accel_decay_ = 1.0;        //!< e^{−Δt/kAccelMemory_s}
   std::int64_t lost_since_ns_ = -1;
 };
 
