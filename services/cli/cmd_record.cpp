@@ -9,8 +9,8 @@
 #include "commands.hpp"
 #include "dds_common.hpp"
 #include "tetra/dds/convert.hpp"
-#include "tetra/dds/topics.hpp"
 #include "tetra/dds/shutdown.hpp"
+#include "tetra/dds/topics.hpp"
 #include "tetra/dds_tools/record.hpp"
 
 namespace tetra::cli {

@@ -145,8 +145,8 @@ std::string overrides_given(const SimRunOptions& run) {
 
 // Any other scenario: built in or read from a file, then the unit and the overrides.
 Result<sim::Scenario> load_scenario(const SimRunOptions& o, const std::optional<Calibration>& unit) {
-  for (const std::string& argument : o.plan_given)
-    return bad_input(name_of(o.names, argument) + " applies to the turntable scenario only");
+  if (!o.plan_given.empty())
+    return bad_input(name_of(o.names, o.plan_given.front()) + " applies to the turntable scenario only");
   Result<sim::Scenario> scenario =
       is_scenario_file(o.scenario) ? sim::read_scenario(o.scenario) : sim::builtin_scenario(o.scenario);
   if (!scenario) return scenario.error();

@@ -13,7 +13,7 @@
 
 #include "tetra/core/result.hpp"
 #include "tetra/dds/shutdown.hpp"
-#include "tetra/report/file_names.hpp"
+#include "tetra/report/argument_names.hpp"
 #include "tetra/service/epoch_assembler.hpp"
 
 namespace tetra::dds_tools {

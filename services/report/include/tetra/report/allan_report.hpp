@@ -8,7 +8,7 @@
 
 #include "tetra/core/allan.hpp"
 #include "tetra/core/result.hpp"
-#include "tetra/report/file_names.hpp"
+#include "tetra/report/argument_names.hpp"
 
 namespace tetra::report {
 
@@ -29,14 +29,14 @@ struct AllanReportOptions {
   ArgumentNames names;
 };
 
-//! Error::subject of the report's errors about its arguments besides allan's own (kSubjectTaus, ...):
-//! "update_calibration" and "kalibr_path" (need calibration_path), "dt_tolerance" and "confidence" (out
-//! of range; the value as given), kPlotSubject (the plot).
 struct AllanReport {
   allan::LogAllan analysis;
   bool calibration_updated = false;  //!< the noise terms were written into calibration_path
 };
 
+//! Error::subject of the report's errors about its arguments besides allan's own (kSubjectTaus, ...):
+//! "update_calibration" and "kalibr_path" (need calibration_path), "dt_tolerance" and "confidence" (out
+//! of range; the value as given), kPlotSubject (the plot).
 //! Reads the log block by block (never whole), prints the table on `out` and notes on `err`, writes the
 //! outputs asked for (all or none: through the output layer).
 Result<AllanReport> write_allan_report(const AllanReportOptions& options, std::ostream& out,

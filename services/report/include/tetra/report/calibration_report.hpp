@@ -9,7 +9,7 @@
 
 #include "tetra/core/calibration.hpp"
 #include "tetra/core/result.hpp"
-#include "tetra/report/file_names.hpp"
+#include "tetra/report/argument_names.hpp"
 
 namespace tetra::report {
 

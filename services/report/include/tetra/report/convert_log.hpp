@@ -6,7 +6,7 @@
 #include <string>
 
 #include "tetra/core/result.hpp"
-#include "tetra/report/file_names.hpp"
+#include "tetra/report/argument_names.hpp"
 
 namespace tetra::report {
 

@@ -12,7 +12,7 @@
 
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/types.hpp"
-#include "tetra/report/file_names.hpp"
+#include "tetra/report/argument_names.hpp"
 
 namespace tetra::report {
 

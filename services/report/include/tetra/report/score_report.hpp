@@ -7,7 +7,7 @@
 
 #include "tetra/core/attitude_score.hpp"
 #include "tetra/core/result.hpp"
-#include "tetra/report/file_names.hpp"
+#include "tetra/report/argument_names.hpp"
 
 namespace tetra::report {
 

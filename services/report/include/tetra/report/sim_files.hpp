@@ -13,7 +13,7 @@
 
 #include "tetra/core/calibration.hpp"
 #include "tetra/core/result.hpp"
-#include "tetra/report/file_names.hpp"
+#include "tetra/report/argument_names.hpp"
 #include "tetra/sim/scenario.hpp"
 #include "tetra/sim/simulator.hpp"
 #include "tetra/sim/turntable.hpp"
