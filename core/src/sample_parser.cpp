@@ -32,7 +32,8 @@ void LineProtocolParser::parse_line(std::string_view line, std::vector<RawGyroSa
   split_protocol_fields(line, n + 2, f);
   double time_s = 0.0;
   if (f.size() < 3) return refuse(where + "expected TIME_S,GYRO,RAW or TIME_S,all,RAW1..RAWN");
-  if (!parse_number(f[0], time_s) || log_time_problem(time_s)) return refuse(where + "time_s is not a finite time");
+  if (!parse_number(f[0], time_s) || log_time_problem(time_s))
+    return refuse(where + "time_s is not a finite time");
   const std::size_t first = out.size();
   if (f[1] == "all") {
     if (f.size() != n + 2) {
@@ -65,7 +66,8 @@ void LineProtocolParser::feed(std::span<const std::uint8_t> bytes, std::vector<R
     if (b == '\n') {
       if (overlong_) {
         ++line_no_;
-        refuse("line " + std::to_string(line_no_) + ": longer than " + std::to_string(kMaxLineBytes) + " bytes");
+        refuse("line " + std::to_string(line_no_) + ": longer than " + std::to_string(kMaxLineBytes) +
+               " bytes");
         overlong_ = false;
       } else {
         parse_line(pending_, out);
