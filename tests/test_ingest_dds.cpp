@@ -51,14 +51,14 @@ TEST(LineProtocol, OneGyroOrAllGyrosPerLine) {
 TEST(LineProtocol, MalformedLinesAreCountedWithTheirReason) {
   LineProtocolParser p(4);
   const auto s = feed_all(p,
-                          "x,1,2\n"            // time
-                          "1,5,0.1\n"          // gyro out of range
-                          "1,all,1,2,3\n"      // too few
-                          "1,2,abc\n"          // raw
-                          "1,2,inf\n"          // raw
-                          "1,2\n"              // too few fields
-                          "1,1.5,0\n"          // gyro not whole
-                          "2,1,0.5\n");        // good
+                          "x,1,2\n"        // time
+                          "1,5,0.1\n"      // gyro out of range
+                          "1,all,1,2,3\n"  // too few
+                          "1,2,abc\n"      // raw
+                          "1,2,inf\n"      // raw
+                          "1,2\n"          // too few fields
+                          "1,1.5,0\n"      // gyro not whole
+                          "2,1,0.5\n");    // good
   EXPECT_EQ(s.size(), 1U);
   EXPECT_EQ(p.malformed(), 7U);
   EXPECT_EQ(p.last_problem(), "line 7: gyro must be 1..4 or 'all'");
@@ -86,8 +86,8 @@ TEST(IngestDds, PseudoTerminalLinesReachTheWireMalformedCounted) {
   TetraProcess record({"record", "--unit", "lab-2", "--gyros", "4", "--rate", "100", "--domain", d, "-o",
                        dir.file("rec.csv"), "--until-idle"},
                       dir.file("record.log"));
-  TetraProcess ingest({"ingest", "--serial", device, "--baud", "115200", "--parity", "even", "--unit", "lab-2",
-                       "--gyros", "4", "--domain", d, "--quiet"},
+  TetraProcess ingest({"ingest", "--serial", device, "--baud", "115200", "--parity", "even", "--unit",
+                       "lab-2", "--gyros", "4", "--domain", d, "--quiet"},
                       dir.file("ingest.log"));
   std::string text;
   for (int k = 0; k < 200; ++k) {

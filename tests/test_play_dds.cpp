@@ -1,7 +1,8 @@
-// `tetra play` into `tetra fusion` (docs/dds.md, "Playing a log"): real processes on loopback DDS, each test on
-// its own domain. A faulted log played in lockstep gives the service exactly the epochs `tetra replay` sees:
-// the same events and, for every attitude the recorder received, the same numbers bit for bit. Paced, the
-// service sees the same epochs when nothing is lost; the test states its bound below. No timing is asserted.
+// `tetra play` into `tetra fusion` (docs/dds.md, "Playing a log"): real processes on loopback DDS, each test
+// on its own domain. A faulted log played in lockstep gives the service exactly the epochs `tetra replay`
+// sees: the same events and, for every attitude the recorder received, the same numbers bit for bit. Paced,
+// the service sees the same epochs when nothing is lost; the test states its bound below. No timing is
+// asserted.
 #include <map>
 #include <sstream>
 #include <string>
@@ -25,12 +26,15 @@ struct PlayFiles {
     EXPECT_EQ(run_tetra("sim --write-unit " + dir.file("cal.yaml")).exit_status, 0);
     std::string cal = read_file(dir.file("cal.yaml"));
     config = dir.file("fusion.yaml");
-    write_file(config, "unit: lab-1\ncalibration: cal.yaml\nsample_rate_hz: 100\nspeed: 1\nmax_latency_s: 0.05\n"
-                       "health_period_s: 0.2\n");
+    write_file(config,
+               "unit: lab-1\ncalibration: cal.yaml\nsample_rate_hz: 100\nspeed: 1\nmax_latency_s: 0.05\n"
+               "health_period_s: 0.2\n");
     log = dir.file("faulted.csv");
     // 100 Hz, 15 s of orbit motion without a reference, gyro 2 stuck from 5 s.
-    const auto sim = run_tetra("sim orbit --rate-hz 100 --minutes 0.25 --reference-hz 0 "
-                               "--fault gyro=2,kind=stuck,at=5 -o " + log);
+    const auto sim = run_tetra(
+        "sim orbit --rate-hz 100 --minutes 0.25 --reference-hz 0 "
+        "--fault gyro=2,kind=stuck,at=5 -o " +
+        log);
     EXPECT_EQ(sim.exit_status, 0) << sim.err;
   }
 };
@@ -40,7 +44,8 @@ std::string without_stream_events(const std::string& events) {
   std::istringstream in(events);
   std::string out;
   for (std::string line; std::getline(in, line);) {
-    if (line.find("all gyros silent") == std::string::npos && line.find("gyro samples back") == std::string::npos)
+    if (line.find("all gyros silent") == std::string::npos &&
+        line.find("gyro samples back") == std::string::npos)
       out += line + '\n';
   }
   return out;
@@ -88,15 +93,18 @@ std::map<std::string, std::string> attitude_rows(const std::string& text) {
 
 void play_and_compare(const std::string& speed, int domain) {
   PlayFiles f;
-  const auto replay = run_tetra("replay " + f.log + " --calibration " + f.dir.file("cal.yaml") + " --attitude " +
-                                f.dir.file("replay_att.csv") + " --events " + f.dir.file("replay_ev.jsonl"));
+  const auto replay =
+      run_tetra("replay " + f.log + " --calibration " + f.dir.file("cal.yaml") + " --attitude " +
+                f.dir.file("replay_att.csv") + " --events " + f.dir.file("replay_ev.jsonl"));
   ASSERT_EQ(replay.exit_status, 0) << replay.err;
   const std::string d = std::to_string(domain);
   TetraProcess fusion({"fusion", "--config", f.config, "--domain", d}, f.dir.file("fusion.log"));
-  TetraProcess record({"record", "--config", f.config, "--domain", d, "-o", f.dir.file("rec.csv"), "--attitude",
-                       f.dir.file("dds_att.csv"), "--events", f.dir.file("dds_ev.jsonl"), "--until-idle"},
-                      f.dir.file("record.log"));
-  const auto play = run_tetra("play " + f.log + " --unit lab-1 --speed " + speed + " --wait-readers 2 --domain " + d);
+  TetraProcess record(
+      {"record", "--config", f.config, "--domain", d, "-o", f.dir.file("rec.csv"), "--attitude",
+       f.dir.file("dds_att.csv"), "--events", f.dir.file("dds_ev.jsonl"), "--until-idle"},
+      f.dir.file("record.log"));
+  const auto play =
+      run_tetra("play " + f.log + " --unit lab-1 --speed " + speed + " --wait-readers 2 --domain " + d);
   ASSERT_EQ(play.exit_status, 0) << play.err << play.out << read_file(f.dir.file("fusion.log"));
   EXPECT_NE(play.out.find("epochs published: 1500"), std::string::npos) << play.out;
   ASSERT_EQ(record.wait_exit(), 0) << read_file(f.dir.file("record.log"));

@@ -24,7 +24,8 @@ using test::TempDir;
 
 // make_tdms.py IN OUT ARGS; true when it worked.
 void make_tdms(const std::string& in, const std::string& out, const std::string& args = "") {
-  const auto r = run_shell("python3 " + source_path("tests/tdms/make_tdms.py") + " " + in + " " + out + " " + args);
+  const auto r =
+      run_shell("python3 " + source_path("tests/tdms/make_tdms.py") + " " + in + " " + out + " " + args);
   ASSERT_EQ(r.exit_status, 0) << r.err;
 }
 
@@ -51,7 +52,8 @@ TEST(TdmsLog, SixteenPositionPlanCalibratesAsItsCsv) {
   const auto ref = run_tetra("calibrate " + csv + " -o " + dir.file("csv.yaml"));
   ASSERT_EQ(ref.exit_status, 0) << ref.err;
   for (const char* name : {"plan", "plan_il"}) {
-    const auto r = run_tetra("calibrate " + dir.file(std::string(name) + ".tdms") + " -o " + dir.file(std::string(name) + ".yaml"));
+    const auto r = run_tetra("calibrate " + dir.file(std::string(name) + ".tdms") + " -o " +
+                             dir.file(std::string(name) + ".yaml"));
     ASSERT_EQ(r.exit_status, 0) << r.err;
     EXPECT_EQ(without_comments(test::read_file(dir.file("csv.yaml"))),
               without_comments(test::read_file(dir.file(std::string(name) + ".yaml"))))
@@ -64,18 +66,20 @@ TEST(TdmsLog, SixteenPositionPlanCalibratesAsItsCsv) {
 TEST(TdmsLog, GyroLogWithChannelMapReplaysAsItsCsv) {
   TempDir dir;
   const std::string csv = dir.file("log.csv");
-  auto r = run_tetra("sim static --minutes 0.5 --rate-hz 20 --fault gyro=2,kind=bias,at=10,size=0.5 -o " + csv);
+  auto r =
+      run_tetra("sim static --minutes 0.5 --rate-hz 20 --fault gyro=2,kind=bias,at=10,size=0.5 -o " + csv);
   ASSERT_EQ(r.exit_status, 0) << r.err;
-  make_tdms(csv, dir.file("lab.tdms"),
-            "--rename time_s=Time g1=FOG_A g2=FOG_B g3=FOG_C g4=FOG_D --rename-property latitude_deg=Latitude");
+  make_tdms(
+      csv, dir.file("lab.tdms"),
+      "--rename time_s=Time g1=FOG_A g2=FOG_B g3=FOG_C g4=FOG_D --rename-property latitude_deg=Latitude");
   test::write_file(dir.file("lab.channels.yaml"),
                    "channels:\n  time_s: Time\n  g1: FOG_A\n  g2: Log/FOG_B\n  g3: FOG_C\n  g4: FOG_D\n"
                    "properties:\n  latitude_deg: Latitude\n");
   const std::string cal = "--calibration " + source_path("examples/factory.yaml");
   for (const char* in : {"log.csv", "lab.tdms"}) {
     const std::string base = dir.file(in);
-    r = run_tetra("replay " + base + " " + cal + " --latitude -23.2 --attitude " + base + ".att.csv --events " +
-                  base + ".ev.jsonl");
+    r = run_tetra("replay " + base + " " + cal + " --latitude -23.2 --attitude " + base +
+                  ".att.csv --events " + base + ".ev.jsonl");
     ASSERT_EQ(r.exit_status, 0) << r.err;
     r = run_tetra("convert " + base + " " + base + ".out.csv");
     ASSERT_EQ(r.exit_status, 0) << r.err;
@@ -149,11 +153,13 @@ Bytes doubles(std::initializer_list<double> v) {
   return r;
 }
 
-Result<TdmsFile> parse(const Bytes& file) { return parse_tdms(file.b, "x.tdms"); }
+Result<TdmsFile> parse(const Bytes& file) {
+  return parse_tdms(file.b, "x.tdms");
+}
 
 TEST(TdmsParse, IncrementalMetadataAndInterleavedChunks) {
   Bytes file = segment(0x0E, two_channels(2), doubles({1, 2, 10, 20}));  // contiguous: a a b b
-  Bytes seg2 = segment(0x08, {}, doubles({3, 4, 30, 40}));               // previous metadata, contiguous: one chunk
+  Bytes seg2 = segment(0x08, {}, doubles({3, 4, 30, 40}));  // previous metadata, contiguous: one chunk
   file.raw(seg2.b.data(), seg2.b.size());
   Bytes m3;  // incremental: "b" as before, "a" with one value per chunk; interleaved
   m3.u32(1);
@@ -163,12 +169,14 @@ TEST(TdmsParse, IncrementalMetadataAndInterleavedChunks) {
   m3.u32(1);
   m3.u64(1);
   m3.u32(0);
-  Bytes seg3 = segment(0x0A | 0x20, m3, doubles({5, 50, 6, 60, 7, 70}));  // a has 1, b 2 values a chunk: refused
+  Bytes seg3 =
+      segment(0x0A | 0x20, m3, doubles({5, 50, 6, 60, 7, 70}));  // a has 1, b 2 values a chunk: refused
   Bytes bad = file;
   bad.raw(seg3.b.data(), seg3.b.size());
   const auto refused = parse(bad);
   ASSERT_FALSE(refused);
-  EXPECT_NE(refused.error().message.find("x.tdms: segment 3 at byte"), std::string::npos) << refused.error().message;
+  EXPECT_NE(refused.error().message.find("x.tdms: segment 3 at byte"), std::string::npos)
+      << refused.error().message;
   EXPECT_NE(refused.error().message.find("different value counts"), std::string::npos);
   m3.b.clear();
   m3.u32(2);
@@ -290,8 +298,9 @@ TEST(TdmsParse, TableNeedsNumericColumnsOfEqualLength) {
   map.channels = {{"time_s", "nope"}};
   const auto unmapped = tdms_to_table(*file, map);
   ASSERT_FALSE(unmapped);
-  EXPECT_NE(unmapped.error().message.find("m.yaml: channels: no channel 'nope' in x.tdms (channels: g/a, g/b)"),
-            std::string::npos)
+  EXPECT_NE(
+      unmapped.error().message.find("m.yaml: channels: no channel 'nope' in x.tdms (channels: g/a, g/b)"),
+      std::string::npos)
       << unmapped.error().message;
 }
 

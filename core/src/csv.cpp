@@ -21,13 +21,13 @@
 
 namespace tetra {
 
-namespace {
-
-std::string_view trim(std::string_view s) {
+std::string_view trim_blanks(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
   while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
   return s;
 }
+
+namespace {
 
 int hex_digit(char c) {
   if (c >= '0' && c <= '9') return c - '0';
@@ -126,10 +126,10 @@ inline void split_fields(std::string_view line, std::vector<std::string_view>& f
   while (true) {
     const std::size_t comma = line.find(',', start);
     if (comma == std::string_view::npos) {
-      fields.push_back(trim(line.substr(start)));
+      fields.push_back(trim_blanks(line.substr(start)));
       return;
     }
-    fields.push_back(trim(line.substr(start, comma - start)));
+    fields.push_back(trim_blanks(line.substr(start, comma - start)));
     start = comma + 1;
   }
 }
@@ -209,7 +209,7 @@ Status parse_lines(std::string_view text, std::size_t& pos, std::size_t& line_no
     pos += len + 1;
     ++line_no;
 
-    const std::string_view content = trim(line);
+    const std::string_view content = trim_blanks(line);
     if (content.empty()) continue;
     if (content.front() == '#') {
       parse_metadata_comment(content.substr(1), t.metadata);

@@ -9,18 +9,12 @@ namespace tetra {
 
 namespace {
 
-std::string_view trimmed(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
 // The comma-separated fields of a line, at most `limit` (one more means "too many").
-void split_fields(std::string_view line, std::size_t limit, std::vector<std::string_view>& fields) {
+void split_protocol_fields(std::string_view line, std::size_t limit, std::vector<std::string_view>& fields) {
   fields.clear();
   while (fields.size() <= limit) {
     const std::size_t comma = line.find(',');
-    fields.push_back(trimmed(line.substr(0, comma)));
+    fields.push_back(trim_blanks(line.substr(0, comma)));
     if (comma == std::string_view::npos) return;
     line.remove_prefix(comma + 1);
   }
@@ -30,15 +24,16 @@ void split_fields(std::string_view line, std::size_t limit, std::vector<std::str
 
 void LineProtocolParser::parse_line(std::string_view line, std::vector<RawGyroSample>& out) {
   ++line_no_;
-  line = trimmed(line);
+  line = trim_blanks(line);
   if (line.empty() || line.front() == '#') return;
   const std::string where = "line " + std::to_string(line_no_) + ": ";
   thread_local std::vector<std::string_view> f;
   const auto n = static_cast<std::size_t>(gyro_count_);
-  split_fields(line, n + 2, f);
+  split_protocol_fields(line, n + 2, f);
   double time_s = 0.0;
   if (f.size() < 3) return refuse(where + "expected TIME_S,GYRO,RAW or TIME_S,all,RAW1..RAWN");
-  if (!parse_number(f[0], time_s) || log_time_problem(time_s)) return refuse(where + "time_s is not a finite time");
+  if (!parse_number(f[0], time_s) || log_time_problem(time_s))
+    return refuse(where + "time_s is not a finite time");
   const std::size_t first = out.size();
   if (f[1] == "all") {
     if (f.size() != n + 2) {
@@ -71,7 +66,8 @@ void LineProtocolParser::feed(std::span<const std::uint8_t> bytes, std::vector<R
     if (b == '\n') {
       if (overlong_) {
         ++line_no_;
-        refuse("line " + std::to_string(line_no_) + ": longer than " + std::to_string(kMaxLineBytes) + " bytes");
+        refuse("line " + std::to_string(line_no_) + ": longer than " + std::to_string(kMaxLineBytes) +
+               " bytes");
         overlong_ = false;
       } else {
         parse_line(pending_, out);

@@ -49,13 +49,30 @@ std::string hex_type(std::uint32_t type) {
 // Size in bytes of one value of a fixed-size type, 0 for strings and unknown types.
 std::size_t type_size(std::uint32_t type) {
   switch (type) {
-    case 1: case 5: case kTdsBoolean: return 1;  // I8, U8, Boolean
-    case 2: case 6: return 2;                    // I16, U16
-    case 3: case 7: case 9: case 0x19: return 4;  // I32, U32, SingleFloat (with unit)
-    case 4: case 8: case 10: case 0x1A: return 8;  // I64, U64, DoubleFloat (with unit)
-    case 0x08000C: return 8;                      // ComplexSingleFloat
-    case kTdsTimeStamp: case 0x10000D: return 16;  // TimeStamp, ComplexDoubleFloat
-    default: return 0;
+    case 1:
+    case 5:
+    case kTdsBoolean:
+      return 1;  // I8, U8, Boolean
+    case 2:
+    case 6:
+      return 2;  // I16, U16
+    case 3:
+    case 7:
+    case 9:
+    case 0x19:
+      return 4;  // I32, U32, SingleFloat (with unit)
+    case 4:
+    case 8:
+    case 10:
+    case 0x1A:
+      return 8;  // I64, U64, DoubleFloat (with unit)
+    case 0x08000C:
+      return 8;  // ComplexSingleFloat
+    case kTdsTimeStamp:
+    case 0x10000D:
+      return 16;  // TimeStamp, ComplexDoubleFloat
+    default:
+      return 0;
   }
 }
 
@@ -110,16 +127,28 @@ class Cursor {
 // A value of a fixed-size numeric type as a double.
 double load_number(const std::uint8_t* at, std::uint32_t type, bool big) {
   switch (type) {
-    case 1: return Cursor::load<std::int8_t>(at, big);
-    case 2: return Cursor::load<std::int16_t>(at, big);
-    case 3: return Cursor::load<std::int32_t>(at, big);
-    case 4: return static_cast<double>(Cursor::load<std::int64_t>(at, big));
-    case 5: case kTdsBoolean: return Cursor::load<std::uint8_t>(at, big);
-    case 6: return Cursor::load<std::uint16_t>(at, big);
-    case 7: return Cursor::load<std::uint32_t>(at, big);
-    case 8: return static_cast<double>(Cursor::load<std::uint64_t>(at, big));
-    case 9: case 0x19: return Cursor::load<float>(at, big);
-    default: return Cursor::load<double>(at, big);  // 10, 0x1A
+    case 1:
+      return Cursor::load<std::int8_t>(at, big);
+    case 2:
+      return Cursor::load<std::int16_t>(at, big);
+    case 3:
+      return Cursor::load<std::int32_t>(at, big);
+    case 4:
+      return static_cast<double>(Cursor::load<std::int64_t>(at, big));
+    case 5:
+    case kTdsBoolean:
+      return Cursor::load<std::uint8_t>(at, big);
+    case 6:
+      return Cursor::load<std::uint16_t>(at, big);
+    case 7:
+      return Cursor::load<std::uint32_t>(at, big);
+    case 8:
+      return static_cast<double>(Cursor::load<std::uint64_t>(at, big));
+    case 9:
+    case 0x19:
+      return Cursor::load<float>(at, big);
+    default:
+      return Cursor::load<double>(at, big);  // 10, 0x1A
   }
 }
 
@@ -178,8 +207,8 @@ class TdmsParser {
   std::size_t segment_ = 0;
   std::size_t segment_start_ = 0;
   bool big_ = false;
-  std::vector<ListedObject> list_;                    // the current segment's objects, in data order
-  std::vector<std::optional<RawIndex>> last_index_;  // per channel: its last raw data index
+  std::vector<ListedObject> list_;                           // the current segment's objects, in data order
+  std::vector<std::optional<RawIndex>> last_index_;          // per channel: its last raw data index
   std::unordered_map<std::string, std::size_t> channel_at_;  // object path → channel index
   std::vector<std::size_t> listed_at_;  // per channel: its place in the list being read, or kNotListed
 };
@@ -215,7 +244,8 @@ Result<std::vector<std::string>> TdmsParser::split_path(const std::string& path)
 
 Result<std::size_t> TdmsParser::channel_for(const std::vector<std::string>& parts, const std::string& path) {
   if (const auto it = channel_at_.find(path); it != channel_at_.end()) return it->second;
-  if (file_.channels.size() >= kMaxChannels) return fail("more than " + std::to_string(kMaxChannels) + " channels");
+  if (file_.channels.size() >= kMaxChannels)
+    return fail("more than " + std::to_string(kMaxChannels) + " channels");
   channel_at_.emplace(path, file_.channels.size());
   TdmsChannel ch;
   ch.group = parts[0];
@@ -287,7 +317,8 @@ Status TdmsParser::read_object(Cursor& c, std::vector<ListedObject>& list) {
   auto parts = split_path(path);
   if (!parts) return parts.error();
   const bool is_channel = parts->size() == 2;
-  if (!is_channel && marker != kNoRawData) return fail("object '" + path + "' is not a channel but has raw data");
+  if (!is_channel && marker != kNoRawData)
+    return fail("object '" + path + "' is not a channel but has raw data");
   if (!is_channel) {
     return read_properties(c, parts->empty() ? &file_.properties : nullptr, path);
   }
@@ -308,16 +339,21 @@ Status TdmsParser::read_object(Cursor& c, std::vector<ListedObject>& list) {
     if (!c.get(idx.type) || !c.get(dimension) || !c.get(idx.count)) {
       return fail("channel '" + path + "': truncated raw data index");
     }
-    if (dimension != 1) return fail("channel '" + path + "': array dimension " + std::to_string(dimension) + ", expected 1");
+    if (dimension != 1)
+      return fail("channel '" + path + "': array dimension " + std::to_string(dimension) + ", expected 1");
     const std::size_t size = type_size(idx.type);
     if (idx.type == kTdsString) {
-      if (marker != 28 || !c.get(idx.chunk_bytes)) return fail("channel '" + path + "': bad string raw data index");
+      if (marker != 28 || !c.get(idx.chunk_bytes))
+        return fail("channel '" + path + "': bad string raw data index");
     } else if (size == 0) {
       return fail("channel '" + path + "': data type " + hex_type(idx.type) + " is not supported");
     } else {
-      if (marker != 20) return fail("channel '" + path + "': raw data index of " + std::to_string(marker) + " bytes, expected 20");
+      if (marker != 20)
+        return fail("channel '" + path + "': raw data index of " + std::to_string(marker) +
+                    " bytes, expected 20");
       if (idx.count > bytes_.size() / size) {
-        return fail("channel '" + path + "': " + std::to_string(idx.count) + " values per chunk cannot fit in the file");
+        return fail("channel '" + path + "': " + std::to_string(idx.count) +
+                    " values per chunk cannot fit in the file");
       }
       idx.chunk_bytes = idx.count * size;
     }
@@ -365,7 +401,8 @@ Status TdmsParser::read_chunk(Cursor& c, bool interleaved) {
       ch.value_count += o.index.count;
       if (!ch.numeric) continue;
       const std::size_t size = type_size(o.index.type);
-      for (std::uint64_t v = 0; v < o.index.count; ++v) ch.values.push_back(load_number(at + v * size, o.index.type, big_));
+      for (std::uint64_t v = 0; v < o.index.count; ++v)
+        ch.values.push_back(load_number(at + v * size, o.index.type, big_));
     }
     return ok_status();
   }
@@ -399,7 +436,8 @@ Status TdmsParser::read_raw(std::size_t begin, std::size_t end, std::uint32_t to
   }
   const std::size_t raw = end - begin;
   if (chunk == 0) {
-    if (raw != 0) return fail(std::to_string(raw) + " bytes of raw data but no channel has data in this segment");
+    if (raw != 0)
+      return fail(std::to_string(raw) + " bytes of raw data but no channel has data in this segment");
     return ok_status();
   }
   if (raw % chunk != 0) {
@@ -428,14 +466,16 @@ Result<TdmsFile> TdmsParser::run() {
       return fail("truncated lead-in (" + std::to_string(bytes_.size() - pos) + " of 28 bytes)");
     }
     const std::uint8_t* lead = bytes_.data() + pos;
-    if (std::memcmp(lead, "TDSh", 4) == 0) return fail("this is a .tdms_index file: give the .tdms file itself");
+    if (std::memcmp(lead, "TDSh", 4) == 0)
+      return fail("this is a .tdms_index file: give the .tdms file itself");
     if (std::memcmp(lead, "TDSm", 4) != 0) return fail("no 'TDSm' tag: not a TDMS segment");
     const auto toc = Cursor::load<std::uint32_t>(lead + 4, false);
     big_ = (toc & kTocBigEndian) != 0;
     const auto version = Cursor::load<std::uint32_t>(lead + 8, big_);
     const auto next_offset = Cursor::load<std::uint64_t>(lead + 12, big_);
     const auto raw_offset = Cursor::load<std::uint64_t>(lead + 20, big_);
-    if (version != 4712 && version != 4713) return fail("version " + std::to_string(version) + ", expected 4712 or 4713");
+    if (version != 4712 && version != 4713)
+      return fail("version " + std::to_string(version) + ", expected 4712 or 4713");
     if ((toc & kTocDAQmxRawData) != 0) return fail("DAQmx raw data is not supported: save numeric channels");
     const std::size_t body = pos + kLeadInBytes;
     const std::size_t left = bytes_.size() - body;
@@ -469,7 +509,8 @@ Result<TdmsFile> TdmsParser::run() {
 bool is_tdms_path(const std::string& path) {
   if (path.size() < 5) return false;
   std::string ext = path.substr(path.size() - 5);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
   return ext == ".tdms";
 }
 

@@ -13,7 +13,8 @@ namespace tetra {
 namespace {
 
 // The channel a map entry names: "Channel" (one group holds that name) or "Group/Channel".
-Result<const TdmsChannel*> find_channel(const TdmsFile& file, const std::string& ref, const std::string& where) {
+Result<const TdmsChannel*> find_channel(const TdmsFile& file, const std::string& ref,
+                                        const std::string& where) {
   const TdmsChannel* found = nullptr;
   for (const TdmsChannel& ch : file.channels) {
     if (ch.name != ref) continue;
@@ -41,8 +42,9 @@ Result<std::vector<std::pair<std::string, const TdmsChannel*>>> pick_columns(con
       if (ch.type == 0) continue;  // an object without values (e.g. a property holder)
       for (const auto& [name, other] : cols) {
         if (name == ch.name) {
-          return bad_input(file.source + ": channel '" + ch.name + "' is in groups '" + other->group + "' and '" +
-                           ch.group + "': choose one in a channel map (" + tdms_channel_map_path(file.source) + ")");
+          return bad_input(file.source + ": channel '" + ch.name + "' is in groups '" + other->group +
+                           "' and '" + ch.group + "': choose one in a channel map (" +
+                           tdms_channel_map_path(file.source) + ")");
         }
       }
       cols.emplace_back(ch.name, &ch);
@@ -56,7 +58,8 @@ Result<std::vector<std::pair<std::string, const TdmsChannel*>>> pick_columns(con
     }
   }
   if (cols.empty()) return bad_input(file.source + ": no channel holds values");
-  if (cols.size() > kMaxColumns) return bad_input(file.source + ": more than " + std::to_string(kMaxColumns) + " channels");
+  if (cols.size() > kMaxColumns)
+    return bad_input(file.source + ": more than " + std::to_string(kMaxColumns) + " channels");
   for (const auto& [name, ch] : cols) {
     if (!ch->numeric) {
       return bad_input(file.source + ": channel '" + ch->group + "/" + ch->name + "' (column '" + name +
@@ -65,7 +68,8 @@ Result<std::vector<std::pair<std::string, const TdmsChannel*>>> pick_columns(con
     if (ch->values.size() != cols.front().second->values.size()) {
       return bad_input(file.source + ": channel '" + ch->name + "' has " + std::to_string(ch->values.size()) +
                        " values, channel '" + cols.front().second->name + "' has " +
-                       std::to_string(cols.front().second->values.size()) + ": every column needs one per row");
+                       std::to_string(cols.front().second->values.size()) +
+                       ": every column needs one per row");
     }
   }
   return cols;
@@ -74,7 +78,8 @@ Result<std::vector<std::pair<std::string, const TdmsChannel*>>> pick_columns(con
 }  // namespace
 
 std::string tdms_channel_map_path(const std::string& tdms_path) {
-  return tdms_path.substr(0, is_tdms_path(tdms_path) ? tdms_path.size() - 5 : tdms_path.size()) + ".channels.yaml";
+  return tdms_path.substr(0, is_tdms_path(tdms_path) ? tdms_path.size() - 5 : tdms_path.size()) +
+         ".channels.yaml";
 }
 
 Result<TdmsChannelMap> parse_tdms_channel_map(const std::string& text, const std::string& source) {
@@ -88,7 +93,8 @@ Result<TdmsChannelMap> parse_tdms_channel_map(const std::string& text, const std
   for (const char* key : {"channels", "properties"}) {
     const YAML::Node node = (*root)[key];
     if (!node || node.IsNull()) continue;
-    if (!node.IsMap()) return yaml.error(node, key, "expected a mapping 'name in tetra: name in the TDMS file'");
+    if (!node.IsMap())
+      return yaml.error(node, key, "expected a mapping 'name in tetra: name in the TDMS file'");
     auto& into = std::string(key) == "channels" ? map.channels : map.properties;
     for (const auto& kv : node) {
       auto name = yaml.text(kv.first, key);

@@ -33,13 +33,15 @@ void add_play_options(CLI::App& app, PlayCli& o) {
           [](std::string& text) -> std::string {
             if (text == "max") return {};
             const auto v = parse_decimal(text);
-            return v && *v >= 1e-3 && *v <= 1e6 ? std::string() : "'" + text + "' must be max or from 0.001 to 1e6";
+            return v && *v >= 1e-3 && *v <= 1e6 ? std::string()
+                                                : "'" + text + "' must be max or from 0.001 to 1e6";
           },
           "max|X", "speed"));
   app.add_flag("--loop", o.options.loop, "start again at the end, times continuing (until Ctrl-C)");
   app.add_option("--start", o.start_s, "[s] first log time to play (inclusive)")->check(number_in(-9e9, 9e9));
   app.add_option("--end", o.end_s, "[s] last log time to play (inclusive)")->check(number_in(-9e9, 9e9));
-  app.add_option("--unit", o.options.unit, "the unit's key on the wire (default: the log's '# unit=' comment, else tetra-1)")
+  app.add_option("--unit", o.options.unit,
+                 "the unit's key on the wire (default: the log's '# unit=' comment, else tetra-1)")
       ->check(unit_name_check());
   app.add_option("--wait-readers", o.options.wait_readers, "GyroSample readers to wait for before publishing")
       ->check(CLI::NonNegativeNumber);
@@ -52,8 +54,8 @@ void add_play_options(CLI::App& app, PlayCli& o) {
 void print_play_report(const player::PlayReport& r, bool lockstep) {
   std::cout << "unit: " << r.unit << '\n'
             << "epochs published: " << r.epochs << " (" << r.samples << " gyro samples, " << r.references
-            << " references) in " << fixed(r.wall_s, 2) << " s, " << r.passes << (r.passes == 1 ? " pass" : " passes")
-            << '\n'
+            << " references) in " << fixed(r.wall_s, 2) << " s, " << r.passes
+            << (r.passes == 1 ? " pass" : " passes") << '\n'
             << "log times: " << fixed(r.first_time_s, 3) << " to " << fixed(r.last_time_s, 3) << " s\n"
             << "attitudes received: " << r.attitudes << '\n';
   if (lockstep) {
@@ -76,7 +78,8 @@ int cmd_play(int argc, char** argv) {
   if (app.count("--start") > 0) o.options.start_s = o.start_s;
   if (app.count("--end") > 0) o.options.end_s = o.end_s;
   if (o.options.start_s && o.options.end_s && *o.options.end_s < *o.options.start_s) {
-    return report("play", bad_input("--end " + fixed(o.end_s, 3) + " is before --start " + fixed(o.start_s, 3)));
+    return report("play",
+                  bad_input("--end " + fixed(o.end_s, 3) + " is before --start " + fixed(o.start_s, 3)));
   }
   dds::ShutdownSignal shutdown;
   const auto progress = [&](const player::PlayReport& r) {

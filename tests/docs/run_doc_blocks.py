@@ -16,7 +16,7 @@ before a block may adjust how it runs (the reader does not see it):
     <!-- doc-test: expect FILE -->                FILE must exist afterwards (besides those found below)
 
 The blocks of one document run in order in one temporary folder (a later block may use an earlier one's
-files). The folder holds links to the repository's examples/, config/, scripts/, bench/, web/ and the
+files). The folder holds links to the repository's examples/, config/, scripts/, bench/, web/, tests/ and the
 build folder, so the paths the docs show work; `tetra` on PATH is the program built, and `build/tetra`
 is it too; `build/python` is the Python package built beside it (when it is). A block fails on a
 non-zero exit status (bash -e, pipefail) or when a file it names as an output (-o, --out, --truth,
@@ -41,7 +41,7 @@ FENCE = re.compile(r"^```\s*(\w*)\s*$")
 MARKER = re.compile(r"<!--\s*doc-test:(.*?)-->", re.S)
 OUTPUT_OPTIONS = ("-o", "--out", "--truth", "--attitude", "--events", "--json", "--plot", "--summary",
                   "--pointing", "--write-unit", "--kalibr")
-LINKED = ("examples", "config", "scripts", "bench", "web", "idl", "packaging")
+LINKED = ("examples", "config", "scripts", "bench", "web", "idl", "packaging", "tests")
 
 
 class Block:

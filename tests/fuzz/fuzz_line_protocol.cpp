@@ -1,6 +1,7 @@
 // libFuzzer target: the line protocol of `tetra ingest` (core/sample_parser.hpp) on arbitrary bytes, fed in
 // two pieces split where the first byte says (a stream may break a line anywhere). Every line is either
-// samples of gyros 1..N with finite times or one refusal; never a crash; the split does not change the result.
+// samples of gyros 1..N with finite times or one refusal; never a crash; the split does not change the
+// result.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>

@@ -16,14 +16,22 @@ namespace {
 
 Result<speed_t> baud_constant(int baud) {
   switch (baud) {
-    case 9600: return B9600;
-    case 19200: return B19200;
-    case 38400: return B38400;
-    case 57600: return B57600;
-    case 115200: return B115200;
-    case 230400: return B230400;
-    case 460800: return B460800;
-    case 921600: return B921600;
+    case 9600:
+      return B9600;
+    case 19200:
+      return B19200;
+    case 38400:
+      return B38400;
+    case 57600:
+      return B57600;
+    case 115200:
+      return B115200;
+    case 230400:
+      return B230400;
+    case 460800:
+      return B460800;
+    case 921600:
+      return B921600;
     default:
       return bad_input(ErrorSubject("baud", std::to_string(baud)),
                        "not a standard rate (9600, 19200, 38400, 57600, 115200, 230400, 460800, 921600)");
@@ -34,7 +42,8 @@ Status configure_serial(int fd, const IngestOptions& o) {
   auto speed = baud_constant(o.baud);
   if (!speed) return speed.error();
   termios tio{};
-  if (::tcgetattr(fd, &tio) != 0) return bad_input(o.serial_path + ": not a terminal: " + std::strerror(errno));
+  if (::tcgetattr(fd, &tio) != 0)
+    return bad_input(o.serial_path + ": not a terminal: " + std::strerror(errno));
   ::cfmakeraw(&tio);
   tio.c_cflag |= CLOCAL | CREAD;
   tio.c_cflag &= ~static_cast<tcflag_t>(CSTOPB | PARENB | PARODD | CSIZE);
@@ -42,12 +51,15 @@ Status configure_serial(int fd, const IngestOptions& o) {
   if (o.parity != Parity::kNone) {
     tio.c_cflag |= PARENB;
     if (o.parity == Parity::kOdd) tio.c_cflag |= PARODD;
-    tio.c_iflag |= INPCK | IGNPAR;  // check parity; a byte with a parity error is dropped (its line is malformed)
+    tio.c_iflag |=
+        INPCK | IGNPAR;  // check parity; a byte with a parity error is dropped (its line is malformed)
   }
   tio.c_cc[VMIN] = 1;
   tio.c_cc[VTIME] = 0;
-  if (::cfsetispeed(&tio, *speed) != 0 || ::cfsetospeed(&tio, *speed) != 0 || ::tcsetattr(fd, TCSANOW, &tio) != 0) {
-    return failure(o.serial_path + ": cannot set " + std::to_string(o.baud) + " baud: " + std::strerror(errno));
+  if (::cfsetispeed(&tio, *speed) != 0 || ::cfsetospeed(&tio, *speed) != 0 ||
+      ::tcsetattr(fd, TCSANOW, &tio) != 0) {
+    return failure(o.serial_path + ": cannot set " + std::to_string(o.baud) +
+                   " baud: " + std::strerror(errno));
   }
   return ok_status();
 }

@@ -18,8 +18,8 @@ class ByteSource {
   ByteSource(const ByteSource&) = delete;
   ByteSource& operator=(const ByteSource&) = delete;
   ~ByteSource();
-  int fd() const { return fd_; }                  //!< for poll()
-  bool datagrams() const { return datagrams_; }   //!< each read is one whole datagram
+  int fd() const { return fd_; }                 //!< for poll()
+  bool datagrams() const { return datagrams_; }  //!< each read is one whole datagram
   const std::string& name() const { return name_; }
   //! Reads what is there (never blocks once poll() said readable); `ended` at end of file or hang-up.
   Result<std::size_t> read(std::span<std::uint8_t> buffer, bool& ended);

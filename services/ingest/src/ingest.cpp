@@ -76,14 +76,15 @@ std::unique_ptr<SampleParser> line_protocol_parser(const IngestOptions& options)
   return std::make_unique<LineProtocolParser>(options.gyro_count);
 }
 
-Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shutdown, const ParserFactory& make_parser,
+Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shutdown,
+                                const ParserFactory& make_parser,
                                 const std::function<void(const IngestReport&)>& on_progress) {
   auto session = dds::Session::open(o.domain, o.unit);
   if (!session) return session.error();
   dds::Qos qos = dds::gyro_sample_qos(std::chrono::nanoseconds(seconds_to_ns(1.0 / o.rate_hz)));
   qos.no_autodispose();
-  // A source may deliver a burst (a serial buffer read at once): keep every sample until acknowledged, not the
-  // topic's last 64 (history is not part of the reader-writer contract: any reader still matches).
+  // A source may deliver a burst (a serial buffer read at once): keep every sample until acknowledged, not
+  // the topic's last 64 (history is not part of the reader-writer contract: any reader still matches).
   qos.keep_last(kWriterDepth);
   auto writer = session->writer<tetra_GyroSample>(qos);
   if (!writer) return writer.error();
@@ -120,7 +121,8 @@ Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shu
     const std::int64_t now = dds::monotonic_ns();
     if (now >= stop_at) break;
     pollfd pfd{(*source)->fd(), POLLIN, 0};
-    const int ready = ::poll(&pfd, 1, static_cast<int>(std::min<std::int64_t>(100, (stop_at - now) / 1'000'000 + 1)));
+    const int ready =
+        ::poll(&pfd, 1, static_cast<int>(std::min<std::int64_t>(100, (stop_at - now) / 1'000'000 + 1)));
     if (ready > 0) {
       auto got = (*source)->read(buffer, ended);
       if (!got) return got.error();

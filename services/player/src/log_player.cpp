@@ -20,11 +20,11 @@ namespace {
 // What the first pass learns of the log before anything is published.
 struct LogShape {
   GyroLog header;
-  double rate_hz = 0.0;       // [Hz] from the median period of the first block
-  double period_s = 0.0;      // [s] that median period
-  double first_s = 0.0;       // [s] first time in [start, end]
-  double last_s = 0.0;        // [s] last time in [start, end]
-  std::uint64_t epochs = 0;   // epochs in [start, end]
+  double rate_hz = 0.0;      // [Hz] from the median period of the first block
+  double period_s = 0.0;     // [s] that median period
+  double first_s = 0.0;      // [s] first time in [start, end]
+  double last_s = 0.0;       // [s] last time in [start, end]
+  std::uint64_t epochs = 0;  // epochs in [start, end]
 };
 
 bool in_window(double t, const PlayOptions& o) {
@@ -39,8 +39,9 @@ Result<LogShape> inspect(const std::string& path, const PlayOptions& options) {
   LogShape shape;
   shape.header = reader.header();
   if (shape.header.units_dps) {
-    return bad_input(path + ": the log holds rates (units=dps); GyroSample carries the gyros' raw outputs [V]: "
-                            "play a log in volts (as tetra record writes it)");
+    return bad_input(path +
+                     ": the log holds rates (units=dps); GyroSample carries the gyros' raw outputs [V]: "
+                     "play a log in volts (as tetra record writes it)");
   }
   GyroLog block;
   std::vector<double> periods;
@@ -59,7 +60,8 @@ Result<LogShape> inspect(const std::string& path, const PlayOptions& options) {
   }
   if (shape.epochs == 0) return bad_input(path + ": no epoch within --start/--end");
   if (periods.empty()) periods.push_back(0.01);
-  std::nth_element(periods.begin(), periods.begin() + static_cast<std::ptrdiff_t>(periods.size() / 2), periods.end());
+  std::nth_element(periods.begin(), periods.begin() + static_cast<std::ptrdiff_t>(periods.size() / 2),
+                   periods.end());
   shape.period_s = periods[periods.size() / 2];
   shape.rate_hz = 1.0 / shape.period_s;
   return shape;
@@ -106,12 +108,15 @@ class Player {
       next_progress_ = *start_wall_ + 1'000'000'000;
     }
     if (!lockstep) {
-      const auto due = *start_wall_ + static_cast<std::int64_t>(static_cast<double>(stamp - first_stamp_) / options_.speed);
-      for (std::int64_t now = dds::monotonic_ns(); now < due && !link_.stop_requested(); now = dds::monotonic_ns()) {
+      const auto due = *start_wall_ +
+                       static_cast<std::int64_t>(static_cast<double>(stamp - first_stamp_) / options_.speed);
+      for (std::int64_t now = dds::monotonic_ns(); now < due && !link_.stop_requested();
+           now = dds::monotonic_ns()) {
         if (Status s = link_.wait_until(due); !s) return s;
         if (Status s = link_.take_attitudes(report_.attitudes, newest_); !s) return s;
       }
-      report_.worst_lag_ms = std::max(report_.worst_lag_ms, static_cast<double>(dds::monotonic_ns() - due) * 1e-6);
+      report_.worst_lag_ms =
+          std::max(report_.worst_lag_ms, static_cast<double>(dds::monotonic_ns() - due) * 1e-6);
     }
     if (Status s = link_.publish(stamp, ++seq_, raw, present, ref, lockstep, report_.samples); !s) return s;
     report_.references += ref ? 1 : 0;
@@ -147,7 +152,8 @@ class Player {
 
 }  // namespace
 
-Result<PlayReport> play_log(const std::string& path, const PlayOptions& options, dds::ShutdownSignal* shutdown,
+Result<PlayReport> play_log(const std::string& path, const PlayOptions& options,
+                            dds::ShutdownSignal* shutdown,
                             const std::function<void(const PlayReport&)>& on_progress) {
   auto shape = inspect(path, options);
   if (!shape) return shape.error();
@@ -160,7 +166,8 @@ Result<PlayReport> play_log(const std::string& path, const PlayOptions& options,
   const std::int64_t pass_span_ns = seconds_to_ns(shape->last_s - shape->first_s + shape->period_s);
   const std::int64_t start = dds::monotonic_ns();
   do {
-    if (Status s = player.pass(path, static_cast<std::int64_t>(report.passes) * pass_span_ns); !s) return s.error();
+    if (Status s = player.pass(path, static_cast<std::int64_t>(report.passes) * pass_span_ns); !s)
+      return s.error();
     ++report.passes;
   } while (options.loop && !(*link)->stop_requested());
   report.wall_s = ns_to_seconds(dds::monotonic_ns() - start);

@@ -15,8 +15,9 @@ enum PlayerToken : std::intptr_t { kPlayerAttitude = 1, kPlayerMatched, kPlayerS
 constexpr std::int64_t kPlayerSettle_ns = 200'000'000;  //!< [ns] discovery settling for other readers
 }  // namespace
 
-Result<std::unique_ptr<PlayerLink>> PlayerLink::open(const std::string& unit, double rate_hz, bool with_reference,
-                                                     const PlayOptions& options, dds::ShutdownSignal* shutdown) {
+Result<std::unique_ptr<PlayerLink>> PlayerLink::open(const std::string& unit, double rate_hz,
+                                                     bool with_reference, const PlayOptions& options,
+                                                     dds::ShutdownSignal* shutdown) {
   auto session = dds::Session::open(options.domain, unit);
   if (!session) return session.error();
   const double wall_rate_hz = rate_hz * (options.speed > 0 ? options.speed : 1.0);
@@ -43,7 +44,8 @@ Result<std::unique_ptr<PlayerLink>> PlayerLink::open(const std::string& unit, do
 Status PlayerLink::wait_for_readers(const PlayOptions& options, bool with_reference) {
   if (auto s = session_.watch_data(attitude_.handle(), kPlayerAttitude); !s) return s.error();
   for (dds_entity_t w : {gyro_.handle(), reference_.handle()}) {
-    if (auto s = session_.watch_statuses(w, DDS_PUBLICATION_MATCHED_STATUS, kPlayerMatched); !s) return s.error();
+    if (auto s = session_.watch_statuses(w, DDS_PUBLICATION_MATCHED_STATUS, kPlayerMatched); !s)
+      return s.error();
   }
   auto guard = session_.add_guard(kPlayerShutdown);
   if (!guard) return guard.error();
@@ -59,7 +61,8 @@ Status PlayerLink::wait_for_readers(const PlayOptions& options, bool with_refere
     if (!references) return references.error();
     // A log with a reference: the service's reference reader too (its first sample sets the attitude).
     const int references_needed = with_reference ? std::min(options.wait_readers, 1) : 0;
-    if (static_cast<int>(*gyros) >= options.wait_readers && static_cast<int>(*references) >= references_needed)
+    if (static_cast<int>(*gyros) >= options.wait_readers &&
+        static_cast<int>(*references) >= references_needed)
       return ok_status();
     if (stop_requested()) return failure("interrupted while waiting for readers");
     const std::int64_t now = dds::monotonic_ns();
@@ -101,7 +104,8 @@ Status PlayerLink::wait_for_service(const PlayOptions& options) {
     if (auto s = waitset->wait(std::chrono::nanoseconds(limit - now), fired); !s) return s.error();
   }
   // The service's Attitude writer (lockstep waits on it), briefly; then a settling time for other readers.
-  if (auto s = session_.watch_statuses(attitude_.handle(), DDS_SUBSCRIPTION_MATCHED_STATUS, kPlayerMatched); !s)
+  if (auto s = session_.watch_statuses(attitude_.handle(), DDS_SUBSCRIPTION_MATCHED_STATUS, kPlayerMatched);
+      !s)
     return s.error();
   const std::int64_t until = dds::monotonic_ns() + (hears ? 1'000'000'000 : kPlayerSettle_ns);
   for (;;) {

@@ -21,8 +21,9 @@ class PlayerLink {
  public:
   //! Creates the entities (the deadline offered: 3 periods of `rate_hz` at `speed`, at 1 in lockstep)
   //! and waits for the readers and the service of `unit`.
-  static Result<std::unique_ptr<PlayerLink>> open(const std::string& unit, double rate_hz, bool with_reference,
-                                                  const PlayOptions& options, dds::ShutdownSignal* shutdown);
+  static Result<std::unique_ptr<PlayerLink>> open(const std::string& unit, double rate_hz,
+                                                  bool with_reference, const PlayOptions& options,
+                                                  dds::ShutdownSignal* shutdown);
   //! The reference first (acknowledged before the samples in lockstep), then the samples delivered.
   Status publish(std::int64_t stamp_ns, std::uint64_t seq, std::span<const double> raw,
                  std::span<const std::uint8_t> present, const std::optional<std::array<double, 4>>& ref_wxyz,

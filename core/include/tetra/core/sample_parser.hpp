@@ -34,8 +34,8 @@ class SampleParser {
   virtual void feed(std::span<const std::uint8_t> bytes, std::vector<RawGyroSample>& out) = 0;
   //! Everything still buffered is a complete unit (end of stream, or the end of a datagram).
   virtual void flush(std::vector<RawGyroSample>& out) = 0;
-  std::uint64_t accepted() const { return accepted_; }    //!< lines or frames that gave samples
-  std::uint64_t malformed() const { return malformed_; }  //!< lines or frames refused
+  std::uint64_t accepted() const { return accepted_; }               //!< lines or frames that gave samples
+  std::uint64_t malformed() const { return malformed_; }             //!< lines or frames refused
   const std::string& last_problem() const { return last_problem_; }  //!< why the last one was refused
 
  protected:

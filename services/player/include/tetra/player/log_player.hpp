@@ -23,28 +23,28 @@ namespace tetra::player {
 
 struct PlayOptions {
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
-  std::string unit;                  //!< DDS key; empty: the log's "# unit=" comment, else "tetra-1"
-  double speed = 1.0;                //!< 1 = the log's pace, X = X times faster, 0 = lockstep
-  bool loop = false;                 //!< start again at the end (times keep increasing, see log_player.cpp)
-  std::optional<double> start_s;     //!< [s] first log time played (inclusive)
-  std::optional<double> end_s;       //!< [s] last log time played (inclusive)
-  int wait_readers = 1;              //!< GyroSample readers to wait for before the first sample
-  double wait_timeout_s = 10.0;      //!< [s] give up waiting for them
-  double lockstep_timeout_s = 2.0;   //!< [s] lockstep: longest wait for an epoch's Attitude
+  std::string unit;                 //!< DDS key; empty: the log's "# unit=" comment, else "tetra-1"
+  double speed = 1.0;               //!< 1 = the log's pace, X = X times faster, 0 = lockstep
+  bool loop = false;                //!< start again at the end (times keep increasing, see log_player.cpp)
+  std::optional<double> start_s;    //!< [s] first log time played (inclusive)
+  std::optional<double> end_s;      //!< [s] last log time played (inclusive)
+  int wait_readers = 1;             //!< GyroSample readers to wait for before the first sample
+  double wait_timeout_s = 10.0;     //!< [s] give up waiting for them
+  double lockstep_timeout_s = 2.0;  //!< [s] lockstep: longest wait for an epoch's Attitude
 };
 
 struct PlayReport {
-  std::string unit;                     //!< the key the samples went out with
-  std::uint64_t epochs = 0;             //!< epochs published
-  std::uint64_t samples = 0;            //!< GyroSample written
-  std::uint64_t references = 0;         //!< AttitudeReference written
-  std::uint64_t passes = 0;             //!< passes over the log (1 without --loop)
-  std::uint64_t attitudes = 0;          //!< Attitude of this unit received
-  std::uint64_t lockstep_missing = 0;   //!< lockstep: epochs whose Attitude did not come in time
-  double first_time_s = 0.0;            //!< [s] log time of the first epoch published
-  double last_time_s = 0.0;             //!< [s] log time of the last epoch published
-  double wall_s = 0.0;                  //!< [s] publishing time
-  double worst_lag_ms = 0.0;            //!< [ms] paced: worst lateness of a write behind its due time
+  std::string unit;                    //!< the key the samples went out with
+  std::uint64_t epochs = 0;            //!< epochs published
+  std::uint64_t samples = 0;           //!< GyroSample written
+  std::uint64_t references = 0;        //!< AttitudeReference written
+  std::uint64_t passes = 0;            //!< passes over the log (1 without --loop)
+  std::uint64_t attitudes = 0;         //!< Attitude of this unit received
+  std::uint64_t lockstep_missing = 0;  //!< lockstep: epochs whose Attitude did not come in time
+  double first_time_s = 0.0;           //!< [s] log time of the first epoch published
+  double last_time_s = 0.0;            //!< [s] log time of the last epoch published
+  double wall_s = 0.0;                 //!< [s] publishing time
+  double worst_lag_ms = 0.0;           //!< [ms] paced: worst lateness of a write behind its due time
 };
 
 //! Plays the log until its end (every pass with `loop`: until a shutdown signal). `on_progress` is
