@@ -133,9 +133,10 @@ PerturbedRun fault_in_slew(Rng& rng, std::uint64_t index) {
   r.max_angular_acceleration_dps2 = rng.uniform() < 0.5 ? 2e-4 : 1e-3;
   static constexpr std::array<const char*, 7> kKinds = {
       "stuck", "zero", "bias 1e-2..3e-2", "bias 1e-3..3e-3", "noise", "ramp", "scale"};
-  r.case_name = std::string(kKinds[static_cast<std::size_t>(kind)]) + " at the " + kWhen[when];
-  r.label = "N=" + std::to_string(n) + " " + fault_text(r.options.faults[0]) + " at the " + kWhen[when] +
-            " of " + slew_text(slew) + (reference ? " ref" : "");
+  r.case_name = std::string(kKinds[static_cast<std::size_t>(kind)]) + " at the " +
+                kWhen[static_cast<std::size_t>(when)];
+  r.label = "N=" + std::to_string(n) + " " + fault_text(r.options.faults[0]) + " at the " +
+            kWhen[static_cast<std::size_t>(when)] + " of " + slew_text(slew) + (reference ? " ref" : "");
   return r;
 }
 
