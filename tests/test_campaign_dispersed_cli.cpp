@@ -60,7 +60,8 @@ TEST(CampaignDispersedCli, RowsCarryTheDrawsAndTheReportJudgesTheRequirements) {
   // A row torn among the draws' columns is redone on resume, to the same row.
   const std::string complete = read_file(dir.file("b") + "/runs.csv");
   write_file(dir.file("b") + "/runs.csv", complete.substr(0, complete.size() - 20));
-  const auto resumed = run_tetra("campaign " + dir.file("spec.yaml") + " --out " + dir.file("b") + " --no-report");
+  const auto resumed =
+      run_tetra("campaign " + dir.file("spec.yaml") + " --out " + dir.file("b") + " --no-report");
   ASSERT_EQ(resumed.exit_status, 0) << resumed.err;
   EXPECT_NE(resumed.err.find("5 already done"), std::string::npos) << resumed.err;
   EXPECT_EQ(sorted_lines(read_file(dir.file("b") + "/runs.csv")), rows);

@@ -9,8 +9,8 @@ namespace {
 TEST(Cli, HelpListsEveryCommand) {
   const auto r = test::run_tetra("help");
   EXPECT_EQ(r.exit_status, 0);
-  for (const char* c :
-       {"calibrate", "allan", "sim", "replay", "fusion", "monitor", "command", "record", "play", "ingest", "demo"}) {
+  for (const char* c : {"calibrate", "allan", "sim", "replay", "fusion", "monitor", "command", "record",
+                        "play", "ingest", "demo"}) {
     EXPECT_NE(r.out.find(c), std::string::npos) << c;
   }
 }

@@ -270,7 +270,8 @@ Status GyroLogWriter::open_output(OutputFile& out, int gyro_count, bool with_ref
   if (out_ != nullptr) return failure(out_->path() + ": writer already open");
   if (gyro_count < 1) return bad_input(out.path() + ": a gyro log needs at least one gyro column");
   if (is_tdms_path(out.path())) {
-    return bad_input(out.path() + ": tetra reads TDMS logs but does not write them: name the output .csv or .h5");
+    return bad_input(out.path() +
+                     ": tetra reads TDMS logs but does not write them: name the output .csv or .h5");
   }
   for (std::size_t i = 0; i < comments.size(); ++i) {
     if (comments[i].find_first_of("\n\r") != std::string::npos) {  // it would end the comment line

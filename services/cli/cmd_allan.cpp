@@ -15,7 +15,8 @@ namespace {
 
 void add_options(CLI::App& app, report::AllanReportOptions& o) {
   app.add_option("log", o.log_path,
-                 "gyro log (CSV, HDF5 when named .h5, TDMS when named .tdms; docs/formats.md): time_s,g1..gN; volts, or deg/s "
+                 "gyro log (CSV, HDF5 when named .h5, TDMS when named .tdms; docs/formats.md): "
+                 "time_s,g1..gN; volts, or deg/s "
                  "with '# units=dps'")
       ->required();
   app.add_option("--calibration", o.calibration_path,

@@ -25,7 +25,8 @@ struct CalibrateOptions {
 };
 
 void add_options(CLI::App& app, CalibrateOptions& o) {
-  app.add_option("TURNTABLE.csv", o.input, "turntable log: sequence,time_s,inner_deg,outer_deg,g1..gN (CSV, or TDMS when named .tdms)")
+  app.add_option("TURNTABLE.csv", o.input,
+                 "turntable log: sequence,time_s,inner_deg,outer_deg,g1..gN (CSV, or TDMS when named .tdms)")
       ->required();
   app.add_option("-o,--output", o.output,
                  "calibration file to write (YAML, docs/interfaces.md §2.3; - for standard output)")

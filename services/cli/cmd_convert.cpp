@@ -8,8 +8,10 @@ namespace tetra::cli {
 
 int cmd_convert(int argc, char** argv) {
   CLI::App app{
-      "Convert a gyro log between CSV and HDF5, or from TDMS (docs/formats.md); each file's format follows its "
-      "name: .h5 or .hdf5 is HDF5, .tdms TDMS (read only), anything else CSV. CSV -> HDF5 -> CSV gives back a "
+      "Convert a gyro log between CSV and HDF5, or from TDMS (docs/formats.md); each file's format follows "
+      "its "
+      "name: .h5 or .hdf5 is HDF5, .tdms TDMS (read only), anything else CSV. CSV -> HDF5 -> CSV gives back "
+      "a "
       "file written by tetra byte for byte.",
       "convert"};
   report::ConvertLogOptions o;

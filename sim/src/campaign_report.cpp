@@ -239,15 +239,17 @@ std::string error_section(const std::vector<CampaignRow>& errors) {
   std::string out =
       "| run | scenario | kind | gyro | onset_s | size | seed | error |\n|---|---|---|---|---|---|---|---|\n";
   for (const CampaignRow& r : errors) {
-    out += "| " + std::to_string(r.run) + " | " + r.scenario + " | " + r.kind + " | " + std::to_string(r.gyro) +
-           " | " + g(r.onset_s) + " | " + g(r.size) + " | " + std::to_string(r.seed) + " | " + r.error + " |\n";
+    out += "| " + std::to_string(r.run) + " | " + r.scenario + " | " + r.kind + " | " +
+           std::to_string(r.gyro) + " | " + g(r.onset_s) + " | " + g(r.size) + " | " +
+           std::to_string(r.seed) + " | " + r.error + " |\n";
   }
   return out;
 }
 
 }  // namespace
 
-CampaignReport campaign_report(const std::vector<CampaignRow>& all_rows, const CampaignReportOptions& options) {
+CampaignReport campaign_report(const std::vector<CampaignRow>& all_rows,
+                               const CampaignReportOptions& options) {
   std::vector<CampaignRow> rows;
   std::vector<CampaignRow> errors;
   for (const CampaignRow& r : all_rows) (r.error.empty() ? rows : errors).push_back(r);

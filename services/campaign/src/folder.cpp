@@ -139,7 +139,8 @@ Result<std::vector<Row>> read_rows(const std::string& runs_csv, const std::strin
   std::string line;
   if (!std::getline(in, line)) return rows;
   if (line != header)
-    return bad_input(runs_csv + ":1: not the header of this campaign (another version, or other dispersions)");
+    return bad_input(runs_csv +
+                     ":1: not the header of this campaign (another version, or other dispersions)");
   for (std::size_t number = 2; std::getline(in, line); ++number) {
     auto row = sim::parse_campaign_row(line, header);
     if (!row) continue;  // a torn line (an interrupted write): the run is done again
@@ -202,7 +203,8 @@ Result<std::vector<std::size_t>> prepare_folder(const sim::CampaignSpec& spec, c
                        shard_text(options.shard) + " of this campaign");
   }
   // Without the torn line and the error rows (those runs are done again).
-  if (Status st = folder::write_rows(summary.runs_csv, sim::campaign_csv_header(spec), *rows); !st) return st.error();
+  if (Status st = folder::write_rows(summary.runs_csv, sim::campaign_csv_header(spec), *rows); !st)
+    return st.error();
   if (!has_hash) {
     auto text = read_input(options.spec_path, kMaxYamlBytes);
     if (!text) return text.error();

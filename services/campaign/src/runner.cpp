@@ -370,7 +370,8 @@ Result<RunSummary> run_campaign(const sim::CampaignSpec& spec, const RunOptions&
   if (rows->size() != summary.total)
     return failure(summary.runs_csv + ": " + std::to_string(rows->size()) + " rows of " +
                    std::to_string(summary.total) + " runs after the campaign");
-  if (Status st = folder::write_rows(summary.runs_csv, sim::campaign_csv_header(spec), *rows); !st) return st.error();
+  if (Status st = folder::write_rows(summary.runs_csv, sim::campaign_csv_header(spec), *rows); !st)
+    return st.error();
   summary.errors = static_cast<std::size_t>(
       std::count_if(rows->begin(), rows->end(), [](const folder::Row& r) { return r.error; }));
   return summary;

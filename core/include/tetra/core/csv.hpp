@@ -54,7 +54,8 @@ struct CsvTable {
 //! [columns] widest header read (a gyro log has at most 64 gyros and a few more columns).
 inline constexpr std::size_t kMaxColumns = 1024;
 
-//! `s` without its leading blanks and tabs and its trailing blanks, tabs and CR: a cell as the reader sees it.
+//! `s` without its leading blanks and tabs and its trailing blanks, tabs and CR: a cell as the reader sees
+//! it.
 std::string_view trim_blanks(std::string_view s);
 //! Strict number parse of a whole cell: plain decimal ("-1.5", "2e-3", a leading '+'), "nan" or
 //! "inf" (any case). Hexadecimal, a decimal comma, blanks or trailing text are refused.

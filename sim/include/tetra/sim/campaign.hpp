@@ -50,7 +50,7 @@ struct CampaignSpec {
   std::string pipeline_yaml;  //!< that map as YAML text ("{}" without one), for a service's configuration
   CampaignLoop loop = CampaignLoop::kClosed;
   CampaignTarget target = CampaignTarget::kInProcess;
-  int dds_domain = 0;  //!< `domain:` the DDS domain id (target dds)
+  int dds_domain = 0;                     //!< `domain:` the DDS domain id (target dds)
   DispersionSpec dispersions;             //!< `dispersions:` (none: every run the nominal truth)
   std::vector<Requirement> requirements;  //!< `requirements:` judged by the report
   //! The most gyros of any scenario (the rows' per-gyro dispersion columns).
