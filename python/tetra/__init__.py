@@ -392,14 +392,17 @@ def campaign_spec(spec: Union[PathLike, Mapping[str, Any], CampaignSpec], *,
 
 
 class CampaignResult:
-    """The rows of a campaign: ``rows`` (a pandas DataFrame with the columns of runs.csv) and ``csv`` (the
-    text of runs.csv for these runs, byte for byte what ``tetra campaign`` writes, in run order)."""
+    """The rows of a campaign: ``rows`` (a pandas DataFrame with the columns of runs.csv), ``csv`` (the
+    text of runs.csv for these runs, byte for byte what ``tetra campaign`` writes, in run order) and
+    ``report`` (report.md for these runs, byte for byte ``tetra campaign``'s; its plots are drawn by the
+    command, or from ``rows`` with matplotlib)."""
 
-    def __init__(self, csv: str):
+    def __init__(self, csv: str, report: str = ""):
         import io
 
         import pandas as pd
         self.csv = csv
+        self.report = report
         # round_trip: the rows' shortest round-trip numbers read back to the same doubles
         self.rows = pd.read_csv(io.StringIO(csv), float_precision="round_trip",
                                 dtype={"scenario": str, "kind": str, "outcome": str})
@@ -414,8 +417,9 @@ class CampaignResult:
 def campaign(spec: Union[PathLike, Mapping[str, Any], CampaignSpec], *, runs: Optional[Sequence[int]] = None,
              base_dir: Optional[PathLike] = None) -> CampaignResult:
     """Runs a campaign in process (``tetra campaign`` with ``target: in_process``), one run after the other
-    with the GIL released: every run of the matrix, or the run ids ``runs``. The report and its plots are
-    ``tetra campaign``'s."""
+    with the GIL released: every run of the matrix, or the run ids ``runs``; a run that fails is an error
+    row, as ``tetra campaign`` writes it. The result's ``report`` is ``tetra campaign``'s report.md."""
     s = campaign_spec(spec, base_dir=base_dir)
     lines = _tetra._campaign_rows(s, None if runs is None else [int(r) for r in runs])
-    return CampaignResult(_tetra._campaign_csv_header(s) + "\n" + "".join(line + "\n" for line in lines))
+    csv = _tetra._campaign_csv_header(s) + "\n" + "".join(line + "\n" for line in lines)
+    return CampaignResult(csv, _tetra._campaign_report(s, csv))

@@ -101,6 +101,7 @@ def campaign_spec(spec: Union[PathLike, Mapping[str, Any], CampaignSpec], *,
 class CampaignResult:
     csv: str
     rows: pandas.DataFrame
+    report: str
     def __len__(self) -> int: ...
 
 def campaign(spec: Union[PathLike, Mapping[str, Any], CampaignSpec], *, runs: Optional[Sequence[int]] = ...,

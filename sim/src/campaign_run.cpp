@@ -138,6 +138,17 @@ Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCa
   return run_campaign_case(spec, c, in_process_estimators(spec));
 }
 
+CampaignRow campaign_run_row(const CampaignSpec& spec, std::size_t index, const EstimatorFactory& make) {
+  try {
+    auto row = run_campaign_case(spec, campaign_case(spec, index), make);
+    return row ? *row : campaign_error_row(spec, index, describe(row.error()));
+  } catch (const std::exception& e) {
+    return campaign_error_row(spec, index, std::string("exception: ") + e.what());
+  } catch (...) {
+    return campaign_error_row(spec, index, "unknown exception");
+  }
+}
+
 std::string pipeline_yaml_from(const CampaignSpec& spec, const Quaternion& initial_q_RB) {
   YAML::Node map = YAML::Load(spec.pipeline_yaml);
   if (!map.IsMap()) map = YAML::Node(YAML::NodeType::Map);

@@ -38,3 +38,16 @@ def test_campaign_errors():
         tetra.campaign(SPEC, runs=[7])
     with pytest.raises(tetra.BadInputError, match="kinds"):
         tetra.campaign_spec({**SPEC, "kinds": ["meteor"]})
+
+
+def test_campaign_report_equals_the_command(tmp_path, run_cli):
+    spec = {**SPEC, "dispersions": {"seed": 7, "unit.arw_factor": {"uniform": [0.9, 1.1]}},
+            "requirements": ["wrong_exclusion_rate < 1e-3 at 0.95"]}
+    (tmp_path / "spec.yaml").write_text(json.dumps(spec))
+    run_cli("campaign", tmp_path / "spec.yaml", "--out", tmp_path / "out", "--jobs", 1)
+    result = tetra.campaign(spec)
+    assert result.csv == (tmp_path / "out" / "runs.csv").read_text()
+    assert result.report == (tmp_path / "out" / "report.md").read_text()
+    assert "unit.arw_factor.g1" in result.rows.columns
+    assert "## Requirements" in result.report
+

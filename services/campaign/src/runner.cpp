@@ -83,14 +83,7 @@ bool write_all(int fd, const std::string& text) {
 
 //! The row of one run: an error value or an exception is an error row with its message.
 std::string run_row(const sim::CampaignSpec& spec, std::size_t index, const sim::EstimatorFactory& make) {
-  try {
-    auto row = sim::run_campaign_case(spec, sim::campaign_case(spec, index), make);
-    return sim::campaign_csv_row(row ? *row : sim::campaign_error_row(spec, index, describe(row.error())));
-  } catch (const std::exception& e) {
-    return sim::campaign_csv_row(sim::campaign_error_row(spec, index, std::string("exception: ") + e.what()));
-  } catch (...) {
-    return sim::campaign_csv_row(sim::campaign_error_row(spec, index, "unknown exception"));
-  }
+  return sim::campaign_csv_row(sim::campaign_run_row(spec, index, make));
 }
 
 [[noreturn]] void worker_main(const sim::CampaignSpec& spec, const RunOptions& options, int task_fd,

@@ -130,6 +130,9 @@ Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCa
                                       const EstimatorFactory& make);
 //! Runs one case to its row with the pipeline in process.
 Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCase& c);
+//! The row of run `index` whatever happens in it: its result, or an error row (campaign_error_row) with
+//! the message of an error value or of an exception.
+CampaignRow campaign_run_row(const CampaignSpec& spec, std::size_t index, const EstimatorFactory& make);
 
 //! The spec's `pipeline:` map with `initial_q_wxyz` set to `initial_q_RB` (every digit kept), as YAML
 //! text: a service configured with it starts where the in-process pipeline starts.
