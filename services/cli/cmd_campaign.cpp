@@ -12,10 +12,10 @@
 #include <spdlog/fmt/fmt.h>
 
 #include "campaign_dds.hpp"
-#include "campaign_report.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "tetra/campaign/runner.hpp"
+#include "tetra/report/campaign_report.hpp"
 #include "tetra/sim/campaign.hpp"
 
 namespace tetra::cli {
@@ -127,7 +127,8 @@ int cmd_campaign(int argc, char** argv) {
     std::cerr << "tetra campaign: " << done->errors << " of " << done->total
               << " runs ended in an error (rows with outcome error in " << done->runs_csv << ")\n";
   if (no_report || options.shard.n > 1) return kExitOk;
-  if (Status st = write_campaign_report(done->runs_csv, options.out_dir, sim::report_options(*spec)); !st)
+  if (Status st = report::write_campaign_report(done->runs_csv, options.out_dir, sim::report_options(*spec));
+      !st)
     return report(kCampaignName, st.error());
   std::cerr << "tetra campaign: report -> " << (std::filesystem::path(options.out_dir) / "report.md").string()
             << '\n';
