@@ -25,7 +25,7 @@ bool shutdown_requested() {
 
 int sim_dds_closed_loop_main(const sim::Scenario& scenario, const sim::SimOptions& sim_options,
                              const ClosedLoopCliOptions& loop_options, const SimDdsOptions& dds_options) {
-  if (Status st = check_closed_loop_options(scenario, loop_options, true); !st)
+  if (Status st = report::check_closed_loop_options(scenario, loop_options, true); !st)
     return report(kDdsLoopName, st.error());
   auto simulator = sim::ClosedLoopSimulator::create(scenario, sim_options);
   if (!simulator) return report(kDdsLoopName, simulator.error());
@@ -44,7 +44,8 @@ int sim_dds_closed_loop_main(const sim::Scenario& scenario, const sim::SimOption
               << DdsEstimator::kLockstepTimeout_ns / 1'000'000'000
               << " s (the loop went on with the latest)\n";
   }
-  return write_closed_loop_outputs(scenario, *simulator, *record, loop_options);
+  const Status st = report::write_closed_loop_outputs(scenario, *simulator, *record, loop_options, std::cout);
+  return st ? kExitOk : report(kDdsLoopName, st.error());
 }
 
 }  // namespace tetra::cli
