@@ -19,6 +19,7 @@
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
+#include "tetra/dds_tools/child_process.hpp"
 
 namespace tetra::cli {
 
@@ -214,9 +215,9 @@ sim::EstimatorFactory dds_campaign_estimators(const sim::CampaignSpec& spec, con
     const std::string unit = fmt::format("campaign-{}-{}", ::getpid(), c.index);
     auto files = write_service_files(spec, sc, unit, initial_q_RB, work_dir);
     if (!files) return files.error();
-    const int pid = spawn_self({"fusion", "--config", files->config, "--domain",
-                                std::to_string(spec.dds_domain), "--log-level", "warn"},
-                               files->log, files->log);
+    const int pid = dds_tools::spawn_self({"fusion", "--config", files->config, "--domain",
+                                           std::to_string(spec.dds_domain), "--log-level", "warn"},
+                                          files->log, files->log);
     if (pid < 0) return failure("cannot start `tetra fusion` for run " + std::to_string(c.index));
     auto estimator = std::make_unique<ServiceEstimator>(std::move(files.value()), pid);
     if (Status st = estimator->open(unit, sc, spec.dds_domain); !st) return st.error();

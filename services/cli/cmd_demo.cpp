@@ -134,14 +134,14 @@ bool after_the_run(const DemoOptions& o, const std::string& unit, int gyro) {
       << "\nmonitor view after the run (tetra monitor --once; the simulator has stopped, so its gyros are "
          "absent and the unit LOST; the event history is the late joiner's):\n"
       << std::flush;
-  dds_tools::ChildProcess monitor(
-      spawn_self({"monitor", "--once", "--unit", unit, "--domain", domain_text, "--timeout", "5"}));
+  dds_tools::ChildProcess monitor(dds_tools::spawn_self(
+      {"monitor", "--once", "--unit", unit, "--domain", domain_text, "--timeout", "5"}));
   monitor.wait();
   // The operator's side: reinstate the failed gyro; the service obeys and acknowledges it as an event.
   const std::string gyro_text = std::to_string(gyro);
   std::cout << "\noperator: tetra command --unit " << unit << " reinstate " << gyro_text << '\n'
             << std::flush;
-  dds_tools::ChildProcess command(spawn_self(
+  dds_tools::ChildProcess command(dds_tools::spawn_self(
       {"command", "--unit", unit, "reinstate", gyro_text, "--domain", domain_text, "--timeout", "5"}));
   return command.wait() == 0;
 }
@@ -159,8 +159,9 @@ void print_banner(const DemoOptions& o, const sim::Simulator& simulator, const s
 //! The ground station (--web) as a child process; pid -1 without --web.
 int start_ground(const DemoOptions& o, const std::string& dir) {
   if (!o.web) return -1;
-  const int pid = spawn_self({"ground", "--listen", o.listen, "--domain", std::to_string(o.domain)},
-                             dir + "/ground.log", dir + "/ground.log");
+  const int pid =
+      dds_tools::spawn_self({"ground", "--listen", o.listen, "--domain", std::to_string(o.domain)},
+                            dir + "/ground.log", dir + "/ground.log");
   if (pid > 0) {
     std::cout << "  ground station: http://" << o.listen << "/  (open it in a browser; log " << dir
               << "/ground.log)\n"
@@ -194,9 +195,9 @@ int cmd_demo(int argc, char** argv) {
     return report("demo", s.error());
 
   print_banner(o, *simulator, *dir);
-  dds_tools::ChildProcess fusion(
-      spawn_self({"fusion", "--config", *dir + "/fusion.yaml", "--domain", std::to_string(o.domain)},
-                 *dir + "/fusion.log", *dir + "/fusion.log"));
+  dds_tools::ChildProcess fusion(dds_tools::spawn_self(
+      {"fusion", "--config", *dir + "/fusion.yaml", "--domain", std::to_string(o.domain)},
+      *dir + "/fusion.log", *dir + "/fusion.log"));
   if (fusion.pid() <= 0) return report("demo", failure("cannot start tetra fusion"));
   std::cout << "  service pid " << fusion.pid() << '\n';
   dds_tools::ChildProcess ground(start_ground(o, *dir));
