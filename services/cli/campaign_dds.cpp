@@ -13,15 +13,18 @@
 #include <spdlog/fmt/fmt.h>
 
 #include "dds_common.hpp"
-#include "sim_dds_estimator.hpp"
-#include "sim_dds_link.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
 #include "tetra/dds_tools/child_process.hpp"
+#include "tetra/dds_tools/sim_dds_estimator.hpp"
+#include "tetra/dds_tools/sim_dds_link.hpp"
 
 namespace tetra::cli {
+
+using dds_tools::DdsEstimator;
+using dds_tools::SimDdsLink;
 
 namespace {
 

@@ -4,12 +4,15 @@
 
 #include "cli_common.hpp"
 #include "dds_common.hpp"
-#include "sim_dds_estimator.hpp"
-#include "sim_dds_link.hpp"
 #include "tetra/dds/shutdown.hpp"
+#include "tetra/dds_tools/sim_dds_estimator.hpp"
+#include "tetra/dds_tools/sim_dds_link.hpp"
 #include "tetra/sim/closed_loop_run.hpp"
 
 namespace tetra::cli {
+
+using dds_tools::DdsEstimator;
+using dds_tools::SimDdsLink;
 
 namespace {
 
