@@ -11,9 +11,9 @@
 
 #include <spdlog/fmt/fmt.h>
 
-#include "campaign_dds.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "tetra/campaign/dds_estimators.hpp"
 #include "tetra/campaign/runner.hpp"
 #include "tetra/report/campaign_report.hpp"
 #include "tetra/sim/campaign.hpp"
@@ -102,7 +102,7 @@ int cmd_campaign(int argc, char** argv) {
   const std::string dds_dir = (std::filesystem::path(options.out_dir) / "dds").string();
   if (over_dds) {
     options.estimators = [dds_dir](const sim::CampaignSpec& s) {
-      return dds_campaign_estimators(s, dds_dir);
+      return campaign::dds_campaign_estimators(s, dds_dir);
     };
   }
   options.spec_path = spec_path;
