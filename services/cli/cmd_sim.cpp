@@ -36,7 +36,7 @@ struct SimArgs {
   std::vector<CLI::Option*> turntable_only;  // --table-rate, --revolutions, --order, --wrap
   ClosedLoopCliOptions loop;
 #if TETRA_WITH_DDS
-  SimDdsOptions dds;
+  SimDdsCliOptions dds;
 #endif
 };
 

@@ -9,7 +9,7 @@
 
 namespace tetra::cli {
 
-void add_sim_dds_options(CLI::App& app, SimDdsOptions& options) {
+void add_sim_dds_options(CLI::App& app, SimDdsCliOptions& options) {
   app.add_flag("--dds", options.enabled,
                "publish on DDS (GyroSample, AttitudeReference) instead of writing files, "
                "and score the Attitude received against the truth");
@@ -34,7 +34,7 @@ void add_sim_dds_options(CLI::App& app, SimDdsOptions& options) {
   add_domain_option(app, options.domain);
 }
 
-int sim_dds_main(sim::Simulator& simulator, const SimDdsOptions& options) {
+int sim_dds_main(sim::Simulator& simulator, const SimDdsCliOptions& options) {
   dds::ShutdownSignal shutdown;
   const auto progress = [&](const SimDdsScore& s) {
     if (options.quiet) return;

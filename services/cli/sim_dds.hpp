@@ -13,10 +13,15 @@ using dds_tools::ScoredEpoch;
 using dds_tools::SimDdsOptions;
 using dds_tools::SimDdsScore;
 
+struct SimDdsCliOptions : SimDdsOptions {
+  bool enabled = false;  //!< --dds given
+  bool quiet = false;    //!< no progress lines on stderr
+};
+
 //! Adds --dds, --speed, --domain, --dds-unit, --wait-readers, --wait-timeout to `tetra sim`.
-void add_sim_dds_options(CLI::App& app, SimDdsOptions& options);
+void add_sim_dds_options(CLI::App& app, SimDdsCliOptions& options);
 
 //! The `tetra sim --dds` command body after the scenario is built: runs, prints the score.
-int sim_dds_main(sim::Simulator& simulator, const SimDdsOptions& options);
+int sim_dds_main(sim::Simulator& simulator, const SimDdsCliOptions& options);
 
 }  // namespace tetra::cli

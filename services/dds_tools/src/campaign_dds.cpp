@@ -137,14 +137,12 @@ class ServiceEstimator final : public sim::Estimator {
 Status ServiceEstimator::open(const std::string& unit, const sim::Scenario& sc, int domain) {
   unit_ = unit;
   SimDdsOptions options;
-  options.enabled = true;
   options.domain = static_cast<dds_domainid_t>(domain);
   options.unit = unit;
   // The gyro writer offers a deadline 1 % shorter than the service requests (offered <= requested, or
   // DDS does not match them; both are computed from the speed, rounded to nanoseconds their own way).
   options.speed = service_speed(sc.rate_hz) * 1.01;
   options.wait_timeout_s = kServiceStart_s;
-  options.quiet = true;
   auto link = SimDdsLink::open(unit, sc.rate_hz, options, nullptr);
   if (!link) return failure("the service of unit " + unit + ": " + link.error().message + log_hint());
   link_ = std::move(link.value());

@@ -140,7 +140,6 @@ Result<bool> run_demo(const DemoOptions& o, const sim::FaultSpec& fault, dds::Sh
   if (!watch) return watch.error();
 
   SimDdsOptions sim_options;
-  sim_options.enabled = true;
   sim_options.domain = o.domain;
   sim_options.speed = o.speed;
   sim_options.wait_readers = 1;  // the service

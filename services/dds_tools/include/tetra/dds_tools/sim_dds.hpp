@@ -21,13 +21,11 @@ class ShutdownSignal;
 namespace tetra::dds_tools {
 
 struct SimDdsOptions {
-  bool enabled = false;  //!< the command line's --dds given
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
   std::string unit;              //!< DDS key; empty: the simulated unit's name
   double speed = 1.0;            //!< 1 = real time, 10 = ten times faster, 0 = as fast as possible
   int wait_readers = 1;          //!< gyro readers to wait for before publishing
   double wait_timeout_s = 10.0;  //!< [s] give up waiting for them
-  bool quiet = false;            //!< the command line prints no progress lines
 };
 
 //! Attitude error [deg] at one epoch: angle between the received estimate and the truth.
