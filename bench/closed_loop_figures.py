@@ -29,7 +29,7 @@ import doc_figures as figures
 
 
 def quantile(values, q):
-    """The report's quantile (services/cli/campaign_report.cpp): nearest rank on the sorted values."""
+    """The report's quantile (sim/src/campaign_report.cpp): nearest rank on the sorted values."""
     v = sorted(values)
     return v[min(int(q * (len(v) - 1) + 0.5), len(v) - 1)]
 

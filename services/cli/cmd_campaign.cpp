@@ -11,11 +11,11 @@
 
 #include <spdlog/fmt/fmt.h>
 
-#include "campaign_dds.hpp"
-#include "campaign_report.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "tetra/campaign/dds_estimators.hpp"
 #include "tetra/campaign/runner.hpp"
+#include "tetra/report/campaign_report.hpp"
 #include "tetra/sim/campaign.hpp"
 
 namespace tetra::cli {
@@ -102,7 +102,7 @@ int cmd_campaign(int argc, char** argv) {
   const std::string dds_dir = (std::filesystem::path(options.out_dir) / "dds").string();
   if (over_dds) {
     options.estimators = [dds_dir](const sim::CampaignSpec& s) {
-      return dds_campaign_estimators(s, dds_dir);
+      return campaign::dds_campaign_estimators(s, dds_dir);
     };
   }
   options.spec_path = spec_path;
@@ -127,7 +127,8 @@ int cmd_campaign(int argc, char** argv) {
     std::cerr << "tetra campaign: " << done->errors << " of " << done->total
               << " runs ended in an error (rows with outcome error in " << done->runs_csv << ")\n";
   if (no_report || options.shard.n > 1) return kExitOk;
-  if (Status st = write_campaign_report(done->runs_csv, options.out_dir, sim::report_options(*spec)); !st)
+  if (Status st = report::write_campaign_report(done->runs_csv, options.out_dir, sim::report_options(*spec));
+      !st)
     return report(kCampaignName, st.error());
   std::cerr << "tetra campaign: report -> " << (std::filesystem::path(options.out_dir) / "report.md").string()
             << '\n';

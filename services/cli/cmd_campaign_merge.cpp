@@ -4,10 +4,10 @@
 #include <string>
 #include <vector>
 
-#include "campaign_report.hpp"
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "tetra/campaign/runner.hpp"
+#include "tetra/report/campaign_report.hpp"
 
 namespace tetra::cli {
 
@@ -33,7 +33,7 @@ int cmd_campaign_merge(int argc, char** argv) {
   if (no_report) return kExitOk;
   auto options = campaign::folder_report_options(out_dir);
   if (!options) return report(kName, options.error());
-  if (Status st = write_campaign_report(merged->runs_csv, out_dir, *options); !st)
+  if (Status st = report::write_campaign_report(merged->runs_csv, out_dir, *options); !st)
     return report(kName, st.error());
   std::cerr << "tetra campaign merge: report -> " << out_dir << "/report.md\n";
   return kExitOk;

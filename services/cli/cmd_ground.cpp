@@ -9,44 +9,22 @@
 #include "commands.hpp"
 #include "dds_common.hpp"
 #include "tetra/dds/shutdown.hpp"
-#include "tetra/ground/ground_bridge.hpp"
-#include "tetra/ground/http_api.hpp"
+#include "tetra/ground/ground_run.hpp"
 
 namespace tetra::cli {
-
-namespace {
-
-//! "HOST:PORT" -> host and port (port 0: any free port).
-Status parse_listen(const std::string& text, std::string& host, int& port) {
-  const auto colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0)
-    return bad_input("--listen '" + text + "': expected HOST:PORT");
-  host = text.substr(0, colon);
-  try {
-    std::size_t used = 0;
-    port = std::stoi(text.substr(colon + 1), &used);
-    if (used != text.size() - colon - 1 || port < 0 || port > 65535) throw std::out_of_range("port");
-  } catch (const std::exception&) {
-    return bad_input("--listen '" + text + "': the port must be 0..65535");
-  }
-  return ok_status();
-}
-
-}  // namespace
 
 int cmd_ground(int argc, char** argv) {
   if (argc > 1 && std::string(argv[1]) == "passwd") return cmd_ground_passwd(argc - 1, argv + 1);
   dds::ShutdownSignal shutdown;
   CLI::App app{"Ground station in the browser: DDS to HTTP bridge and the Open MCT application.", "ground"};
-  std::string listen = "127.0.0.1:8080";
-  std::string web_dir = default_web_dir();
-  ground::StoreConfig store_config;
-  ground::ServerConfig server_config;
-  double command_timeout_s = 5.0;
-  dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
-  app.add_option("--listen", listen, "HOST:PORT to serve on (default loopback only; port 0: any free port)");
+  ground::GroundOptions o;
+  o.server.web_dir = default_web_dir();
+  ground::StoreConfig& store_config = o.store;
+  ground::ServerConfig& server_config = o.server;
+  app.add_option("--listen", o.listen,
+                 "HOST:PORT to serve on (default loopback only; port 0: any free port)");
   app.add_option(
-         "--web", web_dir,
+         "--web", server_config.web_dir,
          "the web application's directory (with node_modules/ from npm ci); default: ../share/tetra/web "
          "beside the program when installed, else the source tree's web/")
       ->capture_default_str();
@@ -58,7 +36,8 @@ int cmd_ground(int argc, char** argv) {
   app.add_option("--attitude-rate", store_config.attitude_rate_hz,
                  "[Hz] attitude rate streamed to browsers and kept in history")
       ->check(CLI::Range(0.1, 100.0));
-  app.add_option("--command-timeout", command_timeout_s, "[s] wait this long for a command's acknowledgement")
+  app.add_option("--command-timeout", o.command_timeout_s,
+                 "[s] wait this long for a command's acknowledgement")
       ->check(CLI::PositiveNumber);
   app.add_option("--users", server_config.users_path,
                  "operator accounts (tetra ground passwd USER --users FILE); required unless --no-auth")
@@ -79,33 +58,10 @@ int cmd_ground(int argc, char** argv) {
                  "event streams held at once (beyond: 503)")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  add_domain_option(app, domain);
+  add_domain_option(app, o.domain);
   if (auto exit = parse(app, argc, argv)) return *exit;
-  if (server_config.no_auth && !server_config.users_path.empty())
-    return report("ground", bad_input("--no-auth and --users: one or the other"));
-
-  server_config.web_dir = web_dir;
-  if (auto s = parse_listen(listen, server_config.host, server_config.port); !s)
-    return report("ground", s.error());
-  if (server_config.no_auth && !ground::is_loopback_host(server_config.host))
-    return report("ground", bad_input("--no-auth: only on a loopback address (--listen 127.0.0.1:PORT)"));
-  if (!server_config.no_auth && server_config.users_path.empty())
-    return report("ground", bad_input("--users FILE (tetra ground passwd USER --users FILE) or, on loopback "
-                                      "only, --no-auth"));
-  auto readers = ground::GroundReaders::open(domain, "", shutdown);
-  if (!readers) return report("ground", readers.error());
-  ground::GroundStore store(store_config);
-  ground::GroundBridge bridge(std::move(readers).value(), store);
-  const auto timeout = std::chrono::milliseconds(static_cast<std::int64_t>(command_timeout_s * 1000));
-  ground::GroundServer server(
-      store, [&](const ground::CommandRequest& request) { return bridge.send(request, timeout); },
-      server_config);
-  if (auto s = server.start(); !s) return report("ground", s.error());
-  std::cout << "tetra ground: " << (server_config.tls.cert.empty() ? "http" : "https") << "://"
-            << server_config.host << ':' << server.port() << "/" << std::endl;
-  auto status = bridge.run(shutdown);
-  server.stop();
-  if (!status) return report("ground", status.error());
+  if (auto status = ground::run_ground(std::move(o), shutdown, std::cout); !status)
+    return report("ground", status.error());
   return kExitOk;
 }
 

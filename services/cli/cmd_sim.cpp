@@ -36,7 +36,7 @@ struct SimArgs {
   std::vector<CLI::Option*> turntable_only;  // --table-rate, --revolutions, --order, --wrap
   ClosedLoopCliOptions loop;
 #if TETRA_WITH_DDS
-  SimDdsOptions dds;
+  SimDdsCliOptions dds;
 #endif
 };
 
@@ -188,7 +188,11 @@ int run_elsewhere(const SimArgs& a, const report::SimRunOptions& run) {
   if (a.loop.enabled && a.dds.enabled)
     return sim_dds_closed_loop_main(prepared->scenario, prepared->options, a.loop, a.dds);
 #endif
-  if (a.loop.enabled) return sim_closed_loop_main(prepared->scenario, prepared->options, a.loop);
+  if (a.loop.enabled) {
+    const Status st =
+        report::run_closed_loop_to_files(prepared->scenario, prepared->options, a.loop, std::cout);
+    return st ? kExitOk : report(kSimName, st.error());
+  }
 #if TETRA_WITH_DDS
   auto simulator = sim::Simulator::create(prepared->scenario, prepared->options);
   if (!simulator) return report(kSimName, simulator.error());

@@ -1,6 +1,6 @@
 #pragma once
-// Plumbing shared by the DDS subcommands: the --domain option, the local clock, spawning
-// the program itself (demo), and the report library's formatting helpers (tetra/report/text.hpp).
+// Plumbing shared by the DDS subcommands: the --domain option, the local clock, the web folder's default,
+// and the report library's formatting helpers (tetra/report/text.hpp).
 
 #include <chrono>
 #include <cstdint>
@@ -27,18 +27,9 @@ using dds::wall_ns;
 //! characters); CLI11 names the option in the error.
 CLI::Validator unit_name_check();
 
-//! Path of the running program (/proc/self/exe).
-std::string self_executable();
-
 //! The ground station's web application: `../share/tetra/web` beside the program when it is installed
 //! (cmake --install), else the source tree's `web/` the program was built from.
 std::string default_web_dir();
-
-//! Starts `self_executable() args...` as a child with SIGINT/SIGTERM unblocked; stdout/stderr
-//! go to the given files (empty: inherited); the child gets SIGTERM when the calling thread ends
-//! (PR_SET_PDEATHSIG: call it from the thread that outlives the child). Returns the pid, or -1.
-int spawn_self(const std::vector<std::string>& args, const std::string& stdout_path = "",
-               const std::string& stderr_path = "");
 
 using report::fixed;
 using report::json_number;

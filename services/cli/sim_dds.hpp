@@ -1,67 +1,27 @@
 #pragma once
-// `tetra sim --dds`: the simulated unit on the wire. Publishes each epoch's gyro samples (and the
-// attitude reference) in real time or `--speed` times faster, subscribes to the unit's Attitude and
-// scores it live against the truth (error now, worst, at the end). Also used in-process by `tetra demo`.
+// `tetra sim --dds`: its options and its printed score (the run: tetra/dds_tools/sim_dds.hpp).
 
-#include <cstdint>
-#include <deque>
-#include <functional>
-#include <string>
-#include <vector>
-
-#include <dds/dds.h>
 #include <CLI/CLI.hpp>
 
-#include "tetra/core/result.hpp"
+#include "tetra/dds_tools/sim_dds.hpp"
 #include "tetra/sim/simulator.hpp"
-
-namespace tetra::dds {
-class ShutdownSignal;
-}
 
 namespace tetra::cli {
 
-struct SimDdsOptions {
+using dds_tools::run_sim_dds;
+using dds_tools::ScoredEpoch;
+using dds_tools::SimDdsOptions;
+using dds_tools::SimDdsScore;
+
+struct SimDdsCliOptions : SimDdsOptions {
   bool enabled = false;  //!< --dds given
-  dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
-  std::string unit;              //!< DDS key; empty: the simulated unit's name
-  double speed = 1.0;            //!< 1 = real time, 10 = ten times faster, 0 = as fast as possible
-  int wait_readers = 1;          //!< gyro readers to wait for before publishing
-  double wait_timeout_s = 10.0;  //!< [s] give up waiting for them
-  bool quiet = false;            //!< no progress lines on stderr
+  bool quiet = false;    //!< no progress lines on stderr
 };
 
 //! Adds --dds, --speed, --domain, --dds-unit, --wait-readers, --wait-timeout to `tetra sim`.
-void add_sim_dds_options(CLI::App& app, SimDdsOptions& options);
-
-//! Attitude error [deg] at one epoch: angle between the received estimate and the truth.
-struct ScoredEpoch {
-  double time_s = 0.0;
-  double error_deg = 0.0;
-  std::string mode;
-  std::string gyros;
-};
-
-struct SimDdsScore {
-  std::uint64_t epochs_published = 0;
-  std::uint64_t attitudes_scored = 0;  //!< received and matched to a truth epoch
-  std::uint64_t missing = 0;           //!< epochs before a received attitude that got none
-  double first_missing_s = 0.0;        //!< [s] the first of them
-  double wall_s = 0.0;                 //!< [s] publishing time
-  double worst_deg = 0.0;
-  double worst_time_s = 0.0;
-  //! Every scored epoch, in order. A deque: an hour at 100 Hz never moves the whole series at once
-  //! (a vector doubling its 30 MB would stall the simulator for tens of milliseconds).
-  std::deque<ScoredEpoch> series;
-};
-
-//! Runs the simulator on the wire until its end (or a shutdown signal). `on_progress` is called
-//! about once per wall-clock second with the score so far.
-Result<SimDdsScore> run_sim_dds(sim::Simulator& simulator, const SimDdsOptions& options,
-                                const dds::ShutdownSignal* shutdown,
-                                const std::function<void(const SimDdsScore&)>& on_progress = {});
+void add_sim_dds_options(CLI::App& app, SimDdsCliOptions& options);
 
 //! The `tetra sim --dds` command body after the scenario is built: runs, prints the score.
-int sim_dds_main(sim::Simulator& simulator, const SimDdsOptions& options);
+int sim_dds_main(sim::Simulator& simulator, const SimDdsCliOptions& options);
 
 }  // namespace tetra::cli

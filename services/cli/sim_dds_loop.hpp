@@ -1,10 +1,6 @@
 #pragma once
-// `tetra sim SCENARIO.yaml --closed-loop --dds`: the closed loop over DDS, with a running
-// `tetra fusion` service as the estimator (docs/sim.md "Closed loop over DDS").
-//   lockstep (default)  publish epoch k's samples, wait for epoch k's Attitude, control, integrate
-//                       to k+1: as fast as the loop allows, and the same numbers as in process
-//   --real-time         publish at the wall-clock rate (--speed); the controller uses the newest
-//                       Attitude received, however old (latency and losses are the experiment)
+// `tetra sim SCENARIO.yaml --closed-loop --dds`: runs the closed loop over DDS
+// (tetra/dds_tools/sim_dds_loop.hpp) and prints and writes its outputs (tetra/report/closed_loop_files.hpp).
 
 #include "sim_closed_loop.hpp"
 #include "sim_dds.hpp"

@@ -11,19 +11,19 @@
 
 #include <dds/dds.h>
 
-#include "sim_dds.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/session.hpp"
 #include "tetra/dds/shutdown.hpp"
+#include "tetra/dds_tools/sim_dds.hpp"
 #include "tetra/fdi/types.hpp"
 #include "tetra/sim/simulator.hpp"
 
-namespace tetra::cli {
+namespace tetra::dds_tools {
 
 class SimDdsLink {
  public:
-  //! Creates the entities and waits for `options.wait_readers` gyro readers (see sim_dds_link.cpp).
+  //! Creates the entities and waits for `options.wait_readers` gyro readers (see src/sim_dds_link.cpp).
   static Result<std::unique_ptr<SimDdsLink>> open(const std::string& unit, double rate_hz,
                                                   const SimDdsOptions& options,
                                                   const dds::ShutdownSignal* shutdown);
@@ -73,4 +73,4 @@ class SimDdsLink {
   tetra_AttitudeReference reference_{};
 };
 
-}  // namespace tetra::cli
+}  // namespace tetra::dds_tools

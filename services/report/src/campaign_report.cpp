@@ -1,11 +1,11 @@
-#include "campaign_report.hpp"
+#include "tetra/report/campaign_report.hpp"
 
 #include <filesystem>
 
-#include "gnuplot.hpp"
 #include "tetra/core/csv.hpp"
+#include "tetra/report/gnuplot.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 
 Status write_campaign_report(const std::string& runs_csv, const std::string& out_dir,
                              const sim::CampaignReportOptions& options) {
@@ -32,4 +32,4 @@ Status write_campaign_report(const sim::CampaignSpec& spec, const std::string& o
                                sim::report_options(spec));
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::report

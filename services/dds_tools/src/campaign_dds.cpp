@@ -1,4 +1,5 @@
-#include "campaign_dds.hpp"
+// `target: dds` campaigns (tetra/campaign/dds_estimators.hpp).
+#include "tetra/campaign/dds_estimators.hpp"
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -12,15 +13,18 @@
 
 #include <spdlog/fmt/fmt.h>
 
-#include "dds_common.hpp"
-#include "sim_dds_estimator.hpp"
-#include "sim_dds_link.hpp"
 #include "tetra/core/calibration_file.hpp"
+#include "tetra/dds/clock.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
+#include "tetra/dds_tools/child_process.hpp"
+#include "tetra/dds_tools/sim_dds_estimator.hpp"
+#include "tetra/dds_tools/sim_dds_link.hpp"
 
-namespace tetra::cli {
+namespace tetra::dds_tools {
+
+using dds::monotonic_ns;
 
 namespace {
 
@@ -133,14 +137,12 @@ class ServiceEstimator final : public sim::Estimator {
 Status ServiceEstimator::open(const std::string& unit, const sim::Scenario& sc, int domain) {
   unit_ = unit;
   SimDdsOptions options;
-  options.enabled = true;
   options.domain = static_cast<dds_domainid_t>(domain);
   options.unit = unit;
   // The gyro writer offers a deadline 1 % shorter than the service requests (offered <= requested, or
   // DDS does not match them; both are computed from the speed, rounded to nanoseconds their own way).
   options.speed = service_speed(sc.rate_hz) * 1.01;
   options.wait_timeout_s = kServiceStart_s;
-  options.quiet = true;
   auto link = SimDdsLink::open(unit, sc.rate_hz, options, nullptr);
   if (!link) return failure("the service of unit " + unit + ": " + link.error().message + log_hint());
   link_ = std::move(link.value());
@@ -208,20 +210,24 @@ Status ServiceEstimator::finish(std::vector<fdi::FdiEvent>& events) {
 
 }  // namespace
 
+}  // namespace tetra::dds_tools
+
+namespace tetra::campaign {
+
 sim::EstimatorFactory dds_campaign_estimators(const sim::CampaignSpec& spec, const std::string& work_dir) {
   return [&spec, work_dir](const sim::Scenario& sc, const sim::CampaignCase& c,
                            const Quaternion& initial_q_RB) -> Result<std::unique_ptr<sim::Estimator>> {
     const std::string unit = fmt::format("campaign-{}-{}", ::getpid(), c.index);
-    auto files = write_service_files(spec, sc, unit, initial_q_RB, work_dir);
+    auto files = dds_tools::write_service_files(spec, sc, unit, initial_q_RB, work_dir);
     if (!files) return files.error();
-    const int pid = spawn_self({"fusion", "--config", files->config, "--domain",
-                                std::to_string(spec.dds_domain), "--log-level", "warn"},
-                               files->log, files->log);
+    const int pid = dds_tools::spawn_self({"fusion", "--config", files->config, "--domain",
+                                           std::to_string(spec.dds_domain), "--log-level", "warn"},
+                                          files->log, files->log);
     if (pid < 0) return failure("cannot start `tetra fusion` for run " + std::to_string(c.index));
-    auto estimator = std::make_unique<ServiceEstimator>(std::move(files.value()), pid);
+    auto estimator = std::make_unique<dds_tools::ServiceEstimator>(std::move(files.value()), pid);
     if (Status st = estimator->open(unit, sc, spec.dds_domain); !st) return st.error();
     return std::unique_ptr<sim::Estimator>(std::move(estimator));
   };
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::campaign

@@ -7,7 +7,7 @@
 #include "tetra/core/result.hpp"
 #include "tetra/sim/campaign_report.hpp"
 
-namespace tetra::cli {
+namespace tetra::report {
 
 //! The report of `runs_csv` into `out_dir`.
 Status write_campaign_report(const std::string& runs_csv, const std::string& out_dir,
@@ -15,4 +15,4 @@ Status write_campaign_report(const std::string& runs_csv, const std::string& out
 //! The report of the campaign `spec` in `out_dir` (its runs.csv), with the options the spec asks for.
 Status write_campaign_report(const sim::CampaignSpec& spec, const std::string& out_dir);
 
-}  // namespace tetra::cli
+}  // namespace tetra::report

@@ -1,6 +1,6 @@
 #pragma once
-// A `tetra fusion` service over DDS as the estimator of a simulated run (closed loop: sim_dds_loop;
-// campaigns: campaign_dds). Each epoch's samples are published on the link; then
+// A `tetra fusion` service over DDS as the estimator of a simulated run (closed loop and campaigns
+// over DDS). Each epoch's samples are published on the link; then
 //   lockstep   wait (up to 2 s) for that epoch's Attitude: the same numbers as the pipeline in process
 //   real time  publish at the wall-clock rate (`speed`) and return the newest Attitude received
 // The estimate returned is the newest Attitude received so far.
@@ -8,10 +8,10 @@
 #include <cstdint>
 #include <optional>
 
-#include "sim_dds_link.hpp"
+#include "tetra/dds_tools/sim_dds_link.hpp"
 #include "tetra/sim/closed_loop_run.hpp"
 
-namespace tetra::cli {
+namespace tetra::dds_tools {
 
 class DdsEstimator final : public sim::Estimator {
  public:
@@ -43,4 +43,4 @@ class DdsEstimator final : public sim::Estimator {
   std::int64_t start_ns_ = 0;
 };
 
-}  // namespace tetra::cli
+}  // namespace tetra::dds_tools

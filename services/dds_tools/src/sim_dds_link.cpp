@@ -1,15 +1,18 @@
-#include "sim_dds_link.hpp"
+#include "tetra/dds_tools/sim_dds_link.hpp"
 
 #include <algorithm>
 #include <utility>
 
-#include "cli_common.hpp"
-#include "dds_common.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/dds/clock.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/topics.hpp"
+#include "tetra/report/text.hpp"
 
-namespace tetra::cli {
+namespace tetra::dds_tools {
+
+using dds::monotonic_ns;
+using report::fixed;
 
 namespace {
 enum LinkToken : std::intptr_t { kLinkAttitude = 1, kLinkMatched, kLinkShutdown };
@@ -217,4 +220,4 @@ void SimDdsLink::wait_for_acks() {
   (void)gyro_writer_.wait_for_acks(std::chrono::seconds(2));
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::dds_tools

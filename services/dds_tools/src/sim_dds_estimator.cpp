@@ -1,8 +1,10 @@
-#include "sim_dds_estimator.hpp"
+#include "tetra/dds_tools/sim_dds_estimator.hpp"
 
-#include "dds_common.hpp"
+#include "tetra/dds/clock.hpp"
 
-namespace tetra::cli {
+namespace tetra::dds_tools {
+
+using dds::monotonic_ns;
 
 Result<sim::EstimatorOutput> DdsEstimator::estimate(const sim::SimEpoch& epoch) {
   if (!lockstep_) {
@@ -44,4 +46,4 @@ Status DdsEstimator::pace(std::int64_t stamp_ns) {
   return ok_status();
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::dds_tools

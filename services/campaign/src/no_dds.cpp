@@ -1,7 +1,7 @@
 // `target: dds` campaigns in a build without DDS.
-#include "campaign_dds.hpp"
+#include "tetra/campaign/dds_estimators.hpp"
 
-namespace tetra::cli {
+namespace tetra::campaign {
 
 sim::EstimatorFactory dds_campaign_estimators(const sim::CampaignSpec&, const std::string&) {
   return [](const sim::Scenario&, const sim::CampaignCase&,
@@ -10,4 +10,4 @@ sim::EstimatorFactory dds_campaign_estimators(const sim::CampaignSpec&, const st
   };
 }
 
-}  // namespace tetra::cli
+}  // namespace tetra::campaign
