@@ -209,7 +209,7 @@ py::array_t<double> vector(const Eigen::VectorXd& v) {
 
 }  // namespace
 
-void bind_calibration(py::module_& m) {
+static void bind_calibration_class(py::module_& m) {
   py::class_<Calibration>(
       m, "Calibration",
       "A gyro package's calibration (docs/interfaces.md §2.3): per gyro a scale factor "
@@ -287,7 +287,9 @@ void bind_calibration(py::module_& m) {
         return "<tetra.Calibration unit='" + c.unit + "' method='" + c.method +
                "' gyros=" + std::to_string(c.gyro_count()) + ">";
       });
+}
 
+static void bind_calibration_results(py::module_& m) {
   py::class_<Calibrated>(m, "CalibrationResult", "The outcome of tetra.calibrate.")
       .def_property_readonly(
           "calibration", [](const Calibrated& r) { return r.result.calibration; },
@@ -337,6 +339,11 @@ void bind_calibration(py::module_& m) {
       },
       "sequence"_a, "time_s"_a, "inner_deg"_a, "outer_deg"_a, "g_V"_a, "latitude_deg"_a, "method"_a,
       "bias_model"_a, "unit"_a, "noise"_a, "correlation_s"_a);
+}
+
+void bind_calibration(py::module_& m) {
+  bind_calibration_class(m);
+  bind_calibration_results(m);
 }
 
 }  // namespace tetra::python

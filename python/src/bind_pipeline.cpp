@@ -201,7 +201,7 @@ py::dict health_dict(const fdi::Health& h, int n) {
 
 }  // namespace
 
-void bind_pipeline(py::module_& m) {
+static void bind_pipeline_config(py::module_& m) {
   py::class_<fdi::PipelineConfig>(m, "PipelineConfig",
                                   "The pipeline's configuration (the `pipeline:` map, docs/fdi.md).")
       .def(py::init<>(), "Every key at its default.")
@@ -220,7 +220,9 @@ void bind_pipeline(py::module_& m) {
   m.def(
       "_read_pipeline_config", [](const std::string& path) { return take(fdi::read_pipeline_config(path)); },
       "path"_a);
+}
 
+static void bind_pipeline_class(py::module_& m) {
   py::class_<PyPipeline>(m, "_Pipeline")
       .def(py::init([](const Calibration& calibration, fdi::PipelineConfig config, bool units_dps) {
              config.raw_units_dps = units_dps;
@@ -293,6 +295,11 @@ void bind_pipeline(py::module_& m) {
         return d.data == a.data();
       },
       "array"_a, "True when tetra reads `array` in place (C-contiguous float64), False when it copies it.");
+}
+
+void bind_pipeline(py::module_& m) {
+  bind_pipeline_config(m);
+  bind_pipeline_class(m);
 }
 
 }  // namespace tetra::python

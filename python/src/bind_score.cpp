@@ -68,7 +68,7 @@ AttitudeSeries series_from_arrays(const std::string& source, const py::handle& t
 
 }  // namespace
 
-void bind_score(py::module_& m) {
+static void bind_attitude_series(py::module_& m) {
   py::class_<AttitudeSeries>(m, "AttitudeSeries", "Rows of an attitude (estimate or truth) to score.")
       .def_readonly("source", &AttitudeSeries::source)
       .def_property_readonly("epochs", [](const AttitudeSeries& s) { return s.time_s.size(); });
@@ -78,7 +78,9 @@ void bind_score(py::module_& m) {
       "path"_a, "with_sigma"_a);
   m.def("_attitude_series", &series_from_arrays, "source"_a, "time_s"_a, "q_RB_wxyz"_a, "omega_BR_B_dps"_a,
         "sigma_deg"_a, "sigma_B_deg"_a);
+}
 
+static void bind_attitude_score(py::module_& m) {
   py::class_<AttitudeScore>(
       m, "AttitudeScore",
       "The figures of `tetra score` (docs/score.md); angles in degrees, vectors per body "
@@ -165,6 +167,11 @@ void bind_score(py::module_& m) {
         return take(std::move(r));
       },
       "attitude"_a, "truth"_a, "time_tolerance_s"_a, "axis_B"_a);
+}
+
+void bind_score(py::module_& m) {
+  bind_attitude_series(m);
+  bind_attitude_score(m);
 }
 
 }  // namespace tetra::python

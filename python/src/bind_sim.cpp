@@ -51,7 +51,7 @@ PyTruth to_python(sim::Truth&& t) {
 
 }  // namespace
 
-void bind_sim(py::module_& m) {
+static void bind_scenarios(py::module_& m) {
   py::class_<sim::Scenario>(m, "Scenario",
                             "What is simulated (docs/sim.md): motion, duration, sampling, unit, reference, "
                             "faults. Made by tetra.scenario from a built-in name, a file or a dict.")
@@ -79,7 +79,9 @@ void bind_sim(py::module_& m) {
         return take(sim::parse_scenario(text, source, base_dir));
       },
       "text"_a, "source"_a, "base_dir"_a);
+}
 
+static void bind_sim_runs(py::module_& m) {
   py::class_<PyTruth>(m, "Truth", "The simulated truth, one row per epoch.")
       .def_readonly("time_s", &PyTruth::time_s, "[s] (n,)")
       .def_readonly("q_RB_wxyz", &PyTruth::q_RB_wxyz,
@@ -139,6 +141,11 @@ void bind_sim(py::module_& m) {
         return d;
       },
       "unit"_a, "table_rate_dps"_a, "revolutions"_a, "rate_hz"_a, "latitude_deg"_a, "seed"_a);
+}
+
+void bind_sim(py::module_& m) {
+  bind_scenarios(m);
+  bind_sim_runs(m);
 }
 
 }  // namespace tetra::python

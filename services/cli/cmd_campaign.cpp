@@ -44,6 +44,83 @@ void print_progress(const campaign::Progress& p) {
             << (isatty(2) && !p.final ? "   " : "\n") << std::flush;
 }
 
+//! The command line's values that are not campaign::RunOptions.
+struct CampaignArgs {
+  std::string spec_path;
+  bool no_report = false;
+  std::string shard_text;
+  int domain = 0;
+  CLI::Option* domain_opt = nullptr;
+};
+
+void add_campaign_options(CLI::App& app, CampaignArgs& a, campaign::RunOptions& options) {
+  app.add_option("SPEC", a.spec_path, "campaign spec YAML")->required();
+  app.add_option("--out,-o", options.out_dir,
+                 "output folder: runs.csv, report.md, plots, spec.yaml, spec.sha256, shard.txt (target "
+                 "dds: dds/, the services' files while they run)")
+      ->required();
+  app.add_option("--jobs,-j", options.jobs, "worker processes (default: the number of cores; at most 1024)")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
+  app.add_option("--run-timeout", options.run_timeout_s,
+                 "[s] a run without its row after this long is killed and is an error row")
+      ->check(CLI::Range(0.001, 1e7))
+      ->capture_default_str();
+  app.add_option("--shard", a.shard_text,
+                 "K/N: run only the runs i with i mod N = K-1 (K from 1 to N), e.g. one Slurm array task; "
+                 "no report (tetra campaign merge writes it)");
+  app.add_flag("--no-report", a.no_report, "only the runs (no report, no plots)");
+  a.domain_opt = app.add_option("--domain", a.domain,
+                                "DDS domain of the services (target dds; overrides the spec's domain:)")
+                     ->check(CLI::Range(0, 232));
+}
+
+//! The spec as the command line amends it (--domain), and the run options it implies (--shard, DDS).
+Result<sim::CampaignSpec> campaign_setup(const CampaignArgs& a, campaign::RunOptions& options) {
+  if (!a.shard_text.empty()) {
+    auto shard = campaign::parse_shard(a.shard_text);
+    if (!shard) return shard.error();
+    options.shard = *shard;
+  }
+  auto spec = sim::read_campaign_spec(a.spec_path);
+  if (!spec) return spec.error();
+  if (a.domain_opt->count() != 0) {
+    if (spec->target != sim::CampaignTarget::kDds)
+      return bad_input("--domain applies to a campaign with target: dds only");
+    spec->dds_domain = a.domain;
+  }
+  if (spec->target == sim::CampaignTarget::kDds) {
+    const std::string dds_dir = (std::filesystem::path(options.out_dir) / "dds").string();
+    options.estimators = [dds_dir](const sim::CampaignSpec& s) {
+      return campaign::dds_campaign_estimators(s, dds_dir);
+    };
+  }
+  options.spec_path = a.spec_path;
+  options.on_progress = print_progress;
+  return spec;
+}
+
+//! Prepares the folder (and the services' folder over DDS) and says what is about to run.
+Status prepare(const sim::CampaignSpec& spec, const campaign::RunOptions& options) {
+  campaign::RunSummary summary;
+  auto pending = campaign::prepare_folder(spec, options, summary);
+  if (!pending) return pending.error();
+  const bool over_dds = spec.target == sim::CampaignTarget::kDds;
+  if (over_dds) {
+    const std::string dds_dir = (std::filesystem::path(options.out_dir) / "dds").string();
+    std::error_code ec;
+    std::filesystem::create_directories(dds_dir, ec);
+    if (ec) return failure(dds_dir + ": cannot create the folder");
+  }
+  std::cerr << "tetra campaign: " << summary.total << " runs"
+            << (options.shard.n > 1 ? " of shard " + campaign::shard_text(options.shard) : std::string())
+            << " (" << (spec.loop == sim::CampaignLoop::kClosed ? "closed" : "open") << " loop, "
+            << (over_dds ? "fusion services over DDS, domain " + std::to_string(spec.dds_domain)
+                         : std::string("pipeline in process"))
+            << "), " << summary.done_before << " already done, " << options.jobs << " jobs\n";
+  return ok_status();
+}
+
 }  // namespace
 
 int cmd_campaign(int argc, char** argv) {
@@ -58,75 +135,21 @@ int cmd_campaign(int argc, char** argv) {
       "Interrupted campaigns continue where they stopped. `--shard K/N` runs a part for a cluster; "
       "`tetra campaign merge OUT SHARD_DIRS...` joins the parts.",
       kCampaignName};
-  std::string spec_path;
+  CampaignArgs args;
   campaign::RunOptions options;
   options.jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  bool no_report = false;
-  std::string shard_text;
-  app.add_option("SPEC", spec_path, "campaign spec YAML")->required();
-  app.add_option("--out,-o", options.out_dir,
-                 "output folder: runs.csv, report.md, plots, spec.yaml, spec.sha256, shard.txt (target "
-                 "dds: dds/, the services' files while they run)")
-      ->required();
-  app.add_option("--jobs,-j", options.jobs, "worker processes (default: the number of cores; at most 1024)")
-      ->check(CLI::Range(1, 1024))
-      ->capture_default_str();
-  app.add_option("--run-timeout", options.run_timeout_s,
-                 "[s] a run without its row after this long is killed and is an error row")
-      ->check(CLI::Range(0.001, 1e7))
-      ->capture_default_str();
-  app.add_option("--shard", shard_text,
-                 "K/N: run only the runs i with i mod N = K-1 (K from 1 to N), e.g. one Slurm array task; "
-                 "no report (tetra campaign merge writes it)");
-  app.add_flag("--no-report", no_report, "only the runs (no report, no plots)");
-  int domain = 0;
-  CLI::Option* domain_opt =
-      app.add_option("--domain", domain,
-                     "DDS domain of the services (target dds; overrides the spec's domain:)")
-          ->check(CLI::Range(0, 232));
+  add_campaign_options(app, args, options);
   if (auto status = parse(app, argc, argv)) return *status;
 
-  if (!shard_text.empty()) {
-    auto shard = campaign::parse_shard(shard_text);
-    if (!shard) return report(kCampaignName, shard.error());
-    options.shard = *shard;
-  }
-  auto spec = sim::read_campaign_spec(spec_path);
+  auto spec = campaign_setup(args, options);
   if (!spec) return report(kCampaignName, spec.error());
-  if (domain_opt->count() != 0) {
-    if (spec->target != sim::CampaignTarget::kDds)
-      return report(kCampaignName, bad_input("--domain applies to a campaign with target: dds only"));
-    spec->dds_domain = domain;
-  }
-  const bool over_dds = spec->target == sim::CampaignTarget::kDds;
-  const std::string dds_dir = (std::filesystem::path(options.out_dir) / "dds").string();
-  if (over_dds) {
-    options.estimators = [dds_dir](const sim::CampaignSpec& s) {
-      return campaign::dds_campaign_estimators(s, dds_dir);
-    };
-  }
-  options.spec_path = spec_path;
-  options.on_progress = print_progress;
-  campaign::RunSummary summary;
-  auto pending = campaign::prepare_folder(*spec, options, summary);
-  if (!pending) return report(kCampaignName, pending.error());
-  if (over_dds) {
-    std::error_code ec;
-    std::filesystem::create_directories(dds_dir, ec);
-    if (ec) return report(kCampaignName, failure(dds_dir + ": cannot create the folder"));
-  }
-  std::cerr << "tetra campaign: " << summary.total << " runs"
-            << (options.shard.n > 1 ? " of shard " + campaign::shard_text(options.shard) : std::string())
-            << " (" << (spec->loop == sim::CampaignLoop::kClosed ? "closed" : "open") << " loop, "
-            << (over_dds ? "fusion services over DDS, domain " + std::to_string(spec->dds_domain)
-                         : std::string("pipeline in process"))
-            << "), " << summary.done_before << " already done, " << options.jobs << " jobs\n";
+  if (Status st = prepare(*spec, options); !st) return report(kCampaignName, st.error());
   auto done = campaign::run_campaign(*spec, options);
   if (!done) return report(kCampaignName, done.error());
   if (done->errors > 0)
     std::cerr << "tetra campaign: " << done->errors << " of " << done->total
               << " runs ended in an error (rows with outcome error in " << done->runs_csv << ")\n";
-  if (no_report || options.shard.n > 1) return kExitOk;
+  if (args.no_report || options.shard.n > 1) return kExitOk;
   if (Status st = report::write_campaign_report(done->runs_csv, options.out_dir, sim::report_options(*spec));
       !st)
     return report(kCampaignName, st.error());

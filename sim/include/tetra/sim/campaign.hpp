@@ -33,7 +33,7 @@ enum class CampaignLoop {
 //! `target:` where the fusion pipeline runs.
 enum class CampaignTarget {
   kInProcess,  //!< in the campaign's worker processes
-  kDds,        //!< a `tetra fusion` service per run, over DDS in lockstep (services/cli/campaign_dds.hpp)
+  kDds,        //!< a `tetra fusion` service per run, over DDS in lockstep (tetra/campaign/dds_estimators.hpp)
 };
 
 struct CampaignSpec {
