@@ -144,8 +144,9 @@ std::string requirements_section(const std::vector<Requirement>& requirements,
   for (const Requirement& q : requirements) {
     const RequirementJudgement j = judge_requirement(q, rows);
     const bool fa = q.metric == RequirementMetric::kFalseAlarmsPerHour;
-    const std::string observed = fa ? std::to_string(j.events) + " in " + num(j.trials) + " h"
-                                    : std::to_string(j.events) + " of " + num(j.trials) + " runs";
+    const std::string observed =
+        fa ? std::to_string(j.events) + " in " + num(j.trials) + " h"
+           : std::to_string(j.events) + " of " + std::to_string(static_cast<long long>(j.trials)) + " runs";
     const std::string verdict = j.verdict == Verdict::kPass   ? "**pass**"
                                 : j.verdict == Verdict::kFail ? "**fail**"
                                                               : "not yet decidable";
