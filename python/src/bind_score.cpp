@@ -151,6 +151,9 @@ static void bind_attitude_score(py::module_& m) {
                              [](const AttitudeScore& s) { return vec3(s.truth_angle_B_deg); })
       .def_readonly("angle_axis_deg", &AttitudeScore::angle_axis_deg)
       .def_readonly("truth_angle_axis_deg", &AttitudeScore::truth_angle_axis_deg);
+}
+
+static void bind_score_function(py::module_& m) {
   m.def(
       "_score",
       [](const AttitudeSeries& attitude, const AttitudeSeries& truth, double time_tolerance_s,
@@ -172,6 +175,7 @@ static void bind_attitude_score(py::module_& m) {
 void bind_score(py::module_& m) {
   bind_attitude_series(m);
   bind_attitude_score(m);
+  bind_score_function(m);
 }
 
 }  // namespace tetra::python

@@ -112,6 +112,37 @@ std::string domain_problem(Domain domain, const Distribution& d) {
   return "";
 }
 
+//! A `{choice: [...]}`: fault kinds among the spec's kinds, or gyros among the spec's gyros.
+Status parse_choices(const YamlReader& yaml, const YAML::Node& v, const std::string& at,
+                     const ParamInfo& info, const std::vector<FaultKind>& kinds,
+                     const std::vector<int>& gyros, Distribution& d) {
+  if (!v.IsSequence() || v.size() == 0) return yaml.error(v, at, "expected a non-empty list");
+  d.kind = DistributionKind::kChoice;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::string item = at + "[" + std::to_string(i) + "]";
+    if (info.parameter == P::kFaultKind) {
+      auto name = yaml.text(v[i], item);
+      if (!name) return name.error();
+      const auto kind = fault_kind_from_name(*name);
+      const auto it = kind ? std::find(kinds.begin(), kinds.end(), *kind) : kinds.end();
+      if (it == kinds.end()) return yaml.error(v[i], item, "'" + *name + "' is not one of the spec's kinds");
+      d.choices.push_back(static_cast<double>(it - kinds.begin()));
+    } else {
+      auto g = yaml.integer(v[i], item, 1, kMaxGyros);
+      if (!g) return g.error();
+      if (std::find(gyros.begin(), gyros.end(), static_cast<int>(*g)) == gyros.end())
+        return yaml.error(v[i], item,
+                          "gyro " + std::to_string(*g) +
+                              " is not in gyros (the gyros the "
+                              "campaign checks)");
+      d.choices.push_back(static_cast<double>(*g));
+    }
+  }
+  d.min = *std::min_element(d.choices.begin(), d.choices.end());
+  d.max = *std::max_element(d.choices.begin(), d.choices.end());
+  return ok_status();
+}
+
 //! One distribution: `calibration`, {calibration: k}, {normal: [..]}, {uniform: [..]}, ...
 Result<Distribution> parse_distribution(const YamlReader& yaml, const YAML::Node& node,
                                         const std::string& what, const ParamInfo& info,
@@ -169,31 +200,7 @@ Result<Distribution> parse_distribution(const YamlReader& yaml, const YAML::Node
     d.min = (*n)[2];
     d.max = (*n)[3];
   } else if (form == "choice" && info.domain == Domain::kChoice) {
-    if (!v.IsSequence() || v.size() == 0) return yaml.error(v, at, "expected a non-empty list");
-    d.kind = DistributionKind::kChoice;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const std::string item = at + "[" + std::to_string(i) + "]";
-      if (info.parameter == P::kFaultKind) {
-        auto name = yaml.text(v[i], item);
-        if (!name) return name.error();
-        const auto kind = fault_kind_from_name(*name);
-        const auto it = kind ? std::find(kinds.begin(), kinds.end(), *kind) : kinds.end();
-        if (it == kinds.end())
-          return yaml.error(v[i], item, "'" + *name + "' is not one of the spec's kinds");
-        d.choices.push_back(static_cast<double>(it - kinds.begin()));
-      } else {
-        auto g = yaml.integer(v[i], item, 1, kMaxGyros);
-        if (!g) return g.error();
-        if (std::find(gyros.begin(), gyros.end(), static_cast<int>(*g)) == gyros.end())
-          return yaml.error(v[i], item,
-                            "gyro " + std::to_string(*g) +
-                                " is not in gyros (the gyros the "
-                                "campaign checks)");
-        d.choices.push_back(static_cast<double>(*g));
-      }
-    }
-    d.min = *std::min_element(d.choices.begin(), d.choices.end());
-    d.max = *std::max_element(d.choices.begin(), d.choices.end());
+    if (Status st = parse_choices(yaml, v, at, info, kinds, gyros, d); !st) return st.error();
   } else {
     return yaml.error(node.begin()->first, what, "'" + form + "' is not a distribution for " + info.name);
   }
