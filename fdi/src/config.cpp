@@ -66,6 +66,8 @@ const std::vector<KeyDef>& scalar_keys() {
       {"reference_bias_window_s", &PipelineConfig::reference_bias_window_s},
       {"reference_check_false_alarm_probability", &PipelineConfig::reference_check_false_alarm_probability},
       {"reference_reaccept_s", &PipelineConfig::reference_reaccept_s},
+      {"reference_bias_arcsec", &PipelineConfig::reference_bias_arcsec},
+      {"reference_latency_max_s", &PipelineConfig::reference_latency_max_s},
       {"integrity_risk", &PipelineConfig::integrity_risk},
       {"calibration_error_sigmas", &PipelineConfig::calibration_error_sigmas},
   };
@@ -215,6 +217,12 @@ Status validate(const PipelineConfig& c) {
        "in (0, 0.5)"},
       {"reference_reaccept_s", std::isfinite(c.reference_reaccept_s) && c.reference_reaccept_s >= 0.0,
        ">= 0"},
+      {"reference_bias_arcsec", std::isfinite(c.reference_bias_arcsec) && c.reference_bias_arcsec >= 0.0,
+       ">= 0"},
+      {"reference_latency_max_s",
+       std::isfinite(c.reference_latency_max_s) && c.reference_latency_max_s >= 0.0 &&
+           c.reference_latency_max_s <= 10.0,
+       "in [0, 10]"},
       {"integrity_risk", probability(c.integrity_risk), "in (0, 0.5)"},
       {"calibration_error_sigmas",
        std::isfinite(c.calibration_error_sigmas) && c.calibration_error_sigmas >= 0.0 &&

@@ -31,6 +31,7 @@
 #include "parity_detector.hpp"
 #include "protection_level.hpp"
 #include "rate_attitude.hpp"
+#include "reference_budget.hpp"
 #include "reference_consistency.hpp"
 #include "reference_monitor.hpp"
 #include "stamp_judge.hpp"
@@ -62,6 +63,11 @@ std::int64_t pipeline_time_before_ns(std::int64_t now_ns, std::int64_t span_ns) 
              ? now_ns - span_ns
              : std::numeric_limits<std::int64_t>::min();
 }
+
+//! Per axis √(a² + b²): an independent error added to a 1σ.
+Eigen::Vector3d root_sum_square(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return (a.cwiseProduct(a) + b.cwiseProduct(b)).cwiseSqrt();
+}
 }  // namespace
 
 class Pipeline::Impl {
@@ -80,7 +86,8 @@ class Pipeline::Impl {
         gyro_set_(n_),
         attitude_(config_, noise_models(cal, series_, config_)),
         consistency_(config_),
-        protection_(config_) {
+        protection_(config_),
+        budget_(config_) {
     frame_.resize(n_);
     found_.reserve(static_cast<std::size_t>(n_));
     result_.events.reserve(32);
@@ -150,6 +157,7 @@ class Pipeline::Impl {
   ReferenceConsistency consistency_;  //!< the reference as a sensor that can fail
   DisagreementTrend trend_;     //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
   ProtectionLevel protection_;  //!< the integrity bound beside sigma
+  ReferenceBudget budget_;      //!< the reference's stated bias and latency, which its samples cannot show
 
   EpochFrame frame_;
   Isolations found_;
@@ -485,7 +493,10 @@ void Pipeline::Impl::publish_attitude() {
   if (frame_.reference_q_RB && reference_usable_) {
     // Never set the attitude onto a reference that disagrees with gyros that vouch for theirs.
     const ReferenceUse use = attitude_.reference(*frame_.reference_q_RB, !gyros_vouch_);
-    if (use != ReferenceUse::kRejected) protection_.anchor(frame_.now_ns);  // the error known again
+    if (use != ReferenceUse::kRejected) {
+      protection_.anchor(frame_.now_ns);  // the error known again
+      budget_.used(1e-9 * static_cast<double>(frame_.now_ns), attitude_.omega_meas_B());
+    }
     if (use == ReferenceUse::kInitialized || use == ReferenceUse::kReinitialized)
       reference_set_ns_ = frame_.now_ns;
     ++(use == ReferenceUse::kRejected ? health_.counters.reference_rejected
@@ -499,10 +510,8 @@ void Pipeline::Impl::publish_attitude() {
   a.stamp_ns = frame_.now_ns;
   a.q_RB = attitude_.q_RB();
   a.sigma_rad = attitude_.sigma_rad();
-  if (trend_.active()) {
-    const Eigen::Vector3d d = trend_.bound(frame_.now_ns);
-    a.sigma_rad = (a.sigma_rad.cwiseProduct(a.sigma_rad) + d.cwiseProduct(d)).cwiseSqrt();
-  }
+  if (trend_.active()) a.sigma_rad = root_sum_square(a.sigma_rad, trend_.bound(frame_.now_ns));
+  if (budget_.active()) a.sigma_rad = root_sum_square(a.sigma_rad, budget_.sigma_rad());
   if (!observable) {
     a.protection_level_rad.setConstant(std::numeric_limits<double>::infinity());
   } else if (subsets_.ready()) {
@@ -698,6 +707,7 @@ void Pipeline::Impl::reset() {
   reference_.reset();
   consistency_.reset();
   trend_.stop();
+  budget_.reset();
   bias_check_.reset();
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);

@@ -85,6 +85,12 @@ struct PipelineConfig {
   double reference_check_false_alarm_probability = 1.0e-9;
   //! [s] a rejected reference is used again after its samples passed every test for this long
   double reference_reaccept_s = 30.0;
+  //! [arcsec] 1σ per axis of the reference's slowly varying error its specification states (thermo-elastic
+  //! bias, low-spatial-frequency error): the filter follows it unseen, so sigma carries it (0: none stated)
+  double reference_bias_arcsec = 0.0;
+  //! [s] the largest latency of the reference's time stamps its specification allows: at a steady rate it is
+  //! an unseen offset ω·τ, so sigma carries |ω|·this (0: stamps exact)
+  double reference_latency_max_s = 0.0;
 
   // --- integrity (docs/fdi.md, "Protection level")
   //! [-] probability that the attitude error exceeds the published protection level without an alarm

@@ -1,0 +1,40 @@
+#pragma once
+// What the reference's own specification states but its samples cannot show: a slowly varying error (a
+// thermo-elastic bias, a low-spatial-frequency error) of 1σ `reference_bias_arcsec` per axis, and a time
+// stamp late by up to `reference_latency_max_s`. The filter follows either within its noise (docs/fdi.md,
+// "Reference consistency", Limits): once the attitude has been tied to the reference it carries the error,
+// and no test of the samples can tell. The published sigma carries the stated budget in quadrature instead:
+// σ_β per axis, and for the latency the rotation over τ_max at the largest body rate of the recent reference
+// updates, |ω_a|·τ_max (the offset a late reference shows at a rate ω is ω·τ). Both zero by default: the
+// budget is what the user states, never a guess of the pipeline's.
+
+#include <Eigen/Core>
+
+#include "tetra/fdi/config.hpp"
+
+namespace tetra::fdi::detail {
+
+class ReferenceBudget {
+ public:
+  //! The budget of `config` (reference_bias_arcsec, reference_latency_max_s); the largest body rate of the
+  //! updates is forgotten over reference_check_window_s (the filter's own memory of an offset is shorter).
+  explicit ReferenceBudget(const PipelineConfig& config);
+  //! No reference used since (a start, an operator's reset): no budget.
+  void reset();
+  //! A reference sample was used (initialized, accepted, re-initialized) at `time_s` [s] while the body
+  //! turned at `omega_B_rad_s` [rad/s].
+  void used(double time_s, const Eigen::Vector3d& omega_B_rad_s);
+  //! [rad] per axis: the budget's 1σ, zero before the first sample used or with an empty budget.
+  Eigen::Vector3d sigma_rad() const;
+  bool active() const { return used_ && (bias_rad_ > 0.0 || latency_max_s_ > 0.0); }
+
+ private:
+  double bias_rad_ = 0.0;
+  double latency_max_s_ = 0.0;
+  double hold_s_ = 30.0;
+  bool used_ = false;
+  double last_s_ = 0.0;
+  Eigen::Vector3d rate_held_rad_s_ = Eigen::Vector3d::Zero();  //!< [rad/s] per axis, decaying peak of |ω|
+};
+
+}  // namespace tetra::fdi::detail
