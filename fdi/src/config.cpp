@@ -66,6 +66,7 @@ const std::vector<KeyDef>& scalar_keys() {
       {"reference_bias_window_s", &PipelineConfig::reference_bias_window_s},
       {"reference_check_false_alarm_probability", &PipelineConfig::reference_check_false_alarm_probability},
       {"reference_reaccept_s", &PipelineConfig::reference_reaccept_s},
+      {"reference_noise_max_factor", &PipelineConfig::reference_noise_max_factor},
       {"reference_bias_arcsec", &PipelineConfig::reference_bias_arcsec},
       {"reference_latency_max_s", &PipelineConfig::reference_latency_max_s},
       {"integrity_risk", &PipelineConfig::integrity_risk},
@@ -217,6 +218,10 @@ Status validate(const PipelineConfig& c) {
        "in (0, 0.5)"},
       {"reference_reaccept_s", std::isfinite(c.reference_reaccept_s) && c.reference_reaccept_s >= 0.0,
        ">= 0"},
+      {"reference_noise_max_factor",
+       std::isfinite(c.reference_noise_max_factor) && c.reference_noise_max_factor >= 1.0 &&
+           c.reference_noise_max_factor <= 100.0,
+       "in [1, 100]"},
       {"reference_bias_arcsec", std::isfinite(c.reference_bias_arcsec) && c.reference_bias_arcsec >= 0.0,
        ">= 0"},
       {"reference_latency_max_s",

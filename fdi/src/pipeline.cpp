@@ -135,6 +135,8 @@ class Pipeline::Impl {
   void isolate_all(Isolations& found);
   void restart_detectors();
   void gap();
+  //! The `reference_accepted` event's text: with the re-estimated noise when it is not the configured one.
+  std::string reaccepted_detail() const;
   //! [ns] how long before a finding outside an episode its fault may have begun.
   std::int64_t signature_span_ns() const;
   void update_mode(std::int64_t now_ns);
@@ -230,6 +232,17 @@ void Pipeline::Impl::update_fdi_available() {
   emit(std::move(e));
 }
 
+std::string Pipeline::Impl::reaccepted_detail() const {
+  const double sigma_arcsec = consistency_.sigma_rad() / kArcsecToRad;
+  if (sigma_arcsec <= config_.reference_sigma_arcsec) return "attitude reference consistent again: used";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "attitude reference consistent again with its noise re-estimated: used with 1-sigma %.3g "
+                "arcsec (%.3g configured)",
+                sigma_arcsec, config_.reference_sigma_arcsec);
+  return text;
+}
+
 void Pipeline::Impl::judge_reference() {
   // The reference sample is tested before anything uses it (docs/fdi.md, "Reference consistency"); the
   // gyros vouch for their attitude when they leave parity, no episode is open and the rate is observable.
@@ -249,6 +262,10 @@ void Pipeline::Impl::judge_reference() {
     return;
   const ReferenceVerdict v = consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_);
   reference_usable_ = v.use;
+  // The σ the sample is used with: the configured one, or the re-estimated noise (an operator's reset judges
+  // the reference afresh, from the configured σ).
+  attitude_.set_reference_sigma_rad(consistency_.sigma_rad());
+  reference_.set_reference_sigma_rad(consistency_.sigma_rad());
   if (v.rejected) trend_.start(frame_.now_ns);
   if (v.reaccepted) trend_.stop();
   if (consistency_.state() == ReferenceState::kRejected) trend_.add(frame_.now_ns, z, S.diagonal());
@@ -259,7 +276,7 @@ void Pipeline::Impl::judge_reference() {
     e.why = v.rejected ? *v.rejected : ReferenceCheck::kNone;
     e.statistic = consistency_.windowed_nis();
     e.detail = v.rejected ? "attitude reference inconsistent with the gyros: left out, sigma from the gyros"
-                          : "attitude reference consistent again: used";
+                          : reaccepted_detail();
     emit(std::move(e));
   }
   if (v.rejected) {

@@ -83,9 +83,11 @@ RateAttitude::RateAttitude(const PipelineConfig& config, std::vector<GyroNoiseMo
                                            : std::nullopt),
       mekf_(std::move(gyros)),
       snapshots_(mekf_),
-      gate_chi2_(allan::chi2_quantile(1.0 - config.reference_gate_false_alarm_probability, 3.0)) {}
+      gate_chi2_(allan::chi2_quantile(1.0 - config.reference_gate_false_alarm_probability, 3.0)),
+      sigma_ref_rad_(config.reference_sigma_arcsec * kArcsecToRad) {}
 
 void RateAttitude::reset(const Quaternion& q0_RB) {
+  sigma_ref_rad_ = config_.reference_sigma_arcsec * kArcsecToRad;
   propagator_.reset(q0_RB);
   mekf_.reset(config_.initial_sigma_deg * kDegToRad);
   snapshots_.reset();
@@ -128,7 +130,7 @@ bool RateAttitude::predict_reference(const Quaternion& q_ref_RB, double dt_s, do
       0.5 * (omega_prev_ + omega_meas_) + curvature_rad_s(dt_s, period_s) - correction_;
   const Quaternion q_pred = propagator_.q_RB() * quat_exp(omega * dt_s);
   z = quat_log(q_pred.conjugate() * q_ref_RB);
-  const double sigma_ref = config_.reference_sigma_arcsec * kArcsecToRad;
+  const double sigma_ref = sigma_ref_rad_;
   const Eigen::Vector3d bound = propagator_.sigma_rad();
   S = mekf_.covariance().topLeftCorner<3, 3>();
   S.diagonal() += bound.cwiseProduct(bound) + Eigen::Vector3d::Constant(sigma_ref * sigma_ref);
@@ -136,7 +138,7 @@ bool RateAttitude::predict_reference(const Quaternion& q_ref_RB, double dt_s, do
 }
 
 ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB, bool may_reinitialize) {
-  const double sigma_ref = config_.reference_sigma_arcsec * kArcsecToRad;
+  const double sigma_ref = sigma_ref_rad_;
   if (!reference_seen_) {
     // The first sample sets the attitude (replay and service alike): known to the reference's σ from now on.
     reference_seen_ = true;

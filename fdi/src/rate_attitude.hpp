@@ -108,6 +108,8 @@ class RateAttitude {
   Eigen::Vector3d omega_BR_B() const { return omega_meas_ - propagator_.earth_rate_B(); }
   Eigen::Vector3d earth_rate_B() const { return propagator_.earth_rate_B(); }
   const Quaternion& q_RB() const { return propagator_.q_RB(); }
+  //! [rad] 1σ per axis of the reference samples from now on (reference_sigma_arcsec until re-estimated).
+  void set_reference_sigma_rad(double sigma_rad) { sigma_ref_rad_ = sigma_rad; }
   //! [rad] 1σ per body axis: the filter's, with the bound of a fault or a lost rate in quadrature.
   Eigen::Vector3d sigma_rad() const;
   const Mekf& filter() const { return mekf_; }
@@ -122,7 +124,8 @@ class RateAttitude {
   double gate_chi2_ = 0.0;   //!< χ²₃ quantile of the reference gate
   Eigen::Vector3d correction_ = Eigen::Vector3d::Zero();  //!< [rad/s] H*·b̂ of the last observable epoch
   bool reference_seen_ = false;
-  int rejected_run_ = 0;  //!< reference samples rejected in a row
+  double sigma_ref_rad_ = 0.0;  //!< [rad] 1σ of a reference sample per axis
+  int rejected_run_ = 0;        //!< reference samples rejected in a row
   double last_chi2_ = 0.0;
   Eigen::Vector3d omega_prev_ = Eigen::Vector3d::Zero();  //!< [rad/s] previous epoch's estimate
   Eigen::Vector3d omega_meas_ = Eigen::Vector3d::Zero();  //!< [rad/s] last estimate (Earth rate included)

@@ -23,7 +23,8 @@ ReferenceConsistency::ReferenceConsistency(const PipelineConfig& config)
       jump_chi2_(allan::chi2_quantile(1.0 - config.reference_check_false_alarm_probability, 3.0)),
       lag_chi2_(allan::chi2_quantile(1.0 - config.reference_check_false_alarm_probability, 1.0)),
       z_tail_(
-          std::sqrt(allan::chi2_quantile(1.0 - 2.0 * config.reference_check_false_alarm_probability, 1.0))) {
+          std::sqrt(allan::chi2_quantile(1.0 - 2.0 * config.reference_check_false_alarm_probability, 1.0))),
+      sigma_config_rad_(config.reference_sigma_arcsec * kArcsecToRad) {
   reset();
 }
 
@@ -31,6 +32,8 @@ void ReferenceConsistency::reset() {
   state_ = ReferenceState::kAbsent;
   consistent_since_ns_ = 0;
   nis_per_dof_ = 0.0;
+  sigma_rad_ = sigma_config_rad_;
+  rejected_for_nis_ = false;
   restart();
 }
 
@@ -118,6 +121,42 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
   return std::nullopt;
 }
 
+bool ReferenceConsistency::reestimate_noise(std::int64_t now_ns, const Eigen::Vector3d& z) {
+  // Evaluated once a block (reference_check_window_s), over every rejected sample since the rejection. The
+  // difference of successive innovations: the reference's white noise twice (2σ² per axis), the
+  // attitude's error changing over one sample interval (the gyros' noise and bias error over ~1 s: far below
+  // an arcsecond), so the estimate does not depend on how loose the gyro-propagated attitude has become. A
+  // steady drift of that error is a mean of the differences, removed per axis.
+  if (have_last_z_) {
+    const Eigen::Vector3d d = z - last_z_;
+    noise_sum_ += d;
+    noise_sum_sq_ += d.cwiseProduct(d);
+    ++noise_count_;
+  }
+  last_z_ = z;
+  have_last_z_ = true;
+  if (now_ns - noise_start_ns_ < seconds_to_ns(config_.reference_check_window_s) || noise_count_ < 4)
+    return false;
+  const double k = noise_count_;
+  const double var_d_rad2 =
+      (noise_sum_sq_ - noise_sum_.cwiseProduct(noise_sum_) / k).sum() / (3.0 * (k - 1.0));
+  // Successive differences share a sample (correlation −1/2): counted as half as many independent squares,
+  // the upper bound at 1 − 1e-3 of σ² = var(d)/2 is ν·σ̂²/χ²_ν(1e-3) with ν = 3(k − 1)/2.
+  const double dof = 1.5 * (k - 1.0);
+  const double estimate_rad2 = 0.5 * std::max(var_d_rad2, 0.0);
+  const double upper_rad = std::sqrt(estimate_rad2 * dof / allan::chi2_quantile(1e-3, dof));
+  noise_start_ns_ = now_ns;  // the next evaluation a block later, over every difference since the rejection
+  if (upper_rad > config_.reference_noise_max_factor * sigma_config_rad_) {
+    noise_explained_ = false;  // beyond what the reference may be: it stays rejected
+    return false;
+  }
+  noise_explained_ = true;
+  const bool grew = upper_rad > sigma_rad_;
+  // More differences tighten the bound: a smaller σ (never below the configured one) needs no new start.
+  sigma_rad_ = std::max(upper_rad, sigma_config_rad_);
+  return grew;
+}
+
 ReferenceVerdict ReferenceConsistency::observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
                                                const Eigen::Matrix3d& S, const Eigen::Vector3d& omega_rad_s,
                                                bool judge) {
@@ -148,11 +187,24 @@ ReferenceVerdict ReferenceConsistency::observe(std::int64_t now_ns, const Eigen:
     v.use = false;
     v.rejected = failed;
     rejected_lag_s_ = *failed == ReferenceCheck::kLag ? std::abs(lag_s_) : 0.0;
+    rejected_for_nis_ = *failed == ReferenceCheck::kNis;
+    noise_start_ns_ = now_ns;
+    noise_sum_.setZero();
+    noise_sum_sq_.setZero();
+    noise_count_ = 0;
+    have_last_z_ = false;
+    noise_explained_ = false;
     restart_blocks(now_ns);
     consistent_since_ns_ = now_ns + 1;  // from the next sample on
     return v;
   }
   v.use = false;
+  if (rejected_for_nis_ && reestimate_noise(now_ns, z_rad)) {
+    // Judged again from the next sample on, against the new σ.
+    restart_blocks(now_ns);
+    consistent_since_ns_ = now_ns + 1;
+    return v;
+  }
   if (failed) {
     restart_blocks(now_ns);
     consistent_since_ns_ = now_ns + 1;
@@ -164,8 +216,9 @@ ReferenceVerdict ReferenceConsistency::observe(std::int64_t now_ns, const Eigen:
   const bool lag_seen = half_lag == 0.0 || (reaccept_den_ + lag_den_) * half_lag * half_lag >= lag_chi2_;
   // ...and only while the attitude is known at least as well as the reference claims to know it, so the
   // tests can tell a reference twice as noisy (a looser attitude makes any reference look consistent).
-  const double sigma_ref = config_.reference_sigma_arcsec * kArcsecToRad;
-  const bool tests_see = S.trace() / 3.0 <= 2.0 * sigma_ref * sigma_ref;
+  // (After a `nis` rejection the noise estimate, which needs no tight attitude, tells it instead.)
+  const bool tests_see =
+      S.trace() / 3.0 <= 2.0 * sigma_rad_ * sigma_rad_ || (rejected_for_nis_ && noise_explained_);
   if (now_ns - consistent_since_ns_ >= seconds_to_ns(config_.reference_reaccept_s) && lag_seen && tests_see) {
     state_ = ReferenceState::kAccepted;
     v.use = true;

@@ -16,6 +16,10 @@
 // parity among the gyros used and no fault episode open. Then a failed test rejects the reference: its
 // samples are no longer used (sigma grows with the gyro propagation) until they pass every test for
 // reference_reaccept_s. Without judging, a failed test is reported (`inconsistent`) and nothing else changes.
+// A reference rejected for `nis` alone is noisier than configured: while rejected, its noise is re-estimated
+// from its innovations over each block (their second moment less the attitude's share, at its upper
+// confidence bound); at most reference_noise_max_factor × the configured σ, the tests go on against that σ,
+// and the reference is used again with it once they pass (sigma_rad()).
 
 #include <cstdint>
 #include <optional>
@@ -55,6 +59,8 @@ class ReferenceConsistency {
   }
 
   ReferenceState state() const { return state_; }
+  //! [rad] 1σ per axis of a reference sample: reference_sigma_arcsec, or the re-estimated noise.
+  double sigma_rad() const { return sigma_rad_; }
   //! The window's NIS per degree of freedom (Σ zᵀS⁻¹z / 3m: 1 for a consistent reference); 0 before any.
   double windowed_nis() const { return nis_per_dof_; }
 
@@ -63,6 +69,8 @@ class ReferenceConsistency {
   std::optional<ReferenceCheck> test(std::int64_t now_ns, const Eigen::Vector3d& z, const Eigen::Vector3d& w,
                                      double nis, const Eigen::Vector3d& omega);
   void restart_blocks(std::int64_t now_ns);
+  //! Rejected for `nis`: this sample into the noise estimate; true when a block's estimate raised sigma_rad_.
+  bool reestimate_noise(std::int64_t now_ns, const Eigen::Vector3d& z);
 
   const PipelineConfig& config_;
   double jump_chi2_ = 0.0;  //!< χ²₃(1 − p)
@@ -74,8 +82,18 @@ class ReferenceConsistency {
   Eigen::Vector3d lag_offset_rad_ = Eigen::Vector3d::Zero();  //!< [rad] |ω̄·τ̂| of the block so far
   double lag_s_ = 0.0;                                        //!< [s] τ̂ of the block so far
   double lag_den_ = 0.0;  //!< [1/rad²·(rad/s)²] Σ_a Σw(ω − ω̄)² of the block so far: 1/var(τ̂)
-  double rejected_lag_s_ = 0.0;  //!< [s] |τ̂| when rejected for `lag` (0: another reason)
-  double reaccept_den_ = 0.0;    //!< rejected: Σ of lag_den_ over the blocks completed since consistent
+  double rejected_lag_s_ = 0.0;      //!< [s] |τ̂| when rejected for `lag` (0: another reason)
+  double reaccept_den_ = 0.0;        //!< rejected: Σ of lag_den_ over the blocks completed since consistent
+  double sigma_config_rad_ = 0.0;    //!< [rad] reference_sigma_arcsec
+  double sigma_rad_ = 0.0;           //!< [rad] the σ the samples are judged and used with
+  bool rejected_for_nis_ = false;    //!< rejected, and for `nis`
+  std::int64_t noise_start_ns_ = 0;  //!< the noise estimate's block
+  Eigen::Vector3d noise_sum_ = Eigen::Vector3d::Zero();  //!< [rad] Σ of successive innovations' differences
+  Eigen::Vector3d noise_sum_sq_ = Eigen::Vector3d::Zero();  //!< [rad²] Σ of their squares
+  int noise_count_ = 0;                                     //!< differences in the block
+  Eigen::Vector3d last_z_ = Eigen::Vector3d::Zero();  //!< [rad] the previous rejected sample's innovation
+  bool have_last_z_ = false;
+  bool noise_explained_ = false;  //!< the last block's estimate is within sigma_rad_
 
   // the nis and lag block (reference_check_window_s)
   std::int64_t block_start_ns_ = -1;

@@ -16,9 +16,11 @@ ReferenceMonitor::ReferenceMonitor(const Eigen::MatrixX3d& axes_B, const Pipelin
       snap_q_(kSnapshots, Quaternion::Identity()),
       snap_angle_(static_cast<std::size_t>(kSnapshots) * n_, 0.0),
       snap_ref_(static_cast<std::size_t>(kSnapshots) * n_, 0.0),
-      snap_theta_(kSnapshots, Eigen::Vector3d::Zero()) {}
+      snap_theta_(kSnapshots, Eigen::Vector3d::Zero()),
+      sigma_ref_rad_(config.reference_sigma_arcsec * kArcsecToRad) {}
 
 void ReferenceMonitor::reset() {
+  sigma_ref_rad_ = config_.reference_sigma_arcsec * kArcsecToRad;
   for (auto& t : tracks_) t = Track{};
   snap_count_ = 0;
   windows_.reset();
@@ -155,7 +157,7 @@ std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, co
 double ReferenceMonitor::disagreement_sigma(const GyroConstants& c, double span_s, double rot_rad) const {
   // Two reference samples, white noise over the span, the calibrated bias and its instability acting over
   // it, the calibrated scale factor on the rotation, and the angle quantization at both ends.
-  const double sig_ref = config_.reference_sigma_arcsec * kArcsecToRad;
+  const double sig_ref = sigma_ref_rad_;
   return std::sqrt(2.0 * sig_ref * sig_ref + c.arw_rad_rts * c.arw_rad_rts * span_s +
                    std::pow((c.bias_sigma_rad_s + c.bias_instability_rad_s) * span_s, 2) +
                    std::pow(c.scale_rel_sigma * rot_rad, 2) + 2.0 * c.quantization_rad * c.quantization_rad);
@@ -216,7 +218,7 @@ bool ReferenceMonitor::scale_significant(int culprit, int old) const {
   const double det = stt * srr - str * str;
   if (!(stt > 0.0 && srr > 0.0 && det > 1e-4 * stt * srr)) return false;  // |corr(τ, rot)| ≥ 0.99995
   const double b = (stt * sre - str * ste) / det;
-  const double sig_ref = config_.reference_sigma_arcsec * kArcsecToRad;
+  const double sig_ref = sigma_ref_rad_;
   const double sigma_b = std::sqrt(2.0) * sig_ref * std::sqrt(stt / det);
   return std::abs(b) > 5.0 * sigma_b;
 }

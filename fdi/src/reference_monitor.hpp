@@ -84,6 +84,8 @@ class ReferenceMonitor {
     filter_.reset();
   }
   void reset();
+  //! [rad] 1σ per axis of the reference samples from now on (reference_sigma_arcsec until re-estimated).
+  void set_reference_sigma_rad(double sigma_rad) { sigma_ref_rad_ = sigma_rad; }
 
  private:
   static constexpr int kSnapshots = 512;  //!< reference snapshots kept
@@ -121,6 +123,7 @@ class ReferenceMonitor {
   int snap_count_ = 0;                       //!< total pushed
   LoneGyro windows_;                         //!< the windows' comparisons
   LoneGyro filter_;                          //!< the filter's bias estimates at reference samples
+  double sigma_ref_rad_ = 0.0;               //!< [rad] 1σ of a reference sample per axis
 };
 
 }  // namespace tetra::fdi::detail

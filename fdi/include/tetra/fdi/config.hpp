@@ -85,6 +85,9 @@ struct PipelineConfig {
   double reference_check_false_alarm_probability = 1.0e-9;
   //! [s] a rejected reference is used again after its samples passed every test for this long
   double reference_reaccept_s = 30.0;
+  //! [-] a reference rejected for `nis` alone is used again with its noise re-estimated from its samples
+  //! (upper confidence bound) when that is at most this times reference_sigma_arcsec (1: never)
+  double reference_noise_max_factor = 3.0;
   //! [arcsec] 1σ per axis of the reference's slowly varying error its specification states (thermo-elastic
   //! bias, low-spatial-frequency error): the filter follows it unseen, so sigma carries it (0: none stated)
   double reference_bias_arcsec = 0.0;
