@@ -60,6 +60,7 @@ ParityDetector::ParityDetector(int n_gyros, double nominal_window_s)
   p_slow_ = Eigen::VectorXd::Zero(dmax);
   p_ema_ = Eigen::VectorXd::Zero(dmax);
   p_ = Eigen::VectorXd::Zero(dmax);
+  p_raw_ = Eigen::VectorXd::Zero(dmax);
   dp_ = Eigen::VectorXd::Zero(dmax);
 }
 
@@ -109,10 +110,13 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   Detection d;
   d.onset_index = frame.index;
   // The χ² sees one sample: with quantization its own whitening (white noise and quantization error). Both
-  // leave out the calibration's rate-proportional term, bounded by `calibration_bound` in either whitening
-  // (the sample's columns are no longer than the white noise's).
-  double chi2 = shrink_by(p_.data(), s.dof, calibration_bound,
-                          apply_parity(s, frame.usable, frame.y_rad_s.data(), sqrt_period, p_.data()));
+  // leave out the calibration's term, bounded by `calibration_bound` in either whitening (the sample's
+  // columns are no longer than the white noise's). The CUSUM sums: it takes the parity as it is and the bound
+  // in its reference (below), since moving each sample towards 0 barely moves the mean of noisy samples.
+  const double sum_sq = apply_parity(s, frame.usable, frame.y_rad_s.data(), sqrt_period, p_.data());
+  const auto dof = static_cast<Eigen::Index>(s.dof);
+  p_raw_.head(dof) = p_.head(dof);
+  double chi2 = shrink_by(p_.data(), s.dof, calibration_bound, sum_sq);
   if (s.quantized)
     chi2 = shrink_by(
         dp_.data(), s.dof, calibration_bound,
@@ -145,7 +149,9 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   slow_var_ = beta / (2.0 - beta) + 2.0 * beta * beta / (2.0 - beta) * qs * qs;
   slow_age_s_ += frame.dt_s;
   std::int64_t onset = d.onset_index;
-  const double stat = cusum_.step(p_, s.dof, s.cusum_k, frame.index, onset);
+  // A calibration term m with |m| ≤ D moves the CUSUM's sum by at most D per epoch: with the reference k + D
+  // the statistic never exceeds that of the noise alone (d = 1; for d ≥ 2 its radial drift).
+  const double stat = cusum_.step(p_raw_, s.dof, s.cusum_k + calibration_bound, frame.index, onset);
   health.cusum = stat;
   health.cusum_threshold = s.cusum_h;
   if (level_change(s, frame.index, d)) {

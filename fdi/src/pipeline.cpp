@@ -354,6 +354,7 @@ void Pipeline::Impl::detect() {
   const GyroMask active = gyro_set_.active();
   const double calibration = subsets_.calibration_bound(s, frame_.usable, attitude_.omega_meas_B());
   const Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), calibration, health_);
+  protection_.widen(calibration, frame_.dt_s);  // the CUSUM's reference k + D: a larger fault unseen
   if (d.cusum_ran) {
     isolator_.accumulate(detector_.parity(), s.dof);
     bias_check_.record(detector_.parity(), s);

@@ -21,7 +21,7 @@ Eigen::Vector3d ProtectionLevel::bound(const Subset& s, const Eigen::Vector3d& s
   if (s.dof < 1 || !s.observable) return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   const double period = sqrt_period * sqrt_period;
   const double t = std::max(0.0, ns_to_seconds(now_ns - anchor_ns_));
-  const double reach = s.cusum_k * t + (s.cusum_h + kCusumOvershoot) * period;  // [σ·s]
+  const double reach = s.cusum_k * t + calibration_reach_ + (s.cusum_h + kCusumOvershoot) * period;  // [σ·s]
   Eigen::Vector3d fault = Eigen::Vector3d::Zero();
   for (Eigen::Index i = 0; i < s.pinv.cols(); ++i) {
     if (!has_gyro(s.mask, static_cast<int>(i) + 1)) continue;

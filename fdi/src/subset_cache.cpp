@@ -61,7 +61,8 @@ SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s
   if (scale_rel_sigma_.size() != geometry_.gyro_count())
     scale_rel_sigma_ = Eigen::VectorXd::Zero(gyro_count());
   if (axis_sigma_.cols() != geometry_.gyro_count()) axis_sigma_ = Eigen::Matrix3Xd::Zero(3, gyro_count());
-  calibration_sigma_ = (scale_rel_sigma_.array() > 0.0).any() || (axis_sigma_.array() > 0.0).any();
+  calibration_sigma_ = (scale_rel_sigma_.array() > 0.0).any() || (axis_sigma_.array() > 0.0).any() ||
+                       (bias_sigma_rad_s_.array() > 0.0).any();
   subsets_.reserve(gyro_count() <= 8 ? 512 : 4096);
   if (gyro_count() <= 8) by_mask_.assign(std::size_t{1} << static_cast<unsigned>(gyro_count()), nullptr);
 }
@@ -206,6 +207,11 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   s.cusum_k = 0.5 * delta;
   add_quantization(s, v, mask);
   s.bias_wander_sigma = parity_bias_sigma(s, mask);
+  s.calibration_bias_bound = 0.0;
+  for (int i = 0; i < n; ++i) {
+    if (has_gyro(mask, i + 1)) s.calibration_bias_bound += s.parity_col_norm[i] * bias_sigma_rad_s_[i];
+  }
+  s.calibration_bias_bound *= config.calibration_error_sigmas * sqrt_period_;
   s.cusum_h = cusum_threshold(s.dof, s.cusum_k, config.cusum_arl0_epochs, s.bias_wander_sigma) +
               s.quantization_margin;
   // The held level (mean of M epochs over isolation_window_s) misses the episode's true level by N(0, 1/M)

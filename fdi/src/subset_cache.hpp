@@ -38,6 +38,9 @@ struct Subset {
   double cusum_k = 0.0;              //!< [σ] CUSUM reference
   double cusum_h = 0.0;              //!< [σ] CUSUM threshold
   double bias_wander_sigma = 0.0;    //!< [σ] per parity axis: the slowly wandering bias (B, K) in the parity
+  //! [σ] bound on the parity's term from the calibrated biases when each is within calibration_error_sigmas
+  //! (e) of its stated 1σ σ_β,i: e·√T·Σ_{i∈S} |w_i|·σ_β,i (the constant part of `calibration_bound`)
+  double calibration_bias_bound = 0.0;
   int level_epochs = 1;              //!< epochs an episode's parity level is averaged over before it is held
   double level_k = 0.0;              //!< [σ] reference of the CUSUM on the parity minus the held level
   double level_h = 0.0;              //!< [σ] its threshold
@@ -111,10 +114,10 @@ class SubsetCache {
   const GyroGeometry& geometry() const { return geometry_; }
   int gyro_count() const { return geometry_.gyro_count(); }
 
-  //! [σ] bound on the normalized parity's calibration term at the body rate ω [rad/s] when every scale
-  //! factor and axis component of the subset's gyros is within `calibration_error_sigmas` of its stated 1σ:
-  //! e·√T·Σ_{i∈S} |w_i|·(σ_s,i·|h_i·ω| + Σ_j σ_h,ij·|ω_j|) (docs/fdi.md, "Calibration uncertainty").
-  //! 0 without stated σ.
+  //! [σ] bound on the normalized parity's calibration term at the body rate ω [rad/s] when every bias, scale
+  //! factor and axis component of the subset's gyros is within `calibration_error_sigmas` (e) of its stated
+  //! 1σ: e·√T·Σ_{i∈S} |w_i|·(σ_β,i + σ_s,i·|h_i·ω| + Σ_j σ_h,ij·|ω_j|) (docs/fdi.md, "Calibration
+  //! uncertainty"). 0 without stated σ.
   double calibration_bound(const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s) const {
     if (!calibration_sigma_ || s.dof < 1) return 0.0;
     const Eigen::Vector3d w_abs = omega_rad_s.cwiseAbs();
@@ -124,7 +127,7 @@ class SubsetCache {
       const double along = std::abs(geometry_.axes_B().row(i).dot(omega_rad_s));
       sum += s.parity_col_norm[i] * (scale_rel_sigma_[i] * along + axis_sigma_.col(i).dot(w_abs));
     }
-    return config_->calibration_error_sigmas * sqrt_period_ * sum;
+    return s.calibration_bias_bound + config_->calibration_error_sigmas * sqrt_period_ * sum;
   }
   //! [rad/s] per body axis: the largest rate error the subset's scale factors and axes make at the body rate
   //! ω [rad/s] when each is within `calibration_error_sigmas` (e) of its stated 1σ, the detectors' bound:
@@ -164,7 +167,7 @@ class SubsetCache {
   Eigen::VectorXd bias_wander_rad_s_;  //!< [rad/s] per gyro (zeros when none)
   Eigen::VectorXd scale_rel_sigma_;    //!< [-] per gyro (zeros when none)
   Eigen::Matrix3Xd axis_sigma_;        //!< [-] per gyro and component (zeros when none)
-  bool calibration_sigma_ = false;     //!< some scale factor or axis has a stated σ > 0
+  bool calibration_sigma_ = false;     //!< some bias, scale factor or axis has a stated σ > 0
   const PipelineConfig* config_;       //!< owned by the pipeline, outlives the cache
   double period_s_ = 0.0;
   double sqrt_period_ = 0.0;
