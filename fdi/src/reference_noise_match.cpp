@@ -10,7 +10,8 @@ namespace tetra::fdi::detail {
 
 namespace {
 constexpr double kDesignRatio = 4.0;  //!< ρ: the CUSUM's alternative, the block mean's variance ×4
-constexpr double kBlock_s = 10.0;     //!< [s] the CUSUM's block
+constexpr double kBlock_s = 10.0;     //!< [s] the block of the mean innovation
+constexpr double kGain = 0.3;         //!< γ: the matched ratio's step per block, ×e^{γ(u − 1)}
 }  // namespace
 
 ReferenceNoiseMatch::ReferenceNoiseMatch(const PipelineConfig& config, int gyro_count)
@@ -21,7 +22,8 @@ ReferenceNoiseMatch::ReferenceNoiseMatch(const PipelineConfig& config, int gyro_
       mean_square_(static_cast<std::size_t>(gyro_count), 0.0),
       block_z_(static_cast<std::size_t>(gyro_count), 0.0),
       block_s_(static_cast<std::size_t>(gyro_count), 0.0),
-      matched_(static_cast<std::size_t>(gyro_count), false) {}
+      matched_(static_cast<std::size_t>(gyro_count), false),
+      ratio_(static_cast<std::size_t>(gyro_count), 1.0) {}
 
 void ReferenceNoiseMatch::reset() {
   mask_ = 0;
@@ -31,6 +33,7 @@ void ReferenceNoiseMatch::reset() {
   std::fill(block_z_.begin(), block_z_.end(), 0.0);
   std::fill(block_s_.begin(), block_s_.end(), 0.0);
   std::fill(matched_.begin(), matched_.end(), false);
+  std::fill(ratio_.begin(), ratio_.end(), 1.0);
 }
 
 std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
@@ -39,8 +42,10 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
                                                          Mekf& filter) {
   if (mask != mask_) {  // other gyros: statistics afresh (a matched gyro keeps its filter noise)
     const std::vector<bool> keep = matched_;
+    const std::vector<double> keep_ratio = ratio_;
     reset();
     matched_ = keep;
+    ratio_ = keep_ratio;
     mask_ = mask;
   }
   const double dt_s = last_ns_ < 0 ? 0.0 : ns_to_seconds(now_ns - last_ns_);
@@ -68,28 +73,28 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
     }
     block_z_[k] += zd;
     block_s_[k] += s;
-    if (close_block) {
-      if (test_block(k) && !matched_[k]) {
-        matched_[k] = true;
-        filter.add_attitude_variance_along(d, std::max(mean_square_[k] - s, 0.0));
-        if (!found) found = NoiseFinding{i + 1, cusum_[k]};
-      }
+    if (!close_block) continue;
+    const double u = block_z_[k] * block_z_[k] / block_s_[k];
+    block_z_[k] = 0.0;
+    block_s_[k] = 0.0;
+    cusum_[k] = std::max(0.0, cusum_[k] + 0.5 * ((1.0 - 1.0 / kDesignRatio) * u - std::log(kDesignRatio)));
+    const double n2 = filter.arw_rad_rts(i + 1) * filter.arw_rad_rts(i + 1);
+    if (matched_[k]) {
+      ratio_[k] = std::clamp(ratio_[k] * std::exp(kGain * (u - 1.0)), 1.0, kMaxNoiseRatio * kMaxNoiseRatio);
+    } else if (cusum_[k] > threshold_) {
+      matched_[k] = true;
+      filter.add_attitude_variance_along(d, std::max(mean_square_[k] - s, 0.0));
+      ratio_[k] = std::clamp(1.0 + mapped_noise(i, d, h2, T, pinv, mask, filter) / n2, 1.0,
+                             kMaxNoiseRatio * kMaxNoiseRatio);
+      if (!found) found = NoiseFinding{i + 1, cusum_[k]};
     }
-    if (matched_[k] && !first) match(i, d, h2, T, pinv, mask, filter);
+    if (matched_[k]) filter.set_added_noise(i + 1, (ratio_[k] - 1.0) * n2);
   }
   return found;
 }
 
-bool ReferenceNoiseMatch::test_block(std::size_t k) {
-  const double u = block_z_[k] * block_z_[k] / block_s_[k];
-  block_z_[k] = 0.0;
-  block_s_[k] = 0.0;
-  cusum_[k] = std::max(0.0, cusum_[k] + 0.5 * ((1.0 - 1.0 / kDesignRatio) * u - std::log(kDesignRatio)));
-  return cusum_[k] > threshold_;
-}
-
-void ReferenceNoiseMatch::match(int i, const Eigen::Vector3d& d, double h2, double T,
-                                const Eigen::Matrix3Xd& pinv, GyroMask mask, Mekf& filter) const {
+double ReferenceNoiseMatch::mapped_noise(int i, const Eigen::Vector3d& d, double h2, double T,
+                                         const Eigen::Matrix3Xd& pinv, GyroMask mask, const Mekf& filter) const {
   // The step noise along d_i whose steady-state a-priori variance is P.
   const double P = std::max(mean_square_[static_cast<std::size_t>(i)] - reference_var_, 0.0);
   const double q = P * P / ((P + reference_var_) * T);
@@ -99,9 +104,7 @@ void ReferenceNoiseMatch::match(int i, const Eigen::Vector3d& d, double h2, doub
     const double n = filter.arw_rad_rts(j + 1);
     q_model += n * n * std::pow(d.dot(pinv.col(j)), 2);
   }
-  const double n_i = filter.arw_rad_rts(i + 1);
-  const double cap = (kMaxNoiseRatio * kMaxNoiseRatio - 1.0) * n_i * n_i;
-  filter.set_added_noise(i + 1, std::min(std::max(q - q_model, 0.0) / h2, cap));
+  return std::max(q - q_model, 0.0) / h2;
 }
 
 void ReferenceNoiseMatch::match_all() {

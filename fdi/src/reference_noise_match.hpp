@@ -61,11 +61,10 @@ class ReferenceNoiseMatch {
   void match_all();
 
  private:
-  //! The block's CUSUM step for gyro index `k`; true when it crosses the threshold. The block restarts.
-  bool test_block(std::size_t k);
-  //! Gyro index `i`'s added noise from its mean square along `d` (|h_i|² = `h2`, sample interval `T`).
-  void match(int i, const Eigen::Vector3d& d, double h2, double T, const Eigen::Matrix3Xd& pinv, GyroMask mask,
-             Mekf& filter) const;
+  //! [rad²/s] gyro index `i`'s noise beyond the model from its mean square along `d` (|h_i|² = `h2`, sample
+  //! interval `T`): the covariance-matching start.
+  double mapped_noise(int i, const Eigen::Vector3d& d, double h2, double T, const Eigen::Matrix3Xd& pinv,
+                      GyroMask mask, const Mekf& filter) const;
 
   double threshold_ = 0.0;     //!< ln(1/p)
   double window_s_ = 30.0;     //!< [s] the mean square's time constant
@@ -78,6 +77,7 @@ class ReferenceNoiseMatch {
   std::vector<double> block_z_;        //!< [rad] Σ d_iᵀz over the block
   std::vector<double> block_s_;        //!< [rad²] Σ s_i over the block
   std::vector<bool> matched_;
+  std::vector<double> ratio_;  //!< [-] the matched noise variance over the model's, N'²/N², 1..kMaxNoiseRatio²
 };
 
 }  // namespace tetra::fdi::detail
