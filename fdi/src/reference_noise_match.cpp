@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "mekf.hpp"
 #include "tetra/core/units.hpp"
@@ -15,7 +17,7 @@ constexpr double kGain = 0.3;         //!< γ: the matched ratio's step per bloc
 }  // namespace
 
 ReferenceNoiseMatch::ReferenceNoiseMatch(const PipelineConfig& config, int gyro_count)
-    : threshold_(std::log(1.0 / config.reference_check_false_alarm_probability)),
+    : false_alarm_(config.reference_check_false_alarm_probability),
       window_s_(config.reference_check_window_s),
       reference_var_(std::pow(config.reference_sigma_arcsec * kArcsecToRad, 2)),
       cusum_(static_cast<std::size_t>(gyro_count), 0.0),
@@ -28,6 +30,7 @@ ReferenceNoiseMatch::ReferenceNoiseMatch(const PipelineConfig& config, int gyro_
 void ReferenceNoiseMatch::reset() {
   mask_ = 0;
   last_ns_ = -1;
+  block_samples_ = 0;
   std::fill(cusum_.begin(), cusum_.end(), 0.0);
   std::fill(mean_square_.begin(), mean_square_.end(), 0.0);
   std::fill(block_z_.begin(), block_z_.end(), 0.0);
@@ -52,8 +55,14 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
   const bool first = last_ns_ < 0 || dt_s > window_s_;
   if (first) block_start_ns_ = now_ns;
   last_ns_ = now_ns;
+  block_samples_ = first ? 1 : block_samples_ + 1;
   const bool close_block = now_ns - block_start_ns_ >= seconds_to_ns(kBlock_s);
-  if (close_block) block_start_ns_ = now_ns;
+  // A block of n samples stands for n of the per-sample false-alarm probability p.
+  const double threshold = -std::log(false_alarm_ * block_samples_);
+  if (close_block) {
+    block_start_ns_ = now_ns;
+    block_samples_ = 0;
+  }
   const double T = std::max(dt_s, 1e-3);
   const double alpha = first ? 1.0 : -std::expm1(-T / window_s_);
   std::optional<NoiseFinding> found;
@@ -66,6 +75,7 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
     if (!(s > 0.0)) continue;
     const Eigen::Vector3d d = h / std::sqrt(h2);
     const double zd = d.dot(z_rad);
+    if (std::getenv("T3_DUMP")) std::printf("D %.1f %d %.6g %.6g\n", ns_to_seconds(now_ns), i + 1, zd / kArcsecToRad, s / (kArcsecToRad * kArcsecToRad));
     mean_square_[k] = first ? s : mean_square_[k] + alpha * (zd * zd - mean_square_[k]);
     if (first) {
       block_z_[k] = 0.0;
@@ -81,7 +91,7 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
     const double n2 = filter.arw_rad_rts(i + 1) * filter.arw_rad_rts(i + 1);
     if (matched_[k]) {
       ratio_[k] = std::clamp(ratio_[k] * std::exp(kGain * (u - 1.0)), 1.0, kMaxNoiseRatio * kMaxNoiseRatio);
-    } else if (cusum_[k] > threshold_) {
+    } else if (cusum_[k] > threshold) {
       matched_[k] = true;
       filter.add_attitude_variance_along(d, std::max(mean_square_[k] - s, 0.0));
       ratio_[k] = std::clamp(1.0 + mapped_noise(i, d, h2, T, pinv, mask, filter) / n2, 1.0,

@@ -66,12 +66,13 @@ class ReferenceNoiseMatch {
   double mapped_noise(int i, const Eigen::Vector3d& d, double h2, double T, const Eigen::Matrix3Xd& pinv,
                       GyroMask mask, const Mekf& filter) const;
 
-  double threshold_ = 0.0;     //!< ln(1/p)
+  double false_alarm_ = 0.0;   //!< p per sample
   double window_s_ = 30.0;     //!< [s] the mean square's time constant
   double reference_var_ = 0.0; //!< [rad²] r, the reference's variance per axis
   GyroMask mask_ = 0;          //!< the three gyros of the statistics
   std::int64_t last_ns_ = -1;  //!< the last sample's time
   std::int64_t block_start_ns_ = -1;  //!< the CUSUM block's first sample
+  int block_samples_ = 0;             //!< samples in the block
   std::vector<double> cusum_;          //!< [-] g_i
   std::vector<double> mean_square_;    //!< [rad²] m_i
   std::vector<double> block_z_;        //!< [rad] Σ d_iᵀz over the block
