@@ -405,7 +405,8 @@ void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, d
     bias_noise_[n_ + i] = frozen ? 0.0 : gm_var_[k];
     const auto& g = gyros_[k];
     if (has_gyro(used, i + 1))
-      q_theta_ += pinv.col(i) * pinv.col(i).transpose() * ((g.arw_rad_rts * g.arw_rad_rts + added_noise_[k]) * dt_s);
+      q_theta_ +=
+          pinv.col(i) * pinv.col(i).transpose() * ((g.arw_rad_rts * g.arw_rad_rts + added_noise_[k]) * dt_s);
   }
   decay2_.noalias() = decay_ * decay_.transpose();  // d_j·d_k = d_k·d_j: the block stays exactly symmetric
   if (pinv.cols() == n_) step_pinv_ = pinv;         // sized at creation: no allocation

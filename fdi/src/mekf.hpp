@@ -161,8 +161,8 @@ class Mekf {
   Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
   Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
   Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
-  Eigen::VectorXd parity_h_;   //!< N: a parity row's h per gyro (scratch)
-  Eigen::VectorXd prior_var_;  //!< [rad²/s²] per gyro: the variance of c + g without any measurement
+  Eigen::VectorXd parity_h_;         //!< N: a parity row's h per gyro (scratch)
+  Eigen::VectorXd prior_var_;        //!< [rad²/s²] per gyro: the variance of c + g without any measurement
   std::vector<double> added_noise_;  //!< [rad²/s] per gyro: white rate noise added to N² (set_added_noise)
 };
 

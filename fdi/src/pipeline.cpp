@@ -151,9 +151,9 @@ class Pipeline::Impl {
   GyroSet gyro_set_;
   RateAttitude attitude_;
   ReferenceConsistency consistency_;  //!< the reference as a sensor that can fail
-  DisagreementTrend trend_;     //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
+  DisagreementTrend trend_;  //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
   ReferenceNoiseMatch noise_match_;  //!< three gyros: a gyro's noise or ramp in the reference's innovations
-  ProtectionLevel protection_;  //!< the integrity bound beside sigma
+  ProtectionLevel protection_;       //!< the integrity bound beside sigma
 
   EpochFrame frame_;
   Isolations found_;

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "mekf.hpp"
 #include "tetra/core/units.hpp"
@@ -29,14 +27,18 @@ ReferenceNoiseMatch::ReferenceNoiseMatch(const PipelineConfig& config, int gyro_
 
 void ReferenceNoiseMatch::reset() {
   mask_ = 0;
+  restart_statistics();
+  std::fill(matched_.begin(), matched_.end(), false);
+  std::fill(ratio_.begin(), ratio_.end(), 1.0);
+}
+
+void ReferenceNoiseMatch::restart_statistics() {
   last_ns_ = -1;
   block_samples_ = 0;
   std::fill(cusum_.begin(), cusum_.end(), 0.0);
   std::fill(mean_square_.begin(), mean_square_.end(), 0.0);
   std::fill(block_z_.begin(), block_z_.end(), 0.0);
   std::fill(block_s_.begin(), block_s_.end(), 0.0);
-  std::fill(matched_.begin(), matched_.end(), false);
-  std::fill(ratio_.begin(), ratio_.end(), 1.0);
 }
 
 std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
@@ -44,11 +46,7 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
                                                          const Eigen::Matrix3Xd& pinv, GyroMask mask,
                                                          Mekf& filter) {
   if (mask != mask_) {  // other gyros: statistics afresh (a matched gyro keeps its filter noise)
-    const std::vector<bool> keep = matched_;
-    const std::vector<double> keep_ratio = ratio_;
-    reset();
-    matched_ = keep;
-    ratio_ = keep_ratio;
+    restart_statistics();
     mask_ = mask;
   }
   const double dt_s = last_ns_ < 0 ? 0.0 : ns_to_seconds(now_ns - last_ns_);
@@ -69,13 +67,12 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
   for (int i = 0; i < static_cast<int>(cusum_.size()); ++i) {
     if (!has_gyro(mask, i + 1)) continue;
     const auto k = static_cast<std::size_t>(i);
-    const Eigen::Vector3d h = pinv.col(i);
-    const double h2 = h.squaredNorm();
-    const double s = h2 > 0.0 ? (h / std::sqrt(h2)).dot(S * h) / std::sqrt(h2) : 0.0;
+    const double h2 = pinv.col(i).squaredNorm();
+    if (!(h2 > 0.0)) continue;
+    const Eigen::Vector3d d = pinv.col(i) / std::sqrt(h2);
+    const double s = d.dot(S * d);
     if (!(s > 0.0)) continue;
-    const Eigen::Vector3d d = h / std::sqrt(h2);
     const double zd = d.dot(z_rad);
-    if (std::getenv("T3_DUMP")) std::printf("D %.1f %d %.6g %.6g\n", ns_to_seconds(now_ns), i + 1, zd / kArcsecToRad, s / (kArcsecToRad * kArcsecToRad));
     mean_square_[k] = first ? s : mean_square_[k] + alpha * (zd * zd - mean_square_[k]);
     if (first) {
       block_z_[k] = 0.0;
@@ -104,7 +101,8 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
 }
 
 double ReferenceNoiseMatch::mapped_noise(int i, const Eigen::Vector3d& d, double h2, double T,
-                                         const Eigen::Matrix3Xd& pinv, GyroMask mask, const Mekf& filter) const {
+                                         const Eigen::Matrix3Xd& pinv, GyroMask mask,
+                                         const Mekf& filter) const {
   // The step noise along d_i whose steady-state a-priori variance is P.
   const double P = std::max(mean_square_[static_cast<std::size_t>(i)] - reference_var_, 0.0);
   const double q = P * P / ((P + reference_var_) * T);
