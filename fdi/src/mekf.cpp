@@ -245,6 +245,7 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
   gm_kappa_.assign(gyros_.size(), 1.0);
   rrw_var_.assign(gyros_.size(), 0.0);
   gm_var_.assign(gyros_.size(), 0.0);
+  added_noise_.assign(gyros_.size(), 0.0);
   step_pinv_ = Eigen::Matrix3Xd::Zero(3, n_);
   reset(0.0);
 }
@@ -254,6 +255,8 @@ void Mekf::reset(double attitude_sigma_rad) {
   bias_.setZero();
   frozen_mask_ = 0;
   for (int i = 0; i < n_; ++i) set_prior(i);
+  std::fill(added_noise_.begin(), added_noise_.end(), 0.0);
+  step_dt_s_ = -1.0;  // the step constants again from the model's noise
   P_.topLeftCorner<3, 3>().diagonal().setConstant(attitude_sigma_rad * attitude_sigma_rad);
 }
 
@@ -340,6 +343,16 @@ void Mekf::thaw(int id) {
   if (id < 1 || id > n_) return;
   frozen_mask_ = without_gyro(frozen_mask_, id);
   set_prior(id - 1);
+  set_added_noise(id, 0.0);
+}
+
+void Mekf::set_added_noise(int id, double added_rad2_s) {
+  if (id < 1 || id > n_) return;
+  double& added = added_noise_[static_cast<std::size_t>(id - 1)];
+  const double v = std::max(added_rad2_s, 0.0);
+  if (v == added) return;
+  added = v;
+  step_dt_s_ = -1.0;  // Qθ recomputed at the next step
 }
 
 Eigen::Vector3d Mekf::rate_correction(const Eigen::Matrix3Xd& pinv, GyroMask mask) const {
@@ -392,7 +405,8 @@ void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, d
     bias_noise_[n_ + i] = frozen ? 0.0 : gm_var_[k];
     const auto& g = gyros_[k];
     if (has_gyro(used, i + 1))
-      q_theta_ += pinv.col(i) * pinv.col(i).transpose() * (g.arw_rad_rts * g.arw_rad_rts * dt_s);
+      q_theta_ +=
+          pinv.col(i) * pinv.col(i).transpose() * ((g.arw_rad_rts * g.arw_rad_rts + added_noise_[k]) * dt_s);
   }
   decay2_.noalias() = decay_ * decay_.transpose();  // d_j·d_k = d_k·d_j: the block stays exactly symmetric
   if (pinv.cols() == n_) step_pinv_ = pinv;         // sized at creation: no allocation
@@ -422,6 +436,10 @@ void Mekf::gauss_markov_transitions(double dt_s) {
 
 void Mekf::add_attitude_variance(const Eigen::Vector3d& var_rad2) {
   P_.topLeftCorner<3, 3>().diagonal() += var_rad2;
+}
+
+void Mekf::add_attitude_variance_along(const Eigen::Vector3d& d, double var_rad2) {
+  P_.topLeftCorner<3, 3>().noalias() += (var_rad2 * d) * d.transpose();
 }
 
 ReferenceUpdate Mekf::update_reference(const Quaternion& q_est_RB, const Quaternion& q_ref_RB,

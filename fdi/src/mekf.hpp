@@ -63,6 +63,15 @@ class Mekf {
 
   //! Adds a variance [rad²] per axis to the attitude (e.g. a bound turned into a 1σ before an update).
   void add_attitude_variance(const Eigen::Vector3d& var_rad2);
+  //! Adds `var_rad2` [rad²] along the unit body direction `d` to the attitude: P_θθ += var·d·dᵀ.
+  void add_attitude_variance_along(const Eigen::Vector3d& d, double var_rad2);
+
+  //! Gyro `id`'s white rate noise as the filter models it from the next step on: N_i² + `added_rad2_s`
+  //! [rad²/s] (≥ 0; the noise the reference's innovations show beyond the model, docs/fdi.md "Reference
+  //! consistency"). reset() and thaw() put it back to the model's.
+  void set_added_noise(int id, double added_rad2_s);
+  //! [rad/√s] gyro `id`'s modelled white rate noise N (without any added noise).
+  double arw_rad_rts(int id) const { return gyros_[static_cast<std::size_t>(id - 1)].arw_rad_rts; }
 
   //! A reference sample of the attitude, 1σ `sigma_rad` per axis; rejected (nothing changed) when the χ² of
   //! its innovation exceeds `gate_chi2`. An accepted sample updates the biases itself; the caller applies
@@ -152,8 +161,9 @@ class Mekf {
   Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
   Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
   Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
-  Eigen::VectorXd parity_h_;   //!< N: a parity row's h per gyro (scratch)
-  Eigen::VectorXd prior_var_;  //!< [rad²/s²] per gyro: the variance of c + g without any measurement
+  Eigen::VectorXd parity_h_;         //!< N: a parity row's h per gyro (scratch)
+  Eigen::VectorXd prior_var_;        //!< [rad²/s²] per gyro: the variance of c + g without any measurement
+  std::vector<double> added_noise_;  //!< [rad²/s] per gyro: white rate noise added to N² (set_added_noise)
 };
 
 //! ∫₀^Δt exp(−[ω×]u) du in closed form (a series for small |ω|Δt).

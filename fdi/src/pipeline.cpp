@@ -34,6 +34,7 @@
 #include "reference_budget.hpp"
 #include "reference_consistency.hpp"
 #include "reference_monitor.hpp"
+#include "reference_noise_match.hpp"
 #include "stamp_judge.hpp"
 #include "subset_cache.hpp"
 #include "tetra/core/csv.hpp"
@@ -86,6 +87,7 @@ class Pipeline::Impl {
         gyro_set_(n_),
         attitude_(config_, noise_models(cal, series_, config_)),
         consistency_(config_),
+        noise_match_(config_, n_),
         protection_(config_),
         budget_(config_) {
     frame_.resize(n_);
@@ -130,6 +132,7 @@ class Pipeline::Impl {
   void publish_filter_health() const;
   void update_fdi_available();
   void judge_reference();
+  void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
 
   void isolate(const Isolation& iso);
   void isolate_all(Isolations& found);
@@ -157,9 +160,10 @@ class Pipeline::Impl {
   GyroSet gyro_set_;
   RateAttitude attitude_;
   ReferenceConsistency consistency_;  //!< the reference as a sensor that can fail
-  DisagreementTrend trend_;     //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
-  ProtectionLevel protection_;  //!< the integrity bound beside sigma
-  ReferenceBudget budget_;      //!< the reference's stated bias and latency, which its samples cannot show
+  DisagreementTrend trend_;  //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
+  ReferenceNoiseMatch noise_match_;  //!< three gyros: a gyro's noise or ramp in the reference's innovations
+  ProtectionLevel protection_;       //!< the integrity bound beside sigma
+  ReferenceBudget budget_;           //!< the reference's stated bias and latency, which its samples cannot show
 
   EpochFrame frame_;
   Isolations found_;
@@ -301,7 +305,23 @@ void Pipeline::Impl::judge_reference() {
         "); three gyros: the data cannot tell which, sigma and bias states widened";
     attitude_.add_variance(z.cwiseProduct(z));
     attitude_.fault_opened(z.norm() / config_.reference_check_window_s);
+    noise_match_.match_all();
   }
+  if (v.use) match_three_gyro_noise(z, S);
+}
+
+void Pipeline::Impl::match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {
+  // Three gyros, no parity: the reference's innovations are the only witness of a gyro's noise or ramp
+  // (docs/fdi.md, "Three gyros: a second fault"); the gyro's noise in the filter follows them from then on.
+  const Subset& s = subsets_.get(gyro_set_.active());
+  if (tetra::gyro_count(s.mask) != 3 || !s.observable || s.dof >= 1) return;
+  const auto found = noise_match_.observe(frame_.now_ns, z, S, s.pinv, s.mask, attitude_.filter());
+  if (!found) return;
+  emit_detected(DetectionTest::kReference, found->statistic, frame_.now_ns);
+  result_.events.back().why = ReferenceCheck::kNis;
+  result_.events.back().detail = "attitude reference innovations along gyro " + std::to_string(found->gyro) +
+                                 "'s rate axis exceed the model (noise or ramp); three gyros: its noise in "
+                                 "the filter matched to the innovations, sigma widened";
 }
 
 bool Pipeline::Impl::accept(const Epoch& epoch) {
@@ -726,6 +746,7 @@ void Pipeline::Impl::reset() {
   consistency_.reset();
   trend_.stop();
   budget_.reset();
+  noise_match_.reset();
   bias_check_.reset();
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);
@@ -809,6 +830,8 @@ FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   for (int id = 1; id <= n_; ++id) reinstate(id);
   consistency_.reset();
   trend_.stop();
+  noise_match_.reset();
+  for (int id = 1; id <= n_; ++id) attitude_.filter().set_added_noise(id, 0.0);
   restart_detectors();
   update_mode(stamp_ns);
   FdiEvent ack;

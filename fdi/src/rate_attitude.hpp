@@ -113,6 +113,7 @@ class RateAttitude {
   //! [rad] 1σ per body axis: the filter's, with the bound of a fault or a lost rate in quadrature.
   Eigen::Vector3d sigma_rad() const;
   const Mekf& filter() const { return mekf_; }
+  Mekf& filter() { return mekf_; }
   //! The last reference sample's χ² (3 dof); 0 before any.
   double reference_chi2() const { return last_chi2_; }
 

@@ -302,6 +302,65 @@ TEST(ReferenceBudget, AnEmptyBudgetChangesNothing) {
   EXPECT_EQ(a.final_error_arcsec, b.final_error_arcsec);
 }
 
+//! Three gyros (gyro 4 absent) and the reference, `kind` of `size` on gyro `gyro` from 60 s, `duration_s`.
+sim::Scenario three_gyros_with(sim::FaultKind kind, int gyro, double size, double duration_s) {
+  sim::Scenario sc = scenario(duration_s, false);
+  sc.unit.gyros.pop_back();
+  sim::FaultSpec f;
+  f.gyro = gyro;
+  f.kind = kind;
+  f.at_s = 60.0;
+  f.size = size;
+  sc.faults = {f};
+  return sc;
+}
+
+//! [s] the first `detected` event that names gyro `id` along its rate axis (the three-gyro noise test), or −1.
+double named_detection_s(const Outcome& o, int id) {
+  for (const auto& e : o.events) {
+    if (e.type == fdi::EventType::kDetected &&
+        e.detail.find("along gyro " + std::to_string(id) + "'s") != std::string::npos)
+      return ns_to_seconds(e.stamp_ns);
+  }
+  return -1.0;
+}
+
+TEST(ReferenceConsistency, WithThreeGyrosANoiseIncreaseIsDetectedAndSigmaMatchesIt) {
+  // Three gyros, noise x10 on gyro 2 from 60 s, 600 s, twelve seeds: the reference's innovations along gyro 2's
+  // rate axis raise their 10-s block means' CUSUM (docs/fdi.md, "Three gyros: a noise increase or a ramp"), the
+  // gyro is named and its noise in the filter matched to the innovations from then on. Named 51–441 s after
+  // onset (median 166 s; the `second-fault` family's median 252 s), 99.55–100 % within 3σ after. Before, the
+  // block NIS or mean-innovation test fired in 7 of the 12 (136–374 s after onset, no gyro named) and sigma
+  // stayed short (74–89 % within 3σ over the run). Bounds: named within 500 s of onset, and from the
+  // detection on the campaign's criterion, 97 % within 3σ.
+  for (const std::uint64_t seed : {1u, 2u, 3u, 4u, 5u, 6u, 7u, 8u, 9u, 10u, 11u, 12u}) {
+    const Outcome o = run(three_gyros_with(sim::FaultKind::kNoise, 2, 10.0, 600.0), seed);
+    const double t = named_detection_s(o, 2);
+    ASSERT_GE(t, 60.0) << summary(o);
+    EXPECT_LE(t, 560.0) << summary(o);
+    EXPECT_EQ(o.rejected, 0) << summary(o);
+    EXPECT_GE(fraction(o.within_after, o.total_after), 0.97) << summary(o);
+  }
+}
+
+TEST(ReferenceConsistency, WithThreeGyrosARampStaysCoveredAfterItsDetection) {
+  // Three gyros, a ramp of 1e-6 or 2e-6 deg/s² on each gyro in turn from 60 s, two seeds, 600 s: detected by
+  // the reference's tests 71–111 s after onset, then the rate error keeps growing. Before, the bias states
+  // opened once by |z|/window and sigma fell short as the ramp grew (90.3–97.2 % within 3σ after the
+  // detection in these runs); the noise matched along the gyro's rate axis now keeps it over the ramp
+  // (98.4–100 %). Criterion: the campaign's 97 % within 3σ from the detection on.
+  for (const double size : {1e-6, 2e-6}) {
+    for (const int gyro : {1, 2, 3}) {
+      for (const std::uint64_t seed : {1u, 2u}) {
+        const Outcome o = run(three_gyros_with(sim::FaultKind::kRamp, gyro, size, 600.0), seed);
+        ASSERT_GE(o.first_detected_s, 60.0) << summary(o);
+        EXPECT_GE(fraction(o.within_after, o.total_after), 0.97) << size << " gyro " << gyro << " seed " << seed
+                                                                 << ": " << summary(o);
+      }
+    }
+  }
+}
+
 TEST(ProtectionLevel, SlowRampBelowTheThresholdStaysWithinIt) {
   // 3e-7 deg/s² from 60 s, no reference, 30 min: the CUSUM sees it after 210..285 s (its rate then ≈ 7e-5
   // deg/s, below the CUSUM's k); the error stays within the protection level on every axis at every sampled
