@@ -163,7 +163,7 @@ class Pipeline::Impl {
   DisagreementTrend trend_;  //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
   ReferenceNoiseMatch noise_match_;  //!< three gyros: a gyro's noise or ramp in the reference's innovations
   ProtectionLevel protection_;       //!< the integrity bound beside sigma
-  ReferenceBudget budget_;           //!< the reference's stated bias and latency, which its samples cannot show
+  ReferenceBudget budget_;  //!< the reference's stated bias and latency, which its samples cannot show
 
   EpochFrame frame_;
   Isolations found_;
