@@ -23,8 +23,8 @@ constexpr double kNormalLevel = 2.0;  //!< noise ratio of a gyro whose own secon
 //! [samples] another gyro's repeat run that leaves a coarse gyro's repeats unjudged
 constexpr int kOtherRepeats = 3;
 //! Pieces of a repeat run that one other gyro's fault explains: its level changed at most twice during the
-//! run (a step; a spike or a pulse that came and went), so the others' view of the axis may sit at up to three
-//! levels while the gyro's own rate stood still.
+//! run (a step; a spike or a pulse that came and went), so the others' view of the axis may sit at up to
+//! three levels while the gyro's own rate stood still.
 constexpr int kPiecesOneFaultExplains = 3;
 }  // namespace
 
@@ -230,8 +230,8 @@ void GyroSeries::extend_run(int id, Track& t, double rate, double sqrt_period) {
   // repeating gyro allows (its own rate stood within a step; two steps and the others' noise); a projection
   // beyond it starts the next piece. Greedy cuts the fewest pieces of any such split.
   if (!t.run_seen || t.view_rate_sigma > t.run_sigma) {
-    // The run's first projection, or a noisier view (other gyros): pieces cut with the narrower width might be
-    // one with this one. The count starts again from the current piece: fewer pieces, never more evidence.
+    // The run's first projection, or a noisier view (other gyros): pieces cut with the narrower width might
+    // be one with this one. The count starts again from the current piece: fewer pieces, never more evidence.
     if (!t.run_seen) t.run_low = t.run_high = rate;
     t.run_sigma = t.view_rate_sigma;
     t.run_pieces = 1;
@@ -357,10 +357,10 @@ bool GyroSeries::repeats_are_stuck(int id, const Track& t, double sqrt_period) c
     if (j != id && !has_gyro(excluded_, j) && track(j).repeat_count >= kOtherRepeats) return false;
   }
   // A healthy quantized gyro's sample is the mean rate over the sample period within one step: when the rate
-  // the others see along its axis moved by two steps beyond their noise, its output must have changed — if the
-  // others are healthy. A fault of one of them moves that view too (a bias step of 0.017 deg/s on gyro 1 moves
-  // gyro 2's by 0.019 deg/s, one width), so its repeats are stuck only when no fault of one other gyro that
-  // changed at most twice during the run explains the view: more pieces than such a fault leaves.
+  // the others see along its axis moved by two steps beyond their noise, its output must have changed — if
+  // the others are healthy. A fault of one of them moves that view too (a bias step of 0.017 deg/s on gyro 1
+  // moves gyro 2's by 0.019 deg/s, one width), so its repeats are stuck only when no fault of one other gyro
+  // that changed at most twice during the run explains the view: more pieces than such a fault leaves.
   return t.run_seen && t.run_pieces > kPiecesOneFaultExplains;
 }
 

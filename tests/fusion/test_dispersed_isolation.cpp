@@ -1,9 +1,9 @@
-// Wrong exclusions of the dispersed campaign (docs/fdi.md, "Repeated values"): examples/campaign_dispersed.yaml
-// with 11,112 seeds (100,008 runs) excluded a healthy gyro in 96 runs, every one a bias step of 0.012–0.02
-// deg/s on gyro 1, 2 or 3 that moved a coarsely quantized healthy gyro's view (the rate the others see along
-// its axis) while that gyro repeated its value: the repeated-value rule called it stuck. A few of those very
-// runs, rebuilt from the spec (the draws are a function of the dispersion seed and the run's index), each
-// a 10-minute closed loop (about 1 s in all).
+// Wrong exclusions of the dispersed campaign (docs/fdi.md, "Repeated values"):
+// examples/campaign_dispersed.yaml with 11,112 seeds (100,008 runs) excluded a healthy gyro in 96 runs, every
+// one a bias step of 0.012–0.02 deg/s on gyro 1, 2 or 3 that moved a coarsely quantized healthy gyro's view
+// (the rate the others see along its axis) while that gyro repeated its value: the repeated-value rule called
+// it stuck. A few of those very runs, rebuilt from the spec (the draws are a function of the dispersion seed
+// and the run's index), each a 10-minute closed loop (about 1 s in all).
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -11,8 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#include "tetra/sim/campaign.hpp"
 #include "test_support.hpp"
+#include "tetra/sim/campaign.hpp"
 
 namespace tetra {
 namespace {

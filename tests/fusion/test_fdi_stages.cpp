@@ -160,8 +160,9 @@ TEST(GyroSeries, SignaturesNameTheGyroAndItsKind) {
 }
 
 //! A coarsely quantized unit (Q = 6e-5° on every gyro: a sample step of 2e-3 deg/s at 10 Hz, twenty times the
-//! white noise) whose gyro 2 repeats one raw value for 10 s while the others see the body rate `omega(k)` plus
-//! `fault(k, gyro)` [rad/s] and white noise. Returns the first isolation the signatures make (gyro 0: none).
+//! white noise) whose gyro 2 repeats one raw value for 10 s while the others see the body rate `omega(k)`
+//! plus `fault(k, gyro)` [rad/s] and white noise. Returns the first isolation the signatures make (gyro 0:
+//! none).
 template <class Omega, class Fault>
 Isolation repeat_run(Omega omega, Fault fault) {
   Fixture f(4, 6e-5);
@@ -189,19 +190,17 @@ Isolation repeat_run(Omega omega, Fault fault) {
 }
 
 TEST(GyroSeries, AStepOfAnotherGyroIsNotACoarseGyroStuck) {
-  // The body at the orbit's pitch rate, steady: gyro 2 repeats its value as a healthy coarse gyro does. A bias
-  // step of 0.03 deg/s on gyro 1 at 2 s moves the rate the others see along gyro 2's axis by about 1.1 times
-  // that, beyond the width a repeating gyro allows (two steps and 10σ of that view, ≈ 0.018 deg/s): before,
-  // gyro 2 was called stuck 0.1 s after the step (the dispersed campaign's wrong exclusions). A step explains
-  // two pieces of the run, a pulse (0.05 deg/s on gyro 3 for 0.3 s) three: no call.
+  // The body at the orbit's pitch rate, steady: gyro 2 repeats its value as a healthy coarse gyro does. A
+  // bias step of 0.03 deg/s on gyro 1 at 2 s moves the rate the others see along gyro 2's axis by about 1.1
+  // times that, beyond the width a repeating gyro allows (two steps and 10σ of that view, ≈ 0.018 deg/s):
+  // before, gyro 2 was called stuck 0.1 s after the step (the dispersed campaign's wrong exclusions). A step
+  // explains two pieces of the run, a pulse (0.05 deg/s on gyro 3 for 0.3 s) three: no call.
   const auto orbit = [](int) { return Eigen::Vector3d(0.0, -0.06 * kDegToRad, 0.0); };
-  const Isolation step = repeat_run(orbit, [](int k, int gyro) {
-    return gyro == 1 && k >= 20 ? 0.03 * kDegToRad : 0.0;
-  });
+  const Isolation step =
+      repeat_run(orbit, [](int k, int gyro) { return gyro == 1 && k >= 20 ? 0.03 * kDegToRad : 0.0; });
   EXPECT_EQ(step.gyro, 0) << "gyro " << step.gyro << " isolated for a step of gyro 1";
-  const Isolation pulse = repeat_run(orbit, [](int k, int gyro) {
-    return gyro == 3 && k >= 20 && k < 23 ? 0.05 * kDegToRad : 0.0;
-  });
+  const Isolation pulse = repeat_run(
+      orbit, [](int k, int gyro) { return gyro == 3 && k >= 20 && k < 23 ? 0.05 * kDegToRad : 0.0; });
   EXPECT_EQ(pulse.gyro, 0) << "gyro " << pulse.gyro << " isolated for a pulse of gyro 3";
 }
 
