@@ -22,6 +22,10 @@ constexpr double kQuietMotion = 2.0;  //!< [σ] motion level the noise-level tes
 constexpr double kNormalLevel = 2.0;  //!< noise ratio of a gyro whose own second differences look normal
 //! [samples] another gyro's repeat run that leaves a coarse gyro's repeats unjudged
 constexpr int kOtherRepeats = 3;
+//! Pieces of a repeat run that one other gyro's fault explains: its level changed at most twice during the
+//! run (a step; a spike or a pulse that came and went), so the others' view of the axis may sit at up to
+//! three levels while the gyro's own rate stood still.
+constexpr int kPiecesOneFaultExplains = 3;
 }  // namespace
 
 double select_rank(double* a, int n, int k) {
@@ -203,14 +207,8 @@ void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
     Track& t = tracks_[static_cast<std::size_t>(id - 1)];
     const GyroMask others = without_gyro(frame.usable, id);
     if (!motion_view(id, others, subsets)) continue;  // the others cannot see the motion: no evidence
-    // A coarse gyro's repeat run: the range of the rate the others see along its axis, and its 1σ.
-    if (t.view_coarse) {
-      const double rate = project(t, frame.y_rad_s.data());
-      t.run_low = t.run_seen ? std::min(t.run_low, rate) : rate;
-      t.run_high = t.run_seen ? std::max(t.run_high, rate) : rate;
-      t.run_sigma = t.run_seen ? std::max(t.run_sigma, t.view_rate_sigma) : t.view_rate_sigma;
-      t.run_seen = true;
-    }
+    // A coarse gyro's repeat run: the rate the others see along its axis, cut into pieces.
+    if (t.view_coarse) extend_run(id, t, project(t, frame.y_rad_s.data()), subsets.sqrt_period());
     // The motion's second difference along the axis, when every other gyro has one this epoch, in units of
     // the others' own noise on it.
     if (t.d2_fresh && (fresh & others) == others) {
@@ -220,6 +218,34 @@ void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
           std::abs(project(t, d2_all_.data())) / t.motion_sigma;
     }
   }
+}
+
+double GyroSeries::run_width(int id, double sigma, double sqrt_period) const {
+  const double step = std::sqrt(12.0) * constants(id).quantization_rad / (sqrt_period * sqrt_period);
+  return 2.0 * step + 2.0 * config_.onset_sigma * sigma;
+}
+
+void GyroSeries::extend_run(int id, Track& t, double rate, double sqrt_period) {
+  // Greedy, online: a piece grows while the range of its projections stays within the width a healthy
+  // repeating gyro allows (its own rate stood within a step; two steps and the others' noise); a projection
+  // beyond it starts the next piece. Greedy cuts the fewest pieces of any such split.
+  if (!t.run_seen || t.view_rate_sigma > t.run_sigma) {
+    // The run's first projection, or a noisier view (other gyros): pieces cut with the narrower width might
+    // be one with this one. The count starts again from the current piece: fewer pieces, never more evidence.
+    if (!t.run_seen) t.run_low = t.run_high = rate;
+    t.run_sigma = t.view_rate_sigma;
+    t.run_pieces = 1;
+    t.run_seen = true;
+  }
+  const double low = std::min(t.run_low, rate);
+  const double high = std::max(t.run_high, rate);
+  if (high - low <= run_width(id, t.run_sigma, sqrt_period)) {
+    t.run_low = low;
+    t.run_high = high;
+    return;
+  }
+  ++t.run_pieces;
+  t.run_low = t.run_high = rate;
 }
 
 bool GyroSeries::motion_view(int id, GyroMask others, SubsetCache& subsets) {
@@ -331,9 +357,11 @@ bool GyroSeries::repeats_are_stuck(int id, const Track& t, double sqrt_period) c
     if (j != id && !has_gyro(excluded_, j) && track(j).repeat_count >= kOtherRepeats) return false;
   }
   // A healthy quantized gyro's sample is the mean rate over the sample period within one step: when the rate
-  // the others see along its axis moved by two steps beyond their noise, its output must have changed.
-  const double step = std::sqrt(12.0) * constants(id).quantization_rad / (sqrt_period * sqrt_period);
-  return t.run_seen && t.run_high - t.run_low > 2.0 * step + 2.0 * config_.onset_sigma * t.run_sigma;
+  // the others see along its axis moved by two steps beyond their noise, its output must have changed — if
+  // the others are healthy. A fault of one of them moves that view too (a bias step of 0.017 deg/s on gyro 1
+  // moves gyro 2's by 0.019 deg/s, one width), so its repeats are stuck only when no fault of one other gyro
+  // that changed at most twice during the run explains the view: more pieces than such a fault leaves.
+  return t.run_seen && t.run_pieces > kPiecesOneFaultExplains;
 }
 
 double* GyroSeries::recent(const std::vector<double>& ring, const Track& t, int n) const {

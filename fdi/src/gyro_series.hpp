@@ -110,9 +110,12 @@ class GyroSeries {
     bool d2_fresh = false;   //!< d2_last belongs to this epoch
     std::vector<double> d2;  //!< ring of |Δ²y| [rad/s], size noise_window
     std::vector<double> m2;  //!< ring of |h·Δ²ω̂| the other gyros see [rad/s] (∞: not seen), aligned with d2
-    double run_low = 0.0;  //!< [rad/s] range of h·ω̂ of the other gyros during the current repeat run
+    // A coarse gyro's repeat run: h·ω̂ of the other gyros cut into the fewest consecutive pieces each within
+    // `run_width` (extend_run).
+    double run_low = 0.0;  //!< [rad/s] range of h·ω̂ of the other gyros in the run's current piece
     double run_high = 0.0;
-    double run_sigma = 0.0;  //!< [rad/s] largest 1σ of that projection during the run
+    double run_sigma = 0.0;  //!< [rad/s] largest 1σ of that projection in the pieces counted
+    int run_pieces = 0;      //!< pieces counted
     bool run_seen = false;
     GyroMask view_mask = ~GyroMask{0};  //!< the other gyros of the cached view (none yet)
     double view_period = 0.0;           //!< [√s] the sample period's root it was made for
@@ -152,6 +155,11 @@ class GyroSeries {
   bool noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const;
   //! Every other gyro in use has a normal second-difference level.
   bool others_normal(int id, double sqrt_period) const;
+  //! [rad/s] how far the others' view of gyro `id`'s axis (1σ `sigma`) may range while its own rate stands
+  //! within a quantization step: two steps and 2·onset_sigma·σ.
+  double run_width(int id, double sigma, double sqrt_period) const;
+  //! Adds the others' view `rate` [rad/s] of gyro `id`'s axis to its repeat run's pieces.
+  void extend_run(int id, Track& t, double rate, double sqrt_period);
   //! Repeated values that the motion the other gyros saw rules out for a healthy (quantized) gyro.
   bool repeats_are_stuck(int id, const Track& t, double sqrt_period) const;
   //! Some signature of `t` may be due this epoch (false: check_one would find nothing and change nothing).

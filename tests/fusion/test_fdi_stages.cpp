@@ -32,8 +32,12 @@ struct Fixture {
   Calibration cal = seed_as_built_unit();
   std::vector<GyroConstants> constants;
   std::unique_ptr<SubsetCache> subsets;
-  explicit Fixture(int n = 4) {
+  //! `quantization_deg`: the angle quantization Q of every gyro (0: the seed unit's noise section as it is).
+  explicit Fixture(int n = 4, double quantization_deg = 0.0) {
     if (n == 3) cal.gyros.resize(3);
+    if (quantization_deg > 0.0) {
+      for (auto& g : cal.gyros) g.noise->quantization_deg = quantization_deg;
+    }
     constants = *gyro_constants(cal, config);
     Eigen::VectorXd arw(n), bias(n);
     for (int i = 0; i < n; ++i) {
@@ -153,6 +157,69 @@ TEST(GyroSeries, SignaturesNameTheGyroAndItsKind) {
   }
   EXPECT_TRUE(dropout && stuck);
   EXPECT_NEAR(ratio, 1.0, 0.3);
+}
+
+//! A coarsely quantized unit (Q = 6e-5° on every gyro: a sample step of 2e-3 deg/s at 10 Hz, twenty times the
+//! white noise) whose gyro 2 repeats one raw value for 10 s while the others see the body rate `omega(k)`
+//! plus `fault(k, gyro)` [rad/s] and white noise. Returns the first isolation the signatures make (gyro 0:
+//! none).
+template <class Omega, class Fault>
+Isolation repeat_run(Omega omega, Fault fault) {
+  Fixture f(4, 6e-5);
+  GyroSeries series(f.constants, f.config);
+  EpochFrame frame;
+  frame.resize(4);
+  Counters counters;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  const double stuck_raw = f.raw_epoch(0, f.rates(omega(0))).raw[1];
+  Isolations found;
+  for (int k = 0; k < 100; ++k) {
+    std::vector<double> y = f.rates(omega(k));
+    for (int i = 0; i < 4; ++i) y[static_cast<std::size_t>(i)] += noise(rng) + fault(k, i + 1);
+    Epoch e = f.raw_epoch(seconds_to_ns(k * kPeriod), y);
+    e.raw[1] = stuck_raw;  // gyro 2 repeats its first value
+    frame.now_ns = e.stamp_ns;
+    series.ingest(e, frame, counters);
+    frame.usable = frame.valid;
+    series.observe_motion(frame, *f.subsets);
+    series.check(frame.now_ns, 0, kPeriod, std::sqrt(kPeriod), found);
+    if (!found.empty()) return found.front();
+  }
+  return {};
+}
+
+TEST(GyroSeries, AStepOfAnotherGyroIsNotACoarseGyroStuck) {
+  // The body at the orbit's pitch rate, steady: gyro 2 repeats its value as a healthy coarse gyro does. A
+  // bias step of 0.03 deg/s on gyro 1 at 2 s moves the rate the others see along gyro 2's axis by about 1.1
+  // times that, beyond the width a repeating gyro allows (two steps and 10σ of that view, ≈ 0.018 deg/s):
+  // before, gyro 2 was called stuck 0.1 s after the step (the dispersed campaign's wrong exclusions). A step
+  // explains two pieces of the run, a pulse (0.05 deg/s on gyro 3 for 0.3 s) three: no call.
+  const auto orbit = [](int) { return Eigen::Vector3d(0.0, -0.06 * kDegToRad, 0.0); };
+  const Isolation step =
+      repeat_run(orbit, [](int k, int gyro) { return gyro == 1 && k >= 20 ? 0.03 * kDegToRad : 0.0; });
+  EXPECT_EQ(step.gyro, 0) << "gyro " << step.gyro << " isolated for a step of gyro 1";
+  const Isolation pulse = repeat_run(
+      orbit, [](int k, int gyro) { return gyro == 3 && k >= 20 && k < 23 ? 0.05 * kDegToRad : 0.0; });
+  EXPECT_EQ(pulse.gyro, 0) << "gyro " << pulse.gyro << " isolated for a pulse of gyro 3";
+}
+
+TEST(GyroSeries, ACoarseGyroStuckWhileTheBodyTurnsIsStillFound) {
+  // The body accelerating at 0.05 deg/s² about gyro 2's axis from 1 s, the others healthy: their view of that
+  // axis leaves every piece's width (≈ 0.018 deg/s) within about 0.4 s, so a fourth piece begins about 1.1 s
+  // after the turn began. Gyro 2, repeating, is stuck (kind stuck, evidence repeated) within 3 s.
+  Fixture axes(4);
+  const Eigen::Vector3d h2 = axes.cal.gyros[1].axis_B.normalized();
+  const auto turning = [h2](int k) {
+    const double t_s = std::max(0.0, k * kPeriod - 1.0);
+    return Eigen::Vector3d(Eigen::Vector3d(0.0, -0.06 * kDegToRad, 0.0) + h2 * 0.05 * kDegToRad * t_s);
+  };
+  const Isolation found = repeat_run(turning, [](int, int) { return 0.0; });
+  EXPECT_EQ(found.gyro, 2);
+  EXPECT_EQ(found.kind, FaultKind::kStuck);
+  EXPECT_EQ(found.evidence, Evidence::kRepeated);
+  EXPECT_GT(found.statistic, 0.0);
+  EXPECT_LE(found.statistic, 40.0) << "repeats before the call (10 s at most: 100)";
 }
 
 TEST(GyroSeries, SelectRankGivesTheValueNthElementGives) {
