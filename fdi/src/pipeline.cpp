@@ -132,6 +132,8 @@ class Pipeline::Impl {
   void publish_filter_health() const;
   void update_fdi_available();
   void judge_reference();
+  //! A gyro fault just detected may be what had the reference rejected: the rejection is withdrawn.
+  void withdraw_reference_rejection();
   void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
 
   void isolate(const Isolation& iso);
@@ -183,6 +185,8 @@ class Pipeline::Impl {
   bool reference_usable_ = false;  //!< this epoch's reference sample passed the consistency tests
   bool gyros_vouch_ = false;       //!< this epoch: parity among the gyros used, no episode, rate observable
   std::optional<std::int64_t> reference_set_ns_;  //!< the last time a reference sample set the attitude
+  //! [ns] when the reference was last rejected by a slow test (nis, bias), until it is used again
+  std::optional<std::int64_t> reference_rejected_ns_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -247,6 +251,25 @@ std::string Pipeline::Impl::reaccepted_detail() const {
   return text;
 }
 
+void Pipeline::Impl::withdraw_reference_rejection() {
+  // The reference is judged only while the gyros vouch for their attitude, but a gyro fault grows for a while
+  // below the parity's threshold: its error in the attitude can fail the reference's slow tests (nis, bias)
+  // before the parity detects it. A rejection by those tests after the fault's estimated onset (less one
+  // block of the tests, which it may have filled) is therefore withdrawn at the detection: the reference is
+  // used again, unjudged while the episode is open, and its windows can isolate the gyro (docs/fdi.md).
+  if (!reference_rejected_ns_ || consistency_.state() != ReferenceState::kRejected) return;
+  const std::int64_t block_ns = seconds_to_ns(config_.reference_check_window_s);
+  if (*reference_rejected_ns_ < pipeline_time_before_ns(isolator_.episode().onset_ns, block_ns)) return;
+  consistency_.reset();
+  trend_.stop();
+  reference_rejected_ns_.reset();
+  FdiEvent e;
+  e.stamp_ns = frame_.now_ns;
+  e.type = EventType::kReferenceAccepted;
+  e.detail = "attitude reference used again: a gyro fault detected since may have caused its rejection";
+  emit(std::move(e));
+}
+
 void Pipeline::Impl::judge_reference() {
   // The reference sample is tested before anything uses it (docs/fdi.md, "Reference consistency"); the
   // gyros vouch for their attitude when they leave parity, no episode is open and the rate is observable.
@@ -270,7 +293,12 @@ void Pipeline::Impl::judge_reference() {
   // the reference afresh, from the configured σ).
   attitude_.set_reference_sigma_rad(consistency_.sigma_rad());
   reference_.set_reference_sigma_rad(consistency_.sigma_rad());
-  if (v.rejected) trend_.start(frame_.now_ns);
+  if (v.rejected) {
+    trend_.start(frame_.now_ns);
+    if (*v.rejected == ReferenceCheck::kNis || *v.rejected == ReferenceCheck::kBias)
+      reference_rejected_ns_ = frame_.now_ns;
+  }
+  if (v.reaccepted) reference_rejected_ns_.reset();
   if (v.reaccepted) trend_.stop();
   if (consistency_.state() == ReferenceState::kRejected) trend_.add(frame_.now_ns, z, S.diagonal());
   if (v.rejected || v.reaccepted) {
@@ -392,6 +420,7 @@ void Pipeline::Impl::detect() {
     attitude_.hold_biases(isolator_.episode().onset_ns);  // before the filter opens them to the fault
     detector_.open_episode();
     emit_detected(d.test, d.statistic, frame_.now_ns);
+    withdraw_reference_rejection();
     // The fault acted since its onset: widen the uncertainty for the time already spent.
     attitude_.add_bound(
         fault_rate_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()) *
@@ -756,6 +785,7 @@ void Pipeline::Impl::reset() {
   protection_.anchor(0);
   last_reference_ns_.reset();
   reference_set_ns_.reset();
+  reference_rejected_ns_.reset();
   health_.fdi_available = true;
   result_.attitude.fdi_available = true;
   frame_.index = -1;

@@ -145,12 +145,14 @@ bool ReferenceConsistency::reestimate_noise(std::int64_t now_ns, const Eigen::Ve
   const double dof = 1.5 * (k - 1.0);
   const double estimate_rad2 = 0.5 * std::max(var_d_rad2, 0.0);
   const double upper_rad = std::sqrt(estimate_rad2 * dof / allan::chi2_quantile(1e-3, dof));
+  const double lower_rad = std::sqrt(estimate_rad2 * dof / allan::chi2_quantile(1.0 - 1e-3, dof));
   noise_start_ns_ = now_ns;  // the next evaluation a block later, over every difference since the rejection
-  if (upper_rad > config_.reference_noise_max_factor * sigma_config_rad_) {
-    noise_explained_ = false;  // beyond what the reference may be: it stays rejected
-    return false;
-  }
-  noise_explained_ = true;
+  // Noise explains the rejection only if the samples are shown noisier than configured (the lower bound
+  // above it): a step or a drift of the reference raises the NIS, not the differences, and stays rejected.
+  // Beyond reference_noise_max_factor it is not the sensor its configuration describes: rejected too.
+  noise_explained_ =
+      lower_rad > sigma_config_rad_ && upper_rad <= config_.reference_noise_max_factor * sigma_config_rad_;
+  if (!noise_explained_) return false;
   const bool grew = upper_rad > sigma_rad_;
   // More differences tighten the bound: a smaller σ (never below the configured one) needs no new start.
   sigma_rad_ = std::max(upper_rad, sigma_config_rad_);
