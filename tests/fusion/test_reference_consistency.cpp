@@ -4,14 +4,17 @@
 // never set onto a reference the gyros contradict; a healthy reference is never rejected.
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "test_support.hpp"
 #include "tetra/core/quaternion.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/pipeline.hpp"
+#include "tetra/sim/scenario.hpp"
 #include "tetra/sim/simulator.hpp"
 
 namespace tetra {
@@ -193,6 +196,34 @@ TEST(ReferenceConsistency, AReferenceSomewhatNoisierThanConfiguredIsUsedAgainWit
   }
 }
 
+TEST(ReferenceConsistency, ARejectionAGyroFaultMayHaveCausedIsWithdrawnAtItsDetection) {
+  // examples/sim/calibrated_unit.yaml (its stated 1σ raises the CUSUM's reference), the orbit, the 1 Hz 5″
+  // reference, gyro 2 stuck at 300 s (seed 4): its error grows with the rate's change along its axis and
+  // fails the reference's `nis` test at 359 s, before the parity detects it at 366 s. The rejection is
+  // withdrawn at the detection (a `reference_accepted` at that epoch) and the reference's windows isolate
+  // gyro 2 (382 s measured); kept rejected, the episode ended unisolated.
+  auto sc = sim::parse_scenario(
+      "scenario: orbit\nduration_s: 600\nrate_hz: 10\norbit_period_s: 6000\nunit: sim/calibrated_unit.yaml\n"
+      "reference: {rate_hz: 1, noise_arcsec: 5}\nfaults: [\"gyro=2,kind=stuck,at=300\"]\n",
+      "stuck-after-rejection", test::source_path("examples"));
+  ASSERT_TRUE(sc.ok()) << describe(sc.error());
+  const Outcome o = run(*sc, 4);
+  double detected_s = -1.0;
+  double withdrawn_s = -1.0;
+  std::optional<int> isolated;
+  for (const auto& e : o.events) {
+    const double t = ns_to_seconds(e.stamp_ns);
+    if (e.type == fdi::EventType::kDetected && detected_s < 0.0) detected_s = t;
+    if (e.type == fdi::EventType::kReferenceAccepted && withdrawn_s < 0.0) withdrawn_s = t;
+    if (e.type == fdi::EventType::kIsolated && !isolated) isolated = e.gyro;
+  }
+  ASSERT_GE(o.first_rejected_s, 300.0) << summary(o);
+  EXPECT_EQ(o.first_why, fdi::ReferenceCheck::kNis) << summary(o);
+  ASSERT_GT(detected_s, o.first_rejected_s) << summary(o);
+  EXPECT_EQ(withdrawn_s, detected_s) << summary(o);
+  EXPECT_EQ(isolated, std::optional<int>(2)) << summary(o);
+}
+
 TEST(ReferenceConsistency, AMisidentifiedReferenceIsAJumpNeverSetsTheAttitudeAndIsUsedAgain) {
   // 0.5° off for 12 s from 100 s: `jump` at its first sample; the attitude stays the gyros' (never set onto
   // it); used again 30 s after the episode ends (reference_reaccept_s), the error back to arcseconds.
@@ -315,7 +346,8 @@ sim::Scenario three_gyros_with(sim::FaultKind kind, int gyro, double size, doubl
   return sc;
 }
 
-//! [s] the first `detected` event that names gyro `id` along its rate axis (the three-gyro noise test), or −1.
+//! [s] the first `detected` event that names gyro `id` along its rate axis (the three-gyro noise test), or
+//! −1.
 double named_detection_s(const Outcome& o, int id) {
   for (const auto& e : o.events) {
     if (e.type == fdi::EventType::kDetected &&
@@ -326,13 +358,13 @@ double named_detection_s(const Outcome& o, int id) {
 }
 
 TEST(ReferenceConsistency, WithThreeGyrosANoiseIncreaseIsDetectedAndSigmaMatchesIt) {
-  // Three gyros, noise x10 on gyro 2 from 60 s, 600 s, twelve seeds: the reference's innovations along gyro 2's
-  // rate axis raise their 10-s block means' CUSUM (docs/fdi.md, "Three gyros: a noise increase or a ramp"), the
-  // gyro is named and its noise in the filter matched to the innovations from then on. Named 51–441 s after
-  // onset (median 166 s; the `second-fault` family's median 252 s), 99.55–100 % within 3σ after. Before, the
-  // block NIS or mean-innovation test fired in 7 of the 12 (136–374 s after onset, no gyro named) and sigma
-  // stayed short (74–89 % within 3σ over the run). Bounds: named within 500 s of onset, and from the
-  // detection on the campaign's criterion, 97 % within 3σ.
+  // Three gyros, noise x10 on gyro 2 from 60 s, 600 s, twelve seeds: the reference's innovations along gyro
+  // 2's rate axis raise their 10-s block means' CUSUM (docs/fdi.md, "Three gyros: a noise increase or a
+  // ramp"), the gyro is named and its noise in the filter matched to the innovations from then on. Named
+  // 51–441 s after onset (median 166 s; the `second-fault` family's median 252 s), 99.55–100 % within 3σ
+  // after. Before, the block NIS or mean-innovation test fired in 7 of the 12 (136–374 s after onset, no gyro
+  // named) and sigma stayed short (74–89 % within 3σ over the run). Bounds: named within 500 s of onset, and
+  // from the detection on the campaign's criterion, 97 % within 3σ.
   for (const std::uint64_t seed : {1u, 2u, 3u, 4u, 5u, 6u, 7u, 8u, 9u, 10u, 11u, 12u}) {
     const Outcome o = run(three_gyros_with(sim::FaultKind::kNoise, 2, 10.0, 600.0), seed);
     const double t = named_detection_s(o, 2);
@@ -354,8 +386,8 @@ TEST(ReferenceConsistency, WithThreeGyrosARampStaysCoveredAfterItsDetection) {
       for (const std::uint64_t seed : {1u, 2u}) {
         const Outcome o = run(three_gyros_with(sim::FaultKind::kRamp, gyro, size, 600.0), seed);
         ASSERT_GE(o.first_detected_s, 60.0) << summary(o);
-        EXPECT_GE(fraction(o.within_after, o.total_after), 0.97) << size << " gyro " << gyro << " seed " << seed
-                                                                 << ": " << summary(o);
+        EXPECT_GE(fraction(o.within_after, o.total_after), 0.97)
+            << size << " gyro " << gyro << " seed " << seed << ": " << summary(o);
       }
     }
   }
