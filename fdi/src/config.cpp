@@ -154,6 +154,8 @@ Result<PipelineConfig> read_pipeline_config(const std::string& path) {
 Status validate(const PipelineConfig& c) {
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   auto probability = [](double v) { return std::isfinite(v) && v > 0.0 && v < 0.5; };
+  auto within = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  auto at_least = [](double v, double lo) { return std::isfinite(v) && v >= lo; };
   if (c.latitude_deg && (!std::isfinite(*c.latitude_deg) || std::abs(*c.latitude_deg) > 90.0)) {
     return bad_input("pipeline.latitude_deg: must be within [-90, 90]");
   }
@@ -173,11 +175,10 @@ Status validate(const PipelineConfig& c) {
       {"max_abs_raw_V", positive(c.max_abs_raw_V), "> 0"},
       {"max_abs_rate_dps", positive(c.max_abs_rate_dps), "> 0"},
       {"default_arw_dps_rtHz", positive(c.default_arw_dps_rtHz), "> 0"},
-      {"default_bias_instability_dps",
-       std::isfinite(c.default_bias_instability_dps) && c.default_bias_instability_dps >= 0.0, ">= 0"},
+      {"default_bias_instability_dps", at_least(c.default_bias_instability_dps, 0.0), ">= 0"},
       {"chi2_false_alarm_probability", probability(c.chi2_false_alarm_probability), "in (0, 0.5)"},
       {"cusum_min_fault_dps", positive(c.cusum_min_fault_dps), "> 0"},
-      {"cusum_arl0_epochs", std::isfinite(c.cusum_arl0_epochs) && c.cusum_arl0_epochs >= 10.0, ">= 10"},
+      {"cusum_arl0_epochs", at_least(c.cusum_arl0_epochs, 10.0), ">= 10"},
       {"rate_random_walk_horizon_s", positive(c.rate_random_walk_horizon_s), "> 0"},
       {"clear_after_s", positive(c.clear_after_s), "> 0"},
       {"isolation_window_s", positive(c.isolation_window_s), "> 0"},
@@ -193,9 +194,8 @@ Status validate(const PipelineConfig& c) {
       {"invalid_timeout_s", positive(c.invalid_timeout_s), "> 0"},
       {"stuck_repeat_count", c.stuck_repeat_count >= 3, ">= 3"},
       {"noise_window", c.noise_window >= 8 && c.noise_window <= 256, "in [8, 256]"},
-      {"noise_high_ratio", std::isfinite(c.noise_high_ratio) && c.noise_high_ratio > 1.0, "> 1"},
-      {"noise_low_ratio",
-       std::isfinite(c.noise_low_ratio) && c.noise_low_ratio > 0.0 && c.noise_low_ratio < 1.0, "in (0, 1)"},
+      {"noise_high_ratio", positive(c.noise_high_ratio - 1.0), "> 1"},
+      {"noise_low_ratio", positive(c.noise_low_ratio) && c.noise_low_ratio < 1.0, "in (0, 1)"},
       {"spike_count", c.spike_count >= 2 && c.spike_count <= 64, "in [2, 64]"},
       {"spike_window_s", positive(c.spike_window_s), "> 0"},
       {"reference_window_s", positive(c.reference_window_s), "> 0"},
@@ -204,9 +204,7 @@ Status validate(const PipelineConfig& c) {
       {"reference_confirm_count", c.reference_confirm_count >= 1 && c.reference_confirm_count <= 100,
        "in [1, 100]"},
       {"glt_false_alarm_probability", probability(c.glt_false_alarm_probability), "in (0, 0.5)"},
-      {"initial_sigma_deg",
-       std::isfinite(c.initial_sigma_deg) && c.initial_sigma_deg >= 0.0 && c.initial_sigma_deg <= 180.0,
-       "in [0, 180]"},
+      {"initial_sigma_deg", within(c.initial_sigma_deg, 0.0, 180.0), "in [0, 180]"},
       {"bias_instability_correlation_s", positive(c.bias_instability_correlation_s), "> 0"},
       {"reference_gate_false_alarm_probability", probability(c.reference_gate_false_alarm_probability),
        "in (0, 0.5)"},
@@ -216,23 +214,12 @@ Status validate(const PipelineConfig& c) {
       {"reference_bias_window_s", positive(c.reference_bias_window_s), "> 0"},
       {"reference_check_false_alarm_probability", probability(c.reference_check_false_alarm_probability),
        "in (0, 0.5)"},
-      {"reference_reaccept_s", std::isfinite(c.reference_reaccept_s) && c.reference_reaccept_s >= 0.0,
-       ">= 0"},
-      {"reference_noise_max_factor",
-       std::isfinite(c.reference_noise_max_factor) && c.reference_noise_max_factor >= 1.0 &&
-           c.reference_noise_max_factor <= 100.0,
-       "in [1, 100]"},
-      {"reference_bias_arcsec", std::isfinite(c.reference_bias_arcsec) && c.reference_bias_arcsec >= 0.0,
-       ">= 0"},
-      {"reference_latency_max_s",
-       std::isfinite(c.reference_latency_max_s) && c.reference_latency_max_s >= 0.0 &&
-           c.reference_latency_max_s <= 10.0,
-       "in [0, 10]"},
+      {"reference_reaccept_s", at_least(c.reference_reaccept_s, 0.0), ">= 0"},
+      {"reference_noise_max_factor", within(c.reference_noise_max_factor, 1.0, 100.0), "in [1, 100]"},
+      {"reference_bias_arcsec", at_least(c.reference_bias_arcsec, 0.0), ">= 0"},
+      {"reference_latency_max_s", within(c.reference_latency_max_s, 0.0, 10.0), "in [0, 10]"},
       {"integrity_risk", probability(c.integrity_risk), "in (0, 0.5)"},
-      {"calibration_error_sigmas",
-       std::isfinite(c.calibration_error_sigmas) && c.calibration_error_sigmas >= 0.0 &&
-           c.calibration_error_sigmas <= 100.0,
-       "in [0, 100]"},
+      {"calibration_error_sigmas", within(c.calibration_error_sigmas, 0.0, 100.0), "in [0, 100]"},
   };
   for (const auto& check : checks) {
     if (!check.ok) return bad_input(std::string("pipeline.") + check.name + ": must be " + check.rule);

@@ -55,9 +55,10 @@ class ParityDetector {
   explicit ParityDetector(int n_gyros, double nominal_window_s = 30.0);
 
   //! The epoch's parity over `frame.usable` (`s` its subset), the χ² test, and the CUSUMs when every active
-  //! gyro is usable. Writes the statistics into `health`. `calibration_bound` D [σ]: the bound on the parity's
-  //! calibration term at this epoch's rate (`SubsetCache::calibration_bound`): the parity (`parity()`, the χ²)
-  //! is moved towards 0 by D, and the CUSUM, on the parity as it is, takes k + D as its reference.
+  //! gyro is usable. Writes the statistics into `health`. `calibration_bound` D [σ]: the bound on the
+  //! parity's calibration term at this epoch's rate (`SubsetCache::calibration_bound`): the parity
+  //! (`parity()`, the χ²) is moved towards 0 by D, and the CUSUM, on the parity as it is, takes k + D as its
+  //! reference.
   Detection update(const EpochFrame& frame, const Subset& s, GyroMask active, double sqrt_period,
                    double calibration_bound, Health& health);
   //! After an alarm: the CUSUM that raised it starts again from zero, so a persisting fault keeps alarming

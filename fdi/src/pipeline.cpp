@@ -30,6 +30,7 @@
 #include "outlier_gate.hpp"
 #include "parity_detector.hpp"
 #include "protection_level.hpp"
+#include "quadrature.hpp"
 #include "rate_attitude.hpp"
 #include "reference_budget.hpp"
 #include "reference_consistency.hpp"
@@ -63,11 +64,6 @@ std::int64_t pipeline_time_before_ns(std::int64_t now_ns, std::int64_t span_ns) 
   return now_ns >= std::numeric_limits<std::int64_t>::min() + span_ns
              ? now_ns - span_ns
              : std::numeric_limits<std::int64_t>::min();
-}
-
-//! Per axis √(a² + b²): an independent error added to a 1σ.
-Eigen::Vector3d root_sum_square(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return (a.cwiseProduct(a) + b.cwiseProduct(b)).cwiseSqrt();
 }
 }  // namespace
 
@@ -260,7 +256,7 @@ void Pipeline::Impl::withdraw_reference_rejection() {
   if (!reference_rejected_ns_ || consistency_.state() != ReferenceState::kRejected) return;
   const std::int64_t block_ns = seconds_to_ns(config_.reference_check_window_s);
   if (*reference_rejected_ns_ < pipeline_time_before_ns(isolator_.episode().onset_ns, block_ns)) return;
-  consistency_.reset();
+  consistency_.reopen();
   trend_.stop();
   reference_rejected_ns_.reset();
   FdiEvent e;
@@ -293,10 +289,11 @@ void Pipeline::Impl::judge_reference() {
   // the reference afresh, from the configured σ).
   attitude_.set_reference_sigma_rad(consistency_.sigma_rad());
   reference_.set_reference_sigma_rad(consistency_.sigma_rad());
+  noise_match_.set_reference_sigma_rad(consistency_.sigma_rad());
   if (v.rejected) {
     trend_.start(frame_.now_ns);
-    if (*v.rejected == ReferenceCheck::kNis || *v.rejected == ReferenceCheck::kBias)
-      reference_rejected_ns_ = frame_.now_ns;
+    const bool slow = *v.rejected == ReferenceCheck::kNis || *v.rejected == ReferenceCheck::kBias;
+    reference_rejected_ns_ = slow ? std::optional<std::int64_t>(frame_.now_ns) : std::nullopt;
   }
   if (v.reaccepted) reference_rejected_ns_.reset();
   if (v.reaccepted) trend_.stop();
@@ -333,14 +330,15 @@ void Pipeline::Impl::judge_reference() {
         "); three gyros: the data cannot tell which, sigma and bias states widened";
     attitude_.add_variance(z.cwiseProduct(z));
     attitude_.fault_opened(z.norm() / config_.reference_check_window_s);
-    noise_match_.match_all();
+    noise_match_.match_all(subsets_.get(active).mask);
   }
   if (v.use) match_three_gyro_noise(z, S);
 }
 
 void Pipeline::Impl::match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {
   // Three gyros, no parity: the reference's innovations are the only witness of a gyro's noise or ramp
-  // (docs/fdi.md, "Three gyros: a second fault"); the gyro's noise in the filter follows them from then on.
+  // (docs/fdi.md, "Three gyros: a noise increase or a ramp"); the gyro's noise in the filter follows them
+  // from then on.
   const Subset& s = subsets_.get(gyro_set_.active());
   if (tetra::gyro_count(s.mask) != 3 || !s.observable || s.dof >= 1) return;
   const auto found = noise_match_.observe(frame_.now_ns, z, S, s.pinv, s.mask, attitude_.filter());
@@ -562,7 +560,7 @@ void Pipeline::Impl::publish_attitude() {
     const ReferenceUse use = attitude_.reference(*frame_.reference_q_RB, !gyros_vouch_);
     if (use != ReferenceUse::kRejected) {
       protection_.anchor(frame_.now_ns);  // the error known again
-      budget_.used(1e-9 * static_cast<double>(frame_.now_ns), attitude_.omega_meas_B());
+      budget_.used(ns_to_seconds(frame_.now_ns), attitude_.omega_BR_B());
     }
     if (use == ReferenceUse::kInitialized || use == ReferenceUse::kReinitialized)
       reference_set_ns_ = frame_.now_ns;
@@ -802,6 +800,7 @@ void Pipeline::Impl::reset() {
 void Pipeline::Impl::reinstate(int id) {
   publish_filter_health();  // the health keeps the last step's filter
   if (gyro_set_.is_excluded(id)) attitude_.thaw(id);
+  noise_match_.forget(id);
   gyro_set_.reinstate(id);
   series_.forget_evidence(id);
   reference_.restart_windows();  // the reinstated gyro's angle has a gap: the reference windows start again
@@ -859,6 +858,7 @@ FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   // attitude and time go on.
   for (int id = 1; id <= n_; ++id) reinstate(id);
   consistency_.reset();
+  reference_rejected_ns_.reset();
   trend_.stop();
   noise_match_.reset();
   for (int id = 1; id <= n_; ++id) attitude_.filter().set_added_noise(id, 0.0);

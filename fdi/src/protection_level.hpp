@@ -10,8 +10,8 @@
 // |H*(a, i)|·f·n·T, so over the time t = n·T since the anchor (the run's start, or the last reference sample
 // used) the bound is
 //   PL_a = K·σ_a + max_i |H*(a, i)|/|w_i| · (k·t + ∫D dt + (h + 1.166)·T),   K = Φ⁻¹(1 − integrity_risk/2),
-// D the calibration's bound the CUSUM adds to k at each epoch (0 without stated σ), integrated since the anchor.
-// Without parity among the gyros used nothing detects a fault: the bound is +∞ (no integrity).
+// D the calibration's bound the CUSUM adds to k at each epoch (0 without stated σ), integrated since the
+// anchor. Without parity among the gyros used nothing detects a fault: the bound is +∞ (no integrity).
 
 #include <cstdint>
 
@@ -31,7 +31,8 @@ class ProtectionLevel {
     anchor_ns_ = now_ns;
     calibration_reach_ = 0.0;
   }
-  //! The CUSUM's reference was k + `calibration_bound` [σ] for `dt_s` [s]: a fault that much larger goes unseen.
+  //! The CUSUM's reference was k + `calibration_bound` [σ] for `dt_s` [s]: a fault that much larger goes
+  //! unseen.
   void widen(double calibration_bound, double dt_s) { calibration_reach_ += calibration_bound * dt_s; }
   //! [rad] per axis, over the active subset `s` (its parity, k and h), with the published σ [rad].
   Eigen::Vector3d bound(const Subset& s, const Eigen::Vector3d& sigma_rad, std::int64_t now_ns,

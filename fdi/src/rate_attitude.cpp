@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "quadrature.hpp"
 #include "tetra/core/allan_stats.hpp"
 #include "tetra/core/correlated_noise.hpp"  // kGaussMarkovSigmaPerB
 #include "tetra/core/units.hpp"
@@ -106,7 +107,7 @@ void RateAttitude::reset(const Quaternion& q0_RB) {
 Eigen::Vector3d RateAttitude::sigma_rad() const {
   const Eigen::Vector3d f = mekf_.attitude_sigma_rad();
   const Eigen::Vector3d b = propagator_.sigma_rad();  // the bound alone: its noise inputs are zero
-  return (f.cwiseProduct(f) + b.cwiseProduct(b)).cwiseSqrt();
+  return root_sum_square(f, b);
 }
 
 void RateAttitude::parity(const Subset& s, const Eigen::VectorXd& p, double sqrt_period) {

@@ -19,7 +19,7 @@ class ReferenceBudget {
   //! The budget of `config` (reference_bias_arcsec, reference_latency_max_s); the largest body rate of the
   //! updates is forgotten over reference_check_window_s (the filter's own memory of an offset is shorter).
   explicit ReferenceBudget(const PipelineConfig& config);
-  //! No reference used since (a start, an operator's reset): no budget.
+  //! No reference used since (a start): no budget. (An operator's reset keeps the attitude, so the budget.)
   void reset();
   //! A reference sample was used (initialized, accepted, re-initialized) at `time_s` [s] while the body
   //! turned at `omega_B_rad_s` [rad/s].

@@ -29,10 +29,14 @@ ReferenceConsistency::ReferenceConsistency(const PipelineConfig& config)
 }
 
 void ReferenceConsistency::reset() {
+  sigma_rad_ = sigma_config_rad_;
+  reopen();
+}
+
+void ReferenceConsistency::reopen() {
   state_ = ReferenceState::kAbsent;
   consistent_since_ns_ = 0;
   nis_per_dof_ = 0.0;
-  sigma_rad_ = sigma_config_rad_;
   rejected_for_nis_ = false;
   restart();
 }

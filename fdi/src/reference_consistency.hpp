@@ -17,9 +17,9 @@
 // samples are no longer used (sigma grows with the gyro propagation) until they pass every test for
 // reference_reaccept_s. Without judging, a failed test is reported (`inconsistent`) and nothing else changes.
 // A reference rejected for `nis` alone is noisier than configured: while rejected, its noise is re-estimated
-// from its innovations over each block (their second moment less the attitude's share, at its upper
-// confidence bound); at most reference_noise_max_factor × the configured σ, the tests go on against that σ,
-// and the reference is used again with it once they pass (sigma_rad()).
+// from the differences of its successive innovations (at their upper confidence bound, once a block, when
+// the lower bound shows it noisier than configured); at most reference_noise_max_factor × the configured σ,
+// the tests go on against that σ, and the reference is used again with it once they pass (sigma_rad()).
 
 #include <cstdint>
 #include <optional>
@@ -46,7 +46,8 @@ class ReferenceConsistency {
  public:
   explicit ReferenceConsistency(const PipelineConfig& config);
 
-  void reset();    //!< absent, windows empty
+  void reset();    //!< absent, windows empty, the configured σ
+  void reopen();   //!< absent, windows empty: judged afresh, with the σ it has (re-estimated or configured)
   void restart();  //!< windows empty (the gyro set changed, an episode ended); the state kept
 
   //! One sample at `now_ns`: its innovation `z_rad` with covariance `S`, the body rate `omega_rad_s` at its

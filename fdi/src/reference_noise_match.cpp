@@ -56,7 +56,8 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
   block_samples_ = first ? 1 : block_samples_ + 1;
   const bool close_block = now_ns - block_start_ns_ >= seconds_to_ns(kBlock_s);
   // A block of n samples stands for n of the per-sample false-alarm probability p.
-  const double threshold = -std::log(false_alarm_ * block_samples_);
+  // (p·n at most 1/2, so the threshold stays above ln 2 whatever p the configuration allows)
+  const double threshold = -std::log(std::min(false_alarm_ * block_samples_, 0.5));
   if (close_block) {
     block_start_ns_ = now_ns;
     block_samples_ = 0;
@@ -115,9 +116,15 @@ double ReferenceNoiseMatch::mapped_noise(int i, const Eigen::Vector3d& d, double
   return std::max(q - q_model, 0.0) / h2;
 }
 
-void ReferenceNoiseMatch::match_all() {
+void ReferenceNoiseMatch::match_all(GyroMask mask) {
   for (std::size_t k = 0; k < matched_.size(); ++k)
-    if (has_gyro(mask_, static_cast<int>(k) + 1)) matched_[k] = true;
+    if (has_gyro(mask, static_cast<int>(k) + 1)) matched_[k] = true;
+}
+
+void ReferenceNoiseMatch::forget(int id) {
+  const auto k = static_cast<std::size_t>(id - 1);
+  matched_[k] = false;
+  ratio_[k] = 1.0;
 }
 
 }  // namespace tetra::fdi::detail

@@ -58,9 +58,13 @@ class ReferenceNoiseMatch {
                                       const Eigen::Matrix3d& S, const Eigen::Matrix3Xd& pinv, GyroMask mask,
                                       Mekf& filter);
 
-  //! A test of the reference failed with three gyros (the data cannot tell which gyro): every gyro's noise
-  //! is matched from the next sample on.
-  void match_all();
+  //! A test of the reference failed with three gyros (the data cannot tell which gyro): every gyro of
+  //! `mask` has its noise matched from the next sample on.
+  void match_all(GyroMask mask);
+  //! Gyro `id` reinstated: its filter noise is the model's again (the filter's thaw), and so is its match.
+  void forget(int id);
+  //! [rad] 1σ per axis of the reference samples from now on (the configured one, or its re-estimated noise).
+  void set_reference_sigma_rad(double sigma_rad) { reference_var_ = sigma_rad * sigma_rad; }
 
  private:
   void restart_statistics();  //!< the CUSUMs, mean squares and blocks empty; what is matched kept

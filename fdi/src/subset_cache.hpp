@@ -41,12 +41,12 @@ struct Subset {
   //! [σ] bound on the parity's term from the calibrated biases when each is within calibration_error_sigmas
   //! (e) of its stated 1σ σ_β,i: e·√T·Σ_{i∈S} |w_i|·σ_β,i (the constant part of `calibration_bound`)
   double calibration_bias_bound = 0.0;
-  int level_epochs = 1;              //!< epochs an episode's parity level is averaged over before it is held
-  double level_k = 0.0;              //!< [σ] reference of the CUSUM on the parity minus the held level
-  double level_h = 0.0;              //!< [σ] its threshold
-  double nominal_threshold = 0.0;    //!< χ²_d(1 − 1e-3): the slow parity mean back to nominal
-  double glt_accept = 0.0;           //!< χ²_{d−1} quantile accepting a single-gyro hypothesis
-  double glt_reject = 0.0;           //!< χ²_{d−1} quantile rejecting one
+  int level_epochs = 1;            //!< epochs an episode's parity level is averaged over before it is held
+  double level_k = 0.0;            //!< [σ] reference of the CUSUM on the parity minus the held level
+  double level_h = 0.0;            //!< [σ] its threshold
+  double nominal_threshold = 0.0;  //!< χ²_d(1 − 1e-3): the slow parity mean back to nominal
+  double glt_accept = 0.0;         //!< χ²_{d−1} quantile accepting a single-gyro hypothesis
+  double glt_reject = 0.0;         //!< χ²_{d−1} quantile rejecting one
 };
 
 //! What the detectors' reference noise takes from each gyro's `noise:` section beyond its white noise N_i

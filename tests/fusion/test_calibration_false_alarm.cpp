@@ -1,9 +1,9 @@
-// No false alarm from a unit that differs from its calibration within the stated 1σ (docs/fdi.md, "Calibration
-// uncertainty"): in steady nadir pointing a bias error, and an axis error times the orbit's pitch rate, is a
-// constant offset of the parity, which the CUSUM would integrate like a fault. The unit is the dispersed
-// campaign's (examples/sim/calibrated_unit.yaml: angle quantization, stated σ of bias, scale and axis), its
-// errors set to 1σ and 2σ in the direction that moves the parity most; 10-minute `orbit` runs without
-// reference straight from the simulator into the pipeline (about 0.5 s of CPU in all).
+// No false alarm from a unit that differs from its calibration within the stated 1σ (docs/fdi.md,
+// "Calibration uncertainty"): in steady nadir pointing a bias error, and an axis error times the orbit's
+// pitch rate, is a constant offset of the parity, which the CUSUM would integrate like a fault. The unit is
+// the dispersed campaign's (examples/sim/calibrated_unit.yaml: angle quantization, stated σ of bias, scale
+// and axis), its errors set to 1σ and 2σ in the direction that moves the parity most; 10-minute `orbit` runs
+// without reference straight from the simulator into the pipeline (about 0.5 s of CPU in all).
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -12,10 +12,10 @@
 #include <gtest/gtest.h>
 
 #include "campaign.hpp"
+#include "test_support.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/geometry.hpp"
 #include "tetra/core/quaternion.hpp"
-#include "test_support.hpp"
 
 namespace tetra {
 namespace {
@@ -93,7 +93,8 @@ int false_alarms(const Calibration& cal, Error error, const fdi::PipelineConfig&
       const auto run = test::run_campaign(orbit(truth(cal, error, sigmas)), so, cal, config);
       const int d = detections(run);
       n += d;
-      if (d > 0) what += std::to_string(sigmas) + " sigma, seed " + std::to_string(seed) + ":\n" + test::describe(run);
+      if (d > 0)
+        what += std::to_string(sigmas) + " sigma, seed " + std::to_string(seed) + ":\n" + test::describe(run);
     }
   }
   return n;
@@ -128,8 +129,8 @@ TEST(CalibrationFalseAlarm, AxesWithinTwiceTheStatedSigmaRaiseNoDetectionInNadir
 TEST(CalibrationFalseAlarm, ABiasFaultAboveTheToleranceIsStillDetected) {
   // The price of the tolerance: the CUSUM's reference grows by the bound D (docs/fdi.md). On the example unit
   // with 2σ axis errors a 1e-3 deg/s bias step on gyro 1 at 300 s (a parity shift of 4.8σ against k + D ≈
-  // 1.5σ: Wald's delay (h + 1.17)/(4.8 − 1.5) ≈ 15 epochs, 1.5 s) is still detected, within 30 s (3 seeds; the
-  // margin is for the noise, far below what a CUSUM blind to the fault would take).
+  // 1.5σ: Wald's delay (h + 1.17)/(4.8 − 1.5) ≈ 15 epochs, 1.5 s) is still detected, within 30 s (3 seeds;
+  // the margin is for the noise, far below what a CUSUM blind to the fault would take).
   const Calibration cal = calibrated_unit();
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     auto sc = orbit(truth(cal, Error::kAxis, 2.0));
@@ -147,11 +148,11 @@ TEST(CalibrationFalseAlarm, ABiasFaultAboveTheToleranceIsStillDetected) {
 
 TEST(CalibrationFalseAlarm, AFaultTheToleranceHidesStaysWithinTheProtectionLevel) {
   // What the tolerance hides the protection level must still bound (docs/fdi.md, "Protection level": the
-  // CUSUM's k + D integrated since the anchor). The example unit exactly as calibrated, no reference, a 2.5e-4
-  // deg/s bias on gyro 1 from 60 s: a parity shift of 1.2σ, below k + D ≈ 1.5σ at the orbit's pitch rate, so
-  // never detected in the 10 min; its attitude error (≈ 0.1°) stays within the level at every epoch (worst
-  // |error|/PL 0.12 measured; 0.14 with k alone: without a reference the level's K·σ, which carries the
-  // calibration's own bound, dominates here, and with one the anchor comes back every second).
+  // CUSUM's k + D integrated since the anchor). The example unit exactly as calibrated, no reference,
+  // a 2.5e-4 deg/s bias on gyro 1 from 60 s: a parity shift of 1.2σ, below k + D ≈ 1.5σ at the orbit's pitch
+  // rate, so never detected in the 10 min; its attitude error (≈ 0.1°) stays within the level at every epoch
+  // (worst |error|/PL 0.12 measured; 0.14 with k alone: without a reference the level's K·σ, which carries
+  // the calibration's own bound, dominates here, and with one the anchor comes back every second).
   const Calibration cal = calibrated_unit();
   auto sc = orbit(cal);
   sc.faults = {test::fault(1, sim::FaultKind::kBias, 60.0, 2.5e-4)};

@@ -35,7 +35,7 @@ sim::CampaignSpec dispersed_spec(int seeds) {
 TEST(DispersedCampaign, BiasStepsNextToARepeatingQuantizedGyroExcludeNoHealthyGyro) {
   // Runs of the 100,008-run campaign that excluded a healthy gyro (faulty → excluded): 11146 and 11393
   // (gyro 1 → 2), 16777 (1 → 3), 23866 and 25321 (2 → 3), 33379 and 33783 (3 → 2). Each must now isolate
-  // the faulty gyro or none: with the fix 4 of them isolate it, 3 end unisolated.
+  // the faulty gyro or none: now 4 of them isolate it, 3 end unisolated.
   const sim::CampaignSpec spec = dispersed_spec(11112);
   ASSERT_FALSE(spec.scenarios.empty());
   std::string what;

@@ -290,14 +290,15 @@ TEST(ReferenceBudget, ALatencyWithinTheStatedBoundIsCoveredBeforeTheSlewShowsIt)
   sim::Scenario sc = scenario(300.0, true);
   sc.reference.latency_s = 0.2;
   const Outcome unstated = run(sc, 1);
-  EXPECT_GT(unstated.worst_ratio, 10.0) << summary(unstated);
+  EXPECT_GT(unstated.worst_ratio, 10.0) << summary(unstated);  // 50σ measured: a margin of 5 on the limit
   fdi::PipelineConfig config;
   config.reference_latency_max_s = 0.2;
   for (std::uint64_t seed = 1; seed <= 2; ++seed) {
     const Outcome o = run(sc, seed, config);
     EXPECT_EQ(o.first_why, fdi::ReferenceCheck::kLag) << summary(o);
     EXPECT_GE(fraction(o.within_3sigma, o.total), 0.97) << summary(o);
-    EXPECT_LE(o.worst_ratio, 4.0) << summary(o);  // the offset itself is ≤ 1σ of the budget's term
+    // A 3σ criterion with one sampled axis-epoch's slack: the offset itself is ≤ 1σ of the budget's term.
+    EXPECT_LE(o.worst_ratio, 4.0) << summary(o);
   }
 }
 
@@ -310,7 +311,7 @@ TEST(ReferenceBudget, ABiasTheFilterFollowsIsCoveredWhenStated) {
   sc.reference.bias_arcsec = 10.0;
   sc.reference.bias_at_s = 30.0;
   const Outcome unstated = run(sc, 1);
-  EXPECT_GT(unstated.worst_ratio, 5.0) << summary(unstated);
+  EXPECT_GT(unstated.worst_ratio, 5.0) << summary(unstated);  // well beyond 3σ: the budget is what covers it
   fdi::PipelineConfig config;
   config.reference_bias_arcsec = 10.0;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
