@@ -322,18 +322,6 @@ TEST(ReferenceBudget, ABiasTheFilterFollowsIsCoveredWhenStated) {
   }
 }
 
-TEST(ReferenceBudget, AnEmptyBudgetChangesNothing) {
-  // The default (0, 0) publishes the filter's sigma bit for bit: the budget exists only when stated.
-  sim::Scenario sc = scenario(120.0, true);
-  fdi::PipelineConfig zero;
-  zero.reference_bias_arcsec = 0.0;
-  zero.reference_latency_max_s = 0.0;
-  const Outcome a = run(sc, 3);
-  const Outcome b = run(sc, 3, zero);
-  EXPECT_EQ(a.worst_ratio, b.worst_ratio);
-  EXPECT_EQ(a.final_error_arcsec, b.final_error_arcsec);
-}
-
 //! Three gyros (gyro 4 absent) and the reference, `kind` of `size` on gyro `gyro` from 60 s, `duration_s`.
 sim::Scenario three_gyros_with(sim::FaultKind kind, int gyro, double size, double duration_s) {
   sim::Scenario sc = scenario(duration_s, false);
