@@ -28,6 +28,7 @@
 #include "isolator.hpp"
 #include "mekf.hpp"
 #include "outlier_gate.hpp"
+#include "own_noise_level.hpp"
 #include "parity_detector.hpp"
 #include "protection_level.hpp"
 #include "quadrature.hpp"
@@ -75,6 +76,7 @@ class Pipeline::Impl {
         n_(cal.gyro_count()),
         subsets_(std::move(geometry), bias_sigmas(constants), config_, detector_noise(cal, config_)),
         bias_check_(constants),
+        own_noise_(constants, config_),
         series_(std::move(constants), config_),
         gate_(n_, config_),
         detector_(n_, config_.clear_after_s),
@@ -131,6 +133,9 @@ class Pipeline::Impl {
   //! A gyro fault just detected may be what had the reference rejected: the rejection is withdrawn.
   void withdraw_reference_rejection();
   void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
+  void match_own_noise();
+  //! The rate solution of the gyros in use when they are exactly three (no parity left), else null.
+  const Subset* three_gyros_without_parity();
 
   void isolate(const Isolation& iso);
   void isolate_all(Isolations& found);
@@ -150,6 +155,7 @@ class Pipeline::Impl {
   int n_;
   SubsetCache subsets_;
   BiasHypothesis bias_check_;  //!< the fault-model check of the filter's bias states
+  OwnNoiseLevel own_noise_;    //!< three gyros: each gyro's noise level where motion does not reach
   GyroSeries series_;
   OutlierGate gate_;
   ParityDetector detector_;
@@ -196,6 +202,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   if (!result_.accepted) return result_;
   if (frame_.dt_s > config_.max_gap_s) gap();
   series_.ingest(epoch, frame_, health_.counters);
+  own_noise_.ingest(frame_);
   isolator_.record(frame_);
   frame_.usable = frame_.valid & gyro_set_.active();
   measured_ = ~GyroMask{0};
@@ -203,6 +210,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
     reject_outliers();
     series_.observe_motion(frame_, subsets_);
     detect();
+    match_own_noise();
   }
   reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B(),
                        subsets_.observable(frame_.usable));
@@ -339,15 +347,42 @@ void Pipeline::Impl::match_three_gyro_noise(const Eigen::Vector3d& z, const Eige
   // Three gyros, no parity: the reference's innovations are the only witness of a gyro's noise or ramp
   // (docs/fdi.md, "Three gyros: a noise increase or a ramp"); the gyro's noise in the filter follows them
   // from then on.
-  const Subset& s = subsets_.get(gyro_set_.active());
-  if (tetra::gyro_count(s.mask) != 3 || !s.observable || s.dof >= 1) return;
-  const auto found = noise_match_.observe(frame_.now_ns, z, S, s.pinv, s.mask, attitude_.filter());
+  const Subset* s = three_gyros_without_parity();
+  if (s == nullptr) return;
+  const auto found = noise_match_.observe(frame_.now_ns, z, S, s->pinv, s->mask, attitude_.filter());
   if (!found) return;
   emit_detected(DetectionTest::kReference, found->statistic, frame_.now_ns);
   result_.events.back().why = ReferenceCheck::kNis;
   result_.events.back().detail = "attitude reference innovations along gyro " + std::to_string(found->gyro) +
                                  "'s rate axis exceed the model (noise or ramp); three gyros: its noise in "
                                  "the filter matched to the innovations, sigma widened";
+}
+
+const Subset* Pipeline::Impl::three_gyros_without_parity() {
+  const Subset& s = subsets_.get(gyro_set_.active());
+  return tetra::gyro_count(s.mask) == 3 && s.observable && s.dof < 1 ? &s : nullptr;
+}
+
+void Pipeline::Impl::match_own_noise() {
+  // Three gyros, no parity: a gyro's own fourth differences show its white noise where the body's motion does
+  // not reach (docs/fdi.md, "Three gyros: a gyro's own noise level"). A gyro beyond the limit is named, never
+  // excluded (three gyros are the rate), and its noise in the filter follows its level from then on.
+  const Subset* s = three_gyros_without_parity();
+  if (s == nullptr) return;
+  const auto found = own_noise_.evaluate(s->mask, subsets_.sqrt_period());
+  for (int id = 1; id <= n_; ++id) {
+    if (has_gyro(s->mask, id) && own_noise_.ratio(id) > 1.0)
+      noise_match_.set_own_ratio(id, own_noise_.ratio(id), attitude_.filter());
+  }
+  if (!found) return;
+  emit_detected(DetectionTest::kSignature, found->level, frame_.now_ns);
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "gyro %d's own noise level is %.3g times its model (fourth differences, which smooth body "
+                "motion does not reach); three gyros: named, not excluded; its noise in the filter matched "
+                "(variance x%.3g), sigma widened",
+                found->gyro, found->level, found->ratio);
+  result_.events.back().detail = text;
 }
 
 bool Pipeline::Impl::accept(const Epoch& epoch) {
@@ -711,6 +746,7 @@ void Pipeline::Impl::gap() {
   const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
   attitude_.add_bound(Eigen::Vector3d::Constant(0.25 * a_max * tau * tau));
   series_.bridge_gap();
+  own_noise_.bridge_gap();
   gate_.restart();
   reference_.restart_windows();
   FdiEvent e;
@@ -768,6 +804,7 @@ void Pipeline::Impl::update_mode(std::int64_t now_ns) {
 void Pipeline::Impl::reset() {
   publish_filter_health();  // the health keeps the last step's filter
   series_.reset();
+  own_noise_.reset();
   gate_.reset();
   reference_.reset();
   consistency_.reset();
@@ -801,6 +838,7 @@ void Pipeline::Impl::reinstate(int id) {
   publish_filter_health();  // the health keeps the last step's filter
   if (gyro_set_.is_excluded(id)) attitude_.thaw(id);
   noise_match_.forget(id);
+  own_noise_.forget(id);
   gyro_set_.reinstate(id);
   series_.forget_evidence(id);
   reference_.restart_windows();  // the reinstated gyro's angle has a gap: the reference windows start again

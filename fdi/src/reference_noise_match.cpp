@@ -23,13 +23,15 @@ ReferenceNoiseMatch::ReferenceNoiseMatch(const PipelineConfig& config, int gyro_
       block_z_(static_cast<std::size_t>(gyro_count), 0.0),
       block_s_(static_cast<std::size_t>(gyro_count), 0.0),
       matched_(static_cast<std::size_t>(gyro_count), false),
-      ratio_(static_cast<std::size_t>(gyro_count), 1.0) {}
+      ratio_(static_cast<std::size_t>(gyro_count), 1.0),
+      own_(static_cast<std::size_t>(gyro_count), 1.0) {}
 
 void ReferenceNoiseMatch::reset() {
   mask_ = 0;
   restart_statistics();
   std::fill(matched_.begin(), matched_.end(), false);
   std::fill(ratio_.begin(), ratio_.end(), 1.0);
+  std::fill(own_.begin(), own_.end(), 1.0);
 }
 
 void ReferenceNoiseMatch::restart_statistics() {
@@ -86,19 +88,32 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
     block_z_[k] = 0.0;
     block_s_[k] = 0.0;
     cusum_[k] = std::max(0.0, cusum_[k] + 0.5 * ((1.0 - 1.0 / kDesignRatio) * u - std::log(kDesignRatio)));
-    const double n2 = filter.arw_rad_rts(i + 1) * filter.arw_rad_rts(i + 1);
     if (matched_[k]) {
       ratio_[k] = std::clamp(ratio_[k] * std::exp(kGain * (u - 1.0)), 1.0, kMaxNoiseRatio * kMaxNoiseRatio);
     } else if (cusum_[k] > threshold) {
       matched_[k] = true;
       filter.add_attitude_variance_along(d, std::max(mean_square_[k] - s, 0.0));
+      const double n2 = filter.arw_rad_rts(i + 1) * filter.arw_rad_rts(i + 1);
       ratio_[k] = std::clamp(1.0 + mapped_noise(i, d, h2, T, pinv, mask, filter) / n2, 1.0,
                              kMaxNoiseRatio * kMaxNoiseRatio);
       if (!found) found = NoiseFinding{i + 1, cusum_[k]};
     }
-    if (matched_[k]) filter.set_added_noise(i + 1, (ratio_[k] - 1.0) * n2);
+    apply(k, filter);
   }
   return found;
+}
+
+void ReferenceNoiseMatch::apply(std::size_t k, Mekf& filter) const {
+  if (!matched_[k] && own_[k] <= 1.0) return;  // the model's noise: nothing set
+  const int id = static_cast<int>(k) + 1;
+  const double n2 = filter.arw_rad_rts(id) * filter.arw_rad_rts(id);
+  filter.set_added_noise(id, (std::max(matched_[k] ? ratio_[k] : 1.0, own_[k]) - 1.0) * n2);
+}
+
+void ReferenceNoiseMatch::set_own_ratio(int id, double ratio, Mekf& filter) {
+  const auto k = static_cast<std::size_t>(id - 1);
+  own_[k] = std::clamp(ratio, 1.0, kMaxNoiseRatio * kMaxNoiseRatio);
+  apply(k, filter);
 }
 
 double ReferenceNoiseMatch::mapped_noise(int i, const Eigen::Vector3d& d, double h2, double T,
@@ -125,6 +140,7 @@ void ReferenceNoiseMatch::forget(int id) {
   const auto k = static_cast<std::size_t>(id - 1);
   matched_[k] = false;
   ratio_[k] = 1.0;
+  own_[k] = 1.0;
 }
 
 }  // namespace tetra::fdi::detail

@@ -63,11 +63,16 @@ class ReferenceNoiseMatch {
   void match_all(GyroMask mask);
   //! Gyro `id` reinstated: its filter noise is the model's again (the filter's thaw), and so is its match.
   void forget(int id);
+  //! Gyro `id`'s own noise level (own_noise_level.hpp) shows a white noise variance `ratio` (≥ 1) times the
+  //! model's: the filter's noise for it is at least that from now on, whatever the innovations say.
+  void set_own_ratio(int id, double ratio, Mekf& filter);
   //! [rad] 1σ per axis of the reference samples from now on (the configured one, or its re-estimated noise).
   void set_reference_sigma_rad(double sigma_rad) { reference_var_ = sigma_rad * sigma_rad; }
 
  private:
   void restart_statistics();  //!< the CUSUMs, mean squares and blocks empty; what is matched kept
+  //! The filter's noise of gyro index `k`: the larger of the innovations' match and its own level's.
+  void apply(std::size_t k, Mekf& filter) const;
   //! [rad²/s] gyro index `i`'s noise beyond the model from its mean square along `d` (|h_i|² = `h2`, sample
   //! interval `T`): the covariance-matching start.
   double mapped_noise(int i, const Eigen::Vector3d& d, double h2, double T, const Eigen::Matrix3Xd& pinv,
@@ -87,6 +92,7 @@ class ReferenceNoiseMatch {
   std::vector<bool> matched_;  //!< per gyro: detected (or a reference test failed), its noise matched since
   std::vector<double>
       ratio_;  //!< [-] the matched noise variance over the model's, N'²/N², 1..kMaxNoiseRatio²
+  std::vector<double> own_;  //!< [-] per gyro: the variance ratio its own noise level shows (1: none)
 };
 
 }  // namespace tetra::fdi::detail
