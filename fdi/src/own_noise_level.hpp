@@ -20,11 +20,13 @@
 //
 // Beyond that limit the gyro is named (an event, never an exclusion: three gyros are the rate) and from
 // then on its white noise in the filter is matched to the level: the variance ratio λ = 1 + (r² − 1)·σ²_Δ⁴ /
-// (70·N²/T) (the whole excess read as white noise), smoothed over kSmoothEvaluations evaluations and never
-// below the last window's, so that a window that happens to be low does not shrink sigma.
+// (70·N²/T) (the whole excess read as white noise), smoothed over kSmoothEvaluations evaluations (so that a
+// window that happens to be low does not shrink sigma) and never below the last window's (so that a rise
+// counts at once). A named gyro's level is followed whatever the set (with parity back, the noise-level test
+// of gyro_series judges it); it is named no more once the smoothed λ is back below λ(kNormalLevel), and then
+// matched no more. An epoch farther than half a sample period from the next expected one (a dropped epoch) or
+// a gap breaks every series: a difference across a missing sample would carry the body's acceleration.
 
-#include <cstdint>
-#include <optional>
 #include <vector>
 
 #include "epoch_frame.hpp"
@@ -50,13 +52,16 @@ class OwnNoiseLevel {
   void forget(int id);
   //! No epoch for a while: the differences do not straddle the gap.
   void bridge_gap();
-  //! Each valid sample of `frame` extends its gyro's series; an absent or invalid one breaks it.
-  void ingest(const EpochFrame& frame);
-  //! The gyros of `mask` (three, without parity) due for an evaluation are evaluated at the sample period
-  //! √T = `sqrt_period`: the one named at this epoch, if one is (the lowest). `ratio` is then current.
-  std::optional<OwnNoiseFinding> evaluate(GyroMask mask, double sqrt_period);
+  //! Each valid sample of `frame` extends its gyro's series; an absent or invalid one breaks it, and so does
+  //! an epoch `frame.dt_s` farther than half of `period_s` from it (0: not yet known) for every gyro.
+  void ingest(const EpochFrame& frame, double period_s);
+  //! The gyros due for an evaluation at the sample period √T = `sqrt_period`: those of `candidates` (three,
+  //! without parity) may be named, every named one is followed. The gyros named at this epoch are appended to
+  //! `named` (cleared first); `ratio` is then current.
+  void evaluate(GyroMask candidates, double sqrt_period, std::vector<OwnNoiseFinding>& named);
   //! [-] λ of gyro `id`: its matched white noise variance over the model's (1 while not named).
   double ratio(int id) const { return tracks_[static_cast<std::size_t>(id - 1)].ratio; }
+  bool named(int id) const { return tracks_[static_cast<std::size_t>(id - 1)].named; }
   //! [-] r of gyro `id` over the whole window; NaN until the window is full.
   double level(int id, double sqrt_period) const;
 
@@ -76,7 +81,10 @@ class OwnNoiseLevel {
   double d4_sigma(int id, double sqrt_period) const;
   //! [-] the white noise variance ratio that level `r` shows (≥ 1).
   double white_ratio(int id, double r, double sqrt_period) const;
-  void clear(Track& t) const;
+  //! Follows named gyro `id` (track `t`) at level `r`; false when it is named no more.
+  bool follow(Track& t, int id, double r, double sqrt_period) const;
+  static void clear(Track& t);       //!< the series empty, named no more
+  static void clear_name(Track& t);  //!< named no more, the model's noise
 
   std::vector<GyroConstants> constants_;
   int window_ = 30;

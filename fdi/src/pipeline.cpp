@@ -90,6 +90,7 @@ class Pipeline::Impl {
         budget_(config_) {
     frame_.resize(n_);
     found_.reserve(static_cast<std::size_t>(n_));
+    own_named_.reserve(static_cast<std::size_t>(n_));
     result_.events.reserve(32);
     pending_.reserve(16);
     health_.gyros.resize(static_cast<std::size_t>(n_));
@@ -167,6 +168,7 @@ class Pipeline::Impl {
   DisagreementTrend trend_;  //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
   ReferenceNoiseMatch noise_match_;  //!< three gyros: a gyro's noise or ramp in the reference's innovations
   ProtectionLevel protection_;       //!< the integrity bound beside sigma
+  std::vector<OwnNoiseFinding> own_named_;  //!< the gyros own_noise_ named at this epoch (capacity N)
   ReferenceBudget budget_;  //!< the reference's stated bias and latency, which its samples cannot show
 
   EpochFrame frame_;
@@ -202,7 +204,7 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   if (!result_.accepted) return result_;
   if (frame_.dt_s > config_.max_gap_s) gap();
   series_.ingest(epoch, frame_, health_.counters);
-  own_noise_.ingest(frame_);
+  own_noise_.ingest(frame_, subsets_.ready() ? subsets_.period_s() : 0.0);
   isolator_.record(frame_);
   frame_.usable = frame_.valid & gyro_set_.active();
   measured_ = ~GyroMask{0};
@@ -344,14 +346,15 @@ void Pipeline::Impl::judge_reference() {
 }
 
 void Pipeline::Impl::match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {
-  // Three gyros, no parity: the reference's innovations are the only witness of a gyro's noise or ramp
-  // (docs/fdi.md, "Three gyros: a noise increase or a ramp"); the gyro's noise in the filter follows them
-  // from then on.
+  // Three gyros, no parity: the reference's innovations are the only witness of a gyro's ramp, and of a noise
+  // its own level cannot show (docs/fdi.md, "Three gyros: a noise increase or a ramp"); the gyro's noise in
+  // the filter follows them from then on.
   const Subset* s = three_gyros_without_parity();
   if (s == nullptr) return;
   const auto found = noise_match_.observe(frame_.now_ns, z, S, s->pinv, s->mask, attitude_.filter());
   if (!found) return;
   emit_detected(DetectionTest::kReference, found->statistic, frame_.now_ns);
+  result_.events.back().gyro = found->gyro;
   result_.events.back().why = ReferenceCheck::kNis;
   result_.events.back().detail = "attitude reference innovations along gyro " + std::to_string(found->gyro) +
                                  "'s rate axis exceed the model (noise or ramp); three gyros: its noise in "
@@ -366,23 +369,22 @@ const Subset* Pipeline::Impl::three_gyros_without_parity() {
 void Pipeline::Impl::match_own_noise() {
   // Three gyros, no parity: a gyro's own fourth differences show its white noise where the body's motion does
   // not reach (docs/fdi.md, "Three gyros: a gyro's own noise level"). A gyro beyond the limit is named, never
-  // excluded (three gyros are the rate), and its noise in the filter follows its level from then on.
+  // excluded (three gyros are the rate), and its noise in the filter follows its level until it is normal.
   const Subset* s = three_gyros_without_parity();
-  if (s == nullptr) return;
-  const auto found = own_noise_.evaluate(s->mask, subsets_.sqrt_period());
-  for (int id = 1; id <= n_; ++id) {
-    if (has_gyro(s->mask, id) && own_noise_.ratio(id) > 1.0)
-      noise_match_.set_own_ratio(id, own_noise_.ratio(id), attitude_.filter());
+  own_noise_.evaluate(s != nullptr ? s->mask : GyroMask{0}, subsets_.sqrt_period(), own_named_);
+  for (int id = 1; id <= n_; ++id) noise_match_.set_own_ratio(id, own_noise_.ratio(id), attitude_.filter());
+  for (const OwnNoiseFinding& f : own_named_) {
+    emit_detected(DetectionTest::kSignature, f.level, frame_.now_ns);
+    FdiEvent& e = result_.events.back();
+    e.gyro = f.gyro;
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "gyro %d's own noise level is %.3g times its model (fourth differences, which smooth body "
+                  "motion does not reach); three gyros: named, not excluded; its noise in the filter matched "
+                  "(variance x%.3g), sigma widened",
+                  f.gyro, f.level, f.ratio);
+    e.detail = text;
   }
-  if (!found) return;
-  emit_detected(DetectionTest::kSignature, found->level, frame_.now_ns);
-  char text[320];
-  std::snprintf(text, sizeof text,
-                "gyro %d's own noise level is %.3g times its model (fourth differences, which smooth body "
-                "motion does not reach); three gyros: named, not excluded; its noise in the filter matched "
-                "(variance x%.3g), sigma widened",
-                found->gyro, found->level, found->ratio);
-  result_.events.back().detail = text;
 }
 
 bool Pipeline::Impl::accept(const Epoch& epoch) {

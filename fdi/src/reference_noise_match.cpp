@@ -104,7 +104,6 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
 }
 
 void ReferenceNoiseMatch::apply(std::size_t k, Mekf& filter) const {
-  if (!matched_[k] && own_[k] <= 1.0) return;  // the model's noise: nothing set
   const int id = static_cast<int>(k) + 1;
   const double n2 = filter.arw_rad_rts(id) * filter.arw_rad_rts(id);
   filter.set_added_noise(id, (std::max(matched_[k] ? ratio_[k] : 1.0, own_[k]) - 1.0) * n2);

@@ -1,12 +1,13 @@
 #pragma once
 // Three gyros and a reference (docs/fdi.md, "Three gyros: a noise increase or a ramp"): no parity is left, so
-// a gyro whose noise rises (or whose bias starts to ramp) shows only in the reference's innovations, along
-// that gyro's column h_i of the rate solution H* (a rate error f on gyro i turns the attitude by h_i·f). Per
-// gyro, the innovations z projected on d_i = h_i/|h_i| are summed over blocks of kBlock_s (10 s); a block's
-// u_i = (Σ d_iᵀz)²/Σ s_i (s_i = d_iᵀ·S·d_i) is χ²₁ while the filter's model holds (its innovations are white
-// with covariance S) and grows when the attitude error wanders beyond the model (it is slow: the extra error
-// is correlated over tens of seconds, so a block mean sees it where one sample, dominated by the reference's
-// own noise, barely does). A CUSUM of the log-likelihood ratio for a block variance ρ times the predicted,
+// a gyro whose bias starts to ramp (or whose noise rises where its own level, own_noise_level.hpp, cannot
+// show it) shows only in the reference's innovations, along that gyro's column h_i of the rate solution H* (a
+// rate error f on gyro i turns the attitude by h_i·f). Per gyro, the innovations z projected on d_i =
+// h_i/|h_i| are summed over blocks of kBlock_s (10 s); a block's u_i = (Σ d_iᵀz)²/Σ s_i (s_i = d_iᵀ·S·d_i) is
+// χ²₁ while the filter's model holds (its innovations are white with covariance S) and grows when the
+// attitude error wanders beyond the model (it is slow: the extra error is correlated over tens of seconds, so
+// a block mean sees it where one sample, dominated by the reference's own noise, barely does). A CUSUM of the
+// log-likelihood ratio for a block variance ρ times the predicted,
 //
 //   g_i ← max(0, g_i + ½·((1 − 1/ρ)·u_i − ln ρ)),   ρ = 4;   detected when g_i > ln(1/(p·n))
 //

@@ -228,7 +228,13 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
   switch (event.type) {
     case EventType::kDetected:
     case EventType::kUnisolated:
-      out += ", \"gyro\": null, \"test\": ";
+      out += ", \"gyro\": ";
+      if (event.gyro) {  // a detection that names a gyro without excluding it (three gyros)
+        append_int(out, *event.gyro);
+      } else {
+        out += "null";
+      }
+      out += ", \"test\": ";
       append_json_string(out, to_string(event.test));
       out += ", \"statistic\": ";
       if (std::isfinite(event.statistic)) {

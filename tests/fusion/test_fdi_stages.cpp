@@ -1,6 +1,7 @@
 // Each stage of the pipeline on its own (fdi/src/*.hpp): the invariants a stage promises, checked without the
 // rest of the pipeline around it. The whole pipeline is guarded by the golden trace (test_golden_trace.cpp).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -12,6 +13,7 @@
 #include "gyro_set.hpp"
 #include "isolator.hpp"
 #include "outlier_gate.hpp"
+#include "own_noise_level.hpp"
 #include "parity_detector.hpp"
 #include "rate_attitude.hpp"
 #include "reference_monitor.hpp"
@@ -471,6 +473,109 @@ TEST(BiasHypothesis, OneGyrosPersistingFaultIsToldAndAPassingOneIsNot) {
     BiasHypothesis check(f.constants);
     const auto span = fault_records(check, s, 2, [](double) { return 0.0; });
     EXPECT_EQ(check.best(s, span, std::sqrt(kPeriod)).gyro, 0);
+  }
+}
+
+//! Feeds `seconds` of 10 Hz samples of three gyros to `level`: white noise of the model times `factor[i]` on
+//! gyro i, plus a common rate `rate(t)` [rad/s]; every `drop_every`-th epoch (0: none) is missing. The gyros
+//! named are collected in `named`.
+template <typename Rate>
+void feed(OwnNoiseLevel& level, std::mt19937_64& rng, double t0_s, double seconds,
+          std::array<double, 3> factor, Rate rate, int drop_every, std::vector<int>& named) {
+  std::normal_distribution<double> n01;
+  EpochFrame frame;
+  frame.resize(3);
+  std::vector<OwnNoiseFinding> found;
+  double last_s = t0_s - kPeriod;
+  for (int k = 0; k * kPeriod < seconds; ++k) {
+    const double t_s = t0_s + k * kPeriod;
+    if (drop_every > 0 && k % drop_every == drop_every - 1) continue;
+    frame.dt_s = t_s - last_s;
+    last_s = t_s;
+    frame.valid = 0b111;
+    for (int i = 0; i < 3; ++i)
+      frame.y_rad_s[static_cast<std::size_t>(i)] =
+          rate(t_s) + factor[static_cast<std::size_t>(i)] * kSigma * n01(rng);
+    level.ingest(frame, kPeriod);
+    level.evaluate(0b111, std::sqrt(kPeriod), found);
+    for (const auto& f : found) named.push_back(f.gyro);
+  }
+}
+
+TEST(OwnNoiseLevel, EveryGyroWhoseNoiseRoseIsNamedAndAHealthyOneIsNot) {
+  // Three gyros, 60 s: gyros 1 and 3 at noise x6 from the start, gyro 2 healthy — both raised ones named at
+  // the same evaluation (each its own event), with λ near 36, gyro 2 never.
+  Fixture f(3);
+  OwnNoiseLevel level(f.constants, f.config);
+  std::mt19937_64 rng(5);
+  std::vector<int> named;
+  feed(
+      level, rng, 0.0, 60.0, {6.0, 1.0, 6.0}, [](double) { return 0.0; }, 0, named);
+  EXPECT_EQ(named, (std::vector<int>{1, 3}));
+  EXPECT_TRUE(level.named(1) && level.named(3) && !level.named(2));
+  // λ within 36 ± 50 %: the level of one window of 30 correlated values is good to about ±20 % in σ.
+  EXPECT_GT(level.ratio(1), 18.0);
+  EXPECT_LT(level.ratio(1), 54.0);
+  EXPECT_EQ(level.ratio(2), 1.0);
+}
+
+TEST(OwnNoiseLevel, ANamedGyroBackToNormalIsNamedNoMoreAndForgetClearsIt) {
+  // Gyro 2 at x8 for 20 s, then healthy for 60 s: named, then (its smoothed level below 1.5) named no more,
+  // λ 1; named again at x8, then `forget` clears it at once; `reset` too.
+  Fixture f(3);
+  OwnNoiseLevel level(f.constants, f.config);
+  std::mt19937_64 rng(9);
+  std::vector<int> named;
+  const auto still = [](double) { return 0.0; };
+  feed(level, rng, 0.0, 20.0, {1.0, 8.0, 1.0}, still, 0, named);
+  ASSERT_TRUE(level.named(2));
+  feed(level, rng, 20.0, 60.0, {1.0, 1.0, 1.0}, still, 0, named);
+  EXPECT_FALSE(level.named(2));
+  EXPECT_EQ(level.ratio(2), 1.0);
+  feed(level, rng, 80.0, 20.0, {1.0, 8.0, 1.0}, still, 0, named);
+  EXPECT_EQ(named, (std::vector<int>{2, 2}));
+  level.forget(2);
+  EXPECT_FALSE(level.named(2));
+  EXPECT_EQ(level.ratio(2), 1.0);
+  feed(level, rng, 100.0, 10.0, {1.0, 8.0, 1.0}, still, 0, named);
+  ASSERT_TRUE(level.named(2));
+  level.reset();
+  EXPECT_FALSE(level.named(2));
+}
+
+TEST(OwnNoiseLevel, AMissingEpochInASlewBreaksTheSeriesInsteadOfReadingAsNoise) {
+  // Healthy gyros, a steady acceleration of 2.8 deg/s² (the families' fastest slew's peak) for 60 s, every
+  // 7th epoch missing: a difference across the missing sample would carry a·T ≈ 0.28 deg/s, some 3,000σ of
+  // the white level; the series restarts at it instead and nothing is named. Without the restart (every
+  // epoch taken as one period on) all three are named.
+  Fixture f(3);
+  const auto slew = [](double t_s) { return 2.8 * kDegToRad * t_s; };
+  std::vector<int> named;
+  {
+    OwnNoiseLevel level(f.constants, f.config);
+    std::mt19937_64 rng(3);
+    feed(level, rng, 0.0, 60.0, {1.0, 1.0, 1.0}, slew, 7, named);
+    EXPECT_TRUE(named.empty());
+  }
+  {
+    // The same samples with the epoch's interval unknown (period 0): the series spans the missing epochs.
+    OwnNoiseLevel level(f.constants, f.config);
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> n01;
+    EpochFrame frame;
+    frame.resize(3);
+    std::vector<OwnNoiseFinding> found;
+    int names = 0;
+    for (int k = 0; k * kPeriod < 60.0; ++k) {
+      if (k % 7 == 6) continue;
+      frame.valid = 0b111;
+      for (int i = 0; i < 3; ++i)
+        frame.y_rad_s[static_cast<std::size_t>(i)] = slew(k * kPeriod) + kSigma * n01(rng);
+      level.ingest(frame, 0.0);
+      level.evaluate(0b111, std::sqrt(kPeriod), found);
+      names += static_cast<int>(found.size());
+    }
+    EXPECT_EQ(names, 3);
   }
 }
 

@@ -90,8 +90,8 @@ TEST(PerturbationFamilies, Calibration) {
 TEST(PerturbationFamilies, CalibrationWithoutNoise) {
   check_family(sim::Family::kCalibrationWithoutNoise, 18);
 }
-// Three gyros: a noise increase shows in the reference's innovations late (252 s median) or not at all, and
-// sigma is short until then (docs/fdi.md, "Perturbation families"); a ramp is covered from its detection on.
+// Three gyros: a noise increase is named by the gyro's own level within seconds, a bias or a ramp by the
+// reference's innovations, and each is covered from then on (docs/fdi.md, "Perturbation families").
 TEST(PerturbationFamilies, SecondFault) {
   check_family(sim::Family::kSecondFault, 12);
 }

@@ -122,7 +122,9 @@ struct Epoch {
 struct FdiEvent {
   std::int64_t stamp_ns = 0;  //!< [ns] time of the epoch that triggered the event
   EventType type = EventType::kDetected;
-  std::optional<int> gyro;                    //!< 1..N: isolated gyro, or the gyro a command named
+  //! 1..N: isolated gyro, the gyro a command named, or the gyro a detection names without excluding it
+  //! (three gyros: its own noise level or the reference's innovations along its rate axis)
+  std::optional<int> gyro;
   DetectionTest test = DetectionTest::kNone;  //!< detected, unisolated, isolated: the test
   double statistic = std::numeric_limits<double>::quiet_NaN();  //!< detected: value of the test statistic
   FaultKind kind = FaultKind::kUnknown;                         //!< isolated: classified fault kind
