@@ -70,6 +70,15 @@ class Mekf {
   //! [rad²/s] (≥ 0; the noise the reference's innovations show beyond the model, docs/fdi.md "Reference
   //! consistency"). reset() and thaw() put it back to the model's.
   void set_added_noise(int id, double added_rad2_s);
+  //! Gyro `id`'s slow bias g_i as the filter models it from now on: a Gauss–Markov process of stationary
+  //! variance σ_GM² + `added_rad2_s2` [rad²/s²] (same T_c) — a slow rate error the parity shows beyond the
+  //! bias model (docs/fdi.md, "A slow error below the detectors"). The added variance only grows: a larger
+  //! one opens g_i's variance by the difference at once. reset() and thaw() put it back to the model's.
+  void add_bias_instability(int id, double added_rad2_s2);
+  //! Gyro `id`'s slow bias back to the model's Gauss–Markov process (its current variance kept).
+  void clear_bias_instability(int id);
+  //! [rad²/s²] gyro `id`'s variance added to its Gauss–Markov bias (add_bias_instability), 0 by default.
+  double added_bias_instability(int id) const { return added_gm_var_[static_cast<std::size_t>(id - 1)]; }
   //! [rad/√s] gyro `id`'s modelled white rate noise N (without any added noise).
   double arw_rad_rts(int id) const { return gyros_[static_cast<std::size_t>(id - 1)].arw_rad_rts; }
 
@@ -128,6 +137,10 @@ class Mekf {
   void gauss_markov_transitions(double dt_s);
   void refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, double dt_s);
   void propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta);
+  //! [rad²/s²] gyro index `i`'s Gauss–Markov stationary variance: the model's σ_GM² and any added.
+  double gm_stationary_var(std::size_t i) const {
+    return gyros_[i].gm_sigma_rad_s * gyros_[i].gm_sigma_rad_s + added_gm_var_[i];
+  }
 
   std::vector<GyroNoiseModel> gyros_;
   int n_;
@@ -164,6 +177,7 @@ class Mekf {
   Eigen::VectorXd parity_h_;         //!< N: a parity row's h per gyro (scratch)
   Eigen::VectorXd prior_var_;        //!< [rad²/s²] per gyro: the variance of c + g without any measurement
   std::vector<double> added_noise_;  //!< [rad²/s] per gyro: white rate noise added to N² (set_added_noise)
+  std::vector<double> added_gm_var_;  //!< [rad²/s²] per gyro: added to σ_GM² (add_bias_instability)
 };
 
 //! ∫₀^Δt exp(−[ω×]u) du in closed form (a series for small |ω|Δt).
