@@ -19,6 +19,11 @@ ParityBiasMatch::ParityBiasMatch(const PipelineConfig& config, int gyro_count)
       cusum_(static_cast<std::size_t>(gyro_count), 0.0),
       excess_(static_cast<std::size_t>(gyro_count), 0.0),
       block_excess_(static_cast<std::size_t>(gyro_count), 0.0),
+      walk_(static_cast<std::size_t>(gyro_count), 0.0),
+      last_f_(static_cast<std::size_t>(gyro_count), 0.0),
+      last_var_(static_cast<std::size_t>(gyro_count), 0.0),
+      block_f_(static_cast<std::size_t>(gyro_count), 0.0),
+      block_var_(static_cast<std::size_t>(gyro_count), 0.0),
       innovation_(Eigen::VectorXd::Zero(std::max(gyro_count - 3, 1))),
       projection_(Eigen::VectorXd::Zero(gyro_count)) {}
 
@@ -26,6 +31,7 @@ void ParityBiasMatch::reset() {
   restart();
   matched_ = false;
   std::fill(excess_.begin(), excess_.end(), 0.0);
+  std::fill(walk_.begin(), walk_.end(), 0.0);
 }
 
 void ParityBiasMatch::restart() {
@@ -35,11 +41,13 @@ void ParityBiasMatch::restart() {
   std::fill(sum_wnu_.begin(), sum_wnu_.end(), 0.0);
   std::fill(sum_w2_.begin(), sum_w2_.end(), 0.0);
   std::fill(cusum_.begin(), cusum_.end(), 0.0);
+  std::fill(last_var_.begin(), last_var_.end(), 0.0);
 }
 
 void ParityBiasMatch::forget(int id) {
   const auto k = static_cast<std::size_t>(id - 1);
   excess_[k] = 0.0;
+  walk_[k] = 0.0;
   cusum_[k] = 0.0;
 }
 
@@ -67,12 +75,12 @@ void ParityBiasMatch::observe(std::int64_t now_ns, const Subset& s, const Eigen:
   }
   ++block_epochs_;
   if (now_ns - block_start_ns_ < seconds_to_ns(kBiasBlock_s)) return;
-  close_block(s, filter);
+  close_block(s, ns_to_seconds(now_ns - block_start_ns_), filter);
   block_start_ns_ = now_ns;
   block_epochs_ = 0;
 }
 
-void ParityBiasMatch::close_block(const Subset& s, Mekf& filter) {
+void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter) {
   // A block of n epochs stands for n of the per-epoch false-alarm probability p, and each gyro's CUSUM is one
   // test (p·n·|S| at most 1/2, so the threshold stays above ln 2 whatever p the configuration allows).
   const double threshold =
@@ -107,16 +115,28 @@ void ParityBiasMatch::close_block(const Subset& s, Mekf& filter) {
     alarm = alarm || cusum_[k] > threshold;
     // The excess under gyro i's hypothesis (the error is gyro i's alone): kept per gyro, used once matched.
     block_excess_[k] = f * f - predicted;
+    block_f_[k] = f;
+    block_var_[k] = predicted;
   }
   matched_ = matched_ || alarm;
-  if (!matched_) return;
   // Which gyro the parity's blocks cannot always tell (their columns are not orthogonal): every gyro of the
   // set takes the excess its own hypothesis gives, so sigma covers each single-gyro explanation.
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < n && matched_; ++i) {
     const auto k = static_cast<std::size_t>(i);
     if (!has_gyro(s.mask, i + 1)) continue;
     excess_[k] = std::max(excess_[k], block_excess_[k]);
-    filter.add_bias_instability(i + 1, excess_[k]);
+    // How fast it moves: the change from the last block beyond both blocks' predicted variances, per second
+    // of block (covariance matching on differences: a random walk of K² moves a block mean by K²·T).
+    if (last_var_[k] > 0.0) {
+      const double step = block_f_[k] - last_f_[k];
+      walk_[k] = std::max(walk_[k], (step * step - block_var_[k] - last_var_[k]) / block_s);
+    }
+    filter.open_bias_model(i + 1, excess_[k], walk_[k]);
+  }
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    last_f_[k] = block_f_[k];
+    last_var_[k] = has_gyro(s.mask, i + 1) ? block_var_[k] : 0.0;
   }
 }
 

@@ -50,7 +50,7 @@ class ParityBiasMatch {
   void forget(int id);
 
  private:
-  void close_block(const Subset& s, Mekf& filter);
+  void close_block(const Subset& s, double block_s, Mekf& filter);
 
   double false_alarm_ = 0.0;          //!< p per epoch
   GyroMask mask_ = 0;                 //!< the gyros of the statistics
@@ -62,6 +62,11 @@ class ParityBiasMatch {
   bool matched_ = false;           //!< a gyro's CUSUM crossed: every gyro's slow bias follows the blocks
   std::vector<double> excess_;     //!< [rad²/s²] F_i², the largest excess so far under gyro i's hypothesis
   std::vector<double> block_excess_;  //!< [rad²/s²] the last block's f̂_i² less its predicted variance
+  std::vector<double> walk_;          //!< [rad²/s³] the largest excess of a block-to-block change per second
+  std::vector<double> last_f_;        //!< [rad/s] the previous block's f̂_i
+  std::vector<double> last_var_;      //!< [rad²/s²] its predicted variance (0: no previous block)
+  std::vector<double> block_f_;       //!< [rad/s] this block's f̂_i (scratch)
+  std::vector<double> block_var_;     //!< [rad²/s²] its predicted variance (scratch)
   Eigen::VectorXd innovation_;     //!< ν (scratch, sized for N − 3 rows)
   Eigen::VectorXd projection_;     //!< per gyro: √T·W column's response along w_i / |w_i|² (scratch)
 };

@@ -876,7 +876,7 @@ FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   bias_match_.reset();
   for (int id = 1; id <= n_; ++id) {
     attitude_.filter().set_added_noise(id, 0.0);
-    attitude_.filter().clear_bias_instability(id);
+    attitude_.filter().clear_bias_model(id);
   }
   restart_detectors();
   update_mode(stamp_ns);

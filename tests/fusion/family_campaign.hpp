@@ -167,6 +167,8 @@ struct DrawComparison {
   //! One-sided exact p-value of McNemar's test that the run fails the criterion no more often than its twin:
   //! P(X ≥ only_run_fails), X ~ Binomial(only_run_fails + only_twin_fails, ½).
   double failure_p = 1.0;
+  Eigen::Vector3d mean_run_nees = Eigen::Vector3d::Zero();   //!< per-axis NEES averaged over the draws' runs
+  Eigen::Vector3d mean_twin_nees = Eigen::Vector3d::Zero();  //!< ...and over their twins
 };
 
 //! Draws of the noise a run charged against its one twin is judged over (the perturbation, motion, unit and
@@ -204,6 +206,8 @@ inline DrawComparison compare_over_draws(const sim::PerturbedRun& r) {
     const FamilyVerdict v = judge_run(drawn);
     const FamilyVerdict t = judge_run(sim::unperturbed_twin(drawn));
     const double d = v.nees.maxCoeff() - t.nees.maxCoeff();
+    c.mean_run_nees += v.nees / kChargeDraws;
+    c.mean_twin_nees += t.nees / kChargeDraws;
     sum += d;
     sum2 += d * d;
     const bool run_fails = v.within < kMinWithin3Sigma || v.nees.maxCoeff() > kMaxNeesPerAxis;
