@@ -326,7 +326,8 @@ void Mekf::restore_biases(const double* state, GyroMask gyros, double elapsed_s)
   for (int i = 0; i < n_; ++i) {
     if (!restored(i)) continue;
     const auto& g = gyros_[static_cast<std::size_t>(i)];
-    P_(c_of(i), c_of(i)) += (g.rrw_rad_s_rts * g.rrw_rad_s_rts + added_rrw_var_[static_cast<std::size_t>(i)]) * elapsed_s;
+    P_(c_of(i), c_of(i)) +=
+        (g.rrw_rad_s_rts * g.rrw_rad_s_rts + added_rrw_var_[static_cast<std::size_t>(i)]) * elapsed_s;
     const double d = decay(n_ + i);
     P_(g_of(i), g_of(i)) += gm_stationary_var(static_cast<std::size_t>(i)) * (1.0 - d * d);
   }
@@ -458,7 +459,8 @@ void Mekf::gauss_markov_transitions(double dt_s) {
     const double stationary = gm_stationary_var(i);
     gm_phi_[i] = stationary > 0.0 ? std::exp(-dt_s / g.gm_correlation_s) : 1.0;
     // The Gauss–Markov bias decays within the step: its mean over the step is κ·g, κ = T_c(1 − φ)/Δt.
-    gm_kappa_[i] = stationary > 0.0 ? g.gm_correlation_s * -std::expm1(-dt_s / g.gm_correlation_s) / dt_s : 1.0;
+    gm_kappa_[i] =
+        stationary > 0.0 ? g.gm_correlation_s * -std::expm1(-dt_s / g.gm_correlation_s) / dt_s : 1.0;
     rrw_var_[i] = (g.rrw_rad_s_rts * g.rrw_rad_s_rts + added_rrw_var_[i]) * dt_s;
     gm_var_[i] = stationary * (1.0 - gm_phi_[i] * gm_phi_[i]);
   }

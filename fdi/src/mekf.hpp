@@ -72,9 +72,9 @@ class Mekf {
   void set_added_noise(int id, double added_rad2_s);
   //! Gyro `id`'s bias as the filter models it from now on: g_i a Gauss–Markov process of stationary variance
   //! σ_GM² + `gm_var_rad2_s2` [rad²/s²] (same T_c), c_i a random walk of K² + `rrw_var_rad2_s3` [rad²/s³] — a
-  //! slow rate error the parity shows beyond the bias model (docs/fdi.md, "A slow error below the detectors").
-  //! Each added variance only grows: a larger Gauss–Markov one opens g_i's variance by the difference at once.
-  //! reset() and thaw() put the model back.
+  //! slow rate error the parity shows beyond the bias model (docs/fdi.md, "A slow error below the
+  //! detectors"). Each added variance only grows: a larger Gauss–Markov one opens g_i's variance by the
+  //! difference at once. reset() and thaw() put the model back.
   void open_bias_model(int id, double gm_var_rad2_s2, double rrw_var_rad2_s3);
   //! Gyro `id`'s bias back to the model's processes (its current variance kept).
   void clear_bias_model(int id);
@@ -177,10 +177,10 @@ class Mekf {
   Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
   Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
   Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
-  Eigen::VectorXd parity_h_;         //!< N: a parity row's h per gyro (scratch)
-  Eigen::VectorXd prior_var_;        //!< [rad²/s²] per gyro: the variance of c + g without any measurement
-  std::vector<double> added_noise_;  //!< [rad²/s] per gyro: white rate noise added to N² (set_added_noise)
-  std::vector<double> added_gm_var_;   //!< [rad²/s²] per gyro: added to σ_GM² (open_bias_model)
+  Eigen::VectorXd parity_h_;          //!< N: a parity row's h per gyro (scratch)
+  Eigen::VectorXd prior_var_;         //!< [rad²/s²] per gyro: the variance of c + g without any measurement
+  std::vector<double> added_noise_;   //!< [rad²/s] per gyro: white rate noise added to N² (set_added_noise)
+  std::vector<double> added_gm_var_;  //!< [rad²/s²] per gyro: added to σ_GM² (open_bias_model)
   std::vector<double> added_rrw_var_;  //!< [rad²/s³] per gyro: added to K² (open_bias_model)
 };
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "mekf.hpp"
+#include "tetra/core/units.hpp"
 
 namespace tetra::fdi::detail {
 
@@ -83,8 +84,7 @@ void ParityBiasMatch::observe(std::int64_t now_ns, const Subset& s, const Eigen:
 void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter) {
   // A block of n epochs stands for n of the per-epoch false-alarm probability p, and each gyro's CUSUM is one
   // test (p·n·|S| at most 1/2, so the threshold stays above ln 2 whatever p the configuration allows).
-  const double threshold =
-      -std::log(std::min(false_alarm_ * block_epochs_ * tetra::gyro_count(s.mask), 0.5));
+  const double threshold = -std::log(std::min(false_alarm_ * block_epochs_ * tetra::gyro_count(s.mask), 0.5));
   const int n = static_cast<int>(sum_wnu_.size());
   const Eigen::MatrixXd& P = filter.covariance();
   bool alarm = false;
@@ -101,11 +101,12 @@ void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter)
       if (projection_[j] == 0.0) continue;
       for (int l = 0; l < n; ++l) {
         if (projection_[l] == 0.0) continue;
-        const double cov = P(3 + j, 3 + l) + P(3 + j, 3 + n + l) + P(3 + n + j, 3 + l) + P(3 + n + j, 3 + n + l);
+        const double cov =
+            P(3 + j, 3 + l) + P(3 + j, 3 + n + l) + P(3 + n + j, 3 + l) + P(3 + n + j, 3 + n + l);
         v += projection_[j] * cov * projection_[l];
       }
     }
-    const double f = sum_wnu_[k] / sum_w2_[k];                      // [rad/s] the block's mean error
+    const double f = sum_wnu_[k] / sum_w2_[k];                     // [rad/s] the block's mean error
     const double predicted = 1.0 / sum_w2_[k] + std::max(v, 0.0);  // [rad²/s²] its variance under the model
     const double u = f * f / predicted;
     sum_wnu_[k] = 0.0;

@@ -17,8 +17,8 @@
 // is a Gauss–Markov process whose stationary variance carries, beyond the model's σ_GM², the excess its own
 // hypothesis gives, F_i² = f̂_i² − (1/Σ|w_i|² + v_i) (the largest of the blocks since) — sigma covers each
 // single-gyro explanation, and the filter follows the error through the parity (and the reference). No event:
-// nothing is excluded or reported; the bias model is matched to the data. Blocks run on the epochs whose parity
-// is over the whole active set, outside fault episodes (a fault the detectors see is theirs to judge).
+// nothing is excluded or reported; the bias model is matched to the data. Blocks run on the epochs whose
+// parity is over the whole active set, outside fault episodes (a fault the detectors see is theirs to judge).
 
 #include <cstdint>
 #include <vector>
@@ -41,9 +41,9 @@ class ParityBiasMatch {
   void reset();
   //! The statistics empty; what is matched kept (an episode opened: its fault is the detectors' to judge).
   void restart();
-  //! One epoch's normalized parity `p` over the active set's subset `s` (no episode open), before the filter's
-  //! parity update. At a block's end a gyro whose mean rate error exceeds the model has its slow bias opened in
-  //! `filter` (Mekf::add_bias_instability).
+  //! One epoch's normalized parity `p` over the active set's subset `s` (no episode open), before the
+  //! filter's parity update. At a block's end a gyro whose mean rate error exceeds the model has its slow
+  //! bias opened in `filter` (Mekf::add_bias_instability).
   void observe(std::int64_t now_ns, const Subset& s, const Eigen::VectorXd& p, double sqrt_period,
                Mekf& filter);
   //! Gyro `id` reinstated: its bias model is the filter's prior again, and so is its match.
@@ -56,17 +56,17 @@ class ParityBiasMatch {
   GyroMask mask_ = 0;                 //!< the gyros of the statistics
   std::int64_t block_start_ns_ = -1;  //!< the block's first epoch
   int block_epochs_ = 0;
-  std::vector<double> sum_wnu_;    //!< [1/(rad/s)] Σ w_iᵀν over the block
-  std::vector<double> sum_w2_;     //!< [1/(rad/s)²] Σ |w_i|² over the block
-  std::vector<double> cusum_;      //!< [-] g_i
-  bool matched_ = false;           //!< a gyro's CUSUM crossed: every gyro's slow bias follows the blocks
-  std::vector<double> excess_;     //!< [rad²/s²] F_i², the largest excess so far under gyro i's hypothesis
+  std::vector<double> sum_wnu_;  //!< [1/(rad/s)] Σ w_iᵀν over the block
+  std::vector<double> sum_w2_;   //!< [1/(rad/s)²] Σ |w_i|² over the block
+  std::vector<double> cusum_;    //!< [-] g_i
+  bool matched_ = false;         //!< a gyro's CUSUM crossed: every gyro's slow bias follows the blocks
+  std::vector<double> excess_;   //!< [rad²/s²] F_i², the largest excess so far under gyro i's hypothesis
   std::vector<double> block_excess_;  //!< [rad²/s²] the last block's f̂_i² less its predicted variance
-  std::vector<double> walk_;          //!< [rad²/s³] the largest excess of a block-to-block change per second
-  std::vector<double> last_f_;        //!< [rad/s] the previous block's f̂_i
-  std::vector<double> last_var_;      //!< [rad²/s²] its predicted variance (0: no previous block)
-  std::vector<double> block_f_;       //!< [rad/s] this block's f̂_i (scratch)
-  std::vector<double> block_var_;     //!< [rad²/s²] its predicted variance (scratch)
+  std::vector<double> walk_;       //!< [rad²/s³] the largest excess of a block-to-block change per second
+  std::vector<double> last_f_;     //!< [rad/s] the previous block's f̂_i
+  std::vector<double> last_var_;   //!< [rad²/s²] its predicted variance (0: no previous block)
+  std::vector<double> block_f_;    //!< [rad/s] this block's f̂_i (scratch)
+  std::vector<double> block_var_;  //!< [rad²/s²] its predicted variance (scratch)
   Eigen::VectorXd innovation_;     //!< ν (scratch, sized for N − 3 rows)
   Eigen::VectorXd projection_;     //!< per gyro: √T·W column's response along w_i / |w_i|² (scratch)
 };

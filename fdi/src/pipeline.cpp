@@ -558,7 +558,8 @@ void Pipeline::Impl::publish_attitude() {
         if (episode)
           bias_match_.restart();
         else if (frame_.usable == gyro_set_.active())
-          bias_match_.observe(frame_.now_ns, sol, detector_.parity(), subsets_.sqrt_period(), attitude_.filter());
+          bias_match_.observe(frame_.now_ns, sol, detector_.parity(), subsets_.sqrt_period(),
+                              attitude_.filter());
         attitude_.parity(sol, detector_.parity(), subsets_.sqrt_period());
       }
     }

@@ -220,16 +220,16 @@ inline DrawComparison compare_over_draws(const sim::PerturbedRun& r) {
   c.failure_p = binomial_half_tail(c.only_run_fails, c.only_run_fails + c.only_twin_fails);
   c.draws = kChargeDraws;
   c.mean_difference = sum / c.draws;
-  const double var = std::max(sum2 / c.draws - c.mean_difference * c.mean_difference, 0.0) * c.draws /
-                     (c.draws - 1.0);
+  const double var =
+      std::max(sum2 / c.draws - c.mean_difference * c.mean_difference, 0.0) * c.draws / (c.draws - 1.0);
   c.standard_error = std::sqrt(var / c.draws);
   return c;
 }
 
-//! Whether a run's sigma is charged to its perturbation: it fails the per-run criterion, its twin meets it and
-//! the run is materially worse (worse_than_twin) — and, since one twin is a single paired draw of a NEES whose
-//! few degrees of freedom scatter it widely, the same run over kChargeDraws other draws of the noise confirms
-//! it (compare_over_draws, kChargeStandardErrors, kChargeFailureP): a run that is only a statistical
+//! Whether a run's sigma is charged to its perturbation: it fails the per-run criterion, its twin meets it
+//! and the run is materially worse (worse_than_twin) — and, since one twin is a single paired draw of a NEES
+//! whose few degrees of freedom scatter it widely, the same run over kChargeDraws other draws of the noise
+//! confirms it (compare_over_draws, kChargeStandardErrors, kChargeFailureP): a run that is only a statistical
 //! borderline is not charged; its draws are written to `note` (the sweep prints them).
 inline bool charged(const sim::PerturbedRun& r, const FamilyVerdict& v, const FamilyVerdict& twin,
                     std::string& note) {
@@ -241,8 +241,9 @@ inline bool charged(const sim::PerturbedRun& r, const FamilyVerdict& v, const Fa
   std::snprintf(line, sizeof line,
                 "%s\n  over %d other draws of the noise: largest per-axis NEES run - twin %+.3f +- %.3f "
                 "(standard error), runs failing %d, twins failing %d (McNemar p %.3f): %s\n",
-                r.label.c_str(), c.draws, c.mean_difference, c.standard_error, c.runs_failing, c.twins_failing,
-                c.failure_p, confirmed ? "charged" : "a statistical borderline, not charged");
+                r.label.c_str(), c.draws, c.mean_difference, c.standard_error, c.runs_failing,
+                c.twins_failing, c.failure_p,
+                confirmed ? "charged" : "a statistical borderline, not charged");
   note = line;
   return confirmed;
 }

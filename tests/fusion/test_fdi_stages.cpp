@@ -351,8 +351,9 @@ TEST(ParityBiasMatch, WhiteParityNeverOpensTheBiasModelAndASlowErrorDoes) {
   // change seen through the attitude control's wobble, docs/fdi.md "A slow error below the detectors"), a
   // quarter of the CUSUM's 2e-4 deg/s: matched within its 600 s (here after 300 s: a block's mean is at most
   // 0.64 of the amplitude, u ≤ 5 with the filter's prior bias uncertainty half of the predicted variance, so
-  // the CUSUM needs several blocks to pass ln(1/(p·n·|S|)) = 14.3), after which every gyro's slow bias carries
-  // an excess of the error's order (a block mean's square of the sinusoid: below its amplitude squared).
+  // the CUSUM needs several blocks to pass ln(1/(p·n·|S|)) = 14.3), after which every gyro's slow bias
+  // carries an excess of the error's order (a block mean's square of the sinusoid: below its amplitude
+  // squared).
   Fixture f;
   std::vector<GyroNoiseModel> models(4);
   for (std::size_t i = 0; i < 4; ++i) {
