@@ -18,7 +18,10 @@
 // hypothesis gives, F_i² = f̂_i² − (1/Σ|w_i|² + v_i) (the largest of the blocks since) — sigma covers each
 // single-gyro explanation, and the filter follows the error through the parity (and the reference). No event:
 // nothing is excluded or reported; the bias model is matched to the data. Blocks run on the epochs whose
-// parity is over the whole active set, outside fault episodes (a fault the detectors see is theirs to judge).
+// parity is over the whole active set, outside fault episodes (a fault the detectors see is theirs to judge),
+// once the reference has been seen (before it the filter estimates no bias, and the biases' own wander,
+// slower than a block, would make successive blocks correlated). The random-walk bias also opens, by the
+// largest excess of a block-to-block change over both blocks' predicted variances, per second of block.
 
 #include <cstdint>
 #include <vector>

@@ -552,12 +552,13 @@ void Pipeline::Impl::publish_attitude() {
           subsets_.calibration_rate_bound(sol, frame_.usable, attitude_.omega_meas_B());
       attitude_.propagate(frame_, sol, active, bound, subsets_.period_s());
       // The epoch's parity, when it was computed over the gyros published, measures their biases; over the
-      // whole active set outside an episode, its blocks also judge each gyro's bias model (a slow error below
-      // the detectors).
+      // whole active set outside an episode, once the reference has been seen (the filter then estimates the
+      // biases, so the blocks of its innovations are nearly independent), its blocks also judge each gyro's
+      // bias model (a slow error below the detectors).
       if (frame_.usable == measured_ && sol.observable) {
         if (episode)
           bias_match_.restart();
-        else if (frame_.usable == gyro_set_.active())
+        else if (frame_.usable == gyro_set_.active() && attitude_.reference_aided())
           bias_match_.observe(frame_.now_ns, sol, detector_.parity(), subsets_.sqrt_period(),
                               attitude_.filter());
         attitude_.parity(sol, detector_.parity(), subsets_.sqrt_period());
