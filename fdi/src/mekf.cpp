@@ -246,6 +246,8 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
   rrw_var_.assign(gyros_.size(), 0.0);
   gm_var_.assign(gyros_.size(), 0.0);
   added_noise_.assign(gyros_.size(), 0.0);
+  added_gm_var_.assign(gyros_.size(), 0.0);
+  added_rrw_var_.assign(gyros_.size(), 0.0);
   step_pinv_ = Eigen::Matrix3Xd::Zero(3, n_);
   reset(0.0);
 }
@@ -256,6 +258,9 @@ void Mekf::reset(double attitude_sigma_rad) {
   frozen_mask_ = 0;
   for (int i = 0; i < n_; ++i) set_prior(i);
   std::fill(added_noise_.begin(), added_noise_.end(), 0.0);
+  std::fill(added_gm_var_.begin(), added_gm_var_.end(), 0.0);
+  std::fill(added_rrw_var_.begin(), added_rrw_var_.end(), 0.0);
+  gm_dt_s_ = -1.0;
   step_dt_s_ = -1.0;  // the step constants again from the model's noise
   P_.topLeftCorner<3, 3>().diagonal().setConstant(attitude_sigma_rad * attitude_sigma_rad);
 }
@@ -301,8 +306,8 @@ void Mekf::restore_biases(const double* state, GyroMask gyros, double elapsed_s)
   auto restored = [&](int i) { return has_gyro(gyros, i + 1) && !frozen(i + 1); };
   auto decay = [&](Eigen::Index k) {  // k: 0..2N−1, c then g
     if (k < n_) return 1.0;
-    const auto& g = gyros_[static_cast<std::size_t>(k - n_)];
-    return g.gm_sigma_rad_s > 0.0 ? std::exp(-elapsed_s / g.gm_correlation_s) : 1.0;
+    const auto j = static_cast<std::size_t>(k - n_);
+    return gm_stationary_var(j) > 0.0 ? std::exp(-elapsed_s / gyros_[j].gm_correlation_s) : 1.0;
   };
   for (int i = 0; i < n_; ++i) {  // every restored state loses its correlations first
     if (!restored(i)) continue;
@@ -321,9 +326,10 @@ void Mekf::restore_biases(const double* state, GyroMask gyros, double elapsed_s)
   for (int i = 0; i < n_; ++i) {
     if (!restored(i)) continue;
     const auto& g = gyros_[static_cast<std::size_t>(i)];
-    P_(c_of(i), c_of(i)) += g.rrw_rad_s_rts * g.rrw_rad_s_rts * elapsed_s;
+    P_(c_of(i), c_of(i)) +=
+        (g.rrw_rad_s_rts * g.rrw_rad_s_rts + added_rrw_var_[static_cast<std::size_t>(i)]) * elapsed_s;
     const double d = decay(n_ + i);
-    P_(g_of(i), g_of(i)) += g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - d * d);
+    P_(g_of(i), g_of(i)) += gm_stationary_var(static_cast<std::size_t>(i)) * (1.0 - d * d);
   }
 }
 
@@ -344,6 +350,32 @@ void Mekf::thaw(int id) {
   frozen_mask_ = without_gyro(frozen_mask_, id);
   set_prior(id - 1);
   set_added_noise(id, 0.0);
+  clear_bias_model(id);
+}
+
+void Mekf::clear_bias_model(int id) {
+  if (id < 1 || id > n_) return;
+  const auto k = static_cast<std::size_t>(id - 1);
+  if (added_gm_var_[k] == 0.0 && added_rrw_var_[k] == 0.0) return;
+  added_gm_var_[k] = 0.0;
+  added_rrw_var_[k] = 0.0;
+  gm_dt_s_ = -1.0;  // the bias transitions and the step constants recomputed at the next step
+  step_dt_s_ = -1.0;
+}
+
+void Mekf::open_bias_model(int id, double gm_var_rad2_s2, double rrw_var_rad2_s3) {
+  if (id < 1 || id > n_ || frozen(id)) return;
+  const auto k = static_cast<std::size_t>(id - 1);
+  const bool gm = gm_var_rad2_s2 > added_gm_var_[k];
+  const bool rrw = rrw_var_rad2_s3 > added_rrw_var_[k];
+  if (!gm && !rrw) return;
+  if (gm) {
+    P_(g_of(id - 1), g_of(id - 1)) += gm_var_rad2_s2 - added_gm_var_[k];
+    added_gm_var_[k] = gm_var_rad2_s2;
+  }
+  if (rrw) added_rrw_var_[k] = rrw_var_rad2_s3;
+  gm_dt_s_ = -1.0;  // the bias transitions and the step constants recomputed at the next step
+  step_dt_s_ = -1.0;
 }
 
 void Mekf::set_added_noise(int id, double added_rad2_s) {
@@ -424,12 +456,13 @@ void Mekf::propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d&
 void Mekf::gauss_markov_transitions(double dt_s) {
   for (std::size_t i = 0; i < gyros_.size(); ++i) {
     const auto& g = gyros_[i];
-    gm_phi_[i] = g.gm_sigma_rad_s > 0.0 ? std::exp(-dt_s / g.gm_correlation_s) : 1.0;
+    const double stationary = gm_stationary_var(i);
+    gm_phi_[i] = stationary > 0.0 ? std::exp(-dt_s / g.gm_correlation_s) : 1.0;
     // The Gauss–Markov bias decays within the step: its mean over the step is κ·g, κ = T_c(1 − φ)/Δt.
     gm_kappa_[i] =
-        g.gm_sigma_rad_s > 0.0 ? g.gm_correlation_s * -std::expm1(-dt_s / g.gm_correlation_s) / dt_s : 1.0;
-    rrw_var_[i] = g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
-    gm_var_[i] = g.gm_sigma_rad_s * g.gm_sigma_rad_s * (1.0 - gm_phi_[i] * gm_phi_[i]);
+        stationary > 0.0 ? g.gm_correlation_s * -std::expm1(-dt_s / g.gm_correlation_s) / dt_s : 1.0;
+    rrw_var_[i] = (g.rrw_rad_s_rts * g.rrw_rad_s_rts + added_rrw_var_[i]) * dt_s;
+    gm_var_[i] = stationary * (1.0 - gm_phi_[i] * gm_phi_[i]);
   }
   gm_dt_s_ = dt_s;
 }

@@ -70,6 +70,18 @@ class Mekf {
   //! [rad²/s] (≥ 0; the noise the reference's innovations show beyond the model, docs/fdi.md "Reference
   //! consistency"). reset() and thaw() put it back to the model's.
   void set_added_noise(int id, double added_rad2_s);
+  //! Gyro `id`'s bias as the filter models it from now on: g_i a Gauss–Markov process of stationary variance
+  //! σ_GM² + `gm_var_rad2_s2` [rad²/s²] (same T_c), c_i a random walk of K² + `rrw_var_rad2_s3` [rad²/s³] — a
+  //! slow rate error the parity shows beyond the bias model (docs/fdi.md, "A slow error below the
+  //! detectors"). Each added variance only grows: a larger Gauss–Markov one opens g_i's variance by the
+  //! difference at once. reset() and thaw() put the model back.
+  void open_bias_model(int id, double gm_var_rad2_s2, double rrw_var_rad2_s3);
+  //! Gyro `id`'s bias back to the model's processes (its current variance kept).
+  void clear_bias_model(int id);
+  //! [rad²/s²] gyro `id`'s variance added to its Gauss–Markov bias (open_bias_model), 0 by default.
+  double added_bias_instability(int id) const { return added_gm_var_[static_cast<std::size_t>(id - 1)]; }
+  //! [rad²/s³] gyro `id`'s variance rate added to its random-walk bias (open_bias_model), 0 by default.
+  double added_rate_random_walk(int id) const { return added_rrw_var_[static_cast<std::size_t>(id - 1)]; }
   //! [rad/√s] gyro `id`'s modelled white rate noise N (without any added noise).
   double arw_rad_rts(int id) const { return gyros_[static_cast<std::size_t>(id - 1)].arw_rad_rts; }
 
@@ -128,6 +140,10 @@ class Mekf {
   void gauss_markov_transitions(double dt_s);
   void refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, double dt_s);
   void propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta);
+  //! [rad²/s²] gyro index `i`'s Gauss–Markov stationary variance: the model's σ_GM² and any added.
+  double gm_stationary_var(std::size_t i) const {
+    return gyros_[i].gm_sigma_rad_s * gyros_[i].gm_sigma_rad_s + added_gm_var_[i];
+  }
 
   std::vector<GyroNoiseModel> gyros_;
   int n_;
@@ -161,9 +177,11 @@ class Mekf {
   Eigen::MatrixXd joseph_;     //!< (3+2N)² scratch of the Joseph update
   Eigen::MatrixX3d gain_;      //!< (3+2N)×3 Kalman gain
   Eigen::VectorXd ph_;         //!< (3+2N) P·hᵀ of a scalar update (scratch)
-  Eigen::VectorXd parity_h_;         //!< N: a parity row's h per gyro (scratch)
-  Eigen::VectorXd prior_var_;        //!< [rad²/s²] per gyro: the variance of c + g without any measurement
-  std::vector<double> added_noise_;  //!< [rad²/s] per gyro: white rate noise added to N² (set_added_noise)
+  Eigen::VectorXd parity_h_;          //!< N: a parity row's h per gyro (scratch)
+  Eigen::VectorXd prior_var_;         //!< [rad²/s²] per gyro: the variance of c + g without any measurement
+  std::vector<double> added_noise_;   //!< [rad²/s] per gyro: white rate noise added to N² (set_added_noise)
+  std::vector<double> added_gm_var_;  //!< [rad²/s²] per gyro: added to σ_GM² (open_bias_model)
+  std::vector<double> added_rrw_var_;  //!< [rad²/s³] per gyro: added to K² (open_bias_model)
 };
 
 //! ∫₀^Δt exp(−[ω×]u) du in closed form (a series for small |ω|Δt).

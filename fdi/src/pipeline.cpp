@@ -29,6 +29,7 @@
 #include "mekf.hpp"
 #include "outlier_gate.hpp"
 #include "own_noise_level.hpp"
+#include "parity_bias_match.hpp"
 #include "parity_detector.hpp"
 #include "protection_level.hpp"
 #include "quadrature.hpp"
@@ -86,6 +87,7 @@ class Pipeline::Impl {
         attitude_(config_, noise_models(cal, series_, config_)),
         consistency_(config_),
         noise_match_(config_, n_),
+        bias_match_(config_, n_),
         protection_(config_),
         budget_(config_) {
     frame_.resize(n_);
@@ -167,6 +169,7 @@ class Pipeline::Impl {
   ReferenceConsistency consistency_;  //!< the reference as a sensor that can fail
   DisagreementTrend trend_;  //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
   ReferenceNoiseMatch noise_match_;  //!< three gyros: a gyro's noise or ramp in the reference's innovations
+  ParityBiasMatch bias_match_;       //!< a slow error below the detectors: the gyro's bias model opened
   ProtectionLevel protection_;       //!< the integrity bound beside sigma
   std::vector<OwnNoiseFinding> own_named_;  //!< the gyros own_noise_ named at this epoch (capacity N)
   ReferenceBudget budget_;  //!< the reference's stated bias and latency, which its samples cannot show
@@ -585,9 +588,18 @@ void Pipeline::Impl::publish_attitude() {
                    : Eigen::Vector3d::Zero()) +
           subsets_.calibration_rate_bound(sol, frame_.usable, attitude_.omega_meas_B());
       attitude_.propagate(frame_, sol, active, bound, subsets_.period_s());
-      // The epoch's parity, when it was computed over the gyros published, measures their biases.
-      if (frame_.usable == measured_ && sol.observable)
+      // The epoch's parity, when it was computed over the gyros published, measures their biases; over the
+      // whole active set outside an episode, once the reference has been seen (the filter then estimates the
+      // biases, so the blocks of its innovations are nearly independent), its blocks also judge each gyro's
+      // bias model (a slow error below the detectors).
+      if (frame_.usable == measured_ && sol.observable) {
+        if (episode)
+          bias_match_.restart();
+        else if (frame_.usable == gyro_set_.active() && attitude_.reference_aided())
+          bias_match_.observe(frame_.now_ns, sol, detector_.parity(), subsets_.sqrt_period(),
+                              attitude_.filter());
         attitude_.parity(sol, detector_.parity(), subsets_.sqrt_period());
+      }
     }
   }
   // The reference sample, at this epoch's time, once the attitude is there too.
@@ -813,6 +825,7 @@ void Pipeline::Impl::reset() {
   trend_.stop();
   budget_.reset();
   noise_match_.reset();
+  bias_match_.reset();
   bias_check_.reset();
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);
@@ -841,6 +854,7 @@ void Pipeline::Impl::reinstate(int id) {
   if (gyro_set_.is_excluded(id)) attitude_.thaw(id);
   noise_match_.forget(id);
   own_noise_.forget(id);
+  bias_match_.forget(id);
   gyro_set_.reinstate(id);
   series_.forget_evidence(id);
   reference_.restart_windows();  // the reinstated gyro's angle has a gap: the reference windows start again
@@ -901,7 +915,11 @@ FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   reference_rejected_ns_.reset();
   trend_.stop();
   noise_match_.reset();
-  for (int id = 1; id <= n_; ++id) attitude_.filter().set_added_noise(id, 0.0);
+  bias_match_.reset();
+  for (int id = 1; id <= n_; ++id) {
+    attitude_.filter().set_added_noise(id, 0.0);
+    attitude_.filter().clear_bias_model(id);
+  }
   restart_detectors();
   update_mode(stamp_ns);
   FdiEvent ack;

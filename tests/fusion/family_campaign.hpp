@@ -5,11 +5,13 @@
 // and the figures of a family over many runs.
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
 #include "campaign.hpp"
 #include "tetra/sim/perturbation_families.hpp"
+#include "tetra/sim/random.hpp"  // splitmix64
 
 namespace tetra::test {
 
@@ -152,18 +154,111 @@ inline bool worse_than_twin(const FamilyVerdict& v, const FamilyVerdict& twin) {
          v.within < twin.within - kTwinWithinMargin;
 }
 
+//! The same run over other draws of the simulator's noise, each against its own twin: the paired difference
+//! of the largest per-axis NEES (run − twin) averaged over the draws, and its standard error.
+struct DrawComparison {
+  int draws = 0;
+  double mean_difference = 0.0;  //!< [-] mean over the draws of max NEES(run) − max NEES(twin)
+  double standard_error = 0.0;   //!< [-] its standard error (sample σ/√draws)
+  int runs_failing = 0;          //!< draws whose run fails the per-run criterion
+  int twins_failing = 0;         //!< draws whose twin fails it
+  int only_run_fails = 0;        //!< draws whose run fails the criterion and whose twin meets it
+  int only_twin_fails = 0;       //!< draws whose twin fails it and whose run meets it
+  //! One-sided exact p-value of McNemar's test that the run fails the criterion no more often than its twin:
+  //! P(X ≥ only_run_fails), X ~ Binomial(only_run_fails + only_twin_fails, ½).
+  double failure_p = 1.0;
+  Eigen::Vector3d mean_run_nees = Eigen::Vector3d::Zero();   //!< per-axis NEES averaged over the draws' runs
+  Eigen::Vector3d mean_twin_nees = Eigen::Vector3d::Zero();  //!< ...and over their twins
+};
+
+//! Draws of the noise a run charged against its one twin is judged over (the perturbation, motion, unit and
+//! fusion as they are; the simulator's seed replaced by splitmix64(seed + k)).
+inline constexpr int kChargeDraws = 20;
+//! The perturbation is charged when it makes the largest per-axis NEES worse on average over the draws by
+//! more than this many standard errors of the mean paired difference (one-sided: a perturbation that changes
+//! nothing is charged with probability ≈ 2.3 %; the undetected scale change that motivated the check,
+//! fault-in-slew #124 seed 1 before the parity's block match, stood at +0.71 ± 0.20, 3.6 standard errors)...
+inline constexpr double kChargeStandardErrors = 2.0;
+//! ...or when it makes the run fail the per-run criterion more often than its twin at this one-sided level of
+//! McNemar's exact test (a NEES whose spread hides a shift of its mean: a reference bias ramp of 20″, 8 of 20
+//! draws failing against 1 twin). Both together charge a perturbation that changes nothing with probability
+//! ≤ 5 %.
+inline constexpr double kChargeFailureP = 0.025;
+
+//! P(X ≥ k), X ~ Binomial(n, ½).
+inline double binomial_half_tail(int k, int n) {
+  double term = std::pow(0.5, n);  // C(n, 0)/2ⁿ
+  double tail = 0.0;
+  for (int j = 0; j <= n; ++j) {
+    if (j >= k) tail += term;
+    term *= static_cast<double>(n - j) / (j + 1.0);
+  }
+  return tail;
+}
+
+inline DrawComparison compare_over_draws(const sim::PerturbedRun& r) {
+  DrawComparison c;
+  double sum = 0.0;
+  double sum2 = 0.0;
+  for (int k = 0; k < kChargeDraws; ++k) {
+    sim::PerturbedRun drawn = r;
+    drawn.options.seed = sim::splitmix64(r.options.seed + static_cast<std::uint64_t>(k) + 1);
+    const FamilyVerdict v = judge_run(drawn);
+    const FamilyVerdict t = judge_run(sim::unperturbed_twin(drawn));
+    const double d = v.nees.maxCoeff() - t.nees.maxCoeff();
+    c.mean_run_nees += v.nees / kChargeDraws;
+    c.mean_twin_nees += t.nees / kChargeDraws;
+    sum += d;
+    sum2 += d * d;
+    const bool run_fails = v.within < kMinWithin3Sigma || v.nees.maxCoeff() > kMaxNeesPerAxis;
+    const bool twin_fails = t.within < kMinWithin3Sigma || t.nees.maxCoeff() > kMaxNeesPerAxis;
+    c.runs_failing += run_fails ? 1 : 0;
+    c.twins_failing += twin_fails ? 1 : 0;
+    c.only_run_fails += run_fails && !twin_fails ? 1 : 0;
+    c.only_twin_fails += twin_fails && !run_fails ? 1 : 0;
+  }
+  c.failure_p = binomial_half_tail(c.only_run_fails, c.only_run_fails + c.only_twin_fails);
+  c.draws = kChargeDraws;
+  c.mean_difference = sum / c.draws;
+  const double var =
+      std::max(sum2 / c.draws - c.mean_difference * c.mean_difference, 0.0) * c.draws / (c.draws - 1.0);
+  c.standard_error = std::sqrt(var / c.draws);
+  return c;
+}
+
+//! Whether a run's sigma is charged to its perturbation: it fails the per-run criterion, its twin meets it
+//! and the run is materially worse (worse_than_twin) — and, since one twin is a single paired draw of a NEES
+//! whose few degrees of freedom scatter it widely, the same run over kChargeDraws other draws of the noise
+//! confirms it (compare_over_draws, kChargeStandardErrors, kChargeFailureP): a run that is only a statistical
+//! borderline is not charged; its draws are written to `note` (the sweep prints them).
+inline bool charged(const sim::PerturbedRun& r, const FamilyVerdict& v, const FamilyVerdict& twin,
+                    std::string& note) {
+  if (honest(v) || !honest(twin) || !worse_than_twin(v, twin)) return false;
+  const DrawComparison c = compare_over_draws(r);
+  const bool confirmed =
+      c.mean_difference > kChargeStandardErrors * c.standard_error || c.failure_p < kChargeFailureP;
+  char line[400];
+  std::snprintf(line, sizeof line,
+                "%s\n  over %d other draws of the noise: largest per-axis NEES run - twin %+.3f +- %.3f "
+                "(standard error), runs failing %d, twins failing %d (McNemar p %.3f): %s\n",
+                r.label.c_str(), c.draws, c.mean_difference, c.standard_error, c.runs_failing,
+                c.twins_failing, c.failure_p,
+                confirmed ? "charged" : "a statistical borderline, not charged");
+  note = line;
+  return confirmed;
+}
+
 //! One run and its unperturbed twin (sim::unperturbed_twin) into a family's figures. Sigma is charged to the
-//! perturbation when the run fails the per-run criterion and its twin meets it; a twin that fails too is the
-//! fusion's fault-free character over that motion and noise (counted apart, `twin`).
+//! perturbation when `dishonest` (charged()); a twin that fails the criterion is the fusion's fault-free
+//! character over that motion and noise (counted apart, `twin`).
 inline void add_run(FamilyFigures& f, const sim::PerturbedRun& r, const FamilyVerdict& v,
-                    const FamilyVerdict& twin, bool lost_allowed) {
+                    const FamilyVerdict& twin, bool lost_allowed, bool dishonest) {
   ++f.runs;
   f.wrong_exclusions += v.wrong_exclusion ? 1 : 0;
   f.exclusions_without_fault += v.exclusion_no_fault ? 1 : 0;
   f.lost += v.lost ? 1 : 0;
   f.lost_from_one_fault += v.lost && !lost_allowed ? 1 : 0;
   f.healthy_reference_rejected += v.healthy_reference_rejected ? 1 : 0;
-  const bool dishonest = !honest(v) && (honest(twin) ? worse_than_twin(v, twin) : false);
   f.dishonest += dishonest ? 1 : 0;
   f.twin_dishonest += honest(twin) ? 0 : 1;
   f.honest_from_flag +=

@@ -4,10 +4,12 @@
 // bench/perturbation_sweep.sh. Asserted per family: no exclusion of a gyro without a fault begun, no
 // exclusion in a fault-free run, never LOST from one fault, and every run's sigma honest (≥ 97 % of
 // axis-epochs within 3σ, per-axis NEES ≤ 2). The figures are printed per family.
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -32,19 +34,25 @@ void check_family(sim::Family family, std::uint64_t fallback, const std::set<std
   const std::uint64_t seed = env_count("TETRA_FAMILY_SEED", 1);
   test::FamilyFigures f;
   std::map<std::string, test::FamilyFigures> cases;
+  std::string borderline;  //!< runs worse than their one twin, judged over other draws of the noise
   for (std::uint64_t i = 0; i < runs; ++i) {
     const sim::PerturbedRun r = sim::perturbed_run(family, seed, i);
     // With three gyros (redundancy exhausted) or two faults, an exclusion leaves the rate unobservable.
     const bool lost_allowed = r.scenario.unit.gyro_count() - 1 < 3 || r.options.faults.size() > 1;
     const test::FamilyVerdict v = test::judge_run(r);
     const test::FamilyVerdict twin = test::judge_run(sim::unperturbed_twin(r));
-    test::add_run(f, r, v, twin, lost_allowed);
-    test::add_run(cases[r.case_name], r, v, twin, lost_allowed);
+    std::string note;
+    const bool dishonest = test::charged(r, v, twin, note);
+    borderline += note;
+    test::add_run(f, r, v, twin, lost_allowed, dishonest);
+    test::add_run(cases[r.case_name], r, v, twin, lost_allowed, dishonest);
   }
   test::print_figures_header();
   test::print_figures(std::string(sim::family_name(family)), f);
   for (const auto& [name, c] : cases)
     test::print_figures("  " + name + (limits.count(name) ? " (limit)" : ""), c);
+  if (!borderline.empty())
+    std::printf("runs worse than their twin, over other draws of the noise:\n%s", borderline.c_str());
   for (const auto& [name, c] : cases) {
     EXPECT_EQ(c.wrong_exclusions, 0) << name << "\n" << c.failures;
     EXPECT_EQ(c.exclusions_without_fault, 0) << name << "\n" << c.failures;
@@ -65,6 +73,46 @@ TEST(PerturbationFamilies, GeneratorsArePureFunctionsOfSeedAndIndex) {
     EXPECT_NE(a.label, sim::perturbed_run(family, 3, 18).label);
     EXPECT_EQ(sim::family_from_name(sim::family_name(family)), family);
     EXPECT_TRUE(sim::validate_scenario(a.scenario).ok()) << a.label;
+  }
+}
+
+// A scale change too small for the detectors: +2.8 % on the gyro along X in the middle of a slew about −Y,
+// N = 6 with the reference (fault-in-slew #124). The slew never shows it; afterwards it is a rate error of
+// the attitude control's wobble times 2.8 % (≈ 4.5e-5 deg/s, a quarter of the CUSUM's 2e-4), which the bias
+// model did not allow and the parity's block means show (docs/fdi.md, "A slow error below the detectors").
+// Over the 20 draws of the noise the sweep judges such a run by (compare_over_draws): before the block match
+// 15 runs failed the per-run criterion against 3 twins (12 where the twin met it, none the other way: McNemar
+// p 2e-4) and the mean x-axis NEES (the axis of the error) was 2.32; with it 3 against 3 (2 and 2, p 0.69)
+// and 1.73 (the twins' 1.04: what is left is the time before the match, docs/fdi.md). Asserted: the run fails
+// the criterion no more often than its twin (p ≥ kChargeFailureP) and the mean x-axis NEES is at most 2, the
+// per-run bound.
+TEST(PerturbationFamilies, AScaleChangeBelowTheDetectorsLeavesSigmaHonest) {
+  const sim::PerturbedRun r = sim::perturbed_run(sim::Family::kFaultInSlew, 1, 124);
+  const test::DrawComparison c = test::compare_over_draws(r);
+  std::printf(
+      "%s: over %d draws %+.3f +- %.3f, runs failing %d, twins failing %d, McNemar p %.3f, mean x NEES "
+      "%.2f (twins %.2f)\n",
+      r.label.c_str(), c.draws, c.mean_difference, c.standard_error, c.runs_failing, c.twins_failing,
+      c.failure_p, c.mean_run_nees.x(), c.mean_twin_nees.x());
+  EXPECT_GE(c.failure_p, test::kChargeFailureP);
+  EXPECT_LE(c.mean_run_nees.x(), test::kMaxNeesPerAxis);
+}
+
+// The two runs the sweep once charged for noise ×8 at a slew's start (N = 6, fault-in-slew #117) and for
+// drops and jitter (N = 5, data-path #196): over 20 other draws of the noise the perturbed run is no worse
+// than its twin — largest per-axis NEES run − twin −0.025 ± 0.030 and −0.090 ± 0.037, runs failing the
+// per-run criterion 1 and 2 against twins 2 and 3 — so their NEES of 2.21 and 2.43 are the spread of a χ² of
+// few degrees of freedom (the twins reach 2.74 on the same runs), not their perturbation. Asserted: neither
+// is charged (compare_over_draws: paired mean ≤ 2 standard errors, McNemar p ≥ 0.025).
+TEST(PerturbationFamilies, TheBorderlineRunsAreTheNoiseNotTheirPerturbation) {
+  for (const auto& [family, index] :
+       {std::pair{sim::Family::kFaultInSlew, 117}, {sim::Family::kDataPath, 196}}) {
+    const sim::PerturbedRun r = sim::perturbed_run(family, 1, static_cast<std::uint64_t>(index));
+    const test::DrawComparison c = test::compare_over_draws(r);
+    std::printf("%s: %+.3f +- %.3f, runs failing %d, twins failing %d, McNemar p %.3f\n", r.label.c_str(),
+                c.mean_difference, c.standard_error, c.runs_failing, c.twins_failing, c.failure_p);
+    EXPECT_LE(c.mean_difference, test::kChargeStandardErrors * c.standard_error) << r.label;
+    EXPECT_GE(c.failure_p, test::kChargeFailureP) << r.label;
   }
 }
 
