@@ -5,7 +5,8 @@
 # fails the per-run criterion (< 97 % within 3 sigma or a per-axis NEES > 2) where their twin meets it, twins
 # failing it, runs honest only from their first flag on, the worst within-3-sigma share and per-axis NEES, the
 # mean per-axis NEES, and the delay from the perturbation to its first flag (detection or reference
-# rejection). A run worse than its one twin is judged again over 20 other draws of the simulator's noise
+# rejection), and the runs whose error exceeds the protection level while no alarm stands (>PL) with the
+# largest |e|/PL. A run worse than its one twin is judged again over 20 other draws of the simulator's noise
 # (tests/fusion/family_campaign.hpp, charged()); those runs are listed with their draws' figures. Exit status
 # 1 when a family breaks a promise (the runs are listed).
 # RUNS = 300: 2,100 runs (4,200 with the twins); about 3 min of CPU.

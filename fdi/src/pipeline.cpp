@@ -93,6 +93,7 @@ class Pipeline::Impl {
     frame_.resize(n_);
     found_.reserve(static_cast<std::size_t>(n_));
     own_named_.reserve(static_cast<std::size_t>(n_));
+    held_parity_ = Eigen::VectorXd::Zero(std::max(1, n_ - 3));
     result_.events.reserve(32);
     pending_.reserve(16);
     health_.gyros.resize(static_cast<std::size_t>(n_));
@@ -123,6 +124,9 @@ class Pipeline::Impl {
  private:
   bool accept(const Epoch& epoch);
   void reject_outliers();
+  //! The gyros left after the jump test have no parity (from the set `before` it): sigma carries what they
+  //! may be wrong by over this epoch's step.
+  void cover_unchecked_rate(GyroMask before);
   void detect();
   void level_changed(const Detection& d);
   void seek_evidence();
@@ -172,7 +176,8 @@ class Pipeline::Impl {
   ParityBiasMatch bias_match_;       //!< a slow error below the detectors: the gyro's bias model opened
   ProtectionLevel protection_;       //!< the integrity bound beside sigma
   std::vector<OwnNoiseFinding> own_named_;  //!< the gyros own_noise_ named at this epoch (capacity N)
-  ReferenceBudget budget_;  //!< the reference's stated bias and latency, which its samples cannot show
+  Eigen::VectorXd held_parity_;  //!< the parity before the jump test, when it left the rest without one
+  ReferenceBudget budget_;       //!< the reference's stated bias and latency, which its samples cannot show
 
   EpochFrame frame_;
   Isolations found_;
@@ -428,9 +433,25 @@ bool Pipeline::Impl::accept(const Epoch& epoch) {
 }
 
 void Pipeline::Impl::reject_outliers() {
+  const GyroMask before = frame_.usable;
   gate_.update(frame_, subsets_, series_, health_.counters, found_);
   isolate_all(found_);
   frame_.usable &= gyro_set_.active();
+  cover_unchecked_rate(before & gyro_set_.active());
+}
+
+void Pipeline::Impl::cover_unchecked_rate(GyroMask before) {
+  // The jump test left a gyro out of this epoch as the one whose jump explains the parity's: right when its
+  // hypothesis is, but with four gyros every hypothesis explains a single parity, and only the motion judged
+  // possible picks one. When the gyros left have no parity of their own nothing checks them, so the rate
+  // they give carries what any of them may be wrong by (docs/fdi.md, "One-epoch jump test"): the largest
+  // rate error under every single-gyro hypothesis of the parity before the test, for this epoch's step.
+  if (frame_.usable == before || !(frame_.dt_s > 0.0)) return;
+  const Subset& used = subsets_.get(frame_.usable);
+  const Subset& full = subsets_.get(before);
+  if (used.dof >= 1 || !used.observable || full.dof < 1) return;
+  (void)apply_parity(full, before, frame_.y_rad_s.data(), subsets_.sqrt_period(), held_parity_.data());
+  attitude_.add_bound(unchecked_rate_bound(full, used, held_parity_, subsets_.sqrt_period()) * frame_.dt_s);
 }
 
 void Pipeline::Impl::detect() {

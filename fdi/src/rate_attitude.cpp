@@ -29,15 +29,20 @@ double single_gyro_fault(const Subset& s, Eigen::Index i, const Eigen::VectorXd&
 }
 }  // namespace
 
-Eigen::Vector3d fault_rate_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period) {
+Eigen::Vector3d unchecked_rate_bound(const Subset& full, const Subset& used, const Eigen::VectorXd& p,
+                                     double sqrt_period) {
   Eigen::Vector3d bound = Eigen::Vector3d::Zero();
-  if (s.dof < 1) return bound;
-  for (Eigen::Index i = 0; i < s.pinv.cols(); ++i) {
-    if (!has_gyro(s.mask, static_cast<int>(i) + 1)) continue;
-    const double f = single_gyro_fault(s, i, parity_ema, sqrt_period);
-    bound = bound.cwiseMax((s.pinv.col(i) * f).cwiseAbs());
+  if (full.dof < 1) return bound;
+  for (Eigen::Index i = 0; i < used.pinv.cols(); ++i) {
+    if (!has_gyro(used.mask, static_cast<int>(i) + 1)) continue;
+    const double f = single_gyro_fault(full, i, p, sqrt_period);
+    bound = bound.cwiseMax((used.pinv.col(i) * f).cwiseAbs());
   }
   return bound;
+}
+
+Eigen::Vector3d fault_rate_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period) {
+  return unchecked_rate_bound(s, s, parity_ema, sqrt_period);
 }
 
 double fault_size_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period) {
@@ -96,6 +101,7 @@ void RateAttitude::reset(const Quaternion& q0_RB) {
   omega_prev_.setZero();
   correction_.setZero();
   lost_since_ns_ = -1;
+  measured_ns_ = -1;
   slope_prev_.setZero();
   accel_seen_.setZero();
   have_slope_ = false;
@@ -168,7 +174,18 @@ ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB, bool may_reinit
 }
 
 void RateAttitude::measure(const Subset& s, const EpochFrame& frame) {
-  if (s.observable) omega_meas_ = apply_pinv(s.pinv, frame.usable, frame.y_rad_s.data());
+  if (!s.observable) return;
+  omega_meas_ = apply_pinv(s.pinv, frame.usable, frame.y_rad_s.data());
+  if (lost_since_ns_ >= 0 && measured_ns_ >= 0 && frame.now_ns != measured_ns_) {
+    // The first rate after a lost one: the previous epoch's, held since the last one measured, is no sample
+    // of the motion (a slew moved on by a·τ meanwhile). The step takes it on the line between the last
+    // measured rate and this one, and no curvature (its slopes straddle the held stretch).
+    const double span_s = ns_to_seconds(frame.now_ns - measured_ns_);
+    const double held_s = span_s - frame.dt_s;
+    if (span_s > 0.0 && held_s > 0.0) omega_prev_ += (omega_meas_ - omega_prev_) * (held_s / span_s);
+    have_slope_ = false;
+  }
+  measured_ns_ = frame.now_ns;
 }
 
 bool RateAttitude::measure_unprepared(const GyroGeometry& geometry, const EpochFrame& frame) {

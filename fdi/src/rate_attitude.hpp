@@ -24,6 +24,13 @@ namespace tetra::fdi::detail {
 //! fault f_i = wᵢᵀp̄/|wᵢ|² (p̄ the parity EMA), which moves the estimate by H*(:, i)·f_i; the per-axis maximum.
 Eigen::Vector3d fault_rate_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period);
 
+//! [rad/s] per axis, the largest rate error of the solution over `used` — `full` without the gyros the jump
+//! test left out, no parity of its own — under every single-gyro hypothesis of `full`'s normalized parity
+//! `p`: gyro i of `used` carrying f_i = wᵢᵀp/|wᵢ|² (wᵢ its column of `full`'s parity) moves that solution by
+//! H*_used(:, i)·f_i; a left-out gyro carrying it moves it by nothing.
+Eigen::Vector3d unchecked_rate_bound(const Subset& full, const Subset& used, const Eigen::VectorXd& p,
+                                     double sqrt_period);
+
 //! [rad/s] the largest single-gyro fault size f_i = wᵢᵀp̄/|wᵢ|² over the gyros of the subset.
 double fault_size_bound(const Subset& s, const Eigen::VectorXd& parity_ema, double sqrt_period);
 
@@ -138,6 +145,7 @@ class RateAttitude {
   double accel_decay_dt_s_ = -1.0;  //!< [s] the step of accel_decay_
   double accel_decay_ = 1.0;        //!< e^{−Δt/kAccelMemory_s}
   std::int64_t lost_since_ns_ = -1;
+  std::int64_t measured_ns_ = -1;  //!< [ns] the last epoch whose rate was measured
 };
 
 }  // namespace tetra::fdi::detail

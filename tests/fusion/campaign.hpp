@@ -22,10 +22,12 @@ struct CampaignRun {
   fdi::FaultKind isolated_kind = fdi::FaultKind::kNone;
   bool unisolated = false;
   fdi::Mode final_mode = fdi::Mode::kNominal;
-  double angle_y_deg = 0.0;                //!< Σ wy_dps·Δt (the seed's "angle")
-  std::vector<double> time_s;              //!< per accepted epoch (when `keep_errors`)
-  std::vector<Eigen::Vector3d> error_rad;  //!< log(q_true* ⊗ q_est) per accepted epoch
-  std::vector<Eigen::Vector3d> sigma_rad;  //!< the published 1σ per body axis, per accepted epoch
+  double angle_y_deg = 0.0;                           //!< Σ wy_dps·Δt (the seed's "angle")
+  std::vector<double> time_s;                         //!< per accepted epoch (when `keep_errors`)
+  std::vector<Eigen::Vector3d> error_rad;             //!< log(q_true* ⊗ q_est) per accepted epoch
+  std::vector<Eigen::Vector3d> sigma_rad;             //!< the published 1σ per body axis, per accepted epoch
+  std::vector<Eigen::Vector3d> protection_level_rad;  //!< the published protection level, per accepted epoch
+  std::vector<fdi::Mode> mode;                        //!< the published mode, per accepted epoch
   double final_sigma_deg = 0.0;
   double final_error_deg = 0.0;
 };
@@ -90,6 +92,8 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
       run.time_s.push_back(se.time_s);
       run.error_rad.push_back(quat_log(se.truth_q_RB.conjugate() * r.attitude.q_RB));
       run.sigma_rad.push_back(r.attitude.sigma_rad);
+      run.protection_level_rad.push_back(r.attitude.protection_level_rad);
+      run.mode.push_back(r.attitude.mode);
     }
     run.final_sigma_deg = r.attitude.sigma_rad.norm() * kRadToDeg;
     run.final_error_deg = angle_between(se.truth_q_RB, r.attitude.q_RB) * kRadToDeg;

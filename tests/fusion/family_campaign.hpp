@@ -33,8 +33,10 @@ struct FamilyVerdict {
   double within = 1.0;                      //!< share of axis-epochs with |e| ≤ 3σ from kHonestyFrom_s
   Eigen::Vector3d nees = Eigen::Vector3d::Zero();  //!< per-axis mean e²/σ² over the same epochs
   double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
-  std::optional<double> flagged_after_s;           //!< [s] first detection or reference rejection after the
-                                                   //!< perturbation began
+  int beyond_protection = 0;              //!< axis-epochs with |e| above the (finite) protection level
+  double worst_protection_ratio = 0.0;    //!< largest |e|/PL of an axis (0 where PL is +∞)
+  std::optional<double> flagged_after_s;  //!< [s] first detection or reference rejection after the
+                                          //!< perturbation began
   //! Sigma meets the per-run criterion over the epochs from the first flag on: what the perturbation did
   //! before anything could see it is the protection level's to bound, not sigma's (docs/fdi.md).
   bool honest_after_flag = false;
@@ -53,6 +55,8 @@ struct Honesty {
   Eigen::Vector3d nees = Eigen::Vector3d::Zero();  //!< per-axis mean e²/σ²
   double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
   double worst_error_deg = 0.0;                    //!< [deg] largest |e| of an axis
+  int beyond_protection = 0;                       //!< axis-epochs with |e| above the protection level
+  double worst_protection_ratio = 0.0;             //!< largest |e|/PL of an axis
 };
 
 inline Honesty honesty(const CampaignRun& run, double from_s) {
@@ -68,6 +72,12 @@ inline Honesty honesty(const CampaignRun& run, double from_s) {
       h.nees[a] += z * z;
       h.worst_sigmas = std::max(h.worst_sigmas, z);
       h.worst_error_deg = std::max(h.worst_error_deg, std::abs(run.error_rad[k][a]) * kRadToDeg);
+      // An alarm standing (SUSPECT: a fault detected, not yet isolated; LOST) is what the protection level
+      // is not for: it bounds the error without an alarm.
+      const bool alarm = run.mode[k] == fdi::Mode::kSuspect || run.mode[k] == fdi::Mode::kLost;
+      const double pl = alarm ? 0.0 : std::abs(run.error_rad[k][a]) / run.protection_level_rad[k][a];
+      h.beyond_protection += pl > 1.0 ? 1 : 0;
+      h.worst_protection_ratio = std::max(h.worst_protection_ratio, pl);
     }
   }
   if (epochs > 0) {
@@ -108,6 +118,8 @@ inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
   v.within = whole.within;
   v.nees = whole.nees;
   v.worst_sigmas = whole.worst_sigmas;
+  v.beyond_protection = whole.beyond_protection;
+  v.worst_protection_ratio = whole.worst_protection_ratio;
   if (v.flagged_after_s) {
     const Honesty after = honesty(run, std::max(kHonestyFrom_s, start + *v.flagged_after_s));
     v.honest_after_flag = after.within >= kMinWithin3Sigma && after.nees.maxCoeff() <= kMaxNeesPerAxis;
@@ -135,7 +147,9 @@ struct FamilyFigures {
   int flagged = 0;
   double max_flag_delay_s = 0.0;
   std::vector<double> flag_delays_s;
-  std::string failures;  //!< label, figures and events of every run that broke a promise
+  int beyond_protection = 0;            //!< runs with an axis-epoch above the protection level
+  double worst_protection_ratio = 0.0;  //!< largest |e|/PL over the runs
+  std::string failures;                 //!< label, figures and events of every run that broke a promise
 };
 
 //! A run's sigma meets the per-run criterion over the whole run, or from an honest flag on.
@@ -268,18 +282,21 @@ inline void add_run(FamilyFigures& f, const sim::PerturbedRun& r, const FamilyVe
   f.nees_sum += v.nees;
   f.worst_within = std::min(f.worst_within, v.within);
   f.worst_nees = std::max(f.worst_nees, v.nees.maxCoeff());
+  f.beyond_protection += v.beyond_protection > 0 ? 1 : 0;
+  f.worst_protection_ratio = std::max(f.worst_protection_ratio, v.worst_protection_ratio);
   if (v.flagged_after_s) {
     ++f.flagged;
     f.flag_delays_s.push_back(*v.flagged_after_s);
     f.max_flag_delay_s = std::max(f.max_flag_delay_s, *v.flagged_after_s);
   }
-  if (v.wrong_exclusion || v.exclusion_no_fault || (v.lost && !lost_allowed) || dishonest) {
+  if (v.wrong_exclusion || v.exclusion_no_fault || (v.lost && !lost_allowed) || dishonest ||
+      v.beyond_protection > 0) {
     char line[320];
     std::snprintf(
         line, sizeof line,
-        "  %.2f %% within 3 sigma, NEES %.2f %.2f %.2f, worst %.1f sigma%s%s%s (twin: %.2f %%, NEES "
-        "%.2f %.2f %.2f)\n",
-        100.0 * v.within, v.nees[0], v.nees[1], v.nees[2], v.worst_sigmas,
+        "  %.2f %% within 3 sigma, NEES %.2f %.2f %.2f, worst %.1f sigma, |e|/PL %.2f%s%s%s (twin: %.2f %%, "
+        "NEES %.2f %.2f %.2f)\n",
+        100.0 * v.within, v.nees[0], v.nees[1], v.nees[2], v.worst_sigmas, v.worst_protection_ratio,
         v.wrong_exclusion ? ", wrong exclusion" : "", v.exclusion_no_fault ? ", exclusion without fault" : "",
         v.lost ? ", LOST" : "", 100.0 * twin.within, twin.nees[0], twin.nees[1], twin.nees[2]);
     f.failures += r.label + "\n" + line + v.events;
@@ -287,9 +304,10 @@ inline void add_run(FamilyFigures& f, const sim::PerturbedRun& r, const FamilyVe
 }
 
 inline void print_figures_header() {
-  std::printf("%-36s %5s %5s %8s %4s %7s %9s %4s %9s %6s %6s %8s %7s %16s %7s %11s %9s\n", "family", "runs",
-              "wrong", "no-fault", "LOST", "ref-rej", "dishonest", "twin", "from flag", "<97%", "NEES>2",
-              "worst<3s", "worstNEES", "mean NEES x y z", "flagged", "median flag", "max flag");
+  std::printf("%-36s %5s %5s %8s %4s %7s %9s %4s %9s %6s %6s %8s %7s %16s %7s %11s %9s %8s %7s\n", "family",
+              "runs", "wrong", "no-fault", "LOST", "ref-rej", "dishonest", "twin", "from flag", "<97%",
+              "NEES>2", "worst<3s", "worstNEES", "mean NEES x y z", "flagged", "median flag", "max flag",
+              ">PL", "e/PL");
 }
 
 inline void print_figures(const std::string& name, FamilyFigures f) {
@@ -297,11 +315,12 @@ inline void print_figures(const std::string& name, FamilyFigures f) {
   const double median = f.flag_delays_s.empty() ? 0.0 : f.flag_delays_s[f.flag_delays_s.size() / 2];
   const Eigen::Vector3d mean = f.nees_sum / std::max(f.runs, 1);
   std::printf(
-      "%-36s %5d %5d %8d %4d %7d %9d %4d %9d %6d %6d %7.2f%% %9.2f %5.2f %4.2f %4.2f %7d %9.1f s %7.1f s\n",
+      "%-36s %5d %5d %8d %4d %7d %9d %4d %9d %6d %6d %7.2f%% %9.2f %5.2f %4.2f %4.2f %7d %9.1f s %7.1f s %8d "
+      "%7.2f\n",
       name.c_str(), f.runs, f.wrong_exclusions, f.exclusions_without_fault, f.lost,
       f.healthy_reference_rejected, f.dishonest, f.twin_dishonest, f.honest_from_flag, f.below_within,
       f.above_nees, 100.0 * f.worst_within, f.worst_nees, mean[0], mean[1], mean[2], f.flagged, median,
-      f.max_flag_delay_s);
+      f.max_flag_delay_s, f.beyond_protection, f.worst_protection_ratio);
 }
 
 }  // namespace tetra::test
