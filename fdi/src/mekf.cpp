@@ -233,6 +233,7 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
       decay_(Eigen::VectorXd::Ones(n_)),
       decay2_(Eigen::MatrixXd::Ones(n_, n_)),
       bias_noise_(Eigen::VectorXd::Zero(2 * n_)),
+      prior_noise_(Eigen::VectorXd::Zero(n_)),
       coupling_(Eigen::Matrix3Xd::Zero(3, n_)),
       fold_(Eigen::VectorXd::Zero(dim_ * n_)),
       cross_(Eigen::VectorXd::Zero(dim_ * 3)),
@@ -418,7 +419,7 @@ void Mekf::propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, G
   }
   propagate_covariance(A, q_theta_);
   P_.diagonal().tail(2 * n_) += bias_noise_;  // zero on a frozen gyro's states
-  prior_var_ += bias_noise_.head(n_);
+  prior_var_ += prior_noise_;                // the model's K² only: an opened model does not widen the prior
   bias_.tail(n_).array() *= decay_.array();  // 1 on a frozen gyro
   // Symmetric by construction but for the attitude block (symmetrized above).
 }
@@ -436,6 +437,7 @@ void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, d
     bias_noise_[i] = frozen ? 0.0 : rrw_var_[k];
     bias_noise_[n_ + i] = frozen ? 0.0 : gm_var_[k];
     const auto& g = gyros_[k];
+    prior_noise_[i] = frozen ? 0.0 : g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
     if (has_gyro(used, i + 1))
       q_theta_ +=
           pinv.col(i) * pinv.col(i).transpose() * ((g.arw_rad_rts * g.arw_rad_rts + added_noise_[k]) * dt_s);

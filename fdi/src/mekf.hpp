@@ -165,6 +165,7 @@ class Mekf {
   Eigen::VectorXd decay_;
   Eigen::MatrixXd decay2_;
   Eigen::VectorXd bias_noise_;
+  Eigen::VectorXd prior_noise_;  //!< [rad²/s²] per gyro: the model's K²·Δt over a step (0 when frozen)
   Eigen::Matrix3d q_theta_ = Eigen::Matrix3d::Zero();
   Eigen::Matrix3Xd step_pinv_;
   GyroMask step_used_ = 0;

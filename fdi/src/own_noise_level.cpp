@@ -94,8 +94,9 @@ double OwnNoiseLevel::white_ratio(int id, double r, double sqrt_period) const {
   return std::min(1.0 + (r * r - 1.0) * s * s / white, cap);
 }
 
-void OwnNoiseLevel::evaluate(GyroMask candidates, double sqrt_period, std::vector<OwnNoiseFinding>& named) {
+bool OwnNoiseLevel::evaluate(GyroMask candidates, double sqrt_period, std::vector<OwnNoiseFinding>& named) {
   named.clear();
+  bool changed = false;
   for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
     Track& t = tracks_[static_cast<std::size_t>(id - 1)];
     if (!(t.named || has_gyro(candidates, id)) || t.since_eval < kOwnEvalEvery) continue;
@@ -104,13 +105,16 @@ void OwnNoiseLevel::evaluate(GyroMask candidates, double sqrt_period, std::vecto
     if (!std::isfinite(r)) continue;
     if (t.named) {
       if (!follow(t, id, r, sqrt_period)) clear_name(t);
+      changed = true;
     } else if (r > high_ratio_) {
       t.named = true;
       t.smoothed = white_ratio(id, r, sqrt_period);
       t.ratio = t.smoothed;
       named.push_back({id, r, t.ratio});
+      changed = true;
     }
   }
+  return changed;
 }
 
 bool OwnNoiseLevel::follow(Track& t, int id, double r, double sqrt_period) const {

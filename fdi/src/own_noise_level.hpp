@@ -57,8 +57,8 @@ class OwnNoiseLevel {
   void ingest(const EpochFrame& frame, double period_s);
   //! The gyros due for an evaluation at the sample period √T = `sqrt_period`: those of `candidates` (three,
   //! without parity) may be named, every named one is followed. The gyros named at this epoch are appended to
-  //! `named` (cleared first); `ratio` is then current.
-  void evaluate(GyroMask candidates, double sqrt_period, std::vector<OwnNoiseFinding>& named);
+  //! `named` (cleared first); `ratio` is then current. True when a gyro's ratio changed.
+  bool evaluate(GyroMask candidates, double sqrt_period, std::vector<OwnNoiseFinding>& named);
   //! [-] λ of gyro `id`: its matched white noise variance over the model's (1 while not named).
   double ratio(int id) const { return tracks_[static_cast<std::size_t>(id - 1)].ratio; }
   bool named(int id) const { return tracks_[static_cast<std::size_t>(id - 1)].named; }

@@ -11,6 +11,7 @@ namespace tetra::fdi::detail {
 namespace {
 constexpr double kBiasDesignRatio = 4.0;  //!< ρ: the CUSUM's alternative, the block mean's variance ×4
 constexpr double kBiasBlock_s = 30.0;     //!< [s] the block of the mean parity innovation
+constexpr int kQuietBlocks = 10;          //!< matched: blocks in a row with every CUSUM at 0 that end it
 }  // namespace
 
 ParityBiasMatch::ParityBiasMatch(const PipelineConfig& config, int gyro_count)
@@ -43,6 +44,14 @@ void ParityBiasMatch::restart() {
   std::fill(sum_w2_.begin(), sum_w2_.end(), 0.0);
   std::fill(cusum_.begin(), cusum_.end(), 0.0);
   std::fill(last_var_.begin(), last_var_.end(), 0.0);
+}
+
+void ParityBiasMatch::release(Mekf& filter) {
+  const bool was = matched_;
+  reset();
+  quiet_blocks_ = 0;
+  if (!was) return;
+  for (int id = 1; id <= static_cast<int>(excess_.size()); ++id) filter.clear_bias_model(id);
 }
 
 void ParityBiasMatch::forget(int id) {
@@ -118,6 +127,16 @@ void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter)
     block_excess_[k] = f * f - predicted;
     block_f_[k] = f;
     block_var_[k] = predicted;
+  }
+  if (matched_ && !alarm) {
+    bool quiet = true;
+    for (int i = 0; i < n; ++i)
+      quiet = quiet && !(has_gyro(s.mask, i + 1) && cusum_[static_cast<std::size_t>(i)] > 0.0);
+    quiet_blocks_ = quiet ? quiet_blocks_ + 1 : 0;
+    if (quiet_blocks_ >= kQuietBlocks) {
+      release(filter);
+      return;
+    }
   }
   matched_ = matched_ || alarm;
   // Which gyro the parity's blocks cannot always tell (their columns are not orthogonal): every gyro of the

@@ -12,7 +12,8 @@
 //   g_i ← max(0, g_i + ½·((1 − 1/ρ)·u_i − ln ρ));   matched when some g_i > ln(1/(p·n·|S|))
 //
 // (p = chi2_false_alarm_probability per epoch, n the block's epochs, |S| the gyros: by Wald's bound the mean
-// run length without such an error is at least 1/(p·n·|S|) blocks). The parity columns of different gyros
+// run length of each gyro's CUSUM without such an error is at least 1/(p·n·|S|) blocks, of the first of the
+// |S| at least about 1/(p·n·|S|²)). The parity columns of different gyros
 // are not orthogonal, so a block does not always tell which gyro it is: once matched, every gyro's slow bias
 // is a Gauss–Markov process whose stationary variance carries, beyond the model's σ_GM², the excess its own
 // hypothesis gives, F_i² = f̂_i² − (1/Σ|w_i|² + v_i) (the largest of the blocks since) — sigma covers each
@@ -21,7 +22,9 @@
 // parity is over the whole active set, outside fault episodes (a fault the detectors see is theirs to judge),
 // once the reference has been seen (before it the filter estimates no bias, and the biases' own wander,
 // slower than a block, would make successive blocks correlated). The random-walk bias also opens, by the
-// largest excess of a block-to-block change over both blocks' predicted variances, per second of block.
+// largest excess of a block-to-block change over both blocks' predicted variances, per second of block. The
+// match ends — every model the calibration's again — at an exclusion, or after kQuietBlocks (10) blocks in a
+// row with every CUSUM at 0; the bias states' prior spread (the filter-bias test's) keeps the model's K.
 
 #include <cstdint>
 #include <vector>
@@ -46,11 +49,15 @@ class ParityBiasMatch {
   void restart();
   //! One epoch's normalized parity `p` over the active set's subset `s` (no episode open), before the
   //! filter's parity update. At a block's end a gyro whose mean rate error exceeds the model has its slow
-  //! bias opened in `filter` (Mekf::add_bias_instability).
+  //! bias opened in `filter` (Mekf::open_bias_model).
   void observe(std::int64_t now_ns, const Subset& s, const Eigen::VectorXd& p, double sqrt_period,
                Mekf& filter);
-  //! Gyro `id` reinstated: its bias model is the filter's prior again, and so is its match.
+  //! Gyro `id` reinstated: its match forgotten (the filter's thaw restores its bias model).
   void forget(int id);
+  //! Nothing matched any more: every gyro's bias model in `filter` is the calibration's again and the blocks
+  //! judge afresh — after an exclusion (the error that matched may have been the excluded gyro's), or after
+  //! kQuietBlocks blocks in which no gyro's CUSUM was above 0.
+  void release(Mekf& filter);
 
  private:
   void close_block(const Subset& s, double block_s, Mekf& filter);
@@ -63,6 +70,7 @@ class ParityBiasMatch {
   std::vector<double> sum_w2_;   //!< [1/(rad/s)²] Σ |w_i|² over the block
   std::vector<double> cusum_;    //!< [-] g_i
   bool matched_ = false;         //!< a gyro's CUSUM crossed: every gyro's slow bias follows the blocks
+  int quiet_blocks_ = 0;         //!< matched: blocks in a row with every CUSUM at 0
   std::vector<double> excess_;   //!< [rad²/s²] F_i², the largest excess so far under gyro i's hypothesis
   std::vector<double> block_excess_;  //!< [rad²/s²] the last block's f̂_i² less its predicted variance
   std::vector<double> walk_;       //!< [rad²/s³] the largest excess of a block-to-block change per second

@@ -379,7 +379,7 @@ void Pipeline::Impl::match_own_noise() {
   // not reach (docs/fdi.md, "Three gyros: a gyro's own noise level"). A gyro beyond the limit is named, never
   // excluded (three gyros are the rate), and its noise in the filter follows its level until it is normal.
   const Subset* s = three_gyros_without_parity();
-  own_noise_.evaluate(s != nullptr ? s->mask : GyroMask{0}, subsets_.sqrt_period(), own_named_);
+  if (!own_noise_.evaluate(s != nullptr ? s->mask : GyroMask{0}, subsets_.sqrt_period(), own_named_)) return;
   for (int id = 1; id <= n_; ++id) noise_match_.set_own_ratio(id, own_noise_.ratio(id), attitude_.filter());
   for (const OwnNoiseFinding& f : own_named_) {
     emit_detected(DetectionTest::kSignature, f.level, frame_.now_ns);
@@ -731,6 +731,7 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   emit(std::move(e));
   gyro_set_.exclude(iso.gyro, iso.kind);
   attitude_.freeze(iso.gyro);
+  bias_match_.release(attitude_.filter());  // the error that opened the bias models may have been this fault
   // What the fault leaked into the other gyros' bias states since its onset is undone (docs/fdi.md).
   attitude_.repair_biases(gyro_set_.active(),
                           isolator_.episode().active ? isolator_.episode().onset_ns
@@ -782,6 +783,7 @@ void Pipeline::Impl::gap() {
   attitude_.add_bound(Eigen::Vector3d::Constant(0.25 * a_max * tau * tau));
   series_.bridge_gap();
   own_noise_.bridge_gap();
+  bias_match_.restart();  // a block does not straddle the gap
   gate_.restart();
   reference_.restart_windows();
   FdiEvent e;
