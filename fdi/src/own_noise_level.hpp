@@ -7,6 +7,8 @@
 //
 //   Δ⁴y_k = y_k − 4y_{k−1} + 6y_{k−2} − 4y_{k−3} + y_{k−4}
 //
+// (on the stamped times: the fourth divided difference over the five epochs, scaled by 4!·T̄⁴ and normalized
+// to Σa² = 70 — the same weights on an even grid, and zero for a cubic in time however the samples fall)
 // passes white rate noise with variance 70·N²/T (and an angle quantization Q, whose rate error is
 // (e_k − e_{k−1})/T, with 252·Q²/T²), while a motion of time scale τ ≫ T is attenuated by about (2πT/τ)⁴: a
 // 45° slew in 10 s (4.5 deg/s at 0.1 Hz) sampled at 10 Hz leaves 7e-5 deg/s, 9 % of the white level of a
@@ -27,6 +29,7 @@
 // matched no more. An epoch farther than half a sample period from the next expected one (a dropped epoch) or
 // a gap breaks every series: a difference across a missing sample would carry the body's acceleration.
 
+#include <cstdint>
 #include <vector>
 
 #include "epoch_frame.hpp"
@@ -83,6 +86,8 @@ class OwnNoiseLevel {
   double white_ratio(int id, double r, double sqrt_period) const;
   //! Follows named gyro `id` (track `t`) at level `r`; false when it is named no more.
   bool follow(Track& t, int id, double r, double sqrt_period) const;
+  //! The last five epochs' times with `now_ns`, and the fourth difference's weights over them.
+  void difference_weights(std::int64_t now_ns);
   static void clear(Track& t);       //!< the series empty, named no more
   static void clear_name(Track& t);  //!< named no more, the model's noise
 
@@ -90,6 +95,9 @@ class OwnNoiseLevel {
   int window_ = 30;
   double high_ratio_ = 4.0;
   std::vector<Track> tracks_;
+  std::int64_t times_ns_[5] = {0, 0, 0, 0, 0};       //!< [ns] the last five epochs, newest first
+  int epochs_ = 0;                                   //!< epochs in times_ns_ (up to 5)
+  double weights_[5] = {1.0, -4.0, 6.0, -4.0, 1.0};  //!< Δ⁴'s weights over them, newest first
   mutable std::vector<double> scratch_;
 };
 

@@ -546,13 +546,14 @@ void feed(OwnNoiseLevel& level, std::mt19937_64& rng, double t0_s, double second
     const double t_s = t0_s + k * kPeriod;
     if (drop_every > 0 && k % drop_every == drop_every - 1) continue;
     frame.dt_s = t_s - last_s;
+    frame.now_ns = seconds_to_ns(t_s);
     last_s = t_s;
     frame.valid = 0b111;
     for (int i = 0; i < 3; ++i)
       frame.y_rad_s[static_cast<std::size_t>(i)] =
           rate(t_s) + factor[static_cast<std::size_t>(i)] * kSigma * n01(rng);
     level.ingest(frame, kPeriod);
-    level.evaluate(0b111, std::sqrt(kPeriod), found);
+    (void)level.evaluate(0b111, std::sqrt(kPeriod), found);
     for (const auto& f : found) named.push_back(f.gyro);
   }
 }
@@ -598,11 +599,12 @@ TEST(OwnNoiseLevel, ANamedGyroBackToNormalIsNamedNoMoreAndForgetClearsIt) {
   EXPECT_FALSE(level.named(2));
 }
 
-TEST(OwnNoiseLevel, AMissingEpochInASlewBreaksTheSeriesInsteadOfReadingAsNoise) {
+TEST(OwnNoiseLevel, AMissingEpochInASlewReadsAsNothing) {
   // Healthy gyros, a steady acceleration of 2.8 deg/s² (the families' fastest slew's peak) for 60 s, every
-  // 7th epoch missing: a difference across the missing sample would carry a·T ≈ 0.28 deg/s, some 3,000σ of
-  // the white level; the series restarts at it instead and nothing is named. Without the restart (every
-  // epoch taken as one period on) all three are named.
+  // 7th epoch missing: the series restarts at the missing epoch (its interval is off by a period), and the
+  // weights over the stamps' times leave a cubic in time nothing however the epochs fall; nothing is named.
+  // The same samples stamped as if evenly spaced (stamps that hide the missing epochs) put a·T ≈ 0.28 deg/s,
+  // some 3,000 times the white level, into the differences across them: all three gyros named.
   Fixture f(3);
   const auto slew = [](double t_s) { return 2.8 * kDegToRad * t_s; };
   std::vector<int> named;
@@ -612,26 +614,26 @@ TEST(OwnNoiseLevel, AMissingEpochInASlewBreaksTheSeriesInsteadOfReadingAsNoise) 
     feed(level, rng, 0.0, 60.0, {1.0, 1.0, 1.0}, slew, 7, named);
     EXPECT_TRUE(named.empty());
   }
-  {
-    // The same samples with the epoch's interval unknown (period 0): the series spans the missing epochs.
-    OwnNoiseLevel level(f.constants, f.config);
-    std::mt19937_64 rng(3);
-    std::normal_distribution<double> n01;
-    EpochFrame frame;
-    frame.resize(3);
-    std::vector<OwnNoiseFinding> found;
-    int names = 0;
-    for (int k = 0; k * kPeriod < 60.0; ++k) {
-      if (k % 7 == 6) continue;
-      frame.valid = 0b111;
-      for (int i = 0; i < 3; ++i)
-        frame.y_rad_s[static_cast<std::size_t>(i)] = slew(k * kPeriod) + kSigma * n01(rng);
-      level.ingest(frame, 0.0);
-      level.evaluate(0b111, std::sqrt(kPeriod), found);
-      names += static_cast<int>(found.size());
-    }
-    EXPECT_EQ(names, 3);
+  OwnNoiseLevel level(f.constants, f.config);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n01;
+  EpochFrame frame;
+  frame.resize(3);
+  std::vector<OwnNoiseFinding> found;
+  int names = 0;
+  int stamped = 0;
+  for (int k = 0; k * kPeriod < 60.0; ++k) {
+    if (k % 7 == 6) continue;
+    frame.valid = 0b111;
+    frame.dt_s = kPeriod;
+    frame.now_ns = seconds_to_ns(kPeriod * stamped++);
+    for (int i = 0; i < 3; ++i)
+      frame.y_rad_s[static_cast<std::size_t>(i)] = slew(k * kPeriod) + kSigma * n01(rng);
+    level.ingest(frame, kPeriod);
+    (void)level.evaluate(0b111, std::sqrt(kPeriod), found);
+    names += static_cast<int>(found.size());
   }
+  EXPECT_EQ(names, 3);
 }
 
 TEST(GyroSet, ExclusionsAreLatchedUntilReinstated) {

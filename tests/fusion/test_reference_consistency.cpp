@@ -389,35 +389,43 @@ TEST(ThreeGyroNoise, ANoiseIncreaseIsNamedWithinSecondsAndSigmaCoversIt) {
   }
 }
 
-TEST(ThreeGyroNoise, AgileSlewsAndACoarselyQuantizedUnitNameNoHealthyGyro) {
+TEST(ThreeGyroNoise, AgileSlewsJitterAndACoarselyQuantizedUnitNameNoHealthyGyro) {
   // Three healthy gyros, 300 s of agile slews (45° in 10 s, the perturbation families' fastest: 4.5 deg/s
   // at 0.1 Hz, which the fourth difference passes at 7e-5 deg/s, 9 % of a 3e-5 deg/√s gyro's white level)
   // about X, Y, Z and about the axis perpendicular to gyros 2 and 3 (a motion only gyro 1 sees), with no
   // quantization and with an angle quantization of 1e-5 deg (a step of 3.6σ: repeated values are the norm),
-  // four seeds each: no gyro is named, no detection at all. The level measured at most 2.4 over these runs
-  // (3,564 evaluations without quantization, median 1.05), as white noise alone gives it (beyond 2.5 once in
-  // 2e4 evaluations); the limit is noise_high_ratio, 4.
+  // with and without a sampling jitter of ±5 ms (each sample the rate at its own, stamped instant: on even
+  // weights a slew's acceleration times the jitter read as noise, up to 20 times the white level, and named
+  // healthy gyros; the weights over the stamps' times leave nothing of it), four seeds each: no gyro is
+  // named, no detection at all. The level measured at most 2.4 over the runs without jitter or quantization
+  // (3,564 evaluations, median 1.05), as white noise alone gives it (beyond 2.5 once in 2e4 evaluations); the
+  // limit is noise_high_ratio, 4.
   const Eigen::Vector3d across_2_3 = Eigen::Vector3d(0.42638, 0.78516, -0.44914)
                                          .cross(Eigen::Vector3d(0.51389, -0.74179, -0.43088))
                                          .normalized();
-  for (const double quantization_deg : {0.0, 1e-5}) {
-    for (const std::uint64_t seed : {1u, 2u, 3u, 4u}) {
-      sim::Scenario sc = scenario(300.0, false);
-      sc.unit.gyros.pop_back();
-      double start_s = 30.0;
-      for (const Eigen::Vector3d& axis :
-           {Eigen::Vector3d(Eigen::Vector3d::UnitX()), Eigen::Vector3d(Eigen::Vector3d::UnitY()),
-            Eigen::Vector3d(Eigen::Vector3d::UnitZ()), across_2_3, Eigen::Vector3d(-across_2_3)}) {
-        sc.motion.slews.push_back({axis, 45.0, start_s, 10.0});
-        start_s += 50.0;
+  for (const double jitter_s : {0.0, 0.005}) {
+    for (const double quantization_deg : {0.0, 1e-5}) {
+      for (const std::uint64_t seed : {1u, 2u, 3u, 4u}) {
+        sim::Scenario sc = scenario(300.0, false);
+        sc.unit.gyros.pop_back();
+        sc.jitter_s = jitter_s;
+        double start_s = 30.0;
+        for (const Eigen::Vector3d& axis :
+             {Eigen::Vector3d(Eigen::Vector3d::UnitX()), Eigen::Vector3d(Eigen::Vector3d::UnitY()),
+              Eigen::Vector3d(Eigen::Vector3d::UnitZ()), across_2_3, Eigen::Vector3d(-across_2_3)}) {
+          sc.motion.slews.push_back({axis, 45.0, start_s, 10.0});
+          start_s += 50.0;
+        }
+        for (auto& g : sc.unit.gyros) {
+          if (!g.noise) g.noise = GyroNoise{};
+          g.noise->quantization_deg = quantization_deg;
+        }
+        fdi::PipelineConfig config;
+        config.sample_period_s = 0.1;  // as a service with jitter configures it
+        const Outcome o = run(sc, seed, config);
+        EXPECT_LT(o.first_detected_s, 0.0) << "jitter " << jitter_s << " s, quantization " << quantization_deg
+                                           << " seed " << seed << ": " << summary(o);
       }
-      for (auto& g : sc.unit.gyros) {
-        if (!g.noise) g.noise = GyroNoise{};
-        g.noise->quantization_deg = quantization_deg;
-      }
-      const Outcome o = run(sc, seed);
-      EXPECT_LT(o.first_detected_s, 0.0)
-          << "quantization " << quantization_deg << " seed " << seed << ": " << summary(o);
     }
   }
 }
