@@ -218,6 +218,26 @@ void append_gyro_list(std::string& out, GyroMask mask, int n_gyros) {
   out += ']';
 }
 
+//! `, "gyro": ` and the gyro, or null.
+void append_gyro(std::string& out, const std::optional<int>& gyro) {
+  out += ", \"gyro\": ";
+  if (gyro) {
+    append_int(out, *gyro);
+  } else {
+    out += "null";
+  }
+}
+
+//! `, "statistic": ` and the value, or null when it is not finite.
+void append_statistic(std::string& out, double statistic) {
+  out += ", \"statistic\": ";
+  if (std::isfinite(statistic)) {
+    append_double(out, statistic);
+  } else {
+    out += "null";
+  }
+}
+
 }  // namespace
 
 std::string to_json(const FdiEvent& event, int n_gyros) {
@@ -228,28 +248,13 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
   switch (event.type) {
     case EventType::kDetected:
     case EventType::kUnisolated:
-      out += ", \"gyro\": ";
-      if (event.gyro) {  // a detection that names a gyro without excluding it (three gyros)
-        append_int(out, *event.gyro);
-      } else {
-        out += "null";
-      }
+      append_gyro(out, event.gyro);  // a detection may name a gyro without excluding it (three gyros)
       out += ", \"test\": ";
       append_json_string(out, to_string(event.test));
-      out += ", \"statistic\": ";
-      if (std::isfinite(event.statistic)) {
-        append_double(out, event.statistic);
-      } else {
-        out += "null";
-      }
+      append_statistic(out, event.statistic);
       break;
     case EventType::kIsolated:
-      out += ", \"gyro\": ";
-      if (event.gyro) {
-        append_int(out, *event.gyro);
-      } else {
-        out += "null";
-      }
+      append_gyro(out, event.gyro);
       out += ", \"kind\": ";
       append_json_string(out, to_string(event.kind));
       out += ", \"evidence\": ";
@@ -265,12 +270,7 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
         out += ", \"why\": ";
         append_json_string(out, to_string(event.why));
       }
-      out += ", \"statistic\": ";
-      if (std::isfinite(event.statistic)) {
-        append_double(out, event.statistic);
-      } else {
-        out += "null";
-      }
+      append_statistic(out, event.statistic);
       break;
     case EventType::kReconfigured:
     case EventType::kCleared:
@@ -285,12 +285,7 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
       append_double(out, event.statistic);
       break;
     case EventType::kCommand:
-      out += ", \"gyro\": ";
-      if (event.gyro) {
-        append_int(out, *event.gyro);
-      } else {
-        out += "null";
-      }
+      append_gyro(out, event.gyro);
       out += ", \"gyros\": ";
       append_gyro_list(out, event.gyros, n_gyros);
       out += event.refused() ? ", \"accepted\": false" : ", \"accepted\": true";

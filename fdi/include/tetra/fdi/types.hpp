@@ -125,7 +125,7 @@ struct FdiEvent {
   //! 1..N: isolated gyro, the gyro a command named, or the gyro a detection names without excluding it
   //! (three gyros: its own noise level or the reference's innovations along its rate axis)
   std::optional<int> gyro;
-  DetectionTest test = DetectionTest::kNone;  //!< detected, unisolated, isolated: the test
+  DetectionTest test = DetectionTest::kNone;                    //!< detected, unisolated, isolated: the test
   double statistic = std::numeric_limits<double>::quiet_NaN();  //!< detected: value of the test statistic
   FaultKind kind = FaultKind::kUnknown;                         //!< isolated: classified fault kind
   Evidence evidence = Evidence::kNone;                          //!< isolated: what told the gyro
