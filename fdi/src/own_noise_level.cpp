@@ -38,6 +38,7 @@ void OwnNoiseLevel::clear(Track& t) {
 void OwnNoiseLevel::reset() {
   for (auto& t : tracks_) clear(t);
   epochs_ = 0;
+  std::fill(steps_ns_, steps_ns_ + 4, 0);
 }
 
 void OwnNoiseLevel::forget(int id) {
@@ -59,6 +60,14 @@ void OwnNoiseLevel::difference_weights(std::int64_t now_ns) {
   times_ns_[0] = now_ns;
   epochs_ = std::min(epochs_ + 1, 5);
   if (epochs_ < 5) return;
+  // The same spacings as the last epoch's (an even stream, nearly every epoch): the same weights.
+  bool same = true;
+  for (int j = 0; j < 4; ++j) {
+    const std::int64_t step_ns = times_ns_[j] - times_ns_[j + 1];
+    same = same && step_ns == steps_ns_[j];
+    steps_ns_[j] = step_ns;
+  }
+  if (same) return;
   const double mean_step_s = ns_to_seconds(times_ns_[0] - times_ns_[4]) / 4.0;
   for (int j = 0; j < 4; ++j) {
     if (times_ns_[j] <= times_ns_[j + 1]) {  // not increasing (the pipeline's stamps are): the even grid's

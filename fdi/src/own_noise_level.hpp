@@ -97,6 +97,7 @@ class OwnNoiseLevel {
   std::vector<Track> tracks_;
   std::int64_t times_ns_[5] = {0, 0, 0, 0, 0};       //!< [ns] the last five epochs, newest first
   int epochs_ = 0;                                   //!< epochs in times_ns_ (up to 5)
+  std::int64_t steps_ns_[4] = {0, 0, 0, 0};          //!< [ns] their spacings when weights_ were made
   double weights_[5] = {1.0, -4.0, 6.0, -4.0, 1.0};  //!< Δ⁴'s weights over them, newest first
   mutable std::vector<double> scratch_;
 };

@@ -938,11 +938,8 @@ FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   reference_rejected_ns_.reset();
   trend_.stop();
   noise_match_.reset();
-  bias_match_.reset();
-  for (int id = 1; id <= n_; ++id) {
-    attitude_.filter().set_added_noise(id, 0.0);
-    attitude_.filter().clear_bias_model(id);
-  }
+  bias_match_.release(attitude_.filter());  // every bias model the calibration's again
+  for (int id = 1; id <= n_; ++id) attitude_.filter().set_added_noise(id, 0.0);
   restart_detectors();
   update_mode(stamp_ns);
   FdiEvent ack;
