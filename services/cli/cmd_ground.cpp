@@ -43,8 +43,9 @@ int cmd_ground(int argc, char** argv) {
                  "operator accounts (tetra ground passwd USER --users FILE); required unless --no-auth")
       ->check(CLI::ExistingFile);
   app.add_option("--session-key", server_config.session_key_path,
-                 "the key sessions are signed with (default: the --users file's name + .session-key; created "
-                 "when absent)");
+                 "the key of the session journal and the CSRF tokens (default: the --users file's name + "
+                 ".session-key; created when absent, refused when group or others may read it); the sessions "
+                 "are kept in the --users file's name + .sessions");
   app.add_flag(
       "--no-auth", server_config.no_auth,
       "no accounts: whoever reaches the port commands as 'anonymous' (loopback addresses only; logged)");

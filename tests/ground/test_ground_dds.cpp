@@ -211,6 +211,24 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   (void)post_command(port, {{"unit", "tetra-1"}, {"action", "exclude"}}, status);
   EXPECT_EQ(status, 400);
 
+  // An operator id that is not UTF-8 (any DDS writer may send one; \351 is Latin-1's e-acute): the ground
+  // shows it with the replacement character and lives on; it ended `tetra ground` with a JSON exception.
+  const auto odd =
+      run_tetra("command --unit tetra-1 reset --operator \"$(printf 'caf\\351')\" --domain " + d);
+  EXPECT_EQ(odd.exit_status, 0) << odd.err << odd.out;
+  auto after_odd = client.Get("/api/history?unit=tetra-1&kind=event");
+  ASSERT_TRUE(after_odd && after_odd->status == 200) << read_file(dir.file("ground.log"));
+  EXPECT_NE(after_odd->body.find("\"operator\":\"caf\xef\xbf\xbd\""), std::string::npos) << after_odd->body;
+  // A second ground started while the service still holds that acknowledgement (transient local) starts.
+  TetraProcess ground2({"ground", "--listen", "127.0.0.1:0", "--no-auth", "--domain", d},
+                       dir.file("ground2.log"));
+  const int port2 = ground_port(dir.file("ground2.log"));
+  ASSERT_GT(port2, 0) << read_file(dir.file("ground2.log"));
+  std::this_thread::sleep_for(1s);  // time for the held acknowledgements to arrive
+  auto served = httplib::Client("127.0.0.1", port2).Get("/api/units");
+  EXPECT_TRUE(served && served->status == 200) << read_file(dir.file("ground2.log"));
+  EXPECT_EQ(ground2.signal_and_wait(SIGTERM), 0) << read_file(dir.file("ground2.log"));
+
   // kill -9 of the service: the ground says STALE (or SERVICE LOST) within a few Health periods.
   fusion->kill_now(SIGKILL);
   const auto lost = read_stream(

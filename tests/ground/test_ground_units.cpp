@@ -316,12 +316,14 @@ TEST(Operators, AccountsPasswordsSessionsAndRoles) {
   ASSERT_EQ(accounts->size(), 2U);
   EXPECT_EQ(std::filesystem::status(users).permissions() & std::filesystem::perms::all,
             std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
-  auto ops = Operators::open(users, dir.file("key"));
+  auto ops = Operators::open(users, dir.file("key"), dir.file("sessions"), 1000);
   ASSERT_TRUE(ops.ok()) << ops.error().message;
   EXPECT_FALSE(ops->login("alice", "wrong").has_value());
   EXPECT_FALSE(ops->login("nobody", "correct horse").has_value());
   ASSERT_TRUE(ops->login("alice", "correct horse").has_value());
-  const std::string token = ops->issue("alice", 1000, 3600);
+  const std::string token = *ops->issue("alice", 1000, 3600);
+  EXPECT_EQ(token.size(), 64U);  // 32 random bytes, nothing of the user inside
+  EXPECT_EQ(token.find("alice"), std::string::npos);
   auto s = ops->session(token, 2000);
   ASSERT_TRUE(s.has_value());
   EXPECT_EQ(s->user, "alice");
@@ -329,22 +331,106 @@ TEST(Operators, AccountsPasswordsSessionsAndRoles) {
   EXPECT_EQ(s->csrf.size(), 64U);
   EXPECT_FALSE(ops->session(token, 5000).has_value());  // expired
   std::string forged = token;
-  forged[0] = 'b';  // another user with alice's signature
+  forged[0] = forged[0] == 'b' ? 'c' : 'b';  // another id: not in the store
   EXPECT_FALSE(ops->session(forged, 2000).has_value());
-  // Signed with the key of its file: a restarted ground station still knows the session.
-  auto again = Operators::open(users, dir.file("key"));
+  // In the journal of its file: a restarted ground station still knows the session.
+  auto again = Operators::open(users, dir.file("key"), dir.file("sessions"), 1500);
   ASSERT_TRUE(again.ok());
   EXPECT_TRUE(again->session(token, 2000).has_value());
-  again->revoke(token);
+  ASSERT_TRUE(again->revoke(token).ok());
   EXPECT_FALSE(again->session(token, 2000).has_value());
+  // The other instance sees the sign-out in the journal, and so does every later start.
+  EXPECT_FALSE(ops->session(token, 2000).has_value());
+  EXPECT_FALSE(Operators::open(users, dir.file("key"), dir.file("sessions"), 1500)->session(token, 2000));
   // A role changed in the file applies to open sessions.
+  const std::string second = *ops->issue("alice", 1000, 3600);
   ASSERT_TRUE(set_account(users, {"alice", Role::kViewer, *hash}).ok());
   std::filesystem::last_write_time(users,
                                    std::filesystem::file_time_type::clock::now() + std::chrono::seconds(5));
-  EXPECT_EQ(ops->session(token, 2000)->role, Role::kViewer);
+  EXPECT_EQ(ops->session(second, 2000)->role, Role::kViewer);
   test::write_file(dir.file("broken"), "alice:admin:$argon2id$x\n");
   EXPECT_EQ(read_accounts(dir.file("broken")).error().message,
             dir.file("broken") + ":1: role must be viewer or commander");
+}
+
+// A viewer whose name starts with a commander's name and a dot signed in as that commander when the user
+// was read from the session token up to its first dot; a dotted name then had no working session at all.
+TEST(Operators, ADottedViewerIsItselfAndNeverTheCommanderItsNameStartsWith) {
+  test::TempDir dir;
+  const std::string users = dir.file("users");
+  const std::string hash = *hash_password("correct horse");
+  ASSERT_TRUE(set_account(users, {"alice", Role::kCommander, hash}).ok());
+  ASSERT_TRUE(set_account(users, {"alice.2000000000", Role::kViewer, hash}).ok());
+  ASSERT_TRUE(set_account(users, {"john.smith", Role::kViewer, hash}).ok());
+  ASSERT_TRUE(set_account(users, {"a_b-c.D9", Role::kViewer, hash}).ok());
+  auto ops = Operators::open(users, dir.file("key"), dir.file("sessions"), 1000);
+  ASSERT_TRUE(ops.ok()) << ops.error().message;
+  for (const std::string user : {"alice.2000000000", "john.smith", "a_b-c.D9"}) {
+    ASSERT_TRUE(ops->login(user, "correct horse").has_value()) << user;
+    const auto session = ops->session(*ops->issue(user, 1000, 3600), 2000);
+    ASSERT_TRUE(session.has_value()) << user;
+    EXPECT_EQ(session->user, user);
+    EXPECT_EQ(session->role, Role::kViewer) << user;
+  }
+}
+
+TEST(Operators, SignOutSticksPastManySignOutsAndAUserHoldsAtMost64Sessions) {
+  test::TempDir dir;
+  const std::string users = dir.file("users");
+  ASSERT_TRUE(set_account(users, {"alice", Role::kCommander, *hash_password("correct horse")}).ok());
+  auto ops = Operators::open(users, dir.file("key"), dir.file("sessions"), 1000);
+  ASSERT_TRUE(ops.ok());
+  const std::string kept = *ops->issue("alice", 1000, 3600);
+  const std::string first = *ops->issue("alice", 1000, 3600);
+  ASSERT_TRUE(ops->revoke(first).ok());
+  // 400 sign-ins and sign-outs (three journal compactions among them): the first sign-out still holds.
+  for (int i = 0; i < 400; ++i) ASSERT_TRUE(ops->revoke(*ops->issue("alice", 1000, 3600)).ok());
+  EXPECT_FALSE(ops->session(first, 2000).has_value());
+  EXPECT_TRUE(ops->session(kept, 2000).has_value());
+  // The journal stays bounded: compacted to the live sessions.
+  EXPECT_LT(std::filesystem::file_size(dir.file("sessions")), 100000U);
+  // 64 sessions per user: the 65th sign-in ends the one nearest to expiry (here `kept`, the oldest).
+  std::vector<std::string> open;
+  for (int i = 0; i < 64; ++i) open.push_back(*ops->issue("alice", 1001 + i, 3600));
+  EXPECT_FALSE(ops->session(kept, 2000).has_value());
+  for (const auto& id : open) EXPECT_TRUE(ops->session(id, 2000).has_value());
+}
+
+TEST(Operators, AKeyOrJournalOthersCanReadIsRefusedAndADamagedJournalNamesItsLine) {
+  test::TempDir dir;
+  const std::string users = dir.file("users");
+  ASSERT_TRUE(set_account(users, {"alice", Role::kCommander, *hash_password("correct horse")}).ok());
+  test::write_file(dir.file("key"), std::string(64, 'k') + "\n");
+  std::filesystem::permissions(dir.file("key"),
+                               std::filesystem::perms::owner_read | std::filesystem::perms::owner_write |
+                                   std::filesystem::perms::group_read | std::filesystem::perms::others_read);
+  auto refused = Operators::open(users, dir.file("key"), dir.file("sessions"), 1000);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().message,
+            dir.file("key") +
+                ": the session key is readable or writable by group or others (mode 0644); whoever "
+                "reads it can sign in as any operator: chmod 600 " +
+                dir.file("key"));
+  std::filesystem::permissions(dir.file("key"),
+                               std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  ASSERT_TRUE(Operators::open(users, dir.file("key"), dir.file("sessions"), 1000).ok());
+  test::write_file(dir.file("sessions"), "# journal\n+ 00 12 alice\n");
+  std::filesystem::permissions(dir.file("sessions"),
+                               std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  auto damaged = Operators::open(users, dir.file("key"), dir.file("sessions"), 1000);
+  ASSERT_FALSE(damaged.ok());
+  EXPECT_EQ(damaged.error().message.rfind(dir.file("sessions") + ":2: expected", 0), 0U)
+      << damaged.error().message;
+}
+
+// Any bytes in a DDS string (here an operator id and a unit name that are not UTF-8) become text, never an
+// exception: nlohmann::json::dump throws on invalid UTF-8, which ended `tetra ground`.
+TEST(Encode, StringsThatAreNotUtf8AreShownWithTheReplacementCharacter) {
+  nlohmann::json ack = {{"operator", std::string("caf\xe9")}, {std::string("unit\xff"), "x\x80y"}};
+  std::string text;
+  ASSERT_NO_THROW(text = json_text(ack));
+  EXPECT_EQ(text, "{\"operator\":\"caf\xef\xbf\xbd\",\"unit\xef\xbf\xbd\":\"x\xef\xbf\xbdy\"}");
+  EXPECT_TRUE(nlohmann::json::accept(text));
 }
 
 TEST(GroundServer, NoAuthOnlyOnLoopback) {

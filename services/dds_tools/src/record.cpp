@@ -210,7 +210,7 @@ Status Recording::take_outputs(const RecordLink& link) {
     const auto view = dds::from_wire(s);
     if (view.unit != o_.unit) return;
     event_lines_[view.event_seq] = fdi::to_json(view.event, n_);
-    if (view.command_id != 0) command_lines_[view.event_seq] = ground::ack_json(view, n_).dump();
+    if (view.command_id != 0) command_lines_[view.event_seq] = ground::json_text(ground::ack_json(view, n_));
   });
   if (!e) return e.error();
   return ok_status();

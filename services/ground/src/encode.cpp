@@ -50,6 +50,10 @@ json counters_json(const dds::HealthView& view) {
 
 }  // namespace
 
+std::string json_text(const json& value) {
+  return value.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 double utc_ms(std::int64_t utc_ns) {
   return static_cast<double>(utc_ns) / 1e6;
 }

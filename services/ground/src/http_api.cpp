@@ -23,7 +23,7 @@ constexpr std::size_t kMaxCatchUp = 4096;  //!< a resume further behind gets a r
 HttpResponse json_reply(int status, const json& body) {
   HttpResponse res;
   res.status = status;
-  res.body = body.dump();
+  res.body = json_text(body);
   res.headers.emplace_back("Cache-Control", "no-store");
   return res;
 }
@@ -103,7 +103,7 @@ Status GroundServer::start() {
       return bad_input("--users FILE (made by `tetra ground passwd`) or, on loopback only, --no-auth");
     const std::string key =
         config_.session_key_path.empty() ? config_.users_path + ".session-key" : config_.session_key_path;
-    auto ops = Operators::open(config_.users_path, key);
+    auto ops = Operators::open(config_.users_path, key, config_.users_path + ".sessions", utc_now_s());
     if (!ops) return ops.error();
     operators_.emplace(std::move(ops).value());
   }
@@ -208,7 +208,10 @@ HttpResponse GroundServer::serve(const HttpRequest& req, const std::optional<Ses
   if (req.method == "POST") {
     if (req.path == "/api/command") return command(req, *session);
     if (req.path == "/api/logout") {
-      if (operators_) operators_->revoke(cookie_value(req.header("cookie"), kCookie));
+      if (operators_) {
+        if (auto s = operators_->revoke(cookie_value(req.header("cookie"), kCookie)); !s)
+          return error_reply(500, "sign-out not recorded: " + s.error().message);
+      }
       auto res = json_reply(200, {{"signed_out", session->user}});
       res.headers.emplace_back("Set-Cookie",
                                std::string(kCookie) + "=; Path=/; Max-Age=0; HttpOnly; SameSite=Strict");
@@ -258,7 +261,12 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
   lock.unlock();
   if (!account) return refuse(req, 401, "user or password wrong", valid_user_name(user) ? user : "?");
   const auto lifetime = static_cast<std::int64_t>(config_.session_lifetime_s);
-  const std::string token = operators_->issue(account->user, utc_now_s(), lifetime);
+  const auto issued = operators_->issue(account->user, utc_now_s(), lifetime);
+  if (!issued) {
+    spdlog::error("ground: {}", issued.error().message);
+    return error_reply(500, "the session cannot be recorded");
+  }
+  const std::string& token = *issued;
   spdlog::info("ground audit: {} ({}) signed in from {}", account->user, to_string(account->role),
                req.remote_addr);
   auto res = json_reply(

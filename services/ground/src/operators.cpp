@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/ground/private_file.hpp"
 
 namespace tetra::ground {
 
@@ -25,36 +26,15 @@ std::string to_hex(const unsigned char* data, std::size_t n) {
   return out;
 }
 
-std::int64_t mtime_ns(const std::string& path) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) return -1;
-  return static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1000000000LL + st.st_mtim.tv_nsec;
-}
+}  // namespace
 
-//! Writes `text` to `path` with mode 0600: a new file beside it, renamed over it.
-Status write_private(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".new" + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) return failure(path + ": cannot write (" + tmp + ")");
-  const bool written =
-      ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) && ::fsync(fd) == 0;
-  ::close(fd);
-  if (!written || ::rename(tmp.c_str(), path.c_str()) != 0) {
-    ::unlink(tmp.c_str());
-    return failure(path + ": cannot write");
-  }
-  return ok_status();
-}
-
-//! "user.expiry.nonce" and its keyed hash.
-std::string signature(const std::string& key, const std::string& text) {
+std::string keyed_hash_hex(const std::string& key, const std::string& text) {
+  sodium_ready();
   unsigned char mac[32];
   crypto_generichash(mac, sizeof mac, reinterpret_cast<const unsigned char*>(text.data()), text.size(),
                      reinterpret_cast<const unsigned char*>(key.data()), key.size());
   return to_hex(mac, sizeof mac);
 }
-
-}  // namespace
 
 const char* to_string(Role role) {
   return role == Role::kCommander ? "commander" : "viewer";
@@ -86,7 +66,7 @@ bool same_secret(const std::string& a, const std::string& b) {
 }
 
 std::string csrf_of(const std::string& key, const std::string& token) {
-  return signature(key, "csrf:" + token);
+  return keyed_hash_hex(key, "csrf:" + token);
 }
 
 Result<std::vector<Account>> read_accounts(const std::string& path) {
@@ -144,14 +124,16 @@ Status set_account(const std::string& path, const Account& account) {
   return write_private(path, text);
 }
 
-Result<Operators> Operators::open(const std::string& users_path, const std::string& key_path) {
+Result<Operators> Operators::open(const std::string& users_path, const std::string& key_path,
+                                  const std::string& sessions_path, std::int64_t now_s) {
   if (!sodium_ready()) return failure("libsodium cannot start");
   Operators ops;
   ops.users_path_ = users_path;
   auto accounts = read_accounts(users_path);
   if (!accounts) return accounts.error();
   ops.accounts_ = std::move(accounts).value();
-  ops.accounts_mtime_ns_ = mtime_ns(users_path);
+  ops.accounts_stamp_ = file_stamp(users_path);
+  if (auto s = check_private(key_path, "the session key"); !s) return s.error();
   auto key = read_text_file(key_path);
   if (!key) {
     if (::access(key_path.c_str(), F_OK) == 0) return key.error();
@@ -161,6 +143,9 @@ Result<Operators> Operators::open(const std::string& users_path, const std::stri
   }
   ops.key_ = key->substr(0, key->find('\n'));
   if (ops.key_.size() < 32) return bad_input(key_path + ": a session key of at least 32 characters");
+  auto sessions = SessionStore::open(sessions_path, ops.key_, now_s);
+  if (!sessions) return sessions.error();
+  ops.sessions_.emplace(std::move(sessions).value());
   return ops;
 }
 
@@ -168,15 +153,15 @@ Operators::Operators(Operators&& other) noexcept
     : users_path_(std::move(other.users_path_)),
       key_(std::move(other.key_)),
       accounts_(std::move(other.accounts_)),
-      accounts_mtime_ns_(other.accounts_mtime_ns_),
-      revoked_(std::move(other.revoked_)),
+      accounts_stamp_(other.accounts_stamp_),
+      sessions_(std::move(other.sessions_)),
       dummy_hash_(std::move(other.dummy_hash_)) {}
 
 void Operators::reload() {
-  const std::int64_t m = mtime_ns(users_path_);
-  if (m == accounts_mtime_ns_) return;
+  const FileStamp stamp = file_stamp(users_path_);
+  if (stamp == accounts_stamp_) return;
   auto accounts = read_accounts(users_path_);
-  accounts_mtime_ns_ = m;
+  accounts_stamp_ = stamp;
   // A file being edited or broken: no accounts until it reads again (refuse rather than guess).
   accounts_ = accounts ? std::move(accounts).value() : std::vector<Account>{};
 }
@@ -200,29 +185,18 @@ std::optional<Account> Operators::login(const std::string& user, const std::stri
   return account && match ? account : std::nullopt;
 }
 
-std::string Operators::issue(const std::string& user, std::int64_t now_s, std::int64_t lifetime_s) {
-  const std::string text = user + "." + std::to_string(now_s + lifetime_s) + "." + random_hex(16);
-  return text + "." + signature(key_, text);
+Result<std::string> Operators::issue(const std::string& user, std::int64_t now_s, std::int64_t lifetime_s) {
+  const std::lock_guard lock(mutex_);
+  return sessions_->issue(user, now_s, lifetime_s);
 }
 
 std::optional<Session> Operators::session(const std::string& token, std::int64_t now_s) {
-  const auto dot = token.rfind('.');
-  if (dot == std::string::npos || token.size() > 256) return std::nullopt;
-  const std::string text = token.substr(0, dot);
-  if (!same_secret(token.substr(dot + 1), signature(key_, text))) return std::nullopt;
-  const auto d1 = text.find('.');
-  const auto d2 = text.find('.', d1 + 1);
-  if (d1 == std::string::npos || d2 == std::string::npos) return std::nullopt;
-  const std::string user = text.substr(0, d1);
-  const std::string expiry = text.substr(d1 + 1, d2 - d1 - 1);
-  if (expiry.empty() || expiry.size() > 18 || expiry.find_first_not_of("0123456789") != std::string::npos ||
-      std::stoll(expiry) < now_s)
-    return std::nullopt;
   const std::lock_guard lock(mutex_);
-  if (revoked_.count(token) != 0) return std::nullopt;
+  const auto user = sessions_->user_of(token, now_s);
+  if (!user) return std::nullopt;
   reload();
   for (const auto& a : accounts_) {
-    if (a.user == user) return Session{user, a.role, csrf_of(key_, token)};
+    if (a.user == *user) return Session{a.user, a.role, csrf_of(key_, token)};
   }
   return std::nullopt;
 }
@@ -231,10 +205,9 @@ std::string Operators::csrf(const std::string& token) const {
   return csrf_of(key_, token);
 }
 
-void Operators::revoke(const std::string& token) {
+Status Operators::revoke(const std::string& token) {
   const std::lock_guard lock(mutex_);
-  if (revoked_.size() > 100000) revoked_.clear();  // bounded; tokens expire anyway
-  revoked_.insert(token);
+  return sessions_->revoke(token);
 }
 
 }  // namespace tetra::ground

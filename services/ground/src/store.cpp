@@ -39,7 +39,7 @@ int GroundStore::gyro_count(const Unit& u) const {
 }
 
 void GroundStore::stream(const char* event, const json& data) {
-  stream_.push({next_id_++, event, data.dump()});
+  stream_.push({next_id_++, event, json_text(data)});
   arrived_.notify_all();
   if (listener_) listener_();
 }
@@ -158,13 +158,13 @@ std::vector<StreamMessage> GroundStore::snapshot(std::int64_t now_ns) const {
   for (const auto& [name, u] : units_) {
     if (!u.health.empty()) {
       const auto& h = u.health.newest();
-      out.push_back({0, "health", health_json(h.value, h.utc_ns).dump()});
+      out.push_back({0, "health", json_text(health_json(h.value, h.utc_ns))});
     }
     if (!u.attitude.empty()) {
       const auto& a = u.attitude.newest();
-      out.push_back({0, "attitude", attitude_json(name, a.value, a.utc_ns).dump()});
+      out.push_back({0, "attitude", json_text(attitude_json(name, a.value, a.utc_ns))});
     }
-    out.push_back({0, "link", link_json(name, u, now_ns).dump()});
+    out.push_back({0, "link", json_text(link_json(name, u, now_ns))});
   }
   return out;
 }

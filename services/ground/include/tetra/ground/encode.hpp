@@ -13,6 +13,11 @@
 
 namespace tetra::ground {
 
+//! The JSON text of `value`, whatever bytes its strings hold: a DDS string (unit, operator id, event
+//! detail) need not be UTF-8, and any byte that is not part of valid UTF-8 is written as U+FFFD (the
+//! replacement character), so the text is always valid UTF-8 JSON and never an exception.
+std::string json_text(const nlohmann::json& value);
+
 //! [ms] UTC milliseconds of a DDS source timestamp (ns since 1970).
 double utc_ms(std::int64_t utc_ns);
 

@@ -1,18 +1,20 @@
 #pragma once
 // Operator accounts of the ground station (docs/ground.md, "Accounts"): a file of `user:role:hash` lines,
 // the hash argon2id (libsodium's crypto_pwhash_str, memory-hard), managed by `tetra ground passwd`; and
-// sessions as signed tokens (keyed BLAKE2b over user, expiry and a nonce, with a key kept in a file of
-// its own), so a session survives a restart of the ground station. A session's role is read from the
-// accounts file at each request: a changed role or a removed account takes effect at once.
+// sessions as opaque random ids kept in a journal of the ground's (session_store.hpp), so a session
+// survives a restart and a signed-out one stays out. A session's user and role are looked up, never read
+// from the id: the role is read from the accounts file at each request, so a changed role or a removed
+// account takes effect at once.
 
 #include <cstdint>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <string>
 #include <vector>
 
 #include "tetra/core/result.hpp"
+#include "tetra/ground/private_file.hpp"
+#include "tetra/ground/session_store.hpp"
 
 namespace tetra::ground {
 
@@ -44,17 +46,20 @@ struct Session {
 
 class Operators {
  public:
-  //! Reads the accounts; reads the session key from `key_path`, creating it (mode 0600) when absent.
-  static Result<Operators> open(const std::string& users_path, const std::string& key_path);
+  //! Reads the accounts; reads the session key from `key_path`, creating it (mode 0600) when absent and
+  //! refusing it when group or others may read it; opens the session journal `sessions_path`.
+  static Result<Operators> open(const std::string& users_path, const std::string& key_path,
+                                const std::string& sessions_path, std::int64_t now_s);
   Operators(Operators&& other) noexcept;
 
   //! The account when the password matches (the same work is done for an unknown user).
   std::optional<Account> login(const std::string& user, const std::string& password);
-  //! A session token for the user, valid `lifetime_s` from `now_s` (UTC seconds).
-  std::string issue(const std::string& user, std::int64_t now_s, std::int64_t lifetime_s);
-  //! The session of a token: signed by this key, not expired, not revoked, its account still there.
+  //! A new session id for the user, valid `lifetime_s` from `now_s` (UTC seconds), recorded in the journal.
+  Result<std::string> issue(const std::string& user, std::int64_t now_s, std::int64_t lifetime_s);
+  //! The session of an id: in the journal, not expired, not signed out, its account still there.
   std::optional<Session> session(const std::string& token, std::int64_t now_s);
-  void revoke(const std::string& token);
+  //! Signs the session out for good (recorded in the journal).
+  Status revoke(const std::string& token);
   //! The CSRF token of a session token.
   std::string csrf(const std::string& token) const;
 
@@ -65,13 +70,15 @@ class Operators {
   std::string key_;
   std::mutex mutex_;
   std::vector<Account> accounts_;
-  std::int64_t accounts_mtime_ns_ = -1;
-  std::set<std::string> revoked_;
+  FileStamp accounts_stamp_;
+  std::optional<SessionStore> sessions_;
   std::string dummy_hash_;
 };
 
 //! The CSRF token of a session token (keyed hash; the same for every request of the session).
 std::string csrf_of(const std::string& key, const std::string& token);
+//! The keyed BLAKE2b (32 bytes) of `text`, as hexadecimal.
+std::string keyed_hash_hex(const std::string& key, const std::string& text);
 //! Constant-time comparison.
 bool same_secret(const std::string& a, const std::string& b);
 //! `n` random bytes as hexadecimal.
