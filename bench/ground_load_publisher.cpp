@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
   auto health_writer =
       must(dds::Writer<tetra_Health>::create(participant, topics.health, dds::health_qos()), "health writer");
   auto event_writer =
-      must(dds::Writer<tetra_FdiEvent>::create(participant, topics.event, dds::event_qos()), "event writer");
+      must(dds::Writer<tetra_FdiEvent2>::create(participant, topics.event, dds::event_qos()), "event writer");
 
   std::vector<std::string> names;
   for (int u = 0; u < units; ++u) names.push_back("load-" + std::to_string(u + 1));
@@ -99,8 +99,8 @@ int main(int argc, char** argv) {
         view.event.stamp_ns = a.stamp_ns;
         view.event.type = fdi::EventType::kDetected;
         view.event.test = fdi::DetectionTest::kChi2;
-        tetra_FdiEvent event_wire{};
-        if (dds::to_wire(view, event_wire) && event_writer.write(event_wire)) ++events;
+        dds::WireEvent event_wire;
+        if (dds::to_wire(view, event_wire) && event_writer.write(event_wire.msg)) ++events;
       }
     }
   }

@@ -110,7 +110,7 @@ void every_topic_readable(dds::DataRepresentation representation, dds_domainid_t
   auto reference = counted_reader<tetra_AttitudeReference>(*participant, topics->reference, representation);
   auto attitude = counted_reader<tetra_Attitude>(*participant, topics->attitude, representation);
   auto health = counted_reader<tetra_Health>(*participant, topics->health, representation);
-  auto event = counted_reader<tetra_FdiEvent>(*participant, topics->event, representation);
+  auto event = counted_reader<tetra_FdiEvent2>(*participant, topics->event, representation);
   auto command = counted_reader<tetra_Command>(*participant, topics->command, representation);
   ASSERT_TRUE(gyro.reader && reference.reader && attitude.reader && health.reader && event.reader &&
               command.reader);

@@ -103,7 +103,7 @@ TEST_F(DdsSecurity, UnauthenticatedParticipantSeesAndInjectsNothing) {
     ASSERT_TRUE(topics.ok()) << topics.error().message;
     auto health = dds::Reader<tetra_Health>::create(*participant, topics->health, dds::health_qos());
     auto attitude = dds::Reader<tetra_Attitude>::create(*participant, topics->attitude, dds::attitude_qos());
-    auto events = dds::Reader<tetra_FdiEvent>::create(*participant, topics->event, dds::event_qos());
+    auto events = dds::Reader<tetra_FdiEvent2>::create(*participant, topics->event, dds::event_qos());
     auto samples =
         dds::Reader<tetra_GyroSample>::create(*participant, topics->gyro_sample, dds::gyro_sample_qos());
     auto references =

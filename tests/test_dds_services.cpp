@@ -68,7 +68,7 @@ class Observer {
     attitude_.emplace(
         std::move(dds::Reader<tetra_Attitude>::create(*participant_, topics_->attitude, deep)).value());
     events_.emplace(
-        std::move(dds::Reader<tetra_FdiEvent>::create(*participant_, topics_->event, dds::event_qos()))
+        std::move(dds::Reader<tetra_FdiEvent2>::create(*participant_, topics_->event, dds::event_qos()))
             .value());
     waitset_.emplace(std::move(dds::WaitSet::create(*participant_)).value());
     for (dds_entity_t reader : {health_->handle(), attitude_->handle(), events_->handle()}) {
@@ -101,7 +101,7 @@ class Observer {
       attitudes.push_back(dds::from_wire(m));
     });
     (void)events_->take(
-        [&](const tetra_FdiEvent& m, const dds_sample_info_t&) { events.push_back(dds::from_wire(m)); });
+        [&](const tetra_FdiEvent2& m, const dds_sample_info_t&) { events.push_back(dds::from_wire(m)); });
   }
   bool has_event(fdi::EventType type, std::optional<int> gyro = std::nullopt) const {
     for (const auto& e : events) {
@@ -120,7 +120,7 @@ class Observer {
   std::optional<dds::Topics> topics_;
   std::optional<dds::Reader<tetra_Health>> health_;
   std::optional<dds::Reader<tetra_Attitude>> attitude_;
-  std::optional<dds::Reader<tetra_FdiEvent>> events_;
+  std::optional<dds::Reader<tetra_FdiEvent2>> events_;
   std::vector<dds::Condition> conditions_;
   std::optional<dds::WaitSet> waitset_;
 };

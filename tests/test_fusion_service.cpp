@@ -201,13 +201,13 @@ TEST(FusionServiceLibrary, SilenceOfEveryGyroIsReportedWithHysteresisNeverBefore
   std::thread thread([&] { run_status = (*service)->run(); });
   auto session = std::move(dds::Session::open(kSilenceDomain)).value();
   auto gyro = std::move(session.writer<tetra_GyroSample>(dds::gyro_sample_qos(10ms))).value();
-  auto events = std::move(session.reader<tetra_FdiEvent>(dds::event_qos())).value();
+  auto events = std::move(session.reader<tetra_FdiEvent2>(dds::event_qos())).value();
   auto health = std::move(session.reader<tetra_Health>(dds::health_qos())).value();
   std::vector<dds::EventView> seen;
   std::uint64_t silences = 0;
   const auto drain = [&] {
     (void)events.take(
-        [&](const tetra_FdiEvent& e, const dds_sample_info_t&) { seen.push_back(dds::from_wire(e)); });
+        [&](const tetra_FdiEvent2& e, const dds_sample_info_t&) { seen.push_back(dds::from_wire(e)); });
     (void)health.take(
         [&](const tetra_Health& h, const dds_sample_info_t&) { silences = h.counters.unit_silences; });
   };

@@ -351,6 +351,24 @@ function TetraPlugin(options) {
     if (text !== undefined) e.textContent = text;
     return e;
   }
+  // Why a decision was taken: its ledger rows (docs/fdi.md, "The ledger and the arbiter"), one per line.
+  function rowText(r) {
+    const num = (v) => (v === null || v === undefined ? 'none' : Number(v).toPrecision(4));
+    const unit = r.unit + (r.dof !== undefined ? ' (' + r.dof + ' dof)' : '');
+    const limit = r.accept !== undefined ? 'accept <= ' + num(r.accept) + ', reject > ' + num(r.threshold)
+      : 'threshold ' + num(r.threshold);
+    return r.source + ' ' + r.hypothesis + ': ' + num(r.statistic) + ' ' + unit + ', ' + limit + ': ' + r.verdict;
+  }
+  function whyCell(e) {
+    const td = el('td', { class: 'tetra-why' });
+    if (!Array.isArray(e.ledger) || e.ledger.length === 0) return td;
+    const details = el('details', {});
+    const rejected = e.ledger.filter((r) => r.verdict === 'rejected').length;
+    details.appendChild(el('summary', {}, e.ledger.length + ' rows, ' + rejected + ' rejected'));
+    e.ledger.forEach((r) => details.appendChild(el('div', { class: 'tetra-why-row tetra-why--' + r.verdict.replace(' ', '-') }, rowText(r))));
+    td.appendChild(details);
+    return td;
+  }
   const fmt = (v, digits) => (v === null || v === undefined || Number.isNaN(v) ? 'not available' : v.toFixed(digits));
   const utcText = (ms) => (ms ? new Date(ms).toISOString().replace('T', ' ').replace('Z', ' UTC') : '-');
 
@@ -510,6 +528,7 @@ function TetraPlugin(options) {
           let detail = e.detail || e.kind || e.test || '';
           if (e.operator) detail += ' [' + e.operator + ' @ ' + e.origin + (e.accepted ? ', accepted' : ', refused') + ']';
           tr.appendChild(el('td', {}, detail));
+          tr.appendChild(whyCell(e));
           events.appendChild(tr);
         });
     }
@@ -531,7 +550,7 @@ function TetraPlugin(options) {
         '<section><div class="tetra-events-head"><h2>FDI events</h2><label>kind ' +
         '<select id="tetra-event-filter"></select></label></div>' +
         '<table class="tetra-table"><thead><tr><th>UTC</th><th>sensor time [s]</th>' +
-        '<th>event</th><th>gyro</th><th>detail</th></tr></thead><tbody id="tetra-events"></tbody></table></section>';
+        '<th>event</th><th>gyro</th><th>detail</th><th>why (ledger)</th></tr></thead><tbody id="tetra-events"></tbody></table></section>';
       r.querySelector('.tetra-name').textContent = 'Unit ' + unit;
       r.querySelector('.tetra-commands').appendChild(commandButton('FDI reset', { unit, action: 'reset' }));
       const showOperator = () => {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tetra/core/geometry.hpp"
+#include "evidence_rows.hpp"
 #include "tetra/fdi/types.hpp"
 
 namespace tetra::fdi::detail {
@@ -36,6 +37,7 @@ struct Isolation {
   Evidence evidence = Evidence::kNone;
   DetectionTest test = DetectionTest::kNone;
   double statistic = 0.0;
+  EvidenceRows rows;  //!< the rows the finding rests on, per hypothesis (the arbiter reads them)
 };
 
 //! Up to N isolations found in one pass of a stage (capacity reserved once).

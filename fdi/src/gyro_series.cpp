@@ -442,25 +442,32 @@ bool GyroSeries::may_signal(const Track& t) const {
 
 bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_s, double sqrt_period,
                            Isolations& out) {
-  auto found = [&](FaultKind kind, Evidence evidence, double statistic) {
-    out.push_back({id, kind, evidence, DetectionTest::kSignature, statistic});
+  // A signature is the gyro's own signal: the hypothesis that it is healthy (every other gyro's, H0, Href)
+  // is rejected by the statistic that names it (docs/fdi.md, "The sources").
+  const GyroMask active = all_gyros(static_cast<int>(tracks_.size())) & ~excluded_;
+  auto found = [&](FaultKind kind, Evidence evidence, double statistic, double threshold) {
+    Isolation iso{id, kind, evidence, DetectionTest::kSignature, statistic, {}};
+    iso.rows.own_signal(source_of(evidence), id, active, statistic, threshold);
+    out.push_back(iso);
     return true;
   };
   if (t.absent_since_ns >= 0 && now_ns - t.absent_since_ns >= seconds_to_ns(config_.dropout_timeout_s))
-    return found(FaultKind::kDropout, Evidence::kTimeout, ns_to_seconds(now_ns - t.absent_since_ns));
+    return found(FaultKind::kDropout, Evidence::kTimeout, ns_to_seconds(now_ns - t.absent_since_ns),
+                 config_.dropout_timeout_s);
   if (t.invalid_since_ns >= 0 && now_ns - t.invalid_since_ns >= seconds_to_ns(config_.invalid_timeout_s))
-    return found(FaultKind::kInvalid, Evidence::kInvalid, ns_to_seconds(now_ns - t.invalid_since_ns));
+    return found(FaultKind::kInvalid, Evidence::kInvalid, ns_to_seconds(now_ns - t.invalid_since_ns),
+                 config_.invalid_timeout_s);
   if (t.repeat_count >= config_.stuck_repeat_count && repeats_are_stuck(id, t, sqrt_period))
-    return found(FaultKind::kStuck, t.last_raw == 0.0 ? Evidence::kZero : Evidence::kRepeated,
-                 t.repeat_count);
+    return found(FaultKind::kStuck, t.last_raw == 0.0 ? Evidence::kZero : Evidence::kRepeated, t.repeat_count,
+                 config_.stuck_repeat_count);
   if (t.d2_since_eval >= kNoiseEvalEvery && period_s > 0.0) {
     t.d2_since_eval = 0;
     if (!noise_ratio_within(t, id, sqrt_period, config_.noise_low_ratio, config_.noise_high_ratio)) {
       const double r = noise_ratio(id, sqrt_period);
       if (std::isfinite(r) && r > config_.noise_high_ratio && noise_beyond_motion(id, t, r, sqrt_period))
-        return found(FaultKind::kNoise, Evidence::kNoiseLevel, r);
+        return found(FaultKind::kNoise, Evidence::kNoiseLevel, r, config_.noise_high_ratio);
       if (std::isfinite(r) && r < config_.noise_low_ratio && !coarse(id, sqrt_period))
-        return found(FaultKind::kStuck, Evidence::kVariance, r);
+        return found(FaultKind::kStuck, Evidence::kVariance, r, config_.noise_low_ratio);
     }
   }
   // Recurring spikes: enough confirmed one-epoch outliers within the window, the first one old enough for the
@@ -474,7 +481,7 @@ bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_
     return false;
   const double r = noise_ratio(id, sqrt_period);
   if (std::isfinite(r) && r < 0.5 * config_.noise_high_ratio)
-    return found(FaultKind::kSpike, Evidence::kRecurringSpikes, config_.spike_count);
+    return found(FaultKind::kSpike, Evidence::kRecurringSpikes, config_.spike_count, config_.spike_count);
   return false;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "tetra/core/units.hpp"
 
@@ -74,10 +75,13 @@ void Isolator::accumulate(const Eigen::VectorXd& p, int dof) {
 Verdict Isolator::decide(std::int64_t now_ns, std::int64_t index, GyroMask active, SubsetCache& subsets,
                          const GyroSeries& series, Isolation& found) {
   if (!episode_.active) return Verdict::kNone;
+  rows_.clear();
   Evidence evidence = Evidence::kOnset;
   int culprit = onset_test(index, active, subsets, series);
   if (culprit == 0) {
-    culprit = glt_test(subsets.get(active));
+    const Subset& s = subsets.get(active);
+    if (s.dof >= 2 && glt_n_ >= 3) rows_.clear();  // the GLT runs: its rows, not the silent onset test's
+    culprit = glt_test(s);
     evidence = Evidence::kGlt;
   }
   if (culprit > 0) {
@@ -103,7 +107,7 @@ Verdict Isolator::decide(std::int64_t now_ns, std::int64_t index, GyroMask activ
     // A noise level neither normal nor clearly high: wait for more samples rather than guess the kind.
     const bool ambiguous = !repeated && raised && quiet && r <= config_.noise_high_ratio;
     if (ambiguous) return Verdict::kNone;
-    found = {culprit, kind, evidence, episode_.test, episode_.statistic};
+    found = {culprit, kind, evidence, episode_.test, episode_.statistic, rows_};
     return Verdict::kIsolated;
   }
   if (!episode_.declared_unisolated && now_ns >= episode_.deadline_ns) {
@@ -137,8 +141,9 @@ double Isolator::window_means(std::int64_t b, std::int64_t e, std::vector<double
 }
 
 int Isolator::motion_within_bound(GyroMask mask, double separation_s, SubsetCache& subsets,
-                                  const GyroSeries& series) const {
+                                  const GyroSeries& series, double* ratio) const {
   const Subset& h = subsets.get(mask);
+  if (ratio != nullptr) *ratio = std::numeric_limits<double>::quiet_NaN();
   if (!h.observable) return -1;
   Eigen::Vector3d dw = Eigen::Vector3d::Zero();
   double var = 0.0;
@@ -157,7 +162,9 @@ int Isolator::motion_within_bound(GyroMask mask, double separation_s, SubsetCach
     }
   }
   const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
-  return dw.norm() <= a_max * separation_s + config_.onset_sigma * std::sqrt(var) ? 1 : 0;
+  const double bound = a_max * separation_s + config_.onset_sigma * std::sqrt(var);
+  if (ratio != nullptr) *ratio = dw.norm() / bound;
+  return dw.norm() <= bound ? 1 : 0;
 }
 
 double Isolator::two_windows(std::int64_t b1, std::int64_t e1, std::int64_t b2, std::int64_t e2) {
@@ -191,13 +198,23 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
   if (motion_within_bound(active, two_windows(k0, post_mid, post_mid, post_end), subsets, series) == 0)
     return 0;
   const double separation = two_windows(pre_begin, pre_end, k0, post_end);
-  // All gyros consistent with a possible motion: no abrupt change beyond motion, nothing to tell.
-  if (motion_within_bound(active, separation, subsets, series) != 0) return 0;
+  // All gyros consistent with a possible motion: no abrupt change beyond motion, nothing to tell. Each
+  // hypothesis's row: the rate change of the gyros it holds healthy over the motion bound (docs/fdi.md).
+  double ratio = 0.0;
+  const int all = motion_within_bound(active, separation, subsets, series, &ratio);
+  rows_.add(stated(EvidenceSource::kOnset, kHypothesisNone,
+                   all == 0 ? RowVerdict::kRejected : RowVerdict::kNoCall, ratio, 1.0));
+  if (all != 0) return 0;
+  // The onset is in the gyros' own data: a wrong reference does not move them.
+  rows_.add(stated(EvidenceSource::kOnset, kHypothesisReference, RowVerdict::kRejected, ratio, 1.0));
   int count = 0;
   int culprit = 0;
   for (int j = 1; j <= n_; ++j) {
     if (!has_gyro(active, j)) continue;
-    const int c = motion_within_bound(without_gyro(active, j), separation, subsets, series);
+    const int c = motion_within_bound(without_gyro(active, j), separation, subsets, series, &ratio);
+    rows_.add(stated(EvidenceSource::kOnset, static_cast<std::uint8_t>(j),
+                     c < 0 ? RowVerdict::kNoCall : (c == 1 ? RowVerdict::kConsistent : RowVerdict::kRejected),
+                     ratio, 1.0));
     if (c < 0) return 0;
     if (c == 1) {
       ++count;
@@ -209,7 +226,7 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
 
 // GLT on the mean normalized parity since the onset (N ≥ 5): the residual after fitting a fault of gyro i is
 // χ²_{d−1} under hypothesis i. Isolate i when it is accepted and every other is rejected.
-int Isolator::glt_test(const Subset& s) const {
+int Isolator::glt_test(const Subset& s) {
   if (s.dof < 2 || glt_n_ < 3) return 0;
   const double n = glt_n_;
   Eigen::VectorXd& mean = glt_mean_[static_cast<std::size_t>(s.dof)];
@@ -225,6 +242,8 @@ int Isolator::glt_test(const Subset& s) const {
     w = s.parity.col(i);
     const double proj = w.dot(mean);
     const double r = n * (mean.squaredNorm() - proj * proj / w.squaredNorm());
+    rows_.add(judge(EvidenceSource::kGlt, static_cast<std::uint8_t>(i + 1), r, s.glt_accept, s.glt_reject,
+                    s.dof - 1));
     if (r <= s.glt_accept) {
       ++accepted;
       best = i + 1;

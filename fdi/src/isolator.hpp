@@ -62,6 +62,9 @@ class Isolator {
   void close();
 
   const Episode& episode() const { return episode_; }
+  //! The rows of the last `decide`: the onset test's per hypothesis, or the GLT's when the onset test told
+  //! nothing (empty when neither could run).
+  const EvidenceRows& rows() const { return rows_; }
   //! [ns] time of a history epoch.
   std::int64_t time_of(std::int64_t index) const;
   //! [ns] time of epoch `onset_index`, or of the oldest epoch kept when it is older (`index`: this epoch).
@@ -78,9 +81,10 @@ class Isolator {
   double two_windows(std::int64_t b1, std::int64_t e1, std::int64_t b2, std::int64_t e2);
   //! 1: the change between the two windows' means seen by `mask` is a possible motion (within the
   //! acceleration bound over `separation_s` and the noise); 0: it is not; −1: cannot judge.
-  int motion_within_bound(GyroMask mask, double separation_s, SubsetCache& subsets,
-                          const GyroSeries& series) const;
-  int glt_test(const Subset& s) const;
+  //! `ratio`, when given: the change over its bound (NaN when it cannot judge).
+  int motion_within_bound(GyroMask mask, double separation_s, SubsetCache& subsets, const GyroSeries& series,
+                          double* ratio = nullptr) const;
+  int glt_test(const Subset& s);
   //! Window means of each gyro's rate over history epochs [b, e); returns the mean time offset from b [s].
   double window_means(std::int64_t b, std::int64_t e, std::vector<double>& mean,
                       std::vector<int>& count) const;
@@ -91,6 +95,7 @@ class Isolator {
   int n_;
   const PipelineConfig& config_;
   Episode episode_;
+  EvidenceRows rows_;
   Eigen::VectorXd glt_sum_;  //!< Σ p since the onset (d ≥ 2)
   int glt_n_ = 0;
   std::vector<double> hist_y_;  //!< kHistory×N [rad/s]

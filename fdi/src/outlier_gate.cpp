@@ -70,19 +70,38 @@ void OutlierGate::update(EpochFrame& frame, SubsetCache& subsets, GyroSeries& se
 
 Isolation OutlierGate::classify_step(int id, const EpochFrame& frame, const GyroSeries& series,
                                      double sqrt_period) const {
+  // At every epoch of the run only this gyro's hypothesis explained the step with a possible motion: the
+  // rows are the run's length against the confirmation count (docs/fdi.md, "The sources").
+  Isolation iso = step_kind(id, frame, series, sqrt_period);
+  const auto& t = tracks_[static_cast<std::size_t>(id - 1)];
+  iso.rows.own_signal(EvidenceSource::kJump, id, frame.usable, t.outlier_run, config_.onset_confirm_epochs);
+  return iso;
+}
+
+Isolation OutlierGate::step_kind(int id, const EpochFrame& frame, const GyroSeries& series,
+                                 double sqrt_period) const {
   const auto& t = tracks_[static_cast<std::size_t>(id - 1)];
   const bool zero = t.outlier_repeated && frame.raw[static_cast<std::size_t>(id - 1)] == 0.0;
   const double r = series.recent_noise_ratio(id, sqrt_period, config_.onset_confirm_epochs);
   if (t.outlier_repeated)
-    return {id, FaultKind::kStuck, zero ? Evidence::kZero : Evidence::kRepeated, DetectionTest::kOnset,
-            static_cast<double>(t.outlier_run)};
+    return {id,
+            FaultKind::kStuck,
+            zero ? Evidence::kZero : Evidence::kRepeated,
+            DetectionTest::kOnset,
+            static_cast<double>(t.outlier_run),
+            {}};
   if (std::isfinite(r) && r > config_.noise_high_ratio) {
     // A raised level while the body moves may be its jerk: the step is certain, its kind is not.
     const bool quiet = series.motion_quiet(id, sqrt_period, config_.onset_confirm_epochs);
-    return {id, quiet ? FaultKind::kNoise : FaultKind::kUnknown,
-            quiet ? Evidence::kNoiseLevel : Evidence::kOnset, DetectionTest::kOnset, r};
+    return {id,
+            quiet ? FaultKind::kNoise : FaultKind::kUnknown,
+            quiet ? Evidence::kNoiseLevel : Evidence::kOnset,
+            DetectionTest::kOnset,
+            r,
+            {}};
   }
-  return {id, FaultKind::kBias, Evidence::kOnset, DetectionTest::kOnset, static_cast<double>(t.outlier_run)};
+  return {id, FaultKind::kBias, Evidence::kOnset, DetectionTest::kOnset, static_cast<double>(t.outlier_run),
+          {}};
 }
 
 bool OutlierGate::possible_motion(const Subset& h, double dt_s, const GyroSeries& series,

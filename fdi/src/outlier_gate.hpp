@@ -44,8 +44,10 @@ class OutlierGate {
   //! [rad/s] onset_sigma × 1σ of the rate change the gyros of `h` imply from their sample noise alone (kept
   //! per subset and sample period).
   double motion_noise(const Subset& h, const GyroSeries& series, double sqrt_period) const;
+  //! The confirmed step of gyro `id`, its kind and its ledger rows.
   Isolation classify_step(int id, const EpochFrame& frame, const GyroSeries& series,
                           double sqrt_period) const;
+  Isolation step_kind(int id, const EpochFrame& frame, const GyroSeries& series, double sqrt_period) const;
 
   const PipelineConfig& config_;
   std::vector<Track> tracks_;

@@ -124,7 +124,8 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   health.chi2 = chi2;
   health.chi2_threshold = s.chi2_threshold;
   health.parity_residual = s.dof >= 1 ? std::sqrt(chi2) : 0.0;
-  if (s.dof >= 1 && chi2 > s.chi2_threshold) d = {true, DetectionTest::kChi2, chi2, frame.index, false};
+  if (s.dof >= 1 && chi2 > s.chi2_threshold)
+    d = {true, DetectionTest::kChi2, chi2, frame.index, false, s.chi2_threshold, s.dof};
   if (frame.usable != active || s.dof < 1) return d;
 
   d.cusum_ran = true;
@@ -163,6 +164,7 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
     d.test = DetectionTest::kCusum;
     d.statistic = stat;
     d.onset_index = onset;
+    d.threshold = s.cusum_h;
   }
   level_alarm_ = false;
   return d;
@@ -183,7 +185,7 @@ bool ParityDetector::level_change(const Subset& s, std::int64_t index, Detection
   std::int64_t onset = index;
   const double stat = level_cusum_.step(dp_, s.dof, s.level_k, index, onset);
   if (stat <= s.level_h) return false;
-  d = {true, DetectionTest::kLevel, stat, onset, true};
+  d = {true, DetectionTest::kLevel, stat, onset, true, s.level_h, 0};
   return true;
 }
 

@@ -20,6 +20,8 @@ struct Detection {
   double statistic = 0.0;
   std::int64_t onset_index = 0;  //!< estimated first faulty epoch (the CUSUM's change time)
   bool cusum_ran = false;        //!< the CUSUM saw this epoch (full active subset present)
+  double threshold = 0.0;        //!< the alarm's threshold, in the statistic's unit
+  int dof = 0;                   //!< χ²: its degrees of freedom
 };
 
 //! One CUSUM on d-dimensional normalized parity: two-sided for d = 1, Crosier's vector form for d ≥ 2, with

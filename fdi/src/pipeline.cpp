@@ -116,6 +116,7 @@ class Pipeline::Impl {
   bool observable(GyroMask gyros) const { return subsets_.geometry().observable(gyros); }
   int gyro_count() const { return n_; }
   const PipelineConfig& config() const { return config_; }
+  std::uint64_t arbiter_refusals() const { return arbiter_refusals_; }
 
   // The pipeline keeps a copy of the configuration that its stages refer to: it is created in place, once.
   Impl(const Impl&) = delete;
@@ -137,6 +138,10 @@ class Pipeline::Impl {
   void publish_filter_health() const;
   void update_fdi_available();
   void judge_reference();
+  //! The reference's failing test as rows: H0 rejected, Href `reference` (rejected when the gyros vouch for
+  //! their attitude; no call with three gyros, where the data cannot tell the reference from a gyro), and
+  //! each gyro in use no call then.
+  void reference_rows(RowVerdict reference, std::vector<LedgerRow>& ledger) const;
   //! A gyro fault just detected may be what had the reference rejected: the rejection is withdrawn.
   void withdraw_reference_rejection();
   void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
@@ -154,7 +159,12 @@ class Pipeline::Impl {
   std::int64_t signature_span_ns() const;
   void update_mode(std::int64_t now_ns);
   void emit(FdiEvent event) { result_.events.push_back(std::move(event)); }
-  void emit_detected(DetectionTest test, double statistic, std::int64_t now_ns);
+  //! A `detected` event with the rows that rejected H0 (none: the event carries no ledger).
+  void emit_detected(DetectionTest test, double statistic, std::int64_t now_ns,
+                     const EvidenceRows* rows = nullptr);
+  //! The arbiter's ruling on an isolation's rows (the episode's detection rows with them), and the rows an
+  //! event carries: every hypothesis of the gyros in use, H0 and Href.
+  int rule(const EvidenceRows& rows, std::vector<LedgerRow>& ledger) const;
   FdiEvent acknowledge(CommandVerb verb, int id, CommandOutcome outcome, bool changed, std::int64_t stamp_ns);
   void reinstate(int id);
 
@@ -178,6 +188,9 @@ class Pipeline::Impl {
   std::vector<OwnNoiseFinding> own_named_;  //!< the gyros own_noise_ named at this epoch (capacity N)
   Eigen::VectorXd held_parity_;  //!< the parity before the jump test, when it left the rest without one
   ReferenceBudget budget_;       //!< the reference's stated bias and latency, which its samples cannot show
+  EvidenceRows episode_rows_;    //!< the rows of the detection that opened the open episode
+  EvidenceRows decision_rows_;   //!< scratch: an isolation's rows with the episode's
+  std::uint64_t arbiter_refusals_ = 0;  //!< findings whose rows the arbiter did not confirm
 
   EpochFrame frame_;
   Isolations found_;
@@ -284,6 +297,19 @@ void Pipeline::Impl::withdraw_reference_rejection() {
   emit(std::move(e));
 }
 
+void Pipeline::Impl::reference_rows(RowVerdict reference, std::vector<LedgerRow>& ledger) const {
+  const auto& c = consistency_.failed_check();
+  const auto src = EvidenceSource::kReferenceTest;
+  ledger.push_back(judge(src, kHypothesisNone, c.statistic, c.threshold, c.threshold, c.dof));
+  ledger.push_back(stated(src, kHypothesisReference, reference, c.statistic, c.threshold, c.dof));
+  if (reference != RowVerdict::kNoCall) return;
+  for (int id = 1; id <= n_; ++id) {
+    if (gyro_set_.is_excluded(id)) continue;
+    ledger.push_back(
+        stated(src, static_cast<std::uint8_t>(id), RowVerdict::kNoCall, c.statistic, c.threshold, c.dof));
+  }
+}
+
 void Pipeline::Impl::judge_reference() {
   // The reference sample is tested before anything uses it (docs/fdi.md, "Reference consistency"); the
   // gyros vouch for their attitude when they leave parity, no episode is open and the rate is observable.
@@ -324,6 +350,7 @@ void Pipeline::Impl::judge_reference() {
     e.statistic = consistency_.windowed_nis();
     e.detail = v.rejected ? "attitude reference inconsistent with the gyros: left out, sigma from the gyros"
                           : reaccepted_detail();
+    if (v.rejected) reference_rows(RowVerdict::kRejected, e.ledger);
     emit(std::move(e));
   }
   if (v.rejected) {
@@ -346,6 +373,7 @@ void Pipeline::Impl::judge_reference() {
     result_.events.back().detail =
         std::string("attitude reference and gyros disagree (") + to_string(*v.inconsistent) +
         "); three gyros: the data cannot tell which, sigma and bias states widened";
+    reference_rows(RowVerdict::kNoCall, result_.events.back().ledger);
     attitude_.add_variance(z.cwiseProduct(z));
     attitude_.fault_opened(z.norm() / config_.reference_check_window_s);
     noise_match_.match_all(subsets_.get(active).mask);
@@ -385,6 +413,10 @@ void Pipeline::Impl::match_own_noise() {
     emit_detected(DetectionTest::kSignature, f.level, frame_.now_ns);
     FdiEvent& e = result_.events.back();
     e.gyro = f.gyro;
+    e.ledger.push_back(stated(EvidenceSource::kNoiseLevel, kHypothesisNone, RowVerdict::kRejected, f.level,
+                              config_.noise_high_ratio));
+    e.ledger.push_back(stated(EvidenceSource::kNoiseLevel, static_cast<std::uint8_t>(f.gyro),
+                              RowVerdict::kConsistent, f.level, config_.noise_high_ratio));
     char text[320];
     std::snprintf(text, sizeof text,
                   "gyro %d's own noise level is %.3g times its model (fourth differences, which smooth body "
@@ -478,7 +510,9 @@ void Pipeline::Impl::detect() {
   if (isolator_.open(d, frame_.now_ns, frame_.index, s, detector_)) {
     attitude_.hold_biases(isolator_.episode().onset_ns);  // before the filter opens them to the fault
     detector_.open_episode();
-    emit_detected(d.test, d.statistic, frame_.now_ns);
+    episode_rows_.clear();
+    episode_rows_.detection(source_of(d.test), d.statistic, d.threshold, d.dof);
+    emit_detected(d.test, d.statistic, frame_.now_ns, &episode_rows_);
     withdraw_reference_rejection();
     // The fault acted since its onset: widen the uncertainty for the time already spent.
     attitude_.add_bound(
@@ -496,7 +530,9 @@ void Pipeline::Impl::level_changed(const Detection& d) {
   // (docs/fdi.md, "Detection"). The episode's isolation goes on as it was (a second onset inside a drift
   // gave the onset test chances to blame a healthy gyro); the level test measures from the new level.
   const GyroMask active = gyro_set_.active();
-  emit_detected(d.test, d.statistic, frame_.now_ns);
+  EvidenceRows level;
+  level.detection(source_of(d.test), d.statistic, d.threshold, d.dof);
+  emit_detected(d.test, d.statistic, frame_.now_ns, &level);
   attitude_.add_bound(fault_rate_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()) *
                       ns_to_seconds(frame_.now_ns - isolator_.onset_time(d.onset_index, frame_.index)));
   attitude_.fault_opened(
@@ -516,7 +552,7 @@ void Pipeline::Impl::seek_evidence() {
       const FaultKind drift =
           isolator_.classify_drift(finding->gyro, frame_.index, gyro_set_.active(), subsets_);
       isolate({finding->gyro, finding->scale ? FaultKind::kScale : drift, Evidence::kReference,
-               DetectionTest::kReference, finding->statistic});
+               DetectionTest::kReference, finding->statistic, finding->rows});
     } else if (config_.filter_bias_isolation && isolator_.episode().active && attitude_.reference_aided()) {
       // The filter's bias estimates (reference + parity make each gyro's observable): one gyro alone off.
       if (const auto bias = reference_.filter_update(attitude_.filter(), gyro_set_.active()))
@@ -550,7 +586,7 @@ void Pipeline::Impl::isolate_filter_bias(const ReferenceFinding& bias) {
   const FaultKind kind = reference_.span_scale(fit.gyro, span)
                              ? FaultKind::kScale
                              : isolator_.classify_drift(fit.gyro, frame_.index, active, subsets_);
-  isolate({fit.gyro, kind, Evidence::kReference, DetectionTest::kReference, bias.statistic});
+  isolate({fit.gyro, kind, Evidence::kReference, DetectionTest::kReference, bias.statistic, bias.rows});
 }
 
 void Pipeline::Impl::decide_episode() {
@@ -569,6 +605,10 @@ void Pipeline::Impl::decide_episode() {
       u.test = episode.test;
       u.statistic = episode.statistic;
       u.detail = "no evidence tells which gyro; all gyros kept, sigma covers every single-gyro hypothesis";
+      decision_rows_.clear();
+      decision_rows_.add(episode_rows_);
+      decision_rows_.add(isolator_.rows());
+      (void)rule(decision_rows_, u.ledger);
       emit(std::move(u));
       break;
     }
@@ -580,6 +620,8 @@ void Pipeline::Impl::decide_episode() {
       c.type = EventType::kCleared;
       c.gyros = gyro_set_.active();
       c.detail = "no alarm for clear_after_s";
+      c.ledger.push_back(stated(EvidenceSource::kQuiet, kHypothesisNone, RowVerdict::kConsistent,
+                                ns_to_seconds(frame_.now_ns - episode.last_alarm_ns), config_.clear_after_s));
       emit(std::move(c));
       break;
     }
@@ -695,7 +737,17 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   if (gyro_set_.is_excluded(iso.gyro)) return;
   const std::int64_t now = frame_.now_ns;
   const bool episode = isolator_.episode().active;
-  if (!episode) emit_detected(iso.test, iso.statistic, now);
+  // The arbiter decides: a finding whose rows do not make the case (another hypothesis standing, one not
+  // judged, no fault shown) excludes nothing (docs/fdi.md, "The ledger and the arbiter").
+  decision_rows_.clear();
+  decision_rows_.add(iso.rows);
+  if (episode) decision_rows_.add(episode_rows_);
+  FdiEvent e;
+  if (rule(decision_rows_, e.ledger) != iso.gyro) {
+    ++arbiter_refusals_;
+    return;
+  }
+  if (!episode) emit_detected(iso.test, iso.statistic, now, &decision_rows_);
   if (subsets_.ready()) {
     // The fault corrupted the rate from its onset until now: keep that in the attitude uncertainty — the
     // parity's mean fault over the span, and the sum of each kept epoch's (a fault that grew faster than the
@@ -711,7 +763,6 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
                                                ns_to_seconds(now - isolator_.episode().onset_ns)));
     attitude_.add_bound(bound);
   }
-  FdiEvent e;
   e.stamp_ns = now;
   e.type = EventType::kIsolated;
   e.gyro = iso.gyro;
@@ -799,13 +850,32 @@ void Pipeline::Impl::gap() {
   emit(std::move(e));
 }
 
-void Pipeline::Impl::emit_detected(DetectionTest test, double statistic, std::int64_t now_ns) {
+void Pipeline::Impl::emit_detected(DetectionTest test, double statistic, std::int64_t now_ns,
+                                   const EvidenceRows* rows) {
   FdiEvent d;
   d.stamp_ns = now_ns;
   d.type = EventType::kDetected;
   d.test = test;
   d.statistic = statistic;
+  if (rows != nullptr) {
+    for (const LedgerRow& row : *rows) {
+      if (row.hypothesis == kHypothesisNone || row.hypothesis == kHypothesisReference)
+        d.ledger.push_back(row);
+    }
+  }
   emit(std::move(d));
+}
+
+int Pipeline::Impl::rule(const EvidenceRows& rows, std::vector<LedgerRow>& ledger) const {
+  const GyroMask active = gyro_set_.active();
+  const bool reference =
+      last_reference_ns_ && frame_.now_ns - *last_reference_ns_ <= seconds_to_ns(config_.reference_window_s);
+  ledger.clear();
+  for (const LedgerRow& row : rows) {
+    const bool gyro = row.hypothesis != kHypothesisNone && row.hypothesis != kHypothesisReference;
+    if (!gyro || has_gyro(active, row.hypothesis)) ledger.push_back(row);
+  }
+  return arbitrate(rows, active, reference);
 }
 
 void Pipeline::Impl::update_mode(std::int64_t now_ns) {
@@ -1037,6 +1107,9 @@ const PipelineConfig& Pipeline::config() const {
 }
 std::string Pipeline::describe_thresholds() const {
   return impl_->describe_thresholds();
+}
+std::uint64_t Pipeline::arbiter_refusals() const {
+  return impl_->arbiter_refusals();
 }
 
 }  // namespace tetra::fdi

@@ -108,6 +108,7 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
   if (nis > jump_chi2_) {
     // One sample far off: a lag only if the fitted lag explains this sample too (a mis-identification
     // during a rate change is not a lag).
+    failed_ = {nis, jump_chi2_, 3};
     if (!lag) return ReferenceCheck::kJump;
     double residual = 0.0;
     for (int a = 0; a < 3; ++a) {
@@ -115,12 +116,20 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
       const double r = z[a] - (offset - omega[a] * lag_s_);
       residual += r * r * w[a];
     }
+    failed_ = {residual, jump_chi2_, 3};
     if (residual > jump_chi2_) return ReferenceCheck::kJump;
   }
-  if (lag) return ReferenceCheck::kLag;
-  if (nis_high) return ReferenceCheck::kNis;
+  if (lag) {
+    failed_ = {num * num / den, lag_chi2_, 1};
+    return ReferenceCheck::kLag;
+  }
+  if (nis_high) {
+    failed_ = {block_nis_, chi2_upper_wh(dof, z_tail_), static_cast<int>(dof)};
+    return ReferenceCheck::kNis;
+  }
   double bias = 0.0;
   for (int a = 0; a < 3; ++a) bias += bias_swz_[a] * bias_swz_[a] / bias_sw_[a];
+  failed_ = {bias, jump_chi2_, 3};
   if (bias > jump_chi2_) return ReferenceCheck::kBias;
   return std::nullopt;
 }

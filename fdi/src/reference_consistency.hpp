@@ -64,6 +64,14 @@ class ReferenceConsistency {
   double sigma_rad() const { return sigma_rad_; }
   //! The window's NIS per degree of freedom (Σ zᵀS⁻¹z / 3m: 1 for a consistent reference); 0 before any.
   double windowed_nis() const { return nis_per_dof_; }
+  //! The statistic of the last test that failed (or was the last one computed), its χ² threshold and
+  //! degrees of freedom: the ledger row of a rejection.
+  struct CheckValue {
+    double statistic = 0.0;
+    double threshold = 0.0;
+    int dof = 0;
+  };
+  const CheckValue& failed_check() const { return failed_; }
 
  private:
   //! The first test that fails over the blocks with this sample in, or none.
@@ -95,6 +103,7 @@ class ReferenceConsistency {
   Eigen::Vector3d last_z_ = Eigen::Vector3d::Zero();  //!< [rad] the previous rejected sample's innovation
   bool have_last_z_ = false;
   bool noise_explained_ = false;  //!< the last block's estimate is within sigma_rad_
+  CheckValue failed_;             //!< the last test's statistic and threshold
 
   // the nis and lag block (reference_check_window_s)
   std::int64_t block_start_ns_ = -1;

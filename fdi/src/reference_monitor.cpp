@@ -34,7 +34,9 @@ std::optional<ReferenceFinding> ReferenceMonitor::filter_update(const Mekf& filt
   }
   const int culprit = filter_.confirm(config_.reference_confirm_count, 3);
   if (culprit == 0) return std::nullopt;
-  return ReferenceFinding{culprit, filter_.statistic(), false};
+  ReferenceFinding found{culprit, filter_.statistic(), false, {}};
+  filter_.rows(EvidenceSource::kFilterBias, active, found.rows);
+  return found;
 }
 
 void LoneGyro::begin() {
@@ -43,6 +45,11 @@ void LoneGyro::begin() {
 }
 
 void LoneGyro::add(int id, double z, double threshold) {
+  if (members_ < kMaxGyros) {
+    member_id_[static_cast<std::size_t>(members_)] = id;
+    member_z_[static_cast<std::size_t>(members_)] = z;
+  }
+  threshold_ = threshold;
   ++members_;
   if (z > threshold) {
     ++flagged_;
@@ -51,6 +58,26 @@ void LoneGyro::add(int id, double z, double threshold) {
   } else if (z > 0.5 * threshold) {
     ++loud_;
   }
+}
+
+void LoneGyro::rows(EvidenceSource source, GyroMask active, EvidenceRows& out) const {
+  const int members = std::min(members_, kMaxGyros);
+  const auto largest_without = [&](int j) {
+    double z = 0.0;
+    for (int m = 0; m < members; ++m) {
+      if (member_id_[static_cast<std::size_t>(m)] != j)
+        z = std::max(z, member_z_[static_cast<std::size_t>(m)]);
+    }
+    return z;
+  };
+  for (int j = 1; j <= kMaxGyros; ++j) {
+    if (has_gyro(active, j))
+      out.add(judge(source, static_cast<std::uint8_t>(j), largest_without(j), 0.5 * threshold_, threshold_));
+  }
+  out.add(judge(source, kHypothesisNone, largest_without(0), 0.5 * threshold_, threshold_));
+  const bool lone = flagged_ == 1 && loud_ == 0;
+  out.add(stated(source, kHypothesisReference, lone ? RowVerdict::kRejected : RowVerdict::kNoCall, stat_,
+                 threshold_));
 }
 
 int LoneGyro::confirm(int count, int min_members) {
@@ -151,7 +178,9 @@ std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, co
   // comparisons (consecutive windows share no reference sample, so one wild reference sample cannot do it).
   const int culprit = windows_.confirm(config_.reference_confirm_count, 2);
   if (culprit == 0) return std::nullopt;
-  return ReferenceFinding{culprit, windows_.statistic(), scale_significant(culprit, old)};
+  ReferenceFinding found{culprit, windows_.statistic(), scale_significant(culprit, old), {}};
+  windows_.rows(EvidenceSource::kReferenceWindow, all_gyros(static_cast<int>(n_)) & ~excluded, found.rows);
+  return found;
 }
 
 double ReferenceMonitor::disagreement_sigma(const GyroConstants& c, double span_s, double rot_rad) const {

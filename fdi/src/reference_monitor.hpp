@@ -3,6 +3,7 @@
 // rotation the reference saw about that gyro's axis, over windows of `reference_window_s`. One gyro alone
 // beyond the threshold, every other quiet, in `reference_confirm_count` consecutive windows isolates it.
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -23,6 +24,7 @@ struct ReferenceFinding {
   int gyro = 0;
   double statistic = 0.0;  //!< [σ] disagreement of the gyro
   bool scale = false;      //!< the error follows the rotation during a slew: a scale-factor error
+  EvidenceRows rows;       //!< the comparison's ledger rows
 };
 
 //! "One gyro alone beyond the threshold, every other below half of it, in `count` consecutive comparisons":
@@ -35,6 +37,11 @@ class LoneGyro {
   //! compared), else 0; a confirmed gyro starts the run again.
   int confirm(int count, int min_members);
   double statistic() const { return stat_; }  //!< [σ] the flagged gyro's
+  //! The last comparison as ledger rows: for each gyro j of `active`, Hj's statistic is the largest
+  //! disagreement among the gyros it holds healthy (consistent at or below half the threshold, rejected
+  //! above it); H0's the largest of all; Href rejected by the flagged gyro's when the others agree with the
+  //! reference (a wrong reference would move them too).
+  void rows(EvidenceSource source, GyroMask active, EvidenceRows& out) const;
   void reset() { run_gyro_ = run_ = 0; }
   //! A confirmed gyro that was not acted on: the next comparison that flags it alone confirms it again.
   void rearm(int id, int count) {
@@ -45,6 +52,9 @@ class LoneGyro {
  private:
   int flagged_ = 0, loud_ = 0, culprit_ = 0, members_ = 0;
   double stat_ = 0.0;
+  double threshold_ = 0.0;
+  std::array<int, kMaxGyros> member_id_{};
+  std::array<double, kMaxGyros> member_z_{};
   int run_gyro_ = 0;  //!< gyro flagged alone by the last comparisons
   int run_ = 0;       //!< how many in a row
 };

@@ -240,6 +240,19 @@ void append_statistic(std::string& out, double statistic) {
 
 }  // namespace
 
+int ruling_of(const FdiEvent& event) {
+  std::uint32_t active = 0;
+  bool reference = false;
+  for (const LedgerRow& row : event.ledger) {
+    if (row.hypothesis == kHypothesisReference) {
+      reference = true;
+    } else if (row.hypothesis != kHypothesisNone && row.hypothesis <= 32) {
+      active |= std::uint32_t{1} << (row.hypothesis - 1U);
+    }
+  }
+  return arbitrate(event.ledger.data(), event.ledger.data() + event.ledger.size(), active, reference);
+}
+
 std::string to_json(const FdiEvent& event, int n_gyros) {
   std::string out = "{\"time_s\": ";
   append_double(out, ns_to_seconds(event.stamp_ns));
@@ -294,6 +307,14 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
   if (!event.detail.empty()) {
     out += ", \"detail\": ";
     append_json_string(out, event.detail);
+  }
+  if (!event.ledger.empty()) {
+    out += ", \"ledger\": [";
+    for (std::size_t i = 0; i < event.ledger.size(); ++i) {
+      if (i > 0) out += ", ";
+      append_json(out, event.ledger[i]);
+    }
+    out += ']';
   }
   out += '}';
   return out;

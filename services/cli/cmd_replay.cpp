@@ -30,6 +30,10 @@ void add_options(CLI::App& app, report::ReplayLogOptions& o) {
                  "operator commands to re-apply where the service obeyed them (JSON lines of tetra record "
                  "--commands)");
   app.add_flag("-v,--verbose", o.verbose, "echo the configuration and the derived thresholds on stderr");
+  app.add_option(
+      "--explain", o.explain_s,
+      "[s] print the hypothesis ledger at this time of the log on stdout: the detectors' state and "
+      "the last decisions before it, each with the rows that decided it (docs/fdi.md)");
 }
 
 }  // namespace
@@ -50,8 +54,10 @@ int cmd_replay(int argc, char** argv) {
   add_options(app, options);
   if (auto status = parse(app, argc, argv)) return *status;
   options.progress_terminal = ::isatty(STDERR_FILENO) == 1 ? stderr : nullptr;
-  if (auto replayed = report::replay_log(options, std::cerr); !replayed)
+  auto replayed = report::replay_log(options, std::cerr);
+  if (!replayed)
     return report("replay", replayed.error(), {{report::kSubjectInitialQ, "--initial-q: {message}"}});
+  std::cout << replayed->explanation;
   return kExitOk;
 }
 

@@ -293,7 +293,14 @@ std::vector<std::string> trace(const GoldenScenario& g) {
     e.present = se.present;
     e.reference_q_RB = se.reference_q_RB;
     const auto& r = pipeline->step(e);
-    for (const auto& ev : r.events) lines.push_back(event_line(ev, index));
+    for (const auto& ev : r.events) {
+      lines.push_back(event_line(ev, index));
+      // Each isolation is rebuilt from its event alone: the arbiter's rule over its ledger rows names its
+      // gyro.
+      if (ev.type == fdi::EventType::kIsolated && fdi::ruling_of(ev) != ev.gyro.value_or(0))
+        lines.push_back("ARBITER: the ledger of this isolation names gyro " +
+                        std::to_string(fdi::ruling_of(ev)));
+    }
     hash_epoch(h, r, pipeline->health());
     if (r.accepted) last = r.attitude;
     if (++index % kBlock == 0) {
@@ -303,6 +310,9 @@ std::vector<std::string> trace(const GoldenScenario& g) {
   } while (simulator->next(se));
   if (index % kBlock != 0) lines.push_back(block_line(index / kBlock, h, last));
   lines.push_back(health_line(pipeline->health()));
+  // Every source's finding is one the rule confirms from its rows (the arbiter refused none).
+  if (pipeline->arbiter_refusals() != 0)
+    lines.push_back("ARBITER: refused " + std::to_string(pipeline->arbiter_refusals()) + " findings");
   return lines;
 }
 

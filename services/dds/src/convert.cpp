@@ -197,15 +197,85 @@ HealthView from_wire(const tetra_Health& in) {
 }
 
 namespace {
+//! The text, or as much as fits followed by how much was cut: never cut silently.
 template <std::size_t N>
-void copy_truncated(char (&dest)[N], const std::string& text) {
-  const std::size_t n = std::min(text.size(), N - 1);
-  text.copy(dest, n);
-  dest[n] = '\0';
+void copy_marked(char (&dest)[N], const std::string& text) {
+  std::string shown = text;
+  if (shown.size() > N - 1) {
+    std::string mark = " [cut: " + std::to_string(text.size()) + " bytes not sent]";
+    shown = text.substr(0, N - 1 - mark.size());
+    mark = " [cut: " + std::to_string(text.size() - shown.size()) + " bytes not sent]";
+    shown = text.substr(0, N - 1 - mark.size()) + mark;
+  }
+  shown.copy(dest, shown.size());
+  dest[shown.size()] = '\0';
+}
+
+tetra_RowVerdict verdict_to_wire(fdi::RowVerdict verdict) {
+  switch (verdict) {
+    case fdi::RowVerdict::kConsistent:
+      return tetra_ROW_CONSISTENT;
+    case fdi::RowVerdict::kRejected:
+      return tetra_ROW_REJECTED;
+    case fdi::RowVerdict::kNoCall:
+      break;
+  }
+  return tetra_ROW_NO_CALL;
+}
+
+fdi::RowVerdict verdict_from_wire(tetra_RowVerdict verdict) {
+  switch (verdict) {
+    case tetra_ROW_CONSISTENT:
+      return fdi::RowVerdict::kConsistent;
+    case tetra_ROW_REJECTED:
+      return fdi::RowVerdict::kRejected;
+    default:
+      return fdi::RowVerdict::kNoCall;
+  }
+}
+
+void ledger_to_wire(const std::vector<fdi::LedgerRow>& ledger, WireEvent& out) {
+  const std::size_t n = std::min(ledger.size(), out.rows.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    const fdi::LedgerRow& r = ledger[i];
+    tetra_LedgerRow& w = out.rows[i];
+    w = tetra_LedgerRow{};
+    std::string(fdi::to_string(r.source)).copy(w.source, sizeof w.source - 1);
+    std::string(fdi::to_string(fdi::info(r.source).unit)).copy(w.unit, sizeof w.unit - 1);
+    w.hypothesis = r.hypothesis;
+    w.verdict = verdict_to_wire(r.verdict);
+    w.dof = r.dof;
+    w.statistic = r.statistic;
+    w.threshold = r.threshold;
+    w.accept = r.accept;
+  }
+  out.msg.ledger._buffer = out.rows.data();
+  out.msg.ledger._length = static_cast<std::uint32_t>(n);
+  out.msg.ledger._maximum = static_cast<std::uint32_t>(out.rows.size());
+  out.msg.ledger._release = false;
+  out.msg.ledger_dropped = static_cast<std::uint16_t>(std::min<std::size_t>(ledger.size() - n, 65535));
+}
+
+std::vector<fdi::LedgerRow> ledger_from_wire(const tetra_FdiEvent2& in) {
+  std::vector<fdi::LedgerRow> ledger;
+  for (std::uint32_t i = 0; i < in.ledger._length && in.ledger._buffer != nullptr; ++i) {
+    const tetra_LedgerRow& w = in.ledger._buffer[i];
+    fdi::LedgerRow r;
+    if (!fdi::evidence_source_from_string(from_wire(w.source), r.source)) continue;  // a source unknown here
+    r.hypothesis = w.hypothesis;
+    r.verdict = verdict_from_wire(w.verdict);
+    r.dof = w.dof;
+    r.statistic = w.statistic;
+    r.threshold = w.threshold;
+    r.accept = w.accept;
+    ledger.push_back(r);
+  }
+  return ledger;
 }
 }  // namespace
 
-Status to_wire(const EventView& view, tetra_FdiEvent& out) {
+Status to_wire(const EventView& view, WireEvent& wire) {
+  tetra_FdiEvent2& out = wire.msg;
   if (auto status = copy_bounded(out.unit, view.unit, "unit"); !status) return status;
   const fdi::FdiEvent& e = view.event;
   // A reference event's test is why the reference was rejected (nis, lag, bias, jump).
@@ -216,7 +286,8 @@ Status to_wire(const EventView& view, tetra_FdiEvent& out) {
   if (auto status = copy_bounded(out.evidence, std::string(fdi::to_string(e.evidence)), "event evidence");
       !status)
     return status;
-  copy_truncated(out.detail, e.detail);
+  copy_marked(out.detail, e.detail);
+  ledger_to_wire(e.ledger, wire);
   out.event_seq = view.event_seq;
   out.command_id = view.command_id;
   out.stamp_ns = e.stamp_ns;
@@ -256,7 +327,7 @@ fdi::CommandOutcome outcome_from_wire(const std::string& detail, bool refused) {
 }
 }  // namespace
 
-EventView from_wire(const tetra_FdiEvent& in) {
+EventView from_wire(const tetra_FdiEvent2& in) {
   EventView out;
   out.unit = from_wire(in.unit);
   out.event_seq = in.event_seq;
@@ -274,6 +345,7 @@ EventView from_wire(const tetra_FdiEvent& in) {
   e.gyros = in.gyros;
   e.detail = from_wire(in.detail);
   e.outcome = outcome_from_wire(e.detail, in.refused);
+  e.ledger = ledger_from_wire(in);
   out.command = {in.command, in.force, from_wire(in.operator_id), from_wire(in.origin)};
   return out;
 }

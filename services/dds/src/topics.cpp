@@ -82,7 +82,7 @@ Result<Topics> Topics::create(const Participant& participant) {
   if (!attitude) return attitude.error();
   auto health = Topic::create(participant, &tetra_Health_desc, "Health", health_qos());
   if (!health) return health.error();
-  auto event = Topic::create(participant, &tetra_FdiEvent_desc, "FdiEvent", event_qos());
+  auto event = Topic::create(participant, &tetra_FdiEvent2_desc, "FdiEvent", event_qos());
   if (!event) return event.error();
   auto command = Topic::create(participant, &tetra_Command_desc, "Command", command_qos());
   if (!command) return command.error();

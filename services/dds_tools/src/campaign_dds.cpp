@@ -126,7 +126,7 @@ class ServiceEstimator final : public sim::Estimator {
   std::string unit_;
   std::unique_ptr<SimDdsLink> link_;
   std::optional<DdsEstimator> lockstep_;
-  std::optional<dds::Reader<tetra_FdiEvent>> event_reader_;
+  std::optional<dds::Reader<tetra_FdiEvent2>> event_reader_;
   std::optional<dds::Reader<tetra_Health>> health_reader_;
   std::map<std::uint64_t, fdi::FdiEvent> events_;  //!< pipeline events by event_seq
   std::uint64_t acks_ = 0;                         //!< command acknowledgements seen (none expected)
@@ -147,7 +147,7 @@ Status ServiceEstimator::open(const std::string& unit, const sim::Scenario& sc, 
   if (!link) return failure("the service of unit " + unit + ": " + link.error().message + log_hint());
   link_ = std::move(link.value());
   auto events =
-      dds::Reader<tetra_FdiEvent>::create(link_->participant(), link_->topics().event, dds::event_qos());
+      dds::Reader<tetra_FdiEvent2>::create(link_->participant(), link_->topics().event, dds::event_qos());
   if (!events) return events.error();
   event_reader_ = std::move(events.value());
   auto health =
@@ -159,7 +159,7 @@ Status ServiceEstimator::open(const std::string& unit, const sim::Scenario& sc, 
 }
 
 Status ServiceEstimator::take_events() {
-  auto taken = event_reader_->take([&](const tetra_FdiEvent& msg, const dds_sample_info_t&) {
+  auto taken = event_reader_->take([&](const tetra_FdiEvent2& msg, const dds_sample_info_t&) {
     if (dds::from_wire(msg.unit) != unit_) return;
     dds::EventView view = dds::from_wire(msg);
     if (view.command_id != 0) {

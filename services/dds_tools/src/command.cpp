@@ -68,7 +68,7 @@ Result<dds::EventView> send_command(const CommandOptions& o) {
   if (!session) return session.error();
   auto writer = session->writer<tetra_Command>(dds::command_qos());
   if (!writer) return writer.error();
-  auto events = session->reader<tetra_FdiEvent>(dds::event_qos());
+  auto events = session->reader<tetra_FdiEvent2>(dds::event_qos());
   if (!events) return events.error();
   if (auto s = session->watch_statuses(writer->handle(), DDS_PUBLICATION_MATCHED_STATUS, kCommandMatched); !s)
     return s.error();
@@ -87,7 +87,7 @@ Result<dds::EventView> send_command(const CommandOptions& o) {
       }
     }
     std::optional<dds::EventView> ack;
-    auto taken = events->take([&](const tetra_FdiEvent& msg, const dds_sample_info_t&) {
+    auto taken = events->take([&](const tetra_FdiEvent2& msg, const dds_sample_info_t&) {
       if (msg.command_id == command.command_id && dds::from_wire(msg.unit) == unit) ack = dds::from_wire(msg);
     });
     if (!taken) return taken.error();

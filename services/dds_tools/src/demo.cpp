@@ -70,7 +70,7 @@ void DemoWatch::take() {
   (void)health_reader_.take(
       [&](const tetra_Health& msg, const dds_sample_info_t&) { health_ = dds::from_wire(msg); });
   (void)event_reader_.take(
-      [&](const tetra_FdiEvent& msg, const dds_sample_info_t&) { on_event(dds::from_wire(msg).event); });
+      [&](const tetra_FdiEvent2& msg, const dds_sample_info_t&) { on_event(dds::from_wire(msg).event); });
 }
 
 void DemoWatch::on_event(const fdi::FdiEvent& e) {

@@ -171,7 +171,13 @@ std::string dashboard_block(const std::string& unit, const UnitView& view, std::
       << "  deadlines " << c.deadlines_missed << "  liveliness " << c.liveliness_lost << "  time-outlier "
       << c.time_outlier << "  seq-jump " << c.seq_discontinuity << "  restarts " << c.sensor_restarts << '\n';
   out << "  recent events:" << (view.events.empty() ? " none\n" : "\n");
-  for (const auto& e : view.events) out << "    " << fdi::to_json(e.event, n) << '\n';
+  for (const auto& e : view.events) {
+    // The event on one line, then why: its ledger rows, one per line.
+    fdi::FdiEvent shown = e.event;
+    shown.ledger.clear();
+    out << "    " << fdi::to_json(shown, n) << '\n';
+    for (const auto& row : e.event.ledger) out << "        " << fdi::to_text(row) << '\n';
+  }
   return out.str();
 }
 

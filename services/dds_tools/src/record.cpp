@@ -54,7 +54,7 @@ struct RecordLink {
   std::optional<dds::Reader<tetra_Attitude>> attitude;
   std::optional<dds::Reader<tetra_GyroSample>> gyro;
   std::optional<dds::Reader<tetra_AttitudeReference>> reference;
-  std::optional<dds::Reader<tetra_FdiEvent>> event;
+  std::optional<dds::Reader<tetra_FdiEvent2>> event;
 };
 
 //! Recording the service's output too: waits for its Attitude writer before the gyro reader exists,
@@ -102,7 +102,7 @@ Result<RecordLink> open_record_link(const RecordOptions& o, dds::ShutdownSignal&
   if (auto s = assign(link.gyro, link.session.reader<tetra_GyroSample>(deep)); !s) return s.error();
   if (auto s = assign(link.reference, link.session.reader<tetra_AttitudeReference>(deep)); !s)
     return s.error();
-  if (auto s = assign(link.event, link.session.reader<tetra_FdiEvent>(dds::event_qos())); !s)
+  if (auto s = assign(link.event, link.session.reader<tetra_FdiEvent2>(dds::event_qos())); !s)
     return s.error();
   for (dds_entity_t reader :
        {link.gyro->handle(), link.reference->handle(), link.attitude->handle(), link.event->handle()}) {
@@ -206,7 +206,7 @@ Status Recording::take_outputs(const RecordLink& link) {
     last_attitude_ns_ = attitude.stamp_ns;
   });
   if (!a) return a.error();
-  auto e = link.event->take([&](const tetra_FdiEvent& s, const dds_sample_info_t&) {
+  auto e = link.event->take([&](const tetra_FdiEvent2& s, const dds_sample_info_t&) {
     const auto view = dds::from_wire(s);
     if (view.unit != o_.unit) return;
     event_lines_[view.event_seq] = fdi::to_json(view.event, n_);

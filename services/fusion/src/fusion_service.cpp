@@ -69,7 +69,7 @@ Status FusionService::open_endpoints() {
   if (auto s = assign(command_reader_, session.reader<tetra_Command>(dds::command_qos())); !s) return s;
   if (auto s = assign(attitude_writer_, session.writer<tetra_Attitude>(dds::attitude_qos())); !s) return s;
   if (auto s = assign(health_writer_, session.writer<tetra_Health>(dds::health_qos())); !s) return s;
-  if (auto s = assign(event_writer_, session.writer<tetra_FdiEvent>(dds::event_qos())); !s) return s;
+  if (auto s = assign(event_writer_, session.writer<tetra_FdiEvent2>(dds::event_qos())); !s) return s;
   if (!config_.ros2.enabled) return ok_status();
   const Ros2ViewConfig names = config_.ros2.resolved(config_.unit);
   dds::Ros2View::Settings ros2{{names.name, names.frame_id, names.reference_frame_id},
@@ -423,10 +423,9 @@ Status FusionService::process_epochs(std::int64_t now_ns) {
 Status FusionService::publish_event(const fdi::FdiEvent& event, std::uint64_t command_id,
                                     const dds::CommandAudit& audit) {
   dds::EventView view{config_.unit, ++event_seq_, command_id, event, audit};
-  tetra_FdiEvent wire{};
-  if (auto s = dds::to_wire(view, wire); !s) return s;
+  if (auto s = dds::to_wire(view, event_wire_); !s) return s;
   if (event.type != fdi::EventType::kCommand) spdlog::info("fusion: event {}", fdi::to_json(event, n_gyros_));
-  return event_writer_->write(wire);
+  return event_writer_->write(event_wire_.msg);
 }
 
 void FusionService::current_health(fdi::Health& health) const {

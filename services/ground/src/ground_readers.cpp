@@ -15,7 +15,7 @@ Result<GroundReaders> GroundReaders::open(dds_domainid_t domain, const std::stri
   if (auto s = assign(r.session_, dds::Session::open(domain, unit)); !s) return s.error();
   dds::Session& session = *r.session_;
   if (auto s = assign(r.health_, session.reader<tetra_Health>(dds::health_qos())); !s) return s.error();
-  if (auto s = assign(r.event_, session.reader<tetra_FdiEvent>(dds::event_qos())); !s) return s.error();
+  if (auto s = assign(r.event_, session.reader<tetra_FdiEvent2>(dds::event_qos())); !s) return s.error();
   // A deeper history than the writer's keep-last 1: a busy ground thread still sees every epoch, so the
   // attitude it keeps is exactly one per attitude period (docs/ground.md).
   auto attitude_qos = dds::attitude_qos();
@@ -53,7 +53,7 @@ Status GroundReaders::take_health(const std::function<void(dds::HealthView&&, st
 }
 
 Status GroundReaders::take_events(const std::function<void(dds::EventView&&, std::int64_t)>& on_event) const {
-  auto taken = event_->take([&](const tetra_FdiEvent& msg, const dds_sample_info_t& info) {
+  auto taken = event_->take([&](const tetra_FdiEvent2& msg, const dds_sample_info_t& info) {
     on_event(dds::from_wire(msg), info.source_timestamp);
   });
   if (!taken) return taken.error();

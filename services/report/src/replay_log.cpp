@@ -20,20 +20,13 @@
 #include "tetra/report/attitude_csv.hpp"
 #include "tetra/report/attitude_writer.hpp"
 #include "tetra/report/command_log.hpp"
+#include "tetra/report/ledger_explainer.hpp"
 #include "tetra/report/progress.hpp"
+#include "tetra/report/text.hpp"
 
 namespace tetra::report {
 
 namespace {
-
-// printf's text as a string (the summary's figures formatted as the command has always printed them).
-template <class... Args>
-std::string printf_text(const char* format, Args... args) {
-  const int n = std::snprintf(nullptr, 0, format, args...);
-  std::string text(static_cast<std::size_t>(n > 0 ? n : 0), '\0');
-  if (n > 0) std::snprintf(text.data(), text.size() + 1, format, args...);
-  return text;
-}
 
 Result<Quaternion> parse_quaternion(const std::string& text) {
   std::array<double, 4> q{};
@@ -127,6 +120,7 @@ Status replay_block(const GyroLog& block, fdi::Pipeline& pipeline, fdi::Epoch& e
     if (block.has_reference && block.reference_present[k] != 0)
       epoch.reference_q_RB = from_wxyz(block.reference_wxyz[k]);
     const auto& r = pipeline.step(epoch);
+    if (out.explainer) out.explainer->observe(block.time_s[k], r, pipeline);
     for (const auto& e : r.events) {
       events.buffer() += fdi::to_json(e, block.gyro_count);
       events.buffer() += '\n';
@@ -145,7 +139,8 @@ Status replay_block(const GyroLog& block, fdi::Pipeline& pipeline, fdi::Epoch& e
 // their stamp, each acknowledgement written before that epoch's own events.
 Result<ReplayedLog> replay_blocks(GyroLogPrefetcher& log, fdi::Pipeline& pipeline,
                                   const std::vector<RecordedCommand>& commands, AttitudeWriter& att,
-                                  BufferedOutput& events, std::FILE* terminal) {
+                                  BufferedOutput& events, std::FILE* terminal,
+                                  std::optional<double> explain_s) {
   const int n = log.header().gyro_count;
   std::size_t next_command = 0;
   auto apply_commands_before = [&](std::int64_t stamp_ns, bool all) {
@@ -156,6 +151,7 @@ Result<ReplayedLog> replay_blocks(GyroLogPrefetcher& log, fdi::Pipeline& pipelin
     }
   };
   ReplayedLog out;
+  if (explain_s) out.explainer.emplace(*explain_s);
   fdi::Epoch epoch;
   epoch.raw.resize(static_cast<std::size_t>(n));
   epoch.present.resize(static_cast<std::size_t>(n));
@@ -248,7 +244,8 @@ Result<ReplayedLog> replay_log(const ReplayLogOptions& o, std::ostream& err) {
   preamble += attitude_header(n);
   AttitudeWriter att(**attitude_out, n, std::move(preamble));
   BufferedOutput events(**events_out);
-  auto replayed = replay_blocks(*in->log, *pipeline, in->commands, att, events, o.progress_terminal);
+  auto replayed =
+      replay_blocks(*in->log, *pipeline, in->commands, att, events, o.progress_terminal, o.explain_s);
   if (!replayed) return replayed.error();
   if (Status st = att.finish(); !st) return st.error();
   if (Status st = events.flush(); !st) return st.error();
@@ -260,6 +257,7 @@ Result<ReplayedLog> replay_log(const ReplayLogOptions& o, std::ostream& err) {
   if (const std::string w = fdi::default_noise_warning(in->cal, *config); !w.empty())
     err << command << ": warning: " << o.calibration_path << ": " << w << "\n";
   replayed->health = pipeline->health();
+  if (replayed->explainer) replayed->explanation = replayed->explainer->text(n);
   return replayed;
 }
 

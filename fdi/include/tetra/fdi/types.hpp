@@ -14,6 +14,7 @@
 
 #include "tetra/core/geometry.hpp"
 #include "tetra/core/quaternion.hpp"
+#include "tetra/fdi/ledger.hpp"
 
 namespace tetra::fdi {
 
@@ -134,10 +135,18 @@ struct FdiEvent {
   CommandOutcome outcome = CommandOutcome::kDone;  //!< command: its outcome
   ReferenceCheck why = ReferenceCheck::kNone;  //!< reference_rejected (and a `reference` detection): the test
   std::string detail;                          //!< free text: e.g. the command acknowledged and its outcome
+  //! detected, isolated, unisolated, cleared, reference_rejected: the ledger rows that decided it
+  //! (ledger.hpp)
+  std::vector<LedgerRow> ledger;
 
   //! command: refused (the outcome says why); nothing changed.
   bool refused() const { return type == EventType::kCommand && outcome != CommandOutcome::kDone; }
 };
+
+//! The gyro the arbiter's rule names from an event's ledger alone (its gyro hypotheses are the gyros that
+//! were in use; a reference existed when an Href row is there), or 0: an `isolated` event's gyro is rebuilt
+//! from it.
+int ruling_of(const FdiEvent& event);
 
 //! One JSON object (one line, no newline) per docs/interfaces.md §2.5; `n_gyros` formats the `gyros` lists.
 std::string to_json(const FdiEvent& event, int n_gyros);

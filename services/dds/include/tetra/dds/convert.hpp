@@ -71,8 +71,14 @@ struct EventView {
   fdi::FdiEvent event;
   CommandAudit command;  //!< acknowledgements (command_id != 0) only
 };
-//! Long free text is cut to the wire's bound (the detail is informative only).
-Status to_wire(const EventView& view, tetra_FdiEvent& out);
-EventView from_wire(const tetra_FdiEvent& in);
+//! An event on the wire, with the storage its ledger rows point into.
+struct WireEvent {
+  tetra_FdiEvent2 msg{};
+  std::array<tetra_LedgerRow, tetra_LEDGER_ROWS_MAX> rows{};
+};
+//! The whole event: its detail (up to 1023 bytes: every text of the pipeline; a longer one ends with
+//! "[cut: N bytes not sent]") and its ledger rows (beyond 40, `ledger_dropped` counts them).
+Status to_wire(const EventView& view, WireEvent& out);
+EventView from_wire(const tetra_FdiEvent2& in);
 
 }  // namespace tetra::dds

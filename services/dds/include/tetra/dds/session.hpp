@@ -34,7 +34,7 @@ const Topic& topic_of(const Topics& topics) {
     return topics.attitude;
   } else if constexpr (std::is_same_v<T, tetra_Health>) {
     return topics.health;
-  } else if constexpr (std::is_same_v<T, tetra_FdiEvent>) {
+  } else if constexpr (std::is_same_v<T, tetra_FdiEvent2>) {
     return topics.event;
   } else {
     static_assert(std::is_same_v<T, tetra_Command>, "not a tetra topic type");

@@ -56,7 +56,7 @@ class DemoWatch {
     if (!session) return session.error();
     auto health = session->reader<tetra_Health>(dds::health_qos());
     if (!health) return health.error();
-    auto event = session->reader<tetra_FdiEvent>(dds::event_qos());
+    auto event = session->reader<tetra_FdiEvent2>(dds::event_qos());
     if (!event) return event.error();
     return DemoWatch(std::move(session).value(), std::move(health).value(), std::move(event).value(), n_gyros,
                      out);
@@ -68,7 +68,7 @@ class DemoWatch {
   const DemoTimeline& timeline() const { return timeline_; }
 
  private:
-  DemoWatch(dds::Session session, dds::Reader<tetra_Health> health, dds::Reader<tetra_FdiEvent> event, int n,
+  DemoWatch(dds::Session session, dds::Reader<tetra_Health> health, dds::Reader<tetra_FdiEvent2> event, int n,
             std::ostream& out)
       : session_(std::move(session)),
         health_reader_(std::move(health)),
@@ -79,7 +79,7 @@ class DemoWatch {
 
   dds::Session session_;
   dds::Reader<tetra_Health> health_reader_;
-  dds::Reader<tetra_FdiEvent> event_reader_;
+  dds::Reader<tetra_FdiEvent2> event_reader_;
   int n_;
   std::ostream& out_;
   DemoTimeline timeline_;

@@ -132,7 +132,8 @@ class FusionService {
   std::optional<dds::Reader<tetra_Command>> command_reader_;
   std::optional<dds::Writer<tetra_Attitude>> attitude_writer_;
   std::optional<dds::Writer<tetra_Health>> health_writer_;
-  std::optional<dds::Writer<tetra_FdiEvent>> event_writer_;
+  std::optional<dds::Writer<tetra_FdiEvent2>> event_writer_;
+  dds::WireEvent event_wire_;                 //!< the event being written, its ledger rows' storage with it
   std::optional<dds::Ros2View> ros2_view_;    //!< `ros2: enabled: true` (docs/ros2.md)
   std::optional<DuplicateWatch> duplicates_;  //!< another service of this unit on the domain
   const dds::Condition* wake_ = nullptr;  //!< the listener wakes the waitset thread for an epoch's deadline

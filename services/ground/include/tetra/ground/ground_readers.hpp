@@ -39,7 +39,7 @@ class GroundReaders {
   GroundReaders() = default;
   std::optional<dds::Session> session_;
   std::optional<dds::Reader<tetra_Health>> health_;
-  std::optional<dds::Reader<tetra_FdiEvent>> event_;
+  std::optional<dds::Reader<tetra_FdiEvent2>> event_;
   std::optional<dds::Reader<tetra_Attitude>> attitude_;
   std::optional<dds::Writer<tetra_Command>> command_;
 };

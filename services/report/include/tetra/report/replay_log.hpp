@@ -13,6 +13,7 @@
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/types.hpp"
 #include "tetra/report/argument_names.hpp"
+#include "tetra/report/ledger_explainer.hpp"
 
 namespace tetra::report {
 
@@ -27,6 +28,7 @@ struct ReplayLogOptions {
   std::optional<std::string> initial_q;    //!< initial attitude "w,x,y,z"; none: the configuration's
   bool verbose = false;                    //!< the configuration and the derived thresholds on `err`
   std::FILE* progress_terminal = nullptr;  //!< a terminal to draw the progress line on; nullptr: none
+  std::optional<double> explain_s;         //!< [s] explain the ledger at this time (ReplayedLog::explanation)
   //! How messages name the arguments (log_path, attitude_path, ...) and the command ("command").
   ArgumentNames names;
 };
@@ -35,9 +37,11 @@ struct ReplayLogOptions {
 inline constexpr const char* kSubjectInitialQ = "initial_q";
 
 struct ReplayedLog {
-  std::size_t epochs = 0;                   //!< epochs read
-  std::map<std::string, int> event_counts;  //!< per event type (fdi::to_string)
-  fdi::Health health;                       //!< the pipeline's health after the last epoch
+  std::size_t epochs = 0;                    //!< epochs read
+  std::map<std::string, int> event_counts;   //!< per event type (fdi::to_string)
+  fdi::Health health;                        //!< the pipeline's health after the last epoch
+  std::optional<LedgerExplainer> explainer;  //!< with explain_s: what it saw
+  std::string explanation;                   //!< with explain_s: the ledger at that time
 };
 
 //! Replays the log; the outputs are written all or none (through the output layer). The summary (and

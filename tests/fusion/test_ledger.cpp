@@ -1,0 +1,156 @@
+// The hypothesis ledger and the arbiter (docs/fdi.md, "The ledger and the arbiter"): the one helper that
+// fills a row, the source table, the single rule over crafted rows (each condition of the rule removed in
+// turn must change the ruling), the rows in JSON, and the whole event — detail and rows — through the DDS
+// type and back, nothing cut.
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "tetra/dds/convert.hpp"
+#include "tetra/fdi/ledger.hpp"
+#include "tetra/fdi/types.hpp"
+
+namespace tetra::fdi {
+namespace {
+
+std::uint8_t h(int i) {
+  return static_cast<std::uint8_t>(i);
+}
+
+TEST(Ledger, TheHelperJudgesAStatisticAgainstItsThresholds) {
+  EXPECT_EQ(judge(EvidenceSource::kGlt, h(1), 3.0, 2.0, 9.0, 1).verdict, RowVerdict::kNoCall);
+  EXPECT_EQ(judge(EvidenceSource::kGlt, h(1), 2.0, 2.0, 9.0, 1).verdict, RowVerdict::kConsistent);
+  EXPECT_EQ(judge(EvidenceSource::kGlt, h(1), 9.5, 2.0, 9.0, 1).verdict, RowVerdict::kRejected);
+  EXPECT_EQ(judge(EvidenceSource::kGlt, h(1), std::nan(""), 2.0, 9.0, 1).verdict, RowVerdict::kNoCall);
+  const LedgerRow r = judge(EvidenceSource::kChi2, kHypothesisNone, 30.0, 16.27, 16.27, 3);
+  EXPECT_EQ(r.verdict, RowVerdict::kRejected);
+  EXPECT_EQ(r.dof, 3);
+}
+
+TEST(Ledger, OneTableNamesEverySourceWithItsUnit) {
+  for (int i = 0; i < kEvidenceSourceCount; ++i) {
+    const auto& s = kEvidenceSources[i];
+    EXPECT_EQ(static_cast<int>(s.source), i) << s.name;  // the table is in the enum's order
+    EvidenceSource back{};
+    ASSERT_TRUE(evidence_source_from_string(s.name, back)) << s.name;
+    EXPECT_EQ(back, s.source);
+    EXPECT_NE(std::string(s.tests), "");
+  }
+  EvidenceSource none{};
+  EXPECT_FALSE(evidence_source_from_string("lone_gyro_below_half", none));
+  for (std::uint8_t hyp :
+       {std::uint8_t{0}, std::uint8_t{1}, std::uint8_t{16}, std::uint8_t{32}, kHypothesisReference}) {
+    std::uint8_t back = 99;
+    ASSERT_TRUE(hypothesis_from_string(hypothesis_name(hyp), back)) << hypothesis_name(hyp);
+    EXPECT_EQ(back, hyp);
+  }
+  std::uint8_t x = 0;
+  EXPECT_FALSE(hypothesis_from_string("H33", x));
+  EXPECT_FALSE(hypothesis_from_string("H01", x));
+  EXPECT_FALSE(hypothesis_from_string("Hx", x));
+}
+
+//! An onset test's rows on four gyros where gyro 2 alone explains the data.
+std::vector<LedgerRow> gyro_two_alone() {
+  const auto src = EvidenceSource::kOnset;
+  return {stated(src, kHypothesisNone, RowVerdict::kRejected, 3.1, 1.0),
+          stated(src, kHypothesisReference, RowVerdict::kRejected, 3.1, 1.0),
+          stated(src, h(1), RowVerdict::kRejected, 2.9, 1.0),
+          stated(src, h(2), RowVerdict::kConsistent, 0.4, 1.0),
+          stated(src, h(3), RowVerdict::kRejected, 2.5, 1.0),
+          stated(src, h(4), RowVerdict::kRejected, 2.7, 1.0)};
+}
+
+int rule(const std::vector<LedgerRow>& rows, std::uint32_t active = 0xF, bool reference = true) {
+  return arbitrate(rows.data(), rows.data() + rows.size(), active, reference);
+}
+
+TEST(Arbiter, ExcludesOnlyTheHypothesisThatStandsAloneAndSaysNoOtherwise) {
+  auto rows = gyro_two_alone();
+  EXPECT_EQ(rule(rows), 2);
+  // A competing hypothesis the data cannot judge: no exclusion.
+  rows[4].verdict = RowVerdict::kNoCall;
+  EXPECT_EQ(rule(rows), 0);
+  // Two hypotheses consistent: no exclusion.
+  rows = gyro_two_alone();
+  rows[4].verdict = RowVerdict::kConsistent;
+  EXPECT_EQ(rule(rows), 0);
+  // The standing hypothesis rejected by another source: no exclusion.
+  rows = gyro_two_alone();
+  rows.push_back(stated(EvidenceSource::kGlt, h(2), RowVerdict::kRejected, 40.0, 9.0));
+  EXPECT_EQ(rule(rows), 0);
+  // No fault shown (H0 not rejected): no exclusion.
+  rows = gyro_two_alone();
+  rows[0].verdict = RowVerdict::kConsistent;
+  EXPECT_EQ(rule(rows), 0);
+  // A reference exists and nothing rejects it being the wrong one: no exclusion; without one, gyro 2.
+  rows = gyro_two_alone();
+  rows.erase(rows.begin() + 1);
+  EXPECT_EQ(rule(rows, 0xF, true), 0);
+  EXPECT_EQ(rule(rows, 0xF, false), 2);
+  // Gyros out of the set in use do not compete; one in use without any row does.
+  rows = gyro_two_alone();
+  EXPECT_EQ(rule(rows, 0x7), 2);
+  EXPECT_EQ(rule(rows, 0x1F), 0);
+}
+
+TEST(Ledger, DecisionEventsCarryTheirRowsInJsonAndTheRuleRebuildsTheIsolation) {
+  FdiEvent e;
+  e.type = EventType::kIsolated;
+  e.gyro = 2;
+  e.evidence = Evidence::kOnset;
+  e.ledger = gyro_two_alone();
+  EXPECT_EQ(ruling_of(e), 2);
+  const std::string json = to_json(e, 4);
+  EXPECT_NE(
+      json.find("\"ledger\": [{\"source\": \"onset\", \"hypothesis\": \"H0\", \"statistic\": 3.1, \"unit\": "
+                "\"motion bound\", \"threshold\": 1, \"verdict\": \"rejected\"}"),
+      std::string::npos)
+      << json;
+  EXPECT_NE(
+      json.find("{\"source\": \"onset\", \"hypothesis\": \"H2\", \"statistic\": 0.4, \"unit\": \"motion "
+                "bound\", \"threshold\": 1, \"verdict\": \"consistent\"}"),
+      std::string::npos)
+      << json;
+  const LedgerRow glt = judge(EvidenceSource::kGlt, h(3), 5.0, 2.0, 9.0, 1);
+  std::string one;
+  append_json(one, glt);
+  EXPECT_EQ(one,
+            "{\"source\": \"glt\", \"hypothesis\": \"H3\", \"statistic\": 5, \"unit\": \"chi2\", \"dof\": 1, "
+            "\"threshold\": 9, \"accept\": 2, \"verdict\": \"no call\"}");
+}
+
+TEST(Ledger, AnEventCrossesTheWireWholeItsDetailAndEveryRow) {
+  dds::EventView view;
+  view.unit = "unit one";
+  view.event_seq = 7;
+  view.event.type = EventType::kIsolated;
+  view.event.gyro = 2;
+  view.event.ledger = gyro_two_alone();
+  // The pipeline's longest texts are about 320 bytes; 127 used to be the wire's bound.
+  view.event.detail = std::string(600, 'd');
+  dds::WireEvent wire;
+  ASSERT_TRUE(dds::to_wire(view, wire).ok());
+  const dds::EventView back = dds::from_wire(wire.msg);
+  EXPECT_EQ(back.event.detail, view.event.detail);
+  EXPECT_EQ(back.event.ledger, view.event.ledger);
+  EXPECT_EQ(wire.msg.ledger_dropped, 0);
+  EXPECT_EQ(ruling_of(back.event), 2);
+  // Beyond the bound the text says so: never cut silently.
+  view.event.detail = std::string(1500, 'x');
+  ASSERT_TRUE(dds::to_wire(view, wire).ok());
+  const std::string cut = dds::from_wire(wire.msg).event.detail;
+  EXPECT_EQ(cut.size(), 1023U);
+  EXPECT_NE(cut.find("[cut: "), std::string::npos) << cut.substr(cut.size() - 40);
+  EXPECT_EQ(cut.substr(cut.size() - 15), "bytes not sent]");
+  // More rows than the wire holds: the count of those not carried travels with them.
+  view.event.ledger.assign(45, gyro_two_alone()[0]);
+  ASSERT_TRUE(dds::to_wire(view, wire).ok());
+  EXPECT_EQ(wire.msg.ledger._length, 40U);
+  EXPECT_EQ(wire.msg.ledger_dropped, 5);
+}
+
+}  // namespace
+}  // namespace tetra::fdi
