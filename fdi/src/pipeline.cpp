@@ -587,7 +587,7 @@ void Pipeline::Impl::decide_episode() {
 }
 
 void Pipeline::Impl::publish_attitude() {
-  frame_.usable &= gyro_set_.active();
+  frame_.usable = gate_.usable(frame_, gyro_set_.active());
   bool observable = false;
   if (!subsets_.ready()) {
     // First epoch: no time step yet, so no sample period and no subset cache; the rate is still estimated (it
