@@ -345,6 +345,10 @@ bool GyroSeries::others_normal(int id, double sqrt_period) const {
     if (j == id || has_gyro(excluded_, j)) continue;
     const double r = noise_ratio(j, sqrt_period);
     if (!std::isfinite(r) || r > kNormalLevel) return false;
+    // A finely quantized output repeating its value has just stuck (its own test needs more repeats): its
+    // frozen output is part of the motion the others see along this axis, which then hides the jerk of a
+    // slew's start from it (N = 4, a gyro at 0 V as a slew began: the healthy one was excluded first).
+    if (!coarse(j, sqrt_period) && track(j).repeat_count >= kOtherRepeats) return false;
   }
   return true;
 }

@@ -153,7 +153,7 @@ class GyroSeries {
   double project(const Track& t, const double* v) const;
   //! A noise level `r` that the motion the other gyros see cannot explain.
   bool noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const;
-  //! Every other gyro in use has a normal second-difference level.
+  //! Every other gyro in use has a normal second-difference level, and none has just begun repeating.
   bool others_normal(int id, double sqrt_period) const;
   //! [rad/s] how far the others' view of gyro `id`'s axis (1σ `sigma`) may range while its own rate stands
   //! within a quantization step: two steps and 2·onset_sigma·σ.

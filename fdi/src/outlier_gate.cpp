@@ -30,16 +30,23 @@ void OutlierGate::restart() {
   // The last step judged may have had the removed gyro in it: no call until a clean step of the gyros now in
   // use has shown the body within the bound.
   fast_motion_ = true;
+  withdrawn_ = true;
 }
 
 void OutlierGate::reset() {
   for (auto& t : tracks_) t = Track{};
   fast_motion_ = false;
+  left_out_ = 0;
+  withdrawn_ = false;
 }
 
 void OutlierGate::update(EpochFrame& frame, SubsetCache& subsets, GyroSeries& series, Counters& counters,
                          Isolations& out) {
   const int culprit = jump_culprit(frame, subsets, series);
+  left_out_ = culprit > 0 && has_gyro(frame.usable, culprit)
+                  ? GyroMask{1} << static_cast<unsigned>(culprit - 1)
+                  : GyroMask{0};
+  withdrawn_ = false;
   if (culprit > 0) {
     auto& t = tracks_[static_cast<std::size_t>(culprit - 1)];
     const double raw = frame.raw[static_cast<std::size_t>(culprit - 1)];

@@ -21,6 +21,12 @@ class OutlierGate {
   //! persistent outlier (an abrupt step) to `out`.
   void update(EpochFrame& frame, SubsetCache& subsets, GyroSeries& series, Counters& counters,
               Isolations& out);
+  //! The epoch's gyros to publish among `active`: `frame.usable`, with the sample the jump test left out of
+  //! this epoch back when a restart (an isolation) followed its call — the jump was the isolated gyro's, one
+  //! fault, so the call on another gyro is withdrawn rather than leave fewer gyros than delivered.
+  GyroMask usable(const EpochFrame& frame, GyroMask active) const {
+    return (frame.usable | (withdrawn_ ? left_out_ : GyroMask{0})) & active;
+  }
   //! Outlier runs of this gyro (> 0: its sample is being left out).
   int outlier_run(int id) const { return tracks_[static_cast<std::size_t>(id - 1)].outlier_run; }
   //! Forgets every gyro's last good sample and outlier run (after a reconfiguration).
@@ -56,6 +62,8 @@ class OutlierGate {
   mutable std::vector<double> motion_noise_;  //!< by subset mask (NaN: not yet computed); empty for N > 8
   mutable double motion_noise_period_ = 0.0;  //!< [√s] the sample period's root they were computed for
   bool fast_motion_ = false;  //!< the last step without a jump turned the body beyond the acceleration bound
+  GyroMask left_out_ = 0;     //!< the gyro this epoch's call left out of `frame.usable` (0: none)
+  bool withdrawn_ = false;    //!< a restart followed this epoch's call: it no longer stands
 };
 
 }  // namespace tetra::fdi::detail

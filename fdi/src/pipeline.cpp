@@ -629,7 +629,7 @@ void Pipeline::Impl::decide_episode() {
 }
 
 void Pipeline::Impl::publish_attitude() {
-  frame_.usable &= gyro_set_.active();
+  frame_.usable = gate_.usable(frame_, gyro_set_.active());
   bool observable = false;
   if (!subsets_.ready()) {
     // First epoch: no time step yet, so no sample period and no subset cache; the rate is still estimated (it
@@ -827,11 +827,11 @@ std::int64_t Pipeline::Impl::signature_span_ns() const {
 void Pipeline::Impl::gap() {
   // No epoch for dt: a fact of the data path, not of a gyro (docs/fdi.md, "Data path"). The rate between the
   // two epochs is unknown but for the acceleration bound: the trapezoid over the gap can miss the angle by up
-  // to a_max·τ²/4 per axis (the rate leaving its chord at a_max and coming back). The tests whose evidence
-  // would straddle the gap start again on its far side.
+  // to a·τ²/4 per axis, a the bound or the acceleration seen before it (RateAttitude::gap_bound_rad). The
+  // tests whose evidence would straddle the gap start again on its far side.
   const double tau = frame_.dt_s;
-  const double a_max = config_.max_angular_acceleration_dps2 * kDegToRad;
-  attitude_.add_bound(Eigen::Vector3d::Constant(0.25 * a_max * tau * tau));
+  const double hidden = attitude_.gap_bound_rad(tau, subsets_.get(gyro_set_.active()));
+  attitude_.add_bound(Eigen::Vector3d::Constant(hidden));
   series_.bridge_gap();
   own_noise_.bridge_gap();
   bias_match_.restart();  // a block does not straddle the gap
@@ -841,11 +841,11 @@ void Pipeline::Impl::gap() {
   e.stamp_ns = frame_.now_ns;
   e.type = EventType::kGap;
   e.statistic = tau;
-  char text[160];
+  char text[192];
   std::snprintf(text, sizeof text,
                 "no epoch for %.6g s: attitude propagated across it, sigma widened by %.3g deg per axis "
-                "(max_angular_acceleration_dps2 * gap^2 / 4)",
-                tau, 0.25 * a_max * tau * tau * kRadToDeg);
+                "(max_angular_acceleration_dps2, or the acceleration seen before it if larger, * gap^2 / 4)",
+                tau, hidden * kRadToDeg);
   e.detail = text;
   emit(std::move(e));
 }

@@ -102,6 +102,10 @@ class RateAttitude {
   void thaw(int id) { mekf_.thaw(id); }
 
   void add_bound(const Eigen::Vector3d& angle_rad) { propagator_.add_bound(angle_rad); }
+  //! [rad] on every axis: the most the trapezoid across a gap of `tau_s` can miss, a·τ²/4 (the rate leaving
+  //! its chord at a and coming back), a the larger of the configured bound and the norm of the acceleration
+  //! the gyros saw before the gap beyond its noise (`s`: the gyros in use).
+  double gap_bound_rad(double tau_s, const Subset& s) const;
   //! Adds a variance [rad²] per axis to the filter's attitude (e.g. what a rejected reference put in).
   void add_variance(const Eigen::Vector3d& var_rad2) { mekf_.add_attitude_variance(var_rad2); }
   void reset(const Quaternion& q0_RB);

@@ -28,6 +28,7 @@ struct CampaignRun {
   std::vector<Eigen::Vector3d> sigma_rad;             //!< the published 1σ per body axis, per accepted epoch
   std::vector<Eigen::Vector3d> protection_level_rad;  //!< the published protection level, per accepted epoch
   std::vector<fdi::Mode> mode;                        //!< the published mode, per accepted epoch
+  std::vector<GyroMask> delivered;  //!< the gyros whose sample was delivered and finite, per accepted epoch
   double final_sigma_deg = 0.0;
   double final_error_deg = 0.0;
 };
@@ -94,6 +95,10 @@ inline CampaignRun run_campaign(const sim::Scenario& scenario, const sim::SimOpt
       run.sigma_rad.push_back(r.attitude.sigma_rad);
       run.protection_level_rad.push_back(r.attitude.protection_level_rad);
       run.mode.push_back(r.attitude.mode);
+      GyroMask delivered = 0;
+      for (std::size_t i = 0; i < se.present.size(); ++i)
+        if (se.present[i] != 0 && std::isfinite(se.raw_V[i])) delivered |= GyroMask{1} << i;
+      run.delivered.push_back(delivered);
     }
     run.final_sigma_deg = r.attitude.sigma_rad.norm() * kRadToDeg;
     run.final_error_deg = angle_between(se.truth_q_RB, r.attitude.q_RB) * kRadToDeg;
