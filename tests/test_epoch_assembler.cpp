@@ -221,8 +221,43 @@ TEST(EpochAssembler, ReferenceIsAttachedToTheEpochWithinTolerance) {
   EXPECT_FALSE(out[0].reference_q_RB.has_value());
   ASSERT_TRUE(out[1].reference_q_RB.has_value());
   EXPECT_EQ(out[1].reference_q_RB->w(), 0.5);
-  a.add_reference(kPeriod, q);  // for an epoch already emitted
-  EXPECT_EQ(a.counters().references_late, 1U);
+  EXPECT_FALSE(out[1].reference_stamp_ns.has_value());  // its own epoch's: no stamp of its own
+}
+
+// A star tracker delivering after the epoch of its stamp was emitted: the reference goes with the next epoch,
+// stamped with its own time, for the pipeline's fusion horizon (docs/dds.md, "Epoch assembly"); of two
+// waiting the newer goes, and an epoch's own reference wins over a late one. Without the change the late
+// reference was dropped (references_late 1, no reference on epoch 3).
+TEST(EpochAssembler, AReferenceForAnEmittedEpochGoesWithTheNextAtItsOwnStamp) {
+  auto a = make();
+  const Quaternion q = from_wxyz(0.5, 0.5, 0.5, 0.5);
+  const Quaternion q_newer = from_wxyz(0.0, 1.0, 0.0, 0.0);
+  std::vector<fdi::Epoch> out;
+  for (int k = 0; k < 3; ++k) feed_epoch(a, k, 0);
+  a.poll(0, out);
+  ASSERT_EQ(out.size(), 3U);
+  a.add_reference(0, q);        // epoch 0's, 2 periods late
+  a.add_reference(kPeriod, q_newer);  // epoch 1's: newer, it replaces the first
+  a.add_reference(100, q);      // older than the one waiting: late
+  feed_epoch(a, 3, 0);
+  out.clear();
+  a.poll(0, out);
+  ASSERT_EQ(out.size(), 1U);
+  ASSERT_TRUE(out[0].reference_q_RB.has_value());
+  EXPECT_EQ(out[0].reference_q_RB->x(), 1.0);
+  ASSERT_TRUE(out[0].reference_stamp_ns.has_value());
+  EXPECT_EQ(*out[0].reference_stamp_ns, kPeriod);
+  EXPECT_EQ(a.counters().references_late, 2U);
+  // The next epoch's own reference wins over a late one waiting.
+  a.add_reference(2 * kPeriod, q);
+  a.add_reference(4 * kPeriod, q_newer);
+  feed_epoch(a, 4, 0);
+  out.clear();
+  a.poll(0, out);
+  ASSERT_EQ(out.size(), 1U);
+  ASSERT_TRUE(out[0].reference_q_RB.has_value());
+  EXPECT_FALSE(out[0].reference_stamp_ns.has_value());
+  EXPECT_EQ(a.counters().references_late, 3U);
 }
 
 // A sample that says its reference was written holds the epoch until the reference is in, whichever of the
@@ -249,8 +284,8 @@ TEST(EpochAssembler, AnEpochWhoseReferenceWasWrittenWaitsForIt) {
   ASSERT_EQ(out.size(), 1U);
   EXPECT_FALSE(out[0].reference_q_RB.has_value());
   EXPECT_EQ(a.counters().references_late, 1U);
-  a.add_reference(kPeriod, q);
-  EXPECT_EQ(a.counters().references_late, 2U);
+  a.add_reference(kPeriod, q);  // after all: it goes with the next epoch, at its own stamp
+  EXPECT_EQ(a.counters().references_late, 1U);
 }
 
 // --- The unit's clock (docs/dds.md, "Epoch assembly"): one bad stamp or sequence number never blinds it.

@@ -40,7 +40,10 @@
 //   * attitude references are attached to the epoch whose stamp is within the tolerance of theirs. A
 //     sample that says a reference for its stamp was written (`reference_written`) makes its epoch
 //     wait for that reference too (within max_latency_ns like a sample), whatever order the two
-//     streams arrive in.
+//     streams arrive in. A reference for an epoch already emitted (a star tracker delivering late) goes
+//     with the next epoch emitted, stamped with its own time (`fdi::Epoch::reference_stamp_ns`): the
+//     pipeline fuses it at that time within its fusion horizon, or counts and reports it as too late;
+//     of several waiting, the newest goes (the others count as late), and an epoch's own reference wins.
 // Times: stamps are sensor time [ns]; `now_ns` is the caller's local monotonic clock [ns].
 
 #include <cstdint>
@@ -98,7 +101,7 @@ class EpochAssembler {
   //! `reference_written`: the sender wrote a reference for this stamp (the epoch waits for it).
   Verdict add_sample(int gyro_id, std::uint64_t seq, std::int64_t stamp_ns, double raw, std::int64_t now_ns,
                      bool reference_written = false);
-  //! An attitude reference for the epoch at `stamp_ns`.
+  //! An attitude reference for the epoch at `stamp_ns` (one already emitted: with the next, at its stamp).
   void add_reference(std::int64_t stamp_ns, const Quaternion& q_RB);
   //! The gyro's stream stopped (deadline missed or liveliness lost): epochs no longer wait for it.
   //! It is present again as soon as it delivers a sample.
@@ -160,6 +163,8 @@ class EpochAssembler {
   std::vector<GyroTrack> gyros_;
   std::deque<Pending> pending_;                                 //!< sorted by stamp
   std::deque<std::pair<std::int64_t, Quaternion>> references_;  //!< sorted by stamp
+  //! the newest reference for an epoch already emitted: it goes with the next epoch, at its own stamp
+  std::optional<std::pair<std::int64_t, Quaternion>> late_reference_;
   std::optional<std::int64_t> last_emitted_ns_;
   Clock clock_;                     //!< the unit's clock
   std::optional<Clock> candidate_;  //!< a new time base the outliers may be on
