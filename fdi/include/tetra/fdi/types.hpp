@@ -120,7 +120,7 @@ struct Epoch {
   std::optional<Quaternion> reference_q_RB;  //!< attitude reference (e.g. star tracker), body → reference
   //! [ns] the reference's own time when it is not this epoch's: a reference delivered after the epoch of its
   //! stamp was fused, fused at its own time within `reference_horizon_s` (docs/fdi.md, "Late references")
-  std::optional<std::int64_t> reference_stamp_ns;
+  std::optional<std::int64_t> reference_stamp_ns = std::nullopt;
 };
 
 struct FdiEvent {

@@ -1,0 +1,127 @@
+/* A minimal tetra subscriber in C, from idl/tetra.idl alone (docs/dds.md, "Your own subscriber"):
+ * every Attitude, Health and FdiEvent of one unit as one JSON line each on stdout, in the wire's SI units.
+ * Build:  idlc -o gen idl/tetra.idl && cc -Igen examples/dds/attitude_subscriber.c gen/tetra.c -lddsc
+ * Run:    attitude_subscriber UNIT [DOMAIN [SECONDS]]   (SECONDS: stop after that long; default 0: never)
+ * A program in any language can read its standard output (examples/dds/python_bridge.py). */
+#include <inttypes.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dds/dds.h"
+#include "tetra.h"
+
+static const char* kModes[] = {"NOMINAL", "DEGRADED", "SUSPECT", "LOST"};
+static const char* kEvents[] = {"detected", "isolated", "unisolated", "reconfigured", "cleared",
+                                "lost", "command", "fdi_unavailable", "fdi_available", "gap",
+                                "reference_rejected", "reference_accepted", "reference_late"};
+static const char* kReferenceStates[] = {"absent", "accepted", "rejected"};
+
+static const char* name_of(const char** names, size_t count, int value) {
+  return value >= 0 && (size_t)value < count ? names[value] : "unknown";
+}
+#define NAME(names, value) name_of(names, sizeof names / sizeof names[0], (int)(value))
+
+/* JSON has no Inf or NaN: null (a protection level of +Inf means no integrity bound). */
+static void vec(const char* key, const double* v, int n) {
+  printf(", \"%s\": [", key);
+  for (int i = 0; i < n; ++i) {
+    if (isfinite(v[i])) printf("%s%.17g", i ? ", " : "", v[i]);
+    else printf("%snull", i ? ", " : "");
+  }
+  printf("]");
+}
+
+static void attitude(const tetra_Attitude* a) {
+  printf("{\"type\": \"attitude\", \"unit\": \"%s\", \"stamp_ns\": %" PRId64, a->unit, (int64_t)a->stamp_ns);
+  vec("q_RB", a->q_RB, 4);
+  vec("omega_BR_B_rad_s", a->omega_BR_B_rad_s, 3);
+  vec("sigma_rad", a->sigma_rad, 3);
+  vec("protection_level_rad", a->protection_level_rad, 3);
+  printf(", \"mode\": \"%s\", \"gyros\": %" PRIu32 ", \"fdi_available\": %s}\n", NAME(kModes, a->mode),
+         (uint32_t)a->gyros, a->fdi_available ? "true" : "false");
+}
+
+static void health(const tetra_Health* h) {
+  printf("{\"type\": \"health\", \"unit\": \"%s\", \"stamp_ns\": %" PRId64 ", \"mode\": \"%s\", \"used\": %" PRIu32
+         ", \"epochs_accepted\": %" PRIu64 ", \"reference_state\": \"%s\", \"reference_nis\": %.6g"
+         ", \"references_delayed\": %" PRIu64 ", \"references_too_late\": %" PRIu64
+         ", \"reference_horizon_s\": %.6g, \"samples_late\": %" PRIu64 "}\n",
+         h->unit, (int64_t)h->stamp_ns, NAME(kModes, h->mode), (uint32_t)h->used,
+         (uint64_t)h->counters.epochs_accepted, NAME(kReferenceStates, h->reference_state), h->reference_nis,
+         (uint64_t)h->references_delayed, (uint64_t)h->references_too_late, h->reference_horizon_s,
+         (uint64_t)h->counters.samples_late);
+}
+
+static void event(const tetra_FdiEvent* e) {
+  printf("{\"type\": \"event\", \"unit\": \"%s\", \"event_seq\": %" PRIu64 ", \"stamp_ns\": %" PRId64
+         ", \"event\": \"%s\", \"gyro\": %d, \"test\": \"%s\"",
+         e->unit, (uint64_t)e->event_seq, (int64_t)e->stamp_ns, NAME(kEvents, e->type), (int)e->gyro, e->test);
+  if (isfinite(e->statistic)) printf(", \"statistic\": %.9g", e->statistic);
+  printf(", \"detail\": \""); /* the detail is plain text without quotes or backslashes */
+  for (const char* c = e->detail; *c; ++c) putchar(*c == '"' || *c == '\\' ? '\'' : *c);
+  printf("\"}\n");
+}
+
+/* Takes every sample of `reader` whose key is `unit` and prints it with `print`. */
+static void take_all(dds_entity_t reader, const char* unit, void (*print)(const void*)) {
+  void* samples[16] = {NULL};
+  dds_sample_info_t infos[16];
+  int n;
+  while ((n = dds_take(reader, samples, infos, 16, 16)) > 0) {
+    for (int i = 0; i < n; ++i)
+      if (infos[i].valid_data && strcmp((const char*)samples[i], unit) == 0) print(samples[i]);
+    dds_return_loan(reader, samples, n);
+  }
+  fflush(stdout);
+}
+static void print_attitude(const void* s) { attitude((const tetra_Attitude*)s); }
+static void print_health(const void* s) { health((const tetra_Health*)s); }
+static void print_event(const void* s) { event((const tetra_FdiEvent*)s); }
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    fprintf(stderr, "usage: %s UNIT [DOMAIN [SECONDS]]\n", argv[0]);
+    return 2;
+  }
+  const char* unit = argv[1];
+  const dds_domainid_t domain = argc > 2 ? (dds_domainid_t)atoi(argv[2]) : DDS_DOMAIN_DEFAULT;
+  const double seconds = argc > 3 ? atof(argv[3]) : 0.0;
+  const dds_entity_t participant = dds_create_participant(domain, NULL, NULL);
+  if (participant < 0) {
+    fprintf(stderr, "dds_create_participant: %s\n", dds_strretcode(participant));
+    return 1;
+  }
+  /* QoS as docs/dds.md's table; the Attitude reader keeps more than the writer's 1 so none is lost here. */
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 256);
+  const dds_entity_t attitude_topic = dds_create_topic(participant, &tetra_Attitude_desc, "Attitude", NULL, NULL);
+  const dds_entity_t attitude_reader = dds_create_reader(participant, attitude_topic, qos, NULL);
+  dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL); /* Health and events: a late joiner's history */
+  const dds_entity_t health_topic = dds_create_topic(participant, &tetra_Health_desc, "Health", NULL, NULL);
+  const dds_entity_t health_reader = dds_create_reader(participant, health_topic, qos, NULL);
+  const dds_entity_t event_topic = dds_create_topic(participant, &tetra_FdiEvent_desc, "FdiEvent", NULL, NULL);
+  const dds_entity_t event_reader = dds_create_reader(participant, event_topic, qos, NULL);
+  dds_delete_qos(qos);
+  if (attitude_reader < 0 || health_reader < 0 || event_reader < 0) {
+    fprintf(stderr, "could not create the readers\n");
+    return 1;
+  }
+  const dds_entity_t waitset = dds_create_waitset(participant);
+  const dds_entity_t readers[3] = {attitude_reader, health_reader, event_reader};
+  for (int i = 0; i < 3; ++i) {
+    const dds_entity_t condition = dds_create_readcondition(readers[i], DDS_ANY_STATE);
+    dds_waitset_attach(waitset, condition, readers[i]);
+  }
+  const dds_time_t end = seconds > 0.0 ? dds_time() + (dds_duration_t)(seconds * 1e9) : DDS_NEVER;
+  while (dds_time() < end) {
+    if (dds_waitset_wait_until(waitset, NULL, 0, end) < 0) break;
+    take_all(event_reader, unit, print_event); /* an epoch's events before its attitude */
+    take_all(attitude_reader, unit, print_attitude);
+    take_all(health_reader, unit, print_health);
+  }
+  dds_delete(participant);
+  return 0;
+}
