@@ -236,9 +236,9 @@ TEST(EpochAssembler, AReferenceForAnEmittedEpochGoesWithTheNextAtItsOwnStamp) {
   for (int k = 0; k < 3; ++k) feed_epoch(a, k, 0);
   a.poll(0, out);
   ASSERT_EQ(out.size(), 3U);
-  a.add_reference(0, q);        // epoch 0's, 2 periods late
+  a.add_reference(0, q);              // epoch 0's, 2 periods late
   a.add_reference(kPeriod, q_newer);  // epoch 1's: newer, it replaces the first
-  a.add_reference(100, q);      // older than the one waiting: late
+  a.add_reference(100, q);            // older than the one waiting: late
   feed_epoch(a, 3, 0);
   out.clear();
   a.poll(0, out);

@@ -108,6 +108,19 @@ TEST(SimCli, WriteUnitWritesTheShippedSeedUnit) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("u2.yaml")));
 }
 
+// `sim --dds` writes no files: --out and --truth are refused (exit 2, one line naming both) before any DDS
+// entity is made, never silently ignored (before the change: a run without readers, exit 1, and no file).
+TEST(SimCli, DdsRefusesOutAndTruthInsteadOfIgnoringThem) {
+  TempDir dir;
+  for (const std::string option : {"--truth", "-o"}) {
+    const auto r = run_tetra("sim orbit --dds --domain 226 --minutes 0.1 --wait-timeout 1 " + option + " " +
+                             dir.file("f.csv"));
+    EXPECT_EQ(r.exit_status, 2) << option << ": " << r.err;
+    EXPECT_NE(r.err.find("--out and --truth do not apply with --dds"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("f.csv")));
+  }
+}
+
 TEST(FusionCli, ShippedServiceConfigurationIsAcceptedAndItsReadersTimeoutNamesTheRefusedQos) {
   ASSERT_TRUE(kLoopback);
   TempDir dir;

@@ -13,9 +13,19 @@
 #include "tetra.h"
 
 static const char* kModes[] = {"NOMINAL", "DEGRADED", "SUSPECT", "LOST"};
-static const char* kEvents[] = {"detected", "isolated", "unisolated", "reconfigured", "cleared",
-                                "lost", "command", "fdi_unavailable", "fdi_available", "gap",
-                                "reference_rejected", "reference_accepted", "reference_late"};
+static const char* kEvents[] = {"detected",
+                                "isolated",
+                                "unisolated",
+                                "reconfigured",
+                                "cleared",
+                                "lost",
+                                "command",
+                                "fdi_unavailable",
+                                "fdi_available",
+                                "gap",
+                                "reference_rejected",
+                                "reference_accepted",
+                                "reference_late"};
 static const char* kReferenceStates[] = {"absent", "accepted", "rejected"};
 
 static const char* name_of(const char** names, size_t count, int value) {
@@ -27,8 +37,10 @@ static const char* name_of(const char** names, size_t count, int value) {
 static void vec(const char* key, const double* v, int n) {
   printf(", \"%s\": [", key);
   for (int i = 0; i < n; ++i) {
-    if (isfinite(v[i])) printf("%s%.17g", i ? ", " : "", v[i]);
-    else printf("%snull", i ? ", " : "");
+    if (isfinite(v[i]))
+      printf("%s%.17g", i ? ", " : "", v[i]);
+    else
+      printf("%snull", i ? ", " : "");
   }
   printf("]");
 }
@@ -44,8 +56,9 @@ static void attitude(const tetra_Attitude* a) {
 }
 
 static void health(const tetra_Health* h) {
-  printf("{\"type\": \"health\", \"unit\": \"%s\", \"stamp_ns\": %" PRId64 ", \"mode\": \"%s\", \"used\": %" PRIu32
-         ", \"epochs_accepted\": %" PRIu64 ", \"reference_state\": \"%s\", \"reference_nis\": %.6g"
+  printf("{\"type\": \"health\", \"unit\": \"%s\", \"stamp_ns\": %" PRId64
+         ", \"mode\": \"%s\", \"used\": %" PRIu32 ", \"epochs_accepted\": %" PRIu64
+         ", \"reference_state\": \"%s\", \"reference_nis\": %.6g"
          ", \"references_delayed\": %" PRIu64 ", \"references_too_late\": %" PRIu64
          ", \"reference_horizon_s\": %.6g, \"samples_late\": %" PRIu64 "}\n",
          h->unit, (int64_t)h->stamp_ns, NAME(kModes, h->mode), (uint32_t)h->used,
@@ -57,7 +70,8 @@ static void health(const tetra_Health* h) {
 static void event(const tetra_FdiEvent* e) {
   printf("{\"type\": \"event\", \"unit\": \"%s\", \"event_seq\": %" PRIu64 ", \"stamp_ns\": %" PRId64
          ", \"event\": \"%s\", \"gyro\": %d, \"test\": \"%s\"",
-         e->unit, (uint64_t)e->event_seq, (int64_t)e->stamp_ns, NAME(kEvents, e->type), (int)e->gyro, e->test);
+         e->unit, (uint64_t)e->event_seq, (int64_t)e->stamp_ns, NAME(kEvents, e->type), (int)e->gyro,
+         e->test);
   if (isfinite(e->statistic)) printf(", \"statistic\": %.9g", e->statistic);
   printf(", \"detail\": \""); /* the detail is plain text without quotes or backslashes */
   for (const char* c = e->detail; *c; ++c) putchar(*c == '"' || *c == '\\' ? '\'' : *c);
@@ -76,9 +90,15 @@ static void take_all(dds_entity_t reader, const char* unit, void (*print)(const 
   }
   fflush(stdout);
 }
-static void print_attitude(const void* s) { attitude((const tetra_Attitude*)s); }
-static void print_health(const void* s) { health((const tetra_Health*)s); }
-static void print_event(const void* s) { event((const tetra_FdiEvent*)s); }
+static void print_attitude(const void* s) {
+  attitude((const tetra_Attitude*)s);
+}
+static void print_health(const void* s) {
+  health((const tetra_Health*)s);
+}
+static void print_event(const void* s) {
+  event((const tetra_FdiEvent*)s);
+}
 
 int main(int argc, char** argv) {
   if (argc < 2) {
@@ -97,12 +117,14 @@ int main(int argc, char** argv) {
   dds_qos_t* qos = dds_create_qos();
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 256);
-  const dds_entity_t attitude_topic = dds_create_topic(participant, &tetra_Attitude_desc, "Attitude", NULL, NULL);
+  const dds_entity_t attitude_topic =
+      dds_create_topic(participant, &tetra_Attitude_desc, "Attitude", NULL, NULL);
   const dds_entity_t attitude_reader = dds_create_reader(participant, attitude_topic, qos, NULL);
   dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL); /* Health and events: a late joiner's history */
   const dds_entity_t health_topic = dds_create_topic(participant, &tetra_Health_desc, "Health", NULL, NULL);
   const dds_entity_t health_reader = dds_create_reader(participant, health_topic, qos, NULL);
-  const dds_entity_t event_topic = dds_create_topic(participant, &tetra_FdiEvent_desc, "FdiEvent", NULL, NULL);
+  const dds_entity_t event_topic =
+      dds_create_topic(participant, &tetra_FdiEvent_desc, "FdiEvent", NULL, NULL);
   const dds_entity_t event_reader = dds_create_reader(participant, event_topic, qos, NULL);
   dds_delete_qos(qos);
   if (attitude_reader < 0 || health_reader < 0 || event_reader < 0) {

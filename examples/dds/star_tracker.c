@@ -63,8 +63,10 @@ int main(int argc, char** argv) {
     }
     ref.stamp_ns = stamp_ns;
     const dds_return_t rc = dds_write(writer, &ref);
-    if (rc != DDS_RETCODE_OK) fprintf(stderr, "dds_write: %s\n", dds_strretcode(rc));
-    else ++written;
+    if (rc != DDS_RETCODE_OK)
+      fprintf(stderr, "dds_write: %s\n", dds_strretcode(rc));
+    else
+      ++written;
   }
   fprintf(stderr, "star_tracker: %llu references written\n", written);
   dds_sleepfor(DDS_MSECS(200)); /* reliable: let the last ones be acknowledged before the participant goes */

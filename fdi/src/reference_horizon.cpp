@@ -56,7 +56,8 @@ PlacedReference ReferenceHorizon::place(std::int64_t ref_ns, const Quaternion& q
       continue;
     }
     const Quaternion& newest = ring_[head_].gyro_RB;
-    placed.q_RB = propagate((q_ref_RB * (e.gyro_RB.conjugate() * newest)).normalized(), omega_BR_B_rad_s, dt_s);
+    placed.q_RB =
+        propagate((q_ref_RB * (e.gyro_RB.conjugate() * newest)).normalized(), omega_BR_B_rad_s, dt_s);
     placed.age = ReferenceAge::kDelayed;
     return placed;
   }

@@ -3,9 +3,11 @@
 // stamped with its own time (fdi::Epoch::reference_stamp_ns), as the service's epoch assembler hands it over.
 // Seeded simulator runs of the slews scenario (its 1 Hz, 5″ reference; slews up to 1 deg/s, where 300 ms is
 // 0.3° against 5″) straight into fdi::Pipeline:
-//   * in time (the baseline), late within the fusion horizon, late beyond it (horizon 0), and late but fused as
+//   * in time (the baseline), late within the fusion horizon, late beyond it (horizon 0), and late but fused
+//   as
 //     if taken on the epoch it reached (no horizon: what a pipeline without it would do);
-//   * NEES e_a²/σ_a² over the three axes averaged over a run's sampled epochs, then over the runs (the band of
+//   * NEES e_a²/σ_a² over the three axes averaged over a run's sampled epochs, then over the runs (the band
+//   of
 //     test_mekf.cpp: [χ²_{3R}(0.025), χ²_{3R}(0.975)]/R), the fraction within 3σ, the RMS error.
 #include <cmath>
 #include <cstdio>

@@ -67,7 +67,8 @@ static_assert(static_cast<int>(tetra_EVENT_FDI_AVAILABLE) == static_cast<int>(fd
 static_assert(static_cast<int>(tetra_EVENT_GAP) == static_cast<int>(fdi::EventType::kGap));
 static_assert(static_cast<int>(tetra_EVENT_REFERENCE_ACCEPTED) ==
               static_cast<int>(fdi::EventType::kReferenceAccepted));
-static_assert(static_cast<int>(tetra_EVENT_REFERENCE_LATE) == static_cast<int>(fdi::EventType::kReferenceLate));
+static_assert(static_cast<int>(tetra_EVENT_REFERENCE_LATE) ==
+              static_cast<int>(fdi::EventType::kReferenceLate));
 static_assert(static_cast<int>(tetra_REFERENCE_REJECTED) == static_cast<int>(fdi::ReferenceState::kRejected));
 
 Status to_wire(const std::string& unit, const fdi::AttitudeEstimate& attitude, tetra_Attitude& out) {

@@ -172,7 +172,7 @@ struct Counters {
   std::uint64_t reference_rejected = 0;  //!< reference samples its χ² gate rejected or left out (rejected)
   std::uint64_t reference_reinitialized = 0;  //!< times a run of rejections set the attitude again
   std::uint64_t reference_invalid = 0;  //!< reference samples left out: not finite or norm not 1 within 1e-3
-  std::uint64_t reference_delayed = 0;   //!< reference samples stamped before their epoch, fused at their time
+  std::uint64_t reference_delayed = 0;  //!< reference samples stamped before their epoch, fused at their time
   std::uint64_t reference_too_late = 0;  //!< reference samples stamped beyond the fusion horizon: left out
 };
 
