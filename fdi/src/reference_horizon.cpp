@@ -18,6 +18,11 @@ void ReferenceHorizon::prepare(double period_s) {
   ring_.assign(size, Entry{});
   head_ = 0;
   count_ = 0;
+  // The epochs before the period was known (the first one): the newest stays buffered.
+  if (has_final_ && !ring_.empty()) {
+    ring_[0] = newest_;
+    count_ = 1;
+  }
 }
 
 void ReferenceHorizon::reset() {
@@ -33,9 +38,10 @@ void ReferenceHorizon::record(std::int64_t stamp_ns, const Quaternion& q_propaga
   if (has_final_) gyro_RB_ = (gyro_RB_ * (last_final_RB_.conjugate() * q_propagated_RB)).normalized();
   last_final_RB_ = q_final_RB;
   has_final_ = true;
+  newest_ = {stamp_ns, gyro_RB_};
   if (ring_.empty()) return;
   head_ = (head_ + 1) % ring_.size();
-  ring_[head_] = {stamp_ns, gyro_RB_};
+  ring_[head_] = newest_;
   if (count_ < ring_.size()) ++count_;
 }
 
@@ -84,10 +90,10 @@ std::optional<Quaternion> ReferenceHorizon::admit(const Epoch& epoch, const Quat
     e.stamp_ns = epoch.stamp_ns;
     e.type = EventType::kReferenceLate;
     e.statistic = placed.late_s;
-    char text[160];
+    char text[256];
     std::snprintf(text, sizeof text,
-                  "attitude reference stamped %.3f s before its epoch, beyond the fusion horizon "
-                  "(reference_horizon_s %.3g): left out, and every later one as late",
+                  "attitude reference stamped %.3f s before the epoch it reached: beyond the fusion horizon "
+                  "(reference_horizon_s %.3g) or at no epoch it holds; left out, and every later one as late",
                   placed.late_s, horizon_s_);
     e.detail = text;
     events.push_back(std::move(e));

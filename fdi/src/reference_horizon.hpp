@@ -70,6 +70,7 @@ class ReferenceHorizon {
   bool has_final_ = false;
   bool late_run_ = false;  //!< the last reference was too late (reported once per run)
   Quaternion last_final_RB_ = Quaternion::Identity();
+  Entry newest_;  //!< the newest epoch recorded (kept while the ring is not sized yet)
   Quaternion gyro_RB_ = Quaternion::Identity();
 };
 

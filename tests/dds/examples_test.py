@@ -8,7 +8,7 @@ it), and the C subscriber (examples/dds/attitude_subscriber) hands every Attitud
 service back to Python. Run twice: with the default fusion horizon (0.5 s) every late reference is fused at its
 own time and the attitude follows the truth with an honest sigma; with `reference_horizon_s: 0` every one is too
 late, counted in Health and reported by one `reference_late` event, and the attitude is the gyros' alone (the
-constant offset of the service's initial attitude from the truth). Prints `[ figure ]` lines; exit 0 on pass.
+service starts 0.5 deg off the truth, which only the references can tell it). Prints `[ figure ]` lines; exit 0 on pass.
 """
 import argparse
 import csv
@@ -71,11 +71,13 @@ def run_case(args, horizon_s, domain, work):
     for r in csv.reader(line for line in open(truth_path) if not line.startswith("#")):
         if r[0] != "time_s":
             truth[round(float(r[0]) * 1e6)] = tuple(float(v) for v in r[1:5])
+    # The service starts 0.5 deg off the truth: only the references can tell it (the first one sets it).
+    q0 = qmul(truth[round(epochs[0][0] * 1e6)], qexp([0.5 * math.pi / 180, 0.0, 0.0]))
     config = os.path.join(work, "fusion.yaml")
     with open(config, "w") as f:
         f.write("unit: tetra-py\ncalibration: %s\nsample_rate_hz: 100\nspeed: 1\nhealth_period_s: 0.5\n"
-                "pipeline:\n  initial_q_wxyz: [1, 0, 0, 0]\n  reference_horizon_s: %g\n"
-                % (os.path.join(args.source, "examples", "seed_unit.yaml"), horizon_s))
+                "pipeline:\n  initial_q_wxyz: [%.17g, %.17g, %.17g, %.17g]\n  reference_horizon_s: %g\n"
+                % (os.path.join(args.source, "examples", "seed_unit.yaml"), *q0, horizon_s))
     fusion_log = open(os.path.join(work, "fusion.log"), "w")
     fusion = subprocess.Popen([args.tetra, "fusion", "--config", config, "--domain", str(domain)],
                               stdout=fusion_log, stderr=fusion_log)
