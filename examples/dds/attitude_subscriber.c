@@ -1,7 +1,7 @@
 /* A minimal tetra subscriber in C, from idl/tetra.idl alone (docs/dds.md, "Your own subscriber"):
  * every Attitude, Health and FdiEvent of one unit as one JSON line each on stdout, in the wire's SI units.
  * Build:  idlc -o gen idl/tetra.idl && cc -Igen examples/dds/attitude_subscriber.c gen/tetra.c -lddsc
- * Run:    attitude_subscriber UNIT [DOMAIN [SECONDS]]   (SECONDS: stop after that long; default 0: never)
+ * Run:    attitude_subscriber UNIT [--domain N] [--seconds S]   (stop after S seconds; default: never)
  * A program in any language can read its standard output (examples/dds/python_bridge.py). */
 #include <inttypes.h>
 #include <math.h>
@@ -45,7 +45,8 @@ static void vec(const char* key, const double* v, int n) {
   printf("]");
 }
 
-static void attitude(const tetra_Attitude* a) {
+static void print_attitude(const void* sample) {
+  const tetra_Attitude* a = sample;
   printf("{\"type\": \"attitude\", \"unit\": \"%s\", \"stamp_ns\": %" PRId64, a->unit, (int64_t)a->stamp_ns);
   vec("q_RB", a->q_RB, 4);
   vec("omega_BR_B_rad_s", a->omega_BR_B_rad_s, 3);
@@ -55,7 +56,8 @@ static void attitude(const tetra_Attitude* a) {
          (uint32_t)a->gyros, a->fdi_available ? "true" : "false");
 }
 
-static void health(const tetra_Health* h) {
+static void print_health(const void* sample) {
+  const tetra_Health* h = sample;
   printf("{\"type\": \"health\", \"unit\": \"%s\", \"stamp_ns\": %" PRId64
          ", \"mode\": \"%s\", \"used\": %" PRIu32 ", \"epochs_accepted\": %" PRIu64
          ", \"reference_state\": \"%s\", \"reference_nis\": %.6g"
@@ -67,7 +69,8 @@ static void health(const tetra_Health* h) {
          (uint64_t)h->counters.samples_late);
 }
 
-static void event(const tetra_FdiEvent* e) {
+static void print_event(const void* sample) {
+  const tetra_FdiEvent* e = sample;
   printf("{\"type\": \"event\", \"unit\": \"%s\", \"event_seq\": %" PRIu64 ", \"stamp_ns\": %" PRId64
          ", \"event\": \"%s\", \"gyro\": %d, \"test\": \"%s\"",
          e->unit, (uint64_t)e->event_seq, (int64_t)e->stamp_ns, NAME(kEvents, e->type), (int)e->gyro,
@@ -78,7 +81,7 @@ static void event(const tetra_FdiEvent* e) {
   printf("\"}\n");
 }
 
-/* Takes every sample of `reader` whose key is `unit` and prints it with `print`. */
+/* Prints every sample of `reader` whose key is `unit` (every tetra type begins with its key). */
 static void take_all(dds_entity_t reader, const char* unit, void (*print)(const void*)) {
   void* samples[16] = {NULL};
   dds_sample_info_t infos[16];
@@ -90,24 +93,23 @@ static void take_all(dds_entity_t reader, const char* unit, void (*print)(const 
   }
   fflush(stdout);
 }
-static void print_attitude(const void* s) {
-  attitude((const tetra_Attitude*)s);
-}
-static void print_health(const void* s) {
-  health((const tetra_Health*)s);
-}
-static void print_event(const void* s) {
-  event((const tetra_FdiEvent*)s);
-}
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    fprintf(stderr, "usage: %s UNIT [DOMAIN [SECONDS]]\n", argv[0]);
+  const char* unit = argc > 1 ? argv[1] : "";
+  dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
+  double seconds = 0.0;
+  for (int i = 2; i + 1 < argc; i += 2) {
+    if (strcmp(argv[i], "--domain") == 0)
+      domain = (dds_domainid_t)atoi(argv[i + 1]);
+    else if (strcmp(argv[i], "--seconds") == 0)
+      seconds = atof(argv[i + 1]);
+    else
+      argc = 0;
+  }
+  if (argc < 2 || argc % 2 != 0) {
+    fprintf(stderr, "usage: %s UNIT [--domain N] [--seconds S]\n", argv[0]);
     return 2;
   }
-  const char* unit = argv[1];
-  const dds_domainid_t domain = argc > 2 ? (dds_domainid_t)atoi(argv[2]) : DDS_DOMAIN_DEFAULT;
-  const double seconds = argc > 3 ? atof(argv[3]) : 0.0;
   const dds_entity_t participant = dds_create_participant(domain, NULL, NULL);
   if (participant < 0) {
     fprintf(stderr, "dds_create_participant: %s\n", dds_strretcode(participant));

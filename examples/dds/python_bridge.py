@@ -16,8 +16,8 @@ class Subscriber:
     """Every Attitude, Health and FdiEvent of `unit` as dicts (key "type": attitude, health, event)."""
 
     def __init__(self, exe, unit, domain, seconds=0.0):
-        self.proc = subprocess.Popen([exe, unit, str(domain), str(seconds)], stdout=subprocess.PIPE,
-                                     text=True, bufsize=1)
+        self.proc = subprocess.Popen([exe, unit, "--domain", str(domain), "--seconds", str(seconds)],
+                                     stdout=subprocess.PIPE, text=True, bufsize=1)
 
     def __iter__(self):
         for line in self.proc.stdout:
@@ -33,7 +33,7 @@ class StarTracker:
     """Publishes attitude references: send(stamp_ns, q_RB_wxyz) writes one at once, stamped with its time."""
 
     def __init__(self, exe, unit, domain):
-        self.proc = subprocess.Popen([exe, unit, str(domain)], stdin=subprocess.PIPE,
+        self.proc = subprocess.Popen([exe, unit, "--domain", str(domain)], stdin=subprocess.PIPE,
                                      stderr=subprocess.PIPE, text=True, bufsize=1)
         ready = self.proc.stderr.readline()  # the service's reader matched
         if ready.strip() != "ready":

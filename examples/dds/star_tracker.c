@@ -3,7 +3,8 @@
  * taken at [ns] and the body -> reference quaternion, scalar first — as soon as the line is read, however
  * late that is: the service fuses a reference at its own stamp within its fusion horizon (default 0.5 s).
  * Build:  idlc -o gen idl/tetra.idl && cc -Igen examples/dds/star_tracker.c gen/tetra.c -lddsc
- * Run:    star_tracker UNIT [DOMAIN]   (waits up to 10 s for a reader, says `ready` on stderr, then reads) */
+ * Run:    star_tracker UNIT [--domain N]   (waits up to 10 s for a reader, says `ready` on stderr, then
+ * reads) */
 #include <inttypes.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,11 +14,12 @@
 #include "tetra.h"
 
 int main(int argc, char** argv) {
-  if (argc < 2 || strlen(argv[1]) > 31) {
-    fprintf(stderr, "usage: %s UNIT [DOMAIN]   (UNIT: 1-31 bytes)\n", argv[0]);
+  const int with_domain = argc == 4 && strcmp(argv[2], "--domain") == 0;
+  if ((argc != 2 && !with_domain) || strlen(argv[1]) > 31) {
+    fprintf(stderr, "usage: %s UNIT [--domain N]   (UNIT: 1-31 bytes)\n", argv[0]);
     return 2;
   }
-  const dds_domainid_t domain = argc > 2 ? (dds_domainid_t)atoi(argv[2]) : DDS_DOMAIN_DEFAULT;
+  const dds_domainid_t domain = with_domain ? (dds_domainid_t)atoi(argv[3]) : DDS_DOMAIN_DEFAULT;
   const dds_entity_t participant = dds_create_participant(domain, NULL, NULL);
   if (participant < 0) {
     fprintf(stderr, "dds_create_participant: %s\n", dds_strretcode(participant));
