@@ -90,11 +90,12 @@ std::optional<Quaternion> ReferenceHorizon::admit(const Epoch& epoch, const Quat
     e.stamp_ns = epoch.stamp_ns;
     e.type = EventType::kReferenceLate;
     e.statistic = placed.late_s;
-    char text[256];
-    std::snprintf(text, sizeof text,
-                  "attitude reference stamped %.3f s before the epoch it reached: beyond the fusion horizon "
-                  "(reference_horizon_s %.3g) or at no epoch it holds; left out, and every later one as late",
-                  placed.late_s, horizon_s_);
+    char text[160];  // within FdiEvent.detail's 127 bytes on the wire
+    std::snprintf(
+        text, sizeof text,
+        "attitude reference %.3f s late, beyond the fusion horizon (%.3g s) or off its epochs: left "
+        "out, as is each one as late",
+        placed.late_s, horizon_s_);
     e.detail = text;
     events.push_back(std::move(e));
   }

@@ -47,7 +47,8 @@ struct Outcome {
   int late_events = 0;
   int other_events = 0;
   double late_event_s = 0.0;  //!< [s] the first reference_late event's statistic
-  double min_late_s = 1e9;    //!< [s] (delivered references only)
+  std::size_t late_detail_bytes = 0;
+  double min_late_s = 1e9;  //!< [s] (delivered references only)
   double max_late_s = 0.0;
 
   double mean_nees() const { return nees_sum / kRuns; }
@@ -107,6 +108,7 @@ void run(std::uint64_t seed, Delivery delivery, double horizon_s, Outcome& o) {
     for (const auto& ev : r.events) {
       if (ev.type == fdi::EventType::kReferenceLate) {
         if (o.late_events++ == 0) o.late_event_s = ev.statistic;
+        o.late_detail_bytes = std::max(o.late_detail_bytes, ev.detail.size());
       } else {
         ++o.other_events;
       }
@@ -181,6 +183,7 @@ TEST(LateReference, BeyondTheHorizonIsCountedAndReportedAndFusingItAsIfNowWouldB
   EXPECT_EQ(dropped.late_events, kRuns);  // one per run: the first of a run of late samples
   EXPECT_GE(dropped.late_event_s, 0.05);
   EXPECT_LE(dropped.late_event_s, 0.31);
+  EXPECT_LE(dropped.late_detail_bytes, 127U);  // arrives whole in FdiEvent.detail (string<127>)
   EXPECT_EQ(dropped.accepted, 0U);
   EXPECT_GE(dropped.within_3sigma(), 0.99);
   const Outcome as_if_now = campaign(Delivery::kLateAsIfNow, 0.5, "50-300 ms late, fused as if now");
