@@ -221,7 +221,41 @@ TEST(EpochAssembler, ReferenceIsAttachedToTheEpochWithinTolerance) {
   EXPECT_FALSE(out[0].reference_q_RB.has_value());
   ASSERT_TRUE(out[1].reference_q_RB.has_value());
   EXPECT_EQ(out[1].reference_q_RB->w(), 0.5);
-  a.add_reference(kPeriod, q);  // for an epoch already emitted
+  EXPECT_FALSE(out[1].reference_stamp_ns.has_value());  // its own epoch's: no stamp of its own
+}
+
+// A star tracker delivering after the epoch of its stamp was emitted: the reference goes with the next epoch,
+// stamped with its own time, for the pipeline's fusion horizon (docs/dds.md, "Epoch assembly"); several
+// waiting go one an epoch, oldest first, and an epoch's own reference goes before them. Without the change
+// each late reference was dropped (references_late 3, no reference on epochs 3 and 4).
+TEST(EpochAssembler, AReferenceForAnEmittedEpochGoesWithTheNextAtItsOwnStamp) {
+  auto a = make();
+  const Quaternion q = from_wxyz(0.5, 0.5, 0.5, 0.5);
+  const Quaternion q_other = from_wxyz(0.0, 1.0, 0.0, 0.0);
+  std::vector<fdi::Epoch> out;
+  for (int k = 0; k < 3; ++k) feed_epoch(a, k, 0);
+  a.poll(0, out);
+  ASSERT_EQ(out.size(), 3U);
+  a.add_reference(kPeriod, q_other);  // epoch 1's, 2 periods late
+  a.add_reference(0, q);              // epoch 0's, later still: it goes first (oldest stamp)
+  a.add_reference(4 * kPeriod, q);    // epoch 4's own, in time
+  out.clear();
+  for (int k = 3; k < 6; ++k) feed_epoch(a, k, 0);
+  a.poll(0, out);
+  ASSERT_EQ(out.size(), 3U);
+  ASSERT_TRUE(out[0].reference_q_RB.has_value());  // epoch 3: the oldest late one
+  EXPECT_EQ(out[0].reference_q_RB->w(), 0.5);
+  ASSERT_TRUE(out[0].reference_stamp_ns.has_value());
+  EXPECT_EQ(*out[0].reference_stamp_ns, 0);
+  ASSERT_TRUE(out[1].reference_q_RB.has_value());  // epoch 4: its own
+  EXPECT_FALSE(out[1].reference_stamp_ns.has_value());
+  ASSERT_TRUE(out[2].reference_q_RB.has_value());  // epoch 5: the next late one
+  EXPECT_EQ(out[2].reference_q_RB->x(), 1.0);
+  EXPECT_EQ(out[2].reference_stamp_ns.value_or(-1), kPeriod);
+  EXPECT_EQ(a.counters().references_late, 0U);
+  // At most kMaxLateReferences wait: the oldest beyond gives way, counted.
+  for (std::size_t i = 0; i <= EpochAssembler::kMaxLateReferences; ++i)
+    a.add_reference(static_cast<std::int64_t>(i) * 1000, q);
   EXPECT_EQ(a.counters().references_late, 1U);
 }
 
@@ -249,8 +283,8 @@ TEST(EpochAssembler, AnEpochWhoseReferenceWasWrittenWaitsForIt) {
   ASSERT_EQ(out.size(), 1U);
   EXPECT_FALSE(out[0].reference_q_RB.has_value());
   EXPECT_EQ(a.counters().references_late, 1U);
-  a.add_reference(kPeriod, q);
-  EXPECT_EQ(a.counters().references_late, 2U);
+  a.add_reference(kPeriod, q);  // after all: it goes with the next epoch, at its own stamp
+  EXPECT_EQ(a.counters().references_late, 1U);
 }
 
 // --- The unit's clock (docs/dds.md, "Epoch assembly"): one bad stamp or sequence number never blinds it.

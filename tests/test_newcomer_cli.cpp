@@ -108,6 +108,36 @@ TEST(SimCli, WriteUnitWritesTheShippedSeedUnit) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("u2.yaml")));
 }
 
+// README.md's `--compare` example, as its prose writes it, runs and prints the ratios it quotes (without `-o`
+// it exited 2: `--output is required`).
+TEST(Readme, CompareExampleRunsAsWritten) {
+  const std::string readme = read_file(source_path("README.md"));
+  const std::string start = "`tetra calibrate examples/turntable.csv";
+  const auto at = readme.find(start);
+  ASSERT_NE(at, std::string::npos);
+  std::string command = readme.substr(at + 7, readme.find('`', at + 1) - at - 7);  // after "`tetra "
+  TempDir dir;
+  for (const std::string file : {"examples/turntable.csv", "examples/factory.yaml"})
+    command.replace(command.find(file), file.size(), source_path(file));
+  command.replace(command.find("cal.yaml"), 8, dir.file("cal.yaml"));
+  const auto r = run_tetra(command);
+  ASSERT_EQ(r.exit_status, 0) << command << "\n" << r.err;
+  EXPECT_NE(r.out.find("4.25e+04  g2 2.24e+05  g3 5.11e+04  g4 1.44e+05"), std::string::npos) << r.out;
+}
+
+// `sim --dds` writes no files: --out and --truth are refused (exit 2, one line naming both) before any DDS
+// entity is made, never silently ignored (before the change: a run without readers, exit 1, and no file).
+TEST(SimCli, DdsRefusesOutAndTruthInsteadOfIgnoringThem) {
+  TempDir dir;
+  for (const std::string option : {"--truth", "-o"}) {
+    const auto r = run_tetra("sim orbit --dds --domain 226 --minutes 0.1 --wait-timeout 1 " + option + " " +
+                             dir.file("f.csv"));
+    EXPECT_EQ(r.exit_status, 2) << option << ": " << r.err;
+    EXPECT_NE(r.err.find("--out and --truth do not apply with --dds"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("f.csv")));
+  }
+}
+
 TEST(FusionCli, ShippedServiceConfigurationIsAcceptedAndItsReadersTimeoutNamesTheRefusedQos) {
   ASSERT_TRUE(kLoopback);
   TempDir dir;

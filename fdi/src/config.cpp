@@ -69,6 +69,7 @@ const std::vector<KeyDef>& scalar_keys() {
       {"reference_noise_max_factor", &PipelineConfig::reference_noise_max_factor},
       {"reference_bias_arcsec", &PipelineConfig::reference_bias_arcsec},
       {"reference_latency_max_s", &PipelineConfig::reference_latency_max_s},
+      {"reference_horizon_s", &PipelineConfig::reference_horizon_s},
       {"integrity_risk", &PipelineConfig::integrity_risk},
       {"calibration_error_sigmas", &PipelineConfig::calibration_error_sigmas},
   };
@@ -218,6 +219,7 @@ Status validate(const PipelineConfig& c) {
       {"reference_noise_max_factor", within(c.reference_noise_max_factor, 1.0, 100.0), "in [1, 100]"},
       {"reference_bias_arcsec", at_least(c.reference_bias_arcsec, 0.0), ">= 0"},
       {"reference_latency_max_s", within(c.reference_latency_max_s, 0.0, 10.0), "in [0, 10]"},
+      {"reference_horizon_s", within(c.reference_horizon_s, 0.0, 10.0), "in [0, 10]"},
       {"integrity_risk", probability(c.integrity_risk), "in (0, 0.5)"},
       {"calibration_error_sigmas", within(c.calibration_error_sigmas, 0.0, 100.0), "in [0, 100]"},
   };

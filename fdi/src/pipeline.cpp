@@ -36,6 +36,7 @@
 #include "rate_attitude.hpp"
 #include "reference_budget.hpp"
 #include "reference_consistency.hpp"
+#include "reference_horizon.hpp"
 #include "reference_monitor.hpp"
 #include "reference_noise_match.hpp"
 #include "stamp_judge.hpp"
@@ -89,7 +90,8 @@ class Pipeline::Impl {
         noise_match_(config_, n_),
         bias_match_(config_, n_),
         protection_(config_),
-        budget_(config_) {
+        budget_(config_),
+        horizon_(config_.reference_horizon_s) {
     frame_.resize(n_);
     found_.reserve(static_cast<std::size_t>(n_));
     own_named_.reserve(static_cast<std::size_t>(n_));
@@ -191,6 +193,7 @@ class Pipeline::Impl {
   EvidenceRows episode_rows_;    //!< the rows of the detection that opened the open episode
   EvidenceRows decision_rows_;   //!< scratch: an isolation's rows with the episode's
   std::uint64_t arbiter_refusals_ = 0;  //!< findings whose rows the arbiter did not confirm
+  ReferenceHorizon horizon_;     //!< a late reference fused at its own time (docs/fdi.md, "Late references")
 
   EpochFrame frame_;
   Isolations found_;
@@ -447,6 +450,7 @@ bool Pipeline::Impl::accept(const Epoch& epoch) {
   if (!has_time_) protection_.anchor(epoch.stamp_ns);  // the start: the attitude known to its initial σ
   if (!subsets_.ready() && frame_.dt_s > 0.0) subsets_.prepare(frame_.dt_s);
   if (!clock_.has_period() && subsets_.ready()) clock_.set_period(seconds_to_ns(subsets_.period_s()));
+  if (subsets_.ready()) horizon_.prepare(subsets_.period_s());
   has_time_ = true;
   last_ns_ = epoch.stamp_ns;
   frame_.now_ns = epoch.stamp_ns;
@@ -457,7 +461,8 @@ bool Pipeline::Impl::accept(const Epoch& epoch) {
     const Quaternion& q = *epoch.reference_q_RB;
     const bool unit = q.coeffs().allFinite() && std::abs(q.norm() - 1.0) <= 1e-3;
     if (unit)
-      frame_.reference_q_RB = q.normalized();
+      frame_.reference_q_RB = horizon_.admit(epoch, q.normalized(), attitude_.omega_BR_B(), frame_.dt_s,
+                                             counters, result_.events);
     else
       ++counters.reference_invalid;
   }
@@ -665,6 +670,7 @@ void Pipeline::Impl::publish_attitude() {
       }
     }
   }
+  const Quaternion q_propagated_RB = attitude_.q_RB();  // the gyros' step, for the fusion horizon
   // The reference sample, at this epoch's time, once the attitude is there too.
   if (frame_.reference_q_RB && !reference_usable_) ++health_.counters.reference_rejected;
   if (frame_.reference_q_RB && reference_usable_) {
@@ -702,6 +708,7 @@ void Pipeline::Impl::publish_attitude() {
   a.gyros = observable ? frame_.usable : GyroMask{0};
   health_.used = a.gyros;
   attitude_.finish_epoch();
+  horizon_.record(frame_.now_ns, q_propagated_RB, attitude_.q_RB());
 }
 
 void Pipeline::Impl::publish_filter() {
@@ -922,6 +929,7 @@ void Pipeline::Impl::reset() {
   bias_check_.reset();
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);
+  horizon_.reset();
   has_time_ = false;
   last_ns_ = 0;
   clock_.reset();

@@ -66,6 +66,8 @@ const char* to_string(EventType type) {
       return "reference_rejected";
     case EventType::kReferenceAccepted:
       return "reference_accepted";
+    case EventType::kReferenceLate:
+      return "reference_late";
   }
   return "command";
 }
@@ -292,6 +294,10 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
     case EventType::kFdiAvailable:
       out += ", \"gyros\": ";
       append_gyro_list(out, event.gyros, n_gyros);
+      break;
+    case EventType::kReferenceLate:
+      out += ", \"late_s\": ";
+      append_double(out, event.statistic);
       break;
     case EventType::kGap:
       out += ", \"length_s\": ";

@@ -195,7 +195,8 @@ py::dict health_dict(const fdi::Health& h, int n) {
       "samples_accepted"_a = c.samples_accepted, "samples_invalid"_a = c.samples_invalid,
       "samples_absent"_a = c.samples_absent, "samples_outlier"_a = c.samples_outlier, "spikes"_a = c.spikes,
       "reference_accepted"_a = c.reference_accepted, "reference_rejected"_a = c.reference_rejected,
-      "reference_reinitialized"_a = c.reference_reinitialized, "reference_invalid"_a = c.reference_invalid);
+      "reference_reinitialized"_a = c.reference_reinitialized, "reference_invalid"_a = c.reference_invalid,
+      "reference_delayed"_a = c.reference_delayed, "reference_too_late"_a = c.reference_too_late);
   return d;
 }
 

@@ -235,6 +235,12 @@ int cmd_sim(int argc, char** argv) {
 #else
   const bool dds = false;
 #endif
+  // The open loop over DDS writes no files: refused rather than ignored. The same scenario and seed without
+  // --dds writes the same epochs and truth (docs/dds.md, "tetra sim SCENARIO --dds").
+  if (dds && !a.loop.enabled && run.scenario != "turntable" &&
+      (!run.out_path.empty() || !run.truth_path.empty()))
+    return report(kSimName, bad_input("--out and --truth do not apply with --dds: run the same scenario and "
+                                      "--seed without --dds to write the log and the truth"));
   if ((a.loop.enabled || dds) && run.scenario != "turntable") return run_elsewhere(a, run);
   if (auto files = report::simulate_to_files(run, std::cerr); !files) return report_sim(files.error());
   return kExitOk;

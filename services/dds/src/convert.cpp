@@ -56,7 +56,7 @@ tetra_EventType to_wire(fdi::EventType type) {
 }
 fdi::EventType from_wire(tetra_EventType type) {
   const int value = static_cast<int>(type);
-  return value >= 0 && value <= static_cast<int>(fdi::EventType::kReferenceAccepted)
+  return value >= 0 && value <= static_cast<int>(fdi::EventType::kReferenceLate)
              ? static_cast<fdi::EventType>(value)
              : fdi::EventType::kCommand;
 }
@@ -67,6 +67,8 @@ static_assert(static_cast<int>(tetra_EVENT_FDI_AVAILABLE) == static_cast<int>(fd
 static_assert(static_cast<int>(tetra_EVENT_GAP) == static_cast<int>(fdi::EventType::kGap));
 static_assert(static_cast<int>(tetra_EVENT_REFERENCE_ACCEPTED) ==
               static_cast<int>(fdi::EventType::kReferenceAccepted));
+static_assert(static_cast<int>(tetra_EVENT_REFERENCE_LATE) ==
+              static_cast<int>(fdi::EventType::kReferenceLate));
 static_assert(static_cast<int>(tetra_REFERENCE_REJECTED) == static_cast<int>(fdi::ReferenceState::kRejected));
 
 Status to_wire(const std::string& unit, const fdi::AttitudeEstimate& attitude, tetra_Attitude& out) {
@@ -126,6 +128,8 @@ Status to_wire(const std::string& unit, const fdi::Health& health, const service
   out.msg.reference_state = static_cast<tetra_ReferenceState>(static_cast<int>(health.reference_state));
   out.msg.reference_nis = health.reference_nis;
   for (int i = 0; i < 3; ++i) out.msg.protection_level_rad[i] = health.protection_level_rad[i];
+  out.msg.references_delayed = health.counters.reference_delayed;
+  out.msg.references_too_late = health.counters.reference_too_late;
   tetra_SampleCounters& c = out.msg.counters;
   c.epochs_accepted = health.counters.epochs_accepted;
   c.epochs_rejected_time = health.counters.epochs_rejected_time;
@@ -172,6 +176,9 @@ HealthView from_wire(const tetra_Health& in) {
           : fdi::ReferenceState::kAbsent;
   h.reference_nis = in.reference_nis;
   for (int i = 0; i < 3; ++i) h.protection_level_rad[i] = in.protection_level_rad[i];
+  h.counters.reference_delayed = in.references_delayed;
+  h.counters.reference_too_late = in.references_too_late;
+  out.reference_horizon_s = in.reference_horizon_s;
   const tetra_SampleCounters& c = in.counters;
   h.counters.epochs_accepted = c.epochs_accepted;
   h.counters.epochs_rejected_time = c.epochs_rejected_time;

@@ -229,7 +229,9 @@ Status Recording::write_epochs() {
     for (int i = 0; i < n_; ++i)
       values_[static_cast<std::size_t>(i)] = epoch.raw[static_cast<std::size_t>(i)];
     std::optional<std::array<double, 4>> ref;
-    if (epoch.reference_q_RB) ref = to_wxyz(*epoch.reference_q_RB);
+    // A reference delivered after its epoch (fused by the service at its own stamp) has no row of its own in
+    // a log: it is left out rather than written as if taken at this row's time (docs/dds.md, "Known limits").
+    if (epoch.reference_q_RB && !epoch.reference_stamp_ns) ref = to_wxyz(*epoch.reference_q_RB);
     if (auto s = log_.write(ns_to_seconds(epoch.stamp_ns), values_, epoch.present, ref); !s) return s;
     last_epoch_ns_ = epoch.stamp_ns;
     ++epochs_written_;

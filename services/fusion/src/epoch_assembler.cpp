@@ -93,6 +93,7 @@ void EpochAssembler::forget_time_base() {
   for (GyroTrack& g : gyros_) g = GyroTrack{{}, {}, {}, g.absent};
   pending_.clear();
   references_.clear();
+  late_references_.clear();
   last_emitted_ns_.reset();
   clock_ = Clock{};
   candidate_.reset();
@@ -230,7 +231,14 @@ Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t 
 
 void EpochAssembler::add_reference(std::int64_t stamp_ns, const Quaternion& q_RB) {
   if (last_emitted_ns_ && stamp_ns <= *last_emitted_ns_ + config_.tolerance_ns) {
-    ++counters_.references_late;
+    // Its epoch was fused: it goes with one of the next at its own time (the pipeline's fusion horizon).
+    if (late_references_.size() == kMaxLateReferences) {
+      ++counters_.references_late;  // the oldest waiting gives way
+      late_references_.pop_front();
+    }
+    auto at = std::upper_bound(late_references_.begin(), late_references_.end(), stamp_ns,
+                               [](std::int64_t t, const auto& r) { return t < r.first; });
+    late_references_.insert(at, {stamp_ns, q_RB});
     return;
   }
   auto pos = std::upper_bound(references_.begin(), references_.end(), stamp_ns,
@@ -281,6 +289,11 @@ void EpochAssembler::emit(Pending& epoch, std::vector<fdi::Epoch>& out) {
     references_.pop_front();
   } else if (epoch.awaits_reference) {
     ++counters_.references_late;  // announced, and not in within max_latency_ns: the epoch goes without
+  }
+  if (!result.reference_q_RB && !late_references_.empty()) {  // an epoch's own reference goes first
+    result.reference_q_RB = late_references_.front().second;
+    result.reference_stamp_ns = late_references_.front().first;
+    late_references_.pop_front();
   }
   last_emitted_ns_ = epoch.stamp_ns;
   ++counters_.epochs_emitted;

@@ -463,6 +463,7 @@ Status FusionService::publish_health(std::int64_t now_ns, bool force) {
   wire.msg.events_published = event_seq_;
   wire.msg.gyro_writers = gyro_writers_;
   wire.msg.health_period_s = config_.health_period_s;
+  wire.msg.reference_horizon_s = pipeline_.config().reference_horizon_s;
   if (auto s = health_writer_->write(wire.msg); !s) return s;
   if (ros2_view_) {
     if (auto s = ros2_view_->publish(health); !s) return s;

@@ -94,6 +94,10 @@ struct PipelineConfig {
   //! [s] the largest latency of the reference's time stamps its specification allows: at a steady rate it is
   //! an unseen offset ω·τ, so sigma carries |ω|·this (0: stamps exact)
   double reference_latency_max_s = 0.0;
+  //! [s] the fusion horizon: a reference delivered after its epoch was fused and stamped at most this long
+  //! before the epoch it reaches is fused at its own time; an older one is left out, counted and reported
+  //! (`reference_late`). Covers a star tracker delivering up to 300 ms late, with the service's wait.
+  double reference_horizon_s = 0.5;
 
   // --- integrity (docs/fdi.md, "Protection level")
   //! [-] probability that the attitude error exceeds the published protection level without an alarm

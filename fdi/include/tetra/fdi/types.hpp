@@ -55,7 +55,8 @@ enum class EventType : std::uint8_t {
   kFdiAvailable,
   kGap,                //!< no epoch for longer than max_gap_s (statistic: the gap's length [s])
   kReferenceRejected,  //!< the attitude reference failed a consistency test (why: ReferenceCheck)
-  kReferenceAccepted   //!< a rejected reference passed every test for reference_reaccept_s: used again
+  kReferenceAccepted,  //!< a rejected reference passed every test for reference_reaccept_s: used again
+  kReferenceLate       //!< a reference stamped beyond the fusion horizon (statistic: how late [s]): left out
 };
 const char* to_string(EventType type);
 
@@ -118,6 +119,9 @@ struct Epoch {
   std::vector<double> raw;                   //!< [V] (or [deg/s] when the log says units=dps), size N
   std::vector<std::uint8_t> present;         //!< size N; 0 = no sample delivered this epoch
   std::optional<Quaternion> reference_q_RB;  //!< attitude reference (e.g. star tracker), body → reference
+  //! [ns] the reference's own time when it is not this epoch's: a reference delivered after the epoch of its
+  //! stamp was fused, fused at its own time within `reference_horizon_s` (docs/fdi.md, "Late references")
+  std::optional<std::int64_t> reference_stamp_ns = std::nullopt;
 };
 
 struct FdiEvent {
@@ -177,6 +181,8 @@ struct Counters {
   std::uint64_t reference_rejected = 0;  //!< reference samples its χ² gate rejected or left out (rejected)
   std::uint64_t reference_reinitialized = 0;  //!< times a run of rejections set the attitude again
   std::uint64_t reference_invalid = 0;  //!< reference samples left out: not finite or norm not 1 within 1e-3
+  std::uint64_t reference_delayed = 0;  //!< reference samples stamped before their epoch, fused at their time
+  std::uint64_t reference_too_late = 0;  //!< reference samples stamped beyond the fusion horizon: left out
 };
 
 struct Health {

@@ -50,6 +50,7 @@ struct HealthView {
   std::uint64_t events_published = 0;  //!< event_seq of the service's last event
   std::uint32_t gyro_writers = 0;      //!< GyroSample writers the service has matched
   double health_period_s = 0.0;        //!< [s] the service writes Health at least this often
+  double reference_horizon_s = 0.0;    //!< [s] the service's fusion horizon for late references
 };
 HealthView from_wire(const tetra_Health& in);
 

@@ -40,7 +40,11 @@
 //   * attitude references are attached to the epoch whose stamp is within the tolerance of theirs. A
 //     sample that says a reference for its stamp was written (`reference_written`) makes its epoch
 //     wait for that reference too (within max_latency_ns like a sample), whatever order the two
-//     streams arrive in.
+//     streams arrive in. A reference for an epoch already emitted (a star tracker delivering late) goes
+//     with the next epoch emitted, stamped with its own time (`fdi::Epoch::reference_stamp_ns`): the
+//     pipeline fuses it at that time within its fusion horizon, or counts and reports it as too late.
+//     Several waiting go one an epoch, oldest first, after an epoch's own reference (at most
+//     kMaxLateReferences wait: the oldest beyond gives way, counted as late).
 // Times: stamps are sensor time [ns]; `now_ns` is the caller's local monotonic clock [ns].
 
 #include <cstdint>
@@ -92,13 +96,16 @@ enum class AbsentReason : std::uint8_t { kDeadline, kLiveliness };
 
 class EpochAssembler {
  public:
+  //! References for emitted epochs that may wait for an epoch to go with (the reference reader's history).
+  static constexpr std::size_t kMaxLateReferences = 8;
+
   static Result<EpochAssembler> create(const AssemblerConfig& config);
 
   //! One gyro sample (raw may be NaN: that is for the pipeline to judge).
   //! `reference_written`: the sender wrote a reference for this stamp (the epoch waits for it).
   Verdict add_sample(int gyro_id, std::uint64_t seq, std::int64_t stamp_ns, double raw, std::int64_t now_ns,
                      bool reference_written = false);
-  //! An attitude reference for the epoch at `stamp_ns`.
+  //! An attitude reference for the epoch at `stamp_ns` (one already emitted: with the next, at its stamp).
   void add_reference(std::int64_t stamp_ns, const Quaternion& q_RB);
   //! The gyro's stream stopped (deadline missed or liveliness lost): epochs no longer wait for it.
   //! It is present again as soon as it delivers a sample.
@@ -160,6 +167,9 @@ class EpochAssembler {
   std::vector<GyroTrack> gyros_;
   std::deque<Pending> pending_;                                 //!< sorted by stamp
   std::deque<std::pair<std::int64_t, Quaternion>> references_;  //!< sorted by stamp
+  //! references for epochs already emitted, sorted by stamp: each goes with one of the next epochs, at its
+  //! own stamp (at most kMaxLateReferences wait; the oldest gives way)
+  std::deque<std::pair<std::int64_t, Quaternion>> late_references_;
   std::optional<std::int64_t> last_emitted_ns_;
   Clock clock_;                     //!< the unit's clock
   std::optional<Clock> candidate_;  //!< a new time base the outliers may be on
