@@ -4,8 +4,8 @@
 # off so the build is a first build. Prints the wall time of each step and the total.
 #
 # The build figure is what the README quotes; run it on an idle machine (the load is printed first).
-# setup.sh's time depends on what is installed: with every package present it is the web application's
-# `npm ci` alone.
+# setup.sh's time depends on what is installed: with every package present it checks them and installs nothing
+# (the web application is setup.sh --web's, not the Quick start's).
 #
 # usage: bench/quick_start.sh [KEEP_DIR]     (KEEP_DIR: keep the clone there instead of deleting it)
 set -euo pipefail
@@ -38,7 +38,7 @@ elapsed() { # STEP LOG COMMAND...: runs COMMAND, its output to LOG, and prints t
 
 echo "| step                         | wall time     |"
 echo "|------------------------------|---------------|"
-elapsed "setup (packages, npm ci)" "$work/setup.log" bash scripts/setup.sh
+elapsed "setup (packages)" "$work/setup.log" bash scripts/setup.sh
 elapsed "build (tetra only, no ccache)" "$work/build.log" env TETRA_BUILD_TESTS=OFF bash scripts/build.sh --target tetra
 elapsed "tetra demo" "$work/demo.log" ./build/tetra demo
 awk 'NR == 1 { a = $1 } { b = $2 } END { d = b - a; printf "| %-28s | %3d min %4.1f s |\n", "total (bash scripts/run.sh)", int(d / 60), d - 60 * int(d / 60) }' "$work/times"

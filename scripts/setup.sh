@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Installs what tetra needs from Debian 12's packages, then the ground station's web application (web/:
-# Open MCT, pinned by web/package-lock.json) with `npm ci`.
-#   setup.sh          what building and running the program needs (scripts/run.sh)
-#   setup.sh --test   that and what the test suite needs: GoogleTest, Google Benchmark, gnuplot (allan
+# Installs what tetra needs from Debian 12's packages and, when asked for, the ground station's web
+# application (web/: Open MCT, pinned by web/package-lock.json) with `npm ci`.
+#   setup.sh          what building and running the program needs (scripts/run.sh: tetra demo needs no web
+#                     application, so neither Node.js nor npm ci)
+#   setup.sh --web    that and the web application of `tetra ground` (Node.js and npm, then npm ci in web/)
+#   setup.sh --test   that, the web application, and what the test suite needs: GoogleTest, Google Benchmark, gnuplot (allan
 #                     --plot), clang (fuzzers), openssl (DDS Security PKI), iproute2 (netns tests), chromium
 #                     and selenium (the ground station's browser test), slurm-wlm and munge (the
 #                     campaign's Slurm test), pybind11 and Python's numpy, pandas, pytest and matplotlib
@@ -20,8 +22,10 @@ packages=(
   libhdf5-dev                                 # HDF5 gyro logs
   help2man                                    # man pages from the --help texts (cmake --install)
 )
+web=false
+if [ "${1:-}" = "--web" ] || [ "${1:-}" = "--test" ]; then web=true; fi
 # Node.js and npm for web/ (Debian's nodejs and npm, unless a node with npm is already installed).
-command -v npm >/dev/null || packages+=(nodejs npm)
+if $web && ! command -v npm >/dev/null; then packages+=(nodejs npm); fi
 if [ "${1:-}" = "--test" ]; then
   packages+=(
     libgtest-dev libgmock-dev libbenchmark-dev
@@ -54,7 +58,7 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages present"
-  web_packages
+  if $web; then web_packages; fi
   exit 0
 fi
 
@@ -68,4 +72,4 @@ echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 apt-get update -qq
 apt-get install -y -qq --no-install-recommends "${missing[@]}"
-web_packages
+if $web; then web_packages; fi

@@ -70,6 +70,34 @@ TEST(ReplayCli, WritesAttitudeAndEventsAndSummary) {
   EXPECT_NE(r.err.find("final mode: DEGRADED"), std::string::npos) << r.err;
 }
 
+// --explain T prints the ledger at T on stdout: the detectors' state and the decisions up to T, each with the
+// rows that decided it (a dropout of gyro 2 at 50 s, isolated after the 1 s timeout): the isolation's rows
+// name gyro 2 alone consistent and the rule holds on them; before the fault, no decision.
+TEST(ReplayCli, ExplainPrintsTheLedgerOfTheDecisionsUpToATime) {
+  TempDir dir;
+  const auto log =
+      write_log(dir, "log.csv", 100.0, test::SynthFault{2, fdi::FaultKind::kDropout, false, 50.0, 0.0});
+  const auto cal = write_cal(dir);
+  const std::string args = "replay " + log + " --calibration " + cal + " --attitude " + dir.file("att.csv") +
+                           " --events " + dir.file("ev.jsonl") + " --explain ";
+  const auto after = run_tetra(args + "60");
+  ASSERT_EQ(after.exit_status, 0) << after.err;
+  EXPECT_NE(after.out.find("the ledger at t = 60 s"), std::string::npos) << after.out;
+  EXPECT_NE(after.out.find("isolated gyro 2 (dropout, evidence timeout): the rule holds on these rows"),
+            std::string::npos)
+      << after.out;
+  EXPECT_NE(after.out.find("timeout          H2 "), std::string::npos) << after.out;
+  EXPECT_NE(after.out.find("consistent"), std::string::npos) << after.out;
+  EXPECT_NE(after.out.find("mode DEGRADED, gyros used 134"), std::string::npos) << after.out;
+  const auto before = run_tetra(args + "40");
+  ASSERT_EQ(before.exit_status, 0) << before.err;
+  EXPECT_NE(before.out.find("no decision up to then"), std::string::npos) << before.out;
+  EXPECT_NE(before.out.find("mode NOMINAL"), std::string::npos) << before.out;
+  // The events file carries the same rows.
+  const std::string ev = test::read_file(dir.file("ev.jsonl"));
+  EXPECT_NE(ev.find(R"({"source": "timeout", "hypothesis": "H2", "statistic": )"), std::string::npos) << ev;
+}
+
 // --verbose prints the thresholds the pipeline derived, each a positive number: the parity tests' and the
 // level test's that runs during an episode.
 TEST(ReplayCli, VerbosePrintsTheDerivedThresholds) {

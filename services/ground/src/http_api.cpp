@@ -113,8 +113,8 @@ Status GroundServer::start() {
     return bad_input("--web " + config_.web_dir + ": no such directory");
   const std::filesystem::path openmct = std::filesystem::path(config_.web_dir) / "node_modules/openmct/dist";
   if (!files_.mount("/openmct/", openmct.string()))
-    return failure(openmct.string() + " missing: run `npm ci` in " + config_.web_dir +
-                   " (scripts/setup.sh does)");
+    return failure(openmct.string() + " missing: run `bash scripts/setup.sh --web` (npm ci in " +
+                   config_.web_dir + "; the other commands do not need it)");
   instance_ = random_hex(4);
   no_auth_csrf_ = random_hex(32);
   StreamFeed feed{[this](std::uint64_t after, std::string& out) { return feed_next(after, out); },
