@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The long sweep of the one-fault, sigma-after-isolation and data-path campaigns (docs/fdi.md, "One fault, one
-# exclusion", "Bias states repaired at isolation", "Data path"): the ctest cases of
+# The long sweep of the one-fault, sigma-after-isolation and data-path campaigns (docs/fdi_validation.md, "One
+# fault, one exclusion", "Bias states repaired at isolation", "Data path"): the ctest cases of
 # tests/fusion/test_isolation_adversarial.cpp run over SEEDS seeds each instead of ctest's one or two.
 # SEEDS = 5: 1,800 one-fault runs, 1,350 sigma runs, 240 data-path runs (3,390 in all; about 35 s wall at
 # load 15 on 2 cores).

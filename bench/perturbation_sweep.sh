@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The long sweep of the perturbation families (docs/fdi.md, "Perturbation families"): every family of
+# The long sweep of the perturbation families (docs/fdi_validation.md, "Perturbation families"): every family of
 # sim/perturbation_families.hpp over RUNS runs each (and each run's unperturbed twin) instead of ctest's
 # dozen or so, printing per family: runs, wrong exclusions, exclusions without a fault, LOST, runs whose sigma
 # fails the per-run criterion (< 97 % within 3 sigma or a per-axis NEES > 2) where their twin meets it, twins

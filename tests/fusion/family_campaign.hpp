@@ -1,5 +1,5 @@
 #pragma once
-// The perturbation families' campaign (docs/fdi.md, "Perturbation families"): one generated run
+// The perturbation families' campaign (docs/fdi_validation.md, "Perturbation families"): one generated run
 // (sim/perturbation_families.hpp) through the pipeline, judged against the promises — no exclusion of a gyro
 // without a fault begun, no exclusion in a fault-free run, never LOST from one fault, sigma honest per run —
 // and the figures of a family over many runs.

@@ -1,4 +1,4 @@
-// Wrong exclusions of the dispersed campaign (docs/fdi.md, "Repeated values"):
+// Wrong exclusions of the dispersed campaign (docs/fdi_validation.md, "Repeated values"):
 // examples/campaign_dispersed.yaml with 11,112 seeds (100,008 runs) excluded a healthy gyro in 96 runs, every
 // one a bias step of 0.012–0.02 deg/s on gyro 1, 2 or 3 that moved a coarsely quantized healthy gyro's view
 // (the rate the others see along its axis) while that gyro repeated its value: the repeated-value rule called

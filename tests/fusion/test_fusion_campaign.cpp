@@ -1,7 +1,7 @@
 // Acceptance campaign of the fusion pipeline on simulated data (sim/): the seed's experiment, false alarms
 // over ten orbits, detection delays, isolation with and without a reference, reconfiguration. Scenarios run
 // in one process, straight from the simulator into the pipeline. Measured figures are printed for
-// docs/fdi.md.
+// docs/fdi_validation.md ("Acceptance campaign").
 #include <algorithm>
 #include <cstdio>
 #include <map>

@@ -168,7 +168,7 @@ TEST(IsolationAdversarial, AgileFaultFreeSlewsExcludeNothing) {
 }
 
 //! The seed count of the filter-bias cases: `fallback` in ctest, TETRA_FILTER_BIAS_SEEDS for a longer sweep
-//! (docs/fdi.md's 1,260-run figures: 12).
+//! (docs/fdi_validation.md's 1,260-run figures: 12).
 std::uint64_t filter_bias_seeds(std::uint64_t fallback) {
   const char* v = std::getenv("TETRA_FILTER_BIAS_SEEDS");
   const long n = v != nullptr ? std::strtol(v, nullptr, 10) : 0;
@@ -497,7 +497,7 @@ TEST(IsolationAdversarial, FaultOnGyroFourDuringAGentleSlew) {
 }
 
 TEST(IsolationAdversarial, OnsetIsolationAtTheDefaults) {
-  // docs/fdi.md's onset figures, measured for the default acceleration bound (1e-3 deg/s²) and the orbit's
+  // docs/fdi_validation.md's onset figures ("Onset test"), measured for the default acceleration bound (1e-3 deg/s²) and the orbit's
   // (2e-4): bias steps on each gyro in the orbit with attitude-control motion, no reference, three seeds. A
   // step is isolated by its onset only when it moves the rate beyond what the bound allows over the onset
   // windows (a_max times about 4 s) — smaller steps end `unisolated`. Printed, and no wrong exclusion

@@ -1,4 +1,4 @@
-// The perturbation families' campaign (docs/fdi.md, "Perturbation families"): every family of
+// The perturbation families' campaign (docs/fdi_validation.md, "Perturbation families"): every family of
 // sim/perturbation_families.hpp as its own seeded generator, a cheap subset in ctest (TETRA_FAMILY_RUNS runs
 // per family, default below; TETRA_FAMILY_SEED the seed, default 1), the long sweep in
 // bench/perturbation_sweep.sh. Asserted per family: no exclusion of a gyro without a fault begun, no
@@ -145,7 +145,7 @@ TEST(PerturbationFamilies, CalibrationWithoutNoise) {
   check_family(sim::Family::kCalibrationWithoutNoise, 18);
 }
 // Three gyros: a noise increase is named by the gyro's own level within seconds, a bias or a ramp by the
-// reference's innovations, and each is covered from then on (docs/fdi.md, "Perturbation families").
+// reference's innovations, and each is covered from then on (docs/fdi_validation.md, "Perturbation families").
 // The protection level bounds one gyro fault: two that cancel in the parity are beyond it.
 TEST(PerturbationFamilies, SecondFault) {
   check_family(sim::Family::kSecondFault, 12, {}, {"two biases cancelling in the parity"});

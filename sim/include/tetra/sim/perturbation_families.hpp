@@ -68,7 +68,7 @@ Calibration unit_with_gyros(int n);
 Calibration stated_calibration(const Calibration& truth, double errors, double scale_sigma, double axis_sigma,
                                std::uint64_t seed);
 
-//! The run `index` of `family` under `seed` (docs/fdi.md lists each family's draws).
+//! The run `index` of `family` under `seed` (docs/fdi_validation.md lists each family's draws).
 PerturbedRun perturbed_run(Family family, std::uint64_t seed, std::uint64_t index);
 
 //! The same run with its perturbation removed: same motion, unit, seed (so the same noise samples), no gyro
