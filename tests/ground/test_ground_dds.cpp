@@ -7,6 +7,7 @@
 #include <signal.h>
 
 #include <atomic>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <thread>
@@ -183,6 +184,17 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   auto history_events = client.Get("/api/history?unit=tetra-1&kind=event");
   ASSERT_TRUE(history_events && history_events->status == 200);
   EXPECT_NE(history_events->body.find("\"isolated\""), std::string::npos);
+  // The isolation arrived over DDS with the ledger rows that decided it: gyro 2's hypothesis consistent,
+  // every other gyro's rejected, and the rule rebuilt from the rows names gyro 2.
+  bool explained = false;
+  for (const auto& ev : json::parse(history_events->body)) {
+    if (ev.value("event", "") != "isolated") continue;
+    std::map<std::string, std::string> verdict;
+    for (const auto& row : ev["ledger"]) verdict[row["hypothesis"].get<std::string>()] = row["verdict"];
+    explained = verdict["H2"] == "consistent" && verdict["H1"] == "rejected" && verdict["H3"] == "rejected" &&
+                verdict["H4"] == "rejected" && verdict["H0"] == "rejected";
+  }
+  EXPECT_TRUE(explained) << history_events->body;
   auto unknown = client.Get("/api/history?unit=nobody&kind=event");
   ASSERT_TRUE(unknown);
   EXPECT_EQ(unknown->status, 404);
