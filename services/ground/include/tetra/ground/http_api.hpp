@@ -18,8 +18,10 @@
 
 #include "tetra/core/result.hpp"
 #include "tetra/dds/convert.hpp"
+#include "tetra/ground/audit_log.hpp"
 #include "tetra/ground/command_request.hpp"
 #include "tetra/ground/http_server.hpp"
+#include "tetra/ground/login_throttle.hpp"
 #include "tetra/ground/operators.hpp"
 #include "tetra/ground/static_files.hpp"
 #include "tetra/ground/store.hpp"
@@ -36,10 +38,13 @@ struct ServerConfig {
   std::string records_dir;       //!< `tetra record` files served by /api/records ("": none)
   std::string users_path;        //!< operator accounts (tetra ground passwd); "" only with no_auth
   std::string session_key_path;  //!< the key sessions are signed with (created when absent)
-  bool no_auth = false;          //!< no accounts: everyone who reaches the port is commander "anonymous"
+  std::string
+      audit_path;        //!< the audit file ("": the --users file's name + .audit.jsonl; none under no_auth)
+  bool no_auth = false;  //!< no accounts: everyone who reaches the port is commander "anonymous"
   std::vector<std::string> allow_origins;  //!< more HOST:PORT a browser may reach the ground as
   TlsFiles tls;
   HttpLimits limits;
+  ThrottleLimits throttle;                  //!< sign-in back-off and lockout
   double session_lifetime_s = 12 * 3600.0;  //!< [s]
   int commands_in_flight = 2;  //!< commands waiting for their acknowledgement at once; beyond: 503
 };
@@ -62,8 +67,11 @@ class GroundServer {
  private:
   HttpResponse handle(const HttpRequest& req);
   HttpResponse serve(const HttpRequest& req, const std::optional<Session>& session);
-  HttpResponse refuse(const HttpRequest& req, int status, const std::string& why, const std::string& user);
+  HttpResponse refuse(const HttpRequest& req, int status, const std::string& why, const std::string& user,
+                      const std::string& role = "");
+  void audit(const HttpRequest& req, AuditRecord record);
   HttpResponse login(const HttpRequest& req);
+  HttpResponse logout(const HttpRequest& req, const Session& session);
   HttpResponse command(const HttpRequest& req, const Session& session);
   HttpResponse stream(const HttpRequest& req);
   HttpResponse history(const HttpRequest& req);
@@ -81,7 +89,8 @@ class GroundServer {
   std::set<std::string> allowed_hosts_;  //!< "host:port", lower case
   std::string instance_;                 //!< this run's prefix of every event id
   std::string no_auth_csrf_;
-  std::mutex login_mutex_;  //!< one password check at a time (64 MiB each)
+  AuditLog audit_;
+  LoginThrottle throttle_;
   std::atomic<int> commands_waiting_{0};
 };
 
