@@ -140,7 +140,13 @@ struct HttpServer::Impl {
     c.fd = -1;
   }
 
-  void drop(Conn& c) {
+  //! Closes the connection; `abort`: at once, what the kernel still holds for it discarded (a client
+  //! past its deadline is not fed from the kernel's buffers either).
+  void drop(Conn& c, bool abort = false) {
+    if (abort) {
+      const linger now{1, 0};
+      ::setsockopt(c.fd, SOL_SOCKET, SO_LINGER, &now, sizeof now);
+    }
     if (c.state == Conn::State::kStream) {
       streams.erase(c.id);
       owner->streams_ = streams.size();
@@ -424,7 +430,7 @@ struct HttpServer::Impl {
       if (c.pending() + chunk->size() > limits.stream_buffer_bytes) {
         spdlog::warn("ground: event stream to {} closed: {} bytes not read (a slow reader; it may resume)",
                      c.remote, c.pending());
-        drop(c);
+        drop(c, true);
         continue;
       }
       const bool was_waiting = c.want_out;  // its socket is full: EPOLLOUT will flush it
@@ -481,7 +487,7 @@ struct HttpServer::Impl {
           break;
       }
     }
-    for (const auto id : expired) drop(*conns.at(id));
+    for (const auto id : expired) drop(*conns.at(id), true);
   }
 
   void run() {
