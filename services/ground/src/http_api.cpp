@@ -289,7 +289,13 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
   const std::int64_t at = steady_now_ns();
   const auto verdict = throttle_.admit(user, req.remote_addr, at);
   if (!verdict.allowed) {
-    auto res = refuse(req, 429, verdict.reason, shown);
+    // The 1st, 2nd, 4th, 8th... refusal since the last check is recorded, the others only answered.
+    const std::uint64_t n = verdict.refused_before + 1;
+    auto res =
+        (n & (n - 1)) != 0
+            ? error_reply(429, verdict.reason)
+            : refuse(req, 429, verdict.reason + " (refusal " + std::to_string(n) + " since the last check)",
+                     shown);
     res.headers.emplace_back("Retry-After",
                              std::to_string(static_cast<long>(std::ceil(verdict.retry_after_s))));
     return res;

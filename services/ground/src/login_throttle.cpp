@@ -33,7 +33,7 @@ std::string LoginThrottle::address_key(const std::string& address) {
 }
 
 void LoginThrottle::prune(Times& t, std::int64_t now_ns) const {
-  while (!t.empty() && now_ns - t.front() > ns_of(limits_.window_s)) t.pop_front();
+  while (!t.at.empty() && now_ns - t.at.front() > ns_of(limits_.window_s)) t.at.pop_front();
 }
 
 LoginThrottle::Times& LoginThrottle::entry(std::unordered_map<std::string, Times>& map,
@@ -47,11 +47,11 @@ LoginThrottle::Times& LoginThrottle::entry(std::unordered_map<std::string, Times
     // addresses never pushes out one with many).
     for (auto it = map.begin(); it != map.end();) {
       prune(it->second, now_ns);
-      it = it->second.empty() ? map.erase(it) : std::next(it);
+      it = it->second.at.empty() ? map.erase(it) : std::next(it);
     }
     if (map.size() >= limits_.max_tracked) {
       map.erase(std::min_element(map.begin(), map.end(), [](const auto& a, const auto& b) {
-        return a.second.size() < b.second.size();
+        return a.second.at.size() < b.second.at.size();
       }));
     }
   }
@@ -64,32 +64,35 @@ ThrottleVerdict LoginThrottle::admit(const std::string& user, const std::string&
   const std::string where = address_key(address);
   Times& from = entry(by_address_, where, now_ns);
   ThrottleVerdict v;
-  const int failures = static_cast<int>(from.size());
+  const int failures = static_cast<int>(from.at.size());
   if (failures >= limits_.address_free) {
     const double wait_s = std::min(limits_.backoff_max_s,
                                    limits_.backoff_first_s * std::pow(2.0, failures - limits_.address_free));
-    const std::int64_t next_ns = from.back() + ns_of(wait_s);
+    const std::int64_t next_ns = from.at.back() + ns_of(wait_s);
     if (now_ns < next_ns) {
       v.allowed = false;
+      v.refused_before = from.refused++;
       v.retry_after_s = static_cast<double>(next_ns - now_ns) / 1e9;
       v.reason = std::to_string(failures) + " failed sign-ins from this address within the hour: wait";
       return v;
     }
   }
   Times& account = entry(by_account_, user, now_ns);
-  if (static_cast<int>(account.size()) >= limits_.account_max) {
+  if (static_cast<int>(account.at.size()) >= limits_.account_max) {
     const auto proven = proven_.find(user);
     if (proven == proven_.end() ||
         std::find(proven->second.begin(), proven->second.end(), where) == proven->second.end()) {
       v.allowed = false;
-      v.retry_after_s = static_cast<double>(account.front() + ns_of(limits_.window_s) - now_ns) / 1e9;
-      v.reason = "account locked: " + std::to_string(account.size()) +
+      v.refused_before = from.refused++;
+      v.retry_after_s = static_cast<double>(account.at.front() + ns_of(limits_.window_s) - now_ns) / 1e9;
+      v.reason = "account locked: " + std::to_string(account.at.size()) +
                  " failed sign-ins within the hour (it still opens from an address it signed in from)";
       return v;
     }
   }
-  from.push_back(now_ns);
-  account.push_back(now_ns);
+  from.at.push_back(now_ns);
+  from.refused = 0;
+  account.at.push_back(now_ns);
   return v;
 }
 
@@ -98,8 +101,8 @@ void LoginThrottle::record(const std::string& user, const std::string& address, 
   if (!success) return;  // admit() counted it already
   const std::lock_guard lock(mutex_);
   const std::string where = address_key(address);
-  if (const auto it = by_address_.find(where); it != by_address_.end()) forget_one(it->second, now_ns);
-  if (const auto it = by_account_.find(user); it != by_account_.end()) forget_one(it->second, now_ns);
+  if (const auto it = by_address_.find(where); it != by_address_.end()) forget_one(it->second.at, now_ns);
+  if (const auto it = by_account_.find(user); it != by_account_.end()) forget_one(it->second.at, now_ns);
   auto& proven = proven_[user];
   proven.erase(std::remove(proven.begin(), proven.end(), where), proven.end());
   proven.push_back(where);

@@ -29,6 +29,9 @@ struct ThrottleVerdict {
   bool allowed = true;
   double retry_after_s = 0;  //!< [s] when refused: how long until an attempt may be admitted
   std::string reason;        //!< when refused
+  //! When refused: refusals of this address since its last admitted attempt, this one excluded (the
+  //! audit records the 1st, 2nd, 4th, 8th...: a client hammering a back-off does not flood the file).
+  std::uint64_t refused_before = 0;
 };
 
 class LoginThrottle {
@@ -43,7 +46,10 @@ class LoginThrottle {
   static std::string address_key(const std::string& address);
 
  private:
-  using Times = std::deque<std::int64_t>;  //!< failures within the window, oldest first
+  struct Times {
+    std::deque<std::int64_t> at;  //!< failures within the window, oldest first
+    std::uint64_t refused = 0;    //!< refusals since the last admitted attempt
+  };
   void prune(Times& t, std::int64_t now_ns) const;
   Times& entry(std::unordered_map<std::string, Times>& map, const std::string& key, std::int64_t now_ns);
   ThrottleLimits limits_;
