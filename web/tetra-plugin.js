@@ -162,9 +162,20 @@ function TetraPlugin(options) {
 
   // --- object tree --------------------------------------------------------------------------------
   const id = (key) => ({ namespace: NS, key });
+  // A unit's name in an object key as 'x' and the hexadecimal of its UTF-8 bytes: any name (a space, a
+  // '~', a '%', a '/') survives Open MCT's navigation path and the browser's URL encoding unchanged.
+  function unitKey(unit) {
+    return 'x' + Array.from(new TextEncoder().encode(unit), (b) => b.toString(16).padStart(2, '0')).join('');
+  }
+  function unitOfKey(text) {
+    if (!/^x([0-9a-f]{2})*$/.test(text)) return text;
+    const bytes = new Uint8Array((text.length - 1) / 2);
+    for (let i = 0; i < bytes.length; ++i) bytes[i] = parseInt(text.substr(1 + 2 * i, 2), 16);
+    return new TextDecoder().decode(bytes);
+  }
   function parseKey(key) {
     const [kind, unit, point] = key.split('~');
-    return { kind, unit, point };
+    return { kind, unit: unitOfKey(unit || ''), point };
   }
   const objectProvider = {
     async get(identifier) {
@@ -176,7 +187,7 @@ function TetraPlugin(options) {
           name: 'tetra units',
           type: 'folder',
           location: 'ROOT',
-          composition: list.map((u) => id('unit~' + u.unit))
+          composition: list.map((u) => id('unit~' + unitKey(u.unit)))
         };
       }
       const { kind, unit, point } = parseKey(key);
@@ -188,7 +199,7 @@ function TetraPlugin(options) {
           type: 'tetra.unit',
           location: NS + ':units',
           unit,
-          composition: pointsOf(u).map((p) => id('point~' + unit + '~' + p.key))
+          composition: pointsOf(u).map((p) => id('point~' + unitKey(unit) + '~' + p.key))
         };
       }
       const p = pointsOf(u).find((x) => x.key === point);
@@ -208,7 +219,7 @@ function TetraPlugin(options) {
         identifier,
         name: p.name + ' (' + unit + ')',
         type: p.text ? 'tetra.telemetry.text' : 'tetra.telemetry',
-        location: NS + ':unit~' + unit,
+        location: NS + ':unit~' + unitKey(unit),
         unit,
         point: p.key,
         telemetry: {

@@ -454,40 +454,40 @@ struct HttpServer::Impl {
   }
 
   void sweep(std::int64_t now) {
-    std::vector<std::uint64_t> expired;
+    std::vector<std::pair<std::uint64_t, bool>> expired;  // and whether output is left to discard
     for (const auto& [id, c] : conns) {
       switch (c->state) {
         case Conn::State::kReading:
           if (c->request_start_ns != 0 && now - c->request_start_ns > to_ns(limits.request_timeout_s)) {
             spdlog::info("ground: request from {} not complete within {} s: closed", c->remote,
                          limits.request_timeout_s);
-            expired.push_back(id);
+            expired.emplace_back(id, false);
           } else if (c->request_start_ns == 0 && now - c->activity_ns > to_ns(limits.idle_timeout_s)) {
-            expired.push_back(id);
+            expired.emplace_back(id, false);
           } else if (c->ssl != nullptr && !SSL_is_init_finished(c->ssl) &&
                      now - c->accepted_ns > to_ns(limits.request_timeout_s)) {
-            expired.push_back(id);
+            expired.emplace_back(id, false);
           }
           break;
         case Conn::State::kWriting:
           if (now > c->response_deadline_ns) {
             spdlog::info("ground: {} has not read its answer by its deadline ({} s + {} B/s): closed",
                          c->remote, limits.write_timeout_s, limits.min_write_rate);
-            expired.push_back(id);
+            expired.emplace_back(id, true);
           }
           break;
         case Conn::State::kStream:
           if (c->backlog_since_ns != 0 && now - c->backlog_since_ns > to_ns(limits.write_timeout_s)) {
             spdlog::info("ground: event stream to {} behind for {} s: closed (it may resume)", c->remote,
                          limits.write_timeout_s);
-            expired.push_back(id);
+            expired.emplace_back(id, true);
           }
           break;
         case Conn::State::kWorking:
           break;
       }
     }
-    for (const auto id : expired) drop(*conns.at(id), true);
+    for (const auto& [id, abort] : expired) drop(*conns.at(id), abort);
   }
 
   void run() {
