@@ -26,12 +26,7 @@ namespace {
 
 using nlohmann::json;
 using namespace std::chrono_literals;
-using http_test::connect_to;
-using http_test::Ground;
-using http_test::kJson;
-using http_test::parse_reply;
-using http_test::read_from;
-using http_test::Reply;
+using namespace http_test;  // NOLINT(google-build-using-namespace): the tests' client
 
 //! Raw bytes on a new connection; the answer up to the server's close.
 Reply raw(const Ground& g, const std::string& bytes, bool fin = false) {
