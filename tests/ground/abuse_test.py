@@ -187,9 +187,12 @@ def main():
         with socket.socket() as s:
             s.bind(("127.0.0.4", 0))
             s.settimeout(5)
-            s.connect(("127.0.0.1", port))
-            s.sendall(f"GET /api/units HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n".encode())
-            answer = s.recv(4096)
+            try:
+                s.connect(("127.0.0.1", port))
+                s.sendall(f"GET /api/units HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n".encode())
+                answer = s.recv(4096)
+            except OSError as e:
+                answer = repr(e).encode()
         if not answer.startswith(b"HTTP/1.1 200"):
             failures.append(f"an operator beside {IDLE} idle connections of another address: {answer[:40]!r}")
         refused_logged = "refused (503)" in open(log_path, encoding="utf-8", errors="replace").read()
