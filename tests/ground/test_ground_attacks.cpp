@@ -19,6 +19,7 @@
 
 #include "ground_http_client.hpp"
 #include "test_support.hpp"
+#include "tetra/ground/login_throttle.hpp"
 #include "tetra/ground/operators.hpp"
 
 namespace tetra::ground {
@@ -80,6 +81,51 @@ TEST(GroundAttacks, AGuesserBacksOffAndNeverLocksTheOperatorOutFromAnotherAddres
   // ...but not for the addresses it signed in from.
   EXPECT_EQ(sign_in("127.0.0.2", "correct horse").status, 200);
   EXPECT_EQ(sign_in("127.0.0.3", "correct horse").status, 200);
+}
+
+TEST(LoginThrottle, BackOffDoublesTheCapHoldsForAnHourAndAddressesAreKeyedByHost) {
+  LoginThrottle t;  // the defaults: 5 free, 1 s doubling to 60 s, 100 an hour per account
+  constexpr std::int64_t kS = 1'000'000'000;
+  std::int64_t now = 1000 * kS;
+  const auto attempt = [&](const std::string& user, const std::string& from) {
+    const auto v = t.admit(user, from, now);
+    if (v.allowed) t.record(user, from, false, now);
+    return v;
+  };
+  for (int i = 0; i < 5; ++i) EXPECT_TRUE(attempt("alice", "10.0.0.1").allowed);
+  auto v = attempt("alice", "10.0.0.1");
+  EXPECT_FALSE(v.allowed);
+  EXPECT_NEAR(v.retry_after_s, 1.0, 1e-9);
+  now += kS;
+  EXPECT_TRUE(attempt("alice", "10.0.0.1").allowed);  // 6 failures: next 2 s after
+  now += kS;
+  EXPECT_FALSE(attempt("alice", "10.0.0.1").allowed);
+  now += kS;
+  EXPECT_TRUE(attempt("alice", "10.0.0.1").allowed);
+  // One address in an hour: 5, then 1, 2, 4, 8, 16, 32 s apart, then a minute apart.
+  int checked = 7;
+  for (const std::int64_t end = 1000 * kS + 3600 * kS; now < end; now += kS / 4) {
+    checked += attempt("alice", "10.0.0.1").allowed ? 1 : 0;
+  }
+  EXPECT_LE(checked, 70);
+  EXPECT_GE(checked, 60);
+  // Many addresses take bob to 100 failures: locked for a new address, not for one bob signed in from.
+  const std::int64_t start = now;
+  ASSERT_TRUE(t.admit("bob", "10.1.0.1", now).allowed);
+  t.record("bob", "10.1.0.1", true, now);
+  for (int i = 0; i < 100; ++i) EXPECT_TRUE(attempt("bob", "10.2.0." + std::to_string(i)).allowed);
+  v = attempt("bob", "10.3.0.1");
+  EXPECT_FALSE(v.allowed);
+  EXPECT_NE(v.reason.find("account locked"), std::string::npos);
+  EXPECT_TRUE(t.admit("bob", "10.1.0.1", now).allowed);
+  t.record("bob", "10.1.0.1", true, now);
+  now = start + 3601 * kS;  // the hour has passed
+  EXPECT_TRUE(attempt("bob", "10.3.0.1").allowed);
+  // IPv6 by its /64 (one host holds a whole one); IPv4, mapped or not, by the whole address.
+  EXPECT_EQ(LoginThrottle::address_key("2001:db8::1"), LoginThrottle::address_key("2001:db8::ffff:1"));
+  EXPECT_NE(LoginThrottle::address_key("2001:db8::1"), LoginThrottle::address_key("2001:db8:0:1::1"));
+  EXPECT_NE(LoginThrottle::address_key("::ffff:10.0.0.1"), LoginThrottle::address_key("::ffff:10.0.0.2"));
+  EXPECT_EQ(LoginThrottle::address_key("10.0.0.1"), "10.0.0.1");
 }
 
 TEST(GroundAttacks, PasswordChecksNeverBlockOtherSignInsOrTheApi) {

@@ -287,7 +287,9 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
   const std::string shown = valid_user_name(user) ? user : "?";
   // Refused before the password is checked: costs no hash and is not counted as a failure.
   const std::int64_t at = steady_now_ns();
-  const auto verdict = throttle_.admit(user, req.remote_addr, at);
+  // Failures are counted by the name as written when it is a valid user name, else under "?" (no
+  // account has it): a flood of long made-up names takes no memory.
+  const auto verdict = throttle_.admit(shown, req.remote_addr, at);
   if (!verdict.allowed) {
     // The 1st, 2nd, 4th, 8th... refusal since the last check is recorded, the others only answered.
     const std::uint64_t n = verdict.refused_before + 1;
@@ -301,7 +303,7 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
     return res;
   }
   const auto account = operators_->login(user, (*body)["password"].get<std::string>());
-  throttle_.record(user, req.remote_addr, account.has_value(), at);
+  throttle_.record(shown, req.remote_addr, account.has_value(), at);
   if (!account) return refuse(req, 401, "user or password wrong", shown);
   const auto lifetime = static_cast<std::int64_t>(config_.session_lifetime_s);
   const auto issued = operators_->issue(account->user, utc_now_s(), lifetime);

@@ -470,7 +470,8 @@ struct HttpServer::Impl {
           }
           break;
         case Conn::State::kWriting:
-          if (now > c->response_deadline_ns) {
+          if (now > c->response_deadline_ns ||
+              (c->pending() > 0 && now - c->activity_ns > to_ns(limits.write_timeout_s))) {
             spdlog::info("ground: {} has not read its answer by its deadline ({} s + {} B/s): closed",
                          c->remote, limits.write_timeout_s, limits.min_write_rate);
             expired.emplace_back(id, true);

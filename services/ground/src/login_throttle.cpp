@@ -25,7 +25,8 @@ LoginThrottle::LoginThrottle(ThrottleLimits limits) : limits_(limits) {}
 
 std::string LoginThrottle::address_key(const std::string& address) {
   in6_addr a{};
-  if (::inet_pton(AF_INET6, address.c_str(), &a) != 1) return address;
+  // IPv4 (also as ::ffff:a.b.c.d on a dual-stack socket) is keyed by the whole address.
+  if (::inet_pton(AF_INET6, address.c_str(), &a) != 1 || IN6_IS_ADDR_V4MAPPED(&a)) return address;
   std::memset(reinterpret_cast<unsigned char*>(&a) + 8, 0, 8);
   char text[INET6_ADDRSTRLEN] = "";
   ::inet_ntop(AF_INET6, &a, text, sizeof text);
