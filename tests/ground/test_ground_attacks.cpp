@@ -161,6 +161,53 @@ TEST(GroundAttacks, PasswordChecksNeverBlockOtherSignInsOrTheApi) {
   EXPECT_EQ(during.status, 200) << during.body;  // queued behind the checks, never 503
 }
 
+TEST(GroundHttp, AForcedExclusionWaitsForASecondCommander) {
+  Accounts a;
+  auto hash = hash_password("correct horse");
+  ASSERT_TRUE(set_account(a.dir.file("users"), {"bob", Role::kCommander, *hash}).ok());
+  ASSERT_TRUE(set_account(a.dir.file("users"), {"victor", Role::kViewer, *hash}).ok());
+  a.config.approval_timeout_s = 1.0;
+  Ground g(a.config);
+  ASSERT_TRUE(g.start().ok());
+  const auto sign_in = [&](const std::string& user) {
+    const Reply r = g.request("POST", "/api/login", kJson, login_body(user, "correct horse"));
+    EXPECT_EQ(r.status, 200);
+    const auto at = r.head.find("tetra_session=");
+    return "Cookie: " + r.head.substr(at, r.head.find(';', at) - at) + "\r\n" + kJson +
+           "X-CSRF-Token: " + r.data()["csrf"].get<std::string>() + "\r\n";
+  };
+  const std::string alice = sign_in("alice");
+  const std::string bob = sign_in("bob");
+  const std::string victor = sign_in("victor");
+  const std::string force = R"({"unit":"u","action":"exclude","gyro":3,"force":true})";
+  const Reply held = g.request("POST", "/api/command", alice, force);
+  ASSERT_EQ(held.status, 202) << held.body;
+  EXPECT_TRUE(g.sent.empty());  // not sent before the approval
+  const std::string id = held.data()["pending"].get<std::string>();
+  const Reply listed = g.request("GET", "/api/pending", alice);
+  ASSERT_EQ(listed.data().size(), 1U);
+  EXPECT_EQ(listed.data()[0]["operator"], "alice");
+  const std::string approval = json{{"id", id}}.dump();
+  EXPECT_EQ(g.request("POST", "/api/approve", alice, approval).status, 403);   // her own
+  EXPECT_EQ(g.request("POST", "/api/approve", victor, approval).status, 403);  // a viewer
+  EXPECT_TRUE(g.sent.empty());
+  const Reply approved = g.request("POST", "/api/approve", bob, approval);
+  ASSERT_EQ(approved.status, 200) << approved.body;
+  ASSERT_EQ(g.sent.size(), 1U);
+  EXPECT_TRUE(g.sent[0].force);
+  EXPECT_EQ(g.sent[0].operator_id, "alice");
+  EXPECT_EQ(approved.data()["approved_by"], "bob");
+  EXPECT_EQ(g.request("POST", "/api/approve", bob, approval).status, 404);  // once only
+  // One not approved in time is gone; one without force goes at once.
+  const Reply late = g.request("POST", "/api/command", alice, force);
+  ASSERT_EQ(late.status, 202);
+  std::this_thread::sleep_for(1200ms);
+  EXPECT_EQ(g.request("POST", "/api/approve", bob, json{{"id", late.data()["pending"]}}.dump()).status, 404);
+  EXPECT_EQ(g.request("POST", "/api/command", alice, R"({"unit":"u","action":"exclude","gyro":3})").status,
+            200);
+  EXPECT_EQ(g.sent.size(), 2U);
+}
+
 TEST(GroundAttacks, AuditRecordsAreJsonLinesThatNoRequestCanForge) {
   Accounts a;
   a.config.audit_path = a.dir.file("audit.jsonl");

@@ -56,7 +56,8 @@ std::string AuditLog::json_line(const AuditRecord& r, std::int64_t utc_ms) {
 std::string AuditLog::summary(const AuditRecord& r) {
   const std::string who = r.operator_id.empty() ? "no session" : "user " + one_line(r.operator_id);
   std::string line;
-  if (r.decision == "command" && r.decided_by == "service") {
+  if ((r.decision == "command" && (r.decided_by == "service" || r.outcome == "pending")) ||
+      r.decision == "approval") {
     line = one_line(r.operator_id) + " from " + one_line(r.address) + ": " + one_line(r.command) + " to " +
            one_line(r.unit) + ": " + r.outcome + " (" + one_line(r.reason) + ")";
   } else if (r.outcome == "refused" || r.outcome == "unanswered") {

@@ -21,18 +21,6 @@ using nlohmann::json;
 constexpr const char* kCookie = "tetra_session";
 constexpr std::size_t kMaxCatchUp = 4096;  //!< a resume further behind gets a reset and the history
 
-HttpResponse json_reply(int status, const json& body) {
-  HttpResponse res;
-  res.status = status;
-  res.body = json_text(body);
-  res.headers.emplace_back("Cache-Control", "no-store");
-  return res;
-}
-
-HttpResponse error_reply(int status, const std::string& message) {
-  return json_reply(status, {{"error", message}});
-}
-
 std::string lower_case(std::string s) {
   for (auto& ch : s) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   return s;
@@ -83,6 +71,18 @@ std::string with_port(std::string host_port, bool tls) {
 
 }  // namespace
 
+HttpResponse json_reply(int status, const nlohmann::json& body) {
+  HttpResponse res;
+  res.status = status;
+  res.body = json_text(body);
+  res.headers.emplace_back("Cache-Control", "no-store");
+  return res;
+}
+
+HttpResponse error_reply(int status, const std::string& message) {
+  return json_reply(status, {{"error", message}});
+}
+
 bool is_loopback_host(const std::string& host) {
   if (host == "localhost" || host == "::1" || host == "[::1]") return true;
   in_addr a{};
@@ -90,7 +90,11 @@ bool is_loopback_host(const std::string& host) {
 }
 
 GroundServer::GroundServer(GroundStore& store, SendCommand send, ServerConfig config)
-    : store_(store), send_(std::move(send)), config_(std::move(config)), throttle_(config_.throttle) {}
+    : store_(store),
+      send_(std::move(send)),
+      config_(std::move(config)),
+      throttle_(config_.throttle),
+      approvals_(config_.approval_timeout_s) {}
 
 GroundServer::~GroundServer() {
   stop();
@@ -216,7 +220,8 @@ HttpResponse GroundServer::handle(const HttpRequest& req) {
       return refuse(req, 403, "Origin '" + origin + "' not allowed", "");
   }
   // POST for what changes something, GET (or HEAD: the same head, no body) for the rest.
-  const bool post_only = req.path == "/api/login" || req.path == "/api/logout" || req.path == "/api/command";
+  const bool post_only = req.path == "/api/login" || req.path == "/api/logout" ||
+                         req.path == "/api/command" || req.path == "/api/approve";
   const bool get = req.method == "GET" || req.method == "HEAD";
   if (post_only ? req.method != "POST" : !get) {
     auto res = refuse(req, 405, std::string(post_only ? "POST" : "GET or HEAD") + " only here", "");
@@ -246,6 +251,7 @@ HttpResponse GroundServer::handle(const HttpRequest& req) {
 HttpResponse GroundServer::serve(const HttpRequest& req, const std::optional<Session>& session) {
   if (req.method == "POST") {
     if (req.path == "/api/command") return command(req, *session);
+    if (req.path == "/api/approve") return approve(req, *session);
     return logout(req, *session);
   }
   const auto now = steady_now_ns();
@@ -265,6 +271,7 @@ HttpResponse GroundServer::serve(const HttpRequest& req, const std::optional<Ses
                             {"streams", server_->open_streams()},
                             {"units", store_.units_json(now)}});
   }
+  if (req.path == "/api/pending") return json_reply(200, approvals_.list(now));
   if (req.path == "/api/history") return history(req);
   if (req.path == "/api/records") return records(req);
   if (req.path == "/api/stream") return stream(req);
@@ -343,45 +350,6 @@ HttpResponse GroundServer::logout(const HttpRequest& req, const Session& session
   res.headers.emplace_back("Set-Cookie",
                            std::string(kCookie) + "=; Path=/; Max-Age=0; HttpOnly; SameSite=Strict");
   return res;
-}
-
-HttpResponse GroundServer::command(const HttpRequest& req, const Session& session) {
-  const std::string role = to_string(session.role);
-  if (session.role != Role::kCommander)
-    return refuse(req, 403, "the role viewer may not command", session.user, role);
-  auto request = parse_command_request(req.body, session.user, "ground@" + req.remote_addr);
-  if (!request) return refuse(req, 400, request.error().message, session.user, role);
-  if (commands_waiting_.fetch_add(1) >= config_.commands_in_flight) {
-    commands_waiting_.fetch_sub(1);
-    return refuse(req, 503, "other commands are waiting for their acknowledgement: try again", session.user,
-                  role);
-  }
-  auto ack = send_(*request);
-  commands_waiting_.fetch_sub(1);
-  const std::string what = std::string(request->kind == tetra_COMMAND_RESET     ? "reset"
-                                       : request->kind == tetra_COMMAND_EXCLUDE ? "exclude"
-                                                                                : "reinstate") +
-                           (request->gyro != 0 ? " gyro " + std::to_string(request->gyro) : "") +
-                           (request->force ? " force" : "");
-  AuditRecord r;
-  r.decision = "command";
-  r.operator_id = session.user;
-  r.role = role;
-  r.unit = request->unit;
-  r.command = what;
-  if (!ack) {
-    r.outcome = "unanswered";
-    r.status = 504;
-    r.reason = "no acknowledgement: " + ack.error().message;
-    audit(req, std::move(r));
-    return error_reply(504, ack.error().message);
-  }
-  r.outcome = ack->event.refused() ? "refused" : "accepted";
-  r.decided_by = "service";
-  r.status = 200;
-  r.reason = ack->event.detail;
-  audit(req, std::move(r));
-  return json_reply(200, ack_json(*ack, 16));
 }
 
 HttpResponse GroundServer::stream(const HttpRequest& req) {

@@ -18,6 +18,7 @@
 
 #include "tetra/core/result.hpp"
 #include "tetra/dds/convert.hpp"
+#include "tetra/ground/approvals.hpp"
 #include "tetra/ground/audit_log.hpp"
 #include "tetra/ground/command_request.hpp"
 #include "tetra/ground/http_server.hpp"
@@ -46,8 +47,13 @@ struct ServerConfig {
   HttpLimits limits;
   ThrottleLimits throttle;                  //!< sign-in back-off and lockout
   double session_lifetime_s = 12 * 3600.0;  //!< [s]
-  int commands_in_flight = 2;  //!< commands waiting for their acknowledgement at once; beyond: 503
+  int commands_in_flight = 2;         //!< commands waiting for their acknowledgement at once; beyond: 503
+  double approval_timeout_s = 120.0;  //!< [s] a forced exclusion waits this long for a second commander
 };
+
+//! A JSON answer (not cached); an error's is {"error": message}.
+HttpResponse json_reply(int status, const nlohmann::json& body);
+HttpResponse error_reply(int status, const std::string& message);
 
 //! True for 127.0.0.0/8, ::1 and "localhost".
 bool is_loopback_host(const std::string& host);
@@ -73,6 +79,10 @@ class GroundServer {
   HttpResponse login(const HttpRequest& req);
   HttpResponse logout(const HttpRequest& req, const Session& session);
   HttpResponse command(const HttpRequest& req, const Session& session);
+  HttpResponse approve(const HttpRequest& req, const Session& session);
+  //! Sends the command (bounded in flight), audits the answer; `approved_by` a second operator or "".
+  HttpResponse send_command(const HttpRequest& req, const CommandRequest& request, const std::string& role,
+                            const std::string& approved_by);
   HttpResponse stream(const HttpRequest& req);
   HttpResponse history(const HttpRequest& req);
   HttpResponse records(const HttpRequest& req);
@@ -91,6 +101,7 @@ class GroundServer {
   std::string no_auth_csrf_;
   AuditLog audit_;
   LoginThrottle throttle_;
+  Approvals approvals_;
   std::atomic<int> commands_waiting_{0};
 };
 
