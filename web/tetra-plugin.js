@@ -301,17 +301,20 @@ function TetraPlugin(options) {
   function operatorId() {
     return session.user || '?';
   }
-  async function sendCommand(openmct, command) {
+  async function sendCommand(openmct, command, path) {
     try {
       if (!session.csrf) await refreshSession();
-      const response = await fetch(base + '/api/command', {
+      const response = await fetch(base + (path || '/api/command'), {
         method: 'POST',
         credentials: 'same-origin',
         headers: { 'Content-Type': 'application/json', 'X-CSRF-Token': session.csrf || '' },
         body: JSON.stringify(command)
       });
       const answer = await response.json();
-      if (!response.ok) {
+      if (response.status === 202) {
+        // The two-person rule: a forced exclusion waits for a second commander's approval.
+        openmct.notifications.info('Waiting for a second commander to approve: ' + answer.command);
+      } else if (!response.ok) {
         openmct.notifications.error('Command not sent: ' + answer.error);
       } else if (answer.accepted) {
         openmct.notifications.info('Accepted: ' + answer.detail);
@@ -415,7 +418,9 @@ function TetraPlugin(options) {
           out.textContent =
             answer.error !== undefined
               ? 'error: ' + answer.error
-              : (answer.accepted ? 'ACCEPTED: ' : 'REFUSED: ') + answer.detail;
+              : answer.pending !== undefined
+                ? 'WAITING FOR APPROVAL by a second commander within ' + answer.approve_within_s + ' s'
+                : (answer.accepted ? 'ACCEPTED: ' : 'REFUSED: ') + answer.detail;
           out.className = answer.accepted ? 'tetra-ack tetra-ack--ok' : 'tetra-ack tetra-ack--refused';
         }
       });
@@ -554,6 +559,7 @@ function TetraPlugin(options) {
         '<div class="tetra-grid"><section><h2>Gyros</h2><table class="tetra-table"><thead><tr><th>gyro</th>' +
         '<th>state</th><th>fault</th><th>solution</th><th>command</th></tr></thead><tbody id="tetra-gyros"></tbody>' +
         '</table><div class="tetra-commands"></div><div id="tetra-ack" class="tetra-ack"></div>' +
+        '<div id="tetra-pending" class="tetra-pending"></div>' +
         '<div>signed in as <span id="tetra-operator" class="tetra-operator"></span>' +
         ' <button id="tetra-sign-out" class="c-button">Sign out</button></div></section>' +
         '<section><h2>Parity and CUSUM</h2><div id="tetra-parity"></div><h2>Attitude</h2>' +
@@ -613,6 +619,30 @@ function TetraPlugin(options) {
         );
         const ticker = setInterval(render, 500);
         stops.push(() => clearInterval(ticker));
+        // Commands of this unit waiting for a second commander: another commander may approve them.
+        const showPending = async () => {
+          const response = await apiGet('/api/pending');
+          if (!response.ok || !root) return;
+          const box = root.querySelector('#tetra-pending');
+          box.innerHTML = '';
+          for (const p of (await response.json()).filter((x) => x.unit === unit)) {
+            const line = el('div', { class: 'tetra-pending-item' });
+            line.appendChild(el('span', {}, p.operator + ' asks: ' + p.command + ' (' + Math.ceil(p.expires_in_s) + ' s left) '));
+            if (session.role === 'commander' && p.operator !== session.user) {
+              const b = el('button', { class: 'c-button tetra-approve' }, 'Approve');
+              b.addEventListener('click', async () => {
+                const answer = await sendCommand(openmct, { id: p.id }, '/api/approve');
+                if (answer && root) root.querySelector('#tetra-ack').textContent = answer.error !== undefined
+                  ? 'error: ' + answer.error
+                  : (answer.accepted ? 'ACCEPTED: ' : 'REFUSED: ') + answer.detail + ' (approved by ' + operatorId() + ')';
+              });
+              line.appendChild(b);
+            }
+            box.appendChild(line);
+          }
+        };
+        const pendingTicker = setInterval(showPending, 2000);
+        stops.push(() => clearInterval(pendingTicker));
         stops.push(
           listen('event', (m) => {
             if (m.unit !== unit) return;
