@@ -208,6 +208,55 @@ TEST(GroundHttp, AForcedExclusionWaitsForASecondCommander) {
   EXPECT_EQ(g.sent.size(), 2U);
 }
 
+TEST(GroundHttp, PermissionsGrantCommandsPerUnitAndPerOperator) {
+  Accounts a;
+  auto hash = hash_password("correct horse");
+  ASSERT_TRUE(set_account(a.dir.file("users"), {"bob", Role::kCommander, *hash}).ok());
+  {
+    std::ofstream f(a.dir.file("permissions"));
+    f << "# who:unit:commands\n@commander:*:reset\nalice:unit: one:reset,exclude,reinstate,force\n";
+  }
+  a.config.permissions_path = a.dir.file("permissions");
+  Ground g(a.config);
+  ASSERT_TRUE(g.start().ok());
+  const auto sign_in = [&](const std::string& user) {
+    const Reply r = g.request("POST", "/api/login", kJson, login_body(user, "correct horse"));
+    const auto at = r.head.find("tetra_session=");
+    return "Cookie: " + r.head.substr(at, r.head.find(';', at) - at) + "\r\n" + kJson +
+           "X-CSRF-Token: " + r.data()["csrf"].get<std::string>() + "\r\n";
+  };
+  const std::string alice = sign_in("alice");
+  const std::string bob = sign_in("bob");
+  const auto command = [](const std::string& unit, const std::string& action, bool force) {
+    return json{{"unit", unit}, {"action", action}, {"gyro", 3}, {"force", force}}.dump();
+  };
+  const auto reset = [](const std::string& unit) { return json{{"unit", unit}, {"action", "reset"}}.dump(); };
+  // bob has the role's lines: reset anywhere, nothing else.
+  EXPECT_EQ(g.request("POST", "/api/command", bob, reset("unit: one")).status, 200);
+  const Reply no = g.request("POST", "/api/command", bob, command("unit: one", "exclude", false));
+  EXPECT_EQ(no.status, 403);
+  EXPECT_NE(no.body.find("no permission for exclude on unit 'unit: one' (role commander)"), std::string::npos)
+      << no.body;
+  // alice has lines of her own: everything on "unit: one" (a colon in its name), nothing elsewhere.
+  EXPECT_EQ(g.request("POST", "/api/command", alice, command("unit: one", "exclude", false)).status, 200);
+  EXPECT_EQ(g.request("POST", "/api/command", alice, reset("tetra-2")).status, 403);
+  // A forced exclusion needs force from the requester and from the approver.
+  const Reply held = g.request("POST", "/api/command", alice, command("unit: one", "exclude", true));
+  ASSERT_EQ(held.status, 202);
+  EXPECT_EQ(g.request("POST", "/api/approve", bob, json{{"id", held.data()["pending"]}}.dump()).status, 403);
+  EXPECT_EQ(g.sent.size(), 2U);
+  // A line the ground cannot read stops it with the file and line.
+  {
+    std::ofstream f(a.dir.file("bad"));
+    f << "@commander:*:launch\n";
+  }
+  a.config.permissions_path = a.dir.file("bad");
+  Ground bad(a.config);
+  const auto s = bad.start();
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("bad:1: command 'launch'"), std::string::npos) << s.error().message;
+}
+
 TEST(GroundAttacks, AuditRecordsAreJsonLinesThatNoRequestCanForge) {
   Accounts a;
   a.config.audit_path = a.dir.file("audit.jsonl");

@@ -54,6 +54,15 @@ ApprovalOutcome Approvals::approve(const std::string& id, const std::string& app
   return out;
 }
 
+std::optional<PendingCommand> Approvals::find(const std::string& id, std::int64_t now_ns) {
+  const std::lock_guard lock(mutex_);
+  expire(now_ns);
+  for (const auto& p : pending_) {
+    if (same_secret(p.id, id)) return p;
+  }
+  return std::nullopt;
+}
+
 nlohmann::json Approvals::list(std::int64_t now_ns) {
   const std::lock_guard lock(mutex_);
   expire(now_ns);

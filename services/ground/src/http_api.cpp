@@ -115,6 +115,11 @@ Status GroundServer::start() {
   const std::string audit_path = !config_.audit_path.empty() || config_.no_auth
                                      ? config_.audit_path
                                      : config_.users_path + ".audit.jsonl";
+  if (!config_.permissions_path.empty()) {
+    auto permissions = Permissions::read(config_.permissions_path);
+    if (!permissions) return permissions.error();
+    permissions_ = std::move(permissions).value();
+  }
   auto audit = AuditLog::open(audit_path);
   if (!audit) return audit.error();
   audit_ = std::move(audit).value();

@@ -16,6 +16,8 @@ HttpResponse GroundServer::command(const HttpRequest& req, const Session& sessio
     return refuse(req, 403, "the role viewer may not command", session.user, role);
   auto request = parse_command_request(req.body, session.user, "ground@" + req.remote_addr);
   if (!request) return refuse(req, 400, request.error().message, session.user, role);
+  if (const auto no = permissions_.refusal(session.user, role, *request); !no.empty())
+    return refuse(req, 403, no, session.user, role);
   // Under --no-auth there is one operator only: no second one to approve.
   if (!request->force || config_.no_auth) return send_command(req, *request, role, "");
   const auto id = approvals_.add(*request, steady_now_ns());
@@ -44,7 +46,13 @@ HttpResponse GroundServer::approve(const HttpRequest& req, const Session& sessio
   auto body = parse_strict_json(req.body);
   if (!body || !body->is_object() || body->size() != 1 || !(*body)["id"].is_string())
     return refuse(req, 400, "approve: a JSON object {\"id\"}", session.user, role);
-  auto outcome = approvals_.approve((*body)["id"].get<std::string>(), session.user, steady_now_ns());
+  // The approver needs the permission for the command too: it is sent on both operators' word.
+  const std::string id = (*body)["id"].get<std::string>();
+  if (const auto held = approvals_.find(id, steady_now_ns())) {
+    if (const auto no = permissions_.refusal(session.user, role, held->request); !no.empty())
+      return refuse(req, 403, no, session.user, role);
+  }
+  auto outcome = approvals_.approve(id, session.user, steady_now_ns());
   if (!outcome.command) return refuse(req, outcome.status, outcome.message, session.user, role);
   const CommandRequest& request = outcome.command->request;
   AuditRecord r;

@@ -35,6 +35,8 @@ class Approvals {
   std::optional<std::string> add(const CommandRequest& request, std::int64_t now_ns);
   //! `approver` approves `id`: the command when it is another operator's and still held.
   ApprovalOutcome approve(const std::string& id, const std::string& approver, std::int64_t now_ns);
+  //! The command held under `id`, if any.
+  std::optional<PendingCommand> find(const std::string& id, std::int64_t now_ns);
   //! The held commands: [{id, unit, command, operator, expires_in_s}].
   nlohmann::json list(std::int64_t now_ns);
   double timeout_s() const { return timeout_s_; }

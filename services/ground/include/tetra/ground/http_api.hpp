@@ -24,6 +24,7 @@
 #include "tetra/ground/http_server.hpp"
 #include "tetra/ground/login_throttle.hpp"
 #include "tetra/ground/operators.hpp"
+#include "tetra/ground/permissions.hpp"
 #include "tetra/ground/static_files.hpp"
 #include "tetra/ground/store.hpp"
 
@@ -39,9 +40,10 @@ struct ServerConfig {
   std::string records_dir;       //!< `tetra record` files served by /api/records ("": none)
   std::string users_path;        //!< operator accounts (tetra ground passwd); "" only with no_auth
   std::string session_key_path;  //!< the key sessions are signed with (created when absent)
-  std::string
-      audit_path;        //!< the audit file ("": the --users file's name + .audit.jsonl; none under no_auth)
-  bool no_auth = false;  //!< no accounts: everyone who reaches the port is commander "anonymous"
+  //! The audit file ("": the --users file's name + .audit.jsonl; none under no_auth).
+  std::string audit_path;
+  std::string permissions_path;  //!< per-unit and per-command permissions of commanders ("": none)
+  bool no_auth = false;          //!< no accounts: everyone who reaches the port is commander "anonymous"
   std::vector<std::string> allow_origins;  //!< more HOST:PORT a browser may reach the ground as
   TlsFiles tls;
   HttpLimits limits;
@@ -102,6 +104,7 @@ class GroundServer {
   AuditLog audit_;
   LoginThrottle throttle_;
   Approvals approvals_;
+  Permissions permissions_;
   std::atomic<int> commands_waiting_{0};
 };
 
