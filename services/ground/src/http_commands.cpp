@@ -10,6 +10,25 @@
 
 namespace tetra::ground {
 
+namespace {
+
+//! The audit record of a decision about a command.
+AuditRecord command_record(const char* decision, const char* outcome, int status, const std::string& user,
+                           const std::string& role, const CommandRequest& request, std::string reason) {
+  AuditRecord r;
+  r.decision = decision;
+  r.outcome = outcome;
+  r.status = status;
+  r.operator_id = user;
+  r.role = role;
+  r.unit = request.unit;
+  r.command = describe_command(request);
+  r.reason = std::move(reason);
+  return r;
+}
+
+}  // namespace
+
 HttpResponse GroundServer::command(const HttpRequest& req, const Session& session) {
   const std::string role = to_string(session.role);
   if (session.role != Role::kCommander)
@@ -22,16 +41,8 @@ HttpResponse GroundServer::command(const HttpRequest& req, const Session& sessio
   if (!request->force || config_.no_auth) return send_command(req, *request, role, "");
   const auto id = approvals_.add(*request, steady_now_ns());
   if (!id) return refuse(req, 503, "16 commands wait for approval already: try again", session.user, role);
-  AuditRecord r;
-  r.decision = "command";
-  r.outcome = "pending";
-  r.status = 202;
-  r.operator_id = session.user;
-  r.role = role;
-  r.unit = request->unit;
-  r.command = describe_command(*request);
-  r.reason = "held for a second commander's approval (" + *id + ")";
-  audit(req, std::move(r));
+  audit(req, command_record("command", "pending", 202, session.user, role, *request,
+                            "held for a second commander's approval (" + *id + ")"));
   return json_reply(202, {{"pending", *id},
                           {"unit", request->unit},
                           {"command", describe_command(*request)},
@@ -55,16 +66,8 @@ HttpResponse GroundServer::approve(const HttpRequest& req, const Session& sessio
   auto outcome = approvals_.approve(id, session.user, steady_now_ns());
   if (!outcome.command) return refuse(req, outcome.status, outcome.message, session.user, role);
   const CommandRequest& request = outcome.command->request;
-  AuditRecord r;
-  r.decision = "approval";
-  r.outcome = "accepted";
-  r.status = 200;
-  r.operator_id = session.user;
-  r.role = role;
-  r.unit = request.unit;
-  r.command = describe_command(request);
-  r.reason = "approves " + request.operator_id + "'s command (" + outcome.command->id + ")";
-  audit(req, std::move(r));
+  audit(req, command_record("approval", "accepted", 200, session.user, role, request,
+                            "approves " + request.operator_id + "'s command (" + outcome.command->id + ")"));
   return send_command(req, request, "commander", session.user);
 }
 
@@ -77,12 +80,7 @@ HttpResponse GroundServer::send_command(const HttpRequest& req, const CommandReq
   }
   auto ack = send_(request);
   commands_waiting_.fetch_sub(1);
-  AuditRecord r;
-  r.decision = "command";
-  r.operator_id = request.operator_id;
-  r.role = role;
-  r.unit = request.unit;
-  r.command = describe_command(request);
+  AuditRecord r = command_record("command", "", 0, request.operator_id, role, request, "");
   const std::string approval = approved_by.empty() ? "" : " (approved by " + approved_by + ")";
   if (!ack) {
     r.outcome = "unanswered";
