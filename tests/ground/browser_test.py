@@ -35,7 +35,7 @@ from selenium.webdriver.support.ui import WebDriverWait
 
 
 UNIT = "ground test"  # a space: the page and the commands must carry the name as it is
-UNIT_KEY = "x" + UNIT.encode().hex()  # its object key (web/tetra-plugin.js, unitKey)
+UNIT_KEY = "x" + UNIT.encode().hex()  # its object key (web/tetra-model.js, unitKey)
 OPERATOR = "alice"
 PASSWORD = "browser-test-password"
 
