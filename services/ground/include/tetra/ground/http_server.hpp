@@ -1,9 +1,12 @@
 #pragma once
 // A small HTTP/1.1 server built to stay up under abuse (docs/ground.md, threat model): one I/O thread
 // reads and writes every socket without blocking (epoll), so a slow or silent client holds no thread;
-// a request must arrive whole within a deadline and within size limits; handlers run on a small pool
-// of workers; event streams (server-sent events) are written by the I/O thread itself from one shared
-// cursor, each with a bounded output buffer, and their number is bounded. Optional TLS (OpenSSL).
+// a request must arrive whole within a deadline and within size limits (the strict parser of
+// http_parse.hpp), a response be read within its own; a client that does not read is not read either;
+// connections are bounded in all and per address; handlers run on a small pool of workers, slow ones
+// (sign-ins) on a lane of their own; event streams (server-sent events) are written by the I/O thread
+// itself from one shared cursor, each with a bounded output buffer, and their number is bounded.
+// Sockets and TLS (OpenSSL): http_socket.hpp.
 
 #include <atomic>
 #include <cstdint>
