@@ -4,93 +4,13 @@
 // states, parity/CUSUM against thresholds, sigma, attitude, events) and commands with confirmation, sent
 // as the signed-in operator with the session's CSRF token.
 /* exported TetraPlugin */
-/* global EventSource */
+/* global EventSource, TetraModel */
 // eslint-disable-next-line no-unused-vars
 function TetraPlugin(options) {
   'use strict';
+  const { pointsOf, unitKey, unitOfKey } = TetraModel();
   const base = (options && options.baseUrl) || '';
   const NS = 'tetra';
-
-  // --- telemetry points of a unit: where each comes from in the stream's messages ---------------
-  const q = (i) => (m) => m.q[i];
-  const vec = (field, i) => (m) => m[field][i];
-  const euler = (axis) => (m) => m.euler_deg[axis];
-  function attitudePoints() {
-    return [
-      ['q_w', 'Quaternion w', '', q(0)],
-      ['q_x', 'Quaternion x', '', q(1)],
-      ['q_y', 'Quaternion y', '', q(2)],
-      ['q_z', 'Quaternion z', '', q(3)],
-      ['roll_deg', 'Roll (Z-Y-X)', 'deg', euler('roll')],
-      ['pitch_deg', 'Pitch (Z-Y-X)', 'deg', euler('pitch')],
-      ['yaw_deg', 'Yaw (Z-Y-X)', 'deg', euler('yaw')],
-      ['rate_x_dps', 'Rate X', 'deg/s', vec('rate_dps', 0)],
-      ['rate_y_dps', 'Rate Y', 'deg/s', vec('rate_dps', 1)],
-      ['rate_z_dps', 'Rate Z', 'deg/s', vec('rate_dps', 2)],
-      ['sigma_x_deg', 'Sigma X', 'deg', vec('sigma_deg', 0)],
-      ['sigma_y_deg', 'Sigma Y', 'deg', vec('sigma_deg', 1)],
-      ['sigma_z_deg', 'Sigma Z', 'deg', vec('sigma_deg', 2)]
-    ].map(([key, name, units, get]) => ({ key, name, units, source: 'attitude', get }));
-  }
-  function healthPoints(gyroCount) {
-    const points = [
-      { key: 'mode', name: 'Mode', source: 'health', get: (m) => m.mode, text: true },
-      {
-        key: 'parity_residual',
-        name: 'Parity residual',
-        units: 'sigma',
-        source: 'health',
-        get: (m) => m.parity_residual
-      },
-      {
-        key: 'chi2',
-        name: 'Chi-squared',
-        source: 'health',
-        get: (m) => m.chi2,
-        limit: (m) => m.chi2_threshold
-      },
-      {
-        key: 'cusum',
-        name: 'CUSUM',
-        source: 'health',
-        get: (m) => m.cusum,
-        limit: (m) => m.cusum_threshold
-      },
-      {
-        key: 'health_age_s',
-        name: 'Health age',
-        units: 's',
-        source: 'link',
-        get: (m) => m.health_age_s,
-        limit: (m) => m.stale_after_s
-      },
-      { key: 'link', name: 'Link state', source: 'link', get: (m) => m.state, text: true }
-    ];
-    for (let g = 1; g <= gyroCount; g++) {
-      points.push({
-        key: 'gyro' + g + '_state',
-        name: 'Gyro ' + g + ' state',
-        source: 'health',
-        text: true,
-        get: (m) => (m.gyros[g - 1] ? m.gyros[g - 1].state : undefined)
-      });
-    }
-    return points;
-  }
-  function eventPoint() {
-    return {
-      key: 'events',
-      name: 'FDI events',
-      source: 'event',
-      text: true,
-      get: (m) => m.event + (m.gyro ? ' gyro ' + m.gyro : '') + (m.detail ? ': ' + m.detail : '')
-    };
-  }
-  function pointsOf(unit) {
-    return attitudePoints()
-      .concat(healthPoints(unit.gyro_count || 4))
-      .concat([eventPoint()]);
-  }
 
   // --- the ground station's REST and stream ----------------------------------------------------
   // Without a session the ground answers 401: back to the sign-in page.
@@ -164,7 +84,7 @@ function TetraPlugin(options) {
   const id = (key) => ({ namespace: NS, key });
   function parseKey(key) {
     const [kind, unit, point] = key.split('~');
-    return { kind, unit, point };
+    return { kind, unit: unitOfKey(unit || ''), point };
   }
   const objectProvider = {
     async get(identifier) {
@@ -176,7 +96,7 @@ function TetraPlugin(options) {
           name: 'tetra units',
           type: 'folder',
           location: 'ROOT',
-          composition: list.map((u) => id('unit~' + u.unit))
+          composition: list.map((u) => id('unit~' + unitKey(u.unit)))
         };
       }
       const { kind, unit, point } = parseKey(key);
@@ -188,7 +108,7 @@ function TetraPlugin(options) {
           type: 'tetra.unit',
           location: NS + ':units',
           unit,
-          composition: pointsOf(u).map((p) => id('point~' + unit + '~' + p.key))
+          composition: pointsOf(u).map((p) => id('point~' + unitKey(unit) + '~' + p.key))
         };
       }
       const p = pointsOf(u).find((x) => x.key === point);
@@ -208,7 +128,7 @@ function TetraPlugin(options) {
         identifier,
         name: p.name + ' (' + unit + ')',
         type: p.text ? 'tetra.telemetry.text' : 'tetra.telemetry',
-        location: NS + ':unit~' + unit,
+        location: NS + ':unit~' + unitKey(unit),
         unit,
         point: p.key,
         telemetry: {
@@ -290,17 +210,20 @@ function TetraPlugin(options) {
   function operatorId() {
     return session.user || '?';
   }
-  async function sendCommand(openmct, command) {
+  async function sendCommand(openmct, command, path) {
     try {
       if (!session.csrf) await refreshSession();
-      const response = await fetch(base + '/api/command', {
+      const response = await fetch(base + (path || '/api/command'), {
         method: 'POST',
         credentials: 'same-origin',
         headers: { 'Content-Type': 'application/json', 'X-CSRF-Token': session.csrf || '' },
         body: JSON.stringify(command)
       });
       const answer = await response.json();
-      if (!response.ok) {
+      if (response.status === 202) {
+        // The two-person rule: a forced exclusion waits for a second commander's approval.
+        openmct.notifications.info('Waiting for a second commander to approve: ' + answer.command);
+      } else if (!response.ok) {
         openmct.notifications.error('Command not sent: ' + answer.error);
       } else if (answer.accepted) {
         openmct.notifications.info('Accepted: ' + answer.detail);
@@ -404,7 +327,9 @@ function TetraPlugin(options) {
           out.textContent =
             answer.error !== undefined
               ? 'error: ' + answer.error
-              : (answer.accepted ? 'ACCEPTED: ' : 'REFUSED: ') + answer.detail;
+              : answer.pending !== undefined
+                ? 'WAITING FOR APPROVAL by a second commander within ' + answer.approve_within_s + ' s'
+                : (answer.accepted ? 'ACCEPTED: ' : 'REFUSED: ') + answer.detail;
           out.className = answer.accepted ? 'tetra-ack tetra-ack--ok' : 'tetra-ack tetra-ack--refused';
         }
       });
@@ -543,6 +468,7 @@ function TetraPlugin(options) {
         '<div class="tetra-grid"><section><h2>Gyros</h2><table class="tetra-table"><thead><tr><th>gyro</th>' +
         '<th>state</th><th>fault</th><th>solution</th><th>command</th></tr></thead><tbody id="tetra-gyros"></tbody>' +
         '</table><div class="tetra-commands"></div><div id="tetra-ack" class="tetra-ack"></div>' +
+        '<div id="tetra-pending" class="tetra-pending"></div>' +
         '<div>signed in as <span id="tetra-operator" class="tetra-operator"></span>' +
         ' <button id="tetra-sign-out" class="c-button">Sign out</button></div></section>' +
         '<section><h2>Parity and CUSUM</h2><div id="tetra-parity"></div><h2>Attitude</h2>' +
@@ -602,6 +528,30 @@ function TetraPlugin(options) {
         );
         const ticker = setInterval(render, 500);
         stops.push(() => clearInterval(ticker));
+        // Commands of this unit waiting for a second commander: another commander may approve them.
+        const showPending = async () => {
+          const response = await apiGet('/api/pending');
+          if (!response.ok || !root) return;
+          const box = root.querySelector('#tetra-pending');
+          box.innerHTML = '';
+          for (const p of (await response.json()).filter((x) => x.unit === unit)) {
+            const line = el('div', { class: 'tetra-pending-item' });
+            line.appendChild(el('span', {}, p.operator + ' asks: ' + p.command + ' (' + Math.ceil(p.expires_in_s) + ' s left) '));
+            if (session.role === 'commander' && p.operator !== session.user) {
+              const b = el('button', { class: 'c-button tetra-approve' }, 'Approve');
+              b.addEventListener('click', async () => {
+                const answer = await sendCommand(openmct, { id: p.id }, '/api/approve');
+                if (answer && root) root.querySelector('#tetra-ack').textContent = answer.error !== undefined
+                  ? 'error: ' + answer.error
+                  : (answer.accepted ? 'ACCEPTED: ' : 'REFUSED: ') + answer.detail + ' (approved by ' + operatorId() + ')';
+              });
+              line.appendChild(b);
+            }
+            box.appendChild(line);
+          }
+        };
+        const pendingTicker = setInterval(showPending, 2000);
+        stops.push(() => clearInterval(pendingTicker));
         stops.push(
           listen('event', (m) => {
             if (m.unit !== unit) return;

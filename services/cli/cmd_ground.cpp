@@ -46,6 +46,19 @@ int cmd_ground(int argc, char** argv) {
                  "the key of the session journal and the CSRF tokens (default: the --users file's name + "
                  ".session-key; created when absent, refused when group or others may read it); the sessions "
                  "are kept in the --users file's name + .sessions");
+  app.add_option(
+         "--permissions", server_config.permissions_path,
+         "per-unit and per-command permissions of commanders: WHO:UNIT:COMMANDS lines (docs/ground.md, "
+         "Permissions); without it a commander may send every command to every unit")
+      ->check(CLI::ExistingFile);
+  app.add_option("--audit", server_config.audit_path,
+                 "the audit file: one JSON line per sign-in, sign-out, command and refused request (default: "
+                 "the --users file's name + .audit.jsonl; none under --no-auth unless given; mode 0600)");
+  app.add_option("--max-connections-per-address", server_config.limits.max_connections_per_address,
+                 "connections held from one client address (beyond: closed at once; behind a proxy every "
+                 "client has the proxy's address)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   app.add_flag(
       "--no-auth", server_config.no_auth,
       "no accounts: whoever reaches the port commands as 'anonymous' (loopback addresses only; logged)");

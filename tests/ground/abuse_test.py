@@ -2,7 +2,8 @@
 """The ground station under abuse, through raw sockets: `tetra ground --no-auth --max-streams 1000`
 holds 1,000 open event streams and refuses the next with 503; 100 slow clients send their requests a
 byte a second; meanwhile the API answers every request (a socket timeout of 5 s only turns a hang into
-a failure); the slow clients are closed at the request deadline. Prints the API's latency and the
+a failure); the slow clients are closed at the request deadline; 4,200 idle connections from one
+address leave an operator on another answered. Prints the API's latency and the
 ground's resident memory (figures for docs/ground.md; `--requests 1000` for the bench figure).
 Latency is reported, never a pass/fail condition.
 """
@@ -19,6 +20,7 @@ import time
 
 STREAMS = 1000
 SLOW = 100
+IDLE = 4200
 
 
 def free_port():
@@ -92,6 +94,7 @@ def main():
                               stdout=log, stderr=subprocess.STDOUT)
     held = []
     slow = []
+    idle = []
     publisher = None
     if args.publisher:
         publisher = subprocess.Popen([args.publisher, "--domain", args.domain, "--units", "10", "--rate", "100",
@@ -168,6 +171,30 @@ def main():
         if closed != SLOW:
             failures.append(f"{SLOW - closed} of {SLOW} slow clients not closed at the request deadline")
         log.flush()
+        # 4,200 idle connections from one address (127.0.0.3): beyond its share (2048) closed at once, so
+        # an operator on another address (127.0.0.4) is still answered.
+        for _ in range(IDLE):
+            s = socket.socket()
+            s.bind(("127.0.0.3", 0))
+            s.settimeout(5)
+            try:
+                s.connect(("127.0.0.1", port))
+            except OSError:
+                s.close()
+                continue
+            idle.append(s)
+        time.sleep(0.5)
+        with socket.socket() as s:
+            s.bind(("127.0.0.4", 0))
+            s.settimeout(5)
+            try:
+                s.connect(("127.0.0.1", port))
+                s.sendall(f"GET /api/units HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n".encode())
+                answer = s.recv(4096)
+            except OSError as e:
+                answer = repr(e).encode()
+        if not answer.startswith(b"HTTP/1.1 200"):
+            failures.append(f"an operator beside {IDLE} idle connections of another address: {answer[:40]!r}")
         refused_logged = "refused (503)" in open(log_path, encoding="utf-8", errors="replace").read()
         if not refused_logged:
             failures.append("the refused stream is not in the ground's log")
@@ -178,7 +205,8 @@ def main():
                   f"clients; {len(latencies)} API requests: p50 {p50:.1f} ms, p99 {p99:.1f} ms, max {worst:.1f} ms "
                   f"({'within' if worst < 100 else 'NOT within'} 100 ms); resident {rss_idle:.1f} MiB idle, "
                   f"{rss_held:.1f} MiB with the streams; {closed_slow_readers} unread streams closed at their buffer "
-                  f"bound; load average {os.getloadavg()[0]:.1f}")
+                  f"bound; {IDLE} idle connections of one address beside an operator answered; "
+                  f"load average {os.getloadavg()[0]:.1f}")
         if failures:
             print("ground_abuse: FAILED: " + "; ".join(failures), file=sys.stderr)
             print(open(log_path, encoding="utf-8", errors="replace").read()[-2000:], file=sys.stderr)
@@ -190,6 +218,8 @@ def main():
             s.close()
         for entry in slow:
             entry[0].close()
+        for s in idle:
+            s.close()
         if publisher is not None:
             publisher.terminate()
             publisher.wait()

@@ -16,6 +16,7 @@ hang into a failure); nothing is timed.
 
 import argparse
 import http.server
+import json
 import os
 import signal
 import socket
@@ -33,7 +34,8 @@ from selenium.webdriver.support import expected_conditions as ec
 from selenium.webdriver.support.ui import WebDriverWait
 
 
-UNIT = "ground-test"
+UNIT = "ground test"  # a space: the page and the commands must carry the name as it is
+UNIT_KEY = "x" + UNIT.encode().hex()  # its object key (web/tetra-model.js, unitKey)
 OPERATOR = "alice"
 PASSWORD = "browser-test-password"
 
@@ -146,7 +148,7 @@ def main():
     attack = None
     step = "make the operator's account"
     users = os.path.join(args.out, "users")
-    for stale in (users, users + ".session-key"):
+    for stale in (users, users + ".session-key", users + ".sessions", users + ".audit.jsonl"):
         if os.path.exists(stale):
             os.unlink(stale)
     subprocess.run([args.tetra, "ground", "passwd", OPERATOR, "--role", "commander", "--users", users,
@@ -168,7 +170,7 @@ def main():
         assert http_ready(port, 30), "the ground station does not answer"
 
         step = "sign in"
-        app = f"http://127.0.0.1:{port}/#/browse/tetra:units/tetra:unit~{UNIT}"
+        app = f"http://127.0.0.1:{port}/#/browse/tetra:units/tetra:unit~{UNIT_KEY}"
         driver.get(app)
         wait.until(ec.presence_of_element_located((By.ID, "tetra-login-form")))  # sent to the sign-in page
         driver.find_element(By.ID, "tetra-user").send_keys(OPERATOR)
@@ -208,6 +210,10 @@ def main():
         wait.until(lambda d: f"[{OPERATOR} @ ground@127.0.0.1, refused]" in text_of(d, "tetra-events")
                    and f"[{OPERATOR} @ ground@127.0.0.1, accepted]" in text_of(d, "tetra-events"))
         driver.save_screenshot(os.path.join(args.out, "3_commands.png"))
+        with open(users + ".audit.jsonl", encoding="utf-8") as f:
+            records = [json.loads(line) for line in f]
+        sent = [(r["unit"], r["outcome"]) for r in records if r["decision"] == "command" and r["operator"] == OPERATOR]
+        assert sent[-2:] == [(UNIT, "refused"), (UNIT, "accepted")], f"commands not to '{UNIT}': {sent}"
 
         step = "forged cross-site requests are refused and not obeyed"
         commands_before = len([line for line in audit_lines(args.out) if f"audit: {OPERATOR} from" in line])

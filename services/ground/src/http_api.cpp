@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 
 #include "tetra/ground/encode.hpp"
@@ -19,18 +20,6 @@ using nlohmann::json;
 
 constexpr const char* kCookie = "tetra_session";
 constexpr std::size_t kMaxCatchUp = 4096;  //!< a resume further behind gets a reset and the history
-
-HttpResponse json_reply(int status, const json& body) {
-  HttpResponse res;
-  res.status = status;
-  res.body = json_text(body);
-  res.headers.emplace_back("Cache-Control", "no-store");
-  return res;
-}
-
-HttpResponse error_reply(int status, const std::string& message) {
-  return json_reply(status, {{"error", message}});
-}
 
 std::string lower_case(std::string s) {
   for (auto& ch : s) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
@@ -82,6 +71,18 @@ std::string with_port(std::string host_port, bool tls) {
 
 }  // namespace
 
+HttpResponse json_reply(int status, const nlohmann::json& body) {
+  HttpResponse res;
+  res.status = status;
+  res.body = json_text(body);
+  res.headers.emplace_back("Cache-Control", "no-store");
+  return res;
+}
+
+HttpResponse error_reply(int status, const std::string& message) {
+  return json_reply(status, {{"error", message}});
+}
+
 bool is_loopback_host(const std::string& host) {
   if (host == "localhost" || host == "::1" || host == "[::1]") return true;
   in_addr a{};
@@ -89,7 +90,11 @@ bool is_loopback_host(const std::string& host) {
 }
 
 GroundServer::GroundServer(GroundStore& store, SendCommand send, ServerConfig config)
-    : store_(store), send_(std::move(send)), config_(std::move(config)) {}
+    : store_(store),
+      send_(std::move(send)),
+      config_(std::move(config)),
+      throttle_(config_.throttle),
+      approvals_(config_.approval_timeout_s) {}
 
 GroundServer::~GroundServer() {
   stop();
@@ -107,6 +112,17 @@ Status GroundServer::start() {
     if (!ops) return ops.error();
     operators_.emplace(std::move(ops).value());
   }
+  const std::string audit_path = !config_.audit_path.empty() || config_.no_auth
+                                     ? config_.audit_path
+                                     : config_.users_path + ".audit.jsonl";
+  if (!config_.permissions_path.empty()) {
+    auto permissions = Permissions::read(config_.permissions_path);
+    if (!permissions) return permissions.error();
+    permissions_ = std::move(permissions).value();
+  }
+  auto audit = AuditLog::open(audit_path);
+  if (!audit) return audit.error();
+  audit_ = std::move(audit).value();
   if (config_.tls.cert.empty() != config_.tls.key.empty())
     return bad_input("--tls-cert and --tls-key go together");
   if (!files_.mount("/", config_.web_dir))
@@ -119,8 +135,11 @@ Status GroundServer::start() {
   no_auth_csrf_ = random_hex(32);
   StreamFeed feed{[this](std::uint64_t after, std::string& out) { return feed_next(after, out); },
                   [this] { return store_.last_id(); }};
-  server_ = std::make_unique<HttpServer>([this](const HttpRequest& r) { return handle(r); }, std::move(feed),
-                                         config_.limits);
+  // Sign-ins take a password check each (64 MiB, about 0.3 s): on the server's slow lane, their own
+  // workers and queue, so they never hold up the rest of the API or each other beyond that queue.
+  server_ = std::make_unique<HttpServer>(
+      [this](const HttpRequest& r) { return handle(r); }, std::move(feed), config_.limits,
+      [](const HttpRequest& r) { return r.method == "POST" && r.path == "/api/login"; });
   if (auto s = server_->start(config_.host, config_.port, config_.tls); !s) return s;
   const std::string port = ":" + std::to_string(server_->port());
   for (const std::string& h :
@@ -156,10 +175,23 @@ std::uint64_t GroundServer::feed_next(std::uint64_t after, std::string& out) con
   return after;
 }
 
+void GroundServer::audit(const HttpRequest& req, AuditRecord record) {
+  record.address = req.remote_addr;
+  record.method = req.method;
+  record.path = req.path;
+  audit_.write(record);
+}
+
 HttpResponse GroundServer::refuse(const HttpRequest& req, int status, const std::string& why,
-                                  const std::string& user) {
-  spdlog::warn("ground audit: refused {} {} from {} ({}): {}", req.method, req.path, req.remote_addr,
-               user.empty() ? "no session" : "user " + user, why);
+                                  const std::string& user, const std::string& role) {
+  AuditRecord r;
+  r.decision = req.path == "/api/login" ? "sign-in" : (req.path == "/api/command" ? "command" : "request");
+  r.outcome = "refused";
+  r.status = status;
+  r.operator_id = user;
+  r.role = role;
+  r.reason = why;
+  audit(req, std::move(r));
   return error_reply(status, why);
 }
 
@@ -167,7 +199,16 @@ std::optional<Session> GroundServer::session_of(const HttpRequest& req) {
   if (config_.no_auth) return Session{"anonymous", Role::kCommander, no_auth_csrf_};
   const std::string token = cookie_value(req.header("cookie"), kCookie);
   if (token.empty()) return std::nullopt;
-  return operators_->session(token, utc_now_s());
+  auto session = operators_->session(token, utc_now_s());
+  if (!session) {
+    AuditRecord r;
+    r.decision = "session";
+    r.outcome = "refused";
+    r.status = req.path.rfind("/api/", 0) == 0 ? 401 : 302;
+    r.reason = "session cookie unknown, expired or signed out";
+    audit(req, std::move(r));
+  }
+  return session;
 }
 
 HttpResponse GroundServer::handle(const HttpRequest& req) {
@@ -183,12 +224,19 @@ HttpResponse GroundServer::handle(const HttpRequest& req) {
         allowed_hosts_.count(with_port(host_port_of(origin), req.tls)) == 0)
       return refuse(req, 403, "Origin '" + origin + "' not allowed", "");
   }
-  if (req.method != "GET" && req.method != "POST") return error_reply(405, "GET or POST only");
+  // POST for what changes something, GET (or HEAD: the same head, no body) for the rest.
+  const bool post_only = req.path == "/api/login" || req.path == "/api/logout" ||
+                         req.path == "/api/command" || req.path == "/api/approve";
+  const bool get = req.method == "GET" || req.method == "HEAD";
+  if (post_only ? req.method != "POST" : !get) {
+    auto res = refuse(req, 405, std::string(post_only ? "POST" : "GET or HEAD") + " only here", "");
+    res.headers.emplace_back("Allow", post_only ? "POST" : "GET, HEAD");
+    return res;
+  }
   if (req.method == "POST" && !is_json_type(req.header("content-type")))
     return refuse(req, 415, "a POST must be application/json", "");
-  if (req.method == "POST" && req.path == "/api/login") return login(req);
-  if (req.method == "GET" &&
-      (req.path == "/login.html" || req.path == "/login.js" || req.path == "/tetra.css"))
+  if (req.path == "/api/login") return login(req);
+  if (get && (req.path == "/login.html" || req.path == "/login.js" || req.path == "/tetra.css"))
     return serve(req, std::nullopt);
   const auto session = session_of(req);
   if (!session) {
@@ -200,24 +248,16 @@ HttpResponse GroundServer::handle(const HttpRequest& req) {
     return res;
   }
   if (req.method == "POST" && !same_secret(req.header("x-csrf-token"), session->csrf))
-    return refuse(req, 403, "the session's CSRF token is missing or wrong (X-CSRF-Token)", session->user);
+    return refuse(req, 403, "the session's CSRF token is missing or wrong (X-CSRF-Token)", session->user,
+                  to_string(session->role));
   return serve(req, session);
 }
 
 HttpResponse GroundServer::serve(const HttpRequest& req, const std::optional<Session>& session) {
   if (req.method == "POST") {
     if (req.path == "/api/command") return command(req, *session);
-    if (req.path == "/api/logout") {
-      if (operators_) {
-        if (auto s = operators_->revoke(cookie_value(req.header("cookie"), kCookie)); !s)
-          return error_reply(500, "sign-out not recorded: " + s.error().message);
-      }
-      auto res = json_reply(200, {{"signed_out", session->user}});
-      res.headers.emplace_back("Set-Cookie",
-                               std::string(kCookie) + "=; Path=/; Max-Age=0; HttpOnly; SameSite=Strict");
-      return res;
-    }
-    return error_reply(404, "no such request");
+    if (req.path == "/api/approve") return approve(req, *session);
+    return logout(req, *session);
   }
   const auto now = steady_now_ns();
   if (req.path == "/api/session") {
@@ -236,6 +276,7 @@ HttpResponse GroundServer::serve(const HttpRequest& req, const std::optional<Ses
                             {"streams", server_->open_streams()},
                             {"units", store_.units_json(now)}});
   }
+  if (req.path == "/api/pending") return json_reply(200, approvals_.list(now));
   if (req.path == "/api/history") return history(req);
   if (req.path == "/api/records") return records(req);
   if (req.path == "/api/stream") return stream(req);
@@ -255,11 +296,27 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
       body->size() != 2)
     return error_reply(400, "login: a JSON object {\"user\", \"password\"}");
   const std::string user = (*body)["user"].get<std::string>();
-  std::unique_lock lock(login_mutex_, std::try_to_lock);
-  if (!lock.owns_lock()) return error_reply(503, "another sign-in is being checked: try again");
+  const std::string shown = valid_user_name(user) ? user : "?";
+  // Refused before the password is checked: costs no hash and is not counted as a failure.
+  const std::int64_t at = steady_now_ns();
+  // Failures are counted by the name as written when it is a valid user name, else under "?" (no
+  // account has it): a flood of long made-up names takes no memory.
+  const auto verdict = throttle_.admit(shown, req.remote_addr, at);
+  if (!verdict.allowed) {
+    // The 1st, 2nd, 4th, 8th... refusal since the last check is recorded, the others only answered.
+    const std::uint64_t n = verdict.refused_before + 1;
+    auto res =
+        (n & (n - 1)) != 0
+            ? error_reply(429, verdict.reason)
+            : refuse(req, 429, verdict.reason + " (refusal " + std::to_string(n) + " since the last check)",
+                     shown);
+    res.headers.emplace_back("Retry-After",
+                             std::to_string(static_cast<long>(std::ceil(verdict.retry_after_s))));
+    return res;
+  }
   const auto account = operators_->login(user, (*body)["password"].get<std::string>());
-  lock.unlock();
-  if (!account) return refuse(req, 401, "user or password wrong", valid_user_name(user) ? user : "?");
+  throttle_.record(shown, req.remote_addr, account.has_value(), at);
+  if (!account) return refuse(req, 401, "user or password wrong", shown);
   const auto lifetime = static_cast<std::int64_t>(config_.session_lifetime_s);
   const auto issued = operators_->issue(account->user, utc_now_s(), lifetime);
   if (!issued) {
@@ -267,8 +324,13 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
     return error_reply(500, "the session cannot be recorded");
   }
   const std::string& token = *issued;
-  spdlog::info("ground audit: {} ({}) signed in from {}", account->user, to_string(account->role),
-               req.remote_addr);
+  AuditRecord r;
+  r.decision = "sign-in";
+  r.outcome = "accepted";
+  r.status = 200;
+  r.operator_id = account->user;
+  r.role = to_string(account->role);
+  audit(req, std::move(r));
   auto res = json_reply(
       200, {{"user", account->user}, {"role", to_string(account->role)}, {"csrf", operators_->csrf(token)}});
   res.headers.emplace_back("Set-Cookie", std::string(kCookie) + "=" + token +
@@ -277,30 +339,22 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
   return res;
 }
 
-HttpResponse GroundServer::command(const HttpRequest& req, const Session& session) {
-  if (session.role != Role::kCommander)
-    return refuse(req, 403, "the role viewer may not command", session.user);
-  auto request = parse_command_request(req.body, session.user, "ground@" + req.remote_addr);
-  if (!request) return refuse(req, 400, request.error().message, session.user);
-  if (commands_waiting_.fetch_add(1) >= config_.commands_in_flight) {
-    commands_waiting_.fetch_sub(1);
-    return refuse(req, 503, "other commands are waiting for their acknowledgement: try again", session.user);
+HttpResponse GroundServer::logout(const HttpRequest& req, const Session& session) {
+  if (operators_) {
+    if (auto s = operators_->revoke(cookie_value(req.header("cookie"), kCookie)); !s)
+      return error_reply(500, "sign-out not recorded: " + s.error().message);
   }
-  auto ack = send_(*request);
-  commands_waiting_.fetch_sub(1);
-  const std::string what = std::string(request->kind == tetra_COMMAND_RESET     ? "reset"
-                                       : request->kind == tetra_COMMAND_EXCLUDE ? "exclude"
-                                                                                : "reinstate") +
-                           (request->gyro != 0 ? " gyro " + std::to_string(request->gyro) : "") +
-                           (request->force ? " force" : "");
-  if (!ack) {
-    spdlog::warn("ground audit: {} from {}: {} to {}: no acknowledgement ({})", session.user, req.remote_addr,
-                 what, request->unit, ack.error().message);
-    return error_reply(504, ack.error().message);
-  }
-  spdlog::info("ground audit: {} from {}: {} to {}: {} ({})", session.user, req.remote_addr, what,
-               request->unit, ack->event.refused() ? "refused" : "accepted", ack->event.detail);
-  return json_reply(200, ack_json(*ack, 16));
+  AuditRecord r;
+  r.decision = "sign-out";
+  r.outcome = "accepted";
+  r.status = 200;
+  r.operator_id = session.user;
+  r.role = to_string(session.role);
+  audit(req, std::move(r));
+  auto res = json_reply(200, {{"signed_out", session.user}});
+  res.headers.emplace_back("Set-Cookie",
+                           std::string(kCookie) + "=; Path=/; Max-Age=0; HttpOnly; SameSite=Strict");
+  return res;
 }
 
 HttpResponse GroundServer::stream(const HttpRequest& req) {

@@ -1,12 +1,7 @@
 #include "tetra/ground/http_server.hpp"
 
-#include <arpa/inet.h>
-#include <fcntl.h>
-#include <netdb.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
-#include <openssl/err.h>
-#include <openssl/ssl.h>
 #include <spdlog/spdlog.h>
 #include <sys/epoll.h>
 #include <sys/eventfd.h>
@@ -23,12 +18,9 @@
 #include <unordered_map>
 #include <unordered_set>
 
-namespace tetra::ground {
+#include "http_socket.hpp"
 
-std::string HttpRequest::header(const std::string& name) const {
-  const auto it = headers.find(name);
-  return it == headers.end() ? std::string() : it->second;
-}
+namespace tetra::ground {
 
 namespace {
 
@@ -40,134 +32,6 @@ std::int64_t io_now_ns() {
 
 std::int64_t to_ns(double s) {
   return static_cast<std::int64_t>(s * 1e9);
-}
-
-const char* reason_phrase(int status) {
-  switch (status) {
-    case 200:
-      return "OK";
-    case 302:
-      return "Found";
-    case 400:
-      return "Bad Request";
-    case 401:
-      return "Unauthorized";
-    case 403:
-      return "Forbidden";
-    case 404:
-      return "Not Found";
-    case 405:
-      return "Method Not Allowed";
-    case 408:
-      return "Request Timeout";
-    case 413:
-      return "Payload Too Large";
-    case 415:
-      return "Unsupported Media Type";
-    case 431:
-      return "Request Header Fields Too Large";
-    case 500:
-      return "Internal Server Error";
-    case 501:
-      return "Not Implemented";
-    case 503:
-      return "Service Unavailable";
-    case 504:
-      return "Gateway Timeout";
-    default:
-      return "Status";
-  }
-}
-
-std::string to_lower(std::string s) {
-  for (auto& ch : s) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  return s;
-}
-
-std::string trimmed(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
-
-//! Percent-decoding (and '+' as space in a query); false on a bad escape or a NUL.
-bool url_decode(const std::string& in, bool plus_is_space, std::string& out) {
-  out.clear();
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    char ch = in[i];
-    if (ch == '%') {
-      if (i + 2 >= in.size()) return false;
-      const auto hex = [](char h) {
-        return h >= '0' && h <= '9'
-                   ? h - '0'
-                   : (h >= 'a' && h <= 'f' ? h - 'a' + 10 : (h >= 'A' && h <= 'F' ? h - 'A' + 10 : -1));
-      };
-      const int hi = hex(in[i + 1]);
-      const int lo = hex(in[i + 2]);
-      if (hi < 0 || lo < 0) return false;
-      ch = static_cast<char>(hi * 16 + lo);
-      i += 2;
-    } else if (ch == '+' && plus_is_space) {
-      ch = ' ';
-    }
-    if (ch == '\0') return false;
-    out += ch;
-  }
-  return true;
-}
-
-//! The request line and headers (up to the blank line) and the HTTP version; an error names what is wrong.
-Result<HttpRequest> parse_head(const std::string& head, std::string& version) {
-  HttpRequest req;
-  const auto line_end = head.find("\r\n");
-  const std::string line = head.substr(0, line_end);
-  const auto sp1 = line.find(' ');
-  const auto sp2 = line.rfind(' ');
-  if (sp1 == std::string::npos || sp2 == sp1) return bad_input("malformed request line");
-  req.method = line.substr(0, sp1);
-  const std::string target = line.substr(sp1 + 1, sp2 - sp1 - 1);
-  version = line.substr(sp2 + 1);
-  if (version != "HTTP/1.1" && version != "HTTP/1.0") return bad_input("HTTP/1.0 or HTTP/1.1 only");
-  if (target.empty() || target[0] != '/') return bad_input("the request target must be a path");
-  const auto q = target.find('?');
-  if (!url_decode(target.substr(0, q), false, req.path))
-    return bad_input("path: bad percent-encoding or NUL");
-  if (q != std::string::npos) {
-    std::size_t start = q + 1;
-    while (start <= target.size()) {
-      auto amp = target.find('&', start);
-      if (amp == std::string::npos) amp = target.size();
-      const std::string pair = target.substr(start, amp - start);
-      start = amp + 1;
-      if (pair.empty()) continue;
-      const auto eq = pair.find('=');
-      std::string name;
-      std::string value;
-      if (!url_decode(pair.substr(0, eq), true, name)) return bad_input("query: bad percent-encoding or NUL");
-      if (eq != std::string::npos && !url_decode(pair.substr(eq + 1), true, value))
-        return bad_input("parameter '" + name + "': bad percent-encoding or NUL");
-      req.params.emplace_back(std::move(name), std::move(value));
-    }
-  }
-  std::size_t pos = line_end == std::string::npos ? head.size() : line_end + 2;
-  while (pos < head.size()) {
-    auto end = head.find("\r\n", pos);
-    if (end == std::string::npos) end = head.size();
-    const std::string h = head.substr(pos, end - pos);
-    pos = end + 2;
-    const auto colon = h.find(':');
-    if (colon == std::string::npos || colon == 0) return bad_input("malformed header line");
-    const std::string name = to_lower(h.substr(0, colon));
-    const std::string value = trimmed(h.substr(colon + 1));
-    auto [it, fresh] = req.headers.emplace(name, value);
-    if (!fresh) {
-      static const std::unordered_set<std::string> single{
-          "host", "content-length", "content-type", "origin", "x-csrf-token", "cookie", "transfer-encoding"};
-      if (single.count(name) != 0) return bad_input("header '" + name + "' given twice");
-      it->second += ", " + value;
-    }
-  }
-  return req;
 }
 
 }  // namespace
@@ -191,10 +55,15 @@ struct Conn {
   std::size_t chunk_off = 0;    //!< written of chunks.front()
   std::size_t chunk_bytes = 0;  //!< in chunks
   bool close_after = false;
+  bool want_in = true;  //!< EPOLLIN asked for
   bool want_out = false;
+  bool peer_closed = false;  //!< the client sent FIN: its requests read are still answered, then closed
+  bool head_only = false;    //!< the request being answered is a HEAD
   std::int64_t accepted_ns = 0;
-  std::int64_t request_start_ns = 0;  //!< [ns] first byte of the request being read (0: none yet)
-  std::int64_t activity_ns = 0;       //!< [ns] last byte read or written
+  std::int64_t response_deadline_ns = 0;  //!< [ns] the response being written must be out by then
+  std::int64_t backlog_since_ns = 0;      //!< [ns] a stream's buffer not empty since (0: empty)
+  std::int64_t request_start_ns = 0;      //!< [ns] first byte of the request being read (0: none yet)
+  std::int64_t activity_ns = 0;           //!< [ns] last byte read or written
   std::size_t pending() const {
     return out.size() - out_off + (body ? body->size() - body_off : 0) + chunk_bytes - chunk_off;
   }
@@ -204,6 +73,7 @@ struct Job {
   std::uint64_t conn = 0;
   HttpRequest request;
   bool keep_alive = false;
+  bool slow = false;
 };
 struct Done {
   std::uint64_t conn = 0;
@@ -225,6 +95,7 @@ struct HttpServer::Impl {
   Handler handler;
   StreamFeed feed;
   HttpLimits limits;
+  SlowLane slow_lane;
   HttpServer* owner = nullptr;
   int listen_fd = -1;
   int epoll_fd = -1;
@@ -232,6 +103,7 @@ struct HttpServer::Impl {
   SSL_CTX* ssl_ctx = nullptr;
   std::unordered_map<std::uint64_t, std::unique_ptr<Conn>> conns;
   std::unordered_set<std::uint64_t> streams;
+  std::unordered_map<std::string, std::size_t> per_address;  //!< connections of each client address
   std::uint64_t next_id = 2;
   std::uint64_t cursor = 0;  //!< stream messages up to this id are in every stream's buffer
   std::int64_t broadcast_ns = 0;
@@ -239,7 +111,11 @@ struct HttpServer::Impl {
   std::atomic<bool> stopping{false};
   std::mutex mutex;
   std::condition_variable work;
+  std::condition_variable slow_work;
   std::deque<Job> jobs;
+  std::deque<Job> slow_jobs;
+  std::size_t slow_held = 0;                                     //!< slow requests waiting or running
+  std::unordered_map<std::string, std::size_t> slow_by_address;  //!< of them, per client address
   std::deque<Done> done;
   std::vector<std::thread> workers;
   std::thread io;
@@ -264,51 +140,38 @@ struct HttpServer::Impl {
     c.fd = -1;
   }
 
-  void drop(Conn& c) {
+  //! Closes the connection; `abort`: at once, what the kernel still holds for it discarded (a client
+  //! past its deadline is not fed from the kernel's buffers either).
+  void drop(Conn& c, bool abort = false) {
+    if (abort) {
+      const linger now{1, 0};
+      ::setsockopt(c.fd, SOL_SOCKET, SO_LINGER, &now, sizeof now);
+    }
     if (c.state == Conn::State::kStream) {
       streams.erase(c.id);
       owner->streams_ = streams.size();
     }
+    if (const auto it = per_address.find(c.remote); it != per_address.end() && --it->second == 0)
+      per_address.erase(it);
     ::epoll_ctl(epoll_fd, EPOLL_CTL_DEL, c.fd, nullptr);
     close_socket(c);
     conns.erase(c.id);  // destroys c
   }
 
-  void watch(Conn& c, bool out) {
-    if (c.want_out == out) return;
+  std::size_t input_cap() const { return limits.max_head_bytes + limits.max_body_bytes + 16384; }
+
+  //! Asks epoll for what the connection can use: input while its buffer has room (a client that sends
+  //! but never reads is not read further: its buffer stays bounded), output while anything is pending.
+  void interest(Conn& c) {
+    const bool in = !c.peer_closed && (c.state == Conn::State::kStream || c.in.size() < input_cap());
+    const bool out = c.pending() > 0;
+    if (c.want_in == in && c.want_out == out) return;
+    c.want_in = in;
     c.want_out = out;
     epoll_event ev{};
-    ev.events = EPOLLIN | (out ? EPOLLOUT : 0U);
+    ev.events = (in ? EPOLLIN : 0U) | (out ? EPOLLOUT : 0U);
     ev.data.u64 = c.id;
     ::epoll_ctl(epoll_fd, EPOLL_CTL_MOD, c.fd, &ev);
-  }
-
-  //! >0 bytes; 0 closed by the peer; -1 would block; -2 error.
-  static long read_some(Conn& c, char* buf, std::size_t n) {
-    if (c.ssl != nullptr) {
-      ERR_clear_error();
-      const int r = SSL_read(c.ssl, buf, static_cast<int>(n));
-      if (r > 0) return r;
-      const int e = SSL_get_error(c.ssl, r);
-      if (e == SSL_ERROR_WANT_READ || e == SSL_ERROR_WANT_WRITE) return -1;
-      return e == SSL_ERROR_ZERO_RETURN ? 0 : -2;
-    }
-    const ssize_t r = ::recv(c.fd, buf, n, 0);
-    if (r > 0) return static_cast<long>(r);
-    if (r == 0) return 0;
-    return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR ? -1 : -2;
-  }
-  static long write_some(Conn& c, const char* buf, std::size_t n) {
-    if (c.ssl != nullptr) {
-      ERR_clear_error();
-      const int r = SSL_write(c.ssl, buf, static_cast<int>(std::min<std::size_t>(n, 1 << 20)));
-      if (r > 0) return r;
-      const int e = SSL_get_error(c.ssl, r);
-      return e == SSL_ERROR_WANT_READ || e == SSL_ERROR_WANT_WRITE ? -1 : -2;
-    }
-    const ssize_t r = ::send(c.fd, buf, n, MSG_NOSIGNAL);
-    if (r >= 0) return static_cast<long>(r);
-    return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR ? -1 : -2;
   }
 
   void accept_all(std::int64_t now) {
@@ -318,23 +181,21 @@ struct HttpServer::Impl {
       const int fd =
           ::accept4(listen_fd, reinterpret_cast<sockaddr*>(&addr), &len, SOCK_NONBLOCK | SOCK_CLOEXEC);
       if (fd < 0) return;
-      if (conns.size() >= limits.max_connections) {
+      std::string remote = http_detail::address_text(addr);
+      auto& from_there = per_address[remote];
+      if (conns.size() >= limits.max_connections || from_there >= limits.max_connections_per_address) {
+        if (from_there == 0) per_address.erase(remote);
         ::close(fd);
         continue;
       }
+      ++from_there;
       const int one = 1;
       ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
       auto c = std::make_unique<Conn>();
       c->id = next_id++;
       c->fd = fd;
       c->accepted_ns = c->activity_ns = now;
-      char text[INET6_ADDRSTRLEN] = "?";
-      if (addr.ss_family == AF_INET) {
-        ::inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(&addr)->sin_addr, text, sizeof text);
-      } else if (addr.ss_family == AF_INET6) {
-        ::inet_ntop(AF_INET6, &reinterpret_cast<sockaddr_in6*>(&addr)->sin6_addr, text, sizeof text);
-      }
-      c->remote = text;
+      c->remote = std::move(remote);
       if (ssl_ctx != nullptr) {
         c->ssl = SSL_new(ssl_ctx);
         SSL_set_fd(c->ssl, fd);
@@ -350,66 +211,78 @@ struct HttpServer::Impl {
 
   void on_readable(Conn& c, std::int64_t now) {
     char buf[16384];
-    const std::size_t cap = limits.max_head_bytes + limits.max_body_bytes + sizeof buf;
-    for (;;) {
-      const long r = read_some(c, buf, sizeof buf);
+    const std::uint64_t id = c.id;
+    while (c.state == Conn::State::kStream || c.in.size() < input_cap()) {
+      const long r = http_detail::read_some(c.fd, c.ssl, buf, sizeof buf);
       if (r == -1) break;
-      if (r <= 0) return drop(c);
+      if (r == -2) return drop(c);
+      if (r == 0) {
+        c.peer_closed = true;
+        break;
+      }
       if (c.state == Conn::State::kStream) continue;  // a stream's client has nothing to say
       if (c.in.empty() && c.request_start_ns == 0) c.request_start_ns = now;
       c.in.append(buf, static_cast<std::size_t>(r));
       c.activity_ns = now;
-      if (c.in.size() > cap) break;
     }
     if (c.state == Conn::State::kReading) parse(c, now);
+    if (conns.count(id) == 0) return;
+    // FIN: what was asked is answered first; nothing more will come.
+    if (c.peer_closed && (c.state == Conn::State::kReading || c.state == Conn::State::kStream))
+      return drop(c);
+    interest(c);
   }
 
   void refuse(Conn& c, int status, const std::string& message) {
     HttpResponse res;
     res.status = status;
-    res.body = "{\"error\":\"" + message + "\"}";
+    res.body = error_body(message);
     respond(c, std::move(res), false);
   }
 
   void parse(Conn& c, std::int64_t now) {
-    const auto head_end = c.in.find("\r\n\r\n");
-    if (head_end == std::string::npos || head_end > limits.max_head_bytes) {
-      if (c.in.size() > limits.max_head_bytes) refuse(c, 431, "request head longer than the limit");
-      return;
-    }
-    std::string version;
-    auto req = parse_head(c.in.substr(0, head_end), version);
-    if (!req) return refuse(c, 400, req.error().message);
-    if (!req->header("transfer-encoding").empty())
-      return refuse(c, 501, "request bodies in chunks are not accepted: send Content-Length");
-    std::size_t length = 0;
-    const std::string cl = req->header("content-length");
-    if (!cl.empty()) {
-      if (cl.size() > 12 || cl.find_first_not_of("0123456789") != std::string::npos)
-        return refuse(c, 400, "header 'content-length' is not a number");
-      length = std::stoul(cl);
-      if (length > limits.max_body_bytes)
-        return refuse(c, 413, "body longer than " + std::to_string(limits.max_body_bytes) + " bytes");
-    }
-    if (c.in.size() < head_end + 4 + length) return;  // the body is still arriving
-    req->body = c.in.substr(head_end + 4, length);
-    c.in.erase(0, head_end + 4 + length);
+    auto parsed = parse_request(c.in, {limits.max_head_bytes, limits.max_body_bytes});
+    if (parsed.kind == ParseOutcome::Kind::kIncomplete) return;
+    if (parsed.kind == ParseOutcome::Kind::kRefused) return refuse(c, parsed.status, parsed.message);
+    c.in.erase(0, parsed.consumed);
     c.request_start_ns = c.in.empty() ? 0 : now;
-    req->remote_addr = c.remote;
-    req->tls = c.ssl != nullptr;
-    const bool keep_alive = version == "HTTP/1.1" && to_lower(req->header("connection")) != "close";
+    HttpRequest& req = parsed.request;
+    req.remote_addr = c.remote;
+    req.tls = c.ssl != nullptr;
+    c.head_only = req.method == "HEAD";
+    const bool slow = slow_lane && slow_lane(req);
+    int refusal = 0;
     {
       const std::lock_guard lock(mutex);
-      if (jobs.size() >= limits.max_queued) {
-        // Answered below, outside the lock.
+      auto& held_here = slow_by_address[c.remote];
+      if (slow && slow_held >= limits.max_slow_queued) {
+        refusal = 503;
+      } else if (slow && held_here >= limits.max_slow_per_address) {
+        refusal = 429;
+      } else if (!slow && jobs.size() >= limits.max_queued) {
+        refusal = 503;
       } else {
         c.state = Conn::State::kWorking;
-        jobs.push_back({c.id, std::move(req).value(), keep_alive});
-        work.notify_one();
-        return;
+        if (slow) {
+          ++slow_held;
+          ++held_here;
+          slow_jobs.push_back({c.id, std::move(req), parsed.keep_alive, true});
+          slow_work.notify_one();
+        } else {
+          jobs.push_back({c.id, std::move(req), parsed.keep_alive, false});
+          work.notify_one();
+        }
       }
+      if (held_here == 0) slow_by_address.erase(c.remote);
     }
-    refuse(c, 503, "busy: too many requests waiting");
+    if (refusal == 503) return refuse(c, 503, "busy: too many requests waiting");
+    if (refusal == 429) {
+      HttpResponse res;
+      res.status = 429;
+      res.body = error_body("wait for your other request to be answered");
+      res.headers.emplace_back("Retry-After", "1");
+      respond(c, std::move(res), false);
+    }
   }
 
   static void add_common_headers(std::string& head) {
@@ -419,6 +292,12 @@ struct HttpServer::Impl {
   }
 
   void respond(Conn& c, HttpResponse res, bool keep_alive) {
+    keep_alive = keep_alive && !c.peer_closed;
+    if (c.head_only && res.stream) {  // the head of a stream, nothing after it
+      res.stream = false;
+      res.content_type = "text/event-stream";
+      res.body.clear();
+    }
     if (res.stream && res.status == 200) {
       if (streams.size() >= limits.max_streams) {
         spdlog::warn("ground: event stream from {} refused (503): {} streams open, the limit", c.remote,
@@ -456,7 +335,9 @@ struct HttpServer::Impl {
     if (!keep_alive) head += "Connection: close\r\n";
     head += "\r\n";
     c.out += head;
-    if (res.shared_body) {
+    if (c.head_only) {
+      // HEAD: the head alone, with the length the body would have.
+    } else if (res.shared_body) {
       c.body = std::move(res.shared_body);
       c.body_off = 0;
     } else {
@@ -464,7 +345,10 @@ struct HttpServer::Impl {
     }
     c.close_after = !keep_alive;
     c.state = Conn::State::kWriting;
-    flush(c, io_now_ns());
+    const std::int64_t now = io_now_ns();
+    c.response_deadline_ns = now + to_ns(limits.write_timeout_s + static_cast<double>(c.pending()) /
+                                                                      std::max(1.0, limits.min_write_rate));
+    flush(c, now);
   }
 
   void flush(Conn& c, std::int64_t now) {
@@ -485,7 +369,7 @@ struct HttpServer::Impl {
         n = c.chunks.front()->size() - c.chunk_off;
         advanced = &c.chunk_off;
       }
-      const long w = write_some(c, data, n);
+      const long w = http_detail::write_some(c.fd, c.ssl, data, n);
       if (w == -1) break;
       if (w <= 0) return drop(c);
       *advanced += static_cast<std::size_t>(w);
@@ -505,13 +389,18 @@ struct HttpServer::Impl {
     }
     if (c.body && c.body_off == c.body->size()) c.body.reset();
     const bool pending = c.pending() > 0;
-    watch(c, pending);
+    c.backlog_since_ns = !pending ? 0 : (c.backlog_since_ns != 0 ? c.backlog_since_ns : now);
     if (!pending && c.state == Conn::State::kWriting) {
-      if (c.close_after) return drop(c);
+      if (c.close_after || (c.peer_closed && c.in.empty())) return drop(c);
       c.state = Conn::State::kReading;
       c.activity_ns = now;
+      c.head_only = false;
+      const std::uint64_t id = c.id;
       if (!c.in.empty()) parse(c, now);
+      if (conns.count(id) == 0) return;
+      if (c.peer_closed && c.state == Conn::State::kReading) return drop(c);
     }
+    interest(c);
   }
 
   //! Appends the new stream messages (or a keep-alive comment) to every stream.
@@ -541,7 +430,7 @@ struct HttpServer::Impl {
       if (c.pending() + chunk->size() > limits.stream_buffer_bytes) {
         spdlog::warn("ground: event stream to {} closed: {} bytes not read (a slow reader; it may resume)",
                      c.remote, c.pending());
-        drop(c);
+        drop(c, true);
         continue;
       }
       const bool was_waiting = c.want_out;  // its socket is full: EPOLLOUT will flush it
@@ -565,33 +454,41 @@ struct HttpServer::Impl {
   }
 
   void sweep(std::int64_t now) {
-    std::vector<std::uint64_t> expired;
+    std::vector<std::pair<std::uint64_t, bool>> expired;  // and whether output is left to discard
     for (const auto& [id, c] : conns) {
       switch (c->state) {
         case Conn::State::kReading:
           if (c->request_start_ns != 0 && now - c->request_start_ns > to_ns(limits.request_timeout_s)) {
             spdlog::info("ground: request from {} not complete within {} s: closed", c->remote,
                          limits.request_timeout_s);
-            expired.push_back(id);
+            expired.emplace_back(id, false);
           } else if (c->request_start_ns == 0 && now - c->activity_ns > to_ns(limits.idle_timeout_s)) {
-            expired.push_back(id);
+            expired.emplace_back(id, false);
           } else if (c->ssl != nullptr && !SSL_is_init_finished(c->ssl) &&
                      now - c->accepted_ns > to_ns(limits.request_timeout_s)) {
-            expired.push_back(id);
+            expired.emplace_back(id, false);
           }
           break;
         case Conn::State::kWriting:
+          if (now > c->response_deadline_ns ||
+              (c->pending() > 0 && now - c->activity_ns > to_ns(limits.write_timeout_s))) {
+            spdlog::info("ground: {} has not read its answer by its deadline ({} s + {} B/s): closed",
+                         c->remote, limits.write_timeout_s, limits.min_write_rate);
+            expired.emplace_back(id, true);
+          }
+          break;
         case Conn::State::kStream:
-          if (c->pending() > 0 && now - c->activity_ns > to_ns(limits.write_timeout_s)) {
-            spdlog::info("ground: {} reads nothing for {} s: closed", c->remote, limits.write_timeout_s);
-            expired.push_back(id);
+          if (c->backlog_since_ns != 0 && now - c->backlog_since_ns > to_ns(limits.write_timeout_s)) {
+            spdlog::info("ground: event stream to {} behind for {} s: closed (it may resume)", c->remote,
+                         limits.write_timeout_s);
+            expired.emplace_back(id, true);
           }
           break;
         case Conn::State::kWorking:
           break;
       }
     }
-    for (const auto id : expired) drop(*conns.at(id));
+    for (const auto& [id, abort] : expired) drop(*conns.at(id), abort);
   }
 
   void run() {
@@ -615,7 +512,11 @@ struct HttpServer::Impl {
         auto it = conns.find(id);
         if (it == conns.end()) continue;
         Conn& c = *it->second;
-        if ((what & (EPOLLIN | EPOLLHUP | EPOLLERR)) != 0U) {
+        if ((what & (EPOLLHUP | EPOLLERR)) != 0U && ((what & EPOLLIN) == 0U || c.peer_closed)) {
+          drop(c);  // gone both ways: nothing can be written to it
+          continue;
+        }
+        if ((what & EPOLLIN) != 0U) {
           on_readable(c, now);
           if (conns.count(id) == 0) continue;
         }
@@ -634,27 +535,36 @@ struct HttpServer::Impl {
     }
   }
 
-  void serve_requests() {
+  void serve_requests(bool slow) {
+    std::deque<Job>& queue = slow ? slow_jobs : jobs;
+    std::condition_variable& ready = slow ? slow_work : work;
     for (;;) {
       Job job;
       {
         std::unique_lock lock(mutex);
-        work.wait(lock, [&] { return stopping || !jobs.empty(); });
+        ready.wait(lock, [&] { return stopping || !queue.empty(); });
         if (stopping) return;
-        job = std::move(jobs.front());
-        jobs.pop_front();
+        job = std::move(queue.front());
+        queue.pop_front();
       }
       HttpResponse res;
       try {
         res = handler(job.request);
       } catch (const std::exception& e) {
-        spdlog::error("ground: {} {}: {}", job.request.method, job.request.path, e.what());
+        spdlog::error("ground: {} {}: {}", one_line(job.request.method), one_line(job.request.path),
+                      e.what());
         res = HttpResponse{};
         res.status = 500;
-        res.body = "{\"error\":\"internal error\"}";
+        res.body = error_body("internal error");
       }
       {
         const std::lock_guard lock(mutex);
+        if (job.slow) {
+          --slow_held;
+          if (const auto it = slow_by_address.find(job.request.remote_addr);
+              it != slow_by_address.end() && --it->second == 0)
+            slow_by_address.erase(it);
+        }
         done.push_back({job.conn, std::move(res), job.keep_alive});
       }
       wake();
@@ -662,9 +572,10 @@ struct HttpServer::Impl {
   }
 };
 
-HttpServer::HttpServer(Handler handler, StreamFeed feed, HttpLimits limits)
+HttpServer::HttpServer(Handler handler, StreamFeed feed, HttpLimits limits, SlowLane slow)
     : impl_(std::make_unique<Impl>()) {
   impl_->handler = std::move(handler);
+  impl_->slow_lane = std::move(slow);
   impl_->feed = std::move(feed);
   impl_->limits = limits;
   impl_->owner = this;
@@ -687,43 +598,13 @@ Status HttpServer::start(const std::string& host, int port, const TlsFiles& tls)
     ::setrlimit(RLIMIT_NOFILE, &files);
   }
   if (!tls.cert.empty()) {
-    m.ssl_ctx = SSL_CTX_new(TLS_server_method());
-    if (m.ssl_ctx == nullptr) return failure("TLS: cannot create a context");
-    SSL_CTX_set_min_proto_version(m.ssl_ctx, TLS1_2_VERSION);
-    SSL_CTX_set_mode(m.ssl_ctx, SSL_MODE_ENABLE_PARTIAL_WRITE | SSL_MODE_ACCEPT_MOVING_WRITE_BUFFER);
-    if (SSL_CTX_use_certificate_chain_file(m.ssl_ctx, tls.cert.c_str()) != 1)
-      return bad_input("--tls-cert " + tls.cert + ": not a readable PEM certificate");
-    if (SSL_CTX_use_PrivateKey_file(m.ssl_ctx, tls.key.c_str(), SSL_FILETYPE_PEM) != 1)
-      return bad_input("--tls-key " + tls.key + ": not a readable PEM private key");
-    if (SSL_CTX_check_private_key(m.ssl_ctx) != 1)
-      return bad_input("--tls-key " + tls.key + ": does not match the certificate of --tls-cert");
+    auto ctx = http_detail::make_tls_context(tls);
+    if (!ctx) return ctx.error();
+    m.ssl_ctx = *ctx;
   }
-  addrinfo hints{};
-  hints.ai_family = AF_UNSPEC;
-  hints.ai_socktype = SOCK_STREAM;
-  hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
-  addrinfo* found = nullptr;
-  const std::string where = host + ":" + std::to_string(port);
-  if (::getaddrinfo(host.c_str(), std::to_string(port).c_str(), &hints, &found) != 0 || found == nullptr)
-    return bad_input("--listen " + where + ": unknown host");
-  for (addrinfo* a = found; a != nullptr && m.listen_fd < 0; a = a->ai_next) {
-    const int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC, a->ai_protocol);
-    if (fd < 0) continue;
-    const int one = 1;
-    ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-    if (::bind(fd, a->ai_addr, a->ai_addrlen) == 0 && ::listen(fd, 1024) == 0) {
-      m.listen_fd = fd;
-    } else {
-      ::close(fd);
-    }
-  }
-  ::freeaddrinfo(found);
-  if (m.listen_fd < 0) return failure("--listen " + where + ": cannot bind");
-  sockaddr_storage bound{};
-  socklen_t len = sizeof bound;
-  ::getsockname(m.listen_fd, reinterpret_cast<sockaddr*>(&bound), &len);
-  port_ = ntohs(bound.ss_family == AF_INET6 ? reinterpret_cast<sockaddr_in6*>(&bound)->sin6_port
-                                            : reinterpret_cast<sockaddr_in*>(&bound)->sin_port);
+  auto listening = http_detail::listen_on(host, port, port_);
+  if (!listening) return listening.error();
+  m.listen_fd = *listening;
   m.epoll_fd = ::epoll_create1(EPOLL_CLOEXEC);
   m.wake_fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (m.epoll_fd < 0 || m.wake_fd < 0) return failure("cannot create epoll or eventfd descriptors");
@@ -734,7 +615,10 @@ Status HttpServer::start(const std::string& host, int port, const TlsFiles& tls)
   ev.data.u64 = kWakeId;
   ::epoll_ctl(m.epoll_fd, EPOLL_CTL_ADD, m.wake_fd, &ev);
   m.cursor = m.feed.last();
-  for (int i = 0; i < m.limits.workers; ++i) m.workers.emplace_back([&m] { m.serve_requests(); });
+  for (int i = 0; i < m.limits.workers; ++i) m.workers.emplace_back([&m] { m.serve_requests(false); });
+  if (m.slow_lane) {
+    for (int i = 0; i < m.limits.slow_workers; ++i) m.workers.emplace_back([&m] { m.serve_requests(true); });
+  }
   m.io = std::thread([&m] { m.run(); });
   return ok_status();
 }
@@ -746,6 +630,7 @@ void HttpServer::stop() {
     m.stopping = true;
   }
   m.work.notify_all();
+  m.slow_work.notify_all();
   if (m.wake_fd >= 0) m.wake();
   if (m.io.joinable()) m.io.join();
   for (auto& w : m.workers) {

@@ -18,9 +18,13 @@
 
 #include "tetra/core/result.hpp"
 #include "tetra/dds/convert.hpp"
+#include "tetra/ground/approvals.hpp"
+#include "tetra/ground/audit_log.hpp"
 #include "tetra/ground/command_request.hpp"
 #include "tetra/ground/http_server.hpp"
+#include "tetra/ground/login_throttle.hpp"
 #include "tetra/ground/operators.hpp"
+#include "tetra/ground/permissions.hpp"
 #include "tetra/ground/static_files.hpp"
 #include "tetra/ground/store.hpp"
 
@@ -36,13 +40,22 @@ struct ServerConfig {
   std::string records_dir;       //!< `tetra record` files served by /api/records ("": none)
   std::string users_path;        //!< operator accounts (tetra ground passwd); "" only with no_auth
   std::string session_key_path;  //!< the key sessions are signed with (created when absent)
+  //! The audit file ("": the --users file's name + .audit.jsonl; none under no_auth).
+  std::string audit_path;
+  std::string permissions_path;  //!< per-unit and per-command permissions of commanders ("": none)
   bool no_auth = false;          //!< no accounts: everyone who reaches the port is commander "anonymous"
   std::vector<std::string> allow_origins;  //!< more HOST:PORT a browser may reach the ground as
   TlsFiles tls;
   HttpLimits limits;
+  ThrottleLimits throttle;                  //!< sign-in back-off and lockout
   double session_lifetime_s = 12 * 3600.0;  //!< [s]
-  int commands_in_flight = 2;  //!< commands waiting for their acknowledgement at once; beyond: 503
+  int commands_in_flight = 2;         //!< commands waiting for their acknowledgement at once; beyond: 503
+  double approval_timeout_s = 120.0;  //!< [s] a forced exclusion waits this long for a second commander
 };
+
+//! A JSON answer (not cached); an error's is {"error": message}.
+HttpResponse json_reply(int status, const nlohmann::json& body);
+HttpResponse error_reply(int status, const std::string& message);
 
 //! True for 127.0.0.0/8, ::1 and "localhost".
 bool is_loopback_host(const std::string& host);
@@ -62,9 +75,16 @@ class GroundServer {
  private:
   HttpResponse handle(const HttpRequest& req);
   HttpResponse serve(const HttpRequest& req, const std::optional<Session>& session);
-  HttpResponse refuse(const HttpRequest& req, int status, const std::string& why, const std::string& user);
+  HttpResponse refuse(const HttpRequest& req, int status, const std::string& why, const std::string& user,
+                      const std::string& role = "");
+  void audit(const HttpRequest& req, AuditRecord record);
   HttpResponse login(const HttpRequest& req);
+  HttpResponse logout(const HttpRequest& req, const Session& session);
   HttpResponse command(const HttpRequest& req, const Session& session);
+  HttpResponse approve(const HttpRequest& req, const Session& session);
+  //! Sends the command (bounded in flight), audits the answer; `approved_by` a second operator or "".
+  HttpResponse send_command(const HttpRequest& req, const CommandRequest& request, const std::string& role,
+                            const std::string& approved_by);
   HttpResponse stream(const HttpRequest& req);
   HttpResponse history(const HttpRequest& req);
   HttpResponse records(const HttpRequest& req);
@@ -81,7 +101,10 @@ class GroundServer {
   std::set<std::string> allowed_hosts_;  //!< "host:port", lower case
   std::string instance_;                 //!< this run's prefix of every event id
   std::string no_auth_csrf_;
-  std::mutex login_mutex_;  //!< one password check at a time (64 MiB each)
+  AuditLog audit_;
+  LoginThrottle throttle_;
+  Approvals approvals_;
+  Permissions permissions_;
   std::atomic<int> commands_waiting_{0};
 };
 

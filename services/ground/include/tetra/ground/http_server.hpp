@@ -1,9 +1,12 @@
 #pragma once
 // A small HTTP/1.1 server built to stay up under abuse (docs/ground.md, threat model): one I/O thread
 // reads and writes every socket without blocking (epoll), so a slow or silent client holds no thread;
-// a request must arrive whole within a deadline and within size limits; handlers run on a small pool
-// of workers; event streams (server-sent events) are written by the I/O thread itself from one shared
-// cursor, each with a bounded output buffer, and their number is bounded. Optional TLS (OpenSSL).
+// a request must arrive whole within a deadline and within size limits (the strict parser of
+// http_parse.hpp), a response be read within its own; a client that does not read is not read either;
+// connections are bounded in all and per address; handlers run on a small pool of workers, slow ones
+// (sign-ins) on a lane of their own; event streams (server-sent events) are written by the I/O thread
+// itself from one shared cursor, each with a bounded output buffer, and their number is bounded.
+// Sockets and TLS (OpenSSL): http_socket.hpp.
 
 #include <atomic>
 #include <cstdint>
@@ -16,20 +19,9 @@
 #include <vector>
 
 #include "tetra/core/result.hpp"
+#include "tetra/ground/http_parse.hpp"
 
 namespace tetra::ground {
-
-struct HttpRequest {
-  std::string method;
-  std::string path;                                         //!< decoded, without the query
-  std::vector<std::pair<std::string, std::string>> params;  //!< decoded query parameters, in order
-  std::map<std::string, std::string> headers;               //!< names in lower case
-  std::string body;
-  std::string remote_addr;
-  bool tls = false;
-  //! The header's value ("" when absent); `name` in lower case.
-  std::string header(const std::string& name) const;
-};
 
 struct HttpResponse {
   int status = 200;
@@ -52,17 +44,24 @@ struct StreamFeed {
 };
 
 struct HttpLimits {
-  std::size_t max_connections = 4096;            //!< beyond: accepted and closed at once
-  std::size_t max_streams = 1024;                //!< event streams held; beyond: 503 (logged)
-  std::size_t max_head_bytes = 16384;            //!< request line and headers; beyond: 431
-  std::size_t max_body_bytes = 65536;            //!< request body; beyond: 413
+  std::size_t max_connections = 4096;              //!< beyond: accepted and closed at once
+  std::size_t max_connections_per_address = 2048;  //!< from one client address; beyond: closed at once
+  std::size_t max_streams = 1024;                  //!< event streams held; beyond: 503 (logged)
+  std::size_t max_head_bytes = 16384;              //!< request line and headers; beyond: 431
+  std::size_t max_body_bytes = 65536;              //!< request body; beyond: 413
   std::size_t stream_buffer_bytes = 256U << 10;  //!< per stream not yet written; beyond: the stream is closed
   std::size_t max_queued = 256;                  //!< requests waiting for a worker; beyond: 503
   int workers = 4;                               //!< handler threads
-  double request_timeout_s = 10.0;               //!< [s] a request must arrive whole within this
-  double idle_timeout_s = 30.0;                  //!< [s] a kept-alive connection with no request is closed
-  double write_timeout_s = 10.0;  //!< [s] a response (or a stream) making no progress is closed
-  double keepalive_s = 1.0;       //!< [s] a comment line on a quiet stream at least this often
+  int slow_workers = 2;                  //!< threads of the slow lane (sign-ins: a password hash each)
+  std::size_t max_slow_queued = 32;      //!< slow requests waiting or running; beyond: 503
+  std::size_t max_slow_per_address = 2;  //!< slow requests of one address waiting or running; beyond: 429
+  double request_timeout_s = 10.0;       //!< [s] a request must arrive whole within this
+  double idle_timeout_s = 30.0;          //!< [s] a kept-alive connection with no request is closed
+  double write_timeout_s = 10.0;         //!< [s] a response (or a stream) making no progress is closed
+  //! [B/s] a response must be written whole within write_timeout_s + its size at this rate (a client
+  //! reading a byte now and then is closed); a stream whose buffer has not emptied for write_timeout_s too
+  double min_write_rate = 16384.0;
+  double keepalive_s = 1.0;  //!< [s] a comment line on a quiet stream at least this often
 };
 
 struct TlsFiles {
@@ -73,7 +72,10 @@ struct TlsFiles {
 class HttpServer {
  public:
   using Handler = std::function<HttpResponse(const HttpRequest&)>;
-  HttpServer(Handler handler, StreamFeed feed, HttpLimits limits);
+  //! True for a request that runs on the slow lane (its own workers and bounds: a slow request never
+  //! delays the others); called on the I/O thread, so it must be quick.
+  using SlowLane = std::function<bool(const HttpRequest&)>;
+  HttpServer(Handler handler, StreamFeed feed, HttpLimits limits, SlowLane slow = {});
   ~HttpServer();
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;
