@@ -78,9 +78,20 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
                        " missing: the shard is not complete (run it again with the same command)");
     all.insert(all.end(), rows->begin(), rows->end());
   }
-  if (auto old = folder::read_manifest(out_dir); old && old->spec_sha256 != first.spec_sha256)
-    return bad_input(folder::path_in(out_dir, folder::kHashFile) +
-                     ": the output folder holds a campaign of another spec: use another folder");
+  if (auto old = folder::read_manifest(out_dir); old) {
+    if (old->spec_sha256 != first.spec_sha256)
+      return bad_input(folder::path_in(out_dir, folder::kHashFile) +
+                       ": the output folder holds a campaign of another spec: use another folder");
+  } else {
+    // No campaign's manifest: any file the merge would write is another program's, never replaced.
+    for (const char* name : {folder::kRunsFile, folder::kSpecCopy, folder::kShardFile, folder::kHashFile}) {
+      std::error_code exists_ec;
+      const std::string path = folder::path_in(out_dir, name);
+      if (std::filesystem::exists(std::filesystem::symlink_status(path, exists_ec)))
+        return bad_input(path + ": the output folder holds files of no campaign (no " + folder::kShardFile +
+                         " and " + folder::kHashFile + " of one): use another folder");
+    }
+  }
   std::sort(all.begin(), all.end(), [](const folder::Row& a, const folder::Row& b) { return a.run < b.run; });
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
@@ -89,16 +100,17 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
   summary.total = all.size();
   summary.runs_csv = folder::path_in(out_dir, folder::kRunsFile);
   for (const folder::Row& r : all) summary.errors += r.error ? 1 : 0;
-  if (Status st = folder::write_rows(summary.runs_csv, *header, all); !st) return st.error();
   auto spec_copy = read_input(folder::path_in(shard_dirs[0], folder::kSpecCopy), kMaxYamlBytes);
   if (!spec_copy) return spec_copy.error();
-  if (Status st = write_text_file(folder::path_in(out_dir, folder::kSpecCopy), *spec_copy); !st)
-    return st.error();
+  // The manifest first: a merge stopped half-way leaves a folder of this campaign, merged again at will.
   if (Status st = write_text_file(folder::path_in(out_dir, folder::kShardFile),
                                   folder::manifest_text(Shard{1, 1}, first.matrix_runs));
       !st)
     return st.error();
   if (Status st = write_text_file(folder::path_in(out_dir, folder::kHashFile), first.spec_sha256 + "\n"); !st)
+    return st.error();
+  if (Status st = folder::write_rows(summary.runs_csv, *header, all); !st) return st.error();
+  if (Status st = write_text_file(folder::path_in(out_dir, folder::kSpecCopy), *spec_copy); !st)
     return st.error();
   return summary;
 }
