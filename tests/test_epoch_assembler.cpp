@@ -82,6 +82,7 @@ TEST(EpochAssembler, APromisedSampleIsWaitedForPastTheLatencyLimit) {
   a.poll(kLate + 25 * kLatency, out);
   ASSERT_EQ(out.size(), 3U);
   EXPECT_EQ(out[2].present, (std::vector<std::uint8_t>{1, 1, 0, 1}));
+  EXPECT_EQ(a.counters().samples_promised_lost, 1U);
 }
 
 TEST(EpochAssembler, MissingSampleWaitsForTheLatencyLimitOnly) {

@@ -64,8 +64,8 @@ int cmd_record(int argc, char** argv) {
   if (recorded->gyro_samples_lost > 0 || recorded->attitudes_lost > 0) {
     std::cerr << "tetra record: " << recorded->gyro_samples_lost << " gyro samples and "
               << recorded->attitudes_lost
-              << " attitudes lost on the wire (a writer dropped them before this recorder had them: it fell "
-                 "behind); the files lack them\n";
+              << " attitudes lost (dropped by a writer before this recorder had them, or said written for an "
+                 "epoch and never in): the files lack them\n";
     return kExitFailure;
   }
   return kExitOk;

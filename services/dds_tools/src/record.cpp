@@ -334,7 +334,8 @@ Result<Recorded> record_unit(const RecordOptions& options, dds::ShutdownSignal& 
   Recorded recorded{o.unit, recording.epochs_written(), assembler->counters(), 0, 0};
   auto gyro_lost = link->gyro->samples_lost();
   if (!gyro_lost) return gyro_lost.error();
-  recorded.gyro_samples_lost = *gyro_lost;
+  // Lost on the wire (a writer's history overflowed), or promised for an epoch and never in.
+  recorded.gyro_samples_lost = *gyro_lost + assembler->counters().samples_promised_lost;
   if (!o.attitude_path.empty()) {
     auto attitude_lost = link->attitude->samples_lost();
     if (!attitude_lost) return attitude_lost.error();

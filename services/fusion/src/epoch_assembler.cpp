@@ -316,6 +316,9 @@ void EpochAssembler::emit(Pending& epoch, std::vector<fdi::Epoch>& out) {
     result.reference_stamp_ns = late_references_.front().first;
     late_references_.pop_front();
   }
+  const auto delivered = std::count(result.present.begin(), result.present.end(), std::uint8_t{1});
+  if (epoch.promised > delivered)
+    counters_.samples_promised_lost += static_cast<std::uint64_t>(epoch.promised - delivered);
   last_emitted_ns_ = epoch.stamp_ns;
   ++counters_.epochs_emitted;
   out.push_back(std::move(result));
