@@ -263,6 +263,20 @@ TEST(CampaignRunner, ShardsMergeToTheOneMachineFiles) {
     EXPECT_EQ(bad.exit_status, 2) << bad.err;
     EXPECT_NE(bad.err.find("s2/runs.csv:2: campaign row: " + message), std::string::npos) << bad.err;
   }
+  // A row whose values are in range but whose case is not the spec's (gyro 0 of a fault-free run made 1).
+  {
+    std::string shifted = s2;
+    const auto row = shifted.find('\n') + 1;
+    std::size_t at = row;
+    for (int commas = 0; commas < 3; ++at) commas += shifted[at] == ',' ? 1 : 0;
+    ASSERT_EQ(shifted[at], '0');
+    shifted[at] = '1';
+    write_file(dir.file("s2/runs.csv"), shifted);
+    const auto bad = run_tetra("campaign merge " + dir.file("m3") + " " + shards);
+    EXPECT_EQ(bad.exit_status, 2) << bad.err;
+    EXPECT_NE(bad.err.find("s2/runs.csv: run 1 is '1,"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("the spec's case is '1,"), std::string::npos) << bad.err;
+  }
   write_file(dir.file("s2/runs.csv"), s2);
   // Shard 3 with its last row torn off (an interrupted task): incomplete.
   const std::string s3 = read_file(dir.file("s3/runs.csv"));
