@@ -172,6 +172,11 @@ TEST(AllanCli, BadInputExitsTwoWithAReason) {
       test::run_tetra("allan " + dir.file("silent.csv")),
       "gyro 2: 0 valid sample(s): an Allan variance needs at least 2 (--gyro N analyses the others "
       "alone)");
+  // A finite value too large to square (1e300) is named as such: it was blamed on gaps the log has not.
+  test::write_file(dir.file("huge.csv"),
+                   "# units=dps\ntime_s,g1\n0,1\n0.1,2\n0.2,1e300\n0.3,1\n0.4,2\n0.5,1\n");
+  expect_bad_input(test::run_tetra("allan " + dir.file("huge.csv") + " --taus 0.1"),
+                   "the values are too large to square (beyond about 1e150), not gaps");
   EXPECT_EQ(test::run_tetra("allan --help").exit_status, 0);
 }
 

@@ -133,6 +133,7 @@ TEST(CampaignDispersion, SpecErrorsNameTheLineAndKey) {
       {"requirements: [wrong_exclusion_rate < 2 at 0.95]\n", "spec.yaml:9", "requirements[0]"},
       {"requirements: ['detection_rate[ramp] > 0.9 at 0.95']\n", "spec.yaml:9", "runs no ramp"},
       {"requirements: ['false_alarms_per_hour < 0.1 at 95']\n", "spec.yaml:9", "confidence"},
+      {"requirements: ['false_alarms_per_hour < 0x1p-3 at 0.95']\n", "spec.yaml:9", "bound '0x1p-3'"},
   };
   for (const Case& c : cases) {
     const auto spec = spec_from(dir, spec_head() + c.tail);
@@ -140,6 +141,14 @@ TEST(CampaignDispersion, SpecErrorsNameTheLineAndKey) {
     EXPECT_NE(spec.error().message.find(c.line), std::string::npos) << spec.error().message;
     EXPECT_NE(spec.error().message.find(c.text), std::string::npos) << spec.error().message;
   }
+  // Open loop at the orbit's 10 Hz: a jitter reaching half the period (0.05 s) made every run an error row.
+  test::write_file(dir.file("jitter.yaml"),
+                   "loop: open\nscenarios: [orbit]\nkinds: [stuck]\ngyros: [1]\nonsets_s: [100]\nseeds: [1]\n"
+                   "dispersions: {seed: 1, data.jitter_s: {uniform: [0, 0.2]}}\n");
+  const auto jitter = read_campaign_spec(dir.file("jitter.yaml"));
+  ASSERT_FALSE(jitter);
+  EXPECT_NE(jitter.error().message.find("reaches half the sampling period (0.05 s)"), std::string::npos)
+      << jitter.error().message;
   // The seed's unit states no 1σ: `calibration` is refused naming the gyro.
   test::write_file(dir.file("nadir.yaml"), "scenarios: [" +
                                                test::source_path("examples/sim/closed_loop_nadir.yaml") +

@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "test_support.hpp"
@@ -140,6 +142,26 @@ TEST(CampaignRunner, KilledWorkerIsAnErrorRowAndReplaced) {
   EXPECT_NE(err.find("done"), std::string::npos) << err;
 }
 
+// The spec's identity covers the files its scenarios name: the unit file of flat.yaml changed after a
+// run, the same command refuses the folder (it resumed into the old rows without a word).
+TEST(CampaignRunner, ResumeRefusesAChangedUnitFile) {
+  TempDir dir;
+  write_scenarios(dir);
+  write_file(dir.file("spec.yaml"),
+             "scenarios: [flat.yaml]\nkinds: [stuck]\ngyros: [1]\nonsets_s: [60]\nseeds: [1]\n");
+  const std::string out = dir.file("out");
+  const std::string command = "campaign " + dir.file("spec.yaml") + " --out " + out + " --no-report";
+  const auto first = run_tetra(command);
+  ASSERT_EQ(first.exit_status, 0) << first.err;
+  std::string unit = read_file(dir.file("flat_unit.yaml"));
+  unit.replace(unit.find("0.08"), 4, "0.09");
+  write_file(dir.file("flat_unit.yaml"), unit);
+  const auto changed = run_tetra(command);
+  EXPECT_EQ(changed.exit_status, 2) << changed.err;
+  EXPECT_NE(changed.err.find("spec.sha256: this folder holds a campaign of another spec"), std::string::npos)
+      << changed.err;
+}
+
 TEST(CampaignRunner, ResumeRefusesAnotherSpecOrShard) {
   TempDir dir;
   write_small_spec(dir.file("spec.yaml"));
@@ -189,6 +211,18 @@ TEST(CampaignRunner, ShardsMergeToTheOneMachineFiles) {
   EXPECT_EQ(read_file(dir.file("m/runs.csv")), read_file(dir.file("one/runs.csv")));
   EXPECT_EQ(read_file(dir.file("m/report.md")), read_file(dir.file("one/report.md")));
   EXPECT_EQ(read_file(dir.file("m/spec.sha256")), read_file(dir.file("one/spec.sha256")));
+  // Merged again into its own folder: the same files. Into a folder whose runs.csv is no campaign's
+  // (no shard.txt and spec.sha256): refused, the file untouched.
+  ASSERT_EQ(run_tetra("campaign merge " + dir.file("m") + " " + shards + " --no-report").exit_status, 0);
+  EXPECT_EQ(read_file(dir.file("m/runs.csv")), read_file(dir.file("one/runs.csv")));
+  std::filesystem::create_directories(dir.file("foreign"));
+  write_file(dir.file("foreign/runs.csv"), "id,value\n1,2\n");
+  const auto foreign = run_tetra("campaign merge " + dir.file("foreign") + " " + shards);
+  EXPECT_EQ(foreign.exit_status, 2);
+  EXPECT_NE(foreign.err.find("foreign/runs.csv: the output folder holds files of no campaign"),
+            std::string::npos)
+      << foreign.err;
+  EXPECT_EQ(read_file(dir.file("foreign/runs.csv")), "id,value\n1,2\n");
 
   const auto missing =
       run_tetra("campaign merge " + dir.file("m2") + " " + dir.file("s1") + " " + dir.file("s3"));
@@ -205,6 +239,45 @@ TEST(CampaignRunner, ShardsMergeToTheOneMachineFiles) {
                                dir.file("s2") + " " + dir.file("o3"));
   EXPECT_EQ(other.exit_status, 2);
   EXPECT_NE(other.err.find("another spec than"), std::string::npos) << other.err;
+  // A forged row (negative false alarms, gyro 77, a NaN delay) is refused by file and line, never merged.
+  const std::string s2 = read_file(dir.file("s2/runs.csv"));
+  for (const auto& [field, value, message] : std::vector<std::tuple<int, std::string, std::string>>{
+           {12, "-540", "false_alarms '-540' (a count >= 0)"},
+           {3, "77", "gyro '77' (a gyro 0..32)"},
+           {9, "nan", "detection_delay_s 'nan'"}}) {
+    std::vector<std::string> lines;
+    std::stringstream in(s2);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    ASSERT_GE(lines.size(), 3U);
+    std::vector<std::string> f;
+    std::stringstream cells(lines[1]);
+    for (std::string c; std::getline(cells, c, ',');) f.push_back(c);
+    f[static_cast<std::size_t>(field)] = value;
+    std::string forged;
+    for (std::size_t i = 0; i < f.size(); ++i) forged += (i ? "," : "") + f[i];
+    lines[1] = forged + (lines[1].back() == ',' ? "," : "");
+    std::string text;
+    for (const auto& l : lines) text += l + "\n";
+    write_file(dir.file("s2/runs.csv"), text);
+    const auto bad = run_tetra("campaign merge " + dir.file("m3") + " " + shards);
+    EXPECT_EQ(bad.exit_status, 2) << bad.err;
+    EXPECT_NE(bad.err.find("s2/runs.csv:2: campaign row: " + message), std::string::npos) << bad.err;
+  }
+  // A row whose values are in range but whose case is not the spec's (gyro 0 of a fault-free run made 1).
+  {
+    std::string shifted = s2;
+    const auto row = shifted.find('\n') + 1;
+    std::size_t at = row;
+    for (int commas = 0; commas < 3; ++at) commas += shifted[at] == ',' ? 1 : 0;
+    ASSERT_EQ(shifted[at], '0');
+    shifted[at] = '1';
+    write_file(dir.file("s2/runs.csv"), shifted);
+    const auto bad = run_tetra("campaign merge " + dir.file("m3") + " " + shards);
+    EXPECT_EQ(bad.exit_status, 2) << bad.err;
+    EXPECT_NE(bad.err.find("s2/runs.csv: run 1 is '1,"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("the spec's case is '1,"), std::string::npos) << bad.err;
+  }
+  write_file(dir.file("s2/runs.csv"), s2);
   // Shard 3 with its last row torn off (an interrupted task): incomplete.
   const std::string s3 = read_file(dir.file("s3/runs.csv"));
   write_file(dir.file("s3/runs.csv"), s3.substr(0, s3.rfind('\n', s3.size() - 2) + 1));

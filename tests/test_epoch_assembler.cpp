@@ -54,6 +54,37 @@ TEST(EpochAssembler, CompleteEpochIsEmittedAtOnceWithTheOpenersStamp) {
   EXPECT_FALSE(a.next_due_ns().has_value());
 }
 
+// Lockstep play says how many samples an epoch has (promised): the epoch waits for all of them past the
+// latency limit (a loaded machine delays one by 0.5 s: it was fused without that gyro, and every later
+// attitude differed), and goes without a promised sample only once a gyro missing from it moved past it.
+TEST(EpochAssembler, APromisedSampleIsWaitedForPastTheLatencyLimit) {
+  auto a = make();
+  constexpr std::int64_t kLate = 1000 + 25 * kLatency;  // [ns] local time: half a second later
+  for (int g : {1, 2, 4}) EXPECT_EQ(a.add_sample(g, 1, 0, 1.0, 1000, false, 4), Verdict::kAccepted);
+  std::vector<fdi::Epoch> out;
+  a.poll(kLate, out);
+  EXPECT_TRUE(out.empty()) << "fused without gyro 3, which was promised";
+  EXPECT_FALSE(a.next_due_ns().has_value()) << "no timed wake-up: the sample's arrival decides";
+  EXPECT_EQ(a.add_sample(3, 1, 0, 3.0, kLate, false, 4), Verdict::kAccepted);
+  a.poll(kLate, out);
+  ASSERT_EQ(out.size(), 1U);
+  EXPECT_EQ(out[0].present, (std::vector<std::uint8_t>{1, 1, 1, 1}));
+  // Three promised of gyros 1, 2, 4 (gyro 3 not in the log's epoch): complete with three, at once.
+  for (int g : {1, 2, 4}) EXPECT_EQ(a.add_sample(g, 2, kPeriod, 1.0, kLate, false, 3), Verdict::kAccepted);
+  a.poll(kLate, out);
+  ASSERT_EQ(out.size(), 2U);
+  // Four promised, gyro 3's lost: the next epoch's sample of gyro 3 releases it.
+  for (int g : {1, 2, 4})
+    EXPECT_EQ(a.add_sample(g, 3, 2 * kPeriod, 1.0, kLate, false, 4), Verdict::kAccepted);
+  a.poll(kLate + 25 * kLatency, out);
+  EXPECT_EQ(out.size(), 2U);
+  EXPECT_EQ(a.add_sample(3, 3, 3 * kPeriod, 3.0, kLate + 25 * kLatency, false, 4), Verdict::kAccepted);
+  a.poll(kLate + 25 * kLatency, out);
+  ASSERT_EQ(out.size(), 3U);
+  EXPECT_EQ(out[2].present, (std::vector<std::uint8_t>{1, 1, 0, 1}));
+  EXPECT_EQ(a.counters().samples_promised_lost, 1U);
+}
+
 TEST(EpochAssembler, MissingSampleWaitsForTheLatencyLimitOnly) {
   auto a = make();
   for (int g : {1, 2, 4}) a.add_sample(g, 1, 0, 1.0, 1000);

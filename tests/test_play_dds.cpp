@@ -3,9 +3,13 @@
 // sees: the same events and, for every attitude the recorder received, the same numbers bit for bit. Paced,
 // the service sees the same epochs when nothing is lost; the test states its bound below. No timing is
 // asserted.
+#include <atomic>
+#include <chrono>
+#include <csignal>
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -73,6 +77,18 @@ std::map<std::string, std::string> attitude_rows(const std::string& text) {
   return rows;
 }
 
+//! Rows of `expected` that `got` lacks or holds otherwise, plus rows `got` has beyond them.
+std::size_t rows_differing(const std::map<std::string, std::string>& got,
+                           const std::map<std::string, std::string>& expected) {
+  std::size_t n = 0;
+  for (const auto& [time, rest] : expected) {
+    const auto it = got.find(time);
+    n += it == got.end() || it->second != rest ? 1 : 0;
+  }
+  for (const auto& [time, rest] : got) n += expected.count(time) == 0 ? 1 : 0;
+  return n;
+}
+
 void play_and_compare(const std::string& speed, int domain) {
   PlayFiles f;
   const auto replay =
@@ -93,7 +109,8 @@ void play_and_compare(const std::string& speed, int domain) {
   const std::string expected = read_file(f.dir.file("replay_ev.jsonl"));
   EXPECT_NE(expected.find("\"isolated\""), std::string::npos) << expected;
   EXPECT_EQ(without_stream_events(read_file(f.dir.file("dds_ev.jsonl"))), expected);
-  // Attitude is keep-last 1: the recorder may miss some under load; what it did receive equals replay's.
+  // Attitude is keep-last 1 for readers (the service's writer keeps 128): the recorder may miss some under
+  // heavy load; what it did receive equals replay's.
   const auto dds_rows = attitude_rows(read_file(f.dir.file("dds_att.csv")));
   const auto replay_rows = attitude_rows(read_file(f.dir.file("replay_att.csv")));
   ASSERT_EQ(replay_rows.size(), 1500U);
@@ -110,10 +127,54 @@ TEST(PlayDds, FaultedLogInLockstepGivesReplaysEventsAndAttitudes) {
   play_and_compare("max", 171);
 }
 
-// Paced at 10 times the log's pace: with no sample lost (reliable, keep-last 64 at 1 kHz wall rate) the
+// Paced at 10 times the log's pace: with no sample lost (reliable, keep-all at 1 kHz wall rate) the
 // service assembles the same epochs, so the bound is the same: equal events, equal attitudes.
 TEST(PlayDds, FaultedLogPacedGivesReplaysEventsAndAttitudes) {
   play_and_compare("10", 172);
+}
+
+// Lockstep into the service with the recorder paused (SIGSTOP) 0.2 s at a time, five times mid-play:
+// the player's samples wait for it (KEEP_ALL) and the service's attitudes are kept for it, so the
+// recorded log replays to replay's 1,500 attitudes bit for bit and the recorded attitudes are all 1,500
+// of them. Before (the player's writer keeping 64 samples per gyro, the service's Attitude writer 1),
+// both differed: the recorded log replayed to LOST from its first epoch.
+TEST(PlayDds, LockstepWithTheRecorderPausedLosesNothing) {
+  PlayFiles f;
+  const auto replay =
+      run_tetra("replay " + f.log + " --calibration " + f.dir.file("cal.yaml") + " --attitude " +
+                f.dir.file("replay_att.csv") + " --events " + f.dir.file("replay_ev.jsonl"));
+  ASSERT_EQ(replay.exit_status, 0) << replay.err;
+  const std::string d = "174";
+  TetraProcess fusion({"fusion", "--config", f.config, "--domain", d}, f.dir.file("fusion.log"));
+  TetraProcess record({"record", "--config", f.config, "--domain", d, "-o", f.dir.file("rec.csv"),
+                       "--attitude", f.dir.file("dds_att.csv"), "--until-idle"},
+                      f.dir.file("record.log"));
+  std::atomic<bool> done{false};
+  std::thread pauser([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // readers found, playing
+    for (int k = 0; k < 5 && !done; ++k) {
+      record.signal(SIGSTOP);
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      record.signal(SIGCONT);
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    }
+  });
+  const auto play = run_tetra("play " + f.log + " --unit lab-1 --speed max --wait-readers 2 --domain " + d);
+  done = true;
+  pauser.join();
+  record.signal(SIGCONT);
+  ASSERT_EQ(play.exit_status, 0) << play.err << play.out;
+  ASSERT_EQ(record.wait_exit(), 0) << read_file(f.dir.file("record.log"));
+  const auto replay_rows = attitude_rows(read_file(f.dir.file("replay_att.csv")));
+  ASSERT_EQ(replay_rows.size(), 1500U);
+  EXPECT_EQ(rows_differing(attitude_rows(read_file(f.dir.file("dds_att.csv"))), replay_rows), 0U)
+      << "recorded attitudes missing or different";
+  const auto again =
+      run_tetra("replay " + f.dir.file("rec.csv") + " --calibration " + f.dir.file("cal.yaml") +
+                " --attitude " + f.dir.file("again_att.csv") + " --events " + f.dir.file("again_ev.jsonl"));
+  ASSERT_EQ(again.exit_status, 0) << again.err;
+  EXPECT_EQ(rows_differing(attitude_rows(read_file(f.dir.file("again_att.csv"))), replay_rows), 0U)
+      << "the recorded log's epochs replay otherwise";
 }
 
 TEST(PlayCli, BadInputsAreOneLineExitTwo) {

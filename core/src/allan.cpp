@@ -417,6 +417,11 @@ Result<AllanResult> finish_series(std::size_t samples, std::size_t present_sampl
     }
   }
   if (avar.empty()) {
+    // Windows there were, and their variances overflowed: finite values too large to square, not gaps.
+    if (std::any_of(all.begin(), all.end(), [](const AvarPoint& p) { return p.terms > 0; }))
+      return bad_input(
+          "no averaging time has a finite Allan variance: the values are too large to square "
+          "(beyond about 1e150), not gaps");
     return bad_input(
         "no averaging time has a window of consecutive present samples: the gaps leave nothing to analyse");
   }

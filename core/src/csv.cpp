@@ -75,7 +75,7 @@ void parse_metadata_comment(std::string_view comment, Metadata& metadata) {
       token = comment.substr(i, j - i);
     }
     if (eq != std::string_view::npos && eq > 0) {
-      metadata.emplace_back(std::string(token.substr(0, eq)), unescape_meta(token.substr(eq + 1)));
+      metadata.emplace_back(unescape_meta(token.substr(0, eq)), unescape_meta(token.substr(eq + 1)));
     }
     i = j;
   }
@@ -455,14 +455,14 @@ Status write_text_file(const std::string& path, std::string_view content) {
   return files.commit();
 }
 
-void append_metadata(std::string& out, std::string_view key, std::string_view value) {
+namespace {
+
+// Appends `text` with blanks, controls, ',' and '%' (and, in a key, '=') as %XX: one token of a comment.
+void append_escaped(std::string& out, std::string_view text, bool key) {
   static constexpr char kHex[] = "0123456789ABCDEF";
-  out += "# ";
-  out += key;
-  out += '=';
-  for (const char c : value) {
+  for (const char c : text) {
     const auto u = static_cast<unsigned char>(c);
-    if (u <= 0x20 || u == 0x7f || c == ',' || c == '%') {
+    if (u <= 0x20 || u == 0x7f || c == ',' || c == '%' || (key && c == '=')) {
       out += '%';
       out += kHex[u >> 4U];
       out += kHex[u & 0xFU];
@@ -470,6 +470,15 @@ void append_metadata(std::string& out, std::string_view key, std::string_view va
       out += c;
     }
   }
+}
+
+}  // namespace
+
+void append_metadata(std::string& out, std::string_view key, std::string_view value) {
+  out += "# ";
+  append_escaped(out, key, true);
+  out += '=';
+  append_escaped(out, value, false);
   out += '\n';
 }
 

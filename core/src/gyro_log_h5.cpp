@@ -1,202 +1,32 @@
-// HDF5 gyro logs: layout in docs/formats.md. One thread at a time uses the HDF5 library here.
-#include "gyro_log_h5.hpp"
-
-#include <fcntl.h>
-#include <hdf5.h>
-#include <signal.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
+// HDF5 gyro logs: the reader (layout in docs/formats.md): every dataset's shape, type and storage checked
+// before its rows are read, after the file passed the check in a child process (gyro_log_h5_probe.cpp).
+// One thread at a time uses the HDF5 library here.
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <limits>
 
+#include "gyro_log_h5_internal.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/input_files.hpp"
 
 namespace tetra {
 
+using h5io::gyro_name;
+using h5io::H5Header;
+using h5io::Handle;
+using h5io::init_hdf5;
+using h5io::kBlockRows;
+using h5io::kChunkRows;
+using h5io::kFormat;
+using h5io::kNaN;
+using h5io::kRefNames;
+using h5io::kVersion;
+using h5io::read_int_attribute;
+using h5io::read_string_attribute;
+using h5io::VariableStrings;
+
 namespace {
-
-constexpr const char* kFormat = "tetra gyro log";
-constexpr int kVersion = 1;
-constexpr hsize_t kChunkRows = 65536;  // rows per chunk, and per block written
-// Rows per block read: half a chunk (2.8 MB for 4 gyros and a reference); a chunk read raw serves two.
-constexpr hsize_t kBlockRows = kChunkRows / 2;
-constexpr unsigned kDeflateLevel = 1;  // with compression: the noise in gyro values barely compresses anyway
-constexpr std::array<const char*, 4> kRefNames = {"ref_qw", "ref_qx", "ref_qy", "ref_qz"};
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// Owns an HDF5 identifier.
-class Handle {
- public:
-  Handle() = default;
-  Handle(hid_t id, herr_t (*closer)(hid_t)) : id_(id), closer_(closer) {}
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  Handle(Handle&& o) noexcept : id_(o.id_), closer_(o.closer_) { o.id_ = H5I_INVALID_HID; }
-  Handle& operator=(Handle&& o) noexcept {
-    if (this != &o) {
-      reset();
-      id_ = o.id_;
-      closer_ = o.closer_;
-      o.id_ = H5I_INVALID_HID;
-    }
-    return *this;
-  }
-  ~Handle() { reset(); }
-  hid_t get() const { return id_; }
-  bool valid() const { return id_ >= 0; }
-  hid_t release() {
-    const hid_t id = id_;
-    id_ = H5I_INVALID_HID;
-    return id;
-  }
-  void reset() {
-    if (id_ >= 0 && closer_ != nullptr) closer_(id_);
-    id_ = H5I_INVALID_HID;
-  }
-
- private:
-  hid_t id_ = H5I_INVALID_HID;
-  herr_t (*closer_)(hid_t) = nullptr;
-};
-
-// Once, before any other HDF5 call: the library's error stack is never printed (tetra reports one
-// line of its own, naming the file), and the library is not shut down at exit (after a failed write,
-// e.g. a full disk, its shutdown would close the half-written file again and may crash; the process
-// is ending and the temporary file is discarded anyway).
-void init_hdf5() {
-  static const bool done = [] {
-    H5dont_atexit();
-    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-    return true;
-  }();
-  (void)done;
-}
-
-std::string gyro_name(std::size_t index0) {
-  return "g" + std::to_string(index0 + 1);
-}
-
-// --- attributes ---------------------------------------------------------------------------------
-
-constexpr std::size_t kMaxAttributeBytes = std::size_t{16} << 20;  // [bytes] one string attribute read
-
-// Fixed-length UTF-8 strings of `size` bytes each (NUL-padded): stored in the attribute itself, so a
-// reader needs no global heap (variable-length strings live there; see read_string_attribute).
-Handle fixed_string_type(std::size_t size) {
-  Handle t(H5Tcopy(H5T_C_S1), H5Tclose);
-  H5Tset_size(t.get(), std::max<std::size_t>(size, 1));
-  H5Tset_strpad(t.get(), H5T_STR_NULLPAD);
-  H5Tset_cset(t.get(), H5T_CSET_UTF8);
-  return t;
-}
-
-bool write_string_attribute(hid_t obj, const char* name, const std::vector<std::string>& values,
-                            bool scalar) {
-  std::size_t size = 1;
-  for (const std::string& v : values) size = std::max(size, v.size());
-  Handle type = fixed_string_type(size);
-  const hsize_t n = values.size();
-  Handle space(scalar ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, nullptr), H5Sclose);
-  Handle attr(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-  if (!attr.valid()) return false;
-  std::vector<char> buf(values.size() * size, '\0');
-  for (std::size_t i = 0; i < values.size(); ++i)
-    std::memcpy(buf.data() + i * size, values[i].data(), values[i].size());
-  return H5Awrite(attr.get(), type.get(), buf.data()) >= 0;
-}
-
-bool write_int_attribute(hid_t obj, const char* name, int value) {
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
-  Handle attr(H5Acreate2(obj, name, H5T_STD_I32LE, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-  return attr.valid() && H5Awrite(attr.get(), H5T_NATIVE_INT, &value) >= 0;
-}
-
-// Whether variable-length string attributes may be read. Their strings live in the file's global heap,
-// whose damaged sizes libhdf5 follows without checking (a flipped size crashes it): they are read only
-// in the child process that checks a file before it is opened (see probe_in_child).
-enum class VariableStrings { kRead, kRefuse };
-
-// Strings of a string attribute (scalar or 1-D; fixed or variable length): nullopt when absent, an
-// error when it is not strings or larger than kMaxAttributeBytes.
-Result<std::optional<std::vector<std::string>>> read_string_attribute(hid_t obj, const char* name,
-                                                                      const std::string& src,
-                                                                      VariableStrings vlen) {
-  using Strings = std::optional<std::vector<std::string>>;
-  if (H5Aexists(obj, name) <= 0) return Strings{};
-  const std::string what = src + ": attribute '" + name + "'";
-  Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
-  Handle ftype(H5Aget_type(attr.get()), H5Tclose);
-  Handle space(H5Aget_space(attr.get()), H5Sclose);
-  if (!attr.valid() || !ftype.valid() || !space.valid())
-    return bad_input(what + " cannot be read (damaged file?)");
-  if (H5Tget_class(ftype.get()) != H5T_STRING) return bad_input(what + " is not text");
-  const hssize_t count = H5Sget_simple_extent_npoints(space.get());
-  if (count < 0 || H5Sget_simple_extent_ndims(space.get()) > 1 ||
-      static_cast<std::size_t>(count) > kMaxAttributeBytes / 8) {
-    return bad_input(what + " is not a list of strings of bounded size");
-  }
-  const auto n = static_cast<std::size_t>(count);
-  std::vector<std::string> out;
-  if (H5Tis_variable_str(ftype.get()) > 0) {
-    if (vlen == VariableStrings::kRefuse)
-      return bad_input(what + ": variable-length strings are read only in a checked child process");
-    Handle mtype(H5Tcopy(H5T_C_S1), H5Tclose);
-    H5Tset_size(mtype.get(), H5T_VARIABLE);
-    H5Tset_cset(mtype.get(), H5Tget_cset(ftype.get()));  // libhdf5 converts no character set
-    std::vector<char*> ptrs(n, nullptr);
-    if (H5Aread(attr.get(), mtype.get(), ptrs.data()) < 0)
-      return bad_input(what + " cannot be read (damaged file?)");
-    std::size_t total = 0;
-    for (char* p : ptrs) {
-      const std::size_t len = p == nullptr ? 0 : strnlen(p, kMaxAttributeBytes + 1);
-      total += len;
-      if (total > kMaxAttributeBytes) break;
-      out.emplace_back(p == nullptr ? "" : p, len);
-    }
-    H5Dvlen_reclaim(mtype.get(), space.get(), H5P_DEFAULT, ptrs.data());
-    if (total > kMaxAttributeBytes)
-      return bad_input(what + " is larger than " + std::to_string(kMaxAttributeBytes) + " bytes");
-  } else {
-    const std::size_t size = H5Tget_size(ftype.get());
-    if (size == 0 || size > kMaxAttributeBytes || n * size > kMaxAttributeBytes) {
-      return bad_input(what + " is larger than " + std::to_string(kMaxAttributeBytes) + " bytes");
-    }
-    Handle mtype(H5Tcopy(H5T_C_S1), H5Tclose);
-    H5Tset_size(mtype.get(), size);
-    H5Tset_strpad(mtype.get(), H5T_STR_NULLPAD);
-    H5Tset_cset(mtype.get(), H5Tget_cset(ftype.get()));
-    std::vector<char> buf(n * size + 1, '\0');
-    if (H5Aread(attr.get(), mtype.get(), buf.data()) < 0)
-      return bad_input(what + " cannot be read (damaged file?)");
-    for (std::size_t i = 0; i < n; ++i) {
-      const char* s = buf.data() + i * size;
-      out.emplace_back(s, strnlen(s, size));
-    }
-  }
-  return Strings{std::move(out)};
-}
-
-// A scalar integer attribute of at most 64 bits: nullopt when absent or of another kind.
-std::optional<long long> read_int_attribute(hid_t obj, const char* name) {
-  if (H5Aexists(obj, name) <= 0) return std::nullopt;
-  Handle attr(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
-  Handle ftype(H5Aget_type(attr.get()), H5Tclose);
-  Handle space(H5Aget_space(attr.get()), H5Sclose);
-  if (!attr.valid() || !ftype.valid() || !space.valid() || H5Tget_class(ftype.get()) != H5T_INTEGER ||
-      H5Tget_size(ftype.get()) > 8 || H5Sget_simple_extent_npoints(space.get()) != 1) {
-    return std::nullopt;
-  }
-  long long v = 0;
-  if (H5Aread(attr.get(), H5T_NATIVE_LLONG, &v) < 0) return std::nullopt;
-  return v;
-}
 
 // --- reading ------------------------------------------------------------------------------------
 
@@ -402,8 +232,6 @@ bool load_raw_chunk(Dataset& d, hsize_t first, hsize_t count, hid_t mem_type) {
   return true;
 }
 
-using H5Header = GyroLogH5Header;
-
 class H5Reader final : public GyroLogReader {
  public:
   // A file by name: checked first in a child process (probe_in_child), then opened here.
@@ -596,82 +424,6 @@ Status H5Reader::open_file(Handle file, const std::string& source, const H5Heade
   return ok_status();
 }
 
-// --- the checking child process ---------------------------------------------------------------------
-
-constexpr unsigned kProbeSeconds = 30;  // [s] longest the child may take to check a file
-
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define TETRA_H5_ASAN 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__)
-#define TETRA_H5_ASAN 1
-#endif
-
-// libhdf5 sizes some buffers from the file before checking them (an object header claiming 5 GB): in
-// the child, such a malloc fails (an error, the file refused) instead of reserving gigabytes. The limit
-// is the child's address space at the fork plus kProbeExtraBytes. Not under AddressSanitizer, whose
-// shadow memory is terabytes of address space (there, its own allocation limit applies).
-void limit_child_memory() {
-#ifndef TETRA_H5_ASAN
-  constexpr rlim_t kProbeExtraBytes = rlim_t{2} << 30;  // [bytes] address space the child may add
-  std::FILE* statm = std::fopen("/proc/self/statm", "r");
-  unsigned long pages = 0;
-  const bool got = statm != nullptr && std::fscanf(statm, "%lu", &pages) == 1;
-  if (statm != nullptr) std::fclose(statm);
-  if (!got) return;
-  const auto now = static_cast<rlim_t>(pages) * static_cast<rlim_t>(::sysconf(_SC_PAGESIZE));
-  const struct rlimit limit { now + kProbeExtraBytes, now + kProbeExtraBytes };
-  ::setrlimit(RLIMIT_AS, &limit);
-#endif
-}
-
-std::string encode_header(const H5Header& h) {
-  std::string out = "H" + std::to_string(h.gyro_count) + "\n" + (h.units_dps ? "dps" : "V") + "\n" +
-                    std::to_string(h.comments.size()) + "\n";
-  for (const std::string& c : h.comments) out += std::to_string(c.size()) + "\n" + c;
-  return out;
-}
-
-// The child's answer: a header, or an error ("E", then 'b' bad input or 'f' failure, then the message).
-Result<H5Header> decode_answer(const std::string& text, const std::string& path) {
-  const Error garbled = failure(path + ": the process checking the file gave no answer");
-  if (text.size() >= 2 && text[0] == 'E') {
-    return Error{text.substr(2), text[1] == 'b' ? ErrorKind::kBadInput : ErrorKind::kFailure};
-  }
-  if (text.empty() || text[0] != 'H') return garbled;
-  std::size_t pos = 1;
-  auto number = [&](unsigned long long& v) {
-    const std::size_t end = text.find('\n', pos);
-    if (end == std::string::npos) return false;
-    try {
-      v = std::stoull(text.substr(pos, end - pos));
-    } catch (...) {
-      return false;
-    }
-    pos = end + 1;
-    return true;
-  };
-  H5Header h;
-  unsigned long long count = 0;
-  unsigned long long n = 0;
-  if (!number(count)) return garbled;
-  h.gyro_count = static_cast<int>(count);
-  const std::size_t end = text.find('\n', pos);
-  if (end == std::string::npos) return garbled;
-  h.units_dps = text.compare(pos, end - pos, "dps") == 0;
-  pos = end + 1;
-  if (!number(n)) return garbled;
-  for (unsigned long long i = 0; i < n; ++i) {
-    unsigned long long len = 0;
-    if (!number(len) || len > text.size() - pos) return garbled;
-    h.comments.push_back(text.substr(pos, len));
-    pos += len;
-  }
-  return h;
-}
-
 // The whole check of `path` in this process: open, header (variable-length strings included), every
 // dataset's shape, type and storage. What the child runs.
 Result<H5Header> inspect_here(const std::string& path) {
@@ -684,69 +436,11 @@ Result<H5Header> inspect_here(const std::string& path) {
   return reader.header_read();
 }
 
-// libhdf5 trusts the sizes it reads from a file's metadata: some damage (a flipped size in the global
-// heap, where variable-length strings live) makes it read out of bounds and crash, and no check from
-// outside the library can see it first. So a file is first opened and checked whole (its metadata,
-// not its rows) in a child process, which sends the header back; a crash, a hang (kProbeSeconds) or
-// an error there is an error value here naming the file, and this process then opens only a file that
-// passed, reading no variable-length string itself.
-Result<H5Header> probe_in_child(const std::string& path) {
-  int fds[2];
-  if (::pipe2(fds, O_CLOEXEC) != 0) return failure(path + ": cannot create a pipe: " + std::strerror(errno));
-  const pid_t pid = ::fork();
-  if (pid < 0) {
-    ::close(fds[0]);
-    ::close(fds[1]);
-    return failure(path + ": cannot start the process that checks it: " + std::strerror(errno));
-  }
-  if (pid == 0) {
-    ::close(fds[0]);
-    ::alarm(kProbeSeconds);
-    limit_child_memory();
-    const auto header = inspect_here(path);
-    const std::string answer = header ? encode_header(*header)
-                                      : std::string("E") +
-                                            (header.error().kind == ErrorKind::kBadInput ? "b" : "f") +
-                                            header.error().message;
-    std::size_t done = 0;
-    while (done < answer.size()) {
-      const ssize_t n = ::write(fds[1], answer.data() + done, answer.size() - done);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      done += static_cast<std::size_t>(n);
-    }
-    ::_exit(0);  // no exit handlers: the parent's files and libraries are left as they are
-  }
-  ::close(fds[1]);
-  std::string answer;
-  std::array<char, 65536> buf{};
-  while (answer.size() <= kMaxAttributeBytes * 2) {
-    const ssize_t n = ::read(fds[0], buf.data(), buf.size());
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    answer.append(buf.data(), static_cast<std::size_t>(n));
-  }
-  ::close(fds[0]);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (WIFSIGNALED(status)) {
-    if (WTERMSIG(status) == SIGALRM) {
-      return bad_input(path + ": checking this HDF5 file took longer than " + std::to_string(kProbeSeconds) +
-                       " s (damaged file?); nothing was read from it");
-    }
-    return bad_input(path + ": damaged HDF5 file: the HDF5 library failed on it (" +
-                     strsignal(WTERMSIG(status)) +
-                     ") in the process that checks files first; nothing was read from it");
-  }
-  return decode_answer(answer, path);
-}
-
 Status H5Reader::open(const std::string& path) {
   init_hdf5();
   header_.source = path;
   if (Status s = check_input(path, kMaxStreamedLogBytes, true); !s) return s;
-  const auto header = probe_in_child(path);
+  const auto header = h5io::probe_in_child(path, inspect_here);
   if (!header) return header.error();
   Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   return open_file(std::move(file), path, &*header, VariableStrings::kRefuse);
@@ -936,182 +630,6 @@ Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, cons
   if (Status s = reader.open_file(std::move(file), name, &header, VariableStrings::kRefuse); !s)
     return s.error();
   return read_whole(reader, name);
-}
-
-// --- writing ------------------------------------------------------------------------------------
-
-struct GyroLogH5Writer::Impl {
-  std::string path;  // the output's name, for messages
-  Handle file;
-  int gyro_count = 0;
-  bool with_reference = false;
-  bool compress = false;
-  hsize_t rows = 0;  // rows written to the file
-  // Rows buffered for the next chunk.
-  std::vector<double> time_s;
-  std::vector<std::vector<double>> gyro;  // per gyro
-  std::vector<std::uint8_t> present;      // rows×N
-  std::array<std::vector<double>, 4> ref;
-  std::vector<std::uint8_t> ref_present;
-
-  Status create_dataset(const char* name, hid_t type, hsize_t cols) const;
-  Status append_rows(const char* name, hid_t mem_type, const void* data, hsize_t count, hsize_t cols) const;
-  Status flush();
-};
-
-namespace {
-// 'present' is rows×N, 2-D even for one gyro (docs/formats.md); the other datasets are 1-D.
-int rank_of(const char* name) {
-  return std::strcmp(name, "present") == 0 ? 2 : 1;
-}
-}  // namespace
-
-Status GyroLogH5Writer::Impl::create_dataset(const char* name, hid_t type, hsize_t cols) const {
-  const int rank = rank_of(name);
-  const std::array<hsize_t, 2> dims{0, cols};
-  const std::array<hsize_t, 2> max{H5S_UNLIMITED, cols};
-  const std::array<hsize_t, 2> chunk{kChunkRows, cols};
-  Handle space(H5Screate_simple(rank, dims.data(), max.data()), H5Sclose);
-  Handle plist(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
-  H5Pset_chunk(plist.get(), rank, chunk.data());
-  if (compress) {
-    H5Pset_shuffle(plist.get());
-    H5Pset_deflate(plist.get(), kDeflateLevel);
-  }
-  Handle d(H5Dcreate2(file.get(), name, type, space.get(), H5P_DEFAULT, plist.get(), H5P_DEFAULT), H5Dclose);
-  if (!d.valid()) return failure(path + ": cannot create dataset '" + name + "'");
-  return ok_status();
-}
-
-Status GyroLogH5Writer::Impl::append_rows(const char* name, hid_t mem_type, const void* data, hsize_t count,
-                                          hsize_t cols) const {
-  Handle d(H5Dopen2(file.get(), name, H5P_DEFAULT), H5Dclose);
-  const int rank = rank_of(name);
-  const std::array<hsize_t, 2> new_dims{rows + count, cols};
-  if (!d.valid() || H5Dset_extent(d.get(), new_dims.data()) < 0) {
-    return failure(path + ": dataset '" + name + "': cannot extend");
-  }
-  Handle fspace(H5Dget_space(d.get()), H5Sclose);
-  const std::array<hsize_t, 2> start{rows, 0};
-  const std::array<hsize_t, 2> size{count, cols};
-  H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, size.data(), nullptr);
-  Handle mspace(H5Screate_simple(rank, size.data(), nullptr), H5Sclose);
-  if (H5Dwrite(d.get(), mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, data) < 0) {
-    return failure(path + ": dataset '" + name + "': write failed");
-  }
-  return ok_status();
-}
-
-Status GyroLogH5Writer::Impl::flush() {
-  const hsize_t count = time_s.size();
-  if (count == 0) return ok_status();
-  const auto ng = static_cast<hsize_t>(gyro_count);
-  if (Status s = append_rows("time_s", H5T_NATIVE_DOUBLE, time_s.data(), count, 1); !s) return s;
-  for (std::size_t g = 0; g < gyro.size(); ++g) {
-    if (Status s = append_rows(gyro_name(g).c_str(), H5T_NATIVE_DOUBLE, gyro[g].data(), count, 1); !s)
-      return s;
-    gyro[g].clear();
-  }
-  // A 2-D dataset of one column is still 2-D: rank follows the dataset, so write it as rows×1.
-  if (Status s = append_rows("present", H5T_NATIVE_UINT8, present.data(), count, ng); !s) return s;
-  if (with_reference) {
-    for (std::size_t k = 0; k < 4; ++k) {
-      if (Status s = append_rows(kRefNames[k], H5T_NATIVE_DOUBLE, ref[k].data(), count, 1); !s) return s;
-      ref[k].clear();
-    }
-    if (Status s = append_rows("ref_present", H5T_NATIVE_UINT8, ref_present.data(), count, 1); !s) return s;
-    ref_present.clear();
-  }
-  rows += count;
-  time_s.clear();
-  present.clear();
-  return ok_status();
-}
-
-GyroLogH5Writer::GyroLogH5Writer() = default;
-
-GyroLogH5Writer::~GyroLogH5Writer() = default;
-
-Status GyroLogH5Writer::open(const std::string& file_path, const std::string& path, int gyro_count,
-                             bool with_reference, const std::vector<std::string>& comments, bool compress) {
-  if (impl_ && impl_->file.valid()) return failure(path + ": writer already open");
-  if (gyro_count < 1) return bad_input(path + ": a gyro log needs at least one gyro column");
-  init_hdf5();
-  impl_ = std::make_unique<Impl>();
-  Impl& w = *impl_;
-  w.path = path;
-  w.gyro_count = gyro_count;
-  w.with_reference = with_reference;
-  w.compress = compress;
-  w.gyro.resize(static_cast<std::size_t>(gyro_count));
-  // Object headers of HDF5 1.8 on: a string attribute larger than 64 KiB (many comment lines) is then
-  // stored densely instead of failing.
-  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-  if (!fapl.valid() || H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18) < 0) {
-    return failure(path + ": cannot set up the HDF5 library");
-  }
-  w.file = Handle(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose);
-  if (!w.file.valid()) return failure(path + ": cannot write: " + std::strerror(errno));
-
-  Metadata metadata;
-  for (const std::string& c : comments) parse_metadata_comment(c, metadata);
-  std::vector<std::string> meta;
-  for (const auto& [k, v] : metadata) meta.push_back(k + "=" + v);
-  const auto meta_units = last_meta(metadata, "units");
-  const bool dps = meta_units && *meta_units == "dps";
-  const hid_t root = w.file.get();
-  bool ok = write_string_attribute(root, "format", {kFormat}, true) &&
-            write_int_attribute(root, "version", kVersion) &&
-            write_int_attribute(root, "gyro_count", gyro_count) &&
-            write_string_attribute(root, "units", {dps ? "dps" : "V"}, true);
-  if (ok && !comments.empty()) ok = write_string_attribute(root, "comments", comments, false);
-  if (ok && !meta.empty()) ok = write_string_attribute(root, "metadata", meta, false);
-  if (!ok) return failure(path + ": cannot write the attributes");
-
-  const auto ng = static_cast<hsize_t>(gyro_count);
-  if (Status s = w.create_dataset("time_s", H5T_IEEE_F64LE, 1); !s) return s;
-  for (std::size_t g = 0; g < w.gyro.size(); ++g) {
-    if (Status s = w.create_dataset(gyro_name(g).c_str(), H5T_IEEE_F64LE, 1); !s) return s;
-  }
-  if (Status s = w.create_dataset("present", H5T_STD_U8LE, ng); !s) return s;
-  if (with_reference) {
-    for (const char* name : kRefNames) {
-      if (Status s = w.create_dataset(name, H5T_IEEE_F64LE, 1); !s) return s;
-    }
-    if (Status s = w.create_dataset("ref_present", H5T_STD_U8LE, 1); !s) return s;
-  }
-  return ok_status();
-}
-
-Status GyroLogH5Writer::write(double time_s, std::span<const double> values,
-                              std::span<const std::uint8_t> present,
-                              const std::optional<std::array<double, 4>>& reference_wxyz) {
-  if (!impl_ || !impl_->file.valid()) return failure("gyro log writer is not open");
-  Impl& w = *impl_;
-  if (values.size() != static_cast<std::size_t>(w.gyro_count) || present.size() != values.size()) {
-    return failure(w.path + ": epoch has the wrong number of gyro values");
-  }
-  w.time_s.push_back(time_s);
-  for (std::size_t g = 0; g < values.size(); ++g) {
-    w.gyro[g].push_back(present[g] != 0 ? values[g] : kNaN);
-    w.present.push_back(present[g] != 0 ? 1 : 0);
-  }
-  if (w.with_reference) {
-    for (std::size_t k = 0; k < 4; ++k) w.ref[k].push_back(reference_wxyz ? (*reference_wxyz)[k] : kNaN);
-    w.ref_present.push_back(reference_wxyz ? 1 : 0);
-  }
-  if (w.time_s.size() >= kChunkRows) return w.flush();
-  return ok_status();
-}
-
-Status GyroLogH5Writer::close() {
-  if (!impl_ || !impl_->file.valid()) return failure("gyro log writer is not open");
-  Impl& w = *impl_;
-  const Status flushed = w.flush();
-  const bool closed = H5Fclose(w.file.release()) >= 0;
-  if (!flushed) return flushed;
-  if (!closed) return failure(w.path + ": write failed");
-  return ok_status();
 }
 
 }  // namespace tetra

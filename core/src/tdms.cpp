@@ -9,6 +9,7 @@
 #include <cstring>
 #include <ctime>
 #include <optional>
+#include <set>
 #include <unordered_map>
 
 #include "tetra/core/input_files.hpp"
@@ -173,12 +174,16 @@ struct RawIndex {
   std::uint64_t chunk_bytes = 0;  // bytes per chunk (strings: the index's total size)
 };
 
-// An object of the segment's list: a channel index (into TdmsFile::channels) and its data this segment.
+// An object of the segment's list: a channel index (into TdmsFile::channels) and its data this segment
+// (has_data: at least one value per chunk).
 struct ListedObject {
   std::size_t channel = 0;
   bool has_data = false;
   RawIndex index;
 };
+
+// Names of an object's properties → their place in its Metadata (a later segment updates in place).
+using PropertyIndex = std::unordered_map<std::string, std::size_t>;
 
 class TdmsParser {
  public:
@@ -193,9 +198,15 @@ class TdmsParser {
                      std::to_string(segment_start_) + ": " + what);
   }
   Status read_metadata(Cursor& c, std::uint32_t toc);
-  Status read_object(Cursor& c, std::vector<ListedObject>& list);
-  Status read_properties(Cursor& c, Metadata* into, const std::string& path);
-  Result<std::string> property_value(Cursor& c, std::uint32_t type, const std::string& what);
+  Status read_object(Cursor& c);
+  Status read_properties(Cursor& c, Metadata* into, PropertyIndex* index, const std::string& path);
+  //! Puts `obj` in the list (in its place when the channel is listed already, else at the end).
+  void list_object(const ListedObject& obj);
+  //! A new object list: every channel unlisted.
+  void clear_list();
+  //! A property's value as text; an error names the object's path and the property.
+  Result<std::string> property_value(Cursor& c, std::uint32_t type, const std::string& path,
+                                     const std::string& name);
   Status read_raw(std::size_t begin, std::size_t end, std::uint32_t toc, bool incomplete);
   Status read_chunk(Cursor& c, bool interleaved);
   Result<std::vector<std::string>> split_path(const std::string& path) const;
@@ -207,10 +218,18 @@ class TdmsParser {
   std::size_t segment_ = 0;
   std::size_t segment_start_ = 0;
   bool big_ = false;
+  // The work per segment is proportional to its own bytes, never to the objects listed before it: the
+  // list is updated in place, the objects with data and their chunk size are kept as the list changes.
   std::vector<ListedObject> list_;                           // the current segment's objects, in data order
+  std::set<std::size_t> with_data_;                          // places in list_ of the objects with data
+  std::uint64_t chunk_bytes_ = 0;                            // one chunk: the sum over with_data_
+  std::vector<std::size_t> data_order_;                      // with_data_ as a vector (read_raw's loop)
+  bool data_order_stale_ = false;                            // with_data_ changed since data_order_
   std::vector<std::optional<RawIndex>> last_index_;          // per channel: its last raw data index
   std::unordered_map<std::string, std::size_t> channel_at_;  // object path → channel index
-  std::vector<std::size_t> listed_at_;  // per channel: its place in the list being read, or kNotListed
+  std::vector<std::size_t> listed_at_;                       // per channel: its place in list_, or kNotListed
+  std::vector<PropertyIndex> channel_properties_;            // per channel
+  PropertyIndex file_properties_;
 };
 
 Result<std::vector<std::string>> TdmsParser::split_path(const std::string& path) const {
@@ -252,28 +271,33 @@ Result<std::size_t> TdmsParser::channel_for(const std::vector<std::string>& part
   ch.name = parts[1];
   file_.channels.push_back(std::move(ch));
   last_index_.emplace_back();
+  listed_at_.push_back(kNotListed);
+  channel_properties_.emplace_back();
   return file_.channels.size() - 1;
 }
 
-Result<std::string> TdmsParser::property_value(Cursor& c, std::uint32_t type, const std::string& what) {
+Result<std::string> TdmsParser::property_value(Cursor& c, std::uint32_t type, const std::string& path,
+                                               const std::string& name) {
+  // The message is made only on failure: a file of many properties pays for none.
+  const auto what = [&] { return "object '" + path + "', property '" + name + "'"; };
   if (type == kTdsString) {
     std::string s;
-    if (!c.text(s)) return fail(what + ": truncated text value");
+    if (!c.text(s)) return fail(what() + ": truncated text value");
     return s;
   }
   const std::uint8_t* at = nullptr;
   if (type == kTdsTimeStamp) {
-    if (!c.take(16, at)) return fail(what + ": truncated timestamp");
+    if (!c.take(16, at)) return fail(what() + ": truncated timestamp");
     // Little-endian: fractions then seconds; big-endian: seconds then fractions.
     const auto fractions = Cursor::load<std::uint64_t>(big_ ? at + 8 : at, big_);
     const auto seconds = Cursor::load<std::int64_t>(big_ ? at : at + 8, big_);
     return timestamp_text(seconds, fractions);
   }
   if (!is_numeric(type)) {
-    return fail(what + ": property type " + hex_type(type) +
+    return fail(what() + ": property type " + hex_type(type) +
                 " is not supported (numbers, booleans, text and timestamps are)");
   }
-  if (!c.take(type_size(type), at)) return fail(what + ": truncated value");
+  if (!c.take(type_size(type), at)) return fail(what() + ": truncated value");
   const double v = load_number(at, type, big_);
   std::string out;
   if (type == kTdsBoolean) return std::string(v != 0.0 ? "true" : "false");
@@ -286,7 +310,7 @@ Result<std::string> TdmsParser::property_value(Cursor& c, std::uint32_t type, co
   return out;
 }
 
-Status TdmsParser::read_properties(Cursor& c, Metadata* into, const std::string& path) {
+Status TdmsParser::read_properties(Cursor& c, Metadata* into, PropertyIndex* index, const std::string& path) {
   std::uint32_t n = 0;
   if (!c.get(n)) return fail("object '" + path + "': truncated property count");
   if (n > kMaxPropertiesPerObject) {
@@ -297,20 +321,48 @@ Status TdmsParser::read_properties(Cursor& c, Metadata* into, const std::string&
     std::string name;
     std::uint32_t type = 0;
     if (!c.text(name) || !c.get(type)) return fail("object '" + path + "': truncated property");
-    auto value = property_value(c, type, "object '" + path + "', property '" + name + "'");
+    auto value = property_value(c, type, path, name);
     if (!value) return value.error();
     if (into == nullptr) continue;
-    auto same = std::find_if(into->begin(), into->end(), [&](const auto& kv) { return kv.first == name; });
-    if (same != into->end()) {
-      same->second = std::move(*value);  // a later segment updates the property
-    } else {
+    const auto [at, fresh] = index->emplace(name, into->size());
+    if (fresh) {
       into->emplace_back(std::move(name), std::move(*value));
+    } else {
+      (*into)[at->second].second = std::move(*value);  // a later segment updates the property
     }
   }
   return ok_status();
 }
 
-Status TdmsParser::read_object(Cursor& c, std::vector<ListedObject>& list) {
+void TdmsParser::list_object(const ListedObject& obj) {
+  std::size_t& place = listed_at_[obj.channel];
+  if (place == kNotListed) {
+    place = list_.size();
+    list_.push_back(ListedObject{obj.channel, false, {}});
+  }
+  ListedObject& entry = list_[place];
+  if (entry.has_data) chunk_bytes_ -= entry.index.chunk_bytes;
+  if (entry.has_data != obj.has_data) {
+    if (obj.has_data) {
+      with_data_.insert(place);
+    } else {
+      with_data_.erase(place);
+    }
+    data_order_stale_ = true;
+  }
+  entry = obj;
+  if (entry.has_data) chunk_bytes_ += entry.index.chunk_bytes;  // each at most the file's size
+}
+
+void TdmsParser::clear_list() {
+  for (const ListedObject& o : list_) listed_at_[o.channel] = kNotListed;
+  list_.clear();
+  with_data_.clear();
+  chunk_bytes_ = 0;
+  data_order_stale_ = true;
+}
+
+Status TdmsParser::read_object(Cursor& c) {
   std::string path;
   std::uint32_t marker = 0;
   if (!c.text(path) || !c.get(marker)) return fail("truncated object entry");
@@ -320,7 +372,7 @@ Status TdmsParser::read_object(Cursor& c, std::vector<ListedObject>& list) {
   if (!is_channel && marker != kNoRawData)
     return fail("object '" + path + "' is not a channel but has raw data");
   if (!is_channel) {
-    return read_properties(c, parts->empty() ? &file_.properties : nullptr, path);
+    return read_properties(c, parts->empty() ? &file_.properties : nullptr, &file_properties_, path);
   }
   auto channel = channel_for(*parts, path);
   if (!channel) return channel.error();
@@ -331,8 +383,8 @@ Status TdmsParser::read_object(Cursor& c, std::vector<ListedObject>& list) {
     return fail("channel '" + path + "' holds DAQmx raw data, which is not supported: save numeric channels");
   } else if (marker == kSameIndexAsBefore) {
     if (!last_index_[*channel]) return fail("channel '" + path + "' reuses a raw data index it never had");
-    obj.has_data = true;
     obj.index = *last_index_[*channel];
+    obj.has_data = obj.index.count > 0;
   } else if (marker != kNoRawData) {
     std::uint32_t dimension = 0;
     RawIndex idx;
@@ -343,7 +395,9 @@ Status TdmsParser::read_object(Cursor& c, std::vector<ListedObject>& list) {
       return fail("channel '" + path + "': array dimension " + std::to_string(dimension) + ", expected 1");
     const std::size_t size = type_size(idx.type);
     if (idx.type == kTdsString) {
-      if (marker != 28 || !c.get(idx.chunk_bytes))
+      // count offsets of 4 bytes, then the text: a chunk of fewer bytes is no chunk of `count` strings.
+      if (marker != 28 || !c.get(idx.chunk_bytes) || idx.count > bytes_.size() / 4 ||
+          idx.chunk_bytes < 4 * idx.count)
         return fail("channel '" + path + "': bad string raw data index");
     } else if (size == 0) {
       return fail("channel '" + path + "': data type " + hex_type(idx.type) + " is not supported");
@@ -361,40 +415,30 @@ Status TdmsParser::read_object(Cursor& c, std::vector<ListedObject>& list) {
     if (ch.type != 0 && ch.type != idx.type) return fail("channel '" + path + "' changes its data type");
     ch.type = idx.type;
     ch.numeric = is_numeric(idx.type);
-    obj.has_data = true;
+    obj.has_data = idx.count > 0;
     obj.index = idx;
     last_index_[*channel] = idx;
   }
-  listed_at_.resize(file_.channels.size(), kNotListed);
-  if (listed_at_[obj.channel] != kNotListed) {
-    list[listed_at_[obj.channel]] = obj;
-  } else {
-    listed_at_[obj.channel] = list.size();
-    list.push_back(obj);
-  }
-  return read_properties(c, &ch.properties, path);
+  list_object(obj);
+  return read_properties(c, &ch.properties, &channel_properties_[*channel], path);
 }
 
 Status TdmsParser::read_metadata(Cursor& c, std::uint32_t toc) {
-  std::vector<ListedObject> list;
-  if ((toc & kTocNewObjList) == 0) {
-    list = list_;  // an update of the previous segment's list
-  }  // objects not named again keep their data and index; those named again get theirs in read_object
-  listed_at_.assign(file_.channels.size(), kNotListed);
-  for (std::size_t k = 0; k < list.size(); ++k) listed_at_[list[k].channel] = k;
+  // Without a new object list, an update of the previous segment's: objects not named again keep their
+  // data and index; those named again get theirs in read_object.
+  if ((toc & kTocNewObjList) != 0) clear_list();
   std::uint32_t n = 0;
   if (!c.get(n)) return fail("truncated object count");
   for (std::uint32_t k = 0; k < n; ++k) {  // each object takes at least 12 bytes
-    if (Status s = read_object(c, list); !s) return s;
+    if (Status s = read_object(c); !s) return s;
   }
-  list_ = std::move(list);
   return ok_status();
 }
 
 Status TdmsParser::read_chunk(Cursor& c, bool interleaved) {
   if (!interleaved) {
-    for (const ListedObject& o : list_) {
-      if (!o.has_data) continue;
+    for (const std::size_t place : data_order_) {
+      const ListedObject& o = list_[place];
       TdmsChannel& ch = file_.channels[o.channel];
       const std::uint8_t* at = nullptr;
       if (!c.take(o.index.chunk_bytes, at)) return fail("raw data ends inside a chunk");
@@ -408,8 +452,8 @@ Status TdmsParser::read_chunk(Cursor& c, bool interleaved) {
   }
   std::uint64_t count = 0;
   std::size_t row_bytes = 0;
-  for (const ListedObject& o : list_) {
-    if (!o.has_data) continue;
+  for (const std::size_t place : data_order_) {
+    const ListedObject& o = list_[place];
     if (o.index.type == kTdsString) return fail("interleaved raw data holds a text channel");
     if (count != 0 && o.index.count != count) return fail("interleaved channels have different value counts");
     count = o.index.count;
@@ -418,8 +462,8 @@ Status TdmsParser::read_chunk(Cursor& c, bool interleaved) {
   for (std::uint64_t v = 0; v < count; ++v) {
     const std::uint8_t* at = nullptr;
     if (!c.take(row_bytes, at)) return fail("raw data ends inside a chunk");
-    for (const ListedObject& o : list_) {
-      if (!o.has_data) continue;
+    for (const std::size_t place : data_order_) {
+      const ListedObject& o = list_[place];
       TdmsChannel& ch = file_.channels[o.channel];
       ++ch.value_count;
       if (ch.numeric) ch.values.push_back(load_number(at, o.index.type, big_));
@@ -430,24 +474,30 @@ Status TdmsParser::read_chunk(Cursor& c, bool interleaved) {
 }
 
 Status TdmsParser::read_raw(std::size_t begin, std::size_t end, std::uint32_t toc, bool incomplete) {
-  std::uint64_t chunk = 0;
-  for (const ListedObject& o : list_) {
-    if (o.has_data) chunk += o.index.chunk_bytes;  // each at most the file's size: no overflow
-  }
+  const std::uint64_t chunk = chunk_bytes_;
   const std::size_t raw = end - begin;
   if (chunk == 0) {
     if (raw != 0)
       return fail(std::to_string(raw) + " bytes of raw data but no channel has data in this segment");
     return ok_status();
   }
+  if (raw == 0) return ok_status();  // from here on the work is bounded by the segment's bytes
+  if (data_order_stale_) {
+    data_order_.assign(with_data_.begin(), with_data_.end());
+    data_order_stale_ = false;
+  }
   if (raw % chunk != 0) {
     return fail("raw data of " + std::to_string(raw) + " bytes is not a whole number of chunks of " +
                 std::to_string(chunk) + " bytes" + (incomplete ? " (the segment was not finished)" : ""));
   }
   const std::size_t chunks = raw / chunk;
-  for (const ListedObject& o : list_) {  // room for this segment's values (bounded by its bytes)
+  for (const std::size_t place : data_order_) {  // room for this segment's values (bounded by its bytes)
+    const ListedObject& o = list_[place];
     TdmsChannel& ch = file_.channels[o.channel];
-    if (o.has_data && ch.numeric) ch.values.reserve(ch.values.size() + chunks * o.index.count);
+    if (!ch.numeric) continue;
+    // Geometric growth: a stream of many small segments is not copied once per segment.
+    const std::size_t needed = ch.values.size() + chunks * o.index.count;
+    if (needed > ch.values.capacity()) ch.values.reserve(std::max(needed, 2 * ch.values.capacity()));
   }
   Cursor c(bytes_, begin, end, big_);
   for (std::size_t k = 0; k < chunks; ++k) {
@@ -494,10 +544,13 @@ Result<TdmsFile> TdmsParser::run() {
       Cursor c(bytes_, body, raw_begin, big_);
       if (Status s = read_metadata(c, toc); !s) return s.error();
     } else if ((toc & kTocNewObjList) != 0) {
-      list_.clear();
+      clear_list();
     }
     if ((toc & kTocRawData) != 0) {
       if (Status s = read_raw(raw_begin, end, toc, incomplete); !s) return s.error();
+    } else if (end > raw_begin) {
+      return fail(std::to_string(end - raw_begin) +
+                  " bytes after the metadata but the table of contents says the segment has no raw data");
     }
     pos = end;
   }

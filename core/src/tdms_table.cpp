@@ -3,6 +3,9 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <new>
+#include <string_view>
+#include <unordered_map>
 
 #include "tetra/core/input_files.hpp"
 #include "tetra/core/tdms.hpp"
@@ -37,29 +40,36 @@ Result<const TdmsChannel*> find_channel(const TdmsFile& file, const std::string&
 Result<std::vector<std::pair<std::string, const TdmsChannel*>>> pick_columns(const TdmsFile& file,
                                                                              const TdmsChannelMap& map) {
   std::vector<std::pair<std::string, const TdmsChannel*>> cols;
+  const auto too_many = [&] {
+    return bad_input(file.source + ": more than " + std::to_string(kMaxColumns) + " channels");
+  };
   if (map.channels.empty()) {
+    std::unordered_map<std::string_view, const TdmsChannel*> by_name;
     for (const TdmsChannel& ch : file.channels) {
       if (ch.type == 0) continue;  // an object without values (e.g. a property holder)
-      for (const auto& [name, other] : cols) {
-        if (name == ch.name) {
-          return bad_input(file.source + ": channel '" + ch.name + "' is in groups '" + other->group +
-                           "' and '" + ch.group + "': choose one in a channel map (" +
-                           tdms_channel_map_path(file.source) + ")");
-        }
+      if (cols.size() == kMaxColumns) return too_many();
+      if (const auto [other, fresh] = by_name.emplace(ch.name, &ch); !fresh) {
+        return bad_input(file.source + ": channel '" + ch.name + "' is in groups '" + other->second->group +
+                         "' and '" + ch.group + "': choose one in a channel map (" +
+                         tdms_channel_map_path(file.source) + ")");
       }
       cols.emplace_back(ch.name, &ch);
     }
   } else {
     const std::string where = map.source + ": channels: ";
+    std::unordered_map<const TdmsChannel*, std::string_view> column_of;
     for (const auto& [column, ref] : map.channels) {
+      if (cols.size() == kMaxColumns) return too_many();
       auto ch = find_channel(file, ref, where);
       if (!ch) return ch.error();
+      // One channel is one sensor: two columns of it would make two gyros agree by construction.
+      if (const auto [other, fresh] = column_of.emplace(*ch, column); !fresh)
+        return bad_input(where + column + ": channel '" + ref + "' is also column " +
+                         std::string(other->second));
       cols.emplace_back(column, *ch);
     }
   }
   if (cols.empty()) return bad_input(file.source + ": no channel holds values");
-  if (cols.size() > kMaxColumns)
-    return bad_input(file.source + ": more than " + std::to_string(kMaxColumns) + " channels");
   for (const auto& [name, ch] : cols) {
     if (!ch->numeric) {
       return bad_input(file.source + ": channel '" + ch->group + "/" + ch->name + "' (column '" + name +
@@ -113,10 +123,19 @@ Result<CsvTable> tdms_to_table(const TdmsFile& file, const TdmsChannelMap& map) 
   CsvTable t;
   t.source = file.source;
   for (const auto& [name, value] : file.properties) {
+    // A key the map gives another property is the map's: a file property of that name, before or after
+    // the mapped one, does not override it.
     std::string key = name;
+    bool mapped = false;
+    bool shadowed = false;
     for (const auto& [tetra_key, property] : map.properties) {
-      if (property == name) key = tetra_key;
+      if (property == name) {
+        key = tetra_key;
+        mapped = true;
+      }
+      shadowed = shadowed || (tetra_key == name && property != name);
     }
+    if (!mapped && shadowed) continue;
     std::string line;
     append_metadata(line, key, value);
     t.comments.push_back(line.substr(1, line.size() - 2));  // without '#' and the newline
@@ -136,13 +155,13 @@ Result<CsvTable> tdms_to_table(const TdmsFile& file, const TdmsChannelMap& map) 
   return t;
 }
 
-Result<CsvTable> read_tdms_table(const std::string& path) {
+Result<CsvTable> read_tdms_table(const std::string& path) try {
   auto file = read_tdms(path);
   if (!file) return file.error();
   TdmsChannelMap map;
   const std::string map_path = tdms_channel_map_path(path);
   struct stat st {};
-  if (::stat(map_path.c_str(), &st) == 0) {
+  if (::lstat(map_path.c_str(), &st) == 0) {  // a link to nothing is read (and refused), never ignored
     auto text = read_input(map_path, kMaxYamlBytes);
     if (!text) return text.error();
     auto parsed = parse_tdms_channel_map(*text, map_path);
@@ -150,6 +169,12 @@ Result<CsvTable> read_tdms_table(const std::string& path) {
     map = std::move(*parsed);
   }
   return tdms_to_table(*file, map);
+} catch (const std::bad_alloc&) {
+  // Each numeric value takes 8 bytes as read and 9 as a table cell: a file of small integers (int8) needs
+  // about 17 times its size.
+  return failure(path +
+                 ": its values do not fit in memory (about 17 bytes each as read and as a table, "
+                 "against 1 in an int8 file): convert it in parts");
 }
 
 }  // namespace tetra

@@ -15,6 +15,15 @@ namespace tetra::cli {
 
 namespace {
 
+//! One line of standard input, read no further than one character past kMaxPasswordBytes (an endless
+//! input without a newline ends there; hash_password refuses what is too long).
+std::string password_line() {
+  std::string line;
+  char c = 0;
+  while (line.size() <= ground::kMaxPasswordBytes && std::cin.get(c) && c != '\n') line += c;
+  return line;
+}
+
 //! One line from the terminal with echo off.
 std::string ask_hidden(const std::string& prompt) {
   std::cerr << prompt << std::flush;
@@ -25,8 +34,7 @@ std::string ask_hidden(const std::string& prompt) {
     quiet.c_lflag &= ~static_cast<tcflag_t>(ECHO);
     ::tcsetattr(STDIN_FILENO, TCSANOW, &quiet);
   }
-  std::string line;
-  std::getline(std::cin, line);
+  const std::string line = password_line();
   if (tty) ::tcsetattr(STDIN_FILENO, TCSANOW, &old);
   std::cerr << '\n';
   return line;
@@ -53,14 +61,15 @@ int cmd_ground_passwd(int argc, char** argv) {
   if (from_stdin || !::isatty(STDIN_FILENO)) {
     if (!from_stdin)
       return report("ground passwd", bad_input("standard input is not a terminal: --password-stdin"));
-    std::getline(std::cin, password);
+    password = password_line();
   } else {
     password = ask_hidden("password for " + user + ": ");
     if (ask_hidden("again: ") != password)
       return report("ground passwd", bad_input("the two passwords differ"));
   }
-  if (password.size() < 8) return report("ground passwd", bad_input("password: at least 8 characters"));
-  auto hash = ground::hash_password(password);
+  auto taken = ground::password_of_line(password);
+  if (!taken) return report("ground passwd", taken.error());
+  auto hash = ground::hash_password(*taken);
   if (!hash) return report("ground passwd", hash.error());
   const ground::Account account{user, *ground::role_named(role_name), *hash};
   if (auto s = ground::set_account(users_path, account); !s) return report("ground passwd", s.error());

@@ -61,6 +61,13 @@ int cmd_record(int argc, char** argv) {
             << " (late " << c.samples_late << ", duplicate " << c.samples_duplicate << ", out of order "
             << c.samples_out_of_order << ", gap " << c.samples_gap << ", time outlier " << c.time_outlier
             << ", sequence jump " << c.seq_discontinuity << ", restarts " << c.sensor_restarts << ")\n";
+  if (recorded->gyro_samples_lost > 0 || recorded->attitudes_lost > 0) {
+    std::cerr << "tetra record: " << recorded->gyro_samples_lost << " gyro samples and "
+              << recorded->attitudes_lost
+              << " attitudes lost (dropped by a writer before this recorder had them, or said written for an "
+                 "epoch and never in): the files lack them\n";
+    return kExitFailure;
+  }
   return kExitOk;
 }
 

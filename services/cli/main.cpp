@@ -1,6 +1,10 @@
 // tetra — calibration, noise characterization, simulation, fault-tolerant fusion and DDS services
 // for redundant gyro packages.
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -71,7 +75,26 @@ int help(int argc, char** argv) {
 
 }  // namespace
 
+namespace {
+
+//! Standard input, output and error closed by the caller (`<&-`): /dev/null in their place, so the first
+//! file or socket the run opens never becomes "standard input" (ingest would read a DDS socket and never
+//! end) or "standard output" (a `-o -` would go into it).
+void reserve_standard_descriptors() {
+  for (int fd = 0; fd <= 2; ++fd) {
+    if (::fcntl(fd, F_GETFD) >= 0 || errno != EBADF) continue;
+    const int null_fd = ::open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY);
+    if (null_fd >= 0 && null_fd != fd) {
+      (void)::dup2(null_fd, fd);
+      ::close(null_fd);
+    }
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  reserve_standard_descriptors();
   // A closed pipe on standard output is a write error (EPIPE) that each writer reports, never a
   // signal that kills the run before its files are written.
   std::signal(SIGPIPE, SIG_IGN);

@@ -567,58 +567,90 @@ Result<CampaignRow> parse_campaign_row(const std::string& line) {
   if (f.size() < kCampaignColumns)
     return bad_input("campaign row with " + std::to_string(f.size()) + " fields (" +
                      std::to_string(kCampaignColumns) + " or more expected)");
-  try {
-    const auto num = [](const std::string& s) {
-      return s.empty() ? std::numeric_limits<double>::quiet_NaN() : std::stod(s);
-    };
-    const auto opt = [](const std::string& s) {
-      return s.empty() ? std::nullopt : std::optional<double>(std::stod(s));
-    };
-    CampaignRow r;
-    r.run = std::stoul(f[0]);
-    r.scenario = f[1];
-    r.kind = f[2];
-    r.gyro = std::stoi(f[3]);
-    r.onset_s = num(f[4]);
-    r.size = num(f[5]);
-    r.seed = std::stoull(f[6]);
-    r.draws.assign(f.begin() + static_cast<std::ptrdiff_t>(kCampaignColumns), f.end());
-    if (f[7] == "error") {
-      if (f[kErrorColumn].empty()) return bad_input("campaign row: outcome error without its message");
-      r.error = f[kErrorColumn];
-      return r;
+  // Every field as campaign_csv_row writes it: whole numbers in digits, other numbers finite decimal
+  // text within their column's range; a forged or damaged row is refused, never counted.
+  std::vector<std::string> names;
+  std::stringstream header(campaign_csv_header());
+  for (std::string name; std::getline(header, name, ',');) names.push_back(name);
+  std::string bad;  // the first field out of its range
+  const auto refuse = [&](std::size_t i, const char* range) {
+    if (bad.empty()) bad = names[i] + " '" + one_line(f[i].substr(0, 40)) + "' (" + range + ")";
+  };
+  const auto whole = [&](std::size_t i, std::uint64_t max, const char* range) -> std::uint64_t {
+    const std::string& t = f[i];
+    if (t.empty() || t.size() > 20 || t.find_first_not_of("0123456789") != std::string::npos) {
+      refuse(i, range);
+      return 0;
     }
-    if (!f[kErrorColumn].empty())
-      return bad_input("campaign row: an error message with outcome '" + f[7] + "'");
-    bool known = false;
-    for (Outcome o :
-         {Outcome::kNone, Outcome::kRight, Outcome::kWrong, Outcome::kUnisolated, Outcome::kMissed}) {
-      if (outcome_name(o) == f[7]) {
-        r.fdi.outcome = o;
-        known = true;
-      }
+    try {
+      const std::uint64_t v = std::stoull(t);
+      if (v <= max) return v;
+    } catch (const std::exception&) {
     }
-    if (!known) return bad_input("campaign row: unknown outcome '" + f[7] + "'");
-    if (!f[8].empty()) r.fdi.isolated_gyro = std::stoi(f[8]);
-    r.fdi.detection_delay_s = opt(f[9]);
-    r.fdi.isolation_delay_s = opt(f[10]);
-    r.theory_delay_s = opt(f[11]);
-    r.fdi.false_alarms = std::stoi(f[12]);
-    r.fdi.fault_free_s = num(f[13]);
-    r.final_knowledge_error_deg = num(f[14]);
-    r.final_sigma_deg = num(f[15]);
-    r.pointing_max_before_deg = num(f[16]);
-    r.pointing_rms_after_deg = num(f[17]);
-    r.pointing_max_after_deg = num(f[18]);
-    r.recover_s = opt(f[19]);
-    r.bound_deg = num(f[20]);
-    r.max_wheel_momentum_fraction = num(f[21]);
-    if (!f[22].empty()) r.fdi.wrong_gyro = std::stoi(f[22]);
-    r.fdi.wrong_at_s = opt(f[23]);
+    refuse(i, range);
+    return 0;
+  };
+  const auto num = [&](std::size_t i, double lo) {
+    if (f[i].empty()) return std::numeric_limits<double>::quiet_NaN();
+    const auto v = parse_decimal(f[i]);
+    if (!v || *v < lo) {
+      refuse(i, lo == 0.0 ? "a finite number >= 0" : "a finite number");
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    return *v;
+  };
+  const auto opt = [&](std::size_t i) {
+    return f[i].empty() ? std::nullopt : std::optional<double>(num(i, 0.0));
+  };
+  const auto gyro_id = [&](std::size_t i) {
+    return f[i].empty() ? std::nullopt
+                        : std::optional<int>(static_cast<int>(whole(i, kMaxGyros, "a gyro 1..32")));
+  };
+  const double kAny = -std::numeric_limits<double>::max();
+  CampaignRow r;
+  r.run = whole(0, kMaxCampaignRuns, "a run number");
+  r.scenario = f[1];
+  r.kind = f[2];
+  r.gyro = static_cast<int>(whole(3, kMaxGyros, "a gyro 0..32"));
+  r.onset_s = num(4, 0.0);
+  r.size = num(5, kAny);
+  r.seed = whole(6, std::numeric_limits<std::uint64_t>::max(), "a seed");
+  r.draws.assign(f.begin() + static_cast<std::ptrdiff_t>(kCampaignColumns), f.end());
+  if (f[7] == "error") {
+    if (f[kErrorColumn].empty()) return bad_input("campaign row: outcome error without its message");
+    r.error = f[kErrorColumn];
+    if (!bad.empty()) return bad_input("campaign row: " + bad);
     return r;
-  } catch (const std::exception&) {
-    return bad_input("campaign row: a field is not a number");
   }
+  if (!f[kErrorColumn].empty())
+    return bad_input("campaign row: an error message with outcome '" + f[7] + "'");
+  bool known = false;
+  for (Outcome o :
+       {Outcome::kNone, Outcome::kRight, Outcome::kWrong, Outcome::kUnisolated, Outcome::kMissed}) {
+    if (outcome_name(o) == f[7]) {
+      r.fdi.outcome = o;
+      known = true;
+    }
+  }
+  if (!known) return bad_input("campaign row: unknown outcome '" + one_line(f[7].substr(0, 40)) + "'");
+  r.fdi.isolated_gyro = gyro_id(8);
+  r.fdi.detection_delay_s = opt(9);
+  r.fdi.isolation_delay_s = opt(10);
+  r.theory_delay_s = opt(11);
+  r.fdi.false_alarms = static_cast<int>(whole(12, 1'000'000'000, "a count >= 0"));
+  r.fdi.fault_free_s = num(13, 0.0);
+  r.final_knowledge_error_deg = num(14, 0.0);
+  r.final_sigma_deg = num(15, 0.0);
+  r.pointing_max_before_deg = num(16, 0.0);
+  r.pointing_rms_after_deg = num(17, 0.0);
+  r.pointing_max_after_deg = num(18, 0.0);
+  r.recover_s = opt(19);
+  r.bound_deg = num(20, 0.0);
+  r.max_wheel_momentum_fraction = num(21, 0.0);
+  r.fdi.wrong_gyro = gyro_id(22);
+  r.fdi.wrong_at_s = opt(23);
+  if (!bad.empty()) return bad_input("campaign row: " + bad);
+  return r;
 }
 
 }  // namespace tetra::sim

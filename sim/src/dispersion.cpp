@@ -333,6 +333,13 @@ Status check_dispersions(const YamlReader& yaml, const YAML::Node& node, const D
               at, what, "gyro " + std::to_string(g.id) + " of " + name + " has no calibration 1σ (sigma:)");
       }
     }
+    // Sample times within ± jitter of the nominal ones stay in order only below half a period: beyond
+    // it every run would be an error row.
+    if (d.parameter == P::kJitterS && !(dist.max < 0.5 / sc.rate_hz))
+      return yaml.error(at, what,
+                        "jitter up to " + number_text(dist.max) + " s reaches half the sampling period (" +
+                            number_text(0.5 / sc.rate_hz) + " s) of " + name +
+                            ": give a distribution bounded below it");
     if (d.parameter == P::kFaultOnsetS) {
       const auto [lo, hi] = std::minmax_element(onsets_s.begin(), onsets_s.end());
       if (*lo + dist.min < 0.0 || *hi + dist.max >= sc.duration_s)

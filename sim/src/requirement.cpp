@@ -1,10 +1,10 @@
 #include "tetra/sim/requirement.hpp"
 
 #include <cmath>
-#include <cstdlib>
 #include <optional>
 #include <sstream>
 
+#include "tetra/core/csv.hpp"
 #include "tetra/sim/fault.hpp"
 
 namespace tetra::sim {
@@ -17,13 +17,9 @@ constexpr RequirementMetric kMetrics[] = {
     RequirementMetric::kDetectionRate,      RequirementMetric::kIsolationRate,
     RequirementMetric::kWrongExclusionRate, RequirementMetric::kFalseAlarmsPerHour};
 
-//! A finite number written whole in `text`, or nullopt.
+//! A finite decimal number written whole in `text` (no hexadecimal, as everywhere else), or nullopt.
 std::optional<double> number_in(const std::string& text) {
-  if (text.empty()) return std::nullopt;
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() + text.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
+  return parse_decimal(text);
 }
 
 std::string metric_list() {

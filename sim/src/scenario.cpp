@@ -144,6 +144,7 @@ Status read_unit(const YamlReader& yaml, const YAML::Node& root, const std::stri
   auto cal = read_calibration(path.string());
   if (!cal) return yaml.error(unit, "unit", cal.error().message);
   sc.unit = std::move(cal.value());
+  sc.named_files.push_back(path.string());
   return ok_status();
 }
 

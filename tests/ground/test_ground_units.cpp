@@ -433,6 +433,45 @@ TEST(Encode, StringsThatAreNotUtf8AreShownWithTheReplacementCharacter) {
   EXPECT_TRUE(nlohmann::json::accept(text));
 }
 
+// The accounts file through a symbolic link is written through it (the link stays); a damaged hash, an
+// empty file and a file others can read are refused at start; a password beyond 1024 bytes is refused,
+// a final CR is no part of it.
+TEST(Operators, LinkedDamagedOrOpenAccountsFiles) {
+  test::TempDir dir;
+  auto hash = hash_password("correct horse");
+  ASSERT_TRUE(hash.ok());
+  const std::string real = dir.file("real_users");
+  const std::string link = dir.file("users");
+  std::filesystem::create_symlink(real, link);
+  test::write_file(real, "");
+  std::filesystem::permissions(real,
+                               std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  EXPECT_EQ(Operators::open(real, dir.file("key"), dir.file("sessions"), 1000).error().message,
+            real + ": no accounts (add one with tetra ground passwd USER --users " + real + ")");
+  ASSERT_TRUE(set_account(link, {"alice", Role::kCommander, *hash}).ok());
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  ASSERT_EQ(read_accounts(real)->size(), 1U);
+  EXPECT_TRUE(Operators::open(link, dir.file("key"), dir.file("sessions"), 1000).ok());
+  std::filesystem::permissions(real, std::filesystem::perms::others_read, std::filesystem::perm_options::add);
+  EXPECT_EQ(Operators::open(link, dir.file("key"), dir.file("sessions"), 1000).error().message,
+            link +
+                ": the accounts file is readable or writable by group or others (mode 0604); whoever reads "
+                "it can sign in as any operator: chmod 600 " +
+                link);
+  const std::string cut = dir.file("cut");
+  test::write_file(cut, "alice:viewer:" + hash->substr(0, hash->size() - 10) + "\n");
+  EXPECT_EQ(read_accounts(cut).error().message,
+            cut + ":1: the argon2id hash is damaged (set the password again with tetra ground passwd)");
+  test::write_file(cut, "alice:viewer:" + *hash + "\r\n");
+  EXPECT_FALSE(read_accounts(cut).ok());
+  EXPECT_EQ(hash_password(std::string(kMaxPasswordBytes + 1, 'x')).error().message,
+            "password: at most 1024 characters");
+  EXPECT_EQ(*password_of_line("correct horse\r"), "correct horse");
+  EXPECT_EQ(password_of_line(std::string(10 << 20, 'x')).error().message,
+            "password: at most 1024 characters");
+  EXPECT_EQ(password_of_line("seven\r").error().message, "password: at least 8 characters");
+}
+
 TEST(GroundServer, NoAuthOnlyOnLoopback) {
   EXPECT_TRUE(is_loopback_host("127.0.0.1"));
   EXPECT_TRUE(is_loopback_host("127.1.2.3"));

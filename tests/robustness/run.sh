@@ -413,6 +413,37 @@ check_sh roundtrip "the JSON is valid UTF-8" "iconv -f UTF-8 -t UTF-8 n.json >/d
 check_sh provenance "provenance in CSV, YAML, JSON outputs" \
   "grep -q '^# tetra_version=' att.csv && grep -q '^# created_utc=' att.csv && grep -q '# tetra_version=' weird.yaml && grep -q '\"provenance\"' n.json"
 
+# --- the newer surfaces: play, ingest, ground accounts (docs/reliability.md, "Round 4") ---------------
+# Refused before DDS is opened, or ended at once: never a sleep through a far-future row, never a read of
+# a socket as standard input, never a unit key fusion refuses, never a users file replaced or opened up.
+printf 'time_s,g1,g2,g3\n0,1,2,3\n0.1,1,2,3\n1000000,1,2,3\n' >far.csv
+check surfaces "play: a row 1e6 s ahead (it slept 1e5 s)" 2 "far.csv:4: time 1e\+06 s is 999999.9 s after" "" -- \
+  play far.csv --domain 229 --wait-timeout 1
+printf '# unit=caf\xe9\ntime_s,g1,g2,g3\n0,1,2,3\n0.1,1,2,3\n' >cafe.csv
+check surfaces "play: '# unit=' not UTF-8" 2 "cafe.csv.*(UTF-8|unit)" "" -- play cafe.csv --domain 229 --wait-timeout 1
+printf '# unit=a%%0Ab\ntime_s,g1,g2,g3\n0,1,2,3\n0.1,1,2,3\n' >nl_unit.csv
+check surfaces "play: '# unit=' with a newline" 2 "nl_unit.csv: the unit name of '# unit=': contains a control" "" -- \
+  play nl_unit.csv --domain 229 --wait-timeout 1
+printf '# unit=\ntime_s,g1,g2,g3\n0,1,2,3\n0.1,1,2,3\n' >empty_unit.csv
+check surfaces "play: '# unit=' empty" 2 "empty_unit.csv: the unit name of '# unit=': must have 1 to 31 bytes" "" -- \
+  play empty_unit.csv --domain 229 --wait-timeout 1
+check_sh surfaces "ingest with standard input closed ends (it read a DDS socket)" \
+  "\"$TETRA\" ingest --wait-readers 0 --domain 229 -q <&- >/dev/null 2>&1"
+check_sh surfaces "ground passwd writes through a symlinked users file" \
+  "printf 'correct horse\\n' | \"$TETRA\" ground passwd alice --users real_users --password-stdin >/dev/null &&
+   ln -s real_users link_users &&
+   printf 'battery staple\\r\\n' | \"$TETRA\" ground passwd bob --users link_users --password-stdin >/dev/null &&
+   [ -L link_users ] && grep -q '^alice:' real_users && grep -q '^bob:' real_users"
+check_sh surfaces "ground passwd refuses a 10 MB password" \
+  "head -c 10000000 /dev/zero | tr '\\0' x | \"$TETRA\" ground passwd carol --users real_users --password-stdin 2>err_pw;
+   [ \$? = 2 ] && grep -q 'at most 1024 characters' err_pw && ! grep -q '^carol:' real_users"
+chmod 644 real_users 2>/dev/null
+check surfaces "ground on a users file others can read" 2 "real_users: the accounts file is readable or writable by group or others \\(mode 0644\\)" "" -- \
+  ground --listen 127.0.0.1:0 --users real_users --domain 229
+printf 'alice:commander:$argon2id$v=19$m=65536,t=2,p=1$cut\n' >cut_users && chmod 600 cut_users
+check surfaces "ground on a users file with a damaged hash" 2 "cut_users:1: the argon2id hash is damaged" "" -- \
+  ground --listen 127.0.0.1:0 --users cut_users --domain 229
+
 # --- summary -----------------------------------------------------------------------------------------
 echo
 for c in "${!class_count[@]}"; do printf '%s %d\n' "$c" "${class_count[$c]}"; done | sort

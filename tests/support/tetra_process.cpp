@@ -42,6 +42,10 @@ TetraProcess::~TetraProcess() {
   kill_now(SIGKILL);
 }
 
+void TetraProcess::signal(int sig) const {
+  if (pid_ > 0) ::kill(pid_, sig);
+}
+
 void TetraProcess::kill_now(int sig) {
   if (pid_ <= 0) return;
   ::kill(pid_, sig);

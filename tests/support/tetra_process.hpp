@@ -24,6 +24,8 @@ class TetraProcess {
   int signal_and_wait(int sig);
   //! Waits for the process to end by itself; returns its exit status (-1 as above).
   int wait_exit();
+  //! Sends `sig` and returns at once (SIGSTOP / SIGCONT: pausing the process).
+  void signal(int sig) const;
 
  private:
   pid_t pid_ = -1;

@@ -12,8 +12,11 @@ previous one's reused, two chunks), incremental metadata ("same index as before"
 metadata-only segment, and a last segment whose index changes the value count. --layout interleaved
 writes interleaved raw data, --big-endian big-endian segments, --index the optional .tdms_index beside it.
 
+--segment-rows N writes a LabVIEW-style stream instead: the metadata once, then one segment of N rows
+after another, each without metadata (a logger writing as it goes).
+
     make_tdms.py IN.csv OUT.tdms [--layout contiguous|interleaved] [--big-endian] [--one-segment]
-                 [--index] [--int32 COLUMN ...] [--float32 COLUMN ...] [--rename COLUMN=CHANNEL ...]
+                 [--segment-rows N] [--index] [--int32 COLUMN ...] [--float32 COLUMN ...] [--rename COLUMN=CHANNEL ...]
                  [--group NAME] [--rename-property KEY=NAME ...]
 """
 import argparse
@@ -109,6 +112,7 @@ def main():
     ap.add_argument("--layout", choices=["contiguous", "interleaved"], default="contiguous")
     ap.add_argument("--big-endian", action="store_true")
     ap.add_argument("--one-segment", action="store_true")
+    ap.add_argument("--segment-rows", type=int, default=0)
     ap.add_argument("--index", action="store_true")
     ap.add_argument("--int32", nargs="*", default=[])
     ap.add_argument("--float32", nargs="*", default=[])
@@ -136,7 +140,16 @@ def main():
     segs = []
     file_obj = w.text("/") + w.u32(NO_DATA) + w.props(props)
     group_obj = w.text(path_of(a.group)) + w.u32(NO_DATA) + w.props([("description", "written by make_tdms.py")])
-    if a.one_segment or n < 5:
+    if a.segment_rows > 0:
+        k = min(a.segment_rows, n)
+        objs = [file_obj, group_obj] + [channel(nm, full_index(t, k)) for nm, t in zip(names, types)]
+        segs.append(segment(w, TOC_NEW_LIST | inter, objs, raw_data(w, types, rows[:k], inter)))
+        for first in range(k, n - n % k, k):
+            segs.append(segment(w, inter, None, raw_data(w, types, rows[first:first + k], inter)))
+        if n % k:
+            objs = [channel(nm, full_index(t, n % k)) for nm, t in zip(names, types)]
+            segs.append(segment(w, inter, objs, raw_data(w, types, rows[n - n % k:], inter)))
+    elif a.one_segment or n < 5:
         objs = [file_obj, group_obj] + [channel(nm, full_index(t, n)) for nm, t in zip(names, types)]
         segs.append(segment(w, TOC_NEW_LIST | inter, objs, raw_data(w, types, rows, inter)))
     else:

@@ -81,13 +81,23 @@ Result<std::string> campaign_spec_hash(const sim::CampaignSpec& spec, const std:
   } catch (const YAML::Exception& e) {
     return bad_input(spec_path + ": " + e.what());
   }
-  for (const std::string& path : spec.scenario_paths) {
-    canonical += "\n--- scenario " + std::filesystem::path(path).filename().string() + "\n";
+  const auto add_file = [&](const std::string& label, const std::string& path) -> Status {
+    canonical += "\n--- " + label + " " + std::filesystem::path(path).filename().string() + "\n";
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) continue;  // a built-in scenario: its name
-    auto scenario = read_input(path, kMaxYamlBytes);
-    if (!scenario) return scenario.error();
-    canonical += *scenario;
+    if (!std::filesystem::is_regular_file(path, ec)) return ok_status();  // a built-in scenario: its name
+    auto contents = read_input(path, kMaxYamlBytes);
+    if (!contents) return contents.error();
+    canonical += *contents;
+    return ok_status();
+  };
+  for (std::size_t i = 0; i < spec.scenario_paths.size(); ++i) {
+    if (Status s = add_file("scenario", spec.scenario_paths[i]); !s) return s.error();
+    // The files the scenario names (its unit): a unit file changed is another campaign.
+    if (i < spec.scenarios.size()) {
+      for (const std::string& named : spec.scenarios[i].named_files) {
+        if (Status s = add_file("file", named); !s) return s.error();
+      }
+    }
   }
   return hex_sha256(canonical);
 }
@@ -143,7 +153,10 @@ Result<std::vector<Row>> read_rows(const std::string& runs_csv, const std::strin
                      ":1: not the header of this campaign (another version, or other dispersions)");
   for (std::size_t number = 2; std::getline(in, line); ++number) {
     auto row = sim::parse_campaign_row(line, header);
-    if (!row) continue;  // a torn line (an interrupted write): the run is done again
+    // A torn line (an interrupted write) can only be the last one, and lacks its newline: the run is
+    // done again. Any other row that does not read is refused, never dropped or counted.
+    if (!row && in.eof()) continue;
+    if (!row) return bad_input(runs_csv + ":" + std::to_string(number) + ": " + row.error().message);
     if (drop_errors && !row->error.empty()) continue;
     rows.push_back(Row{row->run, !row->error.empty(), line});
   }

@@ -2,11 +2,13 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <optional>
 
 #include "folder.hpp"
 #include "tetra/campaign/runner.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/input_files.hpp"
+#include "tetra/sim/campaign.hpp"
 #include "tetra/sim/requirement.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -18,6 +20,26 @@ namespace {
 bool same_folder(const std::string& a, const std::string& b) {
   std::error_code ec;
   return std::filesystem::equivalent(a, b, ec);
+}
+
+//! The case columns of a row (run, scenario, kind, gyro, onset, size, seed): its first 7 fields.
+std::string case_columns(const std::string& line) {
+  std::size_t end = 0;
+  for (int commas = 0; end < line.size(); ++end) {
+    if (line[end] == ',' && ++commas == 7) break;
+  }
+  return line.substr(0, end);
+}
+
+//! The spec the shards ran, from the first shard's copy, when it reads there (its scenario files found
+//! from that folder) and is the campaign their spec.sha256 names; nullopt otherwise.
+std::optional<sim::CampaignSpec> spec_of(const std::string& shard_dir, const std::string& sha256) {
+  const std::string copy = folder::path_in(shard_dir, folder::kSpecCopy);
+  auto spec = sim::read_campaign_spec(copy);
+  if (!spec) return std::nullopt;
+  auto hash = campaign_spec_hash(*spec, copy);
+  if (!hash || *hash != sha256) return std::nullopt;
+  return std::move(spec).value();
 }
 
 }  // namespace
@@ -56,6 +78,9 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
   // The header (with the spec's dispersion columns) is the first shard's; every shard must have it.
   auto header = folder::read_header(folder::path_in(shard_dirs[0], folder::kRunsFile));
   if (!header) return header.error();
+  // Each row's case as the spec's matrix has it (scenario, kind, gyro, onset, size, seed): a forged or
+  // shifted row is refused, when the spec reads from the shard's folder.
+  const auto spec = spec_of(shard_dirs[0], first.spec_sha256);
   std::vector<folder::Row> all;
   all.reserve(first.matrix_runs);
   for (std::size_t i = 0; i < manifests.size(); ++i) {
@@ -71,6 +96,13 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
       if (r.run != expected)
         return bad_input(runs_csv + ": run " + std::to_string(expected) +
                          " missing: the shard is not complete (run it again with the same command)");
+      if (spec) {
+        const std::string want =
+            case_columns(sim::campaign_csv_row(sim::campaign_error_row(*spec, r.run, "-")));
+        if (case_columns(r.line) != want)
+          return bad_input(runs_csv + ": run " + std::to_string(r.run) + " is '" +
+                           one_line(case_columns(r.line)) + "', the spec's case is '" + want + "'");
+      }
       expected += shard.n;
     }
     if (expected < first.matrix_runs)
@@ -78,9 +110,20 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
                        " missing: the shard is not complete (run it again with the same command)");
     all.insert(all.end(), rows->begin(), rows->end());
   }
-  if (auto old = folder::read_manifest(out_dir); old && old->spec_sha256 != first.spec_sha256)
-    return bad_input(folder::path_in(out_dir, folder::kHashFile) +
-                     ": the output folder holds a campaign of another spec: use another folder");
+  if (auto old = folder::read_manifest(out_dir); old) {
+    if (old->spec_sha256 != first.spec_sha256)
+      return bad_input(folder::path_in(out_dir, folder::kHashFile) +
+                       ": the output folder holds a campaign of another spec: use another folder");
+  } else {
+    // No campaign's manifest: any file the merge would write is another program's, never replaced.
+    for (const char* name : {folder::kRunsFile, folder::kSpecCopy, folder::kShardFile, folder::kHashFile}) {
+      std::error_code exists_ec;
+      const std::string path = folder::path_in(out_dir, name);
+      if (std::filesystem::exists(std::filesystem::symlink_status(path, exists_ec)))
+        return bad_input(path + ": the output folder holds files of no campaign (no " + folder::kShardFile +
+                         " and " + folder::kHashFile + " of one): use another folder");
+    }
+  }
   std::sort(all.begin(), all.end(), [](const folder::Row& a, const folder::Row& b) { return a.run < b.run; });
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
@@ -89,16 +132,17 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
   summary.total = all.size();
   summary.runs_csv = folder::path_in(out_dir, folder::kRunsFile);
   for (const folder::Row& r : all) summary.errors += r.error ? 1 : 0;
-  if (Status st = folder::write_rows(summary.runs_csv, *header, all); !st) return st.error();
   auto spec_copy = read_input(folder::path_in(shard_dirs[0], folder::kSpecCopy), kMaxYamlBytes);
   if (!spec_copy) return spec_copy.error();
-  if (Status st = write_text_file(folder::path_in(out_dir, folder::kSpecCopy), *spec_copy); !st)
-    return st.error();
+  // The manifest first: a merge stopped half-way leaves a folder of this campaign, merged again at will.
   if (Status st = write_text_file(folder::path_in(out_dir, folder::kShardFile),
                                   folder::manifest_text(Shard{1, 1}, first.matrix_runs));
       !st)
     return st.error();
   if (Status st = write_text_file(folder::path_in(out_dir, folder::kHashFile), first.spec_sha256 + "\n"); !st)
+    return st.error();
+  if (Status st = folder::write_rows(summary.runs_csv, *header, all); !st) return st.error();
+  if (Status st = write_text_file(folder::path_in(out_dir, folder::kSpecCopy), *spec_copy); !st)
     return st.error();
   return summary;
 }

@@ -136,8 +136,8 @@ Status to_wire(const std::string& unit, const fdi::Health& health, const service
   c.samples_accepted = health.counters.samples_accepted;
   c.samples_invalid = health.counters.samples_invalid;
   c.samples_absent = health.counters.samples_absent;
-  c.samples_late =
-      counters.samples_late + counters.references_late;  // references: late, or waited for in vain
+  // References late or waited for in vain, and promised samples that never came, count as late.
+  c.samples_late = counters.samples_late + counters.references_late + counters.samples_promised_lost;
   c.samples_duplicate = counters.samples_duplicate;
   c.samples_out_of_order = counters.samples_out_of_order;
   c.samples_gap = counters.samples_gap;

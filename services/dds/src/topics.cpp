@@ -30,6 +30,11 @@ Qos attitude_qos() {
   qos.reliable().volatile_durability().keep_last(1);
   return qos;
 }
+Qos attitude_writer_qos() {
+  Qos qos;
+  qos.reliable().volatile_durability().keep_last(kAttitudeWriterDepth);
+  return qos;
+}
 Qos health_qos() {
   Qos qos;
   // Liveliness: a ground reader learns within a lease that the service is gone (kill -9 included).

@@ -187,7 +187,8 @@ Status Recording::take_gyro_samples(const RecordLink& link, std::int64_t now) {
       err_ << report::name_of(o_.names, "command") << ": recording unit " << o_.unit << '\n';
     }
     if (u != o_.unit) return;
-    (void)assembler_.add_sample(s.gyro, s.seq, s.stamp_ns, s.raw, now, dds::reference_written(s));
+    (void)assembler_.add_sample(s.gyro, s.seq, s.stamp_ns, s.raw, now, dds::reference_written(s),
+                                dds::promised_samples(s));
   });
   if (!g) return g.error();
   auto r = link.reference->take([&](const tetra_AttitudeReference& s, const dds_sample_info_t&) {
@@ -330,7 +331,17 @@ Result<Recorded> record_unit(const RecordOptions& options, dds::ShutdownSignal& 
   if (auto s = record_until_done(o, *link, recording, *assembler, shutdown); !s) return s.error();
   if (auto s = recording.finish(attitude_out, events_out, commands_out); !s) return s.error();
   if (auto s = files.commit(); !s) return s.error();
-  return Recorded{o.unit, recording.epochs_written(), assembler->counters()};
+  Recorded recorded{o.unit, recording.epochs_written(), assembler->counters(), 0, 0};
+  auto gyro_lost = link->gyro->samples_lost();
+  if (!gyro_lost) return gyro_lost.error();
+  // Lost on the wire (a writer's history overflowed), or promised for an epoch and never in.
+  recorded.gyro_samples_lost = *gyro_lost + assembler->counters().samples_promised_lost;
+  if (!o.attitude_path.empty()) {
+    auto attitude_lost = link->attitude->samples_lost();
+    if (!attitude_lost) return attitude_lost.error();
+    recorded.attitudes_lost = *attitude_lost;
+  }
+  return recorded;
 }
 
 }  // namespace tetra::dds_tools

@@ -165,7 +165,7 @@ Verdict EpochAssembler::check_seq(GyroTrack& track, std::uint64_t seq, std::int6
 }
 
 Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t stamp_ns, double raw,
-                                   std::int64_t now_ns, bool reference_written) {
+                                   std::int64_t now_ns, bool reference_written, int promised) {
   if (gyro_id < 1 || gyro_id > config_.gyro_count) {
     ++counters_.samples_unknown_gyro;
     return Verdict::kUnknownGyro;
@@ -226,6 +226,7 @@ Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t 
   it->raw[index] = raw;
   it->present[index] = 1;
   it->awaits_reference = it->awaits_reference || reference_written;
+  it->promised = std::max(it->promised, std::min(promised, config_.gyro_count));
   return Verdict::kAccepted;
 }
 
@@ -263,9 +264,29 @@ bool EpochAssembler::absent(int gyro_id) const {
          gyros_[static_cast<std::size_t>(gyro_id - 1)].absent;
 }
 
-bool EpochAssembler::ready(const Pending& epoch, std::int64_t now_ns) const {
-  if (now_ns - epoch.opened_local_ns >= config_.max_latency_ns) return true;
+namespace {
+bool all_promised_in(const std::vector<std::uint8_t>& present, int promised) {
+  return promised > 0 && std::count(present.begin(), present.end(), std::uint8_t{1}) >= promised;
+}
+}  // namespace
+
+bool EpochAssembler::promise_kept(const Pending& epoch) const {
+  if (all_promised_in(epoch.present, epoch.promised)) return true;
   for (std::size_t i = 0; i < gyros_.size(); ++i) {
+    const GyroTrack& track = gyros_[i];
+    if (epoch.present[i] == 0 && track.last_stamp_ns &&
+        *track.last_stamp_ns > epoch.stamp_ns + config_.tolerance_ns)
+      return true;  // a gyro missing from it has moved on: what it was promised is lost
+  }
+  return false;
+}
+
+bool EpochAssembler::ready(const Pending& epoch, std::int64_t now_ns) const {
+  if (epoch.promised > 0 && !promise_kept(epoch)) return false;  // however late: no max_latency_ns
+  if (now_ns - epoch.opened_local_ns >= config_.max_latency_ns) return true;
+  // Every sample the sender wrote is in: the gyros it did not write are not waited for.
+  const bool complete = all_promised_in(epoch.present, epoch.promised);
+  for (std::size_t i = 0; i < gyros_.size() && !complete; ++i) {
     const GyroTrack& track = gyros_[i];
     const bool moved_past =
         track.last_stamp_ns && *track.last_stamp_ns > epoch.stamp_ns + config_.tolerance_ns;
@@ -295,6 +316,9 @@ void EpochAssembler::emit(Pending& epoch, std::vector<fdi::Epoch>& out) {
     result.reference_stamp_ns = late_references_.front().first;
     late_references_.pop_front();
   }
+  const auto delivered = std::count(result.present.begin(), result.present.end(), std::uint8_t{1});
+  if (epoch.promised > delivered)
+    counters_.samples_promised_lost += static_cast<std::uint64_t>(epoch.promised - delivered);
   last_emitted_ns_ = epoch.stamp_ns;
   ++counters_.epochs_emitted;
   out.push_back(std::move(result));
@@ -309,7 +333,9 @@ void EpochAssembler::poll(std::int64_t now_ns, std::vector<fdi::Epoch>& out) {
 
 std::optional<std::int64_t> EpochAssembler::next_due_ns() const {
   if (pending_.empty()) return std::nullopt;
-  return pending_.front().opened_local_ns + config_.max_latency_ns;
+  const Pending& front = pending_.front();
+  if (front.promised > 0 && !promise_kept(front)) return std::nullopt;  // a sample's arrival decides
+  return front.opened_local_ns + config_.max_latency_ns;
 }
 
 }  // namespace tetra::service

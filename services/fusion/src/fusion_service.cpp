@@ -67,7 +67,8 @@ Status FusionService::open_endpoints() {
   if (auto s = assign(reference_reader_, session.reader<tetra_AttitudeReference>(dds::reference_qos())); !s)
     return s;
   if (auto s = assign(command_reader_, session.reader<tetra_Command>(dds::command_qos())); !s) return s;
-  if (auto s = assign(attitude_writer_, session.writer<tetra_Attitude>(dds::attitude_qos())); !s) return s;
+  if (auto s = assign(attitude_writer_, session.writer<tetra_Attitude>(dds::attitude_writer_qos())); !s)
+    return s;
   if (auto s = assign(health_writer_, session.writer<tetra_Health>(dds::health_qos())); !s) return s;
   if (auto s = assign(event_writer_, session.writer<tetra_FdiEvent2>(dds::event_qos())); !s) return s;
   if (!config_.ros2.enabled) return ok_status();
@@ -266,8 +267,9 @@ Status FusionService::take_gyro_samples(std::int64_t now_ns) {
         }
         ++own_samples_;
         const int gyro = sample.gyro;
-        const auto verdict = assembler_.add_sample(gyro, sample.seq, sample.stamp_ns, sample.raw, now_ns,
-                                                   dds::reference_written(sample));
+        const auto verdict =
+            assembler_.add_sample(gyro, sample.seq, sample.stamp_ns, sample.raw, now_ns,
+                                  dds::reference_written(sample), dds::promised_samples(sample));
         if (gyro >= 1 && gyro <= n_gyros_) last_arrival_ns_[static_cast<std::size_t>(gyro - 1)] = now_ns;
         if (verdict != Verdict::kAccepted) {
           spdlog::debug("fusion: gyro {} seq {} stamp {} ns: {}", gyro, sample.seq, sample.stamp_ns,

@@ -89,6 +89,12 @@ Result<std::vector<Account>> read_accounts(const std::string& path) {
     a.role = *role;
     a.hash = line.substr(c2 + 1);
     if (a.hash.rfind("$argon2id$", 0) != 0) return bad_input(where + ": the hash is not argon2id");
+    // A damaged hash (cut short, a carriage return, parameters out of range) would never sign in.
+    if (!sodium_ready() ||
+        crypto_pwhash_argon2id_str_needs_rehash(a.hash.c_str(), crypto_pwhash_OPSLIMIT_INTERACTIVE,
+                                                crypto_pwhash_MEMLIMIT_INTERACTIVE) < 0)
+      return bad_input(where +
+                       ": the argon2id hash is damaged (set the password again with tetra ground passwd)");
     for (const auto& other : accounts) {
       if (other.user == a.user) return bad_input(where + ": user '" + a.user + "' given twice");
     }
@@ -97,8 +103,18 @@ Result<std::vector<Account>> read_accounts(const std::string& path) {
   return accounts;
 }
 
+Result<std::string> password_of_line(std::string line) {
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line.size() < 8) return bad_input("password: at least 8 characters");
+  if (line.size() > kMaxPasswordBytes)
+    return bad_input("password: at most " + std::to_string(kMaxPasswordBytes) + " characters");
+  return line;
+}
+
 Result<std::string> hash_password(const std::string& password) {
   if (!sodium_ready()) return failure("libsodium cannot start");
+  if (password.size() > kMaxPasswordBytes)
+    return bad_input("password: at most " + std::to_string(kMaxPasswordBytes) + " characters");
   char out[crypto_pwhash_STRBYTES];
   if (crypto_pwhash_str(out, password.data(), password.size(), crypto_pwhash_OPSLIMIT_INTERACTIVE,
                         crypto_pwhash_MEMLIMIT_INTERACTIVE) != 0)
@@ -129,8 +145,12 @@ Result<Operators> Operators::open(const std::string& users_path, const std::stri
   if (!sodium_ready()) return failure("libsodium cannot start");
   Operators ops;
   ops.users_path_ = users_path;
+  if (auto s = check_private(users_path, "the accounts file"); !s) return s.error();
   auto accounts = read_accounts(users_path);
   if (!accounts) return accounts.error();
+  if (accounts->empty())
+    return bad_input(users_path + ": no accounts (add one with tetra ground passwd USER --users " +
+                     users_path + ")");
   ops.accounts_ = std::move(accounts).value();
   ops.accounts_stamp_ = file_stamp(users_path);
   if (auto s = check_private(key_path, "the session key"); !s) return s.error();
@@ -162,8 +182,10 @@ void Operators::reload() {
   if (stamp == accounts_stamp_) return;
   auto accounts = read_accounts(users_path_);
   accounts_stamp_ = stamp;
-  // A file being edited or broken: no accounts until it reads again (refuse rather than guess).
-  accounts_ = accounts ? std::move(accounts).value() : std::vector<Account>{};
+  // A file being edited, broken or opened to others: no accounts until it reads again (refuse rather
+  // than guess).
+  accounts_ = accounts && check_private(users_path_, "the accounts file") ? std::move(accounts).value()
+                                                                          : std::vector<Account>{};
 }
 
 std::optional<Account> Operators::login(const std::string& user, const std::string& password) {

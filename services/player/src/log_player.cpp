@@ -9,9 +9,11 @@
 #include <vector>
 
 #include "player_link.hpp"
+#include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/dds/clock.hpp"
+#include "tetra/service/unit_name.hpp"
 
 namespace tetra::player {
 
@@ -26,6 +28,13 @@ struct LogShape {
   double last_s = 0.0;       // [s] last time in [start, end]
   std::uint64_t epochs = 0;  // epochs in [start, end]
 };
+
+//! [s] the longest step between two epochs played: a row far ahead of the rest (a damaged time) would
+//! have play sleep through it (1e6 s ahead at speed 10: 28 hours).
+constexpr double kMaxPlayStep_s = 3600.0;
+//! Lockstep: epochs between two waits for every reader's acknowledgement (well under the 128 attitudes
+//! the service's writer keeps for a reader behind).
+constexpr std::uint64_t kAckEvery = 32;
 
 bool in_window(double t, const PlayOptions& o) {
   return (!o.start_s || t >= *o.start_s) && (!o.end_s || t <= *o.end_s);
@@ -53,6 +62,17 @@ Result<LogShape> inspect(const std::string& path, const PlayOptions& options) {
       const double t = block.time_s[k];
       if (!in_window(t, options)) continue;
       if (shape.epochs == 0) shape.first_s = t;
+      if (shape.epochs > 0 && t - shape.last_s > kMaxPlayStep_s) {
+        std::string where = path;
+        if (k < block.lines.size()) where += ":" + std::to_string(block.lines[k]);
+        std::string times;
+        append_double(times, t);
+        times += " s is ";
+        append_double(times, t - shape.last_s);
+        return bad_input(where + ": time " + times +
+                         " s after the epoch before it (more than 3600 s, which play would wait through): "
+                         "play the parts on either side with --start/--end");
+      }
       if (shape.epochs > 0 && periods.size() < 1000 && t > shape.last_s) periods.push_back(t - shape.last_s);
       shape.last_s = t;
       ++shape.epochs;
@@ -119,6 +139,9 @@ class Player {
           std::max(report_.worst_lag_ms, static_cast<double>(dds::monotonic_ns() - due) * 1e-6);
     }
     if (Status s = link_.publish(stamp, ++seq_, raw, present, ref, lockstep, report_.samples); !s) return s;
+    // Lockstep waits for the service; every kAckEvery epochs also for every other reader (a recorder),
+    // so none falls further behind than the service's Attitude writer keeps (kAttitudeWriterDepth).
+    if (lockstep && seq_ % kAckEvery == 0) link_.wait_for_acks();
     report_.references += ref ? 1 : 0;
     ++report_.epochs;
     if (Status s = link_.take_attitudes(report_.attitudes, newest_); !s) return s;
@@ -159,6 +182,11 @@ Result<PlayReport> play_log(const std::string& path, const PlayOptions& options,
   if (!shape) return shape.error();
   PlayReport report;
   report.unit = !options.unit.empty() ? options.unit : shape->header.meta("unit").value_or("tetra-1");
+  // The log's name for its unit becomes the key of every sample: one fusion and --unit accept, or none.
+  if (options.unit.empty()) {
+    if (Status s = service::check_unit_name(report.unit, path + ": the unit name of '# unit='"); !s)
+      return s.error();
+  }
   report.first_time_s = shape->first_s;
   auto link = PlayerLink::open(report.unit, shape->rate_hz, shape->header.has_reference, options, shutdown);
   if (!link) return link.error();

@@ -12,7 +12,8 @@ namespace tetra::player {
 
 namespace {
 enum PlayerToken : std::intptr_t { kPlayerAttitude = 1, kPlayerMatched, kPlayerShutdown };
-constexpr std::int64_t kPlayerSettle_ns = 200'000'000;  //!< [ns] discovery settling for other readers
+constexpr std::int64_t kPlayerSettle_ns = 200'000'000;   //!< [ns] discovery settling for other readers
+constexpr std::int64_t kHeldGiveUp_ns = 30'000'000'000;  //!< [ns] longest a reader may hold a write back
 }  // namespace
 
 Result<std::unique_ptr<PlayerLink>> PlayerLink::open(const std::string& unit, double rate_hz,
@@ -23,6 +24,9 @@ Result<std::unique_ptr<PlayerLink>> PlayerLink::open(const std::string& unit, do
   const double wall_rate_hz = rate_hz * (options.speed > 0 ? options.speed : 1.0);
   dds::Qos gyro_qos = dds::gyro_sample_qos(std::chrono::nanoseconds(seconds_to_ns(1.0 / wall_rate_hz)));
   gyro_qos.no_autodispose();
+  // Every sample kept until each reader has acknowledged it: a reader that falls behind (a recorder
+  // paused, a loaded machine) holds the player back instead of losing what it had not taken.
+  gyro_qos.keep_all();
   auto gyro = session->writer<tetra_GyroSample>(gyro_qos);
   if (!gyro) return gyro.error();
   auto reference = session->writer<tetra_AttitudeReference>(dds::reference_qos());
@@ -121,13 +125,18 @@ Status PlayerLink::wait_for_service(const PlayOptions& options) {
 
 Status PlayerLink::publish(std::int64_t stamp_ns, std::uint64_t seq, std::span<const double> raw,
                            std::span<const std::uint8_t> present,
-                           const std::optional<std::array<double, 4>>& ref_wxyz, bool reference_acked,
+                           const std::optional<std::array<double, 4>>& ref_wxyz, bool lockstep,
                            std::uint64_t& samples) {
   if (ref_wxyz) {
     reference_msg_.stamp_ns = stamp_ns;
     for (std::size_t i = 0; i < 4; ++i) reference_msg_.q_RB[i] = (*ref_wxyz)[i];
     if (auto s = reference_.write(reference_msg_); !s) return s.error();
-    if (reference_acked) (void)reference_.wait_for_acks(std::chrono::seconds(2));
+    if (lockstep) (void)reference_.wait_for_acks(std::chrono::seconds(2));
+  }
+  std::uint32_t flags = 0;
+  if (lockstep) {  // the service waits for every sample of the epoch, however late (dds::promised_samples)
+    const auto written = std::count(present.begin(), present.end(), std::uint8_t{1});
+    flags = static_cast<std::uint32_t>(written) << dds::kGyroFlagSamplesShift;
   }
   for (std::size_t g = 0; g < raw.size(); ++g) {
     if (present[g] == 0) continue;  // not delivered in the log: not on the wire either
@@ -135,11 +144,26 @@ Status PlayerLink::publish(std::int64_t stamp_ns, std::uint64_t seq, std::span<c
     sample_.seq = seq;
     sample_.stamp_ns = stamp_ns;
     sample_.raw = raw[g];
-    sample_.flags = 0;
-    if (auto s = gyro_.write(sample_); !s) return s.error();
+    sample_.flags = flags;
+    if (auto s = write_held(); !s) return s;
     ++samples;
   }
   return ok_status();
+}
+
+Status PlayerLink::write_held() {
+  const std::int64_t give_up = dds::monotonic_ns() + kHeldGiveUp_ns;
+  for (;;) {
+    auto written = gyro_.write_unless_held(sample_);
+    if (!written) return written.error();
+    if (*written) return ok_status();
+    if (stop_requested()) return failure("interrupted while a GyroSample reader held the player back");
+    if (dds::monotonic_ns() >= give_up) {
+      return failure("a GyroSample reader has acknowledged nothing for 30 s: stopped at log time " +
+                     std::to_string(ns_to_seconds(sample_.stamp_ns)) +
+                     " s (every sample before it delivered)");
+    }
+  }
 }
 
 Status PlayerLink::take_attitudes(std::uint64_t& count, std::int64_t& newest_stamp_ns) {

@@ -24,10 +24,12 @@ class PlayerLink {
   static Result<std::unique_ptr<PlayerLink>> open(const std::string& unit, double rate_hz,
                                                   bool with_reference, const PlayOptions& options,
                                                   dds::ShutdownSignal* shutdown);
-  //! The reference first (acknowledged before the samples in lockstep), then the samples delivered.
+  //! The reference first (acknowledged before the samples in lockstep), then the samples delivered (in
+  //! lockstep each saying how many the epoch has, dds::promised_samples). A reader behind holds a write
+  //! back, never loses it: written again until it is taken, for at most 30 s.
   Status publish(std::int64_t stamp_ns, std::uint64_t seq, std::span<const double> raw,
                  std::span<const std::uint8_t> present, const std::optional<std::array<double, 4>>& ref_wxyz,
-                 bool reference_acked, std::uint64_t& samples);
+                 bool lockstep, std::uint64_t& samples);
   //! Takes the attitudes of this unit received so far; returns the newest stamp seen (or the previous).
   Status take_attitudes(std::uint64_t& count, std::int64_t& newest_stamp_ns);
   //! Blocks until data arrives, a shutdown is requested or the monotonic time `until_ns` passes.
@@ -46,6 +48,8 @@ class PlayerLink {
         attitude_(std::move(attitude)) {}
   Status wait_for_readers(const PlayOptions& options, bool with_reference);
   Status wait_for_service(const PlayOptions& options);
+  //! Writes sample_, again while a reader holds the writer back (KEEP_ALL history full).
+  Status write_held();
 
   std::string unit_;
   dds::Session session_;

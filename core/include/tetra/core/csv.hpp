@@ -64,7 +64,7 @@ bool parse_number(std::string_view text, double& out);
 std::optional<double> parse_decimal(std::string_view text);
 //! Adds the "key=value" tokens of a comment's text (after the '#') to `metadata`. Tokens are separated
 //! by blanks or commas; a comma followed at once by text without '=' is part of the value (a decimal
-//! comma "-23,2" stays in the value, for its reader to refuse).
+//! comma "-23,2" stays in the value, for its reader to refuse). %XX escapes of keys and values are undone.
 void parse_metadata_comment(std::string_view comment, Metadata& metadata);
 
 //! Parses a whole table from text; `source` names it in messages.
@@ -119,8 +119,9 @@ Result<std::string> read_text_file(const std::string& path);
 //! atomically, writes a device or FIFO straight). Commands with several outputs use RunFiles.
 Status write_text_file(const std::string& path, std::string_view content);
 
-//! Appends the metadata line "# key=value": blanks, commas, '%' and control characters of the value
-//! are written %XX (read back by parse_csv), so any value round-trips. `key` must be a plain name.
+//! Appends the metadata line "# key=value": blanks, commas, '%' and control characters of the key and
+//! the value, and '=' of the key, are written %XX (read back by parse_csv), so any key and value
+//! round-trip: a key "x units=dps" stays that key, never becomes "units".
 void append_metadata(std::string& out, std::string_view key, std::string_view value);
 //! Appends the shortest decimal text that reads back to exactly `value` ("nan" for NaN).
 void append_double(std::string& out, double value);

@@ -45,6 +45,7 @@ struct Scenario {
   double jitter_s = 0.0;                      //!< [s] sample times uniform in nominal ± jitter (< period/2)
   double drop_probability = 0.0;              //!< each gyro sample independently not delivered
   std::optional<ClosedLoopSpec> closed_loop;  //!< closed loop: dynamics and control (closed_loop.hpp)
+  std::vector<std::string> named_files;  //!< files it names, as read (its `unit:`): a campaign's identity
 };
 
 //! Ranges of a scenario's numbers besides the motion's (motion.hpp) and the closed loop's

@@ -80,7 +80,7 @@ Result<std::vector<std::size_t>> prepare_folder(const sim::CampaignSpec& spec, c
 Result<RunSummary> run_campaign(const sim::CampaignSpec& spec, const RunOptions& options);
 
 //! Lowercase hex SHA-256 of the spec as it runs: its YAML re-emitted (comments and layout do not
-//! count) and the contents of the scenario files it names.
+//! count), the contents of the scenario files it names and of the files they name (their units).
 Result<std::string> campaign_spec_hash(const sim::CampaignSpec& spec, const std::string& spec_path);
 
 //! `tetra campaign merge OUT SHARD_DIRS...`: checks that the folders hold one spec (spec.sha256), are

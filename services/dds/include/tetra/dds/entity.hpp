@@ -157,6 +157,15 @@ class Writer {
     if (rc < 0) return dds_error("write " + name_, rc);
     return ok_status();
   }
+  //! As write(), but a KEEP_ALL writer held back past max_blocking_time by a reader that has not
+  //! acknowledged what it has (a slow or stopped reader) answers false instead of an error: the caller
+  //! writes again, nothing is dropped.
+  Result<bool> write_unless_held(const T& sample) const {
+    const dds_return_t rc = dds_write(entity_.handle(), &sample);
+    if (rc == DDS_RETCODE_TIMEOUT) return false;
+    if (rc < 0) return dds_error("write " + name_, rc);
+    return true;
+  }
   //! Unregisters the instance of `sample`'s key (readers see "no writers" for it).
   Status unregister(const T& sample) const {
     const dds_return_t rc = dds_unregister_instance(entity_.handle(), &sample);
@@ -230,6 +239,17 @@ class Reader {
     const dds_return_t rc = dds_instance_get_key(entity_.handle(), instance, &out);
     if (rc < 0) return dds_error("instance key " + name_, rc);
     return ok_status();
+  }
+  //! Samples lost on the way to this reader so far (a writer dropped them from its history before this
+  //! reader had them: it fell behind), and samples rejected by its history.
+  Result<std::uint64_t> samples_lost() const {
+    dds_sample_lost_status_t lost{};
+    dds_return_t rc = dds_get_sample_lost_status(entity_.handle(), &lost);
+    if (rc < 0) return dds_error("sample lost status " + name_, rc);
+    dds_sample_rejected_status_t rejected{};
+    rc = dds_get_sample_rejected_status(entity_.handle(), &rejected);
+    if (rc < 0) return dds_error("sample rejected status " + name_, rc);
+    return static_cast<std::uint64_t>(lost.total_count) + rejected.total_count;
   }
   //! Number of matched writers now.
   Result<std::uint32_t> matched_writers() const {

@@ -11,6 +11,7 @@ namespace tetra::dds {
 
 inline constexpr int kGyroSampleDepth = 64;
 inline constexpr int kReferenceDepth = 8;
+inline constexpr int kAttitudeWriterDepth = 128;
 inline constexpr int kEventDepth = 256;  //!< events kept for late joiners, per unit
 inline constexpr int kCommandDepth = 16;
 inline constexpr int kMaxGyrosOnWire = tetra_MAX_GYROS;
@@ -20,6 +21,15 @@ inline constexpr int kMaxGyrosOnWire = tetra_MAX_GYROS;
 inline constexpr std::uint32_t kGyroFlagReferenceWritten = 0x8000'0000u;
 inline bool reference_written(const tetra_GyroSample& sample) {
   return (sample.flags & kGyroFlagReferenceWritten) != 0;
+}
+//! GyroSample.flags bits 24-29: the number of gyro samples the publisher wrote for this stamp (0: not
+//! said). `tetra play` in lockstep says it, and a service then fuses the epoch only with all of them (or
+//! once a gyro missing from it has moved past it), however late they come: never one without a gyro
+//! it was promised (docs/dds.md, "Playing a log").
+inline constexpr unsigned kGyroFlagSamplesShift = 24;
+inline constexpr std::uint32_t kGyroFlagSamplesMask = 0x3Fu << kGyroFlagSamplesShift;
+inline int promised_samples(const tetra_GyroSample& sample) {
+  return static_cast<int>((sample.flags & kGyroFlagSamplesMask) >> kGyroFlagSamplesShift);
 }
 inline constexpr std::chrono::milliseconds kWriterLease{1000};  //!< automatic liveliness of writers
 
@@ -32,9 +42,13 @@ Qos gyro_sample_reader_qos(std::chrono::nanoseconds sample_period);
 const char* qos_policy_name(std::uint32_t policy_id);
 Qos reference_qos();  //!< reliable / volatile / keep-last 8
 Qos attitude_qos();   //!< reliable / volatile / keep-last 1
-Qos health_qos();     //!< reliable / transient-local / keep-last 1 / automatic liveliness, kWriterLease
-Qos event_qos();      //!< reliable / transient-local / keep-last 256 (durability service 256)
-Qos command_qos();    //!< reliable / volatile / keep-last 16
+//! The service's Attitude writer: attitude_qos() keeping the last kAttitudeWriterDepth until acknowledged,
+//! so a reader a moment behind (a recorder descheduled, a lockstep peer) loses none; small enough
+//! (about 20 kB) never to hold the service's writes back.
+Qos attitude_writer_qos();
+Qos health_qos();   //!< reliable / transient-local / keep-last 1 / automatic liveliness, kWriterLease
+Qos event_qos();    //!< reliable / transient-local / keep-last 256 (durability service 256)
+Qos command_qos();  //!< reliable / volatile / keep-last 16
 
 struct Topics {
   Topic gyro_sample;

@@ -40,10 +40,14 @@ struct Recorded {
   std::string unit;                     //!< the unit recorded; empty: none seen
   std::uint64_t epochs = 0;             //!< epochs written
   service::AssemblerCounters counters;  //!< the assembler's counters
+  std::uint64_t gyro_samples_lost = 0;  //!< GyroSample lost on the wire (writers' history overflowed)
+  std::uint64_t attitudes_lost = 0;     //!< Attitude lost on the wire (with --attitude)
 };
 
 //! Records until `shutdown`, the duration, or (until_idle) the gyro writers gone and the service's last
 //! outputs in; the files are written all or none (through the output layer). Notes go to `err`.
+//! Samples lost on the wire (a writer's history dropped them before this recorder had them) are counted
+//! in the result: the command then fails, saying how many, and the log lacks those samples.
 //! `shutdown` (SIGINT/SIGTERM) wakes the wait.
 Result<Recorded> record_unit(const RecordOptions& options, dds::ShutdownSignal& shutdown, std::ostream& err);
 

@@ -44,7 +44,10 @@
 //     with the next epoch emitted, stamped with its own time (`fdi::Epoch::reference_stamp_ns`): the
 //     pipeline fuses it at that time within its fusion horizon, or counts and reports it as too late.
 //     Several waiting go one an epoch, oldest first, after an epoch's own reference (at most
-//     kMaxLateReferences wait: the oldest beyond gives way, counted as late).
+//     kMaxLateReferences wait: the oldest beyond gives way, counted as late);
+//   * a sample that says how many samples were written for its stamp (`promised`, lockstep play) makes
+//     its epoch wait for all of them, however late, not max_latency_ns: it is emitted when they are in
+//     or when a gyro missing from it has delivered a later stamp (its sample is lost).
 // Times: stamps are sensor time [ns]; `now_ns` is the caller's local monotonic clock [ns].
 
 #include <cstdint>
@@ -103,8 +106,10 @@ class EpochAssembler {
 
   //! One gyro sample (raw may be NaN: that is for the pipeline to judge).
   //! `reference_written`: the sender wrote a reference for this stamp (the epoch waits for it).
+  //! `promised`: the sender wrote this many samples for this stamp (0: not said); the epoch then waits
+  //! for all of them, past max_latency_ns, until a gyro missing from it delivers a later stamp.
   Verdict add_sample(int gyro_id, std::uint64_t seq, std::int64_t stamp_ns, double raw, std::int64_t now_ns,
-                     bool reference_written = false);
+                     bool reference_written = false, int promised = 0);
   //! An attitude reference for the epoch at `stamp_ns` (one already emitted: with the next, at its stamp).
   void add_reference(std::int64_t stamp_ns, const Quaternion& q_RB);
   //! The gyro's stream stopped (deadline missed or liveliness lost): epochs no longer wait for it.
@@ -130,6 +135,7 @@ class EpochAssembler {
     std::vector<double> raw;            //!< [V] per gyro
     std::vector<std::uint8_t> present;  //!< per gyro
     bool awaits_reference = false;      //!< a sample said its reference was written
+    int promised = 0;                   //!< samples the sender said it wrote for this stamp (0: not said)
   };
   struct GyroTrack {
     std::optional<std::uint64_t> last_seq;
@@ -161,6 +167,8 @@ class EpochAssembler {
   //! The sequence-number verdict (kAccepted: go on); counts gaps, duplicates, discontinuities.
   Verdict check_seq(GyroTrack& track, std::uint64_t seq, std::int64_t stamp_ns);
   bool ready(const Pending& epoch, std::int64_t now_ns) const;
+  //! Every sample promised for the epoch is in, or a gyro missing from it moved past it (lost).
+  bool promise_kept(const Pending& epoch) const;
   void emit(Pending& epoch, std::vector<fdi::Epoch>& out);
 
   AssemblerConfig config_;

@@ -32,7 +32,12 @@ struct Account {
 Status valid_user_name(const std::string& user);
 //! The accounts; errors name the file and line.
 Result<std::vector<Account>> read_accounts(const std::string& path);
-//! argon2id with libsodium's interactive limits (64 MiB, 2 passes).
+//! [bytes] the longest password taken.
+inline constexpr std::size_t kMaxPasswordBytes = 1024;
+//! The password a line of input gives: without a final carriage return (a line ended by CR LF), 8 to
+//! kMaxPasswordBytes bytes; bad input otherwise.
+Result<std::string> password_of_line(std::string line);
+//! argon2id with libsodium's interactive limits (64 MiB, 2 passes); bad input beyond kMaxPasswordBytes.
 Result<std::string> hash_password(const std::string& password);
 //! Adds or replaces the account's line, keeping every other line; the file is written anew beside the
 //! old one and renamed over it (mode 0600).
