@@ -206,7 +206,8 @@ Result<SamplingGrid> uniform_grid_lines(
 }
 
 std::vector<AvarPoint> overlapping_avar(std::span<const double> rate, std::span<const std::uint8_t> present,
-                                        double tau0_s, std::span<const std::int64_t> m_values) {
+                                        double tau0_s, std::span<const std::int64_t> m_values,
+                                        Interrupt* interrupt) {
   const std::size_t n = rate.size();
   auto is_present = [&](std::size_t i) {
     return (present.empty() || present[i] != 0) && std::isfinite(rate[i]);
@@ -238,15 +239,17 @@ std::vector<AvarPoint> overlapping_avar(std::span<const double> rate, std::span<
     x[i + 1] = static_cast<double>(acc);
     cum[i + 1] = c;
   }
-  return avar_from_angle(x.data(), count == n ? nullptr : cum.data(), n, tau0_s, m_values);
+  return avar_from_angle(x.data(), count == n ? nullptr : cum.data(), n, tau0_s, m_values, interrupt);
 }
 
 std::vector<AvarPoint> avar_from_angle(const double* x, const std::uint32_t* cum, std::size_t n,
-                                       double tau0_s, std::span<const std::int64_t> m_values) {
+                                       double tau0_s, std::span<const std::int64_t> m_values,
+                                       Interrupt* interrupt) {
   const bool complete = cum == nullptr;
   std::vector<AvarPoint> out;
   out.reserve(m_values.size());
   for (const std::int64_t m_signed : m_values) {
+    if (interrupt_requested(interrupt, out.size(), m_values.size())) break;
     AvarPoint p;
     p.m = m_signed;
     p.tau_s = static_cast<double>(m_signed) * tau0_s;
@@ -397,7 +400,8 @@ Result<AllanResult> analyze_series(std::span<const double> rate, std::span<const
   if (Status st = check_present_samples(present_samples); !st) return st.error();
   auto ms = averaging_factors(options.taus, rate.size(), tau0_s);
   if (!ms) return ms.error();
-  const std::vector<AvarPoint> all = overlapping_avar(rate, present, tau0_s, *ms);
+  const std::vector<AvarPoint> all = overlapping_avar(rate, present, tau0_s, *ms, options.interrupt);
+  if (options.interrupt != nullptr && options.interrupt->stopped()) return interrupted();
   return finish_series(rate.size(), present_samples, all, valid_runs(rate, present), tau0_s, options);
 }
 

@@ -126,7 +126,8 @@ std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
   return meta;
 }
 
-Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options, Truth* truth) {
+Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options, Truth* truth,
+                             Interrupt* interrupt) {
   auto created = Simulator::create(scenario, options);
   if (!created) return created.error();
   Simulator& sim = created.value();
@@ -143,6 +144,10 @@ Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options
   if (truth) *truth = Truth{};
   SimEpoch epoch;
   while (sim.next(epoch)) {
+    if (sim.epochs_done() % 64 == 0 && interrupt_requested(interrupt, sim.epochs_done(), e)) {
+      if (truth) *truth = Truth{};  // no partial truth behind
+      return interrupted();
+    }
     log.time_s.push_back(epoch.time_s);
     log.values.insert(log.values.end(), epoch.raw_V.begin(), epoch.raw_V.end());
     log.present.insert(log.present.end(), epoch.present.begin(), epoch.present.end());
