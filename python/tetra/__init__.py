@@ -20,7 +20,7 @@ import math
 import numbers
 import os
 import warnings
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 from . import _tetra
 from ._tetra import (
@@ -551,21 +551,35 @@ class CampaignResult:
     ``report`` (report.md for these runs, byte for byte ``tetra campaign``'s; its plots are drawn by the
     command, or from ``rows`` with matplotlib)."""
 
-    def __init__(self, csv: str, report: str = ""):
-        import io
-
-        import pandas as pd
+    def __init__(self, csv: str, report: Union[str, Callable[[str], str]] = ""):
         self.csv = csv
-        self.report = report
-        # round_trip: the rows' shortest round-trip numbers read back to the same doubles
-        self.rows = pd.read_csv(io.StringIO(csv), float_precision="round_trip",
-                                dtype={"scenario": str, "kind": str, "outcome": str})
+        self._report = report
+        self._rows = None
+
+    @property
+    def rows(self):
+        """The rows as a pandas DataFrame (the columns of runs.csv; made at the first access)."""
+        if self._rows is None:
+            import io
+
+            import pandas as pd
+            # round_trip: the rows' shortest round-trip numbers read back to the same doubles
+            self._rows = pd.read_csv(io.StringIO(self.csv), float_precision="round_trip",
+                                     dtype={"scenario": str, "kind": str, "outcome": str})
+        return self._rows
+
+    @property
+    def report(self) -> str:
+        """report.md for these runs (made at the first access)."""
+        if callable(self._report):
+            self._report = self._report(self.csv)
+        return self._report
 
     def __len__(self) -> int:
-        return len(self.rows)
+        return self.csv.count("\n") - 1
 
     def __repr__(self) -> str:
-        return f"<tetra.CampaignResult runs={len(self.rows)}>"
+        return f"<tetra.CampaignResult runs={len(self)}>"
 
 
 def campaign(spec: Union[PathLike, Mapping[str, Any], CampaignSpec], *, runs: Optional[Sequence[int]] = None,
@@ -584,7 +598,7 @@ def campaign(spec: Union[PathLike, Mapping[str, Any], CampaignSpec], *, runs: Op
     lines, stopped = _tetra._campaign_rows(s, None if runs is None else [int(r) for r in runs], int(jobs),
                                            _progress(progress))
     csv = _tetra._campaign_csv_header(s) + "\n" + "".join(line + "\n" for line in lines)
-    result = CampaignResult(csv, _tetra._campaign_report(s, csv))
+    result = CampaignResult(csv, lambda text: _tetra._campaign_report(s, text))
     if stopped is not None:
         stopped.partial = result
         raise stopped
