@@ -8,9 +8,9 @@
 #include <pybind11/stl.h>
 
 #include "common.hpp"
-#include "watch.hpp"
 #include "tetra/core/allan.hpp"
 #include "tetra/core/calibration_file.hpp"
+#include "watch.hpp"
 
 namespace tetra::python {
 

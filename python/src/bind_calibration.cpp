@@ -254,7 +254,8 @@ static void bind_calibration_class(py::module_& m) {
           [](const Calibration& c) {
             return per_gyro(c, [](const auto& g) { return g.scale_factor_V_per_dps; });
           },
-          "[V/(deg/s)] scale factors, shape (N,): a read-only copy (make a new calibration with from_arrays).")
+          "[V/(deg/s)] scale factors, shape (N,): a read-only copy (make a new calibration with "
+          "from_arrays).")
       .def_property_readonly(
           "bias_V", [](const Calibration& c) { return per_gyro(c, [](const auto& g) { return g.bias_V; }); },
           "[V] biases, shape (N,).")

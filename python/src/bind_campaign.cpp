@@ -5,16 +5,16 @@
 #include <chrono>
 #include <exception>
 #include <optional>
-#include <thread>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <pybind11/stl.h>
 
 #include "common.hpp"
-#include "watch.hpp"
 #include "tetra/sim/campaign.hpp"
 #include "tetra/sim/campaign_report.hpp"
+#include "watch.hpp"
 
 namespace tetra::python {
 
@@ -80,8 +80,8 @@ std::vector<std::size_t> campaign_indices(const sim::CampaignSpec& spec,
 //! `indices`; a run that fails is an error row, as `tetra campaign` writes it). Called with the GIL
 //! released: the watch is polled from this thread (between the epochs of a run with one job; every 5 ms
 //! while the workers run with more). Once it asks to stop, the runs under way are dropped, not written.
-void run_cases(const sim::CampaignSpec& spec, const std::vector<std::size_t>& indices, int jobs,
-               Watch& watch, std::vector<std::optional<std::string>>& lines) {
+void run_cases(const sim::CampaignSpec& spec, const std::vector<std::size_t>& indices, int jobs, Watch& watch,
+               std::vector<std::optional<std::string>>& lines) {
   const sim::EstimatorFactory make = sim::in_process_estimators(spec);
   const std::size_t total = indices.size();
   std::atomic<std::size_t> next{0};

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <stdexcept>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -14,11 +14,11 @@
 #include "common.hpp"
 #include "events.hpp"
 #include "logs.hpp"
-#include "watch.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/config.hpp"
 #include "tetra/fdi/noise_defaults.hpp"
 #include "tetra/fdi/pipeline.hpp"
+#include "watch.hpp"
 
 namespace tetra::python {
 
@@ -86,7 +86,8 @@ class InUse {
   InUse(PyPipeline& p, const char* method) : p_(p) {
     const char* idle = nullptr;
     if (!p_.user.compare_exchange_strong(idle, method)) {
-      throw std::runtime_error(std::string("tetra.Pipeline is in use: ") + idle + " is running on it (in another "
+      throw std::runtime_error(std::string("tetra.Pipeline is in use: ") + idle +
+                               " is running on it (in another "
                                "thread, or this call came from its progress callback); a Pipeline serves one "
                                "call at a time: give each thread its own Pipeline, or hold a threading.Lock "
                                "around its calls");
@@ -279,7 +280,9 @@ static void bind_pipeline_class(py::module_& m) {
            })
       .def(
           "default_noise_warning",
-          [](const PyPipeline& p, const Calibration& cal) { return fdi::default_noise_warning(cal, p.config); },
+          [](const PyPipeline& p, const Calibration& cal) {
+            return fdi::default_noise_warning(cal, p.config);
+          },
           "calibration"_a)
       .def("reset",
            [](PyPipeline& p) {
@@ -333,7 +336,8 @@ static void bind_pipeline_class(py::module_& m) {
       .def(
           "run",
           [](PyPipeline& p, const py::handle& time_s, const py::handle& raw, const py::object& present,
-             const py::object& reference_wxyz, const py::object& reference_present, const py::object& progress) {
+             const py::object& reference_wxyz, const py::object& reference_present,
+             const py::object& progress) {
             const InUse in_use(p, "Pipeline.run");
             const RunInputs in = run_inputs(time_s, raw, present, reference_wxyz, reference_present, p.n);
             Watch watch(progress);

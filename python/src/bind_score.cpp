@@ -70,7 +70,8 @@ AttitudeSeries series_from_arrays(const std::string& source, const py::handle& t
 
 static void bind_attitude_series(py::module_& m) {
   py::class_<AttitudeSeries>(m, "AttitudeSeries", "Rows of an attitude (estimate or truth) to score.")
-      .def_readonly("source", &AttitudeSeries::source, "What the rows came from (a file name or 'attitude'/'truth').")
+      .def_readonly("source", &AttitudeSeries::source,
+                    "What the rows came from (a file name or 'attitude'/'truth').")
       .def_property_readonly(
           "epochs", [](const AttitudeSeries& s) { return s.time_s.size(); }, "Rows of the series.");
   m.def(
@@ -120,10 +121,14 @@ static void bind_attitude_score(py::module_& m) {
             return read_only(std::move(v));
           },
           "[deg] total 1σ per scored row.")
-      .def_readonly("exact_matches", &AttitudeScore::exact_matches, "Attitude rows with a truth row within time_tolerance_s.")
-      .def_readonly("interpolated", &AttitudeScore::interpolated, "Attitude rows scored against truth interpolated between its rows.")
-      .def_readonly("outside_truth", &AttitudeScore::outside_truth, "Attitude rows before or after the truth's time span: not scored.")
-      .def_readonly("per_axis_sigma", &AttitudeScore::per_axis_sigma, "True when the per-axis 1σ (sigma_B_deg) was used, False: the total sigma_deg.")
+      .def_readonly("exact_matches", &AttitudeScore::exact_matches,
+                    "Attitude rows with a truth row within time_tolerance_s.")
+      .def_readonly("interpolated", &AttitudeScore::interpolated,
+                    "Attitude rows scored against truth interpolated between its rows.")
+      .def_readonly("outside_truth", &AttitudeScore::outside_truth,
+                    "Attitude rows before or after the truth's time span: not scored.")
+      .def_readonly("per_axis_sigma", &AttitudeScore::per_axis_sigma,
+                    "True when the per-axis 1σ (sigma_B_deg) was used, False: the total sigma_deg.")
       .def_property_readonly(
           "rms_B_deg", [](const AttitudeScore& s) { return vec3(s.rms_B_deg); },
           "[deg] RMS of each component of the error e_B, (3,).")
@@ -132,11 +137,15 @@ static void bind_attitude_score(py::module_& m) {
           "[deg] largest |e_a| per body axis, (3,).")
       .def_readonly("rms_total_deg", &AttitudeScore::rms_total_deg, "[deg] RMS of the error angle |e_B|.")
       .def_readonly("max_total_deg", &AttitudeScore::max_total_deg, "[deg] largest error angle |e_B|.")
-      .def_readonly("final_total_deg", &AttitudeScore::final_total_deg, "[deg] error angle |e_B| at the last scored row.")
+      .def_readonly("final_total_deg", &AttitudeScore::final_total_deg,
+                    "[deg] error angle |e_B| at the last scored row.")
       .def_readonly("sigma_epochs", &AttitudeScore::sigma_epochs, "Scored rows with a stated (positive) 1σ.")
-      .def_readonly("no_sigma_epochs", &AttitudeScore::no_sigma_epochs, "Scored rows with a 1σ of 0 or NaN (not in the NEES and σ fractions).")
-      .def_readonly("nees_dof", &AttitudeScore::nees_dof, "Degrees of freedom of the NEES: 3 with per-axis σ, 1 with the total σ.")
-      .def_readonly("mean_nees", &AttitudeScore::mean_nees, "Mean NEES: Σ(e_a/σ_a)² over the axes (expectation 3) or |e|²/σ² (expectation 1).")
+      .def_readonly("no_sigma_epochs", &AttitudeScore::no_sigma_epochs,
+                    "Scored rows with a 1σ of 0 or NaN (not in the NEES and σ fractions).")
+      .def_readonly("nees_dof", &AttitudeScore::nees_dof,
+                    "Degrees of freedom of the NEES: 3 with per-axis σ, 1 with the total σ.")
+      .def_readonly("mean_nees", &AttitudeScore::mean_nees,
+                    "Mean NEES: Σ(e_a/σ_a)² over the axes (expectation 3) or |e|²/σ² (expectation 1).")
       .def_property_readonly(
           "within_B",
           [](const AttitudeScore& s) {
@@ -157,8 +166,10 @@ static void bind_attitude_score(py::module_& m) {
       .def_property_readonly(
           "truth_angle_B_deg", [](const AttitudeScore& s) { return vec3(s.truth_angle_B_deg); },
           "[deg] the same from the truth's rates, (3,).")
-      .def_readonly("angle_axis_deg", &AttitudeScore::angle_axis_deg, "[deg] the estimate's rate integrated about axis_B (the seed experiment's angle).")
-      .def_readonly("truth_angle_axis_deg", &AttitudeScore::truth_angle_axis_deg, "[deg] the same from the truth's rates.");
+      .def_readonly("angle_axis_deg", &AttitudeScore::angle_axis_deg,
+                    "[deg] the estimate's rate integrated about axis_B (the seed experiment's angle).")
+      .def_readonly("truth_angle_axis_deg", &AttitudeScore::truth_angle_axis_deg,
+                    "[deg] the same from the truth's rates.");
 }
 
 static void bind_score_function(py::module_& m) {

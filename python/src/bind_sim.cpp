@@ -6,12 +6,12 @@
 
 #include "common.hpp"
 #include "logs.hpp"
-#include "watch.hpp"
 #include "tetra/core/quaternion.hpp"
 #include "tetra/core/turntable_log.hpp"
 #include "tetra/sim/scenario.hpp"
 #include "tetra/sim/simulator.hpp"
 #include "tetra/sim/turntable.hpp"
+#include "watch.hpp"
 
 namespace tetra::python {
 

@@ -79,7 +79,8 @@ Result<ClosedLoopRecord> run_closed_loop(ClosedLoopSimulator& simulator, Estimat
   const double h_max = simulator.spec().wheels.max_momentum_Nms;
   SimEpoch epoch;
   while (simulator.next(epoch)) {
-    if (interrupt_requested(interrupt, simulator.epochs_done(), simulator.epoch_count())) return interrupted();
+    if (interrupt_requested(interrupt, simulator.epochs_done(), simulator.epoch_count()))
+      return interrupted();
     auto out = estimator.estimate(epoch);
     if (!out) return out.error();
     if (out->latest) latest = out->latest;

@@ -17,7 +17,8 @@ Result<OpenLoopRecord> run_open_loop(Simulator& simulator, Estimator& estimator,
   record.final_sigma_deg = kUnknown;
   SimEpoch epoch;
   while (simulator.next(epoch)) {
-    if (interrupt_requested(interrupt, simulator.epochs_done(), simulator.epoch_count())) return interrupted();
+    if (interrupt_requested(interrupt, simulator.epochs_done(), simulator.epoch_count()))
+      return interrupted();
     auto out = estimator.estimate(epoch);
     if (!out) return out.error();
     record.events.insert(record.events.end(), out->events.begin(), out->events.end());

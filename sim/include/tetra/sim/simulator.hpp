@@ -16,9 +16,9 @@
 #include <Eigen/Core>
 
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/interrupt.hpp"
 #include "tetra/core/output_files.hpp"
 #include "tetra/core/quaternion.hpp"
-#include "tetra/core/interrupt.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/sim/gyro_model.hpp"
