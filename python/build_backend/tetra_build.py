@@ -78,11 +78,15 @@ def _build_module(config_settings) -> Path:
     suffix = sysconfig.get_config_var("EXT_SUFFIX")
     given = _setting(config_settings, "build-dir", "TETRA_BUILD_DIR")
     build = given or SOURCE / "build" / f"python-{suffix.strip('.').rsplit('.', 1)[0]}"
-    if not (build / "CMakeCache.txt").exists():
-        if given:
-            raise RuntimeError(f"{build}: not a configured build folder (no CMakeCache.txt)")
+    # The interpreter itself, not a venv's link to it (a venv may be gone by the next install).
+    python = getattr(sys, "_base_executable", "") or sys.executable
+    cache = build / "CMakeCache.txt"
+    if not cache.exists() and given:
+        raise RuntimeError(f"{build}: not a configured build folder (no CMakeCache.txt)")
+    cached = re.search(r"^Python3_EXECUTABLE:\w+=(.*)$", cache.read_text(), re.M) if cache.exists() else None
+    if not given and not (cached and Path(cached.group(1)).exists()):
         configure = ["cmake", "-S", SOURCE, "-B", build, "-DCMAKE_BUILD_TYPE=Release", "-DTETRA_BUILD_TESTS=OFF",
-                     "-DTETRA_BUILD_BENCH=OFF", "-DTETRA_PYTHON=ON", f"-DPython3_EXECUTABLE={sys.executable}"]
+                     "-DTETRA_BUILD_BENCH=OFF", "-DTETRA_PYTHON=ON", f"-DPython3_EXECUTABLE={python}"]
         if shutil.which("ccache"):
             configure += ["-DCMAKE_C_COMPILER_LAUNCHER=ccache", "-DCMAKE_CXX_COMPILER_LAUNCHER=ccache"]
         _run(configure)
