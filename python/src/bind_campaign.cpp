@@ -101,20 +101,28 @@ void run_cases(const sim::CampaignSpec& spec, const std::vector<std::size_t>& in
     return;
   }
   const auto workers = static_cast<std::size_t>(std::min<std::size_t>(static_cast<std::size_t>(jobs), total));
-  std::atomic<std::size_t> running{workers};
+  std::atomic<std::size_t> running{0};
   std::vector<std::exception_ptr> failures(workers);
   std::vector<std::thread> threads;
-  for (std::size_t w = 0; w < workers; ++w) {
-    threads.emplace_back([&, w] {
-      try {
-        Interrupt interrupt([&](std::size_t, std::size_t) { return stop.load(); });
-        run_from(interrupt);
-      } catch (...) {
-        failures[w] = std::current_exception();
-        stop.store(true);
-      }
-      running.fetch_sub(1);
-    });
+  try {
+    for (std::size_t w = 0; w < workers; ++w) {
+      running.fetch_add(1);
+      threads.emplace_back([&, w] {
+        try {
+          Interrupt interrupt([&](std::size_t, std::size_t) { return stop.load(); });
+          run_from(interrupt);
+        } catch (...) {
+          failures[w] = std::current_exception();
+          stop.store(true);
+        }
+        running.fetch_sub(1);
+      });
+    }
+  } catch (...) {  // a thread that could not start: the others stop, then the error is raised
+    running.fetch_sub(1);
+    stop.store(true);
+    for (auto& t : threads) t.join();
+    throw;
   }
   while (running.load() > 0) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
