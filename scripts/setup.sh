@@ -37,6 +37,7 @@ if [ "${1:-}" = "--test" ]; then
     pybind11-dev python3-dev                     # the Python package tetra (docs/python.md)
     python3-numpy python3-pandas python3-pytest python3-matplotlib  # its tests and notebook example
     python3-venv python3-build python3-mypy      # pip install . in a fresh venv, python3 -m build, stub check
+    python3-tqdm                                 # progress bars of the long calls
   )
 fi
 

@@ -69,14 +69,16 @@ def _is_path(value: Any) -> bool:
 
 
 def _progress(progress: Any) -> Any:
-    """``progress=`` as the callable the module calls with (done, total): None, a callable, or a tqdm-like
+    """``progress=`` as the callable the module calls with (done, total): None, a callable, a tqdm-like
     bar (an object with ``update(n)``: its ``total`` is set when it has none, and it is advanced by the
-    work done since the last call)."""
+    work done since the last call), or such a bar's class (``progress=tqdm``: a bar made for the call and
+    closed at its end)."""
     if progress is None or (callable(progress) and not hasattr(progress, "update")):
         return progress
     if not hasattr(progress, "update"):
         raise TypeError("progress: expected None, a callable progress(done, total) or a tqdm bar")
-    bar = progress
+    own = isinstance(progress, type)
+    bar = progress() if own else progress
     reported = [0]
 
     def advance(done: int, total: int) -> None:
@@ -87,6 +89,8 @@ def _progress(progress: Any) -> Any:
         if done > reported[0]:
             bar.update(done - reported[0])
             reported[0] = done
+        if own and total and done >= total:
+            bar.close()
     return advance
 
 

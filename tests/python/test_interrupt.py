@@ -120,6 +120,15 @@ def test_progress_callable_and_tqdm_like_bar():
         tetra.sim("static", duration_s=10, progress=3)
 
 
+def test_progress_with_tqdm():
+    tqdm = pytest.importorskip("tqdm")
+    bar = tqdm.tqdm(total=None, disable=False, mininterval=0)
+    run = tetra.sim("static", duration_s=600, rate_hz=100, progress=bar)
+    assert bar.total == bar.n == len(run.log)
+    bar.close()
+    tetra.sim("static", duration_s=60, progress=tqdm.tqdm)  # the class: a bar of the call's own
+
+
 def test_an_exception_in_the_progress_callback_stops_the_call():
     def fail(done, total):
         raise ZeroDivisionError("from the callback")
