@@ -35,8 +35,8 @@ class DefaultNoiseWarning(UserWarning): ...
 class _Bar(Protocol):
     def update(self, n: int) -> object: ...
 
-#: progress=: a callable progress(done, total), or a tqdm-like bar (an object with update(n)).
-_ProgressLike = Union[None, Callable[[int, int], object], _Bar]
+#: progress=: a callable progress(done, total), a tqdm-like bar (an object with update(n)) or its class.
+_ProgressLike = Union[None, Callable[[int, int], object], _Bar, type[_Bar]]
 PathLike = Union[str, os.PathLike[str]]
 Taus = Union[str, Sequence[float]]
 _ConfigLike = Union[None, PathLike, Mapping[str, Any], PipelineConfig]
