@@ -191,8 +191,11 @@ def allan(data: Any = None, tau0_s: Optional[float] = None, *, rate: Any = None,
             if pres is None:
                 return None
             return pres if pres.ndim == 1 else np.ascontiguousarray(pres[:, j])
+        def column_report(j: int) -> Any:  # the series one after the other: (done, total) over all of them
+            k = arr.shape[1]
+            return None if report is None else (lambda done, total: report(j * total + done, k * total))
         return [_tetra._allan_series(np.ascontiguousarray(arr[:, j], dtype=np.float64), tau0_s,
-                                     column_present(j), t, confidence, report)
+                                     column_present(j), t, confidence, column_report(j))
                 for j in range(arr.shape[1])]
     return _tetra._allan_series(data, tau0_s, present, t, confidence, report)
 

@@ -120,6 +120,13 @@ def test_progress_callable_and_tqdm_like_bar():
         tetra.sim("static", duration_s=10, progress=3)
 
 
+def test_allan_progress_runs_over_every_series():
+    seen = []
+    tetra.allan(np.random.default_rng(3).standard_normal((2000, 3)), 0.1, progress=lambda d, t: seen.append((d, t)))
+    total = seen[-1][1]
+    assert seen[-1][0] == total and total % 3 == 0 and all(t == total for _, t in seen)
+
+
 def test_progress_with_tqdm():
     tqdm = pytest.importorskip("tqdm")
     bar = tqdm.tqdm(total=None, disable=False, mininterval=0)
