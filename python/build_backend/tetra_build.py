@@ -4,10 +4,10 @@ It needs nothing beyond Python's standard library and the project's own build (C
 scripts/setup.sh), so ``pip install .`` and ``python3 -m build`` work offline, with or without build
 isolation. The wheel is built by the project's CMake for the interpreter running pip: the target
 ``tetra_python`` only (the libraries it links and the module), in the folder ``build/python-<abi>`` of
-the source tree, configured without tests and reused by the next install. ``TETRA_BUILD_DIR`` (or
-``--config-settings build-dir=DIR``) names an existing build folder to build the module in instead, e.g.
-``build`` after ``scripts/build.sh``: only what changed is rebuilt, provided that folder builds the module
-for this interpreter (same extension suffix).
+the source tree, configured without tests and reused by the next install; but in ``build`` itself when
+the module there (``scripts/build.sh``'s) has this interpreter's extension suffix. ``TETRA_BUILD_DIR``
+(or ``--config-settings build-dir=DIR``) names the build folder to build the module in: only what changed
+is rebuilt, provided that folder builds the module for this interpreter (same extension suffix).
 """
 from __future__ import annotations
 
@@ -77,6 +77,8 @@ def _build_module(config_settings) -> Path:
     """Builds the module for this interpreter; returns its file."""
     suffix = sysconfig.get_config_var("EXT_SUFFIX")
     given = _setting(config_settings, "build-dir", "TETRA_BUILD_DIR")
+    if not given and (SOURCE / "build" / "python" / "tetra" / f"_tetra{suffix}").exists():
+        given = SOURCE / "build"  # scripts/build.sh's folder already builds the module for this suffix
     build = given or SOURCE / "build" / f"python-{suffix.strip('.').rsplit('.', 1)[0]}"
     # The interpreter itself, not a venv's link to it (a venv may be gone by the next install).
     python = getattr(sys, "_base_executable", "") or sys.executable
