@@ -302,8 +302,10 @@ static void bind_calibration_class(py::module_& m) {
 static void bind_calibration_results(py::module_& m) {
   py::class_<Calibrated>(m, "CalibrationResult", "The outcome of tetra.calibrate.")
       .def_property_readonly(
-          "calibration", [](const Calibrated& r) { return r.result.calibration; },
-          "The estimates with their 1σ (a tetra.Calibration).")
+          "calibration", [](Calibrated& r) -> Calibration& { return r.result.calibration; },
+          py::return_value_policy::reference_internal,
+          "The estimates with their 1σ (a tetra.Calibration): the result's own, not a copy (setting its unit "
+          "or method sticks).")
       .def_property_readonly(
           "sequence_residual_V", [](const Calibrated& r) { return matrix(r.result.fit.sequence_residual_V); },
           "[V] M×N mean residual of every gyro over each sequence.")

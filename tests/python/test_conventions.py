@@ -142,6 +142,9 @@ def test_arrays_that_are_copies_are_read_only():
     assert not r.adev.flags.writeable and not r.tau_s.flags.writeable
     log = tetra.sim("static", duration_s=5).log
     assert log.values.flags.writeable  # the log's own arrays: writing changes them
+    result = tetra.calibrate(EXAMPLES / "turntable.csv")
+    result.calibration.unit = "renamed"  # the result's own calibration, not a copy that forgets it
+    assert result.calibration.unit == "renamed"
 
 
 def test_every_public_field_has_a_docstring_and_the_module_names_its_parameters():
