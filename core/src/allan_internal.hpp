@@ -25,6 +25,13 @@ std::vector<AvarPoint> avar_from_angle(const double* x, const std::uint32_t* cum
                                        double tau0_s, std::span<const std::int64_t> m_values,
                                        Interrupt* interrupt = nullptr);
 
+//! `options` without its interrupt: the log analyses run their gyros in parallel threads, and an
+//! Interrupt is one caller's, polled from one thread.
+inline AllanOptions without_interrupt(AllanOptions options) {
+  options.interrupt = nullptr;
+  return options;
+}
+
 //! The checks analyze_series makes before it computes anything.
 Status check_series_options(double tau0_s, const AllanOptions& options);
 Status check_present_samples(std::size_t present_samples);

@@ -38,18 +38,23 @@ def long_log():
 CALLS = {
     "Pipeline.run": ("cal, t, raw = long_log()\np = tetra.Pipeline(cal)", "p.run(t, raw)"),
     "Pipeline.run_log": ("log = tetra.sim('static', duration_s=3600, rate_hz=100).log\n"
-                         "p = tetra.Pipeline(tetra.Calibration.seed_unit())\nlogs = [log] * 20",
+                         "p = tetra.Pipeline(tetra.Calibration.seed_unit())\nlogs = [log] * 400",
                          "[p.run_log(l) for l in logs]"),
     "sim": ("", "tetra.sim('static', duration_s=200000, rate_hz=100)"),
     "allan": ("y = np.random.default_rng(2).standard_normal(85_000)", "tetra.allan(y, 0.01, taus='all')"),
+    # SIGINT once every averaging time is done, while the intervals' chi-square quantiles run.
+    "allan, in the intervals": ("y = np.random.default_rng(2).standard_normal(85_000)\nsaid = []\n"
+                                "def told(d, t):\n    if d == t and not said:\n"
+                                "        said.append(print('intervals', flush=True))",
+                                "tetra.allan(y, 0.01, taus='all', progress=told)"),
     "campaign": ("", "tetra.campaign(LONG_CAMPAIGN)"),
     "campaign jobs=2": ("", "tetra.campaign(LONG_CAMPAIGN, jobs=2)"),
 }
 
 
 def interrupt_after(setup, call, delay_s=1.0):
-    """Runs `call` in a child, sends SIGINT `delay_s` into it: (seconds to the KeyboardInterrupt, the
-    child's report line)."""
+    """Runs `call` in a child, sends SIGINT `delay_s` into it (or 50 ms after the child's line 'intervals'
+    when it prints one): (seconds to the KeyboardInterrupt, the child's report line)."""
     child = textwrap.dedent(PRELUDE) + setup + f"""
 print("ready", flush=True)
 t0 = time.monotonic()
@@ -63,6 +68,9 @@ except KeyboardInterrupt as e:
     p = subprocess.Popen([sys.executable, "-c", child], stdout=subprocess.PIPE, text=True)
     try:
         assert p.stdout.readline().strip() == "ready"
+        if "intervals" in call:
+            assert p.stdout.readline().strip() == "intervals"
+            delay_s = 0.05
         time.sleep(delay_s)
         sent = time.monotonic()
         p.send_signal(signal.SIGINT)

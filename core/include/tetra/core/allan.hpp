@@ -155,8 +155,10 @@ inline constexpr double kOneSigmaConfidence = 0.682689492137086;  //!< erf(1/√
 struct AllanOptions {
   TauSpec taus;                             //!< averaging times
   double confidence = kOneSigmaConfidence;  //!< two-sided confidence level of the intervals
-  //! analyze_series polls it (optional, not owned) before each averaging time (τ done of the τ asked):
-  //! when it asks to stop, the call returns interrupted().
+  //! analyze_series polls it (optional, not owned) before each averaging time (τ done of the τ asked)
+  //! and every 16 points of the intervals (reported as all τ done): when it asks to stop, the call returns
+  //! interrupted(). The log analyses (analyze_gyro_log, analyze_gyro_log_file), which run gyros in parallel,
+  //! ignore it.
   Interrupt* interrupt = nullptr;
 };
 
