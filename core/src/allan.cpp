@@ -439,11 +439,11 @@ Result<AllanResult> finish_series(std::size_t samples, std::size_t present_sampl
   Interrupt* interrupt = options.interrupt;
   auto stopped = [&] { return interrupt != nullptr && interrupt->stopped(); };
   set_intervals(result.points, avar, runs, options.confidence, false, interrupt);
-  result.fit = fit_noise_terms(result.points);
+  result.fit = fit_noise_terms(result.points, nullptr, interrupt);
   for (int pass = 0; pass < 4 && !stopped(); ++pass) {
     classify(result.points, result.fit);
     set_intervals(result.points, avar, runs, options.confidence, false, interrupt);
-    result.fit = fit_noise_terms(result.points, &result.fit);
+    result.fit = fit_noise_terms(result.points, &result.fit, interrupt);
   }
   // Intervals consistent with the reported fit.
   classify(result.points, result.fit);

@@ -141,7 +141,19 @@ Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options
   log.time_s.reserve(e);
   log.values.reserve(e * static_cast<std::size_t>(n));
   log.present.reserve(e * static_cast<std::size_t>(n));
-  if (truth) *truth = Truth{};
+  log.lines.reserve(e);
+  if (log.has_reference) {
+    log.reference_present.reserve(e);
+    log.reference_wxyz.reserve(e);
+  }
+  if (truth) {
+    // Reserved like the log: no reallocation (a copy of all so far) between two polls of `interrupt`.
+    *truth = Truth{};
+    truth->time_s.reserve(e);
+    truth->q_RB.reserve(e);
+    truth->omega_BR_B_rad_s.reserve(e);
+    truth->omega_BN_B_rad_s.reserve(e);
+  }
   SimEpoch epoch;
   while (sim.next(epoch)) {
     if (sim.epochs_done() % 64 == 0 && interrupt_requested(interrupt, sim.epochs_done(), e)) {

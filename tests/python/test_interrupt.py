@@ -40,7 +40,7 @@ CALLS = {
     "Pipeline.run_log": ("log = tetra.sim('static', duration_s=3600, rate_hz=100).log\n"
                          "p = tetra.Pipeline(tetra.Calibration.seed_unit())\nlogs = [log] * 400",
                          "[p.run_log(l) for l in logs]"),
-    "sim": ("", "tetra.sim('static', duration_s=200000, rate_hz=100)"),
+    "sim": ("", "tetra.sim('static', duration_s=60000, rate_hz=100)"),
     "allan": ("y = np.random.default_rng(2).standard_normal(85_000)", "tetra.allan(y, 0.01, taus='all')"),
     # SIGINT once every averaging time is done, while the intervals' chi-square quantiles run.
     "allan, in the intervals": ("y = np.random.default_rng(2).standard_normal(85_000)\nsaid = []\n"

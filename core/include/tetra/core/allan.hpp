@@ -146,7 +146,10 @@ struct NoiseFit {
 //! Non-negative weighted least-squares fit of the five terms to the points (exact: every subset of
 //! terms is solved and the best one with all coefficients ≥ 0 kept), then the "observed" test.
 //! Weights are edf/(2σ⁴) with σ² from `weights_from`'s model when given, else the measured value.
-NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weights_from = nullptr);
+//! `interrupt` (optional) is polled between the subsets and every 16 points of the "observed" test (each
+//! point reported as all done): once it asks to stop, the fit returned is unfinished.
+NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weights_from = nullptr,
+                         Interrupt* interrupt = nullptr);
 
 // --- whole analysis ----------------------------------------------------------------------------
 
