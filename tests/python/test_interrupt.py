@@ -68,7 +68,7 @@ except KeyboardInterrupt as e:
     p = subprocess.Popen([sys.executable, "-c", child], stdout=subprocess.PIPE, text=True)
     try:
         assert p.stdout.readline().strip() == "ready"
-        if "intervals" in call:
+        if "intervals" in setup:
             assert p.stdout.readline().strip() == "intervals"
             delay_s = 0.05
         time.sleep(delay_s)
