@@ -8,7 +8,8 @@
 #                     --plot), clang (fuzzers), openssl (DDS Security PKI), iproute2 (netns tests), chromium
 #                     and selenium (the ground station's browser test), slurm-wlm and munge (the
 #                     campaign's Slurm test), pybind11 and Python's numpy, pandas, pytest and matplotlib
-#                     (the Python package, its tests and example)
+#                     (the Python package, its tests and example), venv, build and mypy (pip install .
+#                     in a fresh venv, the wheel, the stub check)
 # As root it runs apt-get; otherwise it prints the exact command to run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -35,6 +36,8 @@ if [ "${1:-}" = "--test" ]; then
     slurm-wlm munge                              # the campaign over a single-node Slurm cluster
     pybind11-dev python3-dev                     # the Python package tetra (docs/python.md)
     python3-numpy python3-pandas python3-pytest python3-matplotlib  # its tests and notebook example
+    python3-venv python3-build python3-mypy      # pip install . in a fresh venv, python3 -m build, stub check
+    python3-tqdm                                 # progress bars of the long calls
   )
 fi
 

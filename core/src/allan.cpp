@@ -206,7 +206,8 @@ Result<SamplingGrid> uniform_grid_lines(
 }
 
 std::vector<AvarPoint> overlapping_avar(std::span<const double> rate, std::span<const std::uint8_t> present,
-                                        double tau0_s, std::span<const std::int64_t> m_values) {
+                                        double tau0_s, std::span<const std::int64_t> m_values,
+                                        Interrupt* interrupt) {
   const std::size_t n = rate.size();
   auto is_present = [&](std::size_t i) {
     return (present.empty() || present[i] != 0) && std::isfinite(rate[i]);
@@ -238,15 +239,17 @@ std::vector<AvarPoint> overlapping_avar(std::span<const double> rate, std::span<
     x[i + 1] = static_cast<double>(acc);
     cum[i + 1] = c;
   }
-  return avar_from_angle(x.data(), count == n ? nullptr : cum.data(), n, tau0_s, m_values);
+  return avar_from_angle(x.data(), count == n ? nullptr : cum.data(), n, tau0_s, m_values, interrupt);
 }
 
 std::vector<AvarPoint> avar_from_angle(const double* x, const std::uint32_t* cum, std::size_t n,
-                                       double tau0_s, std::span<const std::int64_t> m_values) {
+                                       double tau0_s, std::span<const std::int64_t> m_values,
+                                       Interrupt* interrupt) {
   const bool complete = cum == nullptr;
   std::vector<AvarPoint> out;
   out.reserve(m_values.size());
   for (const std::int64_t m_signed : m_values) {
+    if (interrupt_requested(interrupt, out.size(), m_values.size())) break;
     AvarPoint p;
     p.m = m_signed;
     p.tau_s = static_cast<double>(m_signed) * tau0_s;
@@ -324,11 +327,15 @@ std::vector<std::size_t> valid_runs(std::span<const double> rate, std::span<cons
 // EDF and confidence interval of each point for the noise types chosen per point. With gaps, each
 // run of consecutive samples is an independent record: the EDF is the sum over the runs long
 // enough for the averaging time (a run of L samples has L + 1 angle points).
+// `interrupt` (optional) is polled every 16 points (a chi-square quantile of a large EDF takes up to a
+// millisecond); once it asks to stop, the points are left as they are.
 void set_intervals(std::vector<AdevPoint>& points, const std::vector<AvarPoint>& avar,
-                   const std::vector<std::size_t>& runs, double confidence, bool with_bounds) {
+                   const std::vector<std::size_t>& runs, double confidence, bool with_bounds,
+                   Interrupt* interrupt) {
   const double p_hi = 0.5 * (1.0 + confidence);
   const double p_lo = 0.5 * (1.0 - confidence);
   for (std::size_t i = 0; i < points.size(); ++i) {
+    if (i % 16 == 0 && interrupt_requested(interrupt, points.size(), points.size())) return;
     AdevPoint& pt = points[i];
     const double m = static_cast<double>(avar[i].m);
     double edf = 0.0;
@@ -397,7 +404,8 @@ Result<AllanResult> analyze_series(std::span<const double> rate, std::span<const
   if (Status st = check_present_samples(present_samples); !st) return st.error();
   auto ms = averaging_factors(options.taus, rate.size(), tau0_s);
   if (!ms) return ms.error();
-  const std::vector<AvarPoint> all = overlapping_avar(rate, present, tau0_s, *ms);
+  const std::vector<AvarPoint> all = overlapping_avar(rate, present, tau0_s, *ms, options.interrupt);
+  if (options.interrupt != nullptr && options.interrupt->stopped()) return interrupted();
   return finish_series(rate.size(), present_samples, all, valid_runs(rate, present), tau0_s, options);
 }
 
@@ -433,16 +441,19 @@ Result<AllanResult> finish_series(std::size_t samples, std::size_t present_sampl
   // White rate noise and weights from the measured variances first; then the noise types and the
   // weights of the fitted model (iteratively reweighted: weights from the measured values favour
   // points that happen to fall low), for a fixed number of passes.
-  set_intervals(result.points, avar, runs, options.confidence, false);
-  result.fit = fit_noise_terms(result.points);
-  for (int pass = 0; pass < 4; ++pass) {
+  Interrupt* interrupt = options.interrupt;
+  auto stopped = [&] { return interrupt != nullptr && interrupt->stopped(); };
+  set_intervals(result.points, avar, runs, options.confidence, false, interrupt);
+  result.fit = fit_noise_terms(result.points, nullptr, interrupt);
+  for (int pass = 0; pass < 4 && !stopped(); ++pass) {
     classify(result.points, result.fit);
-    set_intervals(result.points, avar, runs, options.confidence, false);
-    result.fit = fit_noise_terms(result.points, &result.fit);
+    set_intervals(result.points, avar, runs, options.confidence, false, interrupt);
+    result.fit = fit_noise_terms(result.points, &result.fit, interrupt);
   }
   // Intervals consistent with the reported fit.
   classify(result.points, result.fit);
-  set_intervals(result.points, avar, runs, options.confidence, true);
+  if (!stopped()) set_intervals(result.points, avar, runs, options.confidence, true, interrupt);
+  if (stopped()) return interrupted();
   return result;
 }
 
@@ -492,7 +503,7 @@ Result<LogAllan> analyze_gyro_log(const GyroLog& log, const LogAllanOptions& opt
     std::size_t delivered = 0;
     for (const std::uint8_t p : present) delivered += p;
     gyro.absent = grid_ref.slots - delivered - gyro.invalid;
-    auto result = analyze_series(rate, present, grid_ref.tau0_s, options.allan);
+    auto result = analyze_series(rate, present, grid_ref.tau0_s, without_interrupt(options.allan));
     if (!result) return gyro_error(result.error(), log.source, id, ids.size());
     gyro.result = std::move(result.value());
     return gyro;

@@ -100,12 +100,15 @@ WeightedSystem weighted_system(const std::vector<const AdevPoint*>& used, const 
 
 // Exact NNLS for five unknowns: the optimum is the unconstrained least-squares solution on its own
 // support, so the best feasible subset solution is the optimum. `allowed` limits the terms.
-Coefficients nnls(const WeightedSystem& sys, int allowed) {
+// `interrupt` (optional): polled before each subset (a QR over every point).
+Coefficients nnls(const WeightedSystem& sys, int allowed, Interrupt* interrupt) {
   const Eigen::Index rows = sys.a.rows();
+  const auto all = static_cast<std::size_t>(rows);
   double best_cost = sys.b.squaredNorm();
   Eigen::VectorXd best = Eigen::VectorXd::Zero(kTermCount);
   for (int mask = 1; mask < (1 << kTermCount); ++mask) {
     if ((mask & ~allowed) != 0) continue;
+    if (interrupt_requested(interrupt, all, all)) break;
     std::vector<int> cols;
     for (int k = 0; k < kTermCount; ++k) {
       if ((mask & (1 << k)) != 0) cols.push_back(k);
@@ -163,11 +166,12 @@ std::vector<int> mark_dominant(const std::vector<const AdevPoint*>& used, const 
 // Observed: the model re-fitted without the term leaves the 95 % confidence interval of the
 // measured variance at some τ where the term dominates — the other terms cannot stand in for it.
 void mark_observed(const WeightedSystem& sys, const std::vector<const AdevPoint*>& used,
-                   const std::vector<int>& largest, NoiseFit& fit) {
+                   const std::vector<int>& largest, NoiseFit& fit, Interrupt* interrupt) {
   for (int k = 0; k < kTermCount; ++k) {
     if (fit.dominant_from_s[static_cast<std::size_t>(k)] == 0.0) continue;
-    const Coefficients without = nnls(sys, kAllTerms & ~(1 << k));
+    const Coefficients without = nnls(sys, kAllTerms & ~(1 << k), interrupt);
     for (std::size_t i = 0; i < used.size() && !fit.observed[static_cast<std::size_t>(k)]; ++i) {
+      if (i % 16 == 0 && interrupt_requested(interrupt, used.size(), used.size())) return;
       if (largest[i] != k) continue;
       const AdevPoint& p = *used[i];
       const double avar = p.adev * p.adev;
@@ -181,17 +185,18 @@ void mark_observed(const WeightedSystem& sys, const std::vector<const AdevPoint*
 
 }  // namespace
 
-NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weights_from) {
+NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weights_from,
+                         Interrupt* interrupt) {
   NoiseFit fit;
   const std::vector<const AdevPoint*> used = usable_points(points);
   fit.points_used = static_cast<int>(used.size());
   if (used.empty()) return fit;
   const WeightedSystem sys = weighted_system(used, weights_from);
-  const Coefficients coeff = nnls(sys, kAllTerms);
+  const Coefficients coeff = nnls(sys, kAllTerms, interrupt);
   for (int k = 0; k < kTermCount; ++k)
     fit.value[static_cast<std::size_t>(k)] = std::sqrt(coeff[static_cast<std::size_t>(k)]);
   const std::vector<int> largest = mark_dominant(used, coeff, fit);
-  mark_observed(sys, used, largest, fit);
+  mark_observed(sys, used, largest, fit, interrupt);
   return fit;
 }
 

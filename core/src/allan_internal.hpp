@@ -20,8 +20,17 @@ Result<SamplingGrid> uniform_grid_lines(
 
 //! Overlapping Allan variance from the angle x[0..n] (in units of τ0) and, when some samples are
 //! missing, the cumulative count of present samples cum[0..n] (nullptr when all are present).
+//! `interrupt` as overlapping_avar's.
 std::vector<AvarPoint> avar_from_angle(const double* x, const std::uint32_t* cum, std::size_t n,
-                                       double tau0_s, std::span<const std::int64_t> m_values);
+                                       double tau0_s, std::span<const std::int64_t> m_values,
+                                       Interrupt* interrupt = nullptr);
+
+//! `options` without its interrupt: the log analyses run their gyros in parallel threads, and an
+//! Interrupt is one caller's, polled from one thread.
+inline AllanOptions without_interrupt(AllanOptions options) {
+  options.interrupt = nullptr;
+  return options;
+}
 
 //! The checks analyze_series makes before it computes anything.
 Status check_series_options(double tau0_s, const AllanOptions& options);

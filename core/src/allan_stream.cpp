@@ -262,7 +262,7 @@ Result<LogAllan> analyze_gyro_log_file(const std::string& path, const LogAllanOp
   out.missing_epochs = grid->missing_epochs;
 
   auto analyse_one = [&](std::size_t j) -> Result<GyroAllan> {
-    auto r = analyse_column(c.rate[j], *grid, options.allan, log.source);
+    auto r = analyse_column(c.rate[j], *grid, without_interrupt(options.allan), log.source);
     if (!r) return gyro_error(r.error(), log.source, c.ids[j], c.ids.size());
     GyroAllan gyro;
     gyro.id = c.ids[j];

@@ -10,6 +10,7 @@
 #include "common.hpp"
 #include "tetra/core/allan.hpp"
 #include "tetra/core/calibration_file.hpp"
+#include "watch.hpp"
 
 namespace tetra::python {
 
@@ -43,7 +44,7 @@ py::array_t<double> point_column(const allan::AllanResult& r, F f) {
   std::vector<double> v;
   v.reserve(r.points.size());
   for (const auto& p : r.points) v.push_back(f(p));
-  return to_numpy(std::move(v));
+  return read_only(std::move(v));
 }
 
 void bind_fit(py::module_& m) {
@@ -125,7 +126,7 @@ void bind_result(py::module_& m) {
           [](const allan::AllanResult& r) {
             std::vector<std::int64_t> v;
             for (const auto& p : r.points) v.push_back(p.terms);
-            return to_numpy(std::move(v));
+            return read_only(std::move(v));
           },
           "Second differences used at each τ.")
       .def_property_readonly(
@@ -183,7 +184,8 @@ void bind_allan(py::module_& m) {
   m.def(
       "_allan_series",
       [](const py::handle& rate, double tau0_s, const py::object& present,
-         const std::variant<std::string, std::vector<double>>& taus, double confidence) {
+         const std::variant<std::string, std::vector<double>>& taus, double confidence,
+         const py::object& progress) {
         const DoubleArray y = doubles(rate, "rate", 0, Finite::kNanAllowed);
         MaskArray p;
         if (!present.is_none()) p = mask(present, "present", y.rows, 0);
@@ -192,6 +194,9 @@ void bind_allan(py::module_& m) {
         allan::AllanOptions options;
         options.taus = tau_spec(taus);
         options.confidence = confidence;
+        Watch watch(progress);
+        Interrupt interrupt = watch.interrupt();
+        options.interrupt = &interrupt;
         Result<allan::AllanResult> r = bad_input("");
         {
           py::gil_scoped_release release;
@@ -200,9 +205,13 @@ void bind_allan(py::module_& m) {
                                 : std::span<const std::uint8_t>();
           r = allan::analyze_series(std::span<const double>(y.data, y.rows), present_span, tau0_s, options);
         }
-        return take(std::move(r));
+        watch.raise_if_stopped();
+        allan::AllanResult result = take(std::move(r));
+        const std::size_t taus_done = result.points.size() + result.uncomputed_tau_s.size();
+        watch.done(taus_done, taus_done);
+        return result;
       },
-      "rate"_a, "tau0_s"_a, "present"_a, "taus"_a, "confidence"_a);
+      "rate"_a, "tau0_s"_a, "present"_a, "taus"_a, "confidence"_a, "progress"_a);
   m.def(
       "_allan_log",
       [](const std::string& path, const Calibration* calibration, const std::vector<int>& gyros,

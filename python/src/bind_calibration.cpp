@@ -1,10 +1,12 @@
 // tetra.Calibration (calibration files) and tetra.calibrate (turntable calibration, from a file or arrays).
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include "common.hpp"
 #include "tetra/core/calibration.hpp"
@@ -23,7 +25,7 @@ template <class F>
 py::array_t<double> per_gyro(const Calibration& cal, F value) {
   std::vector<double> out;
   for (const auto& g : cal.gyros) out.push_back(value(g));
-  return to_numpy(std::move(out));
+  return read_only(std::move(out));
 }
 
 // N×3 rows per gyro.
@@ -34,7 +36,7 @@ py::array_t<double> per_gyro_vec3(const Calibration& cal, F vec) {
     const Eigen::Vector3d v = vec(g);
     out.insert(out.end(), {v.x(), v.y(), v.z()});
   }
-  return to_numpy(std::move(out), cal.gyros.size(), 3);
+  return read_only(std::move(out), cal.gyros.size(), 3);
 }
 
 bool all_have_sigma(const Calibration& cal) {
@@ -200,11 +202,11 @@ py::array_t<double> matrix(const Eigen::MatrixXd& m) {
   std::vector<double> v(static_cast<std::size_t>(m.size()));
   for (Eigen::Index r = 0; r < m.rows(); ++r)
     for (Eigen::Index c = 0; c < m.cols(); ++c) v[static_cast<std::size_t>(r * m.cols() + c)] = m(r, c);
-  return to_numpy(std::move(v), static_cast<std::size_t>(m.rows()), static_cast<std::size_t>(m.cols()));
+  return read_only(std::move(v), static_cast<std::size_t>(m.rows()), static_cast<std::size_t>(m.cols()));
 }
 
 py::array_t<double> vector(const Eigen::VectorXd& v) {
-  return to_numpy(std::vector<double>(v.data(), v.data() + v.size()));
+  return read_only(std::vector<double>(v.data(), v.data() + v.size()));
 }
 
 }  // namespace
@@ -216,8 +218,10 @@ static void bind_calibration_class(py::module_& m) {
       "[V/(deg/s)], a bias [V] and a unit sensing axis in the body frame B, with their 1σ "
       "and noise terms when known.")
       .def_static(
-          "read", [](const std::string& path) { return take(read_calibration(path)); }, "path"_a,
-          "Reads a calibration file (YAML). Raises BadInputError naming the file, line and key.")
+          "read", [](const std::filesystem::path& path) { return take(read_calibration(path.string())); },
+          "path"_a,
+          "Reads a calibration file (YAML; `path` a str or os.PathLike). Raises BadInputError naming the "
+          "file, line and key.")
       .def_static(
           "from_yaml",
           [](const std::string& text, const std::string& source) {
@@ -234,8 +238,13 @@ static void bind_calibration_class(py::module_& m) {
           "to_yaml", [](const Calibration& c) { return format_calibration(c); },
           "The calibration file's text, as `tetra calibrate` writes it (without its provenance comments).")
       .def(
-          "write", [](const Calibration& c, const std::string& path) { check(write_calibration(path, c)); },
-          "path"_a, "Writes the calibration file (atomically: a temporary file renamed into place).")
+          "write",
+          [](const Calibration& c, const std::filesystem::path& path) {
+            check(write_calibration(path.string(), c));
+          },
+          "path"_a,
+          "Writes the calibration file (atomically: a temporary file renamed into place); `path` a str or "
+          "os.PathLike.")
       .def_readwrite("unit", &Calibration::unit, "Free text naming the unit.")
       .def_readwrite("method", &Calibration::method, "How it was made: 'sixteen-position', 'batch', ...")
       .def_readwrite("latitude_deg", &Calibration::latitude_deg, "[deg] where it was calibrated, or None.")
@@ -245,7 +254,8 @@ static void bind_calibration_class(py::module_& m) {
           [](const Calibration& c) {
             return per_gyro(c, [](const auto& g) { return g.scale_factor_V_per_dps; });
           },
-          "[V/(deg/s)] scale factors, shape (N,).")
+          "[V/(deg/s)] scale factors, shape (N,): a read-only copy (make a new calibration with "
+          "from_arrays).")
       .def_property_readonly(
           "bias_V", [](const Calibration& c) { return per_gyro(c, [](const auto& g) { return g.bias_V; }); },
           "[V] biases, shape (N,).")
@@ -292,8 +302,10 @@ static void bind_calibration_class(py::module_& m) {
 static void bind_calibration_results(py::module_& m) {
   py::class_<Calibrated>(m, "CalibrationResult", "The outcome of tetra.calibrate.")
       .def_property_readonly(
-          "calibration", [](const Calibrated& r) { return r.result.calibration; },
-          "The estimates with their 1σ (a tetra.Calibration).")
+          "calibration", [](Calibrated& r) -> Calibration& { return r.result.calibration; },
+          py::return_value_policy::reference_internal,
+          "The estimates with their 1σ (a tetra.Calibration): the result's own, not a copy (setting its unit "
+          "or method sticks).")
       .def_property_readonly(
           "sequence_residual_V", [](const Calibrated& r) { return matrix(r.result.fit.sequence_residual_V); },
           "[V] M×N mean residual of every gyro over each sequence.")

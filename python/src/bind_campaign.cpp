@@ -1,8 +1,12 @@
 // tetra.campaign: a fault-injection campaign in process (docs/campaign.md), its rows as CSV text that the
 // package turns into a pandas DataFrame (the columns of runs.csv).
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <exception>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <pybind11/stl.h>
@@ -10,6 +14,7 @@
 #include "common.hpp"
 #include "tetra/sim/campaign.hpp"
 #include "tetra/sim/campaign_report.hpp"
+#include "watch.hpp"
 
 namespace tetra::python {
 
@@ -60,26 +65,93 @@ std::vector<std::size_t> campaign_indices(const sim::CampaignSpec& spec,
     for (std::size_t r = 0; r < count; ++r) indices.push_back(r);
     return indices;
   }
+  std::vector<bool> seen(count, false);
   for (const std::size_t r : *runs) {
     if (r >= count)
       throw py::value_error("runs: run " + std::to_string(r) + " is not in the matrix (0.." +
                             std::to_string(count - 1) + ")");
+    if (seen[r]) throw py::value_error("runs: run " + std::to_string(r) + " is given twice");
+    seen[r] = true;
   }
   return *runs;
 }
 
-//! One CSV row per run, the GIL released: a run that fails is an error row, as `tetra campaign` writes it.
-std::vector<std::string> campaign_rows(const sim::CampaignSpec& spec,
-                                       const std::optional<std::vector<std::size_t>>& runs) {
+//! Runs the cases `indices`, `jobs` at a time, into `lines` (one CSV row each, in the order of
+//! `indices`; a run that fails is an error row, as `tetra campaign` writes it). Called with the GIL
+//! released: the watch is polled from this thread (between the epochs of a run with one job; every 5 ms
+//! while the workers run with more). Once it asks to stop, the runs under way are dropped, not written.
+void run_cases(const sim::CampaignSpec& spec, const std::vector<std::size_t>& indices, int jobs, Watch& watch,
+               std::vector<std::optional<std::string>>& lines) {
+  const sim::EstimatorFactory make = sim::in_process_estimators(spec);
+  const std::size_t total = indices.size();
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::size_t> finished{0};
+  std::atomic<bool> stop{false};
+  auto run_from = [&](Interrupt& interrupt) {
+    for (std::size_t i = next.fetch_add(1); i < total && !stop.load(); i = next.fetch_add(1)) {
+      const sim::CampaignRow row = sim::campaign_run_row(spec, indices[i], make, &interrupt);
+      if (interrupt.stopped()) return;  // the run it stopped is no row
+      lines[i] = sim::campaign_csv_row(row);
+      finished.fetch_add(1);
+    }
+  };
+  if (jobs == 1) {
+    Interrupt interrupt([&](std::size_t, std::size_t) { return watch.poll(finished.load(), total); });
+    run_from(interrupt);
+    return;
+  }
+  const auto workers = static_cast<std::size_t>(std::min<std::size_t>(static_cast<std::size_t>(jobs), total));
+  std::atomic<std::size_t> running{0};
+  std::vector<std::exception_ptr> failures(workers);
+  std::vector<std::thread> threads;
+  try {
+    for (std::size_t w = 0; w < workers; ++w) {
+      running.fetch_add(1);
+      threads.emplace_back([&, w] {
+        try {
+          Interrupt interrupt([&](std::size_t, std::size_t) { return stop.load(); });
+          run_from(interrupt);
+        } catch (...) {
+          failures[w] = std::current_exception();
+          stop.store(true);
+        }
+        running.fetch_sub(1);
+      });
+    }
+  } catch (...) {  // a thread that could not start: the others stop, then the error is raised
+    running.fetch_sub(1);
+    stop.store(true);
+    for (auto& t : threads) t.join();
+    throw;
+  }
+  while (running.load() > 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (!stop.load() && watch.poll(finished.load(), total)) stop.store(true);
+  }
+  for (auto& t : threads) t.join();
+  for (const auto& f : failures)
+    if (f) std::rethrow_exception(f);
+}
+
+//! The CSV rows of the runs done (in run order) and the exception that stopped the campaign (None when
+//! every run ran): an interrupted campaign returns the rows it has, as the command keeps them to resume.
+py::tuple campaign_rows(const sim::CampaignSpec& spec, const std::optional<std::vector<std::size_t>>& runs,
+                        int jobs, const py::object& progress) {
   if (spec.target != sim::CampaignTarget::kInProcess)
     throw py::value_error("target: Python runs campaigns in process only (`tetra campaign` runs target dds)");
+  if (jobs < 1) throw py::value_error("jobs: must be at least 1");
   const std::vector<std::size_t> indices = campaign_indices(spec, runs);
-  std::vector<std::string> lines;
-  py::gil_scoped_release release;
-  const sim::EstimatorFactory make = sim::in_process_estimators(spec);
-  for (const std::size_t r : indices)
-    lines.push_back(sim::campaign_csv_row(sim::campaign_run_row(spec, r, make)));
-  return lines;
+  std::vector<std::optional<std::string>> lines(indices.size());
+  Watch watch(progress);
+  {
+    py::gil_scoped_release release;
+    run_cases(spec, indices, jobs, watch, lines);
+  }
+  py::list done;
+  for (const auto& line : lines)
+    if (line) done.append(*line);
+  if (!watch.stopped()) watch.done(indices.size(), indices.size());
+  return py::make_tuple(done, watch.pending());
 }
 
 //! report.md of the rows in `csv` (runs.csv's text), with the statistics and requirements the spec asks for.
@@ -100,9 +172,9 @@ std::string campaign_report_markdown(const sim::CampaignSpec& spec, const std::s
 }  // namespace
 
 void bind_campaign_runs(py::module_& m) {
-  m.def("_campaign_rows", &campaign_rows, "spec"_a, "runs"_a,
-        "Runs the cases (all, or the run ids given) one after the other, the GIL released; one CSV row each "
-        "(a run that fails is an error row).");
+  m.def("_campaign_rows", &campaign_rows, "spec"_a, "runs"_a, "jobs"_a, "progress"_a,
+        "Runs the cases (all, or the run ids given), `jobs` at a time, the GIL released: (the CSV rows of "
+        "the runs done, in the order given; the exception that stopped it, or None).");
   m.def("_campaign_report", &campaign_report_markdown, "spec"_a, "csv"_a,
         "report.md of runs.csv's text, as `tetra campaign` writes it (without drawing the plots).");
 }

@@ -1,7 +1,9 @@
 // tetra.GyroLog and tetra.read_gyro_log.
+#include <filesystem>
 #include <limits>
 
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include "common.hpp"
 #include "logs.hpp"
@@ -60,16 +62,18 @@ void bind_logs(py::module_& m) {
       });
   m.def(
       "read_gyro_log",
-      [](const std::string& path) {
+      [](const std::filesystem::path& path) {
+        const std::string name = path.string();
         Result<GyroLog> log = bad_input("");
         {
           py::gil_scoped_release release;
-          log = read_gyro_log(path);
+          log = read_gyro_log(name);
         }
         return to_python(take(std::move(log)));
       },
       "path"_a,
-      "Reads a whole gyro log, CSV or HDF5 (.h5, .hdf5). Raises BadInputError naming file and line.");
+      "Reads a whole gyro log: CSV, HDF5 (.h5, .hdf5) or the lab's TDMS (.tdms; docs/formats.md). `path` "
+      "a str or os.PathLike. Raises BadInputError naming file and line.");
 }
 
 }  // namespace tetra::python

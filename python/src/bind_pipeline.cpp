@@ -1,8 +1,11 @@
 // tetra.Pipeline: the fusion and fault-detection pipeline, one epoch at a time (step) or a whole array of
 // epochs in C++ (run: no Python per epoch, the GIL released).
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -15,6 +18,7 @@
 #include "tetra/fdi/config.hpp"
 #include "tetra/fdi/noise_defaults.hpp"
 #include "tetra/fdi/pipeline.hpp"
+#include "watch.hpp"
 
 namespace tetra::python {
 
@@ -61,10 +65,40 @@ struct RunColumns {
 };
 
 struct PyPipeline {
+  PyPipeline(fdi::Pipeline p, fdi::PipelineConfig c, int gyros)
+      : pipeline(std::move(p)), config(std::move(c)), n(gyros) {
+    epoch.raw.resize(static_cast<std::size_t>(n));
+    epoch.present.resize(static_cast<std::size_t>(n));
+  }
   fdi::Pipeline pipeline;
-  fdi::PipelineConfig config;
-  int n = 0;
+  const fdi::PipelineConfig config;
+  const int n;
   fdi::Epoch epoch;
+  std::atomic<const char*> user{nullptr};  //!< the method running on it (InUse), or null
+};
+
+// One method call's hold on a Pipeline. A second call while one runs — from another thread, or from the
+// progress callback of a run — raises RuntimeError instead of sharing the pipeline's state: a mutex would
+// interleave two threads' epochs into one filter (an estimate of neither), and with the GIL taken back by
+// the run's polls it could deadlock.
+class InUse {
+ public:
+  InUse(PyPipeline& p, const char* method) : p_(p) {
+    const char* idle = nullptr;
+    if (!p_.user.compare_exchange_strong(idle, method)) {
+      throw std::runtime_error(std::string("tetra.Pipeline is in use: ") + idle +
+                               " is running on it (in another "
+                               "thread, or this call came from its progress callback); a Pipeline serves one "
+                               "call at a time: give each thread its own Pipeline, or hold a threading.Lock "
+                               "around its calls");
+    }
+  }
+  InUse(const InUse&) = delete;
+  InUse& operator=(const InUse&) = delete;
+  ~InUse() { p_.user.store(nullptr); }
+
+ private:
+  PyPipeline& p_;
 };
 
 // The inputs of run(): checked, as views of the caller's arrays where they can be.
@@ -121,11 +155,16 @@ void fill_epoch(const RunInputs& in, std::size_t k, std::size_t ng, fdi::Epoch& 
   if (given) epoch.reference_q_RB = from_wxyz(q[0], q[1], q[2], q[3]);
 }
 
-RunColumns run_all(PyPipeline& p, const RunInputs& in) {
+// Every epoch, or those before `interrupt` (polled every 64 epochs) asked to stop.
+RunColumns run_all(PyPipeline& p, const RunInputs& in, Interrupt& interrupt) {
   const auto ng = static_cast<std::size_t>(p.n);
   RunColumns out;
   out.reserve(in.time_s.rows, ng);
   for (std::size_t k = 0; k < in.time_s.rows; ++k) {
+    if (k % 64 == 0 && interrupt.requested(k, in.time_s.rows)) {
+      out.epochs = k;
+      return out;
+    }
     fill_epoch(in, k, ng, p.epoch);
     const auto& r = p.pipeline.step(p.epoch);
     out.events.insert(out.events.end(), r.events.begin(), r.events.end());
@@ -229,36 +268,58 @@ static void bind_pipeline_class(py::module_& m) {
              config.raw_units_dps = units_dps;
              check(fdi::validate(config));
              auto p = take(fdi::Pipeline::create(calibration, config));
-             const int n = calibration.gyro_count();
-             PyPipeline out{std::move(p), config, n, {}};
-             out.epoch.raw.resize(static_cast<std::size_t>(n));
-             out.epoch.present.resize(static_cast<std::size_t>(n));
-             return out;
+             return std::make_unique<PyPipeline>(std::move(p), config, calibration.gyro_count());
            }),
            "calibration"_a, "config"_a, "units_dps"_a)
       .def_property_readonly("gyro_count", [](const PyPipeline& p) { return p.n; })
       .def_property_readonly("config", [](const PyPipeline& p) { return p.config; })
-      .def("describe_thresholds", [](const PyPipeline& p) { return p.pipeline.describe_thresholds(); })
-      .def("default_noise_warning",
-           [](const PyPipeline& p, const Calibration& cal) {
-             return fdi::default_noise_warning(cal, p.config);
+      .def("describe_thresholds",
+           [](PyPipeline& p) {
+             const InUse in_use(p, "Pipeline.describe_thresholds");
+             return p.pipeline.describe_thresholds();
            })
-      .def("reset", [](PyPipeline& p) { p.pipeline.reset(); })
-      .def("health", [](const PyPipeline& p) { return health_dict(p.pipeline.health(), p.n); })
-      .def("exclude", [](PyPipeline& p, int gyro, std::int64_t stamp_ns,
-                         bool force) { return event_dict(p.pipeline.exclude(gyro, stamp_ns, force), p.n); })
-      .def("reinstate",
-           [](PyPipeline& p, int gyro, std::int64_t stamp_ns) {
-             return event_dict(p.pipeline.reinstate(gyro, stamp_ns), p.n);
+      .def(
+          "default_noise_warning",
+          [](const PyPipeline& p, const Calibration& cal) {
+            return fdi::default_noise_warning(cal, p.config);
+          },
+          "calibration"_a)
+      .def("reset",
+           [](PyPipeline& p) {
+             const InUse in_use(p, "Pipeline.reset");
+             p.pipeline.reset();
            })
-      .def("reset_command",
-           [](PyPipeline& p, std::int64_t stamp_ns) {
-             return event_dict(p.pipeline.reset_command(stamp_ns), p.n);
+      .def("health",
+           [](PyPipeline& p) {
+             const InUse in_use(p, "Pipeline.health");
+             return health_dict(p.pipeline.health(), p.n);
            })
+      .def(
+          "exclude",
+          [](PyPipeline& p, int gyro, std::int64_t stamp_ns, bool force) {
+            const InUse in_use(p, "Pipeline.exclude");
+            return event_dict(p.pipeline.exclude(gyro, stamp_ns, force), p.n);
+          },
+          "gyro"_a, "stamp_ns"_a, "force"_a)
+      .def(
+          "reinstate",
+          [](PyPipeline& p, int gyro, std::int64_t stamp_ns) {
+            const InUse in_use(p, "Pipeline.reinstate");
+            return event_dict(p.pipeline.reinstate(gyro, stamp_ns), p.n);
+          },
+          "gyro"_a, "stamp_ns"_a)
+      .def(
+          "reset_command",
+          [](PyPipeline& p, std::int64_t stamp_ns) {
+            const InUse in_use(p, "Pipeline.reset_command");
+            return event_dict(p.pipeline.reset_command(stamp_ns), p.n);
+          },
+          "stamp_ns"_a)
       .def(
           "step",
           [](PyPipeline& p, const py::handle& time_s, const py::handle& raw, const py::object& present,
              const py::object& reference_wxyz) {
+            const InUse in_use(p, "Pipeline.step");
             const RunInputs in = run_inputs(time_s, raw, present, reference_wxyz, py::none(), p.n);
             if (in.time_s.rows != 1) throw py::value_error("time_s: step takes one epoch");
             fill_epoch(in, 0, static_cast<std::size_t>(p.n), p.epoch);
@@ -275,16 +336,22 @@ static void bind_pipeline_class(py::module_& m) {
       .def(
           "run",
           [](PyPipeline& p, const py::handle& time_s, const py::handle& raw, const py::object& present,
-             const py::object& reference_wxyz, const py::object& reference_present) {
+             const py::object& reference_wxyz, const py::object& reference_present,
+             const py::object& progress) {
+            const InUse in_use(p, "Pipeline.run");
             const RunInputs in = run_inputs(time_s, raw, present, reference_wxyz, reference_present, p.n);
+            Watch watch(progress);
+            Interrupt interrupt = watch.interrupt();
             RunColumns columns;
             {
               py::gil_scoped_release release;
-              columns = run_all(p, in);
+              columns = run_all(p, in, interrupt);
             }
+            watch.raise_if_stopped();  // the rows so far are freed with `columns`
+            watch.done(columns.epochs, in.time_s.rows);
             return run_result(std::move(columns), p.n);
           },
-          "time_s"_a, "raw"_a, "present"_a, "reference_wxyz"_a, "reference_present"_a);
+          "time_s"_a, "raw"_a, "present"_a, "reference_wxyz"_a, "reference_present"_a, "progress"_a);
   m.attr("MODE_NAMES") =
       py::make_tuple(fdi::to_string(fdi::Mode::kNominal), fdi::to_string(fdi::Mode::kDegraded),
                      fdi::to_string(fdi::Mode::kSuspect), fdi::to_string(fdi::Mode::kLost));

@@ -15,7 +15,7 @@ namespace {
 using namespace pybind11::literals;
 
 py::array_t<double> vec3(const Eigen::Vector3d& v) {
-  return to_numpy(std::vector<double>{v.x(), v.y(), v.z()});
+  return read_only(std::vector<double>{v.x(), v.y(), v.z()});
 }
 
 // An attitude or truth series from arrays, checked as the file reader checks a file's rows (finite,
@@ -70,8 +70,10 @@ AttitudeSeries series_from_arrays(const std::string& source, const py::handle& t
 
 static void bind_attitude_series(py::module_& m) {
   py::class_<AttitudeSeries>(m, "AttitudeSeries", "Rows of an attitude (estimate or truth) to score.")
-      .def_readonly("source", &AttitudeSeries::source)
-      .def_property_readonly("epochs", [](const AttitudeSeries& s) { return s.time_s.size(); });
+      .def_readonly("source", &AttitudeSeries::source,
+                    "What the rows came from (a file name or 'attitude'/'truth').")
+      .def_property_readonly(
+          "epochs", [](const AttitudeSeries& s) { return s.time_s.size(); }, "Rows of the series.");
   m.def(
       "_read_attitude_series",
       [](const std::string& path, bool with_sigma) { return take(read_attitude_series(path, with_sigma)); },
@@ -90,7 +92,7 @@ static void bind_attitude_score(py::module_& m) {
           [](const AttitudeScore& s) {
             std::vector<double> v;
             for (const auto& e : s.epochs) v.push_back(e.time_s);
-            return to_numpy(std::move(v));
+            return read_only(std::move(v));
           },
           "[s] the scored attitude rows' times.")
       .def_property_readonly(
@@ -99,7 +101,7 @@ static void bind_attitude_score(py::module_& m) {
             std::vector<double> v;
             for (const auto& e : s.epochs)
               v.insert(v.end(), {e.error_B_deg.x(), e.error_B_deg.y(), e.error_B_deg.z()});
-            return to_numpy(std::move(v), s.epochs.size(), 3);
+            return read_only(std::move(v), s.epochs.size(), 3);
           },
           "[deg] error e_B per scored row, (m, 3).")
       .def_property_readonly(
@@ -108,7 +110,7 @@ static void bind_attitude_score(py::module_& m) {
             std::vector<double> v;
             for (const auto& e : s.epochs)
               v.insert(v.end(), {e.sigma_B_deg.x(), e.sigma_B_deg.y(), e.sigma_B_deg.z()});
-            return to_numpy(std::move(v), s.epochs.size(), 3);
+            return read_only(std::move(v), s.epochs.size(), 3);
           },
           "[deg] per-axis 1σ per scored row (NaN without per-axis columns), (m, 3).")
       .def_property_readonly(
@@ -116,41 +118,58 @@ static void bind_attitude_score(py::module_& m) {
           [](const AttitudeScore& s) {
             std::vector<double> v;
             for (const auto& e : s.epochs) v.push_back(e.sigma_deg);
-            return to_numpy(std::move(v));
+            return read_only(std::move(v));
           },
           "[deg] total 1σ per scored row.")
-      .def_readonly("exact_matches", &AttitudeScore::exact_matches)
-      .def_readonly("interpolated", &AttitudeScore::interpolated)
-      .def_readonly("outside_truth", &AttitudeScore::outside_truth)
-      .def_readonly("per_axis_sigma", &AttitudeScore::per_axis_sigma)
-      .def_property_readonly("rms_B_deg", [](const AttitudeScore& s) { return vec3(s.rms_B_deg); })
-      .def_property_readonly("max_abs_B_deg", [](const AttitudeScore& s) { return vec3(s.max_abs_B_deg); })
-      .def_readonly("rms_total_deg", &AttitudeScore::rms_total_deg)
-      .def_readonly("max_total_deg", &AttitudeScore::max_total_deg)
-      .def_readonly("final_total_deg", &AttitudeScore::final_total_deg)
-      .def_readonly("sigma_epochs", &AttitudeScore::sigma_epochs)
-      .def_readonly("no_sigma_epochs", &AttitudeScore::no_sigma_epochs)
-      .def_readonly("nees_dof", &AttitudeScore::nees_dof)
-      .def_readonly("mean_nees", &AttitudeScore::mean_nees)
+      .def_readonly("exact_matches", &AttitudeScore::exact_matches,
+                    "Attitude rows with a truth row within time_tolerance_s.")
+      .def_readonly("interpolated", &AttitudeScore::interpolated,
+                    "Attitude rows scored against truth interpolated between its rows.")
+      .def_readonly("outside_truth", &AttitudeScore::outside_truth,
+                    "Attitude rows before or after the truth's time span: not scored.")
+      .def_readonly("per_axis_sigma", &AttitudeScore::per_axis_sigma,
+                    "True when the per-axis 1σ (sigma_B_deg) was used, False: the total sigma_deg.")
+      .def_property_readonly(
+          "rms_B_deg", [](const AttitudeScore& s) { return vec3(s.rms_B_deg); },
+          "[deg] RMS of each component of the error e_B, (3,).")
+      .def_property_readonly(
+          "max_abs_B_deg", [](const AttitudeScore& s) { return vec3(s.max_abs_B_deg); },
+          "[deg] largest |e_a| per body axis, (3,).")
+      .def_readonly("rms_total_deg", &AttitudeScore::rms_total_deg, "[deg] RMS of the error angle |e_B|.")
+      .def_readonly("max_total_deg", &AttitudeScore::max_total_deg, "[deg] largest error angle |e_B|.")
+      .def_readonly("final_total_deg", &AttitudeScore::final_total_deg,
+                    "[deg] error angle |e_B| at the last scored row.")
+      .def_readonly("sigma_epochs", &AttitudeScore::sigma_epochs, "Scored rows with a stated (positive) 1σ.")
+      .def_readonly("no_sigma_epochs", &AttitudeScore::no_sigma_epochs,
+                    "Scored rows with a 1σ of 0 or NaN (not in the NEES and σ fractions).")
+      .def_readonly("nees_dof", &AttitudeScore::nees_dof,
+                    "Degrees of freedom of the NEES: 3 with per-axis σ, 1 with the total σ.")
+      .def_readonly("mean_nees", &AttitudeScore::mean_nees,
+                    "Mean NEES: Σ(e_a/σ_a)² over the axes (expectation 3) or |e|²/σ² (expectation 1).")
       .def_property_readonly(
           "within_B",
           [](const AttitudeScore& s) {
             std::vector<double> v;
             for (const auto& w : s.within_B) v.insert(v.end(), {w.x(), w.y(), w.z()});
-            return to_numpy(std::move(v), 3, 3);
+            return read_only(std::move(v), 3, 3);
           },
           "Fractions within 1, 2, 3σ (rows) per axis (columns); NaN without per-axis σ.")
       .def_property_readonly(
           "within_total",
           [](const AttitudeScore& s) {
-            return to_numpy(std::vector<double>(s.within_total.begin(), s.within_total.end()));
+            return read_only(std::vector<double>(s.within_total.begin(), s.within_total.end()));
           },
           "Fractions of the total angle within 1, 2, 3σ.")
-      .def_property_readonly("angle_B_deg", [](const AttitudeScore& s) { return vec3(s.angle_B_deg); })
-      .def_property_readonly("truth_angle_B_deg",
-                             [](const AttitudeScore& s) { return vec3(s.truth_angle_B_deg); })
-      .def_readonly("angle_axis_deg", &AttitudeScore::angle_axis_deg)
-      .def_readonly("truth_angle_axis_deg", &AttitudeScore::truth_angle_axis_deg);
+      .def_property_readonly(
+          "angle_B_deg", [](const AttitudeScore& s) { return vec3(s.angle_B_deg); },
+          "[deg] the estimate's rate integrated per body axis, (3,).")
+      .def_property_readonly(
+          "truth_angle_B_deg", [](const AttitudeScore& s) { return vec3(s.truth_angle_B_deg); },
+          "[deg] the same from the truth's rates, (3,).")
+      .def_readonly("angle_axis_deg", &AttitudeScore::angle_axis_deg,
+                    "[deg] the estimate's rate integrated about axis_B (the seed experiment's angle).")
+      .def_readonly("truth_angle_axis_deg", &AttitudeScore::truth_angle_axis_deg,
+                    "[deg] the same from the truth's rates.");
 }
 
 static void bind_score_function(py::module_& m) {

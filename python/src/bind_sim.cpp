@@ -11,6 +11,7 @@
 #include "tetra/sim/scenario.hpp"
 #include "tetra/sim/simulator.hpp"
 #include "tetra/sim/turntable.hpp"
+#include "watch.hpp"
 
 namespace tetra::python {
 
@@ -96,21 +97,26 @@ static void bind_sim_runs(py::module_& m) {
       .def_readonly("truth", &SimRun::truth, "The truth (a tetra.Truth).");
   m.def(
       "_simulate",
-      [](const sim::Scenario& scenario, std::uint64_t seed) {
+      // The scenario by value: a copy no other thread can change while the GIL is released.
+      [](sim::Scenario scenario, std::uint64_t seed, const py::object& progress) {
         sim::SimOptions options;
         options.seed = seed;
         sim::Truth truth;
+        Watch watch(progress);
+        Interrupt interrupt = watch.interrupt();
         Result<GyroLog> log = bad_input("");
         {
           py::gil_scoped_release release;
-          log = sim::simulate_log(scenario, options, &truth);
+          log = sim::simulate_log(scenario, options, &truth, &interrupt);
         }
+        watch.raise_if_stopped();
         SimRun run;
         run.log = to_python(take(std::move(log)));
         run.truth = to_python(std::move(truth));
+        watch.done(run.truth.time_s.size(), run.truth.time_s.size());
         return run;
       },
-      "scenario"_a, "seed"_a);
+      "scenario"_a, "seed"_a, "progress"_a);
 
   m.def(
       "_simulate_turntable",

@@ -100,9 +100,10 @@ MaskArray mask(const py::handle& obj, const char* name, std::size_t rows, std::s
   const char kind = a.dtype().kind();
   const bool byte_sized = (kind == 'b' || kind == 'u') && a.itemsize() == 1;
   if (byte_sized && (a.flags() & py::array::c_style) != 0) {
-    out.holder = a;  // bool and uint8 are one byte 0/1: read in place
+    out.holder = a;  // bool and uint8: one byte, read in place (the library takes any nonzero as present)
   } else {
-    out.holder = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    // Nonzero is present: a cast to uint8 would wrap (256 -> 0) or truncate (0.5 -> 0).
+    out.holder = a.attr("astype")(py::dtype("bool"), py::arg("order") = "C");
   }
   out.data = static_cast<const std::uint8_t*>(out.holder.data());
   return out;

@@ -70,6 +70,23 @@ py::array_t<T> to_numpy(std::vector<T>&& values) {
   return to_numpy(std::move(values), n);
 }
 
+//! `a` made read-only: for arrays a property computes afresh at each access (a copy of the object's
+//! values), so that assigning into one raises instead of changing nothing.
+template <class T>
+py::array_t<T> read_only(py::array_t<T> a) {
+  a.attr("setflags")(py::arg("write") = false);
+  return a;
+}
+//! The same for a vector handed over (to_numpy's shapes).
+template <class T>
+py::array_t<T> read_only(std::vector<T>&& values, std::size_t rows, std::size_t cols = 0) {
+  return read_only(to_numpy(std::move(values), rows, cols));
+}
+template <class T>
+py::array_t<T> read_only(std::vector<T>&& values) {
+  return read_only(to_numpy(std::move(values)));
+}
+
 //! The bindings, one function per file.
 void bind_calibration(py::module_& m);
 void bind_logs(py::module_& m);

@@ -9,13 +9,18 @@ converted once (one copy). Results are numpy arrays that own the library's memor
 numpy is imported when first needed (``import tetra`` alone does not need it).
 Errors: the library's messages raise ``tetra.BadInputError`` (bad input: a ValueError) or ``tetra.Error``
 (other failures); arguments of the wrong shape or dtype raise ValueError or TypeError naming the argument.
+Warnings (``tetra.DefaultNoiseWarning``) go through Python's ``warnings``.
+Long calls (``Pipeline.run``, ``run_log``, ``sim``, ``allan``, ``campaign``) stop on Ctrl-C within a few
+milliseconds (KeyboardInterrupt) and take ``progress=``: a callable ``progress(done, total)`` or a tqdm bar.
 """
 from __future__ import annotations
 
 import json
 import math
+import numbers
 import os
-from typing import Any, Mapping, Optional, Sequence, Union
+import warnings
+from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 from . import _tetra
 from ._tetra import (
@@ -44,11 +49,16 @@ __version__ = _tetra.__version__
 
 __all__ = [
     "AllanResult", "AttitudeScore", "BadInputError", "Calibration", "CalibrationResult", "CampaignResult",
-    "CampaignSpec", "Error", "GyroAllan", "GyroLog", "LogAllan", "MODE_NAMES", "NoiseFit", "ONE_SIGMA_CONFIDENCE",
+    "CampaignSpec", "DefaultNoiseWarning", "Error", "GyroAllan", "GyroLog", "LogAllan", "MODE_NAMES", "NoiseFit", "ONE_SIGMA_CONFIDENCE",
     "Pipeline", "PipelineConfig", "PipelineRun", "Scenario", "SimRun", "Truth", "allan", "allan_log",
     "builtin_scenarios", "calibrate", "campaign", "campaign_spec", "log_frame", "pipeline_config",
-    "read_gyro_log", "scenario", "score", "sim", "simulate_turntable", "truth_frame",
+    "oadev", "read_gyro_log", "scenario", "score", "sim", "simulate_turntable", "truth_frame",
 ]
+
+
+class DefaultNoiseWarning(UserWarning):
+    """A gyro of the calibration has no ``noise:`` section: fault detection runs on conservative default
+    noise figures (the warning ``tetra replay`` prints; ``tetra allan --update-calibration`` measures them)."""
 
 PathLike = Union[str, "os.PathLike[str]"]
 _RAD_TO_DEG = 180.0 / math.pi  # the libraries' kRadToDeg: the same double
@@ -56,6 +66,32 @@ _RAD_TO_DEG = 180.0 / math.pi  # the libraries' kRadToDeg: the same double
 
 def _is_path(value: Any) -> bool:
     return isinstance(value, (str, os.PathLike))
+
+
+def _progress(progress: Any) -> Any:
+    """``progress=`` as the callable the module calls with (done, total): None, a callable, a tqdm-like
+    bar (an object with ``update(n)``: its ``total`` is set when it has none, and it is advanced by the
+    work done since the last call), or such a bar's class (``progress=tqdm``: a bar made for the call and
+    closed at its end)."""
+    if progress is None or (callable(progress) and not hasattr(progress, "update")):
+        return progress
+    if not hasattr(progress, "update"):
+        raise TypeError("progress: expected None, a callable progress(done, total) or a tqdm bar")
+    own = isinstance(progress, type)
+    bar = progress() if own else progress
+    reported = [0]
+
+    def advance(done: int, total: int) -> None:
+        if getattr(bar, "total", None) in (None, 0) and total:
+            bar.total = total
+            if hasattr(bar, "refresh"):
+                bar.refresh()
+        if done > reported[0]:
+            bar.update(done - reported[0])
+            reported[0] = done
+        if own and total and done >= total:
+            bar.close()
+    return advance
 
 
 def _yaml_text(mapping: Mapping[str, Any], what: str) -> str:
@@ -121,21 +157,103 @@ def _taus(taus: Taus) -> Union[str, list]:
     return taus if isinstance(taus, str) else [float(t) for t in taus]
 
 
-def allan(rate: Any, tau0_s: float, *, present: Any = None, taus: Taus = "default",
-          confidence: float = ONE_SIGMA_CONFIDENCE) -> Union[AllanResult, list]:
+def allan(data: Any = None, tau0_s: Optional[float] = None, *, rate: Any = None, present: Any = None,
+          taus: Taus = "default", confidence: float = ONE_SIGMA_CONFIDENCE,
+          progress: Any = None) -> Union[AllanResult, list]:
     """Overlapping Allan deviation, confidence intervals and the IEEE 952 noise terms of uniformly sampled
-    rate data (``tetra allan``'s analysis). ``rate``: shape (n,) — or (n, k) for k series, giving a list —
-    in any unit (the terms come in it); NaN or ``present`` == 0 marks a sample not delivered. ``tau0_s``
-    [s]: the sampling interval. ``taus``: 'default', 'octave', 'decade', 'all' or a list of τ [s]."""
+    rate data (``tetra allan``'s analysis). ``data``: shape (n,) — or (n, k) for k series, giving a list —
+    in any unit (the terms come in it); NaN or ``present`` == 0 (any nonzero: present) marks a sample not
+    delivered; ``present`` is shaped like ``data``, or (n,) for every series of a 2-D ``data``.
+    ``tau0_s`` [s]: the sampling interval, or ``rate`` [Hz] the sampling rate (as allantools takes it).
+    ``taus``: 'default', 'octave', 'decade', 'all' or a list of τ [s]. ``progress``: see the package's
+    docstring (averaging times done). ``tetra.oadev`` (also ``tetra.allan.oadev``) is allantools' call.
+
+    (``rate=`` given an array instead of a number is the data: ``allan(rate=y, tau0_s=0.1)`` still works.)
+    """
     import numpy as np
+    if rate is not None and not isinstance(rate, numbers.Real):
+        if data is not None:
+            raise TypeError("allan: data given twice (data and rate=; rate= is the sampling rate [Hz])")
+        data, rate = rate, None
+    if data is None:
+        raise TypeError("allan: missing the data (the rate samples)")
+    tau0_s = _sampling_interval(tau0_s, rate)
     t = _taus(taus)
-    arr = np.asarray(rate)
+    report = _progress(progress)
+    arr = np.asarray(data)
     if arr.ndim == 2:
         pres = None if present is None else np.asarray(present)
+        if pres is not None and pres.shape not in (arr.shape, arr.shape[:1]):
+            raise ValueError(f"present: expected shape {arr.shape} like data, or ({arr.shape[0]},) for every "
+                             f"series, got {pres.shape}")
+
+        def column_present(j: int) -> Any:
+            if pres is None:
+                return None
+            return pres if pres.ndim == 1 else np.ascontiguousarray(pres[:, j])
+        def column_report(j: int) -> Any:  # the series one after the other: (done, total) over all of them
+            k = arr.shape[1]
+            return None if report is None else (lambda done, total: report(j * total + done, k * total))
         return [_tetra._allan_series(np.ascontiguousarray(arr[:, j], dtype=np.float64), tau0_s,
-                                     None if pres is None else np.ascontiguousarray(pres[:, j]), t, confidence)
+                                     column_present(j), t, confidence, column_report(j))
                 for j in range(arr.shape[1])]
-    return _tetra._allan_series(rate, tau0_s, present, t, confidence)
+    return _tetra._allan_series(data, tau0_s, present, t, confidence, report)
+
+
+def _sampling_interval(tau0_s: Optional[float], rate: Optional[float]) -> float:
+    if (tau0_s is None) == (rate is None):
+        raise TypeError("allan: give the sampling interval tau0_s [s] or the sampling rate rate= [Hz], one of them")
+    if rate is not None:
+        if not (math.isfinite(rate) and rate > 0):
+            raise ValueError("rate: the sampling rate [Hz] must be a positive number")
+        return 1.0 / float(rate)
+    return float(tau0_s)  # type: ignore[arg-type]
+
+
+def oadev(data: Any, rate: float = 1.0, data_type: str = "phase", taus: Any = None) -> tuple:
+    """Overlapping Allan deviation as allantools' ``oadev`` gives it: ``(taus, devs, errs, ns)``, numpy
+    arrays (errs = devs/√ns, ns as floats), computed by tetra's library. ``data``: 1-D, 'phase' (angle or
+    time: the integral of the rate) or 'freq' (rate) samples at ``rate`` [Hz]; ``taus``: None or 'octave'
+    (2^k τ0), 'decade' (1, 2, 4 × 10^k τ0), 'all', or τ values [s] (each rounded to a multiple of τ0).
+    Averaging times are kept, as allantools keeps them, where at least two second differences exist. A NaN
+    sample is a gap (allantools lets it propagate). For the confidence intervals and the noise terms, use
+    ``tetra.allan``."""
+    import numpy as np
+    if data_type not in ("phase", "freq"):
+        raise ValueError(f"data_type: expected 'phase' or 'freq', got {data_type!r}")
+    if not (isinstance(rate, numbers.Real) and math.isfinite(rate) and rate > 0):
+        raise ValueError("rate: the sampling rate [Hz] must be a positive number")
+    x = np.asarray(data, dtype=np.float64)
+    if x.ndim != 1:
+        raise ValueError(f"data: expected a 1-D array, got shape {x.shape}")
+    y = np.diff(x) * rate if data_type == "phase" else x
+    phase_points = len(y) + 1
+    if isinstance(taus, str) or taus is None:
+        spacing = "octave" if taus is None else taus
+        if spacing == "all":
+            m = np.arange(1, phase_points + 1, dtype=np.float64)
+        elif spacing == "octave":
+            m = 2.0 ** np.arange(int(np.floor(np.log2(phase_points))) + 1)
+        elif spacing == "decade":
+            m = np.array([f * 10.0 ** k for k in range(int(np.floor(np.log10(phase_points))) + 1)
+                          for f in (1.0, 2.0, 4.0)])
+        else:
+            raise ValueError(f"taus: expected None, 'octave', 'decade', 'all' or averaging times [s], got {taus!r}")
+    else:
+        m = np.round(np.asarray(taus, dtype=np.float64) * rate)
+    # allantools' tau_generator and remove_small_ns: 0 < m < N phase points, at least 2 terms (N - 2m).
+    m = np.unique(m[(m > 0) & (m < phase_points) & (phase_points - 2 * m >= 2)])
+    if len(m) == 0:
+        empty = np.zeros(0)
+        return empty, empty.copy(), empty.copy(), empty.copy()
+    r = _tetra._allan_series(np.ascontiguousarray(y), 1.0 / rate, None, [float(k) / rate for k in m],
+                             ONE_SIGMA_CONFIDENCE, None)
+    ns = np.asarray(r.terms, dtype=np.float64)
+    devs = np.array(r.adev)
+    return np.array(r.tau_s), devs, devs / np.sqrt(ns), ns
+
+
+allan.oadev = oadev  # type: ignore[attr-defined]
 
 
 def allan_log(path: PathLike, *, calibration: Optional[Calibration] = None,
@@ -171,12 +289,13 @@ def scenario(spec: Union[str, PathLike, Mapping[str, Any], Scenario], *, duratio
 
 
 def sim(spec: Union[str, PathLike, Mapping[str, Any], Scenario], *, seed: int = 1,
-        duration_s: Optional[float] = None, rate_hz: Optional[float] = None) -> SimRun:
+        duration_s: Optional[float] = None, rate_hz: Optional[float] = None, progress: Any = None) -> SimRun:
     """Simulates a scenario (``tetra sim``): its gyro log (``.log``, a GyroLog in volts, with reference
     columns when the scenario has a reference) and its truth (``.truth``), as numpy arrays; the same seed
     gives the same numbers, bit for bit, as ``tetra sim``'s files. ``log_frame``/``truth_frame`` make
-    pandas frames of them."""
-    return _tetra._simulate(scenario(spec, duration_s=duration_s, rate_hz=rate_hz), seed)
+    pandas frames of them. ``progress``: see the package's docstring (epochs simulated). Ctrl-C stops it
+    (KeyboardInterrupt; nothing is kept)."""
+    return _tetra._simulate(scenario(spec, duration_s=duration_s, rate_hz=rate_hz), seed, _progress(progress))
 
 
 def log_frame(log: GyroLog):
@@ -282,7 +401,11 @@ class Pipeline:
     ``tetra fusion`` service run: raw gyro epochs in; attitude, 1σ, mode and FDI events out.
 
     ``calibration``: a Calibration (or a file name); ``config``: see ``pipeline_config``; ``units_dps``: the
-    samples are rates [deg/s] (a log with ``# units=dps``) rather than volts.
+    samples are rates [deg/s] (a log with ``# units=dps``) rather than volts. A calibration without
+    ``noise:`` sections gives a ``DefaultNoiseWarning`` (``warnings``), as ``tetra replay`` warns.
+
+    Threads: a Pipeline serves one call at a time. A call made while another runs on it (from another
+    thread, or from a run's progress callback) raises RuntimeError; give each thread its own Pipeline.
     """
 
     def __init__(self, calibration: Union[Calibration, PathLike],
@@ -291,6 +414,9 @@ class Pipeline:
         self.calibration = calibration if isinstance(calibration, Calibration) else Calibration.read(
             os.fspath(calibration))
         self._p = _tetra._Pipeline(self.calibration, pipeline_config(config), units_dps)
+        warning = self._p.default_noise_warning(self.calibration)
+        if warning:
+            warnings.warn(warning, DefaultNoiseWarning, stacklevel=2)
 
     @property
     def gyro_count(self) -> int:
@@ -312,15 +438,21 @@ class Pipeline:
         return self._p.step(t, r, p, q)
 
     def run(self, time_s: Any, raw: Any, present: Any = None, reference_wxyz: Any = None,
-            reference_present: Any = None) -> PipelineRun:
+            reference_present: Any = None, *, progress: Any = None) -> PipelineRun:
         """Every epoch in C++ (no Python per epoch; the GIL released): ``time_s`` (n,), ``raw`` (n, N),
-        ``present`` (n, N) or None (all delivered), ``reference_wxyz`` (n, 4) with NaN rows where there is
-        no reference (or ``reference_present`` (n,)). float64 C-contiguous arrays are read in place."""
-        return PipelineRun(self._p.run(time_s, raw, present, reference_wxyz, reference_present), self.gyro_count)
+        ``present`` (n, N) or None (all delivered; any nonzero is present), ``reference_wxyz`` (n, 4) with
+        NaN rows where there is no reference (or ``reference_present`` (n,)). float64 C-contiguous arrays
+        are read in place. ``progress``: see the package's docstring (epochs done).
 
-    def run_log(self, log: GyroLog) -> PipelineRun:
+        Ctrl-C raises KeyboardInterrupt within a few milliseconds; the rows made so far are dropped and the
+        pipeline keeps the state of the epochs it stepped (``reset()`` to start again)."""
+        return PipelineRun(self._p.run(time_s, raw, present, reference_wxyz, reference_present,
+                                       _progress(progress)), self.gyro_count)
+
+    def run_log(self, log: GyroLog, *, progress: Any = None) -> PipelineRun:
         """``run`` over a GyroLog (``read_gyro_log``, ``sim(...).log``), as ``tetra replay`` runs a file."""
-        return self.run(log.time_s, log.values, log.present, log.reference_wxyz, log.reference_present)
+        return self.run(log.time_s, log.values, log.present, log.reference_wxyz, log.reference_present,
+                        progress=progress)
 
     def reset(self) -> None:
         """Back to the initial state (all gyros reinstated, the configured initial attitude)."""
@@ -363,14 +495,43 @@ def _series(value: Any, with_sigma: bool, what: str):
         return _tetra._attitude_series(what, value["time_s"], value["q_RB_wxyz"], value["omega_BR_B_dps"],
                                        value.get("sigma_deg") if with_sigma else None,
                                        value.get("sigma_B_deg") if with_sigma else None)
-    raise TypeError(f"{what}: expected a file name, a PipelineRun, a Truth/SimRun or a mapping of arrays")
+    if hasattr(value, "columns") and hasattr(value, "to_numpy"):
+        return _frame_series(value, with_sigma, what)
+    raise TypeError(f"{what}: expected a file name, a PipelineRun, a Truth/SimRun, a DataFrame with the "
+                    "columns of the attitude or truth file, or a mapping of arrays")
+
+
+_FRAME_Q = ["qw", "qx", "qy", "qz"]
+_FRAME_W = ["wx_dps", "wy_dps", "wz_dps"]
+_FRAME_SIGMA_B = ["sigma_x_deg", "sigma_y_deg", "sigma_z_deg"]
+
+
+def _frame_series(frame: Any, with_sigma: bool, what: str) -> Any:
+    """A pandas DataFrame with the columns of ``tetra replay --attitude`` (``PipelineRun.attitude_frame()``)
+    or ``tetra sim --truth`` (``truth_frame()``)."""
+    import numpy as np
+    columns = set(frame.columns)
+    missing = [c for c in ["time_s", *_FRAME_Q, *_FRAME_W] if c not in columns]
+    if missing:
+        raise ValueError(f"{what}: the DataFrame lacks the columns " + ", ".join(missing))
+
+    def block(names: list) -> Any:
+        return np.ascontiguousarray(frame[names].to_numpy(dtype=np.float64))
+    sigma = sigma_b = None
+    if with_sigma and "sigma_deg" in columns:
+        sigma = np.ascontiguousarray(frame["sigma_deg"].to_numpy(dtype=np.float64))
+    if with_sigma and columns.issuperset(_FRAME_SIGMA_B):
+        sigma_b = block(_FRAME_SIGMA_B)
+    return _tetra._attitude_series(what, np.ascontiguousarray(frame["time_s"].to_numpy(dtype=np.float64)),
+                                   block(_FRAME_Q), block(_FRAME_W), sigma, sigma_b)
 
 
 def score(attitude: Any, truth: Any, *, time_tolerance_s: float = 1e-6,
           axis_B: Sequence[float] = (0.0, 1.0, 0.0)) -> AttitudeScore:
-    """``tetra score``: an attitude estimate (a ``tetra replay --attitude`` file, a PipelineRun, or a mapping
-    of time_s, q_RB_wxyz, omega_BR_B_dps, sigma_deg[, sigma_B_deg]) against the truth (a ``tetra sim
-    --truth`` file, a Truth or SimRun, or a mapping of time_s, q_RB_wxyz, omega_BR_B_dps)."""
+    """``tetra score``: an attitude estimate (a ``tetra replay --attitude`` file, a PipelineRun, its
+    ``attitude_frame()``, or a mapping of time_s, q_RB_wxyz, omega_BR_B_dps, sigma_deg[, sigma_B_deg])
+    against the truth (a ``tetra sim --truth`` file, a Truth or SimRun, ``truth_frame()``, or a mapping of
+    time_s, q_RB_wxyz, omega_BR_B_dps)."""
     return _tetra._score(_series(attitude, True, "attitude"), _series(truth, False, "truth"),
                          float(time_tolerance_s), [float(a) for a in axis_B])
 
@@ -397,29 +558,55 @@ class CampaignResult:
     ``report`` (report.md for these runs, byte for byte ``tetra campaign``'s; its plots are drawn by the
     command, or from ``rows`` with matplotlib)."""
 
-    def __init__(self, csv: str, report: str = ""):
-        import io
-
-        import pandas as pd
+    def __init__(self, csv: str, report: Union[str, Callable[[str], str]] = ""):
         self.csv = csv
-        self.report = report
-        # round_trip: the rows' shortest round-trip numbers read back to the same doubles
-        self.rows = pd.read_csv(io.StringIO(csv), float_precision="round_trip",
-                                dtype={"scenario": str, "kind": str, "outcome": str})
+        self._report = report
+        self._rows = None
+
+    @property
+    def rows(self):
+        """The rows as a pandas DataFrame (the columns of runs.csv; made at the first access)."""
+        if self._rows is None:
+            import io
+
+            import pandas as pd
+            # round_trip: the rows' shortest round-trip numbers read back to the same doubles
+            self._rows = pd.read_csv(io.StringIO(self.csv), float_precision="round_trip",
+                                     dtype={"scenario": str, "kind": str, "outcome": str})
+        return self._rows
+
+    @property
+    def report(self) -> str:
+        """report.md for these runs (made at the first access)."""
+        if callable(self._report):
+            self._report = self._report(self.csv)
+        return self._report
 
     def __len__(self) -> int:
-        return len(self.rows)
+        return self.csv.count("\n") - 1
 
     def __repr__(self) -> str:
-        return f"<tetra.CampaignResult runs={len(self.rows)}>"
+        return f"<tetra.CampaignResult runs={len(self)}>"
 
 
 def campaign(spec: Union[PathLike, Mapping[str, Any], CampaignSpec], *, runs: Optional[Sequence[int]] = None,
-             base_dir: Optional[PathLike] = None) -> CampaignResult:
-    """Runs a campaign in process (``tetra campaign`` with ``target: in_process``), one run after the other
-    with the GIL released: every run of the matrix, or the run ids ``runs``; a run that fails is an error
-    row, as ``tetra campaign`` writes it. The result's ``report`` is ``tetra campaign``'s report.md."""
+             base_dir: Optional[PathLike] = None, jobs: int = 1, progress: Any = None) -> CampaignResult:
+    """Runs a campaign in process (``tetra campaign`` with ``target: in_process``) with the GIL released:
+    every run of the matrix, or the run ids ``runs`` (each once); a run that fails is an error row, as
+    ``tetra campaign`` writes it. ``jobs``: runs at a time, in threads of this process (``os.cpu_count()``
+    for all cores); the rows are the same whatever ``jobs``. ``progress``: see the package's docstring
+    (runs done). The result's ``report`` is ``tetra campaign``'s report.md.
+
+    Ctrl-C raises KeyboardInterrupt within a few milliseconds; the runs under way are dropped and the
+    exception's ``partial`` is the CampaignResult of the runs done, so that
+    ``campaign(spec, runs=[r for r in range(campaign_spec(spec).runs) if r not in set(e.partial.rows.run)])``
+    continues, as ``tetra campaign`` resumes."""
     s = campaign_spec(spec, base_dir=base_dir)
-    lines = _tetra._campaign_rows(s, None if runs is None else [int(r) for r in runs])
+    lines, stopped = _tetra._campaign_rows(s, None if runs is None else [int(r) for r in runs], int(jobs),
+                                           _progress(progress))
     csv = _tetra._campaign_csv_header(s) + "\n" + "".join(line + "\n" for line in lines)
-    return CampaignResult(csv, _tetra._campaign_report(s, csv))
+    result = CampaignResult(csv, lambda text: _tetra._campaign_report(s, text))
+    if stopped is not None:
+        stopped.partial = result
+        raise stopped
+    return result

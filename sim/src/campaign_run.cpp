@@ -56,12 +56,12 @@ SimOptions case_options(const CampaignCase& c) {
 }
 
 Result<CampaignRow> run_closed(const CampaignSpec& spec, const CampaignCase& c, const Scenario& sc,
-                               const EstimatorFactory& make) {
+                               const EstimatorFactory& make, Interrupt* interrupt) {
   auto simulator = ClosedLoopSimulator::create(sc, case_options(c));
   if (!simulator) return simulator.error();
   auto estimator = make(pipeline_view(spec, c, sc), c, simulator->initial_q_NB());
   if (!estimator) return estimator.error();
-  auto record = run_closed_loop(*simulator, **estimator);
+  auto record = run_closed_loop(*simulator, **estimator, interrupt);
   if (!record) return record.error();
   const PointingSummary summary = summarize(*record, *simulator);
   CampaignRow row = case_row(spec, c, sc);
@@ -80,13 +80,13 @@ Result<CampaignRow> run_closed(const CampaignSpec& spec, const CampaignCase& c, 
 }
 
 Result<CampaignRow> run_open(const CampaignSpec& spec, const CampaignCase& c, const Scenario& sc,
-                             const EstimatorFactory& make) {
+                             const EstimatorFactory& make, Interrupt* interrupt) {
   const SimOptions options = case_options(c);
   auto simulator = Simulator::create(sc, options);
   if (!simulator) return simulator.error();
   auto estimator = make(pipeline_view(spec, c, sc), c, open_loop_initial_q_RB(*simulator));
   if (!estimator) return estimator.error();
-  auto record = run_open_loop(*simulator, **estimator);
+  auto record = run_open_loop(*simulator, **estimator, interrupt);
   if (!record) return record.error();
   CampaignRow row = case_row(spec, c, sc);
   row.fdi = judge_fdi(record->events, all_faults(sc, options), sc.duration_s);
@@ -129,18 +129,20 @@ EstimatorFactory in_process_estimators(const CampaignSpec& spec) {
 }
 
 Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCase& c,
-                                      const EstimatorFactory& make) {
+                                      const EstimatorFactory& make, Interrupt* interrupt) {
   const Scenario sc = campaign_scenario(spec, c);
-  return spec.loop == CampaignLoop::kClosed ? run_closed(spec, c, sc, make) : run_open(spec, c, sc, make);
+  return spec.loop == CampaignLoop::kClosed ? run_closed(spec, c, sc, make, interrupt)
+                                            : run_open(spec, c, sc, make, interrupt);
 }
 
 Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCase& c) {
   return run_campaign_case(spec, c, in_process_estimators(spec));
 }
 
-CampaignRow campaign_run_row(const CampaignSpec& spec, std::size_t index, const EstimatorFactory& make) {
+CampaignRow campaign_run_row(const CampaignSpec& spec, std::size_t index, const EstimatorFactory& make,
+                             Interrupt* interrupt) {
   try {
-    auto row = run_campaign_case(spec, campaign_case(spec, index), make);
+    auto row = run_campaign_case(spec, campaign_case(spec, index), make, interrupt);
     return row ? *row : campaign_error_row(spec, index, describe(row.error()));
   } catch (const std::exception& e) {
     return campaign_error_row(spec, index, std::string("exception: ") + e.what());

@@ -65,6 +65,13 @@ Result<EstimatorOutput> PipelineEstimator::estimate(const SimEpoch& epoch) {
 
 Result<ClosedLoopRecord> run_closed_loop(ClosedLoopSimulator& simulator, Estimator& estimator,
                                          bool (*stop)()) {
+  if (stop == nullptr) return run_closed_loop(simulator, estimator, static_cast<Interrupt*>(nullptr));
+  Interrupt interrupt([stop](std::size_t, std::size_t) { return stop(); });
+  return run_closed_loop(simulator, estimator, &interrupt);
+}
+
+Result<ClosedLoopRecord> run_closed_loop(ClosedLoopSimulator& simulator, Estimator& estimator,
+                                         Interrupt* interrupt) {
   const auto start = std::chrono::steady_clock::now();
   ClosedLoopRecord record;
   record.series.reserve(simulator.epoch_count());
@@ -72,7 +79,8 @@ Result<ClosedLoopRecord> run_closed_loop(ClosedLoopSimulator& simulator, Estimat
   const double h_max = simulator.spec().wheels.max_momentum_Nms;
   SimEpoch epoch;
   while (simulator.next(epoch)) {
-    if (stop != nullptr && stop()) return failure("interrupted");
+    if (interrupt_requested(interrupt, simulator.epochs_done(), simulator.epoch_count()))
+      return interrupted();
     auto out = estimator.estimate(epoch);
     if (!out) return out.error();
     if (out->latest) latest = out->latest;

@@ -10,13 +10,15 @@ Quaternion open_loop_initial_q_RB(const Simulator& simulator) {
   return simulator.motion().at(0.0).q_RB;
 }
 
-Result<OpenLoopRecord> run_open_loop(Simulator& simulator, Estimator& estimator) {
+Result<OpenLoopRecord> run_open_loop(Simulator& simulator, Estimator& estimator, Interrupt* interrupt) {
   constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
   OpenLoopRecord record;
   record.final_knowledge_error_deg = kUnknown;
   record.final_sigma_deg = kUnknown;
   SimEpoch epoch;
   while (simulator.next(epoch)) {
+    if (interrupt_requested(interrupt, simulator.epochs_done(), simulator.epoch_count()))
+      return interrupted();
     auto out = estimator.estimate(epoch);
     if (!out) return out.error();
     record.events.insert(record.events.end(), out->events.begin(), out->events.end());

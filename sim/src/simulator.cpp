@@ -126,7 +126,8 @@ std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
   return meta;
 }
 
-Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options, Truth* truth) {
+Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options, Truth* truth,
+                             Interrupt* interrupt) {
   auto created = Simulator::create(scenario, options);
   if (!created) return created.error();
   Simulator& sim = created.value();
@@ -140,9 +141,25 @@ Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options
   log.time_s.reserve(e);
   log.values.reserve(e * static_cast<std::size_t>(n));
   log.present.reserve(e * static_cast<std::size_t>(n));
-  if (truth) *truth = Truth{};
+  log.lines.reserve(e);
+  if (log.has_reference) {
+    log.reference_present.reserve(e);
+    log.reference_wxyz.reserve(e);
+  }
+  if (truth) {
+    // Reserved like the log: no reallocation (a copy of all so far) between two polls of `interrupt`.
+    *truth = Truth{};
+    truth->time_s.reserve(e);
+    truth->q_RB.reserve(e);
+    truth->omega_BR_B_rad_s.reserve(e);
+    truth->omega_BN_B_rad_s.reserve(e);
+  }
   SimEpoch epoch;
   while (sim.next(epoch)) {
+    if (sim.epochs_done() % 64 == 0 && interrupt_requested(interrupt, sim.epochs_done(), e)) {
+      if (truth) *truth = Truth{};  // no partial truth behind
+      return interrupted();
+    }
     log.time_s.push_back(epoch.time_s);
     log.values.insert(log.values.end(), epoch.raw_V.begin(), epoch.raw_V.end());
     log.present.insert(log.present.end(), epoch.present.begin(), epoch.present.end());

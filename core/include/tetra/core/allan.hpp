@@ -33,6 +33,7 @@
 #include "tetra/core/allan_stats.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/interrupt.hpp"
 #include "tetra/core/result.hpp"
 
 namespace tetra::allan {
@@ -98,9 +99,11 @@ struct AvarPoint {
 };
 
 //! Overlapping Allan variance at each averaging factor. `present` (same length as `rate`, or empty
-//! for "all present") marks delivered samples; a NaN rate counts as not present.
+//! for "all present") marks delivered samples; a NaN rate counts as not present. `interrupt` (optional)
+//! is polled before each factor: once it asks to stop, the points computed so far are returned.
 std::vector<AvarPoint> overlapping_avar(std::span<const double> rate, std::span<const std::uint8_t> present,
-                                        double tau0_s, std::span<const std::int64_t> m_values);
+                                        double tau0_s, std::span<const std::int64_t> m_values,
+                                        Interrupt* interrupt = nullptr);
 
 // --- noise model -------------------------------------------------------------------------------
 
@@ -143,7 +146,10 @@ struct NoiseFit {
 //! Non-negative weighted least-squares fit of the five terms to the points (exact: every subset of
 //! terms is solved and the best one with all coefficients ≥ 0 kept), then the "observed" test.
 //! Weights are edf/(2σ⁴) with σ² from `weights_from`'s model when given, else the measured value.
-NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weights_from = nullptr);
+//! `interrupt` (optional) is polled between the subsets and every 16 points of the "observed" test (each
+//! point reported as all done): once it asks to stop, the fit returned is unfinished.
+NoiseFit fit_noise_terms(std::span<const AdevPoint> points, const NoiseFit* weights_from = nullptr,
+                         Interrupt* interrupt = nullptr);
 
 // --- whole analysis ----------------------------------------------------------------------------
 
@@ -152,6 +158,11 @@ inline constexpr double kOneSigmaConfidence = 0.682689492137086;  //!< erf(1/√
 struct AllanOptions {
   TauSpec taus;                             //!< averaging times
   double confidence = kOneSigmaConfidence;  //!< two-sided confidence level of the intervals
+  //! analyze_series polls it (optional, not owned) before each averaging time (τ done of the τ asked)
+  //! and every 16 points of the intervals (reported as all τ done): when it asks to stop, the call returns
+  //! interrupted(). The log analyses (analyze_gyro_log, analyze_gyro_log_file), which run gyros in parallel,
+  //! ignore it.
+  Interrupt* interrupt = nullptr;
 };
 
 struct AllanResult {

@@ -125,14 +125,17 @@ EstimatorFactory in_process_estimators(const CampaignSpec& spec);
 //! commas and line breaks become ';' and ' ', so the row stays one CSV line).
 CampaignRow campaign_error_row(const CampaignSpec& spec, std::size_t index, const std::string& message);
 
-//! Runs one case to its row, with the estimator `make` gives.
+//! Runs one case to its row, with the estimator `make` gives. `interrupt` (optional) is polled every
+//! epoch of the run (epochs done of the run's): when it asks to stop, the case returns interrupted().
 Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCase& c,
-                                      const EstimatorFactory& make);
+                                      const EstimatorFactory& make, Interrupt* interrupt = nullptr);
 //! Runs one case to its row with the pipeline in process.
 Result<CampaignRow> run_campaign_case(const CampaignSpec& spec, const CampaignCase& c);
 //! The row of run `index` whatever happens in it: its result, or an error row (campaign_error_row) with
-//! the message of an error value or of an exception.
-CampaignRow campaign_run_row(const CampaignSpec& spec, std::size_t index, const EstimatorFactory& make);
+//! the message of an error value or of an exception. A run its `interrupt` stopped is an error row
+//! "interrupted" (the caller, who asked, knows to drop it).
+CampaignRow campaign_run_row(const CampaignSpec& spec, std::size_t index, const EstimatorFactory& make,
+                             Interrupt* interrupt = nullptr);
 
 //! The spec's `pipeline:` map with `initial_q_wxyz` set to `initial_q_RB` (every digit kept), as YAML
 //! text: a service configured with it starts where the in-process pipeline starts.

@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "tetra/core/calibration_file.hpp"
+#include "tetra/core/interrupt.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/config.hpp"
 #include "tetra/fdi/pipeline.hpp"
@@ -86,5 +87,9 @@ struct ClosedLoopRecord {
 //! Runs the loop to the end of the scenario. `stop` (optional) is polled every epoch.
 Result<ClosedLoopRecord> run_closed_loop(ClosedLoopSimulator& simulator, Estimator& estimator,
                                          bool (*stop)() = nullptr);
+//! The same with an Interrupt (optional), polled every epoch (epochs done of the run's): when it asks to
+//! stop, the run returns interrupted().
+Result<ClosedLoopRecord> run_closed_loop(ClosedLoopSimulator& simulator, Estimator& estimator,
+                                         Interrupt* interrupt);
 
 }  // namespace tetra::sim

@@ -24,6 +24,9 @@ struct OpenLoopRecord {
 Quaternion open_loop_initial_q_RB(const Simulator& simulator);
 
 //! Runs the simulator to its end through `estimator`.
-Result<OpenLoopRecord> run_open_loop(Simulator& simulator, Estimator& estimator);
+//! `interrupt` (optional) is polled every epoch (epochs done of the run's): when it asks to stop, the
+//! run returns interrupted().
+Result<OpenLoopRecord> run_open_loop(Simulator& simulator, Estimator& estimator,
+                                     Interrupt* interrupt = nullptr);
 
 }  // namespace tetra::sim

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "tetra/core/gyro_log.hpp"
+#include "tetra/core/interrupt.hpp"
 #include "tetra/core/output_files.hpp"
 #include "tetra/core/quaternion.hpp"
 #include "tetra/core/result.hpp"
@@ -86,8 +87,10 @@ struct Truth {
 };
 
 //! The whole run in memory as a gyro log (volts, with ref_* columns when the scenario has a
-//! reference); the truth too when `truth` is given.
-Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options, Truth* truth = nullptr);
+//! reference); the truth too when `truth` is given. `interrupt` (optional) is polled every 64 epochs
+//! (epochs done of the run's); when it asks to stop the call returns interrupted().
+Result<GyroLog> simulate_log(const Scenario& scenario, const SimOptions& options, Truth* truth = nullptr,
+                             Interrupt* interrupt = nullptr);
 
 //! Runs the simulator to files: the gyro log (docs/interfaces.md §2.2) and, if `truth_path` is not empty,
 //! the truth (time_s,qw,qx,qy,qz,wx_dps,wy_dps,wz_dps: attitude body → R and rate of B relative to R).

@@ -1,0 +1,31 @@
+"""A typed session over the package's stubs (ctest python_stubs: mypy --strict): every call the docs show,
+with the types the stubs promise, so that a stub out of step with the package fails here."""
+import pathlib
+from typing import Optional
+
+import numpy as np
+import numpy.typing as npt
+
+import tetra
+
+
+def session(examples: pathlib.Path) -> float:
+    cal: tetra.Calibration = tetra.Calibration.read(examples / "seed_unit.yaml")
+    cal.write(pathlib.Path("cal.yaml"))
+    log: tetra.GyroLog = tetra.read_gyro_log(examples / "static.csv")
+    seen: list[tuple[int, int]] = []
+    run: tetra.SimRun = tetra.sim("static", duration_s=60.0, seed=2, progress=lambda d, t: seen.append((d, t)))
+    curves = tetra.allan(run.log.values[:, 0], rate=10.0, taus="octave")
+    assert isinstance(curves, tetra.AllanResult)
+    taus, devs, errs, ns = tetra.oadev(run.log.values[:, 0], rate=10.0, data_type="freq", taus=[1.0, 2.0])
+    also = tetra.allan.oadev(run.log.values[:, 0], rate=10.0)
+    adev: npt.NDArray[np.float64] = curves.adev
+    p = tetra.Pipeline(cal, {"latitude_deg": 45.0})
+    out: tetra.PipelineRun = p.run_log(log, progress=None)
+    health = p.health()
+    frame = out.attitude_frame()
+    score: tetra.AttitudeScore = tetra.score(frame, run)
+    rows: tetra.CampaignResult = tetra.campaign(examples / "campaign.yaml", runs=[0], jobs=2)
+    none: Optional[float] = cal.latitude_deg
+    return float(adev[0] + devs[0] + errs[0] + ns[0] + taus[0] + also[1][0]) + score.rms_total_deg + len(rows) \
+        + len(health) + (none or 0.0) + len(seen)
