@@ -121,7 +121,9 @@ TEST(ConfigKeys, EveryRangeRefusesAValueJustOutsideItNamingTheKey) {
     }
     PipelineConfig c;  // every number must be finite
     set(c, key, std::numeric_limits<double>::quiet_NaN());
-    if (!std::holds_alternative<int PipelineConfig::*>(key.field)) EXPECT_FALSE(validate(c).ok()) << key.name;
+    if (!std::holds_alternative<int PipelineConfig::*>(key.field)) {
+      EXPECT_FALSE(validate(c).ok()) << key.name;
+    }
   }
   EXPECT_GE(limits, 60);  // every number has at least a lower limit, many an upper one too
 }
@@ -130,7 +132,9 @@ TEST(ConfigKeys, EveryNumberHasALimitAndEveryKeyADescription) {
   for (const auto& key : config_keys()) {
     EXPECT_GT(std::string(key.description).size(), 10U) << key.name;
     EXPECT_FALSE(std::string(key.unit).empty()) << key.name;
-    if (numeric(key)) EXPECT_NE(key.min.edge, Edge::kNone) << key.name;
+    if (numeric(key)) {
+      EXPECT_NE(key.min.edge, Edge::kNone) << key.name;
+    }
   }
   EXPECT_EQ(config_keys().size(), 50U);  // 48 scalar keys, latitude_deg and initial_q_wxyz
 }
