@@ -93,6 +93,8 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv) {
   } catch (const CLI::CallForVersion&) {
     std::cout << "tetra " << kVersion << "\n";
     return kExitOk;
+  } catch (const CLI::Success&) {  // a flag that did its work while parsing (replay --config-keys)
+    return kExitOk;
   } catch (const CLI::ParseError& e) {
     std::cerr << "tetra " << app.get_name() << ": " << e.what() << " (see 'tetra " << app.get_name()
               << " --help')\n";

@@ -7,6 +7,7 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "tetra/fdi/config.hpp"
 #include "tetra/report/replay_log.hpp"
 
 namespace tetra::cli {
@@ -29,6 +30,21 @@ void add_options(CLI::App& app, report::ReplayLogOptions& o) {
   app.add_option("--commands", o.commands_path,
                  "operator commands to re-apply where the service obeyed them (JSON lines of tetra record "
                  "--commands)");
+  // Printed while parsing, before the required options are checked: no log is needed.
+  app.add_flag_callback(
+      "--config-keys",
+      [] {
+        std::cout << fdi::describe_keys();
+        throw CLI::Success();
+      },
+      "print every key of the 'pipeline:' map (--config): unit, range, default, meaning; then exit");
+  app.add_flag_callback(
+      "--config-example",
+      [] {
+        std::cout << fdi::example_config();
+        throw CLI::Success();
+      },
+      "print a 'pipeline:' configuration of every key at its default (examples/fusion.yaml); then exit");
   app.add_flag("-v,--verbose", o.verbose, "echo the configuration and the derived thresholds on stderr");
   app.add_option(
       "--explain", o.explain_s,

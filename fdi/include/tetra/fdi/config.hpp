@@ -1,7 +1,9 @@
 #pragma once
 // Pipeline configuration: a struct with in-class defaults, validated once, echoed at start-up.
 // Read from the `pipeline:` map of a YAML file (replay --config, fusion --config).
-// Every key, its unit, its default and how the thresholds follow from it: docs/fdi.md.
+// Every key is declared once, with its unit, range, default and meaning, in one table
+// (fdi/src/config_keys.cpp) that drives parsing, validate(), describe() and describe_keys(); how the
+// thresholds follow: docs/fdi.md.
 
 #include <optional>
 #include <string>
@@ -117,9 +119,14 @@ Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const s
 Result<PipelineConfig> read_pipeline_config(const std::string& path);
 //! The same from YAML text (e.g. a Python dict as JSON); `source` names it in messages.
 Result<PipelineConfig> parse_pipeline_config(const std::string& yaml_text, const std::string& source);
-//! Validates ranges; error names the field.
+//! Validates ranges; the error names the key, the range and the value.
 Status validate(const PipelineConfig& config);
-//! Multi-line "key: value" echo of every field, for start-up logs.
+//! Multi-line "key: value" echo of every key, for start-up logs.
 std::string describe(const PipelineConfig& config);
+//! Every key as a table, one line each: key, unit, range, default, meaning (tetra replay --config-keys).
+std::string describe_keys();
+//! A YAML file with a `pipeline:` map of every key at its default, each after a comment with its unit,
+//! range and meaning: examples/fusion.yaml (tetra replay --config-example).
+std::string example_config();
 
 }  // namespace tetra::fdi

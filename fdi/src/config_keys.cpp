@@ -1,0 +1,219 @@
+#include "config_keys.hpp"
+
+#include <cmath>
+
+#include "tetra/core/csv.hpp"
+
+namespace tetra::fdi {
+
+// Names of this file alone (the library is built in unity batches).
+namespace key_table {
+
+using Edge = ConfigLimit::Edge;
+using C = PipelineConfig;
+
+constexpr ConfigLimit kFree{};
+constexpr ConfigLimit above(double v) {
+  return {Edge::kOpen, v};
+}
+constexpr ConfigLimit from(double v) {
+  return {Edge::kClosed, v};
+}
+constexpr ConfigLimit below(double v) {
+  return {Edge::kOpen, v};
+}
+constexpr ConfigLimit to(double v) {
+  return {Edge::kClosed, v};
+}
+
+std::string number_text(double v) {
+  std::string out;
+  append_double(out, v);
+  return out;
+}
+
+}  // namespace key_table
+
+// One row per key. A per-epoch false-alarm probability is in (0, 0.5): a test at 0.5 or more is no test.
+// Rules one row cannot state are in validate() (config.cpp), after the rows.
+const std::vector<ConfigKey>& config_keys() {
+  using namespace key_table;  // the rows read as a table
+  static const std::vector<ConfigKey> keys = {
+      // --- attitude
+      {"latitude_deg", &C::latitude_deg, "deg", from(-90), to(90),
+       "ground-test mode: remove the Earth rate at this latitude (replay --latitude overrides); none: orbit"},
+      {"initial_q_wxyz", &C::initial_q_RB, "-", kFree, kFree,
+       "initial attitude body -> reference [w, x, y, z] (the lab frame in ground mode)"},
+      // --- input
+      {"raw_units_dps", &C::raw_units_dps, "-", kFree, kFree,
+       "samples are already rates in deg/s: no scale factor or bias applied (replay sets it from "
+       "\"# units=dps\")"},
+      {"sample_period_s", &C::sample_period_s, "s", from(0), kFree,
+       "nominal sample period; 0 = the first time step seen"},
+      {"max_abs_raw_V", &C::max_abs_raw_V, "V", above(0), kFree, "a raw sample beyond this is invalid"},
+      {"max_abs_rate_dps", &C::max_abs_rate_dps, "deg/s", above(0), kFree,
+       "a calibrated rate beyond this is invalid"},
+      {"default_arw_dps_rtHz", &C::default_arw_dps_rtHz, "deg/√s", above(0), kFree,
+       "angle random walk N of a gyro whose calibration has no noise: section (seed Table 6)"},
+      {"default_bias_instability_dps", &C::default_bias_instability_dps, "deg/s", from(0), kFree,
+       "bias instability B of a gyro without noise: section: twice the seed's Table 6 level, conservative"},
+      // --- detection on the parity residual
+      {"chi2_false_alarm_probability", &C::chi2_false_alarm_probability, "-", above(0), below(0.5),
+       "per epoch, the instantaneous parity chi2 test; also the rate of the parity block match (a slow "
+       "error below the CUSUM)"},
+      {"cusum_min_fault_dps", &C::cusum_min_fault_dps, "deg/s", above(0), kFree,
+       "smallest bias step on any gyro the CUSUM is sized for (k = delta_min/2); also the parity block "
+       "match's lower end"},
+      {"cusum_arl0_epochs", &C::cusum_arl0_epochs, "epochs", from(10), kFree,
+       "in-control average run length of the two-sided CUSUM (gives its threshold h)"},
+      {"rate_random_walk_horizon_s", &C::rate_random_walk_horizon_s, "s", above(0), kFree,
+       "a gyro's rate random walk K and rate ramp R enter the detectors' reference noise as a bias of "
+       "K*sqrt(horizon) and R*horizon"},
+      {"clear_after_s", &C::clear_after_s, "s", above(0), kFree,
+       "no alarm for this long ends a SUSPECT episode (cleared)"},
+      // --- isolation
+      {"isolation_window_s", &C::isolation_window_s, "s", above(0), kFree,
+       "evidence is sought this long before unisolated; also the span of the held parity level"},
+      {"max_angular_acceleration_dps2", &C::max_angular_acceleration_dps2, "deg/s²", above(0), kFree,
+       "bound on the vehicle's angular acceleration: the onset and jump tests, and the widening of sigma "
+       "over a gap"},
+      {"onset_sigma", &C::onset_sigma, "σ", above(0), kFree,
+       "noise margin of the onset (physical possibility) test; also of the jump test and of the repeated-"
+       "value (stuck) signature"},
+      {"onset_pre_epochs", &C::onset_pre_epochs, "epochs", from(2), to(200),
+       "window before the estimated onset"},
+      {"onset_post_max_epochs", &C::onset_post_max_epochs, "epochs", from(2), to(200),
+       "at most this many epochs after the onset"},
+      {"jump_false_alarm_probability", &C::jump_false_alarm_probability, "-", above(0), below(0.5),
+       "per epoch, the test of a one-epoch jump of the parity"},
+      {"onset_confirm_epochs", &C::onset_confirm_epochs, "epochs", from(2), to(100),
+       "an outlier this persistent is a step, not a spike"},
+      {"dropout_timeout_s", &C::dropout_timeout_s, "s", above(0), kFree, "absent this long: dropout"},
+      {"max_gap_s", &C::max_gap_s, "s", above(0), kFree,
+       "no epoch for longer than this: a gap event, sigma widened by a*tau^2/4"},
+      {"invalid_timeout_s", &C::invalid_timeout_s, "s", above(0), kFree, "invalid this long: invalid"},
+      {"stuck_repeat_count", &C::stuck_repeat_count, "samples", from(3), kFree,
+       "identical raw values in a row: stuck"},
+      {"noise_window", &C::noise_window, "samples", from(8), to(256),
+       "window of the noise-level (second difference) test and of the own fourth-difference level"},
+      {"noise_high_ratio", &C::noise_high_ratio, "-", above(1), kFree,
+       "robust noise level / expected above this: noise; also the three-gyro own-noise match, the outlier "
+       "gate's and the isolator's noise waits (at half of it)"},
+      {"noise_low_ratio", &C::noise_low_ratio, "-", above(0), below(1),
+       "robust noise level / expected below this: stuck"},
+      {"spike_count", &C::spike_count, "-", from(2), to(64),
+       "this many confirmed one-epoch outliers within spike_window_s: recurring spikes"},
+      {"spike_window_s", &C::spike_window_s, "s", above(0), kFree, "window of the spike count"},
+      // --- the reference
+      {"reference_window_s", &C::reference_window_s, "s", above(0), kFree,
+       "window of the reference comparison; also how long a reference sample counts as recent (absent "
+       "beyond it)"},
+      {"reference_sigma_arcsec", &C::reference_sigma_arcsec, "arcsec", above(0), kFree,
+       "1σ per axis of the attitude reference (filter, reference comparison, consistency tests)"},
+      {"reference_threshold_sigma", &C::reference_threshold_sigma, "σ", above(0), kFree,
+       "reference disagreement threshold; also the filter-bias isolation's"},
+      {"reference_confirm_count", &C::reference_confirm_count, "-", from(1), to(100),
+       "consecutive reference comparisons that must agree"},
+      {"glt_false_alarm_probability", &C::glt_false_alarm_probability, "-", above(0), below(0.5),
+       "N >= 5: the level at which a single-gyro hypothesis is rejected"},
+      {"exclusion_enabled", &C::exclusion_enabled, "-", kFree, kFree,
+       "false: an isolated gyro stays in the solution (the isolated event says \"gyro kept\"; for measuring "
+       "what exclusion is worth)"},
+      {"filter_bias_isolation", &C::filter_bias_isolation, "-", kFree, kFree,
+       "with a reference, during a fault episode, a gyro whose filter bias estimate alone is beyond "
+       "reference_threshold_sigma is isolated once one fault of it explains the episode best; false: "
+       "published only"},
+      // --- attitude filter
+      {"initial_sigma_deg", &C::initial_sigma_deg, "deg", from(0), to(180),
+       "1σ per axis of initial_q_wxyz until a reference sample sets the attitude"},
+      {"bias_instability_correlation_s", &C::bias_instability_correlation_s, "s", above(0), kFree,
+       "correlation time T_c of the Gauss-Markov bias that models each gyro's bias instability B"},
+      {"reference_gate_false_alarm_probability", &C::reference_gate_false_alarm_probability, "-", above(0),
+       below(0.5), "probability that the filter's 3-dof chi2 gate rejects a good reference sample"},
+      {"reference_gate_reset_count", &C::reference_gate_reset_count, "samples", from(1), to(1000),
+       "the last of this many reference samples in a row the gate would reject sets the attitude"},
+      // --- the reference as a sensor that can fail
+      {"reference_check_window_s", &C::reference_check_window_s, "s", above(0), kFree,
+       "block of the reference's NIS and lag tests; also: its noise re-estimate, the three-gyro reference "
+       "noise match, the budget's hold, a rejection withdrawn at a detection, sigma after the reference set "
+       "the attitude, the bias opened with three gyros"},
+      {"reference_bias_window_s", &C::reference_bias_window_s, "s", above(0), kFree,
+       "block of the reference's mean-innovation (bias) test"},
+      {"reference_check_false_alarm_probability", &C::reference_check_false_alarm_probability, "-", above(0),
+       below(0.5),
+       "per sample, each test of a good reference fails with this probability; also the three-gyro "
+       "reference noise match's rate"},
+      {"reference_reaccept_s", &C::reference_reaccept_s, "s", from(0), kFree,
+       "a rejected reference is used again after its samples passed every test this long"},
+      {"reference_noise_max_factor", &C::reference_noise_max_factor, "-", from(1), to(100),
+       "a reference rejected for nis alone is used again with its re-estimated noise up to this times "
+       "reference_sigma_arcsec (1: never)"},
+      {"reference_bias_arcsec", &C::reference_bias_arcsec, "arcsec", from(0), kFree,
+       "1σ per axis of the reference's slowly varying error its specification states, carried in sigma "
+       "(0: none stated)"},
+      {"reference_latency_max_s", &C::reference_latency_max_s, "s", from(0), to(10),
+       "largest latency of the reference's stamps its specification allows: sigma carries |ω|*this "
+       "(0: exact)"},
+      {"reference_horizon_s", &C::reference_horizon_s, "s", from(0), to(10),
+       "fusion horizon: a reference stamped up to this long before the epoch it reaches is fused at its "
+       "own time; older: left out and reported (reference_late)"},
+      // --- integrity, calibration uncertainty
+      {"integrity_risk", &C::integrity_risk, "-", above(0), below(0.5),
+       "probability that the attitude error exceeds the protection level without an alarm"},
+      {"calibration_error_sigmas", &C::calibration_error_sigmas, "-", from(0), to(100),
+       "errors of the biases, scale factors and axes within this many of the calibration's stated 1σ never "
+       "reach the parity tests nor the reference comparison (0: off)"},
+  };
+  return keys;
+}
+
+std::string range_text(const ConfigKey& key) {
+  using namespace key_table;
+  if (std::holds_alternative<bool C::*>(key.field)) return "true or false";
+  if (std::holds_alternative<Quaternion C::*>(key.field)) return "unit norm";
+  const ConfigLimit& lo = key.min;
+  const ConfigLimit& hi = key.max;
+  if (lo.edge == Edge::kNone && hi.edge == Edge::kNone) return "any";
+  if (hi.edge == Edge::kNone) return (lo.edge == Edge::kOpen ? "> " : ">= ") + number_text(lo.value);
+  if (lo.edge == Edge::kNone) return (hi.edge == Edge::kOpen ? "< " : "<= ") + number_text(hi.value);
+  return std::string("in ") + (lo.edge == Edge::kOpen ? "(" : "[") + number_text(lo.value) + ", " +
+         number_text(hi.value) + (hi.edge == Edge::kOpen ? ")" : "]");
+}
+
+bool within_range(const ConfigKey& key, double v) {
+  using namespace key_table;
+  if (!std::isfinite(v)) return false;
+  const ConfigLimit& lo = key.min;
+  const ConfigLimit& hi = key.max;
+  if (lo.edge == Edge::kOpen && !(v > lo.value)) return false;
+  if (lo.edge == Edge::kClosed && !(v >= lo.value)) return false;
+  if (hi.edge == Edge::kOpen && !(v < hi.value)) return false;
+  if (hi.edge == Edge::kClosed && !(v <= hi.value)) return false;
+  return true;
+}
+
+std::string value_text(const PipelineConfig& c, const ConfigKey& key) {
+  using namespace key_table;
+  std::string out;
+  if (const auto* d = std::get_if<double C::*>(&key.field)) {
+    append_double(out, c.*(*d));
+  } else if (const auto* i = std::get_if<int C::*>(&key.field)) {
+    append_int(out, c.*(*i));
+  } else if (const auto* b = std::get_if<bool C::*>(&key.field)) {
+    out = (c.*(*b)) ? "true" : "false";
+  } else if (const auto* o = std::get_if<std::optional<double> C::*>(&key.field)) {
+    if (!(c.*(*o))) return "none";
+    append_double(out, *(c.*(*o)));
+  } else {
+    const auto q = to_wxyz(c.*std::get<Quaternion C::*>(key.field));
+    out = "[";
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (k) out += ", ";
+      append_double(out, q[k]);
+    }
+    out += ']';
+  }
+  return out;
+}
+
+}  // namespace tetra::fdi

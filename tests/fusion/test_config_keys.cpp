@@ -1,0 +1,178 @@
+// The `pipeline:` keys' one table (fdi/src/config_keys.cpp): the example file and docs/fdi.md name every
+// key and no other, every range refuses a value just outside it with a message naming the key, and the
+// listing (tetra replay --config-keys) shows each key's unit, range and default.
+#include <cmath>
+#include <limits>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "config_keys.hpp"
+#include "test_support.hpp"
+#include "tetra/fdi/config.hpp"
+
+namespace tetra::fdi {
+namespace {
+
+using Edge = ConfigLimit::Edge;
+
+std::set<std::string> table_names() {
+  std::set<std::string> names;
+  for (const auto& key : config_keys()) names.insert(key.name);
+  return names;
+}
+
+// The keys a text names: in YAML lines "  key:" or commented "  # key:"; in Markdown rows "| `key` |".
+std::set<std::string> names_matching(const std::string& text, const std::regex& pattern) {
+  std::set<std::string> names;
+  std::istringstream in(text);
+  std::string line;
+  std::smatch m;
+  while (std::getline(in, line)) {
+    if (std::regex_search(line, m, pattern)) names.insert(m[1].str());
+  }
+  return names;
+}
+
+void expect_same_keys(const std::set<std::string>& named, const std::string& where) {
+  for (const auto& name : table_names())
+    EXPECT_EQ(named.count(name), 1U) << where << " does not name " << name;
+  for (const auto& name : named)
+    EXPECT_EQ(table_names().count(name), 1U) << where << " names unknown " << name;
+}
+
+TEST(ConfigKeys, TheExampleFileNamesEveryKeyAndNoOther) {
+  const std::string text = test::read_file(test::source_path("examples/fusion.yaml"));
+  expect_same_keys(names_matching(text, std::regex(R"(^  (?:# )?([A-Za-z0-9_]+):)")), "examples/fusion.yaml");
+  // It reads back as the defaults, and it is the file the table writes (tetra replay --config-example).
+  const auto read = read_pipeline_config(test::source_path("examples/fusion.yaml"));
+  ASSERT_TRUE(read.ok()) << read.error().message;
+  EXPECT_EQ(describe(*read), describe(PipelineConfig{}));
+  EXPECT_EQ(text, example_config()) << "rewrite it: tetra replay --config-example > examples/fusion.yaml";
+}
+
+TEST(ConfigKeys, TheDocsConfigurationSectionNamesEveryKeyAndNoOther) {
+  const std::string doc = test::read_file(test::source_path("docs/fdi.md"));
+  const auto start = doc.find("\n## Configuration");
+  ASSERT_NE(start, std::string::npos);
+  const auto end = doc.find("\n## ", start + 1);
+  const std::string section = doc.substr(start, end == std::string::npos ? std::string::npos : end - start);
+  expect_same_keys(names_matching(section, std::regex(R"(^\| `([A-Za-z0-9_]+)` \|)")),
+                   "docs/fdi.md \"Configuration\"");
+  EXPECT_NE(section.find("tetra replay --config-keys"), std::string::npos);
+}
+
+// Sets the key to v (an int key to v as a whole number).
+void set(PipelineConfig& c, const ConfigKey& key, double v) {
+  if (const auto* d = std::get_if<double PipelineConfig::*>(&key.field)) c.*(*d) = v;
+  if (const auto* i = std::get_if<int PipelineConfig::*>(&key.field)) c.*(*i) = static_cast<int>(v);
+  if (const auto* o = std::get_if<std::optional<double> PipelineConfig::*>(&key.field)) c.*(*o) = v;
+}
+
+bool numeric(const ConfigKey& key) {
+  return !std::holds_alternative<bool PipelineConfig::*>(key.field) &&
+         !std::holds_alternative<Quaternion PipelineConfig::*>(key.field);
+}
+
+// The value just beyond a limit (outward is -1 at the minimum, +1 at the maximum), and just within it.
+double just_outside(const ConfigKey& key, const ConfigLimit& limit, double outward) {
+  if (limit.edge == Edge::kOpen) return limit.value;
+  if (std::holds_alternative<int PipelineConfig::*>(key.field)) return limit.value + outward;
+  return std::nextafter(limit.value, outward * std::numeric_limits<double>::infinity());
+}
+double just_inside(const ConfigKey& key, const ConfigLimit& limit, double outward) {
+  if (limit.edge == Edge::kClosed) return limit.value;
+  if (std::holds_alternative<int PipelineConfig::*>(key.field)) return limit.value - outward;
+  return std::nextafter(limit.value, -outward * std::numeric_limits<double>::infinity());
+}
+
+TEST(ConfigKeys, EveryRangeRefusesAValueJustOutsideItNamingTheKey) {
+  int limits = 0;
+  for (const auto& key : config_keys()) {
+    if (!numeric(key)) continue;
+    for (const auto& [limit, outward] : {std::pair{key.min, -1.0}, std::pair{key.max, 1.0}}) {
+      if (limit.edge == Edge::kNone) continue;
+      ++limits;
+      PipelineConfig c;
+      set(c, key, just_inside(key, limit, outward));
+      EXPECT_TRUE(validate(c).ok()) << key.name << " refuses " << just_inside(key, limit, outward);
+      const double bad = just_outside(key, limit, outward);
+      set(c, key, bad);
+      const Status st = validate(c);
+      ASSERT_FALSE(st.ok()) << key.name << " accepts " << bad;
+      const std::string& message = st.error().message;
+      EXPECT_NE(message.find(std::string("pipeline.") + key.name + ": must be " + range_text(key)),
+                std::string::npos)
+          << message;
+      EXPECT_NE(message.find(", got "), std::string::npos) << message;
+
+      // The same through a file: the source and the key (a denormal is refused as a number already).
+      std::ostringstream yaml;
+      yaml.precision(17);
+      yaml << "pipeline:\n  " << key.name << ": " << bad << "\n";
+      const auto parsed = parse_pipeline_config(yaml.str(), "cfg.yaml");
+      ASSERT_FALSE(parsed.ok()) << yaml.str();
+      EXPECT_NE(parsed.error().message.find("cfg.yaml"), std::string::npos) << parsed.error().message;
+      EXPECT_NE(parsed.error().message.find(std::string("pipeline.") + key.name + ": "), std::string::npos)
+          << parsed.error().message;
+    }
+    PipelineConfig c;  // every number must be finite
+    set(c, key, std::numeric_limits<double>::quiet_NaN());
+    if (!std::holds_alternative<int PipelineConfig::*>(key.field)) {
+      EXPECT_FALSE(validate(c).ok()) << key.name;
+    }
+  }
+  EXPECT_GE(limits, 60);  // every number has at least a lower limit, many an upper one too
+}
+
+TEST(ConfigKeys, EveryNumberHasALimitAndEveryKeyADescription) {
+  for (const auto& key : config_keys()) {
+    EXPECT_GT(std::string(key.description).size(), 10U) << key.name;
+    EXPECT_FALSE(std::string(key.unit).empty()) << key.name;
+    if (numeric(key)) {
+      EXPECT_NE(key.min.edge, Edge::kNone) << key.name;
+    }
+  }
+  EXPECT_EQ(config_keys().size(), 50U);  // 48 scalar keys, latitude_deg and initial_q_wxyz
+}
+
+TEST(ConfigKeys, TheInitialQuaternionMustBeAUnitOne) {
+  const auto parsed = parse_pipeline_config("pipeline:\n  initial_q_wxyz: [1, 0.1, 0, 0]\n", "cfg.yaml");
+  ASSERT_FALSE(parsed.ok());
+  EXPECT_NE(parsed.error().message.find("pipeline.initial_q_wxyz: must be a unit quaternion"),
+            std::string::npos);
+}
+
+TEST(ConfigKeys, TheListingShowsEveryKeysUnitRangeAndDefault) {
+  const std::string listing = describe_keys();
+  const PipelineConfig defaults;
+  std::istringstream in(listing);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line.rfind("key ", 0), 0U) << line;
+  for (const auto& key : config_keys()) {
+    ASSERT_TRUE(std::getline(in, line)) << key.name;
+    std::istringstream row(line);
+    std::string name, unit;
+    row >> name >> unit;
+    EXPECT_EQ(name, key.name);
+    EXPECT_EQ(unit, key.unit);
+    EXPECT_NE(line.find("  " + range_text(key) + "  "), std::string::npos) << line;
+    EXPECT_NE(line.find("  " + value_text(defaults, key) + "  "), std::string::npos) << line;
+    EXPECT_NE(line.find(key.description), std::string::npos) << line;
+  }
+  EXPECT_FALSE(std::getline(in, line));
+
+  const auto run = test::run_tetra("replay --config-keys");
+  EXPECT_EQ(run.exit_status, 0) << run.err;
+  EXPECT_EQ(run.out, listing);
+  const auto example = test::run_tetra("replay --config-example");
+  EXPECT_EQ(example.exit_status, 0) << example.err;
+  EXPECT_EQ(example.out, example_config());
+}
+
+}  // namespace
+}  // namespace tetra::fdi
