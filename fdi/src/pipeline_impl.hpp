@@ -1,0 +1,208 @@
+#pragma once
+// The pipeline's state and stages (Pipeline::Impl): the class the stage files share. pipeline.cpp runs one
+// epoch and decides; pipeline_reference.cpp judges the attitude reference; pipeline_commands.cpp obeys the
+// operator's commands and holds the public API.
+
+#include "tetra/fdi/pipeline.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <string>
+
+#include "bias_hypothesis.hpp"
+#include "disagreement_trend.hpp"
+#include "gyro_series.hpp"
+#include "gyro_set.hpp"
+#include "isolator.hpp"
+#include "mekf.hpp"
+#include "outlier_gate.hpp"
+#include "own_noise_level.hpp"
+#include "parity_bias_match.hpp"
+#include "parity_detector.hpp"
+#include "protection_level.hpp"
+#include "quadrature.hpp"
+#include "rate_attitude.hpp"
+#include "reference_budget.hpp"
+#include "reference_consistency.hpp"
+#include "reference_horizon.hpp"
+#include "reference_monitor.hpp"
+#include "reference_noise_match.hpp"
+#include "stamp_judge.hpp"
+#include "subset_cache.hpp"
+#include "tetra/core/csv.hpp"
+#include "tetra/core/units.hpp"
+#include "tetra/fdi/noise_defaults.hpp"
+
+namespace tetra::fdi {
+
+namespace detail {
+
+inline Eigen::VectorXd bias_sigmas(const std::vector<GyroConstants>& constants) {
+  Eigen::VectorXd b(static_cast<Eigen::Index>(constants.size()));
+  for (std::size_t i = 0; i < constants.size(); ++i)
+    b[static_cast<Eigen::Index>(i)] = constants[i].bias_sigma_rad_s;
+  return b;
+}
+
+//! [ns] now − span, saturating at the earliest representable time (span ≥ 0).
+inline std::int64_t pipeline_time_before_ns(std::int64_t now_ns, std::int64_t span_ns) {
+  return now_ns >= std::numeric_limits<std::int64_t>::min() + span_ns
+             ? now_ns - span_ns
+             : std::numeric_limits<std::int64_t>::min();
+}
+
+}  // namespace detail
+
+using namespace detail;
+
+class Pipeline::Impl {
+ public:
+  Impl(const PipelineConfig& config, const Calibration& cal, GyroGeometry geometry,
+       std::vector<GyroConstants> constants)
+      : config_(config),
+        n_(cal.gyro_count()),
+        subsets_(std::move(geometry), bias_sigmas(constants), config_, detector_noise(cal, config_)),
+        bias_check_(constants),
+        own_noise_(constants, config_),
+        series_(std::move(constants), config_),
+        gate_(n_, config_),
+        detector_(n_, config_.clear_after_s),
+        isolator_(n_, config_),
+        reference_(cal.axes_B(), config_),
+        gyro_set_(n_),
+        attitude_(config_, noise_models(cal, series_, config_)),
+        consistency_(config_),
+        noise_match_(config_, n_),
+        bias_match_(config_, n_),
+        protection_(config_),
+        budget_(config_),
+        horizon_(config_.reference_horizon_s) {
+    frame_.resize(n_);
+    found_.reserve(static_cast<std::size_t>(n_));
+    own_named_.reserve(static_cast<std::size_t>(n_));
+    held_parity_ = Eigen::VectorXd::Zero(std::max(1, n_ - 3));
+    result_.events.reserve(32);
+    pending_.reserve(16);
+    health_.gyros.resize(static_cast<std::size_t>(n_));
+    result_.attitude.gyro_bias_rad_s.assign(static_cast<std::size_t>(n_), 0.0);
+    if (config_.sample_period_s > 0.0) subsets_.prepare(config_.sample_period_s);
+    reset();
+  }
+
+  void reset();
+  const StepResult& step(const Epoch& epoch);
+  FdiEvent command_exclude(int id, std::int64_t stamp_ns, bool force);
+  FdiEvent command_reinstate(int id, std::int64_t stamp_ns);
+  FdiEvent command_reset(std::int64_t stamp_ns);
+  std::string describe_thresholds() const;
+
+  const Health& health() const {
+    publish_filter_health();
+    return health_;
+  }
+  bool observable(GyroMask gyros) const { return subsets_.geometry().observable(gyros); }
+  int gyro_count() const { return n_; }
+  const PipelineConfig& config() const { return config_; }
+  std::uint64_t arbiter_refusals() const { return arbiter_refusals_; }
+
+  // The pipeline keeps a copy of the configuration that its stages refer to: it is created in place, once.
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+
+ private:
+  bool accept(const Epoch& epoch);
+  void reject_outliers();
+  //! The gyros left after the jump test have no parity (from the set `before` it): sigma carries what they
+  //! may be wrong by over this epoch's step.
+  void cover_unchecked_rate(GyroMask before);
+  void detect();
+  void level_changed(const Detection& d);
+  void seek_evidence();
+  void isolate_filter_bias(const ReferenceFinding& bias);
+  void decide_episode();
+  void publish_attitude();
+  void publish_filter();
+  void publish_filter_health() const;
+  void update_fdi_available();
+  void judge_reference();
+  //! The reference's failing test as rows: H0 rejected, Href `reference` (rejected when the gyros vouch for
+  //! their attitude; no call with three gyros, where the data cannot tell the reference from a gyro), and
+  //! each gyro in use no call then.
+  void reference_rows(RowVerdict reference, std::vector<LedgerRow>& ledger) const;
+  //! A gyro fault just detected may be what had the reference rejected: the rejection is withdrawn.
+  void withdraw_reference_rejection();
+  void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
+  void match_own_noise();
+  //! The rate solution of the gyros in use when they are exactly three (no parity left), else null.
+  const Subset* three_gyros_without_parity();
+
+  void isolate(const Isolation& iso);
+  void isolate_all(Isolations& found);
+  void restart_detectors();
+  void gap();
+  //! The `reference_accepted` event's text: with the re-estimated noise when it is not the configured one.
+  std::string reaccepted_detail() const;
+  //! [ns] how long before a finding outside an episode its fault may have begun.
+  std::int64_t signature_span_ns() const;
+  void update_mode(std::int64_t now_ns);
+  void emit(FdiEvent event) { result_.events.push_back(std::move(event)); }
+  //! A `detected` event with the rows that rejected H0 (none: the event carries no ledger).
+  void emit_detected(DetectionTest test, double statistic, std::int64_t now_ns,
+                     const EvidenceRows* rows = nullptr);
+  //! The arbiter's ruling on an isolation's rows (the episode's detection rows with them), and the rows an
+  //! event carries: every hypothesis of the gyros in use, H0 and Href.
+  int rule(const EvidenceRows& rows, std::vector<LedgerRow>& ledger) const;
+  FdiEvent acknowledge(CommandVerb verb, int id, CommandOutcome outcome, bool changed, std::int64_t stamp_ns);
+  void reinstate(int id);
+
+  PipelineConfig config_;
+  int n_;
+  SubsetCache subsets_;
+  BiasHypothesis bias_check_;  //!< the fault-model check of the filter's bias states
+  OwnNoiseLevel own_noise_;    //!< three gyros: each gyro's noise level where motion does not reach
+  GyroSeries series_;
+  OutlierGate gate_;
+  ParityDetector detector_;
+  Isolator isolator_;
+  ReferenceMonitor reference_;
+  GyroSet gyro_set_;
+  RateAttitude attitude_;
+  ReferenceConsistency consistency_;  //!< the reference as a sensor that can fail
+  DisagreementTrend trend_;  //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
+  ReferenceNoiseMatch noise_match_;  //!< three gyros: a gyro's noise or ramp in the reference's innovations
+  ParityBiasMatch bias_match_;       //!< a slow error below the detectors: the gyro's bias model opened
+  ProtectionLevel protection_;       //!< the integrity bound beside sigma
+  std::vector<OwnNoiseFinding> own_named_;  //!< the gyros own_noise_ named at this epoch (capacity N)
+  Eigen::VectorXd held_parity_;  //!< the parity before the jump test, when it left the rest without one
+  ReferenceBudget budget_;       //!< the reference's stated bias and latency, which its samples cannot show
+  EvidenceRows episode_rows_;    //!< the rows of the detection that opened the open episode
+  EvidenceRows decision_rows_;   //!< scratch: an isolation's rows with the episode's
+  std::uint64_t arbiter_refusals_ = 0;  //!< findings whose rows the arbiter did not confirm
+  ReferenceHorizon horizon_;  //!< a late reference fused at its own time (docs/fdi.md, "Late references")
+
+  EpochFrame frame_;
+  Isolations found_;
+  StepResult result_;
+  std::vector<FdiEvent> pending_;  //!< what operator commands caused, emitted with the next step
+  //! Mutable for the filter's per-gyro fields, filled when read (publish_filter_health).
+  mutable Health health_;
+  //! The filter's per-gyro bias and its σ are due in health_: the filter moved since they were filled. Every
+  //! change of the filter outside a step fills them first, so they are always those of the last step's end.
+  mutable bool filter_health_due_ = false;
+  Mode persistent_mode_ = Mode::kNominal;
+  GyroMask measured_ = 0;  //!< the gyros of this epoch's rate estimate so far
+  StampJudge clock_;       //!< the epoch time check: outliers dropped, forward jumps confirmed
+  bool has_time_ = false;
+  std::int64_t last_ns_ = 0;
+  std::optional<std::int64_t> last_reference_ns_;  //!< the last epoch that carried a usable reference
+  bool reference_usable_ = false;  //!< this epoch's reference sample passed the consistency tests
+  bool gyros_vouch_ = false;       //!< this epoch: parity among the gyros used, no episode, rate observable
+  std::optional<std::int64_t> reference_set_ns_;  //!< the last time a reference sample set the attitude
+  //! [ns] when the reference was last rejected by a slow test (nis, bias), until it is used again
+  std::optional<std::int64_t> reference_rejected_ns_;
+};
+
+}  // namespace tetra::fdi

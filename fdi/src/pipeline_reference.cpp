@@ -1,0 +1,168 @@
+// The attitude reference judged before anything uses it, and the three-gyro matches it witnesses
+// (docs/fdi.md, "Reference consistency", "Three gyros"): part of Pipeline::Impl (pipeline_impl.hpp).
+
+#include "pipeline_impl.hpp"
+
+namespace tetra::fdi {
+
+std::string Pipeline::Impl::reaccepted_detail() const {
+  const double sigma_arcsec = consistency_.sigma_rad() / kArcsecToRad;
+  if (sigma_arcsec <= config_.reference_sigma_arcsec) return "attitude reference consistent again: used";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "attitude reference consistent again with its noise re-estimated: used with 1-sigma %.3g "
+                "arcsec (%.3g configured)",
+                sigma_arcsec, config_.reference_sigma_arcsec);
+  return text;
+}
+
+void Pipeline::Impl::withdraw_reference_rejection() {
+  // The reference is judged only while the gyros vouch for their attitude, but a gyro fault grows for a while
+  // below the parity's threshold: its error in the attitude can fail the reference's slow tests (nis, bias)
+  // before the parity detects it. A rejection by those tests after the fault's estimated onset (less one
+  // block of the tests, which it may have filled) is therefore withdrawn at the detection: the reference is
+  // used again, unjudged while the episode is open, and its windows can isolate the gyro (docs/fdi.md).
+  if (!reference_rejected_ns_ || consistency_.state() != ReferenceState::kRejected) return;
+  const std::int64_t block_ns = seconds_to_ns(config_.reference_check_window_s);
+  if (*reference_rejected_ns_ < pipeline_time_before_ns(isolator_.episode().onset_ns, block_ns)) return;
+  consistency_.reopen();
+  trend_.stop();
+  reference_rejected_ns_.reset();
+  FdiEvent e;
+  e.stamp_ns = frame_.now_ns;
+  e.type = EventType::kReferenceAccepted;
+  e.detail = "attitude reference used again: a gyro fault detected since may have caused its rejection";
+  emit(std::move(e));
+}
+
+void Pipeline::Impl::reference_rows(RowVerdict reference, std::vector<LedgerRow>& ledger) const {
+  const auto& c = consistency_.failed_check();
+  const auto src = EvidenceSource::kReferenceTest;
+  ledger.push_back(judge(src, kHypothesisNone, c.statistic, c.threshold, c.threshold, c.dof));
+  ledger.push_back(stated(src, kHypothesisReference, reference, c.statistic, c.threshold, c.dof));
+  if (reference != RowVerdict::kNoCall) return;
+  for (int id = 1; id <= n_; ++id) {
+    if (gyro_set_.is_excluded(id)) continue;
+    ledger.push_back(
+        stated(src, static_cast<std::uint8_t>(id), RowVerdict::kNoCall, c.statistic, c.threshold, c.dof));
+  }
+}
+
+void Pipeline::Impl::judge_reference() {
+  // The reference sample is tested before anything uses it (docs/fdi.md, "Reference consistency"); the
+  // gyros vouch for their attitude when they leave parity, no episode is open and the rate is observable.
+  const GyroMask active = gyro_set_.active();
+  gyros_vouch_ = subsets_.ready() && subsets_.get(active).dof >= 1 &&
+                 subsets_.get(frame_.usable).observable && !isolator_.episode().active;
+  reference_usable_ = frame_.reference_q_RB.has_value();
+  if (!reference_usable_) {
+    if (last_reference_ns_ && frame_.now_ns - *last_reference_ns_ > seconds_to_ns(config_.reference_window_s))
+      consistency_.absent();
+    return;
+  }
+  Eigen::Vector3d z;
+  Eigen::Matrix3d S;
+  if (!subsets_.ready() ||
+      !attitude_.predict_reference(*frame_.reference_q_RB, frame_.dt_s, subsets_.period_s(), z, S))
+    return;
+  const ReferenceVerdict v = consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_);
+  reference_usable_ = v.use;
+  // The σ the sample is used with: the configured one, or the re-estimated noise (an operator's reset judges
+  // the reference afresh, from the configured σ).
+  attitude_.set_reference_sigma_rad(consistency_.sigma_rad());
+  reference_.set_reference_sigma_rad(consistency_.sigma_rad());
+  noise_match_.set_reference_sigma_rad(consistency_.sigma_rad());
+  if (v.rejected) {
+    trend_.start(frame_.now_ns);
+    const bool slow = *v.rejected == ReferenceCheck::kNis || *v.rejected == ReferenceCheck::kBias;
+    reference_rejected_ns_ = slow ? std::optional<std::int64_t>(frame_.now_ns) : std::nullopt;
+  }
+  if (v.reaccepted) reference_rejected_ns_.reset();
+  if (v.reaccepted) trend_.stop();
+  if (consistency_.state() == ReferenceState::kRejected) trend_.add(frame_.now_ns, z, S.diagonal());
+  if (v.rejected || v.reaccepted) {
+    FdiEvent e;
+    e.stamp_ns = frame_.now_ns;
+    e.type = v.rejected ? EventType::kReferenceRejected : EventType::kReferenceAccepted;
+    e.why = v.rejected ? *v.rejected : ReferenceCheck::kNone;
+    e.statistic = consistency_.windowed_nis();
+    e.detail = v.rejected ? "attitude reference inconsistent with the gyros: left out, sigma from the gyros"
+                          : reaccepted_detail();
+    if (v.rejected) reference_rows(RowVerdict::kRejected, e.ledger);
+    emit(std::move(e));
+  }
+  if (v.rejected) {
+    attitude_.add_variance(v.contamination_rad2);
+    // An attitude the reference itself set a block ago or less rests on its samples alone: the rejecting
+    // sample's innovation, on every axis, bounds what they put in.
+    if (reference_set_ns_ &&
+        frame_.now_ns - *reference_set_ns_ <= seconds_to_ns(config_.reference_check_window_s))
+      attitude_.add_variance(Eigen::Vector3d::Constant(z.squaredNorm()));
+  }
+  // A jump is left to the gate (a lone wild sample, or ten in a row set the attitude): only the slower tests
+  // carry evidence of a gyro fault.
+  if (v.inconsistent && *v.inconsistent != ReferenceCheck::kJump && subsets_.get(active).dof < 1 &&
+      !isolator_.episode().active) {
+    // Redundancy exhausted: the reference or one of the gyros used is wrong and nothing tells which. The
+    // reference stays in use (it is the only check left), the fault is reported, and the filter's attitude
+    // and bias states open by what the innovation shows, so the reference can pull both back.
+    emit_detected(DetectionTest::kReference, consistency_.windowed_nis(), frame_.now_ns);
+    result_.events.back().why = *v.inconsistent;
+    result_.events.back().detail =
+        std::string("attitude reference and gyros disagree (") + to_string(*v.inconsistent) +
+        "); three gyros: the data cannot tell which, sigma and bias states widened";
+    reference_rows(RowVerdict::kNoCall, result_.events.back().ledger);
+    attitude_.add_variance(z.cwiseProduct(z));
+    attitude_.fault_opened(z.norm() / config_.reference_check_window_s);
+    noise_match_.match_all(subsets_.get(active).mask);
+  }
+  if (v.use) match_three_gyro_noise(z, S);
+}
+
+void Pipeline::Impl::match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {
+  // Three gyros, no parity: the reference's innovations are the only witness of a gyro's ramp, and of a noise
+  // its own level cannot show (docs/fdi.md, "Three gyros: a noise increase or a ramp"); the gyro's noise in
+  // the filter follows them from then on.
+  const Subset* s = three_gyros_without_parity();
+  if (s == nullptr) return;
+  const auto found = noise_match_.observe(frame_.now_ns, z, S, s->pinv, s->mask, attitude_.filter());
+  if (!found) return;
+  emit_detected(DetectionTest::kReference, found->statistic, frame_.now_ns);
+  result_.events.back().gyro = found->gyro;
+  result_.events.back().why = ReferenceCheck::kNis;
+  result_.events.back().detail = "attitude reference innovations along gyro " + std::to_string(found->gyro) +
+                                 "'s rate axis exceed the model (noise or ramp); three gyros: its noise in "
+                                 "the filter matched to the innovations, sigma widened";
+}
+
+const Subset* Pipeline::Impl::three_gyros_without_parity() {
+  const Subset& s = subsets_.get(gyro_set_.active());
+  return tetra::gyro_count(s.mask) == 3 && s.observable && s.dof < 1 ? &s : nullptr;
+}
+
+void Pipeline::Impl::match_own_noise() {
+  // Three gyros, no parity: a gyro's own fourth differences show its white noise where the body's motion does
+  // not reach (docs/fdi.md, "Three gyros: a gyro's own noise level"). A gyro beyond the limit is named, never
+  // excluded (three gyros are the rate), and its noise in the filter follows its level until it is normal.
+  const Subset* s = three_gyros_without_parity();
+  if (!own_noise_.evaluate(s != nullptr ? s->mask : GyroMask{0}, subsets_.sqrt_period(), own_named_)) return;
+  for (int id = 1; id <= n_; ++id) noise_match_.set_own_ratio(id, own_noise_.ratio(id), attitude_.filter());
+  for (const OwnNoiseFinding& f : own_named_) {
+    emit_detected(DetectionTest::kSignature, f.level, frame_.now_ns);
+    FdiEvent& e = result_.events.back();
+    e.gyro = f.gyro;
+    e.ledger.push_back(stated(EvidenceSource::kNoiseLevel, kHypothesisNone, RowVerdict::kRejected, f.level,
+                              config_.noise_high_ratio));
+    e.ledger.push_back(stated(EvidenceSource::kNoiseLevel, static_cast<std::uint8_t>(f.gyro),
+                              RowVerdict::kConsistent, f.level, config_.noise_high_ratio));
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "gyro %d's own noise level is %.3g times its model (fourth differences, which smooth body "
+                  "motion does not reach); three gyros: named, not excluded; its noise in the filter matched "
+                  "(variance x%.3g), sigma widened",
+                  f.gyro, f.level, f.ratio);
+    e.detail = text;
+  }
+}
+
+}  // namespace tetra::fdi
