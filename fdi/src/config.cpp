@@ -55,7 +55,7 @@ Status set_pipeline_key(PipelineConfig& config, const ConfigKey& key, const Yaml
 // Columns of UTF-8 text (a unit such as "deg/√s" has more bytes than columns).
 std::size_t display_width(const std::string& text) {
   std::size_t n = 0;
-  for (const unsigned char ch : text) n += (ch & 0xC0U) != 0x80U;
+  for (const char ch : text) n += (static_cast<unsigned char>(ch) & 0xC0U) != 0x80U;
   return n;
 }
 
@@ -192,11 +192,10 @@ std::string describe_keys() {
 std::string example_config() {
   const PipelineConfig defaults;
   std::string out =
-      "# Fusion pipeline configuration for tetra replay --config: every key of the `pipeline:` map at its\n"
-      "# default, each after its [unit, range] and meaning (tetra replay --config-example prints this file,\n"
-      "# --config-keys the same as a table). A service's configuration (tetra fusion --config) takes the "
-      "same\n"
-      "# map beside its own keys. How the thresholds follow from the keys: docs/fdi.md, \"Configuration\".\n"
+      "# Fusion pipeline configuration, as tetra replay reads it: every key of the `pipeline:` map at its\n"
+      "# default, each after its [unit, range] and meaning (tetra replay prints this file and the same as a\n"
+      "# table). A service's configuration (tetra fusion) takes the same map beside its own keys. How the\n"
+      "# thresholds follow from the keys: docs/fdi.md, \"Configuration\".\n"
       "pipeline:\n";
   for (const auto& key : config_keys()) {
     std::string head = "[";

@@ -41,7 +41,8 @@ const std::vector<ConfigKey>& config_keys() {
   static const std::vector<ConfigKey> keys = {
       // --- attitude
       {"latitude_deg", &C::latitude_deg, "deg", from(-90), to(90),
-       "ground-test mode: remove the Earth rate at this latitude (replay --latitude overrides); none: orbit"},
+       "ground-test mode: remove the Earth rate at this latitude (the replay command's own latitude "
+       "option overrides it); none: orbit"},
       {"initial_q_wxyz", &C::initial_q_RB, "-", kFree, kFree,
        "initial attitude body -> reference [w, x, y, z] (the lab frame in ground mode)"},
       // --- input

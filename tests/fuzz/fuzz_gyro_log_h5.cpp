@@ -26,6 +26,15 @@ extern "C" const char* __asan_default_options() {  // NOLINT(readability-identif
 extern "C" const char* __lsan_default_suppressions() {  // NOLINT(readability-identifier-naming)
   return "leak:libhdf5\n";
 }
+// libhdf5 also reads out of bounds on some damaged metadata while it opens a dataset (a name in a layout
+// message without its terminating NUL, copied by strdup): ASan sees that through its interceptors, the only
+// part of an uninstrumented library it sees. The reader opens a file by name only after the checking child
+// process opened every dataset the same way, so such a fault ends the child and the file is refused
+// (HostileH5.*); here, in process, the interceptors called from libhdf5 are not reported. tetra's own code is
+// instrumented and still checked everywhere.
+extern "C" const char* __asan_default_suppressions() {  // NOLINT(readability-identifier-naming)
+  return "interceptor_via_lib:libhdf5\n";
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
