@@ -247,8 +247,8 @@ TEST(ScoreCli, WritesReportJsonAndPlot) {
   EXPECT_EQ(png.substr(1, 3), "PNG");
 }
 
-// The seed experiment (README, docs/fdi_validation.md) by commands alone: calibrate from simulated turntable data,
-// replay the lab orbit, and `tetra score --axis y` prints the integrated angle: 360 ± 0.5° (the
+// The seed experiment (README, docs/fdi_validation.md) by commands alone: calibrate from simulated turntable
+// data, replay the lab orbit, and `tetra score --axis y` prints the integrated angle: 360 ± 0.5° (the
 // requirement; measured 359.96°); the truth rates give 0.06 deg/s × 5999.2 s = 359.95° (the last row is one
 // step before the turn closes).
 TEST(ScoreCli, SeedExperimentAngleIsPrintedByTheCommand) {

@@ -89,8 +89,9 @@ static void print_event(const void* sample) {
   printf("\", \"ledger\": [");
   for (uint32_t i = 0; i < e->ledger._length; ++i) {
     const tetra_LedgerRow* r = &e->ledger._buffer[i];
-    printf("%s{\"source\": \"%s\", \"hypothesis\": %u, \"verdict\": \"%s\", \"unit\": \"%s\", \"statistic\": ",
-           i ? ", " : "", r->source, (unsigned)r->hypothesis, NAME(kVerdicts, r->verdict), r->unit);
+    printf(
+        "%s{\"source\": \"%s\", \"hypothesis\": %u, \"verdict\": \"%s\", \"unit\": \"%s\", \"statistic\": ",
+        i ? ", " : "", r->source, (unsigned)r->hypothesis, NAME(kVerdicts, r->verdict), r->unit);
     print_number(r->statistic);
     printf(", \"threshold\": ");
     print_number(r->threshold);

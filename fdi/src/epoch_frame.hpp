@@ -6,8 +6,8 @@
 #include <optional>
 #include <vector>
 
-#include "tetra/core/geometry.hpp"
 #include "evidence_rows.hpp"
+#include "tetra/core/geometry.hpp"
 #include "tetra/fdi/types.hpp"
 
 namespace tetra::fdi::detail {

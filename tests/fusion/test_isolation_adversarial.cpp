@@ -497,11 +497,11 @@ TEST(IsolationAdversarial, FaultOnGyroFourDuringAGentleSlew) {
 }
 
 TEST(IsolationAdversarial, OnsetIsolationAtTheDefaults) {
-  // docs/fdi_validation.md's onset figures ("Onset test"), measured for the default acceleration bound (1e-3 deg/s²) and the orbit's
-  // (2e-4): bias steps on each gyro in the orbit with attitude-control motion, no reference, three seeds. A
-  // step is isolated by its onset only when it moves the rate beyond what the bound allows over the onset
-  // windows (a_max times about 4 s) — smaller steps end `unisolated`. Printed, and no wrong exclusion
-  // asserted.
+  // docs/fdi_validation.md's onset figures ("Onset test"), measured for the default acceleration bound (1e-3
+  // deg/s²) and the orbit's (2e-4): bias steps on each gyro in the orbit with attitude-control motion, no
+  // reference, three seeds. A step is isolated by its onset only when it moves the rate beyond what the bound
+  // allows over the onset windows (a_max times about 4 s) — smaller steps end `unisolated`. Printed, and no
+  // wrong exclusion asserted.
   std::string what;
   for (const double a_max : {1e-3, 2e-4}) {
     std::map<std::string, Tally> table;

@@ -145,8 +145,8 @@ TEST(PerturbationFamilies, CalibrationWithoutNoise) {
   check_family(sim::Family::kCalibrationWithoutNoise, 18);
 }
 // Three gyros: a noise increase is named by the gyro's own level within seconds, a bias or a ramp by the
-// reference's innovations, and each is covered from then on (docs/fdi_validation.md, "Perturbation families").
-// The protection level bounds one gyro fault: two that cancel in the parity are beyond it.
+// reference's innovations, and each is covered from then on (docs/fdi_validation.md, "Perturbation
+// families"). The protection level bounds one gyro fault: two that cancel in the parity are beyond it.
 TEST(PerturbationFamilies, SecondFault) {
   check_family(sim::Family::kSecondFault, 12, {}, {"two biases cancelling in the parity"});
 }
