@@ -44,8 +44,11 @@ std::optional<sim::CampaignSpec> spec_of(const std::string& shard_dir, const std
 
 }  // namespace
 
-Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<std::string>& shard_dirs) {
-  if (shard_dirs.empty()) return bad_input("no shard folder given");
+namespace {
+
+// The shards' manifests: one spec, one split, disjoint, covering every run.
+Result<std::vector<folder::Manifest>> shard_manifests(const std::string& out_dir,
+                                                      const std::vector<std::string>& shard_dirs) {
   std::vector<folder::Manifest> manifests;
   for (const std::string& dir : shard_dirs) {
     if (same_folder(dir, out_dir)) return bad_input(dir + ": the merge's output is one of its shards");
@@ -75,75 +78,107 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
     }
     return bad_input("shards missing (" + missing + "): the shards must cover every run");
   }
-  // The header (with the spec's dispersion columns) is the first shard's; every shard must have it.
-  auto header = folder::read_header(folder::path_in(shard_dirs[0], folder::kRunsFile));
-  if (!header) return header.error();
-  // Each row's case as the spec's matrix has it (scenario, kind, gyro, onset, size, seed): a forged or
-  // shifted row is refused, when the spec reads from the shard's folder.
-  const auto spec = spec_of(shard_dirs[0], first.spec_sha256);
-  std::vector<folder::Row> all;
-  all.reserve(first.matrix_runs);
-  for (std::size_t i = 0; i < manifests.size(); ++i) {
-    const std::string runs_csv = folder::path_in(shard_dirs[i], folder::kRunsFile);
-    auto rows = folder::read_rows(runs_csv, *header, false);
-    if (!rows) return rows.error();
-    const Shard& shard = manifests[i].shard;
-    std::size_t expected = shard.k - 1;
-    for (const folder::Row& r : *rows) {
-      if (!in_shard(shard, r.run) || r.run >= first.matrix_runs)
-        return bad_input(runs_csv + ": run " + std::to_string(r.run) + " is not a run of shard " +
-                         shard_text(shard));
-      if (r.run != expected)
-        return bad_input(runs_csv + ": run " + std::to_string(expected) +
-                         " missing: the shard is not complete (run it again with the same command)");
-      if (spec) {
-        const std::string want =
-            case_columns(sim::campaign_csv_row(sim::campaign_error_row(*spec, r.run, "-")));
-        if (case_columns(r.line) != want)
-          return bad_input(runs_csv + ": run " + std::to_string(r.run) + " is '" +
-                           one_line(case_columns(r.line)) + "', the spec's case is '" + want + "'");
-      }
-      expected += shard.n;
-    }
-    if (expected < first.matrix_runs)
+  return manifests;
+}
+
+// One shard's rows: each of its runs once, in order, none missing; each row's case as the spec's matrix has
+// it (scenario, kind, gyro, onset, size, seed) when the spec reads from the shard's folder.
+Status append_shard_rows(const std::string& dir, const folder::Manifest& manifest, std::size_t matrix_runs,
+                         const std::string& header, const std::optional<sim::CampaignSpec>& spec,
+                         std::vector<folder::Row>& all) {
+  const std::string runs_csv = folder::path_in(dir, folder::kRunsFile);
+  auto rows = folder::read_rows(runs_csv, header, false);
+  if (!rows) return rows.error();
+  const Shard& shard = manifest.shard;
+  std::size_t expected = shard.k - 1;
+  for (const folder::Row& r : *rows) {
+    if (!in_shard(shard, r.run) || r.run >= matrix_runs)
+      return bad_input(runs_csv + ": run " + std::to_string(r.run) + " is not a run of shard " +
+                       shard_text(shard));
+    if (r.run != expected)
       return bad_input(runs_csv + ": run " + std::to_string(expected) +
                        " missing: the shard is not complete (run it again with the same command)");
-    all.insert(all.end(), rows->begin(), rows->end());
+    if (spec) {
+      const std::string want =
+          case_columns(sim::campaign_csv_row(sim::campaign_error_row(*spec, r.run, "-")));
+      if (case_columns(r.line) != want)
+        return bad_input(runs_csv + ": run " + std::to_string(r.run) + " is '" +
+                         one_line(case_columns(r.line)) + "', the spec's case is '" + want + "'");
+    }
+    expected += shard.n;
   }
+  if (expected < matrix_runs)
+    return bad_input(runs_csv + ": run " + std::to_string(expected) +
+                     " missing: the shard is not complete (run it again with the same command)");
+  all.insert(all.end(), rows->begin(), rows->end());
+  return ok_status();
+}
+
+// The output folder: this campaign's (merged again at will), or one holding no file the merge would write.
+Status check_output_folder(const std::string& out_dir, const std::string& spec_sha256) {
   if (auto old = folder::read_manifest(out_dir); old) {
-    if (old->spec_sha256 != first.spec_sha256)
+    if (old->spec_sha256 != spec_sha256)
       return bad_input(folder::path_in(out_dir, folder::kHashFile) +
                        ": the output folder holds a campaign of another spec: use another folder");
-  } else {
-    // No campaign's manifest: any file the merge would write is another program's, never replaced.
-    for (const char* name : {folder::kRunsFile, folder::kSpecCopy, folder::kShardFile, folder::kHashFile}) {
-      std::error_code exists_ec;
-      const std::string path = folder::path_in(out_dir, name);
-      if (std::filesystem::exists(std::filesystem::symlink_status(path, exists_ec)))
-        return bad_input(path + ": the output folder holds files of no campaign (no " + folder::kShardFile +
-                         " and " + folder::kHashFile + " of one): use another folder");
-    }
+    return ok_status();
   }
-  std::sort(all.begin(), all.end(), [](const folder::Row& a, const folder::Row& b) { return a.run < b.run; });
+  // No campaign's manifest: any file the merge would write is another program's, never replaced.
+  for (const char* name : {folder::kRunsFile, folder::kSpecCopy, folder::kShardFile, folder::kHashFile}) {
+    std::error_code exists_ec;
+    const std::string path = folder::path_in(out_dir, name);
+    if (std::filesystem::exists(std::filesystem::symlink_status(path, exists_ec)))
+      return bad_input(path + ": the output folder holds files of no campaign (no " + folder::kShardFile +
+                       " and " + folder::kHashFile + " of one): use another folder");
+  }
+  return ok_status();
+}
+
+// The merged folder: the manifest first (a merge stopped half-way leaves a folder of this campaign), then
+// the rows and the spec's copy.
+Status write_merged(const std::string& out_dir, const std::string& first_shard, const folder::Manifest& first,
+                    const std::string& header, const std::vector<folder::Row>& all,
+                    const std::string& runs_csv) {
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) return failure(out_dir + ": cannot create the folder");
+  auto spec_copy = read_input(folder::path_in(first_shard, folder::kSpecCopy), kMaxYamlBytes);
+  if (!spec_copy) return spec_copy.error();
+  if (Status st = write_text_file(folder::path_in(out_dir, folder::kShardFile),
+                                  folder::manifest_text(Shard{1, 1}, first.matrix_runs));
+      !st)
+    return st;
+  if (Status st = write_text_file(folder::path_in(out_dir, folder::kHashFile), first.spec_sha256 + "\n"); !st)
+    return st;
+  if (Status st = folder::write_rows(runs_csv, header, all); !st) return st;
+  return write_text_file(folder::path_in(out_dir, folder::kSpecCopy), *spec_copy);
+}
+
+}  // namespace
+
+Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<std::string>& shard_dirs) {
+  if (shard_dirs.empty()) return bad_input("no shard folder given");
+  auto manifests = shard_manifests(out_dir, shard_dirs);
+  if (!manifests) return manifests.error();
+  const folder::Manifest& first = manifests->front();
+  // The header (with the spec's dispersion columns) is the first shard's; every shard must have it.
+  auto header = folder::read_header(folder::path_in(shard_dirs[0], folder::kRunsFile));
+  if (!header) return header.error();
+  const auto spec = spec_of(shard_dirs[0], first.spec_sha256);
+  std::vector<folder::Row> all;
+  all.reserve(first.matrix_runs);
+  for (std::size_t i = 0; i < manifests->size(); ++i) {
+    if (Status s = append_shard_rows(shard_dirs[i], (*manifests)[i], first.matrix_runs, *header, spec, all);
+        !s)
+      return s.error();
+  }
+  if (Status s = check_output_folder(out_dir, first.spec_sha256); !s) return s.error();
+  std::sort(all.begin(), all.end(), [](const folder::Row& a, const folder::Row& b) { return a.run < b.run; });
   RunSummary summary;
   summary.total = all.size();
   summary.runs_csv = folder::path_in(out_dir, folder::kRunsFile);
   for (const folder::Row& r : all) summary.errors += r.error ? 1 : 0;
-  auto spec_copy = read_input(folder::path_in(shard_dirs[0], folder::kSpecCopy), kMaxYamlBytes);
-  if (!spec_copy) return spec_copy.error();
-  // The manifest first: a merge stopped half-way leaves a folder of this campaign, merged again at will.
-  if (Status st = write_text_file(folder::path_in(out_dir, folder::kShardFile),
-                                  folder::manifest_text(Shard{1, 1}, first.matrix_runs));
-      !st)
-    return st.error();
-  if (Status st = write_text_file(folder::path_in(out_dir, folder::kHashFile), first.spec_sha256 + "\n"); !st)
-    return st.error();
-  if (Status st = folder::write_rows(summary.runs_csv, *header, all); !st) return st.error();
-  if (Status st = write_text_file(folder::path_in(out_dir, folder::kSpecCopy), *spec_copy); !st)
-    return st.error();
+  if (Status s = write_merged(out_dir, shard_dirs[0], first, *header, all, summary.runs_csv); !s)
+    return s.error();
   return summary;
 }
 
