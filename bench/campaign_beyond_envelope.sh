@@ -6,13 +6,22 @@
 # tracker of 3-10 arcsec delivering 0-0.3 s late, bias and stuck faults on every gyro at a random onset and
 # size; 10-minute runs, SEEDS seeds per case plus as many fault-free runs. Prints per N the wrong
 # exclusions, right isolations, unisolated, missed, false alarms per hour and pointing (docs/fdi_validation.md).
-# Usage: bench/campaign_beyond_envelope.sh [BUILD_DIR] [SEEDS]   (defaults: build, 150: 4,950 runs, ~3 min)
+# Usage: bench/campaign_beyond_envelope.sh [BUILD_DIR] [SEEDS] [N...]   (defaults: build, 150, 4 5 6: 4,950
+# runs, ~3 min). KEEP=DIR keeps the specs and campaign folders there (DIR/cN/runs.csv; a run again with its
+# events: tetra campaign DIR/specN.yaml --run K --events ev.jsonl).
 set -euo pipefail
 build="$(realpath "${1:-build}")"
 seeds="${2:-150}"
 src="$(cd "$(dirname "$0")/.." && pwd)"
-out="$(mktemp -d)"
-trap 'rm -rf "$out"' EXIT
+ns=("${@:3}")
+[ ${#ns[@]} -gt 0 ] || ns=(4 5 6)
+if [ -n "${KEEP:-}" ]; then
+  out="$(realpath -m "$KEEP")"
+  mkdir -p "$out"
+else
+  out="$(mktemp -d)"
+  trap 'rm -rf "$out"' EXIT
+fi
 echo "cores: $(nproc); load before: $(cut -d' ' -f1-3 /proc/loadavg)"
 python3 - "$src" "$out" "$seeds" <<'PY'
 import math, sys
@@ -55,7 +64,7 @@ dispersions:
   fault.size_factor: {{log_uniform: [0.1, 10]}}
 """)
 PY
-for n in 4 5 6; do
+for n in "${ns[@]}"; do
   "$build/tetra" campaign "$out/spec$n.yaml" --out "$out/c$n" >"$out/log$n.txt" 2>&1
   echo "N = $n: $(head -3 "$out/c$n/report.md" | tail -1)"
   grep -E '^\| (right|unisolated|wrong|missed) \(faulty runs\)' "$out/c$n/report.md" | cut -d'|' -f2-5 | sed 's/^/  /'

@@ -59,6 +59,42 @@ TEST(CampaignCli, RunsResumesAndReports) {
   EXPECT_EQ(resumed, rows) << "the resumed campaign has the same rows (runs are deterministic per seed)";
 }
 
+// `--run K` runs one run again, alone, with the same draws: its row is runs.csv's, and `--events` writes
+// its decisions with their ledger rows (why it ended as it did). A run the campaign does not have is refused.
+TEST(CampaignCli, OneRunAgainGivesItsRowAndItsEvents) {
+  TempDir dir;
+  write_spec(dir);
+  const std::string out = dir.file("out");
+  ASSERT_EQ(run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --jobs 2 --no-report").exit_status,
+            0);
+  std::string row3;
+  for (const std::string& line : lines_of(read_file(out + "/runs.csv")))
+    if (line.rfind("3,", 0) == 0) row3 = line;
+  ASSERT_FALSE(row3.empty());
+  const auto again = run_tetra("campaign " + dir.file("spec.yaml") + " --run 3 --events " + dir.file("ev.jsonl"));
+  ASSERT_EQ(again.exit_status, 0) << again.err;
+  const auto printed = lines_of(again.out);
+  ASSERT_EQ(printed.size(), 2u) << again.out;
+  EXPECT_EQ(printed[1], row3);
+  const auto events = lines_of(read_file(dir.file("ev.jsonl")));
+  ASSERT_FALSE(events.empty());
+  bool isolated = false;
+  for (const std::string& e : events) {
+    EXPECT_EQ(e.front(), '{') << e;
+    if (e.find("\"event\": \"isolated\"") != std::string::npos) {
+      isolated = true;
+      EXPECT_NE(e.find("\"ledger\": [{"), std::string::npos) << e;
+    }
+  }
+  EXPECT_TRUE(isolated) << read_file(dir.file("ev.jsonl"));
+  const auto beyond = run_tetra("campaign " + dir.file("spec.yaml") + " --run 10");
+  EXPECT_EQ(beyond.exit_status, 2) << beyond.err;
+  EXPECT_NE(beyond.err.find("runs 0 to 9"), std::string::npos) << beyond.err;
+  const auto no_run = run_tetra("campaign " + dir.file("spec.yaml") + " --events " + dir.file("x.jsonl"));
+  EXPECT_EQ(no_run.exit_status, 2) << no_run.err;
+  EXPECT_NE(no_run.err.find("--events needs --run"), std::string::npos) << no_run.err;
+}
+
 // Open loop (`loop: open`): the built-in orbit and slews scenarios' own motion, nothing steering. The faults
 // are isolated as in closed loop; the pointing columns are empty and the report says why.
 TEST(CampaignCli, OpenLoopCampaign) {

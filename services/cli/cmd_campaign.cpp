@@ -49,6 +49,8 @@ struct CampaignArgs {
   std::string spec_path;
   bool no_report = false;
   std::string shard_text;
+  long long rerun = -1;  //!< --run K: that run again, alone
+  std::string events_path;
   int domain = 0;
   CLI::Option* domain_opt = nullptr;
 };
@@ -57,8 +59,7 @@ void add_campaign_options(CLI::App& app, CampaignArgs& a, campaign::RunOptions& 
   app.add_option("SPEC", a.spec_path, "campaign spec YAML")->required();
   app.add_option("--out,-o", options.out_dir,
                  "output folder: runs.csv, report.md, plots, spec.yaml, spec.sha256, shard.txt (target "
-                 "dds: dds/, the services' files while they run)")
-      ->required();
+                 "dds: dds/, the services' files while they run); required unless --run");
   app.add_option("--jobs,-j", options.jobs, "worker processes (default: the number of cores; at most 1024)")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
@@ -70,6 +71,12 @@ void add_campaign_options(CLI::App& app, CampaignArgs& a, campaign::RunOptions& 
                  "K/N: run only the runs i with i mod N = K-1 (K from 1 to N), e.g. one Slurm array task; "
                  "no report (tetra campaign merge writes it)");
   app.add_flag("--no-report", a.no_report, "only the runs (no report, no plots)");
+  app.add_option("--run", a.rerun,
+                 "K: run K of the campaign (runs.csv's `run`) again, alone and in process, with the same draws; "
+                 "its row on standard output (header and row), nothing else written but --events")
+      ->check(CLI::Range(0LL, 999999LL));
+  app.add_option("--events", a.events_path,
+                 "with --run: the run's FDI events as JSON lines (each decision with its ledger rows)");
   a.domain_opt = app.add_option("--domain", a.domain,
                                 "DDS domain of the services (target dds; overrides the spec's domain:)")
                      ->check(CLI::Range(0, 232));
@@ -121,6 +128,55 @@ Status prepare(const sim::CampaignSpec& spec, const campaign::RunOptions& option
   return ok_status();
 }
 
+//! The in-process pipeline of a run, its events kept for --events.
+class KeepingEstimator final : public sim::Estimator {
+ public:
+  KeepingEstimator(std::unique_ptr<sim::Estimator> inner, std::vector<fdi::FdiEvent>& kept)
+      : inner_(std::move(inner)), kept_(kept) {}
+  Result<sim::EstimatorOutput> estimate(const sim::SimEpoch& epoch) override {
+    auto out = inner_->estimate(epoch);
+    if (out) kept_.insert(kept_.end(), out->events.begin(), out->events.end());
+    return out;
+  }
+  Status finish(std::vector<fdi::FdiEvent>& events) override {
+    const std::size_t before = events.size();
+    Status st = inner_->finish(events);
+    kept_.insert(kept_.end(), events.begin() + static_cast<std::ptrdiff_t>(before), events.end());
+    return st;
+  }
+
+ private:
+  std::unique_ptr<sim::Estimator> inner_;
+  std::vector<fdi::FdiEvent>& kept_;
+};
+
+//! --run K: the run again with the pipeline in process; its row on stdout, its events to `events_path`.
+int rerun_one(const sim::CampaignSpec& spec, std::size_t index, const std::string& events_path) {
+  auto total = sim::campaign_run_count(spec);
+  if (!total) return report(kCampaignName, total.error());
+  if (index >= *total)
+    return report(kCampaignName, bad_input(fmt::format("--run {}: the campaign has runs 0 to {}", index,
+                                                       *total == 0 ? 0 : *total - 1)));
+  std::vector<fdi::FdiEvent> events;
+  const sim::EstimatorFactory inner = sim::in_process_estimators(spec);
+  const sim::EstimatorFactory keeping = [&](const sim::Scenario& scenario, const sim::CampaignCase& c,
+                                            const Quaternion& q) -> Result<std::unique_ptr<sim::Estimator>> {
+    auto made = inner(scenario, c, q);
+    if (!made) return made.error();
+    return std::unique_ptr<sim::Estimator>(std::make_unique<KeepingEstimator>(std::move(*made), events));
+  };
+  const sim::CampaignRow row = sim::campaign_run_row(spec, index, keeping);
+  std::cout << sim::campaign_csv_header(spec) << '\n' << sim::campaign_csv_row(row) << '\n';
+  if (!events_path.empty()) {
+    std::string text;
+    for (const fdi::FdiEvent& e : events) text += fdi::to_json(e, spec.max_gyro_count()) + "\n";
+    if (Status st = write_text_file(events_path, text); !st) return report(kCampaignName, st.error());
+    std::cerr << "tetra campaign: run " << index << ": " << events.size() << " events -> " << events_path
+              << '\n';
+  }
+  return row.error.empty() ? kExitOk : kExitFailure;
+}
+
 }  // namespace
 
 int cmd_campaign(int argc, char** argv) {
@@ -143,6 +199,9 @@ int cmd_campaign(int argc, char** argv) {
 
   auto spec = campaign_setup(args, options);
   if (!spec) return report(kCampaignName, spec.error());
+  if (args.rerun >= 0) return rerun_one(*spec, static_cast<std::size_t>(args.rerun), args.events_path);
+  if (!args.events_path.empty()) return report(kCampaignName, bad_input("--events needs --run K"));
+  if (options.out_dir.empty()) return report(kCampaignName, bad_input("--out is required (unless --run K)"));
   if (Status st = prepare(*spec, options); !st) return report(kCampaignName, st.error());
   auto done = campaign::run_campaign(*spec, options);
   if (!done) return report(kCampaignName, done.error());
