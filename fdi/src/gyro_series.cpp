@@ -19,7 +19,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kRatioMargin = 1e-9;
 constexpr double kCoarseStepPerSigma = 0.1;  //!< a quantization step beyond this many σ makes repeats normal
 constexpr double kQuietMotion = 2.0;  //!< [σ] motion level the noise-level test still tells from noise
-constexpr double kNormalLevel = 2.0;  //!< noise ratio of a gyro whose own second differences look normal
+constexpr double kMotionQuietRatio = 2.0;  //!< noise ratio of a gyro whose own second differences look normal
 //! [samples] another gyro's repeat run that leaves a coarse gyro's repeats unjudged
 constexpr int kOtherRepeats = 3;
 //! Pieces of a repeat run that one other gyro's fault explains: its level changed at most twice during the
@@ -344,7 +344,7 @@ bool GyroSeries::others_normal(int id, double sqrt_period) const {
   for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
     if (j == id || has_gyro(excluded_, j)) continue;
     const double r = noise_ratio(j, sqrt_period);
-    if (!std::isfinite(r) || r > kNormalLevel) return false;
+    if (!std::isfinite(r) || r > kMotionQuietRatio) return false;
     // A finely quantized output repeating its value has just stuck (its own test needs more repeats): its
     // frozen output is part of the motion the others see along this axis, which then hides the jerk of a
     // slew's start from it (N = 4, a gyro at 0 V as a slew began: the healthy one was excluded first).

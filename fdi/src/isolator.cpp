@@ -12,6 +12,8 @@ Isolator::Isolator(int n_gyros, const PipelineConfig& config)
     : n_(n_gyros),
       config_(config),
       glt_sum_(Eigen::VectorXd::Zero(std::max(1, n_gyros - 3))),
+      glt_pre_(Eigen::VectorXd::Zero(std::max(1, n_gyros - 3))),
+      glt_y_pre_(static_cast<std::size_t>(n_gyros), 0.0),
       hist_y_(static_cast<std::size_t>(kHistory) * static_cast<std::size_t>(n_gyros), 0.0),
       hist_valid_(kHistory, 0),
       hist_ns_(kHistory, 0),
@@ -25,6 +27,8 @@ Isolator::Isolator(int n_gyros, const PipelineConfig& config)
   for (int d = 0; d <= std::max(1, n_gyros - 3); ++d) {
     glt_mean_.push_back(Eigen::VectorXd::Zero(d));
     glt_w_.push_back(Eigen::VectorXd::Zero(d));
+    glt_cov_.push_back(Eigen::MatrixXd::Zero(d, d));
+    glt_ldlt_.emplace_back(d);
   }
 }
 
@@ -33,6 +37,10 @@ void Isolator::close() {
   episode_.declared_unisolated = false;
   glt_sum_.setZero();
   glt_n_ = 0;
+  glt_omega_sum_.setZero();
+  glt_baseline_done_ = false;
+  glt_pre_n_ = 0;
+  glt_noise_var_ = 1.0;
 }
 
 std::int64_t Isolator::time_of(std::int64_t index) const {
@@ -48,7 +56,7 @@ void Isolator::record(const EpochFrame& frame) {
 }
 
 bool Isolator::open(const Detection& detection, std::int64_t now_ns, std::int64_t index, const Subset& s,
-                    const ParityDetector& detector) {
+                    const ParityDetector& detector, const Eigen::Vector3d& omega_rad_s) {
   if (episode_.active) return false;
   episode_.active = true;
   episode_.declared_unisolated = false;
@@ -59,16 +67,20 @@ bool Isolator::open(const Detection& detection, std::int64_t now_ns, std::int64_
   if (index - detection.onset_index >= kHistory) episode_.onset_ns = now_ns;
   episode_.test = detection.test;
   episode_.statistic = detection.statistic;
+  glt_baseline_done_ = false;
+  glt_pre_n_ = 0;
   if (s.dof >= 2) {  // the GLT starts from the parity the vector CUSUM summed since its change time
     glt_sum_.head(s.dof) = detector.vector_sum().head(s.dof);
     glt_n_ = detector.vector_count();
+    glt_omega_sum_ = omega_rad_s * glt_n_;  // the epochs before the opening at this epoch's rate
   }
   return true;
 }
 
-void Isolator::accumulate(const Eigen::VectorXd& p, int dof) {
+void Isolator::accumulate(const Eigen::VectorXd& p, int dof, const Eigen::Vector3d& omega_rad_s) {
   if (!episode_.active || dof < 2) return;
   glt_sum_.head(dof) += p.head(dof);
+  glt_omega_sum_ += omega_rad_s;
   ++glt_n_;
 }
 
@@ -81,7 +93,8 @@ Verdict Isolator::decide(std::int64_t now_ns, std::int64_t index, GyroMask activ
   if (culprit == 0) {
     const Subset& s = subsets.get(active);
     if (s.dof >= 2 && glt_n_ >= 3) rows_.clear();  // the GLT runs: its rows, not the silent onset test's
-    culprit = glt_test(s);
+    if (!glt_baseline_done_) glt_baseline(index, s, subsets.sqrt_period());
+    culprit = glt_test(s, subsets);
     evidence = Evidence::kGlt;
   }
   if (culprit > 0) {
@@ -224,14 +237,42 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
   return count == 1 ? culprit : 0;
 }
 
-// GLT on the mean normalized parity since the onset (N ≥ 5): the residual after fitting a fault of gyro i is
-// χ²_{d−1} under hypothesis i. Isolate i when it is accepted and every other is rejected.
-int Isolator::glt_test(const Subset& s) {
+// GLT on the mean normalized parity since the onset (N ≥ 5). Under hypothesis i the mean is a fault along
+// gyro i's column w_i, plus the calibration's term, plus white noise. With C the covariance of what is not the
+// fault, the residual after fitting the best fault along w_i, mᵀC⁻¹m − (w_iᵀC⁻¹m)²/(w_iᵀC⁻¹w_i), is χ²_{d−1}
+// under hypothesis i. Two forms of m and C:
+// - the mean alone, m = p̄: the calibration's term at the mean rate ω̄, C_cal(ω̄) from the stated 1σ times
+//   calibration_error_sigmas (biases, scale factors, axes) and the wandering bias's, plus σ²/n;
+// - the mean minus the baseline before the onset (`glt_baseline`), m = p̄ − p̄_pre: the term is linear in the
+//   rate and its bias part constant, so what is left is that of the rate's change, C_cal(ω̄ − ω̄_pre) without
+//   the biases, plus σ²(1/n + 1/n_pre). A fault that began before the baseline's window moves both means along
+//   w_i: m stays on gyro i's line.
+// σ² is the white-noise variance the baseline shows (`baseline_noise_variance`, at least the model's 1). Each
+// hypothesis's statistic is the larger of the two (the first form is capped by the biases' term, the second
+// by the baseline's noise): a true hypothesis is rejected above χ²_{d−1}(1 − glt_false_alarm_probability)
+// with at most twice that probability for a unit within its calibration's tolerance — and only then can a
+// healthy gyro be excluded. Two gyros whose columns the
+// calibration's term can confuse stay both consistent: the episode waits for more evidence or ends
+// `unisolated` (docs/fdi.md, "GLT").
+int Isolator::glt_test(const Subset& s, const SubsetCache& subsets) {
   if (s.dof < 2 || glt_n_ < 3) return 0;
   const double n = glt_n_;
+  const Eigen::Vector3d omega_mean = glt_omega_sum_ / n;
   Eigen::VectorXd& mean = glt_mean_[static_cast<std::size_t>(s.dof)];
-  Eigen::VectorXd& w = glt_w_[static_cast<std::size_t>(s.dof)];
+  Eigen::MatrixXd& cov = glt_cov_[static_cast<std::size_t>(s.dof)];
+  double r[kMaxGyros];
   mean = glt_sum_.head(s.dof) / n;
+  subsets.calibration_covariance(s, s.mask, omega_mean, true, cov);
+  cov.diagonal().array() += glt_noise_var_ / n;
+  glt_residuals(s, mean, cov, r);
+  if (glt_pre_n_ > 0) {
+    double r_pre[kMaxGyros];
+    mean -= glt_pre_.head(s.dof);
+    subsets.calibration_covariance(s, s.mask, omega_mean - glt_omega_pre_, false, cov);
+    cov.diagonal().array() += glt_noise_var_ * (1.0 / n + 1.0 / glt_pre_n_);
+    glt_residuals(s, mean, cov, r_pre);
+    for (int i = 0; i < n_; ++i) r[i] = std::max(r[i], r_pre[i]);
+  }
   int best = 0;
   int accepted = 0;
   int rejected = 0;
@@ -239,19 +280,88 @@ int Isolator::glt_test(const Subset& s) {
   for (int i = 0; i < n_; ++i) {
     if (!has_gyro(s.mask, i + 1)) continue;
     ++members;
-    w = s.parity.col(i);
-    const double proj = w.dot(mean);
-    const double r = n * (mean.squaredNorm() - proj * proj / w.squaredNorm());
-    rows_.add(judge(EvidenceSource::kGlt, static_cast<std::uint8_t>(i + 1), r, s.glt_accept, s.glt_reject,
+    rows_.add(judge(EvidenceSource::kGlt, static_cast<std::uint8_t>(i + 1), r[i], s.glt_accept, s.glt_reject,
                     s.dof - 1));
-    if (r <= s.glt_accept) {
+    if (r[i] <= s.glt_accept) {
       ++accepted;
       best = i + 1;
-    } else if (r > s.glt_reject) {
+    } else if (r[i] > s.glt_reject) {
       ++rejected;
     }
   }
   return (accepted == 1 && rejected == members - 1) ? best : 0;
+}
+
+void Isolator::glt_residuals(const Subset& s, const Eigen::VectorXd& m, const Eigen::MatrixXd& cov,
+                             double* r) const {
+  Eigen::LDLT<Eigen::MatrixXd>& ldlt = glt_ldlt_[static_cast<std::size_t>(s.dof)];
+  Eigen::VectorXd& w = glt_w_[static_cast<std::size_t>(s.dof)];
+  ldlt.compute(cov);
+  w = ldlt.solve(m);
+  const double m_m = m.dot(w);
+  for (int i = 0; i < n_; ++i) {
+    if (!has_gyro(s.mask, i + 1)) continue;
+    w = ldlt.solve(s.parity.col(i));  // C⁻¹·w_i
+    const double w_m = w.dot(m);
+    r[i] = m_m - w_m * w_m / w.dot(s.parity.col(i));
+  }
+}
+
+void Isolator::glt_baseline(std::int64_t index, const Subset& s, double sqrt_period) {
+  glt_baseline_done_ = true;
+  glt_pre_n_ = 0;
+  const std::int64_t end = episode_.onset_index - 2;  // the onset test's gap
+  const std::int64_t begin = std::max({end - kGltBaselineEpochs, index - kHistory + 1, std::int64_t{0}});
+  if (end - begin < kGltBaselineMin) return;
+  std::fill(glt_y_pre_.begin(), glt_y_pre_.end(), 0.0);
+  int count = 0;
+  for (std::int64_t k = begin; k < end; ++k) {
+    const auto slot = static_cast<std::size_t>(k % kHistory);
+    if ((hist_valid_[slot] & s.mask) != s.mask) continue;
+    for (int i = 0; i < n_; ++i) glt_y_pre_[static_cast<std::size_t>(i)] += y_at(slot, i);
+    ++count;
+  }
+  if (count < kGltBaselineMin) return;
+  for (double& v : glt_y_pre_) v /= count;
+  double p[kMaxGyros];
+  (void)apply_parity(s, s.mask, glt_y_pre_.data(), sqrt_period, p);
+  for (int r = 0; r < s.dof; ++r) glt_pre_[r] = p[r];
+  glt_omega_pre_ = apply_pinv(s.pinv, s.mask, glt_y_pre_.data());
+  glt_pre_n_ = count;
+  glt_noise_var_ = baseline_noise_variance(begin, end, s, sqrt_period);
+}
+
+// The noise the baseline's parity shows: a unit noisier than its `noise:` section (or a gyro among them)
+// makes the parity's spread larger than the model's unit variance, and the GLT's white-noise term follows
+// it. The spread of means of kGltNoiseBlock epochs, times that count: a mean's variance, in which the
+// angle quantization telescopes away as it does in the GLT's own means (one sample's spread would count it
+// whole). The largest eigenvalue of their sample covariance, at least the model's 1. Once per episode (the
+// eigenvalue solver allocates).
+double Isolator::baseline_noise_variance(std::int64_t begin, std::int64_t end, const Subset& s,
+                                         double sqrt_period) const {
+  Eigen::MatrixXd scatter = Eigen::MatrixXd::Zero(s.dof, s.dof);
+  Eigen::VectorXd block = Eigen::VectorXd::Zero(s.dof);
+  double p[kMaxGyros];
+  int in_block = 0;
+  int blocks = 0;
+  for (std::int64_t k = begin; k < end; ++k) {
+    const auto slot = static_cast<std::size_t>(k % kHistory);
+    if ((hist_valid_[slot] & s.mask) != s.mask) continue;
+    (void)apply_parity(s, s.mask, &hist_y_[slot * static_cast<std::size_t>(n_)], sqrt_period, p);
+    for (int r = 0; r < s.dof; ++r) block[r] += p[r] - glt_pre_[r];
+    if (++in_block < kGltNoiseBlock) continue;
+    block /= kGltNoiseBlock;
+    scatter.noalias() += block * block.transpose();
+    block.setZero();
+    in_block = 0;
+    ++blocks;
+  }
+  if (blocks < 2) return 1.0;
+  scatter *= static_cast<double>(kGltNoiseBlock) / blocks;
+  const double largest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scatter, Eigen::EigenvaluesOnly)
+                             .eigenvalues()
+                             .maxCoeff();
+  return std::isfinite(largest) ? std::max(1.0, largest) : 1.0;
 }
 
 // Bias or ramp: the parity projected on gyro j's direction over the history kept (at most kHistory epochs,

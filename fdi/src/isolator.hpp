@@ -10,6 +10,8 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "epoch_frame.hpp"
 #include "gyro_series.hpp"
@@ -41,12 +43,14 @@ class Isolator {
   //! Keeps the epoch's calibrated rates for the onset test and the drift classification.
   void record(const EpochFrame& frame);
   //! A detection opens an episode (no-op when one is open). Returns true when it opened one.
+  //! `omega_rad_s`: this epoch's measured body rate (the GLT's calibration term for the epochs before).
   bool open(const Detection& detection, std::int64_t now_ns, std::int64_t index, const Subset& s,
-            const ParityDetector& detector);
+            const ParityDetector& detector, const Eigen::Vector3d& omega_rad_s);
   //! Every alarm, opening or not, keeps the episode alive.
   void alarmed(std::int64_t now_ns) { episode_.last_alarm_ns = now_ns; }
-  //! The CUSUM saw this epoch: the GLT accumulates its parity while an episode is open.
-  void accumulate(const Eigen::VectorXd& p, int dof);
+  //! The CUSUM saw this epoch: the GLT accumulates its measured parity and body rate [rad/s] while an
+  //! episode is open.
+  void accumulate(const Eigen::VectorXd& p, int dof, const Eigen::Vector3d& omega_rad_s);
   //! Seeks evidence for the open episode. `found` is set with kIsolated.
   Verdict decide(std::int64_t now_ns, std::int64_t index, GyroMask active, SubsetCache& subsets,
                  const GyroSeries& series, Isolation& found);
@@ -84,7 +88,18 @@ class Isolator {
   //! `ratio`, when given: the change over its bound (NaN when it cannot judge).
   int motion_within_bound(GyroMask mask, double separation_s, SubsetCache& subsets, const GyroSeries& series,
                           double* ratio = nullptr) const;
-  int glt_test(const Subset& s);
+  int glt_test(const Subset& s, const SubsetCache& subsets);
+  //! r_i for every gyro i of `s`: the residual of m after the best fault along w_i, in the metric C⁻¹.
+  void glt_residuals(const Subset& s, const Eigen::VectorXd& m, const Eigen::MatrixXd& cov, double* r) const;
+  //! The GLT's baseline: the mean normalized parity and rate over the clean epochs before the onset kept in
+  //! the history (all of `s`'s gyros valid), at most kGltBaselineEpochs of them; none when fewer than
+  //! kGltBaselineMin are kept.
+  void glt_baseline(std::int64_t index, const Subset& s, double sqrt_period);
+  double baseline_noise_variance(std::int64_t begin, std::int64_t end, const Subset& s,
+                                 double sqrt_period) const;
+  static constexpr int kGltBaselineEpochs = 200;  //!< [epochs] the baseline's longest window
+  static constexpr int kGltBaselineMin = 20;      //!< [epochs] its shortest
+  static constexpr int kGltNoiseBlock = 10;       //!< [epochs] the baseline's blocks for its noise
   //! Window means of each gyro's rate over history epochs [b, e); returns the mean time offset from b [s].
   double window_means(std::int64_t b, std::int64_t e, std::vector<double>& mean,
                       std::vector<int>& count) const;
@@ -98,6 +113,15 @@ class Isolator {
   EvidenceRows rows_;
   Eigen::VectorXd glt_sum_;  //!< Σ p since the onset (d ≥ 2)
   int glt_n_ = 0;
+  Eigen::Vector3d glt_omega_sum_ = Eigen::Vector3d::Zero();  //!< [rad/s] Σ ω since the onset
+  bool glt_baseline_done_ = false;  //!< the baseline was sought for this episode
+  int glt_pre_n_ = 0;               //!< epochs of the baseline (0: none)
+  //! [σ²] per parity axis: the white noise's variance the baseline shows, at least the model's 1 (the
+  //! largest eigenvalue of its parity's sample covariance, raised by its 3σ estimation error)
+  double glt_noise_var_ = 1.0;
+  Eigen::VectorXd glt_pre_;         //!< its mean normalized parity
+  Eigen::Vector3d glt_omega_pre_ = Eigen::Vector3d::Zero();  //!< [rad/s] its mean rate
+  std::vector<double> glt_y_pre_;   //!< scratch: its mean rates per gyro
   std::vector<double> hist_y_;  //!< kHistory×N [rad/s]
   std::vector<GyroMask> hist_valid_;
   std::vector<std::int64_t> hist_ns_;
@@ -107,6 +131,8 @@ class Isolator {
   mutable std::vector<double> drift_t_;            //!< [s] its times
   mutable std::vector<Eigen::VectorXd> glt_mean_;  //!< scratch per parity dimension (never resized)
   mutable std::vector<Eigen::VectorXd> glt_w_;
+  std::vector<Eigen::MatrixXd> glt_cov_;                //!< scratch per parity dimension: the mean's covariance
+  mutable std::vector<Eigen::LDLT<Eigen::MatrixXd>> glt_ldlt_;  //!< and its factorization
 };
 
 }  // namespace tetra::fdi::detail

@@ -18,7 +18,8 @@ const EvidenceSourceInfo kEvidenceSources[kEvidenceSourceCount] = {
     {EvidenceSource::kOnset, "onset", StatisticUnit::kMotionBound,
      "the rate change across the onset, without the hypothesis's gyro, against the motion bound"},
     {EvidenceSource::kGlt, "glt", StatisticUnit::kChi2,
-     "the mean parity since the onset, less the hypothesis's gyro's fault fitted"},
+     "the mean parity since the onset (and its change from before it), less the hypothesis's gyro's fault "
+     "fitted, against the noise the data show and the calibration's tolerance"},
     {EvidenceSource::kTimeout, "timeout", StatisticUnit::kSeconds, "how long the gyro has delivered nothing"},
     {EvidenceSource::kInvalid, "invalid", StatisticUnit::kSeconds,
      "how long the gyro has delivered invalid samples"},

@@ -77,6 +77,8 @@ class ParityDetector {
 
   //! This epoch's normalized parity (first `dof` entries).
   const Eigen::VectorXd& parity() const { return p_; }
+  //! This epoch's normalized parity as measured, before the calibration bound moved it (the CUSUM's input).
+  const Eigen::VectorXd& parity_measured() const { return p_raw_; }
   //! 2-s EMA of the normalized parity.
   const Eigen::VectorXd& parity_ema() const { return p_ema_; }
   //! The parity evidence is nominal: the slow mean (time constant `nominal_window_s`) of the full active

@@ -146,7 +146,7 @@ void Pipeline::Impl::detect() {
   const Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), calibration, health_);
   protection_.widen(calibration, frame_.dt_s);  // the CUSUM's reference k + D: a larger fault unseen
   if (d.cusum_ran) {
-    isolator_.accumulate(detector_.parity(), s.dof);
+    isolator_.accumulate(detector_.parity_measured(), s.dof, attitude_.omega_meas_B());
     bias_check_.record(detector_.parity(), s);
   }
   // An open episode ends only once the parity is back to nominal for clear_after_s: a fault whose CUSUM
@@ -158,7 +158,7 @@ void Pipeline::Impl::detect() {
     level_changed(d);
     return;
   }
-  if (isolator_.open(d, frame_.now_ns, frame_.index, s, detector_)) {
+  if (isolator_.open(d, frame_.now_ns, frame_.index, s, detector_, attitude_.omega_meas_B())) {
     attitude_.hold_biases(isolator_.episode().onset_ns);  // before the filter opens them to the fault
     detector_.open_episode();
     episode_rows_.clear();

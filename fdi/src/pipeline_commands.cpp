@@ -2,6 +2,7 @@
 // of Pipeline::Impl (pipeline_impl.hpp).
 
 #include "pipeline_impl.hpp"
+#include "tetra/fdi/budget.hpp"
 
 namespace tetra::fdi {
 
@@ -117,7 +118,7 @@ std::string Pipeline::Impl::describe_thresholds() const {
   append_double(out, s->level_k);
   out += "\nlevel test h (sigma): ";
   append_double(out, s->level_h);
-  out += "\n";
+  out += "\n" + to_text(error_budget(config_, n_, subsets_.period_s()));
   return out;
 }
 

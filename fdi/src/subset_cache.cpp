@@ -228,4 +228,21 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   }
 }
 
+void SubsetCache::calibration_covariance(const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s,
+                                         bool with_bias, Eigen::MatrixXd& out) const {
+  out.setZero(s.dof, s.dof);
+  if (s.dof < 1) return;
+  const double e = config_->calibration_error_sigmas;
+  const Eigen::Vector3d omega_sq = omega_rad_s.cwiseAbs2();
+  for (int i = 0; i < gyro_count(); ++i) {
+    if (!has_gyro(mask, i + 1)) continue;
+    const double along = geometry_.axes_B().row(i).dot(omega_rad_s);
+    const double b = with_bias ? bias_sigma_rad_s_[i] : 0.0;
+    const double sf = scale_rel_sigma_[i] * along;
+    const double var = b * b + sf * sf + axis_sigma_.col(i).cwiseAbs2().dot(omega_sq);  // [rad²/s²]
+    out.noalias() += (e * e * sqrt_period_ * sqrt_period_ * var) * s.parity.col(i) * s.parity.col(i).transpose();
+  }
+  out.diagonal().array() += (e * s.bias_wander_sigma) * (e * s.bias_wander_sigma);
+}
+
 }  // namespace tetra::fdi::detail

@@ -348,7 +348,9 @@ TEST(Pipeline, ExclusionIsLatchedAfterTheFaultGoes) {
 TEST(Pipeline, FiveGyrosIsolateABiasByGlt) {
   // Five gyros: the tetrahedron plus a skewed fifth axis; the parity space is two-dimensional, so the GLT
   // tells which gyro a small persistent bias sits on (the residual of the right hypothesis is χ²₁, the others
-  // grow with n).
+  // grow with n, up to what the calibration's term and the wandering bias, 3σ each, can hide: gyros 1 and 4
+  // are 4e-4 deg/s apart by less than that, so the size is 1e-3 deg/s).
+  constexpr double kSize_dps = 1e-3;
   Calibration cal = seed_as_built_unit();
   GyroCalibration g5;
   g5.id = 5;
@@ -358,7 +360,7 @@ TEST(Pipeline, FiveGyrosIsolateABiasByGlt) {
   g5.axis_B = Eigen::Vector3d(0.3, 0.5, -0.6).normalized();
   cal.gyros.push_back(g5);
   for (int gyro = 1; gyro <= 5; ++gyro) {
-    SynthFault f{gyro, FaultKind::kBias, false, 60.0, 4e-4};
+    SynthFault f{gyro, FaultKind::kBias, false, 60.0, kSize_dps};
     SynthOptions opt;
     opt.seed = 4000U + static_cast<std::uint64_t>(gyro);
     const Outcome o = run(f, 120.0, opt, campaign_config(), cal);

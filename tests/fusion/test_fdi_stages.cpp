@@ -425,7 +425,7 @@ TEST(Isolator, OnsetTestTellsTheSteppedGyroAndClassifiesIt) {
     isolator.record(frame);
     if (k == 52) {
       Detection d{true, DetectionTest::kCusum, 30.0, 50, true};
-      ASSERT_TRUE(isolator.open(d, frame.now_ns, k, f.subsets->get(0b1111), detector));
+      ASSERT_TRUE(isolator.open(d, frame.now_ns, k, f.subsets->get(0b1111), detector, Eigen::Vector3d::Zero()));
     }
     if (isolator.episode().active)
       verdict = isolator.decide(frame.now_ns, k, 0b1111, *f.subsets, series, found);

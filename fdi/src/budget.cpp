@@ -1,0 +1,93 @@
+#include "tetra/fdi/budget.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace tetra::fdi {
+
+namespace {
+
+constexpr double kNotAProbability = std::numeric_limits<double>::quiet_NaN();
+
+//! Two-sided tail of a standard normal beyond `sigmas`.
+double normal_tail(double sigmas) { return std::erfc(sigmas / std::sqrt(2.0)); }
+
+}  // namespace
+
+Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) {
+  Budget b;
+  b.gyros = gyros;
+  b.sample_period_s = sample_period_s;
+  const double epochs_per_hour = 3600.0 / sample_period_s;
+  const double window_epochs = c.isolation_window_s / sample_period_s;
+  const bool parity = gyros >= 4;
+  using K = BudgetKind;
+  if (parity) {
+    b.rows.push_back({"chi2", K::kFalseAlarm, "chi2_false_alarm_probability", c.chi2_false_alarm_probability,
+                      epochs_per_hour, "one epoch's parity"});
+    b.rows.push_back({"cusum", K::kFalseAlarm, "cusum_arl0_epochs", 1.0 / c.cusum_arl0_epochs, epochs_per_hour,
+                      "mean run length between false alarms, the wander and quantization in h"});
+    // The onset test names gyro i when every subset without it shows impossible motion: the true
+    // hypothesis's subset beyond its margin, at most the one-axis tail, per evaluation (from 20 epochs
+    // after the onset to onset_post_max_epochs).
+    b.rows.push_back({"onset", K::kWrongExclusion, "onset_sigma", normal_tail(c.onset_sigma),
+                      std::max(1.0, static_cast<double>(c.onset_post_max_epochs - 20)),
+                      "true hypothesis beyond the motion bound's margin"});
+  }
+  if (gyros >= 5) {
+    b.rows.push_back({"glt", K::kWrongExclusion, "glt_false_alarm_probability",
+                      2.0 * c.glt_false_alarm_probability, window_epochs,
+                      "true hypothesis rejected by either form, per epoch of isolation_window_s"});
+  }
+  if (gyros == 4) {
+    b.rows.push_back({"reference_window", K::kWrongExclusion, "reference_threshold_sigma",
+                      std::pow(normal_tail(c.reference_threshold_sigma), c.reference_confirm_count),
+                      window_epochs, "a healthy gyro's window beyond the threshold, reference_confirm_count times"});
+  }
+  b.rows.push_back({"reference_test", K::kReference, "reference_check_false_alarm_probability",
+                    c.reference_check_false_alarm_probability, 1.0, "per reference sample and test"});
+  b.rows.push_back({"reference_test", K::kReference, "reference_gate_false_alarm_probability",
+                    c.reference_gate_false_alarm_probability, 1.0,
+                    "one sample left out (the gate), rejection after reference_gate_reset_count"});
+  for (const char* signature : {"repeated", "zero", "variance", "noise_level", "recurring_spikes"}) {
+    b.rows.push_back({signature, K::kWrongExclusion, "", kNotAProbability, 1.0,
+                      "the gyro's own samples against a count or ratio: not a probability"});
+  }
+  for (const BudgetRow& row : b.rows) {
+    if (!std::isfinite(row.per_evaluation)) continue;
+    if (row.kind == K::kFalseAlarm) b.false_alarms_per_hour += row.total();
+    if (row.kind == K::kWrongExclusion) b.wrong_exclusion_per_episode += row.total();
+  }
+  return b;
+}
+
+std::string to_text(const Budget& b) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "error budget: %d gyros, sample period %g s\n", b.gyros, b.sample_period_s);
+  out += line;
+  for (const BudgetRow& r : b.rows) {
+    const char* kind = r.kind == BudgetKind::kFalseAlarm       ? "false alarm"
+                       : r.kind == BudgetKind::kWrongExclusion ? "wrong exclusion"
+                                                               : "reference rejected";
+    if (std::isfinite(r.per_evaluation)) {
+      const char* per = r.kind == BudgetKind::kFalseAlarm       ? "/h"
+                        : r.kind == BudgetKind::kWrongExclusion ? "/episode"
+                                                                : "/sample";
+      std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %9.3g x %-9.4g = %9.3g %s  (%s)\n", r.source, kind,
+                    r.key, r.per_evaluation, r.evaluations, r.total(), per, r.note);
+    } else {
+      std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %s\n", r.source, kind, "-", r.note);
+    }
+    out += line;
+  }
+  std::snprintf(line, sizeof line,
+                "  total: %.3g false alarms per 1,000 h; wrong exclusion at most %.3g per fault episode (the "
+                "sources with a probability)\n",
+                b.false_alarms_per_hour * 1000.0, b.wrong_exclusion_per_episode);
+  out += line;
+  return out;
+}
+
+}  // namespace tetra::fdi
