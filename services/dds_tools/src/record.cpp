@@ -329,7 +329,9 @@ Status record_until_done(const RecordOptions& o, const RecordLink& link, Recordi
     if (shutdown.requested() || now >= stop_at) return ok_status();
     const bool idle = o.until_idle && idle_since >= 0;
     if (idle) {
-      // The writers are gone: flush the open epochs, then wait (briefly) for the service's outputs.
+      // The writers are gone: take what they sent since the take above (it is all in: they waited for
+      // its acknowledgement), flush the open epochs, then wait (briefly) for the service's outputs.
+      if (auto s = recording.take(link, clock.now()); !s) return s;
       if (auto s = recording.flush_epochs(); !s) return s;
       if (recording.outputs_done() || now - idle_since >= kIdleGrace_ns) return ok_status();
     }
