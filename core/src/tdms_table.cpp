@@ -200,6 +200,7 @@ Status allocate_cells(CsvTable& t, TdmsCells cells) try {
 
 // A second pass over the file that decodes the columns' values straight into the table's cells.
 Status fill_cells(tdms_detail::Source& src, const TdmsFile& file, const Columns& cols, CsvTable& t) {
+  if (t.cells.empty()) return ok_status();  // no rows: nothing to decode
   tdms_detail::Fill fill;
   fill.column.assign(file.channels.size(), nullptr);
   fill.stride = t.columns.size();
@@ -245,23 +246,38 @@ Result<CsvTable> tdms_to_table(const TdmsFile& file, const TdmsChannelMap& map) 
   return t;
 }
 
-Result<CsvTable> read_tdms_table(const std::string& path, TdmsCells cells) try {
-  // Pass 1 reads the metadata and counts the values; pass 2 decodes the columns' values into their cells.
-  // Memory: the table's cells and a window of the file's bytes, never the file or a copy of the values.
-  auto src = tdms_detail::open_source(path);
-  if (!src) return src.error();
-  auto file = tdms_detail::parse(**src, path, tdms_detail::Pass::count);
+namespace {
+
+// Pass 1 reads the metadata and counts the values; pass 2 decodes the columns' values into their cells.
+// Memory: the table's cells and a window of the file's bytes, never the file or a copy of the values.
+Result<CsvTable> table_from(tdms_detail::Source& src, const std::string& name,
+                            const TdmsChannelMap* map_given, TdmsCells cells) try {
+  auto file = tdms_detail::parse(src, name, tdms_detail::Pass::count);
   if (!file) return file.error();
-  auto map = read_channel_map(path);
+  auto map = map_given != nullptr ? Result<TdmsChannelMap>(*map_given) : read_channel_map(name);
   if (!map) return map.error();
   auto cols = pick_columns(*file, *map);
   if (!cols) return cols.error();
   CsvTable t = table_header(*file, *map, *cols);
   if (Status s = allocate_cells(t, cells); !s) return s.error();
-  if (Status s = fill_cells(**src, *file, *cols, t); !s) return s.error();
+  if (Status s = fill_cells(src, *file, *cols, t); !s) return s.error();
   return t;
 } catch (const std::bad_alloc&) {
-  return failure(path + ": its metadata does not fit in memory");
+  return failure(name + ": its metadata does not fit in memory");
+}
+
+}  // namespace
+
+Result<CsvTable> read_tdms_table(const std::string& path, TdmsCells cells) {
+  auto src = tdms_detail::open_source(path);
+  if (!src) return src.error();
+  return table_from(**src, path, nullptr, cells);
+}
+
+Result<CsvTable> tdms_image_to_table(std::span<const std::uint8_t> bytes, const std::string& source,
+                                     const TdmsChannelMap& map) {
+  tdms_detail::MemorySource src(bytes);
+  return table_from(src, source, &map, TdmsCells::with_flags);
 }
 
 }  // namespace tetra

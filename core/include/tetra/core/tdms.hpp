@@ -77,5 +77,9 @@ enum class TdmsCells {
 //! file. A table that would not fit (more than 3/4 of the address-space limit or of the machine's memory)
 //! is an error naming the file before anything is allocated.
 Result<CsvTable> read_tdms_table(const std::string& path, TdmsCells cells = TdmsCells::with_flags);
+//! The same two passes over a file image in memory with the map given: the table tdms_to_table gives for
+//! parse_tdms of the same bytes (the fuzz target compares them).
+Result<CsvTable> tdms_image_to_table(std::span<const std::uint8_t> bytes, const std::string& source,
+                                     const TdmsChannelMap& map);
 
 }  // namespace tetra
