@@ -149,7 +149,9 @@ Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shu
       next_progress += 1'000'000'000;
     }
   }
-  (void)writer->wait_for_acks(std::chrono::nanoseconds(kHeldGiveUp_ns));  // what a reader has not yet
+  // What a reader has not acknowledged yet: waited for as a held write is (briefly when interrupted).
+  const bool interrupted = shutdown != nullptr && shutdown->requested();
+  (void)writer->wait_for_acks(std::chrono::nanoseconds(interrupted ? 2'000'000'000 : kHeldGiveUp_ns));
   report.wall_s = ns_to_seconds(dds::monotonic_ns() - start);
   report.lines = parser->accepted();
   report.malformed = parser->malformed();
