@@ -138,7 +138,7 @@ TEST(IngestDds, PseudoTerminalLinesReachTheWireMalformedCounted) {
 // recorder paused 0.2 s five times: ingest's writer keeps every sample until the recorder has it (it kept
 // 4,096 a gyro), the recorder's reader keeps every sample until taken (it kept 4,096) and the recorder
 // hands the samples on in time order across takes (a take gives one gyro's after another's: the later
-// gyros became time outliers, 2,039 of 40,000 epochs lost at full speed with no pause), and every line
+// gyros became time outliers: 1,597 of 40,000 epochs lost at full speed with no pause), and every line
 // is recorded as it was written.
 TEST(IngestDds, ARecorderPausedBehindASourceFasterThanRealTimeLosesNothing) {
   TempDir dir;
