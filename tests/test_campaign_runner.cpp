@@ -287,5 +287,43 @@ TEST(CampaignRunner, ShardsMergeToTheOneMachineFiles) {
       << torn.err;
 }
 
+// A spec naming its scenario relative to its own folder, its shards given as relative folders: every row
+// is still checked against the spec's matrix (the spec's copy in a shard does not find the scenario
+// there, and the check was skipped: a row of gyro 1 for gyro 0 merged with exit 0); merged from a folder
+// where the scenario is not found either, an error says the rows cannot be checked.
+TEST(CampaignRunner, ShardsGivenAsRelativeFoldersAreCheckedAgainstTheMatrix) {
+  TempDir dir;
+  write_file(dir.file("nadir.yaml"), read_file(source_path("examples/sim/closed_loop_nadir.yaml")));
+  write_file(dir.file("spec.yaml"),
+             "scenarios: [nadir.yaml]\nduration_s: 120\nkinds: [stuck]\ngyros: [1]\nonsets_s: [60]\n"
+             "seeds: [1, 2]\nfault_free: true\n");
+  const std::string in_dir = "cd " + dir.path().string() + " && " + std::string(TETRA_BINARY) + " ";
+  for (const char* k : {"1", "2"}) {
+    const auto r = run_shell(in_dir + "campaign spec.yaml --out s" + k + " --shard " + k + "/2 --jobs 1");
+    ASSERT_EQ(r.exit_status, 0) << r.err;
+  }
+  const std::string s2 = read_file(dir.file("s2/runs.csv"));
+  std::string forged = s2;  // run 1: fault-free, gyro 0, made gyro 1
+  std::size_t at = forged.find('\n') + 1;
+  for (int commas = 0; commas < 3; ++at) commas += forged[at] == ',' ? 1 : 0;
+  ASSERT_EQ(forged[at], '0') << s2;
+  forged[at] = '1';
+  write_file(dir.file("s2/runs.csv"), forged);
+  auto r = run_shell(in_dir + "campaign merge m s1 s2");
+  EXPECT_EQ(r.exit_status, 2) << r.err;
+  EXPECT_NE(r.err.find("s2/runs.csv: run 1 is '1,nadir.yaml,none,1,"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("m/runs.csv")));
+  write_file(dir.file("s2/runs.csv"), s2);
+  std::filesystem::create_directories(dir.file("elsewhere"));
+  r = run_shell("cd " + dir.file("elsewhere") + " && " + std::string(TETRA_BINARY) +
+                " campaign merge ../m ../s1 ../s2");
+  EXPECT_EQ(r.exit_status, 2) << r.err;
+  EXPECT_NE(r.err.find("../s1/spec.yaml: cannot check the rows against the spec's matrix"), std::string::npos)
+      << r.err;
+  r = run_shell(in_dir + "campaign merge m s1 s2");
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("m/runs.csv")));
+}
+
 }  // namespace
 }  // namespace tetra::test

@@ -309,6 +309,48 @@ TEST(TdmsParse, TableNeedsNumericColumnsOfEqualLength) {
       << unmapped.error().message;
 }
 
+// ---- memory: the table's cells, never the file or a copy of its values ---------------------------------
+
+// Peak resident memory [kB] of `tetra ARGS` (getrusage of the child, through Python), or -1.
+long peak_rss_kb(const std::string& args) {
+  const auto r = run_shell(
+      "python3 -c 'import resource, subprocess, sys; r = subprocess.run(sys.argv[1:]); "
+      "print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss if r.returncode == 0 else -1)' " +
+      std::string(TETRA_BINARY) + " " + args);
+  return r.exit_status == 0 ? std::stol(r.out) : -1;
+}
+
+// A 20 MB int8 file (2.5 million rows of time and 4 gyros: 100 MB of doubles) converts in its cells' memory
+// and a little more (main before: the file, its values and the table, about 2.3 times the cells); as
+// 1000-row segments to the same rows; under an address-space limit it cannot fit in, an error naming it.
+TEST(TdmsLog, ALargeInt8FileTakesTheMemoryOfItsCells) {
+  TempDir dir;
+  const std::string one = dir.file("i8.tdms");
+  const std::string seg = dir.file("seg.tdms");
+  const std::string tool = "python3 " + source_path("tests/tdms/make_int8_tdms.py") + " ";
+  ASSERT_EQ(run_shell(tool + one + " 2500000").exit_status, 0);
+  ASSERT_EQ(run_shell(tool + seg + " 2500000 --segment-rows 1000").exit_status, 0);
+  ASSERT_EQ(run_shell(tool + dir.file("tiny.tdms") + " 1000").exit_status, 0);
+  const long base = peak_rss_kb("convert " + dir.file("tiny.tdms") + " /dev/null");
+  const long big = peak_rss_kb("convert " + one + " /dev/null");
+  ASSERT_GT(base, 0);
+  ASSERT_GT(big, 0);
+  const long cells_kb = 2500000L * 5 * 8 / 1024;
+  EXPECT_LT(big - base, cells_kb * 5 / 4) << "peak " << big << " kB, a tiny file's " << base << " kB";
+  auto r = run_tetra("convert " + one + " " + dir.file("one.csv"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  r = run_tetra("convert " + seg + " " + dir.file("seg.csv"));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const std::string rows = without_comments(test::read_file(dir.file("one.csv")));
+  EXPECT_EQ(rows, without_comments(test::read_file(dir.file("seg.csv"))));
+  EXPECT_EQ(rows.substr(0, 41), "time_s,g1,g2,g3,g4\n0,-100,-100,-100,-100\n");
+  r = run_shell("ulimit -v 100000; " + std::string(TETRA_BINARY) + " convert " + one + " /dev/null");
+  EXPECT_EQ(r.exit_status, 2) << r.err;
+  EXPECT_NE(r.err.find(one + ": its 2500000 rows of 5 columns need 100 MB as numbers"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("bad_alloc"), std::string::npos) << r.err;
+}
+
 // ---- bounded work: linear in the file -----------------------------------------------------------------
 
 // Channel `path`'s object: a raw data index of `count` values of `type` (or a marker), no properties.

@@ -362,7 +362,7 @@ Status CsvStreamReader::open(const std::string& path) {
 }
 
 Status CsvStreamReader::open_tdms(const std::string& path) {
-  auto table = read_tdms_table(path);
+  auto table = read_tdms_table(path, TdmsCells::values_only);  // the cells alone: the rows' flags per block
   if (!table) return table.error();
   whole_ = std::make_unique<CsvTable>(std::move(*table));
   header_.metadata = whole_->metadata;
@@ -380,9 +380,9 @@ bool CsvStreamReader::next_tdms_rows(CsvTable& block) {
   const auto first = static_cast<std::ptrdiff_t>(whole_next_ * nc);
   const auto last = static_cast<std::ptrdiff_t>((whole_next_ + n) * nc);
   block.cells.assign(whole_->cells.begin() + first, whole_->cells.begin() + last);
-  block.empty.assign(whole_->empty.begin() + first, whole_->empty.begin() + last);
-  block.lines.assign(whole_->lines.begin() + static_cast<std::ptrdiff_t>(whole_next_),
-                     whole_->lines.begin() + static_cast<std::ptrdiff_t>(whole_next_ + n));
+  block.empty.assign(n * nc, 0);  // a TDMS cell is never empty
+  block.lines.resize(n);
+  for (std::size_t r = 0; r < n; ++r) block.lines[r] = whole_next_ + r + 1;
   block.rows = n;
   whole_next_ += n;
   consumed_ = whole_next_;

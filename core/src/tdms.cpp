@@ -12,11 +12,23 @@
 #include <set>
 #include <unordered_map>
 
-#include "tetra/core/input_files.hpp"
+#include "tdms_internal.hpp"
+#include "tdms_values.hpp"
 
 namespace tetra {
 
 namespace {
+
+using tdms_detail::Cursor;
+using tdms_detail::decode;
+using tdms_detail::hex_type;
+using tdms_detail::is_numeric;
+using tdms_detail::kTdsBoolean;
+using tdms_detail::kTdsString;
+using tdms_detail::kTdsTimeStamp;
+using tdms_detail::load_number;
+using tdms_detail::timestamp_text;
+using tdms_detail::type_size;
 
 constexpr std::size_t kLeadInBytes = 28;
 constexpr std::uint64_t kIncompleteSegment = 0xFFFFFFFFFFFFFFFFULL;  // LabVIEW stopped while writing it
@@ -32,140 +44,12 @@ constexpr std::uint32_t kNoRawData = 0xFFFFFFFFU;
 constexpr std::uint32_t kSameIndexAsBefore = 0;
 constexpr std::uint32_t kDaqmxFormatChanging = 0x00001269U;
 constexpr std::uint32_t kDaqmxDigitalLine = 0x00001369U;
-// tdsDataType codes
-constexpr std::uint32_t kTdsString = 0x20;
-constexpr std::uint32_t kTdsBoolean = 0x21;
-constexpr std::uint32_t kTdsTimeStamp = 0x44;
-constexpr std::int64_t kSeconds1904To1970 = 2082844800;
 // Bounds that keep a hostile file's work linear in its size
 constexpr std::size_t kMaxChannels = 65536;
 constexpr std::uint32_t kMaxPropertiesPerObject = 4096;
-
-std::string hex_type(std::uint32_t type) {
-  char hex[16];
-  std::snprintf(hex, sizeof hex, "0x%X", type);
-  return hex;
-}
-
-// Size in bytes of one value of a fixed-size type, 0 for strings and unknown types.
-std::size_t type_size(std::uint32_t type) {
-  switch (type) {
-    case 1:
-    case 5:
-    case kTdsBoolean:
-      return 1;  // I8, U8, Boolean
-    case 2:
-    case 6:
-      return 2;  // I16, U16
-    case 3:
-    case 7:
-    case 9:
-    case 0x19:
-      return 4;  // I32, U32, SingleFloat (with unit)
-    case 4:
-    case 8:
-    case 10:
-    case 0x1A:
-      return 8;  // I64, U64, DoubleFloat (with unit)
-    case 0x08000C:
-      return 8;  // ComplexSingleFloat
-    case kTdsTimeStamp:
-    case 0x10000D:
-      return 16;  // TimeStamp, ComplexDoubleFloat
-    default:
-      return 0;
-  }
-}
-
-bool is_numeric(std::uint32_t type) {
-  return (type >= 1 && type <= 10) || type == 0x19 || type == 0x1A || type == kTdsBoolean;
-}
-
-// Bounded reading of one region of the image in the segment's byte order.
-class Cursor {
- public:
-  Cursor(std::span<const std::uint8_t> bytes, std::size_t begin, std::size_t end, bool big_endian)
-      : bytes_(bytes), pos_(begin), end_(end), big_(big_endian) {}
-  std::size_t pos() const { return pos_; }
-  std::size_t left() const { return end_ - pos_; }
-  bool take(std::size_t n, const std::uint8_t*& at) {
-    if (n > left()) return false;
-    at = bytes_.data() + pos_;
-    pos_ += n;
-    return true;
-  }
-  template <class T>
-  bool get(T& out) {
-    const std::uint8_t* at = nullptr;
-    if (!take(sizeof(T), at)) return false;
-    out = load<T>(at, big_);
-    return true;
-  }
-  bool text(std::string& out) {
-    std::uint32_t n = 0;
-    const std::uint8_t* at = nullptr;
-    if (!get(n) || !take(n, at)) return false;
-    out.assign(reinterpret_cast<const char*>(at), n);
-    return true;
-  }
-  template <class T>
-  static T load(const std::uint8_t* at, bool big_endian) {
-    std::uint8_t b[sizeof(T)];
-    std::memcpy(b, at, sizeof(T));
-    if (big_endian) std::reverse(b, b + sizeof(T));
-    T v;
-    std::memcpy(&v, b, sizeof(T));
-    return v;
-  }
-
- private:
-  std::span<const std::uint8_t> bytes_;
-  std::size_t pos_;
-  std::size_t end_;
-  bool big_;
-};
-
-// A value of a fixed-size numeric type as a double.
-double load_number(const std::uint8_t* at, std::uint32_t type, bool big) {
-  switch (type) {
-    case 1:
-      return Cursor::load<std::int8_t>(at, big);
-    case 2:
-      return Cursor::load<std::int16_t>(at, big);
-    case 3:
-      return Cursor::load<std::int32_t>(at, big);
-    case 4:
-      return static_cast<double>(Cursor::load<std::int64_t>(at, big));
-    case 5:
-    case kTdsBoolean:
-      return Cursor::load<std::uint8_t>(at, big);
-    case 6:
-      return Cursor::load<std::uint16_t>(at, big);
-    case 7:
-      return Cursor::load<std::uint32_t>(at, big);
-    case 8:
-      return static_cast<double>(Cursor::load<std::uint64_t>(at, big));
-    case 9:
-    case 0x19:
-      return Cursor::load<float>(at, big);
-    default:
-      return Cursor::load<double>(at, big);  // 10, 0x1A
-  }
-}
-
-// A timestamp (seconds since 1904-01-01 UTC and 2^-64 fractions) as ISO 8601 UTC text.
-std::string timestamp_text(std::int64_t seconds, std::uint64_t fractions) {
-  const std::int64_t unix_s = seconds - kSeconds1904To1970;
-  const auto t = static_cast<std::time_t>(unix_s);
-  std::tm tm{};
-  if (gmtime_r(&t, &tm) == nullptr) return std::to_string(seconds) + " s after 1904-01-01";
-  char date[40];
-  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%S", &tm);
-  char micro[16];
-  std::snprintf(micro, sizeof micro, ".%06llu",
-                static_cast<unsigned long long>(static_cast<double>(fractions) * 0x1p-64 * 1e6) % 1000000ULL);
-  return std::string(date) + micro + "Z";
-}
+constexpr std::uint64_t kMaxMetadataBytes = std::uint64_t{256} << 20;  // one segment's (LabVIEW's: kB)
+// [bytes] raw data decoded from one read: memory for the file's bytes stays this, whatever its size
+constexpr std::size_t kWindowBytes = std::size_t{1} << 20;
 
 // The raw data index of one object in one segment.
 struct RawIndex {
@@ -187,7 +71,9 @@ using PropertyIndex = std::unordered_map<std::string, std::size_t>;
 
 class TdmsParser {
  public:
-  TdmsParser(std::span<const std::uint8_t> bytes, const std::string& source) : bytes_(bytes) {
+  TdmsParser(tdms_detail::Source& src, const std::string& source, tdms_detail::Pass pass,
+             const tdms_detail::Fill* fill)
+      : src_(src), size_(static_cast<std::size_t>(src.size())), pass_(pass), fill_(fill) {
     file_.source = source;
   }
   Result<TdmsFile> run();
@@ -208,13 +94,30 @@ class TdmsParser {
   Result<std::string> property_value(Cursor& c, std::uint32_t type, const std::string& path,
                                      const std::string& name);
   Status read_raw(std::size_t begin, std::size_t end, std::uint32_t toc, bool incomplete);
-  Status read_chunk(Cursor& c, bool interleaved);
+  //! Checks an interleaved segment's objects; their row's bytes and values per chunk.
+  Status interleaved_rows(std::size_t& row_bytes, std::uint64_t& count) const;
+  //! Where this segment's values go (per place of data_order_: the first value's cell, or nullptr).
+  Status value_targets(std::size_t chunks);
+  Status decode_contiguous(std::size_t begin, std::size_t chunks);
+  Status decode_interleaved(std::size_t begin, std::size_t rows, std::size_t row_bytes);
+  //! Bytes [at, at + n) of the file, read through a window of about kWindowBytes.
+  Result<const std::uint8_t*> window(std::size_t at, std::size_t n, std::size_t end);
+  Status read_segment(std::size_t& pos);
   Result<std::vector<std::string>> split_path(const std::string& path) const;
   Result<std::size_t> channel_for(const std::vector<std::string>& parts, const std::string& path);
   static constexpr std::size_t kNotListed = static_cast<std::size_t>(-1);
 
-  std::span<const std::uint8_t> bytes_;
+  tdms_detail::Source& src_;
+  std::size_t size_;
+  tdms_detail::Pass pass_;
+  const tdms_detail::Fill* fill_;
   TdmsFile file_;
+  // The raw data read last (window): file bytes [window_at_, window_at_ + window_n_) at window_data_.
+  std::size_t window_at_ = 0;
+  std::size_t window_n_ = 0;
+  const std::uint8_t* window_data_ = nullptr;
+  std::vector<double*> target_;  // per place of data_order_: this segment's first value's cell
+  std::size_t target_step_ = 1;  // cells from one value of a channel to the next
   std::size_t segment_ = 0;
   std::size_t segment_start_ = 0;
   bool big_ = false;
@@ -396,8 +299,7 @@ Status TdmsParser::read_object(Cursor& c) {
     const std::size_t size = type_size(idx.type);
     if (idx.type == kTdsString) {
       // count offsets of 4 bytes, then the text: a chunk of fewer bytes is no chunk of `count` strings.
-      if (marker != 28 || !c.get(idx.chunk_bytes) || idx.count > bytes_.size() / 4 ||
-          idx.chunk_bytes < 4 * idx.count)
+      if (marker != 28 || !c.get(idx.chunk_bytes) || idx.count > size_ / 4 || idx.chunk_bytes < 4 * idx.count)
         return fail("channel '" + path + "': bad string raw data index");
     } else if (size == 0) {
       return fail("channel '" + path + "': data type " + hex_type(idx.type) + " is not supported");
@@ -405,13 +307,13 @@ Status TdmsParser::read_object(Cursor& c) {
       if (marker != 20)
         return fail("channel '" + path + "': raw data index of " + std::to_string(marker) +
                     " bytes, expected 20");
-      if (idx.count > bytes_.size() / size) {
+      if (idx.count > size_ / size) {
         return fail("channel '" + path + "': " + std::to_string(idx.count) +
                     " values per chunk cannot fit in the file");
       }
       idx.chunk_bytes = idx.count * size;
     }
-    if (idx.chunk_bytes > bytes_.size()) return fail("channel '" + path + "': chunk larger than the file");
+    if (idx.chunk_bytes > size_) return fail("channel '" + path + "': chunk larger than the file");
     if (ch.type != 0 && ch.type != idx.type) return fail("channel '" + path + "' changes its data type");
     ch.type = idx.type;
     ch.numeric = is_numeric(idx.type);
@@ -435,23 +337,19 @@ Status TdmsParser::read_metadata(Cursor& c, std::uint32_t toc) {
   return ok_status();
 }
 
-Status TdmsParser::read_chunk(Cursor& c, bool interleaved) {
-  if (!interleaved) {
-    for (const std::size_t place : data_order_) {
-      const ListedObject& o = list_[place];
-      TdmsChannel& ch = file_.channels[o.channel];
-      const std::uint8_t* at = nullptr;
-      if (!c.take(o.index.chunk_bytes, at)) return fail("raw data ends inside a chunk");
-      ch.value_count += o.index.count;
-      if (!ch.numeric) continue;
-      const std::size_t size = type_size(o.index.type);
-      for (std::uint64_t v = 0; v < o.index.count; ++v)
-        ch.values.push_back(load_number(at + v * size, o.index.type, big_));
-    }
-    return ok_status();
-  }
-  std::uint64_t count = 0;
-  std::size_t row_bytes = 0;
+Result<const std::uint8_t*> TdmsParser::window(std::size_t at, std::size_t n, std::size_t end) {
+  if (window_data_ != nullptr && at >= window_at_ && at + n <= window_at_ + window_n_)
+    return window_data_ + (at - window_at_);
+  const std::size_t len = std::max(n, std::min(kWindowBytes, end - at));
+  auto data = src_.read(at, len);
+  if (!data) return data.error();
+  window_at_ = at;
+  window_n_ = len;
+  window_data_ = *data;
+  return *data;
+}
+
+Status TdmsParser::interleaved_rows(std::size_t& row_bytes, std::uint64_t& count) const {
   for (const std::size_t place : data_order_) {
     const ListedObject& o = list_[place];
     if (o.index.type == kTdsString) return fail("interleaved raw data holds a text channel");
@@ -459,15 +357,73 @@ Status TdmsParser::read_chunk(Cursor& c, bool interleaved) {
     count = o.index.count;
     row_bytes += type_size(o.index.type);
   }
-  for (std::uint64_t v = 0; v < count; ++v) {
-    const std::uint8_t* at = nullptr;
-    if (!c.take(row_bytes, at)) return fail("raw data ends inside a chunk");
-    for (const std::size_t place : data_order_) {
-      const ListedObject& o = list_[place];
-      TdmsChannel& ch = file_.channels[o.channel];
-      ++ch.value_count;
-      if (ch.numeric) ch.values.push_back(load_number(at, o.index.type, big_));
-      at += type_size(o.index.type);
+  return ok_status();
+}
+
+Status TdmsParser::value_targets(std::size_t chunks) {
+  using tdms_detail::Pass;
+  target_.assign(data_order_.size(), nullptr);
+  target_step_ = pass_ == Pass::keep ? 1 : fill_->stride;
+  for (std::size_t i = 0; i < data_order_.size(); ++i) {
+    const ListedObject& o = list_[data_order_[i]];
+    TdmsChannel& ch = file_.channels[o.channel];
+    if (!ch.numeric) continue;
+    const std::size_t first = ch.value_count;
+    const std::size_t needed = first + chunks * o.index.count;  // bounded by the segment's bytes
+    if (pass_ == Pass::keep) {
+      // Geometric growth: a stream of many small segments is not copied once per segment.
+      if (needed > ch.values.capacity()) ch.values.reserve(std::max(needed, 2 * ch.values.capacity()));
+      ch.values.resize(needed);
+      target_[i] = ch.values.data() + first;
+      continue;
+    }
+    double* column = o.channel < fill_->column.size() ? fill_->column[o.channel] : nullptr;
+    if (column == nullptr) continue;  // not a column: its bytes are never read
+    if (needed > fill_->rows) {
+      return fail("channel '" + ch.group + "/" + ch.name + "' has more values than " +
+                  std::to_string(fill_->rows) + ": the file changed while it was read");
+    }
+    target_[i] = column + first * target_step_;
+  }
+  return ok_status();
+}
+
+Status TdmsParser::decode_contiguous(std::size_t begin, std::size_t chunks) {
+  const std::size_t end = begin + chunks * chunk_bytes_;
+  std::size_t at = begin;
+  for (std::size_t k = 0; k < chunks; ++k) {
+    for (std::size_t i = 0; i < data_order_.size(); ++i) {
+      const ListedObject& o = list_[data_order_[i]];
+      if (target_[i] != nullptr) {  // a numeric channel: a value has a fixed size
+        const std::size_t size = type_size(o.index.type);
+        const std::size_t per_read = std::max<std::size_t>(1, kWindowBytes / size);
+        double* out = target_[i] + k * o.index.count * target_step_;
+        for (std::size_t done = 0, n = 0; done < o.index.count; done += n) {
+          n = static_cast<std::size_t>(std::min<std::uint64_t>(per_read, o.index.count - done));
+          auto bytes = window(at + done * size, n * size, end);
+          if (!bytes) return bytes.error();
+          decode(*bytes, n, size, o.index.type, big_, out + done * target_step_, target_step_);
+        }
+      }
+      at += o.index.chunk_bytes;
+    }
+  }
+  return ok_status();
+}
+
+Status TdmsParser::decode_interleaved(std::size_t begin, std::size_t rows, std::size_t row_bytes) {
+  const std::size_t end = begin + rows * row_bytes;
+  const std::size_t per_read = std::max<std::size_t>(1, kWindowBytes / row_bytes);
+  for (std::size_t done = 0, n = 0; done < rows; done += n) {
+    n = std::min(per_read, rows - done);
+    auto bytes = window(begin + done * row_bytes, n * row_bytes, end);
+    if (!bytes) return bytes.error();
+    std::size_t offset = 0;
+    for (std::size_t i = 0; i < data_order_.size(); ++i) {
+      const std::uint32_t type = list_[data_order_[i]].index.type;
+      if (target_[i] != nullptr)
+        decode(*bytes + offset, n, row_bytes, type, big_, target_[i] + done * target_step_, target_step_);
+      offset += type_size(type);
     }
   }
   return ok_status();
@@ -491,68 +447,87 @@ Status TdmsParser::read_raw(std::size_t begin, std::size_t end, std::uint32_t to
                 std::to_string(chunk) + " bytes" + (incomplete ? " (the segment was not finished)" : ""));
   }
   const std::size_t chunks = raw / chunk;
-  for (const std::size_t place : data_order_) {  // room for this segment's values (bounded by its bytes)
-    const ListedObject& o = list_[place];
-    TdmsChannel& ch = file_.channels[o.channel];
-    if (!ch.numeric) continue;
-    // Geometric growth: a stream of many small segments is not copied once per segment.
-    const std::size_t needed = ch.values.size() + chunks * o.index.count;
-    if (needed > ch.values.capacity()) ch.values.reserve(std::max(needed, 2 * ch.values.capacity()));
+  const bool interleaved = (toc & kTocInterleavedData) != 0;
+  std::size_t row_bytes = 0;
+  std::uint64_t per_chunk = 0;
+  if (interleaved) {
+    if (Status s = interleaved_rows(row_bytes, per_chunk); !s) return s;
   }
-  Cursor c(bytes_, begin, end, big_);
-  for (std::size_t k = 0; k < chunks; ++k) {
-    if (Status s = read_chunk(c, (toc & kTocInterleavedData) != 0); !s) return s;
+  if (pass_ != tdms_detail::Pass::count) {
+    if (Status s = value_targets(chunks); !s) return s;
+    Status decoded = interleaved ? decode_interleaved(begin, chunks * per_chunk, row_bytes)
+                                 : decode_contiguous(begin, chunks);
+    if (!decoded) return decoded;
+  }
+  for (const std::size_t place : data_order_) {
+    const ListedObject& o = list_[place];
+    file_.channels[o.channel].value_count += chunks * o.index.count;
   }
   return ok_status();
 }
 
+Status TdmsParser::read_segment(std::size_t& pos) {
+  ++segment_;
+  segment_start_ = pos;
+  window_data_ = nullptr;  // the source's buffer is read again below
+  if (size_ - pos < kLeadInBytes) {
+    return fail("truncated lead-in (" + std::to_string(size_ - pos) + " of 28 bytes)");
+  }
+  auto lead_bytes = src_.read(pos, kLeadInBytes);
+  if (!lead_bytes) return lead_bytes.error();
+  std::uint8_t lead[kLeadInBytes];
+  std::memcpy(lead, *lead_bytes, kLeadInBytes);
+  if (std::memcmp(lead, "TDSh", 4) == 0)
+    return fail("this is a .tdms_index file: give the .tdms file itself");
+  if (std::memcmp(lead, "TDSm", 4) != 0) return fail("no 'TDSm' tag: not a TDMS segment");
+  const auto toc = Cursor::load<std::uint32_t>(lead + 4, false);
+  big_ = (toc & kTocBigEndian) != 0;
+  const auto version = Cursor::load<std::uint32_t>(lead + 8, big_);
+  const auto next_offset = Cursor::load<std::uint64_t>(lead + 12, big_);
+  const auto raw_offset = Cursor::load<std::uint64_t>(lead + 20, big_);
+  if (version != 4712 && version != 4713)
+    return fail("version " + std::to_string(version) + ", expected 4712 or 4713");
+  if ((toc & kTocDAQmxRawData) != 0) return fail("DAQmx raw data is not supported: save numeric channels");
+  const std::size_t body = pos + kLeadInBytes;
+  const std::size_t left = size_ - body;
+  const bool incomplete = next_offset == kIncompleteSegment;
+  if (!incomplete && next_offset > left) {
+    return fail("next segment offset " + std::to_string(next_offset) + " runs past the end of the file (" +
+                std::to_string(left) + " bytes left): truncated segment");
+  }
+  const std::size_t end = body + (incomplete ? left : static_cast<std::size_t>(next_offset));
+  if (raw_offset > end - body) {
+    return fail("raw data offset " + std::to_string(raw_offset) + " is beyond the segment's " +
+                std::to_string(end - body) + " bytes");
+  }
+  const std::size_t raw_begin = body + static_cast<std::size_t>(raw_offset);
+  if ((toc & kTocMetaData) != 0) {
+    if (raw_offset > kMaxMetadataBytes) {
+      return fail("metadata of " + std::to_string(raw_offset) + " bytes (at most " +
+                  std::to_string(kMaxMetadataBytes) + ")");
+    }
+    auto meta = src_.read(body, raw_begin - body);
+    if (!meta) return meta.error();
+    Cursor c(*meta, raw_begin - body, big_);
+    if (Status s = read_metadata(c, toc); !s) return s;
+  } else if ((toc & kTocNewObjList) != 0) {
+    clear_list();
+  }
+  if ((toc & kTocRawData) != 0) {
+    if (Status s = read_raw(raw_begin, end, toc, incomplete); !s) return s;
+  } else if (end > raw_begin) {
+    return fail(std::to_string(end - raw_begin) +
+                " bytes after the metadata but the table of contents says the segment has no raw data");
+  }
+  pos = end;
+  return ok_status();
+}
+
 Result<TdmsFile> TdmsParser::run() {
+  if (size_ == 0) return bad_input(file_.source + ": empty file: not a TDMS file");
   std::size_t pos = 0;
-  if (bytes_.empty()) return bad_input(file_.source + ": empty file: not a TDMS file");
-  while (pos < bytes_.size()) {
-    ++segment_;
-    segment_start_ = pos;
-    if (bytes_.size() - pos < kLeadInBytes) {
-      return fail("truncated lead-in (" + std::to_string(bytes_.size() - pos) + " of 28 bytes)");
-    }
-    const std::uint8_t* lead = bytes_.data() + pos;
-    if (std::memcmp(lead, "TDSh", 4) == 0)
-      return fail("this is a .tdms_index file: give the .tdms file itself");
-    if (std::memcmp(lead, "TDSm", 4) != 0) return fail("no 'TDSm' tag: not a TDMS segment");
-    const auto toc = Cursor::load<std::uint32_t>(lead + 4, false);
-    big_ = (toc & kTocBigEndian) != 0;
-    const auto version = Cursor::load<std::uint32_t>(lead + 8, big_);
-    const auto next_offset = Cursor::load<std::uint64_t>(lead + 12, big_);
-    const auto raw_offset = Cursor::load<std::uint64_t>(lead + 20, big_);
-    if (version != 4712 && version != 4713)
-      return fail("version " + std::to_string(version) + ", expected 4712 or 4713");
-    if ((toc & kTocDAQmxRawData) != 0) return fail("DAQmx raw data is not supported: save numeric channels");
-    const std::size_t body = pos + kLeadInBytes;
-    const std::size_t left = bytes_.size() - body;
-    const bool incomplete = next_offset == kIncompleteSegment;
-    if (!incomplete && next_offset > left) {
-      return fail("next segment offset " + std::to_string(next_offset) + " runs past the end of the file (" +
-                  std::to_string(left) + " bytes left): truncated segment");
-    }
-    const std::size_t end = body + (incomplete ? left : static_cast<std::size_t>(next_offset));
-    if (raw_offset > end - body) {
-      return fail("raw data offset " + std::to_string(raw_offset) + " is beyond the segment's " +
-                  std::to_string(end - body) + " bytes");
-    }
-    const std::size_t raw_begin = body + static_cast<std::size_t>(raw_offset);
-    if ((toc & kTocMetaData) != 0) {
-      Cursor c(bytes_, body, raw_begin, big_);
-      if (Status s = read_metadata(c, toc); !s) return s.error();
-    } else if ((toc & kTocNewObjList) != 0) {
-      clear_list();
-    }
-    if ((toc & kTocRawData) != 0) {
-      if (Status s = read_raw(raw_begin, end, toc, incomplete); !s) return s.error();
-    } else if (end > raw_begin) {
-      return fail(std::to_string(end - raw_begin) +
-                  " bytes after the metadata but the table of contents says the segment has no raw data");
-    }
-    pos = end;
+  while (pos < size_) {
+    if (Status s = read_segment(pos); !s) return s.error();
   }
   return std::move(file_);
 }
@@ -568,14 +543,20 @@ bool is_tdms_path(const std::string& path) {
 }
 
 Result<TdmsFile> parse_tdms(std::span<const std::uint8_t> bytes, const std::string& source) {
-  TdmsParser parser(bytes, source);
-  return parser.run();
+  tdms_detail::MemorySource src(bytes);
+  return tdms_detail::parse(src, source, tdms_detail::Pass::keep);
 }
 
 Result<TdmsFile> read_tdms(const std::string& path) {
-  auto bytes = read_input(path, kMaxTdmsBytes);
-  if (!bytes) return bytes.error();
-  return parse_tdms(std::span(reinterpret_cast<const std::uint8_t*>(bytes->data()), bytes->size()), path);
+  auto src = tdms_detail::open_source(path);
+  if (!src) return src.error();
+  return tdms_detail::parse(**src, path, tdms_detail::Pass::keep);
+}
+
+Result<TdmsFile> tdms_detail::parse(Source& src, const std::string& name, Pass pass, const Fill* fill) {
+  if (pass == Pass::fill && fill == nullptr) return failure(name + ": a fill pass needs its cells");
+  TdmsParser parser(src, name, pass, fill);
+  return parser.run();
 }
 
 }  // namespace tetra

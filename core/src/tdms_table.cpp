@@ -1,12 +1,15 @@
 // A TDMS file as the table a CSV log would give (columns by channel name, metadata from file properties),
 // with the optional channel map beside the file.
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <new>
 #include <string_view>
 #include <unordered_map>
 
+#include "tdms_internal.hpp"
 #include "tetra/core/input_files.hpp"
 #include "tetra/core/tdms.hpp"
 #include "tetra/core/yaml_reader.hpp"
@@ -75,11 +78,10 @@ Result<std::vector<std::pair<std::string, const TdmsChannel*>>> pick_columns(con
       return bad_input(file.source + ": channel '" + ch->group + "/" + ch->name + "' (column '" + name +
                        "') does not hold numbers (text, timestamps or complex values)");
     }
-    if (ch->values.size() != cols.front().second->values.size()) {
-      return bad_input(file.source + ": channel '" + ch->name + "' has " + std::to_string(ch->values.size()) +
+    if (ch->value_count != cols.front().second->value_count) {
+      return bad_input(file.source + ": channel '" + ch->name + "' has " + std::to_string(ch->value_count) +
                        " values, channel '" + cols.front().second->name + "' has " +
-                       std::to_string(cols.front().second->values.size()) +
-                       ": every column needs one per row");
+                       std::to_string(cols.front().second->value_count) + ": every column needs one per row");
     }
   }
   return cols;
@@ -117,9 +119,12 @@ Result<TdmsChannelMap> parse_tdms_channel_map(const std::string& text, const std
   return map;
 }
 
-Result<CsvTable> tdms_to_table(const TdmsFile& file, const TdmsChannelMap& map) {
-  auto cols = pick_columns(file, map);
-  if (!cols) return cols.error();
+namespace {
+
+using Columns = std::vector<std::pair<std::string, const TdmsChannel*>>;
+
+// The table without its cells: metadata, comments, columns and row count.
+CsvTable table_header(const TdmsFile& file, const TdmsChannelMap& map, const Columns& cols) {
   CsvTable t;
   t.source = file.source;
   for (const auto& [name, value] : file.properties) {
@@ -141,40 +146,138 @@ Result<CsvTable> tdms_to_table(const TdmsFile& file, const TdmsChannelMap& map) 
     t.comments.push_back(line.substr(1, line.size() - 2));  // without '#' and the newline
     t.metadata.emplace_back(std::move(key), value);
   }
-  for (const auto& [name, ch] : *cols) t.columns.push_back(name);
-  t.rows = cols->front().second->values.size();
-  const std::size_t nc = t.columns.size();
-  t.cells.resize(t.rows * nc);
-  t.empty.assign(t.rows * nc, 0);
-  for (std::size_t c = 0; c < nc; ++c) {
-    const std::vector<double>& v = (*cols)[c].second->values;
-    for (std::size_t r = 0; r < t.rows; ++r) t.cells[r * nc + c] = v[r];
-  }
-  t.lines.resize(t.rows);
-  for (std::size_t r = 0; r < t.rows; ++r) t.lines[r] = r + 1;
+  for (const auto& [name, ch] : cols) t.columns.push_back(name);
+  t.rows = cols.front().second->value_count;
   return t;
 }
 
-Result<CsvTable> read_tdms_table(const std::string& path) try {
-  auto file = read_tdms(path);
-  if (!file) return file.error();
+// Every cell present; row r is "line" r + 1.
+void add_flags(CsvTable& t) {
+  t.empty.assign(t.cells.size(), 0);
+  t.lines.resize(t.rows);
+  for (std::size_t r = 0; r < t.rows; ++r) t.lines[r] = r + 1;
+}
+
+std::string megabytes(double bytes) {
+  std::string out;
+  append_fixed(out, bytes / 1e6, 0);
+  return out + " MB";
+}
+
+// The memory this process may still take: the address-space limit (ulimit -v) and the machine's memory.
+double memory_available() {
+  double bytes =
+      static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  struct rlimit lim {};
+  if (::getrlimit(RLIMIT_AS, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY)
+    bytes = std::min(bytes, static_cast<double>(lim.rlim_cur));
+  return bytes;
+}
+
+// Room for the table's cells (and flags), or an error naming the file before anything is allocated.
+Status allocate_cells(CsvTable& t, TdmsCells cells) try {
+  const double per_cell = cells == TdmsCells::with_flags ? 9.0 : 8.0;
+  const double per_row = cells == TdmsCells::with_flags ? 8.0 : 0.0;
+  const double need =
+      static_cast<double>(t.rows) * (per_cell * static_cast<double>(t.columns.size()) + per_row);
+  const auto refused = [&](const std::string& why) {
+    return bad_input(t.source + ": its " + std::to_string(t.rows) + " rows of " +
+                     std::to_string(t.columns.size()) + " columns need " + megabytes(need) + " as numbers, " +
+                     why + ": split the recording into shorter files");
+  };
+  if (need > 0.75 * memory_available())
+    return refused("more than this process may take (" + megabytes(memory_available()) +
+                   ", ulimit -v or the machine)");
+  t.cells.resize(t.rows * t.columns.size());
+  if (cells == TdmsCells::with_flags) add_flags(t);
+  return ok_status();
+} catch (const std::bad_alloc&) {
+  t.cells = {};
+  return bad_input(t.source + ": its " + std::to_string(t.rows) + " rows of " +
+                   std::to_string(t.columns.size()) +
+                   " columns do not fit in memory: split the recording into shorter files");
+}
+
+// A second pass over the file that decodes the columns' values straight into the table's cells.
+Status fill_cells(tdms_detail::Source& src, const TdmsFile& file, const Columns& cols, CsvTable& t) {
+  if (t.cells.empty()) return ok_status();  // no rows: nothing to decode
+  tdms_detail::Fill fill;
+  fill.column.assign(file.channels.size(), nullptr);
+  fill.stride = t.columns.size();
+  fill.rows = t.rows;
+  for (std::size_t c = 0; c < cols.size(); ++c)
+    fill.column[static_cast<std::size_t>(cols[c].second - file.channels.data())] = t.cells.data() + c;
+  auto again = tdms_detail::parse(src, file.source, tdms_detail::Pass::fill, &fill);
+  if (!again) return again.error();
+  for (const auto& [name, ch] : cols) {
+    const TdmsChannel& now = again->channels[static_cast<std::size_t>(ch - file.channels.data())];
+    if (now.value_count != ch->value_count)
+      return bad_input(file.source + ": channel '" + ch->name + "' changed while the file was read");
+  }
+  return ok_status();
+}
+
+Result<TdmsChannelMap> read_channel_map(const std::string& path) {
   TdmsChannelMap map;
   const std::string map_path = tdms_channel_map_path(path);
   struct stat st {};
-  if (::lstat(map_path.c_str(), &st) == 0) {  // a link to nothing is read (and refused), never ignored
-    auto text = read_input(map_path, kMaxYamlBytes);
-    if (!text) return text.error();
-    auto parsed = parse_tdms_channel_map(*text, map_path);
-    if (!parsed) return parsed.error();
-    map = std::move(*parsed);
+  if (::lstat(map_path.c_str(), &st) != 0)
+    return map;  // a link to nothing is read (and refused), never ignored
+  auto text = read_input(map_path, kMaxYamlBytes);
+  if (!text) return text.error();
+  return parse_tdms_channel_map(*text, map_path);
+}
+
+}  // namespace
+
+Result<CsvTable> tdms_to_table(const TdmsFile& file, const TdmsChannelMap& map) {
+  auto cols = pick_columns(file, map);
+  if (!cols) return cols.error();
+  CsvTable t = table_header(file, map, *cols);
+  const std::size_t nc = t.columns.size();
+  t.cells.resize(t.rows * nc);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::vector<double>& v = (*cols)[c].second->values;
+    if (v.size() != t.rows)
+      return bad_input(file.source + ": channel '" + (*cols)[c].second->name + "': values not kept");
+    for (std::size_t r = 0; r < t.rows; ++r) t.cells[r * nc + c] = v[r];
   }
-  return tdms_to_table(*file, map);
+  add_flags(t);
+  return t;
+}
+
+namespace {
+
+// Pass 1 reads the metadata and counts the values; pass 2 decodes the columns' values into their cells.
+// Memory: the table's cells and a window of the file's bytes, never the file or a copy of the values.
+Result<CsvTable> table_from(tdms_detail::Source& src, const std::string& name,
+                            const TdmsChannelMap* map_given, TdmsCells cells) try {
+  auto file = tdms_detail::parse(src, name, tdms_detail::Pass::count);
+  if (!file) return file.error();
+  auto map = map_given != nullptr ? Result<TdmsChannelMap>(*map_given) : read_channel_map(name);
+  if (!map) return map.error();
+  auto cols = pick_columns(*file, *map);
+  if (!cols) return cols.error();
+  CsvTable t = table_header(*file, *map, *cols);
+  if (Status s = allocate_cells(t, cells); !s) return s.error();
+  if (Status s = fill_cells(src, *file, *cols, t); !s) return s.error();
+  return t;
 } catch (const std::bad_alloc&) {
-  // Each numeric value takes 8 bytes as read and 9 as a table cell: a file of small integers (int8) needs
-  // about 17 times its size.
-  return failure(path +
-                 ": its values do not fit in memory (about 17 bytes each as read and as a table, "
-                 "against 1 in an int8 file): convert it in parts");
+  return failure(name + ": its metadata does not fit in memory");
+}
+
+}  // namespace
+
+Result<CsvTable> read_tdms_table(const std::string& path, TdmsCells cells) {
+  auto src = tdms_detail::open_source(path);
+  if (!src) return src.error();
+  return table_from(**src, path, nullptr, cells);
+}
+
+Result<CsvTable> tdms_image_to_table(std::span<const std::uint8_t> bytes, const std::string& source,
+                                     const TdmsChannelMap& map) {
+  tdms_detail::MemorySource src(bytes);
+  return table_from(src, source, &map, TdmsCells::with_flags);
 }
 
 }  // namespace tetra

@@ -31,17 +31,29 @@ std::string case_columns(const std::string& line) {
   return line.substr(0, end);
 }
 
-//! The spec the shards ran, from the first shard's copy, when it reads there (its scenario files found
-//! from that folder) and is the campaign their spec.sha256 names; nullopt otherwise.
-std::optional<sim::CampaignSpec> spec_of(const std::string& shard_dir, const std::string& sha256) {
+//! The spec the shards ran, from the first shard's copy, with the files it names found from the shard's
+//! folder or else from the current one (a spec naming its scenarios relative to its own folder, merged
+//! from there), and the campaign their spec.sha256 names. Without it no row could be checked against the
+//! spec's matrix: an error, never a merge unchecked.
+Result<sim::CampaignSpec> spec_of(const std::string& shard_dir, const std::string& sha256) {
   const std::string copy = folder::path_in(shard_dir, folder::kSpecCopy);
-  auto spec = sim::read_campaign_spec(copy);
-  if (!spec) return std::nullopt;
-  auto hash = campaign_spec_hash(*spec, copy);
-  if (!hash || *hash != sha256) return std::nullopt;
-  return std::move(spec).value();
+  auto text = read_input(copy, kMaxYamlBytes);
+  if (!text) return text.error();
+  std::string why;
+  for (const std::string& base : {shard_dir, std::string(".")}) {
+    auto spec = sim::parse_campaign_spec(*text, copy, base);
+    if (!spec) {
+      if (why.empty()) why = spec.error().message;
+      continue;
+    }
+    auto hash = campaign_spec_hash(*spec, copy);
+    if (hash && *hash == sha256) return std::move(spec).value();
+    if (why.empty() || !hash)
+      why = hash ? "the files it names from " + base + " are not those it ran with" : hash.error().message;
+  }
+  return bad_input(copy + ": cannot check the rows against the spec's matrix (" + why +
+                   "): merge from the folder the spec's file names are relative to");
 }
-
 }  // namespace
 
 namespace {
@@ -82,9 +94,9 @@ Result<std::vector<folder::Manifest>> shard_manifests(const std::string& out_dir
 }
 
 // One shard's rows: each of its runs once, in order, none missing; each row's case as the spec's matrix has
-// it (scenario, kind, gyro, onset, size, seed) when the spec reads from the shard's folder.
+// it (scenario, kind, gyro, onset, size, seed).
 Status append_shard_rows(const std::string& dir, const folder::Manifest& manifest, std::size_t matrix_runs,
-                         const std::string& header, const std::optional<sim::CampaignSpec>& spec,
+                         const std::string& header, const sim::CampaignSpec& spec,
                          std::vector<folder::Row>& all) {
   const std::string runs_csv = folder::path_in(dir, folder::kRunsFile);
   auto rows = folder::read_rows(runs_csv, header, false);
@@ -98,13 +110,10 @@ Status append_shard_rows(const std::string& dir, const folder::Manifest& manifes
     if (r.run != expected)
       return bad_input(runs_csv + ": run " + std::to_string(expected) +
                        " missing: the shard is not complete (run it again with the same command)");
-    if (spec) {
-      const std::string want =
-          case_columns(sim::campaign_csv_row(sim::campaign_error_row(*spec, r.run, "-")));
-      if (case_columns(r.line) != want)
-        return bad_input(runs_csv + ": run " + std::to_string(r.run) + " is '" +
-                         one_line(case_columns(r.line)) + "', the spec's case is '" + want + "'");
-    }
+    const std::string want = case_columns(sim::campaign_csv_row(sim::campaign_error_row(spec, r.run, "-")));
+    if (case_columns(r.line) != want)
+      return bad_input(runs_csv + ": run " + std::to_string(r.run) + " is '" +
+                       one_line(case_columns(r.line)) + "', the spec's case is '" + want + "'");
     expected += shard.n;
   }
   if (expected < matrix_runs)
@@ -164,10 +173,11 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
   auto header = folder::read_header(folder::path_in(shard_dirs[0], folder::kRunsFile));
   if (!header) return header.error();
   const auto spec = spec_of(shard_dirs[0], first.spec_sha256);
+  if (!spec) return spec.error();
   std::vector<folder::Row> all;
   all.reserve(first.matrix_runs);
   for (std::size_t i = 0; i < manifests->size(); ++i) {
-    if (Status s = append_shard_rows(shard_dirs[i], (*manifests)[i], first.matrix_runs, *header, spec, all);
+    if (Status s = append_shard_rows(shard_dirs[i], (*manifests)[i], first.matrix_runs, *header, *spec, all);
         !s)
       return s.error();
   }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "sample_merge.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/output_files.hpp"
@@ -99,7 +100,11 @@ Result<RecordLink> open_record_link(const RecordOptions& o, dds::ShutdownSignal&
         !s)
       return s.error();
   }
-  if (auto s = assign(link.gyro, link.session.reader<tetra_GyroSample>(deep)); !s) return s.error();
+  // Every gyro sample kept until taken: a writer that keeps its samples until acknowledged (play, ingest)
+  // bursting faster than the recorder takes them never has them overwritten in this reader's history.
+  dds::Qos every;
+  every.reliable().volatile_durability().keep_all();
+  if (auto s = assign(link.gyro, link.session.reader<tetra_GyroSample>(every)); !s) return s.error();
   if (auto s = assign(link.reference, link.session.reader<tetra_AttitudeReference>(deep)); !s)
     return s.error();
   if (auto s = assign(link.event, link.session.reader<tetra_FdiEvent2>(dds::event_qos())); !s)
@@ -147,9 +152,18 @@ class Recording {
   //! Flushes, closes the log and writes the optional outputs.
   Status finish(OutputFile* attitude_out, OutputFile* events_out, OutputFile* commands_out);
   std::uint64_t epochs_written() const { return epochs_written_; }
+  //! Local time [ns] a sample held for time order is due, or nullopt.
+  std::optional<std::int64_t> next_due_ns() const { return merge_.next_due_ns(); }
 
  private:
   Status take_gyro_samples(const RecordLink& link, std::int64_t now);
+  //! The merged samples due by `now` (all with `flush`) into the assembler.
+  void give_samples(std::int64_t now, bool flush) {
+    merge_.release(now, flush, [&](const tetra_GyroSample& s) {
+      (void)assembler_.add_sample(s.gyro, s.seq, s.stamp_ns, s.raw, now, dds::reference_written(s),
+                                  dds::promised_samples(s));
+    });
+  }
   Status take_outputs(const RecordLink& link);
   Status write_epochs();
   Status open_log();
@@ -166,6 +180,10 @@ class Recording {
   std::map<std::uint64_t, std::string> event_lines_;         // by event_seq: written in order
   std::map<std::uint64_t, std::string> command_lines_;       // acknowledgements, by event_seq
   std::vector<fdi::Epoch> epochs_;
+  // A gyro's sample waits for the other gyros' samples of its time for up to 1 s of the recorder's waiting
+  // clock: a writer the recorder held back (paused, behind) delivers again only after its retransmission
+  // cycle, longer than a sensor's latency limit. A gyro gone silent delays the recording by that second.
+  SampleMerge merge_{n_, std::max<std::int64_t>(assembler_.config().max_latency_ns, 1'000'000'000)};
   std::vector<double> values_;
   std::optional<std::int64_t> last_epoch_ns_;
   std::optional<std::int64_t> last_attitude_ns_;
@@ -186,11 +204,10 @@ Status Recording::take_gyro_samples(const RecordLink& link, std::int64_t now) {
       o_.unit = u;
       err_ << report::name_of(o_.names, "command") << ": recording unit " << o_.unit << '\n';
     }
-    if (u != o_.unit) return;
-    (void)assembler_.add_sample(s.gyro, s.seq, s.stamp_ns, s.raw, now, dds::reference_written(s),
-                                dds::promised_samples(s));
+    if (u == o_.unit) merge_.add(s, now);  // one gyro's samples after another's: merged in time order
   });
   if (!g) return g.error();
+  give_samples(now, false);
   auto r = link.reference->take([&](const tetra_AttitudeReference& s, const dds_sample_info_t&) {
     if (dds::from_wire(s.unit) == o_.unit)
       assembler_.add_reference(s.stamp_ns, from_wxyz(s.q_RB[0], s.q_RB[1], s.q_RB[2], s.q_RB[3]));
@@ -242,6 +259,7 @@ Status Recording::write_epochs() {
 }
 
 Status Recording::flush_epochs() {
+  give_samples(monotonic_ns(), true);
   assembler_.poll(INT64_MAX, epochs_);
   return write_epochs();
 }
@@ -264,6 +282,28 @@ Status Recording::finish(OutputFile* attitude_out, OutputFile* events_out, Outpu
   return write_lines(commands_out, command_lines_);
 }
 
+// The recorder's clock for the epoch assembler (its latency limit, its receive clock): the time it spent
+// waiting for data. A stall of the recorder itself (SIGSTOP, a loaded machine) never makes the writers'
+// samples late: a wait that ended more than kStallSlack_ns past its timeout counts nothing, and the
+// recorder's own work counts nothing, so an epoch whose last sample is still on its way (retransmitted
+// once the recorder runs again) is not given up while the recorder was not listening.
+class WaitingClock {
+ public:
+  std::int64_t now() const { return now_; }
+  //! Waits up to `timeout` [ns] for data.
+  Status wait(const RecordLink& link, std::int64_t timeout, std::vector<std::intptr_t>& triggered) {
+    const std::int64_t before = monotonic_ns();
+    if (auto s = link.session.wait(std::chrono::nanoseconds(timeout), triggered); !s) return s;
+    const std::int64_t waited = monotonic_ns() - before;
+    if (waited <= timeout + kStallSlack_ns) now_ += waited;
+    return ok_status();
+  }
+
+ private:
+  static constexpr std::int64_t kStallSlack_ns = 10'000'000;
+  std::int64_t now_ = monotonic_ns();
+};
+
 //! Records until a signal, --duration, or (--until-idle) the gyro writers gone and the service's last
 //! outputs in.
 Status record_until_done(const RecordOptions& o, const RecordLink& link, Recording& recording,
@@ -272,9 +312,10 @@ Status record_until_done(const RecordOptions& o, const RecordLink& link, Recordi
   std::int64_t idle_since = -1;  // [ns] local time the gyro writers went away; -1: not idle
   const std::int64_t stop_at = o.duration_s > 0 ? monotonic_ns() + seconds_to_ns(o.duration_s) : INT64_MAX;
   std::vector<std::intptr_t> triggered;
+  WaitingClock clock;
   for (;;) {
     const std::int64_t now = monotonic_ns();
-    if (auto s = recording.take(link, now); !s) return s;
+    if (auto s = recording.take(link, clock.now()); !s) return s;
     std::uint32_t status = 0;
     (void)dds_take_status(link.gyro->handle(), &status, DDS_SUBSCRIPTION_MATCHED_STATUS);
     auto matched = link.gyro->matched_writers();
@@ -288,14 +329,17 @@ Status record_until_done(const RecordOptions& o, const RecordLink& link, Recordi
     if (shutdown.requested() || now >= stop_at) return ok_status();
     const bool idle = o.until_idle && idle_since >= 0;
     if (idle) {
-      // The writers are gone: flush the open epochs, then wait (briefly) for the service's outputs.
+      // The writers are gone: take what they sent since the take above (it is all in: they waited for
+      // its acknowledgement), flush the open epochs, then wait (briefly) for the service's outputs.
+      if (auto s = recording.take(link, clock.now()); !s) return s;
       if (auto s = recording.flush_epochs(); !s) return s;
       if (recording.outputs_done() || now - idle_since >= kIdleGrace_ns) return ok_status();
     }
-    std::int64_t wake = std::min(stop_at, now + 1'000'000'000);
-    if (auto due = assembler.next_due_ns()) wake = std::min(wake, *due);
-    if (idle) wake = std::min(wake, idle_since + kIdleGrace_ns);
-    if (auto s = link.session.wait(std::chrono::nanoseconds(wake - now), triggered); !s) return s;
+    std::int64_t timeout = std::min(stop_at - now, std::int64_t{1'000'000'000});
+    if (auto due = assembler.next_due_ns()) timeout = std::min(timeout, *due - clock.now());
+    if (auto due = recording.next_due_ns()) timeout = std::min(timeout, *due - clock.now());
+    if (idle) timeout = std::min(timeout, idle_since + kIdleGrace_ns - now);
+    if (auto s = clock.wait(link, std::max<std::int64_t>(timeout, 0), triggered); !s) return s;
   }
 }
 

@@ -18,8 +18,8 @@ namespace tetra::ingest {
 
 namespace {
 
-constexpr std::size_t kLatencyBins = 100'000;  // 1 µs each
-constexpr int kWriterDepth = 4096;             // samples kept until acknowledged
+constexpr std::size_t kLatencyBins = 100'000;            // 1 µs each
+constexpr std::int64_t kHeldGiveUp_ns = 30'000'000'000;  // [ns] longest a reader may hold a write back
 
 class LatencyHistogram {
  public:
@@ -83,9 +83,11 @@ Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shu
   if (!session) return session.error();
   dds::Qos qos = dds::gyro_sample_qos(std::chrono::nanoseconds(seconds_to_ns(1.0 / o.rate_hz)));
   qos.no_autodispose();
-  // A source may deliver a burst (a serial buffer read at once): keep every sample until acknowledged, not
-  // the topic's last 64 (history is not part of the reader-writer contract: any reader still matches).
-  qos.keep_last(kWriterDepth);
+  // A source may deliver a burst (a serial buffer or a file read at once, faster than real time): every
+  // sample kept until each reader has acknowledged it, as play's writer (history is not part of the
+  // reader-writer contract: any reader still matches). A reader behind (a recorder paused) holds ingest
+  // back, and the source waits in its own buffer (a pipe, a terminal) instead of samples being dropped.
+  qos.keep_all();
   auto writer = session->writer<tetra_GyroSample>(qos);
   if (!writer) return writer.error();
   auto source = ByteSource::open(o);
@@ -109,7 +111,14 @@ Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shu
       msg.stamp_ns = seconds_to_ns(s.time_s);
       msg.raw = s.raw;
       msg.flags = 0;
-      if (auto st = writer->write(msg); !st) return st;
+      auto held = writer->write_held(msg, std::chrono::nanoseconds(kHeldGiveUp_ns),
+                                     [&] { return shutdown != nullptr && shutdown->requested(); });
+      if (!held) return held.error();
+      if (*held == dds::Writer<tetra_GyroSample>::Held::stopped) break;  // interrupted: the loop ends
+      if (*held == dds::Writer<tetra_GyroSample>::Held::timed_out) {
+        return failure("a GyroSample reader has acknowledged nothing for 30 s: stopped at time " +
+                       std::to_string(s.time_s) + " s of the source (every sample before it delivered)");
+      }
       latency.add(dds::monotonic_ns() - read_ns);
       ++report.samples;
     }
@@ -140,7 +149,9 @@ Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shu
       next_progress += 1'000'000'000;
     }
   }
-  (void)writer->wait_for_acks(std::chrono::seconds(2));
+  // What a reader has not acknowledged yet: waited for as a held write is (briefly when interrupted).
+  const bool interrupted = shutdown != nullptr && shutdown->requested();
+  (void)writer->wait_for_acks(std::chrono::nanoseconds(interrupted ? 2'000'000'000 : kHeldGiveUp_ns));
   report.wall_s = ns_to_seconds(dds::monotonic_ns() - start);
   report.lines = parser->accepted();
   report.malformed = parser->malformed();

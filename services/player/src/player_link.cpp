@@ -152,18 +152,16 @@ Status PlayerLink::publish(std::int64_t stamp_ns, std::uint64_t seq, std::span<c
 }
 
 Status PlayerLink::write_held() {
-  const std::int64_t give_up = dds::monotonic_ns() + kHeldGiveUp_ns;
-  for (;;) {
-    auto written = gyro_.write_unless_held(sample_);
-    if (!written) return written.error();
-    if (*written) return ok_status();
-    if (stop_requested()) return failure("interrupted while a GyroSample reader held the player back");
-    if (dds::monotonic_ns() >= give_up) {
-      return failure("a GyroSample reader has acknowledged nothing for 30 s: stopped at log time " +
-                     std::to_string(ns_to_seconds(sample_.stamp_ns)) +
-                     " s (every sample before it delivered)");
-    }
+  auto held =
+      gyro_.write_held(sample_, std::chrono::nanoseconds(kHeldGiveUp_ns), [&] { return stop_requested(); });
+  if (!held) return held.error();
+  using Held = dds::Writer<tetra_GyroSample>::Held;
+  if (*held == Held::stopped) return failure("interrupted while a GyroSample reader held the player back");
+  if (*held == Held::timed_out) {
+    return failure("a GyroSample reader has acknowledged nothing for 30 s: stopped at log time " +
+                   std::to_string(ns_to_seconds(sample_.stamp_ns)) + " s (every sample before it delivered)");
   }
+  return ok_status();
 }
 
 Status PlayerLink::take_attitudes(std::uint64_t& count, std::int64_t& newest_stamp_ns) {

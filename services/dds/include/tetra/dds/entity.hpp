@@ -166,6 +166,22 @@ class Writer {
     if (rc < 0) return dds_error("write " + name_, rc);
     return true;
   }
+  //! How write_held ended.
+  enum class Held { written, stopped, timed_out };
+  //! write_unless_held again and again while a reader holds the write back: until it is written,
+  //! `stop()` is true, or `limit` has passed with the reader acknowledging nothing. Nothing is dropped
+  //! either way (a writer that keeps every sample until acknowledged, sized to any burst).
+  template <class Stop>
+  Result<Held> write_held(const T& sample, std::chrono::nanoseconds limit, Stop&& stop) const {
+    const auto give_up = std::chrono::steady_clock::now() + limit;
+    for (;;) {
+      auto written = write_unless_held(sample);
+      if (!written) return written.error();
+      if (*written) return Held::written;
+      if (stop()) return Held::stopped;
+      if (std::chrono::steady_clock::now() >= give_up) return Held::timed_out;
+    }
+  }
   //! Unregisters the instance of `sample`'s key (readers see "no writers" for it).
   Status unregister(const T& sample) const {
     const dds_return_t rc = dds_unregister_instance(entity_.handle(), &sample);
