@@ -98,8 +98,10 @@ def test_lockstep_equals_the_pipeline_in_process(service):
     assert np.abs(np.array([a.stamp_ns for a in got]) - expected.time_s * 1e9).max() <= 1.0
 
     # The same run's events (the pipeline's, in order, the same lines) and its last Health.
+    # (its mode may already say LOST: the gyros went silent when the steps ended, 0.3 s of wall clock)
     health = sub.wait_health(10.0, lambda h: h.counters["epochs_accepted"] == len(got))
-    assert health.mode == got[-1].mode and health.used == got[-1].gyros
+    assert health.counters["samples_late"] == 0 and health.references_delayed == 0
+    assert health.reference_state == "accepted" and health.references_too_late == 0
     sub.poll(1.0)
     pipeline_types = {e["type"] for e in expected.events}
     wire = [e.json for e in sub.events if e.type in pipeline_types]

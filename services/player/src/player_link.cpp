@@ -132,12 +132,12 @@ Status PlayerLink::publish(std::int64_t stamp_ns, std::uint64_t seq, std::span<c
     reference_msg_.stamp_ns = stamp_ns;
     for (std::size_t i = 0; i < 4; ++i) reference_msg_.q_RB[i] = (*ref_wxyz)[i];
     if (auto s = reference_.write(reference_msg_); !s) return s.error();
-    if (lockstep) (void)reference_.wait_for_acks(std::chrono::seconds(2));
   }
   std::uint32_t flags = 0;
-  if (lockstep) {  // the service waits for every sample of the epoch, however late (dds::promised_samples)
+  if (lockstep) {  // the service waits for every sample of the epoch and its reference, however late
     const auto written = std::count(present.begin(), present.end(), std::uint8_t{1});
     flags = static_cast<std::uint32_t>(written) << dds::kGyroFlagSamplesShift;
+    if (ref_wxyz) flags |= dds::kGyroFlagReferenceWritten;  // no acknowledgement wait (100 ms each)
   }
   for (std::size_t g = 0; g < raw.size(); ++g) {
     if (present[g] == 0) continue;  // not delivered in the log: not on the wire either
