@@ -3,7 +3,7 @@
 on the wire"): `tetra fusion` fed by `tetra sim --dds` for 3 s at 100 Hz, read at once by the C++ subscriber and the
 C one. Checks: the C++ program prints an attitude for (nearly) every epoch, each the same JSON object as the C
 subscriber's for that epoch (the same wire values: no tolerance), unit quaternions; with no service it exits 1 after
-its --seconds. Domain 228. Exit 0 on pass.
+its --seconds. Domain 218. Exit 0 on pass.
 """
 import argparse
 import json
@@ -25,7 +25,7 @@ def main():
     ap.add_argument("--tetra", required=True)
     ap.add_argument("--examples", required=True, help="the folder examples/dds/build.sh built")
     ap.add_argument("--source", required=True)
-    ap.add_argument("--domain", type=int, default=228)
+    ap.add_argument("--domain", type=int, default=218)
     args = ap.parse_args()
     os.environ["CYCLONEDDS_URI"] = "file://" + os.path.join(args.source, "config", "cyclonedds-loopback.xml")
     d = str(args.domain)
