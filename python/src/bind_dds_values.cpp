@@ -50,25 +50,11 @@ py::dict wire_attitude_dict(const fdi::AttitudeEstimate& a, int n_gyros) {
 
 py::dict wire_health_dict(const dds::HealthView& v) {
   const fdi::Health& h = v.health;
-  py::dict d;
+  py::dict d = health_state_dict(h, static_cast<int>(h.gyros.size()));
   d["unit"] = v.unit;
   d["stamp_ns"] = h.stamp_ns;
   d["time_s"] = static_cast<double>(h.stamp_ns) * 1e-9;
-  d["mode"] = fdi::to_string(h.mode);
-  d["used"] = gyro_ids(h.used, static_cast<int>(h.gyros.size()));
-  py::list gyros;
-  for (const auto& g : h.gyros) {
-    gyros.append(py::dict("state"_a = fdi::to_string(g.state), "kind"_a = fdi::to_string(g.kind),
-                          "bias_rad_s"_a = g.bias_rad_s, "bias_sigma_rad_s"_a = g.bias_sigma_rad_s));
-  }
-  d["gyros"] = gyros;
   d["parity_residual"] = h.parity_residual;
-  d["chi2"] = h.chi2;
-  d["cusum"] = h.cusum;
-  d["chi2_threshold"] = h.chi2_threshold;
-  d["cusum_threshold"] = h.cusum_threshold;
-  d["fdi_available"] = h.fdi_available;
-  d["reference_state"] = fdi::to_string(h.reference_state);
   d["reference_nis"] = h.reference_nis;
   d["protection_level_rad"] = vector3(h.protection_level_rad);
   d["references_delayed"] = h.counters.reference_delayed;

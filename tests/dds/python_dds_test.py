@@ -7,7 +7,9 @@ on a loopback domain, stepped from Python.
 - A Subscriber reads the same run's Health and events; commands are acknowledged (and refused with a reason).
 - Errors: wrong arrays raise ValueError before anything is written; no service raises TimeoutError / tetra.Error
   within the timeout given; Ctrl-C in a wait raises KeyboardInterrupt within 0.2 s.
-Domains 206-208 (tests/CMakeLists.txt lists the DDS tests' domains).
+- Real time: gyro epochs paced by the wall clock and a star tracker of its own (ReferencePublisher) delivering
+  50-250 ms late: every reference fused at its own time (Health.references_delayed), none too late.
+Domains 206-209.
 """
 import os
 import pathlib
@@ -32,13 +34,13 @@ ORBIT = {"scenario": "orbit", "duration_s": 40, "rate_hz": 100,
 PIPELINE = {"clear_after_s": 10}
 
 
-def fusion_config(path, unit, pipeline):
-    lines = "".join(f"  {k}: {v}\n" for k, v in pipeline.items())
+def fusion_config(path, unit, pipeline, speed=0.1):
+    lines = "".join(f"  {k}: {v}\n" for k, v in pipeline.items()) or "  {}\n"
     # speed 0.1: the service's silence deadline (3 / (100 Hz * 0.1) = 0.3 s of wall clock) covers a step of a
     # Python simulator on a loaded machine; max_latency_s is not needed in lockstep (each sample says how
     # many the epoch has).
     path.write_text(f"unit: {unit}\ncalibration: {SOURCE / 'examples' / 'seed_unit.yaml'}\nsample_rate_hz: 100\n"
-                    f"speed: 0.1\nhealth_period_s: 0.5\npipeline:\n{lines}")
+                    f"speed: {speed}\nhealth_period_s: 0.5\npipeline:\n{lines}")
     return path
 
 
@@ -179,3 +181,36 @@ def test_ctrl_c_in_a_wait(call):
     print(f"[ figure ] Ctrl-C in {call.split('(')[0]}: KeyboardInterrupt {1e3 * (float(line[1]) - sent):.0f} ms "
           "after SIGINT")
     assert float(line[1]) - sent < 0.2
+
+
+def test_a_tracker_of_its_own_late_is_fused_at_its_time(tmp_path):
+    proc = start_fusion(tmp_path, fusion_config(tmp_path / "rt.yaml", "py-rt", {}, speed=1), DOMAIN + 3)
+    try:
+        run = tetra.sim({"scenario": "orbit", "duration_s": 4, "rate_hz": 100}, seed=7)
+        log, truth = run.log, run.truth
+        sub = dds.Subscriber("py-rt", domain=DOMAIN + 3)
+        gyros = dds.GyroPublisher("py-rt", rate_hz=100, domain=DOMAIN + 3)
+        tracker = dds.ReferencePublisher("py-rt", domain=DOMAIN + 3)
+        due, sent, late_s = [], 0, []  # (wall time to send, stamp, q): 50, 150, 250 ms after the image
+        start = time.monotonic()
+        for k, t in enumerate(log.time_s):
+            time.sleep(max(0.0, start + t - time.monotonic()))
+            stamp = gyros.send(t, log.values[k])
+            if k % 20 == 10:
+                due.append((time.monotonic() + 0.05 + 0.1 * (k // 20 % 3), stamp, truth.q_RB_wxyz[k]))
+            while due and due[0][0] <= time.monotonic():
+                _, ref_stamp, q = due.pop(0)
+                tracker.send(ref_stamp, q)
+                late_s.append(time.monotonic() - start - ref_stamp * 1e-9)
+                sent += 1
+        attitudes = gyros.attitudes(timeout_s=1.0)
+        gyros.close()
+        health = sub.wait_health(5.0, lambda h: h.references_delayed + h.references_too_late >= sent)
+    finally:
+        stop(proc)
+    print(f"[ figure ] real time: {len(attitudes)} attitudes of {len(log.time_s)} epochs; {sent} references "
+          f"{min(late_s):.3f}-{max(late_s):.3f} s late: {health.references_delayed} fused at their time, "
+          f"{health.references_too_late} too late")
+    assert len(attitudes) >= 0.95 * len(log.time_s) and isinstance(attitudes[0], dds.Attitude)
+    assert min(late_s) >= 0.05 and health.references_delayed == sent and health.references_too_late == 0
+    assert health.reference_state == "accepted"
