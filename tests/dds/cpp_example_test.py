@@ -9,11 +9,12 @@ import argparse
 import json
 import math
 import os
-import signal
 import subprocess
 import sys
 import tempfile
 import time
+
+from dds_helpers import start_fusion, stop_fusion, verdict
 
 
 def attitudes(text):
@@ -30,14 +31,9 @@ def main():
     os.environ["CYCLONEDDS_URI"] = "file://" + os.path.join(args.source, "config", "cyclonedds-loopback.xml")
     d = str(args.domain)
     with tempfile.TemporaryDirectory() as work:
-        log_path = os.path.join(work, "fusion.log")
-        fusion = subprocess.Popen([args.tetra, "fusion", "--config", os.path.join(args.source, "examples",
-                                   "fusion_service.yaml"), "--domain", d], stdout=open(log_path, "w"),
-                                  stderr=subprocess.STDOUT)
+        fusion = start_fusion(args.tetra, os.path.join(args.source, "examples", "fusion_service.yaml"), d,
+                              os.path.join(work, "fusion.log"))
         try:
-            while "running" not in open(log_path).read():
-                assert fusion.poll() is None, open(log_path).read()
-                time.sleep(0.05)
             # Into files, not pipes: a full pipe would block a subscriber, and its reader would drop epochs.
             outs = [os.path.join(work, exe + ".jsonl") for exe in ("cpp_subscriber", "attitude_subscriber")]
             readers = [subprocess.Popen([os.path.join(args.examples, exe), "tetra-1", "--domain", d, "--seconds",
@@ -50,23 +46,19 @@ def main():
             readers[1].wait(timeout=30)
             cpp_out, c_out = [open(out).read() for out in outs]
         finally:
-            fusion.send_signal(signal.SIGTERM)
-            fusion.wait(timeout=20)
+            stop_fusion(fusion)
     cpp, c = attitudes(cpp_out), attitudes(c_out)
     norms = [math.sqrt(sum(x * x for x in a["q_RB"])) for a in cpp]
     lonely = subprocess.run([os.path.join(args.examples, "cpp_subscriber"), "nobody", "--domain", d, "--seconds",
                              "0.5"], capture_output=True, text=True)
     print("[ figure ] C++ subscriber: %d attitudes (C subscriber: %d) of 300 epochs, exit %d; alone: exit %d"
           % (len(cpp), len(c), cpp_rc, lonely.returncode))
-    failures = [what for ok, what in [
+    return verdict([
         (cpp_rc == 0 and len(cpp) >= 285, "an attitude for (nearly) every epoch"),
         (cpp == c, "the same attitudes as the C subscriber, value for value"),
         (all(abs(n - 1.0) < 1e-12 for n in norms), "unit quaternions"),
         (lonely.returncode == 1 and lonely.stdout == "", "no service: nothing printed, exit 1"),
-    ] if not ok]
-    for what in failures:
-        print("FAIL: " + what)
-    return 1 if failures else 0
+    ])
 
 
 if __name__ == "__main__":

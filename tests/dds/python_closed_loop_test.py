@@ -12,11 +12,12 @@ bias step at 60 s is isolated (the unit goes DEGRADED and keeps pointing). Domai
 import argparse
 import json
 import os
-import signal
 import subprocess
 import sys
 import tempfile
 import time
+
+from dds_helpers import start_fusion, stop_fusion, verdict
 
 
 def main():
@@ -28,24 +29,16 @@ def main():
     os.environ["CYCLONEDDS_URI"] = "file://" + os.path.join(args.source, "config", "cyclonedds-loopback.xml")
     with tempfile.TemporaryDirectory() as work:
         log_path = os.path.join(work, "fusion.log")
-        fusion = subprocess.Popen([args.tetra, "fusion", "--config",
-                                   os.path.join(args.source, "examples", "dds", "closed_loop_fusion.yaml"),
-                                   "--domain", str(args.domain)], stdout=open(log_path, "w"), stderr=subprocess.STDOUT)
+        fusion = start_fusion(args.tetra, os.path.join(args.source, "examples", "dds", "closed_loop_fusion.yaml"),
+                              args.domain, log_path)
         try:
-            give_up = time.monotonic() + 20
-            while "running" not in open(log_path).read():
-                if fusion.poll() is not None or time.monotonic() > give_up:
-                    print("fusion did not start: " + open(log_path).read())
-                    return 1
-                time.sleep(0.05)
             figures_path = os.path.join(work, "figures.json")
             start = time.monotonic()
             run = subprocess.run([sys.executable, os.path.join(args.source, "examples", "dds", "python_closed_loop.py"),
                                   "--domain", str(args.domain), "--compare", "--json", figures_path], timeout=120)
             wall = time.monotonic() - start
         finally:
-            fusion.send_signal(signal.SIGTERM)
-            fusion.wait(timeout=20)
+            stop_fusion(fusion)
         if run.returncode != 0:
             print("the example failed (exit %d); the service's log:\n%s" % (run.returncode, open(log_path).read()))
             return 1
@@ -54,16 +47,13 @@ def main():
     print("[ figure ] closed loop over DDS, %d epochs, %.1f s with the in-process run: pointing %.5f deg at the "
           "end, at most %.5f deg after the slew; identical to in process: %s"
           % (dds["epochs"], wall, dds["pointing_final_deg"], dds["pointing_max_after_40s_deg"], figures["identical"]))
-    failures = [what for ok, what in [
+    return verdict([
         (figures["identical"] and figures["pointing_difference_max_deg"] == 0.0, "identical to the in-process loop"),
         (dds == local, "the same figures"),
         (dds["epochs"] == 1200, "every epoch stepped"),
         (dds["pointing_max_after_40s_deg"] < 0.005, "the loop closes: within 0.005 deg after the slew"),
         ("DEGRADED" in dds["modes"] and "LOST" not in dds["modes"], "gyro 2 isolated, attitude kept"),
-    ] if not ok]
-    for what in failures:
-        print("FAIL: " + what)
-    return 1 if failures else 0
+    ])
 
 
 if __name__ == "__main__":

@@ -24,6 +24,7 @@ import pytest
 
 import tetra
 import tetra.dds as dds
+from dds_helpers import start_fusion, stop_fusion
 
 SOURCE = pathlib.Path(os.environ.get("TETRA_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
 DOMAIN = 206
@@ -44,27 +45,19 @@ def fusion_config(path, unit, pipeline, speed=0.1):
     return path
 
 
-def start_fusion(tmp, config, domain):
-    log = tmp / "fusion.log"
-    proc = subprocess.Popen([os.environ["TETRA_BIN"], "fusion", "--config", str(config), "--domain", str(domain)],
-                            stdout=log.open("w"), stderr=subprocess.STDOUT)
-    give_up = time.monotonic() + 20
-    while "running" not in log.read_text():
-        assert proc.poll() is None and time.monotonic() < give_up, "fusion did not start: " + log.read_text()
-        time.sleep(0.05)
-    return proc
+def start_service(tmp, config, domain):
+    return start_fusion(os.environ["TETRA_BIN"], config, domain, tmp / "fusion.log")
 
 
 def stop(proc):
-    proc.send_signal(signal.SIGTERM)
-    assert proc.wait(timeout=20) == 0
+    assert stop_fusion(proc) == 0
 
 
 @pytest.fixture(scope="module")
 def service(tmp_path_factory):
     os.environ["CYCLONEDDS_URI"] = "file://" + str(SOURCE / "config" / "cyclonedds-loopback.xml")
     tmp = tmp_path_factory.mktemp("fusion")
-    proc = start_fusion(tmp, fusion_config(tmp / "fusion.yaml", UNIT, PIPELINE), DOMAIN)
+    proc = start_service(tmp, fusion_config(tmp / "fusion.yaml", UNIT, PIPELINE), DOMAIN)
     yield proc
     stop(proc)
 
@@ -184,7 +177,7 @@ def test_ctrl_c_in_a_wait(call):
 
 
 def test_a_tracker_of_its_own_late_is_fused_at_its_time(tmp_path):
-    proc = start_fusion(tmp_path, fusion_config(tmp_path / "rt.yaml", "py-rt", {}, speed=1), DOMAIN + 3)
+    proc = start_service(tmp_path, fusion_config(tmp_path / "rt.yaml", "py-rt", {}, speed=1), DOMAIN + 3)
     try:
         run = tetra.sim({"scenario": "orbit", "duration_s": 4, "rate_hz": 100}, seed=7)
         log, truth = run.log, run.truth
