@@ -53,6 +53,27 @@ void check_unit(const std::string& unit) {
   throw py::error_already_set();
 }
 
+// One method call's hold on a tetra.dds object, taken with the GIL held: a second call while one runs (from
+// another thread, while the first has released the GIL) raises RuntimeError instead of sharing its state.
+class InUse {
+ public:
+  InUse(bool& busy, const char* what) : busy_(busy) {
+    if (busy_) {
+      throw std::runtime_error(
+          std::string(what) +
+          ": another call is running on this object (in another thread); it serves one call "
+          "at a time: give each thread its own, or hold a threading.Lock around the calls");
+    }
+    busy_ = true;
+  }
+  InUse(const InUse&) = delete;
+  InUse& operator=(const InUse&) = delete;
+  ~InUse() { busy_ = false; }
+
+ private:
+  bool& busy_;
+};
+
 // Runs `work` with the GIL released while `slot` points at a Watch over Python's signal handlers (the
 // link's stop poll asks it), then raises what stopped it (KeyboardInterrupt) before any error of `work`.
 template <class Work>
@@ -100,21 +121,17 @@ class GyroLink {
   // One epoch on the wire; returns its stamp [ns].
   std::int64_t send(const py::handle& time_s, const py::handle& raw, const py::object& present,
                     const py::object& reference_wxyz) {
-    const std::int64_t stamp = epoch(time_s, raw, present, reference_wxyz);
-    std::uint64_t samples = 0;
-    check(watched(watch_, [&] {
-      return link_->publish(stamp, ++seq_, raw_, present_, reference_, lockstep_, samples);
-    }));
-    last_stamp_ = stamp;
-    return stamp;
+    const InUse in_use(busy_, "GyroPublisher.send");
+    return publish(time_s, raw, present, reference_wxyz);
   }
 
   // Lockstep: the epoch on the wire and its Attitude back.
   py::dict step(const py::handle& time_s, const py::handle& raw, const py::object& present,
                 const py::object& reference_wxyz, double timeout_s) {
+    const InUse in_use(busy_, "Lockstep.step");
     if (!lockstep_) throw py::value_error("step: the publisher was opened with lockstep=False");
     const std::int64_t wait_ns = timeout_ns(timeout_s, "timeout_s");
-    const std::int64_t stamp = send(time_s, raw, present, reference_wxyz);
+    const std::int64_t stamp = publish(time_s, raw, present, reference_wxyz);
     auto came = watched(watch_, [&] { return link_->wait_for_stamp(stamp, wait_ns, newest_, sink()); });
     if (!take(std::move(came))) {
       raise_timeout("no Attitude of unit '" + unit_ + "' for the epoch at " +
@@ -122,18 +139,12 @@ class GyroLink {
                     " s: is `tetra fusion` running for this unit on this domain? (an epoch the service "
                     "rejects gets none: see its Health counters)");
     }
-    py::dict found;
-    std::vector<fdi::AttitudeEstimate> rest;
-    for (const auto& a : received_) {
-      if (a.stamp_ns == stamp) found = wire_attitude_dict(a, n_);
-      if (a.stamp_ns > stamp) rest.push_back(a);
-    }
-    received_ = std::move(rest);
-    return found;
+    return attitude_of(stamp);
   }
 
   // Every Attitude of the unit received and not yet taken, oldest first; waits up to `timeout_s` for one.
   py::list attitudes(double timeout_s) {
+    const InUse in_use(busy_, "GyroPublisher.attitudes");
     const std::int64_t give_up = dds::monotonic_ns() + timeout_ns(timeout_s, "timeout_s");
     check(watched(watch_, [&] {
       Status s = link_->take_attitudes(sink());
@@ -150,6 +161,7 @@ class GyroLink {
   }
 
   void wait_for_acks() {
+    const InUse in_use(busy_, "GyroPublisher.flush");
     watched(watch_, [&] {
       link_->wait_for_acks();
       return 0;
@@ -161,6 +173,35 @@ class GyroLink {
   bool lockstep() const { return lockstep_; }
 
  private:
+  std::int64_t publish(const py::handle& time_s, const py::handle& raw, const py::object& present,
+                       const py::object& reference_wxyz) {
+    const std::int64_t stamp = epoch(time_s, raw, present, reference_wxyz);
+    std::uint64_t samples = 0;
+    check(watched(watch_, [&] {
+      return link_->publish(stamp, ++seq_, raw_, present_, reference_, lockstep_, samples);
+    }));
+    last_stamp_ = stamp;
+    return stamp;
+  }
+
+  // The attitude of `stamp` among those received (dropping the older ones).
+  py::dict attitude_of(std::int64_t stamp) {
+    std::optional<fdi::AttitudeEstimate> found;
+    std::vector<fdi::AttitudeEstimate> rest;
+    for (const auto& a : received_) {
+      if (a.stamp_ns == stamp) found = a;
+      if (a.stamp_ns > stamp) rest.push_back(a);
+    }
+    received_ = std::move(rest);
+    if (!found) {
+      raise(failure("Attitude of unit '" + unit_ + "' past the epoch at " +
+                    std::to_string(ns_to_seconds(stamp)) +
+                    " s but none of it: the service's epochs are not this publisher's (another publisher of "
+                    "the unit?)"));
+    }
+    return wire_attitude_dict(*found, n_);
+  }
+
   // Checks one epoch's arrays into raw_, present_, reference_ (as Pipeline.step reads them); its stamp.
   std::int64_t epoch(const py::handle& time_s, const py::handle& raw, const py::object& present,
                      const py::object& reference_wxyz) {
@@ -197,6 +238,7 @@ class GyroLink {
   int n_;
   bool lockstep_;
   Watch* watch_ = nullptr;  //!< the running call's, polled by the link's waits
+  bool busy_ = false;       //!< a call is running (InUse)
   std::unique_ptr<player::PlayerLink> link_;
   std::vector<double> raw_;
   std::vector<std::uint8_t> present_;
@@ -284,6 +326,7 @@ class Subscriber {
   // Waits up to `timeout_s` for any sample; then takes every sample of the unit: (attitudes, healths,
   // events).
   py::tuple take_all(double timeout_s) {
+    const InUse in_use(busy_, "Subscriber.poll");
     const std::int64_t until = dds::monotonic_ns() + timeout_ns(timeout_s, "timeout_s");
     std::vector<std::intptr_t> fired;
     check(watched(watch_, [&] { return wait_watched(*session_, *watch_, until, fired); }));
@@ -313,6 +356,7 @@ class Subscriber {
   std::string unit_;
   int n_;
   Watch* watch_ = nullptr;
+  bool busy_ = false;
   std::optional<dds::Session> session_;  // first: deleted last
   std::optional<dds::Reader<tetra_Attitude>> attitude_;
   std::optional<dds::Reader<tetra_Health>> health_;

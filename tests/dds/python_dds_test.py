@@ -113,6 +113,16 @@ def test_subscriber_dataclasses_and_units(service):
     assert set(health.counters) >= {"epochs_accepted", "samples_late", "unit_silences"}
     with pytest.raises(TimeoutError, match="no Attitude of unit 'py-lock' within 0.2 s"):
         sub.wait_attitude(0.2)
+    # One call at a time: a second thread's call while a wait runs (the GIL released) is refused (on a domain
+    # of no service: nothing arrives to end the wait early).
+    import threading
+    quiet = dds.Subscriber("nobody", domain=DOMAIN + 1)
+    waiting = threading.Thread(target=quiet.poll, args=(1.0,))
+    waiting.start()
+    time.sleep(0.2)
+    with pytest.raises(RuntimeError, match="Subscriber.poll: another call is running on this object"):
+        quiet.poll(0.0)
+    waiting.join()
 
 
 def test_commands_acknowledged_and_refused(service):
