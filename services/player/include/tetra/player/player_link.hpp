@@ -35,8 +35,8 @@ class PlayerLink {
                                                   bool with_reference, const PlayOptions& options,
                                                   dds::ShutdownSignal* shutdown, StopPoll stop = {});
   //! The reference first, then the samples delivered (in lockstep each saying how many the epoch has,
-  //! dds::promised_samples, and that its reference was written: the service waits for both). A reader behind holds a write
-  //! back, never loses it: written again until it is taken, for at most 30 s.
+  //! dds::promised_samples, and that its reference was written: the service waits for both). A reader behind
+  //! holds a write back, never loses it: written again until it is taken, for at most 30 s.
   Status publish(std::int64_t stamp_ns, std::uint64_t seq, std::span<const double> raw,
                  std::span<const std::uint8_t> present, const std::optional<std::array<double, 4>>& ref_wxyz,
                  bool lockstep, std::uint64_t& samples);
