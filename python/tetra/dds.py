@@ -134,10 +134,10 @@ class GyroPublisher:
     ``gyros``: samples per epoch; ``rate_hz``: the sample rate (the writer offers the deadline of 3 periods,
     which the service's ``sample_rate_hz`` · ``speed`` must allow). ``reference``: also wait for the
     service's reference reader (epochs will carry references). Opening waits up to ``timeout_s`` for
-    ``wait_readers`` gyro readers and the service's Health saying it hears this writer (TimeoutError...
-    as tetra.Error, naming what was missing). With ``lockstep``, each sample says how many the epoch has
-    (flags bits 24-29) and an epoch's reference is acknowledged before its samples, so the service fuses
-    exactly the epochs sent, however slow the caller: use ``Lockstep``.
+    ``wait_readers`` gyro readers and the service's Health saying it hears this writer (``tetra.Error``
+    naming what did not come). With ``lockstep``, each sample says how many the epoch has (flags bits
+    24-29) and that its reference was written (bit 31), so the service fuses exactly the epochs sent with
+    their references, however slow the caller: use ``Lockstep``.
     """
 
     def __init__(self, unit: str, gyros: int = 4, rate_hz: float = 100.0, *, domain: Optional[int] = None,
