@@ -35,11 +35,11 @@ ORBIT = {"scenario": "orbit", "duration_s": 40, "rate_hz": 100,
 PIPELINE = {"clear_after_s": 10}
 
 
-def fusion_config(path, unit, pipeline, speed=0.1):
+def fusion_config(path, unit, pipeline, speed=0.02):
     lines = "".join(f"  {k}: {v}\n" for k, v in pipeline.items()) or "  {}\n"
-    # speed 0.1: the service's silence deadline (3 / (100 Hz * 0.1) = 0.3 s of wall clock) covers a step of a
-    # Python simulator on a loaded machine; max_latency_s is not needed in lockstep (each sample says how
-    # many the epoch has).
+    # speed 0.02: the service's silence deadline (3 / (100 Hz * 0.02) = 1.5 s of wall clock) covers a step of
+    # a Python simulator on a loaded machine (a stall beyond it would make the gyros absent: not the in-process
+    # epochs); max_latency_s is not needed in lockstep (each sample says how many the epoch has).
     path.write_text(f"unit: {unit}\ncalibration: {SOURCE / 'examples' / 'seed_unit.yaml'}\nsample_rate_hz: 100\n"
                     f"speed: {speed}\nhealth_period_s: 0.5\npipeline:\n{lines}")
     return path
@@ -93,7 +93,7 @@ def test_lockstep_equals_the_pipeline_in_process(service):
     assert np.abs(np.array([a.stamp_ns for a in got]) - expected.time_s * 1e9).max() <= 1.0
 
     # The same run's events (the pipeline's, in order, the same lines) and its last Health.
-    # (its mode may already say LOST: the gyros went silent when the steps ended, 0.3 s of wall clock)
+    # (its mode may already say LOST: the gyros went silent when the steps ended, 1.5 s of wall clock)
     health = sub.wait_health(10.0, lambda h: h.counters["epochs_accepted"] == len(got))
     assert health.counters["samples_late"] == 0 and health.references_delayed == 0
     assert health.reference_state == "accepted" and health.references_too_late == 0
