@@ -116,6 +116,7 @@ class GyroLink {
                                       [this] { return watch_ != nullptr && watch_->poll(0, 0); });
     });
     link_ = take(std::move(opened));
+    if (lockstep_) link_->require_one_attitude_writer();  // a second service would mix into the run
   }
 
   // One epoch on the wire; returns its stamp [ns].

@@ -9,7 +9,8 @@ on a loopback domain, stepped from Python.
   within the timeout given; Ctrl-C in a wait raises KeyboardInterrupt within 0.2 s.
 - Real time: gyro epochs paced by the wall clock and a star tracker of its own (ReferencePublisher) delivering
   50-250 ms late: every reference fused at its own time (Health.references_delayed), none too late.
-Domains 206-209.
+- A service restarted under a lockstep run: its attitudes refused (tetra.Error), not mixed into the run.
+Domains 205-209.
 """
 import os
 import pathlib
@@ -217,3 +218,26 @@ def test_a_tracker_of_its_own_late_is_fused_at_its_time(tmp_path):
     assert len(attitudes) >= 0.95 * len(log.time_s) and isinstance(attitudes[0], dds.Attitude)
     assert min(late_s) >= 0.05 and health.references_delayed == sent and health.references_too_late == 0
     assert health.reference_state == "accepted"
+
+
+def test_a_restarted_service_is_refused_in_lockstep(tmp_path):
+    # (A second service of a running unit refuses to start, services/fusion/duplicate_watch.hpp; a restarted
+    # one is a new Attitude writer whose estimate starts afresh: a lockstep run would mix the two.)
+    config = fusion_config(tmp_path / "f.yaml", "py-dup", {})
+    proc = start_service(tmp_path, config, 205)
+    raw = [2e-4, 4e-4, 2e-4, -3e-4]
+    try:
+        with dds.Lockstep("py-dup", domain=205) as lock:
+            for k in range(50):
+                lock.step(k / 100, raw)
+            stop(proc)
+            proc = start_service(tmp_path, config, 205)
+            with pytest.raises(tetra.Error, match="Attitude of unit py-dup from a second writer: two fusion "
+                                                  "services \\(or one restarted\\)"):
+                for k in range(50, 100):
+                    try:
+                        lock.step(k / 100, raw, timeout_s=1.0)
+                    except TimeoutError:
+                        pass  # an epoch written before the new service had discovered the writer
+    finally:
+        stop(proc)

@@ -175,11 +175,12 @@ Status PlayerLink::take_attitudes(std::uint64_t& count, std::int64_t& newest_sta
 }
 
 Status PlayerLink::take_attitudes(const AttitudeSink& on_attitude) {
-  auto taken = attitude_.take([&](const tetra_Attitude& msg, const dds_sample_info_t&) {
-    if (dds::from_wire(msg.unit) == unit_) on_attitude(dds::from_wire(msg));
+  auto taken = attitude_.take([&](const tetra_Attitude& msg, const dds_sample_info_t& info) {
+    if (dds::from_wire(msg.unit) == unit_ && attitude_writer_.accept(info.publication_handle))
+      on_attitude(dds::from_wire(msg));
   });
   if (!taken) return taken.error();
-  return ok_status();
+  return attitude_writer_.status(unit_);
 }
 
 Result<bool> PlayerLink::wait_for_stamp(std::int64_t stamp_ns, std::int64_t timeout_ns,

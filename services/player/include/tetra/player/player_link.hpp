@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "tetra/core/result.hpp"
+#include "tetra/dds/one_writer.hpp"
 #include "tetra/dds/session.hpp"
 #include "tetra/dds/shutdown.hpp"
 #include "tetra/fdi/types.hpp"
@@ -42,8 +43,11 @@ class PlayerLink {
                  bool lockstep, std::uint64_t& samples);
   //! Takes the attitudes of this unit received so far; returns the newest stamp seen (or the previous).
   Status take_attitudes(std::uint64_t& count, std::int64_t& newest_stamp_ns);
-  //! Takes the attitudes of this unit received so far, in order, each handed to `on_attitude`.
+  //! Takes the attitudes of this unit received so far, in order, each handed to `on_attitude`; after
+  //! require_one_attitude_writer(), an error when they come from a second writer (two services of the unit,
+  //! or one restarted: a lockstep run would mix their estimates).
   Status take_attitudes(const AttitudeSink& on_attitude);
+  void require_one_attitude_writer() { attitude_writer_.require(); }
   //! Lockstep: takes attitudes (each to `on_attitude`, the newest stamp into `newest_stamp_ns`) until one
   //! stamped `stamp_ns` or later has come, `timeout_ns` passes or a stop is asked; false if none came.
   Result<bool> wait_for_stamp(std::int64_t stamp_ns, std::int64_t timeout_ns, std::int64_t& newest_stamp_ns,
@@ -79,6 +83,7 @@ class PlayerLink {
   dds::Reader<tetra_Attitude> attitude_;
   dds::ShutdownSignal* shutdown_ = nullptr;
   StopPoll stop_;
+  dds::OneWriter attitude_writer_;  //!< the Attitude writer of this unit (another: an error once required)
   std::vector<std::intptr_t> triggered_;
   tetra_GyroSample sample_{};
   tetra_AttitudeReference reference_msg_{};
