@@ -85,6 +85,32 @@ TEST(EpochAssembler, APromisedSampleIsWaitedForPastTheLatencyLimit) {
   EXPECT_EQ(a.counters().samples_promised_lost, 1U);
 }
 
+// Lockstep's reference: written before the samples that say so and promise the epoch's count, never
+// acknowledged (an acknowledgement costs a heartbeat, 100 ms). The epoch waits for it past the latency limit
+// (fused without it, the attitude would differ from replay's), and goes without it only once a gyro moves on.
+TEST(EpochAssembler, APromisedEpochsReferenceIsWaitedForPastTheLatencyLimit) {
+  auto a = make();
+  const Quaternion q(0.5, 0.5, 0.5, 0.5);
+  constexpr std::int64_t kLate = 1000 + 25 * kLatency;
+  for (int g = 1; g <= 4; ++g) EXPECT_EQ(a.add_sample(g, 1, 0, 1.0, 1000, true, 4), Verdict::kAccepted);
+  std::vector<fdi::Epoch> out;
+  a.poll(kLate, out);
+  EXPECT_TRUE(out.empty()) << "fused without the reference its samples said was written";
+  a.add_reference(0, q);
+  a.poll(kLate, out);
+  ASSERT_EQ(out.size(), 1U);
+  ASSERT_TRUE(out[0].reference_q_RB.has_value());
+  // Its reference lost: the next epoch's first sample releases it, without one.
+  for (int g = 1; g <= 4; ++g)
+    EXPECT_EQ(a.add_sample(g, 2, kPeriod, 1.0, kLate, true, 4), Verdict::kAccepted);
+  a.poll(kLate + 25 * kLatency, out);
+  EXPECT_EQ(out.size(), 1U);
+  EXPECT_EQ(a.add_sample(1, 3, 2 * kPeriod, 1.0, kLate + 25 * kLatency, false, 4), Verdict::kAccepted);
+  a.poll(kLate + 25 * kLatency, out);
+  ASSERT_EQ(out.size(), 2U);
+  EXPECT_FALSE(out[1].reference_q_RB.has_value());
+}
+
 TEST(EpochAssembler, MissingSampleWaitsForTheLatencyLimitOnly) {
   auto a = make();
   for (int g : {1, 2, 4}) a.add_sample(g, 1, 0, 1.0, 1000);

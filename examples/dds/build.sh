@@ -11,4 +11,8 @@ for name in attitude_subscriber star_tracker; do
   cc -O2 -Wall -Wextra -Werror -I"$out/gen" "$src/examples/dds/$name.c" "$out/gen/tetra.c" -lddsc -lm \
     -o "$out/$name"
 done
-echo "built $out/attitude_subscriber and $out/star_tracker"
+# C++ (Debian 12 has no Cyclone C++ binding): the generated C types compiled by cc, the program by c++.
+cc -O2 -Wall -Wextra -Werror -c -I"$out/gen" "$out/gen/tetra.c" -o "$out/gen/tetra.o"
+c++ -std=c++17 -O2 -Wall -Wextra -Werror -I"$out/gen" "$src/examples/dds/cpp_subscriber.cpp" "$out/gen/tetra.o" \
+  -lddsc -o "$out/cpp_subscriber"
+echo "built $out/attitude_subscriber, $out/star_tracker and $out/cpp_subscriber"

@@ -1,6 +1,6 @@
 """tetra over DDS from Python, without a Cyclone DDS Python binding (Debian 12 ships none).
 
-Three small processes carry the traffic, each speaking lines on a pipe (docs/python.md, "DDS from Python"):
+Three small processes carry the traffic, each speaking lines on a pipe (docs/python.md, "DDS"; tetra.dds needs no pipes):
 
   GyroPublisher  -> `tetra ingest` (stdin line protocol `TIME_S,all,RAW1,...,RAWN`) -> GyroSample
   StarTracker    -> examples/dds/star_tracker (stdin `STAMP_NS QW QX QY QZ`)      -> AttitudeReference

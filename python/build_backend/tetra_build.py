@@ -25,7 +25,7 @@ import zipfile
 from pathlib import Path
 
 SOURCE = Path(__file__).resolve().parents[2]
-PACKAGE_FILES = ("__init__.py", "__init__.pyi", "_tetra.pyi", "py.typed")
+PACKAGE_FILES = ("__init__.py", "__init__.pyi", "_tetra.pyi", "py.typed", "dds.py")
 
 
 def _version() -> str:

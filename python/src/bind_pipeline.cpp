@@ -212,21 +212,7 @@ py::dict attitude_dict(const fdi::AttitudeEstimate& a, int n) {
 }
 
 py::dict health_dict(const fdi::Health& h, int n) {
-  py::dict d;
-  d["mode"] = fdi::to_string(h.mode);
-  d["used"] = gyro_ids(h.used, n);
-  py::list gyros;
-  for (const auto& g : h.gyros) {
-    gyros.append(py::dict("state"_a = fdi::to_string(g.state), "kind"_a = fdi::to_string(g.kind),
-                          "bias_rad_s"_a = g.bias_rad_s, "bias_sigma_rad_s"_a = g.bias_sigma_rad_s));
-  }
-  d["gyros"] = gyros;
-  d["chi2"] = h.chi2;
-  d["cusum"] = h.cusum;
-  d["chi2_threshold"] = h.chi2_threshold;
-  d["cusum_threshold"] = h.cusum_threshold;
-  d["fdi_available"] = h.fdi_available;
-  d["reference_state"] = fdi::to_string(h.reference_state);
+  py::dict d = health_state_dict(h, n);
   const auto& c = h.counters;
   d["counters"] = py::dict(
       "epochs_accepted"_a = c.epochs_accepted, "epochs_rejected_time"_a = c.epochs_rejected_time,

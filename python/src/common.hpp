@@ -95,5 +95,6 @@ void bind_sim(py::module_& m);
 void bind_pipeline(py::module_& m);
 void bind_score(py::module_& m);
 void bind_campaign(py::module_& m);
+void bind_dds(py::module_& m);  //!< with TETRA_WITH_DDS only
 
 }  // namespace tetra::python

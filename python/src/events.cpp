@@ -28,4 +28,24 @@ py::dict event_dict(const fdi::FdiEvent& e, int n_gyros) {
   return d;
 }
 
+py::dict health_state_dict(const fdi::Health& h, int n_gyros) {
+  using namespace pybind11::literals;
+  py::dict d;
+  d["mode"] = fdi::to_string(h.mode);
+  d["used"] = gyro_ids(h.used, n_gyros);
+  py::list gyros;
+  for (const auto& g : h.gyros) {
+    gyros.append(py::dict("state"_a = fdi::to_string(g.state), "kind"_a = fdi::to_string(g.kind),
+                          "bias_rad_s"_a = g.bias_rad_s, "bias_sigma_rad_s"_a = g.bias_sigma_rad_s));
+  }
+  d["gyros"] = gyros;
+  d["chi2"] = h.chi2;
+  d["cusum"] = h.cusum;
+  d["chi2_threshold"] = h.chi2_threshold;
+  d["cusum_threshold"] = h.cusum_threshold;
+  d["fdi_available"] = h.fdi_available;
+  d["reference_state"] = fdi::to_string(h.reference_state);
+  return d;
+}
+
 }  // namespace tetra::python

@@ -12,4 +12,9 @@ PYBIND11_MODULE(_tetra, m) {
   tetra::python::bind_pipeline(m);
   tetra::python::bind_score(m);
   tetra::python::bind_campaign(m);
+#ifdef TETRA_WITH_DDS
+  tetra::python::bind_dds(m);
+#else
+  m.attr("_HAS_DDS") = false;
+#endif
 }

@@ -12,6 +12,7 @@ Errors: the library's messages raise ``tetra.BadInputError`` (bad input: a Value
 Warnings (``tetra.DefaultNoiseWarning``) go through Python's ``warnings``.
 Long calls (``Pipeline.run``, ``run_log``, ``sim``, ``allan``, ``campaign``) stop on Ctrl-C within a few
 milliseconds (KeyboardInterrupt) and take ``progress=``: a callable ``progress(done, total)`` or a tqdm bar.
+DDS: ``import tetra.dds`` puts a simulator on the wire to a ``tetra fusion`` service (lockstep included).
 """
 from __future__ import annotations
 

@@ -29,3 +29,17 @@ def session(examples: pathlib.Path) -> float:
     none: Optional[float] = cal.latitude_deg
     return float(adev[0] + devs[0] + errs[0] + ns[0] + taus[0] + also[1][0]) + score.rms_total_deg + len(rows) \
         + len(health) + (none or 0.0) + len(seen)
+
+
+def dds_session(log: tetra.GyroLog) -> float:
+    """tetra.dds as docs/python.md "DDS" uses it (checked by mypy only: it needs a service)."""
+    import tetra.dds as dds
+    sub = dds.Subscriber("tetra-1", domain=7)
+    with dds.Lockstep("tetra-1", gyros=4, rate_hz=100.0, domain=7) as lock:
+        a: dds.Attitude = lock.step(float(log.time_s[0]), log.values[0], log.present[0], None, timeout_s=2.0)
+    tracker = dds.ReferencePublisher("tetra-1", domain=7, timeout_s=1.0)
+    tracker.send(a.stamp_ns, a.q_RB_wxyz)
+    h: dds.Health = sub.wait_health(1.0, lambda h: h.reference_state == "accepted")
+    e: dds.FdiEvent = dds.command("tetra-1", "exclude", 2, force=False, domain=7, timeout_s=1.0)
+    n: int = sub.poll(0.1)
+    return float(a.sigma_rad[0]) + h.reference_nis + e.statistic + n + len(sub.events)

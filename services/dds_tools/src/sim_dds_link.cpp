@@ -195,19 +195,12 @@ Status SimDdsLink::publish(const sim::SimEpoch& epoch, std::uint64_t k) {
 }
 
 Status SimDdsLink::take_attitudes(const std::function<void(const fdi::AttitudeEstimate&)>& on_attitude) {
-  bool second_writer = false;
   auto taken = attitude_reader_.take([&](const tetra_Attitude& msg, const dds_sample_info_t& info) {
-    if (dds::from_wire(msg.unit) != unit_) return;
-    if (attitude_writer_ == 0 || !one_attitude_writer_) attitude_writer_ = info.publication_handle;
-    if (info.publication_handle != attitude_writer_) second_writer = true;
-    if (!second_writer) on_attitude(dds::from_wire(msg));
+    if (dds::from_wire(msg.unit) == unit_ && attitude_writer_.accept(info.publication_handle))
+      on_attitude(dds::from_wire(msg));
   });
   if (!taken) return taken.error();
-  if (second_writer)
-    return failure("Attitude of unit " + unit_ +
-                   " from a second writer: two fusion services (or one restarted) serve this unit on the "
-                   "domain, and their estimates would mix");
-  return ok_status();
+  return attitude_writer_.status(unit_);
 }
 
 Status SimDdsLink::wait_until(std::int64_t until_ns) {

@@ -281,8 +281,23 @@ bool EpochAssembler::promise_kept(const Pending& epoch) const {
   return false;
 }
 
+bool EpochAssembler::reference_in(const Pending& epoch) const {
+  return std::any_of(references_.begin(), references_.end(), [&](const auto& r) {
+    return std::llabs(r.first - epoch.stamp_ns) <= config_.tolerance_ns;
+  });
+}
+
+bool EpochAssembler::moved_past(const Pending& epoch) const {
+  return std::any_of(gyros_.begin(), gyros_.end(), [&](const GyroTrack& track) {
+    return track.last_stamp_ns && *track.last_stamp_ns > epoch.stamp_ns + config_.tolerance_ns;
+  });
+}
+
 bool EpochAssembler::ready(const Pending& epoch, std::int64_t now_ns) const {
   if (epoch.promised > 0 && !promise_kept(epoch)) return false;  // however late: no max_latency_ns
+  // Its reference too, promised by the same sender (lockstep: written first, never acknowledged).
+  if (epoch.promised > 0 && epoch.awaits_reference && !reference_in(epoch) && !moved_past(epoch))
+    return false;
   if (now_ns - epoch.opened_local_ns >= config_.max_latency_ns) return true;
   // Every sample the sender wrote is in: the gyros it did not write are not waited for.
   const bool complete = all_promised_in(epoch.present, epoch.promised);
@@ -292,9 +307,7 @@ bool EpochAssembler::ready(const Pending& epoch, std::int64_t now_ns) const {
         track.last_stamp_ns && *track.last_stamp_ns > epoch.stamp_ns + config_.tolerance_ns;
     if (epoch.present[i] == 0 && !track.absent && !moved_past) return false;
   }
-  return !epoch.awaits_reference || std::any_of(references_.begin(), references_.end(), [&](const auto& r) {
-    return std::llabs(r.first - epoch.stamp_ns) <= config_.tolerance_ns;
-  });
+  return !epoch.awaits_reference || reference_in(epoch);
 }
 
 void EpochAssembler::emit(Pending& epoch, std::vector<fdi::Epoch>& out) {

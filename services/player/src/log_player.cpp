@@ -8,11 +8,11 @@
 #include <limits>
 #include <vector>
 
-#include "player_link.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/dds/clock.hpp"
+#include "tetra/player/player_link.hpp"
 #include "tetra/service/unit_name.hpp"
 
 namespace tetra::player {
@@ -144,14 +144,13 @@ class Player {
     if (lockstep && seq_ % kAckEvery == 0) link_.wait_for_acks();
     report_.references += ref ? 1 : 0;
     ++report_.epochs;
-    if (Status s = link_.take_attitudes(report_.attitudes, newest_); !s) return s;
     if (lockstep) {
-      const std::int64_t give_up = dds::monotonic_ns() + seconds_to_ns(options_.lockstep_timeout_s);
-      while (newest_ < stamp && dds::monotonic_ns() < give_up && !link_.stop_requested()) {
-        if (Status s = link_.wait_until(give_up); !s) return s;
-        if (Status s = link_.take_attitudes(report_.attitudes, newest_); !s) return s;
-      }
-      if (newest_ < stamp) ++report_.lockstep_missing;
+      auto came = link_.wait_for_stamp(stamp, seconds_to_ns(options_.lockstep_timeout_s), newest_,
+                                       [&](const fdi::AttitudeEstimate&) { ++report_.attitudes; });
+      if (!came) return came.error();
+      if (!*came) ++report_.lockstep_missing;
+    } else if (Status s = link_.take_attitudes(report_.attitudes, newest_); !s) {
+      return s;
     }
     if (on_progress_ && dds::monotonic_ns() >= next_progress_) {
       report_.wall_s = ns_to_seconds(dds::monotonic_ns() - *start_wall_);

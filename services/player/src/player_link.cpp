@@ -1,4 +1,4 @@
-#include "player_link.hpp"
+#include "tetra/player/player_link.hpp"
 
 #include <algorithm>
 #include <utility>
@@ -18,7 +18,7 @@ constexpr std::int64_t kHeldGiveUp_ns = 30'000'000'000;  //!< [ns] longest a rea
 
 Result<std::unique_ptr<PlayerLink>> PlayerLink::open(const std::string& unit, double rate_hz,
                                                      bool with_reference, const PlayOptions& options,
-                                                     dds::ShutdownSignal* shutdown) {
+                                                     dds::ShutdownSignal* shutdown, StopPoll stop) {
   auto session = dds::Session::open(options.domain, unit);
   if (!session) return session.error();
   const double wall_rate_hz = rate_hz * (options.speed > 0 ? options.speed : 1.0);
@@ -38,6 +38,7 @@ Result<std::unique_ptr<PlayerLink>> PlayerLink::open(const std::string& unit, do
   std::unique_ptr<PlayerLink> link(new PlayerLink(unit, std::move(session).value(), std::move(gyro).value(),
                                                   std::move(reference).value(), std::move(attitude).value()));
   link->shutdown_ = shutdown;
+  link->stop_ = std::move(stop);
   if (auto s = dds::copy_bounded(link->sample_.unit, unit, "unit"); !s) return s.error();
   if (auto s = dds::copy_bounded(link->reference_msg_.unit, unit, "unit"); !s) return s.error();
   if (auto s = link->wait_for_readers(options, with_reference); !s) return s.error();
@@ -75,7 +76,7 @@ Status PlayerLink::wait_for_readers(const PlayOptions& options, bool with_refere
                      " GyroSample readers appeared within " + std::to_string(options.wait_timeout_s) +
                      " s (is `tetra fusion` running on this domain? docs/troubleshooting.md)");
     }
-    if (auto s = session_.wait(std::chrono::nanoseconds(give_up - now), triggered_); !s) return s.error();
+    if (auto s = session_.wait(wait_for(give_up), triggered_); !s) return s.error();
   }
 }
 
@@ -105,7 +106,7 @@ Status PlayerLink::wait_for_service(const PlayOptions& options) {
     const std::int64_t now = dds::monotonic_ns();
     const std::int64_t limit = seen ? hears_give_up : first_give_up;
     if (hears || now >= limit || stop_requested()) break;
-    if (auto s = waitset->wait(std::chrono::nanoseconds(limit - now), fired); !s) return s.error();
+    if (auto s = waitset->wait(wait_for(limit), fired); !s) return s.error();
   }
   // The service's Attitude writer (lockstep waits on it), briefly; then a settling time for other readers.
   if (auto s = session_.watch_statuses(attitude_.handle(), DDS_SUBSCRIPTION_MATCHED_STATUS, kPlayerMatched);
@@ -119,7 +120,7 @@ Status PlayerLink::wait_for_service(const PlayOptions& options) {
     if (!matched) return matched.error();
     const std::int64_t now = dds::monotonic_ns();
     if ((*matched > 0 && options.wait_readers <= 1) || now >= until || stop_requested()) return ok_status();
-    if (auto s = session_.wait(std::chrono::nanoseconds(until - now), triggered_); !s) return s.error();
+    if (auto s = session_.wait(wait_for(until), triggered_); !s) return s.error();
   }
 }
 
@@ -131,12 +132,12 @@ Status PlayerLink::publish(std::int64_t stamp_ns, std::uint64_t seq, std::span<c
     reference_msg_.stamp_ns = stamp_ns;
     for (std::size_t i = 0; i < 4; ++i) reference_msg_.q_RB[i] = (*ref_wxyz)[i];
     if (auto s = reference_.write(reference_msg_); !s) return s.error();
-    if (lockstep) (void)reference_.wait_for_acks(std::chrono::seconds(2));
   }
   std::uint32_t flags = 0;
-  if (lockstep) {  // the service waits for every sample of the epoch, however late (dds::promised_samples)
+  if (lockstep) {  // the service waits for every sample of the epoch and its reference, however late
     const auto written = std::count(present.begin(), present.end(), std::uint8_t{1});
     flags = static_cast<std::uint32_t>(written) << dds::kGyroFlagSamplesShift;
+    if (ref_wxyz) flags |= dds::kGyroFlagReferenceWritten;  // no acknowledgement wait (100 ms each)
   }
   for (std::size_t g = 0; g < raw.size(); ++g) {
     if (present[g] == 0) continue;  // not delivered in the log: not on the wire either
@@ -165,19 +166,45 @@ Status PlayerLink::write_held() {
 }
 
 Status PlayerLink::take_attitudes(std::uint64_t& count, std::int64_t& newest_stamp_ns) {
-  auto taken = attitude_.take([&](const tetra_Attitude& msg, const dds_sample_info_t&) {
-    if (dds::from_wire(msg.unit) != unit_) return;
+  return take_attitudes([&](const fdi::AttitudeEstimate& a) {
     ++count;
-    newest_stamp_ns = std::max(newest_stamp_ns, static_cast<std::int64_t>(msg.stamp_ns));
+    newest_stamp_ns = std::max(newest_stamp_ns, a.stamp_ns);
+  });
+}
+
+Status PlayerLink::take_attitudes(const AttitudeSink& on_attitude) {
+  auto taken = attitude_.take([&](const tetra_Attitude& msg, const dds_sample_info_t& info) {
+    if (dds::from_wire(msg.unit) == unit_ && attitude_writer_.accept(info.publication_handle))
+      on_attitude(dds::from_wire(msg));
   });
   if (!taken) return taken.error();
-  return ok_status();
+  return attitude_writer_.status(unit_);
+}
+
+Result<bool> PlayerLink::wait_for_stamp(std::int64_t stamp_ns, std::int64_t timeout_ns,
+                                        std::int64_t& newest_stamp_ns, const AttitudeSink& on_attitude) {
+  const AttitudeSink sink = [&](const fdi::AttitudeEstimate& a) {
+    newest_stamp_ns = std::max(newest_stamp_ns, a.stamp_ns);
+    on_attitude(a);
+  };
+  if (Status s = take_attitudes(sink); !s) return s.error();
+  const std::int64_t give_up = dds::monotonic_ns() + timeout_ns;
+  while (newest_stamp_ns < stamp_ns && dds::monotonic_ns() < give_up && !stop_requested()) {
+    if (Status s = wait_until(give_up); !s) return s.error();
+    if (Status s = take_attitudes(sink); !s) return s.error();
+  }
+  return newest_stamp_ns >= stamp_ns;
 }
 
 Status PlayerLink::wait_until(std::int64_t until_ns) {
   const std::int64_t now = dds::monotonic_ns();
   if (now >= until_ns || stop_requested()) return ok_status();
-  return session_.wait(std::chrono::nanoseconds(until_ns - now), triggered_);
+  return session_.wait(wait_for(until_ns), triggered_);
+}
+
+std::chrono::nanoseconds PlayerLink::wait_for(std::int64_t until_ns) const {
+  const std::int64_t left = std::max<std::int64_t>(0, until_ns - dds::monotonic_ns());
+  return std::chrono::nanoseconds(stop_ ? std::min(left, kStopPollEvery_ns) : left);
 }
 
 void PlayerLink::wait_for_acks() {

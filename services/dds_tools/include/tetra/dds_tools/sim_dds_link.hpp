@@ -13,6 +13,7 @@
 
 #include "tetra/core/result.hpp"
 #include "tetra/dds/entity.hpp"
+#include "tetra/dds/one_writer.hpp"
 #include "tetra/dds/session.hpp"
 #include "tetra/dds/shutdown.hpp"
 #include "tetra/dds_tools/sim_dds.hpp"
@@ -38,7 +39,7 @@ class SimDdsLink {
   //! Blocks until data arrives on the Attitude reader, a shutdown is requested or the monotonic
   //! time `until_ns` passes.
   Status wait_until(std::int64_t until_ns);
-  void require_one_attitude_writer() { one_attitude_writer_ = true; }
+  void require_one_attitude_writer() { attitude_writer_.require(); }
   bool stop_requested() const { return shutdown_ != nullptr && shutdown_->requested(); }
   //! Waits (up to 2 s) until the samples written are acknowledged.
   void wait_for_acks();
@@ -67,8 +68,7 @@ class SimDdsLink {
   dds::Reader<tetra_Attitude> attitude_reader_;
   const dds::ShutdownSignal* shutdown_ = nullptr;
   std::vector<std::intptr_t> triggered_;
-  dds_instance_handle_t attitude_writer_ = 0;  //!< the Attitude writer of this unit heard (0: none yet)
-  bool one_attitude_writer_ = false;           //!< another writer is an error (lockstep)
+  dds::OneWriter attitude_writer_;  //!< the Attitude writer of this unit (another: an error in lockstep)
   tetra_GyroSample sample_{};
   tetra_AttitudeReference reference_{};
 };

@@ -47,7 +47,9 @@
 //     kMaxLateReferences wait: the oldest beyond gives way, counted as late);
 //   * a sample that says how many samples were written for its stamp (`promised`, lockstep play) makes
 //     its epoch wait for all of them, however late, not max_latency_ns: it is emitted when they are in
-//     or when a gyro missing from it has delivered a later stamp (its sample is lost).
+//     or when a gyro missing from it has delivered a later stamp (its sample is lost). Such an epoch
+//     waits as long for the reference its samples say was written (`reference_written`): until it is
+//     in or some gyro has delivered a later stamp (the reference is lost, counted late if it comes).
 // Times: stamps are sensor time [ns]; `now_ns` is the caller's local monotonic clock [ns].
 
 #include <cstdint>
@@ -169,6 +171,10 @@ class EpochAssembler {
   bool ready(const Pending& epoch, std::int64_t now_ns) const;
   //! Every sample promised for the epoch is in, or a gyro missing from it moved past it (lost).
   bool promise_kept(const Pending& epoch) const;
+  //! A reference within the tolerance of the epoch's stamp is in.
+  bool reference_in(const Pending& epoch) const;
+  //! Some gyro has delivered a stamp later than the epoch's.
+  bool moved_past(const Pending& epoch) const;
   void emit(Pending& epoch, std::vector<fdi::Epoch>& out);
 
   AssemblerConfig config_;
