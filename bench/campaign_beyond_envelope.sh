@@ -8,7 +8,8 @@
 # exclusions, right isolations, unisolated, missed, false alarms per hour and pointing (docs/fdi_validation.md).
 # Usage: bench/campaign_beyond_envelope.sh [BUILD_DIR] [SEEDS] [N...]   (defaults: build, 150, 4 5 6: 4,950
 # runs, ~3 min). KEEP=DIR keeps the specs and campaign folders there (DIR/cN/runs.csv; a run again with its
-# events: tetra campaign DIR/specN.yaml --run K --events ev.jsonl).
+# events: tetra campaign DIR/specN.yaml --run K --events ev.jsonl). ENVELOPE=stated draws the same campaign
+# inside the stated envelope instead: the unit at 1 x its calibration's 1-sigma, the noise as stated.
 set -euo pipefail
 build="$(realpath "${1:-build}")"
 seeds="${2:-150}"
@@ -23,9 +24,12 @@ else
   trap 'rm -rf "$out"' EXIT
 fi
 echo "cores: $(nproc); load before: $(cut -d' ' -f1-3 /proc/loadavg)"
-python3 - "$src" "$out" "$seeds" <<'PY'
+python3 - "$src" "$out" "$seeds" "${ENVELOPE:-beyond}" <<'PY'
 import math, sys
-src, out, seeds = sys.argv[1], sys.argv[2], sys.argv[3]
+src, out, seeds, envelope = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
+k = "1.0" if envelope == "stated" else "2.5"
+noise = "" if envelope == "stated" else (
+    "  unit.arw_factor: {uniform: [0.5, 3.0]}\n  unit.bias_instability_factor: {uniform: [0.5, 3.0]}\n")
 unit = open(f"{src}/examples/sim/calibrated_unit.yaml").read()
 scenario = open(f"{src}/examples/sim/closed_loop_calibrated.yaml").read()
 def gyro(i, axis):
@@ -51,12 +55,10 @@ fault_free: true
 pipeline: {{exclusion_enabled: true}}
 dispersions:
   seed: 77
-  unit.scale_factor_ppm: {{calibration: 2.5}}
-  unit.bias_V: {{calibration: 2.5}}
-  unit.axis: {{calibration: 2.5}}
-  unit.arw_factor: {{uniform: [0.5, 3.0]}}
-  unit.bias_instability_factor: {{uniform: [0.5, 3.0]}}
-  spacecraft.inertia_percent: {{truncated_normal: [0, 3, -10, 10]}}
+  unit.scale_factor_ppm: {{calibration: {k}}}
+  unit.bias_V: {{calibration: {k}}}
+  unit.axis: {{calibration: {k}}}
+{noise}  spacecraft.inertia_percent: {{truncated_normal: [0, 3, -10, 10]}}
   disturbance.constant_Nm: {{normal: [0, 1.0e-6]}}
   reference.noise_arcsec: {{uniform: [3, 10]}}
   reference.latency_s: {{uniform: [0, 0.3]}}
