@@ -245,10 +245,14 @@ std::optional<Result<Session>> GroundServer::proxied_session(const HttpRequest& 
   return Result<Session>(std::move(*session));
 }
 
-HttpResponse GroundServer::handle(const HttpRequest& req) {
+bool GroundServer::browser_tls(const HttpRequest& req) const {
   // Behind the trusted proxy, its X-Forwarded-Proto tells whether the browser's side is HTTPS.
-  const bool tls = req.tls || (proxy_.enabled() && proxy_.trusts(req.remote_addr) &&
-                               lower_case(req.header("x-forwarded-proto")) == "https");
+  return req.tls || (proxy_.enabled() && proxy_.trusts(req.remote_addr) &&
+                     lower_case(req.header("x-forwarded-proto")) == "https");
+}
+
+HttpResponse GroundServer::handle(const HttpRequest& req) {
+  const bool tls = browser_tls(req);
   // DNS rebinding: a name that resolves to this host is not enough, the browser must call it by a name
   // of the allow-list. A cross-site page: its Origin is not on the list.
   const std::string host = with_port(lower_case(req.header("host")), tls);
@@ -373,9 +377,9 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
   audit(req, std::move(r));
   auto res = json_reply(
       200, {{"user", account->user}, {"role", to_string(account->role)}, {"csrf", operators_->csrf(token)}});
-  res.headers.emplace_back("Set-Cookie", std::string(kCookie) + "=" + token +
-                                             "; Path=/; Max-Age=" + std::to_string(lifetime) +
-                                             "; HttpOnly; SameSite=Strict" + (req.tls ? "; Secure" : ""));
+  res.headers.emplace_back(
+      "Set-Cookie", std::string(kCookie) + "=" + token + "; Path=/; Max-Age=" + std::to_string(lifetime) +
+                        "; HttpOnly; SameSite=Strict" + (browser_tls(req) ? "; Secure" : ""));
   return res;
 }
 

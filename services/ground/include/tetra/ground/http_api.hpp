@@ -94,6 +94,8 @@ class GroundServer {
   HttpResponse history(const HttpRequest& req);
   HttpResponse records(const HttpRequest& req);
   std::optional<Session> session_of(const HttpRequest& req);
+  //! True when the browser reached the ground over HTTPS: its own TLS, or the trusted proxy's.
+  bool browser_tls(const HttpRequest& req) const;
   //! The operator the trusted proxy's header names; nullopt without the header; an error (the reason of
   //! a 403) when it comes from another address or names no account.
   std::optional<Result<Session>> proxied_session(const HttpRequest& req);
