@@ -338,6 +338,7 @@ TEST(GroundAttacks, RequestsTwoReadersCouldReadDifferentlyAreRefused) {
            "GET /api/units HTTP/1.1\n" + host + "\n",                           // bare LF
            "GET /api/units HTTP/1.1\r\n" + host + "X-A: 1\r\n folded\r\n\r\n",  // obs-fold
            post + "Content-Length: 29\r\nContent-Length: 30\r\n\r\n" + body,    // two lengths
+           post + "Content-Length: 29, 29\r\n\r\n" + body,                      // a list (Beast takes it)
            "GET /api/units HTTP/1.1\r\n" + host + "X-A: a\rb\r\n\r\n",          // a bare CR
            "GET /api/units  HTTP/1.1\r\n" + host + "\r\n",                      // two spaces
        }) {

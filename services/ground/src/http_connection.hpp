@@ -15,7 +15,6 @@
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/write.hpp>
 #include <boost/beast/ssl/ssl_stream.hpp>
-#include <deque>
 #include <sstream>
 #include <type_traits>
 #include <vector>
@@ -241,10 +240,10 @@ class Connection : public StreamSink, public std::enable_shared_from_this<Connec
 
   void write_chunks() {
     writing_ = true;
-    in_flight_.assign(chunks_.begin(), chunks_.end());
+    in_flight_ = chunks_.size();  // their text stays put while more are queued behind them
     std::vector<net::const_buffer> out;
-    out.reserve(in_flight_.size());
-    for (const auto& c : in_flight_) out.push_back(net::buffer(*c));
+    out.reserve(in_flight_);
+    for (const auto& c : chunks_) out.push_back(net::buffer(*c));
     lowest().expires_after(seconds(s_.limits.write_timeout_s));  // the read has no deadline: unchanged
     net::async_write(stream_, out, [self = this->shared_from_this()](auto ec, std::size_t) {
       self->on_chunks_written(ec);
@@ -259,11 +258,9 @@ class Connection : public StreamSink, public std::enable_shared_from_this<Connec
                      s_.limits.write_timeout_s);
       return close();
     }
-    for (std::size_t i = 0; i < in_flight_.size(); ++i) {
-      pending_ -= chunks_.front()->size();
-      chunks_.pop_front();
-    }
-    in_flight_.clear();
+    for (std::size_t i = 0; i < in_flight_; ++i) pending_ -= chunks_[i]->size();
+    chunks_.erase(chunks_.begin(), chunks_.begin() + static_cast<std::ptrdiff_t>(in_flight_));
+    in_flight_ = 0;
     if (!chunks_.empty() && !closed_) write_chunks();
   }
 
@@ -279,9 +276,9 @@ class Connection : public StreamSink, public std::enable_shared_from_this<Connec
   bool streaming_ = false;
   bool closed_ = false;
   bool writing_ = false;
-  std::deque<std::shared_ptr<const std::string>> chunks_;
-  std::vector<std::shared_ptr<const std::string>> in_flight_;
-  std::size_t pending_ = 0;  //!< bytes in chunks_
+  std::vector<std::shared_ptr<const std::string>> chunks_;
+  std::size_t in_flight_ = 0;  //!< the first chunks_, being written
+  std::size_t pending_ = 0;    //!< bytes in chunks_
   char sink_[64] = {};
 };
 
