@@ -16,6 +16,19 @@ namespace tetra::ground {
 
 namespace {
 
+//! The audit record of an accepted sign-in or sign-out.
+AuditRecord accepted_record(const char* decision, const std::string& user, Role role,
+                            std::string reason = "") {
+  AuditRecord r;
+  r.decision = decision;
+  r.outcome = "accepted";
+  r.status = 200;
+  r.operator_id = user;
+  r.role = to_string(role);
+  r.reason = std::move(reason);
+  return r;
+}
+
 using nlohmann::json;
 
 constexpr const char* kCookie = "tetra_session";
@@ -233,14 +246,9 @@ std::optional<Result<Session>> GroundServer::proxied_session(const HttpRequest& 
     first = proxied_seen_.insert(user).second;
   }
   if (first) {  // audited once a run, as a sign-in; every command is audited with the operator anyway
-    AuditRecord r;
-    r.decision = "sign-in";
-    r.outcome = "accepted";
-    r.status = 200;
-    r.operator_id = session->user;
-    r.role = to_string(session->role);
-    r.reason = "authenticated by the proxy at " + req.remote_addr + " (" + config_.trusted_proxy_header + ")";
-    audit(req, std::move(r));
+    audit(req, accepted_record("sign-in", session->user, session->role,
+                               "authenticated by the proxy at " + req.remote_addr + " (" +
+                                   config_.trusted_proxy_header + ")"));
   }
   return Result<Session>(std::move(*session));
 }
@@ -368,13 +376,7 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
     return error_reply(500, "the session cannot be recorded");
   }
   const std::string& token = *issued;
-  AuditRecord r;
-  r.decision = "sign-in";
-  r.outcome = "accepted";
-  r.status = 200;
-  r.operator_id = account->user;
-  r.role = to_string(account->role);
-  audit(req, std::move(r));
+  audit(req, accepted_record("sign-in", account->user, account->role));
   auto res = json_reply(
       200, {{"user", account->user}, {"role", to_string(account->role)}, {"csrf", operators_->csrf(token)}});
   res.headers.emplace_back(
@@ -388,13 +390,7 @@ HttpResponse GroundServer::logout(const HttpRequest& req, const Session& session
     if (auto s = operators_->revoke(cookie_value(req.header("cookie"), kCookie)); !s)
       return error_reply(500, "sign-out not recorded: " + s.error().message);
   }
-  AuditRecord r;
-  r.decision = "sign-out";
-  r.outcome = "accepted";
-  r.status = 200;
-  r.operator_id = session.user;
-  r.role = to_string(session.role);
-  audit(req, std::move(r));
+  audit(req, accepted_record("sign-out", session.user, session.role));
   auto res = json_reply(200, {{"signed_out", session.user}});
   res.headers.emplace_back("Set-Cookie",
                            std::string(kCookie) + "=; Path=/; Max-Age=0; HttpOnly; SameSite=Strict");
