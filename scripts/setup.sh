@@ -20,6 +20,7 @@ packages=(
   cyclonedds-dev cyclonedds-tools
   libcpp-httplib-dev nlohmann-json3-dev       # tetra ground: HTTP client of the tests, JSON
   libsodium-dev libssl-dev                    # tetra ground: argon2id password hashes, TLS
+  libboost-dev                                # tetra ground: its HTTP server (Boost.Beast on Asio, headers only)
   libhdf5-dev                                 # HDF5 gyro logs
   help2man                                    # man pages from the --help texts (cmake --install)
 )

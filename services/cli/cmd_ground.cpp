@@ -64,6 +64,12 @@ int cmd_ground(int argc, char** argv) {
       "no accounts: whoever reaches the port commands as 'anonymous' (loopback addresses only; logged)");
   app.add_option("--allow-origin", server_config.allow_origins,
                  "another HOST:PORT browsers reach this ground as (a DNS name, a proxy); repeatable");
+  app.add_option(
+      "--trusted-proxy-header", server_config.trusted_proxy_header,
+      "sign-in by a reverse proxy: the header naming the user it authenticated (e.g. X-Remote-User; "
+      "taken only from --trusted-proxy, the user needs an account in --users; docs/ground.md)");
+  app.add_option("--trusted-proxy", server_config.trusted_proxies,
+                 "the numeric address the proxy connects from (of --trusted-proxy-header); repeatable");
   app.add_option("--tls-cert", server_config.tls.cert, "PEM certificate (chain): serve HTTPS")
       ->check(CLI::ExistingFile);
   app.add_option("--tls-key", server_config.tls.key, "PEM private key of --tls-cert")

@@ -1,8 +1,9 @@
-// libFuzzer target: the ground station's HTTP request parser (services/ground/src/http_parse.cpp) on
-// arbitrary bytes, as a connection delivers them. Never a crash; a request takes at most the bytes given
-// and has a method, a path starting with '/' and a head and path of UTF-8 without control bytes; a
-// refusal has a status of 400, 413, 431 or 501 and a message whose JSON body parses; a prefix of the bytes
-// is never read as another request than the whole (a proxy and this server cannot disagree).
+// libFuzzer target: the ground station's HTTP request parser (services/ground/src/http_parse.cpp:
+// Boost.Beast's parser and the checks around it) on arbitrary bytes, as a connection delivers them.
+// Never a crash or a hang; a request takes at most the bytes given and has a method, a path starting
+// with '/' and a head and path of UTF-8 without control bytes; a refusal has a status of 400, 413, 431
+// or 501 and a message whose JSON body parses; a prefix of the bytes is never read as another request
+// than the whole (a proxy and this server cannot disagree).
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>

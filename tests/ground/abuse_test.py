@@ -4,11 +4,14 @@ holds 1,000 open event streams and refuses the next with 503; 100 slow clients s
 byte a second; meanwhile the API answers every request (a socket timeout of 5 s only turns a hang into
 a failure); the slow clients are closed at the request deadline; 4,200 idle connections from one
 address leave an operator on another answered. Prints the API's latency and the
-ground's resident memory (figures for docs/ground.md; `--requests 1000` for the bench figure).
-Latency is reported, never a pass/fail condition.
+ground's resident memory (figures for docs/ground.md; `--requests 1000` for the bench figure); with
+`--commands N`, also N commands' round trips (POST /api/command to its acknowledgement through a
+`tetra fusion` of tests/ground/data/fusion.yaml, the 1,000 streams held). Latency is reported, never a
+pass/fail condition.
 """
 
 import argparse
+import json
 import os
 import re
 import resource
@@ -69,6 +72,46 @@ def get(port, path):
     return (int(m.group(1)) if m else -1), time.perf_counter() - start
 
 
+def post_command(port, csrf, unit):
+    """One FDI reset on a new connection, to its acknowledgement: (status, seconds)."""
+    body = json.dumps({"unit": unit, "action": "reset"}).encode()
+    head = (f"POST /api/command HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n"
+            f"Content-Type: application/json\r\nX-CSRF-Token: {csrf}\r\nContent-Length: {len(body)}\r\n\r\n")
+    start = time.perf_counter()
+    with connect(port, 10) as s:
+        s.sendall(head.encode() + body)
+        data = b""
+        while True:
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            data += chunk
+    m = re.match(rb"HTTP/1\.1 (\d+)", data)
+    return (int(m.group(1)) if m else -1), time.perf_counter() - start
+
+
+def command_round_trips(port, count):
+    """`count` resets, one at a time, once the service's unit is heard: their round trips [ms]."""
+    csrf = None
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:  # the service's first Health: its unit is known to the ground
+        with connect(port) as s:
+            s.sendall(f"GET /api/session HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nConnection: close\r\n\r\n".encode())
+            csrf = json.loads(s.makefile("rb").read().split(b"\r\n\r\n", 1)[1])["csrf"]
+        code, _ = get(port, "/api/history?unit=ground%20test&kind=health&max=1")
+        if code == 200:
+            break
+        time.sleep(0.5)
+    times = []
+    for _ in range(count):
+        code, seconds = post_command(port, csrf, "ground test")
+        if code != 200:
+            raise RuntimeError(f"a command: status {code}")
+        times.append(seconds * 1000.0)
+        time.sleep(0.2)
+    return times
+
+
 def percentile(values, q):
     v = sorted(values)
     return v[min(len(v) - 1, int(q * len(v)))]
@@ -82,6 +125,8 @@ def main():
     ap.add_argument("--domain", default="184")  # private to this test (tests/CMakeLists.txt)
     ap.add_argument("--publisher", help="bench/ground_load_publisher: 10 units at 100 Hz stream while measured")
     ap.add_argument("--spread", type=float, default=0.0, help="[s] spread the timed requests over this long")
+    ap.add_argument("--commands", type=int, default=0,
+                    help="commands timed to their acknowledgement (a tetra fusion started for them)")
     args = ap.parse_args()
     soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
     resource.setrlimit(resource.RLIMIT_NOFILE, (hard, hard))
@@ -100,8 +145,14 @@ def main():
         publisher = subprocess.Popen([args.publisher, "--domain", args.domain, "--units", "10", "--rate", "100",
                                       "--seconds", str(int(args.spread) + 120)],
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    fusion = None
+    if args.commands:
+        fusion = subprocess.Popen([args.tetra, "fusion", "--config",
+                                   os.path.join(args.source, "tests", "ground", "data", "fusion.yaml"),
+                                   "--domain", args.domain], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     stop = threading.Event()
     failures = []
+    commands = []
     try:
         for _ in range(300):
             try:
@@ -154,6 +205,11 @@ def main():
             latencies.append(seconds * 1000.0)
             if args.spread:
                 time.sleep(args.spread / args.requests)
+        if args.commands:
+            try:
+                commands = command_round_trips(port, args.commands)
+            except (OSError, RuntimeError, ValueError, KeyError) as e:
+                failures.append(f"commands: {e!r}")
         rss_held = rss_mib(ground.pid)
         closed_slow_readers = open(log_path, encoding="utf-8", errors="replace").read().count("a slow reader")
 
@@ -200,10 +256,14 @@ def main():
             failures.append("the refused stream is not in the ground's log")
 
         if latencies:
-            p50, p99, worst = percentile(latencies, 0.5), percentile(latencies, 0.99), max(latencies)
+            p50, p95, p99 = (percentile(latencies, q) for q in (0.5, 0.95, 0.99))
+            worst = max(latencies)
+            rtt = (f"; {len(commands)} commands' round trips: p50 {percentile(commands, 0.5):.1f} ms, p95 "
+                   f"{percentile(commands, 0.95):.1f} ms, max {max(commands):.1f} ms" if commands else "")
             print(f"ground_abuse: {len(held)} streams held, stream {STREAMS + 1} refused ({beyond}); {SLOW} slow "
-                  f"clients; {len(latencies)} API requests: p50 {p50:.1f} ms, p99 {p99:.1f} ms, max {worst:.1f} ms "
-                  f"({'within' if worst < 100 else 'NOT within'} 100 ms); resident {rss_idle:.1f} MiB idle, "
+                  f"clients; {len(latencies)} API requests: p50 {p50:.1f} ms, p95 {p95:.1f} ms, p99 {p99:.1f} ms, "
+                  f"max {worst:.1f} ms ({'within' if worst < 100 else 'NOT within'} 100 ms){rtt}; "
+                  f"resident {rss_idle:.1f} MiB idle, "
                   f"{rss_held:.1f} MiB with the streams; {closed_slow_readers} unread streams closed at their buffer "
                   f"bound; {IDLE} idle connections of one address beside an operator answered; "
                   f"load average {os.getloadavg()[0]:.1f}")
@@ -220,9 +280,10 @@ def main():
             entry[0].close()
         for s in idle:
             s.close()
-        if publisher is not None:
-            publisher.terminate()
-            publisher.wait()
+        for child in (publisher, fusion):
+            if child is not None:
+                child.terminate()
+                child.wait()
         ground.terminate()
         try:
             ground.wait(timeout=20)

@@ -8,7 +8,10 @@ NOMINAL; the simulator's fault (gyro 2 stuck at 10 s) makes it DEGRADED with gyr
 command that would leave two gyros is REFUSED and a reinstate ACCEPTED, each confirmed in the dialog,
 and the event log shows both with the signed-in operator; a page of another origin (same site, so the
 session cookie goes with its requests) forges commands as a text/plain form POST, a no-cors fetch and
-a beacon: all refused (the ground's audit lines) and none obeyed; after `kill -9` of the ground station
+a beacon: all refused (the ground's audit lines) and none obeyed; the two-person rule: the operator
+asks for a forced exclusion (WAITING FOR APPROVAL, no Approve button for their own), signs out, a
+second commander signs in, sees it and clicks Approve, and the command goes out (ACCEPTED, approved by
+the second, audited as such); after `kill -9` of the ground station
 and its restart, the open page recovers without a reload; after `kill -9` of the fusion service it
 shows SERVICE LOST. Screenshots of each step are kept in --out. Waits are bounded (they only turn a
 hang into a failure); nothing is timed.
@@ -37,6 +40,7 @@ from selenium.webdriver.support.ui import WebDriverWait
 UNIT = "ground test"  # a space: the page and the commands must carry the name as it is
 UNIT_KEY = "x" + UNIT.encode().hex()  # its object key (web/tetra-model.js, unitKey)
 OPERATOR = "alice"
+APPROVER = "bob"  # the second commander of the two-person rule
 PASSWORD = "browser-test-password"
 
 ATTACK = """<!doctype html><html><body>
@@ -111,8 +115,23 @@ def audit_lines(out):
         return [line for line in f if "ground audit" in line]
 
 
-def command_from_page(driver, wait, button):
-    """Clicks a command button, confirms it in the dialog, returns the acknowledgement's text."""
+def sign_in(driver, wait, user):
+    """On the sign-in page (already open): the user's name and password, then away from the page."""
+    wait.until(ec.presence_of_element_located((By.ID, "tetra-login-form")))
+    driver.find_element(By.ID, "tetra-user").send_keys(user)
+    driver.find_element(By.ID, "tetra-password").send_keys(PASSWORD)
+    driver.find_element(By.ID, "tetra-sign-in").click()
+    wait.until(lambda d: "/login.html" not in d.current_url)
+
+
+def audit_records(users):
+    with open(users + ".audit.jsonl", encoding="utf-8") as f:
+        return [json.loads(line) for line in f]
+
+
+def command_from_page(driver, wait, button, answers=("ACCEPTED", "REFUSED", "error")):
+    """Clicks a command button, confirms it in the dialog, returns the acknowledgement's text (one
+    starting with one of `answers`)."""
     driver.execute_script("document.getElementById('tetra-ack').textContent = ''")
 
     def click(d):  # the gyro table is rebuilt when a gyro changes: find the button again then
@@ -121,7 +140,7 @@ def command_from_page(driver, wait, button):
 
     wait.until(click)
     wait.until(ec.element_to_be_clickable((By.XPATH, "//button[contains(., 'Send command')]"))).click()
-    wait.until(lambda d: text_of(d, "tetra-ack").startswith(("ACCEPTED", "REFUSED", "error")))
+    wait.until(lambda d: text_of(d, "tetra-ack").startswith(answers))
     return text_of(driver, "tetra-ack")
 
 
@@ -151,8 +170,9 @@ def main():
     for stale in (users, users + ".session-key", users + ".sessions", users + ".audit.jsonl"):
         if os.path.exists(stale):
             os.unlink(stale)
-    subprocess.run([args.tetra, "ground", "passwd", OPERATOR, "--role", "commander", "--users", users,
-                    "--password-stdin"], input=PASSWORD + "\n", text=True, check=True, capture_output=True)
+    for user in (OPERATOR, APPROVER):
+        subprocess.run([args.tetra, "ground", "passwd", user, "--role", "commander", "--users", users,
+                        "--password-stdin"], input=PASSWORD + "\n", text=True, check=True, capture_output=True)
     step = "start the browser"
     try:
         # The browser first: on a loaded machine it takes seconds to start, and the page must see the
@@ -172,11 +192,7 @@ def main():
         step = "sign in"
         app = f"http://127.0.0.1:{port}/#/browse/tetra:units/tetra:unit~{UNIT_KEY}"
         driver.get(app)
-        wait.until(ec.presence_of_element_located((By.ID, "tetra-login-form")))  # sent to the sign-in page
-        driver.find_element(By.ID, "tetra-user").send_keys(OPERATOR)
-        driver.find_element(By.ID, "tetra-password").send_keys(PASSWORD)
-        driver.find_element(By.ID, "tetra-sign-in").click()
-        wait.until(lambda d: "/login.html" not in d.current_url)
+        sign_in(driver, wait, OPERATOR)  # the page sent the browser to the sign-in page
 
         step = "page loads"
         driver.get(app)
@@ -210,8 +226,7 @@ def main():
         wait.until(lambda d: f"[{OPERATOR} @ ground@127.0.0.1, refused]" in text_of(d, "tetra-events")
                    and f"[{OPERATOR} @ ground@127.0.0.1, accepted]" in text_of(d, "tetra-events"))
         driver.save_screenshot(os.path.join(args.out, "3_commands.png"))
-        with open(users + ".audit.jsonl", encoding="utf-8") as f:
-            records = [json.loads(line) for line in f]
+        records = audit_records(users)
         sent = [(r["unit"], r["outcome"]) for r in records if r["decision"] == "command" and r["operator"] == OPERATOR]
         assert sent[-2:] == [(UNIT, "refused"), (UNIT, "accepted")], f"commands not to '{UNIT}': {sent}"
 
@@ -232,6 +247,35 @@ def main():
         assert len(refused_now) >= 3, "forged requests not all refused: " + "".join(refused_now)
         commands_after = len([line for line in lines if f"audit: {OPERATOR} from" in line])
         assert commands_after == commands_before, "a forged command was obeyed: " + "".join(lines[-5:])
+
+        step = "a forced exclusion waits for a second commander, who approves it on the page"
+        driver.get(app)
+        wait.until(lambda d: text_of(d, "tetra-link") == "LIVE" and OPERATOR in text_of(d, "tetra-operator"))
+        held = command_from_page(driver, wait, "exclude gyro 1 (FORCE)", ("WAITING", "ACCEPTED", "REFUSED", "error"))
+        assert held.startswith("WAITING FOR APPROVAL by a second commander"), held
+        asks = f"{OPERATOR} asks: exclude gyro 1 force"
+        wait.until(lambda d: asks in text_of(d, "tetra-pending"))
+        assert not driver.find_elements(By.CSS_SELECTOR, "button.tetra-approve"), "an Approve button for one's own"
+        assert not [r for r in audit_records(users) if r["decision"] == "command" and r["command"].endswith("force")
+                    and r["outcome"] in ("accepted", "refused")], "the forced exclusion went out unapproved"
+        driver.save_screenshot(os.path.join(args.out, "3b_waiting_for_approval.png"))
+        driver.find_element(By.ID, "tetra-sign-out").click()
+        sign_in(driver, wait, APPROVER)
+        driver.get(app)
+        wait.until(lambda d: APPROVER in text_of(d, "tetra-operator") and asks in text_of(d, "tetra-pending"))
+        driver.execute_script("document.getElementById('tetra-ack').textContent = ''")
+        wait.until(ec.element_to_be_clickable((By.CSS_SELECTOR, "button.tetra-approve"))).click()
+        wait.until(lambda d: f"(approved by {APPROVER})" in text_of(d, "tetra-ack"))
+        approved = text_of(driver, "tetra-ack")
+        assert approved.startswith("ACCEPTED"), approved
+        wait.until(lambda d: asks not in text_of(d, "tetra-pending"))
+        records = audit_records(users)
+        approvals = [r for r in records if r["decision"] == "approval" and r["operator"] == APPROVER]
+        assert approvals and approvals[-1]["unit"] == UNIT, approvals
+        forced = [r for r in records if r["decision"] == "command" and r["command"].endswith("force")
+                  and r["outcome"] == "accepted"]
+        assert forced and forced[-1]["operator"] == OPERATOR and f"(approved by {APPROVER})" in forced[-1]["reason"], forced
+        driver.save_screenshot(os.path.join(args.out, "3c_approved.png"))
 
         step = "the page recovers after a restart of the ground station, without a reload"
         driver.get(app)

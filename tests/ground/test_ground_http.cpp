@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -110,6 +111,84 @@ TEST(GroundHttp, SignInRolesAndCrossSiteDefences) {
   // Signed out: the cookie no longer opens anything.
   EXPECT_EQ(g.request("POST", "/api/logout", alice + kJson + alice_token, "{}").status, 200);
   EXPECT_EQ(g.request("GET", "/api/units", alice).status, 401);
+}
+
+TEST(GroundHttp, TheTrustedProxysUserHeaderSignsInOnlyFromTheProxysAddress) {
+  test::TempDir dir;
+  auto hash = hash_password("correct horse");
+  ASSERT_TRUE(hash.ok());
+  ASSERT_TRUE(set_account(dir.file("users"), {"alice", Role::kCommander, *hash}).ok());
+  ASSERT_TRUE(set_account(dir.file("users"), {"victor", Role::kViewer, *hash}).ok());
+  ServerConfig config;
+  config.users_path = dir.file("users");
+  config.audit_path = dir.file("audit.jsonl");
+  config.trusted_proxy_header = "X-Remote-User";
+  config.trusted_proxies = {"::ffff:127.0.0.2"};  // the same host as 127.0.0.2
+  Ground g(config);
+  ASSERT_TRUE(g.start().ok());
+  const char* proxy = "127.0.0.2";
+  const std::string reset = R"({"unit":"u","action":"reset"})";
+  // From the proxy's address: the user it names, with the role of their account, no password.
+  const Reply alice = g.request("GET", "/api/session", "X-Remote-User: alice\r\n", "", proxy);
+  ASSERT_EQ(alice.status, 200) << alice.body;
+  EXPECT_EQ(alice.data()["user"], "alice");
+  EXPECT_EQ(alice.data()["role"], "commander");
+  EXPECT_EQ(alice.data()["by_proxy"], true);
+  const std::string as_alice = "X-Remote-User: alice\r\n" + kJson;
+  const std::string csrf = "X-CSRF-Token: " + alice.data()["csrf"].get<std::string>() + "\r\n";
+  EXPECT_EQ(g.request("POST", "/api/command", as_alice, reset, proxy).status, 403);  // no CSRF token
+  EXPECT_EQ(g.request("POST", "/api/command", as_alice + csrf, reset, proxy).status, 200);
+  ASSERT_EQ(g.sent.size(), 1U);
+  EXPECT_EQ(g.sent[0].operator_id, "alice");
+  // A viewer stays a viewer; a name without an account, or not a user name, is refused.
+  const Reply victor = g.request("GET", "/api/session", "X-Remote-User: victor\r\n", "", proxy);
+  const std::string as_victor = "X-Remote-User: victor\r\n" + kJson +
+                                "X-CSRF-Token: " + victor.data()["csrf"].get<std::string>() + "\r\n";
+  EXPECT_EQ(g.request("POST", "/api/command", as_victor, reset, proxy).status, 403);
+  const Reply nobody = g.request("GET", "/api/units", "X-Remote-User: mallory\r\n", "", proxy);
+  EXPECT_EQ(nobody.status, 403);
+  EXPECT_NE(nobody.body.find("has no account"), std::string::npos) << nobody.body;
+  EXPECT_EQ(g.request("GET", "/api/units", "X-Remote-User: alice, victor\r\n", "", proxy).status, 403);
+  // From any other address the header is refused (and audited), whatever it names.
+  for (const char* other : {"127.0.0.1", "127.0.0.3"}) {
+    const Reply forged = g.request("POST", "/api/command", as_alice + csrf, reset, other);
+    EXPECT_EQ(forged.status, 403) << other;
+    EXPECT_NE(forged.body.find("not a --trusted-proxy address"), std::string::npos) << forged.body;
+  }
+  EXPECT_EQ(g.sent.size(), 1U);
+  // From the proxy without the header, or with it empty (nobody signed in there): the ground's own
+  // sign-in, as without a proxy.
+  EXPECT_EQ(g.request("GET", "/api/units", "", "", proxy).status, 401);
+  EXPECT_EQ(g.request("GET", "/api/units", "X-Remote-User:\r\n", "", proxy).status, 401);
+  // Signing out is the proxy's: the header still signs alice in.
+  EXPECT_EQ(g.request("POST", "/api/logout", as_alice + csrf, "{}", proxy).status, 200);
+  EXPECT_EQ(g.request("GET", "/api/units", as_alice, "", proxy).status, 200);
+  // Audited: alice's and victor's first sight, the refusals.
+  std::ifstream in(config.audit_path);
+  int by_proxy = 0;
+  int forged = 0;
+  for (std::string line; std::getline(in, line);) {
+    const json r = json::parse(line);
+    by_proxy += r["reason"].get<std::string>().find(
+                    "authenticated by the proxy at 127.0.0.2 (X-Remote-User)") != std::string::npos
+                    ? 1
+                    : 0;
+    forged +=
+        r["reason"].get<std::string>().find("not a --trusted-proxy address") != std::string::npos ? 1 : 0;
+  }
+  EXPECT_EQ(by_proxy, 2);
+  EXPECT_EQ(forged, 2);
+  // Both options or neither; never with --no-auth.
+  for (const auto& [header, address] : {std::pair<std::string, std::string>{"X-Remote-User", ""},
+                                        {"", "127.0.0.2"},
+                                        {"X-Remote-User", "proxy.example"},
+                                        {"X Remote", "127.0.0.2"}}) {
+    ServerConfig bad = config;
+    bad.trusted_proxy_header = header;
+    bad.trusted_proxies = address.empty() ? std::vector<std::string>{} : std::vector<std::string>{address};
+    Ground b(bad);
+    EXPECT_FALSE(b.start().ok()) << header << " " << address;
+  }
 }
 
 TEST(GroundHttp, NoAuthIsRefusedOffLoopbackAndNeedsNoAccounts) {

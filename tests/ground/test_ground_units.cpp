@@ -14,6 +14,7 @@
 #include "tetra/ground/command_tracker.hpp"
 #include "tetra/ground/encode.hpp"
 #include "tetra/ground/http_api.hpp"
+#include "tetra/ground/http_parse.hpp"
 #include "tetra/ground/link_state.hpp"
 #include "tetra/ground/operators.hpp"
 #include "tetra/ground/query_params.hpp"
@@ -233,6 +234,50 @@ TEST(CommandRequest, ValidatesEveryField) {
   auto too_long = parse_command_request(R"({"unit":"u","action":"reset"})", long_operator, "o");
   ASSERT_TRUE(too_long.ok());
   EXPECT_FALSE(to_wire(*too_long, 1, wire).ok());
+}
+
+TEST(HttpParse, BeastsParserWithTheGroundsChecksAsBytesArrive) {
+  using Kind = ParseOutcome::Kind;
+  const ParseLimits limits{256, 16};
+  const auto parse = [&](const std::string& in) { return parse_request(in, limits); };
+  const std::string get = "GET /api/units?unit=a%20b HTTP/1.1\r\nHost: h\r\n\r\n";
+  const auto whole = parse(get + "GET /next HTTP/1.1\r\n");  // a pipelined request's start after it
+  ASSERT_EQ(whole.kind, Kind::kRequest) << whole.message;
+  EXPECT_EQ(whole.consumed, get.size());
+  EXPECT_TRUE(whole.keep_alive);
+  EXPECT_EQ(whole.request.path, "/api/units");
+  EXPECT_EQ(whole.request.params.at(0).second, "a b");
+  EXPECT_EQ(whole.request.header("host"), "h");
+  // Every prefix is incomplete, an empty line's CR included; the body is waited for.
+  for (std::size_t n = 0; n < get.size(); ++n)
+    EXPECT_EQ(parse(get.substr(0, n)).kind, Kind::kIncomplete) << n;
+  EXPECT_EQ(parse("\r").kind, Kind::kIncomplete);
+  EXPECT_EQ(parse("\r\n" + get).kind, Kind::kRequest);
+  const std::string post = "POST /p HTTP/1.0\r\nContent-Length: 5\r\n\r\n";
+  EXPECT_EQ(parse(post + "abc").kind, Kind::kIncomplete);
+  const auto posted = parse(post + "abcdeXYZ");
+  ASSERT_EQ(posted.kind, Kind::kRequest);
+  EXPECT_EQ(posted.request.body, "abcde");
+  EXPECT_EQ(posted.consumed, post.size() + 5);
+  EXPECT_FALSE(posted.keep_alive);  // HTTP/1.0
+  // Refused, with the status: at once for a bare LF (Beast would wait for CRLF CRLF), before the body
+  // for its length.
+  for (const auto& [bytes, status] : std::vector<std::pair<std::string, int>>{
+           {"GET / HTTP/1.1\nHost: h\n", 400},
+           {"GET / HTTP/1.1\r\nX-A: 1\r\n folded\r\n\r\n", 400},
+           {"GET / HTTP/1.1\r\nX-A : 1\r\n\r\n", 400},
+           {"POST / HTTP/1.1\r\nContent-Length: 5, 5\r\n\r\nhello", 400},
+           {"POST / HTTP/1.1\r\nContent-Length: 17\r\n\r\n", 413},
+           {"POST / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n", 501},
+           {"GET / HTTP/2.0\r\n\r\n", 400},
+           {"GET http://h/ HTTP/1.1\r\n\r\n", 400},
+           {"GET / HTTP/1.1\r\nCookie: a\r\nCookie: b\r\n\r\n", 400},
+           {"GET / HTTP/1.1\r\nX-A: " + std::string(300, 'a') + "\r\n\r\n", 431},
+           {"GET / HTTP/1.1\r\nX-A: " + std::string(300, 'a'), 431}}) {  // longer than the limit, unfinished
+    const auto r = parse(bytes);
+    EXPECT_EQ(r.kind, Kind::kRefused) << bytes;
+    EXPECT_EQ(r.status, status) << bytes << ": " << r.message;
+  }
 }
 
 TEST(RecordFiles, AttitudeFilterColumnsAfterTheElevenAreReadPast) {

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """The ground station over TLS (--tls-cert, --tls-key) with an account of `tetra ground passwd`: a
 certificate made with openssl for 127.0.0.1, the sign-in over HTTPS sets the session cookie with
-`Secure` (and HttpOnly, SameSite=Strict), the session opens the API, plain HTTP on the port is not
-served, and a key that does not match the certificate is an input error (exit 2).
+`Secure` (and HttpOnly, SameSite=Strict), the session opens the API, a client offering only TLS 1.0
+or 1.1 gets the server's protocol_version alert, plain HTTP on the port is not served, and a key that does not match the certificate is an input error (exit 2).
 """
 
 import argparse
@@ -71,6 +71,19 @@ def main():
             session = json.loads(res.read())
             assert res.status == 200 and session["user"] == "alice", session
             conn.close()
+            # TLS 1.0 and 1.1 (a client that offers only them): the server's protocol_version alert.
+            for version in (ssl.TLSVersion.TLSv1, ssl.TLSVersion.TLSv1_1):
+                old = ssl.SSLContext(ssl.PROTOCOL_TLS_CLIENT)
+                old.check_hostname, old.verify_mode = False, ssl.CERT_NONE
+                old.set_ciphers("DEFAULT:@SECLEVEL=0")
+                old.minimum_version = old.maximum_version = version
+                try:
+                    with socket.create_connection(("127.0.0.1", port), timeout=10) as raw:
+                        with old.wrap_socket(raw):
+                            refused = None
+                except ssl.SSLError as e:
+                    refused = str(e)
+                assert refused is not None and "ALERT_PROTOCOL_VERSION" in refused, (version, refused)
             # Plain HTTP on the TLS port: no answer in HTTP.
             with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
                 s.sendall(f"GET /api/units HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\n\r\n".encode())
@@ -79,7 +92,7 @@ def main():
                 except OSError:
                     answer = b""
                 assert not answer.startswith(b"HTTP/1.1 200"), answer
-            print("ground_tls: sign-in over HTTPS, cookie Secure; a mismatched key refused (exit 2)")
+            print("ground_tls: sign-in over HTTPS, cookie Secure; TLS 1.0 and 1.1 refused; a mismatched key refused (exit 2)")
             return 0
         finally:
             ground.terminate()

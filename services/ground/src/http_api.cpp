@@ -16,6 +16,19 @@ namespace tetra::ground {
 
 namespace {
 
+//! The audit record of an accepted sign-in or sign-out.
+AuditRecord accepted_record(const char* decision, const std::string& user, Role role,
+                            std::string reason = "") {
+  AuditRecord r;
+  r.decision = decision;
+  r.outcome = "accepted";
+  r.status = 200;
+  r.operator_id = user;
+  r.role = to_string(role);
+  r.reason = std::move(reason);
+  return r;
+}
+
 using nlohmann::json;
 
 constexpr const char* kCookie = "tetra_session";
@@ -112,6 +125,12 @@ Status GroundServer::start() {
     if (!ops) return ops.error();
     operators_.emplace(std::move(ops).value());
   }
+  auto proxy = TrustedProxy::make(config_.trusted_proxy_header, config_.trusted_proxies);
+  if (!proxy) return proxy.error();
+  if (proxy->enabled() && config_.no_auth)
+    return bad_input(
+        "--trusted-proxy-header: the proxy names operators of the --users file, not with --no-auth");
+  proxy_ = std::move(proxy).value();
   const std::string audit_path = !config_.audit_path.empty() || config_.no_auth
                                      ? config_.audit_path
                                      : config_.users_path + ".audit.jsonl";
@@ -211,17 +230,47 @@ std::optional<Session> GroundServer::session_of(const HttpRequest& req) {
   return session;
 }
 
+std::optional<Result<Session>> GroundServer::proxied_session(const HttpRequest& req) {
+  if (!proxy_.enabled() || req.headers.count(proxy_.header()) == 0) return std::nullopt;
+  const std::string user = req.header(proxy_.header());
+  if (!proxy_.trusts(req.remote_addr))
+    return Result<Session>(bad_input("header " + config_.trusted_proxy_header + " from " + req.remote_addr +
+                                     ", not a --trusted-proxy address"));
+  if (user.empty()) return std::nullopt;  // the proxy signed nobody in: the ground's own sign-in
+  auto session = valid_user_name(user) ? operators_->by_proxy(user) : std::nullopt;
+  if (!session)
+    return Result<Session>(bad_input("the proxy's user '" + user + "' has no account in the --users file"));
+  bool first = false;
+  {
+    const std::lock_guard lock(proxied_mutex_);
+    first = proxied_seen_.insert(user).second;
+  }
+  if (first) {  // audited once a run, as a sign-in; every command is audited with the operator anyway
+    audit(req, accepted_record("sign-in", session->user, session->role,
+                               "authenticated by the proxy at " + req.remote_addr + " (" +
+                                   config_.trusted_proxy_header + ")"));
+  }
+  return Result<Session>(std::move(*session));
+}
+
+bool GroundServer::browser_tls(const HttpRequest& req) const {
+  // Behind the trusted proxy, its X-Forwarded-Proto tells whether the browser's side is HTTPS.
+  return req.tls || (proxy_.enabled() && proxy_.trusts(req.remote_addr) &&
+                     lower_case(req.header("x-forwarded-proto")) == "https");
+}
+
 HttpResponse GroundServer::handle(const HttpRequest& req) {
+  const bool tls = browser_tls(req);
   // DNS rebinding: a name that resolves to this host is not enough, the browser must call it by a name
   // of the allow-list. A cross-site page: its Origin is not on the list.
-  const std::string host = with_port(lower_case(req.header("host")), req.tls);
+  const std::string host = with_port(lower_case(req.header("host")), tls);
   if (allowed_hosts_.count(host) == 0)
     return refuse(req, 403, "Host '" + host + "' not allowed (--allow-origin adds one)", "");
   const std::string origin = req.header("origin");
   if (!origin.empty()) {
-    const std::string scheme = req.tls ? "https://" : "http://";
+    const std::string scheme = tls ? "https://" : "http://";
     if (origin.compare(0, scheme.size(), scheme) != 0 ||
-        allowed_hosts_.count(with_port(host_port_of(origin), req.tls)) == 0)
+        allowed_hosts_.count(with_port(host_port_of(origin), tls)) == 0)
       return refuse(req, 403, "Origin '" + origin + "' not allowed", "");
   }
   // POST for what changes something, GET (or HEAD: the same head, no body) for the rest.
@@ -238,7 +287,9 @@ HttpResponse GroundServer::handle(const HttpRequest& req) {
   if (req.path == "/api/login") return login(req);
   if (get && (req.path == "/login.html" || req.path == "/login.js" || req.path == "/tetra.css"))
     return serve(req, std::nullopt);
-  const auto session = session_of(req);
+  auto proxied = proxied_session(req);
+  if (proxied && !*proxied) return refuse(req, 403, proxied->error().message, "");
+  const auto session = proxied ? std::optional<Session>(std::move(**proxied)) : session_of(req);
   if (!session) {
     if (req.path.rfind("/api/", 0) == 0) return error_reply(401, "sign in first (/login.html)");
     HttpResponse res;
@@ -264,7 +315,8 @@ HttpResponse GroundServer::serve(const HttpRequest& req, const std::optional<Ses
     return json_reply(200, {{"user", session->user},
                             {"role", to_string(session->role)},
                             {"csrf", session->csrf},
-                            {"auth", !config_.no_auth}});
+                            {"auth", !config_.no_auth},
+                            {"by_proxy", session->by_proxy}});
   }
   if (req.path == "/api/units") {
     if (!req.params.empty()) return error_reply(400, "parameter '" + req.params[0].first + "' unknown here");
@@ -324,33 +376,21 @@ HttpResponse GroundServer::login(const HttpRequest& req) {
     return error_reply(500, "the session cannot be recorded");
   }
   const std::string& token = *issued;
-  AuditRecord r;
-  r.decision = "sign-in";
-  r.outcome = "accepted";
-  r.status = 200;
-  r.operator_id = account->user;
-  r.role = to_string(account->role);
-  audit(req, std::move(r));
+  audit(req, accepted_record("sign-in", account->user, account->role));
   auto res = json_reply(
       200, {{"user", account->user}, {"role", to_string(account->role)}, {"csrf", operators_->csrf(token)}});
-  res.headers.emplace_back("Set-Cookie", std::string(kCookie) + "=" + token +
-                                             "; Path=/; Max-Age=" + std::to_string(lifetime) +
-                                             "; HttpOnly; SameSite=Strict" + (req.tls ? "; Secure" : ""));
+  res.headers.emplace_back(
+      "Set-Cookie", std::string(kCookie) + "=" + token + "; Path=/; Max-Age=" + std::to_string(lifetime) +
+                        "; HttpOnly; SameSite=Strict" + (browser_tls(req) ? "; Secure" : ""));
   return res;
 }
 
 HttpResponse GroundServer::logout(const HttpRequest& req, const Session& session) {
-  if (operators_) {
+  if (operators_ && !session.by_proxy) {  // by the proxy: signed out at the proxy
     if (auto s = operators_->revoke(cookie_value(req.header("cookie"), kCookie)); !s)
       return error_reply(500, "sign-out not recorded: " + s.error().message);
   }
-  AuditRecord r;
-  r.decision = "sign-out";
-  r.outcome = "accepted";
-  r.status = 200;
-  r.operator_id = session.user;
-  r.role = to_string(session.role);
-  audit(req, std::move(r));
+  audit(req, accepted_record("sign-out", session.user, session.role));
   auto res = json_reply(200, {{"signed_out", session.user}});
   res.headers.emplace_back("Set-Cookie",
                            std::string(kCookie) + "=; Path=/; Max-Age=0; HttpOnly; SameSite=Strict");

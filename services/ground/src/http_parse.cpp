@@ -1,9 +1,13 @@
 #include "tetra/ground/http_parse.hpp"
 
+#include <boost/beast/http/parser.hpp>
+#include <boost/beast/http/string_body.hpp>
 #include <nlohmann/json.hpp>
 #include <unordered_set>
 
 namespace tetra::ground {
+
+namespace http = boost::beast::http;
 
 std::string HttpRequest::header(const std::string& name) const {
   const auto it = headers.find(name);
@@ -95,21 +99,6 @@ ParseOutcome refused(int status, std::string message) {
   return out;
 }
 
-bool is_token_char(char ch) {
-  const auto c = static_cast<unsigned char>(ch);
-  if (c >= 0x80 || c <= 0x20 || c == 0x7F) return false;
-  static constexpr std::string_view kSeparators = "\"(),/:;<=>?@[\\]{}";
-  return kSeparators.find(ch) == std::string_view::npos;
-}
-
-bool is_token(std::string_view s) {
-  if (s.empty()) return false;
-  for (const char ch : s) {
-    if (!is_token_char(ch)) return false;
-  }
-  return true;
-}
-
 //! A control byte other than a tab (the only one a header value may hold).
 bool has_control(std::string_view s) {
   for (const char ch : s) {
@@ -125,12 +114,6 @@ std::string lower(std::string_view s) {
     if (ch >= 'A' && ch <= 'Z') ch = static_cast<char>(ch - 'A' + 'a');
   }
   return out;
-}
-
-std::string_view trim_ows(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
 }
 
 int hex_digit(char h) {
@@ -161,26 +144,6 @@ bool url_decode(std::string_view in, bool plus_is_space, std::string& out) {
   return is_utf8(out);
 }
 
-//! Where the head ends (the index past its blank line), 0 while it has not arrived; a refusal for a
-//! bare LF or CR, or a head longer than the limit.
-ParseOutcome find_head_end(std::string_view in, std::size_t start, std::size_t max_head, std::size_t& end) {
-  end = 0;
-  const std::size_t scan = std::min(in.size(), start + max_head + 4);
-  for (std::size_t i = start; i < scan; ++i) {
-    if (in[i] == '\n' && (i == start || in[i - 1] != '\r'))
-      return refused(400, "a line ends in LF without CR");
-    if (in[i] == '\r' && i + 1 < in.size() && in[i + 1] != '\n')
-      return refused(400, "a CR not followed by LF");
-    if (in[i] == '\n' && i >= start + 3 && in.compare(i - 3, 4, "\r\n\r\n") == 0) {
-      end = i + 1;
-      if (end - start - 4 > max_head) break;
-      return {};
-    }
-  }
-  if (end != 0 || scan - start > max_head) return refused(431, "request head longer than the limit");
-  return {};
-}
-
 ParseOutcome parse_target(std::string_view target, HttpRequest& req) {
   if (target.empty() || target[0] != '/') return refused(400, "the request target must be a path");
   const auto q = target.find('?');
@@ -208,31 +171,36 @@ ParseOutcome parse_target(std::string_view target, HttpRequest& req) {
   return {};
 }
 
-}  // namespace
+//! True when a LF not preceded by CR comes before the head's end (or the end of `in`).
+bool has_bare_lf(std::string_view in) {
+  const std::size_t end = std::min(in.find("\r\n\r\n"), in.size());
+  for (std::size_t i = in.find('\n'); i < end; i = in.find('\n', i + 1)) {
+    if (i == 0 || in[i - 1] != '\r') return true;
+  }
+  return false;
+}
 
-ParseOutcome parse_request(std::string_view in, const ParseLimits& limits) {
-  // An empty line before the request line is ignored (RFC 9112 2.2).
-  std::size_t start = 0;
-  while (in.size() >= start + 2 && in.compare(start, 2, "\r\n") == 0) start += 2;
-  if (start > 8) return refused(400, "empty lines before the request");
-  std::size_t end = 0;
-  if (auto found = find_head_end(in, start, limits.max_head_bytes, end);
-      found.kind == ParseOutcome::Kind::kRefused || end == 0)
-    return found;
-  const std::string_view head = in.substr(start, end - start - 4);
-  ParseOutcome out;
-  HttpRequest& req = out.request;
-  const auto line_end = head.find("\r\n");
-  const std::string_view line = head.substr(0, line_end);
-  const auto sp1 = line.find(' ');
-  const auto sp2 = sp1 == std::string_view::npos ? sp1 : line.find(' ', sp1 + 1);
-  if (sp2 == std::string_view::npos || line.find(' ', sp2 + 1) != std::string_view::npos)
-    return refused(400, "malformed request line: METHOD SP TARGET SP VERSION");
-  req.method = std::string(line.substr(0, sp1));
-  if (!is_token(req.method)) return refused(400, "malformed request line: the method is not a token");
-  const std::string_view target = line.substr(sp1 + 1, sp2 - sp1 - 1);
-  const std::string_view version = line.substr(sp2 + 1);
-  if (version != "HTTP/1.1" && version != "HTTP/1.0") return refused(400, "HTTP/1.0 or HTTP/1.1 only");
+//! The refusal for an error of Beast's parser: 431 and 413 for its limits, 400 for the rest.
+ParseOutcome refused_by_parser(const boost::beast::error_code& ec) {
+  if (ec == http::error::header_limit) return refused(431, "request head longer than the limit");
+  if (ec == http::error::body_limit) return refused(413, "body longer than the limit");
+  return refused(400, "malformed request: " + ec.message());
+}
+
+//! What Beast's parser lets through and this server does not: a header folded onto the next line
+//! (Beast joins it), a version other than 1.0 and 1.1, a target that is not a path of printable ASCII,
+//! header values not UTF-8, a header that counts once given twice, a body in chunks, a length that is a
+//! list.
+ParseOutcome check_head(std::string_view head, const http::request_parser<http::string_body>& parser,
+                        HttpRequest& req) {
+  for (std::size_t i = head.find("\r\n"); i != std::string_view::npos; i = head.find("\r\n", i + 2)) {
+    if (i + 2 < head.size() && (head[i + 2] == ' ' || head[i + 2] == '\t'))
+      return refused(400, "a header folded onto the next line (obs-fold)");
+  }
+  const auto& msg = parser.get();
+  if (msg.version() != 11 && msg.version() != 10) return refused(400, "HTTP/1.0 or HTTP/1.1 only");
+  req.method = std::string(msg.method_string());
+  const std::string_view target = msg.target();
   for (const char ch : target) {
     const auto c = static_cast<unsigned char>(ch);
     if (c <= 0x20 || c >= 0x7F) return refused(400, "the request target holds a byte it may not");
@@ -241,19 +209,9 @@ ParseOutcome parse_request(std::string_view in, const ParseLimits& limits) {
   static const std::unordered_set<std::string> single{
       "host",   "content-length",    "content-type", "origin",       "x-csrf-token",
       "cookie", "transfer-encoding", "connection",   "last-event-id"};
-  std::size_t pos = line_end == std::string_view::npos ? head.size() : line_end + 2;
-  while (pos < head.size()) {
-    auto next = head.find("\r\n", pos);
-    if (next == std::string_view::npos) next = head.size();
-    const std::string_view h = head.substr(pos, next - pos);
-    pos = next + 2;
-    if (!h.empty() && (h[0] == ' ' || h[0] == '\t'))
-      return refused(400, "a header folded onto the next line (obs-fold)");
-    const auto colon = h.find(':');
-    if (colon == std::string_view::npos || !is_token(h.substr(0, colon)))
-      return refused(400, "malformed header line: a token name followed at once by ':'");
-    const std::string name = lower(h.substr(0, colon));
-    const std::string_view value = trim_ows(h.substr(colon + 1));
+  for (const auto& field : msg) {
+    const std::string name = lower(field.name_string());
+    const std::string_view value = field.value();
     if (has_control(value) || !is_utf8(value))
       return refused(400, "header '" + name + "': a control character or bytes not UTF-8");
     auto [it, fresh] = req.headers.emplace(name, std::string(value));
@@ -265,20 +223,51 @@ ParseOutcome parse_request(std::string_view in, const ParseLimits& limits) {
   }
   if (req.headers.count("transfer-encoding") != 0)
     return refused(501, "request bodies in chunks are not accepted: send Content-Length");
-  std::size_t length = 0;
-  if (const auto cl = req.headers.find("content-length"); cl != req.headers.end()) {
-    if (cl->second.empty() || cl->second.size() > 12 ||
-        cl->second.find_first_not_of("0123456789") != std::string::npos)
-      return refused(400, "header 'content-length' is not a number");
-    length = std::stoul(cl->second);
-    if (length > limits.max_body_bytes)
-      return refused(413, "body longer than " + std::to_string(limits.max_body_bytes) + " bytes");
+  // Beast also takes a list of equal lengths ("5, 5"): one number, digits only.
+  if (const auto cl = req.headers.find("content-length");
+      cl != req.headers.end() && cl->second.find_first_not_of("0123456789") != std::string::npos)
+    return refused(400, "header 'content-length' is not a number");
+  return {};
+}
+
+}  // namespace
+
+ParseOutcome parse_request(std::string_view in, const ParseLimits& limits) {
+  // An empty line before the request line is ignored (RFC 9112 2.2).
+  std::size_t start = 0;
+  while (in.size() >= start + 2 && in.compare(start, 2, "\r\n") == 0) start += 2;
+  if (start > 8) return refused(400, "empty lines before the request");
+  if (in.size() == start + 1 && in[start] == '\r') return {};  // an empty line's CR, its LF to come
+  http::request_parser<http::string_body> parser;
+  parser.header_limit(static_cast<std::uint32_t>(std::min<std::size_t>(limits.max_head_bytes, UINT32_MAX)));
+  parser.body_limit(limits.max_body_bytes);
+  parser.eager(false);  // the head first, checked before any of the body is taken
+  ParseOutcome out;
+  std::size_t used = start;
+  bool head_checked = false;
+  while (!parser.is_done()) {
+    boost::beast::error_code ec;
+    const std::size_t n = parser.put(boost::asio::buffer(in.data() + used, in.size() - used), ec);
+    used += n;
+    if (ec && ec != http::error::need_more) return refused_by_parser(ec);
+    if (parser.is_header_done() && !head_checked) {
+      head_checked = true;
+      if (auto h = check_head(in.substr(start, used - start), parser, out.request);
+          h.kind == ParseOutcome::Kind::kRefused)
+        return h;
+      parser.eager(true);
+    }
+    if (!parser.is_done() && (n == 0 || used == in.size())) {
+      // Beast reads a head only once it is whole: a bare LF (a line end to another reader) is refused
+      // before, rather than waited on.
+      if (!head_checked && has_bare_lf(in.substr(start))) return refused(400, "a line ends in LF without CR");
+      return {};
+    }
   }
-  if (in.size() < end + length) return {};  // the body is still arriving
-  req.body = std::string(in.substr(end, length));
-  out.consumed = end + length;
-  out.keep_alive =
-      version == "HTTP/1.1" && lower(req.header("connection")).find("close") == std::string::npos;
+  out.request.body = std::move(parser.get().body());
+  out.consumed = used;
+  out.keep_alive = parser.get().version() == 11 &&
+                   lower(out.request.header("connection")).find("close") == std::string::npos;
   out.kind = ParseOutcome::Kind::kRequest;
   return out;
 }

@@ -1,11 +1,10 @@
 #pragma once
-// The socket side of the ground's HTTP server (http_server.cpp): non-blocking reads and writes over
-// TCP or TLS (OpenSSL), the listening socket, the TLS context, a peer's address as text.
+// The sockets of the ground's HTTP server (http_server.cpp) on Asio: the listening socket, the TLS
+// context (OpenSSL under Asio's ssl::context).
 
-#include <openssl/ssl.h>
-#include <sys/socket.h>
-
-#include <cstddef>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ssl/context.hpp>
+#include <optional>
 #include <string>
 
 #include "tetra/core/result.hpp"
@@ -13,15 +12,11 @@
 
 namespace tetra::ground::http_detail {
 
-//! >0 bytes; 0 closed by the peer; -1 would block; -2 error.
-long read_some(int fd, SSL* ssl, char* buf, std::size_t n);
-//! >0 bytes; -1 would block; -2 error.
-long write_some(int fd, SSL* ssl, const char* buf, std::size_t n);
-//! A TLS 1.2+ server context with the certificate chain and key (an input error when they do not match).
-Result<SSL_CTX*> make_tls_context(const TlsFiles& tls);
-//! A non-blocking listening socket bound to host:port (0: any free port); `bound_port` the one bound.
-Result<int> listen_on(const std::string& host, int port, int& bound_port);
-//! The numeric address of a peer ("?" when neither IPv4 nor IPv6).
-std::string address_text(const sockaddr_storage& addr);
+//! A TLS 1.2+ server context with the certificate chain and key into `out` (an input error when they
+//! do not match).
+Status make_tls_context(const TlsFiles& tls, std::optional<boost::asio::ssl::context>& out);
+//! Opens, binds (port 0: any free port) and listens; `bound_port` the one bound.
+Status listen_on(boost::asio::ip::tcp::acceptor& acceptor, const std::string& host, int port,
+                 int& bound_port);
 
 }  // namespace tetra::ground::http_detail

@@ -216,9 +216,21 @@ std::optional<Session> Operators::session(const std::string& token, std::int64_t
   const std::lock_guard lock(mutex_);
   const auto user = sessions_->user_of(token, now_s);
   if (!user) return std::nullopt;
+  return session_of_account(*user, token);
+}
+
+std::optional<Session> Operators::by_proxy(const std::string& user) {
+  const std::lock_guard lock(mutex_);
+  auto session = session_of_account(user, "proxy:" + user);
+  if (session) session->by_proxy = true;
+  return session;
+}
+
+std::optional<Session> Operators::session_of_account(const std::string& user,
+                                                     const std::string& csrf_of_what) {
   reload();
   for (const auto& a : accounts_) {
-    if (a.user == *user) return Session{a.user, a.role, csrf_of(key_, token)};
+    if (a.user == user) return Session{a.user, a.role, csrf_of(key_, csrf_of_what)};
   }
   return std::nullopt;
 }

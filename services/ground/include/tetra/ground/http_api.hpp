@@ -27,6 +27,7 @@
 #include "tetra/ground/permissions.hpp"
 #include "tetra/ground/static_files.hpp"
 #include "tetra/ground/store.hpp"
+#include "tetra/ground/trusted_proxy.hpp"
 
 namespace tetra::ground {
 
@@ -45,6 +46,10 @@ struct ServerConfig {
   std::string permissions_path;  //!< per-unit and per-command permissions of commanders ("": none)
   bool no_auth = false;          //!< no accounts: everyone who reaches the port is commander "anonymous"
   std::vector<std::string> allow_origins;  //!< more HOST:PORT a browser may reach the ground as
+  //! Sign-in by a reverse proxy: the header naming the operator it authenticated ("": off), taken only
+  //! from these addresses (docs/ground.md, "Sign-in by the proxy").
+  std::string trusted_proxy_header;
+  std::vector<std::string> trusted_proxies;
   TlsFiles tls;
   HttpLimits limits;
   ThrottleLimits throttle;                  //!< sign-in back-off and lockout
@@ -89,6 +94,11 @@ class GroundServer {
   HttpResponse history(const HttpRequest& req);
   HttpResponse records(const HttpRequest& req);
   std::optional<Session> session_of(const HttpRequest& req);
+  //! True when the browser reached the ground over HTTPS: its own TLS, or the trusted proxy's.
+  bool browser_tls(const HttpRequest& req) const;
+  //! The operator the trusted proxy's header names; nullopt without the header; an error (the reason of
+  //! a 403) when it comes from another address or names no account.
+  std::optional<Result<Session>> proxied_session(const HttpRequest& req);
   std::uint64_t feed_next(std::uint64_t after, std::string& out) const;
   void append_message(std::string& out, const StreamMessage& m) const;
 
@@ -105,6 +115,9 @@ class GroundServer {
   LoginThrottle throttle_;
   Approvals approvals_;
   Permissions permissions_;
+  TrustedProxy proxy_;
+  std::mutex proxied_mutex_;
+  std::set<std::string> proxied_seen_;  //!< operators the proxy named in this run (their first audited)
   std::atomic<int> commands_waiting_{0};
 };
 

@@ -1,11 +1,13 @@
 #pragma once
-// The HTTP/1.1 request parser of the ground station's server (docs/ground.md, "Limits"): strict by
-// design, so that no two readers of the same bytes (a proxy, this server) can see different requests.
-// Every line ends in CRLF (a bare LF or CR is refused), a header name is a token followed at once by its
-// colon (`Content-Length : N` is refused), no header is folded onto a following line, no control byte
-// and no byte sequence that is not UTF-8 is anywhere in the head or the decoded path and parameters, a
-// body is announced by a Content-Length of digits only (chunked bodies are refused). Pure: no I/O, no
-// allocation beyond the request's own strings, no exception; fuzzed by tests/fuzz/fuzz_http_request.cpp.
+// The HTTP/1.1 request parser of the ground station's server (docs/ground.md, "Limits"): Boost.Beast's
+// parser over the bytes received so far, with the checks it lacks around it; strict by design, so that
+// no two readers of the same bytes (a proxy, this server) can see different requests. Every line ends
+// in CRLF (a bare LF or CR is refused), a header name is a token followed at once by its colon
+// (`Content-Length : N` is refused), no header is folded onto a following line, no control byte and no
+// byte sequence that is not UTF-8 is anywhere in the head or the decoded path and parameters, a body is
+// announced by a Content-Length of digits only (chunked bodies are refused). Pure: no I/O, no
+// allocation beyond the parser's and the request's own, no exception; fuzzed by
+// tests/fuzz/fuzz_http_request.cpp.
 
 #include <cstddef>
 #include <map>

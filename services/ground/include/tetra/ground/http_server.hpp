@@ -1,12 +1,12 @@
 #pragma once
-// A small HTTP/1.1 server built to stay up under abuse (docs/ground.md, threat model): one I/O thread
-// reads and writes every socket without blocking (epoll), so a slow or silent client holds no thread;
-// a request must arrive whole within a deadline and within size limits (the strict parser of
-// http_parse.hpp), a response be read within its own; a client that does not read is not read either;
-// connections are bounded in all and per address; handlers run on a small pool of workers, slow ones
-// (sign-ins) on a lane of their own; event streams (server-sent events) are written by the I/O thread
-// itself from one shared cursor, each with a bounded output buffer, and their number is bounded.
-// Sockets and TLS (OpenSSL): http_socket.hpp.
+// The ground station's HTTP/1.1 server, built to stay up under abuse (docs/ground.md, threat model), on
+// Boost.Beast and Asio (OpenSSL for TLS, 1.2 and later): one I/O thread runs every socket, so a slow or
+// silent client holds no thread; a request must arrive whole within a deadline and within size limits
+// (Beast's parser and the strict checks of http_parse.hpp), a response be written within its own (Beast's
+// per-operation timeouts); a client that does not read is not read either; connections are bounded in
+// all and per address; handlers run on a small pool of workers, slow ones (sign-ins) on a pool of their
+// own; event streams (server-sent events) are fed by the I/O thread from one shared cursor, each with a
+// bounded buffer, and their number is bounded. Inside: http_server_impl.hpp, http_connection.hpp.
 
 #include <atomic>
 #include <cstdint>
@@ -14,7 +14,6 @@
 #include <map>
 #include <memory>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 

@@ -46,7 +46,8 @@ Status set_account(const std::string& path, const Account& account);
 struct Session {
   std::string user;
   Role role = Role::kViewer;
-  std::string csrf;  //!< the token state-changing requests must carry (bound to this session)
+  std::string csrf;       //!< the token state-changing requests must carry (bound to this session)
+  bool by_proxy = false;  //!< authenticated by the trusted proxy (no session of the ground's to sign out)
 };
 
 class Operators {
@@ -63,6 +64,9 @@ class Operators {
   Result<std::string> issue(const std::string& user, std::int64_t now_s, std::int64_t lifetime_s);
   //! The session of an id: in the journal, not expired, not signed out, its account still there.
   std::optional<Session> session(const std::string& token, std::int64_t now_s);
+  //! The session of a user the trusted proxy authenticated: their account's role, a CSRF token bound to
+  //! the user (keyed: stable across restarts, unforgeable); none without an account.
+  std::optional<Session> by_proxy(const std::string& user);
   //! Signs the session out for good (recorded in the journal).
   Status revoke(const std::string& token);
   //! The CSRF token of a session token.
@@ -71,6 +75,8 @@ class Operators {
  private:
   Operators() = default;
   void reload();
+  //! The session of the user's account (none without one); the lock held.
+  std::optional<Session> session_of_account(const std::string& user, const std::string& csrf_of_what);
   std::string users_path_;
   std::string key_;
   std::mutex mutex_;
