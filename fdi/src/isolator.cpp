@@ -13,6 +13,7 @@ Isolator::Isolator(int n_gyros, const PipelineConfig& config)
       config_(config),
       glt_sum_(Eigen::VectorXd::Zero(std::max(1, n_gyros - 3))),
       glt_pre_(Eigen::VectorXd::Zero(std::max(1, n_gyros - 3))),
+      glt_noise_cov_(Eigen::MatrixXd::Identity(std::max(1, n_gyros - 3), std::max(1, n_gyros - 3))),
       glt_y_pre_(static_cast<std::size_t>(n_gyros), 0.0),
       hist_y_(static_cast<std::size_t>(kHistory) * static_cast<std::size_t>(n_gyros), 0.0),
       hist_valid_(kHistory, 0),
@@ -40,7 +41,7 @@ void Isolator::close() {
   glt_omega_sum_.setZero();
   glt_baseline_done_ = false;
   glt_pre_n_ = 0;
-  glt_noise_var_ = 1.0;
+  glt_noise_cov_.setIdentity();
 }
 
 std::int64_t Isolator::time_of(std::int64_t index) const {
@@ -242,12 +243,12 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
 // fault, the residual after fitting the best fault along w_i, mᵀC⁻¹m − (w_iᵀC⁻¹m)²/(w_iᵀC⁻¹w_i), is χ²_{d−1}
 // under hypothesis i. Two forms of m and C:
 // - the mean alone, m = p̄: the calibration's term at the mean rate ω̄, C_cal(ω̄) from the stated 1σ times
-//   calibration_error_sigmas (biases, scale factors, axes) and the wandering bias's, plus σ²/n;
+//   calibration_error_sigmas (biases, scale factors, axes) and the wandering bias's, plus Σ/n;
 // - the mean minus the baseline before the onset (`glt_baseline`), m = p̄ − p̄_pre: the term is linear in the
 //   rate and its bias part constant, so what is left is that of the rate's change, C_cal(ω̄ − ω̄_pre) without
-//   the biases, plus σ²(1/n + 1/n_pre). A fault that began before the baseline's window moves both means along
+//   the biases, plus Σ(1/n + 1/n_pre). A fault that began before the baseline's window moves both means along
 //   w_i: m stays on gyro i's line.
-// σ² is the white-noise variance the baseline shows (`baseline_noise_variance`, at least the model's 1). Each
+// Σ is the white noise's covariance the baseline shows (`baseline_noise`, at least the model's I). Each
 // hypothesis's statistic is the larger of the two (the first form is capped by the biases' term, the second
 // by the baseline's noise): a true hypothesis is rejected above χ²_{d−1}(1 − glt_false_alarm_probability)
 // with at most twice that probability for a unit within its calibration's tolerance — and only then can a
@@ -263,13 +264,13 @@ int Isolator::glt_test(const Subset& s, const SubsetCache& subsets) {
   double r[kMaxGyros];
   mean = glt_sum_.head(s.dof) / n;
   subsets.calibration_covariance(s, s.mask, omega_mean, true, cov);
-  cov.diagonal().array() += glt_noise_var_ / n;
+  cov.noalias() += glt_noise_cov_.topLeftCorner(s.dof, s.dof) / n;
   glt_residuals(s, mean, cov, r);
   if (glt_pre_n_ > 0) {
     double r_pre[kMaxGyros];
     mean -= glt_pre_.head(s.dof);
     subsets.calibration_covariance(s, s.mask, omega_mean - glt_omega_pre_, false, cov);
-    cov.diagonal().array() += glt_noise_var_ * (1.0 / n + 1.0 / glt_pre_n_);
+    cov.noalias() += glt_noise_cov_.topLeftCorner(s.dof, s.dof) * (1.0 / n + 1.0 / glt_pre_n_);
     glt_residuals(s, mean, cov, r_pre);
     for (int i = 0; i < n_; ++i) r[i] = std::max(r[i], r_pre[i]);
   }
@@ -328,17 +329,17 @@ void Isolator::glt_baseline(std::int64_t index, const Subset& s, double sqrt_per
   for (int r = 0; r < s.dof; ++r) glt_pre_[r] = p[r];
   glt_omega_pre_ = apply_pinv(s.pinv, s.mask, glt_y_pre_.data());
   glt_pre_n_ = count;
-  glt_noise_var_ = baseline_noise_variance(begin, end, s, sqrt_period);
+  baseline_noise(begin, end, s, sqrt_period);
 }
 
-// The noise the baseline's parity shows: a unit noisier than its `noise:` section (or a gyro among them)
-// makes the parity's spread larger than the model's unit variance, and the GLT's white-noise term follows
-// it. The spread of means of kGltNoiseBlock epochs, times that count: a mean's variance, in which the
-// angle quantization telescopes away as it does in the GLT's own means (one sample's spread would count it
-// whole). The largest eigenvalue of their sample covariance, at least the model's 1. Once per episode (the
-// eigenvalue solver allocates).
-double Isolator::baseline_noise_variance(std::int64_t begin, std::int64_t end, const Subset& s,
-                                         double sqrt_period) const {
+// The noise the baseline's parity shows: a unit noisier than its `noise:` section (or one gyro of it) makes
+// the parity's spread larger than the model's identity, and the GLT's white-noise term follows it. The
+// sample covariance of means of kGltNoiseBlock epochs, times that count (a mean's covariance, in which the
+// angle quantization telescopes away as it does in the GLT's own means; one sample's spread would count it
+// whole), each eigenvalue raised to at least the model's 1, so a direction the data show no noisier is
+// taken as stated. Once per episode (the eigenvalue solver allocates).
+void Isolator::baseline_noise(std::int64_t begin, std::int64_t end, const Subset& s, double sqrt_period) {
+  glt_noise_cov_.setIdentity();
   Eigen::MatrixXd scatter = Eigen::MatrixXd::Zero(s.dof, s.dof);
   Eigen::VectorXd block = Eigen::VectorXd::Zero(s.dof);
   double p[kMaxGyros];
@@ -356,12 +357,12 @@ double Isolator::baseline_noise_variance(std::int64_t begin, std::int64_t end, c
     in_block = 0;
     ++blocks;
   }
-  if (blocks < 2) return 1.0;
+  if (blocks < 2 || !scatter.allFinite()) return;
   scatter *= static_cast<double>(kGltNoiseBlock) / blocks;
-  const double largest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(scatter, Eigen::EigenvaluesOnly)
-                             .eigenvalues()
-                             .maxCoeff();
-  return std::isfinite(largest) ? std::max(1.0, largest) : 1.0;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scatter);
+  const Eigen::VectorXd raised = eig.eigenvalues().cwiseMax(1.0);
+  glt_noise_cov_.topLeftCorner(s.dof, s.dof) =
+      eig.eigenvectors() * raised.asDiagonal() * eig.eigenvectors().transpose();
 }
 
 // Bias or ramp: the parity projected on gyro j's direction over the history kept (at most kHistory epochs,

@@ -95,8 +95,7 @@ class Isolator {
   //! the history (all of `s`'s gyros valid), at most kGltBaselineEpochs of them; none when fewer than
   //! kGltBaselineMin are kept.
   void glt_baseline(std::int64_t index, const Subset& s, double sqrt_period);
-  double baseline_noise_variance(std::int64_t begin, std::int64_t end, const Subset& s,
-                                 double sqrt_period) const;
+  void baseline_noise(std::int64_t begin, std::int64_t end, const Subset& s, double sqrt_period);
   static constexpr int kGltBaselineEpochs = 200;  //!< [epochs] the baseline's longest window
   static constexpr int kGltBaselineMin = 20;      //!< [epochs] its shortest
   static constexpr int kGltNoiseBlock = 10;       //!< [epochs] the baseline's blocks for its noise
@@ -116,10 +115,9 @@ class Isolator {
   Eigen::Vector3d glt_omega_sum_ = Eigen::Vector3d::Zero();  //!< [rad/s] Σ ω since the onset
   bool glt_baseline_done_ = false;  //!< the baseline was sought for this episode
   int glt_pre_n_ = 0;               //!< epochs of the baseline (0: none)
-  //! [σ²] per parity axis: the white noise's variance the baseline shows, at least the model's 1 (the
-  //! largest eigenvalue of its parity's sample covariance, raised by its 3σ estimation error)
-  double glt_noise_var_ = 1.0;
   Eigen::VectorXd glt_pre_;         //!< its mean normalized parity
+  //! [σ²] the white noise's covariance the baseline shows (d×d in its top-left corner), at least the model's I
+  Eigen::MatrixXd glt_noise_cov_;
   Eigen::Vector3d glt_omega_pre_ = Eigen::Vector3d::Zero();  //!< [rad/s] its mean rate
   std::vector<double> glt_y_pre_;   //!< scratch: its mean rates per gyro
   std::vector<double> hist_y_;  //!< kHistory×N [rad/s]
