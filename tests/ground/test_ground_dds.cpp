@@ -228,9 +228,18 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   const auto odd =
       run_tetra("command --unit tetra-1 reset --operator \"$(printf 'caf\\351')\" --domain " + d);
   EXPECT_EQ(odd.exit_status, 0) << odd.err << odd.out;
+  // The acknowledgement reaches the ground over DDS after the command returns: wait for it (up to 10 s on a
+  // loaded machine; it takes milliseconds on an idle one).
+  const std::string shown = "\"operator\":\"caf\xef\xbf\xbd\"";
   auto after_odd = client.Get("/api/history?unit=tetra-1&kind=event");
+  for (int i = 0; i < 100 && after_odd && after_odd->status == 200 &&
+                  after_odd->body.find(shown) == std::string::npos;
+       ++i) {
+    std::this_thread::sleep_for(100ms);
+    after_odd = client.Get("/api/history?unit=tetra-1&kind=event");
+  }
   ASSERT_TRUE(after_odd && after_odd->status == 200) << read_file(dir.file("ground.log"));
-  EXPECT_NE(after_odd->body.find("\"operator\":\"caf\xef\xbf\xbd\""), std::string::npos) << after_odd->body;
+  EXPECT_NE(after_odd->body.find(shown), std::string::npos) << after_odd->body;
   // A second ground started while the service still holds that acknowledgement (transient local) starts.
   TetraProcess ground2({"ground", "--listen", "127.0.0.1:0", "--no-auth", "--domain", d},
                        dir.file("ground2.log"));
