@@ -65,13 +65,15 @@ TEST(CampaignCli, OneRunAgainGivesItsRowAndItsEvents) {
   TempDir dir;
   write_spec(dir);
   const std::string out = dir.file("out");
-  ASSERT_EQ(run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --jobs 2 --no-report").exit_status,
-            0);
+  ASSERT_EQ(
+      run_tetra("campaign " + dir.file("spec.yaml") + " --out " + out + " --jobs 2 --no-report").exit_status,
+      0);
   std::string row3;
   for (const std::string& line : lines_of(read_file(out + "/runs.csv")))
     if (line.rfind("3,", 0) == 0) row3 = line;
   ASSERT_FALSE(row3.empty());
-  const auto again = run_tetra("campaign " + dir.file("spec.yaml") + " --run 3 --events " + dir.file("ev.jsonl"));
+  const auto again =
+      run_tetra("campaign " + dir.file("spec.yaml") + " --run 3 --events " + dir.file("ev.jsonl"));
   ASSERT_EQ(again.exit_status, 0) << again.err;
   const auto printed = lines_of(again.out);
   ASSERT_EQ(printed.size(), 2u) << again.out;

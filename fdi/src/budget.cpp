@@ -11,7 +11,9 @@ namespace {
 constexpr double kNotAProbability = std::numeric_limits<double>::quiet_NaN();
 
 //! Two-sided tail of a standard normal beyond `sigmas`.
-double normal_tail(double sigmas) { return std::erfc(sigmas / std::sqrt(2.0)); }
+double normal_tail(double sigmas) {
+  return std::erfc(sigmas / std::sqrt(2.0));
+}
 
 }  // namespace
 
@@ -26,7 +28,8 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
   if (parity) {
     b.rows.push_back({"chi2", K::kFalseAlarm, "chi2_false_alarm_probability", c.chi2_false_alarm_probability,
                       epochs_per_hour, "one epoch's parity"});
-    b.rows.push_back({"cusum", K::kFalseAlarm, "cusum_arl0_epochs", 1.0 / c.cusum_arl0_epochs, epochs_per_hour,
+    b.rows.push_back({"cusum", K::kFalseAlarm, "cusum_arl0_epochs", 1.0 / c.cusum_arl0_epochs,
+                      epochs_per_hour,
                       "mean run length between false alarms, the wander and quantization in h"});
     // The onset test names gyro i when every subset without it shows impossible motion: the true
     // hypothesis's subset beyond its margin, at most the one-axis tail, per evaluation (from 20 epochs
@@ -43,7 +46,8 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
   if (gyros == 4) {
     b.rows.push_back({"reference_window", K::kWrongExclusion, "reference_threshold_sigma",
                       std::pow(normal_tail(c.reference_threshold_sigma), c.reference_confirm_count),
-                      window_epochs, "a healthy gyro's window beyond the threshold, reference_confirm_count times"});
+                      window_epochs,
+                      "a healthy gyro's window beyond the threshold, reference_confirm_count times"});
   }
   b.rows.push_back({"reference_test", K::kReference, "reference_check_false_alarm_probability",
                     c.reference_check_false_alarm_probability, 1.0, "per reference sample and test"});
@@ -65,7 +69,8 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
 std::string to_text(const Budget& b) {
   std::string out;
   char line[256];
-  std::snprintf(line, sizeof line, "error budget: %d gyros, sample period %g s\n", b.gyros, b.sample_period_s);
+  std::snprintf(line, sizeof line, "error budget: %d gyros, sample period %g s\n", b.gyros,
+                b.sample_period_s);
   out += line;
   for (const BudgetRow& r : b.rows) {
     const char* kind = r.kind == BudgetKind::kFalseAlarm       ? "false alarm"
@@ -75,8 +80,8 @@ std::string to_text(const Budget& b) {
       const char* per = r.kind == BudgetKind::kFalseAlarm       ? "/h"
                         : r.kind == BudgetKind::kWrongExclusion ? "/episode"
                                                                 : "/sample";
-      std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %9.3g x %-9.4g = %9.3g %s  (%s)\n", r.source, kind,
-                    r.key, r.per_evaluation, r.evaluations, r.total(), per, r.note);
+      std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %9.3g x %-9.4g = %9.3g %s  (%s)\n", r.source,
+                    kind, r.key, r.per_evaluation, r.evaluations, r.total(), per, r.note);
     } else {
       std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %s\n", r.source, kind, "-", r.note);
     }

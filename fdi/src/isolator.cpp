@@ -239,9 +239,9 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
 }
 
 // GLT on the mean normalized parity since the onset (N ≥ 5). Under hypothesis i the mean is a fault along
-// gyro i's column w_i, plus the calibration's term, plus white noise. With C the covariance of what is not the
-// fault, the residual after fitting the best fault along w_i, mᵀC⁻¹m − (w_iᵀC⁻¹m)²/(w_iᵀC⁻¹w_i), is χ²_{d−1}
-// under hypothesis i. Two forms of m and C:
+// gyro i's column w_i, plus the calibration's term, plus white noise. With C the covariance of what is not
+// the fault, the residual after fitting the best fault along w_i, mᵀC⁻¹m − (w_iᵀC⁻¹m)²/(w_iᵀC⁻¹w_i), is
+// χ²_{d−1} under hypothesis i. Two forms of m and C:
 // - the mean alone, m = p̄: the calibration's term at the mean rate ω̄, C_cal(ω̄) from the stated 1σ times
 //   calibration_error_sigmas (biases, scale factors, axes) and the wandering bias's, plus Σ/n;
 // - the mean minus the baseline before the onset (`glt_baseline`), m = p̄ − p̄_pre: the term is linear in the

@@ -9,8 +9,8 @@
 #include <optional>
 #include <vector>
 
-#include <Eigen/Core>
 #include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
 #include "epoch_frame.hpp"
@@ -113,14 +113,15 @@ class Isolator {
   Eigen::VectorXd glt_sum_;  //!< Σ p since the onset (d ≥ 2)
   int glt_n_ = 0;
   Eigen::Vector3d glt_omega_sum_ = Eigen::Vector3d::Zero();  //!< [rad/s] Σ ω since the onset
-  bool glt_baseline_done_ = false;  //!< the baseline was sought for this episode
-  int glt_pre_n_ = 0;               //!< epochs of the baseline (0: none)
-  Eigen::VectorXd glt_pre_;         //!< its mean normalized parity
-  //! [σ²] the white noise's covariance the baseline shows (d×d in its top-left corner), at least the model's I
+  bool glt_baseline_done_ = false;                           //!< the baseline was sought for this episode
+  int glt_pre_n_ = 0;                                        //!< epochs of the baseline (0: none)
+  Eigen::VectorXd glt_pre_;                                  //!< its mean normalized parity
+  //! [σ²] the white noise's covariance the baseline shows (d×d in its top-left corner), at least the model's
+  //! I
   Eigen::MatrixXd glt_noise_cov_;
   Eigen::Vector3d glt_omega_pre_ = Eigen::Vector3d::Zero();  //!< [rad/s] its mean rate
-  std::vector<double> glt_y_pre_;   //!< scratch: its mean rates per gyro
-  std::vector<double> hist_y_;  //!< kHistory×N [rad/s]
+  std::vector<double> glt_y_pre_;                            //!< scratch: its mean rates per gyro
+  std::vector<double> hist_y_;                               //!< kHistory×N [rad/s]
   std::vector<GyroMask> hist_valid_;
   std::vector<std::int64_t> hist_ns_;
   std::vector<double> mean_pre_, mean_post_;
@@ -129,7 +130,7 @@ class Isolator {
   mutable std::vector<double> drift_t_;            //!< [s] its times
   mutable std::vector<Eigen::VectorXd> glt_mean_;  //!< scratch per parity dimension (never resized)
   mutable std::vector<Eigen::VectorXd> glt_w_;
-  std::vector<Eigen::MatrixXd> glt_cov_;                //!< scratch per parity dimension: the mean's covariance
+  std::vector<Eigen::MatrixXd> glt_cov_;  //!< scratch per parity dimension: the mean's covariance
   mutable std::vector<Eigen::LDLT<Eigen::MatrixXd>> glt_ldlt_;  //!< and its factorization
 };
 

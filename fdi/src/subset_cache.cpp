@@ -240,7 +240,8 @@ void SubsetCache::calibration_covariance(const Subset& s, GyroMask mask, const E
     const double b = with_bias ? bias_sigma_rad_s_[i] : 0.0;
     const double sf = scale_rel_sigma_[i] * along;
     const double var = b * b + sf * sf + axis_sigma_.col(i).cwiseAbs2().dot(omega_sq);  // [rad²/s²]
-    out.noalias() += (e * e * sqrt_period_ * sqrt_period_ * var) * s.parity.col(i) * s.parity.col(i).transpose();
+    out.noalias() +=
+        (e * e * sqrt_period_ * sqrt_period_ * var) * s.parity.col(i) * s.parity.col(i).transpose();
   }
   out.diagonal().array() += (e * s.bias_wander_sigma) * (e * s.bias_wander_sigma);
 }

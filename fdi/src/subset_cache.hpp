@@ -130,13 +130,13 @@ class SubsetCache {
     return s.calibration_bias_bound + config_->calibration_error_sigmas * sqrt_period_ * sum;
   }
   //! [σ²] d×d covariance of the normalized parity's calibration term at the body rate ω [rad/s] (the term is
-  //! linear in ω, so this is also the covariance of its mean over epochs of mean rate ω) when each bias, scale
-  //! factor and axis component of the subset's gyros errs by a Gaussian of `calibration_error_sigmas` (e)
-  //! times its stated 1σ, independently: e²·T·Σ_{i∈S} w_i·w_iᵀ·(σ_β,i² + σ_s,i²·(h_i·ω)² + Σ_j σ_h,ij²·ω_j²),
-  //! plus (e·σ_w)²·I for the wandering bias (σ_w = `bias_wander_sigma`: a unit's bias instability is known
-  //! no better than its calibration) (docs/fdi.md, "GLT"). Written
-  //! into `out` (resized to d×d). `with_bias` false: without the biases' term σ_β,i (a difference of two
-  //! means, in which a constant bias cancels; ω is then the difference of their rates).
+  //! linear in ω, so this is also the covariance of its mean over epochs of mean rate ω) when each bias,
+  //! scale factor and axis component of the subset's gyros errs by a Gaussian of `calibration_error_sigmas`
+  //! (e) times its stated 1σ, independently: e²·T·Σ_{i∈S} w_i·w_iᵀ·(σ_β,i² + σ_s,i²·(h_i·ω)² + Σ_j
+  //! σ_h,ij²·ω_j²), plus (e·σ_w)²·I for the wandering bias (σ_w = `bias_wander_sigma`: a unit's bias
+  //! instability is known no better than its calibration) (docs/fdi.md, "GLT"). Written into `out` (resized
+  //! to d×d). `with_bias` false: without the biases' term σ_β,i (a difference of two means, in which a
+  //! constant bias cancels; ω is then the difference of their rates).
   void calibration_covariance(const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s,
                               bool with_bias, Eigen::MatrixXd& out) const;
   //! [rad/s] per body axis: the largest rate error the subset's scale factors and axes make at the body rate

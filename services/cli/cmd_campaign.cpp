@@ -71,9 +71,10 @@ void add_campaign_options(CLI::App& app, CampaignArgs& a, campaign::RunOptions& 
                  "K/N: run only the runs i with i mod N = K-1 (K from 1 to N), e.g. one Slurm array task; "
                  "no report (tetra campaign merge writes it)");
   app.add_flag("--no-report", a.no_report, "only the runs (no report, no plots)");
-  app.add_option("--run", a.rerun,
-                 "K: run K of the campaign (runs.csv's `run`) again, alone and in process, with the same draws; "
-                 "its row on standard output (header and row), nothing else written but --events")
+  app.add_option(
+         "--run", a.rerun,
+         "K: run K of the campaign (runs.csv's `run`) again, alone and in process, with the same draws; "
+         "its row on standard output (header and row), nothing else written but --events")
       ->check(CLI::Range(0LL, 999999LL));
   app.add_option("--events", a.events_path,
                  "with --run: the run's FDI events as JSON lines (each decision with its ledger rows)");

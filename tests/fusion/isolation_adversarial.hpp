@@ -16,7 +16,6 @@
 #include "test_support.hpp"
 #include "tetra/core/calibration_file.hpp"
 
-
 namespace tetra::isolation_adversarial {
 
 using K = sim::FaultKind;
@@ -110,8 +109,8 @@ inline double median(std::vector<double> v) {
 
 //! One run into its fault's tally: a wrong exclusion (described into `what`), the faulty gyro isolated (with
 //! its delay from `at_s`), or `unisolated`.
-inline void tally(Tally& t, const test::CampaignRun& run, const std::vector<sim::FaultSpec>& faults, double at_s,
-           const std::string& label, int n, std::string& what) {
+inline void tally(Tally& t, const test::CampaignRun& run, const std::vector<sim::FaultSpec>& faults,
+                  double at_s, const std::string& label, int n, std::string& what) {
   ++t.runs;
   if (!wrong_exclusions(run, faults).empty()) {
     ++t.wrong;
@@ -156,6 +155,5 @@ inline const std::vector<FaultCase>& fault_cases() {
   };
   return all;
 }
-
 
 }  // namespace tetra::isolation_adversarial

@@ -57,21 +57,22 @@ TEST(DispersedCampaign, BiasStepsNextToARepeatingQuantizedGyroExcludeNoHealthyGy
 }
 
 // bench/campaign_beyond_envelope.sh's five-gyro unit (examples/sim/calibrated_unit.yaml and a fifth gyro on
-// (0, 0.6, 0.8)): gyros 2 and 4 lie 7.2° apart in its parity plane. Its true axes, scale factors and biases at
-// 2.5 x the calibration's 1σ, white noise and bias instability 0.5-3 x their statement, a late star tracker;
-// bias and stuck faults on gyros 2 and 4. Before the GLT carried the calibration's term and the noise the data
-// show, 85 of the bench's 600 runs of these cases excluded a healthy gyro (77 the other of the pair), most
-// within seconds of the onset; 40 seeds here (160 faulty runs, about 6 s): none may, and most still isolate
-// the right one.
+// (0, 0.6, 0.8)): gyros 2 and 4 lie 7.2° apart in its parity plane. Its true axes, scale factors and biases
+// at 2.5 x the calibration's 1σ, white noise and bias instability 0.5-3 x their statement, a late star
+// tracker; bias and stuck faults on gyros 2 and 4. Before the GLT carried the calibration's term and the
+// noise the data show, 85 of the bench's 600 runs of these cases excluded a healthy gyro (77 the other of the
+// pair), most within seconds of the onset; 40 seeds here (160 faulty runs, about 6 s): none may, and most
+// still isolate the right one.
 TEST(DispersedCampaign, FiveGyrosBeyondTheirCalibrationExcludeNoHealthyGyro) {
   test::TempDir dir;
   const std::string unit = test::read_file(test::source_path("examples/sim/calibrated_unit.yaml"));
-  test::write_file(dir.file("unit5.yaml"),
-                   unit.substr(0, unit.find_last_not_of('\n') + 1) +
-                       "\n  - id: 5\n    scale_factor_V_per_dps: 0.08\n    bias_V: 0.0001\n    axis: [0.0, 0.6, 0.8]\n"
-                       "    sigma: {scale_factor_V_per_dps: 8.0e-06, bias_V: 2.0e-07, axis: [2.0e-04, 2.0e-04, "
-                       "2.0e-04]}\n    noise: {quantization_deg: 5e-05, arw_dps_rtHz: 3e-05, "
-                       "bias_instability_dps: 3e-06}\n");
+  test::write_file(
+      dir.file("unit5.yaml"),
+      unit.substr(0, unit.find_last_not_of('\n') + 1) +
+          "\n  - id: 5\n    scale_factor_V_per_dps: 0.08\n    bias_V: 0.0001\n    axis: [0.0, 0.6, 0.8]\n"
+          "    sigma: {scale_factor_V_per_dps: 8.0e-06, bias_V: 2.0e-07, axis: [2.0e-04, 2.0e-04, "
+          "2.0e-04]}\n    noise: {quantization_deg: 5e-05, arw_dps_rtHz: 3e-05, "
+          "bias_instability_dps: 3e-06}\n");
   std::string scenario = test::read_file(test::source_path("examples/sim/closed_loop_calibrated.yaml"));
   const std::string from = "unit: calibrated_unit.yaml";
   ASSERT_NE(scenario.find(from), std::string::npos) << "the example scenario's unit changed";

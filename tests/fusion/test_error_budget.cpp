@@ -1,5 +1,6 @@
 // The error budget the configuration implies (docs/fdi.md, "The budget"): its sums are the rows', its
-// false-alarm total is the figure docs/fdi.md states for the defaults at 10 Hz, and each row moves with its key.
+// false-alarm total is the figure docs/fdi.md states for the defaults at 10 Hz, and each row moves with its
+// key.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -18,7 +19,8 @@ TEST(ErrorBudget, DefaultsAt10HzGiveTheDocumentedFalseAlarmRate) {
     if (r.kind == BudgetKind::kWrongExclusion && std::isfinite(r.per_evaluation)) sum += r.total();
   EXPECT_DOUBLE_EQ(b.wrong_exclusion_per_episode, sum);
   EXPECT_GT(b.wrong_exclusion_per_episode, 0.0);
-  EXPECT_LT(b.wrong_exclusion_per_episode, 1e-4);  // onset 5σ (5.7e-7) x 30 evaluations, the windows' 6σ cubed
+  EXPECT_LT(b.wrong_exclusion_per_episode,
+            1e-4);  // onset 5σ (5.7e-7) x 30 evaluations, the windows' 6σ cubed
 }
 
 TEST(ErrorBudget, TheGltRowAppearsFromFiveGyrosAndFollowsItsKey) {
@@ -34,7 +36,8 @@ TEST(ErrorBudget, TheGltRowAppearsFromFiveGyrosAndFollowsItsKey) {
   c.glt_false_alarm_probability = 1e-6;
   EXPECT_NEAR(glt(error_budget(c, 5, 0.1)), 2e-6 * 50.0, 1e-15);
   c.sample_period_s = 0.01;
-  EXPECT_NEAR(error_budget(c, 6, 0.01).false_alarms_per_hour, 10.0 * error_budget(c, 6, 0.1).false_alarms_per_hour,
+  EXPECT_NEAR(error_budget(c, 6, 0.01).false_alarms_per_hour,
+              10.0 * error_budget(c, 6, 0.1).false_alarms_per_hour,
               1e-12);  // per epoch: ten times the epochs, ten times the alarms
 }
 

@@ -11,7 +11,6 @@
 
 #include "bias_hypothesis.hpp"
 #include "gyro_series.hpp"
-#include "gyro_set.hpp"
 #include "isolator.hpp"
 #include "outlier_gate.hpp"
 #include "own_noise_level.hpp"
@@ -19,7 +18,6 @@
 #include "parity_detector.hpp"
 #include "rate_attitude.hpp"
 #include "reference_monitor.hpp"
-#include "stamp_judge.hpp"
 #include "subset_cache.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/detectors.hpp"
@@ -425,7 +423,8 @@ TEST(Isolator, OnsetTestTellsTheSteppedGyroAndClassifiesIt) {
     isolator.record(frame);
     if (k == 52) {
       Detection d{true, DetectionTest::kCusum, 30.0, 50, true};
-      ASSERT_TRUE(isolator.open(d, frame.now_ns, k, f.subsets->get(0b1111), detector, Eigen::Vector3d::Zero()));
+      ASSERT_TRUE(
+          isolator.open(d, frame.now_ns, k, f.subsets->get(0b1111), detector, Eigen::Vector3d::Zero()));
     }
     if (isolator.episode().active)
       verdict = isolator.decide(frame.now_ns, k, 0b1111, *f.subsets, series, found);
@@ -636,19 +635,6 @@ TEST(OwnNoiseLevel, AMissingEpochInASlewReadsAsNothing) {
   EXPECT_EQ(names, 3);
 }
 
-TEST(GyroSet, ExclusionsAreLatchedUntilReinstated) {
-  GyroSet set(4);
-  EXPECT_EQ(set.active(), 0b1111U);
-  set.exclude(2, FaultKind::kStuck);
-  EXPECT_EQ(set.active(), 0b1101U);
-  EXPECT_EQ(set.kind(2), FaultKind::kStuck);
-  EXPECT_TRUE(set.is_excluded(2));
-  EXPECT_FALSE(set.contains(5));
-  set.reinstate(2);
-  EXPECT_EQ(set.active(), 0b1111U);
-  EXPECT_EQ(set.kind(2), FaultKind::kNone);
-}
-
 TEST(RateAttitude, ConstantRatePropagatesExactly) {
   // q(t) = exp(ω t) for a constant rate (exact exponential map, trapezoid of equal rates): 600 steps leave
   // less than 1e-12 rad of rounding.
@@ -679,65 +665,6 @@ TEST(RateAttitude, ConstantRatePropagatesExactly) {
   // process noise H*·diag(N²)·H*ᵀ has the trace of diag((HᵀR⁻¹H)⁻¹)). Relative 1e-12: rounding of 600 sums.
   const double expect = s.arw_sq_rad2_s.sum() * 60.0;
   EXPECT_NEAR(attitude.sigma_rad().squaredNorm(), expect, 1e-12 * expect);
-}
-
-// The epoch time check: 10 ms period, so the window is 1000 periods = 10 s.
-constexpr std::int64_t kJudgePeriod_ns = 10'000'000;
-
-StampJudge judge_at(std::int64_t start_ns) {
-  StampJudge j;
-  j.set_period(kJudgePeriod_ns);
-  EXPECT_EQ(j.judge(start_ns), StampVerdict::kAccepted);
-  return j;
-}
-
-TEST(StampJudge, AStampFarAheadOrBehindIsAnOutlierAndNeverMovesTheTime) {
-  StampJudge j = judge_at(0);
-  for (const std::int64_t glitch :
-       {std::int64_t{1'000'000} * kNanosPerSecond, -std::int64_t{1'000'000} * kNanosPerSecond,
-        std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::min()}) {
-    EXPECT_EQ(j.judge(glitch), StampVerdict::kOutlier) << glitch;
-  }
-  EXPECT_EQ(*j.last_ns(), 0);
-  EXPECT_EQ(j.judge(kJudgePeriod_ns), StampVerdict::kAccepted);
-}
-
-TEST(StampJudge, DuplicatesAndSmallStepsBackAreNotIncreasing) {
-  StampJudge j = judge_at(0);
-  EXPECT_EQ(j.judge(kJudgePeriod_ns), StampVerdict::kAccepted);
-  EXPECT_EQ(j.judge(kJudgePeriod_ns), StampVerdict::kNotIncreasing);
-  EXPECT_EQ(j.judge(kJudgePeriod_ns / 2), StampVerdict::kNotIncreasing);
-  // The window's edge: 1000 periods ahead is accepted (a gap), 1000 periods back is not increasing.
-  EXPECT_EQ(j.judge(1001 * kJudgePeriod_ns), StampVerdict::kAccepted);
-  EXPECT_EQ(j.judge(kJudgePeriod_ns), StampVerdict::kNotIncreasing);
-  EXPECT_EQ(j.judge(kJudgePeriod_ns - 1), StampVerdict::kOutlier);
-}
-
-TEST(StampJudge, AForwardJumpIsFollowedAfterThreeAgreeingStamps) {
-  StampJudge j = judge_at(0);
-  const std::int64_t jump = 100 * kNanosPerSecond;
-  EXPECT_EQ(j.judge(jump), StampVerdict::kOutlier);
-  EXPECT_EQ(j.judge(jump + kJudgePeriod_ns), StampVerdict::kOutlier);
-  EXPECT_EQ(j.judge(jump + 2 * kJudgePeriod_ns), StampVerdict::kAccepted);
-  EXPECT_EQ(*j.last_ns(), jump + 2 * kJudgePeriod_ns);
-  EXPECT_EQ(j.judge(0), StampVerdict::kOutlier);  // the old time is now far behind
-}
-
-TEST(StampJudge, OutliersInterleavedWithGoodStampsNeverConfirmAJump) {
-  StampJudge j = judge_at(0);
-  for (int k = 1; k <= 10; ++k) {
-    EXPECT_EQ(j.judge(100 * kNanosPerSecond + k * kJudgePeriod_ns), StampVerdict::kOutlier) << k;
-    EXPECT_EQ(j.judge(k * kJudgePeriod_ns), StampVerdict::kAccepted) << k;
-  }
-}
-
-TEST(StampJudge, WithoutAPeriodOnlyTheOrderIsJudged) {
-  StampJudge j;
-  EXPECT_EQ(j.judge(0), StampVerdict::kAccepted);
-  EXPECT_EQ(j.judge(1'000'000 * kNanosPerSecond), StampVerdict::kAccepted);
-  EXPECT_EQ(j.judge(0), StampVerdict::kNotIncreasing);
-  j.reset();
-  EXPECT_EQ(j.judge(0), StampVerdict::kAccepted);
 }
 
 }  // namespace

@@ -232,8 +232,8 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   // loaded machine; it takes milliseconds on an idle one).
   const std::string shown = "\"operator\":\"caf\xef\xbf\xbd\"";
   auto after_odd = client.Get("/api/history?unit=tetra-1&kind=event");
-  for (int i = 0; i < 100 && after_odd && after_odd->status == 200 &&
-                  after_odd->body.find(shown) == std::string::npos;
+  for (int i = 0;
+       i < 100 && after_odd && after_odd->status == 200 && after_odd->body.find(shown) == std::string::npos;
        ++i) {
     std::this_thread::sleep_for(100ms);
     after_odd = client.Get("/api/history?unit=tetra-1&kind=event");

@@ -20,11 +20,11 @@ enum class BudgetKind : unsigned char {
 };
 
 struct BudgetRow {
-  const char* source;        //!< the ledger's source name (kEvidenceSources)
+  const char* source;  //!< the ledger's source name (kEvidenceSources)
   BudgetKind kind;
-  const char* key;           //!< the configuration key that sets it ("" when none)
-  double per_evaluation;     //!< [-] probability per evaluation (NaN: not a probability)
-  double evaluations;        //!< evaluations per hour (false alarms) or per episode (wrong exclusions)
+  const char* key;        //!< the configuration key that sets it ("" when none)
+  double per_evaluation;  //!< [-] probability per evaluation (NaN: not a probability)
+  double evaluations;     //!< evaluations per hour (false alarms) or per episode (wrong exclusions)
   double total() const { return per_evaluation * evaluations; }  //!< [1/h] or [1/episode]
   const char* note;
 };
