@@ -15,7 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake ninja-build pkg-config
   libeigen3-dev libspdlog-dev libfmt-dev libyaml-cpp-dev libcli11-dev
   cyclonedds-dev cyclonedds-tools
   libcpp-httplib-dev nlohmann-json3-dev       # tetra ground: HTTP client of the tests, JSON
