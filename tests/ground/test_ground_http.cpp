@@ -27,14 +27,21 @@ using nlohmann::json;
 using namespace std::chrono_literals;
 using namespace http_test;  // NOLINT(google-build-using-namespace): the tests' client
 
-TEST(GroundHttp, SignInRolesAndCrossSiteDefences) {
-  test::TempDir dir;
+//! A users file in `dir` with commander alice and viewer victor, both "correct horse"; its configuration.
+ServerConfig alice_and_victor(const test::TempDir& dir) {
   auto hash = hash_password("correct horse");
-  ASSERT_TRUE(hash.ok());
-  ASSERT_TRUE(set_account(dir.file("users"), {"alice", Role::kCommander, *hash}).ok());
-  ASSERT_TRUE(set_account(dir.file("users"), {"victor", Role::kViewer, *hash}).ok());
+  EXPECT_TRUE(hash.ok());
+  if (!hash.ok()) return {};
+  EXPECT_TRUE(set_account(dir.file("users"), {"alice", Role::kCommander, *hash}).ok());
+  EXPECT_TRUE(set_account(dir.file("users"), {"victor", Role::kViewer, *hash}).ok());
   ServerConfig config;
   config.users_path = dir.file("users");
+  return config;
+}
+
+TEST(GroundHttp, SignInRolesAndCrossSiteDefences) {
+  test::TempDir dir;
+  ServerConfig config = alice_and_victor(dir);
   Ground g(config);
   ASSERT_TRUE(g.start().ok());
 
@@ -115,12 +122,7 @@ TEST(GroundHttp, SignInRolesAndCrossSiteDefences) {
 
 TEST(GroundHttp, TheTrustedProxysUserHeaderSignsInOnlyFromTheProxysAddress) {
   test::TempDir dir;
-  auto hash = hash_password("correct horse");
-  ASSERT_TRUE(hash.ok());
-  ASSERT_TRUE(set_account(dir.file("users"), {"alice", Role::kCommander, *hash}).ok());
-  ASSERT_TRUE(set_account(dir.file("users"), {"victor", Role::kViewer, *hash}).ok());
-  ServerConfig config;
-  config.users_path = dir.file("users");
+  ServerConfig config = alice_and_victor(dir);
   config.audit_path = dir.file("audit.jsonl");
   config.trusted_proxy_header = "X-Remote-User";
   config.trusted_proxies = {"::ffff:127.0.0.2"};  // the same host as 127.0.0.2
