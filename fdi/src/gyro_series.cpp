@@ -18,7 +18,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 //! median/level, far below any meaningful change of the limits
 constexpr double kRatioMargin = 1e-9;
 constexpr double kCoarseStepPerSigma = 0.1;  //!< a quantization step beyond this many σ makes repeats normal
-constexpr double kQuietMotion = 2.0;  //!< [σ] motion level the noise-level test still tells from noise
+constexpr double kQuietMotion = 2.0;       //!< [σ] motion level the noise-level test still tells from noise
 constexpr double kMotionQuietRatio = 2.0;  //!< noise ratio of a gyro whose own second differences look normal
 //! [samples] another gyro's repeat run that leaves a coarse gyro's repeats unjudged
 constexpr int kOtherRepeats = 3;

@@ -15,7 +15,7 @@ constexpr double kMedianOfHalfNormal = 0.6744897501960817;  //!< median of |N(0,
 constexpr double kWhiteD4 = 70.0;                           //!< var(Δ⁴) of unit white noise: C(8,4)
 constexpr double kQuantizationD4 = 252.0;    //!< var(Δ⁵e) of unit white angle error: C(10,5)
 constexpr double kSmoothEvaluations = 10.0;  //!< λ's smoothing, in evaluations
-constexpr double kNamedNormalRatio = 1.5;         //!< [-] a named gyro's smoothed level back below this: normal
+constexpr double kNamedNormalRatio = 1.5;    //!< [-] a named gyro's smoothed level back below this: normal
 }  // namespace
 
 OwnNoiseLevel::OwnNoiseLevel(const std::vector<GyroConstants>& constants, const PipelineConfig& config)

@@ -248,15 +248,16 @@ static void bind_pipeline_config(py::module_& m) {
       "path"_a);
 }
 
-static void bind_pipeline_class(py::module_& m) {
-  py::class_<PyPipeline>(m, "_Pipeline")
-      .def(py::init([](const Calibration& calibration, fdi::PipelineConfig config, bool units_dps) {
-             config.raw_units_dps = units_dps;
-             check(fdi::validate(config));
-             auto p = take(fdi::Pipeline::create(calibration, config));
-             return std::make_unique<PyPipeline>(std::move(p), config, calibration.gyro_count());
-           }),
-           "calibration"_a, "config"_a, "units_dps"_a)
+//! The class, its constructor and what it tells of itself.
+static py::class_<PyPipeline> bind_pipeline_basics(py::module_& m) {
+  py::class_<PyPipeline> c(m, "_Pipeline");
+  c.def(py::init([](const Calibration& calibration, fdi::PipelineConfig config, bool units_dps) {
+          config.raw_units_dps = units_dps;
+          check(fdi::validate(config));
+          auto p = take(fdi::Pipeline::create(calibration, config));
+          return std::make_unique<PyPipeline>(std::move(p), config, calibration.gyro_count());
+        }),
+        "calibration"_a, "config"_a, "units_dps"_a)
       .def_property_readonly("gyro_count", [](const PyPipeline& p) { return p.n; })
       .def_property_readonly("config", [](const PyPipeline& p) { return p.config; })
       .def("describe_thresholds",
@@ -269,12 +270,17 @@ static void bind_pipeline_class(py::module_& m) {
           [](const PyPipeline& p, const Calibration& cal) {
             return fdi::default_noise_warning(cal, p.config);
           },
-          "calibration"_a)
-      .def("reset",
-           [](PyPipeline& p) {
-             const InUse in_use(p, "Pipeline.reset");
-             p.pipeline.reset();
-           })
+          "calibration"_a);
+  return c;
+}
+
+//! The operator commands and the state they reset or read.
+static void bind_pipeline_commands(py::class_<PyPipeline>& c) {
+  c.def("reset",
+        [](PyPipeline& p) {
+          const InUse in_use(p, "Pipeline.reset");
+          p.pipeline.reset();
+        })
       .def("health",
            [](PyPipeline& p) {
              const InUse in_use(p, "Pipeline.health");
@@ -300,25 +306,29 @@ static void bind_pipeline_class(py::module_& m) {
             const InUse in_use(p, "Pipeline.reset_command");
             return event_dict(p.pipeline.reset_command(stamp_ns), p.n);
           },
-          "stamp_ns"_a)
-      .def(
-          "step",
-          [](PyPipeline& p, const py::handle& time_s, const py::handle& raw, const py::object& present,
-             const py::object& reference_wxyz) {
-            const InUse in_use(p, "Pipeline.step");
-            const RunInputs in = run_inputs(time_s, raw, present, reference_wxyz, py::none(), p.n);
-            if (in.time_s.rows != 1) throw py::value_error("time_s: step takes one epoch");
-            fill_epoch(in, 0, static_cast<std::size_t>(p.n), p.epoch);
-            const auto& r = p.pipeline.step(p.epoch);
-            py::dict d;
-            d["accepted"] = r.accepted;
-            d["attitude"] = r.accepted ? py::object(attitude_dict(r.attitude, p.n)) : py::object(py::none());
-            py::list events;
-            for (const auto& e : r.events) events.append(event_dict(e, p.n));
-            d["events"] = events;
-            return d;
-          },
-          "time_s"_a, "raw"_a, "present"_a, "reference_wxyz"_a)
+          "stamp_ns"_a);
+}
+
+//! One epoch at a time, or a whole log.
+static void bind_pipeline_stepping(py::class_<PyPipeline>& c) {
+  c.def(
+       "step",
+       [](PyPipeline& p, const py::handle& time_s, const py::handle& raw, const py::object& present,
+          const py::object& reference_wxyz) {
+         const InUse in_use(p, "Pipeline.step");
+         const RunInputs in = run_inputs(time_s, raw, present, reference_wxyz, py::none(), p.n);
+         if (in.time_s.rows != 1) throw py::value_error("time_s: step takes one epoch");
+         fill_epoch(in, 0, static_cast<std::size_t>(p.n), p.epoch);
+         const auto& r = p.pipeline.step(p.epoch);
+         py::dict d;
+         d["accepted"] = r.accepted;
+         d["attitude"] = r.accepted ? py::object(attitude_dict(r.attitude, p.n)) : py::object(py::none());
+         py::list events;
+         for (const auto& e : r.events) events.append(event_dict(e, p.n));
+         d["events"] = events;
+         return d;
+       },
+       "time_s"_a, "raw"_a, "present"_a, "reference_wxyz"_a)
       .def(
           "run",
           [](PyPipeline& p, const py::handle& time_s, const py::handle& raw, const py::object& present,
@@ -338,6 +348,10 @@ static void bind_pipeline_class(py::module_& m) {
             return run_result(std::move(columns), p.n);
           },
           "time_s"_a, "raw"_a, "present"_a, "reference_wxyz"_a, "reference_present"_a, "progress"_a);
+}
+
+//! The module's constants and helpers of the class.
+static void bind_pipeline_helpers(py::module_& m) {
   m.attr("MODE_NAMES") =
       py::make_tuple(fdi::to_string(fdi::Mode::kNominal), fdi::to_string(fdi::Mode::kDegraded),
                      fdi::to_string(fdi::Mode::kSuspect), fdi::to_string(fdi::Mode::kLost));
@@ -349,6 +363,13 @@ static void bind_pipeline_class(py::module_& m) {
         return d.data == a.data();
       },
       "array"_a, "True when tetra reads `array` in place (C-contiguous float64), False when it copies it.");
+}
+
+static void bind_pipeline_class(py::module_& m) {
+  py::class_<PyPipeline> c = bind_pipeline_basics(m);
+  bind_pipeline_commands(c);
+  bind_pipeline_stepping(c);
+  bind_pipeline_helpers(m);
 }
 
 void bind_pipeline(py::module_& m) {

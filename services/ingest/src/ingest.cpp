@@ -76,11 +76,10 @@ std::unique_ptr<SampleParser> line_protocol_parser(const IngestOptions& options)
   return std::make_unique<LineProtocolParser>(options.gyro_count);
 }
 
-Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shutdown,
-                                const ParserFactory& make_parser,
-                                const std::function<void(const IngestReport&)>& on_progress) {
-  auto session = dds::Session::open(o.domain, o.unit);
-  if (!session) return session.error();
+namespace {
+
+//! The GyroSample writer: every sample kept until each reader has acknowledged it.
+Result<dds::Writer<tetra_GyroSample>> gyro_writer(dds::Session& session, const IngestOptions& o) {
   dds::Qos qos = dds::gyro_sample_qos(std::chrono::nanoseconds(seconds_to_ns(1.0 / o.rate_hz)));
   qos.no_autodispose();
   // A source may deliver a burst (a serial buffer or a file read at once, faster than real time): every
@@ -88,43 +87,86 @@ Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shu
   // reader-writer contract: any reader still matches). A reader behind (a recorder paused) holds ingest
   // back, and the source waits in its own buffer (a pipe, a terminal) instead of samples being dropped.
   qos.keep_all();
-  auto writer = session->writer<tetra_GyroSample>(qos);
-  if (!writer) return writer.error();
-  auto source = ByteSource::open(o);
-  if (!source) return source.error();
-  if (Status s = wait_for_readers(*session, *writer, o, shutdown); !s) return s.error();
-  auto parser = make_parser(o);
-  tetra_GyroSample msg{};
-  if (auto s = dds::copy_bounded(msg.unit, o.unit, "unit"); !s) return s.error();
-  std::vector<std::uint64_t> seq(static_cast<std::size_t>(o.gyro_count) + 1, 0);
-  std::vector<RawGyroSample> samples;
-  std::array<std::uint8_t, 65536> buffer{};
-  LatencyHistogram latency;
-  IngestReport report;
-  const std::int64_t start = dds::monotonic_ns();
-  const std::int64_t stop_at = o.duration_s > 0 ? start + seconds_to_ns(o.duration_s) : INT64_MAX;
-  std::int64_t next_progress = start + 1'000'000'000;
-  const auto publish = [&](std::int64_t read_ns) -> Status {
+  return session.writer<tetra_GyroSample>(qos);
+}
+
+//! Writes parsed samples, each held until the readers take it, counting them and their latency.
+class SamplePublisher {
+ public:
+  SamplePublisher(dds::Writer<tetra_GyroSample>& writer, const IngestOptions& o,
+                  dds::ShutdownSignal* shutdown)
+      : writer_(writer), shutdown_(shutdown), seq_(static_cast<std::size_t>(o.gyro_count) + 1, 0) {}
+  Status unit(const std::string& name) { return dds::copy_bounded(msg_.unit, name, "unit"); }
+  //! Writes and clears `samples`, read from the source at `read_ns`.
+  Status publish(std::vector<RawGyroSample>& samples, std::int64_t read_ns, IngestReport& report) {
     for (const RawGyroSample& s : samples) {
-      msg.gyro = static_cast<std::uint16_t>(s.gyro);
-      msg.seq = ++seq[static_cast<std::size_t>(s.gyro)];
-      msg.stamp_ns = seconds_to_ns(s.time_s);
-      msg.raw = s.raw;
-      msg.flags = 0;
-      auto held = writer->write_held(msg, std::chrono::nanoseconds(kHeldGiveUp_ns),
-                                     [&] { return shutdown != nullptr && shutdown->requested(); });
+      msg_.gyro = static_cast<std::uint16_t>(s.gyro);
+      msg_.seq = ++seq_[static_cast<std::size_t>(s.gyro)];
+      msg_.stamp_ns = seconds_to_ns(s.time_s);
+      msg_.raw = s.raw;
+      msg_.flags = 0;
+      auto held = writer_.write_held(msg_, std::chrono::nanoseconds(kHeldGiveUp_ns),
+                                     [&] { return shutdown_ != nullptr && shutdown_->requested(); });
       if (!held) return held.error();
       if (*held == dds::Writer<tetra_GyroSample>::Held::stopped) break;  // interrupted: the loop ends
       if (*held == dds::Writer<tetra_GyroSample>::Held::timed_out) {
         return failure("a GyroSample reader has acknowledged nothing for 30 s: stopped at time " +
                        std::to_string(s.time_s) + " s of the source (every sample before it delivered)");
       }
-      latency.add(dds::monotonic_ns() - read_ns);
+      latency_.add(dds::monotonic_ns() - read_ns);
       ++report.samples;
     }
     samples.clear();
     return ok_status();
-  };
+  }
+  const LatencyHistogram& latency() const { return latency_; }
+
+ private:
+  dds::Writer<tetra_GyroSample>& writer_;
+  dds::ShutdownSignal* shutdown_;
+  tetra_GyroSample msg_{};
+  std::vector<std::uint64_t> seq_;
+  LatencyHistogram latency_;
+};
+
+//! The parser's counts into `report`.
+void count_lines(const SampleParser& parser, IngestReport& report) {
+  report.lines = parser.accepted();
+  report.malformed = parser.malformed();
+}
+
+//! The report's closing figures: wall time since `start`, the parser's last problem, the latency quantiles.
+void close_report(IngestReport& report, const SampleParser& parser, const LatencyHistogram& latency,
+                  std::int64_t start) {
+  report.wall_s = ns_to_seconds(dds::monotonic_ns() - start);
+  count_lines(parser, report);
+  report.last_problem = parser.last_problem();
+  report.latency_p50_ms = latency.quantile_ms(0.5);
+  report.latency_p99_ms = latency.quantile_ms(0.99);
+  report.latency_max_ms = latency.max_ms();
+}
+
+}  // namespace
+
+Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shutdown,
+                                const ParserFactory& make_parser,
+                                const std::function<void(const IngestReport&)>& on_progress) {
+  auto session = dds::Session::open(o.domain, o.unit);
+  if (!session) return session.error();
+  auto writer = gyro_writer(*session, o);
+  if (!writer) return writer.error();
+  auto source = ByteSource::open(o);
+  if (!source) return source.error();
+  if (Status s = wait_for_readers(*session, *writer, o, shutdown); !s) return s.error();
+  auto parser = make_parser(o);
+  SamplePublisher publisher(*writer, o, shutdown);
+  if (auto s = publisher.unit(o.unit); !s) return s.error();
+  std::vector<RawGyroSample> samples;
+  std::array<std::uint8_t, 65536> buffer{};
+  IngestReport report;
+  const std::int64_t start = dds::monotonic_ns();
+  const std::int64_t stop_at = o.duration_s > 0 ? start + seconds_to_ns(o.duration_s) : INT64_MAX;
+  std::int64_t next_progress = start + 1'000'000'000;
   bool ended = false;
   while (!ended && (shutdown == nullptr || !shutdown->requested())) {
     const std::int64_t now = dds::monotonic_ns();
@@ -139,12 +181,11 @@ Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shu
       report.bytes += *got;
       parser->feed(std::span(buffer.data(), *got), samples);
       if ((*source)->datagrams() || ended) parser->flush(samples);
-      if (auto st = publish(read_ns); !st) return st.error();
-      if (ready > 0 && *got == 0 && !ended && (pfd.revents & POLLHUP) != 0) ended = true;
+      if (auto st = publisher.publish(samples, read_ns, report); !st) return st.error();
+      if (*got == 0 && !ended && (pfd.revents & POLLHUP) != 0) ended = true;
     }
     if (on_progress && dds::monotonic_ns() >= next_progress) {
-      report.lines = parser->accepted();
-      report.malformed = parser->malformed();
+      count_lines(*parser, report);
       on_progress(report);
       next_progress += 1'000'000'000;
     }
@@ -152,13 +193,7 @@ Result<IngestReport> run_ingest(const IngestOptions& o, dds::ShutdownSignal* shu
   // What a reader has not acknowledged yet: waited for as a held write is (briefly when interrupted).
   const bool interrupted = shutdown != nullptr && shutdown->requested();
   (void)writer->wait_for_acks(std::chrono::nanoseconds(interrupted ? 2'000'000'000 : kHeldGiveUp_ns));
-  report.wall_s = ns_to_seconds(dds::monotonic_ns() - start);
-  report.lines = parser->accepted();
-  report.malformed = parser->malformed();
-  report.last_problem = parser->last_problem();
-  report.latency_p50_ms = latency.quantile_ms(0.5);
-  report.latency_p99_ms = latency.quantile_ms(0.99);
-  report.latency_max_ms = latency.max_ms();
+  close_report(report, *parser, publisher.latency(), start);
   return report;
 }
 
