@@ -1,5 +1,7 @@
 #include "tetra/fdi/budget.hpp"
 
+#include "isolator.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -32,11 +34,12 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
                       epochs_per_hour,
                       "mean run length between false alarms, the wander and quantization in h"});
     // The onset test names gyro i when every subset without it shows impossible motion: the true
-    // hypothesis's subset beyond its margin, at most the one-axis tail, per evaluation (from 20 epochs
-    // after the onset to onset_post_max_epochs).
-    b.rows.push_back({"onset", K::kWrongExclusion, "onset_sigma", normal_tail(c.onset_sigma),
-                      std::max(1.0, static_cast<double>(c.onset_post_max_epochs - 20)),
-                      "true hypothesis beyond the motion bound's margin"});
+    // hypothesis's subset beyond its margin, at most the one-axis tail, per evaluation (from
+    // kOnsetMinPostEpochs after the onset to onset_post_max_epochs).
+    b.rows.push_back(
+        {"onset", K::kWrongExclusion, "onset_sigma", normal_tail(c.onset_sigma),
+         std::max(1.0, static_cast<double>(c.onset_post_max_epochs - detail::Isolator::kOnsetMinPostEpochs)),
+         "true hypothesis beyond the motion bound's margin"});
   }
   if (gyros >= 5) {
     b.rows.push_back({"glt", K::kWrongExclusion, "glt_false_alarm_probability",

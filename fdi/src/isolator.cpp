@@ -198,7 +198,7 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
   const std::int64_t pre_begin = k0 - gap - config_.onset_pre_epochs;
   const std::int64_t pre_end = k0 - gap;
   const std::int64_t post_end = std::min(index + 1, k0 + config_.onset_post_max_epochs);
-  if (pre_begin < 0 || pre_begin <= index - kHistory || post_end - k0 < 20) return 0;
+  if (pre_begin < 0 || pre_begin <= index - kHistory || post_end - k0 < kOnsetMinPostEpochs) return 0;
   // Every hypothesis below is judged against the acceleration bound. Before the onset the data are clean:
   // when the body already turned faster than the bound there (a slew the bound does not cover), the true
   // hypothesis may be the impossible one and a wrong one possible by chance. Nothing can be told.
