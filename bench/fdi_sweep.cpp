@@ -9,8 +9,9 @@
 // examples/sim/allan_unit.yaml): the simulator runs that unit and the pipeline reads the same file.
 // --quantization gives every gyro of the default unit an angle quantization Q [deg] (N = 4, 5, 6 quantized).
 //
-// --arl0 lowers the design in-control ARL (cusum_arl0_epochs) so that a sweep of a few hundred hours counts
-// enough false alarms to test the threshold computation itself (at the default 1e8, 1,000 h expect 0.4).
+// --arl0 lowers the CUSUM's design in-control ARL so that a sweep of a few hundred hours counts enough false
+// alarms to test the threshold computation itself (at the default 1e8, 1,000 h expect 0.4). It sets the
+// budget's unit false_alarm_probability to 1/(10 ARL0) (the CUSUM's share is 10): every test scales with it.
 //
 // --three-gyro-hours runs H fault-free hours of the unit's first three gyros (no parity: the own noise level
 // and, with --reference 1, the reference's innovations are the detectors; docs/fdi.md "Three gyros") and
@@ -35,6 +36,7 @@
 #include "subset_cache.hpp"
 #include "tetra/core/calibration_file.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/fdi/budget.hpp"
 #include "tetra/fdi/detectors.hpp"
 #include "tetra/fdi/pipeline.hpp"
 #include "tetra/sim/simulator.hpp"
@@ -54,9 +56,9 @@ struct RunOutcome {
 };
 
 //! One simulated run of `duration_s` straight into a pipeline; counts `detected` events.
-double g_arl0 = fdi::PipelineConfig{}.cusum_arl0_epochs;  // set once by main before any thread starts
-std::optional<Calibration> g_unit;                        // --unit; set once by main
-double g_quantization_deg = 0.0;                          // --quantization; set once by main
+double g_false_alarm_probability = fdi::PipelineConfig{}.false_alarm_probability;  // set once by main
+std::optional<Calibration> g_unit;                                                 // --unit; set once by main
+double g_quantization_deg = 0.0;  // --quantization; set once by main
 bool g_reference =
     false;  // --reference 1: the orbit's 1 Hz, 5″ reference into the pipeline; set once by main
 
@@ -92,7 +94,7 @@ RunOutcome run(int n, double duration_s, std::uint64_t seed, const std::vector<s
   sim::SimEpoch se;
   if (!simulator->next(se)) return out;
   fdi::PipelineConfig config;
-  config.cusum_arl0_epochs = g_arl0;
+  config.false_alarm_probability = g_false_alarm_probability;
   config.initial_q_RB = se.truth_q_RB;
   auto pipeline = fdi::Pipeline::create(sc->unit, config);
   if (!pipeline) {
@@ -143,7 +145,7 @@ struct Theory {
 Theory theory(int n) {
   const Calibration cal = sweep_unit(n);
   fdi::PipelineConfig config;
-  config.cusum_arl0_epochs = g_arl0;
+  config.false_alarm_probability = g_false_alarm_probability;
   const auto constants = fdi::detail::gyro_constants(cal, config);
   Eigen::VectorXd arw(n);
   for (int i = 0; i < n; ++i) arw[i] = (*constants)[static_cast<std::size_t>(i)].arw_rad_rts;
@@ -155,8 +157,8 @@ Theory theory(int n) {
            s.cusum_k,
            s.cusum_h,
            s.bias_wander_sigma,
-           config.chi2_false_alarm_probability,
-           config.cusum_arl0_epochs,
+           fdi::allocated_probability(config, fdi::BudgetTest::kChi2),
+           fdi::cusum_arl0_epochs(config),
            {}};
   for (int i = 0; i < n; ++i) t.w_norm.push_back(s.parity.col(i).norm() * cache.sqrt_period());
   return t;
@@ -292,7 +294,8 @@ int main(int argc, char** argv) {
           "  false alarms in H fault-free one-hour orbits per N = 4, 5, 6 (default 1000), then the "
           "detection\n"
           "  delays of the documented faults (S seeds per fault and gyro, default 10), on J threads.\n"
-          "  --arl0: the CUSUM's design in-control ARL [epochs] (default 1e8).\n"
+          "  --arl0: the CUSUM's design in-control ARL [epochs] (default 1e8; > 200): the budget's\n"
+          "          false_alarm_probability becomes 1/(10 ARL0), every test scaled with it.\n"
           "  --unit: simulate and fuse this calibration file's unit instead (its own N only).\n"
           "  --quantization: angle quantization [deg] of every gyro of the default unit.\n"
           "  --reference 1: feed the orbit's 1 Hz, 5\" reference too and count reference rejections.\n");
@@ -303,9 +306,11 @@ int main(int argc, char** argv) {
       return 2;
     }
     if (arg == "--arl0") {
-      g_arl0 = std::atof(argv[++a]);
-      if (!(g_arl0 >= 10.0)) {
-        std::fprintf(stderr, "fdi_sweep: option --arl0 must be >= 10\n");
+      const double arl0 = std::atof(argv[++a]);
+      const double share = fdi::kAllocations[static_cast<int>(fdi::BudgetTest::kCusum)].share;
+      g_false_alarm_probability = 1.0 / (share * arl0);
+      if (!(arl0 > 200.0) || !(g_false_alarm_probability < 0.5 / fdi::kLargestShare)) {
+        std::fprintf(stderr, "fdi_sweep: option --arl0 must be > 200\n");
         return 2;
       }
       continue;

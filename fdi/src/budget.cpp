@@ -19,6 +19,30 @@ double normal_tail(double sigmas) {
 
 }  // namespace
 
+const Allocation kAllocations[kBudgetTestCount] = {
+    {BudgetTest::kChi2, "chi2", 1.0, "per epoch: a large fault seen at once"},
+    {BudgetTest::kCusum, "cusum", 10.0,
+     "per epoch (1/ARL0): most of the budget's false alarms, spent on the delay of the smallest fault "
+     "(h grows as ln ARL0)"},
+    {BudgetTest::kJump, "jump", 1.0, "per epoch; confirmed over onset_confirm_epochs before it names a step"},
+    {BudgetTest::kParityBlockMatch, "parity_block_match", 1.0,
+     "per epoch, by Wald's bound on the block match's mean run length"},
+    {BudgetTest::kGlt, "glt", 1.0, "per form and epoch: two forms, the larger decides"},
+    {BudgetTest::kReferenceCheck, "reference_test", 1.0, "per sample and test of a good reference"},
+    {BudgetTest::kReferenceNoiseMatch, "reference_noise_match", 1.0, "per sample, three gyros only"},
+    {BudgetTest::kReferenceGate, "reference_gate", kLargestShare,
+     "per sample: a good sample left out costs one sample, not a decision (rejection takes "
+     "reference_gate_reset_count in a row)"},
+};
+
+double allocated_probability(const PipelineConfig& config, BudgetTest test) {
+  return config.false_alarm_probability * kAllocations[static_cast<int>(test)].share;
+}
+
+double cusum_arl0_epochs(const PipelineConfig& config) {
+  return 1.0 / allocated_probability(config, BudgetTest::kCusum);
+}
+
 Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) {
   Budget b;
   b.gyros = gyros;
@@ -28,10 +52,10 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
   const bool parity = gyros >= 4;
   using K = BudgetKind;
   if (parity) {
-    b.rows.push_back({"chi2", K::kFalseAlarm, "chi2_false_alarm_probability", c.chi2_false_alarm_probability,
-                      epochs_per_hour, "one epoch's parity"});
-    b.rows.push_back({"cusum", K::kFalseAlarm, "cusum_arl0_epochs", 1.0 / c.cusum_arl0_epochs,
-                      epochs_per_hour,
+    b.rows.push_back({"chi2", K::kFalseAlarm, "false_alarm_probability",
+                      allocated_probability(c, BudgetTest::kChi2), epochs_per_hour, "one epoch's parity"});
+    b.rows.push_back({"cusum", K::kFalseAlarm, "false_alarm_probability",
+                      allocated_probability(c, BudgetTest::kCusum), epochs_per_hour,
                       "mean run length between false alarms, the wander and quantization in h"});
     // The onset test names gyro i when every subset without it shows impossible motion: the true
     // hypothesis's subset beyond its margin, at most the one-axis tail, per evaluation (from
@@ -42,8 +66,8 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
          "true hypothesis beyond the motion bound's margin"});
   }
   if (gyros >= 5) {
-    b.rows.push_back({"glt", K::kWrongExclusion, "glt_false_alarm_probability",
-                      2.0 * c.glt_false_alarm_probability, window_epochs,
+    b.rows.push_back({"glt", K::kWrongExclusion, "false_alarm_probability",
+                      2.0 * allocated_probability(c, BudgetTest::kGlt), window_epochs,
                       "true hypothesis rejected by either form, per epoch of isolation_window_s"});
   }
   if (gyros == 4) {
@@ -52,10 +76,11 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
                       window_epochs,
                       "a healthy gyro's window beyond the threshold, reference_confirm_count times"});
   }
-  b.rows.push_back({"reference_test", K::kReference, "reference_check_false_alarm_probability",
-                    c.reference_check_false_alarm_probability, 1.0, "per reference sample and test"});
-  b.rows.push_back({"reference_test", K::kReference, "reference_gate_false_alarm_probability",
-                    c.reference_gate_false_alarm_probability, 1.0,
+  b.rows.push_back({"reference_test", K::kReference, "false_alarm_probability",
+                    allocated_probability(c, BudgetTest::kReferenceCheck), 1.0,
+                    "per reference sample and test"});
+  b.rows.push_back({"reference_test", K::kReference, "false_alarm_probability",
+                    allocated_probability(c, BudgetTest::kReferenceGate), 1.0,
                     "one sample left out (the gate), rejection after reference_gate_reset_count"});
   for (const char* signature : {"repeated", "zero", "variance", "noise_level", "recurring_spikes"}) {
     b.rows.push_back({signature, K::kWrongExclusion, "", kNotAProbability, 1.0,

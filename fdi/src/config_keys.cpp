@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "tetra/core/csv.hpp"
+#include "tetra/fdi/budget.hpp"
 
 namespace tetra::fdi {
 
@@ -58,15 +59,15 @@ const std::vector<ConfigKey>& config_keys() {
        "angle random walk N of a gyro whose calibration has no noise: section (seed Table 6)"},
       {"default_bias_instability_dps", &C::default_bias_instability_dps, "deg/s", from(0), kFree,
        "bias instability B of a gyro without noise: section: twice the seed's Table 6 level, conservative"},
+      // --- the error budget
+      {"false_alarm_probability", &C::false_alarm_probability, "-", above(0), below(0.5 / kLargestShare),
+       "the budget's unit: each test's error probability per epoch or sample is its share of this (chi2, "
+       "jump, parity block match, GLT, each reference test 1; CUSUM 10, i.e. ARL0 = 1/(10 p); reference "
+       "gate 1000; the verbose replay prints the budget)"},
       // --- detection on the parity residual
-      {"chi2_false_alarm_probability", &C::chi2_false_alarm_probability, "-", above(0), below(0.5),
-       "per epoch, the instantaneous parity chi2 test; also the rate of the parity block match (a slow "
-       "error below the CUSUM)"},
       {"cusum_min_fault_dps", &C::cusum_min_fault_dps, "deg/s", above(0), kFree,
        "smallest bias step on any gyro the CUSUM is sized for (k = delta_min/2); also the parity block "
        "match's lower end"},
-      {"cusum_arl0_epochs", &C::cusum_arl0_epochs, "epochs", from(10), kFree,
-       "in-control average run length of the two-sided CUSUM (gives its threshold h)"},
       {"rate_random_walk_horizon_s", &C::rate_random_walk_horizon_s, "s", above(0), kFree,
        "a gyro's rate random walk K and rate ramp R enter the detectors' reference noise as a bias of "
        "K*sqrt(horizon) and R*horizon"},
@@ -85,14 +86,12 @@ const std::vector<ConfigKey>& config_keys() {
        "window before the estimated onset"},
       {"onset_post_max_epochs", &C::onset_post_max_epochs, "epochs", from(2), to(200),
        "at most this many epochs after the onset"},
-      {"jump_false_alarm_probability", &C::jump_false_alarm_probability, "-", above(0), below(0.5),
-       "per epoch, the test of a one-epoch jump of the parity"},
       {"onset_confirm_epochs", &C::onset_confirm_epochs, "epochs", from(2), to(100),
        "an outlier this persistent is a step, not a spike"},
-      {"dropout_timeout_s", &C::dropout_timeout_s, "s", above(0), kFree, "absent this long: dropout"},
+      {"dropout_timeout_s", &C::dropout_timeout_s, "s", above(0), kFree,
+       "absent this long: dropout; invalid this long: invalid"},
       {"max_gap_s", &C::max_gap_s, "s", above(0), kFree,
        "no epoch for longer than this: a gap event, sigma widened by a*tau^2/4"},
-      {"invalid_timeout_s", &C::invalid_timeout_s, "s", above(0), kFree, "invalid this long: invalid"},
       {"stuck_repeat_count", &C::stuck_repeat_count, "samples", from(3), kFree,
        "identical raw values in a row: stuck"},
       {"noise_window", &C::noise_window, "samples", from(8), to(256),
@@ -115,8 +114,6 @@ const std::vector<ConfigKey>& config_keys() {
        "reference disagreement threshold; also the filter-bias isolation's"},
       {"reference_confirm_count", &C::reference_confirm_count, "-", from(1), to(100),
        "consecutive reference comparisons that must agree"},
-      {"glt_false_alarm_probability", &C::glt_false_alarm_probability, "-", above(0), below(0.5),
-       "N >= 5: the level at which a single-gyro hypothesis is rejected"},
       {"exclusion_enabled", &C::exclusion_enabled, "-", kFree, kFree,
        "false: an isolated gyro stays in the solution (the isolated event says \"gyro kept\"; for measuring "
        "what exclusion is worth)"},
@@ -129,23 +126,16 @@ const std::vector<ConfigKey>& config_keys() {
        "1σ per axis of initial_q_wxyz until a reference sample sets the attitude"},
       {"bias_instability_correlation_s", &C::bias_instability_correlation_s, "s", above(0), kFree,
        "correlation time T_c of the Gauss-Markov bias that models each gyro's bias instability B"},
-      {"reference_gate_false_alarm_probability", &C::reference_gate_false_alarm_probability, "-", above(0),
-       below(0.5), "probability that the filter's 3-dof chi2 gate rejects a good reference sample"},
       {"reference_gate_reset_count", &C::reference_gate_reset_count, "samples", from(1), to(1000),
        "the last of this many reference samples in a row the gate would reject sets the attitude"},
       // --- the reference as a sensor that can fail
       {"reference_check_window_s", &C::reference_check_window_s, "s", above(0), kFree,
-       "block of the reference's NIS and lag tests; also: its noise re-estimate, the three-gyro reference "
-       "noise match, the budget's hold, a rejection withdrawn at a detection, sigma after the reference set "
-       "the attitude, the bias opened with three gyros"},
+       "block of the reference's NIS and lag tests; also: a rejected reference is used again after its "
+       "samples passed every test this long, its noise re-estimate, the three-gyro reference noise match, "
+       "the budget's hold, a rejection withdrawn at a detection, sigma after the reference set the "
+       "attitude, the bias opened with three gyros"},
       {"reference_bias_window_s", &C::reference_bias_window_s, "s", above(0), kFree,
        "block of the reference's mean-innovation (bias) test"},
-      {"reference_check_false_alarm_probability", &C::reference_check_false_alarm_probability, "-", above(0),
-       below(0.5),
-       "per sample, each test of a good reference fails with this probability; also the three-gyro "
-       "reference noise match's rate"},
-      {"reference_reaccept_s", &C::reference_reaccept_s, "s", from(0), kFree,
-       "a rejected reference is used again after its samples passed every test this long"},
       {"reference_noise_max_factor", &C::reference_noise_max_factor, "-", from(1), to(100),
        "a reference rejected for nis alone is used again with its re-estimated noise up to this times "
        "reference_sigma_arcsec (1: never)"},

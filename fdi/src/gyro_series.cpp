@@ -458,9 +458,9 @@ bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_
   if (t.absent_since_ns >= 0 && now_ns - t.absent_since_ns >= seconds_to_ns(config_.dropout_timeout_s))
     return found(FaultKind::kDropout, Evidence::kTimeout, ns_to_seconds(now_ns - t.absent_since_ns),
                  config_.dropout_timeout_s);
-  if (t.invalid_since_ns >= 0 && now_ns - t.invalid_since_ns >= seconds_to_ns(config_.invalid_timeout_s))
+  if (t.invalid_since_ns >= 0 && now_ns - t.invalid_since_ns >= seconds_to_ns(config_.dropout_timeout_s))
     return found(FaultKind::kInvalid, Evidence::kInvalid, ns_to_seconds(now_ns - t.invalid_since_ns),
-                 config_.invalid_timeout_s);
+                 config_.dropout_timeout_s);
   if (t.repeat_count >= config_.stuck_repeat_count && repeats_are_stuck(id, t, sqrt_period))
     return found(FaultKind::kStuck, t.last_raw == 0.0 ? Evidence::kZero : Evidence::kRepeated, t.repeat_count,
                  config_.stuck_repeat_count);

@@ -250,11 +250,10 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
 //   w_i: m stays on gyro i's line.
 // Σ is the white noise's covariance the baseline shows (`baseline_noise`, at least the model's I). Each
 // hypothesis's statistic is the larger of the two (the first form is capped by the biases' term, the second
-// by the baseline's noise): a true hypothesis is rejected above χ²_{d−1}(1 − glt_false_alarm_probability)
-// with at most twice that probability for a unit within its calibration's tolerance — and only then can a
-// healthy gyro be excluded. Two gyros whose columns the
-// calibration's term can confuse stay both consistent: the episode waits for more evidence or ends
-// `unisolated` (docs/fdi.md, "GLT").
+// by the baseline's noise): a true hypothesis is rejected above χ²_{d−1}(1 − p_glt) (p_glt: budget.hpp,
+// BudgetTest::kGlt) with at most twice that probability for a unit within its calibration's tolerance — and
+// only then can a healthy gyro be excluded. Two gyros whose columns the calibration's term can confuse stay
+// both consistent: the episode waits for more evidence or ends `unisolated` (docs/fdi.md, "GLT").
 int Isolator::glt_test(const Subset& s, const SubsetCache& subsets) {
   if (s.dof < 2 || glt_n_ < 3) return 0;
   const double n = glt_n_;

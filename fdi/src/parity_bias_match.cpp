@@ -5,6 +5,7 @@
 
 #include "mekf.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/fdi/budget.hpp"
 
 namespace tetra::fdi::detail {
 
@@ -15,7 +16,7 @@ constexpr int kQuietBlocks = 10;          //!< matched: blocks in a row with eve
 }  // namespace
 
 ParityBiasMatch::ParityBiasMatch(const PipelineConfig& config, int gyro_count)
-    : false_alarm_(config.chi2_false_alarm_probability),
+    : false_alarm_(allocated_probability(config, BudgetTest::kParityBlockMatch)),
       sum_wnu_(static_cast<std::size_t>(gyro_count), 0.0),
       sum_w2_(static_cast<std::size_t>(gyro_count), 0.0),
       cusum_(static_cast<std::size_t>(gyro_count), 0.0),

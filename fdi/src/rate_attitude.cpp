@@ -7,6 +7,7 @@
 #include "tetra/core/allan_stats.hpp"
 #include "tetra/core/correlated_noise.hpp"  // kGaussMarkovSigmaPerB
 #include "tetra/core/units.hpp"
+#include "tetra/fdi/budget.hpp"
 
 namespace tetra::fdi::detail {
 
@@ -92,7 +93,7 @@ RateAttitude::RateAttitude(const PipelineConfig& config, std::vector<GyroNoiseMo
                                            : std::nullopt),
       mekf_(std::move(gyros)),
       snapshots_(mekf_),
-      gate_chi2_(allan::chi2_quantile(1.0 - config.reference_gate_false_alarm_probability, 3.0)),
+      gate_chi2_(allan::chi2_quantile(1.0 - allocated_probability(config, BudgetTest::kReferenceGate), 3.0)),
       sigma_ref_rad_(config.reference_sigma_arcsec * kArcsecToRad) {}
 
 void RateAttitude::reset(const Quaternion& q0_RB) {

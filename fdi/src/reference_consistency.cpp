@@ -5,6 +5,7 @@
 
 #include "tetra/core/allan_stats.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/fdi/budget.hpp"
 
 namespace tetra::fdi::detail {
 
@@ -20,10 +21,10 @@ double chi2_upper_wh(double dof, double z) {
 
 ReferenceConsistency::ReferenceConsistency(const PipelineConfig& config)
     : config_(config),
-      jump_chi2_(allan::chi2_quantile(1.0 - config.reference_check_false_alarm_probability, 3.0)),
-      lag_chi2_(allan::chi2_quantile(1.0 - config.reference_check_false_alarm_probability, 1.0)),
-      z_tail_(
-          std::sqrt(allan::chi2_quantile(1.0 - 2.0 * config.reference_check_false_alarm_probability, 1.0))),
+      jump_chi2_(allan::chi2_quantile(1.0 - allocated_probability(config, BudgetTest::kReferenceCheck), 3.0)),
+      lag_chi2_(allan::chi2_quantile(1.0 - allocated_probability(config, BudgetTest::kReferenceCheck), 1.0)),
+      z_tail_(std::sqrt(
+          allan::chi2_quantile(1.0 - 2.0 * allocated_probability(config, BudgetTest::kReferenceCheck), 1.0))),
       sigma_config_rad_(config.reference_sigma_arcsec * kArcsecToRad) {
   reset();
 }
@@ -234,7 +235,8 @@ ReferenceVerdict ReferenceConsistency::observe(std::int64_t now_ns, const Eigen:
   // (After a `nis` rejection the noise estimate, which needs no tight attitude, tells it instead.)
   const bool tests_see =
       S.trace() / 3.0 <= 2.0 * sigma_rad_ * sigma_rad_ || (rejected_for_nis_ && noise_explained_);
-  if (now_ns - consistent_since_ns_ >= seconds_to_ns(config_.reference_reaccept_s) && lag_seen && tests_see) {
+  if (now_ns - consistent_since_ns_ >= seconds_to_ns(config_.reference_check_window_s) && lag_seen &&
+      tests_see) {
     state_ = ReferenceState::kAccepted;
     v.use = true;
     v.reaccepted = true;

@@ -8,14 +8,15 @@
 //   lag   z = a − ω·τ fitted over the window (a per-axis offset, τ common): τ̂²/var(τ̂) > χ²₁(1 − p)
 //   bias  the long window's weighted mean innovation: Σ_a (Σ z_a/S_aa)²/Σ 1/S_aa > χ²₃(1 − p)
 //
-// p = reference_check_false_alarm_probability per sample. Windows are consecutive blocks (the nis and lag
+// p = the budget's kReferenceCheck share per sample. Windows are consecutive blocks (the nis and lag
 // tests' of reference_check_window_s, the bias test's of reference_bias_window_s), each test evaluated at
 // every sample over its block so far. Without a gyro fault the innovations are white with covariance S (the
 // filter's model), so each statistic has the stated distribution; what a fault of the reference does to them
 // is in docs/fdi.md. A reference is judged only while the gyro solution is consistent (the caller's `judge`):
 // parity among the gyros used and no fault episode open. Then a failed test rejects the reference: its
-// samples are no longer used (sigma grows with the gyro propagation) until they pass every test for
-// reference_reaccept_s. Without judging, a failed test is reported (`inconsistent`) and nothing else changes.
+// samples are no longer used (sigma grows with the gyro propagation) until they pass every test for one
+// block, reference_check_window_s. Without judging, a failed test is reported (`inconsistent`) and nothing
+// else changes.
 // A reference rejected for `nis` alone is noisier than configured: while rejected, its noise is re-estimated
 // from the differences of its successive innovations (at their upper confidence bound, once a block, when
 // the lower bound shows it noisier than configured); at most reference_noise_max_factor × the configured σ,

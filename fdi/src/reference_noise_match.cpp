@@ -5,6 +5,7 @@
 
 #include "mekf.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/fdi/budget.hpp"
 
 namespace tetra::fdi::detail {
 
@@ -15,7 +16,7 @@ constexpr double kGain = 0.3;         //!< γ: the matched ratio's step per bloc
 }  // namespace
 
 ReferenceNoiseMatch::ReferenceNoiseMatch(const PipelineConfig& config, int gyro_count)
-    : false_alarm_(config.reference_check_false_alarm_probability),
+    : false_alarm_(allocated_probability(config, BudgetTest::kReferenceNoiseMatch)),
       window_s_(config.reference_check_window_s),
       reference_var_(std::pow(config.reference_sigma_arcsec * kArcsecToRad, 2)),
       cusum_(static_cast<std::size_t>(gyro_count), 0.0),

@@ -11,7 +11,7 @@
 //
 //   g_i ← max(0, g_i + ½·((1 − 1/ρ)·u_i − ln ρ)),   ρ = 4;   detected when g_i > ln(1/(p·n))
 //
-// (p = reference_check_false_alarm_probability per sample, n the block's samples: the mean run length without
+// (p = the budget's kReferenceNoiseMatch share per sample, n the block's samples: the mean run length without
 // a fault is at least 1/(p·n) blocks, Wald's bound) names the gyro. From then on the gyro's white rate noise
 // in the filter is N_i²·λ_i: λ_i starts where covariance matching puts it (m_i, the mean square of d_iᵀz over
 // reference_check_window_s, less the reference's variance r is the a-priori error variance P along d_i; a

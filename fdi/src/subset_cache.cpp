@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include "tetra/core/units.hpp"
+#include "tetra/fdi/budget.hpp"
 #include "tetra/fdi/detectors.hpp"
 
 namespace tetra::fdi::detail {
@@ -195,8 +196,8 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
     if (has_gyro(mask, i + 1)) s.parity_col_norm[i] = s.parity.col(i).norm();
   }
   const PipelineConfig& config = *config_;
-  s.chi2_threshold = chi2_threshold(config.chi2_false_alarm_probability, s.dof);
-  s.jump_threshold = chi2_threshold(config.jump_false_alarm_probability, s.dof);
+  s.chi2_threshold = chi2_threshold(allocated_probability(config, BudgetTest::kChi2), s.dof);
+  s.jump_threshold = chi2_threshold(allocated_probability(config, BudgetTest::kJump), s.dof);
   s.nominal_threshold = chi2_threshold(1e-3, s.dof);
   // Smallest parity shift [σ] a step of cusum_min_fault_dps on any gyro of the subset produces.
   double min_col = std::numeric_limits<double>::infinity();
@@ -212,7 +213,7 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
     if (has_gyro(mask, i + 1)) s.calibration_bias_bound += s.parity_col_norm[i] * bias_sigma_rad_s_[i];
   }
   s.calibration_bias_bound *= config.calibration_error_sigmas * sqrt_period_;
-  s.cusum_h = cusum_threshold(s.dof, s.cusum_k, config.cusum_arl0_epochs, s.bias_wander_sigma) +
+  s.cusum_h = cusum_threshold(s.dof, s.cusum_k, cusum_arl0_epochs(config), s.bias_wander_sigma) +
               s.quantization_margin;
   // The held level (mean of M epochs over isolation_window_s) misses the episode's true level by N(0, 1/M)
   // per axis, a constant offset for the level test: its reference k grows by kLevelMarginSigma/√M, which
@@ -220,11 +221,11 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   // episode).
   s.level_epochs = std::max(2, static_cast<int>(std::lround(config.isolation_window_s / period_s_)));
   s.level_k = s.cusum_k + kLevelMarginSigma / std::sqrt(static_cast<double>(s.level_epochs));
-  s.level_h = cusum_threshold(s.dof, s.level_k, config.cusum_arl0_epochs, s.bias_wander_sigma) +
+  s.level_h = cusum_threshold(s.dof, s.level_k, cusum_arl0_epochs(config), s.bias_wander_sigma) +
               quantization_margin(s, mask, s.level_k);
   if (s.dof >= 2) {
     s.glt_accept = chi2_threshold(1e-3, s.dof - 1);
-    s.glt_reject = chi2_threshold(config.glt_false_alarm_probability, s.dof - 1);
+    s.glt_reject = chi2_threshold(allocated_probability(config, BudgetTest::kGlt), s.dof - 1);
   }
 }
 

@@ -13,6 +13,7 @@
 #include "tetra/core/geometry.hpp"
 #include "tetra/core/input_files.hpp"
 #include "tetra/core/yaml_reader.hpp"
+#include "tetra/fdi/budget.hpp"
 #include "tetra/fdi/detectors.hpp"
 #include "tetra/fdi/pipeline.hpp"
 #include "tetra/sim/closed_loop_run.hpp"
@@ -497,7 +498,7 @@ std::optional<double> cusum_theory_delay_s(const Calibration& unit, const fdi::P
   const double norm = std::sqrt((p.array().square() * sigma_dps.array().square()).sum());
   const Eigen::VectorXd w = p.cwiseAbs() / norm;
   const double k = 0.5 * config.cusum_min_fault_dps * w.minCoeff();
-  const double h = fdi::cusum_threshold(k, config.cusum_arl0_epochs);
+  const double h = fdi::cusum_threshold(k, fdi::cusum_arl0_epochs(config));
   const double delta = std::abs(size_dps) * w[gyro - 1];
   if (delta <= k) return std::nullopt;
   return fdi::cusum_arl(delta, k, h) * dt_s;

@@ -1,6 +1,7 @@
 // The error budget the configuration implies (docs/fdi.md, "The budget"): its sums are the rows', its
 // false-alarm total is the figure docs/fdi.md states for the defaults at 10 Hz, and each row moves with its
 // key.
+#include <array>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -33,12 +34,36 @@ TEST(ErrorBudget, TheGltRowAppearsFromFiveGyrosAndFollowsItsKey) {
   EXPECT_EQ(glt(error_budget(c, 4, 0.1)), -1.0);
   const double base = glt(error_budget(c, 5, 0.1));
   EXPECT_NEAR(base, 2e-9 * 50.0, 1e-18);  // two forms, per epoch of the 5 s isolation window at 10 Hz
-  c.glt_false_alarm_probability = 1e-6;
+  c.false_alarm_probability = 1e-6;
   EXPECT_NEAR(glt(error_budget(c, 5, 0.1)), 2e-6 * 50.0, 1e-15);
   c.sample_period_s = 0.01;
   EXPECT_NEAR(error_budget(c, 6, 0.01).false_alarms_per_hour,
               10.0 * error_budget(c, 6, 0.1).false_alarms_per_hour,
               1e-12);  // per epoch: ten times the epochs, ten times the alarms
+}
+
+TEST(ErrorBudget, EveryProbabilityIsItsShareOfTheOneKey) {
+  // One key, one table of shares: doubling false_alarm_probability doubles every test's probability and the
+  // false-alarm total; the CUSUM's in-control ARL is 1/(10 p): 1e8 epochs at the default 1e-9.
+  PipelineConfig c;
+  EXPECT_DOUBLE_EQ(cusum_arl0_epochs(c), 1e8);
+  EXPECT_DOUBLE_EQ(allocated_probability(c, BudgetTest::kReferenceGate), 1e-6);
+  const double total = error_budget(c, 4, 0.1).false_alarms_per_hour;
+  std::array<double, kBudgetTestCount> before{};
+  for (int t = 0; t < kBudgetTestCount; ++t) {
+    EXPECT_EQ(static_cast<int>(kAllocations[t].test), t) << kAllocations[t].name;  // the table's order
+    EXPECT_GT(kAllocations[t].share, 0.0);
+    EXPECT_LE(kAllocations[t].share, kLargestShare);
+    before[static_cast<std::size_t>(t)] = allocated_probability(c, kAllocations[t].test);
+  }
+  c.false_alarm_probability *= 2.0;
+  for (int t = 0; t < kBudgetTestCount; ++t)
+    EXPECT_DOUBLE_EQ(allocated_probability(c, kAllocations[t].test),
+                     2.0 * before[static_cast<std::size_t>(t)]);
+  EXPECT_DOUBLE_EQ(error_budget(c, 4, 0.1).false_alarms_per_hour, 2.0 * total);
+  // The key's range keeps the largest share a test: p below 0.5 / 1000.
+  c.false_alarm_probability = 0.5 / kLargestShare;
+  EXPECT_FALSE(validate(c).ok());
 }
 
 TEST(ErrorBudget, SignaturesAreListedWithoutAFigure) {

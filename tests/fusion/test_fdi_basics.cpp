@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include "tetra/fdi/budget.hpp"
 #include "tetra/fdi/config.hpp"
 #include "tetra/fdi/detectors.hpp"
 #include "tetra/fdi/types.hpp"
@@ -45,30 +46,32 @@ TEST(Config, DefaultsValidateAndDescribeEveryKey) {
   const PipelineConfig c;
   EXPECT_TRUE(validate(c).ok());
   const std::string d = describe(c);
-  for (const char* key : {"latitude_deg", "cusum_arl0_epochs", "reference_window_s", "noise_high_ratio"}) {
+  for (const char* key :
+       {"latitude_deg", "false_alarm_probability", "reference_window_s", "noise_high_ratio"}) {
     EXPECT_NE(d.find(key), std::string::npos) << key;
   }
 }
 
 TEST(Config, ParsesKeysAndRejectsUnknownOnesWithLine) {
-  const auto root =
-      YAML::Load("pipeline:\n  latitude_deg: -23.2\n  cusum_arl0_epochs: 1e7\n  raw_units_dps: true\n");
+  const auto root = YAML::Load(
+      "pipeline:\n  latitude_deg: -23.2\n  false_alarm_probability: 1e-8\n  raw_units_dps: true\n");
   auto c = pipeline_config_from_yaml(root["pipeline"], "cfg.yaml");
   ASSERT_TRUE(c.ok()) << c.error().message;
   EXPECT_DOUBLE_EQ(*c->latitude_deg, -23.2);
-  EXPECT_DOUBLE_EQ(c->cusum_arl0_epochs, 1e7);
+  EXPECT_DOUBLE_EQ(c->false_alarm_probability, 1e-8);
+  EXPECT_DOUBLE_EQ(cusum_arl0_epochs(*c), 1e7);  // the CUSUM's share: 10
   EXPECT_TRUE(c->raw_units_dps);
 
-  const auto bad = YAML::Load("pipeline:\n  latitude_deg: 1\n  cusum_arlo_epochs: 5\n");
+  const auto bad = YAML::Load("pipeline:\n  latitude_deg: 1\n  false_alarm_probabilty: 5\n");
   auto e = pipeline_config_from_yaml(bad["pipeline"], "cfg.yaml");
   ASSERT_FALSE(e.ok());
   EXPECT_NE(e.error().message.find("cfg.yaml:3:"), std::string::npos) << e.error().message;
-  EXPECT_NE(e.error().message.find("cusum_arlo_epochs"), std::string::npos);
+  EXPECT_NE(e.error().message.find("false_alarm_probabilty"), std::string::npos);
 
-  const auto range = YAML::Load("pipeline:\n  chi2_false_alarm_probability: 2\n");
+  const auto range = YAML::Load("pipeline:\n  false_alarm_probability: 0.001\n");
   auto r = pipeline_config_from_yaml(range["pipeline"], "cfg.yaml");
   ASSERT_FALSE(r.ok());
-  EXPECT_NE(r.error().message.find("chi2_false_alarm_probability"), std::string::npos);
+  EXPECT_NE(r.error().message.find("false_alarm_probability"), std::string::npos);
 
   const auto text = YAML::Load("pipeline:\n  onset_sigma: abc\n");
   EXPECT_FALSE(pipeline_config_from_yaml(text["pipeline"], "cfg.yaml").ok());

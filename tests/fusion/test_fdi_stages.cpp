@@ -88,10 +88,10 @@ TEST(SubsetCache, ParityAnnihilatesMotionAndPseudoinverseRecoversIt) {
 TEST(SubsetCache, ThresholdsFollowFromTheConfiguration) {
   Fixture f;
   const Subset& s = f.subsets->get(0b1111);
-  EXPECT_DOUBLE_EQ(s.chi2_threshold, chi2_threshold(f.config.chi2_false_alarm_probability, 1));
+  EXPECT_DOUBLE_EQ(s.chi2_threshold, chi2_threshold(f.config.false_alarm_probability, 1));
   // The fixture's unit has no wandering bias (no `bias_wander_rad_s`): the plain two-sided threshold.
   EXPECT_EQ(s.bias_wander_sigma, 0.0);
-  EXPECT_NEAR(s.cusum_h, cusum_threshold(s.cusum_k, f.config.cusum_arl0_epochs), 1e-5);
+  EXPECT_NEAR(s.cusum_h, cusum_threshold(s.cusum_k, 0.1 / f.config.false_alarm_probability), 1e-5);
   // k = δ_min/2 with δ_min the smallest parity shift of a cusum_min_fault_dps step: gyros 1–3 move the
   // tetrahedron's parity by f/(√6 σ) (docs/fdi.md: k = 0.438 at 10 Hz for the nominal unit; the as-built
   // unit's axes differ by arcminutes, hence 1 %).

@@ -116,7 +116,7 @@ struct QuantizedCache {
   Calibration cal = seed_as_built_unit();
   std::optional<detail::SubsetCache> cache;
   QuantizedCache(double q_deg, double arl0) {
-    config.cusum_arl0_epochs = arl0;
+    config.false_alarm_probability = 1.0 / (10.0 * arl0);  // the CUSUM's share is 10 (budget.hpp)
     Eigen::VectorXd arw(cal.gyro_count());
     for (auto& g : cal.gyros) g.noise->quantization_deg = q_deg;
     for (int i = 0; i < cal.gyro_count(); ++i) arw[i] = config.default_arw_dps_rtHz * kDegToRad;

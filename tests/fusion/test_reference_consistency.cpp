@@ -226,7 +226,8 @@ TEST(ReferenceConsistency, ARejectionAGyroFaultMayHaveCausedIsWithdrawnAtItsDete
 
 TEST(ReferenceConsistency, AMisidentifiedReferenceIsAJumpNeverSetsTheAttitudeAndIsUsedAgain) {
   // 0.5° off for 12 s from 100 s: `jump` at its first sample; the attitude stays the gyros' (never set onto
-  // it); used again 30 s after the episode ends (reference_reaccept_s), the error back to arcseconds.
+  // it); used again 30 s after the episode ends (one block of the tests, reference_check_window_s), the error
+  // back to arcseconds.
   sim::Scenario sc = scenario(300.0, true);
   sc.reference.misid_deg = 0.5;
   sc.reference.misid_at_s = 100.0;

@@ -1,9 +1,10 @@
 #pragma once
-// The FDI's error budget (docs/fdi.md, "The budget"): what each evidence source's configured probability
-// allows, per hour of fault-free flight (false alarms) and per fault episode (a healthy gyro named), summed
-// into the totals the configuration implies for a unit of N gyros sampled every T seconds. Sources whose
-// thresholds are counts or ratios, not probabilities, are listed with no figure: the budget does not cover
-// them.
+// The FDI's error budget (docs/fdi.md, "The budget"). One key, `false_alarm_probability` (p), is the unit
+// every test's error probability is allocated in: each test's share of p is one row of kAllocations, with
+// the reason for it, and every probability threshold derives from p × share. error_budget() states what
+// that allows, per hour of fault-free flight (false alarms) and per fault episode (a healthy gyro named),
+// summed into the totals for a unit of N gyros sampled every T seconds. Sources whose thresholds are counts
+// or ratios, not probabilities, are listed with no figure: the budget does not cover them.
 
 #include <string>
 #include <vector>
@@ -11,6 +12,35 @@
 #include "tetra/fdi/config.hpp"
 
 namespace tetra::fdi {
+
+//! The tests whose error probability is allocated from `false_alarm_probability`.
+enum class BudgetTest : unsigned char {
+  kChi2,                 //!< one epoch's parity χ² (per epoch)
+  kCusum,                //!< the parity CUSUM and the held-level CUSUM (1 / in-control ARL, per epoch)
+  kJump,                 //!< the one-epoch jump of the parity (per epoch)
+  kParityBlockMatch,     //!< the parity block match of a slow error (per epoch)
+  kGlt,                  //!< N ≥ 5: one form of the GLT rejecting a true single-gyro hypothesis
+  kReferenceCheck,       //!< each consistency test of the reference (per sample)
+  kReferenceNoiseMatch,  //!< three gyros: the reference noise match (per sample)
+  kReferenceGate         //!< the filter's 3-dof gate leaving out a good reference sample (per sample)
+};
+constexpr int kBudgetTestCount = 8;
+
+//! One row of the allocation: a test's share of false_alarm_probability, and why.
+struct Allocation {
+  BudgetTest test;
+  const char* name;
+  double share;  //!< [-] the test's probability is share × false_alarm_probability
+  const char* why;
+};
+extern const Allocation kAllocations[kBudgetTestCount];
+//! The largest share: false_alarm_probability × it stays below 0.5 (config_keys.cpp's range).
+inline constexpr double kLargestShare = 1000.0;
+
+//! share × false_alarm_probability: the probability `test`'s threshold is set at.
+double allocated_probability(const PipelineConfig& config, BudgetTest test);
+//! [epochs] the CUSUMs' in-control average run length, 1 / allocated_probability(kCusum).
+double cusum_arl0_epochs(const PipelineConfig& config);
 
 //! What a row of the budget spends.
 enum class BudgetKind : unsigned char {

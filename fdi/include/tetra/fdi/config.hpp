@@ -31,10 +31,13 @@ struct PipelineConfig {
   //! [deg/s] B of a gyro without `noise:` section: twice the seed's Table 6 level, conservative
   double default_bias_instability_dps = 1.0e-5;
 
+  // --- the error budget (docs/fdi.md, "The budget"; fdi/include/tetra/fdi/budget.hpp)
+  //! [-] the unit of the budget: each test's error probability (per epoch or per sample) is its share of
+  //! this (χ², jump, GLT, reference tests 1; CUSUM 10; reference gate 1000: kAllocations)
+  double false_alarm_probability = 1.0e-9;
+
   // --- detection on the parity residual
-  double chi2_false_alarm_probability = 1.0e-9;  //!< [-] per epoch, instantaneous χ² test
   double cusum_min_fault_dps = 2.0e-4;  //!< [deg/s] smallest bias step on any gyro the CUSUM is sized for
-  double cusum_arl0_epochs = 1.0e8;     //!< [epochs] in-control average run length (two-sided)
   //! [s] the rate random walk K of a gyro's `noise:` enters the detectors' reference noise as K·√horizon
   double rate_random_walk_horizon_s = 3600.0;
   double clear_after_s = 30.0;  //!< [s] no alarm for this long ends a SUSPECT episode
@@ -45,11 +48,9 @@ struct PipelineConfig {
   double onset_sigma = 5.0;                       //!< [σ] margin of the onset (physical possibility) test
   int onset_pre_epochs = 20;                      //!< [epochs] window before the estimated onset
   int onset_post_max_epochs = 50;                 //!< [epochs] at most this many epochs after the onset
-  double jump_false_alarm_probability = 1.0e-9;   //!< [-] per epoch, test of a one-epoch jump of the parity
   int onset_confirm_epochs = 10;           //!< [epochs] an outlier this persistent is a step, not a spike
-  double dropout_timeout_s = 1.0;          //!< [s] absent this long → dropout
+  double dropout_timeout_s = 1.0;          //!< [s] absent (dropout) or invalid (invalid) this long
   double max_gap_s = 2.0;                  //!< [s] no epoch for longer than this: a `gap` event
-  double invalid_timeout_s = 1.0;          //!< [s] invalid this long → invalid
   int stuck_repeat_count = 10;             //!< [samples] identical raw values in a row → stuck
   int noise_window = 30;                   //!< [samples] window of the noise-level (2nd difference) test
   double noise_high_ratio = 4.0;           //!< [-] robust noise level / expected above this → noise
@@ -60,7 +61,6 @@ struct PipelineConfig {
   double reference_sigma_arcsec = 5.0;     //!< [arcsec] 1σ per axis of the attitude reference
   double reference_threshold_sigma = 6.0;  //!< [σ] reference disagreement threshold
   int reference_confirm_count = 3;         //!< [-] consecutive reference comparisons that must agree
-  double glt_false_alarm_probability = 1.0e-9;  //!< [-] N ≥ 5: rejecting a single-gyro hypothesis
   //! false: a gyro isolated as faulty stays in the solution (detection and isolation still run and
   //! report; for experiments that measure what exclusion is worth). The `isolated` event then says
   //! "gyro kept" and detection starts again; replay, the service and the closed-loop simulator alike.
@@ -75,18 +75,12 @@ struct PipelineConfig {
   double initial_sigma_deg = 0.1;
   //! [s] correlation time T_c of the Gauss–Markov bias that models each gyro's bias instability B.
   double bias_instability_correlation_s = 100.0;
-  //! [-] probability that the χ² gate rejects a good reference sample (3 dof).
-  double reference_gate_false_alarm_probability = 1.0e-6;
   //! [-] the last of this many reference samples in a row that the gate would reject sets the attitude.
   int reference_gate_reset_count = 10;
 
   // --- the reference as a sensor that can fail (docs/fdi.md, "Reference consistency")
   double reference_check_window_s = 30.0;  //!< [s] window of the NIS and lag tests of the reference
   double reference_bias_window_s = 120.0;  //!< [s] window of the mean-innovation (bias) test
-  //! [-] per sample: the probability that a test of a good reference (with consistent gyros) fails
-  double reference_check_false_alarm_probability = 1.0e-9;
-  //! [s] a rejected reference is used again after its samples passed every test for this long
-  double reference_reaccept_s = 30.0;
   //! [-] a reference rejected for `nis` alone is used again with its noise re-estimated from its samples
   //! (upper confidence bound) when that is at most this times reference_sigma_arcsec (1: never)
   double reference_noise_max_factor = 3.0;

@@ -25,7 +25,7 @@ enum class EvidenceSource : std::uint8_t {
   kOnset,            //!< window means before and after the onset against the motion bound
   kGlt,              //!< generalized likelihood test on the mean parity since the onset (N ≥ 5)
   kTimeout,          //!< a gyro absent for dropout_timeout_s
-  kInvalid,          //!< a gyro invalid for invalid_timeout_s
+  kInvalid,          //!< a gyro invalid for dropout_timeout_s
   kRepeated,         //!< identical raw values in a row (stuck)
   kZero,             //!< identical raw values, all 0 V
   kVariance,         //!< robust noise level too low

@@ -55,7 +55,7 @@ enum class EventType : std::uint8_t {
   kFdiAvailable,
   kGap,                //!< no epoch for longer than max_gap_s (statistic: the gap's length [s])
   kReferenceRejected,  //!< the attitude reference failed a consistency test (why: ReferenceCheck)
-  kReferenceAccepted,  //!< a rejected reference passed every test for reference_reaccept_s: used again
+  kReferenceAccepted,  //!< a rejected reference passed every test for reference_check_window_s: used again
   kReferenceLate       //!< a reference stamped beyond the fusion horizon (statistic: how late [s]): left out
 };
 const char* to_string(EventType type);
@@ -84,7 +84,7 @@ DetectionTest detection_test_from_string(std::string_view text);
 //! What told which gyro failed.
 enum class Evidence : std::uint8_t {
   kNone,
-  kInvalid,          //!< invalid samples for invalid_timeout_s
+  kInvalid,          //!< invalid samples for dropout_timeout_s
   kTimeout,          //!< absent for dropout_timeout_s
   kRepeated,         //!< identical raw values in a row
   kZero,             //!< identical raw values, all 0 V
