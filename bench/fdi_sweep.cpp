@@ -3,11 +3,14 @@
 // straight into the pipeline in process, one-hour orbits on every thread.
 //
 //   fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS] [--unit CAL.yaml] [--quantization DEG]
-//             [--reference 1] [--three-gyro-hours H]
+//             [--rate-random-walk K] [--rate-ramp R] [--run-hours L] [--reference 1] [--three-gyro-hours H]
 //
 // --unit replaces the default unit by a calibration file's (its own N only; e.g. the coarsely quantized
 // examples/sim/allan_unit.yaml): the simulator runs that unit and the pipeline reads the same file.
 // --quantization gives every gyro of the default unit an angle quantization Q [deg] (N = 4, 5, 6 quantized).
+// --rate-random-walk K [deg/s/√s] and --rate-ramp R [deg/s²] state (in `noise:`) and simulate on every gyro
+// of the default unit a rate random walk and a rate ramp (+R on each gyro). --run-hours L runs H/L orbits of
+// L hours each instead of H one-hour ones, so a random walk or a ramp grows for L hours unreset.
 //
 // --arl0 lowers the CUSUM's design in-control ARL so that a sweep of a few hundred hours counts enough false
 // alarms to test the threshold computation itself (at the default 1e8, 1,000 h expect 0.4). It sets the
@@ -22,6 +25,7 @@
 // CUSUM theory of fdi/include/tetra/fdi/detectors.hpp.
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -52,6 +56,7 @@ struct RunOutcome {
   int detections = 0;
   int own_level = 0;             //!< detections by a gyro's own noise level (three gyros)
   int reference_rejections = 0;  //!< reference_rejected events (--reference 1)
+  std::array<int, 7> by_test{};  //!< detections per DetectionTest
   double first_detected_s = -1.0;
 };
 
@@ -59,6 +64,8 @@ struct RunOutcome {
 double g_false_alarm_probability = fdi::PipelineConfig{}.false_alarm_probability;  // set once by main
 std::optional<Calibration> g_unit;                                                 // --unit; set once by main
 double g_quantization_deg = 0.0;  // --quantization; set once by main
+double g_rrw_dps_rts = 0.0;       // --rate-random-walk; set once by main
+double g_ramp_dps_s = 0.0;        // --rate-ramp; set once by main
 bool g_reference =
     false;  // --reference 1: the orbit's 1 Hz, 5″ reference into the pipeline; set once by main
 
@@ -67,11 +74,12 @@ bool g_reference =
 Calibration sweep_unit(int n) {
   if (g_unit) return *g_unit;
   Calibration cal = unit_with(n);
-  if (g_quantization_deg > 0.0) {
-    for (auto& g : cal.gyros) {
-      if (!g.noise) g.noise = GyroNoise{};
-      g.noise->quantization_deg = g_quantization_deg;
-    }
+  if (g_quantization_deg == 0.0 && g_rrw_dps_rts == 0.0 && g_ramp_dps_s == 0.0) return cal;
+  for (auto& g : cal.gyros) {
+    if (!g.noise) g.noise = GyroNoise{};
+    if (g_quantization_deg > 0.0) g.noise->quantization_deg = g_quantization_deg;
+    if (g_rrw_dps_rts > 0.0) g.noise->rate_random_walk_dps_per_rts = g_rrw_dps_rts;
+    if (g_ramp_dps_s > 0.0) g.noise->rate_ramp_dps_per_s = g_ramp_dps_s;
   }
   return cal;
 }
@@ -111,6 +119,7 @@ RunOutcome run(int n, double duration_s, std::uint64_t seed, const std::vector<s
       out.reference_rejections += ev.type == fdi::EventType::kReferenceRejected ? 1 : 0;
       if (ev.type != fdi::EventType::kDetected) continue;
       ++out.detections;
+      ++out.by_test[static_cast<std::size_t>(ev.test)];
       out.own_level += ev.detail.find("own noise level") != std::string::npos ? 1 : 0;
       if (out.first_detected_s < 0.0) out.first_detected_s = ns_to_seconds(ev.stamp_ns);
     }
@@ -179,14 +188,18 @@ double ramp_delay_s(const Theory& t, double c) {
   return INFINITY;
 }
 
-void false_alarm_sweep(int n, int hours, int jobs) {
-  std::vector<int> detections(static_cast<std::size_t>(hours), 0);
-  std::vector<int> rejections(static_cast<std::size_t>(hours), 0);
-  parallel(hours, jobs, [&](int i) {
-    const RunOutcome o =
-        run(n, 3600.0, 1000003ULL * static_cast<std::uint64_t>(n) + static_cast<std::uint64_t>(i), {});
+void false_alarm_sweep(int n, int hours, int run_hours, int jobs) {
+  const int runs = hours / run_hours;
+  hours = runs * run_hours;
+  std::vector<int> detections(static_cast<std::size_t>(runs), 0);
+  std::vector<int> rejections(static_cast<std::size_t>(runs), 0);
+  std::vector<std::array<int, 7>> by_test(static_cast<std::size_t>(runs));
+  parallel(runs, jobs, [&](int i) {
+    const RunOutcome o = run(n, 3600.0 * run_hours,
+                             1000003ULL * static_cast<std::uint64_t>(n) + static_cast<std::uint64_t>(i), {});
     detections[static_cast<std::size_t>(i)] = o.detections;
     rejections[static_cast<std::size_t>(i)] = o.reference_rejections;
+    by_test[static_cast<std::size_t>(i)] = o.by_test;
   });
   int total = 0;
   int runs_with = 0;
@@ -198,10 +211,19 @@ void false_alarm_sweep(int n, int hours, int jobs) {
   const double epochs_per_1000h = 1000.0 * 3600.0 * kRateHz;
   const double design = epochs_per_1000h * (1.0 / t.arl0 + t.chi2_p);
   std::printf(
-      "N=%d  %d h: %d detections (%d runs)  %.2f per 1000 h  design %.2f  ratio %.2f  (d=%d k=%.3f h=%.2f "
-      "s=%.3f)\n",
-      n, hours, total, runs_with, 1000.0 * total / hours, design, 1000.0 * total / hours / design, t.dof, t.k,
-      t.h, t.s);
+      "N=%d  %d h in %d-h runs: %d detections (%d runs)  %.2f per 1000 h  design %.2f  ratio %.2f  (d=%d "
+      "k=%.3f h=%.2f s=%.3f)\n",
+      n, hours, run_hours, total, runs_with, 1000.0 * total / hours, design, 1000.0 * total / hours / design,
+      t.dof, t.k, t.h, t.s);
+  std::array<int, 7> tests{};
+  for (const auto& r : by_test)
+    for (std::size_t j = 0; j < tests.size(); ++j) tests[j] += r[j];
+  if (total > 0) {
+    std::printf("N=%d  detections by test:", n);
+    for (std::size_t j = 1; j < tests.size(); ++j)
+      if (tests[j] > 0) std::printf(" %s %d", fdi::to_string(static_cast<fdi::DetectionTest>(j)), tests[j]);
+    std::printf("\n");
+  }
   if (g_reference) {
     int rejected = 0;
     for (int r : rejections) rejected += r;
@@ -285,12 +307,14 @@ int main(int argc, char** argv) {
   int jobs = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   int delay_seeds = 10;
   int three_gyro_hours = 0;
+  int run_hours = 1;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (arg == "--help" || arg == "-h") {
       std::printf(
           "fdi_sweep [--hours H] [--jobs J] [--delay-seeds S] [--arl0 EPOCHS] [--unit CAL.yaml]\n"
-          "          [--quantization DEG] [--reference 1]\n"
+          "          [--quantization DEG] [--rate-random-walk K] [--rate-ramp R] [--run-hours L]\n"
+          "          [--reference 1]\n"
           "  false alarms in H fault-free one-hour orbits per N = 4, 5, 6 (default 1000), then the "
           "detection\n"
           "  delays of the documented faults (S seeds per fault and gyro, default 10), on J threads.\n"
@@ -298,6 +322,10 @@ int main(int argc, char** argv) {
           "          false_alarm_probability becomes 1/(10 ARL0), every test scaled with it.\n"
           "  --unit: simulate and fuse this calibration file's unit instead (its own N only).\n"
           "  --quantization: angle quantization [deg] of every gyro of the default unit.\n"
+          "  --rate-random-walk K [deg/s/sqrt(s)], --rate-ramp R [deg/s^2]: stated and simulated on every "
+          "gyro\n"
+          "          of the default unit (the ramp +R on each).\n"
+          "  --run-hours L: H/L runs of L hours each (default 1).\n"
           "  --reference 1: feed the orbit's 1 Hz, 5\" reference too and count reference rejections.\n");
       return 0;
     }
@@ -315,12 +343,15 @@ int main(int argc, char** argv) {
       }
       continue;
     }
-    if (arg == "--quantization") {
-      g_quantization_deg = std::atof(argv[++a]);
-      if (!(g_quantization_deg >= 0.0)) {
-        std::fprintf(stderr, "fdi_sweep: option --quantization must be >= 0\n");
+    if (arg == "--quantization" || arg == "--rate-random-walk" || arg == "--rate-ramp") {
+      const double v = std::atof(argv[++a]);
+      if (!(v >= 0.0)) {
+        std::fprintf(stderr, "fdi_sweep: option %s must be >= 0\n", arg.c_str());
         return 2;
       }
+      (arg == "--quantization" ? g_quantization_deg
+       : arg == "--rate-ramp"  ? g_ramp_dps_s
+                               : g_rrw_dps_rts) = v;
       continue;
     }
     if (arg == "--unit") {
@@ -345,6 +376,8 @@ int main(int argc, char** argv) {
       delay_seeds = value;
     } else if (arg == "--reference") {
       g_reference = value != 0;
+    } else if (arg == "--run-hours") {
+      run_hours = std::max(1, value);
     } else if (arg == "--three-gyro-hours") {
       three_gyro_hours = value;
     } else {
@@ -354,7 +387,7 @@ int main(int argc, char** argv) {
   }
   const int n_first = g_unit ? g_unit->gyro_count() : 4;
   const int n_last = g_unit ? g_unit->gyro_count() : 6;
-  for (int n = n_first; n <= n_last && hours > 0; ++n) false_alarm_sweep(n, hours, jobs);
+  for (int n = n_first; n <= n_last && hours > 0; ++n) false_alarm_sweep(n, hours, run_hours, jobs);
   if (three_gyro_hours > 0) three_gyro_sweep(three_gyro_hours, jobs);
   if (delay_seeds > 0) {
     std::printf("\n| N | fault | gyro | mean delay [s] | theory [s] | ratio | detected after onset |\n");

@@ -1,6 +1,7 @@
 #include "tetra/fdi/detectors.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace tetra::fdi {
 
@@ -75,7 +76,11 @@ namespace {
 constexpr double kVectorOvershoot = 0.8;    // b − h for Crosier's statistic (detectors.hpp)
 constexpr double kScalarOvershoot = 1.166;  // b − h in Siegmund's formula
 constexpr int kArlSteps = 400;              // trapezoid steps of the ARL integral (relative error < 1e-3)
-constexpr int kBiasNodes = 32;              // nodes of the average over the parity bias, out to 6 s
+//! The averaged design is kept unless absorbing the mean detects the design shift more than this many times
+//! sooner: the two are within a few per cent for a wander well inside the reach, the average's h grows
+//! without bound as the reach passes k.
+constexpr double kAverageKeptWithin = 2.0;
+constexpr int kBiasNodes = 32;  // nodes of the average over the parity bias, out to its reach
 
 double int_pow(double x, int n) {
   double r = 1.0;
@@ -122,7 +127,7 @@ double cusum_arl0_with_bias(int dof, double k, double h, double bias_sigma) {
     double tilt = 0.0;
     double weight = 0.0;
     for (int j = -kBiasNodes; j <= kBiasNodes; ++j) {
-      const double x = 6.0 * j / kBiasNodes;
+      const double x = kBiasAverageReach * j / kBiasNodes;
       const double w = std::exp(-0.5 * x * x);
       tilt += w * arl_free / cusum_arl(bias_sigma * x, k, h1);
       weight += w;
@@ -131,7 +136,7 @@ double cusum_arl0_with_bias(int dof, double k, double h, double bias_sigma) {
   }
   // d = 1: E[1/ARL] over |μ| = s·x, x ~ |N(0, 1)|, both branches of Siegmund's formula, on a grid out to x
   // = 6.
-  const double dx = 6.0 / kBiasNodes;
+  const double dx = kBiasAverageReach / kBiasNodes;
   double rate = 0.0;
   double weight = 0.0;
   for (int j = 0; j <= kBiasNodes; ++j) {
@@ -141,6 +146,20 @@ double cusum_arl0_with_bias(int dof, double k, double h, double bias_sigma) {
     weight += w;
   }
   return weight / rate;
+}
+
+CusumDesign cusum_design(int dof, double k, double arl0, double bias_sigma, double tolerance_sigmas) {
+  const CusumDesign averaged{k, cusum_threshold(dof, k, arl0, bias_sigma), true};
+  if (!(bias_sigma > 0.0)) return averaged;
+  // At the tolerance's edge the statistic drifts as a drift-free CUSUM of reference k: h is that one's.
+  const CusumDesign absorbed{k + tolerance_sigmas * bias_sigma, cusum_threshold(dof, k, arl0, 0.0), false};
+  if (!std::isfinite(averaged.h)) return absorbed;
+  // The delay to the design shift 2k, (h + overshoot) / (2k − reference): none once the reference reaches it.
+  const auto delay = [k](const CusumDesign& d) {
+    return d.k < 2.0 * k ? (d.h + kScalarOvershoot) / (2.0 * k - d.k)
+                         : std::numeric_limits<double>::infinity();
+  };
+  return delay(averaged) <= kAverageKeptWithin * delay(absorbed) ? averaged : absorbed;
 }
 
 double cusum_threshold(int dof, double k, double arl0, double bias_sigma) {
@@ -157,6 +176,9 @@ double cusum_threshold(int dof, double k, double arl0, double bias_sigma) {
     hi *= 2.0;
     f_hi = f(hi);
   }
+  // No h up to the bracket's end holds the ARL (a mean beyond k drifts the statistic up whatever h), or the
+  // ARL overflowed: no threshold.
+  if (!(f_hi >= 0.0)) return std::numeric_limits<double>::infinity();
   int side = 0;
   for (int it = 0; it < 60 && hi - lo > 1e-6; ++it) {
     const double h = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);

@@ -16,18 +16,16 @@ namespace {
 constexpr double kLevelMarginSigma = 3.0;  //!< [σ of the held level] offset the level test's k absorbs
 }  // namespace
 
-double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s,
-                         double rate_ramp_rad_s2) {
+double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s) {
   const double b = kBiasWanderPerB * bias_instability_rad_s;
   const double k = rate_random_walk_rad_s_rts;
-  const double r = rate_ramp_rad_s2 * horizon_s;
-  return std::sqrt(b * b + k * k * horizon_s + r * r);
+  return std::sqrt(b * b + k * k * horizon_s);
 }
 
 DetectorNoise detector_noise(const Calibration& cal, const PipelineConfig& config) {
   const Eigen::Index n = cal.gyro_count();
   DetectorNoise out{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n),
-                    Eigen::Matrix3Xd::Zero(3, n)};
+                    Eigen::VectorXd::Zero(n), Eigen::Matrix3Xd::Zero(3, n)};
   for (Eigen::Index i = 0; i < n; ++i) {
     const GyroCalibration& g = cal.gyros[static_cast<std::size_t>(i)];
     if (g.sigma) {  // a log already in deg/s has no scale factor to be wrong (`raw_units_dps`)
@@ -41,7 +39,8 @@ DetectorNoise detector_noise(const Calibration& cal, const PipelineConfig& confi
     const double b = noise->bias_instability_dps.value_or(0.0) * kDegToRad;
     const double k = noise->rate_random_walk_dps_per_rts.value_or(0.0) * kDegToRad;
     const double r = noise->rate_ramp_dps_per_s.value_or(0.0) * kDegToRad;
-    out.bias_wander_rad_s[i] = bias_wander_sigma(b, k, config.rate_random_walk_horizon_s, r);
+    out.bias_wander_rad_s[i] = bias_wander_sigma(b, k, config.rate_random_walk_horizon_s);
+    out.ramp_bound_rad_s[i] = std::abs(r) * config.rate_random_walk_horizon_s;
   }
   return out;
 }
@@ -52,6 +51,7 @@ SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s
       bias_sigma_rad_s_(std::move(bias_sigma_rad_s)),
       quantization_rad_(std::move(noise.quantization_rad)),
       bias_wander_rad_s_(std::move(noise.bias_wander_rad_s)),
+      ramp_bound_rad_s_(std::move(noise.ramp_bound_rad_s)),
       scale_rel_sigma_(std::move(noise.scale_rel_sigma)),
       axis_sigma_(std::move(noise.axis_sigma)),
       config_(&config) {
@@ -59,6 +59,8 @@ SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s
     quantization_rad_ = Eigen::VectorXd::Zero(gyro_count());
   if (bias_wander_rad_s_.size() != geometry_.gyro_count())
     bias_wander_rad_s_ = Eigen::VectorXd::Zero(gyro_count());
+  if (ramp_bound_rad_s_.size() != geometry_.gyro_count())
+    ramp_bound_rad_s_ = Eigen::VectorXd::Zero(gyro_count());
   if (scale_rel_sigma_.size() != geometry_.gyro_count())
     scale_rel_sigma_ = Eigen::VectorXd::Zero(gyro_count());
   if (axis_sigma_.cols() != geometry_.gyro_count()) axis_sigma_ = Eigen::Matrix3Xd::Zero(3, gyro_count());
@@ -213,15 +215,26 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
     if (has_gyro(mask, i + 1)) s.calibration_bias_bound += s.parity_col_norm[i] * bias_sigma_rad_s_[i];
   }
   s.calibration_bias_bound *= config.calibration_error_sigmas * sqrt_period_;
-  s.cusum_h = cusum_threshold(s.dof, s.cusum_k, cusum_arl0_epochs(config), s.bias_wander_sigma) +
-              s.quantization_margin;
+  for (int i = 0; i < n; ++i) {  // the stated ramps over the horizon, each of either sign
+    if (has_gyro(mask, i + 1))
+      s.calibration_bias_bound += s.parity_col_norm[i] * ramp_bound_rad_s_[i] * sqrt_period_;
+  }
+  // A stated wander whose average would reach the reference (a large rate random walk) is a tolerance
+  // instead: e·s joins the bound D, which the χ²'s dead zone, the CUSUMs' reference and the protection
+  // level carry, where that reaches the design shift sooner (detectors.hpp, cusum_design).
+  const CusumDesign design = cusum_design(s.dof, s.cusum_k, cusum_arl0_epochs(config), s.bias_wander_sigma,
+                                          config.calibration_error_sigmas);
+  s.wander_averaged = design.averaged;
+  s.calibration_bias_bound += design.k - s.cusum_k;
+  s.cusum_h = design.h + s.quantization_margin;
+  const double averaged_wander = s.wander_averaged ? s.bias_wander_sigma : 0.0;
   // The held level (mean of M epochs over isolation_window_s) misses the episode's true level by N(0, 1/M)
   // per axis, a constant offset for the level test: its reference k grows by kLevelMarginSigma/√M, which
   // absorbs such an offset (a larger one, rarer than 3σ, only hastens the test's false alarms in that
   // episode).
   s.level_epochs = std::max(2, static_cast<int>(std::lround(config.isolation_window_s / period_s_)));
   s.level_k = s.cusum_k + kLevelMarginSigma / std::sqrt(static_cast<double>(s.level_epochs));
-  s.level_h = cusum_threshold(s.dof, s.level_k, cusum_arl0_epochs(config), s.bias_wander_sigma) +
+  s.level_h = cusum_threshold(s.dof, s.level_k, cusum_arl0_epochs(config), averaged_wander) +
               quantization_margin(s, mask, s.level_k);
   if (s.dof >= 2) {
     s.glt_accept = chi2_threshold(1e-3, s.dof - 1);

@@ -38,8 +38,11 @@ struct Subset {
   double cusum_k = 0.0;              //!< [σ] CUSUM reference
   double cusum_h = 0.0;              //!< [σ] CUSUM threshold
   double bias_wander_sigma = 0.0;    //!< [σ] per parity axis: the slowly wandering bias (B, K) in the parity
-  //! [σ] bound on the parity's term from the calibrated biases when each is within calibration_error_sigmas
-  //! (e) of its stated 1σ σ_β,i: e·√T·Σ_{i∈S} |w_i|·σ_β,i (the constant part of `calibration_bound`)
+  //! the wander is averaged in h (true), or beyond the average's reach a tolerance e·s in the bound D (false)
+  bool wander_averaged = true;
+  //! [σ] the constant part D₀ of `calibration_bound`: the calibrated biases within calibration_error_sigmas
+  //! (e) of their stated 1σ σ_β,i, e·√T·Σ_{i∈S} |w_i|·σ_β,i; the stated ramps over the horizon,
+  //! √T·Σ|w_i|·R_i·H; and a wander beyond the average's reach, e·s (`wander_averaged` false)
   double calibration_bias_bound = 0.0;
   int level_epochs = 1;            //!< epochs an episode's parity level is averaged over before it is held
   double level_k = 0.0;            //!< [σ] reference of the CUSUM on the parity minus the held level
@@ -54,6 +57,9 @@ struct Subset {
 struct DetectorNoise {
   Eigen::VectorXd quantization_rad;   //!< [rad] angle quantization Q_i (0 if absent)
   Eigen::VectorXd bias_wander_rad_s;  //!< [rad/s] 1σ of the slowly wandering bias (`bias_wander_sigma`)
+  //! [rad/s] what the stated rate ramp R moves the bias by over the horizon, R·horizon: deterministic, of
+  //! either sign, it bounds the parity as the calibrated biases do (linearly, `calibration_bias_bound`)
+  Eigen::VectorXd ramp_bound_rad_s;
   //! The calibration's stated 1σ (`sigma:`), for the rate-proportional parity term ("Calibration
   //! uncertainty")
   Eigen::VectorXd scale_rel_sigma;  //!< [-] 1σ of each scale factor relative to it (0 if absent)
@@ -117,9 +123,10 @@ class SubsetCache {
   //! [σ] bound on the normalized parity's calibration term at the body rate ω [rad/s] when every bias, scale
   //! factor and axis component of the subset's gyros is within `calibration_error_sigmas` (e) of its stated
   //! 1σ: e·√T·Σ_{i∈S} |w_i|·(σ_β,i + σ_s,i·|h_i·ω| + Σ_j σ_h,ij·|ω_j|) (docs/fdi.md, "Calibration
-  //! uncertainty"). 0 without stated σ.
+  //! uncertainty"), plus the stated ramps and an absorbed wander (`calibration_bias_bound`).
   double calibration_bound(const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s) const {
-    if (!calibration_sigma_ || s.dof < 1) return 0.0;
+    if (s.dof < 1) return 0.0;
+    if (!calibration_sigma_) return s.calibration_bias_bound;  // no stated σ: ramps and wander only
     const Eigen::Vector3d w_abs = omega_rad_s.cwiseAbs();
     double sum = 0.0;
     for (int i = 0; i < gyro_count(); ++i) {
@@ -175,6 +182,7 @@ class SubsetCache {
   Eigen::VectorXd bias_sigma_rad_s_;   //!< [rad/s] per gyro
   Eigen::VectorXd quantization_rad_;   //!< [rad] per gyro (zeros when none)
   Eigen::VectorXd bias_wander_rad_s_;  //!< [rad/s] per gyro (zeros when none)
+  Eigen::VectorXd ramp_bound_rad_s_;   //!< [rad/s] per gyro, R·horizon (zeros when none)
   Eigen::VectorXd scale_rel_sigma_;    //!< [-] per gyro (zeros when none)
   Eigen::Matrix3Xd axis_sigma_;        //!< [-] per gyro and component (zeros when none)
   bool calibration_sigma_ = false;     //!< some bias, scale factor or axis has a stated σ > 0
@@ -187,10 +195,9 @@ class SubsetCache {
 };
 
 //! [rad/s] 1σ of a gyro's slowly wandering bias over the detectors' horizon: the stationary σ of the
-//! bias-instability process (kBiasWanderPerB·B), the rate random walk over `horizon_s` (K·√horizon) and the
-//! rate ramp over it (R·horizon), in quadrature. B [rad/s], K [rad/s/√s], R [rad/s²].
-double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s,
-                         double rate_ramp_rad_s2 = 0.0);
+//! bias-instability process (kBiasWanderPerB·B) and the rate random walk over `horizon_s` (K·√horizon), in
+//! quadrature. B [rad/s], K [rad/s/√s]. The rate ramp is no random term: DetectorNoise::ramp_bound_rad_s.
+double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s);
 //! σ_b / B: the stationary σ of a first-order Gauss–Markov bias whose Allan deviation peaks at the IEEE 952
 //! floor 0.664·B (the simulator's bias-instability model, docs/sim.md).
 inline constexpr double kBiasWanderPerB = kGaussMarkovSigmaPerB;

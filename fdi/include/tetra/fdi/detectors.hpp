@@ -45,8 +45,24 @@ double cusum_threshold(double k, double arl0);
 //! shift larger than k).
 double vector_cusum_arl(int dof, double k, double h);
 //! In-control ARL of the CUSUM used for dimension `dof` (two-sided scalar for 1, Crosier's for ≥ 2) when
-//! the parity carries a quasi-static mean N(0, bias_sigma² I) [σ units], averaged as 1/ARL₀ = E[1/ARL].
+//! the parity carries a quasi-static mean N(0, bias_sigma² I) [σ units], averaged as 1/ARL₀ = E[1/ARL] over
+//! a mean out to kBiasAverageReach × bias_sigma. A mean beyond k drifts the statistic up at (mean − k) per
+//! step whatever h: once the reach passes k the average's h grows without bound (cusum_design below).
 double cusum_arl0_with_bias(int dof, double k, double h, double bias_sigma);
+inline constexpr double kBiasAverageReach = 6.0;  //!< [bias_sigma] the average's reach
+
+//! A CUSUM's reference and threshold for a quasi-static mean of 1σ `bias_sigma` per axis, in-control ARL
+//! `arl0`, designed for a shift 2k. Two designs hold the ARL, each in its model: the mean averaged
+//! (reference k, h from cusum_arl0_with_bias), or the mean a tolerance as the calibration's bound is
+//! (reference k + tolerance_sigmas·bias_sigma, h the drift-free one of reference k: at the tolerance's edge
+//! the statistic drifts as that CUSUM's, and holds ARL₀). The one that detects the 2k shift sooner
+//! (h / (2k − reference)) is taken; the average where its h is finite and no later.
+struct CusumDesign {
+  double k = 0.0;        //!< [σ] reference
+  double h = 0.0;        //!< [σ] threshold
+  bool averaged = true;  //!< the mean averaged (true) or absorbed in k (false)
+};
+CusumDesign cusum_design(int dof, double k, double arl0, double bias_sigma, double tolerance_sigmas);
 //! Threshold h whose `cusum_arl0_with_bias` is `arl0` (steps).
 double cusum_threshold(int dof, double k, double arl0, double bias_sigma);
 
