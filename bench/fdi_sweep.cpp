@@ -189,7 +189,7 @@ double ramp_delay_s(const Theory& t, double c) {
 }
 
 void false_alarm_sweep(int n, int hours, int run_hours, int jobs) {
-  const int runs = hours / run_hours;
+  const int runs = std::max(1, hours / run_hours);
   hours = runs * run_hours;
   std::vector<int> detections(static_cast<std::size_t>(runs), 0);
   std::vector<int> rejections(static_cast<std::size_t>(runs), 0);
@@ -349,9 +349,9 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "fdi_sweep: option %s must be >= 0\n", arg.c_str());
         return 2;
       }
-      (arg == "--quantization" ? g_quantization_deg
-       : arg == "--rate-ramp"  ? g_ramp_dps_s
-                               : g_rrw_dps_rts) = v;
+      if (arg == "--quantization") g_quantization_deg = v;
+      if (arg == "--rate-random-walk") g_rrw_dps_rts = v;
+      if (arg == "--rate-ramp") g_ramp_dps_s = v;
       continue;
     }
     if (arg == "--unit") {

@@ -112,7 +112,8 @@ std::string Pipeline::Impl::describe_thresholds() const {
   append_double(out, s->cusum_k);
   out += "\nbias wander in the parity (sigma): ";
   append_double(out, s->bias_wander_sigma);
-  out += s->wander_averaged ? " (averaged in h)" : " (beyond the average's reach: a tolerance in the bound D)";
+  out +=
+      s->wander_averaged ? " (averaged in h)" : " (beyond the average's reach: a tolerance in the bound D)";
   out += "\nconstant bound D0 (sigma: calibrated biases, stated ramps, absorbed wander): ";
   append_double(out, s->calibration_bias_bound);
   out += "\ncusum h (sigma): ";

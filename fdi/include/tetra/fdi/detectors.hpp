@@ -58,9 +58,10 @@ inline constexpr double kBiasAverageReach = 6.0;  //!< [bias_sigma] the average'
 //! the statistic drifts as that CUSUM's, and holds ARL₀). The one that detects the 2k shift sooner
 //! (h / (2k − reference)) is taken; the average where its h is finite and no later.
 struct CusumDesign {
-  double k = 0.0;        //!< [σ] reference
-  double h = 0.0;        //!< [σ] threshold
-  bool averaged = true;  //!< the mean averaged (true) or absorbed in k (false)
+  double k = 0.0;  //!< [σ] reference
+  double h = 0.0;  //!< [σ] threshold
+  bool averaged =
+      true;  //!< the mean averaged (true) or absorbed in the reference (false: k − the input k joins D)
 };
 CusumDesign cusum_design(int dof, double k, double arl0, double bias_sigma, double tolerance_sigmas);
 //! Threshold h whose `cusum_arl0_with_bias` is `arl0` (steps).
