@@ -2,6 +2,7 @@
 // samples; determinism; scenario files.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "sim_test_util.hpp"
@@ -283,6 +284,40 @@ TEST(SimScenario, YamlFileOverridesTheBuiltIn) {
   EXPECT_EQ(sc->faults[0].gyro, 2);
 }
 
+// The warm-up's stage: each gyro's output moves by s_i·c_i·(T(t) − T_cal), T(t) the first-order transient,
+// on the same noise samples (the stage draws nothing); a scenario file states it in `thermal:`.
+TEST(SimThermal, EachGyroFollowsTheTransientByItsOwnCoefficient) {
+  Scenario sc = short_static();
+  const GyroLog cold = run(sc, {});
+  auto parsed = parse_scenario(
+      "scenario: static\nduration_s: 60\nthermal: {start_C: 5, end_C: 25, time_constant_s: 20, "
+      "bias_dps_per_K: [1e-4, -2e-4, 0, 3e-4]}\n",
+      "warm.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.error().message;
+  const GyroLog warm = run(*parsed, {});
+  ASSERT_EQ(warm.epochs(), cold.epochs());
+  const std::array<double, 4> c = {1e-4, -2e-4, 0.0, 3e-4};
+  for (std::size_t k = 0; k < warm.epochs(); ++k) {
+    const double t = warm.time_s[k];
+    const double kelvin = (5.0 - 25.0) * std::exp(-t / 20.0);  // T(t) − T_cal, T_cal = end_C
+    for (int i = 0; i < 4; ++i) {
+      const double s = sc.unit.gyros[static_cast<std::size_t>(i)].scale_factor_V_per_dps;
+      // 1e-15 V: a few roundings of ~0.1 V numbers (no quantization in this unit's noise).
+      ASSERT_NEAR(warm.value(k, i) - cold.value(k, i), s * c[static_cast<std::size_t>(i)] * kelvin, 1e-15)
+          << "gyro " << i + 1 << " t " << t;
+    }
+  }
+  // Settled: calibrated_at_C other than the end leaves a constant offset.
+  ThermalOptions t;
+  t.start_C = 5.0;
+  t.end_C = 25.0;
+  t.calibrated_at_C = 20.0;
+  t.bias_dps_per_K = {1e-4};
+  EXPECT_NEAR(t.bias_dps(0, 1e9), 5e-4, 1e-18);
+  EXPECT_NEAR(t.bias_dps(0, 0.0), -1.5e-3, 1e-18);
+  EXPECT_EQ(t.bias_dps(1, 0.0), 0.0);  // no coefficient: no term
+}
+
 TEST(SimScenario, YamlErrorsNameLineAndKey) {
   const std::vector<std::pair<std::string, std::string>> bad = {
       {"scenario: orbit\nduration: 10\n", "test.yaml:2: unknown key 'duration'"},
@@ -305,6 +340,16 @@ TEST(SimScenario, YamlErrorsNameLineAndKey) {
       {"scenario: orbit\nfaults: [\"gyro=1,kind=bias,at=1,size=1e300\"]\n",
        "size: must be finite and at most"},
       {"scenario: [unclosed\n", "test.yaml:"},
+      {"scenario: static\nthermal: {start_C: 0, end_C: 20}\n",
+       "test.yaml:2: thermal.bias_dps_per_K: missing"},
+      {"scenario: static\nthermal: {bias_dps_per_K: [1e-6, 1e-6]}\n",
+       "thermal.bias_dps_per_K has 2 coefficients; the unit has 4 gyros"},
+      {"scenario: static\nthermal: {start_C: 0, end_C: 20, bias_dps_per_K: [1e-6, 1e-6, 1e-6, 1]}\n",
+       "is a bias above 1 deg/s"},
+      {"scenario: static\nthermal: {time_constant_s: 0, bias_dps_per_K: [0, 0, 0, 0]}\n",
+       "thermal.time_constant_s must be above 0"},
+      {"scenario: static\nthermal: {start: 0, bias_dps_per_K: [0, 0, 0, 0]}\n",
+       "test.yaml:2: thermal: unknown key 'start'"},
   };
   for (const auto& [text, needle] : bad) {
     auto r = parse_scenario(text, "test.yaml");

@@ -15,7 +15,8 @@ GyroPackage::GyroPackage(const Scenario& scenario, std::vector<FaultSpec> faults
       drop_probability_(scenario.drop_probability),
       reference_options_(scenario.reference),
       unit_(scenario.unit),
-      model_(scenario.model) {
+      model_(scenario.model),
+      thermal_(scenario.thermal) {
   reset();
 }
 
@@ -90,7 +91,11 @@ void GyroPackage::sample(const Eigen::Vector3d& sensed_dps, double t_s, std::vec
   present.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     const auto iu = static_cast<std::size_t>(i);
-    double v = channels_[iu].sample_V(sensed_dps, t_s);
+    GyroChannel& channel = channels_[iu];
+    // The warm-up's bias enters with the true rate, before noise, quantization and saturation.
+    double v = thermal_.active()
+                   ? channel.sample_axis_V(channel.axis_B().dot(sensed_dps) + thermal_.bias_dps(iu, t_s), t_s)
+                   : channel.sample_V(sensed_dps, t_s);
     bool delivered = true;
     // Dropped samples (an option of the scenario, not a fault): drawn every epoch so that the
     // stream does not depend on anything else.

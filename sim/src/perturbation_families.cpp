@@ -15,7 +15,7 @@ namespace {
 
 constexpr std::array<std::string_view, kFamilyCount> kFamilyNames = {
     "fault-in-slew", "data-path", "gap", "reference", "calibration", "calibration-without-noise",
-    "second-fault"};
+    "second-fault",  "warm-up"};
 
 constexpr double kSlewStart_s = 30.0;                //!< [s] the detectors have a full history by then
 constexpr double kConfiguredReference_arcsec = 5.0;  //!< [arcsec] the star tracker's stated 1σ
@@ -320,6 +320,35 @@ PerturbedRun second_fault(Rng& rng, std::uint64_t index) {
   return r;
 }
 
+//! A warm-up from switch-on: 10–25 K in a first-order transient of τ = 120–600 s, each gyro's bias moving by
+//! its own coefficient (a common part of 0.5–2e-6 deg/s/K with a random sign, each gyro 0.5–1.5× it), so 5e-6
+//! to 8e-5 deg/s at the start, below every detector; an orbit with gentle attitude control and one agile slew
+//! at 3τ/4. A third of the runs carry a gyro fault (maybe_fault, around the slew).
+PerturbedRun warm_up(Rng& rng, std::uint64_t index) {
+  const int n = 4 + static_cast<int>(index / 9 % 3);
+  const bool reference = index / 27 % 2 == 1;
+  PerturbedRun r;
+  ThermalOptions t;
+  t.end_C = 20.0;
+  t.start_C = t.end_C - between(rng, 10.0, 25.0);
+  t.time_constant_s = between(rng, 120.0, 600.0);
+  const double common = (rng.uniform() < 0.5 ? -1.0 : 1.0) * between(rng, 0.5e-6, 2e-6);
+  for (int i = 0; i < n; ++i) t.bias_dps_per_K.push_back(common * between(rng, 0.5, 1.5));
+  Slew slew = agile_slew(rng, pick(rng, 6));
+  slew.start_s = 0.75 * t.time_constant_s;
+  r.scenario = base(n, reference, 3.0 * t.time_constant_s + kAfter_s);
+  r.scenario.motion.slews = {slew};
+  r.scenario.thermal = t;
+  char text[160];
+  std::snprintf(text, sizeof text, " warm-up %.1f to %.1f degC, tau %.0f s, %.2e deg/s/K common,", t.start_C,
+                t.end_C, t.time_constant_s, common);
+  r.label = "N=" + std::to_string(n) + text + " " + slew_text(slew) + (reference ? " ref" : "");
+  r.case_name = reference ? "fault-free, reference" : "fault-free";
+  maybe_fault(rng, index, n, slew, r);
+  if (!r.options.faults.empty() && reference) r.case_name += ", reference";
+  return r;
+}
+
 }  // namespace
 
 std::string_view family_name(Family family) {
@@ -409,6 +438,7 @@ PerturbedRun unperturbed_twin(const PerturbedRun& run) {
   twin.reference_fault_at_s = -1.0;
   twin.calibration = run.scenario.unit;
   twin.stated_sigma_multiple = 0.0;
+  twin.scenario.thermal = ThermalOptions{};
   return twin;
 }
 
@@ -436,6 +466,9 @@ PerturbedRun perturbed_run(Family family, std::uint64_t seed, std::uint64_t inde
       break;
     case Family::kSecondFault:
       r = second_fault(rng, index);
+      break;
+    case Family::kWarmUp:
+      r = warm_up(rng, index);
       break;
   }
   if (r.calibration.gyros.empty()) r.calibration = r.scenario.unit;

@@ -44,7 +44,7 @@ Result<Scenario> base_scenario(const YAML::Node& root, const YamlReader& yaml) {
   if (Status st = yaml.check_keys(root,
                                   {"scenario", "duration_s", "rate_hz", "latitude_deg", "pitch_rate_dps",
                                    "orbit_period_s", "acs", "slews", "reference", "unit", "gyro_model",
-                                   "jitter_s", "drop_probability", "faults", "closed_loop"},
+                                   "thermal", "jitter_s", "drop_probability", "faults", "closed_loop"},
                                   "");
       !st)
     return st.error();
@@ -133,6 +133,36 @@ Status read_gyro_model(const YamlReader& yaml, const YAML::Node& root, Scenario&
   return ok_status();
 }
 
+// The warm-up: the temperature transient and one bias coefficient per gyro (checked against the unit in
+// validate_scenario).
+Status read_thermal(const YamlReader& yaml, const YAML::Node& root, Scenario& sc) {
+  const YAML::Node thermal = root["thermal"];
+  if (!thermal) return ok_status();
+  ThermalOptions& t = sc.thermal;
+  if (Status st = yaml.check_keys(
+          thermal, {"start_C", "end_C", "time_constant_s", "calibrated_at_C", "bias_dps_per_K"}, "thermal");
+      !st)
+    return st;
+  if (Status st = maybe_numbers(yaml, thermal, "thermal",
+                                {{"start_C", &t.start_C},
+                                 {"end_C", &t.end_C},
+                                 {"time_constant_s", &t.time_constant_s},
+                                 {"calibrated_at_C", &t.calibrated_at_C}});
+      !st)
+    return st;
+  const YAML::Node c = thermal["bias_dps_per_K"];
+  if (!c) return yaml.error(thermal, "thermal.bias_dps_per_K", "missing (one coefficient per gyro)");
+  if (!c.IsSequence() || c.size() == 0)
+    return yaml.error(c, "thermal.bias_dps_per_K", "expected a list of numbers, one per gyro");
+  t.bias_dps_per_K.clear();
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    auto v = yaml.number(c[i], "thermal.bias_dps_per_K[" + std::to_string(i) + "]");
+    if (!v) return v.error();
+    t.bias_dps_per_K.push_back(*v);
+  }
+  return ok_status();
+}
+
 // The unit's calibration file, relative to the scenario file's folder `base_dir`.
 Status read_unit(const YamlReader& yaml, const YAML::Node& root, const std::string& base_dir, Scenario& sc) {
   const YAML::Node unit = root["unit"];
@@ -177,7 +207,8 @@ Status read_closed_loop(const YamlReader& yaml, const YAML::Node& root, Scenario
 Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, const std::string& base_dir) {
   auto sc = base_scenario(root, yaml);
   if (!sc) return sc.error();
-  for (auto* read_section : {read_top_numbers, read_acs, read_slews, read_reference, read_gyro_model}) {
+  for (auto* read_section :
+       {read_top_numbers, read_acs, read_slews, read_reference, read_gyro_model, read_thermal}) {
     if (Status st = read_section(yaml, root, *sc); !st) return st.error();
   }
   if (Status st = read_unit(yaml, root, base_dir, *sc); !st) return st.error();
@@ -253,6 +284,39 @@ Result<Scenario> read_scenario(const std::string& path) {
   return parse_scenario(*text, path, parent.empty() ? "." : parent.string());
 }
 
+namespace {
+
+Status validate_thermal(const ThermalOptions& t, int gyro_count) {
+  if (!t.active()) return ok_status();
+  for (const auto& [value, key] : {std::pair{t.start_C, "thermal.start_C"}, {t.end_C, "thermal.end_C"}}) {
+    if (Status st = check_range(key, value, kMinTemperature_C, kMaxTemperature_C, "degC"); !st) return st;
+  }
+  if (!std::isnan(t.calibrated_at_C)) {
+    if (Status st = check_range("thermal.calibrated_at_C", t.calibrated_at_C, kMinTemperature_C,
+                                kMaxTemperature_C, "degC");
+        !st)
+      return st;
+  }
+  if (Status st = check_range("thermal.time_constant_s", t.time_constant_s, 0.0, kMaxDuration_s, "s", true);
+      !st)
+    return st;
+  if (static_cast<int>(t.bias_dps_per_K.size()) != gyro_count) {
+    return bad_input("thermal.bias_dps_per_K has " + std::to_string(t.bias_dps_per_K.size()) +
+                     " coefficients; the unit has " + std::to_string(gyro_count) + " gyros (one each)");
+  }
+  const double cal_C = std::isnan(t.calibrated_at_C) ? t.end_C : t.calibrated_at_C;
+  const double kelvin = std::max(std::abs(t.start_C - cal_C), std::abs(t.end_C - cal_C));
+  for (const double c : t.bias_dps_per_K) {
+    if (!std::isfinite(c) || std::abs(c) * kelvin > kMaxThermalBias_dps) {
+      return bad_input("thermal.bias_dps_per_K: " + number_text(c) + " deg/s/K over " + number_text(kelvin) +
+                       " K is a bias above " + number_text(kMaxThermalBias_dps) + " deg/s");
+    }
+  }
+  return ok_status();
+}
+
+}  // namespace
+
 Status validate_scenario(const Scenario& sc) {
   if (Status st = validate_calibration(sc.unit, "unit"); !st) return st;
   if (Status st = check_range("duration_s", sc.duration_s, 0.0, kMaxDuration_s, "s", true); !st) return st;
@@ -298,6 +362,7 @@ Status validate_scenario(const Scenario& sc) {
         !st)
       return st;
   }
+  if (Status st = validate_thermal(sc.thermal, sc.unit.gyro_count()); !st) return st;
   for (const FaultSpec& f : sc.faults) {
     if (f.gyro < 1 || f.gyro > sc.unit.gyro_count()) {
       return bad_input("fault '" + format_fault_spec(f) + "': gyro " + std::to_string(f.gyro) +

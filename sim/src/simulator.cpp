@@ -114,6 +114,12 @@ std::vector<std::pair<std::string, std::string>> Simulator::metadata() const {
     if (r.drop_probability > 0.0)
       meta.emplace_back("reference_drop_probability", number_text(r.drop_probability));
   }
+  if (const ThermalOptions& t = scenario_.thermal; t.active()) {
+    std::string text = number_text(t.start_C) + " to " + number_text(t.end_C) + " degC, tau " +
+                       number_text(t.time_constant_s) + " s, deg/s/K";
+    for (const double c : t.bias_dps_per_K) text += " " + number_text(c);
+    meta.emplace_back("thermal", text);
+  }
   if (scenario_.jitter_s > 0.0) meta.emplace_back("jitter_s", number_text(scenario_.jitter_s));
   if (scenario_.drop_probability > 0.0) {
     meta.emplace_back("drop_probability", number_text(scenario_.drop_probability));

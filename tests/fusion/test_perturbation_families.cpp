@@ -151,6 +151,7 @@ TEST(PerturbationFamilies, SecondFault) {
   check_family(sim::Family::kSecondFault, 12, {}, {"two biases cancelling in the parity"});
 }
 
+
 TEST(PerturbationFamilies, AGyroStuckAtASlewsStartIsCoveredWhileTheJumpTestHoldsAnotherOut) {
   // Four gyros with the reference, a gyro stuck at the start of an agile slew: with one parity every
   // single-gyro hypothesis explains the jump, the motion judged possible (at the configured bound, below the

@@ -1,9 +1,9 @@
 #pragma once
-// The simulated gyro package: one GyroChannel per gyro, the injected faults (fault.hpp), dropped
-// samples and the star-tracker-like attitude reference. It turns the sensed inertial body rate at a
-// sample time into the raw outputs of that epoch. Shared by the open-loop Simulator (truth from the
-// closed-form motion) and the closed-loop simulator (truth from the rigid-body dynamics), so both
-// draw the same seeded streams in the same order.
+// The simulated gyro package: one GyroChannel per gyro, a warm-up's bias transient (thermal.hpp), the
+// injected faults (fault.hpp), dropped samples and the star-tracker-like attitude reference. It turns the
+// sensed inertial body rate at a sample time into the raw outputs of that epoch. Shared by the open-loop
+// Simulator (truth from the closed-form motion) and the closed-loop simulator (truth from the rigid-body
+// dynamics), so both draw the same seeded streams in the same order.
 
 #include <cstdint>
 #include <deque>
@@ -49,6 +49,7 @@ class GyroPackage {
   ReferenceOptions reference_options_;
   Calibration unit_;
   GyroModelOptions model_;
+  ThermalOptions thermal_;
   std::vector<GyroChannel> channels_;
   Rng reference_rng_;
   Rng reference_drop_rng_;  //!< its own stream: dropouts leave the noise samples as they were

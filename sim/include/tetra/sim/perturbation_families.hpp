@@ -3,10 +3,10 @@
 // layer (docs/fdi.md, "Perturbation families"). Each family is one kind of departure from the ideal: a gyro
 // fault at the start, middle or end of an agile slew, a lossy data path, a gap, a failing star tracker, a
 // calibration off by up to twice its stated 1σ, a calibration without noise, a second fault once redundancy
-// is exhausted. `perturbed_run(family, seed, index)` is a pure function: the same three numbers give the same
-// run, bit for bit, whatever was drawn before; indices cover the family's cases in turn (slew axis and
-// timing, fault kind, gyro count) and the seed varies the draws within them. Knows nothing of DDS or of the
-// fusion's types: what the fusion must be told (its calibration, sample period, acceleration bound, an
+// is exhausted, a warm-up. `perturbed_run(family, seed, index)` is a pure function: the same three numbers
+// give the same run, bit for bit, whatever was drawn before; indices cover the family's cases in turn (slew
+// axis and timing, fault kind, gyro count) and the seed varies the draws within them. Knows nothing of DDS or
+// of the fusion's types: what the fusion must be told (its calibration, sample period, acceleration bound, an
 // operator exclusion, a gap in delivery) is carried as plain data.
 
 #include <cstdint>
@@ -30,8 +30,10 @@ enum class Family {
   kCalibration,  //!< scale and axis errors up to 2× the calibration's stated 1σ (a fault in 1/3)
   kCalibrationWithoutNoise,  //!< the fusion's calibration has no noise: section (a fault in 1/3)
   kSecondFault,              //!< three gyros and the reference, a fault on one of them (redundancy exhausted)
+  kWarmUp,  //!< every gyro's bias follows a temperature transient, each by its own coefficient (a fault in
+            //!< 1/3)
 };
-inline constexpr int kFamilyCount = 7;
+inline constexpr int kFamilyCount = 8;
 
 std::string_view family_name(Family family);
 std::optional<Family> family_from_name(std::string_view name);

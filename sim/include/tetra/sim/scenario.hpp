@@ -13,6 +13,7 @@
 #include "tetra/sim/fault.hpp"
 #include "tetra/sim/gyro_model.hpp"
 #include "tetra/sim/motion.hpp"
+#include "tetra/sim/thermal.hpp"
 
 namespace tetra::sim {
 
@@ -41,6 +42,7 @@ struct Scenario {
   Calibration unit = seed_as_built_unit();    //!< the as-built truth of the simulated unit
   GyroModelOptions model;                     //!< options the calibration file does not carry
   ReferenceOptions reference;                 //!< attitude reference (none by default)
+  ThermalOptions thermal;                     //!< a warm-up's bias transient (none by default; thermal.hpp)
   std::vector<FaultSpec> faults;              //!< injected faults
   double jitter_s = 0.0;                      //!< [s] sample times uniform in nominal ± jitter (< period/2)
   double drop_probability = 0.0;              //!< each gyro sample independently not delivered
