@@ -9,7 +9,7 @@
 # largest |e|/PL. A run worse than its one twin is judged again over 20 other draws of the simulator's noise
 # (tests/fusion/family_campaign.hpp, charged()); those runs are listed with their draws' figures. Exit status
 # 1 when a family breaks a promise (the runs are listed).
-# RUNS = 300: 2,100 runs (4,200 with the twins); about 3 min of CPU.
+# RUNS = 300: 2,400 runs (4,800 with the twins); about 3.5 min of CPU.
 # Usage: bench/perturbation_sweep.sh [BUILD_DIR] [RUNS] [SEED]   (defaults: build, 300, 1); TETRA_FAMILY_FILTER
 #   selects families (a gtest filter, e.g. '*.Reference:*.SecondFault').
 # Build: scripts/build.sh --target test_perturbation_families

@@ -33,6 +33,9 @@ const Allocation kAllocations[kBudgetTestCount] = {
     {BudgetTest::kReferenceGate, "reference_gate", kLargestShare,
      "per sample: a good sample left out costs one sample, not a decision (rejection takes "
      "reference_gate_reset_count in a row)"},
+    {BudgetTest::kReferenceBiasMatch, "reference_bias_match", kLargestShare,
+     "per sample of a good reference, its mean innovation over reference_bias_window_s: a match opens the "
+     "gyros' bias model and says so (noise_model), it decides nothing"},
 };
 
 double allocated_probability(const PipelineConfig& config, BudgetTest test) {

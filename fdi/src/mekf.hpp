@@ -129,6 +129,8 @@ class Mekf {
   double bias_rad_s(int id) const;
   double bias_sigma_rad_s(int id) const;
   int gyro_count() const { return n_; }
+  //! Gyro `id`'s noise as the filter models it (the calibration's, without anything added).
+  const GyroNoiseModel& noise_model(int id) const { return gyros_[static_cast<std::size_t>(id - 1)]; }
   //! The covariance (3 + 2N square: δθ, then c_1..c_N, then g_1..g_N).
   const Eigen::MatrixXd& covariance() const { return P_; }
 

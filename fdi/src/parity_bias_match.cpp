@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "block_match.hpp"
 #include "mekf.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/budget.hpp"
@@ -10,9 +11,8 @@
 namespace tetra::fdi::detail {
 
 namespace {
-constexpr double kBiasDesignRatio = 4.0;  //!< ρ: the CUSUM's alternative, the block mean's variance ×4
-constexpr double kBiasBlock_s = 30.0;     //!< [s] the block of the mean parity innovation
-constexpr int kQuietBlocks = 10;          //!< matched: blocks in a row with every CUSUM at 0 that end it
+constexpr double kBiasBlock_s = 30.0;  //!< [s] the block of the mean parity innovation
+constexpr int kQuietBlocks = 10;       //!< matched: blocks in a row with every CUSUM at 0 that end it
 }  // namespace
 
 ParityBiasMatch::ParityBiasMatch(const PipelineConfig& config, int gyro_count)
@@ -94,7 +94,7 @@ void ParityBiasMatch::observe(std::int64_t now_ns, const Subset& s, const Eigen:
 void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter) {
   // A block of n epochs stands for n of the per-epoch false-alarm probability p, and each gyro's CUSUM is one
   // test (p·n·|S| at most 1/2, so the threshold stays above ln 2 whatever p the configuration allows).
-  const double threshold = -std::log(std::min(false_alarm_ * block_epochs_ * tetra::gyro_count(s.mask), 0.5));
+  const double threshold = block_cusum_threshold(false_alarm_ * block_epochs_ * tetra::gyro_count(s.mask));
   const int n = static_cast<int>(sum_wnu_.size());
   const Eigen::MatrixXd& P = filter.covariance();
   bool alarm = false;
@@ -121,8 +121,7 @@ void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter)
     const double u = f * f / predicted;
     sum_wnu_[k] = 0.0;
     sum_w2_[k] = 0.0;
-    cusum_[k] =
-        std::max(0.0, cusum_[k] + 0.5 * ((1.0 - 1.0 / kBiasDesignRatio) * u - std::log(kBiasDesignRatio)));
+    cusum_[k] = block_cusum_step(cusum_[k], u, 1.0);
     alarm = alarm || cusum_[k] > threshold;
     // The excess under gyro i's hypothesis (the error is gyro i's alone): kept per gyro, used once matched.
     block_excess_[k] = f * f - predicted;

@@ -436,6 +436,7 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   gyro_set_.exclude(iso.gyro, iso.kind);
   attitude_.freeze(iso.gyro);
   bias_match_.release(attitude_.filter());  // the error that opened the bias models may have been this fault
+  drift_match_.reset();                     // (and the drift matched may have been it)
   // What the fault leaked into the other gyros' bias states since its onset is undone (docs/fdi.md).
   attitude_.repair_biases(gyro_set_.active(),
                           isolator_.episode().active ? isolator_.episode().onset_ns
@@ -487,6 +488,7 @@ void Pipeline::Impl::gap() {
   series_.bridge_gap();
   own_noise_.bridge_gap();
   bias_match_.restart();  // a block does not straddle the gap
+  drift_match_.restart();
   gate_.restart();
   reference_.restart_windows();
   FdiEvent e;
@@ -571,6 +573,7 @@ void Pipeline::Impl::reset() {
   budget_.reset();
   noise_match_.reset();
   bias_match_.reset();
+  drift_match_.reset();
   bias_check_.reset();
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);

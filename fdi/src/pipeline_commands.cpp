@@ -76,6 +76,7 @@ FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   trend_.stop();
   noise_match_.reset();
   bias_match_.release(attitude_.filter());  // every bias model the calibration's again
+  drift_match_.reset();
   for (int id = 1; id <= n_; ++id) attitude_.filter().set_added_noise(id, 0.0);
   restart_detectors();
   update_mode(stamp_ns);

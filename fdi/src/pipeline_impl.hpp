@@ -25,6 +25,7 @@
 #include "protection_level.hpp"
 #include "quadrature.hpp"
 #include "rate_attitude.hpp"
+#include "reference_bias_match.hpp"
 #include "reference_budget.hpp"
 #include "reference_consistency.hpp"
 #include "reference_horizon.hpp"
@@ -77,6 +78,7 @@ class Pipeline::Impl {
         consistency_(config_),
         noise_match_(config_, n_),
         bias_match_(config_, n_),
+        drift_match_(config_),
         protection_(config_),
         budget_(config_),
         horizon_(config_.reference_horizon_s) {
@@ -135,6 +137,8 @@ class Pipeline::Impl {
   //! A gyro fault just detected may be what had the reference rejected: the rejection is withdrawn.
   void withdraw_reference_rejection();
   void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
+  void match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
+  void emit_drift_matched(double statistic, const char* evidence);
   void match_own_noise();
   //! The rate solution of the gyros in use when they are exactly three (no parity left), else null.
   const Subset* three_gyros_without_parity();
@@ -174,7 +178,9 @@ class Pipeline::Impl {
   DisagreementTrend trend_;  //!< rejected by a slow test: the gyro attitude's error if the gyros are wrong
   ReferenceNoiseMatch noise_match_;  //!< three gyros: a gyro's noise or ramp in the reference's innovations
   ParityBiasMatch bias_match_;       //!< a slow error below the detectors: the gyro's bias model opened
-  ProtectionLevel protection_;       //!< the integrity bound beside sigma
+  ReferenceBiasMatch
+      drift_match_;             //!< a common drift in the reference's innovations: every bias model opened
+  ProtectionLevel protection_;  //!< the integrity bound beside sigma
   std::vector<OwnNoiseFinding> own_named_;  //!< the gyros own_noise_ named at this epoch (capacity N)
   Eigen::VectorXd held_parity_;  //!< the parity before the jump test, when it left the rest without one
   ReferenceBudget budget_;       //!< the reference's stated bias and latency, which its samples cannot show

@@ -65,7 +65,25 @@ void Pipeline::Impl::judge_reference() {
   if (!subsets_.ready() ||
       !attitude_.predict_reference(*frame_.reference_q_RB, frame_.dt_s, subsets_.period_s(), z, S))
     return;
-  const ReferenceVerdict v = consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_);
+  // The bias block's mean so far may be matched as a drift only while the gyros vouch, not right after a
+  // match, and when a working unit's drift could be that large.
+  const bool drift_possible =
+      gyros_vouch_ && drift_match_.may_explain(frame_.now_ns) &&
+      ReferenceBiasMatch::plausible(consistency_.bias_mean_rad(), consistency_.bias_span_s(frame_.now_ns),
+                                    active, attitude_.filter());
+  const double drift_threshold =
+      drift_possible ? drift_match_.threshold() : std::numeric_limits<double>::infinity();
+  const ReferenceVerdict v =
+      consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_, drift_threshold);
+  if (v.drift) {
+    // A mean innovation with the gyros consistent: the reference's bias or the gyros' common drift, which the
+    // parity cannot see. The drift is matched first — the gyros' bias model opened by what the test saw —
+    // and the reference rejected only if its mean persists (docs/fdi.md, "A common drift below the
+    // detectors").
+    drift_match_.match_mean(frame_.now_ns, v.bias_mean_rad, v.bias_span_s, active, attitude_.filter());
+    drift_match_.restart();
+    emit_drift_matched(consistency_.drift_check().statistic, "the reference's mean innovation");
+  }
   reference_usable_ = v.use;
   // The σ the sample is used with: the configured one, or the re-estimated noise (an operator's reset judges
   // the reference afresh, from the configured σ).
@@ -117,6 +135,7 @@ void Pipeline::Impl::judge_reference() {
     noise_match_.match_all(subsets_.get(active).mask);
   }
   if (v.use) match_three_gyro_noise(z, S);
+  if (v.use) match_common_drift(z, S);
 }
 
 void Pipeline::Impl::match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {
@@ -133,6 +152,36 @@ void Pipeline::Impl::match_three_gyro_noise(const Eigen::Vector3d& z, const Eige
   result_.events.back().detail = "attitude reference innovations along gyro " + std::to_string(found->gyro) +
                                  "'s rate axis exceed the model (noise or ramp); three gyros: its noise in "
                                  "the filter matched to the innovations, sigma widened";
+}
+
+void Pipeline::Impl::match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {
+  // A drift of every gyro's bias together shows in the reference's innovations, not in the parity
+  // (docs/fdi.md, "A common drift below the detectors"): judged while the gyros vouch for their attitude, the
+  // bias models opened once the blocks show it.
+  if (!gyros_vouch_) {
+    drift_match_.restart();
+    return;
+  }
+  if (const auto found = drift_match_.observe(frame_.now_ns, z, S, gyro_set_.active(), attitude_.filter())) {
+    consistency_.restart_bias_block(frame_.now_ns);
+    emit_drift_matched(found->statistic, "the reference's mean innovation over four bias windows");
+  }
+}
+
+void Pipeline::Impl::emit_drift_matched(double statistic, const char* evidence) {
+  FdiEvent e;
+  e.stamp_ns = frame_.now_ns;
+  e.type = EventType::kNoiseModel;
+  e.statistic = statistic;
+  char text[320];
+  std::snprintf(
+      text, sizeof text,
+      "gyro bias drift beyond the noise model, common to the gyros (the parity cannot see it), in %s: "
+      "the reference or this drift, the data cannot tell which; reference kept, every gyro's bias "
+      "random walk opened to %.3g times the model's wander",
+      evidence, drift_match_.ratio());
+  e.detail = text;
+  emit(std::move(e));
 }
 
 const Subset* Pipeline::Impl::three_gyros_without_parity() {

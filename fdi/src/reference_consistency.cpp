@@ -54,6 +54,10 @@ void ReferenceConsistency::restart_blocks(std::int64_t now_ns) {
   block_count_ = 0;
   block_nis_ = 0.0;
   for (Eigen::Vector3d* v : {&sw_, &swo_, &swz_, &swoo_, &swoz_, &szz_, &sss_}) v->setZero();
+  restart_bias_block(now_ns);
+}
+
+void ReferenceConsistency::restart_bias_block(std::int64_t now_ns) {
   bias_start_ns_ = now_ns;
   bias_count_ = 0;
   bias_sw_.setZero();
@@ -131,6 +135,7 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
   double bias = 0.0;
   for (int a = 0; a < 3; ++a) bias += bias_swz_[a] * bias_swz_[a] / bias_sw_[a];
   failed_ = {bias, jump_chi2_, 3};
+  bias_statistic_ = bias;
   if (bias > jump_chi2_) return ReferenceCheck::kBias;
   return std::nullopt;
 }
@@ -175,15 +180,29 @@ bool ReferenceConsistency::reestimate_noise(std::int64_t now_ns, const Eigen::Ve
 
 ReferenceVerdict ReferenceConsistency::observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
                                                const Eigen::Matrix3d& S, const Eigen::Vector3d& omega_rad_s,
-                                               bool judge) {
+                                               bool judge, double drift_threshold) {
   ReferenceVerdict v;
   const double nis = z_rad.dot(S.ldlt().solve(z_rad));
   const Eigen::Vector3d w = S.diagonal().cwiseInverse();
   const Eigen::Vector3d used_excess = szz_ - sss_;  // Σz² − ΣS_aa of the samples used in the block
   const int used_count = block_start_ns_ < 0 ? 0 : block_count_;
+  bias_statistic_ = 0.0;
   const std::optional<ReferenceCheck> failed = test(now_ns, z_rad, w, nis, omega_rad_s);
   if (state_ != ReferenceState::kRejected) {
     state_ = ReferenceState::kAccepted;
+    if ((!failed || *failed == ReferenceCheck::kBias) && judge && bias_statistic_ > drift_threshold) {
+      // The gyros vouch, and a drift of their common bias (which their parity cannot see) shows the same mean
+      // innovation: the caller opens their bias model — at the match's level, below the rejection's, since a
+      // match decides nothing — and the sample is used; the bias block starts afresh.
+      v.drift = true;
+      v.bias_mean_rad = bias_mean_rad();
+      v.bias_span_s = ns_to_seconds(now_ns - bias_start_ns_);
+      drift_check_ = {bias_statistic_, drift_threshold, 3};
+      restart_bias_block(now_ns);
+      szz_ += z_rad.cwiseProduct(z_rad);
+      sss_ += S.diagonal();
+      return v;
+    }
     if (!failed) {
       szz_ += z_rad.cwiseProduct(z_rad);
       sss_ += S.diagonal();

@@ -23,6 +23,7 @@
 // the tests go on against that σ, and the reference is used again with it once they pass (sigma_rad()).
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 
 #include <Eigen/Core>
@@ -41,6 +42,12 @@ struct ReferenceVerdict {
   //! gyro is wrong, and the data cannot tell which.
   std::optional<ReferenceCheck> inconsistent;
   Eigen::Vector3d contamination_rad2 = Eigen::Vector3d::Zero();  //!< rejected: what the used samples put in
+  //! The bias test failed where a drift of the gyros' common bias may explain it (the caller's
+  //! `drift_possible`): the sample is used, and the caller opens the gyros' bias model by what the test saw —
+  //! [rad] its weighted mean innovation per axis over its block, and [s] the block's span to this sample.
+  bool drift = false;
+  Eigen::Vector3d bias_mean_rad = Eigen::Vector3d::Zero();
+  double bias_span_s = 0.0;
 };
 
 class ReferenceConsistency {
@@ -52,9 +59,12 @@ class ReferenceConsistency {
   void restart();  //!< windows empty (the gyro set changed, an episode ended); the state kept
 
   //! One sample at `now_ns`: its innovation `z_rad` with covariance `S`, the body rate `omega_rad_s` at its
-  //! time, and whether the gyros are consistent enough to judge the reference.
+  //! time, whether the gyros are consistent enough to judge the reference, and the bias statistic above
+  //! which its mean is matched as their common drift instead (then the verdict says `drift`, not `rejected`;
+  //! +∞: never).
   ReferenceVerdict observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S,
-                           const Eigen::Vector3d& omega_rad_s, bool judge);
+                           const Eigen::Vector3d& omega_rad_s, bool judge,
+                           double drift_threshold = std::numeric_limits<double>::infinity());
   //! No sample for reference_window_s: absent (an accepted reference only; a rejected one stays rejected).
   void absent() {
     if (state_ == ReferenceState::kAccepted) state_ = ReferenceState::kAbsent;
@@ -73,6 +83,16 @@ class ReferenceConsistency {
     int dof = 0;
   };
   const CheckValue& failed_check() const { return failed_; }
+  //! The bias block empty from `now_ns` on (a drift matched elsewhere: the mean it saw is accounted for).
+  void restart_bias_block(std::int64_t now_ns);
+  //! The bias statistic at the last drift match and its threshold (the noise_model event's).
+  const CheckValue& drift_check() const { return drift_check_; }
+  //! [rad] the bias test's weighted mean innovation per axis over its block so far, and [s] the block's span
+  //! to `now_ns` (0 before a sample).
+  Eigen::Vector3d bias_mean_rad() const { return bias_swz_.cwiseQuotient(bias_sw_); }
+  double bias_span_s(std::int64_t now_ns) const {
+    return bias_start_ns_ < 0 ? 0.0 : ns_to_seconds(now_ns - bias_start_ns_);
+  }
 
  private:
   //! The first test that fails over the blocks with this sample in, or none.
@@ -83,9 +103,11 @@ class ReferenceConsistency {
   bool reestimate_noise(std::int64_t now_ns, const Eigen::Vector3d& z);
 
   const PipelineConfig& config_;
-  double jump_chi2_ = 0.0;  //!< χ²₃(1 − p)
-  double lag_chi2_ = 0.0;   //!< χ²₁(1 − p)
-  double z_tail_ = 0.0;     //!< Φ⁻¹(1 − p), for the Wilson–Hilferty χ²_{3m} quantile
+  double jump_chi2_ = 0.0;       //!< χ²₃(1 − p)
+  double lag_chi2_ = 0.0;        //!< χ²₁(1 − p)
+  double bias_statistic_ = 0.0;  //!< the bias test's statistic at this sample (0 when not reached)
+  CheckValue drift_check_;       //!< the bias statistic at the last drift match, and its threshold
+  double z_tail_ = 0.0;          //!< Φ⁻¹(1 − p), for the Wilson–Hilferty χ²_{3m} quantile
   ReferenceState state_ = ReferenceState::kAbsent;
   std::int64_t consistent_since_ns_ = 0;  //!< rejected: every sample since passed every test
   double nis_per_dof_ = 0.0;

@@ -3,17 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "block_match.hpp"
 #include "mekf.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/budget.hpp"
 
 namespace tetra::fdi::detail {
-
-namespace {
-constexpr double kDesignRatio = 4.0;  //!< ρ: the CUSUM's alternative, the block mean's variance ×4
-constexpr double kBlock_s = 10.0;     //!< [s] the block of the mean innovation
-constexpr double kGain = 0.3;         //!< γ: the matched ratio's step per block, ×e^{γ(u − 1)}
-}  // namespace
 
 ReferenceNoiseMatch::ReferenceNoiseMatch(const PipelineConfig& config, int gyro_count)
     : false_alarm_(allocated_probability(config, BudgetTest::kReferenceNoiseMatch)),
@@ -57,10 +52,10 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
   if (first) block_start_ns_ = now_ns;
   last_ns_ = now_ns;
   block_samples_ = first ? 1 : block_samples_ + 1;
-  const bool close_block = now_ns - block_start_ns_ >= seconds_to_ns(kBlock_s);
+  const bool close_block = now_ns - block_start_ns_ >= seconds_to_ns(kReferenceBlock_s);
   // A block of n samples stands for n of the per-sample false-alarm probability p.
   // (p·n at most 1/2, so the threshold stays above ln 2 whatever p the configuration allows)
-  const double threshold = -std::log(std::min(false_alarm_ * block_samples_, 0.5));
+  const double threshold = block_cusum_threshold(false_alarm_ * block_samples_);
   if (close_block) {
     block_start_ns_ = now_ns;
     block_samples_ = 0;
@@ -88,9 +83,10 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
     const double u = block_z_[k] * block_z_[k] / block_s_[k];
     block_z_[k] = 0.0;
     block_s_[k] = 0.0;
-    cusum_[k] = std::max(0.0, cusum_[k] + 0.5 * ((1.0 - 1.0 / kDesignRatio) * u - std::log(kDesignRatio)));
+    cusum_[k] = block_cusum_step(cusum_[k], u, 1.0);
     if (matched_[k]) {
-      ratio_[k] = std::clamp(ratio_[k] * std::exp(kGain * (u - 1.0)), 1.0, kMaxNoiseRatio * kMaxNoiseRatio);
+      ratio_[k] =
+          std::clamp(ratio_[k] * std::exp(kBlockMatchGain * (u - 1.0)), 1.0, kMaxNoiseRatio * kMaxNoiseRatio);
     } else if (cusum_[k] > threshold) {
       matched_[k] = true;
       filter.add_attitude_variance_along(d, std::max(mean_square_[k] - s, 0.0));

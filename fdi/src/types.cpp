@@ -68,6 +68,8 @@ const char* to_string(EventType type) {
       return "reference_accepted";
     case EventType::kReferenceLate:
       return "reference_late";
+    case EventType::kNoiseModel:
+      return "noise_model";
   }
   return "command";
 }
@@ -302,6 +304,9 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
     case EventType::kGap:
       out += ", \"length_s\": ";
       append_double(out, event.statistic);
+      break;
+    case EventType::kNoiseModel:
+      append_statistic(out, event.statistic);
       break;
     case EventType::kCommand:
       append_gyro(out, event.gyro);

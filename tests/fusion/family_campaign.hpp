@@ -35,8 +35,8 @@ struct FamilyVerdict {
   double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
   int beyond_protection = 0;              //!< axis-epochs with |e| above the (finite) protection level
   double worst_protection_ratio = 0.0;    //!< largest |e|/PL of an axis (0 where PL is +∞)
-  std::optional<double> flagged_after_s;  //!< [s] first detection or reference rejection after the
-                                          //!< perturbation began
+  std::optional<double> flagged_after_s;  //!< [s] first detection, reference rejection or noise_model after
+                                          //!< the perturbation began
   //! Sigma meets the per-run criterion over the epochs from the first flag on: what the perturbation did
   //! before anything could see it is the protection level's to bound, not sigma's (docs/fdi.md).
   bool honest_after_flag = false;
@@ -105,8 +105,9 @@ inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
     if (e.type == fdi::EventType::kLost) v.lost = true;
     if (e.type == fdi::EventType::kReferenceRejected && r.reference_failure == sim::ReferenceFailure::kNone)
       v.healthy_reference_rejected = true;
-    if ((e.type == fdi::EventType::kDetected || e.type == fdi::EventType::kReferenceRejected) && t >= start &&
-        !v.flagged_after_s)
+    if ((e.type == fdi::EventType::kDetected || e.type == fdi::EventType::kReferenceRejected ||
+         e.type == fdi::EventType::kNoiseModel) &&
+        t >= start && !v.flagged_after_s)
       v.flagged_after_s = t - start;
     if (e.type != fdi::EventType::kIsolated) continue;
     if (r.options.faults.empty()) v.exclusion_no_fault = true;

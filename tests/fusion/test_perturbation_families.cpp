@@ -150,7 +150,14 @@ TEST(PerturbationFamilies, CalibrationWithoutNoise) {
 TEST(PerturbationFamilies, SecondFault) {
   check_family(sim::Family::kSecondFault, 12, {}, {"two biases cancelling in the parity"});
 }
-
+// A warm-up's common drift, which the parity cannot see, is matched from the reference's mean innovation (a
+// noise_model event, the gyros' bias model opened, the reference kept) once that mean is significant; the
+// protection level bounds single-gyro faults, and before the match the drift is not one (docs/fdi.md, "A
+// common drift below the detectors").
+TEST(PerturbationFamilies, WarmUp) {
+  check_family(sim::Family::kWarmUp, 54, {},
+               {"fault-free, reference", "bias, reference", "stuck, reference", "zero, reference"});
+}
 
 TEST(PerturbationFamilies, AGyroStuckAtASlewsStartIsCoveredWhileTheJumpTestHoldsAnotherOut) {
   // Four gyros with the reference, a gyro stuck at the start of an agile slew: with one parity every

@@ -22,9 +22,10 @@ enum class BudgetTest : unsigned char {
   kGlt,                  //!< N ≥ 5: one form of the GLT rejecting a true single-gyro hypothesis
   kReferenceCheck,       //!< each consistency test of the reference (per sample)
   kReferenceNoiseMatch,  //!< three gyros: the reference noise match (per sample)
-  kReferenceGate         //!< the filter's 3-dof gate leaving out a good reference sample (per sample)
+  kReferenceGate,        //!< the filter's 3-dof gate leaving out a good reference sample (per sample)
+  kReferenceBiasMatch  //!< a common drift in the reference's innovations, its bias model opened (per sample)
 };
-constexpr int kBudgetTestCount = 8;
+constexpr int kBudgetTestCount = 9;
 
 //! One row of the allocation: a test's share of false_alarm_probability, and why.
 struct Allocation {

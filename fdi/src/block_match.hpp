@@ -1,0 +1,33 @@
+#pragma once
+// The block matches' one CUSUM (parity_bias_match.hpp, reference_noise_match.hpp, reference_bias_match.hpp):
+// a block statistic u that is χ²_d while the model holds, against the alternative that the block's covariance
+// is ρ times the predicted. The log-likelihood ratio's CUSUM,
+//
+//   g ← max(0, g + ½·((1 − 1/ρ)·u − d·ln ρ)),
+//
+// has by Wald's bound a mean run length of at least e^h blocks without such an error at the threshold h;
+// each match sets h = ln(1/(p·n)) from its budget share p per sample and the block's n samples.
+
+#include <algorithm>
+#include <cmath>
+
+namespace tetra::fdi::detail {
+
+//! ρ: the matches' alternative, the block's covariance ×4.
+inline constexpr double kBlockMatchRatio = 4.0;
+//! [s] the reference matches' block of the mean innovation.
+inline constexpr double kReferenceBlock_s = 10.0;
+//! γ: a matched ratio's step per block, ×e^{γ(u/d − 1)}.
+inline constexpr double kBlockMatchGain = 0.3;
+
+//! The CUSUM `g` after a block whose statistic `u` has `dof` degrees of freedom under the model.
+inline double block_cusum_step(double g, double u, double dof) {
+  return std::max(0.0, g + 0.5 * ((1.0 - 1.0 / kBlockMatchRatio) * u - dof * std::log(kBlockMatchRatio)));
+}
+
+//! The threshold h = ln(1/(p·n)) for `per_block` = p·n (p per sample, n the block's samples), at least ln 2.
+inline double block_cusum_threshold(double per_block) {
+  return -std::log(std::min(per_block, 0.5));
+}
+
+}  // namespace tetra::fdi::detail

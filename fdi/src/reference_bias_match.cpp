@@ -1,0 +1,87 @@
+#include "reference_bias_match.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "block_match.hpp"
+#include "mekf.hpp"
+#include "tetra/core/allan_stats.hpp"
+#include "tetra/fdi/budget.hpp"
+
+namespace tetra::fdi::detail {
+
+ReferenceBiasMatch::ReferenceBiasMatch(const PipelineConfig& config)
+    : threshold_(
+          allan::chi2_quantile(1.0 - allocated_probability(config, BudgetTest::kReferenceBiasMatch), 3.0)),
+      bias_window_ns_(seconds_to_ns(config.reference_bias_window_s)),
+      long_window_ns_(seconds_to_ns(kLongWindows * config.reference_bias_window_s)) {}
+
+void ReferenceBiasMatch::reset() {
+  restart();
+  matched_ = false;
+  ratio_ = 1.0;
+  last_match_ns_ = -1;
+}
+
+void ReferenceBiasMatch::restart() {
+  start_ns_ = -1;
+  sw_.setZero();
+  swz_.setZero();
+}
+
+std::optional<DriftFinding> ReferenceBiasMatch::observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
+                                                        const Eigen::Matrix3d& S, GyroMask active,
+                                                        Mekf& filter) {
+  if (start_ns_ < 0 || now_ns - start_ns_ > long_window_ns_) {  // consecutive windows, as the bias test's
+    restart();
+    start_ns_ = now_ns;
+  }
+  const Eigen::Vector3d w = S.diagonal().cwiseInverse();
+  sw_ += w;
+  swz_ += w.cwiseProduct(z_rad);
+  const double statistic = swz_.cwiseProduct(swz_).cwiseQuotient(sw_).sum();
+  if (!(statistic > threshold_) || !may_explain(now_ns)) return std::nullopt;
+  const Eigen::Vector3d mean_rad = swz_.cwiseQuotient(sw_);
+  const double span_s = ns_to_seconds(now_ns - start_ns_);
+  if (!plausible(mean_rad, span_s, active, filter)) return std::nullopt;
+  match_mean(now_ns, mean_rad, span_s, active, filter);
+  restart();
+  return DriftFinding{statistic, threshold_, ratio_};
+}
+
+double ReferenceBiasMatch::needed_ratio(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
+                                        const Mekf& filter) {
+  if (!(span_s > 0.0)) return std::numeric_limits<double>::infinity();
+  const double rate_rad_s = 2.0 * mean_rad.norm() / span_s;
+  const double walk = kBlockMatchRatio * rate_rad_s * rate_rad_s / span_s;  // [rad²/s³], ρ·|b|²/T
+  double smallest = std::numeric_limits<double>::infinity();
+  for (int id = 1; id <= filter.gyro_count(); ++id)
+    if (has_gyro(active, id)) smallest = std::min(smallest, wander(filter.noise_model(id)));
+  const double ratio = walk / smallest;
+  return smallest > 0.0 && std::isfinite(ratio) ? ratio : std::numeric_limits<double>::infinity();
+}
+
+void ReferenceBiasMatch::match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s,
+                                    GyroMask active, Mekf& filter) {
+  const double needed = needed_ratio(mean_rad, span_s, active, filter);
+  if (!(needed <= kMaxWanderRatio)) return;
+  last_match_ns_ = now_ns;
+  matched_ = true;
+  ratio_ = std::clamp(needed, kBlockMatchRatio * ratio_, kMaxWanderRatio);
+  open(active, filter);
+}
+
+double ReferenceBiasMatch::wander(const GyroNoiseModel& m) {
+  const double tc = m.gm_correlation_s;
+  return m.rrw_rad_s_rts * m.rrw_rad_s_rts + 2.0 * m.gm_sigma_rad_s * m.gm_sigma_rad_s / tc +
+         m.arw_rad_rts * m.arw_rad_rts / (tc * tc);
+}
+
+void ReferenceBiasMatch::open(GyroMask active, Mekf& filter) const {
+  for (int id = 1; id <= filter.gyro_count(); ++id) {
+    if (has_gyro(active, id)) filter.open_bias_model(id, 0.0, ratio_ * wander(filter.noise_model(id)));
+  }
+}
+
+}  // namespace tetra::fdi::detail

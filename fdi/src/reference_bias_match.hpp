@@ -1,0 +1,97 @@
+#pragma once
+// A common drift below the detectors (docs/fdi.md, "A common drift below the detectors"): every gyro's bias
+// moving together — a warm-up, each gyro following the temperature by its own coefficient — is a body-rate
+// error the parity cannot see (its common part) and the bias model does not expect. With a reference it shows
+// in the innovations as a mean: the filter's attitude error lags the drift. The reference's own bias test
+// (reference_consistency.hpp) sees the same mean over reference_bias_window_s W, and cannot tell a drift of
+// the gyros from a bias of the reference; so, while the gyros vouch for their attitude (parity over the
+// active set, no episode open), the drift is matched first, at a lower level than a rejection — a match opens
+// a model and decides nothing:
+//
+//   mean test  over W (the reference's bias block) and over 4W (here, a slower drift): the weighted mean
+//              innovation's Σ_a (Σ z_a/S_aa)²/Σ 1/S_aa > χ²₃(1 − p_m)
+//
+// (p_m = the budget's kReferenceBiasMatch share per sample). A match opens every active gyro's slow bias c_i
+// to a random walk of K_i² + λ·q_i [rad²/s³] (Mekf::open_bias_model), q_i = K_i² + 2σ_GM,i²/T_c + N_i²/T_c²
+// the model's own wander per second: a body-rate error b = 2·z̄/T grown within the window T is a random walk
+// of |b|²/T, and λ is at least ρ (kBlockMatchRatio) times that over q_i — and at least ρ times its last
+// value, so a drift that goes on opens the model further at every match. A mean that persists within W of a
+// match, the model opened, is the reference's: its bias test rejects it as before. The match is kept (the
+// models only open) until a reset or an exclusion; each match is a noise_model event.
+
+#include <cstdint>
+#include <optional>
+
+#include <Eigen/Core>
+
+#include "tetra/fdi/config.hpp"
+#include "tetra/fdi/types.hpp"
+
+namespace tetra::fdi::detail {
+
+class Mekf;
+struct GyroNoiseModel;
+
+//! A common drift matched at this sample.
+struct DriftFinding {
+  double statistic = 0.0;  //!< [-] the mean test's χ²₃
+  double threshold = 0.0;  //!< [-] χ²₃(1 − p_m)
+  double ratio = 0.0;      //!< [-] λ, the bias random walk's variance over the model's wander q
+};
+
+class ReferenceBiasMatch {
+ public:
+  //! The largest λ: a mean that needs more (a random walk 100 times the model's own wander in σ) is not a
+  //! drift of working gyros but the reference's, and is left to its tests (a warm-up of 5e-6 to 8e-5 deg/s
+  //! over minutes needs up to about 700; a reference's bias of 10–40″ 5e4 in the median).
+  static constexpr double kMaxWanderRatio = 1.0e4;
+  //! The long window, in reference bias windows.
+  static constexpr double kLongWindows = 4.0;
+
+  explicit ReferenceBiasMatch(const PipelineConfig& config);
+
+  void reset();    //!< nothing matched, the window empty
+  void restart();  //!< the window empty (a gap, an episode, a match); what is matched kept
+
+  //! One reference sample the filter uses at `now_ns`, before its update, while the gyros vouch: its
+  //! innovation `z_rad` with covariance `S`, over the gyros of `active`. The long window's mean test; a match
+  //! opens `filter`'s bias models and is returned.
+  std::optional<DriftFinding> observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
+                                      const Eigen::Matrix3d& S, GyroMask active, Mekf& filter);
+  //! The mean `mean_rad` [rad] over `span_s` [s] matched as a drift at `now_ns` (the reference's bias block,
+  //! or the long window): every active gyro's slow bias opened (nothing when it is not plausible).
+  void match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
+                  Mekf& filter);
+  //! Whether a mean at `now_ns` may be matched as a drift: not within reference_bias_window_s of the last
+  //! match (a mean that persists with the model opened is the reference's).
+  bool may_explain(std::int64_t now_ns) const {
+    return last_match_ns_ < 0 || now_ns - last_match_ns_ >= bias_window_ns_;
+  }
+  //! λ·q_i ≥ ρ·|b|²/T: the ratio the mean `mean_rad` over `span_s` needs (+∞ without a span or a wander).
+  static double needed_ratio(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
+                             const Mekf& filter);
+  //! Whether that mean may be a drift of working gyros: its ratio at most kMaxWanderRatio.
+  static bool plausible(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active, const Mekf& filter) {
+    return needed_ratio(mean_rad, span_s, active, filter) <= kMaxWanderRatio;
+  }
+  double threshold() const { return threshold_; }  //!< χ²₃(1 − p_m)
+  bool matched() const { return matched_; }
+  double ratio() const { return ratio_; }
+
+ private:
+  void open(GyroMask active, Mekf& filter) const;  //!< every active gyro's random walk at λ·q_i
+  //! [rad²/s³] q_i, the model's own wander per second: K² + 2σ_GM²/T_c + N²/T_c².
+  static double wander(const GyroNoiseModel& m);
+
+  double threshold_ = 0.0;                         //!< χ²₃(1 − p_m)
+  std::int64_t bias_window_ns_ = 0;                //!< W
+  std::int64_t long_window_ns_ = 0;                //!< 4W
+  std::int64_t start_ns_ = -1;                     //!< the long window's first sample
+  Eigen::Vector3d sw_ = Eigen::Vector3d::Zero();   //!< [1/rad²] per axis Σ 1/S_aa
+  Eigen::Vector3d swz_ = Eigen::Vector3d::Zero();  //!< [1/rad] per axis Σ z_a/S_aa
+  std::int64_t last_match_ns_ = -1;
+  bool matched_ = false;
+  double ratio_ = 1.0;  //!< λ
+};
+
+}  // namespace tetra::fdi::detail
