@@ -366,7 +366,7 @@ namespace {
 
 TEST(SimScenario, ExampleFilesAreValid) {
   for (const char* name : {"examples/sim/orbit_fault.yaml", "examples/sim/slews_custom.yaml",
-                           "examples/sim/static_allan.yaml"}) {
+                           "examples/sim/static_allan.yaml", "examples/sim/warm_up.yaml"}) {
     auto sc = read_scenario(test::source_path(name));
     ASSERT_TRUE(sc.ok()) << name << ": " << sc.error().message;
   }
