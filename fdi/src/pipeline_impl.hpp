@@ -139,6 +139,9 @@ class Pipeline::Impl {
   void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
   void match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
   void emit_drift_matched(double statistic, const char* evidence);
+  //! The bias statistic above which the reference's mean is matched as a common drift (+∞: not now).
+  double drift_threshold(GyroMask active);
+  void match_drift_mean(const ReferenceVerdict& v, GyroMask active);
   void match_own_noise();
   //! The rate solution of the gyros in use when they are exactly three (no parity left), else null.
   const Subset* three_gyros_without_parity();

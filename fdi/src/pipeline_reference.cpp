@@ -65,25 +65,9 @@ void Pipeline::Impl::judge_reference() {
   if (!subsets_.ready() ||
       !attitude_.predict_reference(*frame_.reference_q_RB, frame_.dt_s, subsets_.period_s(), z, S))
     return;
-  // The bias block's mean so far may be matched as a drift only while the gyros vouch, not right after a
-  // match, and when a working unit's drift could be that large.
-  const bool drift_possible =
-      gyros_vouch_ && drift_match_.may_explain(frame_.now_ns) &&
-      ReferenceBiasMatch::plausible(consistency_.bias_mean_rad(), consistency_.bias_span_s(frame_.now_ns),
-                                    active, attitude_.filter());
-  const double drift_threshold =
-      drift_possible ? drift_match_.threshold() : std::numeric_limits<double>::infinity();
-  const ReferenceVerdict v =
-      consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_, drift_threshold);
-  if (v.drift) {
-    // A mean innovation with the gyros consistent: the reference's bias or the gyros' common drift, which the
-    // parity cannot see. The drift is matched first — the gyros' bias model opened by what the test saw —
-    // and the reference rejected only if its mean persists (docs/fdi.md, "A common drift below the
-    // detectors").
-    drift_match_.match_mean(frame_.now_ns, v.bias_mean_rad, v.bias_span_s, active, attitude_.filter());
-    drift_match_.restart();
-    emit_drift_matched(consistency_.drift_check().statistic, "the reference's mean innovation");
-  }
+  const ReferenceVerdict v = consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_,
+                                                  drift_threshold(active));
+  if (v.drift) match_drift_mean(v, active);
   reference_usable_ = v.use;
   // The σ the sample is used with: the configured one, or the re-estimated noise (an operator's reset judges
   // the reference afresh, from the configured σ).
@@ -152,6 +136,26 @@ void Pipeline::Impl::match_three_gyro_noise(const Eigen::Vector3d& z, const Eige
   result_.events.back().detail = "attitude reference innovations along gyro " + std::to_string(found->gyro) +
                                  "'s rate axis exceed the model (noise or ramp); three gyros: its noise in "
                                  "the filter matched to the innovations, sigma widened";
+}
+
+double Pipeline::Impl::drift_threshold(GyroMask active) {
+  // The bias block's mean so far may be matched as a drift only while the gyros vouch, not right after a
+  // match, and when a working unit's drift could be that large.
+  const bool possible =
+      gyros_vouch_ && drift_match_.may_explain(frame_.now_ns) &&
+      ReferenceBiasMatch::plausible(consistency_.bias_mean_rad(), consistency_.bias_span_s(frame_.now_ns),
+                                    active, attitude_.filter());
+  return possible ? drift_match_.threshold() : std::numeric_limits<double>::infinity();
+}
+
+void Pipeline::Impl::match_drift_mean(const ReferenceVerdict& v, GyroMask active) {
+  // A mean innovation with the gyros consistent: the reference's bias or the gyros' common drift, which the
+  // parity cannot see. The drift is matched first — the gyros' bias model opened by what the test saw — and
+  // the reference rejected only if its mean persists (docs/fdi.md, "A common drift below the detectors").
+  // (A mean that grew beyond a working unit's drift with this very sample opens nothing and says nothing.)
+  drift_match_.restart();
+  if (drift_match_.match_mean(frame_.now_ns, v.bias_mean_rad, v.bias_span_s, active, attitude_.filter()))
+    emit_drift_matched(consistency_.drift_check().statistic, "the reference's mean innovation");
 }
 
 void Pipeline::Impl::match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {

@@ -62,14 +62,15 @@ double ReferenceBiasMatch::needed_ratio(const Eigen::Vector3d& mean_rad, double 
   return smallest > 0.0 && std::isfinite(ratio) ? ratio : std::numeric_limits<double>::infinity();
 }
 
-void ReferenceBiasMatch::match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s,
+bool ReferenceBiasMatch::match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s,
                                     GyroMask active, Mekf& filter) {
   const double needed = needed_ratio(mean_rad, span_s, active, filter);
-  if (!(needed <= kMaxWanderRatio)) return;
+  if (!(needed <= kMaxWanderRatio)) return false;
   last_match_ns_ = now_ns;
   matched_ = true;
   ratio_ = std::clamp(needed, kBlockMatchRatio * ratio_, kMaxWanderRatio);
   open(active, filter);
+  return true;
 }
 
 double ReferenceBiasMatch::wander(const GyroNoiseModel& m) {

@@ -59,8 +59,9 @@ class ReferenceBiasMatch {
   std::optional<DriftFinding> observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
                                       const Eigen::Matrix3d& S, GyroMask active, Mekf& filter);
   //! The mean `mean_rad` [rad] over `span_s` [s] matched as a drift at `now_ns` (the reference's bias block,
-  //! or the long window): every active gyro's slow bias opened (nothing when it is not plausible).
-  void match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
+  //! or the long window): every active gyro's slow bias opened; false (nothing opened) when it is not
+  //! plausible.
+  bool match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
                   Mekf& filter);
   //! Whether a mean at `now_ns` may be matched as a drift: not within reference_bias_window_s of the last
   //! match (a mean that persists with the model opened is the reference's).
