@@ -138,7 +138,7 @@ class Pipeline::Impl {
   void withdraw_reference_rejection();
   void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
   void match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
-  void emit_drift_matched(double statistic, const char* evidence);
+  void emit_drift_matched(double statistic, double threshold, const char* evidence);
   //! The bias statistic above which the reference's mean is matched as a common drift (+∞: not now).
   double drift_threshold(GyroMask active);
   void match_drift_mean(const ReferenceVerdict& v, GyroMask active);

@@ -155,7 +155,8 @@ void Pipeline::Impl::match_drift_mean(const ReferenceVerdict& v, GyroMask active
   // (A mean that grew beyond a working unit's drift with this very sample opens nothing and says nothing.)
   drift_match_.restart();
   if (drift_match_.match_mean(frame_.now_ns, v.bias_mean_rad, v.bias_span_s, active, attitude_.filter()))
-    emit_drift_matched(consistency_.drift_check().statistic, "the reference's mean innovation");
+    emit_drift_matched(consistency_.drift_check().statistic, consistency_.drift_check().threshold,
+                       "the reference's mean innovation");
 }
 
 void Pipeline::Impl::match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {
@@ -168,15 +169,21 @@ void Pipeline::Impl::match_common_drift(const Eigen::Vector3d& z, const Eigen::M
   }
   if (const auto found = drift_match_.observe(frame_.now_ns, z, S, gyro_set_.active(), attitude_.filter())) {
     consistency_.restart_bias_block(frame_.now_ns);
-    emit_drift_matched(found->statistic, "the reference's mean innovation over four bias windows");
+    emit_drift_matched(found->statistic, found->threshold,
+                       "the reference's mean innovation over four bias windows");
   }
 }
 
-void Pipeline::Impl::emit_drift_matched(double statistic, const char* evidence) {
+void Pipeline::Impl::emit_drift_matched(double statistic, double threshold, const char* evidence) {
   FdiEvent e;
   e.stamp_ns = frame_.now_ns;
   e.type = EventType::kNoiseModel;
   e.statistic = statistic;
+  // Its rows: the model (H0) rejected by the mean at the match's level; the reference's fault (Href) no call
+  // — a drift of the gyros shows the same mean.
+  const auto src = EvidenceSource::kReferenceTest;
+  e.ledger.push_back(judge(src, kHypothesisNone, statistic, threshold, threshold, 3));
+  e.ledger.push_back(stated(src, kHypothesisReference, RowVerdict::kNoCall, statistic, threshold, 3));
   char text[320];
   std::snprintf(
       text, sizeof text,

@@ -40,7 +40,7 @@ std::optional<DriftFinding> ReferenceBiasMatch::observe(std::int64_t now_ns, con
   const Eigen::Vector3d w = S.diagonal().cwiseInverse();
   sw_ += w;
   swz_ += w.cwiseProduct(z_rad);
-  const double statistic = swz_.cwiseProduct(swz_).cwiseQuotient(sw_).sum();
+  const double statistic = mean_innovation_chi2(sw_, swz_);
   if (!(statistic > threshold_) || !may_explain(now_ns)) return std::nullopt;
   const Eigen::Vector3d mean_rad = swz_.cwiseQuotient(sw_);
   const double span_s = ns_to_seconds(now_ns - start_ns_);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "block_match.hpp"
 #include "tetra/core/allan_stats.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/budget.hpp"
@@ -132,8 +133,7 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
     failed_ = {block_nis_, chi2_upper_wh(dof, z_tail_), static_cast<int>(dof)};
     return ReferenceCheck::kNis;
   }
-  double bias = 0.0;
-  for (int a = 0; a < 3; ++a) bias += bias_swz_[a] * bias_swz_[a] / bias_sw_[a];
+  const double bias = mean_innovation_chi2(bias_sw_, bias_swz_);
   failed_ = {bias, jump_chi2_, 3};
   bias_statistic_ = bias;
   if (bias > jump_chi2_) return ReferenceCheck::kBias;
@@ -181,66 +181,72 @@ bool ReferenceConsistency::reestimate_noise(std::int64_t now_ns, const Eigen::Ve
 ReferenceVerdict ReferenceConsistency::observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
                                                const Eigen::Matrix3d& S, const Eigen::Vector3d& omega_rad_s,
                                                bool judge, double drift_threshold) {
-  ReferenceVerdict v;
   const double nis = z_rad.dot(S.ldlt().solve(z_rad));
   const Eigen::Vector3d w = S.diagonal().cwiseInverse();
   const Eigen::Vector3d used_excess = szz_ - sss_;  // Σz² − ΣS_aa of the samples used in the block
   const int used_count = block_start_ns_ < 0 ? 0 : block_count_;
   bias_statistic_ = 0.0;
   const std::optional<ReferenceCheck> failed = test(now_ns, z_rad, w, nis, omega_rad_s);
-  if (state_ != ReferenceState::kRejected) {
-    state_ = ReferenceState::kAccepted;
-    if ((!failed || *failed == ReferenceCheck::kBias) && judge && bias_statistic_ > drift_threshold) {
-      // The gyros vouch, and a drift of their common bias (which their parity cannot see) shows the same mean
-      // innovation: the caller opens their bias model — at the match's level, below the rejection's, since a
-      // match decides nothing — and the sample is used; the bias block starts afresh.
-      v.drift = true;
-      v.bias_mean_rad = bias_mean_rad();
-      v.bias_span_s = ns_to_seconds(now_ns - bias_start_ns_);
-      drift_check_ = {bias_statistic_, drift_threshold, 3};
-      restart_bias_block(now_ns);
-      szz_ += z_rad.cwiseProduct(z_rad);
-      sss_ += S.diagonal();
-      return v;
-    }
-    if (!failed) {
-      szz_ += z_rad.cwiseProduct(z_rad);
-      sss_ += S.diagonal();
-      return v;
-    }
-    if (!judge) {
-      v.inconsistent = failed;
-      restart_blocks(now_ns);  // reported once per failure, then judged afresh
-      return v;
-    }
-    // Rejected: what the samples used in this block may have put in the attitude beyond what the filter
-    // assumed is their innovations' second moment beyond the predicted one.
-    if (used_count > 0) v.contamination_rad2 = (used_excess / used_count).cwiseMax(0.0);
-    if (*failed == ReferenceCheck::kLag)
-      v.contamination_rad2 += lag_offset_rad_.cwiseProduct(lag_offset_rad_);
-    state_ = ReferenceState::kRejected;
-    v.use = false;
-    v.rejected = failed;
-    rejected_lag_s_ = *failed == ReferenceCheck::kLag ? std::abs(lag_s_) : 0.0;
-    rejected_for_nis_ = *failed == ReferenceCheck::kNis;
-    noise_start_ns_ = now_ns;
-    noise_sum_.setZero();
-    noise_sum_sq_.setZero();
-    noise_count_ = 0;
-    have_last_z_ = false;
-    noise_explained_ = false;
-    restart_blocks(now_ns);
-    consistent_since_ns_ = now_ns + 1;  // from the next sample on
+  if (state_ == ReferenceState::kRejected) return judge_rejected(now_ns, z_rad, S, failed);
+  state_ = ReferenceState::kAccepted;
+  ReferenceVerdict v;
+  if ((!failed || *failed == ReferenceCheck::kBias) && judge && bias_statistic_ > drift_threshold) {
+    // The gyros vouch, and a drift of their common bias (which their parity cannot see) shows the same mean
+    // innovation: the caller opens their bias model — at the match's level, below the rejection's, since a
+    // match decides nothing — and the sample is used; the bias block starts afresh.
+    v.drift = true;
+    v.bias_mean_rad = bias_mean_rad();
+    v.bias_span_s = ns_to_seconds(now_ns - bias_start_ns_);
+    drift_check_ = {bias_statistic_, drift_threshold, 3};
+    restart_bias_block(now_ns);
+    add_used(z_rad, S);
     return v;
   }
+  if (!failed) {
+    add_used(z_rad, S);
+    return v;
+  }
+  if (!judge) {
+    v.inconsistent = failed;
+    restart_blocks(now_ns);  // reported once per failure, then judged afresh
+    return v;
+  }
+  // Rejected: what the samples used in this block may have put in the attitude beyond what the filter
+  // assumed is their innovations' second moment beyond the predicted one.
+  if (used_count > 0) v.contamination_rad2 = (used_excess / used_count).cwiseMax(0.0);
+  if (*failed == ReferenceCheck::kLag) v.contamination_rad2 += lag_offset_rad_.cwiseProduct(lag_offset_rad_);
   v.use = false;
-  if (rejected_for_nis_ && reestimate_noise(now_ns, z_rad)) {
-    // Judged again from the next sample on, against the new σ.
-    restart_blocks(now_ns);
-    consistent_since_ns_ = now_ns + 1;
-    return v;
-  }
-  if (failed) {
+  v.rejected = failed;
+  reject(now_ns, *failed);
+  return v;
+}
+
+void ReferenceConsistency::add_used(const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S) {
+  szz_ += z_rad.cwiseProduct(z_rad);
+  sss_ += S.diagonal();
+}
+
+void ReferenceConsistency::reject(std::int64_t now_ns, ReferenceCheck why) {
+  state_ = ReferenceState::kRejected;
+  rejected_lag_s_ = why == ReferenceCheck::kLag ? std::abs(lag_s_) : 0.0;
+  rejected_for_nis_ = why == ReferenceCheck::kNis;
+  noise_start_ns_ = now_ns;
+  noise_sum_.setZero();
+  noise_sum_sq_.setZero();
+  noise_count_ = 0;
+  have_last_z_ = false;
+  noise_explained_ = false;
+  restart_blocks(now_ns);
+  consistent_since_ns_ = now_ns + 1;  // from the next sample on
+}
+
+ReferenceVerdict ReferenceConsistency::judge_rejected(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
+                                                      const Eigen::Matrix3d& S,
+                                                      const std::optional<ReferenceCheck>& failed) {
+  ReferenceVerdict v;
+  v.use = false;
+  if ((rejected_for_nis_ && reestimate_noise(now_ns, z_rad)) || failed) {
+    // Judged again from the next sample on (after a new noise estimate, against the new σ).
     restart_blocks(now_ns);
     consistent_since_ns_ = now_ns + 1;
     return v;

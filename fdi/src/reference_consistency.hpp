@@ -99,6 +99,13 @@ class ReferenceConsistency {
   std::optional<ReferenceCheck> test(std::int64_t now_ns, const Eigen::Vector3d& z, const Eigen::Vector3d& w,
                                      double nis, const Eigen::Vector3d& omega);
   void restart_blocks(std::int64_t now_ns);
+  //! A sample used: its innovation's second moment against the predicted one, into the block.
+  void add_used(const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S);
+  //! Rejected at `now_ns` for `why`: the noise estimate and the blocks start afresh.
+  void reject(std::int64_t now_ns, ReferenceCheck why);
+  //! A sample while rejected: left out, or used again once every test passed for a block.
+  ReferenceVerdict judge_rejected(std::int64_t now_ns, const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S,
+                                  const std::optional<ReferenceCheck>& failed);
   //! Rejected for `nis`: this sample into the noise estimate; true when a block's estimate raised sigma_rad_.
   bool reestimate_noise(std::int64_t now_ns, const Eigen::Vector3d& z);
 
