@@ -22,31 +22,74 @@ void EvidenceRows::detection(EvidenceSource source, double statistic, double thr
 
 namespace tetra::fdi {
 
-int arbitrate(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active, bool reference_exists) {
-  // Per hypothesis: did any row reject it, did any row find it consistent.
-  std::array<bool, kMaxGyros + 2> rejected{};
-  std::array<bool, kMaxGyros + 2> consistent{};
-  const auto slot = [](std::uint8_t h) {
-    return h == kHypothesisReference ? kMaxGyros + 1 : static_cast<int>(h);
-  };
-  for (const LedgerRow* row_it = begin; row_it != end; ++row_it) {
-    const LedgerRow& row = *row_it;
-    const int s = slot(row.hypothesis);
-    if (s > kMaxGyros + 1) continue;
-    rejected[static_cast<std::size_t>(s)] |= row.verdict == RowVerdict::kRejected;
-    consistent[static_cast<std::size_t>(s)] |= row.verdict == RowVerdict::kConsistent;
+namespace {
+
+//! Per hypothesis: whether any row rejected it, whether any row found it consistent.
+struct Tally {
+  static constexpr int kReference = kMaxGyros + 1;
+  static constexpr int kDrift = kMaxGyros + 2;
+  std::array<bool, kMaxGyros + 3> rejected{};
+  std::array<bool, kMaxGyros + 3> consistent{};
+
+  Tally(const LedgerRow* begin, const LedgerRow* end) {
+    for (const LedgerRow* row = begin; row != end; ++row) {
+      const int s = slot(row->hypothesis);
+      if (s < 0) continue;
+      rejected[static_cast<std::size_t>(s)] |= row->verdict == RowVerdict::kRejected;
+      consistent[static_cast<std::size_t>(s)] |= row->verdict == RowVerdict::kConsistent;
+    }
   }
-  if (!rejected[0]) return 0;  // no fault shown
-  if (reference_exists && !rejected[static_cast<std::size_t>(kMaxGyros + 1)]) return 0;
+  static int slot(std::uint8_t h) {
+    if (h == kHypothesisReference) return kReference;
+    if (h == kHypothesisDrift) return kDrift;
+    return h <= kMaxGyros ? static_cast<int>(h) : -1;
+  }
+  bool is_rejected(int s) const { return rejected[static_cast<std::size_t>(s)]; }
+  //! Consistent: some row says so and none rejects it.
+  bool stands(int s) const { return consistent[static_cast<std::size_t>(s)] && !is_rejected(s); }
+  bool every_gyro_rejected(std::uint32_t active) const {
+    for (int j = 1; j <= kMaxGyros; ++j)
+      if (has_gyro(active, j) && !is_rejected(j)) return false;
+    return true;
+  }
+};
+
+}  // namespace
+
+int arbitrate(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active, bool reference_exists) {
+  const Tally t(begin, end);
+  if (!t.is_rejected(0)) return 0;  // no fault shown
+  if (reference_exists && !t.is_rejected(Tally::kReference)) return 0;
   int standing = 0;
   for (int j = 1; j <= kMaxGyros; ++j) {
-    if (!has_gyro(active, j)) continue;
-    const auto u = static_cast<std::size_t>(j);
-    if (rejected[u]) continue;
-    if (!consistent[u] || standing != 0) return 0;  // no call on Hj, or a second hypothesis standing
+    if (!has_gyro(active, j) || t.is_rejected(j)) continue;
+    if (!t.consistent[static_cast<std::size_t>(j)] || standing != 0) return 0;  // no call, or a second one
     standing = j;
   }
   return standing;
+}
+
+ReferenceDecision arbitrate_reference(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active) {
+  const Tally t(begin, end);
+  if (!t.is_rejected(0)) return ReferenceDecision::kUse;
+  if (!t.every_gyro_rejected(active)) return ReferenceDecision::kNoCall;
+  if (t.stands(Tally::kDrift)) return ReferenceDecision::kMatchDrift;
+  if (t.stands(Tally::kReference) && t.is_rejected(Tally::kDrift)) return ReferenceDecision::kReject;
+  return ReferenceDecision::kNoCall;
+}
+
+const char* to_string(ReferenceDecision decision) {
+  switch (decision) {
+    case ReferenceDecision::kUse:
+      return "use";
+    case ReferenceDecision::kReject:
+      return "reject";
+    case ReferenceDecision::kMatchDrift:
+      return "match drift";
+    case ReferenceDecision::kNoCall:
+      break;
+  }
+  return "no call";
 }
 
 }  // namespace tetra::fdi

@@ -37,6 +37,9 @@ const EvidenceSourceInfo kEvidenceSources[kEvidenceSourceCount] = {
     {EvidenceSource::kReferenceTest, "reference_test", StatisticUnit::kChi2,
      "the reference's innovations (the failing test: jump, lag, block NIS or bias) against the gyros"},
     {EvidenceSource::kQuiet, "quiet", StatisticUnit::kSeconds, "time since the last alarm of the episode"},
+    {EvidenceSource::kDriftWander, "drift_wander", StatisticUnit::kRatio,
+     "the bias random walk a common drift of the gyros needs for the reference's mean innovation, over the "
+     "model's own wander (working gyros: at most 1e4, and not again within a bias window of a match)"},
 };
 
 const char* to_string(RowVerdict verdict) {
@@ -89,12 +92,13 @@ bool evidence_source_from_string(std::string_view text, EvidenceSource& out) {
 
 std::string hypothesis_name(std::uint8_t hypothesis) {
   if (hypothesis == kHypothesisReference) return "Href";
+  if (hypothesis == kHypothesisDrift) return "Hdrift";
   return "H" + std::to_string(hypothesis);
 }
 
 bool hypothesis_from_string(std::string_view text, std::uint8_t& out) {
-  if (text == "Href") {
-    out = kHypothesisReference;
+  if (text == "Href" || text == "Hdrift") {
+    out = text == "Href" ? kHypothesisReference : kHypothesisDrift;
     return true;
   }
   if (text.size() < 2 || text.size() > 3 || text[0] != 'H') return false;

@@ -164,7 +164,7 @@ void Pipeline::Impl::detect() {
     episode_rows_.clear();
     episode_rows_.detection(source_of(d.test), d.statistic, d.threshold, d.dof);
     emit_detected(d.test, d.statistic, frame_.now_ns, &episode_rows_);
-    withdraw_reference_rejection();
+    reconsider_reference_rejection();
     // The fault acted since its onset: widen the uncertainty for the time already spent.
     attitude_.add_bound(
         fault_rate_bound(subsets_.get(active), detector_.parity_ema(), subsets_.sqrt_period()) *

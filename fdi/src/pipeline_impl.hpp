@@ -130,15 +130,25 @@ class Pipeline::Impl {
   void publish_filter_health() const;
   void update_fdi_available();
   void judge_reference();
-  //! The reference's failing test as rows: H0 rejected, Href `reference` (rejected when the gyros vouch for
-  //! their attitude; no call with three gyros, where the data cannot tell the reference from a gyro), and
-  //! each gyro in use no call then.
-  void reference_rows(RowVerdict reference, std::vector<LedgerRow>& ledger) const;
-  //! A gyro fault just detected may be what had the reference rejected: the rejection is withdrawn.
-  void withdraw_reference_rejection();
+  //! The arbiter's decision on the sample tested (`drift_threshold` the drift match's level, +∞ not now);
+  //! its rows in reference_rows_ unless every test passed.
+  ReferenceDecision decide_reference(const ReferenceEvidence& evidence, double drift_threshold,
+                                     GyroMask active);
+  //! The rows of a sample some test failed (or whose mean reached the drift match's level): H0 rejected,
+  //! Href consistent, Hdrift and each active gyro's hypothesis as the gyros' parity and the test show.
+  void write_reference_rows(const ReferenceEvidence& evidence, double drift_threshold, GyroMask active,
+                            EvidenceRows& rows) const;
+  //! The sample's decision applied: the events, sigma, the reference's σ and the matches.
+  void apply_reference_verdict(const ReferenceVerdict& v, const Eigen::Vector3d& z, const Eigen::Matrix3d& S,
+                               GyroMask active);
+  //! A gyro fault just detected, since before a rejection: the parity's rows of that rejection make no call
+  //! then, and the arbiter judges it again (the reference used again when it no longer stands alone).
+  void reconsider_reference_rejection();
   void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
   void match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
-  void emit_drift_matched(double statistic, double threshold, const char* evidence);
+  //! A noise_model event: `rows` the arbiter's decision's (null: the long window's match, its three rows).
+  void emit_drift_matched(double statistic, double threshold, const char* evidence,
+                          const EvidenceRows* rows = nullptr);
   //! The bias statistic above which the reference's mean is matched as a common drift (+∞: not now).
   double drift_threshold(GyroMask active);
   void match_drift_mean(const ReferenceVerdict& v, GyroMask active);
@@ -210,8 +220,12 @@ class Pipeline::Impl {
   bool reference_usable_ = false;  //!< this epoch's reference sample passed the consistency tests
   bool gyros_vouch_ = false;       //!< this epoch: parity among the gyros used, no episode, rate observable
   std::optional<std::int64_t> reference_set_ns_;  //!< the last time a reference sample set the attitude
-  //! [ns] when the reference was last rejected by a slow test (nis, bias), until it is used again
+  //! [ns] when the reference was last rejected, until it is used again, and the rows that rejected it
   std::optional<std::int64_t> reference_rejected_ns_;
+  EvidenceRows rejection_rows_;
+  EvidenceRows reference_rows_;  //!< the last reference decision's rows
+  //! [-] this sample: the bias wander a common drift would need for the reference's mean (NaN: not judged)
+  double drift_ratio_needed_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace tetra::fdi

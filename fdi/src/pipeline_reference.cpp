@@ -16,15 +16,23 @@ std::string Pipeline::Impl::reaccepted_detail() const {
   return text;
 }
 
-void Pipeline::Impl::withdraw_reference_rejection() {
-  // The reference is judged only while the gyros vouch for their attitude, but a gyro fault grows for a while
-  // below the parity's threshold: its error in the attitude can fail the reference's slow tests (nis, bias)
-  // before the parity detects it. A rejection by those tests after the fault's estimated onset (less one
-  // block of the tests, which it may have filled) is therefore withdrawn at the detection: the reference is
-  // used again, unjudged while the episode is open, and its windows can isolate the gyro (docs/fdi.md).
+void Pipeline::Impl::reconsider_reference_rejection() {
+  // A reference rejected by a slow test (nis, bias) had every gyro's hypothesis rejected by the parity, which
+  // vouched for them; but a gyro fault grows for a while below the parity's threshold, and its error in the
+  // attitude can fail those tests first. A fault detected now whose estimated onset precedes the rejection
+  // (less one block of the tests, which it may have filled) shows the parity's rows of that rejection were
+  // premature: they make no call, and the arbiter judges the rejection again. With a gyro's hypothesis
+  // standing beside Href, the reference is used again, unjudged while the episode is open, and its windows
+  // can isolate the gyro (docs/fdi.md). (A jump's or a lag's rows reject the gyros by the test itself.)
   if (!reference_rejected_ns_ || consistency_.state() != ReferenceState::kRejected) return;
   const std::int64_t block_ns = seconds_to_ns(config_.reference_check_window_s);
   if (*reference_rejected_ns_ < pipeline_time_before_ns(isolator_.episode().onset_ns, block_ns)) return;
+  EvidenceRows rows;
+  for (LedgerRow row : rejection_rows_) {
+    if (row.source == EvidenceSource::kCusum) row.verdict = RowVerdict::kNoCall;
+    rows.add(row);
+  }
+  if (arbitrate_reference(rows.begin(), rows.end(), gyro_set_.active()) == ReferenceDecision::kReject) return;
   consistency_.reopen();
   trend_.stop();
   reference_rejected_ns_.reset();
@@ -32,19 +40,57 @@ void Pipeline::Impl::withdraw_reference_rejection() {
   e.stamp_ns = frame_.now_ns;
   e.type = EventType::kReferenceAccepted;
   e.detail = "attitude reference used again: a gyro fault detected since may have caused its rejection";
+  e.ledger.assign(rows.begin(), rows.end());
   emit(std::move(e));
 }
 
-void Pipeline::Impl::reference_rows(RowVerdict reference, std::vector<LedgerRow>& ledger) const {
-  const auto& c = consistency_.failed_check();
+ReferenceDecision Pipeline::Impl::decide_reference(const ReferenceEvidence& evidence, double drift_threshold,
+                                                   GyroMask active) {
+  const bool mean = !evidence.failed || *evidence.failed == ReferenceCheck::kBias;
+  if (!evidence.failed && !(mean && evidence.bias_statistic > drift_threshold))
+    return ReferenceDecision::kUse;  // every test passed: H0 stands (no rows)
+  reference_rows_.clear();
+  write_reference_rows(evidence, drift_threshold, active, reference_rows_);
+  return arbitrate_reference(reference_rows_.begin(), reference_rows_.end(), active);
+}
+
+void Pipeline::Impl::write_reference_rows(const ReferenceEvidence& evidence, double drift_threshold,
+                                          GyroMask active, EvidenceRows& rows) const {
   const auto src = EvidenceSource::kReferenceTest;
-  ledger.push_back(judge(src, kHypothesisNone, c.statistic, c.threshold, c.threshold, c.dof));
-  ledger.push_back(stated(src, kHypothesisReference, reference, c.statistic, c.threshold, c.dof));
-  if (reference != RowVerdict::kNoCall) return;
+  const auto& c = consistency_.failed_check();  // the failing test's, or (none failed) the bias test's
+  const bool mean = !evidence.failed || *evidence.failed == ReferenceCheck::kBias;
+  const bool slow = mean || *evidence.failed == ReferenceCheck::kNis;
+  // H0: the failing test rejects it, or the bias test's mean at the drift match's level.
+  if (evidence.failed)
+    rows.add(judge(src, kHypothesisNone, c.statistic, c.threshold, c.threshold, c.dof));
+  else
+    rows.add(judge(src, kHypothesisNone, evidence.bias_statistic, drift_threshold, drift_threshold, 3));
+  // Href: a wrong reference explains whatever failed.
+  rows.add(stated(src, kHypothesisReference, RowVerdict::kConsistent, c.statistic, c.threshold, c.dof));
+  // Hdrift: a drift common to the gyros explains a mean alone (no jump, lag or raised NIS before it), while
+  // the gyros vouch and a working unit's drift could be that large.
+  if (!gyros_vouch_)
+    rows.add(stated(src, kHypothesisDrift, RowVerdict::kNoCall, c.statistic, c.threshold, c.dof));
+  else if (!mean)
+    rows.add(stated(src, kHypothesisDrift, RowVerdict::kRejected, c.statistic, c.threshold, c.dof));
+  else
+    rows.add(
+        stated(EvidenceSource::kDriftWander, kHypothesisDrift,
+               evidence.bias_statistic > drift_threshold ? RowVerdict::kConsistent : RowVerdict::kRejected,
+               drift_ratio_needed_, ReferenceBiasMatch::kMaxWanderRatio));
+  // Each gyro's: no call unless the gyros vouch; then rejected by the parity for a slow test's evidence (a
+  // gyro's fault that moved the attitude so far would have shown in it) and by the test itself for a jump or
+  // a lag (a gyro's fault below the parity's threshold is neither).
   for (int id = 1; id <= n_; ++id) {
-    if (gyro_set_.is_excluded(id)) continue;
-    ledger.push_back(
-        stated(src, static_cast<std::uint8_t>(id), RowVerdict::kNoCall, c.statistic, c.threshold, c.dof));
+    if (!has_gyro(active, id)) continue;
+    const auto h = static_cast<std::uint8_t>(id);
+    if (!gyros_vouch_)
+      rows.add(stated(src, h, RowVerdict::kNoCall, c.statistic, c.threshold, c.dof));
+    else if (slow)
+      rows.add(
+          stated(EvidenceSource::kCusum, h, RowVerdict::kRejected, health_.cusum, health_.cusum_threshold));
+    else
+      rows.add(stated(src, h, RowVerdict::kRejected, c.statistic, c.threshold, c.dof));
   }
 }
 
@@ -65,8 +111,12 @@ void Pipeline::Impl::judge_reference() {
   if (!subsets_.ready() ||
       !attitude_.predict_reference(*frame_.reference_q_RB, frame_.dt_s, subsets_.period_s(), z, S))
     return;
-  const ReferenceVerdict v = consistency_.observe(frame_.now_ns, z, S, attitude_.omega_BR_B(), gyros_vouch_,
-                                                  drift_threshold(active));
+  // The tests write the evidence, the arbiter decides, the reference's state follows.
+  const double drift_level = drift_threshold(active);
+  const ReferenceEvidence evidence = consistency_.test_sample(frame_.now_ns, z, S, attitude_.omega_BR_B());
+  const ReferenceDecision decision =
+      consistency_.judged() ? decide_reference(evidence, drift_level, active) : ReferenceDecision::kUse;
+  const ReferenceVerdict v = consistency_.decide(frame_.now_ns, z, S, evidence, decision, drift_level);
   if (v.drift) match_drift_mean(v, active);
   reference_usable_ = v.use;
   // The σ the sample is used with: the configured one, or the re-estimated noise (an operator's reset judges
@@ -74,10 +124,17 @@ void Pipeline::Impl::judge_reference() {
   attitude_.set_reference_sigma_rad(consistency_.sigma_rad());
   reference_.set_reference_sigma_rad(consistency_.sigma_rad());
   noise_match_.set_reference_sigma_rad(consistency_.sigma_rad());
+  apply_reference_verdict(v, z, S, active);
+  if (v.use) match_three_gyro_noise(z, S);
+  if (v.use) match_common_drift(z, S);
+}
+
+void Pipeline::Impl::apply_reference_verdict(const ReferenceVerdict& v, const Eigen::Vector3d& z,
+                                             const Eigen::Matrix3d& S, GyroMask active) {
   if (v.rejected) {
     trend_.start(frame_.now_ns);
-    const bool slow = *v.rejected == ReferenceCheck::kNis || *v.rejected == ReferenceCheck::kBias;
-    reference_rejected_ns_ = slow ? std::optional<std::int64_t>(frame_.now_ns) : std::nullopt;
+    reference_rejected_ns_ = frame_.now_ns;
+    rejection_rows_ = reference_rows_;
   }
   if (v.reaccepted) reference_rejected_ns_.reset();
   if (v.reaccepted) trend_.stop();
@@ -90,7 +147,7 @@ void Pipeline::Impl::judge_reference() {
     e.statistic = consistency_.windowed_nis();
     e.detail = v.rejected ? "attitude reference inconsistent with the gyros: left out, sigma from the gyros"
                           : reaccepted_detail();
-    if (v.rejected) reference_rows(RowVerdict::kRejected, e.ledger);
+    if (v.rejected) e.ledger.assign(reference_rows_.begin(), reference_rows_.end());
     emit(std::move(e));
   }
   if (v.rejected) {
@@ -105,21 +162,20 @@ void Pipeline::Impl::judge_reference() {
   // carry evidence of a gyro fault.
   if (v.inconsistent && *v.inconsistent != ReferenceCheck::kJump && subsets_.get(active).dof < 1 &&
       !isolator_.episode().active) {
-    // Redundancy exhausted: the reference or one of the gyros used is wrong and nothing tells which. The
-    // reference stays in use (it is the only check left), the fault is reported, and the filter's attitude
-    // and bias states open by what the innovation shows, so the reference can pull both back.
+    // Redundancy exhausted: the reference or one of the gyros used is wrong and nothing tells which (the
+    // arbiter made no call). The reference stays in use (it is the only check left), the fault is reported,
+    // and the filter's attitude and bias states open by what the innovation shows, so the reference can pull
+    // both back.
     emit_detected(DetectionTest::kReference, consistency_.windowed_nis(), frame_.now_ns);
     result_.events.back().why = *v.inconsistent;
     result_.events.back().detail =
         std::string("attitude reference and gyros disagree (") + to_string(*v.inconsistent) +
         "); three gyros: the data cannot tell which, sigma and bias states widened";
-    reference_rows(RowVerdict::kNoCall, result_.events.back().ledger);
+    result_.events.back().ledger.assign(reference_rows_.begin(), reference_rows_.end());
     attitude_.add_variance(z.cwiseProduct(z));
     attitude_.fault_opened(z.norm() / config_.reference_check_window_s);
     noise_match_.match_all(subsets_.get(active).mask);
   }
-  if (v.use) match_three_gyro_noise(z, S);
-  if (v.use) match_common_drift(z, S);
 }
 
 void Pipeline::Impl::match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {
@@ -140,11 +196,14 @@ void Pipeline::Impl::match_three_gyro_noise(const Eigen::Vector3d& z, const Eige
 
 double Pipeline::Impl::drift_threshold(GyroMask active) {
   // The bias block's mean so far may be matched as a drift only while the gyros vouch, not right after a
-  // match, and when a working unit's drift could be that large.
-  const bool possible =
-      gyros_vouch_ && drift_match_.may_explain(frame_.now_ns) &&
-      ReferenceBiasMatch::plausible(consistency_.bias_mean_rad(), consistency_.bias_span_s(frame_.now_ns),
-                                    active, attitude_.filter());
+  // match, and when a working unit's drift could be that large (the ratio it needs: the Hdrift row's).
+  drift_ratio_needed_ = gyros_vouch_
+                            ? ReferenceBiasMatch::needed_ratio(consistency_.bias_mean_rad(),
+                                                               consistency_.bias_span_s(frame_.now_ns),
+                                                               active, attitude_.filter())
+                            : std::numeric_limits<double>::quiet_NaN();
+  const bool possible = gyros_vouch_ && drift_match_.may_explain(frame_.now_ns) &&
+                        drift_ratio_needed_ <= ReferenceBiasMatch::kMaxWanderRatio;
   return possible ? drift_match_.threshold() : std::numeric_limits<double>::infinity();
 }
 
@@ -156,7 +215,7 @@ void Pipeline::Impl::match_drift_mean(const ReferenceVerdict& v, GyroMask active
   drift_match_.restart();
   if (drift_match_.match_mean(frame_.now_ns, v.bias_mean_rad, v.bias_span_s, active, attitude_.filter()))
     emit_drift_matched(consistency_.drift_check().statistic, consistency_.drift_check().threshold,
-                       "the reference's mean innovation");
+                       "the reference's mean innovation", &reference_rows_);
 }
 
 void Pipeline::Impl::match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {
@@ -174,16 +233,23 @@ void Pipeline::Impl::match_common_drift(const Eigen::Vector3d& z, const Eigen::M
   }
 }
 
-void Pipeline::Impl::emit_drift_matched(double statistic, double threshold, const char* evidence) {
+void Pipeline::Impl::emit_drift_matched(double statistic, double threshold, const char* evidence,
+                                        const EvidenceRows* rows) {
   FdiEvent e;
   e.stamp_ns = frame_.now_ns;
   e.type = EventType::kNoiseModel;
   e.statistic = statistic;
-  // Its rows: the model (H0) rejected by the mean at the match's level; the reference's fault (Href) no call
-  // — a drift of the gyros shows the same mean.
+  // Its rows: the arbiter's decision's, or (the long window's match) the model (H0) rejected by the mean at
+  // the match's level, Hdrift and Href consistent — the data cannot tell a drift of the gyros from a
+  // reference's bias; the match is the step that keeps the reference and decides nothing.
   const auto src = EvidenceSource::kReferenceTest;
-  e.ledger.push_back(judge(src, kHypothesisNone, statistic, threshold, threshold, 3));
-  e.ledger.push_back(stated(src, kHypothesisReference, RowVerdict::kNoCall, statistic, threshold, 3));
+  if (rows != nullptr) {
+    e.ledger.assign(rows->begin(), rows->end());
+  } else {
+    e.ledger.push_back(judge(src, kHypothesisNone, statistic, threshold, threshold, 3));
+    e.ledger.push_back(stated(src, kHypothesisDrift, RowVerdict::kConsistent, statistic, threshold, 3));
+    e.ledger.push_back(stated(src, kHypothesisReference, RowVerdict::kConsistent, statistic, threshold, 3));
+  }
   char text[320];
   std::snprintf(
       text, sizeof text,

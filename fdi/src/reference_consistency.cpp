@@ -67,7 +67,8 @@ void ReferenceConsistency::restart_bias_block(std::int64_t now_ns) {
 
 std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, const Eigen::Vector3d& z,
                                                          const Eigen::Vector3d& w, double nis,
-                                                         const Eigen::Vector3d& omega) {
+                                                         const Eigen::Vector3d& omega,
+                                                         double& bias_statistic) {
   // Blocks: a new one when the last has run its length (the sample opens the next).
   if (block_start_ns_ < 0 || now_ns - block_start_ns_ > seconds_to_ns(config_.reference_check_window_s)) {
     if (block_start_ns_ >= 0) reaccept_den_ += lag_den_;
@@ -135,7 +136,7 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
   }
   const double bias = mean_innovation_chi2(bias_sw_, bias_swz_);
   failed_ = {bias, jump_chi2_, 3};
-  bias_statistic_ = bias;
+  bias_statistic = bias;
   if (bias > jump_chi2_) return ReferenceCheck::kBias;
   return std::nullopt;
 }
@@ -178,46 +179,58 @@ bool ReferenceConsistency::reestimate_noise(std::int64_t now_ns, const Eigen::Ve
   return grew;
 }
 
-ReferenceVerdict ReferenceConsistency::observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
-                                               const Eigen::Matrix3d& S, const Eigen::Vector3d& omega_rad_s,
-                                               bool judge, double drift_threshold) {
+ReferenceEvidence ReferenceConsistency::test_sample(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
+                                                    const Eigen::Matrix3d& S,
+                                                    const Eigen::Vector3d& omega_rad_s) {
   const double nis = z_rad.dot(S.ldlt().solve(z_rad));
   const Eigen::Vector3d w = S.diagonal().cwiseInverse();
-  const Eigen::Vector3d used_excess = szz_ - sss_;  // Σz² − ΣS_aa of the samples used in the block
-  const int used_count = block_start_ns_ < 0 ? 0 : block_count_;
-  bias_statistic_ = 0.0;
-  const std::optional<ReferenceCheck> failed = test(now_ns, z_rad, w, nis, omega_rad_s);
-  if (state_ == ReferenceState::kRejected) return judge_rejected(now_ns, z_rad, S, failed);
+  ReferenceEvidence e;
+  e.used_excess_rad2 = szz_ - sss_;  // before the sample (which may open the next block)
+  e.used_count = block_start_ns_ < 0 ? 0 : block_count_;
+  e.failed = test(now_ns, z_rad, w, nis, omega_rad_s, e.bias_statistic);
+  return e;
+}
+
+ReferenceVerdict ReferenceConsistency::decide(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
+                                              const Eigen::Matrix3d& S, const ReferenceEvidence& evidence,
+                                              ReferenceDecision decision, double drift_threshold) {
+  if (state_ == ReferenceState::kRejected) return judge_rejected(now_ns, z_rad, S, evidence.failed);
   state_ = ReferenceState::kAccepted;
   ReferenceVerdict v;
-  if ((!failed || *failed == ReferenceCheck::kBias) && judge && bias_statistic_ > drift_threshold) {
-    // The gyros vouch, and a drift of their common bias (which their parity cannot see) shows the same mean
-    // innovation: the caller opens their bias model — at the match's level, below the rejection's, since a
-    // match decides nothing — and the sample is used; the bias block starts afresh.
-    v.drift = true;
-    v.bias_mean_rad = bias_mean_rad();
-    v.bias_span_s = ns_to_seconds(now_ns - bias_start_ns_);
-    drift_check_ = {bias_statistic_, drift_threshold, 3};
-    restart_bias_block(now_ns);
-    add_used(z_rad, S);
-    return v;
+  switch (decision) {
+    case ReferenceDecision::kMatchDrift:
+      // The caller opens the gyros' bias model — at the match's level, below the rejection's, since a match
+      // decides nothing — and the sample is used; the bias block starts afresh.
+      v.drift = true;
+      v.bias_mean_rad = bias_mean_rad();
+      v.bias_span_s = ns_to_seconds(now_ns - bias_start_ns_);
+      drift_check_ = {evidence.bias_statistic, drift_threshold, 3};
+      restart_bias_block(now_ns);
+      add_used(z_rad, S);
+      return v;
+    case ReferenceDecision::kUse:
+      add_used(z_rad, S);
+      return v;
+    case ReferenceDecision::kNoCall:
+      v.inconsistent = evidence.failed;
+      restart_blocks(now_ns);  // reported once per failure, then judged afresh
+      return v;
+    case ReferenceDecision::kReject:
+      break;
   }
-  if (!failed) {
+  if (!evidence.failed) {  // (rows that reject without a failed test: none are written; used as it is)
     add_used(z_rad, S);
-    return v;
-  }
-  if (!judge) {
-    v.inconsistent = failed;
-    restart_blocks(now_ns);  // reported once per failure, then judged afresh
     return v;
   }
   // Rejected: what the samples used in this block may have put in the attitude beyond what the filter
   // assumed is their innovations' second moment beyond the predicted one.
-  if (used_count > 0) v.contamination_rad2 = (used_excess / used_count).cwiseMax(0.0);
-  if (*failed == ReferenceCheck::kLag) v.contamination_rad2 += lag_offset_rad_.cwiseProduct(lag_offset_rad_);
+  if (evidence.used_count > 0)
+    v.contamination_rad2 = (evidence.used_excess_rad2 / evidence.used_count).cwiseMax(0.0);
+  if (*evidence.failed == ReferenceCheck::kLag)
+    v.contamination_rad2 += lag_offset_rad_.cwiseProduct(lag_offset_rad_);
   v.use = false;
-  v.rejected = failed;
-  reject(now_ns, *failed);
+  v.rejected = evidence.failed;
+  reject(now_ns, *evidence.failed);
   return v;
 }
 

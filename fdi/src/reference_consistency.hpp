@@ -12,11 +12,11 @@
 // tests' of reference_check_window_s, the bias test's of reference_bias_window_s), each test evaluated at
 // every sample over its block so far. Without a gyro fault the innovations are white with covariance S (the
 // filter's model), so each statistic has the stated distribution; what a fault of the reference does to them
-// is in docs/fdi.md. A reference is judged only while the gyro solution is consistent (the caller's `judge`):
-// parity among the gyros used and no fault episode open. Then a failed test rejects the reference: its
-// samples are no longer used (sigma grows with the gyro propagation) until they pass every test for one
-// block, reference_check_window_s. Without judging, a failed test is reported (`inconsistent`) and nothing
-// else changes.
+// is in docs/fdi.md. The tests decide nothing: the caller writes their ledger rows and the arbiter decides
+// (arbitrate_reference: rejected only while the gyros' parity rejects every single-gyro hypothesis and a
+// common drift is ruled out). A rejected reference's samples are no longer used (sigma grows with the gyro
+// propagation) until they pass every test for one block, reference_check_window_s. With no call, a failed
+// test is reported (`inconsistent`) and nothing else changes.
 // A reference rejected for `nis` alone is noisier than configured: while rejected, its noise is re-estimated
 // from the differences of its successive innovations (at their upper confidence bound, once a block, when
 // the lower bound shows it noisier than configured); at most reference_noise_max_factor × the configured σ,
@@ -29,22 +29,32 @@
 #include <Eigen/Core>
 
 #include "tetra/fdi/config.hpp"
+#include "tetra/fdi/ledger.hpp"
 #include "tetra/fdi/types.hpp"
 
 namespace tetra::fdi::detail {
 
-//! What one reference sample's tests said.
+//! What one sample's tests show, before anything is decided: the evidence the ledger's rows are written from.
+struct ReferenceEvidence {
+  std::optional<ReferenceCheck> failed;  //!< the first test that failed over the blocks, or none
+  double bias_statistic = 0.0;           //!< the bias test's χ²₃ at this sample (0 when not reached)
+  //! [rad²] per axis Σz² − ΣS_aa of the samples used in the nis block before this sample, and their count
+  Eigen::Vector3d used_excess_rad2 = Eigen::Vector3d::Zero();
+  int used_count = 0;
+};
+
+//! What the sample's decision did.
 struct ReferenceVerdict {
   bool use = true;                         //!< the sample may update the filter and the reference windows
   std::optional<ReferenceCheck> rejected;  //!< the reference was rejected at this sample, and why
   bool reaccepted = false;                 //!< the reference is used again from this sample on
-  //! A test failed while the gyros could not be judged (no parity or an open episode): the reference or a
-  //! gyro is wrong, and the data cannot tell which.
+  //! A test failed and the arbiter made no call (a gyro's hypothesis stands beside the reference's: no
+  //! parity or an open episode): the reference or a gyro is wrong, and the data cannot tell which.
   std::optional<ReferenceCheck> inconsistent;
   Eigen::Vector3d contamination_rad2 = Eigen::Vector3d::Zero();  //!< rejected: what the used samples put in
-  //! The bias test failed where a drift of the gyros' common bias may explain it (the caller's
-  //! `drift_possible`): the sample is used, and the caller opens the gyros' bias model by what the test saw —
-  //! [rad] its weighted mean innovation per axis over its block, and [s] the block's span to this sample.
+  //! The gyros' common drift matched (ReferenceDecision::kMatchDrift): the sample is used, and the caller
+  //! opens the gyros' bias model by what the test saw — [rad] its weighted mean innovation per axis over its
+  //! block, and [s] the block's span to this sample.
   bool drift = false;
   Eigen::Vector3d bias_mean_rad = Eigen::Vector3d::Zero();
   double bias_span_s = 0.0;
@@ -58,13 +68,18 @@ class ReferenceConsistency {
   void reopen();   //!< absent, windows empty: judged afresh, with the σ it has (re-estimated or configured)
   void restart();  //!< windows empty (the gyro set changed, an episode ended); the state kept
 
-  //! One sample at `now_ns`: its innovation `z_rad` with covariance `S`, the body rate `omega_rad_s` at its
-  //! time, whether the gyros are consistent enough to judge the reference, and the bias statistic above
-  //! which its mean is matched as their common drift instead (then the verdict says `drift`, not `rejected`;
-  //! +∞: never).
-  ReferenceVerdict observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S,
-                           const Eigen::Vector3d& omega_rad_s, bool judge,
-                           double drift_threshold = std::numeric_limits<double>::infinity());
+  //! One sample at `now_ns`: its innovation `z_rad` with covariance `S` and the body rate `omega_rad_s` at
+  //! its time, into the tests' blocks; what they show (nothing decided).
+  ReferenceEvidence test_sample(std::int64_t now_ns, const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S,
+                                const Eigen::Vector3d& omega_rad_s);
+  //! Whether the arbiter decides this sample: the reference is not rejected (a rejected one is used again
+  //! here, once its samples pass every test for a block).
+  bool judged() const { return state_ != ReferenceState::kRejected; }
+  //! The sample tested last, under the arbiter's `decision` (ignored while rejected); `drift_threshold` the
+  //! bias statistic a drift was matched at (the noise_model event's).
+  ReferenceVerdict decide(std::int64_t now_ns, const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S,
+                          const ReferenceEvidence& evidence, ReferenceDecision decision,
+                          double drift_threshold);
   //! No sample for reference_window_s: absent (an accepted reference only; a rejected one stays rejected).
   void absent() {
     if (state_ == ReferenceState::kAccepted) state_ = ReferenceState::kAbsent;
@@ -76,7 +91,7 @@ class ReferenceConsistency {
   //! The window's NIS per degree of freedom (Σ zᵀS⁻¹z / 3m: 1 for a consistent reference); 0 before any.
   double windowed_nis() const { return nis_per_dof_; }
   //! The statistic of the last test that failed (or was the last one computed), its χ² threshold and
-  //! degrees of freedom: the ledger row of a rejection.
+  //! degrees of freedom: the ledger rows of a decision.
   struct CheckValue {
     double statistic = 0.0;
     double threshold = 0.0;
@@ -96,8 +111,9 @@ class ReferenceConsistency {
 
  private:
   //! The first test that fails over the blocks with this sample in, or none.
+  //! (`bias_statistic` the bias test's χ²₃, left as it is when the test is not reached).
   std::optional<ReferenceCheck> test(std::int64_t now_ns, const Eigen::Vector3d& z, const Eigen::Vector3d& w,
-                                     double nis, const Eigen::Vector3d& omega);
+                                     double nis, const Eigen::Vector3d& omega, double& bias_statistic);
   void restart_blocks(std::int64_t now_ns);
   //! A sample used: its innovation's second moment against the predicted one, into the block.
   void add_used(const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S);
@@ -110,11 +126,10 @@ class ReferenceConsistency {
   bool reestimate_noise(std::int64_t now_ns, const Eigen::Vector3d& z);
 
   const PipelineConfig& config_;
-  double jump_chi2_ = 0.0;       //!< χ²₃(1 − p)
-  double lag_chi2_ = 0.0;        //!< χ²₁(1 − p)
-  double bias_statistic_ = 0.0;  //!< the bias test's statistic at this sample (0 when not reached)
-  CheckValue drift_check_;       //!< the bias statistic at the last drift match, and its threshold
-  double z_tail_ = 0.0;          //!< Φ⁻¹(1 − p), for the Wilson–Hilferty χ²_{3m} quantile
+  double jump_chi2_ = 0.0;  //!< χ²₃(1 − p)
+  double lag_chi2_ = 0.0;   //!< χ²₁(1 − p)
+  CheckValue drift_check_;  //!< the bias statistic at the last drift match, and its threshold
+  double z_tail_ = 0.0;     //!< Φ⁻¹(1 − p), for the Wilson–Hilferty χ²_{3m} quantile
   ReferenceState state_ = ReferenceState::kAbsent;
   std::int64_t consistent_since_ns_ = 0;  //!< rejected: every sample since passed every test
   double nis_per_dof_ = 0.0;

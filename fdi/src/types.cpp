@@ -244,17 +244,26 @@ void append_statistic(std::string& out, double statistic) {
 
 }  // namespace
 
-int ruling_of(const FdiEvent& event) {
+namespace {
+//! The gyros whose hypotheses an event's rows judge: the gyros that were in use.
+std::uint32_t gyros_of(const FdiEvent& event) {
   std::uint32_t active = 0;
-  bool reference = false;
-  for (const LedgerRow& row : event.ledger) {
-    if (row.hypothesis == kHypothesisReference) {
-      reference = true;
-    } else if (row.hypothesis != kHypothesisNone && row.hypothesis <= 32) {
+  for (const LedgerRow& row : event.ledger)
+    if (row.hypothesis != kHypothesisNone && row.hypothesis <= 32)
       active |= std::uint32_t{1} << (row.hypothesis - 1U);
-    }
-  }
-  return arbitrate(event.ledger.data(), event.ledger.data() + event.ledger.size(), active, reference);
+  return active;
+}
+}  // namespace
+
+int ruling_of(const FdiEvent& event) {
+  bool reference = false;
+  for (const LedgerRow& row : event.ledger) reference |= row.hypothesis == kHypothesisReference;
+  return arbitrate(event.ledger.data(), event.ledger.data() + event.ledger.size(), gyros_of(event),
+                   reference);
+}
+
+ReferenceDecision reference_ruling_of(const FdiEvent& event) {
+  return arbitrate_reference(event.ledger.data(), event.ledger.data() + event.ledger.size(), gyros_of(event));
 }
 
 std::string to_json(const FdiEvent& event, int n_gyros) {

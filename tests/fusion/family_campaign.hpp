@@ -30,7 +30,10 @@ struct FamilyVerdict {
   bool lost =
       false;  //!< a `lost` event (exclusions left the rate unobservable; one epoch short of samples is not)
   bool healthy_reference_rejected = false;  //!< `reference_rejected` of a reference without a failure
-  double within = 1.0;                      //!< share of axis-epochs with |e| ≤ 3σ from kHonestyFrom_s
+  //! Decisions whose own rows the arbiter's rule does not rebuild (isolated: its gyro; reference_rejected:
+  //! kReject; noise_model: kMatchDrift)
+  int unexplained = 0;
+  double within = 1.0;  //!< share of axis-epochs with |e| ≤ 3σ from kHonestyFrom_s
   Eigen::Vector3d nees = Eigen::Vector3d::Zero();  //!< per-axis mean e²/σ² over the same epochs
   double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
   int beyond_protection = 0;              //!< axis-epochs with |e| above the (finite) protection level
@@ -87,6 +90,20 @@ inline Honesty honesty(const CampaignRun& run, double from_s) {
   return h;
 }
 
+//! A decision event's rows rebuild it under the arbiter's rule (other events: nothing to rebuild).
+inline bool explained(const fdi::FdiEvent& e) {
+  switch (e.type) {
+    case fdi::EventType::kIsolated:
+      return fdi::ruling_of(e) == e.gyro.value_or(0);
+    case fdi::EventType::kReferenceRejected:
+      return fdi::reference_ruling_of(e) == fdi::ReferenceDecision::kReject;
+    case fdi::EventType::kNoiseModel:
+      return fdi::reference_ruling_of(e) == fdi::ReferenceDecision::kMatchDrift;
+    default:
+      return true;
+  }
+}
+
 inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
   fdi::PipelineConfig config;
   if (r.sample_period_s > 0.0) config.sample_period_s = r.sample_period_s;
@@ -105,6 +122,7 @@ inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
     if (e.type == fdi::EventType::kLost) v.lost = true;
     if (e.type == fdi::EventType::kReferenceRejected && r.reference_failure == sim::ReferenceFailure::kNone)
       v.healthy_reference_rejected = true;
+    v.unexplained += explained(e) ? 0 : 1;
     if ((e.type == fdi::EventType::kDetected || e.type == fdi::EventType::kReferenceRejected ||
          e.type == fdi::EventType::kNoiseModel) &&
         t >= start && !v.flagged_after_s)
@@ -136,6 +154,7 @@ struct FamilyFigures {
   int exclusions_without_fault = 0;
   int lost = 0;
   int healthy_reference_rejected = 0;  //!< runs whose healthy reference was rejected
+  int unexplained = 0;                 //!< decision events their own rows do not rebuild
   int lost_from_one_fault = 0;         //!< LOST where one fault left three gyros or more
   int dishonest = 0;                   //!< runs failing the per-run criterion whose twin meets it
   int twin_dishonest = 0;              //!< twins failing it (the fault-free character)
@@ -274,6 +293,7 @@ inline void add_run(FamilyFigures& f, const sim::PerturbedRun& r, const FamilyVe
   f.lost += v.lost ? 1 : 0;
   f.lost_from_one_fault += v.lost && !lost_allowed ? 1 : 0;
   f.healthy_reference_rejected += v.healthy_reference_rejected ? 1 : 0;
+  f.unexplained += v.unexplained;
   f.dishonest += dishonest ? 1 : 0;
   f.twin_dishonest += honest(twin) ? 0 : 1;
   f.honest_from_flag +=

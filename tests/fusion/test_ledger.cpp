@@ -96,6 +96,56 @@ TEST(Arbiter, ExcludesOnlyTheHypothesisThatStandsAloneAndSaysNoOtherwise) {
   EXPECT_EQ(rule(rows, 0x1F), 0);
 }
 
+//! A reference sample's rows with four gyros vouching (the parity rejects each Hi) and a mean that a common
+//! drift may explain: H0 rejected, Href consistent, Hdrift consistent, H1..H4 rejected.
+std::vector<LedgerRow> a_mean_the_gyros_vouch_for() {
+  const auto src = EvidenceSource::kReferenceTest;
+  std::vector<LedgerRow> rows = {
+      judge(src, kHypothesisNone, 60.0, 44.9, 44.9, 3),
+      stated(src, kHypothesisReference, RowVerdict::kConsistent, 60.0, 44.9, 3),
+      stated(EvidenceSource::kDriftWander, kHypothesisDrift, RowVerdict::kConsistent, 120.0, 1e4)};
+  for (int i = 1; i <= 4; ++i)
+    rows.push_back(stated(EvidenceSource::kCusum, h(i), RowVerdict::kRejected, 2.0, 20.0));
+  return rows;
+}
+
+ReferenceDecision reference_rule(const std::vector<LedgerRow>& rows, std::uint32_t active = 0xF) {
+  return arbitrate_reference(rows.data(), rows.data() + rows.size(), active);
+}
+
+TEST(Arbiter, TheReferenceIsRejectedOnlyWhenItsHypothesisStandsAlone) {
+  auto rows = a_mean_the_gyros_vouch_for();
+  // Hdrift and Href both stand: the drift is matched (the step that keeps the reference).
+  EXPECT_EQ(reference_rule(rows), ReferenceDecision::kMatchDrift);
+  // Hdrift rejected (a working unit's drift could not be that large): the reference is rejected.
+  rows[2].verdict = RowVerdict::kRejected;
+  EXPECT_EQ(reference_rule(rows), ReferenceDecision::kReject);
+  // ...but not while a gyro's hypothesis is not rejected (an open episode, a parity that cannot vouch).
+  rows[4].verdict = RowVerdict::kNoCall;
+  EXPECT_EQ(reference_rule(rows), ReferenceDecision::kNoCall);
+  // A gyro out of the set in use does not compete; one in use without a row does.
+  EXPECT_EQ(reference_rule(rows, 0xD), ReferenceDecision::kReject);
+  EXPECT_EQ(reference_rule(rows, 0x1D), ReferenceDecision::kNoCall);
+  // Hdrift with no call (the gyros cannot vouch): neither rejected nor matched.
+  rows = a_mean_the_gyros_vouch_for();
+  rows[2].verdict = RowVerdict::kNoCall;
+  EXPECT_EQ(reference_rule(rows), ReferenceDecision::kNoCall);
+  // H0 not rejected: the sample is used, whatever else the rows say.
+  rows = a_mean_the_gyros_vouch_for();
+  rows[0].verdict = RowVerdict::kConsistent;
+  EXPECT_EQ(reference_rule(rows), ReferenceDecision::kUse);
+  // Href rejected too (nothing explains the failure): no call.
+  rows = a_mean_the_gyros_vouch_for();
+  rows[2].verdict = RowVerdict::kRejected;
+  rows[1].verdict = RowVerdict::kRejected;
+  EXPECT_EQ(reference_rule(rows), ReferenceDecision::kNoCall);
+  EXPECT_STREQ(to_string(ReferenceDecision::kMatchDrift), "match drift");
+  std::uint8_t back = 0;
+  ASSERT_TRUE(hypothesis_from_string(hypothesis_name(kHypothesisDrift), back));
+  EXPECT_EQ(back, kHypothesisDrift);
+  EXPECT_EQ(hypothesis_name(kHypothesisDrift), "Hdrift");
+}
+
 TEST(Ledger, DecisionEventsCarryTheirRowsInJsonAndTheRuleRebuildsTheIsolation) {
   FdiEvent e;
   e.type = EventType::kIsolated;

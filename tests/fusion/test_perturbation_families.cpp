@@ -59,6 +59,7 @@ void check_family(sim::Family family, std::uint64_t fallback, const std::set<std
     EXPECT_EQ(c.wrong_exclusions, 0) << name << "\n" << c.failures;
     EXPECT_EQ(c.exclusions_without_fault, 0) << name << "\n" << c.failures;
     EXPECT_EQ(c.lost_from_one_fault, 0) << name << "\n" << c.failures;
+    EXPECT_EQ(c.unexplained, 0) << name << ": decisions their rows do not rebuild";
     if (limits.count(name) == 0) {
       EXPECT_EQ(c.dishonest, 0) << name << "\n" << c.failures;
     }

@@ -214,7 +214,15 @@ TEST(ReferenceConsistency, ARejectionAGyroFaultMayHaveCausedIsWithdrawnAtItsDete
   for (const auto& e : o.events) {
     const double t = ns_to_seconds(e.stamp_ns);
     if (e.type == fdi::EventType::kDetected && detected_s < 0.0) detected_s = t;
-    if (e.type == fdi::EventType::kReferenceAccepted && withdrawn_s < 0.0) withdrawn_s = t;
+    if (e.type == fdi::EventType::kReferenceAccepted && withdrawn_s < 0.0) {
+      withdrawn_s = t;
+      // The arbiter's rule over the rejection's rows once the parity's rows make no call: a gyro's
+      // hypothesis stands beside Href, so the reference no longer stands alone.
+      EXPECT_EQ(fdi::reference_ruling_of(e), fdi::ReferenceDecision::kNoCall) << summary(o);
+    }
+    if (e.type == fdi::EventType::kReferenceRejected) {  // each rejection rebuilt from its event alone
+      EXPECT_EQ(fdi::reference_ruling_of(e), fdi::ReferenceDecision::kReject) << summary(o);
+    }
     if (e.type == fdi::EventType::kIsolated && !isolated) isolated = e.gyro;
   }
   ASSERT_GE(o.first_rejected_s, 300.0) << summary(o);
@@ -236,6 +244,11 @@ TEST(ReferenceConsistency, AMisidentifiedReferenceIsAJumpNeverSetsTheAttitudeAnd
     const Outcome o = run(sc, seed);
     ASSERT_EQ(o.rejected, 1) << summary(o);
     EXPECT_EQ(o.first_why, fdi::ReferenceCheck::kJump) << summary(o);
+    for (const auto& e : o.events) {  // a jump's rows reject every gyro's hypothesis by the test itself
+      if (e.type == fdi::EventType::kReferenceRejected) {
+        EXPECT_EQ(fdi::reference_ruling_of(e), fdi::ReferenceDecision::kReject) << summary(o);
+      }
+    }
     EXPECT_EQ(o.first_rejected_s, 100.0) << summary(o);
     EXPECT_GE(o.first_accepted_s, 112.0 + 30.0) << summary(o);
     EXPECT_LE(o.first_accepted_s, 112.0 + 32.0) << summary(o);

@@ -34,9 +34,10 @@ enum class EvidenceSource : std::uint8_t {
   kReferenceWindow,  //!< each gyro's angle against the reference's over a window
   kFilterBias,       //!< the attitude filter's bias estimates (reference and parity)
   kReferenceTest,    //!< the reference's own consistency tests (NIS, lag, bias, jump)
-  kQuiet             //!< no alarm for clear_after_s: the episode's fault is gone
+  kQuiet,            //!< no alarm for clear_after_s: the episode's fault is gone
+  kDriftWander       //!< the bias wander a common drift of the gyros would need, against a working unit's
 };
-constexpr int kEvidenceSourceCount = 17;
+constexpr int kEvidenceSourceCount = 18;
 
 //! The unit of a source's statistic (one meaning per source, stated in its table row).
 enum class StatisticUnit : std::uint8_t {
@@ -62,12 +63,14 @@ const char* to_string(EvidenceSource source);
 //! The source named by `text` (as written by to_string), if any.
 bool evidence_source_from_string(std::string_view text, EvidenceSource& out);
 
-//! Hypotheses: 0 is H0, 1..N gyro i, kHypothesisReference the reference.
+//! Hypotheses: 0 is H0, 1..N gyro i, kHypothesisReference the reference, kHypothesisDrift the gyros' common
+//! bias drifting beyond their noise model (every gyro's bias together: the parity cannot see it).
 inline constexpr std::uint8_t kHypothesisNone = 0;
+inline constexpr std::uint8_t kHypothesisDrift = 254;
 inline constexpr std::uint8_t kHypothesisReference = 255;
-//! "H0", "H3", "Href".
+//! "H0", "H3", "Hdrift", "Href".
 std::string hypothesis_name(std::uint8_t hypothesis);
-//! The hypothesis named by `text` ("H0", "H1".."H32", "Href"), if any.
+//! The hypothesis named by `text` ("H0", "H1".."H32", "Hdrift", "Href"), if any.
 bool hypothesis_from_string(std::string_view text, std::uint8_t& out);
 
 //! One ledger row: `source`'s verdict on `hypothesis`. The statistic is compared with `threshold`: above it
@@ -97,6 +100,21 @@ LedgerRow stated(EvidenceSource source, std::uint8_t hypothesis, RowVerdict verd
 //! and Href too when a reference exists (`reference_exists`). Returns i, or 0 when no hypothesis stands
 //! alone.
 int arbitrate(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active, bool reference_exists);
+
+//! What the arbiter makes of a reference sample's rows.
+enum class ReferenceDecision : std::uint8_t {
+  kUse,         //!< H0 stands: the sample is used
+  kReject,      //!< Href stands alone: the reference is left out
+  kMatchDrift,  //!< Hdrift stands (Href may too): the gyros' bias model opened, the reference kept
+  kNoCall       //!< a gyro's hypothesis stands beside Href: reported, nothing else changes
+};
+const char* to_string(ReferenceDecision decision);  // "use", "reject", "match drift", "no call"
+
+//! The same rule for the reference (docs/fdi.md, "The arbiter"): H0 not rejected — the sample is used;
+//! else, unless every single-gyro hypothesis of `active` is rejected, no call; else a consistent Hdrift is
+//! matched (the cheaper step: it opens a model and keeps the reference, and a mean that persists after it
+//! rejects Hdrift); else Href consistent with Hdrift rejected rejects the reference.
+ReferenceDecision arbitrate_reference(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active);
 
 //! `{"source": …, "hypothesis": …, "statistic": …, "unit": …, "dof": …, "threshold": …, "accept": …,
 //! "verdict": …}` appended (dof only for χ², accept only where it differs from the threshold).

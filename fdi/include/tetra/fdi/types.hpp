@@ -152,6 +152,9 @@ struct FdiEvent {
 //! were in use; a reference existed when an Href row is there), or 0: an `isolated` event's gyro is rebuilt
 //! from it.
 int ruling_of(const FdiEvent& event);
+//! The arbiter's reference rule over an event's ledger alone (its gyro hypotheses the gyros in use): a
+//! `reference_rejected` event's rows rebuild kReject, a `noise_model` event's kMatchDrift.
+ReferenceDecision reference_ruling_of(const FdiEvent& event);
 
 //! One JSON object (one line, no newline) per docs/interfaces.md §2.5; `n_gyros` formats the `gyros` lists.
 std::string to_json(const FdiEvent& event, int n_gyros);
