@@ -91,8 +91,10 @@ TEST(IngestDds, PseudoTerminalLinesReachTheWireMalformedCounted) {
                        dir.file("rec.csv"), "--until-idle"},
                       dir.file("record.log"));
   TetraProcess ingest({"ingest", "--serial", device, "--baud", "115200", "--parity", "even", "--unit",
-                       "lab-2", "--gyros", "4", "--domain", d, "--quiet"},
+                       "lab-2", "--gyros", "4", "--domain", d, "--quiet", "--wait-readers", "1"},
                       dir.file("ingest.log"));
+  // ingest reads the terminal only once the recorder's reader has matched (a loaded machine discovers late:
+  // without the wait, the first 16 epochs reached no reader).
   std::string text;
   for (int k = 0; k < 200; ++k) {
     const std::string t = std::to_string(k * 0.01);

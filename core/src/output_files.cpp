@@ -75,6 +75,24 @@ int register_temporary(const std::string& path) {
   return -1;
 }
 
+// mkstemp(templ) and its registration with the signals that remove temporaries blocked: a signal
+// between the two (the file there, not yet in the table) would leave it behind. A pending signal is
+// delivered once the slot is live. The descriptor, or -1 with errno set by mkstemp.
+int create_registered_temporary(std::string& templ, int& slot) {
+  install_temp_removal();
+  sigset_t removal{};
+  sigset_t previous{};
+  sigemptyset(&removal);
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&removal, sig);
+  ::pthread_sigmask(SIG_BLOCK, &removal, &previous);
+  const int fd = ::mkstemp(templ.data());
+  const int saved_errno = errno;
+  if (fd >= 0) slot = register_temporary(templ);
+  ::pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  errno = saved_errno;
+  return fd;
+}
+
 void unregister_temporary(int& slot) {
   if (slot >= 0) g_temp_slots[static_cast<std::size_t>(slot)].state.store(0);
   slot = -1;
@@ -352,10 +370,10 @@ Result<OutputFile*> RunFiles::add(const std::string& path, const std::string& la
     if (out->fd_ < 0) return bad_input(who + ": cannot open: " + errno_text());
   } else {
     std::string templ = *dir + "/." + base_of(*followed) + ".tetra-XXXXXX";
-    out->fd_ = ::mkstemp(templ.data());
+    const int created = create_registered_temporary(templ, out->temp_slot_);
+    out->fd_ = created;
     if (out->fd_ < 0) return bad_input(who + ": cannot create a file in " + *dir + ": " + errno_text());
     out->temp_ = templ;
-    out->temp_slot_ = register_temporary(templ);
     const mode_t mode = exists ? static_cast<mode_t>(st.st_mode & 07777) : new_file_mode();
     ::fchmod(out->fd_, mode);
   }

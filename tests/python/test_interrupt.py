@@ -41,7 +41,12 @@ CALLS = {
                          "p = tetra.Pipeline(tetra.Calibration.seed_unit())\nlogs = [log] * 400",
                          "[p.run_log(l) for l in logs]"),
     "sim": ("", "tetra.sim('static', duration_s=60000, rate_hz=100)"),
-    "allan": ("y = np.random.default_rng(2).standard_normal(85_000)", "tetra.allan(y, 0.01, taus='all')"),
+    # SIGINT a quarter of the way through the averaging times (the whole call takes about 1 s: a fixed
+    # second could come after it returned).
+    "allan": ("y = np.random.default_rng(2).standard_normal(85_000)\nsaid = []\n"
+              "def told(d, t):\n    if 4 * d >= t and not said:\n"
+              "        said.append(print('intervals', flush=True))",
+              "tetra.allan(y, 0.01, taus='all', progress=told)"),
     # SIGINT once every averaging time is done, while the intervals' chi-square quantiles run.
     "allan, in the intervals": ("y = np.random.default_rng(2).standard_normal(85_000)\nsaid = []\n"
                                 "def told(d, t):\n    if d == t and not said:\n"
@@ -54,7 +59,7 @@ CALLS = {
 
 def interrupt_after(setup, call, delay_s=1.0):
     """Runs `call` in a child, sends SIGINT `delay_s` into it (or 50 ms after the child's line 'intervals'
-    when it prints one): (seconds to the KeyboardInterrupt, the child's report line)."""
+    when its progress callable prints one): (seconds to the KeyboardInterrupt, the child's report line)."""
     child = textwrap.dedent(PRELUDE) + setup + f"""
 print("ready", flush=True)
 t0 = time.monotonic()
