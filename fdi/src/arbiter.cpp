@@ -28,8 +28,9 @@ namespace {
 struct Tally {
   static constexpr int kReference = kMaxGyros + 1;
   static constexpr int kDrift = kMaxGyros + 2;
-  std::array<bool, kMaxGyros + 3> rejected{};
-  std::array<bool, kMaxGyros + 3> consistent{};
+  static constexpr int kCalibration = kMaxGyros + 3;
+  std::array<bool, kMaxGyros + 4> rejected{};
+  std::array<bool, kMaxGyros + 4> consistent{};
 
   Tally(const LedgerRow* begin, const LedgerRow* end) {
     for (const LedgerRow* row = begin; row != end; ++row) {
@@ -42,6 +43,7 @@ struct Tally {
   static int slot(std::uint8_t h) {
     if (h == kHypothesisReference) return kReference;
     if (h == kHypothesisDrift) return kDrift;
+    if (h == kHypothesisCalibration) return kCalibration;
     return h <= kMaxGyros ? static_cast<int>(h) : -1;
   }
   bool is_rejected(int s) const { return rejected[static_cast<std::size_t>(s)]; }
@@ -60,6 +62,7 @@ int arbitrate(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active
   const Tally t(begin, end);
   if (!t.is_rejected(0)) return 0;  // no fault shown
   if (reference_exists && !t.is_rejected(Tally::kReference)) return 0;
+  if (t.stands(Tally::kCalibration)) return 0;  // the calibration's error explains the parity
   int standing = 0;
   for (int j = 1; j <= kMaxGyros; ++j) {
     if (!has_gyro(active, j) || t.is_rejected(j)) continue;
@@ -76,6 +79,11 @@ ReferenceDecision arbitrate_reference(const LedgerRow* begin, const LedgerRow* e
   if (t.stands(Tally::kDrift)) return ReferenceDecision::kMatchDrift;
   if (t.stands(Tally::kReference) && t.is_rejected(Tally::kDrift)) return ReferenceDecision::kReject;
   return ReferenceDecision::kNoCall;
+}
+
+bool arbitrate_calibration(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active) {
+  const Tally t(begin, end);
+  return t.is_rejected(0) && t.every_gyro_rejected(active) && t.stands(Tally::kCalibration);
 }
 
 const char* to_string(ReferenceDecision decision) {

@@ -1,5 +1,6 @@
 #include "tetra/fdi/budget.hpp"
 
+#include "calibration_fit.hpp"
 #include "isolator.hpp"
 
 #include <cmath>
@@ -36,6 +37,9 @@ const Allocation kAllocations[kBudgetTestCount] = {
     {BudgetTest::kReferenceBiasMatch, "reference_bias_match", kLargestShare,
      "per sample of a good reference, its mean innovation over reference_bias_window_s: a match opens the "
      "gyros' bias model and says so (noise_model), it decides nothing"},
+    {BudgetTest::kMotionFit, "motion_fit", kLargestShare,
+     "per block of the motion fit and hypothesis: a mismatch needs two blocks in a row, and it excludes "
+     "nothing (it withholds exclusions the calibration's error could explain)"},
 };
 
 double allocated_probability(const PipelineConfig& config, BudgetTest test) {
@@ -85,6 +89,12 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
   b.rows.push_back({"reference_test", K::kReference, "false_alarm_probability",
                     allocated_probability(c, BudgetTest::kReferenceGate), 1.0,
                     "one sample left out (the gate), rejection after reference_gate_reset_count"});
+  if (parity) {
+    b.rows.push_back({"motion_fit", K::kMismatch, "false_alarm_probability",
+                      allocated_probability(c, BudgetTest::kMotionFit),
+                      3600.0 / detail::kMotionFitBlockS,
+                      "one block's H0 rejected (a mismatch needs two in a row and every Hi rejected too)"});
+  }
   for (const char* signature : {"repeated", "zero", "variance", "noise_level", "recurring_spikes"}) {
     b.rows.push_back({signature, K::kWrongExclusion, "", kNotAProbability, 1.0,
                       "the gyro's own samples against a count or ratio: not a probability"});
@@ -106,9 +116,10 @@ std::string to_text(const Budget& b) {
   for (const BudgetRow& r : b.rows) {
     const char* kind = r.kind == BudgetKind::kFalseAlarm       ? "false alarm"
                        : r.kind == BudgetKind::kWrongExclusion ? "wrong exclusion"
+                       : r.kind == BudgetKind::kMismatch       ? "calibration mismatch"
                                                                : "reference rejected";
     if (std::isfinite(r.per_evaluation)) {
-      const char* per = r.kind == BudgetKind::kFalseAlarm       ? "/h"
+      const char* per = r.kind == BudgetKind::kFalseAlarm || r.kind == BudgetKind::kMismatch ? "/h"
                         : r.kind == BudgetKind::kWrongExclusion ? "/episode"
                                                                 : "/sample";
       std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %9.3g x %-9.4g = %9.3g %s  (%s)\n", r.source,

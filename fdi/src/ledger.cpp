@@ -40,7 +40,25 @@ const EvidenceSourceInfo kEvidenceSources[kEvidenceSourceCount] = {
     {EvidenceSource::kDriftWander, "drift_wander", StatisticUnit::kRatio,
      "the bias random walk a common drift of the gyros needs for the reference's mean innovation, over the "
      "model's own wander (working gyros: at most 1e4, and not again within a bias window of a match)"},
+    {EvidenceSource::kMotionFit, "motion_fit", StatisticUnit::kChi2,
+     "the parity's linear fit to the body rate over a block (the hypothesis's own form fitted: H0 none, "
+     "Hi gyro i's alone), against the noise and the calibration's stated tolerance"},
 };
+
+bool reads_own_signal(EvidenceSource source) {
+  switch (source) {
+    case EvidenceSource::kTimeout:
+    case EvidenceSource::kInvalid:
+    case EvidenceSource::kRepeated:
+    case EvidenceSource::kZero:
+    case EvidenceSource::kVariance:
+    case EvidenceSource::kNoiseLevel:
+    case EvidenceSource::kRecurringSpikes:
+      return true;
+    default:
+      return false;
+  }
+}
 
 const char* to_string(RowVerdict verdict) {
   switch (verdict) {
@@ -93,12 +111,13 @@ bool evidence_source_from_string(std::string_view text, EvidenceSource& out) {
 std::string hypothesis_name(std::uint8_t hypothesis) {
   if (hypothesis == kHypothesisReference) return "Href";
   if (hypothesis == kHypothesisDrift) return "Hdrift";
+  if (hypothesis == kHypothesisCalibration) return "Hcal";
   return "H" + std::to_string(hypothesis);
 }
 
 bool hypothesis_from_string(std::string_view text, std::uint8_t& out) {
-  if (text == "Href" || text == "Hdrift") {
-    out = text == "Href" ? kHypothesisReference : kHypothesisDrift;
+  if (text == "Href" || text == "Hdrift" || text == "Hcal") {
+    out = text == "Href" ? kHypothesisReference : text == "Hdrift" ? kHypothesisDrift : kHypothesisCalibration;
     return true;
   }
   if (text.size() < 2 || text.size() > 3 || text[0] != 'H') return false;

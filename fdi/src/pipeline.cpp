@@ -148,6 +148,10 @@ void Pipeline::Impl::detect() {
   if (d.cusum_ran) {
     isolator_.accumulate(detector_.parity_measured(), s.dof, attitude_.omega_meas_B());
     bias_check_.record(detector_.parity(), s);
+    if (frame_.usable == active &&
+        calibration_fit_.record(detector_.parity_measured(), s, active, attitude_.omega_meas_B(), frame_.now_ns,
+                                subsets_, config_))
+      emit_calibration_mismatch();
   }
   // An open episode ends only once the parity is back to nominal for clear_after_s: a fault whose CUSUM
   // alarms grow sparse (a slow ramp near the reference k) keeps it open.
@@ -395,6 +399,9 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   decision_rows_.clear();
   decision_rows_.add(iso.rows);
   if (episode) decision_rows_.add(episode_rows_);
+  // A standing calibration mismatch explains what the parity shows, not what a gyro's own signal does.
+  if (calibration_fit_.mismatch() && !reads_own_signal(source_of(iso.evidence)))
+    decision_rows_.add(calibration_fit_.hcal_row());
   FdiEvent e;
   if (rule(decision_rows_, e.ledger) != iso.gyro) {
     ++arbiter_refusals_;
@@ -504,6 +511,19 @@ void Pipeline::Impl::gap() {
   emit(std::move(e));
 }
 
+void Pipeline::Impl::emit_calibration_mismatch() {
+  FdiEvent e;
+  e.stamp_ns = frame_.now_ns;
+  e.type = EventType::kCalibrationMismatch;
+  e.statistic = calibration_fit_.statistic();
+  e.detail =
+      "the parity follows the body rate as no single gyro's fault makes it: the calibration's scale factors "
+      "or axes do not describe this unit; nothing is excluded on the parity while it stands, and sigma "
+      "does not cover it: calibrate the unit (tetra calibrate)";
+  e.ledger.assign(calibration_fit_.rows().begin(), calibration_fit_.rows().end());
+  emit(std::move(e));
+}
+
 void Pipeline::Impl::emit_detected(DetectionTest test, double statistic, std::int64_t now_ns,
                                    const EvidenceRows* rows) {
   FdiEvent d;
@@ -526,7 +546,7 @@ int Pipeline::Impl::rule(const EvidenceRows& rows, std::vector<LedgerRow>& ledge
       last_reference_ns_ && frame_.now_ns - *last_reference_ns_ <= seconds_to_ns(config_.reference_window_s);
   ledger.clear();
   for (const LedgerRow& row : rows) {
-    const bool gyro = row.hypothesis != kHypothesisNone && row.hypothesis != kHypothesisReference;
+    const bool gyro = row.hypothesis != kHypothesisNone && row.hypothesis <= kMaxGyros;
     if (!gyro || has_gyro(active, row.hypothesis)) ledger.push_back(row);
   }
   return arbitrate(rows, active, reference);
@@ -575,6 +595,7 @@ void Pipeline::Impl::reset() {
   bias_match_.reset();
   drift_match_.reset();
   bias_check_.reset();
+  calibration_fit_.reset();
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);
   horizon_.reset();

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "bias_hypothesis.hpp"
+#include "calibration_fit.hpp"
 #include "disagreement_trend.hpp"
 #include "gyro_series.hpp"
 #include "gyro_set.hpp"
@@ -156,6 +157,8 @@ class Pipeline::Impl {
   //! The rate solution of the gyros in use when they are exactly three (no parity left), else null.
   const Subset* three_gyros_without_parity();
 
+  //! The motion fit named a mismatch: the `calibration_mismatch` event, with its block's rows.
+  void emit_calibration_mismatch();
   void isolate(const Isolation& iso);
   void isolate_all(Isolations& found);
   void restart_detectors();
@@ -194,6 +197,7 @@ class Pipeline::Impl {
   ReferenceBiasMatch
       drift_match_;             //!< a common drift in the reference's innovations: every bias model opened
   ProtectionLevel protection_;  //!< the integrity bound beside sigma
+  CalibrationFit calibration_fit_;  //!< the parity against the body rate: a calibration that is not the unit's
   std::vector<OwnNoiseFinding> own_named_;  //!< the gyros own_noise_ named at this epoch (capacity N)
   Eigen::VectorXd held_parity_;  //!< the parity before the jump test, when it left the rest without one
   ReferenceBudget budget_;       //!< the reference's stated bias and latency, which its samples cannot show

@@ -242,6 +242,22 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   }
 }
 
+void SubsetCache::rate_coefficient_covariance(const Subset& s, GyroMask mask, Eigen::MatrixXd& out) const {
+  const int d = s.dof;
+  out.setZero(3 * d, 3 * d);
+  if (d < 1 || !calibration_sigma_) return;
+  const double e = config_->calibration_error_sigmas;
+  for (int i = 0; i < gyro_count(); ++i) {
+    if (!has_gyro(mask, i + 1)) continue;
+    const Eigen::Vector3d h = geometry_.axes_B().row(i).transpose();
+    Eigen::Matrix3d g = scale_rel_sigma_[i] * scale_rel_sigma_[i] * h * h.transpose();
+    g.diagonal() += axis_sigma_.col(i).cwiseAbs2();
+    g *= e * e * period_s_;
+    for (int j = 0; j < d; ++j)
+      for (int k = 0; k < d; ++k) out.block<3, 3>(3 * j, 3 * k) += s.parity(j, i) * s.parity(k, i) * g;
+  }
+}
+
 void SubsetCache::calibration_covariance(const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s,
                                          bool with_bias, Eigen::MatrixXd& out) const {
   out.setZero(s.dof, s.dof);

@@ -146,6 +146,12 @@ class SubsetCache {
   //! constant bias cancels; ω is then the difference of their rates).
   void calibration_covariance(const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s,
                               bool with_bias, Eigen::MatrixXd& out) const;
+  //! [σ²·s²/rad²] 3d×3d covariance of the normalized parity's rate coefficients M (p = M·ω + …, d×3),
+  //! stacked by parity axis (row j of M at 3j…3j+2), when each scale factor and axis component of the
+  //! subset's gyros errs by a Gaussian of `calibration_error_sigmas` (e) times its stated 1σ: e²·T·Σ_{i∈S}
+  //! (w_i·w_iᵀ) ⊗ (σ_s,i²·h_i·h_iᵀ + diag(σ_h,i²)) (docs/fdi.md, "A calibration that does not describe
+  //! the unit"). Written into `out`; zero without stated σ.
+  void rate_coefficient_covariance(const Subset& s, GyroMask mask, Eigen::MatrixXd& out) const;
   //! [rad/s] per body axis: the largest rate error the subset's scale factors and axes make at the body rate
   //! ω [rad/s] when each is within `calibration_error_sigmas` (e) of its stated 1σ, the detectors' bound:
   //! e·Σ_{i∈S} |H*(:, i)|·(σ_s,i·|h_i·ω| + Σ_j σ_h,ij·|ω_j|) (docs/fdi.md, "Calibration uncertainty"); the

@@ -70,6 +70,8 @@ const char* to_string(EventType type) {
       return "reference_late";
     case EventType::kNoiseModel:
       return "noise_model";
+    case EventType::kCalibrationMismatch:
+      return "calibration_mismatch";
   }
   return "command";
 }
@@ -266,6 +268,11 @@ ReferenceDecision reference_ruling_of(const FdiEvent& event) {
   return arbitrate_reference(event.ledger.data(), event.ledger.data() + event.ledger.size(), gyros_of(event));
 }
 
+bool calibration_ruling_of(const FdiEvent& event) {
+  return arbitrate_calibration(event.ledger.data(), event.ledger.data() + event.ledger.size(),
+                               gyros_of(event));
+}
+
 std::string to_json(const FdiEvent& event, int n_gyros) {
   std::string out = "{\"time_s\": ";
   append_double(out, ns_to_seconds(event.stamp_ns));
@@ -315,6 +322,7 @@ std::string to_json(const FdiEvent& event, int n_gyros) {
       append_double(out, event.statistic);
       break;
     case EventType::kNoiseModel:
+    case EventType::kCalibrationMismatch:
       append_statistic(out, event.statistic);
       break;
     case EventType::kCommand:

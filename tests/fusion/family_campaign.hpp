@@ -99,6 +99,8 @@ inline bool explained(const fdi::FdiEvent& e) {
       return fdi::reference_ruling_of(e) == fdi::ReferenceDecision::kReject;
     case fdi::EventType::kNoiseModel:
       return fdi::reference_ruling_of(e) == fdi::ReferenceDecision::kMatchDrift;
+    case fdi::EventType::kCalibrationMismatch:
+      return fdi::calibration_ruling_of(e);
     default:
       return true;
   }

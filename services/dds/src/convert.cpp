@@ -56,7 +56,7 @@ tetra_EventType to_wire(fdi::EventType type) {
 }
 fdi::EventType from_wire(tetra_EventType type) {
   const int value = static_cast<int>(type);
-  return value >= 0 && value <= static_cast<int>(fdi::EventType::kNoiseModel)
+  return value >= 0 && value <= static_cast<int>(fdi::EventType::kCalibrationMismatch)
              ? static_cast<fdi::EventType>(value)
              : fdi::EventType::kCommand;
 }
@@ -70,6 +70,8 @@ static_assert(static_cast<int>(tetra_EVENT_REFERENCE_ACCEPTED) ==
 static_assert(static_cast<int>(tetra_EVENT_REFERENCE_LATE) ==
               static_cast<int>(fdi::EventType::kReferenceLate));
 static_assert(static_cast<int>(tetra_EVENT_NOISE_MODEL) == static_cast<int>(fdi::EventType::kNoiseModel));
+static_assert(static_cast<int>(tetra_EVENT_CALIBRATION_MISMATCH) ==
+              static_cast<int>(fdi::EventType::kCalibrationMismatch));
 static_assert(static_cast<int>(tetra_REFERENCE_REJECTED) == static_cast<int>(fdi::ReferenceState::kRejected));
 
 Status to_wire(const std::string& unit, const fdi::AttitudeEstimate& attitude, tetra_Attitude& out) {

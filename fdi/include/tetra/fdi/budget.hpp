@@ -23,9 +23,10 @@ enum class BudgetTest : unsigned char {
   kReferenceCheck,       //!< each consistency test of the reference (per sample)
   kReferenceNoiseMatch,  //!< three gyros: the reference noise match (per sample)
   kReferenceGate,        //!< the filter's 3-dof gate leaving out a good reference sample (per sample)
-  kReferenceBiasMatch  //!< a common drift in the reference's innovations, its bias model opened (per sample)
+  kReferenceBiasMatch,  //!< a common drift in the reference's innovations, its bias model opened (per sample)
+  kMotionFit            //!< the parity's fit to the body rate rejecting H0 or a single-gyro hypothesis (per block)
 };
-constexpr int kBudgetTestCount = 9;
+constexpr int kBudgetTestCount = 10;
 
 //! One row of the allocation: a test's share of false_alarm_probability, and why.
 struct Allocation {
@@ -47,7 +48,8 @@ double cusum_arl0_epochs(const PipelineConfig& config);
 enum class BudgetKind : unsigned char {
   kFalseAlarm,      //!< H0 rejected while true: a `detected` event without a fault [per hour]
   kWrongExclusion,  //!< a true single-gyro hypothesis rejected while a wrong one stands [per episode]
-  kReference        //!< a healthy reference rejected [per reference sample]
+  kReference,       //!< a healthy reference rejected [per reference sample]
+  kMismatch         //!< a calibration_mismatch named on a unit its calibration describes [per hour]
 };
 
 struct BudgetRow {

@@ -35,9 +35,13 @@ enum class EvidenceSource : std::uint8_t {
   kFilterBias,       //!< the attitude filter's bias estimates (reference and parity)
   kReferenceTest,    //!< the reference's own consistency tests (NIS, lag, bias, jump)
   kQuiet,            //!< no alarm for clear_after_s: the episode's fault is gone
-  kDriftWander       //!< the bias wander a common drift of the gyros would need, against a working unit's
+  kDriftWander,      //!< the bias wander a common drift of the gyros would need, against a working unit's
+  kMotionFit         //!< the parity's fit to the body rate over a block: scale factors and axes
 };
-constexpr int kEvidenceSourceCount = 18;
+constexpr int kEvidenceSourceCount = 19;
+//! True for the sources that read a gyro's own signal (timeout, invalid, repeated, zero, variance,
+//! noise_level, recurring_spikes): no error of the calibration makes what they see.
+bool reads_own_signal(EvidenceSource source);
 
 //! The unit of a source's statistic (one meaning per source, stated in its table row).
 enum class StatisticUnit : std::uint8_t {
@@ -64,13 +68,16 @@ const char* to_string(EvidenceSource source);
 bool evidence_source_from_string(std::string_view text, EvidenceSource& out);
 
 //! Hypotheses: 0 is H0, 1..N gyro i, kHypothesisReference the reference, kHypothesisDrift the gyros' common
-//! bias drifting beyond their noise model (every gyro's bias together: the parity cannot see it).
+//! bias drifting beyond their noise model (every gyro's bias together: the parity cannot see it),
+//! kHypothesisCalibration the calibration's scale factors and axes not describing the unit (several gyros
+//! at once, beyond their stated tolerance).
 inline constexpr std::uint8_t kHypothesisNone = 0;
+inline constexpr std::uint8_t kHypothesisCalibration = 253;
 inline constexpr std::uint8_t kHypothesisDrift = 254;
 inline constexpr std::uint8_t kHypothesisReference = 255;
-//! "H0", "H3", "Hdrift", "Href".
+//! "H0", "H3", "Hcal", "Hdrift", "Href".
 std::string hypothesis_name(std::uint8_t hypothesis);
-//! The hypothesis named by `text` ("H0", "H1".."H32", "Hdrift", "Href"), if any.
+//! The hypothesis named by `text` ("H0", "H1".."H32", "Hcal", "Hdrift", "Href"), if any.
 bool hypothesis_from_string(std::string_view text, std::uint8_t& out);
 
 //! One ledger row: `source`'s verdict on `hypothesis`. The statistic is compared with `threshold`: above it
@@ -97,8 +104,8 @@ LedgerRow stated(EvidenceSource source, std::uint8_t hypothesis, RowVerdict verd
 
 //! The single rule (docs/fdi.md, "The arbiter"): gyro i is excluded when Hi is consistent — some row says so
 //! and none rejects it — and every other single-gyro hypothesis of `active` is rejected by some row, H0 too,
-//! and Href too when a reference exists (`reference_exists`). Returns i, or 0 when no hypothesis stands
-//! alone.
+//! Href too when a reference exists (`reference_exists`), and Hcal does not stand (a row writes it only
+//! while a calibration mismatch stands). Returns i, or 0 when no hypothesis stands alone.
 int arbitrate(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active, bool reference_exists);
 
 //! What the arbiter makes of a reference sample's rows.
@@ -115,6 +122,10 @@ const char* to_string(ReferenceDecision decision);  // "use", "reject", "match d
 //! matched (the cheaper step: it opens a model and keeps the reference, and a mean that persists after it
 //! rejects Hdrift); else Href consistent with Hdrift rejected rejects the reference.
 ReferenceDecision arbitrate_reference(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active);
+
+//! The same rule for a block of the motion fit: true when Hcal stands alone — H0 and every single-gyro
+//! hypothesis of `active` rejected, Hcal consistent.
+bool arbitrate_calibration(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active);
 
 //! `{"source": …, "hypothesis": …, "statistic": …, "unit": …, "dof": …, "threshold": …, "accept": …,
 //! "verdict": …}` appended (dof only for χ², accept only where it differs from the threshold).

@@ -57,7 +57,10 @@ enum class EventType : std::uint8_t {
   kReferenceRejected,  //!< the attitude reference failed a consistency test (why: ReferenceCheck)
   kReferenceAccepted,  //!< a rejected reference passed every test for reference_check_window_s: used again
   kReferenceLate,      //!< a reference stamped beyond the fusion horizon (statistic: how late [s]): left out
-  kNoiseModel  //!< the data show the noise model optimistic: a model opened to what they show (detail: which)
+  kNoiseModel,  //!< the data show the noise model optimistic: a model opened to what they show (detail: which)
+  //! the parity follows the body rate as no single gyro's fault makes it: the calibration's scale factors
+  //! and axes do not describe the unit (statistic: the motion fit's χ²); no exclusion while it stands
+  kCalibrationMismatch
 };
 const char* to_string(EventType type);
 
@@ -155,6 +158,9 @@ int ruling_of(const FdiEvent& event);
 //! The arbiter's reference rule over an event's ledger alone (its gyro hypotheses the gyros in use): a
 //! `reference_rejected` event's rows rebuild kReject, a `noise_model` event's kMatchDrift.
 ReferenceDecision reference_ruling_of(const FdiEvent& event);
+//! The arbiter's calibration rule over an event's ledger alone: a `calibration_mismatch` event's rows
+//! rebuild true.
+bool calibration_ruling_of(const FdiEvent& event);
 
 //! One JSON object (one line, no newline) per docs/interfaces.md §2.5; `n_gyros` formats the `gyros` lists.
 std::string to_json(const FdiEvent& event, int n_gyros);

@@ -1,0 +1,84 @@
+#pragma once
+// A calibration that does not describe the unit (docs/fdi.md, "A calibration that does not describe the
+// unit"). Scale factors or axes off make the parity follow the body rate: p_k = p̄ + M·(ω_k − ω̄) + n_k. Over
+// each block of kMotionFitBlockS the gyro set's normalized parity is fitted to the measured rate, and the
+// fit is judged per hypothesis: H0 (M within the calibration's stated tolerance), Hi (M what gyro i alone
+// makes: its scale factor with four gyros, any error of its own from five on), Hcal (any M). Two blocks in
+// a row with H0 and every Hi rejected name a mismatch: the unit's calibration is wrong in several gyros at
+// once, which no exclusion mends. It then stands (for the gyro set), and exclusions whose evidence a
+// calibration's error can make are withheld; a gyro's own signal still excludes it.
+
+#include <cstdint>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
+#include "evidence_rows.hpp"
+#include "subset_cache.hpp"
+
+namespace tetra::fdi::detail {
+
+//! [s] one block of the motion fit: long enough for a slew or two, short enough to name a mismatch within
+//! ten minutes of motion.
+inline constexpr double kMotionFitBlockS = 300.0;
+//! Blocks in a row whose rows make the case before a mismatch is named: a fault's onset inside a block
+//! bends that block's fit; the next block shows the fault as the single gyro's it is.
+inline constexpr int kMotionFitBlocksInARow = 2;
+
+class CalibrationFit {
+ public:
+  //! Forgets the block, the streak and a standing mismatch (a reset of the pipeline).
+  void reset();
+  //! One epoch of gyro set `mask`'s normalized parity `p` (s.dof values, the parity as measured) at the
+  //! measured body rate ω [rad/s], at `now_ns`. A new set restarts the fit. True when this epoch closed a
+  //! block whose rows name a mismatch for the first time (rows(): that block's).
+  bool record(const Eigen::VectorXd& p, const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s,
+              std::int64_t now_ns, const SubsetCache& cache, const PipelineConfig& config);
+  //! A mismatch stands for the gyro set in use.
+  bool mismatch() const { return mismatch_; }
+  //! The last block's rows (H0, each Hi of the set, Hcal).
+  const EvidenceRows& rows() const { return rows_; }
+  //! The last block's χ² of the fit under H0.
+  double statistic() const { return h0_statistic_; }
+  //! While a mismatch stands, the Hcal row an isolation's decision adds when its evidence is one a
+  //! calibration's error can make (not a gyro's own signal): consistent, the last block's fit.
+  LedgerRow hcal_row() const;
+
+ private:
+  void restart(const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s, std::int64_t now_ns);
+  void accumulate(const Eigen::VectorXd& p, int dof, const Eigen::Vector3d& omega_rad_s);
+  //! The block's rows written into rows_; true when they name a mismatch (arbitrate_calibration).
+  bool judge_block(const Subset& s, GyroMask mask, const SubsetCache& cache, const PipelineConfig& config);
+  //! z = vec((ω − ω̄)ᵀ(p − p̄)) and its covariance S under H0 (noise, stated tolerance, wander).
+  void moments(const Subset& s, GyroMask mask, const SubsetCache& cache, const PipelineConfig& config);
+  //! The residual χ² of z once `basis`'s columns are fitted (none: H0), and its degrees of freedom.
+  double residual(const Eigen::MatrixXd& basis, int columns, int& dof);
+
+  GyroMask mask_ = 0;
+  int dof_ = 0;
+  std::int64_t start_ns_ = 0;
+  double epochs_ = 0.0;
+  Eigen::Matrix3d sum_ww_ = Eigen::Matrix3d::Zero();  //!< Σ ω ωᵀ [rad²/s²]
+  Eigen::Vector3d sum_w_ = Eigen::Vector3d::Zero();   //!< Σ ω
+  Eigen::Vector3d sum_dev_ = Eigen::Vector3d::Zero(); //!< Σ |ω − ω_first| per axis (the wander's reach)
+  Eigen::Vector3d first_w_ = Eigen::Vector3d::Zero();
+  Eigen::MatrixXd sum_wp_;  //!< 3×d Σ ω pᵀ
+  Eigen::VectorXd sum_p_;   //!< d Σ p
+  // Scratch of the block's judgement, sized once per gyro set (a block allocates nothing).
+  Eigen::Matrix3d omega_c_ = Eigen::Matrix3d::Zero();
+  Eigen::VectorXd z_;
+  Eigen::MatrixXd cov_;
+  Eigen::MatrixXd tolerance_;
+  Eigen::MatrixXd basis_;
+  Eigen::MatrixXd whitened_basis_;
+  Eigen::VectorXd whitened_z_;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver_;
+  int streak_ = 0;
+  bool mismatch_ = false;
+  double h0_statistic_ = 0.0;
+  double h0_threshold_ = 0.0;
+  int h0_dof_ = 0;
+  EvidenceRows rows_;
+};
+
+}  // namespace tetra::fdi::detail
