@@ -153,6 +153,7 @@ void Pipeline::Impl::detect() {
                                 subsets_, config_))
       emit_calibration_mismatch();
   }
+  if (d.cusum_ran && !d.alarm && !isolator_.episode().active) parity_seen_nominal_ = true;
   // An open episode ends only once the parity is back to nominal for clear_after_s: a fault whose CUSUM
   // alarms grow sparse (a slow ramp near the reference k) keeps it open.
   if (d.cusum_ran && !d.alarm && isolator_.episode().active && !detector_.parity_nominal(s))
@@ -399,9 +400,18 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   decision_rows_.clear();
   decision_rows_.add(iso.rows);
   if (episode) decision_rows_.add(episode_rows_);
-  // A standing calibration mismatch explains what the parity shows, not what a gyro's own signal does.
-  if (calibration_fit_.mismatch() && !reads_own_signal(source_of(iso.evidence)))
-    decision_rows_.add(calibration_fit_.hcal_row());
+  // A standing calibration mismatch explains what the parity shows, not what a gyro's own signal does; so
+  // does a parity beyond its threshold since the first epoch (no fault-free history: no onset to tell a
+  // fault from the calibration's error).
+  if (!reads_own_signal(source_of(iso.evidence))) {
+    if (calibration_fit_.mismatch()) decision_rows_.add(calibration_fit_.hcal_row());
+    if (!parity_seen_nominal_ && episode && !episode_rows_.empty()) {
+      LedgerRow since_start = *episode_rows_.begin();
+      since_start.hypothesis = kHypothesisCalibration;
+      since_start.verdict = RowVerdict::kConsistent;
+      decision_rows_.add(since_start);
+    }
+  }
   FdiEvent e;
   if (rule(decision_rows_, e.ledger) != iso.gyro) {
     ++arbiter_refusals_;
@@ -596,6 +606,7 @@ void Pipeline::Impl::reset() {
   drift_match_.reset();
   bias_check_.reset();
   calibration_fit_.reset();
+  parity_seen_nominal_ = false;
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);
   horizon_.reset();

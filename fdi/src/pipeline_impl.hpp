@@ -222,7 +222,9 @@ class Pipeline::Impl {
   std::int64_t last_ns_ = 0;
   std::optional<std::int64_t> last_reference_ns_;  //!< the last epoch that carried a usable reference
   bool reference_usable_ = false;  //!< this epoch's reference sample passed the consistency tests
-  bool gyros_vouch_ = false;       //!< this epoch: parity among the gyros used, no episode, rate observable
+  bool gyros_vouch_ = false;
+  //! The parity was judged outside an episode at least once since the reset: a fault has a history before it
+  bool parity_seen_nominal_ = false;       //!< this epoch: parity among the gyros used, no episode, rate observable
   std::optional<std::int64_t> reference_set_ns_;  //!< the last time a reference sample set the attitude
   //! [ns] when the reference was last rejected, until it is used again, and the rows that rejected it
   std::optional<std::int64_t> reference_rejected_ns_;

@@ -15,7 +15,7 @@ namespace {
 
 constexpr std::array<std::string_view, kFamilyCount> kFamilyNames = {
     "fault-in-slew", "data-path", "gap", "reference", "calibration", "calibration-without-noise",
-    "second-fault",  "warm-up"};
+    "second-fault",  "warm-up",         "data-sheet"};
 
 constexpr double kSlewStart_s = 30.0;                //!< [s] the detectors have a full history by then
 constexpr double kConfiguredReference_arcsec = 5.0;  //!< [arcsec] the star tracker's stated 1σ
@@ -349,6 +349,42 @@ PerturbedRun warm_up(Rng& rng, std::uint64_t index) {
   return r;
 }
 
+//! A unit flown on its data sheet: the fusion's calibration has every scale factor 10–30 % off (random
+//! sign), every axis 2–10 mrad off, biases off by 1e-3 V, no sigma: and no noise: section (a data sheet
+//! states neither). The motion: slews of 20–40° in 20 s about X, Y and Z in turn, one every 100 s, so
+//! that every block of the motion fit sees the rate vary about every axis. A third of the runs carry a
+//! gyro fault (maybe_fault, around the first slew).
+PerturbedRun data_sheet(Rng& rng, std::uint64_t index) {
+  const int n = 4 + static_cast<int>(index / 9 % 3);
+  const bool reference = index / 27 % 2 == 1;
+  PerturbedRun r;
+  r.scenario = base(n, reference, 1200.0);
+  for (int k = 0; k < 11; ++k) {
+    const double sign = rng.uniform() < 0.5 ? -1.0 : 1.0;
+    r.scenario.motion.slews.push_back({signed_axis(2 * (k % 3)), sign * between(rng, 20.0, 40.0),
+                                       kSlewStart_s + 100.0 * k, 20.0});
+  }
+  r.calibration = r.scenario.unit;
+  double worst = 0.0;
+  for (auto& g : r.calibration.gyros) {
+    const double off = (rng.uniform() < 0.5 ? -1.0 : 1.0) * between(rng, 0.1, 0.3);
+    worst = std::max(worst, std::abs(off));
+    g.scale_factor_V_per_dps *= 1.0 + off;
+    Eigen::Vector3d d(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5);
+    d -= g.axis_B * g.axis_B.dot(d);
+    g.axis_B = (g.axis_B + between(rng, 2e-3, 1e-2) * d.normalized()).normalized();
+    g.bias_V += (rng.uniform() < 0.5 ? -1e-3 : 1e-3);
+    g.sigma.reset();
+    g.noise.reset();
+  }
+  char text[96];
+  std::snprintf(text, sizeof text, " data-sheet calibration (scale factors up to %.0f %% off)", 100.0 * worst);
+  r.label = "N=" + std::to_string(n) + " eleven slews about X, Y, Z" + text + (reference ? " ref" : "");
+  r.case_name = "fault-free";
+  maybe_fault(rng, index, n, r.scenario.motion.slews.front(), r);
+  return r;
+}
+
 }  // namespace
 
 std::string_view family_name(Family family) {
@@ -469,6 +505,9 @@ PerturbedRun perturbed_run(Family family, std::uint64_t seed, std::uint64_t inde
       break;
     case Family::kWarmUp:
       r = warm_up(rng, index);
+      break;
+    case Family::kDataSheet:
+      r = data_sheet(rng, index);
       break;
   }
   if (r.calibration.gyros.empty()) r.calibration = r.scenario.unit;

@@ -30,6 +30,7 @@ struct FamilyVerdict {
   bool lost =
       false;  //!< a `lost` event (exclusions left the rate unobservable; one epoch short of samples is not)
   bool healthy_reference_rejected = false;  //!< `reference_rejected` of a reference without a failure
+  bool calibration_mismatch = false;        //!< a `calibration_mismatch` named
   //! Decisions whose own rows the arbiter's rule does not rebuild (isolated: its gyro; reference_rejected:
   //! kReject; noise_model: kMatchDrift)
   int unexplained = 0;
@@ -125,8 +126,9 @@ inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
     if (e.type == fdi::EventType::kReferenceRejected && r.reference_failure == sim::ReferenceFailure::kNone)
       v.healthy_reference_rejected = true;
     v.unexplained += explained(e) ? 0 : 1;
+    v.calibration_mismatch |= e.type == fdi::EventType::kCalibrationMismatch;
     if ((e.type == fdi::EventType::kDetected || e.type == fdi::EventType::kReferenceRejected ||
-         e.type == fdi::EventType::kNoiseModel) &&
+         e.type == fdi::EventType::kNoiseModel || e.type == fdi::EventType::kCalibrationMismatch) &&
         t >= start && !v.flagged_after_s)
       v.flagged_after_s = t - start;
     if (e.type != fdi::EventType::kIsolated) continue;

@@ -32,8 +32,9 @@ enum class Family {
   kSecondFault,              //!< three gyros and the reference, a fault on one of them (redundancy exhausted)
   kWarmUp,  //!< every gyro's bias follows a temperature transient, each by its own coefficient (a fault in
             //!< 1/3)
+  kDataSheet,  //!< the fusion given a data-sheet calibration: scale factors 10–30 % off, axes by mrad, no σ
 };
-inline constexpr int kFamilyCount = 8;
+inline constexpr int kFamilyCount = 9;
 
 std::string_view family_name(Family family);
 std::optional<Family> family_from_name(std::string_view name);
