@@ -211,6 +211,29 @@ TEST(ReplayCli, MisStampedRowsAreTimeOutliersAndAGenuineJumpIsAGap) {
   EXPECT_EQ(rows, 598);
 }
 
+// A data-sheet calibration (examples/factory.yaml: the seed's scale factors and nominal axes) on slews about
+// three axes: the parity follows the motion in every block. The motion fit names it once two blocks agree
+// (calibration_mismatch at 600 s, the rows rebuilding it), replay warns, and nothing is excluded; the unit's
+// own calibration on the same log names nothing.
+TEST(ReplayCli, ADataSheetCalibrationIsNamedAndExcludesNothing) {
+  TempDir dir;
+  const auto sim = run_tetra("sim slews --minutes 20 -o " + dir.file("log.csv"));
+  ASSERT_EQ(sim.exit_status, 0) << sim.err;
+  const std::string out = " --attitude " + dir.file("att.csv") + " --events " + dir.file("ev.jsonl");
+  const auto r = run_tetra("replay " + dir.file("log.csv") + " --calibration " +
+                           test::source_path("examples/factory.yaml") + out);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: the calibration does not describe this unit"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("excluded: none"), std::string::npos) << r.err;
+  const std::string ev = test::read_file(dir.file("ev.jsonl"));
+  EXPECT_NE(ev.find(R"({"time_s": 600.1, "event": "calibration_mismatch")"), std::string::npos) << ev;
+  EXPECT_EQ(ev.find(R"("event": "isolated")"), std::string::npos) << ev;
+  const auto own = run_tetra("replay " + dir.file("log.csv") + " --calibration " + write_cal(dir) + out);
+  ASSERT_EQ(own.exit_status, 0) << own.err;
+  EXPECT_EQ(own.err.find("calibration does not describe"), std::string::npos) << own.err;
+  EXPECT_EQ(test::read_file(dir.file("ev.jsonl")).find("calibration_mismatch"), std::string::npos);
+}
+
 // Most of a log rejected is never a quiet success: a warning line with the counts.
 TEST(ReplayCli, MostEpochsRejectedIsAWarning) {
   TempDir dir;

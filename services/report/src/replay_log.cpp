@@ -203,6 +203,11 @@ void print_summary(std::ostream& err, const std::string& command, const fdi::Pip
              static_cast<unsigned long long>(c.samples_outlier), static_cast<unsigned long long>(c.spikes),
              ev.empty() ? "none" : ev.c_str(), fdi::to_string(h.mode), mask_to_string(h.used, n).c_str(),
              excluded.empty() ? "none" : excluded.c_str());
+  if (const auto it = replayed.event_counts.find("calibration_mismatch"); it != replayed.event_counts.end())
+    err << command
+        << ": warning: the calibration does not describe this unit (calibration_mismatch: the parity follows "
+           "the body rate as no single gyro's fault makes it): sigma does not cover it and the parity's "
+           "evidence excluded nothing; calibrate the unit (tetra calibrate)\n";
   // Most of the log left out is never a quiet success: the exit status stays 0 (the outputs are what the
   // pipeline made of the log), the warning says what was lost.
   const std::uint64_t rejected = c.epochs_rejected_time + c.epochs_time_outlier + c.epochs_rejected_shape;
