@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tetra/ground/private_file.hpp"
+#include "tetra/ground/unit_id.hpp"
 
 namespace tetra::ground {
 
@@ -47,8 +48,8 @@ std::string AuditLog::json_line(const AuditRecord& r, std::int64_t utc_ms) {
                             {"status", r.status},   {"operator", r.operator_id},
                             {"role", r.role},       {"address", r.address},
                             {"method", r.method},   {"path", r.path},
-                            {"unit", r.unit},       {"command", r.command},
-                            {"reason", r.reason}};
+                            {"unit", r.unit},       {"unit_id", unit_id(r.unit)},
+                            {"command", r.command}, {"reason", r.reason}};
   // Every string escaped (control characters as \uXXXX, bytes that are not UTF-8 as U+FFFD).
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }

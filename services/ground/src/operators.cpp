@@ -19,21 +19,21 @@ bool sodium_ready() {
   return ready;
 }
 
-std::string to_hex(const unsigned char* data, std::size_t n) {
-  std::string out(n * 2 + 1, '\0');
-  sodium_bin2hex(out.data(), out.size(), data, n);
+}  // namespace
+
+std::string hex_of(std::string_view bytes) {
+  std::string out(bytes.size() * 2 + 1, '\0');
+  sodium_bin2hex(out.data(), out.size(), reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
   out.pop_back();
   return out;
 }
-
-}  // namespace
 
 std::string keyed_hash_hex(const std::string& key, const std::string& text) {
   sodium_ready();
   unsigned char mac[32];
   crypto_generichash(mac, sizeof mac, reinterpret_cast<const unsigned char*>(text.data()), text.size(),
                      reinterpret_cast<const unsigned char*>(key.data()), key.size());
-  return to_hex(mac, sizeof mac);
+  return hex_of(std::string_view(reinterpret_cast<const char*>(mac), sizeof mac));
 }
 
 const char* to_string(Role role) {
@@ -58,7 +58,7 @@ std::string random_hex(std::size_t n) {
   sodium_ready();
   std::string bytes(n, '\0');
   randombytes_buf(bytes.data(), n);
-  return to_hex(reinterpret_cast<const unsigned char*>(bytes.data()), n);
+  return hex_of(bytes);
 }
 
 bool same_secret(const std::string& a, const std::string& b) {
