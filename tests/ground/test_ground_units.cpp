@@ -512,6 +512,36 @@ TEST(Operators, AKeyOrJournalOthersCanReadIsRefusedAndADamagedJournalNamesItsLin
       << damaged.error().message;
 }
 
+// Each file others may read or write is refused with what they could do with that file: the audit file
+// and the session journal said "whoever reads it can sign in as any operator", which is not so of either
+// (the audit file signs no one in; the journal holds keyed hashes, never a session id, but a line written
+// into it can give one's own session another user).
+TEST(PrivateFiles, EachFileOpenToOthersIsRefusedWithWhatTheyCouldDoWithIt) {
+  test::TempDir dir;
+  const auto open_to_others = [&](const std::string& name) {
+    test::write_file(dir.file(name), "");
+    using std::filesystem::perms;
+    std::filesystem::permissions(
+        dir.file(name), perms::owner_read | perms::owner_write | perms::group_read | perms::others_read);
+    return dir.file(name);
+  };
+  const std::string audit = open_to_others("audit.jsonl");
+  EXPECT_EQ(
+      AuditLog::open(audit).error().message,
+      audit +
+          ": the audit file is readable or writable by group or others (mode 0644); whoever reads it learns "
+          "who signed in from where and what they commanded, whoever writes it can forge or erase the "
+          "record: chmod 600 " +
+          audit);
+  const std::string journal = open_to_others("sessions");
+  EXPECT_EQ(
+      SessionStore::open(journal, "key", 1000).error().message,
+      journal +
+          ": the session journal is readable or writable by group or others (mode 0644); whoever writes it "
+          "can sign in as any operator: chmod 600 " +
+          journal);
+}
+
 // Any bytes in a DDS string (here an operator id and a unit name that are not UTF-8) become text, never an
 // exception: nlohmann::json::dump throws on invalid UTF-8, which ended `tetra ground`.
 TEST(Encode, StringsThatAreNotUtf8AreShownWithTheReplacementCharacter) {

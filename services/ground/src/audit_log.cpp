@@ -14,10 +14,20 @@
 
 namespace tetra::ground {
 
+namespace {
+
+//! What group or others could do with the audit file: it signs no one in, but tells and keeps the record.
+constexpr const char* kOpenAuditFile =
+    "whoever reads it learns who signed in from where and what they commanded, whoever writes it can forge "
+    "or "
+    "erase the record";
+
+}  // namespace
+
 Result<AuditLog> AuditLog::open(const std::string& path) {
   AuditLog log;
   if (path.empty()) return log;
-  if (auto s = check_private(path, "the audit file"); !s) return s.error();
+  if (auto s = check_private(path, "the audit file", kOpenAuditFile); !s) return s.error();
   log.fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0600);
   if (log.fd_ < 0) return failure(path + ": cannot open the audit file: " + std::strerror(errno));
   log.path_ = path;

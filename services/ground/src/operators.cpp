@@ -14,6 +14,9 @@ namespace tetra::ground {
 
 namespace {
 
+//! What group or others could do with the accounts file or the session key.
+constexpr const char* kAnyOperator = "whoever reads it can sign in as any operator";
+
 bool sodium_ready() {
   static const bool ready = sodium_init() >= 0;
   return ready;
@@ -145,7 +148,7 @@ Result<Operators> Operators::open(const std::string& users_path, const std::stri
   if (!sodium_ready()) return failure("libsodium cannot start");
   Operators ops;
   ops.users_path_ = users_path;
-  if (auto s = check_private(users_path, "the accounts file"); !s) return s.error();
+  if (auto s = check_private(users_path, "the accounts file", kAnyOperator); !s) return s.error();
   auto accounts = read_accounts(users_path);
   if (!accounts) return accounts.error();
   if (accounts->empty())
@@ -153,7 +156,7 @@ Result<Operators> Operators::open(const std::string& users_path, const std::stri
                      users_path + ")");
   ops.accounts_ = std::move(accounts).value();
   ops.accounts_stamp_ = file_stamp(users_path);
-  if (auto s = check_private(key_path, "the session key"); !s) return s.error();
+  if (auto s = check_private(key_path, "the session key", kAnyOperator); !s) return s.error();
   auto key = read_text_file(key_path);
   if (!key) {
     if (::access(key_path.c_str(), F_OK) == 0) return key.error();
@@ -184,8 +187,9 @@ void Operators::reload() {
   accounts_stamp_ = stamp;
   // A file being edited, broken or opened to others: no accounts until it reads again (refuse rather
   // than guess).
-  accounts_ = accounts && check_private(users_path_, "the accounts file") ? std::move(accounts).value()
-                                                                          : std::vector<Account>{};
+  accounts_ = accounts && check_private(users_path_, "the accounts file", kAnyOperator)
+                  ? std::move(accounts).value()
+                  : std::vector<Account>{};
 }
 
 std::optional<Account> Operators::login(const std::string& user, const std::string& password) {
