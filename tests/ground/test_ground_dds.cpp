@@ -1,6 +1,7 @@
 // Integration of the ground station: simulator (sim --dds) + fusion service + tetra ground
 // as separate processes on a private loopback domain; an HTTP client reads the event stream and the
-// history, and commands through POST. Waits have generous upper bounds that only turn a hang into a
+// history, and commands through POST; and a DDS peer of another make, in this process, whose unit names
+// are not UTF-8, reached by their unit ids. Waits have generous upper bounds that only turn a hang into a
 // failure; nothing asserts on elapsed time.
 
 #include <gtest/gtest.h>
