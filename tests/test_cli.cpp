@@ -42,5 +42,21 @@ TEST(Cli, SingleValuedOptionGivenTwiceIsRefusedNamingIt) {
   EXPECT_NE(r.err.find("--minutes"), std::string::npos) << r.err;
 }
 
+// A user name may start with '-' (docs/ground.md, "Accounts"), and as the first argument it reads as an
+// option: the help and the docs show it after "--", and that command works.
+TEST(Cli, GroundPasswdTakesANameStartingWithADashAfterDoubleDash) {
+  test::TempDir dir;
+  test::write_file(dir.file("pw"), "correct horse\n");
+  const std::string users = dir.file("users");
+  const std::string tail = " --password-stdin < " + dir.file("pw");
+  EXPECT_EQ(test::run_tetra("ground passwd -x --users " + users + tail).exit_status, 2);
+  const auto help = test::run_tetra("ground passwd --help");
+  EXPECT_NE(help.out.find("ground passwd --users FILE -- -x"), std::string::npos) << help.out;
+  const auto added = test::run_tetra("ground passwd --users " + users + tail + " -- -x");
+  EXPECT_EQ(added.exit_status, 0) << added.err;
+  const std::string accounts = test::read_file(users);
+  EXPECT_NE(accounts.find("\n-x:viewer:$argon2id$"), std::string::npos) << accounts;
+}
+
 }  // namespace
 }  // namespace tetra

@@ -84,16 +84,23 @@ function TetraModel() {
       .concat([eventPoint()]);
   }
 
-  // A unit's name in an object key as 'x' and the hexadecimal of its UTF-8 bytes: any name (a space, a
-  // '~', a '%', a '/') survives Open MCT's navigation path and the browser's URL encoding unchanged.
-  function unitKey(unit) {
-    return 'x' + Array.from(new TextEncoder().encode(unit), (b) => b.toString(16).padStart(2, '0')).join('');
+  // A unit in an object key as 'x' and its unit_id (the ground's hexadecimal of the bytes of its name, the
+  // DDS key as it came): any name (a space, a '~', a '%', a '/', bytes that are not UTF-8) survives Open
+  // MCT's navigation path and the browser's URL encoding unchanged, and two names that look alike (both
+  // shown with U+FFFD) keep keys of their own.
+  function unitKey(unitId) {
+    return 'x' + unitId;
   }
-  function unitOfKey(text) {
-    if (!/^x([0-9a-f]{2})*$/.test(text)) return text;
-    const bytes = new Uint8Array((text.length - 1) / 2);
-    for (let i = 0; i < bytes.length; ++i) bytes[i] = parseInt(text.substr(1 + 2 * i, 2), 16);
+  // The unit_id of an object key; a key that is not 'x' and hexadecimal is taken as the name itself.
+  function unitIdOfKey(text) {
+    if (/^x([0-9a-f]{2})*$/.test(text)) return text.slice(1);
+    return Array.from(new TextEncoder().encode(text), (b) => b.toString(16).padStart(2, '0')).join('');
+  }
+  // The name of a unit_id as the ground shows it (bytes that are not UTF-8 as U+FFFD).
+  function nameOfUnitId(unitId) {
+    const bytes = new Uint8Array(unitId.length / 2);
+    for (let i = 0; i < bytes.length; ++i) bytes[i] = parseInt(unitId.substr(2 * i, 2), 16);
     return new TextDecoder().decode(bytes);
   }
-  return { pointsOf, unitKey, unitOfKey };
+  return { pointsOf, unitKey, unitIdOfKey, nameOfUnitId };
 }

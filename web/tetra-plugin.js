@@ -8,7 +8,7 @@
 // eslint-disable-next-line no-unused-vars
 function TetraPlugin(options) {
   'use strict';
-  const { pointsOf, unitKey, unitOfKey } = TetraModel();
+  const { pointsOf, unitKey, unitIdOfKey, nameOfUnitId } = TetraModel();
   const base = (options && options.baseUrl) || '';
   const NS = 'tetra';
 
@@ -37,8 +37,10 @@ function TetraPlugin(options) {
     }
     return unitsCache;
   }
-  async function unitNamed(name) {
-    return (await units()).find((u) => u.unit === name) || { unit: name, gyro_count: 4 };
+  // A unit by its unit_id (the ground's id of its DDS key: the name may not be UTF-8, two names may look alike).
+  async function unitWithId(unitId) {
+    const known = (await units()).find((u) => u.unit_id === unitId);
+    return known || { unit: nameOfUnitId(unitId), unit_id: unitId, gyro_count: 4 };
   }
 
   // One EventSource for the page; listeners by message type. The browser reconnects by itself and
@@ -84,7 +86,7 @@ function TetraPlugin(options) {
   const id = (key) => ({ namespace: NS, key });
   function parseKey(key) {
     const [kind, unit, point] = key.split('~');
-    return { kind, unit: unitOfKey(unit || ''), point };
+    return { kind, unitId: unitIdOfKey(unit || ''), point };
   }
   const objectProvider = {
     async get(identifier) {
@@ -96,11 +98,12 @@ function TetraPlugin(options) {
           name: 'tetra units',
           type: 'folder',
           location: 'ROOT',
-          composition: list.map((u) => id('unit~' + unitKey(u.unit)))
+          composition: list.map((u) => id('unit~' + unitKey(u.unit_id)))
         };
       }
-      const { kind, unit, point } = parseKey(key);
-      const u = await unitNamed(unit);
+      const { kind, unitId, point } = parseKey(key);
+      const u = await unitWithId(unitId);
+      const unit = u.unit;
       if (kind === 'unit') {
         return {
           identifier,
@@ -108,7 +111,8 @@ function TetraPlugin(options) {
           type: 'tetra.unit',
           location: NS + ':units',
           unit,
-          composition: pointsOf(u).map((p) => id('point~' + unitKey(unit) + '~' + p.key))
+          unitId,
+          composition: pointsOf(u).map((p) => id('point~' + unitKey(unitId) + '~' + p.key))
         };
       }
       const p = pointsOf(u).find((x) => x.key === point);
@@ -128,8 +132,9 @@ function TetraPlugin(options) {
         identifier,
         name: p.name + ' (' + unit + ')',
         type: p.text ? 'tetra.telemetry.text' : 'tetra.telemetry',
-        location: NS + ':unit~' + unitKey(unit),
+        location: NS + ':unit~' + unitKey(unitId),
         unit,
+        unitId,
         point: p.key,
         telemetry: {
           values: [
@@ -143,7 +148,7 @@ function TetraPlugin(options) {
   };
 
   function pointOf(domainObject) {
-    return unitNamed(domainObject.unit).then((u) => pointsOf(u).find((p) => p.key === domainObject.point));
+    return unitWithId(domainObject.unitId).then((u) => pointsOf(u).find((p) => p.key === domainObject.point));
   }
   const isPoint = (o) => o.type === 'tetra.telemetry' || o.type === 'tetra.telemetry.text';
 
@@ -155,7 +160,7 @@ function TetraPlugin(options) {
       pointOf(domainObject).then((p) => {
         if (!p || cancelled) return;
         stop = listen(p.source, (m) => {
-          if (m.unit === domainObject.unit) callback(datum(p, m));
+          if (m.unit_id === domainObject.unitId) callback(datum(p, m));
         });
       });
       return () => {
@@ -172,8 +177,8 @@ function TetraPlugin(options) {
       if (!p || p.source === 'link') return [];
       const url =
         base +
-        '/api/history?unit=' +
-        encodeURIComponent(domainObject.unit) +
+        '/api/history?unit_id=' +
+        domainObject.unitId +
         '&kind=' +
         p.source +
         '&start=' +
@@ -239,13 +244,14 @@ function TetraPlugin(options) {
   function describe(command) {
     return command.action + (command.gyro ? ' gyro ' + command.gyro : '') + (command.force ? ' (FORCE)' : '');
   }
-  //! Asks for confirmation, then sends; resolves with the acknowledgement (or null when cancelled).
-  function confirmAndSend(openmct, command) {
+  //! Asks for confirmation naming the unit, then sends; resolves with the acknowledgement (or null when
+  //! cancelled). The command names the unit by its unit_id.
+  function confirmAndSend(openmct, unit, command) {
     return new Promise((resolve) => {
       const dialog = openmct.overlays.dialog({
         iconClass: command.force ? 'error' : 'alert',
         message:
-          'Send "' + describe(command) + '" to unit ' + command.unit + ' as operator "' + operatorId() + '"?',
+          'Send "' + describe(command) + '" to unit ' + unit + ' as operator "' + operatorId() + '"?',
         buttons: [
           {
             label: 'Send command',
@@ -297,6 +303,7 @@ function TetraPlugin(options) {
 
   function unitView(openmct, domainObject) {
     const unit = domainObject.unit;
+    const unitId = domainObject.unitId;
     const stops = [];
     let root = null;
     const state = { health: null, attitude: null, link: null, linkAt: 0, events: [], filter: '' };
@@ -321,7 +328,7 @@ function TetraPlugin(options) {
     function commandButton(label, command) {
       const b = el('button', { class: 'c-button tetra-command', 'data-command': describe(command) }, label);
       b.addEventListener('click', async () => {
-        const answer = await confirmAndSend(openmct, command);
+        const answer = await confirmAndSend(openmct, unit, command);
         if (answer && root) {
           const out = root.querySelector('#tetra-ack');
           out.textContent =
@@ -383,10 +390,10 @@ function TetraPlugin(options) {
           tr.appendChild(el('td', {}, h.gyros_used.includes(g.id) ? 'used' : '-'));
           const cmd = el('td');
           if (g.state === 'excluded') {
-            cmd.appendChild(commandButton('Reinstate', { unit, action: 'reinstate', gyro: g.id }));
+            cmd.appendChild(commandButton('Reinstate', { unit_id: unitId, action: 'reinstate', gyro: g.id }));
           } else {
-            cmd.appendChild(commandButton('Exclude', { unit, action: 'exclude', gyro: g.id }));
-            cmd.appendChild(commandButton('Exclude (force)', { unit, action: 'exclude', gyro: g.id, force: true }));
+            cmd.appendChild(commandButton('Exclude', { unit_id: unitId, action: 'exclude', gyro: g.id }));
+            cmd.appendChild(commandButton('Exclude (force)', { unit_id: unitId, action: 'exclude', gyro: g.id, force: true }));
           }
           tr.appendChild(cmd);
           gyros.appendChild(tr);
@@ -478,7 +485,7 @@ function TetraPlugin(options) {
         '<table class="tetra-table"><thead><tr><th>UTC</th><th>sensor time [s]</th>' +
         '<th>event</th><th>gyro</th><th>detail</th><th>why (ledger)</th></tr></thead><tbody id="tetra-events"></tbody></table></section>';
       r.querySelector('.tetra-name').textContent = 'Unit ' + unit;
-      r.querySelector('.tetra-commands').appendChild(commandButton('FDI reset', { unit, action: 'reset' }));
+      r.querySelector('.tetra-commands').appendChild(commandButton('FDI reset', { unit_id: unitId, action: 'reset' }));
       const showOperator = () => {
         r.querySelector('#tetra-operator').textContent = session.user ? session.user + ' (' + session.role + ')' : '?';
       };
@@ -507,7 +514,7 @@ function TetraPlugin(options) {
         element.appendChild(root);
         stops.push(
           listen('health', (m) => {
-            if (m.unit !== unit) return;
+            if (m.unit_id !== unitId) return;
             state.health = m;
             render();
             // Latency from the service's write (DDS source timestamp) to this display, for
@@ -517,10 +524,10 @@ function TetraPlugin(options) {
             if (lat.length > 10000) lat.shift();
           })
         );
-        stops.push(listen('attitude', (m) => m.unit === unit && ((state.attitude = m), render())));
+        stops.push(listen('attitude', (m) => m.unit_id === unitId && ((state.attitude = m), render())));
         stops.push(
           listen('link', (m) => {
-            if (m.unit !== unit) return;
+            if (m.unit_id !== unitId) return;
             state.link = m;
             state.linkAt = Date.now();
             render();
@@ -534,7 +541,7 @@ function TetraPlugin(options) {
           if (!response.ok || !root) return;
           const box = root.querySelector('#tetra-pending');
           box.innerHTML = '';
-          for (const p of (await response.json()).filter((x) => x.unit === unit)) {
+          for (const p of (await response.json()).filter((x) => x.unit_id === unitId)) {
             const line = el('div', { class: 'tetra-pending-item' });
             line.appendChild(el('span', {}, p.operator + ' asks: ' + p.command + ' (' + Math.ceil(p.expires_in_s) + ' s left) '));
             if (session.role === 'commander' && p.operator !== session.user) {
@@ -554,7 +561,7 @@ function TetraPlugin(options) {
         stops.push(() => clearInterval(pendingTicker));
         stops.push(
           listen('event', (m) => {
-            if (m.unit !== unit) return;
+            if (m.unit_id !== unitId) return;
             state.events.push(m);
             if (state.events.length > MAX_EVENTS) state.events.shift();
             render();
@@ -570,7 +577,7 @@ function TetraPlugin(options) {
         stops.push(() => streamState.listeners.delete(lost));
         // The event history; again after a reset of the stream (a restarted ground station, a gap).
         const loadEvents = () =>
-          apiGet('/api/history?unit=' + encodeURIComponent(unit) + '&kind=event&max=' + MAX_EVENTS)
+          apiGet('/api/history?unit_id=' + unitId + '&kind=event&max=' + MAX_EVENTS)
             .then((r) => (r.ok ? r.json() : []))
             .then((rows) => {
               const seen = new Set(state.events.map((e) => e.event_seq + '/' + e.utc_ms));
@@ -618,7 +625,8 @@ function TetraPlugin(options) {
       cssClass: 'icon-refresh',
       group: 'action',
       appliesTo: (objectPath) => objectPath[0] && objectPath[0].type === 'tetra.unit',
-      invoke: (objectPath) => confirmAndSend(openmct, { unit: objectPath[0].unit, action: 'reset' })
+      invoke: (objectPath) =>
+        confirmAndSend(openmct, objectPath[0].unit, { unit_id: objectPath[0].unitId, action: 'reset' })
     });
   };
 }

@@ -48,7 +48,10 @@ int cmd_ground_passwd(int argc, char** argv) {
   std::string users_path;
   std::string role_name = "viewer";
   bool from_stdin = false;
-  app.add_option("user", user, "the operator's id (1 to 31 of A-Z a-z 0-9 . _ -)")->required();
+  app.add_option("user", user,
+                 "the operator's id (1 to 31 of A-Z a-z 0-9 . _ -); one starting with - goes after --, which "
+                 "ends the options: ground passwd --users FILE -- -x")
+      ->required();
   app.add_option("--users", users_path, "the accounts file (created when absent, mode 0600)")->required();
   app.add_option("--role", role_name, "viewer (sees) or commander (sees and commands)")
       ->check(CLI::IsMember({"viewer", "commander"}))

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <chrono>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -159,6 +160,50 @@ TEST(GroundAttacks, PasswordChecksNeverBlockOtherSignInsOrTheApi) {
   for (auto& t : guessers) t.join();
   EXPECT_EQ(api_ok, 20);
   EXPECT_EQ(during.status, 200) << during.body;  // queued behind the checks, never 503
+}
+
+// The sign-in lane's bounds as docs/ground.md states them: 32 sign-ins waiting or checked, 2 of one
+// address (here 7, with one worker, so a few fill it). Sign-ins sent at once: the third of one address is a
+// 429; a guesser on many addresses fills the lane, and every sign-in beyond it is a 503 (nothing checked).
+TEST(GroundAttacks, TheSignInLaneHoldsAFixedNumberAndTwoOfOneAddress) {
+  EXPECT_EQ(HttpLimits{}.max_slow_queued, 32U);
+  EXPECT_EQ(HttpLimits{}.max_slow_per_address, 2U);
+  EXPECT_EQ(HttpLimits{}.slow_workers, 2);
+  Accounts a;
+  a.config.limits.max_slow_queued = 7;
+  a.config.limits.slow_workers = 1;
+  Ground g(a.config);
+  ASSERT_TRUE(g.start().ok());
+  const auto send_login = [&](const std::string& from) {
+    const int fd = connect_to(g.port(), from.c_str());
+    const std::string body = login_body("alice", "guess");
+    const std::string req = "POST /api/login HTTP/1.1\r\nHost: " + g.host() + "\r\nConnection: close\r\n" +
+                            kJson + "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body;
+    (void)::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+    return fd;
+  };
+  std::vector<int> one_address;
+  for (int i = 0; i < 3; ++i) one_address.push_back(send_login("127.0.2.1"));
+  std::this_thread::sleep_for(10ms);  // admitted before the rest (a check takes far longer)
+  std::vector<int> many;
+  for (int k = 2; k <= 7; ++k) {
+    for (int i = 0; i < 2; ++i) many.push_back(send_login("127.0.2." + std::to_string(k)));
+  }
+  const auto statuses = [](const std::vector<int>& fds) {
+    std::multiset<int> out;
+    for (const int fd : fds) {
+      out.insert(parse_reply(read_from(fd)).status);
+      ::close(fd);
+    }
+    return out;
+  };
+  EXPECT_EQ(statuses(one_address), (std::multiset<int>{401, 401, 429}));
+  // 2 of the lane's 7 held by the first address: 5 of these 12 admitted, the rest 503 unless a check
+  // ended meanwhile.
+  const auto answered = statuses(many);
+  EXPECT_EQ(answered.count(401) + answered.count(503), 12U);
+  EXPECT_GE(answered.count(503), 1U);
+  EXPECT_LE(answered.count(401), 10U);
 }
 
 TEST(GroundHttp, AForcedExclusionWaitsForASecondCommander) {

@@ -1,19 +1,28 @@
 // Integration of the ground station: simulator (sim --dds) + fusion service + tetra ground
 // as separate processes on a private loopback domain; an HTTP client reads the event stream and the
-// history, and commands through POST. Waits have generous upper bounds that only turn a hang into a
+// history, and commands through POST; and a DDS peer of another make, in this process, whose unit names
+// are not UTF-8, reached by their unit ids. Waits have generous upper bounds that only turn a hang into a
 // failure; nothing asserts on elapsed time.
 
 #include <gtest/gtest.h>
 #include <signal.h>
 
 #include <atomic>
+#include <functional>
 #include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <set>
+#include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "test_support.hpp"
 #include "tetra/core/calibration_file.hpp"
+#include "tetra/dds/convert.hpp"
+#include "tetra/dds/session.hpp"
 #include "tetra_process.hpp"
 // After Eigen (through the headers above): httplib.h brings <resolv.h>, whose `_res` macro breaks Eigen.
 #include <httplib.h>
@@ -266,6 +275,168 @@ TEST(GroundStation, StreamHistoryCommandsAndStaleness) {
   bool stale = false;
   for (const auto& e : lost) stale = stale || (e.event == "link" && e.data.value("state", "") != "LIVE");
   EXPECT_TRUE(stale);
+  EXPECT_EQ(ground.signal_and_wait(SIGTERM), 0) << read_file(dir.file("ground.log"));
+}
+
+//! A unit as a DDS peer of another make may publish it, from this process: Health and Attitude under
+//! `name` (any bytes: tetra's own tools refuse a name that is not UTF-8) every 200 ms, and an
+//! acknowledgement (reset done) of every Command to that name.
+class ForeignUnit {
+ public:
+  ForeignUnit(int domain, std::string name)
+      : name_(std::move(name)), thread_([this, domain] { serve(domain); }) {}
+  ~ForeignUnit() {
+    stop_ = true;
+    thread_.join();
+  }
+  ForeignUnit(const ForeignUnit&) = delete;
+  ForeignUnit& operator=(const ForeignUnit&) = delete;
+  //! The unit of each Command received (as its bytes), and the operator it carried.
+  std::vector<std::pair<std::string, std::string>> commands() const {
+    const std::lock_guard lock(mutex_);
+    return commands_;
+  }
+
+ private:
+  void serve(int domain) {
+    auto session = dds::Session::open(domain);
+    ASSERT_TRUE(session.ok()) << session.error().message;
+    auto health = session->writer<tetra_Health>(dds::health_qos());
+    auto attitude = session->writer<tetra_Attitude>(dds::attitude_writer_qos());
+    auto events = session->writer<tetra_FdiEvent2>(dds::event_qos());
+    auto commands = session->reader<tetra_Command>(dds::command_qos());
+    ASSERT_TRUE(health.ok() && attitude.ok() && events.ok() && commands.ok());
+    for (int tick = 0; !stop_; ++tick) {
+      if (tick % 10 == 0) publish(*health, *attitude, tick);
+      auto taken =
+          commands->take([&](const tetra_Command& c, const dds_sample_info_t&) { answer(*events, c); });
+      ASSERT_TRUE(taken.ok()) << taken.error().message;
+      std::this_thread::sleep_for(20ms);
+    }
+  }
+  void publish(const dds::Writer<tetra_Health>& health, const dds::Writer<tetra_Attitude>& attitude,
+               int tick) {
+    fdi::Health h;
+    h.stamp_ns = std::int64_t{tick} * 20'000'000;
+    h.gyros.resize(4);
+    h.used = 0b1111;
+    h.counters.epochs_accepted = static_cast<std::uint64_t>(tick);
+    dds::WireHealth wire;
+    ASSERT_TRUE(dds::to_wire(name_, h, {}, wire).ok());
+    wire.msg.health_period_s = 0.2;
+    ASSERT_TRUE(health.write(wire.msg).ok());
+    fdi::AttitudeEstimate a;
+    a.stamp_ns = h.stamp_ns;
+    tetra_Attitude att{};
+    ASSERT_TRUE(dds::to_wire(name_, a, att).ok());
+    ASSERT_TRUE(attitude.write(att).ok());
+  }
+  void answer(const dds::Writer<tetra_FdiEvent2>& events, const tetra_Command& c) {
+    const std::string unit = dds::from_wire(c.unit);
+    {
+      const std::lock_guard lock(mutex_);
+      commands_.emplace_back(unit, dds::from_wire(c.operator_id));
+    }
+    if (unit != name_) return;
+    dds::EventView ack{name_,
+                       ++event_seq_,
+                       c.command_id,
+                       {},
+                       {c.kind, c.force, dds::from_wire(c.operator_id), dds::from_wire(c.origin)}};
+    ack.event.type = fdi::EventType::kCommand;
+    ack.event.command = fdi::CommandVerb::kReset;
+    ack.event.detail = "reset: done";
+    dds::WireEvent wire;
+    ASSERT_TRUE(dds::to_wire(ack, wire).ok());
+    ASSERT_TRUE(events.write(wire.msg).ok());
+  }
+
+  std::string name_;
+  std::atomic<bool> stop_{false};
+  std::uint64_t event_seq_ = 0;
+  mutable std::mutex mutex_;
+  std::vector<std::pair<std::string, std::string>> commands_;
+  std::thread thread_;
+};
+
+//! GET `path` until `done` holds of the answer (or 20 s pass); the last answer.
+httplib::Result get_until(httplib::Client& client, const std::string& path,
+                          const std::function<bool(const httplib::Response&)>& done) {
+  auto res = client.Get(path);
+  for (int i = 0; i < 200 && !(res && done(*res)); ++i) {
+    std::this_thread::sleep_for(100ms);
+    res = client.Get(path);
+  }
+  return res;
+}
+
+// A unit whose DDS key is not UTF-8 (\351 is Latin-1's e-acute; \350 e-grave looks the same once shown):
+// the ground showed it as "caf\uFFFD", but kept it under its bytes, and the only way to name it, the name
+// in a parameter or a command, refused it (not UTF-8) or named another unit: its history and commands were
+// out of reach. Every unit has its unit_id, the hexadecimal of its bytes, and is reached by it.
+TEST(GroundStation, AUnitWhoseKeyIsNotUtf8IsReachedByItsUnitId) {
+  const int domain = 182;
+  const std::string d = std::to_string(domain);
+  TempDir dir;
+  TetraProcess ground({"ground", "--listen", "127.0.0.1:0", "--no-auth", "--domain", d},
+                      dir.file("ground.log"));
+  const int port = ground_port(dir.file("ground.log"));
+  ASSERT_GT(port, 0) << read_file(dir.file("ground.log"));
+  const std::string latin = "caf\xe9";
+  ForeignUnit cafe(domain, latin);
+  ForeignUnit other(domain, "caf\xe8");
+  const std::string id = "636166e9";
+  const std::string shown = "caf\xef\xbf\xbd";  // U+FFFD
+
+  httplib::Client client("127.0.0.1", port);
+  client.set_read_timeout(10, 0);
+  const auto units = get_until(client, "/api/units", [](const httplib::Response& r) {
+    const json j = json::parse(r.body, nullptr, false);
+    return j.is_array() && j.size() == 2;
+  });
+  ASSERT_TRUE(units && units->status == 200) << read_file(dir.file("ground.log"));
+  const json listed = json::parse(units->body);
+  ASSERT_EQ(listed.size(), 2U) << units->body;
+  std::set<std::string> ids;
+  for (const auto& u : listed) {
+    EXPECT_EQ(u["unit"], shown);  // the two look alike
+    ids.insert(u.value("unit_id", ""));
+  }
+  EXPECT_EQ(ids, (std::set<std::string>{"636166e8", id}));
+
+  // The name itself cannot be sent (a parameter must be UTF-8); the id reaches the unit's own history.
+  EXPECT_EQ(client.Get("/api/history?unit=caf%E9&kind=health")->status, 400);
+  for (const char* kind : {"health", "attitude"}) {
+    const auto rows = get_until(client, "/api/history?unit_id=" + id + "&kind=" + kind,
+                                [](const httplib::Response& r) { return r.status == 200 && r.body != "[]"; });
+    ASSERT_TRUE(rows && rows->status == 200) << kind;
+    for (const auto& row : json::parse(rows->body)) EXPECT_EQ(row["unit_id"], id) << kind << rows->body;
+  }
+
+  // A command by the id goes to the unit's own key; its acknowledgement comes back and into the history.
+  int status = 0;
+  const json ack = post_command(port, {{"unit_id", id}, {"action", "reset"}}, status);
+  ASSERT_EQ(status, 200) << ack.dump() << read_file(dir.file("ground.log"));
+  EXPECT_TRUE(ack["accepted"].get<bool>()) << ack.dump();
+  EXPECT_EQ(ack["unit_id"], id);
+  EXPECT_EQ(ack["unit"], shown);
+  const auto received = cafe.commands();
+  ASSERT_EQ(received.size(), 1U);
+  EXPECT_EQ(received[0].first, latin);
+  const auto events =
+      get_until(client, "/api/history?unit_id=" + id + "&kind=event", [&](const httplib::Response& r) {
+        return r.body.find(ack["command_id"].get<std::string>()) != std::string::npos;
+      });
+  ASSERT_TRUE(events && events->status == 200);
+  EXPECT_NE(events->body.find(ack["command_id"].get<std::string>()), std::string::npos) << events->body;
+  // The stream carries the id with every message of the unit.
+  const auto of_cafe = [&](const std::vector<Sse>& ev) {
+    for (const auto& e : ev) {
+      if (e.event == "health" && e.data.value("unit_id", "") == id) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(of_cafe(read_stream(port, of_cafe, "", 20s)));
   EXPECT_EQ(ground.signal_and_wait(SIGTERM), 0) << read_file(dir.file("ground.log"));
 }
 

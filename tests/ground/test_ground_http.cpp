@@ -10,6 +10,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -290,6 +291,46 @@ TEST(GroundHttp, ParametersBodiesStreamsAndSlowClientsAreBounded) {
   const std::string answer = read_from(slow);  // returns when the server closes (bounded: 10 s)
   EXPECT_EQ(answer.find("200"), std::string::npos);
   ::close(slow);
+}
+
+//! [s] until the server closes `fd` (its FIN or reset); -1 when it is still open after the client's 10 s.
+double seconds_until_closed(int fd) {
+  const auto start = std::chrono::steady_clock::now();
+  char byte = 0;
+  const ssize_t n = ::recv(fd, &byte, 1, 0);
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return n == 0 || (n < 0 && errno == ECONNRESET) ? waited : -1.0;
+}
+
+// The idle deadline (HttpLimits::idle_timeout_s, 30 s by default, 2 s here): a connection that sends
+// nothing, and a kept-alive one once its answer is out, is closed when it has passed, not before (the
+// request deadline, 0.5 s here, counts only from a request's first byte) and not never.
+TEST(GroundHttp, AnIdleConnectionIsClosedAtTheIdleDeadline) {
+  ServerConfig config;
+  config.no_auth = true;
+  config.limits.idle_timeout_s = 2.0;
+  config.limits.request_timeout_s = 0.5;
+  Ground g(config);
+  ASSERT_TRUE(g.start().ok());
+  const auto at_deadline = [](double waited) {
+    // A timer never fires early; the upper bound only turns a hang into a failure on a loaded machine.
+    EXPECT_GE(waited, 1.95);
+    EXPECT_LT(waited, 7.0);
+  };
+  const int silent = connect_to(g.port());
+  ASSERT_GE(silent, 0);
+  at_deadline(seconds_until_closed(silent));
+  ::close(silent);
+
+  const int kept = connect_to(g.port());
+  ASSERT_GE(kept, 0);
+  const std::string req = "GET /api/units HTTP/1.1\r\nHost: " + g.host() + "\r\n\r\n";
+  (void)::send(kept, req.data(), req.size(), MSG_NOSIGNAL);
+  const Reply answer = parse_reply(read_from(kept, "[]"));
+  ASSERT_EQ(answer.status, 200) << answer.head;
+  EXPECT_EQ(answer.head.find("Connection: close"), std::string::npos) << answer.head;
+  at_deadline(seconds_until_closed(kept));
+  ::close(kept);
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "tetra/ground/record_files.hpp"
 #include "tetra/ground/ring_buffer.hpp"
 #include "tetra/ground/store.hpp"
+#include "tetra/ground/unit_id.hpp"
 
 namespace tetra::ground {
 namespace {
@@ -85,6 +86,40 @@ TEST(Encode, ParityFieldsAreNotAvailableWithFewerThanFourGyros) {
   fdi::AttitudeEstimate a;
   a.fdi_available = false;
   EXPECT_FALSE(attitude_json("u", a, kUtc0_ns)["fdi_available"].get<bool>());
+}
+
+// A unit is named in the API by the hexadecimal of its bytes: every name, UTF-8 or not, has an id of its
+// own that gives it back, and the id is the one spelling of it (lowercase, two digits a byte).
+TEST(UnitId, EveryNameHasAnIdThatGivesItBack) {
+  EXPECT_EQ(unit_id("unit one"), "756e6974206f6e65");
+  EXPECT_EQ(unit_id("caf\xe9"), "636166e9");
+  std::string every_byte;
+  for (int b = 1; b < 256; ++b) every_byte += static_cast<char>(b);
+  EXPECT_EQ(unit_of_id(unit_id(every_byte)), every_byte);
+  for (const char* bad : {"", "7", "636166E9", "63 6166", "6g", "%e9"})
+    EXPECT_FALSE(unit_of_id(bad).has_value()) << bad;
+  using Name = std::optional<std::string>;
+  EXPECT_EQ(*requested_unit(Name("unit one"), std::nullopt, "parameter"), "unit one");
+  EXPECT_EQ(*requested_unit(std::nullopt, Name("636166e9"), "parameter"), "caf\xe9");
+  EXPECT_EQ(requested_unit(Name("a"), Name("61"), "parameter").error().message,
+            "parameter 'unit' or 'unit_id', not both");
+  EXPECT_EQ(requested_unit(std::nullopt, std::nullopt, "parameter").error().message,
+            "parameter 'unit' (or 'unit_id') missing");
+  EXPECT_EQ(requested_unit(std::nullopt, Name("636166E9"), "parameter").error().message,
+            "parameter 'unit_id': the lowercase hexadecimal of the unit's name, as /api/units gives it");
+  // Every object the ground shows a unit in carries its id.
+  const std::string latin = "caf\xe9";
+  EXPECT_EQ(health_json(health(latin, 0b1111), kUtc0_ns)["unit_id"], "636166e9");
+  EXPECT_EQ(attitude_json(latin, fdi::AttitudeEstimate{}, kUtc0_ns)["unit_id"], "636166e9");
+  dds::EventView event;
+  event.unit = latin;
+  EXPECT_EQ(event_json(event, 4, kUtc0_ns)["unit_id"], "636166e9");
+  GroundStore store(StoreConfig{});
+  store.add_health(health(latin, 0b1111), kUtc0_ns, 0);
+  EXPECT_EQ(store.units_json(0)[0]["unit_id"], "636166e9");
+  AuditRecord record;
+  record.unit = latin;
+  EXPECT_EQ(json::parse(AuditLog::json_line(record, 0))["unit_id"], "636166e9");
 }
 
 TEST(Encode, AcknowledgementCarriesTheAuditTrail) {
@@ -230,6 +265,15 @@ TEST(CommandRequest, ValidatesEveryField) {
                 .error()
                 .message.find("'action' given twice"),
             std::string::npos);
+  // The unit by its id: any bytes; by its name or its id, not both.
+  auto by_id = parse_command_request(R"({"unit_id":"636166e9","action":"reset"})", "bob", "o");
+  ASSERT_TRUE(by_id.ok()) << by_id.error().message;
+  EXPECT_EQ(by_id->unit, "caf\xe9");
+  for (const char* bad :
+       {R"({"unit":"u","unit_id":"75","action":"reset"})", R"({"unit_id":"7","action":"reset"})",
+        R"({"unit_id":117,"action":"reset"})", R"({"unit":"","action":"reset"})"}) {
+    EXPECT_FALSE(parse_command_request(bad, "alice", "o").ok()) << bad;
+  }
   const std::string long_operator(40, 'x');
   auto too_long = parse_command_request(R"({"unit":"u","action":"reset"})", long_operator, "o");
   ASSERT_TRUE(too_long.ok());
@@ -466,6 +510,36 @@ TEST(Operators, AKeyOrJournalOthersCanReadIsRefusedAndADamagedJournalNamesItsLin
   ASSERT_FALSE(damaged.ok());
   EXPECT_EQ(damaged.error().message.rfind(dir.file("sessions") + ":2: expected", 0), 0U)
       << damaged.error().message;
+}
+
+// Each file others may read or write is refused with what they could do with that file: the audit file
+// and the session journal said "whoever reads it can sign in as any operator", which is not so of either
+// (the audit file signs no one in; the journal holds keyed hashes, never a session id, but a line written
+// into it can give one's own session another user).
+TEST(PrivateFiles, EachFileOpenToOthersIsRefusedWithWhatTheyCouldDoWithIt) {
+  test::TempDir dir;
+  const auto open_to_others = [&](const std::string& name) {
+    test::write_file(dir.file(name), "");
+    using std::filesystem::perms;
+    std::filesystem::permissions(
+        dir.file(name), perms::owner_read | perms::owner_write | perms::group_read | perms::others_read);
+    return dir.file(name);
+  };
+  const std::string audit = open_to_others("audit.jsonl");
+  EXPECT_EQ(
+      AuditLog::open(audit).error().message,
+      audit +
+          ": the audit file is readable or writable by group or others (mode 0644); whoever reads it learns "
+          "who signed in from where and what they commanded, whoever writes it can forge or erase the "
+          "record: chmod 600 " +
+          audit);
+  const std::string journal = open_to_others("sessions");
+  EXPECT_EQ(
+      SessionStore::open(journal, "key", 1000).error().message,
+      journal +
+          ": the session journal is readable or writable by group or others (mode 0644); whoever writes it "
+          "can sign in as any operator: chmod 600 " +
+          journal);
 }
 
 // Any bytes in a DDS string (here an operator id and a unit name that are not UTF-8) become text, never an

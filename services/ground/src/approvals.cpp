@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "tetra/ground/operators.hpp"
+#include "tetra/ground/unit_id.hpp"
 
 namespace tetra::ground {
 
@@ -70,6 +71,7 @@ nlohmann::json Approvals::list(std::int64_t now_ns) {
   for (const auto& p : pending_) {
     out.push_back({{"id", p.id},
                    {"unit", p.request.unit},
+                   {"unit_id", unit_id(p.request.unit)},
                    {"command", describe_command(p.request)},
                    {"operator", p.request.operator_id},
                    {"expires_in_s", static_cast<double>(p.expires_ns - now_ns) / 1e9}});

@@ -10,13 +10,24 @@
 #include <nlohmann/json.hpp>
 
 #include "tetra/ground/private_file.hpp"
+#include "tetra/ground/unit_id.hpp"
 
 namespace tetra::ground {
+
+namespace {
+
+//! What group or others could do with the audit file: it signs no one in, but tells and keeps the record.
+constexpr const char* kOpenAuditFile =
+    "whoever reads it learns who signed in from where and what they commanded, whoever writes it can forge "
+    "or "
+    "erase the record";
+
+}  // namespace
 
 Result<AuditLog> AuditLog::open(const std::string& path) {
   AuditLog log;
   if (path.empty()) return log;
-  if (auto s = check_private(path, "the audit file"); !s) return s.error();
+  if (auto s = check_private(path, "the audit file", kOpenAuditFile); !s) return s.error();
   log.fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0600);
   if (log.fd_ < 0) return failure(path + ": cannot open the audit file: " + std::strerror(errno));
   log.path_ = path;
@@ -47,8 +58,8 @@ std::string AuditLog::json_line(const AuditRecord& r, std::int64_t utc_ms) {
                             {"status", r.status},   {"operator", r.operator_id},
                             {"role", r.role},       {"address", r.address},
                             {"method", r.method},   {"path", r.path},
-                            {"unit", r.unit},       {"command", r.command},
-                            {"reason", r.reason}};
+                            {"unit", r.unit},       {"unit_id", unit_id(r.unit)},
+                            {"command", r.command}, {"reason", r.reason}};
   // Every string escaped (control characters as \uXXXX, bytes that are not UTF-8 as U+FFFD).
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }

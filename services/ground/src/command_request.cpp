@@ -5,10 +5,31 @@
 #include "tetra/dds/entity.hpp"
 #include "tetra/dds/topics.hpp"
 #include "tetra/ground/strict_json.hpp"
+#include "tetra/ground/unit_id.hpp"
 
 namespace tetra::ground {
 
 using nlohmann::json;
+
+namespace {
+
+//! The text of `key` when `j` has it as a string; nullopt when absent; an error when it is not a string.
+Result<std::optional<std::string>> optional_text(const json& j, const char* key) {
+  if (!j.contains(key)) return std::optional<std::string>();
+  if (!j[key].is_string()) return bad_input(std::string("command: field '") + key + "' must be a string");
+  return std::optional<std::string>(j[key].get<std::string>());
+}
+
+//! The unit a command names by its field `unit` or `unit_id`.
+Result<std::string> command_unit(const json& j) {
+  auto name = optional_text(j, "unit");
+  if (!name) return name.error();
+  auto id = optional_text(j, "unit_id");
+  if (!id) return id.error();
+  return requested_unit(*name, *id, "command: field");
+}
+
+}  // namespace
 
 Result<CommandRequest> parse_command_request(const std::string& body, const std::string& operator_id,
                                              const std::string& origin) {
@@ -19,15 +40,16 @@ Result<CommandRequest> parse_command_request(const std::string& body, const std:
   for (const auto& item : j.items()) {
     if (item.key() == "operator")
       return bad_input("command: field 'operator' is not accepted: the operator is the signed-in user");
-    if (item.key() != "unit" && item.key() != "action" && item.key() != "gyro" && item.key() != "force")
-      return bad_input("command: field '" + item.key() + "' unknown (unit, action, gyro, force)");
+    if (item.key() != "unit" && item.key() != "unit_id" && item.key() != "action" && item.key() != "gyro" &&
+        item.key() != "force")
+      return bad_input("command: field '" + item.key() + "' unknown (unit or unit_id, action, gyro, force)");
   }
   CommandRequest c;
   c.origin = origin;
   c.operator_id = operator_id;
-  if (!j.contains("unit") || !j["unit"].is_string() || j["unit"].get<std::string>().empty())
-    return bad_input("command: field 'unit' (string) missing");
-  c.unit = j["unit"].get<std::string>();
+  auto unit = command_unit(j);
+  if (!unit) return unit.error();
+  c.unit = std::move(unit).value();
   const std::string action =
       j.contains("action") && j["action"].is_string() ? j["action"].get<std::string>() : "";
   if (action == "reset") {

@@ -4,6 +4,7 @@
 
 #include "tetra/core/geometry.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/ground/unit_id.hpp"
 
 namespace tetra::ground {
 
@@ -84,6 +85,7 @@ json health_json(const dds::HealthView& view, std::int64_t utc_ns) {
   const auto when_parity = [&](double value) { return parity ? number(value) : json(nullptr); };
   return {{"type", "health"},
           {"unit", view.unit},
+          {"unit_id", unit_id(view.unit)},
           {"utc_ms", utc_ms(utc_ns)},
           {"sensor_time_s", ns_to_seconds(h.stamp_ns)},
           {"mode", fdi::to_string(h.mode)},
@@ -114,6 +116,7 @@ json attitude_json(const std::string& unit, const fdi::AttitudeEstimate& a, std:
   const EulerDeg e = euler_zyx_deg(a.q_RB);
   return {{"type", "attitude"},
           {"unit", unit},
+          {"unit_id", unit_id(unit)},
           {"utc_ms", utc_ms(utc_ns)},
           {"sensor_time_s", ns_to_seconds(a.stamp_ns)},
           {"q", json::array({q[0], q[1], q[2], q[3]})},
@@ -131,6 +134,7 @@ json event_json(const dds::EventView& view, int n_gyros, std::int64_t utc_ns) {
   if (out.is_discarded()) out = json::object();
   out["type"] = "event";
   out["unit"] = view.unit;
+  out["unit_id"] = unit_id(view.unit);
   out["event_seq"] = view.event_seq;
   out["utc_ms"] = utc_ms(utc_ns);
   out["sensor_time_s"] = ns_to_seconds(view.event.stamp_ns);

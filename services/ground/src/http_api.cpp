@@ -11,6 +11,7 @@
 #include "tetra/ground/query_params.hpp"
 #include "tetra/ground/record_files.hpp"
 #include "tetra/ground/strict_json.hpp"
+#include "tetra/ground/unit_id.hpp"
 
 namespace tetra::ground {
 
@@ -428,7 +429,7 @@ HttpResponse GroundServer::stream(const HttpRequest& req) {
 }
 
 HttpResponse GroundServer::history(const HttpRequest& req) {
-  auto q = QueryParams::of(req.params, {"unit", "kind", "start", "end", "max"});
+  auto q = QueryParams::of(req.params, {"unit", "unit_id", "kind", "start", "end", "max"});
   if (!q) return error_reply(400, q.error().message);
   const auto start = q->number("start", 0);
   const auto end = q->number("end", 1e300);
@@ -437,8 +438,9 @@ HttpResponse GroundServer::history(const HttpRequest& req) {
        {start ? nullptr : &start.error(), end ? nullptr : &end.error(), max ? nullptr : &max.error()}) {
     if (e != nullptr) return error_reply(400, e->message);
   }
-  if (!q->has("unit")) return error_reply(400, "parameter 'unit' missing");
-  auto h = store_.history(q->text("unit"), q->text("kind"), *start, *end, *max);
+  const auto unit = requested_unit(q->given("unit"), q->given("unit_id"), "parameter");
+  if (!unit) return error_reply(400, unit.error().message);
+  auto h = store_.history(*unit, q->text("kind"), *start, *end, *max);
   if (!h) return error_reply(h.error().message.rfind("history kind", 0) == 0 ? 400 : 404, h.error().message);
   return json_reply(200, *h);
 }

@@ -7,6 +7,7 @@
 #include "tetra/ground/encode.hpp"
 #include "tetra/ground/http_api.hpp"
 #include "tetra/ground/strict_json.hpp"
+#include "tetra/ground/unit_id.hpp"
 
 namespace tetra::ground {
 
@@ -45,6 +46,7 @@ HttpResponse GroundServer::command(const HttpRequest& req, const Session& sessio
                             "held for a second commander's approval (" + *id + ")"));
   return json_reply(202, {{"pending", *id},
                           {"unit", request->unit},
+                          {"unit_id", unit_id(request->unit)},
                           {"command", describe_command(*request)},
                           {"operator", session.user},
                           {"approve_within_s", approvals_.timeout_s()}});

@@ -14,26 +14,29 @@ namespace tetra::ground {
 
 namespace {
 
+//! What group or others could do with the accounts file or the session key.
+constexpr const char* kAnyOperator = "whoever reads it can sign in as any operator";
+
 bool sodium_ready() {
   static const bool ready = sodium_init() >= 0;
   return ready;
 }
 
-std::string to_hex(const unsigned char* data, std::size_t n) {
-  std::string out(n * 2 + 1, '\0');
-  sodium_bin2hex(out.data(), out.size(), data, n);
+}  // namespace
+
+std::string hex_of(std::string_view bytes) {
+  std::string out(bytes.size() * 2 + 1, '\0');
+  sodium_bin2hex(out.data(), out.size(), reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
   out.pop_back();
   return out;
 }
-
-}  // namespace
 
 std::string keyed_hash_hex(const std::string& key, const std::string& text) {
   sodium_ready();
   unsigned char mac[32];
   crypto_generichash(mac, sizeof mac, reinterpret_cast<const unsigned char*>(text.data()), text.size(),
                      reinterpret_cast<const unsigned char*>(key.data()), key.size());
-  return to_hex(mac, sizeof mac);
+  return hex_of(std::string_view(reinterpret_cast<const char*>(mac), sizeof mac));
 }
 
 const char* to_string(Role role) {
@@ -58,7 +61,7 @@ std::string random_hex(std::size_t n) {
   sodium_ready();
   std::string bytes(n, '\0');
   randombytes_buf(bytes.data(), n);
-  return to_hex(reinterpret_cast<const unsigned char*>(bytes.data()), n);
+  return hex_of(bytes);
 }
 
 bool same_secret(const std::string& a, const std::string& b) {
@@ -145,7 +148,7 @@ Result<Operators> Operators::open(const std::string& users_path, const std::stri
   if (!sodium_ready()) return failure("libsodium cannot start");
   Operators ops;
   ops.users_path_ = users_path;
-  if (auto s = check_private(users_path, "the accounts file"); !s) return s.error();
+  if (auto s = check_private(users_path, "the accounts file", kAnyOperator); !s) return s.error();
   auto accounts = read_accounts(users_path);
   if (!accounts) return accounts.error();
   if (accounts->empty())
@@ -153,7 +156,7 @@ Result<Operators> Operators::open(const std::string& users_path, const std::stri
                      users_path + ")");
   ops.accounts_ = std::move(accounts).value();
   ops.accounts_stamp_ = file_stamp(users_path);
-  if (auto s = check_private(key_path, "the session key"); !s) return s.error();
+  if (auto s = check_private(key_path, "the session key", kAnyOperator); !s) return s.error();
   auto key = read_text_file(key_path);
   if (!key) {
     if (::access(key_path.c_str(), F_OK) == 0) return key.error();
@@ -184,8 +187,9 @@ void Operators::reload() {
   accounts_stamp_ = stamp;
   // A file being edited, broken or opened to others: no accounts until it reads again (refuse rather
   // than guess).
-  accounts_ = accounts && check_private(users_path_, "the accounts file") ? std::move(accounts).value()
-                                                                          : std::vector<Account>{};
+  accounts_ = accounts && check_private(users_path_, "the accounts file", kAnyOperator)
+                  ? std::move(accounts).value()
+                  : std::vector<Account>{};
 }
 
 std::optional<Account> Operators::login(const std::string& user, const std::string& password) {

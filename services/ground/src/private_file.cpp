@@ -44,13 +44,12 @@ Status write_private(const std::string& path, const std::string& text) {
   return ok_status();
 }
 
-Status check_private(const std::string& path, const std::string& what) {
+Status check_private(const std::string& path, const std::string& what, const std::string& risk) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return ok_status();
   if ((st.st_mode & 077U) != 0)
     return bad_input(path + ": " + what + " is readable or writable by group or others (mode " +
-                     mode_text(st.st_mode) + "); whoever reads it can sign in as any operator: chmod 600 " +
-                     path);
+                     mode_text(st.st_mode) + "); " + risk + ": chmod 600 " + path);
   return ok_status();
 }
 

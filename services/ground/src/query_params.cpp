@@ -26,10 +26,14 @@ bool QueryParams::has(const std::string& name) const {
 }
 
 std::string QueryParams::text(const std::string& name) const {
+  return given(name).value_or("");
+}
+
+std::optional<std::string> QueryParams::given(const std::string& name) const {
   for (const auto& p : params_) {
     if (p.first == name) return p.second;
   }
-  return "";
+  return std::nullopt;
 }
 
 Result<double> QueryParams::number(const std::string& name, double fallback) const {

@@ -28,7 +28,11 @@ bool is_count(const std::string& text) {
 }  // namespace
 
 Result<SessionStore> SessionStore::open(const std::string& path, const std::string& key, std::int64_t now_s) {
-  if (auto s = check_private(path, "the session journal"); !s) return s.error();
+  // It holds keyed hashes of the session ids, never an id: reading it signs no one in, writing it does (a
+  // line giving one's own session another user).
+  if (auto s = check_private(path, "the session journal", "whoever writes it can sign in as any operator");
+      !s)
+    return s.error();
   SessionStore store;
   store.path_ = path;
   store.key_ = key;

@@ -5,6 +5,7 @@
 
 #include "tetra/core/units.hpp"
 #include "tetra/ground/encode.hpp"
+#include "tetra/ground/unit_id.hpp"
 
 namespace tetra::ground {
 
@@ -102,6 +103,7 @@ json GroundStore::link_json(const std::string& name, const Unit& u, std::int64_t
   const double period_s = u.health.empty() ? 0.0 : u.health.newest().value.health_period_s;
   return {{"type", "link"},
           {"unit", name},
+          {"unit_id", unit_id(name)},
           {"state", to_string(u.link)},
           {"health_age_s", age(u.health_received_ns)},
           {"attitude_age_s", age(u.attitude_received_ns)},

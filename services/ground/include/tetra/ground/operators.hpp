@@ -10,6 +10,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tetra/core/result.hpp"
@@ -94,5 +95,7 @@ std::string keyed_hash_hex(const std::string& key, const std::string& text);
 bool same_secret(const std::string& a, const std::string& b);
 //! `n` random bytes as hexadecimal.
 std::string random_hex(std::size_t n);
+//! Bytes as lowercase hexadecimal, two digits each.
+std::string hex_of(std::string_view bytes);
 
 }  // namespace tetra::ground

@@ -1,6 +1,7 @@
 #pragma once
-// Files of the ground station that hold secrets or grant access (accounts, the session key, the session
-// journal): written with mode 0600, and refused when group or others may read or write them.
+// Files of the ground station that hold secrets, grant access or record it (accounts, the session key, the
+// session journal, the audit file): written with mode 0600, and refused when group or others may read or
+// write them.
 
 #include <cstdint>
 #include <string>
@@ -12,9 +13,9 @@ namespace tetra::ground {
 //! Writes `text` to `path` with mode 0600: a new file beside it, fsynced and renamed over it. When `path`
 //! is a symbolic link the file it points to is replaced (the link stays).
 Status write_private(const std::string& path, const std::string& text);
-//! An error naming the file and its mode when group or others may read or write `path`; ok when it is
-//! private to its owner or absent.
-Status check_private(const std::string& path, const std::string& what);
+//! An error naming the file (`what` it is), its mode and `risk` (what others could do with it) when group
+//! or others may read or write `path`; ok when it is private to its owner or absent.
+Status check_private(const std::string& path, const std::string& what, const std::string& risk);
 
 //! A file's size and modification time, to tell that another process changed it ({-1, -1}: absent).
 struct FileStamp {

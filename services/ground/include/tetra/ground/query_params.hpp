@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,6 +21,8 @@ class QueryParams {
   bool has(const std::string& name) const;
   //! The parameter's text ("" when absent).
   std::string text(const std::string& name) const;
+  //! The parameter's text; nullopt when absent.
+  std::optional<std::string> given(const std::string& name) const;
   //! A finite number; `fallback` when absent.
   Result<double> number(const std::string& name, double fallback) const;
   //! An integer in [min, max]; `fallback` when absent.
