@@ -11,7 +11,7 @@ build=${2:-build}
 shift $(($# > 2 ? 2 : $#))
 names=("$@")
 if [ ${#names[@]} -eq 0 ]; then
-  names=(csv gyro_log gyro_log_h5 turntable_log calibration scenario fault_spec calibrate allan tau_spec pipeline
+  names=(csv gyro_log gyro_log_h5 turntable_log calibration scenario campaign_spec fault_spec calibrate allan tau_spec pipeline
          pipeline_config fusion_config security_profile)
 fi
 bash tests/fuzz/build_fuzzers.sh "$PWD" "$PWD/$build/fuzz" >/dev/null || exit 1

@@ -244,7 +244,11 @@ TEST(CampaignRunner, ShardsMergeToTheOneMachineFiles) {
   for (const auto& [field, value, message] : std::vector<std::tuple<int, std::string, std::string>>{
            {12, "-540", "false_alarms '-540' (a count >= 0)"},
            {3, "77", "gyro '77' (a gyro 0..32)"},
-           {9, "nan", "detection_delay_s 'nan'"}}) {
+           {9, "nan", "detection_delay_s 'nan'"},
+           {8, "5", "isolated_gyro '5' (a gyro 1..4 of the scenario's unit)"},
+           {7, "missed", "outcome 'missed' (a run without a fault is none or wrong)"},
+           {13, "1e6",
+            "fault_free_s '1e+06' (a run without a fault is fault-free to the run's end at 120 s)"}}) {
     std::vector<std::string> lines;
     std::stringstream in(s2);
     for (std::string line; std::getline(in, line);) lines.push_back(line);
@@ -274,8 +278,9 @@ TEST(CampaignRunner, ShardsMergeToTheOneMachineFiles) {
     write_file(dir.file("s2/runs.csv"), shifted);
     const auto bad = run_tetra("campaign merge " + dir.file("m3") + " " + shards);
     EXPECT_EQ(bad.exit_status, 2) << bad.err;
-    EXPECT_NE(bad.err.find("s2/runs.csv: run 1 is '1,"), std::string::npos) << bad.err;
-    EXPECT_NE(bad.err.find("the spec's case is '1,"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("s2/runs.csv:2: campaign row: gyro '1' (run 1 of the spec's matrix has gyro 0)"),
+              std::string::npos)
+        << bad.err;
   }
   write_file(dir.file("s2/runs.csv"), s2);
   // Shard 3 with its last row torn off (an interrupted task): incomplete.
@@ -311,7 +316,9 @@ TEST(CampaignRunner, ShardsGivenAsRelativeFoldersAreCheckedAgainstTheMatrix) {
   write_file(dir.file("s2/runs.csv"), forged);
   auto r = run_shell(in_dir + "campaign merge m s1 s2");
   EXPECT_EQ(r.exit_status, 2) << r.err;
-  EXPECT_NE(r.err.find("s2/runs.csv: run 1 is '1,nadir.yaml,none,1,"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("s2/runs.csv:2: campaign row: gyro '1' (run 1 of the spec's matrix has gyro 0)"),
+            std::string::npos)
+      << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("m/runs.csv")));
   write_file(dir.file("s2/runs.csv"), s2);
   std::filesystem::create_directories(dir.file("elsewhere"));
@@ -323,6 +330,69 @@ TEST(CampaignRunner, ShardsGivenAsRelativeFoldersAreCheckedAgainstTheMatrix) {
   r = run_shell(in_dir + "campaign merge m s1 s2");
   EXPECT_EQ(r.exit_status, 0) << r.err;
   EXPECT_TRUE(std::filesystem::exists(dir.file("m/runs.csv")));
+}
+
+// Every file a campaign writes in its folder (runs.csv, the manifest, report.md and its plots) is checked
+// before any is written, by run and merge alike: in a folder of no campaign any of them is another
+// program's and refused (report.md was replaced); a symbolic link out of the folder, a FIFO or a
+// write-protected file is refused in a campaign's folder too. Each refusal is one line naming the file,
+// exit 2, the file untouched.
+TEST(CampaignRunner, OutputsOfNoCampaignOrOutOfTheFolderAreRefused) {
+  TempDir dir;
+  write_file(dir.file("spec.yaml"),
+             "loop: open\nscenarios: [orbit]\nduration_s: 30\nkinds: [stuck]\ngyros: [1]\nonsets_s: [10]\n"
+             "seeds: [1]\n");
+  const std::string spec = dir.file("spec.yaml");
+  const auto run = [&](const std::string& out) { return run_tetra("campaign " + spec + " --out " + out); };
+  const auto refused = [&](const CommandResult& r, const std::string& message, const std::string& file,
+                           const std::string& text) {
+    EXPECT_EQ(r.exit_status, 2) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_EQ(read_file(file), text) << file;
+  };
+  const std::string no_campaign = "the output folder holds files of no campaign";
+  for (const char* name : {"report.md", "outcomes.png", "detection_vs_size_bias.png"}) {
+    const std::string out = dir.file(std::string("foreign_") + name);
+    std::filesystem::create_directories(out);
+    write_file(out + "/" + name, "someone's\n");
+    refused(run(out), out + "/" + name + ": " + no_campaign, out + "/" + name, "someone's\n");
+    EXPECT_FALSE(std::filesystem::exists(out + "/runs.csv")) << name;
+  }
+  // A campaign's folder whose report.md leads out of it, is write-protected or a FIFO.
+  const std::string out = dir.file("out");
+  ASSERT_EQ(run(out).exit_status, 0);
+  const std::string report = out + "/report.md";
+  const std::string elsewhere = dir.file("elsewhere.md");
+  write_file(elsewhere, "elsewhere\n");
+  std::filesystem::remove(report);
+  std::filesystem::create_symlink(elsewhere, report);
+  refused(run(out), report + ": a symbolic link out of the output folder", elsewhere, "elsewhere\n");
+  std::filesystem::remove(report);
+  write_file(report, "protected\n");
+  std::filesystem::permissions(report, std::filesystem::perms::owner_read);
+  refused(run(out), report + ": is write-protected", report, "protected\n");  // root too: no write bit
+  std::filesystem::remove(report);
+  ASSERT_EQ(run_shell("mkfifo " + report).exit_status, 0);
+  const auto fifo = run(out);
+  EXPECT_EQ(fifo.exit_status, 2) << fifo.err;
+  EXPECT_NE(fifo.err.find(report + ": is a FIFO"), std::string::npos) << fifo.err;
+  std::filesystem::remove(report);
+
+  // merge: the same checks on its output folder.
+  ASSERT_EQ(run_tetra("campaign " + spec + " --out " + dir.file("s1") + " --shard 1/1").exit_status, 0);
+  const std::string merged = dir.file("merged");
+  std::filesystem::create_directories(merged);
+  write_file(merged + "/report.md", "someone's\n");
+  refused(run_tetra("campaign merge " + merged + " " + dir.file("s1")), merged + "/report.md: " + no_campaign,
+          merged + "/report.md", "someone's\n");
+  std::filesystem::remove(merged + "/report.md");
+  std::filesystem::create_symlink(elsewhere, merged + "/runs.csv");
+  refused(run_tetra("campaign merge " + merged + " " + dir.file("s1")),
+          merged + "/runs.csv: a symbolic link out of the output folder", elsewhere, "elsewhere\n");
+  std::filesystem::remove(merged + "/runs.csv");
+  const auto fine = run_tetra("campaign merge " + merged + " " + dir.file("s1"));
+  EXPECT_EQ(fine.exit_status, 0) << fine.err;
 }
 
 }  // namespace

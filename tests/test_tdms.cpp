@@ -515,6 +515,38 @@ TEST(TdmsParse, PropertyNamesMapsAndChannelsEnterOnce) {
       << dangling.error().message;
 }
 
+// `tetra convert` of a TDMS log whose channel map (run.channels.yaml beside it) is a folder, a FIFO, a
+// device or a link to nothing: exit 2 with one line naming the map and what it is; the FIFO is never
+// opened (the read blocked until a writer came), the link to nothing never taken for no map.
+TEST(ConvertTdms, AChannelMapThatIsNotARegularFileIsRefusedByName) {
+  TempDir dir;
+  const Bytes file = segment(0x0E, two_channels(2), doubles({0, 1, 10, 20}));
+  test::write_file(dir.file("run.tdms"), std::string(file.b.begin(), file.b.end()));
+  const std::string map = dir.file("run.channels.yaml");
+  const std::string what = map + ": the channel map of " + dir.file("run.tdms") + " is ";
+  const auto convert = [&] {
+    return run_shell("timeout -s KILL 10 " + std::string(TETRA_BINARY) + " convert " + dir.file("run.tdms") +
+                     " " + dir.file("out.csv"));
+  };
+  const auto refused = [&](const std::string& kind) {
+    const auto r = convert();
+    EXPECT_EQ(r.exit_status, 2) << kind << ": " << r.err;
+    EXPECT_EQ(r.err, "tetra convert: " + what + kind + "\n") << kind;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("out.csv"))) << kind;
+  };
+  std::filesystem::create_directory(map);
+  refused("a folder, not a regular file");
+  std::filesystem::remove(map);
+  ASSERT_EQ(run_shell("mkfifo " + map).exit_status, 0);
+  refused("a FIFO, not a regular file");
+  std::filesystem::remove(map);
+  std::filesystem::create_symlink("/dev/null", map);
+  refused("a character device, not a regular file");
+  std::filesystem::remove(map);
+  std::filesystem::create_symlink(dir.file("gone.yaml"), map);
+  refused("a symbolic link to no file");
+}
+
 TEST(TdmsLog, CommandLineErrorsAreOneLineExitTwo) {
   TempDir dir;
   test::write_file(dir.file("bad.tdms"), "TDSm\x0e");

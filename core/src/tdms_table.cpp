@@ -217,12 +217,22 @@ Status fill_cells(tdms_detail::Source& src, const TdmsFile& file, const Columns&
   return ok_status();
 }
 
+// The channel map beside `tdms_path`, when one is there, must be a regular file: a folder or a device is
+// no map, a FIFO would block the read until a writer came, a link to nothing would be ignored as no map.
+Status check_channel_map(const std::string& map_path, const std::string& tdms_path) {
+  struct stat st {};
+  const std::string what = map_path + ": the channel map of " + tdms_path + " is ";
+  if (::stat(map_path.c_str(), &st) != 0) return bad_input(what + "a symbolic link to no file");
+  if (!S_ISREG(st.st_mode)) return bad_input(what + file_kind(st.st_mode) + ", not a regular file");
+  return ok_status();
+}
+
 Result<TdmsChannelMap> read_channel_map(const std::string& path) {
   TdmsChannelMap map;
   const std::string map_path = tdms_channel_map_path(path);
   struct stat st {};
-  if (::lstat(map_path.c_str(), &st) != 0)
-    return map;  // a link to nothing is read (and refused), never ignored
+  if (::lstat(map_path.c_str(), &st) != 0) return map;  // no map: every channel by its own name
+  if (Status s = check_channel_map(map_path, path); !s) return s.error();
   auto text = read_input(map_path, kMaxYamlBytes);
   if (!text) return text.error();
   return parse_tdms_channel_map(*text, map_path);

@@ -213,8 +213,8 @@ int cmd_campaign(int argc, char** argv) {
   if (Status st = report::write_campaign_report(done->runs_csv, options.out_dir, sim::report_options(*spec));
       !st)
     return report(kCampaignName, st.error());
-  std::cerr << "tetra campaign: report -> " << (std::filesystem::path(options.out_dir) / "report.md").string()
-            << '\n';
+  std::cerr << "tetra campaign: report -> "
+            << (std::filesystem::path(options.out_dir) / sim::kReportMarkdown).string() << '\n';
   return kExitOk;
 }
 

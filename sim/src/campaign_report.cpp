@@ -82,7 +82,7 @@ std::string delay_table(const std::vector<CampaignRow>& rows) {
 }
 
 ReportPlot delay_plot(const std::vector<CampaignRow>& rows) {
-  ReportPlot plot{"delay_vs_theory.png", 800, 600, "", ""};
+  ReportPlot plot{kDelayPlot, 800, 600, "", ""};
   for (const CampaignRow& r : rows) {
     if (r.theory_delay_s && r.fdi.detection_delay_s) {
       plot.data += g(*r.theory_delay_s) + ' ' + g(std::max(*r.fdi.detection_delay_s, 1e-2)) + ' ' +
@@ -104,7 +104,7 @@ bool has_pointing(const CampaignRow& r) {
 }
 
 ReportPlot pointing_plot(const std::vector<CampaignRow>& rows) {
-  ReportPlot plot{"pointing_cdf.png", 800, 600, "", ""};
+  ReportPlot plot{kPointingPlot, 800, 600, "", ""};
   std::vector<double> v;
   double bound = 0.0;
   for (const CampaignRow& r : rows) {
@@ -131,7 +131,7 @@ ReportPlot pointing_plot(const std::vector<CampaignRow>& rows) {
 }
 
 ReportPlot outcome_plot(const std::vector<CampaignRow>& rows) {
-  ReportPlot plot{"outcomes.png", 1000, 600, "", ""};
+  ReportPlot plot{kOutcomePlot, 1000, 600, "", ""};
   std::map<std::string, std::map<Outcome, int>> m;  // "kind g#" → outcome counts
   for (const CampaignRow& r : rows) {
     if (r.kind != "none") ++m[r.kind + "-g" + std::to_string(r.gyro)][r.fdi.outcome];
@@ -212,6 +212,17 @@ double report_quantile(std::vector<double> v, double q) {
   return v[std::min(i, v.size() - 1)];
 }
 
+std::string size_plot_name(const std::string& kind) {
+  return "detection_vs_size_" + kind + ".png";
+}
+
+std::vector<std::string> campaign_report_files() {
+  std::vector<std::string> files{kReportMarkdown, kOutcomePlot, kDelayPlot, kPointingPlot};
+  for (int k = 0; k <= static_cast<int>(FaultKind::kInvalid); ++k)
+    files.push_back(size_plot_name(std::string(fault_kind_name(static_cast<FaultKind>(k)))));
+  return files;
+}
+
 CampaignReportOptions report_options(const CampaignSpec& spec) {
   return {!spec.dispersions.empty(), spec.requirements};
 }
@@ -266,17 +277,20 @@ CampaignReport campaign_report(const std::vector<CampaignRow>& all_rows,
                        : ", and " + std::to_string(errors.size()) +
                              " that ended in an error (\"Errors\", not counted below)") +
        ".\n\n";
-  md += "## Isolation outcome (kind × gyro)\n\n" + outcome_matrix(rows) + "\n![outcomes](outcomes.png)\n\n";
+  md += "## Isolation outcome (kind × gyro)\n\n" + outcome_matrix(rows) + "\n![outcomes](" +
+        std::string(kOutcomePlot) + ")\n\n";
   md += "## Wrong exclusions\n\n" + wrong_section(rows) + "\n";
   md += "## Detection and isolation delays\n\n" + delay_table(rows) +
         "\nCUSUM theory: Siegmund's ARL for the parity shift a bias step makes on its gyro "
-        "(fdi/include/tetra/fdi/detectors.hpp).\n\n![delays](delay_vs_theory.png)\n\n";
+        "(fdi/include/tetra/fdi/detectors.hpp).\n\n![delays](" +
+        std::string(kDelayPlot) + ")\n\n";
   md += "## False alarms\n\n" + std::to_string(false_alarms) + " detections before the fault onset in " +
         g(fault_free_s / 3600.0) + " h of fault-free flight: " +
         (fault_free_s > 0.0 ? g(false_alarms / (fault_free_s / 3600.0)) : std::string("–")) +
         " per hour.\n\n";
   const bool pointing = std::any_of(rows.begin(), rows.end(), has_pointing);
-  md += "## Pointing\n\n" + pointing_section(rows) + (pointing ? "\n![pointing](pointing_cdf.png)\n" : "");
+  md += "## Pointing\n\n" + pointing_section(rows) +
+        (pointing ? "\n![pointing](" + std::string(kPointingPlot) + ")\n" : std::string());
   md += "\n## Errors\n\n" + error_section(errors);
   for (ReportPlot plot : {delay_plot(rows), outcome_plot(rows), pointing_plot(rows)}) {
     if (!plot.data.empty()) report.plots.push_back(std::move(plot));

@@ -266,7 +266,7 @@ void size_curves(const std::vector<CampaignRow>& rows, CampaignReport& report) {
       "|---|---|---|---|---|---|---|\n";
   for (const auto& [kind, runs] : by_kind) {
     const auto [bins, log] = size_bins(runs);
-    ReportPlot plot{"detection_vs_size_" + kind + ".png", 800, 600, "", ""};
+    ReportPlot plot{size_plot_name(kind), 800, 600, "", ""};
     for (const SizeBin& b : bins) {
       if (b.n == 0) continue;
       const Interval d = clopper_pearson(b.detected, b.n, kReportConfidence);
@@ -289,8 +289,7 @@ void size_curves(const std::vector<CampaignRow>& rows, CampaignReport& report) {
     report.plots.push_back(std::move(plot));
   }
   md += "\n";
-  for (const auto& entry : by_kind)
-    md += "![" + entry.first + "](detection_vs_size_" + entry.first + ".png)\n";
+  for (const auto& entry : by_kind) md += "![" + entry.first + "](" + size_plot_name(entry.first) + ")\n";
   md += "\n";
 }
 

@@ -17,6 +17,7 @@
 #include "tetra/ground/http_parse.hpp"
 #include "tetra/ground/link_state.hpp"
 #include "tetra/ground/operators.hpp"
+#include "tetra/ground/private_file.hpp"
 #include "tetra/ground/query_params.hpp"
 #include "tetra/ground/record_files.hpp"
 #include "tetra/ground/ring_buffer.hpp"
@@ -589,6 +590,28 @@ TEST(Operators, LinkedDamagedOrOpenAccountsFiles) {
   EXPECT_EQ(password_of_line(std::string(10 << 20, 'x')).error().message,
             "password: at most 1024 characters");
   EXPECT_EQ(password_of_line("seven\r").error().message, "password: at least 8 characters");
+}
+
+// A users file that is a symbolic link to nothing is refused by name: neither replaced by a file (the link
+// lost) nor followed to create a file where it points; a link to a file is still written through.
+TEST(PrivateFile, ADanglingLinkIsRefusedNeverReplacedNorFollowed) {
+  test::TempDir dir;
+  const std::string link = dir.file("users");
+  const std::string nowhere = dir.file("gone/users");
+  std::filesystem::create_symlink(nowhere, link);
+  const Status written = write_private(link, "alice:viewer:x\n");
+  ASSERT_FALSE(written.ok());
+  EXPECT_EQ(written.error().kind, ErrorKind::kBadInput);
+  EXPECT_EQ(written.error().message.rfind(link + ": a symbolic link to no file (", 0), 0U)
+      << written.error().message;
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(nowhere)));
+  std::filesystem::create_symlink(dir.file("nothing"), dir.file("users2"));
+  auto hash = hash_password("correct horse");
+  ASSERT_TRUE(hash.ok());
+  EXPECT_FALSE(set_account(dir.file("users2"), {"alice", Role::kCommander, *hash}).ok());
+  EXPECT_TRUE(std::filesystem::is_symlink(dir.file("users2")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("nothing")));
 }
 
 TEST(GroundServer, NoAuthOnlyOnLoopback) {

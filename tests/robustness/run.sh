@@ -156,6 +156,21 @@ check outputs "sim -o /dev/full: refused (a device)" 2 "--out /dev/full: is a ch
 mkdir -p camp_fifo && mkfifo camp_fifo/runs.csv
 check outputs "campaign whose runs.csv is a FIFO: refused" 2 "runs.csv: is a FIFO" "" -- \
   campaign "$SRC/examples/campaign.yaml" --out camp_fifo
+# Every file a campaign writes in --out is checked first (run and merge): in a folder of no campaign any of
+# them is another program's (report.md was replaced); a symbolic link out of the folder is refused.
+mkdir -p camp_foreign && echo "someone's notes" >camp_foreign/report.md
+check outputs "campaign --out a folder of no campaign holding report.md" 2 \
+  "camp_foreign/report.md: the output folder holds files of no campaign" "" -- \
+  campaign "$SRC/examples/campaign.yaml" --out camp_foreign
+mkdir -p camp_link && ln -s ../out.csv camp_link/runs.csv
+check outputs "campaign --out whose runs.csv links out of it" 2 \
+  "camp_link/runs.csv: a symbolic link out of the output folder" "" -- \
+  campaign "$SRC/examples/campaign.yaml" --out camp_link
+printf 'loop: open\nscenarios: [orbit]\nduration_s: 30\nkinds: [stuck]\ngyros: [1]\nonsets_s: [10]\nseeds: [1]\n' >tiny_camp.yaml
+"$TETRA" campaign tiny_camp.yaml --out camp_s1 --no-report 2>/dev/null || { echo "fixture: campaign failed"; exit 1; }
+check outputs "campaign merge into a folder of no campaign holding report.md" 2 \
+  "camp_foreign/report.md: the output folder holds files of no campaign" "" -- \
+  campaign merge camp_foreign camp_s1
 # A file without write permission is never replaced (the rename would go around the protection).
 echo "protected" >ro.csv && chmod 0444 ro.csv
 check outputs "sim -o a 0444 file: refused" 2 "--out ro.csv: is write-protected" "" -- sim static --minutes 0.1 -o ro.csv
@@ -437,12 +452,32 @@ check_sh surfaces "ground passwd writes through a symlinked users file" \
 check_sh surfaces "ground passwd refuses a 10 MB password" \
   "head -c 10000000 /dev/zero | tr '\\0' x | \"$TETRA\" ground passwd carol --users real_users --password-stdin 2>err_pw;
    [ \$? = 2 ] && grep -q 'at most 1024 characters' err_pw && ! grep -q '^carol:' real_users"
+ln -s gone_users dangling_users
+check_sh surfaces "ground passwd refuses a users file linked to nothing" \
+  "printf 'correct horse\\n' | \"$TETRA\" ground passwd dave --users dangling_users --password-stdin 2>err_dl;
+   [ \$? = 2 ] && [ \$(wc -l <err_dl) = 1 ] && grep -q 'dangling_users: a symbolic link to no file' err_dl &&
+   [ -L dangling_users ] && [ ! -e gone_users ]"
 chmod 644 real_users 2>/dev/null
 check surfaces "ground on a users file others can read" 2 "real_users: the accounts file is readable or writable by group or others \\(mode 0644\\)" "" -- \
   ground --listen 127.0.0.1:0 --users real_users --domain 229
 printf 'alice:commander:$argon2id$v=19$m=65536,t=2,p=1$cut\n' >cut_users && chmod 600 cut_users
 check surfaces "ground on a users file with a damaged hash" 2 "cut_users:1: the argon2id hash is damaged" "" -- \
   ground --listen 127.0.0.1:0 --users cut_users --domain 229
+
+# A TDMS log's channel map (LOG.channels.yaml beside it) is read only as a regular file: a FIFO blocked the
+# read until a writer came, a link to nothing was taken for no map.
+python3 "$SRC/tests/tdms/make_tdms.py" "$LOG" maps.tdms --one-segment >/dev/null 2>&1 ||
+  { echo "fixture: make_tdms.py failed"; exit 1; }
+mkfifo maps.channels.yaml
+check surfaces "convert: a channel map that is a FIFO" 2 "maps.channels.yaml: the channel map of maps.tdms is a FIFO" "" -- \
+  convert maps.tdms maps.csv
+rm maps.channels.yaml && mkdir maps.channels.yaml
+check surfaces "convert: a channel map that is a folder" 2 "maps.channels.yaml: the channel map of maps.tdms is a folder" "" -- \
+  convert maps.tdms maps.csv
+rmdir maps.channels.yaml && ln -s gone.yaml maps.channels.yaml
+check surfaces "convert: a channel map linked to nothing" 2 "maps.channels.yaml: the channel map of maps.tdms is a symbolic link to no file" "" -- \
+  convert maps.tdms maps.csv
+rm maps.channels.yaml
 
 # --- summary -----------------------------------------------------------------------------------------
 echo

@@ -108,6 +108,63 @@ std::string path_in(const std::string& dir, const char* name) {
   return (std::filesystem::path(dir) / name).string();
 }
 
+std::vector<std::string> output_names(const sim::CampaignSpec& spec) {
+  std::vector<std::string> names{kShardFile, kHashFile, kSpecCopy, kRunsFile};
+  for (const std::string& report : sim::campaign_report_files()) names.push_back(report);
+  if (spec.target == sim::CampaignTarget::kDds) names.emplace_back("dds/");
+  return names;
+}
+
+namespace {
+
+//! Whether `path` lies in the folder `root` (both resolved).
+bool inside(const std::filesystem::path& root, const std::filesystem::path& path) {
+  const auto [end, _] = std::mismatch(root.begin(), root.end(), path.begin(), path.end());
+  return end == root.end();
+}
+
+//! One output of a campaign folder whose real path is `root`: see check_outputs.
+Status check_output(const std::filesystem::path& root, const std::string& path, bool folder) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(path, ec);
+  if (!fs::exists(link)) return ok_status();
+  if (fs::is_symlink(link)) {
+    const fs::path target = fs::weakly_canonical(path, ec);
+    if (ec || !inside(root, target))
+      return bad_input(path + ": a symbolic link out of the output folder (to " +
+                       (ec ? std::string("an unreadable path") : target.string()) +
+                       "): a campaign writes only its folder's own files");
+  }
+  if (!folder) return check_output_path(path, "campaign output");
+  if (!fs::is_directory(path, ec))
+    return bad_input(path + ": is not a folder (a campaign over DDS keeps its services' files there)");
+  return ok_status();
+}
+
+}  // namespace
+
+Status check_outputs(const std::string& dir, const std::vector<std::string>& names) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) return ok_status();
+  const fs::path root = fs::canonical(dir, ec);
+  if (ec) return bad_input(dir + ": cannot resolve the folder: " + ec.message());
+  for (const std::string& name : names) {
+    const bool folder = !name.empty() && name.back() == '/';
+    const std::string path = path_in(dir, name.substr(0, name.size() - (folder ? 1 : 0)).c_str());
+    if (Status s = check_output(root, path, folder); !s) return s;
+  }
+  if (read_manifest(dir)) return ok_status();
+  for (const std::string& name : names) {
+    const std::string path = path_in(dir, name.substr(0, name.find('/')).c_str());
+    if (fs::exists(fs::symlink_status(path, ec)))
+      return bad_input(path + ": the output folder holds files of no campaign (no " +
+                       std::string(kShardFile) + " and " + kHashFile + " of one): use another folder");
+  }
+  return ok_status();
+}
+
 std::string manifest_text(const Shard& shard, std::size_t matrix_runs) {
   return "shard " + shard_text(shard) + "\nruns " + std::to_string(matrix_runs) + "\n";
 }
@@ -142,7 +199,8 @@ Result<std::string> read_header(const std::string& runs_csv) {
   return line;
 }
 
-Result<std::vector<Row>> read_rows(const std::string& runs_csv, const std::string& header, bool drop_errors) {
+Result<std::vector<Row>> read_rows(const std::string& runs_csv, const std::string& header, bool drop_errors,
+                                   const RowCheck& check) {
   std::vector<Row> rows;
   std::ifstream in(runs_csv);
   if (!in) return rows;
@@ -157,6 +215,8 @@ Result<std::vector<Row>> read_rows(const std::string& runs_csv, const std::strin
     // done again. Any other row that does not read is refused, never dropped or counted.
     if (!row && in.eof()) continue;
     if (!row) return bad_input(runs_csv + ":" + std::to_string(number) + ": " + row.error().message);
+    if (Status st = check ? check(*row) : ok_status(); !st)
+      return bad_input(runs_csv + ":" + std::to_string(number) + ": " + st.error().message);
     if (drop_errors && !row->error.empty()) continue;
     rows.push_back(Row{row->run, !row->error.empty(), line});
   }
@@ -176,6 +236,40 @@ Status write_rows(const std::string& runs_csv, const std::string& header, const 
 
 }  // namespace folder
 
+namespace {
+
+//! A new campaign's manifest in `dir`: the spec's copy, the shard, then the hash (the folder is a
+//! campaign's once it is there).
+Status write_manifest(const std::string& dir, const RunOptions& options, std::size_t matrix_runs,
+                      const std::string& hash) {
+  auto text = read_input(options.spec_path, kMaxYamlBytes);
+  if (!text) return text.error();
+  if (Status st = write_text_file(folder::path_in(dir, folder::kSpecCopy), *text); !st) return st;
+  if (Status st = write_text_file(folder::path_in(dir, folder::kShardFile),
+                                  folder::manifest_text(options.shard, matrix_runs));
+      !st)
+    return st;
+  return write_text_file(folder::path_in(dir, folder::kHashFile), hash + "\n");
+}
+
+//! The folder's manifest against this campaign's spec and shard.
+Status check_manifest(const std::string& dir, const RunOptions& options, const std::string& hash) {
+  auto manifest = folder::read_manifest(dir);
+  if (!manifest) return manifest.error();
+  if (manifest->spec_sha256 != hash)
+    return bad_input(folder::path_in(dir, folder::kHashFile) +
+                     ": this folder holds a campaign of another spec (its SHA-256 " +
+                     manifest->spec_sha256.substr(0, 12) + "… differs from " + options.spec_path + "'s " +
+                     hash.substr(0, 12) + "…): use another --out, or remove the folder to start over");
+  if (manifest->shard.k != options.shard.k || manifest->shard.n != options.shard.n)
+    return bad_input(folder::path_in(dir, folder::kShardFile) + ": this folder holds shard " +
+                     shard_text(manifest->shard) + ", not " + shard_text(options.shard) +
+                     ": use another --out");
+  return ok_status();
+}
+
+}  // namespace
+
 Result<std::vector<std::size_t>> prepare_folder(const sim::CampaignSpec& spec, const RunOptions& options,
                                                 RunSummary& summary) {
   const std::string& dir = options.out_dir;
@@ -183,51 +277,30 @@ Result<std::vector<std::size_t>> prepare_folder(const sim::CampaignSpec& spec, c
   if (!matrix_runs) return matrix_runs.error();
   auto hash = campaign_spec_hash(spec, options.spec_path);
   if (!hash) return hash.error();
+  // Every file the campaign writes, before any is: runs.csv is appended to in place (an interrupted
+  // campaign resumes), the report replaced; a folder of no campaign's is never written into.
+  if (Status st = folder::check_outputs(dir, folder::output_names(spec)); !st) return st.error();
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return failure(dir + ": cannot create the folder");
   summary.runs_csv = folder::path_in(dir, folder::kRunsFile);
-  // runs.csv is appended to in place (an interrupted campaign resumes): a FIFO or a write-protected
-  // file is refused as any output is.
-  if (Status st = check_output_path(summary.runs_csv, "campaign output"); !st) return st.error();
-  const std::string hash_path = folder::path_in(dir, folder::kHashFile);
-  const bool has_hash = std::filesystem::exists(hash_path, ec);
-  if (has_hash) {
-    auto manifest = folder::read_manifest(dir);
-    if (!manifest) return manifest.error();
-    if (manifest->spec_sha256 != *hash)
-      return bad_input(hash_path + ": this folder holds a campaign of another spec (its SHA-256 " +
-                       manifest->spec_sha256.substr(0, 12) + "… differs from " + options.spec_path + "'s " +
-                       hash->substr(0, 12) + "…): use another --out, or remove the folder to start over");
-    if (manifest->shard.k != options.shard.k || manifest->shard.n != options.shard.n)
-      return bad_input(folder::path_in(dir, folder::kShardFile) + ": this folder holds shard " +
-                       shard_text(manifest->shard) + ", not " + shard_text(options.shard) +
-                       ": use another --out");
-  } else if (std::filesystem::exists(summary.runs_csv, ec) &&
-             std::filesystem::file_size(summary.runs_csv, ec) > 0) {
-    return bad_input(summary.runs_csv + ": a campaign's rows without " + folder::kHashFile +
-                     " (its spec cannot be checked): use another --out");
-  }
-  auto rows = folder::read_rows(summary.runs_csv, sim::campaign_csv_header(spec), true);
+  const bool has_hash = std::filesystem::exists(folder::path_in(dir, folder::kHashFile), ec);
+  if (Status st =
+          has_hash ? check_manifest(dir, options, *hash) : write_manifest(dir, options, *matrix_runs, *hash);
+      !st)
+    return st.error();
+  const std::string header = sim::campaign_csv_header(spec);
+  auto rows = folder::read_rows(summary.runs_csv, header, true, [&](const sim::CampaignRow& row) {
+    return sim::check_campaign_row(spec, row);
+  });
   if (!rows) return rows.error();
   for (const folder::Row& r : *rows) {
-    if (r.run >= *matrix_runs || !in_shard(options.shard, r.run))
+    if (!in_shard(options.shard, r.run))
       return bad_input(summary.runs_csv + ": run " + std::to_string(r.run) + " is not a run of shard " +
                        shard_text(options.shard) + " of this campaign");
   }
   // Without the torn line and the error rows (those runs are done again).
-  if (Status st = folder::write_rows(summary.runs_csv, sim::campaign_csv_header(spec), *rows); !st)
-    return st.error();
-  if (!has_hash) {
-    auto text = read_input(options.spec_path, kMaxYamlBytes);
-    if (!text) return text.error();
-    if (Status st = write_text_file(folder::path_in(dir, folder::kSpecCopy), *text); !st) return st.error();
-    if (Status st = write_text_file(folder::path_in(dir, folder::kShardFile),
-                                    folder::manifest_text(options.shard, *matrix_runs));
-        !st)
-      return st.error();
-    if (Status st = write_text_file(hash_path, *hash + "\n"); !st) return st.error();
-  }
+  if (Status st = folder::write_rows(summary.runs_csv, header, *rows); !st) return st.error();
   std::vector<std::size_t> pending;
   std::size_t next_done = 0;
   summary.total = 0;

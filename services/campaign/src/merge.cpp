@@ -22,15 +22,6 @@ bool same_folder(const std::string& a, const std::string& b) {
   return std::filesystem::equivalent(a, b, ec);
 }
 
-//! The case columns of a row (run, scenario, kind, gyro, onset, size, seed): its first 7 fields.
-std::string case_columns(const std::string& line) {
-  std::size_t end = 0;
-  for (int commas = 0; end < line.size(); ++end) {
-    if (line[end] == ',' && ++commas == 7) break;
-  }
-  return line.substr(0, end);
-}
-
 //! The spec the shards ran, from the first shard's copy, with the files it names found from the shard's
 //! folder or else from the current one (a spec naming its scenarios relative to its own folder, merged
 //! from there), and the campaign their spec.sha256 names. Without it no row could be checked against the
@@ -93,13 +84,15 @@ Result<std::vector<folder::Manifest>> shard_manifests(const std::string& out_dir
   return manifests;
 }
 
-// One shard's rows: each of its runs once, in order, none missing; each row's case as the spec's matrix has
-// it (scenario, kind, gyro, onset, size, seed).
+// One shard's rows: each of its runs once, in order, none missing; each row as the spec's matrix has it
+// (sim::check_campaign_row: its case, and its results consistent with it).
 Status append_shard_rows(const std::string& dir, const folder::Manifest& manifest, std::size_t matrix_runs,
                          const std::string& header, const sim::CampaignSpec& spec,
                          std::vector<folder::Row>& all) {
   const std::string runs_csv = folder::path_in(dir, folder::kRunsFile);
-  auto rows = folder::read_rows(runs_csv, header, false);
+  auto rows = folder::read_rows(runs_csv, header, false, [&](const sim::CampaignRow& row) {
+    return sim::check_campaign_row(spec, row);
+  });
   if (!rows) return rows.error();
   const Shard& shard = manifest.shard;
   std::size_t expected = shard.k - 1;
@@ -110,10 +103,6 @@ Status append_shard_rows(const std::string& dir, const folder::Manifest& manifes
     if (r.run != expected)
       return bad_input(runs_csv + ": run " + std::to_string(expected) +
                        " missing: the shard is not complete (run it again with the same command)");
-    const std::string want = case_columns(sim::campaign_csv_row(sim::campaign_error_row(spec, r.run, "-")));
-    if (case_columns(r.line) != want)
-      return bad_input(runs_csv + ": run " + std::to_string(r.run) + " is '" +
-                       one_line(case_columns(r.line)) + "', the spec's case is '" + want + "'");
     expected += shard.n;
   }
   if (expected < matrix_runs)
@@ -123,22 +112,14 @@ Status append_shard_rows(const std::string& dir, const folder::Manifest& manifes
   return ok_status();
 }
 
-// The output folder: this campaign's (merged again at will), or one holding no file the merge would write.
-Status check_output_folder(const std::string& out_dir, const std::string& spec_sha256) {
-  if (auto old = folder::read_manifest(out_dir); old) {
-    if (old->spec_sha256 != spec_sha256)
-      return bad_input(folder::path_in(out_dir, folder::kHashFile) +
-                       ": the output folder holds a campaign of another spec: use another folder");
-    return ok_status();
-  }
-  // No campaign's manifest: any file the merge would write is another program's, never replaced.
-  for (const char* name : {folder::kRunsFile, folder::kSpecCopy, folder::kShardFile, folder::kHashFile}) {
-    std::error_code exists_ec;
-    const std::string path = folder::path_in(out_dir, name);
-    if (std::filesystem::exists(std::filesystem::symlink_status(path, exists_ec)))
-      return bad_input(path + ": the output folder holds files of no campaign (no " + folder::kShardFile +
-                       " and " + folder::kHashFile + " of one): use another folder");
-  }
+// The output folder: this campaign's (merged again at will), or one holding no file the merge would write;
+// each of its outputs one the merge may write (folder::check_outputs).
+Status check_output_folder(const std::string& out_dir, const sim::CampaignSpec& spec,
+                           const std::string& spec_sha256) {
+  if (Status s = folder::check_outputs(out_dir, folder::output_names(spec)); !s) return s;
+  if (auto old = folder::read_manifest(out_dir); old && old->spec_sha256 != spec_sha256)
+    return bad_input(folder::path_in(out_dir, folder::kHashFile) +
+                     ": the output folder holds a campaign of another spec: use another folder");
   return ok_status();
 }
 
@@ -181,7 +162,7 @@ Result<RunSummary> merge_shards(const std::string& out_dir, const std::vector<st
         !s)
       return s.error();
   }
-  if (Status s = check_output_folder(out_dir, first.spec_sha256); !s) return s.error();
+  if (Status s = check_output_folder(out_dir, *spec, first.spec_sha256); !s) return s.error();
   std::sort(all.begin(), all.end(), [](const folder::Row& a, const folder::Row& b) { return a.run < b.run; });
   RunSummary summary;
   summary.total = all.size();

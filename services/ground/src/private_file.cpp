@@ -4,21 +4,26 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 namespace tetra::ground {
 
 namespace {
 
-//! The file a path names, through symbolic links (the path itself when it does not exist yet).
-std::string target_of(const std::string& path) {
-  char resolved[PATH_MAX];
+//! The file a path names, through symbolic links (the path itself when it does not exist yet). A link to
+//! nothing is bad input: replacing it would drop the link, following it would create a file elsewhere.
+Result<std::string> target_of(const std::string& path) {
   struct stat st {};
-  if (::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode) && ::realpath(path.c_str(), resolved) != nullptr)
-    return resolved;
-  return path;
+  if (::lstat(path.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return path;
+  char resolved[PATH_MAX];
+  if (::realpath(path.c_str(), resolved) == nullptr || ::stat(resolved, &st) != 0)
+    return bad_input(path + ": a symbolic link to no file (" + std::strerror(errno) +
+                     "): point it at the file, or remove it to start a new one");
+  return std::string(resolved);
 }
 
 std::string mode_text(unsigned mode) {
@@ -30,7 +35,9 @@ std::string mode_text(unsigned mode) {
 }  // namespace
 
 Status write_private(const std::string& path, const std::string& text) {
-  const std::string target = target_of(path);
+  const auto resolved = target_of(path);
+  if (!resolved) return resolved.error();
+  const std::string& target = *resolved;
   const std::string tmp = target + ".new" + std::to_string(::getpid());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) return failure(path + ": cannot write (" + tmp + ")");

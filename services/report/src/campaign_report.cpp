@@ -13,7 +13,7 @@ Status write_campaign_report(const std::string& runs_csv, const std::string& out
   if (!rows) return rows.error();
   const sim::CampaignReport report = sim::campaign_report(*rows, options);
   const std::filesystem::path dir(out_dir);
-  if (Status s = write_text_file((dir / "report.md").string(), report.markdown); !s) return s;
+  if (Status s = write_text_file((dir / sim::kReportMarkdown).string(), report.markdown); !s) return s;
   for (const sim::ReportPlot& plot : report.plots) {
     auto tmp = TempDir::create("tetra-campaign");
     if (!tmp) return tmp.error();

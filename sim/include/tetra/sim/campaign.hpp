@@ -152,6 +152,13 @@ Result<CampaignRow> parse_campaign_row(const std::string& line);
 //! more is an error too.
 Result<CampaignRow> parse_campaign_row(const std::string& line, const std::string& header);
 
+//! A row read back (parse_campaign_row) checked against the spec's matrix: its run one of the matrix's, its
+//! case columns (scenario, kind, gyro, onset, size, seed, the dispersion draws) that run's case, and for a
+//! finished run its verdict as judge_fdi gives one (gyros 1..N of the scenario's unit, the outcome the
+//! isolations and detections imply, each delay with its gyro), its times within the run and its columns
+//! those of its kind and loop. Bad input "campaign row: FIELD 'value' (why)" for the first that is not.
+Status check_campaign_row(const CampaignSpec& spec, const CampaignRow& row);
+
 //! [s] expected CUSUM detection delay of a bias step `size_dps` on gyro `gyro` (1..N) for the
 //! pipeline's thresholds (k, h from the configuration and the calibration; fdi/detectors.hpp).
 std::optional<double> cusum_theory_delay_s(const Calibration& unit, const fdi::PipelineConfig& config,

@@ -33,6 +33,17 @@ struct CampaignReportOptions {
   std::vector<Requirement> requirements;  //!< judged in a section of their own (statistics with them)
 };
 
+//! The report's file names beside runs.csv: report.md and its plots (a plot per kind with sizes).
+inline constexpr const char* kReportMarkdown = "report.md";
+inline constexpr const char* kOutcomePlot = "outcomes.png";
+inline constexpr const char* kDelayPlot = "delay_vs_theory.png";
+inline constexpr const char* kPointingPlot = "pointing_cdf.png";
+//! "detection_vs_size_KIND.png".
+std::string size_plot_name(const std::string& kind);
+//! Every file a campaign's report may write (whether or not its data leave a plot out): report.md, the
+//! plots, a size plot for each fault kind.
+std::vector<std::string> campaign_report_files();
+
 //! The options a spec asks for: statistics with dispersions, its requirements.
 CampaignReportOptions report_options(const CampaignSpec& spec);
 

@@ -11,7 +11,8 @@
 namespace tetra::ground {
 
 //! Writes `text` to `path` with mode 0600: a new file beside it, fsynced and renamed over it. When `path`
-//! is a symbolic link the file it points to is replaced (the link stays).
+//! is a symbolic link the file it points to is replaced (the link stays); a link to nothing is bad input
+//! naming it (never replaced by a file, never followed to create one elsewhere).
 Status write_private(const std::string& path, const std::string& text);
 //! An error naming the file (`what` it is), its mode and `risk` (what others could do with it) when group
 //! or others may read or write `path`; ok when it is private to its owner or absent.
