@@ -91,8 +91,7 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
                     "one sample left out (the gate), rejection after reference_gate_reset_count"});
   if (parity) {
     b.rows.push_back({"motion_fit", K::kMismatch, "false_alarm_probability",
-                      allocated_probability(c, BudgetTest::kMotionFit),
-                      3600.0 / detail::kMotionFitBlockS,
+                      allocated_probability(c, BudgetTest::kMotionFit), 3600.0 / detail::kMotionFitBlockS,
                       "one block's H0 rejected (a mismatch needs two in a row and every Hi rejected too)"});
   }
   for (const char* signature : {"repeated", "zero", "variance", "noise_level", "recurring_spikes"}) {
@@ -120,8 +119,8 @@ std::string to_text(const Budget& b) {
                                                                : "reference rejected";
     if (std::isfinite(r.per_evaluation)) {
       const char* per = r.kind == BudgetKind::kFalseAlarm || r.kind == BudgetKind::kMismatch ? "/h"
-                        : r.kind == BudgetKind::kWrongExclusion ? "/episode"
-                                                                : "/sample";
+                        : r.kind == BudgetKind::kWrongExclusion                              ? "/episode"
+                                                                                             : "/sample";
       std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %9.3g x %-9.4g = %9.3g %s  (%s)\n", r.source,
                     kind, r.key, r.per_evaluation, r.evaluations, r.total(), per, r.note);
     } else {

@@ -167,12 +167,13 @@ bool CalibrationFit::judge_block(const Subset& s, GyroMask mask, const SubsetCac
     int dof = 0;
     const double r = residual(basis_, columns, dof);
     const double t = threshold(dof);
-    rows_.add(judge(EvidenceSource::kMotionFit, static_cast<std::uint8_t>(i + 1), dof >= 1 ? r : kNaN, t, t,
-                    dof));
+    rows_.add(
+        judge(EvidenceSource::kMotionFit, static_cast<std::uint8_t>(i + 1), dof >= 1 ? r : kNaN, t, t, dof));
   }
   const bool motion = dof0 >= 1 && h0_statistic_ > h0_threshold_;
   rows_.add(stated(EvidenceSource::kMotionFit, kHypothesisCalibration,
-                   motion ? RowVerdict::kConsistent : RowVerdict::kNoCall, h0_statistic_, h0_threshold_, dof0));
+                   motion ? RowVerdict::kConsistent : RowVerdict::kNoCall, h0_statistic_, h0_threshold_,
+                   dof0));
   return fdi::arbitrate_calibration(rows_.begin(), rows_.end(), mask);
 }
 

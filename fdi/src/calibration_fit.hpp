@@ -58,9 +58,9 @@ class CalibrationFit {
   int dof_ = 0;
   std::int64_t start_ns_ = 0;
   double epochs_ = 0.0;
-  Eigen::Matrix3d sum_ww_ = Eigen::Matrix3d::Zero();  //!< Σ ω ωᵀ [rad²/s²]
-  Eigen::Vector3d sum_w_ = Eigen::Vector3d::Zero();   //!< Σ ω
-  Eigen::Vector3d sum_dev_ = Eigen::Vector3d::Zero(); //!< Σ |ω − ω_first| per axis (the wander's reach)
+  Eigen::Matrix3d sum_ww_ = Eigen::Matrix3d::Zero();   //!< Σ ω ωᵀ [rad²/s²]
+  Eigen::Vector3d sum_w_ = Eigen::Vector3d::Zero();    //!< Σ ω
+  Eigen::Vector3d sum_dev_ = Eigen::Vector3d::Zero();  //!< Σ |ω − ω_first| per axis (the wander's reach)
   Eigen::Vector3d first_w_ = Eigen::Vector3d::Zero();
   Eigen::MatrixXd sum_wp_;  //!< 3×d Σ ω pᵀ
   Eigen::VectorXd sum_p_;   //!< d Σ p

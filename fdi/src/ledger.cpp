@@ -117,7 +117,9 @@ std::string hypothesis_name(std::uint8_t hypothesis) {
 
 bool hypothesis_from_string(std::string_view text, std::uint8_t& out) {
   if (text == "Href" || text == "Hdrift" || text == "Hcal") {
-    out = text == "Href" ? kHypothesisReference : text == "Hdrift" ? kHypothesisDrift : kHypothesisCalibration;
+    out = text == "Href"     ? kHypothesisReference
+          : text == "Hdrift" ? kHypothesisDrift
+                             : kHypothesisCalibration;
     return true;
   }
   if (text.size() < 2 || text.size() > 3 || text[0] != 'H') return false;

@@ -149,8 +149,8 @@ void Pipeline::Impl::detect() {
     isolator_.accumulate(detector_.parity_measured(), s.dof, attitude_.omega_meas_B());
     bias_check_.record(detector_.parity(), s);
     if (frame_.usable == active &&
-        calibration_fit_.record(detector_.parity_measured(), s, active, attitude_.omega_meas_B(), frame_.now_ns,
-                                subsets_, config_))
+        calibration_fit_.record(detector_.parity_measured(), s, active, attitude_.omega_meas_B(),
+                                frame_.now_ns, subsets_, config_))
       emit_calibration_mismatch();
   }
   if (d.cusum_ran && !d.alarm && !isolator_.episode().active) parity_seen_nominal_ = true;

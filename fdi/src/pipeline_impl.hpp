@@ -197,7 +197,8 @@ class Pipeline::Impl {
   ReferenceBiasMatch
       drift_match_;             //!< a common drift in the reference's innovations: every bias model opened
   ProtectionLevel protection_;  //!< the integrity bound beside sigma
-  CalibrationFit calibration_fit_;  //!< the parity against the body rate: a calibration that is not the unit's
+  CalibrationFit
+      calibration_fit_;  //!< the parity against the body rate: a calibration that is not the unit's
   std::vector<OwnNoiseFinding> own_named_;  //!< the gyros own_noise_ named at this epoch (capacity N)
   Eigen::VectorXd held_parity_;  //!< the parity before the jump test, when it left the rest without one
   ReferenceBudget budget_;       //!< the reference's stated bias and latency, which its samples cannot show
@@ -224,7 +225,8 @@ class Pipeline::Impl {
   bool reference_usable_ = false;  //!< this epoch's reference sample passed the consistency tests
   bool gyros_vouch_ = false;
   //! The parity was judged outside an episode at least once since the reset: a fault has a history before it
-  bool parity_seen_nominal_ = false;       //!< this epoch: parity among the gyros used, no episode, rate observable
+  bool parity_seen_nominal_ =
+      false;  //!< this epoch: parity among the gyros used, no episode, rate observable
   std::optional<std::int64_t> reference_set_ns_;  //!< the last time a reference sample set the attitude
   //! [ns] when the reference was last rejected, until it is used again, and the rows that rejected it
   std::optional<std::int64_t> reference_rejected_ns_;

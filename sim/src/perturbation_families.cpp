@@ -14,8 +14,8 @@ namespace tetra::sim {
 namespace {
 
 constexpr std::array<std::string_view, kFamilyCount> kFamilyNames = {
-    "fault-in-slew", "data-path", "gap", "reference", "calibration", "calibration-without-noise",
-    "second-fault",  "warm-up",         "data-sheet"};
+    "fault-in-slew", "data-path", "gap",       "reference", "calibration", "calibration-without-noise",
+    "second-fault",  "warm-up",   "data-sheet"};
 
 constexpr double kSlewStart_s = 30.0;                //!< [s] the detectors have a full history by then
 constexpr double kConfiguredReference_arcsec = 5.0;  //!< [arcsec] the star tracker's stated 1σ
@@ -361,8 +361,8 @@ PerturbedRun data_sheet(Rng& rng, std::uint64_t index) {
   r.scenario = base(n, reference, 1200.0);
   for (int k = 0; k < 11; ++k) {
     const double sign = rng.uniform() < 0.5 ? -1.0 : 1.0;
-    r.scenario.motion.slews.push_back({signed_axis(2 * (k % 3)), sign * between(rng, 20.0, 40.0),
-                                       kSlewStart_s + 100.0 * k, 20.0});
+    r.scenario.motion.slews.push_back(
+        {signed_axis(2 * (k % 3)), sign * between(rng, 20.0, 40.0), kSlewStart_s + 100.0 * k, 20.0});
   }
   r.calibration = r.scenario.unit;
   double worst = 0.0;
@@ -378,7 +378,8 @@ PerturbedRun data_sheet(Rng& rng, std::uint64_t index) {
     g.noise.reset();
   }
   char text[96];
-  std::snprintf(text, sizeof text, " data-sheet calibration (scale factors up to %.0f %% off)", 100.0 * worst);
+  std::snprintf(text, sizeof text, " data-sheet calibration (scale factors up to %.0f %% off)",
+                100.0 * worst);
   r.label = "N=" + std::to_string(n) + " eleven slews about X, Y, Z" + text + (reference ? " ref" : "");
   r.case_name = "fault-free";
   maybe_fault(rng, index, n, r.scenario.motion.slews.front(), r);

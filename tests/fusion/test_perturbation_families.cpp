@@ -173,7 +173,8 @@ TEST(PerturbationFamilies, DataSheet) {
   for (std::uint64_t i = 0; i < 27; ++i) {
     const sim::PerturbedRun r = sim::perturbed_run(sim::Family::kDataSheet, 1, i);
     // Four gyros less a stuck or zero one (its own signal excludes it) leave no parity: nothing to fit.
-    const bool own_signal_fault = !r.options.faults.empty() && r.options.faults[0].kind != sim::FaultKind::kBias;
+    const bool own_signal_fault =
+        !r.options.faults.empty() && r.options.faults[0].kind != sim::FaultKind::kBias;
     const bool parity_left = r.scenario.unit.gyro_count() > 4 || !own_signal_fault;
     if (parity_left && !test::judge_run(r).calibration_mismatch) unnamed += r.label + "\n";
     // The unit's own calibration on the same data names nothing.

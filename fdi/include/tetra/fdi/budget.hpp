@@ -24,7 +24,7 @@ enum class BudgetTest : unsigned char {
   kReferenceNoiseMatch,  //!< three gyros: the reference noise match (per sample)
   kReferenceGate,        //!< the filter's 3-dof gate leaving out a good reference sample (per sample)
   kReferenceBiasMatch,  //!< a common drift in the reference's innovations, its bias model opened (per sample)
-  kMotionFit            //!< the parity's fit to the body rate rejecting H0 or a single-gyro hypothesis (per block)
+  kMotionFit  //!< the parity's fit to the body rate rejecting H0 or a single-gyro hypothesis (per block)
 };
 constexpr int kBudgetTestCount = 10;
 

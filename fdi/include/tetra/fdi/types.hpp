@@ -57,7 +57,8 @@ enum class EventType : std::uint8_t {
   kReferenceRejected,  //!< the attitude reference failed a consistency test (why: ReferenceCheck)
   kReferenceAccepted,  //!< a rejected reference passed every test for reference_check_window_s: used again
   kReferenceLate,      //!< a reference stamped beyond the fusion horizon (statistic: how late [s]): left out
-  kNoiseModel,  //!< the data show the noise model optimistic: a model opened to what they show (detail: which)
+  kNoiseModel,  //!< the data show the noise model optimistic: a model opened to what they show (detail:
+                //!< which)
   //! the parity follows the body rate as no single gyro's fault makes it: the calibration's scale factors
   //! and axes do not describe the unit (statistic: the motion fit's χ²); no exclusion while it stands
   kCalibrationMismatch

@@ -30,8 +30,8 @@ enum class Family {
   kCalibration,  //!< scale and axis errors up to 2× the calibration's stated 1σ (a fault in 1/3)
   kCalibrationWithoutNoise,  //!< the fusion's calibration has no noise: section (a fault in 1/3)
   kSecondFault,              //!< three gyros and the reference, a fault on one of them (redundancy exhausted)
-  kWarmUp,  //!< every gyro's bias follows a temperature transient, each by its own coefficient (a fault in
-            //!< 1/3)
+  kWarmUp,     //!< every gyro's bias follows a temperature transient, each by its own coefficient (a fault in
+               //!< 1/3)
   kDataSheet,  //!< the fusion given a data-sheet calibration: scale factors 10–30 % off, axes by mrad, no σ
 };
 inline constexpr int kFamilyCount = 9;
