@@ -16,6 +16,7 @@ import json
 import math
 import os
 import random
+import re
 import signal
 import subprocess
 import sys
@@ -164,6 +165,14 @@ def run_case(args, horizon_s, domain, work):
     return out, late_events
 
 
+def example_lengths(source):
+    """docs/dds.md's "each under N lines" and the lines of each example its table names."""
+    doc = open(os.path.join(source, "docs", "dds.md"), encoding="utf-8").read()
+    limit = int(re.search(r"each under (\d+) lines", doc).group(1))
+    names = sorted(set(re.findall(r"^\| `(examples/dds/[\w.]+\.(?:c|cpp|py))` \|", doc, re.M)))
+    return limit, {n: sum(1 for _ in open(os.path.join(source, n), encoding="utf-8")) for n in names}
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--tetra", required=True)
@@ -181,6 +190,9 @@ def main():
             failures.append(what)
             print("FAIL: " + what, flush=True)
 
+    limit, lengths = example_lengths(args.source)
+    check(all(n < limit for n in lengths.values()),
+          "each example under %d lines (docs/dds.md): %s" % (limit, lengths))
     with tempfile.TemporaryDirectory() as work:
         fused, _ = run_case(args, 0.5, args.domain, work)
     with tempfile.TemporaryDirectory() as work:
