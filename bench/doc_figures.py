@@ -8,6 +8,7 @@ GROUP:
                calibrate -> lab-orbit -> replay (own calibration, factory calibration) -> score
   closed-loop  docs/sim.md's closed-loop table and the stuck/ramp variants
                (examples/sim/closed_loop_nadir.yaml; --plot rewrites docs/closed_loop_exclusion.png)
+  lab-truth    docs/sim.md's "What to expect downstream": replay of lab-orbit --seed 2 with the truth calibration
   allan        docs/allan.md's example (two hours of the simulated unit at rest, 100 Hz)
   demo-length  the length of `tetra demo` from its defaults (simulated seconds / speed), as the docs quote it
   demo         the length of `tetra demo` measured (wall clock, so never --check'ed)
@@ -145,6 +146,29 @@ CLOSED_LOOP_CHECKS = [  # relative tolerances
 ]
 
 
+# --- replay with the truth calibration (docs/sim.md, "What to expect downstream") ----------------------
+
+def lab_truth(d):
+    tetra("sim", "lab-orbit", "--seed", "2", "-o", "lab2.csv", "--truth", "lab2_truth.csv", cwd=d)
+    tetra("sim", "--write-unit", "truth_cal.yaml", cwd=d)  # the simulated unit itself
+    out = tetra("replay", "lab2.csv", "--calibration", "truth_cal.yaml", "--latitude", "-23.2", "--attitude",
+                "att_truth.csv", "--events", "ev_truth.jsonl", cwd=d)
+    mode = re.search(r"final mode: (\w+)", out).group(1)
+    events = sum(1 for _ in open(os.path.join(d, "ev_truth.jsonl")))
+    score = tetra("score", "att_truth.csv", "lab2_truth.csv", cwd=d)
+    f = {"final_total": num(r"final\s+\S+\s+\S+\s+\S+\s+([\d.e+-]+)", score), "events": events}
+    print(f"lab-orbit --seed 2, truth calibration: final error {f['final_total']:.5f}°, mode {mode}, {events} events")
+    if mode != "NOMINAL" or events:
+        sys.exit("docs/sim.md says mode NOMINAL and no events")
+    return f
+
+
+LAB_TRUTH_CHECKS = [
+    ("docs/sim.md", r"calibration ends\s+([\d.]+)° from the truth attitude", "final_total", 0.000006,
+     "printed to 0.00001°"),
+]
+
+
 def allan(d):
     tetra("sim", "static", "--rate-hz", "100", "--minutes", "120", "-o", "static_2h.csv", cwd=d)
     tetra("sim", "--write-unit", "cal.yaml", cwd=d)
@@ -214,7 +238,7 @@ def main():
     ap.add_argument("--source", default=".")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--plot", action="store_true", help="closed-loop: rewrite docs/closed_loop_exclusion.png")
-    ap.add_argument("groups", nargs="+", choices=["seed", "closed-loop", "allan", "demo-length", "demo"])
+    ap.add_argument("groups", nargs="+", choices=["seed", "closed-loop", "lab-truth", "allan", "demo-length", "demo"])
     ARGS = ap.parse_args()
     ARGS.tetra = os.path.abspath(ARGS.tetra)
     ARGS.source = os.path.abspath(ARGS.source)
@@ -228,6 +252,9 @@ def main():
             elif g == "closed-loop":
                 f = closed_loop(d)
                 bad += check(f, CLOSED_LOOP_CHECKS, True) if ARGS.check else 0
+            elif g == "lab-truth":
+                f = lab_truth(d)
+                bad += check(f, LAB_TRUTH_CHECKS, False) if ARGS.check else 0
             elif g == "allan":
                 f = allan(d)
                 f["B_min"] *= 1e6

@@ -310,10 +310,46 @@ TEST(EpochAssembler, AReferenceForAnEmittedEpochGoesWithTheNextAtItsOwnStamp) {
   EXPECT_EQ(out[2].reference_q_RB->x(), 1.0);
   EXPECT_EQ(out[2].reference_stamp_ns.value_or(-1), kPeriod);
   EXPECT_EQ(a.counters().references_late, 0U);
-  // At most kMaxLateReferences wait: the oldest beyond gives way, counted.
-  for (std::size_t i = 0; i <= EpochAssembler::kMaxLateReferences; ++i)
-    a.add_reference(static_cast<std::int64_t>(i) * 1000, q);
-  EXPECT_EQ(a.counters().references_late, 1U);
+}
+
+// More than kMaxLateReferences late references waiting for an epoch: the oldest gives way, counted as crowded
+// out (on the wire within Health.references_too_late, not samples_late), and the first of a run is returned
+// for the service to report; the run ends once every waiting reference has gone on with an epoch. Before, the
+// one crowded out was only counted in references_late (Health's samples_late) and nothing said it.
+TEST(EpochAssembler, ALateReferenceCrowdedOutIsCountedAndTheFirstOfARunReturned) {
+  auto a = make();
+  const Quaternion q = from_wxyz(0.5, 0.5, 0.5, 0.5);
+  std::vector<fdi::Epoch> out;
+  for (int k = 0; k < 3; ++k) feed_epoch(a, k, 0);
+  a.poll(0, out);
+  ASSERT_EQ(out.size(), 3U);
+  constexpr std::size_t kMax = EpochAssembler::kMaxLateReferences;
+  for (std::size_t i = 0; i < kMax; ++i)
+    EXPECT_FALSE(a.add_reference(static_cast<std::int64_t>(i) * 1000, q).has_value());
+  const auto crowded = a.add_reference(static_cast<std::int64_t>(kMax) * 1000, q);
+  ASSERT_TRUE(crowded.has_value());
+  EXPECT_EQ(crowded->stamp_ns, 0);                                // the oldest
+  EXPECT_DOUBLE_EQ(crowded->late_s, ns_to_seconds(2 * kPeriod));  // against the last epoch emitted
+  EXPECT_FALSE(a.add_reference(static_cast<std::int64_t>(kMax + 1) * 1000, q).has_value());  // same run
+  EXPECT_EQ(a.counters().references_crowded_out, 2U);
+  EXPECT_EQ(a.counters().references_late, 0U);
+  // One epoch takes one: the queue is not empty yet, so the run goes on.
+  out.clear();
+  feed_epoch(a, 3, 0);
+  a.poll(0, out);
+  EXPECT_FALSE(a.add_reference(100, q).has_value());
+  EXPECT_FALSE(a.add_reference(200, q).has_value());
+  EXPECT_EQ(a.counters().references_crowded_out, 3U);
+  // Every waiting one gone on (one an epoch): the next crowded out starts a new run.
+  for (int k = 4; k < 4 + static_cast<int>(kMax); ++k) feed_epoch(a, k, 0);
+  out.clear();
+  a.poll(0, out);
+  ASSERT_EQ(out.size(), kMax);
+  for (const auto& epoch : out) EXPECT_TRUE(epoch.reference_stamp_ns.has_value());
+  for (std::size_t i = 0; i < kMax; ++i)
+    EXPECT_FALSE(a.add_reference(static_cast<std::int64_t>(i) * 1000, q).has_value());
+  EXPECT_TRUE(a.add_reference(static_cast<std::int64_t>(kMax) * 1000, q).has_value());
+  EXPECT_EQ(a.counters().references_crowded_out, 4U);
 }
 
 // A sample that says its reference was written holds the epoch until the reference is in, whichever of the

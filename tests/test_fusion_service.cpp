@@ -5,9 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -31,6 +34,7 @@ using namespace std::chrono_literals;
 const bool kLoopback = use_loopback_dds();
 constexpr dds_domainid_t kDomain = 167;
 constexpr dds_domainid_t kSilenceDomain = 188;  //!< the silence test's own (187 is bench/ground_latency.py's)
+constexpr dds_domainid_t kCrowdDomain = 189;    //!< the crowded-out references' test's own
 constexpr std::int64_t kWaitLimit_ns = 20'000'000'000;  //!< [ns] only turns a hang into a failure
 
 //! The static scenario's unit for 3 s at 100 Hz, and the service set up for it (its files in `dir`).
@@ -254,6 +258,93 @@ TEST(FusionServiceLibrary, SilenceOfEveryGyroIsReportedWithHysteresisNeverBefore
   // The brief and the long silence, a third once the last samples have gone silent, and more on a loaded
   // machine where the publishing loop stalls past the 30 ms deadline: each counted, none an event.
   EXPECT_GE(silences, 2U);
+  (*service)->request_stop();
+  thread.join();
+  EXPECT_TRUE(run_status.ok()) << run_status.error().message;
+}
+
+// More late references than wait for an epoch (a tracker's burst while the gyros pause): the oldest beyond
+// service::EpochAssembler::kMaxLateReferences give way, and that is said — Health's references_too_late
+// counts them (not samples_late) and one `reference_late` event reports the run. Before, only samples_late
+// moved.
+TEST(FusionServiceLibrary, LateReferencesCrowdedOutAreCountedAsTooLateAndReportedOnce) {
+  ASSERT_TRUE(kLoopback);
+  Rig rig;
+  auto service = rig.make_service();
+  ASSERT_TRUE(service.ok()) << service.error().message;
+  ASSERT_TRUE((*service)->open(kCrowdDomain).ok());
+  Status run_status = ok_status();
+  std::thread thread([&] { run_status = (*service)->run(); });
+  auto session = std::move(dds::Session::open(kCrowdDomain)).value();
+  auto gyro = std::move(session.writer<tetra_GyroSample>(dds::gyro_sample_qos(10ms))).value();
+  auto reference = std::move(session.writer<tetra_AttitudeReference>(dds::reference_qos())).value();
+  auto events = std::move(session.reader<tetra_FdiEvent2>(dds::event_qos())).value();
+  auto health = std::move(session.reader<tetra_Health>(dds::health_qos())).value();
+  std::vector<dds::EventView> seen;
+  std::optional<dds::HealthView> last;
+  const auto drain = [&] {
+    (void)events.take(
+        [&](const tetra_FdiEvent2& e, const dds_sample_info_t&) { seen.push_back(dds::from_wire(e)); });
+    (void)health.take([&](const tetra_Health& h, const dds_sample_info_t&) { last = dds::from_wire(h); });
+  };
+  const auto wait_for = [&](const std::function<bool()>& done) {
+    const std::int64_t give_up = dds::monotonic_ns() + kWaitLimit_ns;
+    for (drain(); !done() && dds::monotonic_ns() < give_up; drain()) std::this_thread::sleep_for(20ms);
+    return done();
+  };
+  ASSERT_TRUE(wait_for([&] {
+    return last && last->gyro_writers > 0 && reference.matched_readers().ok() &&
+           *reference.matched_readers() > 0;
+  }));
+
+  const std::string unit = rig.simulator.scenario().unit.unit;
+  tetra_GyroSample sample{};
+  ASSERT_TRUE(dds::copy_bounded(sample.unit, unit, "unit").ok());
+  std::vector<sim::SimEpoch> published;
+  std::uint64_t k = 0;
+  const auto publish = [&](int epochs) {
+    sim::SimEpoch epoch;
+    for (int i = 0; i < epochs && rig.simulator.next(epoch); ++i) {
+      published.push_back(epoch);
+      ++k;
+      for (std::size_t g = 1; g <= epoch.present.size(); ++g) {
+        sample.gyro = static_cast<std::uint16_t>(g);
+        sample.seq = k;
+        sample.stamp_ns = epoch.stamp_ns;
+        sample.raw = epoch.raw_V[g - 1];
+        ASSERT_TRUE(gyro.write(sample).ok());
+      }
+      std::this_thread::sleep_for(2ms);
+    }
+  };
+  publish(20);
+  ASSERT_TRUE(wait_for([&] { return last && last->health.counters.epochs_accepted >= 20; }));
+  // 12 references for epochs 1..12, all fused already, while no epoch comes: 4 more than may wait.
+  constexpr std::size_t kSent = service::EpochAssembler::kMaxLateReferences + 4;
+  tetra_AttitudeReference ref{};
+  ASSERT_TRUE(dds::copy_bounded(ref.unit, unit, "unit").ok());
+  for (std::size_t i = 1; i <= kSent; ++i) {
+    ref.stamp_ns = published[i].stamp_ns;
+    const auto q = to_wxyz(published[i].truth_q_RB);
+    for (std::size_t c = 0; c < 4; ++c) ref.q_RB[c] = q[c];
+    ASSERT_TRUE(reference.write(ref).ok());
+    std::this_thread::sleep_for(5ms);  // taken one by one (the reader keeps 8)
+  }
+  publish(5);  // 5 of the 8 waiting go on, one an epoch
+  const auto crowded_events = [&] {
+    return std::count_if(seen.begin(), seen.end(), [](const dds::EventView& e) {
+      return e.event.type == fdi::EventType::kReferenceLate &&
+             e.event.detail.find("crowded out") != std::string::npos;
+    });
+  };
+  ASSERT_TRUE(wait_for([&] {
+    return last && last->health.counters.epochs_accepted >= 25 && crowded_events() >= 1 &&
+           last->health.counters.reference_delayed >= 5;
+  })) << "references_too_late "
+      << (last ? last->health.counters.reference_too_late : 0);
+  EXPECT_EQ(last->health.counters.reference_too_late, kSent - service::EpochAssembler::kMaxLateReferences);
+  EXPECT_EQ(last->counters.samples_late, 0U);
+  EXPECT_EQ(crowded_events(), 1);  // one run, one event
   (*service)->request_stop();
   thread.join();
   EXPECT_TRUE(run_status.ok()) << run_status.error().message;

@@ -34,6 +34,7 @@ struct LogColumns {
   std::vector<std::size_t> gyros;
   std::array<std::size_t, 4> reference{};
   bool has_reference = false;
+  std::optional<std::size_t> reference_stamp;  //!< ref_stamp_s
 };
 
 Result<LogColumns> find_log_columns(const CsvTable& t, const std::string& head) {
@@ -58,6 +59,9 @@ Result<LogColumns> find_log_columns(const CsvTable& t, const std::string& head) 
   if (ref_found != 0 && ref_found != 4)
     return bad_input(head + "reference columns must be all of ref_qw,ref_qx,ref_qy,ref_qz");
   cols.has_reference = ref_found == 4;
+  cols.reference_stamp = t.find_column("ref_stamp_s");
+  if (cols.reference_stamp && !cols.has_reference)
+    return bad_input(head + "ref_stamp_s needs the reference columns ref_qw,ref_qx,ref_qy,ref_qz");
   return cols;
 }
 
@@ -69,10 +73,11 @@ Status check_every_column_used(const CsvTable& t, const LogColumns& cols, const 
   if (cols.has_reference) {
     for (const std::size_t c : cols.reference) used[c] = true;
   }
+  if (cols.reference_stamp) used[*cols.reference_stamp] = true;
   for (std::size_t c = 0; c < t.column_count(); ++c) {
     if (!used[c]) {
       return bad_input(head + "unknown column '" + t.columns[c] + "' (expected time_s, g1..g" +
-                       std::to_string(cols.gyros.size()) + ", optional ref_qw..ref_qz)");
+                       std::to_string(cols.gyros.size()) + ", optional ref_qw..ref_qz, ref_stamp_s)");
     }
   }
   return ok_status();
@@ -110,6 +115,20 @@ Status read_reference_row(const CsvTable& t, const LogColumns& cols, std::size_t
   return ok_status();
 }
 
+// Row r's ref_stamp_s: empty (the row's time), or a time no later than the row's, on a row with a reference.
+Status read_reference_stamp(const CsvTable& t, std::size_t column, std::size_t r, GyroLog& log) {
+  log.reference_stamp_s[r] = std::numeric_limits<double>::quiet_NaN();
+  if (t.is_empty(r, column)) return ok_status();
+  const double stamp = t.cell(r, column);
+  if (auto why = log_time_problem(stamp)) return bad_input(t.where(r, column) + *why);
+  if (log.reference_present[r] == 0)
+    return bad_input(t.where(r, column) + "ref_stamp_s on a row without reference");
+  if (stamp > log.time_s[r])
+    return bad_input(t.where(r, column) + "ref_stamp_s is later than the row's time_s");
+  log.reference_stamp_s[r] = stamp;
+  return ok_status();
+}
+
 Status read_rows(const CsvTable& t, const LogColumns& cols, GyroLog& log) {
   const std::size_t n = t.rows;
   const auto ng = static_cast<std::size_t>(log.gyro_count);
@@ -120,6 +139,7 @@ Status read_rows(const CsvTable& t, const LogColumns& cols, GyroLog& log) {
     log.reference_wxyz.resize(n);
     log.reference_present.resize(n);
   }
+  if (log.has_reference_stamp) log.reference_stamp_s.resize(n);
   for (std::size_t r = 0; r < n; ++r) {
     if (t.is_empty(r, cols.time)) return bad_input(t.where(r, cols.time) + "time must be a finite number");
     if (auto why = log_time_problem(t.cell(r, cols.time))) return bad_input(t.where(r, cols.time) + *why);
@@ -130,6 +150,9 @@ Status read_rows(const CsvTable& t, const LogColumns& cols, GyroLog& log) {
     }
     if (log.has_reference) {
       if (Status s = read_reference_row(t, cols, r, log); !s) return s;
+    }
+    if (cols.reference_stamp) {
+      if (Status s = read_reference_stamp(t, *cols.reference_stamp, r, log); !s) return s;
     }
   }
   return ok_status();
@@ -144,6 +167,7 @@ Status fill_from_table(const CsvTable& t, GyroLog& log) {
   if (!cols) return cols.error();
   log.gyro_count = static_cast<int>(cols->gyros.size());
   log.has_reference = cols->has_reference;
+  log.has_reference_stamp = cols->reference_stamp.has_value();
   log.units_dps = false;
   if (Status s = check_every_column_used(t, *cols, head); !s) return s;
   if (Status s = read_units(log, t.source); !s) return s;
@@ -256,6 +280,7 @@ Status GyroLogWriter::open_like(const std::string& path, const GyroLog& header) 
 }
 
 Status GyroLogWriter::open_like(OutputFile& out, const GyroLog& header) {
+  with_reference_stamp_ = header.has_reference_stamp;
   return open_output(out, header.gyro_count, header.has_reference, header.comments);
 }
 
@@ -279,6 +304,9 @@ Status GyroLogWriter::open_output(OutputFile& out, int gyro_count, bool with_ref
                        " holds a line break (a comment is one line)");
     }
   }
+  if (with_reference_stamp_ && (!with_reference || is_hdf5_path(out.path()))) {
+    return bad_input(out.path() + ": a ref_stamp_s column needs the reference columns, in a CSV log");
+  }
   if (is_hdf5_path(out.path())) {
     auto file_path = out.library_path();
     if (!file_path) return file_path.error();
@@ -298,13 +326,15 @@ Status GyroLogWriter::open_output(OutputFile& out, int gyro_count, bool with_ref
   buffer_ += "time_s";
   for (int i = 1; i <= gyro_count; ++i) buffer_ += ",g" + std::to_string(i);
   if (with_reference) buffer_ += ",ref_qw,ref_qx,ref_qy,ref_qz";
+  if (with_reference_stamp_) buffer_ += ",ref_stamp_s";
   buffer_ += '\n';
   return ok_status();
 }
 
 Status GyroLogWriter::write(double time_s, std::span<const double> values,
                             std::span<const std::uint8_t> present,
-                            const std::optional<std::array<double, 4>>& reference_wxyz) {
+                            const std::optional<std::array<double, 4>>& reference_wxyz,
+                            std::optional<double> reference_stamp_s) {
   if (out_ == nullptr) return failure("gyro log writer is not open");
   if (h5_) return h5_->write(time_s, values, present, reference_wxyz);
   if (values.size() != static_cast<std::size_t>(gyro_count_) || present.size() != values.size()) {
@@ -320,6 +350,10 @@ Status GyroLogWriter::write(double time_s, std::span<const double> values,
       buffer_ += ',';
       if (reference_wxyz) append_double(buffer_, (*reference_wxyz)[k]);
     }
+  }
+  if (with_reference_stamp_) {
+    buffer_ += ',';
+    if (reference_wxyz && reference_stamp_s) append_double(buffer_, *reference_stamp_s);
   }
   buffer_ += '\n';
   if (buffer_.size() > (1U << 20)) return flush();

@@ -12,21 +12,13 @@
 #include "dds/dds.h"
 #include "tetra.h"
 
+/* clang-format off */
 static const char* kModes[] = {"NOMINAL", "DEGRADED", "SUSPECT", "LOST"};
-static const char* kEvents[] = {"detected",
-                                "isolated",
-                                "unisolated",
-                                "reconfigured",
-                                "cleared",
-                                "lost",
-                                "command",
-                                "fdi_unavailable",
-                                "fdi_available",
-                                "gap",
-                                "reference_rejected",
-                                "reference_accepted",
-                                "reference_late"};
+static const char* kEvents[] = {"detected", "isolated", "unisolated", "reconfigured", "cleared", "lost", "command",
+    "fdi_unavailable", "fdi_available", "gap", "reference_rejected", "reference_accepted", "reference_late"};
 static const char* kReferenceStates[] = {"absent", "accepted", "rejected"};
+static const char* kVerdicts[] = {"consistent", "rejected", "no call"};
+/* clang-format on */
 
 static const char* name_of(const char** names, size_t count, int value) {
   return value >= 0 && (size_t)value < count ? names[value] : "unknown";
@@ -34,19 +26,13 @@ static const char* name_of(const char** names, size_t count, int value) {
 #define NAME(names, value) name_of(names, sizeof names / sizeof names[0], (int)(value))
 
 /* JSON has no Inf or NaN: null (a protection level of +Inf means no integrity bound). */
-static void print_number(double v) {
-  if (isfinite(v))
-    printf("%.17g", v);
-  else
-    printf("null");
+static void number(const char* prefix, double v) {
+  isfinite(v) ? printf("%s%.17g", prefix, v) : printf("%snull", prefix);
 }
 
 static void vec(const char* key, const double* v, int n) {
   printf(", \"%s\": [", key);
-  for (int i = 0; i < n; ++i) {
-    printf("%s", i ? ", " : "");
-    print_number(v[i]);
-  }
+  for (int i = 0; i < n; ++i) number(i ? ", " : "", v[i]);
   printf("]");
 }
 
@@ -74,8 +60,6 @@ static void print_health(const void* sample) {
          (uint64_t)h->counters.samples_late);
 }
 
-static const char* kVerdicts[] = {"consistent", "rejected", "no call"};
-
 static void print_event(const void* sample) {
   const tetra_FdiEvent2* e = sample;
   printf("{\"type\": \"event\", \"unit\": \"%s\", \"event_seq\": %" PRIu64 ", \"stamp_ns\": %" PRId64
@@ -89,12 +73,10 @@ static void print_event(const void* sample) {
   printf("\", \"ledger\": [");
   for (uint32_t i = 0; i < e->ledger._length; ++i) {
     const tetra_LedgerRow* r = &e->ledger._buffer[i];
-    printf(
-        "%s{\"source\": \"%s\", \"hypothesis\": %u, \"verdict\": \"%s\", \"unit\": \"%s\", \"statistic\": ",
-        i ? ", " : "", r->source, (unsigned)r->hypothesis, NAME(kVerdicts, r->verdict), r->unit);
-    print_number(r->statistic);
-    printf(", \"threshold\": ");
-    print_number(r->threshold);
+    printf("%s{\"source\": \"%s\", \"hypothesis\": %u, \"verdict\": \"%s\", \"unit\": \"%s\"", i ? ", " : "",
+           r->source, (unsigned)r->hypothesis, NAME(kVerdicts, r->verdict), r->unit);
+    number(", \"statistic\": ", r->statistic);
+    number(", \"threshold\": ", r->threshold);
     printf("}");
   }
   printf("]}\n");
@@ -113,6 +95,13 @@ static void take_all(dds_entity_t reader, const char* unit, void (*print)(const 
   fflush(stdout);
 }
 
+/* A reader of topic `name` (the type's name) with `qos`; negative on failure. */
+static dds_entity_t reader_of(dds_entity_t participant, const dds_topic_descriptor_t* type, const char* name,
+                              const dds_qos_t* qos) {
+  const dds_entity_t topic = dds_create_topic(participant, type, name, NULL, NULL);
+  return topic < 0 ? topic : dds_create_reader(participant, topic, qos, NULL);
+}
+
 int main(int argc, char** argv) {
   const char* unit = argc > 1 ? argv[1] : "";
   dds_domainid_t domain = DDS_DOMAIN_DEFAULT;
@@ -129,35 +118,24 @@ int main(int argc, char** argv) {
     fprintf(stderr, "usage: %s UNIT [--domain N] [--seconds S]\n", argv[0]);
     return 2;
   }
-  const dds_entity_t participant = dds_create_participant(domain, NULL, NULL);
-  if (participant < 0) {
-    fprintf(stderr, "dds_create_participant: %s\n", dds_strretcode(participant));
-    return 1;
-  }
+  const dds_entity_t participant = dds_create_participant(domain, NULL, NULL); /* checked with the readers */
   /* QoS as docs/dds.md's table; the Attitude reader keeps more than the writer's 1 so none is lost here. */
   dds_qos_t* qos = dds_create_qos();
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 256);
-  const dds_entity_t attitude_topic =
-      dds_create_topic(participant, &tetra_Attitude_desc, "Attitude", NULL, NULL);
-  const dds_entity_t attitude_reader = dds_create_reader(participant, attitude_topic, qos, NULL);
+  const dds_entity_t attitude_reader = reader_of(participant, &tetra_Attitude_desc, "Attitude", qos);
   dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL); /* Health and events: a late joiner's history */
-  const dds_entity_t health_topic = dds_create_topic(participant, &tetra_Health_desc, "Health", NULL, NULL);
-  const dds_entity_t health_reader = dds_create_reader(participant, health_topic, qos, NULL);
-  const dds_entity_t event_topic =
-      dds_create_topic(participant, &tetra_FdiEvent2_desc, "FdiEvent", NULL, NULL);
-  const dds_entity_t event_reader = dds_create_reader(participant, event_topic, qos, NULL);
+  const dds_entity_t health_reader = reader_of(participant, &tetra_Health_desc, "Health", qos);
+  const dds_entity_t event_reader = reader_of(participant, &tetra_FdiEvent2_desc, "FdiEvent", qos);
   dds_delete_qos(qos);
   if (attitude_reader < 0 || health_reader < 0 || event_reader < 0) {
-    fprintf(stderr, "could not create the readers\n");
+    fprintf(stderr, "could not create the participant or its readers (domain %d)\n", (int)domain);
     return 1;
   }
   const dds_entity_t waitset = dds_create_waitset(participant);
   const dds_entity_t readers[3] = {attitude_reader, health_reader, event_reader};
-  for (int i = 0; i < 3; ++i) {
-    const dds_entity_t condition = dds_create_readcondition(readers[i], DDS_ANY_STATE);
-    dds_waitset_attach(waitset, condition, readers[i]);
-  }
+  for (int i = 0; i < 3; ++i)
+    dds_waitset_attach(waitset, dds_create_readcondition(readers[i], DDS_ANY_STATE), readers[i]);
   const dds_time_t end = seconds > 0.0 ? dds_time() + (dds_duration_t)(seconds * 1e9) : DDS_NEVER;
   while (dds_time() < end) {
     if (dds_waitset_wait_until(waitset, NULL, 0, end) < 0) break;

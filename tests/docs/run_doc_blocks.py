@@ -18,7 +18,9 @@ before a block may adjust how it runs (the reader does not see it):
 The blocks of one document run in order in one temporary folder (a later block may use an earlier one's
 files). The folder holds links to the repository's examples/, config/, scripts/, bench/, web/, tests/ and the
 build folder, so the paths the docs show work; `tetra` on PATH is the program built, and `build/tetra`
-is it too; `build/python` is the Python package built beside it (when it is). A block fails on a
+is it too; `build/python` is the Python package built beside it (when it is). A reader has only the README's
+PATH step: every other document that says `tetra` must point to it (quote `export PATH=$PWD/build:$PATH`
+and link the README's Quick start), or it fails. A block fails on a
 non-zero exit status (bash -e, pipefail) or when a file it names as an output (-o, --out, --truth,
 --attitude, --events, --json, --plot, --summary, --pointing, --write-unit, --kalibr, or an expect
 directive) is missing afterwards. Processes a block leaves in the
@@ -41,6 +43,7 @@ FENCE = re.compile(r"^```\s*(\w*)\s*$")
 MARKER = re.compile(r"<!--\s*doc-test:(.*?)-->", re.S)
 OUTPUT_OPTIONS = ("-o", "--out", "--truth", "--attitude", "--events", "--json", "--plot", "--summary",
                   "--pointing", "--write-unit", "--kalibr")
+PATH_STEP = "export PATH=$PWD/build:$PATH"
 LINKED = ("examples", "config", "scripts", "bench", "web", "idl", "packaging", "tests")
 
 
@@ -123,6 +126,16 @@ def named_outputs(text):
     return files
 
 
+def lacks_path_step(path, source):
+    """True for a document besides the README that says `tetra` and neither quotes the README's PATH step nor
+    links the README's Quick start."""
+    if os.path.samefile(path, os.path.join(source, "README.md")):
+        return False
+    text = open(path, encoding="utf-8").read()
+    says_tetra = re.search(r"`tetra[ `]|^tetra ", text, re.M)
+    return bool(says_tetra) and (PATH_STEP not in text or "README.md#quick-start" not in text)
+
+
 def prepare(block, domain):
     text = block.text
     for old, new in block.subs:
@@ -185,6 +198,10 @@ def main():
     domain = args.domain_base
     total_start = time.monotonic()
     for doc in docs:
+        if lacks_path_step(doc, source):
+            label = os.path.relpath(doc, source)
+            failures.append(f"{label}: says `tetra` without the README's PATH step")
+            print(f"FAIL {label}: says `tetra` without pointing to the README's PATH step ({PATH_STEP})")
         blocks = blocks_of(doc)
         if not blocks:
             continue

@@ -132,7 +132,9 @@ Status to_wire(const std::string& unit, const fdi::Health& health, const service
   out.msg.reference_nis = health.reference_nis;
   for (int i = 0; i < 3; ++i) out.msg.protection_level_rad[i] = health.protection_level_rad[i];
   out.msg.references_delayed = health.counters.reference_delayed;
-  out.msg.references_too_late = health.counters.reference_too_late;
+  // Left out: beyond the fusion horizon (the pipeline's), or crowded out before reaching it (the
+  // assembler's).
+  out.msg.references_too_late = health.counters.reference_too_late + counters.references_crowded_out;
   tetra_SampleCounters& c = out.msg.counters;
   c.epochs_accepted = health.counters.epochs_accepted;
   c.epochs_rejected_time = health.counters.epochs_rejected_time;

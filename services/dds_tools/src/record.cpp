@@ -175,6 +175,7 @@ class Recording {
   OutputFile& log_out_;
   int n_;
   GyroLogWriter log_;
+  bool reference_stamps_ = false;  //!< the log has ref_stamp_s (CSV): late references are written
   bool log_open_ = false;
   std::string attitude_text_ = report::attitude_header(n_);  // after n_: members initialize in order
   std::map<std::uint64_t, std::string> event_lines_;         // by event_seq: written in order
@@ -236,6 +237,10 @@ Status Recording::take_outputs(const RecordLink& link) {
 
 Status Recording::open_log() {
   if (log_open_) return ok_status();
+  // A reference delivered after its epoch goes on the row it reached with its own time (CSV: ref_stamp_s), so
+  // replay fuses it at that time as the service did; HDF5 logs have no such column and leave it out.
+  reference_stamps_ = !is_hdf5_path(log_out_.path());
+  log_.set_reference_stamps(reference_stamps_);
   if (auto s = log_.open(log_out_, n_, true, false, record_metadata(o_.unit, files_)); !s) return s;
   log_open_ = true;
   return ok_status();
@@ -247,10 +252,15 @@ Status Recording::write_epochs() {
     for (int i = 0; i < n_; ++i)
       values_[static_cast<std::size_t>(i)] = epoch.raw[static_cast<std::size_t>(i)];
     std::optional<std::array<double, 4>> ref;
-    // A reference delivered after its epoch (fused by the service at its own stamp) has no row of its own in
-    // a log: it is left out rather than written as if taken at this row's time (docs/dds.md, "Known limits").
-    if (epoch.reference_q_RB && !epoch.reference_stamp_ns) ref = to_wxyz(*epoch.reference_q_RB);
-    if (auto s = log_.write(ns_to_seconds(epoch.stamp_ns), values_, epoch.present, ref); !s) return s;
+    std::optional<double> ref_stamp;
+    // A reference delivered after its epoch (fused by the service at its own stamp): on the row it reached,
+    // with its own time (ref_stamp_s); without that column (HDF5) it is left out rather than written as if
+    // taken at this row's time (docs/dds.md, "Known limits").
+    if (epoch.reference_q_RB && epoch.reference_stamp_ns)
+      ref_stamp = ns_to_seconds(*epoch.reference_stamp_ns);
+    if (epoch.reference_q_RB && (!ref_stamp || reference_stamps_)) ref = to_wxyz(*epoch.reference_q_RB);
+    if (auto s = log_.write(ns_to_seconds(epoch.stamp_ns), values_, epoch.present, ref, ref_stamp); !s)
+      return s;
     last_epoch_ns_ = epoch.stamp_ns;
     ++epochs_written_;
   }

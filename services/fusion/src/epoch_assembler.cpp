@@ -94,6 +94,7 @@ void EpochAssembler::forget_time_base() {
   pending_.clear();
   references_.clear();
   late_references_.clear();
+  crowding_ = false;
   last_emitted_ns_.reset();
   clock_ = Clock{};
   candidate_.reset();
@@ -230,21 +231,26 @@ Verdict EpochAssembler::add_sample(int gyro_id, std::uint64_t seq, std::int64_t 
   return Verdict::kAccepted;
 }
 
-void EpochAssembler::add_reference(std::int64_t stamp_ns, const Quaternion& q_RB) {
-  if (last_emitted_ns_ && stamp_ns <= *last_emitted_ns_ + config_.tolerance_ns) {
-    // Its epoch was fused: it goes with one of the next at its own time (the pipeline's fusion horizon).
-    if (late_references_.size() == kMaxLateReferences) {
-      ++counters_.references_late;  // the oldest waiting gives way
-      late_references_.pop_front();
-    }
-    auto at = std::upper_bound(late_references_.begin(), late_references_.end(), stamp_ns,
-                               [](std::int64_t t, const auto& r) { return t < r.first; });
-    late_references_.insert(at, {stamp_ns, q_RB});
-    return;
+std::optional<CrowdedOutReference> EpochAssembler::add_reference(std::int64_t stamp_ns,
+                                                                 const Quaternion& q_RB) {
+  const auto by_stamp = [](std::int64_t t, const auto& r) { return t < r.first; };
+  if (!last_emitted_ns_ || stamp_ns > *last_emitted_ns_ + config_.tolerance_ns) {
+    references_.insert(std::upper_bound(references_.begin(), references_.end(), stamp_ns, by_stamp),
+                       {stamp_ns, q_RB});
+    return std::nullopt;
   }
-  auto pos = std::upper_bound(references_.begin(), references_.end(), stamp_ns,
-                              [](std::int64_t t, const auto& r) { return t < r.first; });
-  references_.insert(pos, {stamp_ns, q_RB});
+  // Its epoch was fused: it goes with one of the next at its own time (the pipeline's fusion horizon).
+  late_references_.insert(
+      std::upper_bound(late_references_.begin(), late_references_.end(), stamp_ns, by_stamp),
+      {stamp_ns, q_RB});
+  if (late_references_.size() <= kMaxLateReferences) return std::nullopt;
+  const CrowdedOutReference crowded{late_references_.front().first,
+                                    ns_to_seconds(*last_emitted_ns_ - late_references_.front().first)};
+  late_references_.pop_front();  // the oldest waiting gives way
+  ++counters_.references_crowded_out;
+  const bool first_of_run = !crowding_;
+  crowding_ = true;
+  return first_of_run ? std::optional<CrowdedOutReference>(crowded) : std::nullopt;
 }
 
 void EpochAssembler::mark_absent(int gyro_id, AbsentReason reason) {
@@ -329,6 +335,7 @@ void EpochAssembler::emit(Pending& epoch, std::vector<fdi::Epoch>& out) {
     result.reference_stamp_ns = late_references_.front().first;
     late_references_.pop_front();
   }
+  crowding_ = crowding_ && !late_references_.empty();  // a run of crowded-out ones ends when all went on
   const auto delivered = std::count(result.present.begin(), result.present.end(), std::uint8_t{1});
   if (epoch.promised > delivered)
     counters_.samples_promised_lost += static_cast<std::uint64_t>(epoch.promised - delivered);

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cstdio>
 
 #include "tetra/core/units.hpp"
 #include "tetra/dds/clock.hpp"
@@ -317,12 +318,31 @@ void FusionService::warn_other_unit(std::int64_t now_ns) {
 }
 
 Status FusionService::take_references() {
+  std::optional<CrowdedOutReference> crowded;
   auto taken = reference_reader_->take([&](const tetra_AttitudeReference& ref, const dds_sample_info_t&) {
     if (dds::from_wire(ref.unit) != config_.unit) return;
-    assembler_.add_reference(ref.stamp_ns, from_wxyz(ref.q_RB[0], ref.q_RB[1], ref.q_RB[2], ref.q_RB[3]));
+    auto gave_way =
+        assembler_.add_reference(ref.stamp_ns, from_wxyz(ref.q_RB[0], ref.q_RB[1], ref.q_RB[2], ref.q_RB[3]));
+    if (gave_way && !crowded) crowded = gave_way;
   });
   if (!taken) return taken.error();
-  return ok_status();
+  return crowded ? report_crowded_out(*crowded) : ok_status();
+}
+
+Status FusionService::report_crowded_out(const CrowdedOutReference& crowded) {
+  // The first of a run of late references that gave way before reaching the pipeline: counted in Health's
+  // references_too_late like one beyond the horizon, and said by the same typed event.
+  fdi::FdiEvent event;
+  event.stamp_ns = pipeline_.health().stamp_ns;  // the last epoch fused
+  event.type = fdi::EventType::kReferenceLate;
+  event.statistic = crowded.late_s;
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "attitude reference %.3f s late crowded out: more than %zu references waited for the next "
+                "epoch; the oldest gives way, as does each one until all have gone on",
+                crowded.late_s, EpochAssembler::kMaxLateReferences);
+  event.detail = text;
+  return publish_event(event, 0, {});
 }
 
 Status FusionService::take_commands() {

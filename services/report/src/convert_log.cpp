@@ -2,6 +2,7 @@
 #include "tetra/report/convert_log.hpp"
 
 #include <array>
+#include <cmath>
 #include <optional>
 #include <span>
 
@@ -33,7 +34,10 @@ Result<ConvertedLog> convert_gyro_log(const ConvertLogOptions& o) {
       const std::span<const std::uint8_t> present(block.present.data() + k * ng, ng);
       std::optional<std::array<double, 4>> ref;
       if (block.has_reference && block.reference_present[k] != 0) ref = block.reference_wxyz[k];
-      if (Status s = writer.write(block.time_s[k], values, present, ref); !s) return s.error();
+      std::optional<double> ref_stamp;
+      if (block.has_reference_stamp && std::isfinite(block.reference_stamp_s[k]))
+        ref_stamp = block.reference_stamp_s[k];
+      if (Status s = writer.write(block.time_s[k], values, present, ref, ref_stamp); !s) return s.error();
     }
     converted.epochs += block.epochs();
   }

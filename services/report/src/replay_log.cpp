@@ -117,8 +117,13 @@ Status replay_block(const GyroLog& block, fdi::Pipeline& pipeline, fdi::Epoch& e
     }
     before_epoch(epoch.stamp_ns);
     epoch.reference_q_RB.reset();
+    epoch.reference_stamp_ns.reset();
     if (block.has_reference && block.reference_present[k] != 0)
       epoch.reference_q_RB = from_wxyz(block.reference_wxyz[k]);
+    // A reference taken before its row (a late star tracker, as recorded): fused at its own time, as the
+    // service did.
+    if (block.has_reference_stamp && std::isfinite(block.reference_stamp_s[k]))
+      epoch.reference_stamp_ns = seconds_to_ns(block.reference_stamp_s[k]);
     const auto& r = pipeline.step(epoch);
     if (out.explainer) out.explainer->observe(block.time_s[k], r, pipeline);
     for (const auto& e : r.events) {

@@ -1,8 +1,10 @@
 #pragma once
-// Gyro log (docs/interfaces.md §2.2): time_s,g1..gN[,ref_qw,ref_qx,ref_qy,ref_qz].
+// Gyro log (docs/interfaces.md §2.2): time_s,g1..gN[,ref_qw,ref_qx,ref_qy,ref_qz[,ref_stamp_s]].
 // An empty gyro cell means "no sample this epoch" (present = 0); "nan" means an invalid sample
 // (present = 1, value NaN). Values are volts unless the file says "# units=dps" (deg/s).
-// Reference columns are all four or none; on a row they are all filled or all empty.
+// Reference columns are all four or none; on a row they are all filled or all empty. The optional
+// ref_stamp_s (CSV, with the reference columns) is the reference's own time where it was taken before its
+// row's epoch (a late star tracker, as `tetra record` writes it); empty: taken at the row's time.
 // The reader checks the format only: times that do not increase are left for the pipeline to
 // reject and count.
 
@@ -38,7 +40,10 @@ struct GyroLog {
   bool has_reference = false;         //!< ref_* columns exist
   std::vector<std::array<double, 4>> reference_wxyz;  //!< body→reference quaternion per epoch
   std::vector<std::uint8_t> reference_present;        //!< 1 where the row carries a reference
-  std::vector<std::size_t> lines;                     //!< 1-based file line of each epoch
+  bool has_reference_stamp = false;                   //!< the ref_stamp_s column exists
+  //! [s] per epoch, with has_reference_stamp: the reference's own time, NaN when it is the row's
+  std::vector<double> reference_stamp_s;
+  std::vector<std::size_t> lines;  //!< 1-based file line of each epoch
 
   std::size_t epochs() const { return time_s.size(); }
   double value(std::size_t epoch, int gyro_index0) const {
@@ -103,13 +108,19 @@ class GyroLogWriter {
   Status open_like(const std::string& path, const GyroLog& header);
   Status open_like(OutputFile& out, const GyroLog& header);
   //! One epoch. `present[i] == 0` writes an empty cell; NaN writes "nan".
+  //! `reference_stamp_s`: the reference's own time when it was taken before `time_s` (written only with
+  //! set_reference_stamps(true); nullopt: at `time_s`).
   Status write(double time_s, std::span<const double> values, std::span<const std::uint8_t> present,
-               const std::optional<std::array<double, 4>>& reference_wxyz = std::nullopt);
+               const std::optional<std::array<double, 4>>& reference_wxyz = std::nullopt,
+               std::optional<double> reference_stamp_s = std::nullopt);
   //! Flushes and closes (and, when opened by path, commits: fsync and rename into place).
   Status close();
   //! HDF5 only, before open: shuffle + deflate every dataset (files 2-4x smaller, read about 5x slower).
   //! Default off: chunked, uncompressed datasets. CSV output ignores it.
   void set_hdf5_compression(bool compress) { compress_ = compress; }
+  //! CSV only, before open: a ref_stamp_s column after the reference columns (open_like sets it from its
+  //! header). An HDF5 output refuses it at open.
+  void set_reference_stamps(bool with_stamps) { with_reference_stamp_ = with_stamps; }
 
  private:
   Result<OutputFile*> open_own(const std::string& path);
@@ -122,6 +133,7 @@ class GyroLogWriter {
   std::string buffer_;
   int gyro_count_ = 0;
   bool with_reference_ = false;
+  bool with_reference_stamp_ = false;
   bool compress_ = false;
 };
 

@@ -44,7 +44,8 @@
 //     with the next epoch emitted, stamped with its own time (`fdi::Epoch::reference_stamp_ns`): the
 //     pipeline fuses it at that time within its fusion horizon, or counts and reports it as too late.
 //     Several waiting go one an epoch, oldest first, after an epoch's own reference (at most
-//     kMaxLateReferences wait: the oldest beyond gives way, counted as late);
+//     kMaxLateReferences wait: the oldest beyond gives way, counted in references_crowded_out, and the
+//     first of a run — until every waiting one has gone on — is said to the caller to report);
 //   * a sample that says how many samples were written for its stamp (`promised`, lockstep play) makes
 //     its epoch wait for all of them, however late, not max_latency_ns: it is emitted when they are in
 //     or when a gyro missing from it has delivered a later stamp (its sample is lost). Such an epoch
@@ -99,6 +100,13 @@ const char* to_string(Verdict verdict);
 
 enum class AbsentReason : std::uint8_t { kDeadline, kLiveliness };
 
+//! A late reference that gave way to newer ones (more than EpochAssembler::kMaxLateReferences waiting), when
+//! it is the first of a run of them: for the caller to report (a `reference_late` event).
+struct CrowdedOutReference {
+  std::int64_t stamp_ns = 0;  //!< [ns] the reference's own stamp
+  double late_s = 0.0;        //!< [s] the last emitted epoch's stamp minus it
+};
+
 class EpochAssembler {
  public:
   //! References for emitted epochs that may wait for an epoch to go with (the reference reader's history).
@@ -113,7 +121,8 @@ class EpochAssembler {
   Verdict add_sample(int gyro_id, std::uint64_t seq, std::int64_t stamp_ns, double raw, std::int64_t now_ns,
                      bool reference_written = false, int promised = 0);
   //! An attitude reference for the epoch at `stamp_ns` (one already emitted: with the next, at its stamp).
-  void add_reference(std::int64_t stamp_ns, const Quaternion& q_RB);
+  //! Returns the reference crowded out by it when that starts a run of them (counted in either case).
+  std::optional<CrowdedOutReference> add_reference(std::int64_t stamp_ns, const Quaternion& q_RB);
   //! The gyro's stream stopped (deadline missed or liveliness lost): epochs no longer wait for it.
   //! It is present again as soon as it delivers a sample.
   void mark_absent(int gyro_id, AbsentReason reason);
@@ -184,6 +193,7 @@ class EpochAssembler {
   //! references for epochs already emitted, sorted by stamp: each goes with one of the next epochs, at its
   //! own stamp (at most kMaxLateReferences wait; the oldest gives way)
   std::deque<std::pair<std::int64_t, Quaternion>> late_references_;
+  bool crowding_ = false;  //!< a late reference was crowded out since late_references_ was last empty
   std::optional<std::int64_t> last_emitted_ns_;
   Clock clock_;                     //!< the unit's clock
   std::optional<Clock> candidate_;  //!< a new time base the outliers may be on

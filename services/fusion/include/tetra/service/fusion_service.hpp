@@ -88,6 +88,8 @@ class FusionService {
   Status publish_event(const fdi::FdiEvent& event, std::uint64_t command_id, const dds::CommandAudit& audit);
   //! An event when every gyro has gone silent, and when samples come back.
   Status report_silence(std::int64_t now_ns);
+  //! A `reference_late` event for the first of a run of late references crowded out in the assembler.
+  Status report_crowded_out(const CrowdedOutReference& crowded);
   Status publish_health(std::int64_t now_ns, bool force);
   //! The health to publish, into `out` (its storage is reused).
   void current_health(fdi::Health& out) const;

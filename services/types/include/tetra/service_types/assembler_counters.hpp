@@ -23,6 +23,9 @@ struct AssemblerCounters {
   std::uint64_t seq_discontinuity = 0;      //!< sequence numbers jumping further than time explains
   std::uint64_t unit_silences = 0;          //!< counted by the caller: every gyro silent at once
   std::uint64_t samples_promised_lost = 0;  //!< said written for an epoch (promised) that went without them
+  //! references for emitted epochs crowded out: the oldest of more than EpochAssembler::kMaxLateReferences
+  //! waiting gives way (on the wire within Health.references_too_late: left out like one beyond the horizon)
+  std::uint64_t references_crowded_out = 0;
 };
 
 }  // namespace tetra::service
