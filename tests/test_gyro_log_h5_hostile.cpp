@@ -333,5 +333,21 @@ TEST(HostileH5, FuzzRegressionInputsEndInAValue) {
   EXPECT_GE(reproducers, 8);
 }
 
+// Files on which libhdf5 itself faults while it opens a dataset (tests/fuzz/libhdf5_faults/: found by the
+// HDF5 fuzzer, whose in-process reading cannot survive them, so they stay out of its corpus): the checking
+// child process meets the fault and the file is refused with an error naming it; nothing is read.
+TEST(HostileH5, FilesOnWhichLibhdf5FaultsAreRefusedByTheCheckingChild) {
+  int files = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(test::source_path("tests/fuzz/libhdf5_faults"))) {
+    ++files;
+    const auto log = read_gyro_log(entry.path().string());
+    ASSERT_FALSE(log.ok()) << entry.path();
+    EXPECT_EQ(log.error().message.rfind(entry.path().string() + ": damaged HDF5 file", 0), 0U)
+        << log.error().message;
+  }
+  EXPECT_GE(files, 1);
+}
+
 }  // namespace
 }  // namespace tetra
