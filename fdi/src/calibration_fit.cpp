@@ -51,6 +51,7 @@ void CalibrationFit::restart(const Subset& s, GyroMask mask, const Eigen::Vector
   first_w_ = omega_rad_s;
   sum_wp_.setZero();
   sum_p_.setZero();
+  sum_pp_ = 0.0;
 }
 
 void CalibrationFit::accumulate(const Eigen::VectorXd& p, int dof, const Eigen::Vector3d& omega_rad_s) {
@@ -60,6 +61,7 @@ void CalibrationFit::accumulate(const Eigen::VectorXd& p, int dof, const Eigen::
   sum_dev_ += (omega_rad_s - first_w_).cwiseAbs();
   for (int j = 0; j < dof; ++j) sum_wp_.col(j) += omega_rad_s * p[j];
   sum_p_ += p.head(dof);
+  sum_pp_ += p.head(dof).squaredNorm();
 }
 
 bool CalibrationFit::record(const Eigen::VectorXd& p, const Subset& s, GyroMask mask,
@@ -92,13 +94,35 @@ void CalibrationFit::moments(const Subset& s, GyroMask mask, const SubsetCache& 
   // block adds at most δ·Σ|ω − ω_first| per axis (a constant bias cancels in the centred sums).
   cache.rate_coefficient_covariance(s, mask, tolerance_);
   const double wander = std::max(config.calibration_error_sigmas, 1.0) * s.bias_wander_sigma;
-  const Eigen::Matrix3d own = omega_c_ + wander * wander * sum_dev_ * sum_dev_.transpose();
+  const Eigen::Matrix3d own = noise_scale() * omega_c_ + wander * wander * sum_dev_ * sum_dev_.transpose();
   for (int j = 0; j < dof_; ++j) {
     for (int k = 0; k < dof_; ++k) {
       cov_.block<3, 3>(3 * j, 3 * k).noalias() = omega_c_ * tolerance_.block<3, 3>(3 * j, 3 * k) * omega_c_;
       if (j == k) cov_.block<3, 3>(3 * j, 3 * k) += own;
     }
   }
+}
+
+double CalibrationFit::noise_scale() const {
+  // The parity's spread about the block's fit, per axis and epoch: 1 for the stated noise. A unit noisier
+  // than its noise: section widens the noise term by what the data show (never narrows it).
+  const double n = epochs_;
+  const double centred = sum_pp_ - sum_p_.squaredNorm() / n;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rate(omega_c_);
+  const double floor = kRankTolerance * std::max(rate.eigenvalues().maxCoeff(), 0.0);
+  double fitted = 0.0;
+  int fitted_dof = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double lambda = rate.eigenvalues()[k];
+    if (!(lambda > floor && lambda > 0.0)) continue;
+    ++fitted_dof;
+    for (int j = 0; j < dof_; ++j) {
+      const double along = rate.eigenvectors().col(k).dot(z_.segment<3>(3 * j));
+      fitted += along * along / lambda;
+    }
+  }
+  const double dof = static_cast<double>(dof_) * (n - 1.0 - fitted_dof);
+  return dof > 0.0 ? std::max(1.0, (centred - fitted) / dof) : 1.0;
 }
 
 double CalibrationFit::residual(const Eigen::MatrixXd& basis, int columns, int& dof) {

@@ -53,6 +53,8 @@ class CalibrationFit {
   void moments(const Subset& s, GyroMask mask, const SubsetCache& cache, const PipelineConfig& config);
   //! The residual χ² of z once `basis`'s columns are fitted (none: H0), and its degrees of freedom.
   double residual(const Eigen::MatrixXd& basis, int columns, int& dof);
+  //! [-] the parity's variance about the block's fit, per axis and epoch, at least 1 (z_ and Ω_c known).
+  double noise_scale() const;
 
   GyroMask mask_ = 0;
   int dof_ = 0;
@@ -64,6 +66,7 @@ class CalibrationFit {
   Eigen::Vector3d first_w_ = Eigen::Vector3d::Zero();
   Eigen::MatrixXd sum_wp_;  //!< 3×d Σ ω pᵀ
   Eigen::VectorXd sum_p_;   //!< d Σ p
+  double sum_pp_ = 0.0;     //!< Σ |p|² (the parity's own spread: a unit noisier than stated)
   // Scratch of the block's judgement, sized once per gyro set (a block allocates nothing).
   Eigen::Matrix3d omega_c_ = Eigen::Matrix3d::Zero();
   Eigen::VectorXd z_;
