@@ -58,10 +58,12 @@ def conj(q):
 ARCSEC = math.pi / 180 / 3600
 
 
-def replay_differences(args, work, recording, q0, horizon_s, attitudes):
+def replay_differences(args, work, recording, q0, horizon_s, attitudes, from_ns):
     """`tetra replay` of the recording with the service's pipeline settings: how many of the service's attitudes
-    (as the subscriber received them, every double exact) differ from replay's of the same epoch, of how many,
-    and the largest angle between the two [arcsec]."""
+    from `from_ns` on (as the subscriber received them, every double exact) differ from replay's of the same
+    epoch, of how many, and the largest angle between the two [arcsec]. The first seconds are left out: a
+    recorder that discovers the tracker late (a loaded machine) misses its first samples, which set the
+    service's attitude from its 0.5 deg start (1,800 arcsec until the next sample reaches the recording)."""
     config = os.path.join(work, "pipeline.yaml")
     with open(config, "w") as f:
         f.write("pipeline:\n  initial_q_wxyz: [%.17g, %.17g, %.17g, %.17g]\n  reference_horizon_s: %g\n"
@@ -74,7 +76,8 @@ def replay_differences(args, work, recording, q0, horizon_s, attitudes):
         raise RuntimeError("tetra replay of the recording: exit %d\n%s" % (run.returncode, run.stderr))
     rows = list(csv.reader(line for line in open(out) if not line.startswith("#")))
     replayed = {round(float(r[0]) * 1e9): tuple(float(v) for v in r[1:5]) for r in rows[1:]}
-    pairs = [(tuple(a["q_RB"]), replayed[a["stamp_ns"]]) for a in attitudes if a["stamp_ns"] in replayed]
+    pairs = [(tuple(a["q_RB"]), replayed[a["stamp_ns"]]) for a in attitudes
+             if a["stamp_ns"] in replayed and a["stamp_ns"] >= from_ns]
     apart = [math.sqrt(sum(x * x for x in qlog(qmul(conj(mine), theirs)))) / ARCSEC for mine, theirs in pairs]
     return sum(1 for mine, theirs in pairs if mine != theirs), len(pairs), max(apart)
 
@@ -166,11 +169,12 @@ def run_case(args, horizon_s, domain, work):
     recorded_refs = 0 if ref_col is None else sum(1 for r in rows[1:] if r[ref_col] != "")
     stamp_col = rows[0].index("ref_stamp_s") if "ref_stamp_s" in rows[0] else None
     recorded_late = 0 if stamp_col is None else sum(1 for r in rows[1:] if r[stamp_col] != "")
-    differing, compared, apart_arcsec = replay_differences(args, work, recording, q0, horizon_s, received["attitude"])
+    settle_ns = (t0 + 5.0) * 1e9
+    differing, compared, apart_arcsec = replay_differences(args, work, recording, q0, horizon_s, received["attitude"],
+                                                           settle_ns)
     health = received["health"][-1]
     late_events = [e for e in received["event"] if e["event"] == "reference_late"]
     errors, nees = [], []
-    settle_ns = (t0 + 5.0) * 1e9
     for a in received["attitude"]:
         q_true = truth.get(round(a["stamp_ns"] / 1e3))
         if q_true is None or a["stamp_ns"] < settle_ns:
@@ -185,6 +189,7 @@ def run_case(args, horizon_s, domain, work):
            "recorded_epochs": len(rows) - 1, "recorded_references": recorded_refs,
            "recorded_late_references": recorded_late, "replay_compared": compared, "replay_differing": differing,
            "replay_apart_max_arcsec": apart_arcsec,
+           "replay_due": sum(1 for a in received["attitude"] if a["stamp_ns"] >= settle_ns),
            "attitudes": len(received["attitude"]), "epochs": len(epochs),
            "rms_arcsec": rms, "final_arcsec": errors[-1] / ARCSEC, "mean_nees": sum(nees) / len(nees),
            "reference_state": health["reference_state"]}
@@ -234,10 +239,12 @@ def main():
     check(fused["recorded_late_references"] == fused["recorded_references"] >= fused["delayed"] - 2,
           "the recorder writes every reference fused late, with its own time (ref_stamp_s)")
     # The recorder's assembler may hand a late reference to another epoch than the service's did (each process
-    # receives the two streams in its own order): replay fuses it at the same stamp, one epoch earlier or later.
-    check(fused["replay_compared"] >= 0.95 * fused["epochs"] and fused["replay_apart_max_arcsec"] < 5.0,
+    # receives the two streams in its own order): replay fuses it at the same stamp, one epoch earlier or later
+    # — or, for a recorder slow at the start, beyond the horizon, so that the first sample, which sets the
+    # attitude from its 0.5 deg start, is left out until the next: compared from 5 s on (replay_differences).
+    check(fused["replay_compared"] >= 0.95 * fused["replay_due"] and fused["replay_apart_max_arcsec"] < 5.0,
           "replay of the recording fuses the late references as the service did (within the tracker's 5 arcsec)")
-    check(dropped["replay_compared"] >= 0.95 * dropped["epochs"] and dropped["replay_differing"] == 0,
+    check(dropped["replay_compared"] >= 0.95 * dropped["replay_due"] and dropped["replay_differing"] == 0,
           "beyond the horizon: replay of the recording gives the service's attitudes bit for bit")
     check(dropped["delayed"] == 0 and dropped["too_late"] >= dropped["sent"] - 2, "beyond the horizon: counted")
     check(dropped["late_events"] == 1 and 0.05 <= events[0]["statistic"] <= 0.35, "said by one event")
