@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "tetra/core/units.hpp"
 #include "tetra/fdi/budget.hpp"
 #include "tetra/fdi/detectors.hpp"
 
@@ -24,6 +25,7 @@ void CalibrationFit::reset() {
   dof_ = 0;
   streak_ = 0;
   mismatch_ = false;
+  seen_nominal_ = false;
   rows_.clear();
 }
 
@@ -74,7 +76,7 @@ bool CalibrationFit::record(const Eigen::VectorXd& p, const Subset& s, GyroMask 
     restart(s, mask, omega_rad_s, now_ns);
   }
   accumulate(p, s.dof, omega_rad_s);
-  if (static_cast<double>(now_ns - start_ns_) < kMotionFitBlockS * 1e9) return false;
+  if (now_ns - start_ns_ < seconds_to_ns(kMotionFitBlockS)) return false;
   const bool named = judge_block(s, mask, cache, config);
   restart(s, mask, omega_rad_s, now_ns);
   streak_ = named ? streak_ + 1 : 0;
@@ -201,9 +203,18 @@ bool CalibrationFit::judge_block(const Subset& s, GyroMask mask, const SubsetCac
   return fdi::arbitrate_calibration(rows_.begin(), rows_.end(), mask);
 }
 
-LedgerRow CalibrationFit::hcal_row() const {
-  return stated(EvidenceSource::kMotionFit, kHypothesisCalibration, RowVerdict::kConsistent, h0_statistic_,
-                h0_threshold_, h0_dof_);
+void CalibrationFit::add_hcal_rows(EvidenceSource evidence, const EvidenceRows* episode,
+                                   EvidenceRows& rows) const {
+  if (reads_own_signal(evidence)) return;
+  if (mismatch_)
+    rows.add(stated(EvidenceSource::kMotionFit, kHypothesisCalibration, RowVerdict::kConsistent,
+                    h0_statistic_, h0_threshold_, h0_dof_));
+  if (!seen_nominal_ && episode != nullptr && !episode->empty()) {
+    LedgerRow since_start = *episode->begin();
+    since_start.hypothesis = kHypothesisCalibration;
+    since_start.verdict = RowVerdict::kConsistent;
+    rows.add(since_start);
+  }
 }
 
 }  // namespace tetra::fdi::detail

@@ -40,9 +40,14 @@ class CalibrationFit {
   const EvidenceRows& rows() const { return rows_; }
   //! The last block's χ² of the fit under H0.
   double statistic() const { return h0_statistic_; }
-  //! While a mismatch stands, the Hcal row an isolation's decision adds when its evidence is one a
-  //! calibration's error can make (not a gyro's own signal): consistent, the last block's fit.
-  LedgerRow hcal_row() const;
+  //! The parity was judged outside an episode: the unit has a fault-free history, so a detection has an
+  //! onset a calibration's error does not make.
+  void judged_nominal() { seen_nominal_ = true; }
+  //! The Hcal rows an isolation's decision carries when `evidence` is one a calibration's error can make (not
+  //! a gyro's own signal): consistent by the last block's fit while a mismatch stands, and consistent by the
+  //! opening detection's statistic (`episode`'s first row) while the parity has been beyond its threshold
+  //! since the first epoch (no fault-free history: no onset tells a fault from the calibration's error).
+  void add_hcal_rows(EvidenceSource evidence, const EvidenceRows* episode, EvidenceRows& rows) const;
 
  private:
   void restart(const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s, std::int64_t now_ns);
@@ -78,6 +83,7 @@ class CalibrationFit {
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver_;
   int streak_ = 0;
   bool mismatch_ = false;
+  bool seen_nominal_ = false;
   double h0_statistic_ = 0.0;
   double h0_threshold_ = 0.0;
   int h0_dof_ = 0;

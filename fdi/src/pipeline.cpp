@@ -153,7 +153,7 @@ void Pipeline::Impl::detect() {
                                 frame_.now_ns, subsets_, config_))
       emit_calibration_mismatch();
   }
-  if (d.cusum_ran && !d.alarm && !isolator_.episode().active) parity_seen_nominal_ = true;
+  if (d.cusum_ran && !d.alarm && !isolator_.episode().active) calibration_fit_.judged_nominal();
   // An open episode ends only once the parity is back to nominal for clear_after_s: a fault whose CUSUM
   // alarms grow sparse (a slow ramp near the reference k) keeps it open.
   if (d.cusum_ran && !d.alarm && isolator_.episode().active && !detector_.parity_nominal(s))
@@ -397,42 +397,14 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
   const bool episode = isolator_.episode().active;
   // The arbiter decides: a finding whose rows do not make the case (another hypothesis standing, one not
   // judged, no fault shown) excludes nothing (docs/fdi.md, "The ledger and the arbiter").
-  decision_rows_.clear();
-  decision_rows_.add(iso.rows);
-  if (episode) decision_rows_.add(episode_rows_);
-  // A standing calibration mismatch explains what the parity shows, not what a gyro's own signal does; so
-  // does a parity beyond its threshold since the first epoch (no fault-free history: no onset to tell a
-  // fault from the calibration's error).
-  if (!reads_own_signal(source_of(iso.evidence))) {
-    if (calibration_fit_.mismatch()) decision_rows_.add(calibration_fit_.hcal_row());
-    if (!parity_seen_nominal_ && episode && !episode_rows_.empty()) {
-      LedgerRow since_start = *episode_rows_.begin();
-      since_start.hypothesis = kHypothesisCalibration;
-      since_start.verdict = RowVerdict::kConsistent;
-      decision_rows_.add(since_start);
-    }
-  }
+  write_decision_rows(iso, episode);
   FdiEvent e;
   if (rule(decision_rows_, e.ledger) != iso.gyro) {
     ++arbiter_refusals_;
     return;
   }
   if (!episode) emit_detected(iso.test, iso.statistic, now, &decision_rows_);
-  if (subsets_.ready()) {
-    // The fault corrupted the rate from its onset until now: keep that in the attitude uncertainty — the
-    // parity's mean fault over the span, and the sum of each kept epoch's (a fault that grew faster than the
-    // mean followed).
-    const GyroMask active = gyro_set_.active();
-    const std::int64_t span_epochs =
-        static_cast<std::int64_t>(std::ceil(ns_to_seconds(signature_span_ns()) / subsets_.period_s()));
-    const std::int64_t from = episode ? isolator_.episode().onset_index : frame_.index - span_epochs;
-    Eigen::Vector3d bound = isolator_.fault_angle(iso.gyro, from, frame_.index, active, subsets_);
-    if (episode)
-      bound = bound.cwiseMax(fault_angle_error(subsets_.get(active), iso.gyro, detector_.parity_ema(),
-                                               subsets_.sqrt_period(),
-                                               ns_to_seconds(now - isolator_.episode().onset_ns)));
-    attitude_.add_bound(bound);
-  }
+  cover_fault_span(iso.gyro, episode, now);
   e.stamp_ns = now;
   e.type = EventType::kIsolated;
   e.gyro = iso.gyro;
@@ -450,27 +422,55 @@ void Pipeline::Impl::isolate(const Isolation& iso) {
     return;
   }
   emit(std::move(e));
-  gyro_set_.exclude(iso.gyro, iso.kind);
-  attitude_.freeze(iso.gyro);
+  reconfigure_without(iso.gyro, iso.kind, now);
+}
+
+void Pipeline::Impl::write_decision_rows(const Isolation& iso, bool episode) {
+  decision_rows_.clear();
+  decision_rows_.add(iso.rows);
+  if (episode) decision_rows_.add(episode_rows_);
+  calibration_fit_.add_hcal_rows(source_of(iso.evidence), episode ? &episode_rows_ : nullptr, decision_rows_);
+}
+
+void Pipeline::Impl::cover_fault_span(int gyro, bool episode, std::int64_t now_ns) {
+  if (!subsets_.ready()) return;
+  // The fault corrupted the rate from its onset until now: keep that in the attitude uncertainty — the
+  // parity's mean fault over the span, and the sum of each kept epoch's (a fault that grew faster than the
+  // mean followed).
+  const GyroMask active = gyro_set_.active();
+  const std::int64_t span_epochs =
+      static_cast<std::int64_t>(std::ceil(ns_to_seconds(signature_span_ns()) / subsets_.period_s()));
+  const std::int64_t from = episode ? isolator_.episode().onset_index : frame_.index - span_epochs;
+  Eigen::Vector3d bound = isolator_.fault_angle(gyro, from, frame_.index, active, subsets_);
+  if (episode)
+    bound = bound.cwiseMax(fault_angle_error(subsets_.get(active), gyro, detector_.parity_ema(),
+                                             subsets_.sqrt_period(),
+                                             ns_to_seconds(now_ns - isolator_.episode().onset_ns)));
+  attitude_.add_bound(bound);
+}
+
+void Pipeline::Impl::reconfigure_without(int gyro, FaultKind kind, std::int64_t now_ns) {
+  gyro_set_.exclude(gyro, kind);
+  attitude_.freeze(gyro);
   bias_match_.release(attitude_.filter());  // the error that opened the bias models may have been this fault
   drift_match_.reset();                     // (and the drift matched may have been it)
   // What the fault leaked into the other gyros' bias states since its onset is undone (docs/fdi.md).
   attitude_.repair_biases(gyro_set_.active(),
                           isolator_.episode().active ? isolator_.episode().onset_ns
-                                                     : pipeline_time_before_ns(now, signature_span_ns()),
-                          now);
+                                                     : pipeline_time_before_ns(now_ns, signature_span_ns()),
+                          now_ns);
   restart_detectors();
   // The remaining gyros' tests restart from evidence the removed fault did not touch (docs/fdi.md, "One
   // fault, one exclusion").
   series_.restart_evidence();
   reference_.restart_windows();
   FdiEvent rc;
-  rc.stamp_ns = now;
+  rc.stamp_ns = now_ns;
   rc.gyros = gyro_set_.active();
   rc.type = subsets_.observable(rc.gyros) ? EventType::kReconfigured : EventType::kLost;
   if (rc.type == EventType::kReconfigured && tetra::gyro_count(rc.gyros) == 3) rc.detail = kThreeGyrosLeft;
   emit(std::move(rc));
-  update_mode(now);
+  update_mode(now_ns);
 }
 
 void Pipeline::Impl::restart_detectors() {
@@ -606,7 +606,6 @@ void Pipeline::Impl::reset() {
   drift_match_.reset();
   bias_check_.reset();
   calibration_fit_.reset();
-  parity_seen_nominal_ = false;
   gyro_set_.reset();
   attitude_.reset(config_.initial_q_RB);
   horizon_.reset();

@@ -160,6 +160,12 @@ class Pipeline::Impl {
   //! The motion fit named a mismatch: the `calibration_mismatch` event, with its block's rows.
   void emit_calibration_mismatch();
   void isolate(const Isolation& iso);
+  //! decision_rows_: the finding's rows, the open episode's detection, and the calibration fit's Hcal rows.
+  void write_decision_rows(const Isolation& iso, bool episode);
+  //! The fault's effect on the rate from its onset (or the signature's span) until now, into sigma.
+  void cover_fault_span(int gyro, bool episode, std::int64_t now_ns);
+  //! The gyro excluded: the filter, the matches and the tests restarted without it; reconfigured or lost.
+  void reconfigure_without(int gyro, FaultKind kind, std::int64_t now_ns);
   void isolate_all(Isolations& found);
   void restart_detectors();
   void gap();
@@ -223,10 +229,7 @@ class Pipeline::Impl {
   std::int64_t last_ns_ = 0;
   std::optional<std::int64_t> last_reference_ns_;  //!< the last epoch that carried a usable reference
   bool reference_usable_ = false;  //!< this epoch's reference sample passed the consistency tests
-  bool gyros_vouch_ = false;
-  //! The parity was judged outside an episode at least once since the reset: a fault has a history before it
-  bool parity_seen_nominal_ =
-      false;  //!< this epoch: parity among the gyros used, no episode, rate observable
+  bool gyros_vouch_ = false;       //!< this epoch: parity among the gyros used, no episode, rate observable
   std::optional<std::int64_t> reference_set_ns_;  //!< the last time a reference sample set the attitude
   //! [ns] when the reference was last rejected, until it is used again, and the rows that rejected it
   std::optional<std::int64_t> reference_rejected_ns_;

@@ -89,97 +89,125 @@ Result<CampaignRow> parse_campaign_row(const std::string& line, const std::strin
   return parse_campaign_row(line);
 }
 
-Result<CampaignRow> parse_campaign_row(const std::string& line) {
+namespace {
+
+//! The fields of one runs.csv row, each read as campaign_csv_row writes it: whole numbers in digits, other
+//! numbers finite decimal text within their column's range. The first field out of its range is kept
+//! (`bad`): a forged or damaged row is refused, never counted.
+class RowFields {
+ public:
+  explicit RowFields(std::vector<std::string> fields) : f_(std::move(fields)) {
+    std::stringstream header(campaign_csv_header());
+    for (std::string name; std::getline(header, name, ',');) names_.push_back(name);
+  }
+  const std::string& text(std::size_t i) const { return f_[i]; }
+  const std::string& bad() const { return bad_; }
+
+  std::uint64_t whole(std::size_t i, std::uint64_t max, const char* range) {
+    const std::string& t = f_[i];
+    if (!t.empty() && t.size() <= 20 && t.find_first_not_of("0123456789") == std::string::npos) {
+      try {
+        const std::uint64_t v = std::stoull(t);
+        if (v <= max) return v;
+      } catch (const std::exception&) {
+      }
+    }
+    refuse(i, range);
+    return 0;
+  }
+  double num(std::size_t i, double lo) {
+    if (f_[i].empty()) return std::numeric_limits<double>::quiet_NaN();
+    const auto v = parse_decimal(f_[i]);
+    if (v && *v >= lo) return *v;
+    refuse(i, lo == 0.0 ? "a finite number >= 0" : "a finite number");
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  std::optional<double> opt(std::size_t i) {
+    return f_[i].empty() ? std::nullopt : std::optional<double>(num(i, 0.0));
+  }
+  std::optional<int> gyro_id(std::size_t i) {
+    return f_[i].empty() ? std::nullopt
+                         : std::optional<int>(static_cast<int>(whole(i, kMaxGyros, "a gyro 1..32")));
+  }
+
+ private:
+  void refuse(std::size_t i, const char* range) {
+    if (bad_.empty()) bad_ = names_[i] + " '" + one_line(f_[i].substr(0, 40)) + "' (" + range + ")";
+  }
+  std::vector<std::string> f_;
+  std::vector<std::string> names_;
+  std::string bad_;
+};
+
+std::vector<std::string> split_fields(const std::string& line) {
   std::vector<std::string> f;
   std::stringstream in(line);
   for (std::string field; std::getline(in, field, ',');) f.push_back(field);
   if (!line.empty() && line.back() == ',') f.emplace_back();
-  if (f.size() < kCampaignColumns)
-    return bad_input("campaign row with " + std::to_string(f.size()) + " fields (" +
+  return f;
+}
+
+//! The run's case: run, scenario, kind, gyro, onset, size, seed and the dispersion draws.
+void read_case(RowFields& f, std::size_t columns, const std::vector<std::string>& all, CampaignRow& r) {
+  r.run = f.whole(0, kMaxCampaignRuns, "a run number");
+  r.scenario = f.text(1);
+  r.kind = f.text(2);
+  r.gyro = static_cast<int>(f.whole(3, kMaxGyros, "a gyro 0..32"));
+  r.onset_s = f.num(4, 0.0);
+  r.size = f.num(5, -std::numeric_limits<double>::max());
+  r.seed = f.whole(6, std::numeric_limits<std::uint64_t>::max(), "a seed");
+  r.draws.assign(all.begin() + static_cast<std::ptrdiff_t>(columns), all.end());
+}
+
+std::optional<Outcome> outcome_from(const std::string& text) {
+  for (Outcome o : {Outcome::kNone, Outcome::kRight, Outcome::kWrong, Outcome::kUnisolated, Outcome::kMissed})
+    if (outcome_name(o) == text) return o;
+  return std::nullopt;
+}
+
+//! The run's result: the FDI's figures, the attitude's and the pointing's.
+void read_result(RowFields& f, CampaignRow& r) {
+  r.fdi.isolated_gyro = f.gyro_id(8);
+  r.fdi.detection_delay_s = f.opt(9);
+  r.fdi.isolation_delay_s = f.opt(10);
+  r.theory_delay_s = f.opt(11);
+  r.fdi.false_alarms = static_cast<int>(f.whole(12, 1'000'000'000, "a count >= 0"));
+  r.fdi.fault_free_s = f.num(13, 0.0);
+  r.final_knowledge_error_deg = f.num(14, 0.0);
+  r.final_sigma_deg = f.num(15, 0.0);
+  r.pointing_max_before_deg = f.num(16, 0.0);
+  r.pointing_rms_after_deg = f.num(17, 0.0);
+  r.pointing_max_after_deg = f.num(18, 0.0);
+  r.recover_s = f.opt(19);
+  r.bound_deg = f.num(20, 0.0);
+  r.max_wheel_momentum_fraction = f.num(21, 0.0);
+  r.fdi.wrong_gyro = f.gyro_id(22);
+  r.fdi.wrong_at_s = f.opt(23);
+}
+
+}  // namespace
+
+Result<CampaignRow> parse_campaign_row(const std::string& line) {
+  std::vector<std::string> all = split_fields(line);
+  if (all.size() < kCampaignColumns)
+    return bad_input("campaign row with " + std::to_string(all.size()) + " fields (" +
                      std::to_string(kCampaignColumns) + " or more expected)");
-  // Every field as campaign_csv_row writes it: whole numbers in digits, other numbers finite decimal
-  // text within their column's range; a forged or damaged row is refused, never counted.
-  std::vector<std::string> names;
-  std::stringstream header(campaign_csv_header());
-  for (std::string name; std::getline(header, name, ',');) names.push_back(name);
-  std::string bad;  // the first field out of its range
-  const auto refuse = [&](std::size_t i, const char* range) {
-    if (bad.empty()) bad = names[i] + " '" + one_line(f[i].substr(0, 40)) + "' (" + range + ")";
-  };
-  const auto whole = [&](std::size_t i, std::uint64_t max, const char* range) -> std::uint64_t {
-    const std::string& t = f[i];
-    if (t.empty() || t.size() > 20 || t.find_first_not_of("0123456789") != std::string::npos) {
-      refuse(i, range);
-      return 0;
-    }
-    try {
-      const std::uint64_t v = std::stoull(t);
-      if (v <= max) return v;
-    } catch (const std::exception&) {
-    }
-    refuse(i, range);
-    return 0;
-  };
-  const auto num = [&](std::size_t i, double lo) {
-    if (f[i].empty()) return std::numeric_limits<double>::quiet_NaN();
-    const auto v = parse_decimal(f[i]);
-    if (!v || *v < lo) {
-      refuse(i, lo == 0.0 ? "a finite number >= 0" : "a finite number");
-      return std::numeric_limits<double>::quiet_NaN();
-    }
-    return *v;
-  };
-  const auto opt = [&](std::size_t i) {
-    return f[i].empty() ? std::nullopt : std::optional<double>(num(i, 0.0));
-  };
-  const auto gyro_id = [&](std::size_t i) {
-    return f[i].empty() ? std::nullopt
-                        : std::optional<int>(static_cast<int>(whole(i, kMaxGyros, "a gyro 1..32")));
-  };
-  const double kAny = -std::numeric_limits<double>::max();
+  RowFields f(all);
   CampaignRow r;
-  r.run = whole(0, kMaxCampaignRuns, "a run number");
-  r.scenario = f[1];
-  r.kind = f[2];
-  r.gyro = static_cast<int>(whole(3, kMaxGyros, "a gyro 0..32"));
-  r.onset_s = num(4, 0.0);
-  r.size = num(5, kAny);
-  r.seed = whole(6, std::numeric_limits<std::uint64_t>::max(), "a seed");
-  r.draws.assign(f.begin() + static_cast<std::ptrdiff_t>(kCampaignColumns), f.end());
-  if (f[7] == "error") {
-    if (f[kErrorColumn].empty()) return bad_input("campaign row: outcome error without its message");
-    r.error = f[kErrorColumn];
-    if (!bad.empty()) return bad_input("campaign row: " + bad);
-    return r;
+  read_case(f, kCampaignColumns, all, r);
+  const std::string& outcome = f.text(7);
+  const std::string& error = f.text(kErrorColumn);
+  if (outcome == "error") {
+    if (error.empty()) return bad_input("campaign row: outcome error without its message");
+    r.error = error;
+  } else {
+    if (!error.empty()) return bad_input("campaign row: an error message with outcome '" + outcome + "'");
+    const auto o = outcome_from(outcome);
+    if (!o) return bad_input("campaign row: unknown outcome '" + one_line(outcome.substr(0, 40)) + "'");
+    r.fdi.outcome = *o;
+    read_result(f, r);
   }
-  if (!f[kErrorColumn].empty())
-    return bad_input("campaign row: an error message with outcome '" + f[7] + "'");
-  bool known = false;
-  for (Outcome o :
-       {Outcome::kNone, Outcome::kRight, Outcome::kWrong, Outcome::kUnisolated, Outcome::kMissed}) {
-    if (outcome_name(o) == f[7]) {
-      r.fdi.outcome = o;
-      known = true;
-    }
-  }
-  if (!known) return bad_input("campaign row: unknown outcome '" + one_line(f[7].substr(0, 40)) + "'");
-  r.fdi.isolated_gyro = gyro_id(8);
-  r.fdi.detection_delay_s = opt(9);
-  r.fdi.isolation_delay_s = opt(10);
-  r.theory_delay_s = opt(11);
-  r.fdi.false_alarms = static_cast<int>(whole(12, 1'000'000'000, "a count >= 0"));
-  r.fdi.fault_free_s = num(13, 0.0);
-  r.final_knowledge_error_deg = num(14, 0.0);
-  r.final_sigma_deg = num(15, 0.0);
-  r.pointing_max_before_deg = num(16, 0.0);
-  r.pointing_rms_after_deg = num(17, 0.0);
-  r.pointing_max_after_deg = num(18, 0.0);
-  r.recover_s = opt(19);
-  r.bound_deg = num(20, 0.0);
-  r.max_wheel_momentum_fraction = num(21, 0.0);
-  r.fdi.wrong_gyro = gyro_id(22);
-  r.fdi.wrong_at_s = opt(23);
-  if (!bad.empty()) return bad_input("campaign row: " + bad);
+  if (!f.bad().empty()) return bad_input("campaign row: " + f.bad());
   return r;
 }
 
