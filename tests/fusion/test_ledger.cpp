@@ -146,6 +146,43 @@ TEST(Arbiter, TheReferenceIsRejectedOnlyWhenItsHypothesisStandsAlone) {
   EXPECT_EQ(hypothesis_name(kHypothesisDrift), "Hdrift");
 }
 
+// Hcal, the calibration that does not describe the unit: a standing Hcal withholds an exclusion the other
+// rows make (the parity's evidence is the calibration's error as well), and a block of the motion fit names
+// the mismatch only when H0 and every gyro's own error are rejected.
+TEST(Arbiter, AStandingCalibrationHypothesisWithholdsTheExclusionAndIsNamedAlone) {
+  auto rows = gyro_two_alone();
+  ASSERT_EQ(rule(rows), 2);
+  rows.push_back(
+      stated(EvidenceSource::kMotionFit, kHypothesisCalibration, RowVerdict::kConsistent, 90.0, 30.7, 3));
+  EXPECT_EQ(rule(rows), 0);
+  rows.back().verdict = RowVerdict::kNoCall;  // Hcal not judged: the other rows decide
+  EXPECT_EQ(rule(rows), 2);
+  rows.back().verdict = RowVerdict::kRejected;
+  EXPECT_EQ(rule(rows), 2);
+
+  std::vector<LedgerRow> block = {judge(EvidenceSource::kMotionFit, kHypothesisNone, 90.0, 30.7, 30.7, 3)};
+  for (std::uint8_t i = 1; i <= 4; ++i)
+    block.push_back(judge(EvidenceSource::kMotionFit, i, 60.0, 27.6, 27.6, 2));
+  block.push_back(
+      stated(EvidenceSource::kMotionFit, kHypothesisCalibration, RowVerdict::kConsistent, 90.0, 30.7, 3));
+  const auto named = [&block](std::uint32_t active) {
+    return arbitrate_calibration(block.data(), block.data() + block.size(), active);
+  };
+  EXPECT_TRUE(named(0xF));
+  EXPECT_FALSE(named(0x1F));  // gyro 5 in use without a row: its hypothesis stands
+  block[3] = judge(EvidenceSource::kMotionFit, 3, 10.0, 27.6, 27.6, 2);  // gyro 3 alone explains the fit
+  EXPECT_FALSE(named(0xF));
+  EXPECT_TRUE(named(0xB));  // ...unless gyro 3 is out of the set
+  block[0] = judge(EvidenceSource::kMotionFit, kHypothesisNone, 12.0, 30.7, 30.7, 3);  // no fit beyond noise
+  EXPECT_FALSE(named(0xB));
+  std::uint8_t back = 0;
+  ASSERT_TRUE(hypothesis_from_string("Hcal", back));
+  EXPECT_EQ(back, kHypothesisCalibration);
+  EXPECT_EQ(hypothesis_name(kHypothesisCalibration), "Hcal");
+  EXPECT_TRUE(reads_own_signal(EvidenceSource::kRepeated));
+  EXPECT_FALSE(reads_own_signal(EvidenceSource::kGlt));
+}
+
 TEST(Ledger, DecisionEventsCarryTheirRowsInJsonAndTheRuleRebuildsTheIsolation) {
   FdiEvent e;
   e.type = EventType::kIsolated;
