@@ -27,7 +27,7 @@ TETRA_FAMILY_RUNS="$runs" TETRA_FAMILY_SEED="$seed" "$build/tests/test_perturbat
   >"$out" 2>&1 || status=$?
 grep -m1 '^family ' "$out"
 # Each family's line, then its cases' (indented; "(limit)": a case docs/fdi.md states the data cannot cover).
-grep -E '^(fault-in-slew|data-path|gap|reference|calibration|calibration-without-noise|second-fault|warm-up|data-sheet) +[0-9]|^  [a-z].* [0-9]+ +[0-9]+ +[0-9]+ +[0-9]+ ' "$out"
+grep -E '^(fault-in-slew|data-path|gap|reference|calibration|calibration-without-noise|second-fault|warm-up|data-sheet|noisy-unit) +[0-9]|^  [a-z].* [0-9]+ +[0-9]+ +[0-9]+ +[0-9]+ ' "$out"
 # Runs worse than their one twin, judged over other draws of the noise (charged, or a statistical borderline).
 if grep -q '^  over [0-9]* other draws' "$out"; then
   echo "runs worse than their twin, over other draws of the noise:"

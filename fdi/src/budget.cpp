@@ -40,6 +40,9 @@ const Allocation kAllocations[kBudgetTestCount] = {
     {BudgetTest::kMotionFit, "motion_fit", kLargestShare,
      "per block of the motion fit and hypothesis: a mismatch needs two blocks in a row, and it excludes "
      "nothing (it withholds exclusions the calibration's error could explain)"},
+    {BudgetTest::kParitySpread, "parity_spread", kLargestShare,
+     "per look at the sums of the parity's differences: a verdict takes the white noise the data show into "
+     "every test and sigma (noise_model), it excludes nothing"},
 };
 
 double allocated_probability(const PipelineConfig& config, BudgetTest test) {
@@ -94,6 +97,11 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
                       allocated_probability(c, BudgetTest::kMotionFit), 3600.0 / detail::kMotionFitBlockS,
                       "one block's H0 rejected (a mismatch needs two in a row and every Hi rejected too)"});
   }
+  if (parity) {
+    b.rows.push_back({"parity_spread", K::kNoiseModel, "false_alarm_probability",
+                      allocated_probability(c, BudgetTest::kParitySpread), epochs_per_hour,
+                      "the stated white noise rejected by the parity's differences (the model then widened)"});
+  }
   for (const char* signature : {"repeated", "zero", "variance", "noise_level", "recurring_spikes"}) {
     b.rows.push_back({signature, K::kWrongExclusion, "", kNotAProbability, 1.0,
                       "the gyro's own samples against a count or ratio: not a probability"});
@@ -116,9 +124,12 @@ std::string to_text(const Budget& b) {
     const char* kind = r.kind == BudgetKind::kFalseAlarm       ? "false alarm"
                        : r.kind == BudgetKind::kWrongExclusion ? "wrong exclusion"
                        : r.kind == BudgetKind::kMismatch       ? "calibration mismatch"
+                       : r.kind == BudgetKind::kNoiseModel     ? "noise model widened"
                                                                : "reference rejected";
     if (std::isfinite(r.per_evaluation)) {
-      const char* per = r.kind == BudgetKind::kFalseAlarm || r.kind == BudgetKind::kMismatch ? "/h"
+      const char* per = r.kind == BudgetKind::kFalseAlarm || r.kind == BudgetKind::kMismatch ||
+                                r.kind == BudgetKind::kNoiseModel
+                            ? "/h"
                         : r.kind == BudgetKind::kWrongExclusion                              ? "/episode"
                                                                                              : "/sample";
       std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %9.3g x %-9.4g = %9.3g %s  (%s)\n", r.source,

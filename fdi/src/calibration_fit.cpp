@@ -74,7 +74,10 @@ bool CalibrationFit::record(const Eigen::VectorXd& p, const Subset& s, GyroMask 
     streak_ = 0;
     mismatch_ = false;
     restart(s, mask, omega_rad_s, now_ns);
+  } else if (restart_pending_) {
+    restart(s, mask, omega_rad_s, now_ns);
   }
+  restart_pending_ = false;
   accumulate(p, s.dof, omega_rad_s);
   if (now_ns - start_ns_ < seconds_to_ns(kMotionFitBlockS)) return false;
   const bool named = judge_block(s, mask, cache, config);

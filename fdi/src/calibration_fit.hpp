@@ -34,6 +34,9 @@ class CalibrationFit {
   //! block whose rows name a mismatch for the first time (rows(): that block's).
   bool record(const Eigen::VectorXd& p, const Subset& s, GyroMask mask, const Eigen::Vector3d& omega_rad_s,
               std::int64_t now_ns, const SubsetCache& cache, const PipelineConfig& config);
+  //! The parity's whitening changed (the noise model widened): the block starts again at the next epoch; the
+  //! streak and a standing mismatch are kept.
+  void restart_block() { restart_pending_ = true; }
   //! A mismatch stands for the gyro set in use.
   bool mismatch() const { return mismatch_; }
   //! The last block's rows (H0, each Hi of the set, Hcal).
@@ -84,6 +87,7 @@ class CalibrationFit {
   int streak_ = 0;
   bool mismatch_ = false;
   bool seen_nominal_ = false;
+  bool restart_pending_ = false;
   double h0_statistic_ = 0.0;
   double h0_threshold_ = 0.0;
   int h0_dof_ = 0;

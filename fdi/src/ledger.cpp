@@ -43,6 +43,9 @@ const EvidenceSourceInfo kEvidenceSources[kEvidenceSourceCount] = {
     {EvidenceSource::kMotionFit, "motion_fit", StatisticUnit::kChi2,
      "the parity's linear fit to the body rate over a block (the hypothesis's own form fitted: H0 none, "
      "Hi gyro i's alone), against the noise and the calibration's stated tolerance"},
+    {EvidenceSource::kParitySpread, "parity_spread", StatisticUnit::kLogLikelihood,
+     "the spread of the parity's differences between consecutive epochs, against the white noise the model "
+     "states (H0: the unit's white noise as stated)"},
 };
 
 bool reads_own_signal(EvidenceSource source) {
@@ -86,6 +89,8 @@ const char* to_string(StatisticUnit unit) {
       return "count";
     case StatisticUnit::kRatio:
       return "ratio";
+    case StatisticUnit::kLogLikelihood:
+      return "log-likelihood ratio";
   }
   return "";
 }

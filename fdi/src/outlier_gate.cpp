@@ -141,13 +141,18 @@ double OutlierGate::motion_noise(const Subset& h, const GyroSeries& series, doub
 int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, const GyroSeries& series) {
   const GyroMask avail = frame.usable;
   const Subset& s = subsets.get(avail);
+  spread_sample_ = std::numeric_limits<double>::quiet_NaN();
+  const std::int64_t previous_ns = previous_ns_;
+  previous_ns_ = frame.now_ns;
   if (!s.observable || s.dof < 1) return 0;
   double dt_max = 0.0;
   std::int64_t since_ns = -1;
+  bool consecutive = true;  // every gyro's last good sample is the previous epoch's
   for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
     if (!has_gyro(avail, id)) continue;
     const auto& t = tracks_[static_cast<std::size_t>(id - 1)];
     if (!t.has_last_good) return 0;
+    consecutive = consecutive && t.outlier_run == 0 && t.last_good_ns == previous_ns;
     // Changes over different spans (a sample dropped since) differ by the body's own rate change over the
     // difference — during a slew, a jump of the gyro that missed one. No call; the next step is not judged
     // either until a step of equal spans has shown the body within the bound. (A gyro in an outlier run keeps
@@ -164,9 +169,17 @@ int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, con
   }
   // Δp = √T·W·Δy/√2 (a difference of two samples has twice the variance; W whitens the difference's noise).
   const double scale = subsets.sqrt_period() / std::sqrt(2.0);
-  if (apply_whitened(s.jump_parity, s.dof, avail, dy_.data(), scale, p_.data()) <= s.jump_threshold) {
+  const double u = apply_whitened(s.jump_parity, s.dof, avail, dy_.data(), scale, p_.data());
+  const bool possible = possible_motion(s, dt_max, series, subsets);
+  // A difference of consecutive samples over a body within the bound on both steps: the parity's own spread.
+  if (consecutive && !fast_motion_ && possible) {
+    spread_sample_ = u;
+    spread_dof_ = s.dof;
+    spread_cap_ = s.jump_threshold;
+  }
+  if (u <= s.jump_threshold) {
     // No jump: this step's rate change is the body's own. Beyond the bound, the next step's cannot be judged.
-    fast_motion_ = !possible_motion(s, dt_max, series, subsets);
+    fast_motion_ = !possible;
     return 0;
   }
   // The body was turning faster than the bound allows on the last clean step: the true hypothesis may be the

@@ -29,6 +29,11 @@ class OutlierGate {
   }
   //! Outlier runs of this gyro (> 0: its sample is being left out).
   int outlier_run(int id) const { return tracks_[static_cast<std::size_t>(id - 1)].outlier_run; }
+  //! This epoch's parity difference of consecutive samples, the body within the motion bound on both steps
+  //! (parity_spread.hpp): its χ² `u` (NaN: none this epoch), degrees of freedom and the jump threshold.
+  double spread_sample() const { return spread_sample_; }
+  int spread_dof() const { return spread_dof_; }
+  double spread_cap() const { return spread_cap_; }
   //! Forgets every gyro's last good sample and outlier run (after a reconfiguration).
   void restart();
   void reset();
@@ -64,6 +69,10 @@ class OutlierGate {
   bool fast_motion_ = false;  //!< the last step without a jump turned the body beyond the acceleration bound
   GyroMask left_out_ = 0;     //!< the gyro this epoch's call left out of `frame.usable` (0: none)
   bool withdrawn_ = false;    //!< a restart followed this epoch's call: it no longer stands
+  std::int64_t previous_ns_ = 0;  //!< [ns] the epoch judged before this one
+  double spread_sample_ = 0.0;    //!< this epoch's spread sample χ² (NaN: none)
+  int spread_dof_ = 1;
+  double spread_cap_ = 0.0;
 };
 
 }  // namespace tetra::fdi::detail

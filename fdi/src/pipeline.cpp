@@ -38,10 +38,13 @@ const StepResult& Pipeline::Impl::step(const Epoch& epoch) {
   isolator_.record(frame_);
   frame_.usable = frame_.valid & gyro_set_.active();
   measured_ = ~GyroMask{0};
+  parity_ran_ = false;
   if (subsets_.ready()) {
     reject_outliers();
+    check_noise_model();
     series_.observe_motion(frame_, subsets_);
     detect();
+    check_long_run_noise();
     match_own_noise();
   }
   reference_.integrate(frame_, gyro_set_.excluded(), attitude_.omega_meas_B(), attitude_.earth_rate_B(),
@@ -143,7 +146,11 @@ void Pipeline::Impl::detect() {
   measured_ = frame_.usable;
   const GyroMask active = gyro_set_.active();
   const double calibration = subsets_.calibration_bound(s, frame_.usable, attitude_.omega_meas_B());
-  const Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), calibration, health_);
+  Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), calibration, health_);
+  // Until the parity's spread has checked the noise model, an alarm judged on it decides nothing.
+  parity_ran_ = d.cusum_ran;
+  const bool held = d.alarm && sample_spread_.holds(d.statistic, d.threshold, d.test == DetectionTest::kChi2);
+  if (held) d.alarm = false;
   protection_.widen(calibration, frame_.dt_s);  // the CUSUM's reference k + D: a larger fault unseen
   if (d.cusum_ran) {
     isolator_.accumulate(detector_.parity_measured(), s.dof, attitude_.omega_meas_B());
@@ -153,7 +160,7 @@ void Pipeline::Impl::detect() {
                                 frame_.now_ns, subsets_, config_))
       emit_calibration_mismatch();
   }
-  if (d.cusum_ran && !d.alarm && !isolator_.episode().active) calibration_fit_.judged_nominal();
+  if (d.cusum_ran && !d.alarm && !held && !isolator_.episode().active) calibration_fit_.judged_nominal();
   // An open episode ends only once the parity is back to nominal for clear_after_s: a fault whose CUSUM
   // alarms grow sparse (a slow ramp near the reference k) keeps it open.
   if (d.cusum_ran && !d.alarm && isolator_.episode().active && !detector_.parity_nominal(s))
@@ -596,6 +603,10 @@ void Pipeline::Impl::reset() {
   publish_filter_health();  // the health keeps the last step's filter
   series_.reset();
   own_noise_.reset();
+  sample_spread_.reset();
+  white_spread_.reset();
+  blocks_.restart();
+  if (subsets_.white_ratio() != 1.0 || subsets_.sample_ratio() != 1.0) subsets_.set_noise_ratios(1.0, 1.0);
   gate_.reset();
   reference_.reset();
   consistency_.reset();

@@ -21,6 +21,8 @@
 #include "mekf.hpp"
 #include "outlier_gate.hpp"
 #include "own_noise_level.hpp"
+#include "parity_spread.hpp"
+#include "tetra/fdi/budget.hpp"
 #include "parity_bias_match.hpp"
 #include "parity_detector.hpp"
 #include "protection_level.hpp"
@@ -69,6 +71,9 @@ class Pipeline::Impl {
         subsets_(std::move(geometry), bias_sigmas(constants), config_, detector_noise(cal, config_)),
         bias_check_(constants),
         own_noise_(constants, config_),
+        sample_spread_(allocated_probability(config_, BudgetTest::kParitySpread)),
+        white_spread_(allocated_probability(config_, BudgetTest::kParitySpread)),
+        blocks_(std::max(1, cal.gyro_count() - 3)),
         series_(std::move(constants), config_),
         gate_(n_, config_),
         detector_(n_, config_.clear_after_s),
@@ -154,6 +159,11 @@ class Pipeline::Impl {
   double drift_threshold(GyroMask active);
   void match_drift_mean(const ReferenceVerdict& v, GyroMask active);
   void match_own_noise();
+  void check_noise_model();
+  void check_long_run_noise();
+  void widen_noise(const SpreadFinding& f, const char* evidence);
+  void emit_noise_widened(const SpreadFinding& f, const char* evidence);
+  void emit_episode_explained(const SpreadFinding& f);
   //! The rate solution of the gyros in use when they are exactly three (no parity left), else null.
   const Subset* three_gyros_without_parity();
 
@@ -189,6 +199,10 @@ class Pipeline::Impl {
   SubsetCache subsets_;
   BiasHypothesis bias_check_;  //!< the fault-model check of the filter's bias states
   OwnNoiseLevel own_noise_;    //!< three gyros: each gyro's noise level where motion does not reach
+  ParitySpread sample_spread_;  //!< the parity's differences between epochs: one sample's noise
+  ParitySpread white_spread_;   //!< between consecutive block sums: the white noise every sum sees
+  BlockDifferences blocks_;     //!< the block sums of the parity for white_spread_
+  bool parity_ran_ = false;     //!< this epoch's parity went through the CUSUM (the full active set)
   GyroSeries series_;
   OutlierGate gate_;
   ParityDetector detector_;

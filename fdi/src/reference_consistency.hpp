@@ -31,6 +31,7 @@
 #include "tetra/fdi/config.hpp"
 #include "tetra/fdi/ledger.hpp"
 #include "tetra/fdi/types.hpp"
+#include "tetra/core/units.hpp"
 
 namespace tetra::fdi::detail {
 

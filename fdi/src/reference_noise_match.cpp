@@ -28,6 +28,7 @@ void ReferenceNoiseMatch::reset() {
   std::fill(matched_.begin(), matched_.end(), false);
   std::fill(ratio_.begin(), ratio_.end(), 1.0);
   std::fill(own_.begin(), own_.end(), 1.0);
+  common_ = 1.0;
 }
 
 void ReferenceNoiseMatch::restart_statistics() {
@@ -103,7 +104,12 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
 void ReferenceNoiseMatch::apply(std::size_t k, Mekf& filter) const {
   const int id = static_cast<int>(k) + 1;
   const double n2 = filter.arw_rad_rts(id) * filter.arw_rad_rts(id);
-  filter.set_added_noise(id, (std::max(matched_[k] ? ratio_[k] : 1.0, own_[k]) - 1.0) * n2);
+  filter.set_added_noise(id, (std::max({matched_[k] ? ratio_[k] : 1.0, own_[k], common_}) - 1.0) * n2);
+}
+
+void ReferenceNoiseMatch::set_common_ratio(double ratio, Mekf& filter) {
+  common_ = std::clamp(ratio, 1.0, kMaxNoiseRatio * kMaxNoiseRatio);
+  for (std::size_t k = 0; k < own_.size(); ++k) apply(k, filter);
 }
 
 void ReferenceNoiseMatch::set_own_ratio(int id, double ratio, Mekf& filter) {

@@ -67,6 +67,9 @@ class ReferenceNoiseMatch {
   //! Gyro `id`'s own noise level (own_noise_level.hpp) shows a white noise variance `ratio` (≥ 1) times the
   //! model's: the filter's noise for it is at least that from now on, whatever the innovations say.
   void set_own_ratio(int id, double ratio, Mekf& filter);
+  //! Every gyro's white noise variance is `ratio` (≥ 1) times the model's as the parity's own spread shows
+  //! it (parity_spread.hpp): the filter's noise for each is at least that from now on.
+  void set_common_ratio(double ratio, Mekf& filter);
   //! [rad] 1σ per axis of the reference samples from now on (the configured one, or its re-estimated noise).
   void set_reference_sigma_rad(double sigma_rad) { reference_var_ = sigma_rad * sigma_rad; }
 
@@ -94,6 +97,7 @@ class ReferenceNoiseMatch {
   std::vector<double>
       ratio_;  //!< [-] the matched noise variance over the model's, N'²/N², 1..kMaxNoiseRatio²
   std::vector<double> own_;  //!< [-] per gyro: the variance ratio its own noise level shows (1: none)
+  double common_ = 1.0;      //!< [-] every gyro: the variance ratio the parity's spread shows (1: none)
 };
 
 }  // namespace tetra::fdi::detail

@@ -82,6 +82,32 @@ void SubsetCache::prepare(double period_s) {
   }
 }
 
+void SubsetCache::set_noise_ratios(double white, double sample) {
+  white_scale_ = std::sqrt(white);
+  sample_ratio_ = sample;
+  // In place: the detectors keep references to the subsets, which stay where they are.
+  if (ready())
+    for (auto& [mask, s] : subsets_) build(s, mask);
+}
+
+double SubsetCache::block_quantization(const Subset& s, int m) const {
+  double sum = 0.0;
+  for (int i = 0; i < gyro_count(); ++i) {
+    if (has_gyro(s.mask, i + 1)) sum += s.parity_col_norm[i] * s.parity_col_norm[i] * quantization_rad_[i] * quantization_rad_[i];
+  }
+  return 20.0 * sum / (period_s_ * 6.0 * m);
+}
+
+double SubsetCache::quantization_share() const {
+  double share = 0.0;
+  for (int i = 0; i < gyro_count(); ++i) {
+    const double total = sample_variance(geometry_.sigma()[i], quantization_rad_[i], period_s_);
+    const double white = sample_variance(geometry_.sigma()[i], 0.0, period_s_);
+    if (total > 0.0) share = std::max(share, 1.0 - white / total);
+  }
+  return share;
+}
+
 const Subset& SubsetCache::insert(GyroMask mask) {
   Subset& s = subsets_[mask];
   build(s, mask);
@@ -122,12 +148,20 @@ void SubsetCache::add_quantization(Subset& s, const Eigen::MatrixXd& v, GyroMask
   s.quantization_margin = s.quantization_sigma = 0.0;
   if (!s.quantized) return;
   // R·T per gyro for one sample and for half a one-sample difference (p = √T·W·Δy/√2 in the jump test).
-  const Eigen::VectorXd& arw = geometry_.sigma();
+  const Eigen::VectorXd arw = geometry_.sigma() * white_scale_;
   Eigen::VectorXd r_sample(gyro_count());
   Eigen::VectorXd r_jump(gyro_count());
   for (int i = 0; i < gyro_count(); ++i) {
-    r_sample[i] = sample_variance(arw[i], quantization_rad_[i], period_s_) * period_s_;
-    r_jump[i] = 0.5 * sample_difference_variance(arw[i], quantization_rad_[i], period_s_) * period_s_;
+    // The larger of what one sample's spread shows (the stated noise times sample_ratio_) and what the white
+    // noise taken gives with the stated quantization.
+    const double stated_arw = arw[i] / white_scale_;
+    r_sample[i] = std::max(sample_ratio_ * sample_variance(stated_arw, quantization_rad_[i], period_s_),
+                           sample_variance(arw[i], quantization_rad_[i], period_s_)) *
+                  period_s_;
+    r_jump[i] = 0.5 *
+                std::max(sample_ratio_ * sample_difference_variance(stated_arw, quantization_rad_[i], period_s_),
+                         sample_difference_variance(arw[i], quantization_rad_[i], period_s_)) *
+                period_s_;
   }
   s.sample_parity = whiten(v, r_sample);
   s.jump_parity = whiten(v, r_jump);
@@ -175,7 +209,7 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   s.parity_col_norm = Eigen::VectorXd::Zero(n);
   if (!s.observable) return;
   s.pinv = *geometry_.pseudoinverse(mask);
-  s.arw_sq_rad2_s = *geometry_.noise_variance_per_axis(mask);
+  s.arw_sq_rad2_s = *geometry_.noise_variance_per_axis(mask) * (white_scale_ * white_scale_);
   for (int a = 0; a < 3; ++a) {
     double v = 0.0;
     for (int i = 0; i < n; ++i) {
@@ -192,7 +226,7 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   // Unit-weight parity V (V H = 0, V Vᵀ = I) whitened by the white noise: cov(V y) = V R Vᵀ/T = L Lᵀ/T,
   // W = L⁻¹ V, R = diag(N_i²) (p = √T·W·y ~ N(0, I) without quantization).
   const Eigen::MatrixXd v = *geometry_.parity_matrix(mask);
-  const Eigen::VectorXd& arw = geometry_.sigma();
+  const Eigen::VectorXd arw = geometry_.sigma() * white_scale_;
   s.parity = whiten(v, arw.cwiseProduct(arw));
   for (int i = 0; i < n; ++i) {
     if (has_gyro(mask, i + 1)) s.parity_col_norm[i] = s.parity.col(i).norm();

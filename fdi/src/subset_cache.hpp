@@ -107,6 +107,22 @@ class SubsetCache {
   double period_s() const { return period_s_; }
   double sqrt_period() const { return sqrt_period_; }
 
+  //! As the parity's own spread shows them (parity_spread.hpp): every gyro's white rate noise N taken `white`
+  //! (≥ 1) times its stated variance — every sum, the CUSUM, the GLT, sigma — and one sample's noise (N and
+  //! the stated quantization) at least `sample` times the stated — the χ² and the jump test. Every subset
+  //! built is rebuilt on them, in place.
+  void set_noise_ratios(double white, double sample);
+  //! [-] the white noise variance taken over the stated.
+  double white_ratio() const { return white_scale_ * white_scale_; }
+  //! [-] one sample's noise variance taken at least, over the stated.
+  double sample_ratio() const { return sample_ratio_; }
+  //! [σ²] the quantization's share of |Δ²|²/(6m) for the second difference Δ² of three consecutive m-epoch
+  //! sums of the subset's normalized parity: 20·Σ_i |w_i|²·Q_i²/(T·6m) (the sums telescope to the ends' angle
+  //! errors, e_c − 3e_b + 3e_a − e_0).
+  double block_quantization(const Subset& s, int m) const;
+  //! [-] the largest share of one sample's stated noise variance that is quantization, over the gyros.
+  double quantization_share() const;
+
   //! The subset's constants, built on first use (only once `ready()`).
   const Subset& get(GyroMask mask) {
     if (mask < by_mask_.size() && by_mask_[mask] != nullptr) return *by_mask_[mask];
@@ -195,6 +211,8 @@ class SubsetCache {
   const PipelineConfig* config_;       //!< owned by the pipeline, outlives the cache
   double period_s_ = 0.0;
   double sqrt_period_ = 0.0;
+  double white_scale_ = 1.0;   //!< [-] √ of the white noise variance taken over the stated
+  double sample_ratio_ = 1.0;  //!< [-] one sample's noise variance taken at least, over the stated
   std::unordered_map<GyroMask, Subset> subsets_;
   //! For N ≤ 8: each built subset by its mask (the map's elements never move), a lookup without hashing.
   std::vector<const Subset*> by_mask_;

@@ -15,7 +15,7 @@ namespace {
 
 constexpr std::array<std::string_view, kFamilyCount> kFamilyNames = {
     "fault-in-slew", "data-path", "gap",       "reference", "calibration", "calibration-without-noise",
-    "second-fault",  "warm-up",   "data-sheet"};
+    "second-fault",  "warm-up",   "data-sheet", "noisy-unit"};
 
 constexpr double kSlewStart_s = 30.0;                //!< [s] the detectors have a full history by then
 constexpr double kConfiguredReference_arcsec = 5.0;  //!< [arcsec] the star tracker's stated 1σ
@@ -386,6 +386,36 @@ PerturbedRun data_sheet(Rng& rng, std::uint64_t index) {
   return r;
 }
 
+//! A unit noisier (or quieter) than its noise: section says: each gyro's true white noise N and bias
+//! instability B drawn at 0.5–3 times the stated terms, the fusion given the stated ones; a slew and back.
+//! A third of the runs carry a gyro fault (maybe_fault).
+PerturbedRun noisy_unit(Rng& rng, std::uint64_t index) {
+  const int n = 4 + static_cast<int>(index / 9 % 3);
+  const bool reference = index / 27 % 2 == 1;
+  PerturbedRun r;
+  Slew slew = agile_slew(rng, pick(rng, 6));
+  Slew back = slew;
+  back.angle_deg = -slew.angle_deg;
+  back.start_s = slew.start_s + slew.duration_s + 30.0;
+  r.scenario = base(n, reference, back.start_s + back.duration_s + kAfter_s);
+  r.scenario.motion.slews = {slew, back};
+  r.calibration = r.scenario.unit;
+  double worst = 0.0;
+  for (auto& g : r.scenario.unit.gyros) {
+    if (!g.noise) continue;
+    const double arw = between(rng, 0.5, 3.0);
+    worst = std::max(worst, arw);
+    if (g.noise->arw_dps_rtHz) *g.noise->arw_dps_rtHz *= arw;
+    if (g.noise->bias_instability_dps) *g.noise->bias_instability_dps *= between(rng, 0.5, 3.0);
+  }
+  char text[96];
+  std::snprintf(text, sizeof text, " noise 0.5-3 x stated (white up to %.2f x)", worst);
+  r.label = "N=" + std::to_string(n) + " " + slew_text(slew) + " and back" + text + (reference ? " ref" : "");
+  r.case_name = "fault-free";
+  maybe_fault(rng, index, n, slew, r);
+  return r;
+}
+
 }  // namespace
 
 std::string_view family_name(Family family) {
@@ -509,6 +539,9 @@ PerturbedRun perturbed_run(Family family, std::uint64_t seed, std::uint64_t inde
       break;
     case Family::kDataSheet:
       r = data_sheet(rng, index);
+      break;
+    case Family::kNoisyUnit:
+      r = noisy_unit(rng, index);
       break;
   }
   if (r.calibration.gyros.empty()) r.calibration = r.scenario.unit;

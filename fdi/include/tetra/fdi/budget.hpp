@@ -24,9 +24,10 @@ enum class BudgetTest : unsigned char {
   kReferenceNoiseMatch,  //!< three gyros: the reference noise match (per sample)
   kReferenceGate,        //!< the filter's 3-dof gate leaving out a good reference sample (per sample)
   kReferenceBiasMatch,  //!< a common drift in the reference's innovations, its bias model opened (per sample)
-  kMotionFit  //!< the parity's fit to the body rate rejecting H0 or a single-gyro hypothesis (per block)
+  kMotionFit,    //!< the parity's fit to the body rate rejecting H0 or a single-gyro hypothesis (per block)
+  kParitySpread  //!< the parity's differences rejecting the stated white noise (per look)
 };
-constexpr int kBudgetTestCount = 10;
+constexpr int kBudgetTestCount = 11;
 
 //! One row of the allocation: a test's share of false_alarm_probability, and why.
 struct Allocation {
@@ -49,7 +50,8 @@ enum class BudgetKind : unsigned char {
   kFalseAlarm,      //!< H0 rejected while true: a `detected` event without a fault [per hour]
   kWrongExclusion,  //!< a true single-gyro hypothesis rejected while a wrong one stands [per episode]
   kReference,       //!< a healthy reference rejected [per reference sample]
-  kMismatch         //!< a calibration_mismatch named on a unit its calibration describes [per hour]
+  kMismatch,        //!< a calibration_mismatch named on a unit its calibration describes [per hour]
+  kNoiseModel       //!< the stated noise widened on a unit it describes (a noise_model event) [per hour]
 };
 
 struct BudgetRow {

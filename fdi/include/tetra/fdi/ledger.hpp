@@ -36,9 +36,10 @@ enum class EvidenceSource : std::uint8_t {
   kReferenceTest,    //!< the reference's own consistency tests (NIS, lag, bias, jump)
   kQuiet,            //!< no alarm for clear_after_s: the episode's fault is gone
   kDriftWander,      //!< the bias wander a common drift of the gyros would need, against a working unit's
-  kMotionFit         //!< the parity's fit to the body rate over a block: scale factors and axes
+  kMotionFit,        //!< the parity's fit to the body rate over a block: scale factors and axes
+  kParitySpread      //!< the parity's differences between consecutive epochs: the unit's white noise
 };
-constexpr int kEvidenceSourceCount = 19;
+constexpr int kEvidenceSourceCount = 20;
 //! True for the sources that read a gyro's own signal (timeout, invalid, repeated, zero, variance,
 //! noise_level, recurring_spikes): no error of the calibration makes what they see.
 bool reads_own_signal(EvidenceSource source);
@@ -50,9 +51,10 @@ enum class StatisticUnit : std::uint8_t {
   kMotionBound,  //!< ratio of a rate change to the motion bound (a_max·Δt + onset_sigma·σ): > 1 impossible
   kSeconds,      //!< [s]
   kCount,        //!< a number of samples or events
-  kRatio         //!< a noise level over the model's
+  kRatio,        //!< a noise level over the model's
+  kLogLikelihood  //!< a log-likelihood ratio
 };
-const char* to_string(StatisticUnit unit);  // "chi2", "sigma", "motion bound", "s", "count", "ratio"
+const char* to_string(StatisticUnit unit);  // "chi2", "sigma", "motion bound", "s", "count", "ratio", "log-likelihood ratio"
 
 //! One row of the source table: its name in events, its statistic's unit and what it tests.
 struct EvidenceSourceInfo {

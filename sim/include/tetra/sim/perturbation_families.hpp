@@ -33,8 +33,9 @@ enum class Family {
   kWarmUp,     //!< every gyro's bias follows a temperature transient, each by its own coefficient (a fault in
                //!< 1/3)
   kDataSheet,  //!< the fusion given a data-sheet calibration: scale factors 10–30 % off, axes by mrad, no σ
+  kNoisyUnit,  //!< each gyro's true white noise and bias instability 0.5–3 times the stated (a fault in 1/3)
 };
-inline constexpr int kFamilyCount = 9;
+inline constexpr int kFamilyCount = 10;
 
 std::string_view family_name(Family family);
 std::optional<Family> family_from_name(std::string_view name);

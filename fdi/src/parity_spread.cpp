@@ -1,0 +1,140 @@
+#include "parity_spread.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tetra/fdi/detectors.hpp"
+
+namespace tetra::fdi::detail {
+
+namespace {
+constexpr double kIntervalSigmas = 1.0;  //!< [σ] the estimate's interval whose upper end the model takes
+constexpr int kSearchSteps = 80;         //!< golden-section steps of the likelihood's maximum
+}  // namespace
+
+ParitySpread::ParitySpread(double false_alarm)
+    : threshold_(std::log(static_cast<double>(kSpreadWindowSamples) / false_alarm)) {}
+
+void ParitySpread::clear_sums() {
+  samples_ = beyond_ = 0;
+  sum_capped_ = sum_d_ = sum_below_ = sum_d_below_ = sum_offset_ = 0.0;
+}
+
+void ParitySpread::reset() {
+  clear_sums();
+  ratio_ = 1.0;
+  checked_ = false;
+  start_ns_ = -1;
+  epochs_ = checked_samples_ = 0;
+}
+
+void ParitySpread::restart() {
+  clear_sums();
+}
+
+bool ParitySpread::holds(double statistic, double threshold, bool chi2) const {
+  return !checked_ && statistic <= threshold * (chi2 ? kSpreadHeldRatio : std::sqrt(kSpreadHeldRatio));
+}
+
+std::optional<SpreadFinding> ParitySpread::observe(double u, int dof, double cap, std::int64_t now_ns,
+                                                   double offset) {
+  if (start_ns_ < 0) start_ns_ = now_ns;
+  epochs_ = std::min(epochs_ + 1, kSpreadHoldEpochs);
+  if (epochs_ >= kSpreadHoldEpochs || now_ns - start_ns_ >= static_cast<std::int64_t>(kSpreadHoldS * 1e9))
+    checked_ = true;
+  if (!std::isfinite(u) || dof < 1) return std::nullopt;
+  checked_samples_ = std::min(checked_samples_ + 1, kSpreadHoldSamples);
+  if (checked_samples_ >= kSpreadHoldSamples) checked_ = true;
+  const double d = dof;
+  dof_ = dof;
+  ++samples_;
+  sum_d_ += d;
+  sum_offset_ += offset;
+  sum_capped_ += std::min(u, cap);
+  if (u < cap) {
+    sum_below_ += u;
+    sum_d_below_ += d;
+  } else {
+    ++beyond_;
+  }
+  const double mean = sum_capped_ / (sum_d_ + sum_offset_);
+  const double g = 0.5 * sum_d_ * (mean - 1.0 - std::log(mean)) / kDifferenceCorrelation;
+  if (g <= threshold_ || samples_ < kSpreadMinSamples) {
+    if (samples_ >= kSpreadWindowSamples) clear_sums();
+    return std::nullopt;
+  }
+  SpreadFinding f;
+  f.statistic = g;
+  f.threshold = threshold_;
+  f.samples = samples_;
+  f.estimate = estimate(cap);
+  // The estimate's 1σ upper end: u's spread per degree of freedom is about (λ̂ + q̄)·√2 (q̄ the offset's mean).
+  const double upper = f.estimate + kIntervalSigmas * std::sqrt(2.0 * kDifferenceCorrelation / sum_d_) *
+                                        (f.estimate + sum_offset_ / sum_d_);
+  const double next = std::max(1.0, ratio_ * upper);
+  clear_sums();
+  if (next == ratio_ || (f.estimate < 1.0 && next > ratio_)) return std::nullopt;
+  ratio_ = next;
+  f.ratio = ratio_;
+  return f;
+}
+
+double ParitySpread::estimate(double cap) const {
+  if (sum_offset_ > 0.0) return std::max(sum_capped_ - sum_offset_, 1e-3 * sum_d_) / sum_d_;
+  if (beyond_ == 0) return sum_below_ / sum_d_below_;
+  // ℓ(λ) over ln λ, unimodal: golden-section search between the capped mean's λ and a hundred times it.
+  const auto loglik = [&](double log_lambda) {
+    const double lambda = std::exp(log_lambda);
+    const double tail = std::max(chi2_survival(cap / lambda, dof_), 1e-300);
+    return -0.5 * sum_d_below_ * log_lambda - sum_below_ / (2.0 * lambda) + beyond_ * std::log(tail);
+  };
+  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+  double lo = std::log(std::max(sum_capped_ / sum_d_, 1e-6));
+  double hi = lo + std::log(100.0);
+  double a = hi - phi * (hi - lo);
+  double b = lo + phi * (hi - lo);
+  double fa = loglik(a);
+  double fb = loglik(b);
+  for (int i = 0; i < kSearchSteps; ++i) {
+    if (fa < fb) {
+      lo = a;
+      a = b;
+      fa = fb;
+      b = lo + phi * (hi - lo);
+      fb = loglik(b);
+    } else {
+      hi = b;
+      b = a;
+      fb = fa;
+      a = hi - phi * (hi - lo);
+      fa = loglik(a);
+    }
+  }
+  return std::exp(0.5 * (lo + hi));
+}
+
+bool BlockDifferences::add(const double* p, int dof, std::uint32_t mask, bool clean, int block_epochs) {
+  if (!clean || mask != mask_ || dof != dof_) {  // the run of blocks is broken: start again from the next epoch
+    mask_ = mask;
+    dof_ = dof;
+    restart();
+    if (!clean) return false;
+  }
+  if (epochs_ == 0) std::fill(sum_.begin(), sum_.begin() + dof, 0.0);
+  for (int r = 0; r < dof; ++r) sum_[static_cast<std::size_t>(r)] += p[r];
+  if (++epochs_ < block_epochs) return false;
+  epochs_ = 0;
+  const bool three = blocks_ >= 2;
+  u_ = 0.0;
+  for (int r = 0; r < dof; ++r) {
+    const auto k = static_cast<std::size_t>(r);
+    const double second = sum_[k] - 2.0 * last_[k] + before_[k];
+    u_ += second * second / (6.0 * block_epochs);
+    before_[k] = last_[k];
+    last_[k] = sum_[k];
+  }
+  blocks_ = std::min(blocks_ + 1, 2);
+  return three;
+}
+
+}  // namespace tetra::fdi::detail

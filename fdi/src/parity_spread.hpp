@@ -1,0 +1,149 @@
+#pragma once
+// The parity's own spread (docs/fdi.md, "A unit noisier than its noise: section"): the white noise the
+// detectors whiten with is checked against the data, not trusted. Between two consecutive epochs of the same
+// gyros, with the body within the motion bound, the jump test's parity difference p_Δ = √T·W_Δ·Δy/√2 is
+// N(0, I_d) under the model whatever the body does (V H = 0), so u = |p_Δ|² is χ²_d; a unit whose white noise
+// (N and Q) is λ times the modelled variance gives λ·χ²_d. A bias, a wander or a calibration error is nearly
+// constant over one sample and does not reach it; a jump beyond the jump test's threshold c is the jump test's
+// (left out: the estimate takes the truncation into account).
+//
+// Over the samples since the last verdict (at most kSpreadWindowSamples, then the sums start again), with λ̂
+// the mean of min(u, c) per degree of freedom, the generalized likelihood ratio of "λ = 1" is
+//
+//   G = ½·Σd·(λ̂ − 1 − ln λ̂) / κ,   κ = kDifferenceCorrelation (successive differences share a sample),
+//
+// rejected when G > ln(kSpreadWindowSamples/p) (p the budget's kParitySpread share; the window's length
+// bounds the looks). Then λ is estimated by maximum likelihood with the samples beyond c censored,
+//
+//   ℓ(λ) = −½·Σd_below·ln λ − Σu_below/(2λ) + n_beyond·ln S_d(c/λ),
+//
+// and the model's white noise is multiplied by the upper end of its 1σ interval (at least kSpreadMinSamples; never
+// below the stated noise), the detectors restart on it, and the sums start again: a rise later in the run is
+// followed the same way, a fall too (the model comes back towards the stated noise, never below it). Until the
+// first kSpreadHoldSamples samples are in (or kSpreadHoldEpochs epochs or kSpreadHoldS have passed) the model
+// is unchecked: a parity alarm that a white noise up to kSpreadHeldRatio times the model's could explain
+// decides nothing yet (pipeline.cpp); a larger one is decided at once.
+//
+// What the parity cannot tell: which gyro is noisier. Every gyro's white noise is taken λ times its model (in
+// the filter too: sigma carries it); a single gyro's noise fault is the noise-level test's, which judges each
+// gyro's own samples against its stated noise and is not rescaled.
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace tetra::fdi::detail {
+
+//! [s] the blocks of the long-run spread (BlockDifferences): the quantization's share of a block difference
+//! falls as 1/m, the white noise's does not.
+inline constexpr double kSpreadBlockS = 5.0;
+//! Samples of one verdict at most; then the sums start again.
+inline constexpr int kSpreadWindowSamples = 3000;
+//! Samples of a verdict at least (its estimate's spread is then within a factor of about 1.45).
+inline constexpr int kSpreadMinSamples = 20;
+//! Samples before the model counts as checked.
+inline constexpr int kSpreadHoldSamples = 100;
+//! Epochs after a reset after which the model counts as checked even without samples (a body that never
+//! keeps within the motion bound, three gyros).
+inline constexpr int kSpreadHoldEpochs = 300;
+//! [s] time after a reset after which the model counts as checked (a slow sample rate).
+inline constexpr double kSpreadHoldS = 30.0;
+//! [-] the largest white noise variance ratio an alarm held before the check may be explained by: a χ² up to
+//! this many times its threshold, a sum (CUSUM) up to its root times.
+inline constexpr double kSpreadHeldRatio = 16.0;
+//! [-] variance inflation of a mean of successive differences' u (lag-one correlation 0.25 for white noise,
+//! 0.47 for quantization, whose rate error is itself a difference): the likelihood ratio is divided by it.
+inline constexpr double kDifferenceCorrelation = 2.0;
+
+//! The model's white noise rejected: the ratio the data show and the one now taken.
+struct SpreadFinding {
+  double statistic = 0.0;  //!< [-] G at the verdict
+  double threshold = 0.0;  //!< [-] ln(kSpreadWindowSamples/p)
+  double estimate = 1.0;   //!< [-] λ̂ relative to the model before
+  double ratio = 1.0;      //!< [-] the white noise variance now taken over the stated
+  int samples = 0;         //!< samples of the verdict
+};
+
+class ParitySpread {
+ public:
+  //! `false_alarm` is p per look (the budget's kParitySpread share).
+  explicit ParitySpread(double false_alarm);
+
+  //! The stated model, unchecked, the sums empty.
+  void reset();
+  //! The sums empty (the gyro set changed, a gap): the ratio and the check's state kept.
+  void restart();
+  //! One epoch: `u` the parity difference's χ² at `dof` with its threshold `cap` (NaN: no clean difference
+  //! this epoch). A finding when the model's white noise is rejected; the ratio is then the new one.
+  //! `offset`: a part of u's expectation the model's noise ratio does not scale (the stated quantization's
+  //! in a block difference, BlockDifferences): u ~ ratio·χ²_d + offset; the estimate is then the moment's,
+  //! (Σu − Σoffset)/Σd, without a cap.
+  std::optional<SpreadFinding> observe(double u, int dof, double cap, std::int64_t now_ns,
+                                       double offset = 0.0);
+  //! An alarm of `statistic` against `threshold` (`chi2`: a χ², else a sum in σ) the unchecked model's white
+  //! noise could explain, up to kSpreadHeldRatio: it decides nothing until the model is checked.
+  bool holds(double statistic, double threshold, bool chi2) const;
+
+  //! [-] the white noise variance taken, over the stated (≥ 1).
+  double ratio() const { return ratio_; }
+  //! Another test showed at least `ratio`: taken if larger, the sums empty (they were on the model before).
+  void raise_to(double ratio) {
+    if (ratio > ratio_) ratio_ = ratio;
+    clear_sums();
+  }
+  //! The model has been checked since the last reset.
+  bool checked() const { return checked_; }
+
+ private:
+  //! [-] the censored maximum-likelihood λ of the sums at the cap `cap` (relative to the current model).
+  double estimate(double cap) const;
+  void clear_sums();
+
+  double threshold_ = 0.0;
+  double ratio_ = 1.0;
+  bool checked_ = false;
+  std::int64_t start_ns_ = -1;  //!< [ns] the first epoch after the reset
+  int epochs_ = 0;          //!< epochs since the reset (up to kSpreadHoldEpochs)
+  int samples_ = 0;          //!< samples in the sums
+  int beyond_ = 0;           //!< of them beyond the cap
+  int checked_samples_ = 0;  //!< samples since the reset (up to kSpreadHoldSamples)
+  int dof_ = 1;              //!< the last sample's
+  double sum_capped_ = 0.0;  //!< Σ min(u, c)
+  double sum_d_ = 0.0;       //!< Σd of every sample
+  double sum_below_ = 0.0;   //!< Σu of the samples below the cap
+  double sum_d_below_ = 0.0; //!< Σd of those
+  double sum_offset_ = 0.0;  //!< Σ offset
+};
+
+//! The long-run white noise (what every sum sees; the quantization telescopes): the normalized parity summed
+//! over blocks of m epochs, and the second difference Δ² of three consecutive blocks' sums, u = |Δ²|²/(6m) ~
+//! λ_N·χ²_d + q (q the stated quantization's share, SubsetCache::block_quantization; a slowly varying mean and
+//! a ramp cancel, a step shows in two values, which the cap censors). A block counts when every epoch of it
+//! was a clean spread sample of the same gyros (OutlierGate) outside a fault episode.
+class BlockDifferences {
+ public:
+  explicit BlockDifferences(int max_dof)
+      : sum_(static_cast<std::size_t>(max_dof), 0.0),
+        last_(static_cast<std::size_t>(max_dof), 0.0),
+        before_(static_cast<std::size_t>(max_dof), 0.0) {}
+  void restart() {
+    epochs_ = 0;
+    blocks_ = 0;
+  }
+  //! One epoch's parity `p` (dof values) of gyro set `mask`, `clean` when it was a clean spread sample. True
+  //! when a block closed with two blocks before it: then u() is the three's statistic.
+  bool add(const double* p, int dof, std::uint32_t mask, bool clean, int block_epochs);
+  double u() const { return u_; }
+
+ private:
+  std::vector<double> sum_;     //!< the block being summed
+  std::vector<double> last_;    //!< the block before it
+  std::vector<double> before_;  //!< and the one before that
+  int epochs_ = 0;
+  int blocks_ = 0;  //!< closed blocks in a row (up to 2 kept)
+  int dof_ = 0;
+  std::uint32_t mask_ = 0;
+  double u_ = 0.0;
+};
+
+}  // namespace tetra::fdi::detail

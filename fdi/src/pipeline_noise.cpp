@@ -1,0 +1,94 @@
+// The noise model checked against the data (docs/fdi.md, "A unit noisier than its noise: section"): the
+// parity's own spread (parity_spread.hpp) — between consecutive epochs (one sample's noise: the χ², the jump
+// test) and between consecutive block sums (the white noise every sum sees: the CUSUM, the GLT, sigma) —
+// rejects the stated noise, and the model takes what the data show, says so, and the detectors start again on
+// it.
+
+#include <cmath>
+#include <limits>
+
+#include "pipeline_impl.hpp"
+#include "tetra/fdi/detectors.hpp"
+
+namespace tetra::fdi {
+
+namespace {
+//! [-] a unit whose stated quantization is at most this share of one sample's noise: what one sample's
+//! spread shows is the white noise's (the long-run test is then not waited for).
+constexpr double kWhiteDominates = 0.1;
+}  // namespace
+
+void Pipeline::Impl::check_noise_model() {
+  const auto found =
+      sample_spread_.observe(gate_.spread_sample(), gate_.spread_dof(), gate_.spread_cap(), frame_.now_ns);
+  if (!found) return;
+  if (subsets_.quantization_share() <= kWhiteDominates) white_spread_.raise_to(found->ratio);
+  widen_noise(*found, "between consecutive epochs (one sample's noise)");
+}
+
+void Pipeline::Impl::check_long_run_noise() {
+  if (!parity_ran_) return;
+  // A fault's mean change is not noise: no block sums while an episode is open.
+  if (isolator_.episode().active) {
+    blocks_.restart();
+    return;
+  }
+  const GyroMask active = gyro_set_.active();
+  const Subset& s = subsets_.get(active);
+  const int m = std::max(2, static_cast<int>(std::lround(kSpreadBlockS / subsets_.period_s())));
+  const bool clean = std::isfinite(gate_.spread_sample()) && frame_.usable == active;
+  if (!blocks_.add(detector_.parity_measured().data(), s.dof, active, clean, m)) return;
+  // A value beyond the test's own χ² threshold (times the quantization's share) is a step, not noise:
+  // censored at it.
+  const double q = subsets_.block_quantization(s, m);
+  const double cap =
+      chi2_threshold(allocated_probability(config_, BudgetTest::kParitySpread), s.dof) * (1.0 + q / s.dof);
+  const auto found = white_spread_.observe(blocks_.u(), s.dof, cap, frame_.now_ns, q);
+  if (found) widen_noise(*found, "between 5-s sums (the white noise every sum sees)");
+}
+
+void Pipeline::Impl::widen_noise(const SpreadFinding& f, const char* evidence) {
+  subsets_.set_noise_ratios(white_spread_.ratio(), sample_spread_.ratio());
+  noise_match_.set_common_ratio(white_spread_.ratio(), attitude_.filter());
+  calibration_fit_.restart_block();
+  blocks_.restart();
+  const bool episode = isolator_.episode().active;
+  // The detectors' statistics are in units of the model before: they start again on the new one.
+  restart_detectors();
+  emit_noise_widened(f, evidence);
+  if (episode) emit_episode_explained(f);
+}
+
+void Pipeline::Impl::emit_noise_widened(const SpreadFinding& f, const char* evidence) {
+  FdiEvent e;
+  e.stamp_ns = frame_.now_ns;
+  e.type = EventType::kNoiseModel;
+  e.statistic = f.statistic;
+  e.gyros = gyro_set_.active();
+  // H0 here is "the noise as stated": rejected by the spread; which gyro is noisier, the parity cannot tell,
+  // so every gyro's noise is taken the same.
+  e.ledger.push_back(stated(EvidenceSource::kParitySpread, kHypothesisNone, RowVerdict::kRejected, f.statistic,
+                            f.threshold));
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "the parity's spread %s is %.3g times the model's over %d samples: every gyro's white noise "
+                "is taken as %.3g times its stated variance from now on (every sum and sigma), one sample's "
+                "noise as at least %.3g times (the parity cannot tell which gyro)",
+                evidence, f.estimate, f.samples, subsets_.white_ratio(), subsets_.sample_ratio());
+  e.detail = text;
+  emit(std::move(e));
+}
+
+void Pipeline::Impl::emit_episode_explained(const SpreadFinding& f) {
+  FdiEvent c;
+  c.stamp_ns = frame_.now_ns;
+  c.type = EventType::kCleared;
+  c.gyros = gyro_set_.active();
+  c.detail = "the episode's alarm was judged on a noise the data reject (noise_model): the detectors start "
+             "again on the noise the data show; sigma keeps what the episode added";
+  c.ledger.push_back(stated(EvidenceSource::kParitySpread, kHypothesisNone, RowVerdict::kConsistent,
+                            f.statistic, f.threshold));
+  emit(std::move(c));
+}
+
+}  // namespace tetra::fdi
