@@ -98,9 +98,10 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
                       "one block's H0 rejected (a mismatch needs two in a row and every Hi rejected too)"});
   }
   if (parity) {
-    b.rows.push_back({"parity_spread", K::kNoiseModel, "false_alarm_probability",
-                      allocated_probability(c, BudgetTest::kParitySpread), epochs_per_hour,
-                      "the stated white noise rejected by the parity's differences (the model then widened)"});
+    b.rows.push_back(
+        {"parity_spread", K::kNoiseModel, "false_alarm_probability",
+         allocated_probability(c, BudgetTest::kParitySpread), epochs_per_hour,
+         "the stated white noise rejected by the parity's differences (the model then widened)"});
   }
   for (const char* signature : {"repeated", "zero", "variance", "noise_level", "recurring_spikes"}) {
     b.rows.push_back({signature, K::kWrongExclusion, "", kNotAProbability, 1.0,
@@ -130,8 +131,8 @@ std::string to_text(const Budget& b) {
       const char* per = r.kind == BudgetKind::kFalseAlarm || r.kind == BudgetKind::kMismatch ||
                                 r.kind == BudgetKind::kNoiseModel
                             ? "/h"
-                        : r.kind == BudgetKind::kWrongExclusion                              ? "/episode"
-                                                                                             : "/sample";
+                        : r.kind == BudgetKind::kWrongExclusion ? "/episode"
+                                                                : "/sample";
       std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %9.3g x %-9.4g = %9.3g %s  (%s)\n", r.source,
                     kind, r.key, r.per_evaluation, r.evaluations, r.total(), per, r.note);
     } else {

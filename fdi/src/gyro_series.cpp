@@ -340,6 +340,21 @@ bool GyroSeries::noise_beyond_motion(int id, const Track& t, double r, double sq
   return r > config_.noise_high_ratio + motion * t.motion_sigma / d2_sigma(id, sqrt_period);
 }
 
+double GyroSeries::unit_level(double sqrt_period) const {
+  // The median of the gyros' levels in use (the upper one of an even count's two), at least 1.
+  constexpr int kMaxUnitGyros = 32;  // a GyroMask's bits
+  double levels[kMaxUnitGyros];
+  int n = 0;
+  for (int j = 1; j <= static_cast<int>(tracks_.size()) && n < kMaxUnitGyros; ++j) {
+    if (has_gyro(excluded_, j)) continue;
+    const double r = noise_ratio(j, sqrt_period);
+    if (std::isfinite(r)) levels[n++] = r;
+  }
+  if (n < 3) return 1.0;
+  std::nth_element(levels, levels + n / 2, levels + n);
+  return std::max(1.0, levels[n / 2]);
+}
+
 bool GyroSeries::others_normal(int id, double sqrt_period) const {
   for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
     if (j == id || has_gyro(excluded_, j)) continue;
@@ -467,7 +482,9 @@ bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_
   if (t.d2_since_eval >= kNoiseEvalEvery && period_s > 0.0) {
     t.d2_since_eval = 0;
     if (!noise_ratio_within(t, id, sqrt_period, config_.noise_low_ratio, config_.noise_high_ratio)) {
-      const double r = noise_ratio(id, sqrt_period);
+      // Judged against the unit's own level (the gyros' median): a unit noisier than stated is not one
+      // noisy gyro (docs/fdi.md, "A unit noisier than its noise: section").
+      const double r = noise_ratio(id, sqrt_period) / unit_level(sqrt_period);
       if (std::isfinite(r) && r > config_.noise_high_ratio && noise_beyond_motion(id, t, r, sqrt_period))
         return found(FaultKind::kNoise, Evidence::kNoiseLevel, r, config_.noise_high_ratio);
       if (std::isfinite(r) && r < config_.noise_low_ratio && !coarse(id, sqrt_period))

@@ -155,6 +155,9 @@ class GyroSeries {
   bool noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const;
   //! Every other gyro in use has a normal second-difference level, and none has just begun repeating.
   bool others_normal(int id, double sqrt_period) const;
+  //! [-] the unit's own noise level: the median of the gyros' levels in use, at least 1 (1 with fewer than
+  //! three): each gyro's level is judged against it.
+  double unit_level(double sqrt_period) const;
   //! [rad/s] how far the others' view of gyro `id`'s axis (1σ `sigma`) may range while its own rate stands
   //! within a quantization step: two steps and 2·onset_sigma·σ.
   double run_width(int id, double sigma, double sqrt_period) const;

@@ -90,7 +90,7 @@ const char* to_string(StatisticUnit unit) {
     case StatisticUnit::kRatio:
       return "ratio";
     case StatisticUnit::kLogLikelihood:
-      return "log-likelihood ratio";
+      return "log-likelihood";  // a log-likelihood ratio (15 bytes on the wire at most)
   }
   return "";
 }

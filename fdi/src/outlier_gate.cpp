@@ -142,6 +142,7 @@ int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, con
   const GyroMask avail = frame.usable;
   const Subset& s = subsets.get(avail);
   spread_sample_ = std::numeric_limits<double>::quiet_NaN();
+  consecutive_ = false;
   const std::int64_t previous_ns = previous_ns_;
   previous_ns_ = frame.now_ns;
   if (!s.observable || s.dof < 1) return 0;
@@ -169,6 +170,7 @@ int OutlierGate::jump_culprit(const EpochFrame& frame, SubsetCache& subsets, con
   }
   // Δp = √T·W·Δy/√2 (a difference of two samples has twice the variance; W whitens the difference's noise).
   const double scale = subsets.sqrt_period() / std::sqrt(2.0);
+  consecutive_ = consecutive;
   const double u = apply_whitened(s.jump_parity, s.dof, avail, dy_.data(), scale, p_.data());
   const bool possible = possible_motion(s, dt_max, series, subsets);
   // A difference of consecutive samples over a body within the bound on both steps: the parity's own spread.

@@ -34,6 +34,8 @@ class OutlierGate {
   double spread_sample() const { return spread_sample_; }
   int spread_dof() const { return spread_dof_; }
   double spread_cap() const { return spread_cap_; }
+  //! This epoch's samples followed the previous epoch's, every gyro of the set in both, no outlier run.
+  bool consecutive() const { return consecutive_; }
   //! Forgets every gyro's last good sample and outlier run (after a reconfiguration).
   void restart();
   void reset();
@@ -73,6 +75,7 @@ class OutlierGate {
   double spread_sample_ = 0.0;    //!< this epoch's spread sample χ² (NaN: none)
   int spread_dof_ = 1;
   double spread_cap_ = 0.0;
+  bool consecutive_ = false;
 };
 
 }  // namespace tetra::fdi::detail

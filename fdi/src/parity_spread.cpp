@@ -114,7 +114,8 @@ double ParitySpread::estimate(double cap) const {
 }
 
 bool BlockDifferences::add(const double* p, int dof, std::uint32_t mask, bool clean, int block_epochs) {
-  if (!clean || mask != mask_ || dof != dof_) {  // the run of blocks is broken: start again from the next epoch
+  if (!clean || mask != mask_ ||
+      dof != dof_) {  // the run of blocks is broken: start again from the next epoch
     mask_ = mask;
     dof_ = dof;
     restart();

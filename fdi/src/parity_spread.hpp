@@ -4,8 +4,8 @@
 // gyros, with the body within the motion bound, the jump test's parity difference p_Δ = √T·W_Δ·Δy/√2 is
 // N(0, I_d) under the model whatever the body does (V H = 0), so u = |p_Δ|² is χ²_d; a unit whose white noise
 // (N and Q) is λ times the modelled variance gives λ·χ²_d. A bias, a wander or a calibration error is nearly
-// constant over one sample and does not reach it; a jump beyond the jump test's threshold c is the jump test's
-// (left out: the estimate takes the truncation into account).
+// constant over one sample and does not reach it; a jump beyond the jump test's threshold c is the jump
+// test's (left out: the estimate takes the truncation into account).
 //
 // Over the samples since the last verdict (at most kSpreadWindowSamples, then the sums start again), with λ̂
 // the mean of min(u, c) per degree of freedom, the generalized likelihood ratio of "λ = 1" is
@@ -17,12 +17,12 @@
 //
 //   ℓ(λ) = −½·Σd_below·ln λ − Σu_below/(2λ) + n_beyond·ln S_d(c/λ),
 //
-// and the model's white noise is multiplied by the upper end of its 1σ interval (at least kSpreadMinSamples; never
-// below the stated noise), the detectors restart on it, and the sums start again: a rise later in the run is
-// followed the same way, a fall too (the model comes back towards the stated noise, never below it). Until the
-// first kSpreadHoldSamples samples are in (or kSpreadHoldEpochs epochs or kSpreadHoldS have passed) the model
-// is unchecked: a parity alarm that a white noise up to kSpreadHeldRatio times the model's could explain
-// decides nothing yet (pipeline.cpp); a larger one is decided at once.
+// and the model's white noise is multiplied by the upper end of its 1σ interval (at least kSpreadMinSamples;
+// never below the stated noise), the detectors restart on it, and the sums start again: a rise later in the
+// run is followed the same way, a fall too (the model comes back towards the stated noise, never below it).
+// Until the first kSpreadHoldSamples samples are in (or kSpreadHoldEpochs epochs or kSpreadHoldS have passed)
+// the model is unchecked: a parity alarm that a white noise up to kSpreadHeldRatio times the model's could
+// explain decides nothing yet (pipeline.cpp); a larger one is decided at once.
 //
 // What the parity cannot tell: which gyro is noisier. Every gyro's white noise is taken λ times its model (in
 // the filter too: sigma carries it); a single gyro's noise fault is the noise-level test's, which judges each
@@ -103,23 +103,23 @@ class ParitySpread {
   double ratio_ = 1.0;
   bool checked_ = false;
   std::int64_t start_ns_ = -1;  //!< [ns] the first epoch after the reset
-  int epochs_ = 0;          //!< epochs since the reset (up to kSpreadHoldEpochs)
-  int samples_ = 0;          //!< samples in the sums
-  int beyond_ = 0;           //!< of them beyond the cap
-  int checked_samples_ = 0;  //!< samples since the reset (up to kSpreadHoldSamples)
-  int dof_ = 1;              //!< the last sample's
-  double sum_capped_ = 0.0;  //!< Σ min(u, c)
-  double sum_d_ = 0.0;       //!< Σd of every sample
-  double sum_below_ = 0.0;   //!< Σu of the samples below the cap
-  double sum_d_below_ = 0.0; //!< Σd of those
-  double sum_offset_ = 0.0;  //!< Σ offset
+  int epochs_ = 0;              //!< epochs since the reset (up to kSpreadHoldEpochs)
+  int samples_ = 0;             //!< samples in the sums
+  int beyond_ = 0;              //!< of them beyond the cap
+  int checked_samples_ = 0;     //!< samples since the reset (up to kSpreadHoldSamples)
+  int dof_ = 1;                 //!< the last sample's
+  double sum_capped_ = 0.0;     //!< Σ min(u, c)
+  double sum_d_ = 0.0;          //!< Σd of every sample
+  double sum_below_ = 0.0;      //!< Σu of the samples below the cap
+  double sum_d_below_ = 0.0;    //!< Σd of those
+  double sum_offset_ = 0.0;     //!< Σ offset
 };
 
 //! The long-run white noise (what every sum sees; the quantization telescopes): the normalized parity summed
 //! over blocks of m epochs, and the second difference Δ² of three consecutive blocks' sums, u = |Δ²|²/(6m) ~
-//! λ_N·χ²_d + q (q the stated quantization's share, SubsetCache::block_quantization; a slowly varying mean and
-//! a ramp cancel, a step shows in two values, which the cap censors). A block counts when every epoch of it
-//! was a clean spread sample of the same gyros (OutlierGate) outside a fault episode.
+//! λ_N·χ²_d + q (q the stated quantization's share, SubsetCache::block_quantization; a slowly varying mean
+//! and a ramp cancel, a step shows in two values, which the cap censors). A block counts when every epoch of
+//! it had the same gyros as the epoch before (OutlierGate::consecutive) outside a fault episode.
 class BlockDifferences {
  public:
   explicit BlockDifferences(int max_dof)

@@ -21,10 +21,9 @@
 #include "mekf.hpp"
 #include "outlier_gate.hpp"
 #include "own_noise_level.hpp"
-#include "parity_spread.hpp"
-#include "tetra/fdi/budget.hpp"
 #include "parity_bias_match.hpp"
 #include "parity_detector.hpp"
+#include "parity_spread.hpp"
 #include "protection_level.hpp"
 #include "quadrature.hpp"
 #include "rate_attitude.hpp"
@@ -38,6 +37,7 @@
 #include "subset_cache.hpp"
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/fdi/budget.hpp"
 #include "tetra/fdi/noise_defaults.hpp"
 
 namespace tetra::fdi {
@@ -197,8 +197,8 @@ class Pipeline::Impl {
   PipelineConfig config_;
   int n_;
   SubsetCache subsets_;
-  BiasHypothesis bias_check_;  //!< the fault-model check of the filter's bias states
-  OwnNoiseLevel own_noise_;    //!< three gyros: each gyro's noise level where motion does not reach
+  BiasHypothesis bias_check_;   //!< the fault-model check of the filter's bias states
+  OwnNoiseLevel own_noise_;     //!< three gyros: each gyro's noise level where motion does not reach
   ParitySpread sample_spread_;  //!< the parity's differences between epochs: one sample's noise
   ParitySpread white_spread_;   //!< between consecutive block sums: the white noise every sum sees
   BlockDifferences blocks_;     //!< the block sums of the parity for white_spread_

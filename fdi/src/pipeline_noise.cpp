@@ -36,7 +36,9 @@ void Pipeline::Impl::check_long_run_noise() {
   const GyroMask active = gyro_set_.active();
   const Subset& s = subsets_.get(active);
   const int m = std::max(2, static_cast<int>(std::lround(kSpreadBlockS / subsets_.period_s())));
-  const bool clean = std::isfinite(gate_.spread_sample()) && frame_.usable == active;
+  // A block's sums need the same gyros on consecutive epochs; the body's motion cancels in the parity, and
+  // what the calibration's error makes of it varies slowly enough for a second difference to cancel.
+  const bool clean = gate_.consecutive() && frame_.usable == active;
   if (!blocks_.add(detector_.parity_measured().data(), s.dof, active, clean, m)) return;
   // A value beyond the test's own χ² threshold (times the quantization's share) is a step, not noise:
   // censored at it.
@@ -67,8 +69,8 @@ void Pipeline::Impl::emit_noise_widened(const SpreadFinding& f, const char* evid
   e.gyros = gyro_set_.active();
   // H0 here is "the noise as stated": rejected by the spread; which gyro is noisier, the parity cannot tell,
   // so every gyro's noise is taken the same.
-  e.ledger.push_back(stated(EvidenceSource::kParitySpread, kHypothesisNone, RowVerdict::kRejected, f.statistic,
-                            f.threshold));
+  e.ledger.push_back(stated(EvidenceSource::kParitySpread, kHypothesisNone, RowVerdict::kRejected,
+                            f.statistic, f.threshold));
   char text[400];
   std::snprintf(text, sizeof text,
                 "the parity's spread %s is %.3g times the model's over %d samples: every gyro's white noise "
@@ -84,8 +86,9 @@ void Pipeline::Impl::emit_episode_explained(const SpreadFinding& f) {
   c.stamp_ns = frame_.now_ns;
   c.type = EventType::kCleared;
   c.gyros = gyro_set_.active();
-  c.detail = "the episode's alarm was judged on a noise the data reject (noise_model): the detectors start "
-             "again on the noise the data show; sigma keeps what the episode added";
+  c.detail =
+      "the episode's alarm was judged on a noise the data reject (noise_model): the detectors start "
+      "again on the noise the data show; sigma keeps what the episode added";
   c.ledger.push_back(stated(EvidenceSource::kParitySpread, kHypothesisNone, RowVerdict::kConsistent,
                             f.statistic, f.threshold));
   emit(std::move(c));

@@ -28,10 +28,10 @@
 
 #include <Eigen/Core>
 
+#include "tetra/core/units.hpp"
 #include "tetra/fdi/config.hpp"
 #include "tetra/fdi/ledger.hpp"
 #include "tetra/fdi/types.hpp"
-#include "tetra/core/units.hpp"
 
 namespace tetra::fdi::detail {
 

@@ -93,7 +93,8 @@ void SubsetCache::set_noise_ratios(double white, double sample) {
 double SubsetCache::block_quantization(const Subset& s, int m) const {
   double sum = 0.0;
   for (int i = 0; i < gyro_count(); ++i) {
-    if (has_gyro(s.mask, i + 1)) sum += s.parity_col_norm[i] * s.parity_col_norm[i] * quantization_rad_[i] * quantization_rad_[i];
+    if (has_gyro(s.mask, i + 1))
+      sum += s.parity_col_norm[i] * s.parity_col_norm[i] * quantization_rad_[i] * quantization_rad_[i];
   }
   return 20.0 * sum / (period_s_ * 6.0 * m);
 }
@@ -158,10 +159,11 @@ void SubsetCache::add_quantization(Subset& s, const Eigen::MatrixXd& v, GyroMask
     r_sample[i] = std::max(sample_ratio_ * sample_variance(stated_arw, quantization_rad_[i], period_s_),
                            sample_variance(arw[i], quantization_rad_[i], period_s_)) *
                   period_s_;
-    r_jump[i] = 0.5 *
-                std::max(sample_ratio_ * sample_difference_variance(stated_arw, quantization_rad_[i], period_s_),
-                         sample_difference_variance(arw[i], quantization_rad_[i], period_s_)) *
-                period_s_;
+    r_jump[i] =
+        0.5 *
+        std::max(sample_ratio_ * sample_difference_variance(stated_arw, quantization_rad_[i], period_s_),
+                 sample_difference_variance(arw[i], quantization_rad_[i], period_s_)) *
+        period_s_;
   }
   s.sample_parity = whiten(v, r_sample);
   s.jump_parity = whiten(v, r_jump);

@@ -273,6 +273,15 @@ bool calibration_ruling_of(const FdiEvent& event) {
                                gyros_of(event));
 }
 
+bool noise_ruling_of(const FdiEvent& event) {
+  for (const LedgerRow& row : event.ledger) {
+    if (row.source == EvidenceSource::kParitySpread && row.hypothesis == kHypothesisNone &&
+        row.verdict == RowVerdict::kRejected)
+      return true;
+  }
+  return reference_ruling_of(event) == ReferenceDecision::kMatchDrift;
+}
+
 std::string to_json(const FdiEvent& event, int n_gyros) {
   std::string out = "{\"time_s\": ";
   append_double(out, ns_to_seconds(event.stamp_ns));

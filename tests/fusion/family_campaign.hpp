@@ -99,7 +99,7 @@ inline bool explained(const fdi::FdiEvent& e) {
     case fdi::EventType::kReferenceRejected:
       return fdi::reference_ruling_of(e) == fdi::ReferenceDecision::kReject;
     case fdi::EventType::kNoiseModel:
-      return fdi::reference_ruling_of(e) == fdi::ReferenceDecision::kMatchDrift;
+      return fdi::noise_ruling_of(e);
     case fdi::EventType::kCalibrationMismatch:
       return fdi::calibration_ruling_of(e);
     default:

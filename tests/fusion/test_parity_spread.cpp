@@ -66,8 +66,9 @@ double relative(Differences& diff, double lambda, const ParitySpread& spread) {
 TEST(ParitySpread, AUnitThreeTimesNoisierIsSeenWithinSecondsAndCovered) {
   // White noise 3× the stated (variance 9), d = 1, the jump threshold censoring 4 % of the samples: over 30
   // seeds the first verdict comes within 60 samples (6 s at 10 Hz), its ratio at least the truth less 30 %
-  // (a 1σ upper end falls short one time in six; the next verdicts raise it) and at most 3 times it (the 1σ upper end of an estimate from 20–40 samples); 3,000 samples later the
-  // ratio is within −20 %/+50 % of the truth.
+  // (a 1σ upper end falls short one time in six; the next verdicts raise it) and at most 3 times it (the 1σ
+  // upper end of an estimate from 20–40 samples); 3,000 samples later the ratio is within −20 %/+50 % of the
+  // truth.
   const double cap = chi2_threshold(kP, 1);
   for (std::uint64_t seed = 1; seed <= 30; ++seed) {
     ParitySpread spread(kP);

@@ -54,7 +54,8 @@ enum class StatisticUnit : std::uint8_t {
   kRatio,        //!< a noise level over the model's
   kLogLikelihood  //!< a log-likelihood ratio
 };
-const char* to_string(StatisticUnit unit);  // "chi2", "sigma", "motion bound", "s", "count", "ratio", "log-likelihood ratio"
+const char* to_string(
+    StatisticUnit unit);  // "chi2", "sigma", "motion bound", "s", "count", "ratio", "log-likelihood"
 
 //! One row of the source table: its name in events, its statistic's unit and what it tests.
 struct EvidenceSourceInfo {

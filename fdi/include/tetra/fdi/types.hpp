@@ -162,6 +162,9 @@ ReferenceDecision reference_ruling_of(const FdiEvent& event);
 //! The arbiter's calibration rule over an event's ledger alone: a `calibration_mismatch` event's rows
 //! rebuild true.
 bool calibration_ruling_of(const FdiEvent& event);
+//! A `noise_model` event's rows rebuild its step: the reference rule's kMatchDrift (a common drift), or the
+//! parity's spread rejecting the stated noise (H0 of source parity_spread rejected).
+bool noise_ruling_of(const FdiEvent& event);
 
 //! One JSON object (one line, no newline) per docs/interfaces.md §2.5; `n_gyros` formats the `gyros` lists.
 std::string to_json(const FdiEvent& event, int n_gyros);
