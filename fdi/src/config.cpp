@@ -108,8 +108,7 @@ Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const s
         if (name != constant.name) continue;
         return yaml.error(kv.first, "pipeline." + name,
                           "a fixed design constant (" + constant_text(constant) +
-                              "), not a key: it cannot be set (tetra replay --config-keys lists the keys "
-                              "and the constants)");
+                              "), not a key: it cannot be set (docs/fdi.md, \"Fixed design constants\")");
       }
       for (const auto& key : config_keys()) {
         if (name != key.name) continue;
