@@ -1,7 +1,6 @@
 #include "tetra/fdi/budget.hpp"
 
 #include "calibration_fit.hpp"
-#include "isolator.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -58,7 +57,7 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
   b.gyros = gyros;
   b.sample_period_s = sample_period_s;
   const double epochs_per_hour = 3600.0 / sample_period_s;
-  const double window_epochs = c.isolation_window_s / sample_period_s;
+  const double window_epochs = design::isolation_window_s / sample_period_s;
   const bool parity = gyros >= 4;
   using K = BudgetKind;
   if (parity) {
@@ -69,10 +68,10 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
                       "mean run length between false alarms, the wander and quantization in h"});
     // The onset test names gyro i when every subset without it shows impossible motion: the true
     // hypothesis's subset beyond its margin, at most the one-axis tail, per evaluation (from
-    // kOnsetMinPostEpochs after the onset to onset_post_max_epochs).
+    // onset_min_post_epochs after the onset to onset_post_max_epochs).
     b.rows.push_back(
         {"onset", K::kWrongExclusion, "onset_sigma", normal_tail(c.onset_sigma),
-         std::max(1.0, static_cast<double>(c.onset_post_max_epochs - detail::Isolator::kOnsetMinPostEpochs)),
+         std::max(1.0, static_cast<double>(design::onset_post_max_epochs - design::onset_min_post_epochs)),
          "true hypothesis beyond the motion bound's margin"});
   }
   if (gyros >= 5) {
@@ -82,7 +81,7 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
   }
   if (gyros == 4) {
     b.rows.push_back({"reference_window", K::kWrongExclusion, "reference_threshold_sigma",
-                      std::pow(normal_tail(c.reference_threshold_sigma), c.reference_confirm_count),
+                      std::pow(normal_tail(c.reference_threshold_sigma), design::reference_confirm_count),
                       window_epochs,
                       "a healthy gyro's window beyond the threshold, reference_confirm_count times"});
   }

@@ -43,13 +43,18 @@ Status set_pipeline_key(PipelineConfig& config, const ConfigKey& key, const Yaml
   if (!v) return v.error();
   if (const auto* d = std::get_if<double PipelineConfig::*>(&key.field)) {
     config.*(*d) = *v;
-  } else if (const auto* o = std::get_if<std::optional<double> PipelineConfig::*>(&key.field)) {
-    config.*(*o) = *v;
   } else {
-    if (*v != std::floor(*v) || std::abs(*v) > 1e9) return yaml.error(value, what, "must be a whole number");
-    config.*std::get<int PipelineConfig::*>(key.field) = static_cast<int>(*v);
+    config.*std::get<std::optional<double> PipelineConfig::*>(key.field) = *v;
   }
   return ok_status();
+}
+
+// A constant's value and unit as the listing and the refusal state them: "30 samples", "0.05".
+std::string constant_text(const DesignConstant& constant) {
+  std::string out;
+  append_double(out, constant.value);
+  if (std::string(constant.unit) != "-") out += std::string(" ") + constant.unit;
+  return out;
 }
 
 // Columns of UTF-8 text (a unit such as "deg/√s" has more bytes than columns).
@@ -91,10 +96,20 @@ Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const s
   const YamlReader yaml{source};
   std::vector<std::string> allowed;
   for (const auto& key : config_keys()) allowed.emplace_back(key.name);
-  if (Status st = yaml.check_keys(node, allowed, "pipeline"); !st) return st.error();
+  std::vector<std::string> names = allowed;  // a constant's name is known, then refused by name
+  for (const auto& constant : design_constants()) names.emplace_back(constant.name);
+  if (Status st = yaml.check_keys(node, names, "pipeline"); !st) {
+    return yaml.check_keys(node, allowed, "pipeline").error();  // the message lists the keys alone
+  }
   try {
     for (const auto& kv : node) {
       const std::string name = kv.first.Scalar();
+      for (const auto& constant : design_constants()) {
+        if (name != constant.name) continue;
+        return yaml.error(kv.first, "pipeline." + name,
+                          "a fixed design constant (" + constant_text(constant) +
+                              "), not a key: it cannot be set (docs/fdi.md, \"Fixed design constants\")");
+      }
       for (const auto& key : config_keys()) {
         if (name != key.name) continue;
         if (Status st = set_pipeline_key(config, key, yaml, kv.first, kv.second); !st) return st.error();
@@ -129,8 +144,6 @@ Status validate(const PipelineConfig& c) {
     double v = 0.0;
     if (const auto* d = std::get_if<double PipelineConfig::*>(&key.field)) {
       v = c.*(*d);
-    } else if (const auto* i = std::get_if<int PipelineConfig::*>(&key.field)) {
-      v = c.*(*i);
     } else if (const auto* o = std::get_if<std::optional<double> PipelineConfig::*>(&key.field)) {
       if (!(c.*(*o))) continue;  // not set
       v = *(c.*(*o));
@@ -186,6 +199,31 @@ std::string describe_keys() {
   row("key", "unit", "range", "default", "meaning");
   for (const auto& key : config_keys())
     row(key.name, key.unit, range_text(key), value_text(defaults, key), key.description);
+
+  // The fixed design constants: not keys (a `pipeline:` map that sets one is refused).
+  std::size_t w_constant = 8, w_value = 5;
+  w_unit = 4;
+  for (const auto& constant : design_constants()) {
+    w_constant = std::max(w_constant, std::string(constant.name).size());
+    w_unit = std::max(w_unit, display_width(constant.unit));
+    std::string value;
+    append_double(value, constant.value);
+    w_value = std::max(w_value, value.size());
+  }
+  out += "\nfixed design constants (not keys: a configuration that sets one is refused)\n";
+  auto constant_row = [&](const std::string& name, const std::string& unit, const std::string& value,
+                          const std::string& meaning) {
+    out += name + std::string(w_constant + 2 - name.size(), ' ');
+    out += unit + std::string(w_unit + 2 - display_width(unit), ' ');
+    out += value + std::string(w_value + 2 - value.size(), ' ');
+    out += meaning + '\n';
+  };
+  constant_row("constant", "unit", "value", "meaning");
+  for (const auto& constant : design_constants()) {
+    std::string value;
+    append_double(value, constant.value);
+    constant_row(constant.name, constant.unit, value, constant.description);
+  }
   return out;
 }
 

@@ -70,50 +70,34 @@ const std::vector<ConfigKey>& config_keys() {
        "match's lower end"},
       {"rate_random_walk_horizon_s", &C::rate_random_walk_horizon_s, "s", above(0), kFree,
        "a gyro's rate random walk K and rate ramp R enter the detectors as a wandering bias of 1 sigma "
-       "K*sqrt(horizon) and a bound R*horizon"},
+       "K*sqrt(horizon) and a bound R*horizon (a mission whose runs are longer sets their length)"},
       {"clear_after_s", &C::clear_after_s, "s", above(0), kFree,
        "no alarm for this long ends a SUSPECT episode (cleared)"},
       // --- isolation
-      {"isolation_window_s", &C::isolation_window_s, "s", above(0), kFree,
-       "evidence is sought this long before unisolated; also the span of the held parity level"},
       {"max_angular_acceleration_dps2", &C::max_angular_acceleration_dps2, "deg/s²", above(0), kFree,
        "bound on the vehicle's angular acceleration: the onset and jump tests, and the widening of sigma "
        "over a gap"},
       {"onset_sigma", &C::onset_sigma, "σ", above(0), kFree,
        "noise margin of the onset (physical possibility) test; also of the jump test and of the repeated-"
        "value (stuck) signature"},
-      {"onset_pre_epochs", &C::onset_pre_epochs, "epochs", from(2), to(200),
-       "window before the estimated onset"},
-      {"onset_post_max_epochs", &C::onset_post_max_epochs, "epochs", from(2), to(200),
-       "at most this many epochs after the onset"},
-      {"onset_confirm_epochs", &C::onset_confirm_epochs, "epochs", from(2), to(100),
-       "an outlier this persistent is a step, not a spike"},
       {"dropout_timeout_s", &C::dropout_timeout_s, "s", above(0), kFree,
        "absent this long: dropout; invalid this long: invalid"},
       {"max_gap_s", &C::max_gap_s, "s", above(0), kFree,
        "no epoch for longer than this: a gap event, sigma widened by a*tau^2/4"},
-      {"stuck_repeat_count", &C::stuck_repeat_count, "samples", from(3), kFree,
-       "identical raw values in a row: stuck"},
-      {"noise_window", &C::noise_window, "samples", from(8), to(256),
-       "window of the noise-level (second difference) test and of the own fourth-difference level"},
       {"noise_high_ratio", &C::noise_high_ratio, "-", above(1), kFree,
        "robust noise level / expected above this: noise; also the three-gyro own-noise match, the outlier "
-       "gate's and the isolator's noise waits (at half of it)"},
-      {"noise_low_ratio", &C::noise_low_ratio, "-", above(0), below(1),
-       "robust noise level / expected below this: stuck"},
-      {"spike_count", &C::spike_count, "-", from(2), to(64),
-       "this many confirmed one-epoch outliers within spike_window_s: recurring spikes"},
-      {"spike_window_s", &C::spike_window_s, "s", above(0), kFree, "window of the spike count"},
+       "gate's and the isolator's noise waits (at noise_raised_fraction of it)"},
       // --- the reference
       {"reference_window_s", &C::reference_window_s, "s", above(0), kFree,
-       "window of the reference comparison; also how long a reference sample counts as recent (absent "
-       "beyond it)"},
+       "window of the reference comparison and how long a reference sample counts as recent (absent beyond "
+       "it); also the block of the reference's NIS and lag tests: a rejected reference is used again after "
+       "its samples passed every test this long, its noise re-estimate, the three-gyro reference noise "
+       "match, the budget's hold, a rejection withdrawn at a detection, sigma after the reference set the "
+       "attitude, the bias opened with three gyros"},
       {"reference_sigma_arcsec", &C::reference_sigma_arcsec, "arcsec", above(0), kFree,
        "1σ per axis of the attitude reference (filter, reference comparison, consistency tests)"},
       {"reference_threshold_sigma", &C::reference_threshold_sigma, "σ", above(0), kFree,
        "reference disagreement threshold; also the filter-bias isolation's"},
-      {"reference_confirm_count", &C::reference_confirm_count, "-", from(1), to(100),
-       "consecutive reference comparisons that must agree"},
       {"exclusion_enabled", &C::exclusion_enabled, "-", kFree, kFree,
        "false: an isolated gyro stays in the solution (the isolated event says \"gyro kept\"; for measuring "
        "what exclusion is worth)"},
@@ -126,19 +110,7 @@ const std::vector<ConfigKey>& config_keys() {
        "1σ per axis of initial_q_wxyz until a reference sample sets the attitude"},
       {"bias_instability_correlation_s", &C::bias_instability_correlation_s, "s", above(0), kFree,
        "correlation time T_c of the Gauss-Markov bias that models each gyro's bias instability B"},
-      {"reference_gate_reset_count", &C::reference_gate_reset_count, "samples", from(1), to(1000),
-       "the last of this many reference samples in a row the gate would reject sets the attitude"},
       // --- the reference as a sensor that can fail
-      {"reference_check_window_s", &C::reference_check_window_s, "s", above(0), kFree,
-       "block of the reference's NIS and lag tests; also: a rejected reference is used again after its "
-       "samples passed every test this long, its noise re-estimate, the three-gyro reference noise match, "
-       "the budget's hold, a rejection withdrawn at a detection, sigma after the reference set the "
-       "attitude, the bias opened with three gyros"},
-      {"reference_bias_window_s", &C::reference_bias_window_s, "s", above(0), kFree,
-       "block of the reference's mean-innovation (bias) test"},
-      {"reference_noise_max_factor", &C::reference_noise_max_factor, "-", from(1), to(100),
-       "a reference rejected for nis alone is used again with its re-estimated noise up to this times "
-       "reference_sigma_arcsec (1: never)"},
       {"reference_bias_arcsec", &C::reference_bias_arcsec, "arcsec", from(0), kFree,
        "1σ per axis of the reference's slowly varying error its specification states, carried in sigma "
        "(0: none stated)"},
@@ -156,6 +128,48 @@ const std::vector<ConfigKey>& config_keys() {
        "reach the parity tests nor the reference comparison (0: off)"},
   };
   return keys;
+}
+
+// One row per fixed design constant: its value is design::'s (config.hpp), its name the same.
+const std::vector<DesignConstant>& design_constants() {
+  static const std::vector<DesignConstant> constants = {
+      // --- detection and isolation on the parity residual
+      {"isolation_window_s", design::isolation_window_s, "s",
+       "evidence is sought this long before unisolated; also the span of the held parity level and the "
+       "budget's GLT and reference-window evaluations"},
+      {"onset_pre_epochs", design::onset_pre_epochs, "epochs", "window before the estimated onset"},
+      {"onset_post_max_epochs", design::onset_post_max_epochs, "epochs",
+       "at most this many epochs after the onset (the budget counts the onset test's evaluations up to it)"},
+      {"onset_min_post_epochs", design::onset_min_post_epochs, "epochs",
+       "the onset test judges once this many epochs follow the onset"},
+      {"onset_confirm_epochs", design::onset_confirm_epochs, "epochs",
+       "an outlier this persistent is a step, not a spike; also the span of the outlier gate's noise and "
+       "motion waits"},
+      // --- a gyro's own samples
+      {"stuck_repeat_count", design::stuck_repeat_count, "samples", "identical raw values in a row: stuck"},
+      {"stuck_repeat_isolated", design::stuck_repeat_isolated, "samples",
+       "identical raw values in a row that make an isolated fault's kind stuck, whatever the onset estimate"},
+      {"noise_window", design::noise_window, "samples",
+       "window of the noise-level (second difference) test and of the own fourth-difference level"},
+      {"noise_low_ratio", design::noise_low_ratio, "-", "robust noise level / expected below this: stuck"},
+      {"noise_raised_fraction", design::noise_raised_fraction, "-",
+       "a noise level above this fraction of noise_high_ratio is raised: the isolator waits or names noise; "
+       "recurring spikes are named only below it"},
+      {"spike_count", design::spike_count, "-",
+       "this many confirmed one-epoch outliers within spike_window_s: recurring spikes"},
+      {"spike_window_s", design::spike_window_s, "s", "window of the spike count"},
+      // --- the reference
+      {"reference_confirm_count", design::reference_confirm_count, "-",
+       "consecutive reference comparisons (and filter bias samples) that must agree"},
+      {"reference_gate_reset_count", design::reference_gate_reset_count, "samples",
+       "the last of this many reference samples in a row the gate would reject sets the attitude"},
+      {"reference_bias_window_s", design::reference_bias_window_s, "s",
+       "block of the reference's mean-innovation (bias) test"},
+      {"reference_noise_max_factor", design::reference_noise_max_factor, "-",
+       "a reference rejected for nis alone is used again with its re-estimated noise up to this times "
+       "reference_sigma_arcsec"},
+  };
+  return constants;
 }
 
 std::string range_text(const ConfigKey& key) {
@@ -188,8 +202,6 @@ std::string value_text(const PipelineConfig& c, const ConfigKey& key) {
   std::string out;
   if (const auto* d = std::get_if<double C::*>(&key.field)) {
     append_double(out, c.*(*d));
-  } else if (const auto* i = std::get_if<int C::*>(&key.field)) {
-    append_int(out, c.*(*i));
   } else if (const auto* b = std::get_if<bool C::*>(&key.field)) {
     out = (c.*(*b)) ? "true" : "false";
   } else if (const auto* o = std::get_if<std::optional<double> C::*>(&key.field)) {

@@ -1,7 +1,9 @@
 #pragma once
 // The keys of the `pipeline:` map, each declared once (config_keys.cpp): name, member, unit, range,
 // description; the default is read from a default-constructed PipelineConfig. Parsing, validate(),
-// describe(), describe_keys() and example_config() (config.cpp) are driven by this table.
+// describe(), describe_keys() and example_config() (config.cpp) are driven by this table. Its second
+// section, the fixed design constants (name, unit, value, meaning; the value is design::'s), is listed by
+// describe_keys() and refused in a `pipeline:` map.
 
 #include <optional>
 #include <string>
@@ -13,7 +15,7 @@
 namespace tetra::fdi {
 
 //! The member a key sets. `initial_q_wxyz` is a quaternion written [w, x, y, z]; `latitude_deg` is optional.
-using ConfigField = std::variant<double PipelineConfig::*, int PipelineConfig::*, bool PipelineConfig::*,
+using ConfigField = std::variant<double PipelineConfig::*, bool PipelineConfig::*,
                                  std::optional<double> PipelineConfig::*, Quaternion PipelineConfig::*>;
 
 //! One end of a key's range: none (only a finite value is required), open (the bound itself is refused)
@@ -36,7 +38,19 @@ struct ConfigKey {
 //! Every key of the `pipeline:` map, in the order describe() and the example file list them.
 const std::vector<ConfigKey>& config_keys();
 
-//! The range as users read it: "> 0", ">= 10", "in (0, 0.5)", "in [2, 200]"; "true or false" for a flag,
+//! A fixed design constant (config.hpp, namespace design): not a key; a `pipeline:` map that sets it is
+//! refused.
+struct DesignConstant {
+  const char* name;  //!< as in namespace design
+  double value;      //!< design::<name>
+  const char* unit;
+  const char* description;  //!< one line; where it serves more than one test, each is named
+};
+
+//! Every fixed design constant, in the order describe_keys() lists them.
+const std::vector<DesignConstant>& design_constants();
+
+//! The range as users read it: "> 0", ">= 10", "in (0, 0.5)", "in [0, 10]"; "true or false" for a flag,
 //! "unit norm" for the quaternion, "any" when only a finite value is required.
 std::string range_text(const ConfigKey& key);
 //! Whether `value` (finite or not) is within the key's range.

@@ -97,12 +97,12 @@ Result<std::vector<GyroConstants>> gyro_constants(const Calibration& cal, const 
 GyroSeries::GyroSeries(std::vector<GyroConstants> constants, const PipelineConfig& config)
     : constants_(std::move(constants)), config_(config), tracks_(constants_.size()) {
   for (auto& t : tracks_) {
-    t.d2.assign(static_cast<std::size_t>(config_.noise_window), 0.0);
-    t.m2.assign(static_cast<std::size_t>(config_.noise_window), kInf);
+    t.d2.assign(static_cast<std::size_t>(design::noise_window), 0.0);
+    t.m2.assign(static_cast<std::size_t>(design::noise_window), kInf);
     t.view_coef.assign(tracks_.size(), 0.0);
     t.view_gyros.assign(tracks_.size(), 0);
   }
-  scratch_.assign(static_cast<std::size_t>(std::max(config_.noise_window, 8)), 0.0);
+  scratch_.assign(static_cast<std::size_t>(std::max(design::noise_window, 8)), 0.0);
   d2_all_.assign(tracks_.size(), 0.0);
 }
 
@@ -184,7 +184,7 @@ void GyroSeries::ingest_sample(Track& t, double raw, double y) {
     t.d2_fresh = true;
     t.d2[static_cast<std::size_t>(t.d2_head)] = std::abs(t.d2_last);
     t.m2[static_cast<std::size_t>(t.d2_head)] = kInf;  // until observe_motion sees the others' motion
-    t.d2_head = (t.d2_head + 1) % config_.noise_window;
+    t.d2_head = (t.d2_head + 1) % design::noise_window;
     ++t.d2_count;
     ++t.d2_since_eval;
   }
@@ -212,7 +212,7 @@ void GyroSeries::observe_motion(const EpochFrame& frame, SubsetCache& subsets) {
     // The motion's second difference along the axis, when every other gyro has one this epoch, in units of
     // the others' own noise on it.
     if (t.d2_fresh && (fresh & others) == others) {
-      const int w = config_.noise_window;
+      const int w = design::noise_window;
       t.motion_sigma = t.view_d2_sigma;
       t.m2[static_cast<std::size_t>((t.d2_head - 1 + w) % w)] =
           std::abs(project(t, d2_all_.data())) / t.motion_sigma;
@@ -322,7 +322,7 @@ bool GyroSeries::motion_quiet(int id, double sqrt_period, int last) const {
   // The whole window: its median, as the noise-level test. The last samples: their trimmed RMS, as the kind
   // at isolation (a slew beginning within them must count, however few samples it has reached).
   const Track& t = track(id);
-  const int n = std::min({last, t.d2_count, config_.noise_window});
+  const int n = std::min({last, t.d2_count, design::noise_window});
   const double motion =
       last == 0 ? noise_ratio(id, sqrt_period, 0, true) : (n < 6 ? kNaN : trimmed_rms(t.m2, t, n));
   return std::isfinite(motion) && motion <= kQuietMotion;
@@ -384,7 +384,7 @@ bool GyroSeries::repeats_are_stuck(int id, const Track& t, double sqrt_period) c
 }
 
 double* GyroSeries::recent(const std::vector<double>& ring, const Track& t, int n) const {
-  const int w = config_.noise_window;
+  const int w = design::noise_window;
   double* buf = scratch_.data();
   for (int k = 0; k < n; ++k) buf[k] = ring[static_cast<std::size_t>((t.d2_head - 1 - k + 2 * w) % w)];
   return buf;
@@ -393,7 +393,7 @@ double* GyroSeries::recent(const std::vector<double>& ring, const Track& t, int 
 double GyroSeries::noise_ratio(int id, double sqrt_period, int last, bool motion) const {
   const Track& t = track(id);
   const std::vector<double>& ring = motion ? t.m2 : t.d2;
-  const int w = config_.noise_window;
+  const int w = design::noise_window;
   const int n = last > 0 ? std::min({last, t.d2_count, w}) : std::min(t.d2_count, w);
   if (n < (last > 0 ? std::min(10, w) : w)) return kNaN;
   double* buf = scratch_.data();
@@ -419,7 +419,7 @@ bool GyroSeries::noise_ratio_within(const Track& t, int id, double sqrt_period, 
                                     double high) const {
   // The limits on the ratio as limits on the median, moved inward by kRatioMargin (relative) so that the
   // rounding of median/level cannot put the ratio itself across a limit that the median is inside of.
-  const int w = config_.noise_window;
+  const int w = design::noise_window;
   if (t.d2_count < w) return false;
   const double level = kNoiseExpectedMedian * d2_sigma(id, sqrt_period);
   return rank_within(t.d2.data(), w, w / 2, low * level * (1.0 + kRatioMargin),
@@ -430,7 +430,7 @@ double GyroSeries::recent_noise_ratio(int id, double sqrt_period, int last) cons
   // RMS of the last `last` second differences without their two largest (a step leaves exactly two), over
   // the expected √6·σ. Efficient on few samples, where the median is not.
   const Track& t = track(id);
-  const int n = std::min({last, t.d2_count, config_.noise_window});
+  const int n = std::min({last, t.d2_count, design::noise_window});
   if (n < 6) return kNaN;
   return trimmed_rms(t.d2, t, n) / d2_sigma(id, sqrt_period);
 }
@@ -455,8 +455,8 @@ void GyroSeries::check(std::int64_t now_ns, GyroMask excluded, double period_s, 
 
 bool GyroSeries::may_signal(const Track& t) const {
   // The entry condition of each signature of check_one: most epochs meet none of them.
-  return t.absent_since_ns >= 0 || t.invalid_since_ns >= 0 || t.repeat_count >= config_.stuck_repeat_count ||
-         t.d2_since_eval >= kNoiseEvalEvery || t.spike_n >= config_.spike_count;
+  return t.absent_since_ns >= 0 || t.invalid_since_ns >= 0 || t.repeat_count >= design::stuck_repeat_count ||
+         t.d2_since_eval >= kNoiseEvalEvery || t.spike_n >= design::spike_count;
 }
 
 bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_s, double sqrt_period,
@@ -476,33 +476,35 @@ bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_
   if (t.invalid_since_ns >= 0 && now_ns - t.invalid_since_ns >= seconds_to_ns(config_.dropout_timeout_s))
     return found(FaultKind::kInvalid, Evidence::kInvalid, ns_to_seconds(now_ns - t.invalid_since_ns),
                  config_.dropout_timeout_s);
-  if (t.repeat_count >= config_.stuck_repeat_count && repeats_are_stuck(id, t, sqrt_period))
+  if (t.repeat_count >= design::stuck_repeat_count && repeats_are_stuck(id, t, sqrt_period))
     return found(FaultKind::kStuck, t.last_raw == 0.0 ? Evidence::kZero : Evidence::kRepeated, t.repeat_count,
-                 config_.stuck_repeat_count);
+                 design::stuck_repeat_count);
   if (t.d2_since_eval >= kNoiseEvalEvery && period_s > 0.0) {
     t.d2_since_eval = 0;
-    if (!noise_ratio_within(t, id, sqrt_period, config_.noise_low_ratio, config_.noise_high_ratio)) {
-      // Judged against the unit's own level (the gyros' median): a unit noisier than stated is not one
-      // noisy gyro (docs/fdi.md, "A unit noisier than its noise: section").
-      const double r = noise_ratio(id, sqrt_period) / unit_level(sqrt_period);
+    if (!noise_ratio_within(t, id, sqrt_period, design::noise_low_ratio, config_.noise_high_ratio)) {
+      // A raised level is judged against the unit's own (the gyros' median): a unit noisier than stated is
+      // not one noisy gyro (docs/fdi.md, "A unit noisier than its noise: section"); a low one against the
+      // stated noise.
+      const double level = noise_ratio(id, sqrt_period);
+      const double r = level / unit_level(sqrt_period);
       if (std::isfinite(r) && r > config_.noise_high_ratio && noise_beyond_motion(id, t, r, sqrt_period))
         return found(FaultKind::kNoise, Evidence::kNoiseLevel, r, config_.noise_high_ratio);
-      if (std::isfinite(r) && r < config_.noise_low_ratio && !coarse(id, sqrt_period))
-        return found(FaultKind::kStuck, Evidence::kVariance, r, config_.noise_low_ratio);
+      if (std::isfinite(level) && level < design::noise_low_ratio && !coarse(id, sqrt_period))
+        return found(FaultKind::kStuck, Evidence::kVariance, level, design::noise_low_ratio);
     }
   }
   // Recurring spikes: enough confirmed one-epoch outliers within the window, the first one old enough for the
   // noise-level test to have spoken, and the gyro's noise level otherwise normal.
-  if (t.spike_n < config_.spike_count) return false;
+  if (t.spike_n < design::spike_count) return false;
   const std::int64_t t_first =
-      t.spike_ns[static_cast<std::size_t>((t.spike_n - config_.spike_count) % kSpikeMemory)];
+      t.spike_ns[static_cast<std::size_t>((t.spike_n - design::spike_count) % kSpikeMemory)];
   const std::int64_t age = now_ns - t_first;
-  if (age > seconds_to_ns(config_.spike_window_s) ||
-      age < seconds_to_ns(3.0 * kNoiseEvalEvery * period_s + config_.noise_window * period_s))
+  if (age > seconds_to_ns(design::spike_window_s) ||
+      age < seconds_to_ns(3.0 * kNoiseEvalEvery * period_s + design::noise_window * period_s))
     return false;
   const double r = noise_ratio(id, sqrt_period);
-  if (std::isfinite(r) && r < 0.5 * config_.noise_high_ratio)
-    return found(FaultKind::kSpike, Evidence::kRecurringSpikes, config_.spike_count, config_.spike_count);
+  if (std::isfinite(r) && r < design::noise_raised_fraction * config_.noise_high_ratio)
+    return found(FaultKind::kSpike, Evidence::kRecurringSpikes, design::spike_count, design::spike_count);
   return false;
 }
 

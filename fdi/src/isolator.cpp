@@ -62,7 +62,7 @@ bool Isolator::open(const Detection& detection, std::int64_t now_ns, std::int64_
   episode_.active = true;
   episode_.declared_unisolated = false;
   episode_.detect_ns = now_ns;
-  episode_.deadline_ns = now_ns + seconds_to_ns(config_.isolation_window_s);
+  episode_.deadline_ns = now_ns + seconds_to_ns(design::isolation_window_s);
   episode_.onset_index = detection.onset_index;
   episode_.onset_ns = time_of(std::max<std::int64_t>(detection.onset_index, 0));
   if (index - detection.onset_index >= kHistory) episode_.onset_ns = now_ns;
@@ -99,15 +99,15 @@ Verdict Isolator::decide(std::int64_t now_ns, std::int64_t index, GyroMask activ
     evidence = Evidence::kGlt;
   }
   if (culprit > 0) {
-    // Kind from the gyro's own samples: identical raw values (5 or more in a row, whatever the onset
-    // estimate) are a stuck output; a noise increase also shifts window means, and its second differences
-    // tell it apart.
-    const bool repeated = series.repeat_count(culprit) >= 5;
+    // Kind from the gyro's own samples: identical raw values (stuck_repeat_isolated or more in a row,
+    // whatever the onset estimate) are a stuck output; a noise increase also shifts window means, and its
+    // second differences tell it apart.
+    const bool repeated = series.repeat_count(culprit) >= design::stuck_repeat_isolated;
     const int last = static_cast<int>(std::max<std::int64_t>(index - episode_.onset_index, 20));
     const double r = series.recent_noise_ratio(culprit, subsets.sqrt_period(), last);
     // While the body moves, second differences carry its jerk: a raised level may be motion, not noise.
     const bool quiet = series.motion_quiet(culprit, subsets.sqrt_period(), last);
-    const bool raised = std::isfinite(r) && r > 0.5 * config_.noise_high_ratio;
+    const bool raised = std::isfinite(r) && r > design::noise_raised_fraction * config_.noise_high_ratio;
     FaultKind kind = FaultKind::kBias;
     if (repeated) {
       kind = FaultKind::kStuck;
@@ -195,14 +195,15 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
                          const GyroSeries& series) {
   const std::int64_t k0 = episode_.onset_index;
   const std::int64_t gap = 2;
-  const std::int64_t pre_begin = k0 - gap - config_.onset_pre_epochs;
+  const std::int64_t pre_begin = k0 - gap - design::onset_pre_epochs;
   const std::int64_t pre_end = k0 - gap;
-  const std::int64_t post_end = std::min(index + 1, k0 + config_.onset_post_max_epochs);
-  if (pre_begin < 0 || pre_begin <= index - kHistory || post_end - k0 < kOnsetMinPostEpochs) return 0;
+  const std::int64_t post_end = std::min(index + 1, k0 + design::onset_post_max_epochs);
+  if (pre_begin < 0 || pre_begin <= index - kHistory || post_end - k0 < design::onset_min_post_epochs)
+    return 0;
   // Every hypothesis below is judged against the acceleration bound. Before the onset the data are clean:
   // when the body already turned faster than the bound there (a slew the bound does not cover), the true
   // hypothesis may be the impossible one and a wrong one possible by chance. Nothing can be told.
-  const std::int64_t pre_mid = pre_begin + config_.onset_pre_epochs / 2;
+  const std::int64_t pre_mid = pre_begin + design::onset_pre_epochs / 2;
   if (motion_within_bound(active, two_windows(pre_begin, pre_mid, pre_mid, pre_end), subsets, series) == 0)
     return 0;
   // After the onset a step is constant: the data since then, the fault included, must not show the body

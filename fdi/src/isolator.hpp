@@ -76,10 +76,6 @@ class Isolator {
     return time_of(std::max({onset_index, index - kHistory + 1, std::int64_t{0}}));
   }
 
-  //! [epochs] the onset test judges once this many epochs follow the onset (the error budget counts its
-  //! evaluations from there to onset_post_max_epochs)
-  static constexpr int kOnsetMinPostEpochs = 20;
-
  private:
   static constexpr int kHistory = 256;  //!< [epochs] history kept for the onset test
   //! [σ²] how much more of the parity one drift model must explain than the other (a 4σ difference)

@@ -60,7 +60,7 @@ void OutlierGate::update(EpochFrame& frame, SubsetCache& subsets, GyroSeries& se
     auto& t = tracks_[static_cast<std::size_t>(id - 1)];
     if (id == culprit) {  // left out of this epoch; a persistent outlier is an abrupt step
       frame.usable = without_gyro(frame.usable, id);
-      if (t.outlier_run >= config_.onset_confirm_epochs)
+      if (t.outlier_run >= design::onset_confirm_epochs)
         out.push_back(classify_step(id, frame, series, subsets.sqrt_period()));
       continue;
     }
@@ -81,7 +81,7 @@ Isolation OutlierGate::classify_step(int id, const EpochFrame& frame, const Gyro
   // rows are the run's length against the confirmation count (docs/fdi.md, "The sources").
   Isolation iso = step_kind(id, frame, series, sqrt_period);
   const auto& t = tracks_[static_cast<std::size_t>(id - 1)];
-  iso.rows.own_signal(EvidenceSource::kJump, id, frame.usable, t.outlier_run, config_.onset_confirm_epochs);
+  iso.rows.own_signal(EvidenceSource::kJump, id, frame.usable, t.outlier_run, design::onset_confirm_epochs);
   return iso;
 }
 
@@ -89,7 +89,7 @@ Isolation OutlierGate::step_kind(int id, const EpochFrame& frame, const GyroSeri
                                  double sqrt_period) const {
   const auto& t = tracks_[static_cast<std::size_t>(id - 1)];
   const bool zero = t.outlier_repeated && frame.raw[static_cast<std::size_t>(id - 1)] == 0.0;
-  const double r = series.recent_noise_ratio(id, sqrt_period, config_.onset_confirm_epochs);
+  const double r = series.recent_noise_ratio(id, sqrt_period, design::onset_confirm_epochs);
   if (t.outlier_repeated)
     return {id,
             FaultKind::kStuck,
@@ -99,7 +99,7 @@ Isolation OutlierGate::step_kind(int id, const EpochFrame& frame, const GyroSeri
             {}};
   if (std::isfinite(r) && r > config_.noise_high_ratio) {
     // A raised level while the body moves may be its jerk: the step is certain, its kind is not.
-    const bool quiet = series.motion_quiet(id, sqrt_period, config_.onset_confirm_epochs);
+    const bool quiet = series.motion_quiet(id, sqrt_period, design::onset_confirm_epochs);
     return {id,
             quiet ? FaultKind::kNoise : FaultKind::kUnknown,
             quiet ? Evidence::kNoiseLevel : Evidence::kOnset,

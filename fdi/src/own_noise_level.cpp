@@ -20,10 +20,10 @@ constexpr double kNamedNormalRatio = 1.5;    //!< [-] a named gyro's smoothed le
 
 OwnNoiseLevel::OwnNoiseLevel(const std::vector<GyroConstants>& constants, const PipelineConfig& config)
     : constants_(constants),
-      window_(config.noise_window),
+      window_(design::noise_window),
       high_ratio_(config.noise_high_ratio),
       tracks_(constants.size()),
-      scratch_(static_cast<std::size_t>(config.noise_window), 0.0) {
+      scratch_(static_cast<std::size_t>(design::noise_window), 0.0) {
   for (auto& t : tracks_) t.d4.assign(static_cast<std::size_t>(window_), 0.0);
 }
 

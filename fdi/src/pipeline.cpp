@@ -492,8 +492,8 @@ std::int64_t Pipeline::Impl::signature_span_ns() const {
   // The longest a finding without an episode takes from its fault's onset: a timeout, the repeated values,
   // the jump test's confirmation; one sample period more for the onset's own epoch.
   const double period = subsets_.ready() ? subsets_.period_s() : 0.0;
-  const double span_s = std::max({config_.dropout_timeout_s, config_.stuck_repeat_count * period,
-                                  config_.onset_confirm_epochs * period}) +
+  const double span_s = std::max({config_.dropout_timeout_s, design::stuck_repeat_count * period,
+                                  design::onset_confirm_epochs * period}) +
                         period;
   // A span longer than any run (epochs days apart) means "since the start"; bounded so that its nanoseconds
   // and now − span stay within int64 (fuzz_pipeline found 2.5e10 s).

@@ -25,7 +25,7 @@ void Pipeline::Impl::reconsider_reference_rejection() {
   // standing beside Href, the reference is used again, unjudged while the episode is open, and its windows
   // can isolate the gyro (docs/fdi.md). (A jump's or a lag's rows reject the gyros by the test itself.)
   if (!reference_rejected_ns_ || consistency_.state() != ReferenceState::kRejected) return;
-  const std::int64_t block_ns = seconds_to_ns(config_.reference_check_window_s);
+  const std::int64_t block_ns = seconds_to_ns(config_.reference_window_s);
   if (*reference_rejected_ns_ < pipeline_time_before_ns(isolator_.episode().onset_ns, block_ns)) return;
   EvidenceRows rows;
   for (LedgerRow row : rejection_rows_) {
@@ -154,8 +154,7 @@ void Pipeline::Impl::apply_reference_verdict(const ReferenceVerdict& v, const Ei
     attitude_.add_variance(v.contamination_rad2);
     // An attitude the reference itself set a block ago or less rests on its samples alone: the rejecting
     // sample's innovation, on every axis, bounds what they put in.
-    if (reference_set_ns_ &&
-        frame_.now_ns - *reference_set_ns_ <= seconds_to_ns(config_.reference_check_window_s))
+    if (reference_set_ns_ && frame_.now_ns - *reference_set_ns_ <= seconds_to_ns(config_.reference_window_s))
       attitude_.add_variance(Eigen::Vector3d::Constant(z.squaredNorm()));
   }
   // A jump is left to the gate (a lone wild sample, or ten in a row set the attitude): only the slower tests
@@ -173,7 +172,7 @@ void Pipeline::Impl::apply_reference_verdict(const ReferenceVerdict& v, const Ei
         "); three gyros: the data cannot tell which, sigma and bias states widened";
     result_.events.back().ledger.assign(reference_rows_.begin(), reference_rows_.end());
     attitude_.add_variance(z.cwiseProduct(z));
-    attitude_.fault_opened(z.norm() / config_.reference_check_window_s);
+    attitude_.fault_opened(z.norm() / config_.reference_window_s);
     noise_match_.match_all(subsets_.get(active).mask);
   }
 }

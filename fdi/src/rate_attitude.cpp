@@ -168,7 +168,7 @@ ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB, bool may_reinit
     propagator_.reset(propagator_.q_RB() * quat_exp(u.correction_rad));
     return ReferenceUse::kAccepted;
   }
-  if (++rejected_run_ < config_.reference_gate_reset_count || !may_reinitialize)
+  if (++rejected_run_ < design::reference_gate_reset_count || !may_reinitialize)
     return ReferenceUse::kRejected;
   // Every recent sample disagrees: the estimate, not the reference, is wrong (e.g. after a lost rate).
   rejected_run_ = 0;

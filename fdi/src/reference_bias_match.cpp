@@ -14,8 +14,8 @@ namespace tetra::fdi::detail {
 ReferenceBiasMatch::ReferenceBiasMatch(const PipelineConfig& config)
     : threshold_(
           allan::chi2_quantile(1.0 - allocated_probability(config, BudgetTest::kReferenceBiasMatch), 3.0)),
-      bias_window_ns_(seconds_to_ns(config.reference_bias_window_s)),
-      long_window_ns_(seconds_to_ns(kLongWindows * config.reference_bias_window_s)) {}
+      bias_window_ns_(seconds_to_ns(design::reference_bias_window_s)),
+      long_window_ns_(seconds_to_ns(kLongWindows * design::reference_bias_window_s)) {}
 
 void ReferenceBiasMatch::reset() {
   restart();

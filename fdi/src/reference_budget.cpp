@@ -11,7 +11,7 @@ namespace tetra::fdi::detail {
 ReferenceBudget::ReferenceBudget(const PipelineConfig& config)
     : bias_rad_(config.reference_bias_arcsec * kArcsecToRad),
       latency_max_s_(config.reference_latency_max_s),
-      hold_s_(config.reference_check_window_s) {}
+      hold_s_(config.reference_window_s) {}
 
 void ReferenceBudget::reset() {
   used_ = false;

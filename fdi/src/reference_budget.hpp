@@ -17,7 +17,7 @@ namespace tetra::fdi::detail {
 class ReferenceBudget {
  public:
   //! The budget of `config` (reference_bias_arcsec, reference_latency_max_s); the largest body rate of the
-  //! updates is forgotten over reference_check_window_s (the filter's own memory of an offset is shorter).
+  //! updates is forgotten over reference_window_s (the filter's own memory of an offset is shorter).
   explicit ReferenceBudget(const PipelineConfig& config);
   //! No reference used since (a start): no budget. (An operator's reset keeps the attitude, so the budget.)
   void reset();

@@ -70,7 +70,7 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
                                                          const Eigen::Vector3d& omega,
                                                          double& bias_statistic) {
   // Blocks: a new one when the last has run its length (the sample opens the next).
-  if (block_start_ns_ < 0 || now_ns - block_start_ns_ > seconds_to_ns(config_.reference_check_window_s)) {
+  if (block_start_ns_ < 0 || now_ns - block_start_ns_ > seconds_to_ns(config_.reference_window_s)) {
     if (block_start_ns_ >= 0) reaccept_den_ += lag_den_;
     lag_den_ = 0.0;
     block_start_ns_ = now_ns;
@@ -78,7 +78,7 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
     block_nis_ = 0.0;
     for (Eigen::Vector3d* v : {&sw_, &swo_, &swz_, &swoo_, &swoz_, &szz_, &sss_}) v->setZero();
   }
-  if (bias_start_ns_ < 0 || now_ns - bias_start_ns_ > seconds_to_ns(config_.reference_bias_window_s)) {
+  if (bias_start_ns_ < 0 || now_ns - bias_start_ns_ > seconds_to_ns(design::reference_bias_window_s)) {
     bias_start_ns_ = now_ns;
     bias_count_ = 0;
     bias_sw_.setZero();
@@ -142,7 +142,7 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
 }
 
 bool ReferenceConsistency::reestimate_noise(std::int64_t now_ns, const Eigen::Vector3d& z) {
-  // Evaluated once a block (reference_check_window_s), over every rejected sample since the rejection. The
+  // Evaluated once a block (reference_window_s), over every rejected sample since the rejection. The
   // difference of successive innovations: the reference's white noise twice (2σ² per axis), the
   // attitude's error changing over one sample interval (the gyros' noise and bias error over ~1 s: far below
   // an arcsecond), so the estimate does not depend on how loose the gyro-propagated attitude has become. A
@@ -155,8 +155,7 @@ bool ReferenceConsistency::reestimate_noise(std::int64_t now_ns, const Eigen::Ve
   }
   last_z_ = z;
   have_last_z_ = true;
-  if (now_ns - noise_start_ns_ < seconds_to_ns(config_.reference_check_window_s) || noise_count_ < 4)
-    return false;
+  if (now_ns - noise_start_ns_ < seconds_to_ns(config_.reference_window_s) || noise_count_ < 4) return false;
   const double k = noise_count_;
   const double var_d_rad2 =
       (noise_sum_sq_ - noise_sum_.cwiseProduct(noise_sum_) / k).sum() / (3.0 * (k - 1.0));
@@ -171,7 +170,7 @@ bool ReferenceConsistency::reestimate_noise(std::int64_t now_ns, const Eigen::Ve
   // above it): a step or a drift of the reference raises the NIS, not the differences, and stays rejected.
   // Beyond reference_noise_max_factor it is not the sensor its configuration describes: rejected too.
   noise_explained_ =
-      lower_rad > sigma_config_rad_ && upper_rad <= config_.reference_noise_max_factor * sigma_config_rad_;
+      lower_rad > sigma_config_rad_ && upper_rad <= design::reference_noise_max_factor * sigma_config_rad_;
   if (!noise_explained_) return false;
   const bool grew = upper_rad > sigma_rad_;
   // More differences tighten the bound: a smaller σ (never below the configured one) needs no new start.
@@ -273,8 +272,7 @@ ReferenceVerdict ReferenceConsistency::judge_rejected(std::int64_t now_ns, const
   // (After a `nis` rejection the noise estimate, which needs no tight attitude, tells it instead.)
   const bool tests_see =
       S.trace() / 3.0 <= 2.0 * sigma_rad_ * sigma_rad_ || (rejected_for_nis_ && noise_explained_);
-  if (now_ns - consistent_since_ns_ >= seconds_to_ns(config_.reference_check_window_s) && lag_seen &&
-      tests_see) {
+  if (now_ns - consistent_since_ns_ >= seconds_to_ns(config_.reference_window_s) && lag_seen && tests_see) {
     state_ = ReferenceState::kAccepted;
     v.use = true;
     v.reaccepted = true;

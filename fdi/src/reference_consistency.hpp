@@ -9,13 +9,13 @@
 //   bias  the long window's weighted mean innovation: Σ_a (Σ z_a/S_aa)²/Σ 1/S_aa > χ²₃(1 − p)
 //
 // p = the budget's kReferenceCheck share per sample. Windows are consecutive blocks (the nis and lag
-// tests' of reference_check_window_s, the bias test's of reference_bias_window_s), each test evaluated at
+// tests' of reference_window_s, the bias test's of reference_bias_window_s), each test evaluated at
 // every sample over its block so far. Without a gyro fault the innovations are white with covariance S (the
 // filter's model), so each statistic has the stated distribution; what a fault of the reference does to them
 // is in docs/fdi.md. The tests decide nothing: the caller writes their ledger rows and the arbiter decides
 // (arbitrate_reference: rejected only while the gyros' parity rejects every single-gyro hypothesis and a
 // common drift is ruled out). A rejected reference's samples are no longer used (sigma grows with the gyro
-// propagation) until they pass every test for one block, reference_check_window_s. With no call, a failed
+// propagation) until they pass every test for one block, reference_window_s. With no call, a failed
 // test is reported (`inconsistent`) and nothing else changes.
 // A reference rejected for `nis` alone is noisier than configured: while rejected, its noise is re-estimated
 // from the differences of its successive innovations (at their upper confidence bound, once a block, when
@@ -151,7 +151,7 @@ class ReferenceConsistency {
   bool noise_explained_ = false;  //!< the last block's estimate is within sigma_rad_
   CheckValue failed_;             //!< the last test's statistic and threshold
 
-  // the nis and lag block (reference_check_window_s)
+  // the nis and lag block (reference_window_s)
   std::int64_t block_start_ns_ = -1;
   int block_count_ = 0;
   double block_nis_ = 0.0;

@@ -32,7 +32,7 @@ std::optional<ReferenceFinding> ReferenceMonitor::filter_update(const Mekf& filt
   for (int id = 1; id <= filter.gyro_count(); ++id) {
     if (has_gyro(active, id)) filter_.add(id, std::abs(filter.bias_z(id)), config_.reference_threshold_sigma);
   }
-  const int culprit = filter_.confirm(config_.reference_confirm_count, 3);
+  const int culprit = filter_.confirm(design::reference_confirm_count, 3);
   if (culprit == 0) return std::nullopt;
   ReferenceFinding found{culprit, filter_.statistic(), false, {}};
   filter_.rows(EvidenceSource::kFilterBias, active, found.rows);
@@ -176,7 +176,7 @@ std::optional<ReferenceFinding> ReferenceMonitor::update(std::int64_t now_ns, co
   }
   // One gyro alone beyond the threshold, the others quiet, in `reference_confirm_count` consecutive
   // comparisons (consecutive windows share no reference sample, so one wild reference sample cannot do it).
-  const int culprit = windows_.confirm(config_.reference_confirm_count, 2);
+  const int culprit = windows_.confirm(design::reference_confirm_count, 2);
   if (culprit == 0) return std::nullopt;
   ReferenceFinding found{culprit, windows_.statistic(), scale_significant(culprit, old), {}};
   windows_.rows(EvidenceSource::kReferenceWindow, all_gyros(static_cast<int>(n_)) & ~excluded, found.rows);

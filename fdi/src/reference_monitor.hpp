@@ -78,7 +78,7 @@ class ReferenceMonitor {
   std::optional<ReferenceFinding> filter_update(const Mekf& filter, GyroMask active);
   //! The filter's finding for `id` was not confirmed by the fault-model check: the next sample that flags
   //! `id` alone is a finding again (the check is retried at every sample rather than after a new run).
-  void filter_rearm(int id) { filter_.rearm(id, config_.reference_confirm_count); }
+  void filter_rearm(int id) { filter_.rearm(id, design::reference_confirm_count); }
   //! Each active gyro's disagreement with the reference from the first snapshot at or after `from_ns` to the
   //! last one (this sample's); false when that span is shorter than `min_span_s`.
   bool span(std::int64_t from_ns, double min_span_s, GyroMask excluded, const GyroSeries& series,

@@ -12,7 +12,7 @@ namespace tetra::fdi::detail {
 
 ReferenceNoiseMatch::ReferenceNoiseMatch(const PipelineConfig& config, int gyro_count)
     : false_alarm_(allocated_probability(config, BudgetTest::kReferenceNoiseMatch)),
-      window_s_(config.reference_check_window_s),
+      window_s_(config.reference_window_s),
       reference_var_(std::pow(config.reference_sigma_arcsec * kArcsecToRad, 2)),
       cusum_(static_cast<std::size_t>(gyro_count), 0.0),
       mean_square_(static_cast<std::size_t>(gyro_count), 0.0),

@@ -14,7 +14,7 @@
 // (p = the budget's kReferenceNoiseMatch share per sample, n the block's samples: the mean run length without
 // a fault is at least 1/(p·n) blocks, Wald's bound) names the gyro. From then on the gyro's white rate noise
 // in the filter is N_i²·λ_i: λ_i starts where covariance matching puts it (m_i, the mean square of d_iᵀz over
-// reference_check_window_s, less the reference's variance r is the a-priori error variance P along d_i; a
+// reference_window_s, less the reference's variance r is the a-priori error variance P along d_i; a
 // step noise q·T along d_i has that steady state when q·T = P²/(P + r)) and then follows the blocks,
 // λ_i ← λ_i·e^{γ(u_i − 1)} (γ = kBlockMatchGain = 0.3), which settles where the block means are as the filter
 // predicts them (E u_i = 1); 1 ≤ λ_i ≤ kMaxNoiseRatio². At the detection the attitude's variance along d_i

@@ -268,7 +268,7 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   // per axis, a constant offset for the level test: its reference k grows by kLevelMarginSigma/√M, which
   // absorbs such an offset (a larger one, rarer than 3σ, only hastens the test's false alarms in that
   // episode).
-  s.level_epochs = std::max(2, static_cast<int>(std::lround(config.isolation_window_s / period_s_)));
+  s.level_epochs = std::max(2, static_cast<int>(std::lround(design::isolation_window_s / period_s_)));
   s.level_k = s.cusum_k + kLevelMarginSigma / std::sqrt(static_cast<double>(s.level_epochs));
   s.level_h = cusum_threshold(s.dof, s.level_k, cusum_arl0_epochs(config), averaged_wander) +
               quantization_margin(s, mask, s.level_k);

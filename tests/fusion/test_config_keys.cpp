@@ -1,6 +1,7 @@
 // The `pipeline:` keys' one table (fdi/src/config_keys.cpp): the example file and docs/fdi.md name every
 // key and no other, every range refuses a value just outside it with a message naming the key, and the
-// listing (tetra replay --config-keys) shows each key's unit, range and default.
+// listing (tetra replay --config-keys) shows each key's unit, range and default. Its second section, the
+// fixed design constants: listed with their unit and value, named in docs/fdi.md, refused in a file.
 #include <cmath>
 #include <limits>
 #include <regex>
@@ -25,6 +26,12 @@ std::set<std::string> table_names() {
   return names;
 }
 
+std::set<std::string> constant_names() {
+  std::set<std::string> names;
+  for (const auto& constant : design_constants()) names.insert(constant.name);
+  return names;
+}
+
 // The keys a text names: in YAML lines "  key:" or commented "  # key:"; in Markdown rows "| `key` |".
 std::set<std::string> names_matching(const std::string& text, const std::regex& pattern) {
   std::set<std::string> names;
@@ -37,11 +44,13 @@ std::set<std::string> names_matching(const std::string& text, const std::regex& 
   return names;
 }
 
+void expect_same_names(const std::set<std::string>& named, const std::set<std::string>& table,
+                       const std::string& where) {
+  for (const auto& name : table) EXPECT_EQ(named.count(name), 1U) << where << " does not name " << name;
+  for (const auto& name : named) EXPECT_EQ(table.count(name), 1U) << where << " names unknown " << name;
+}
 void expect_same_keys(const std::set<std::string>& named, const std::string& where) {
-  for (const auto& name : table_names())
-    EXPECT_EQ(named.count(name), 1U) << where << " does not name " << name;
-  for (const auto& name : named)
-    EXPECT_EQ(table_names().count(name), 1U) << where << " names unknown " << name;
+  expect_same_names(named, table_names(), where);
 }
 
 TEST(ConfigKeys, TheExampleFileNamesEveryKeyAndNoOther) {
@@ -60,15 +69,19 @@ TEST(ConfigKeys, TheDocsConfigurationSectionNamesEveryKeyAndNoOther) {
   ASSERT_NE(start, std::string::npos);
   const auto end = doc.find("\n## ", start + 1);
   const std::string section = doc.substr(start, end == std::string::npos ? std::string::npos : end - start);
-  expect_same_keys(names_matching(section, std::regex(R"(^\| `([A-Za-z0-9_]+)` \|)")),
-                   "docs/fdi.md \"Configuration\"");
+  // The keys' table, then the constants' (under their own heading).
+  const auto constants = section.find("\n### Fixed design constants");
+  ASSERT_NE(constants, std::string::npos);
+  const std::regex row(R"(^\| `([A-Za-z0-9_]+)` \|)");
+  expect_same_keys(names_matching(section.substr(0, constants), row), "docs/fdi.md \"Configuration\"");
+  expect_same_names(names_matching(section.substr(constants), row), constant_names(),
+                    "docs/fdi.md \"Fixed design constants\"");
   EXPECT_NE(section.find("tetra replay --config-keys"), std::string::npos);
 }
 
-// Sets the key to v (an int key to v as a whole number).
+// Sets the key to v.
 void set(PipelineConfig& c, const ConfigKey& key, double v) {
   if (const auto* d = std::get_if<double PipelineConfig::*>(&key.field)) c.*(*d) = v;
-  if (const auto* i = std::get_if<int PipelineConfig::*>(&key.field)) c.*(*i) = static_cast<int>(v);
   if (const auto* o = std::get_if<std::optional<double> PipelineConfig::*>(&key.field)) c.*(*o) = v;
 }
 
@@ -78,14 +91,12 @@ bool numeric(const ConfigKey& key) {
 }
 
 // The value just beyond a limit (outward is -1 at the minimum, +1 at the maximum), and just within it.
-double just_outside(const ConfigKey& key, const ConfigLimit& limit, double outward) {
+double just_outside(const ConfigLimit& limit, double outward) {
   if (limit.edge == Edge::kOpen) return limit.value;
-  if (std::holds_alternative<int PipelineConfig::*>(key.field)) return limit.value + outward;
   return std::nextafter(limit.value, outward * std::numeric_limits<double>::infinity());
 }
-double just_inside(const ConfigKey& key, const ConfigLimit& limit, double outward) {
+double just_inside(const ConfigLimit& limit, double outward) {
   if (limit.edge == Edge::kClosed) return limit.value;
-  if (std::holds_alternative<int PipelineConfig::*>(key.field)) return limit.value - outward;
   return std::nextafter(limit.value, -outward * std::numeric_limits<double>::infinity());
 }
 
@@ -97,9 +108,9 @@ TEST(ConfigKeys, EveryRangeRefusesAValueJustOutsideItNamingTheKey) {
       if (limit.edge == Edge::kNone) continue;
       ++limits;
       PipelineConfig c;
-      set(c, key, just_inside(key, limit, outward));
-      EXPECT_TRUE(validate(c).ok()) << key.name << " refuses " << just_inside(key, limit, outward);
-      const double bad = just_outside(key, limit, outward);
+      set(c, key, just_inside(limit, outward));
+      EXPECT_TRUE(validate(c).ok()) << key.name << " refuses " << just_inside(limit, outward);
+      const double bad = just_outside(limit, outward);
       set(c, key, bad);
       const Status st = validate(c);
       ASSERT_FALSE(st.ok()) << key.name << " accepts " << bad;
@@ -121,11 +132,9 @@ TEST(ConfigKeys, EveryRangeRefusesAValueJustOutsideItNamingTheKey) {
     }
     PipelineConfig c;  // every number must be finite
     set(c, key, std::numeric_limits<double>::quiet_NaN());
-    if (!std::holds_alternative<int PipelineConfig::*>(key.field)) {
-      EXPECT_FALSE(validate(c).ok()) << key.name;
-    }
+    EXPECT_FALSE(validate(c).ok()) << key.name;
   }
-  EXPECT_GE(limits, 55);  // every number has at least a lower limit, many an upper one too
+  EXPECT_GE(limits, 31);  // every number has at least a lower limit, some an upper one too
 }
 
 TEST(ConfigKeys, EveryNumberHasALimitAndEveryKeyADescription) {
@@ -136,7 +145,42 @@ TEST(ConfigKeys, EveryNumberHasALimitAndEveryKeyADescription) {
       EXPECT_NE(key.min.edge, Edge::kNone) << key.name;
     }
   }
-  EXPECT_EQ(config_keys().size(), 43U);  // 41 scalar keys, latitude_deg and initial_q_wxyz
+  for (const auto& constant : design_constants()) {
+    EXPECT_GT(std::string(constant.description).size(), 10U) << constant.name;
+    EXPECT_FALSE(std::string(constant.unit).empty()) << constant.name;
+    EXPECT_TRUE(std::isfinite(constant.value)) << constant.name;
+    EXPECT_EQ(table_names().count(constant.name), 0U) << constant.name << " is a key and a constant";
+  }
+}
+
+TEST(ConfigKeys, AtMostThirtyKeys) {
+  // Issue 37's target: the `pipeline:` map at 30 keys or fewer (latitude_deg and initial_q_wxyz counted);
+  // what a user has no physical reason to set is a fixed design constant.
+  EXPECT_LE(config_keys().size(), 30U);
+  EXPECT_EQ(config_keys().size(), 29U);
+  EXPECT_EQ(design_constants().size(), 16U);
+}
+
+TEST(ConfigKeys, AFileThatSetsADesignConstantIsRefusedNamingIt) {
+  for (const auto& constant : design_constants()) {
+    std::ostringstream yaml;
+    yaml.precision(17);
+    yaml << "pipeline:\n  max_gap_s: 2\n  " << constant.name << ": " << constant.value << "\n";
+    const auto parsed = parse_pipeline_config(yaml.str(), "cfg.yaml");
+    ASSERT_FALSE(parsed.ok()) << yaml.str();
+    const std::string& message = parsed.error().message;
+    EXPECT_NE(
+        message.find(std::string("cfg.yaml:3: pipeline.") + constant.name + ": a fixed design constant"),
+        std::string::npos)
+        << message;
+  }
+  // A name neither a key nor a constant: unknown, the message listing the keys alone.
+  const auto unknown = parse_pipeline_config("pipeline:\n  noise_windw: 30\n", "cfg.yaml");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().message.find("cfg.yaml:2: pipeline: unknown key 'noise_windw'"),
+            std::string::npos)
+      << unknown.error().message;
+  EXPECT_EQ(unknown.error().message.find("noise_window"), std::string::npos) << unknown.error().message;
 }
 
 TEST(ConfigKeys, TheInitialQuaternionMustBeAUnitOne) {
@@ -163,6 +207,24 @@ TEST(ConfigKeys, TheListingShowsEveryKeysUnitRangeAndDefault) {
     EXPECT_NE(line.find("  " + range_text(key) + "  "), std::string::npos) << line;
     EXPECT_NE(line.find("  " + value_text(defaults, key) + "  "), std::string::npos) << line;
     EXPECT_NE(line.find(key.description), std::string::npos) << line;
+  }
+  // The constants under their own heading: name, unit, value, meaning.
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_TRUE(line.empty()) << line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line.rfind("fixed design constants", 0), 0U) << line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line.rfind("constant ", 0), 0U) << line;
+  for (const auto& constant : design_constants()) {
+    ASSERT_TRUE(std::getline(in, line)) << constant.name;
+    std::istringstream row(line);
+    std::string name, unit;
+    double value = 0.0;
+    row >> name >> unit >> value;
+    EXPECT_EQ(name, constant.name);
+    EXPECT_EQ(unit, constant.unit);
+    EXPECT_EQ(value, constant.value) << line;
+    EXPECT_NE(line.find(constant.description), std::string::npos) << line;
   }
   EXPECT_FALSE(std::getline(in, line));
 

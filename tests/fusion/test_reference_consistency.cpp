@@ -234,7 +234,7 @@ TEST(ReferenceConsistency, ARejectionAGyroFaultMayHaveCausedIsWithdrawnAtItsDete
 
 TEST(ReferenceConsistency, AMisidentifiedReferenceIsAJumpNeverSetsTheAttitudeAndIsUsedAgain) {
   // 0.5° off for 12 s from 100 s: `jump` at its first sample; the attitude stays the gyros' (never set onto
-  // it); used again 30 s after the episode ends (one block of the tests, reference_check_window_s), the error
+  // it); used again 30 s after the episode ends (one block of the tests, reference_window_s), the error
   // back to arcseconds.
   sim::Scenario sc = scenario(300.0, true);
   sc.reference.misid_deg = 0.5;

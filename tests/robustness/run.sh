@@ -251,9 +251,13 @@ check yaml "hexadecimal number in YAML" 2 "hexcal.yaml:[0-9]+: gyros\[0\].bias_V
 cal_with 's/^unit:.*/unit: [a, b]/' typeunit.yaml
 check yaml "type error names the key" 2 "typeunit.yaml:[0-9]+: unit: expected a text value" "" -- \
   replay "$LOG" --calibration typeunit.yaml --attitude a.csv --events e.jsonl
-printf 'pipeline:\n  stuck_repeat_count: abc\n' >badint.yaml
-check yaml "bad integer names the key" 2 "badint.yaml:2: pipeline.stuck_repeat_count" "" -- \
-  replay "$LOG" --calibration "$CAL" --config badint.yaml --attitude a.csv --events e.jsonl
+printf 'pipeline:\n  onset_sigma: abc\n' >badnum.yaml
+check yaml "bad number names the key" 2 "badnum.yaml:2: pipeline.onset_sigma: 'abc' is not a number" "" -- \
+  replay "$LOG" --calibration "$CAL" --config badnum.yaml --attitude a.csv --events e.jsonl
+printf 'pipeline:\n  stuck_repeat_count: 3\n' >constant.yaml
+check yaml "a fixed design constant set in a file names it" 2 \
+  "constant.yaml:2: pipeline.stuck_repeat_count: a fixed design constant \(10 samples\)" "" -- \
+  replay "$LOG" --calibration "$CAL" --config constant.yaml --attitude a.csv --events e.jsonl
 # The first data row (the line after the header) with its g1 cell replaced.
 first_row=$(grep -n '^time_s' "$LOG" | cut -d: -f1)
 first_row=$((first_row + 1))

@@ -43,24 +43,15 @@ struct PipelineConfig {
   double clear_after_s = 30.0;  //!< [s] no alarm for this long ends a SUSPECT episode
 
   // --- isolation
-  double isolation_window_s = 5.0;                //!< [s] evidence is sought this long before `unisolated`
   double max_angular_acceleration_dps2 = 1.0e-3;  //!< [deg/s²] bound on the vehicle's angular acceleration
   double onset_sigma = 5.0;                       //!< [σ] margin of the onset (physical possibility) test
-  int onset_pre_epochs = 20;                      //!< [epochs] window before the estimated onset
-  int onset_post_max_epochs = 50;                 //!< [epochs] at most this many epochs after the onset
-  int onset_confirm_epochs = 10;           //!< [epochs] an outlier this persistent is a step, not a spike
-  double dropout_timeout_s = 1.0;          //!< [s] absent (dropout) or invalid (invalid) this long
-  double max_gap_s = 2.0;                  //!< [s] no epoch for longer than this: a `gap` event
-  int stuck_repeat_count = 10;             //!< [samples] identical raw values in a row → stuck
-  int noise_window = 30;                   //!< [samples] window of the noise-level (2nd difference) test
-  double noise_high_ratio = 4.0;           //!< [-] robust noise level / expected above this → noise
-  double noise_low_ratio = 0.05;           //!< [-] robust noise level / expected below this → stuck
-  int spike_count = 3;                     //!< [-] this many one-epoch outliers in the window → spike
-  double spike_window_s = 120.0;           //!< [s] window of the spike count
-  double reference_window_s = 30.0;        //!< [s] window of the reference comparison
+  double dropout_timeout_s = 1.0;                 //!< [s] absent (dropout) or invalid (invalid) this long
+  double max_gap_s = 2.0;                         //!< [s] no epoch for longer than this: a `gap` event
+  double noise_high_ratio = 4.0;                  //!< [-] robust noise level / expected above this → noise
+  //! [s] window of the reference comparison and block of the reference's own tests (docs/fdi.md)
+  double reference_window_s = 30.0;
   double reference_sigma_arcsec = 5.0;     //!< [arcsec] 1σ per axis of the attitude reference
   double reference_threshold_sigma = 6.0;  //!< [σ] reference disagreement threshold
-  int reference_confirm_count = 3;         //!< [-] consecutive reference comparisons that must agree
   //! false: a gyro isolated as faulty stays in the solution (detection and isolation still run and
   //! report; for experiments that measure what exclusion is worth). The `isolated` event then says
   //! "gyro kept" and detection starts again; replay, the service and the closed-loop simulator alike.
@@ -75,15 +66,8 @@ struct PipelineConfig {
   double initial_sigma_deg = 0.1;
   //! [s] correlation time T_c of the Gauss–Markov bias that models each gyro's bias instability B.
   double bias_instability_correlation_s = 100.0;
-  //! [-] the last of this many reference samples in a row that the gate would reject sets the attitude.
-  int reference_gate_reset_count = 10;
 
   // --- the reference as a sensor that can fail (docs/fdi.md, "Reference consistency")
-  double reference_check_window_s = 30.0;  //!< [s] window of the NIS and lag tests of the reference
-  double reference_bias_window_s = 120.0;  //!< [s] window of the mean-innovation (bias) test
-  //! [-] a reference rejected for `nis` alone is used again with its noise re-estimated from its samples
-  //! (upper confidence bound) when that is at most this times reference_sigma_arcsec (1: never)
-  double reference_noise_max_factor = 3.0;
   //! [arcsec] 1σ per axis of the reference's slowly varying error its specification states (thermo-elastic
   //! bias, low-spatial-frequency error): the filter follows it unseen, so sigma carries it (0: none stated)
   double reference_bias_arcsec = 0.0;
@@ -106,6 +90,33 @@ struct PipelineConfig {
   double calibration_error_sigmas = 3.0;
 };
 
+//! Fixed design constants: values the detectors are built around that a user has no physical reason to
+//! set. Each value is declared here once; its unit and meaning are rows of the same table as the keys
+//! (fdi/src/config_keys.cpp, design_constants()), listed by `tetra replay --config-keys` under their own
+//! heading and in docs/fdi.md ("Configuration"). A `pipeline:` map that sets one is an error naming the
+//! file, the line and the constant.
+namespace design {
+// --- detection and isolation on the parity residual
+inline constexpr double isolation_window_s = 5.0;  //!< [s] evidence sought this long before `unisolated`
+inline constexpr int onset_pre_epochs = 20;        //!< [epochs] window before the estimated onset
+inline constexpr int onset_post_max_epochs = 50;   //!< [epochs] at most this many epochs after the onset
+inline constexpr int onset_min_post_epochs = 20;   //!< [epochs] the onset test judges from this many on
+inline constexpr int onset_confirm_epochs = 10;    //!< [epochs] an outlier this persistent is a step
+// --- a gyro's own samples
+inline constexpr int stuck_repeat_count = 10;         //!< [samples] identical raw values in a row: stuck
+inline constexpr int stuck_repeat_isolated = 5;       //!< [samples] repeats that make an isolated fault stuck
+inline constexpr int noise_window = 30;               //!< [samples] window of the noise-level tests
+inline constexpr double noise_low_ratio = 0.05;       //!< [-] robust noise level / expected below: stuck
+inline constexpr double noise_raised_fraction = 0.5;  //!< [-] of noise_high_ratio: a raised noise level
+inline constexpr int spike_count = 3;            //!< [-] confirmed outliers within spike_window_s: spikes
+inline constexpr double spike_window_s = 120.0;  //!< [s] window of the spike count
+// --- the reference
+inline constexpr int reference_confirm_count = 3;         //!< [-] consecutive comparisons that must agree
+inline constexpr int reference_gate_reset_count = 10;     //!< [samples] gate rejections that set the attitude
+inline constexpr double reference_bias_window_s = 120.0;  //!< [s] block of the mean-innovation test
+inline constexpr double reference_noise_max_factor = 3.0;  //!< [-] × reference_sigma_arcsec: re-estimate
+}  // namespace design
+
 //! Parses a `pipeline:` YAML map (unknown keys are errors naming the line); `source` names the file.
 Result<PipelineConfig> pipeline_config_from_yaml(const YAML::Node& node, const std::string& source);
 //! Reads a YAML file whose top level holds a `pipeline:` map (other top-level keys are ignored,
@@ -117,7 +128,8 @@ Result<PipelineConfig> parse_pipeline_config(const std::string& yaml_text, const
 Status validate(const PipelineConfig& config);
 //! Multi-line "key: value" echo of every key, for start-up logs.
 std::string describe(const PipelineConfig& config);
-//! Every key as a table, one line each: key, unit, range, default, meaning (tetra replay --config-keys).
+//! Every key as a table, one line each: key, unit, range, default, meaning; then the fixed design
+//! constants, one line each: name, unit, value, meaning (tetra replay --config-keys).
 std::string describe_keys();
 //! A YAML file with a `pipeline:` map of every key at its default, each after a comment with its unit,
 //! range and meaning: examples/fusion.yaml (tetra replay --config-example).

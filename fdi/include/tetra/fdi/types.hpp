@@ -55,7 +55,7 @@ enum class EventType : std::uint8_t {
   kFdiAvailable,
   kGap,                //!< no epoch for longer than max_gap_s (statistic: the gap's length [s])
   kReferenceRejected,  //!< the attitude reference failed a consistency test (why: ReferenceCheck)
-  kReferenceAccepted,  //!< a rejected reference passed every test for reference_check_window_s: used again
+  kReferenceAccepted,  //!< a rejected reference passed every test for reference_window_s: used again
   kReferenceLate,      //!< a reference stamped beyond the fusion horizon (statistic: how late [s]): left out
   kNoiseModel,  //!< the data show the noise model optimistic: a model opened to what they show (detail:
                 //!< which)
