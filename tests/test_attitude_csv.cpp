@@ -2,10 +2,7 @@
 // buffer: the same text as a row built cell by cell with append_double, within attitude_row_max_bytes for the
 // widest numbers, and the gyros cell cached per mask.
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <limits>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -14,7 +11,6 @@
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/report/attitude_csv.hpp"
-#include "tetra/report/shortest_double.hpp"
 
 namespace tetra::report {
 namespace {
@@ -103,59 +99,6 @@ TEST(AttitudeCsv, WidestRowFitsTheBound) {
   append_attitude_row(row, widest, a, n);
   EXPECT_LE(row.size(), attitude_row_max_bytes(n));
   EXPECT_EQ(row, row_cell_by_cell(widest, a, n));
-}
-
-// format_shortest is format_double's text: for the edges of each layout (fixed, point inside, leading
-// zeros, scientific, three exponent digits, subnormals, whole numbers about 2^53) and for random bit
-// patterns, random binary and random decimal magnitudes.
-std::string with(char* (*format)(char*, double), double value) {
-  char text[kMaxDoubleChars];
-  return std::string(text, format(text, value));
-}
-
-TEST(AttitudeCsv, ShortestIsFormatDouble) {
-  std::vector<double> values = {0.0,
-                                -0.0,
-                                1.0,
-                                -1.0,
-                                0.1,
-                                1e-5,
-                                1.5e-5,
-                                1e-4,
-                                1.2345e-4,
-                                12345.0,
-                                100000.0,
-                                123456.0,
-                                1e15,
-                                1e16,
-                                1e22,
-                                1e23,
-                                9007199254740991.0,
-                                9007199254740992.0,
-                                9007199254740993.0,
-                                123456789012345680000.0,
-                                5e-324,
-                                2.2250738585072014e-308,
-                                -1.7976931348623157e308,
-                                std::numeric_limits<double>::infinity(),
-                                -std::numeric_limits<double>::infinity(),
-                                std::numeric_limits<double>::quiet_NaN(),
-                                -std::numeric_limits<double>::quiet_NaN()};
-  for (int e = -30; e <= 30; ++e) {
-    for (const double m : {1.0, 1.5, 9.999999999999999, 1.2345678901234567})
-      values.push_back(m * std::pow(10.0, e));
-  }
-  std::mt19937_64 rng(7);
-  for (int i = 0; i < 300000; ++i) {
-    const std::uint64_t bits = rng();
-    double v = 0.0;
-    std::memcpy(&v, &bits, sizeof v);
-    values.push_back(v);
-    values.push_back(std::ldexp(static_cast<double>(rng() >> 11), static_cast<int>(rng() % 200) - 150));
-    values.push_back(static_cast<double>(static_cast<std::int64_t>(rng() % 2000001) - 1000000) /
-                     std::pow(10.0, static_cast<double>(rng() % 12)));
-  }
-  for (const double v : values) ASSERT_EQ(with(format_shortest, v), with(format_double, v)) << v;
 }
 
 TEST(AttitudeCsv, GyrosCellCacheFollowsTheMask) {

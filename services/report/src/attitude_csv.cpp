@@ -5,7 +5,6 @@
 
 #include "tetra/core/csv.hpp"
 #include "tetra/core/units.hpp"  // kRadToDeg
-#include "tetra/report/shortest_double.hpp"
 
 namespace tetra::report {
 
@@ -18,7 +17,7 @@ char* put(char* p, std::string_view text) {
 
 char* put_double(char* p, double value) {
   *p++ = ',';
-  return format_shortest(p, value);
+  return format_double(p, value);
 }
 
 // The longest mode name to_string(Mode) gives.
@@ -41,7 +40,7 @@ std::size_t attitude_row_max_bytes(int n_gyros) {
 
 char* format_attitude_row(char* out, double time_s, const fdi::AttitudeEstimate& attitude,
                           std::span<const double> bias_rad_s, int n_gyros, std::string_view gyros) {
-  char* p = format_shortest(out, time_s);
+  char* p = format_double(out, time_s);
   for (const double c : to_wxyz(attitude.q_RB)) p = put_double(p, c);
   for (int i = 0; i < 3; ++i) p = put_double(p, attitude.omega_BR_B_rad_s[i] * kRadToDeg);
   p = put_double(p, attitude.sigma_rad.norm() * kRadToDeg);  // 1σ of the total error angle
