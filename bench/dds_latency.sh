@@ -6,11 +6,14 @@
 #    with the service's gyro samples dispatched by a listener (default) and by the waitset, the four
 #    samples of an epoch written 100 us apart (asynchronous gyro streams) and back to back;
 # 3. ddsperf again, to bracket the (shared, noisy) machine's load.
+# FUSION_ARGS: more options for `tetra fusion`, e.g. FUSION_ARGS="--realtime 50" (docs/dds.md, "Real-time
+# scheduling"; ddsperf itself keeps the default scheduling).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
 DOMAIN=${TETRA_BENCH_DOMAIN:-201}
 RATE=${TETRA_BENCH_RATE:-200}
+read -r -a FUSION_ARGS <<< "${FUSION_ARGS:-}"
 export CYCLONEDDS_URI="file://$PWD/config/cyclonedds-loopback.xml"
 WORK=$(mktemp -d)
 FUSION=""
@@ -40,12 +43,14 @@ floor waitset
 run() {
   printf 'unit: tetra-1\ncalibration: cal.yaml\nsample_rate_hz: %s\ngyro_dispatch: %s\n' "$RATE" "$1" \
     > "$WORK/fusion.yaml"
-  "$BUILD/tetra" fusion --config "$WORK/fusion.yaml" --domain "$DOMAIN" --log-level warn > "$WORK/fusion.log" 2>&1 &
+  "$BUILD/tetra" fusion --config "$WORK/fusion.yaml" --domain "$DOMAIN" --log-level warn "${FUSION_ARGS[@]}" \
+    > "$WORK/fusion.log" 2>&1 &
   FUSION=$!
-  echo "-- service gyro_dispatch $1, Attitude received by a $2, samples ${3} us apart"
+  echo "-- service gyro_dispatch $1 ${FUSION_ARGS[*]}, Attitude received by a $2, samples ${3} us apart"
   "$BUILD/dds_latency" --domain "$DOMAIN" --epochs 3000 --rate "$RATE" --receive "$2" --gyro-spacing-us "$3" |
     tee -a "$WORK/tetra_$2"
   kill "$FUSION"; wait "$FUSION" || true; FUSION=""
+  grep -- "--realtime" "$WORK/fusion.log" || true  # what --realtime could not apply
 }
 echo "== tetra fusion: last GyroSample write -> Attitude receive, ${RATE} Hz"
 echo "   (compare listener with ddsperf's listener mode, waitset with its waitset mode)"

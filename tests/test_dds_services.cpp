@@ -528,6 +528,51 @@ TEST(DdsServices, DefaultLivelinessWriterMatchesAndAnotherUnitIsWarnedAbout) {
   EXPECT_EQ(fusion.signal_and_wait(SIGINT), 0);
 }
 
+TEST(DdsServices, RealtimeOptionLocksMemoryAndSchedulesTheStepThreadsOrWarnsAndRunsOn) {
+  // --realtime 10: mlockall and SCHED_FIFO for the waitset thread and the listener's (receive) thread,
+  // each applied or, without the privilege, warned about by name; either way the service fuses epochs.
+  for (const char* dispatch : {"listener", "waitset"}) {
+    const dds_domainid_t domain = std::string(dispatch) == "listener" ? 198 : 199;
+    ServiceFiles files(50.0, 1.0, "tetra-1", dispatch);
+    Observer observer(domain);
+    TetraProcess fusion({"fusion", "--config", files.config, "--domain", d(domain), "--realtime", "10"},
+                        files.dir.file("fusion.log"));
+    TetraProcess sim({"sim", "static", "--dds", "--dds-unit", "tetra-1", "--domain", d(domain), "--rate-hz",
+                      "50", "--minutes", "1", "--speed", "1"},
+                     files.dir.file("sim.log"));
+    ASSERT_TRUE(observer.wait_until([&] {
+      const auto it = observer.health.find("tetra-1");
+      return it != observer.health.end() && it->second.health.counters.epochs_accepted > 25;
+    })) << dispatch
+        << "\n"
+        << read_file(files.dir.file("fusion.log"));
+    EXPECT_EQ(fusion.signal_and_wait(SIGINT), 0);
+    const std::string log = read_file(files.dir.file("fusion.log"));
+    EXPECT_NE(log.find("realtime: memory locked, SCHED_FIFO priority 10"), std::string::npos) << log;
+    const bool locked = log.find("--realtime: memory locked (mlockall") != std::string::npos;
+    const bool lock_warned =
+        log.find("--realtime: mlockall(MCL_CURRENT | MCL_FUTURE) failed: ") != std::string::npos;
+    EXPECT_NE(locked, lock_warned) << log;
+    std::vector<std::string> threads = {"waitset thread"};
+    if (std::string(dispatch) == "listener") threads.emplace_back("receive thread (gyro listener)");
+    for (const auto& thread : threads) {
+      const bool fifo =
+          log.find("--realtime: " + thread + " under SCHED_FIFO at priority 10") != std::string::npos;
+      const bool warned = log.find("--realtime: " + thread +
+                                   ": pthread_setschedparam(SCHED_FIFO, 10) failed: ") != std::string::npos;
+      EXPECT_NE(fifo, warned) << thread << "\n" << log;
+    }
+    std::printf("[ figure ] --realtime with gyro_dispatch %s: memory %s\n", dispatch,
+                locked ? "locked" : "not locked (warned)");
+  }
+  // The priority is checked when the options are parsed.
+  for (const char* bad : {"0", "100", "high"}) {
+    const auto r = run_tetra(std::string("fusion --config /nonexistent/fusion.yaml --realtime ") + bad);
+    EXPECT_EQ(r.exit_status, 2) << bad;
+    EXPECT_NE(r.err.find("--realtime"), std::string::npos) << r.err;
+  }
+}
+
 TEST(DdsServices, CommandLineErrorsAndAbsentServicesGiveTheExitStatusOfTheContract) {
   // Bad usage or input: 2 and one line naming what is wrong.
   auto r = run_tetra("fusion --config /nonexistent/fusion.yaml");

@@ -171,6 +171,12 @@ std::string describe(const FusionConfig& config) {
       << '\n'
       << (config.security ? describe(*config.security) : std::string("security: none")) << '\n'
       << describe(config.ros2, config.unit) << '\n'
+      << "realtime: "
+      << (config.realtime_priority
+              ? "memory locked, SCHED_FIFO priority " + std::to_string(*config.realtime_priority) +
+                    " for the receive/step threads"
+              : std::string("off"))
+      << '\n'
       << "pipeline:\n"
       << fdi::describe(config.pipeline);
   return out.str();

@@ -9,6 +9,7 @@
 #include "tetra/dds/clock.hpp"
 #include "tetra/dds/convert.hpp"
 #include "tetra/dds/topics.hpp"
+#include "tetra/service/realtime.hpp"
 
 namespace tetra::service {
 
@@ -112,6 +113,10 @@ void FusionService::on_gyro_data(dds_entity_t, void* self) {
   auto& service = *static_cast<FusionService*>(self);
   const std::lock_guard lock(service.mutex_);
   if (service.listener_error_) return;
+  if (service.config_.realtime_priority && !service.listener_realtime_) {
+    service.listener_realtime_ = true;  // Cyclone's receive thread: the first callback is on it
+    make_step_thread_realtime(*service.config_.realtime_priority, "receive thread (gyro listener)");
+  }
   auto status = service.ingest(monotonic_ns());
   if (!status) service.listener_error_ = status.error();
   // An epoch still waiting for samples is due before the waitset thread would wake by itself.
@@ -124,7 +129,27 @@ void FusionService::stop_listener() {
   listening_ = false;
 }
 
+// --realtime: a failure is a warning naming what failed; the service goes on without it.
+void FusionService::make_step_thread_realtime(int priority, const char* thread) {
+  if (Status s = make_thread_realtime(priority); !s) {
+    spdlog::warn("fusion: --realtime: {}: {}", thread, s.error().message);
+    return;
+  }
+  spdlog::info("fusion: --realtime: {} under SCHED_FIFO at priority {}", thread, priority);
+}
+
+void FusionService::apply_realtime() {
+  if (!config_.realtime_priority) return;
+  if (Status s = lock_memory(); !s) {
+    spdlog::warn("fusion: --realtime: {}", s.error().message);
+  } else {
+    spdlog::info("fusion: --realtime: memory locked (mlockall: current and future pages)");
+  }
+  make_step_thread_realtime(*config_.realtime_priority, "waitset thread");
+}
+
 Status FusionService::run() {
+  apply_realtime();
   {
     const std::lock_guard lock(mutex_);
     started_ns_ = monotonic_ns();

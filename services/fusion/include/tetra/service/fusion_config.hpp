@@ -45,7 +45,10 @@ struct FusionConfig {
   std::optional<SecurityProfile> security;  //!< `security: PROFILE.yaml` (opt-in DDS Security; relative: to
                                             //!< the config file)
   Ros2ViewConfig ros2;                      //!< `ros2:` the optional ROS 2 view (docs/ros2.md)
-  std::string source;                       //!< the config file, for messages
+  //! `tetra fusion --realtime[=PRIORITY]` (not a key of the file): memory locked and the receive/step
+  //! threads under SCHED_FIFO at this priority (tetra/service/realtime.hpp); none: default scheduling.
+  std::optional<int> realtime_priority;
+  std::string source;  //!< the config file, for messages
 
   //! [ns] wall-clock time after which a silent gyro is absent: 3 sample periods / speed.
   std::int64_t deadline_ns() const;

@@ -70,6 +70,10 @@ class FusionService {
   //! Removes the listener; returns once no callback runs (call without holding mutex_).
   void stop_listener();
   Status loop();
+  //! --realtime (config_.realtime_priority): memory locked, this (the waitset) thread under SCHED_FIFO;
+  //! what fails is warned about and the service goes on.
+  void apply_realtime();
+  static void make_step_thread_realtime(int priority, const char* thread);
   //! Everything a waitset wake-up calls for: statuses, samples, commands, deadlines, timers.
   Status handle_wakeup(const std::vector<std::intptr_t>& triggered, std::int64_t now_ns);
   //! The gyro reader's statuses: sets `deadline_missed`, `matched_changed`.
@@ -125,6 +129,7 @@ class FusionService {
   std::int64_t scheduled_wake_ns_ = 0;   //!< [ns] when the waitset thread wakes by itself next
   std::optional<Error> listener_error_;  //!< a failure inside the listener, for run() to return
   bool listening_ = false;
+  bool listener_realtime_ = false;  //!< --realtime applied to the listener's thread (its first callback)
 
   std::atomic<bool> stop_requested_{false};
   dds::ShutdownSignal* shutdown_ = nullptr;  //!< SIGINT/SIGTERM stop run() too (optional)
