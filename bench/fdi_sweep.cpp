@@ -58,6 +58,7 @@ struct RunOutcome {
   int reference_rejections = 0;  //!< reference_rejected events (--reference 1)
   std::array<int, 7> by_test{};  //!< detections per DetectionTest
   double first_detected_s = -1.0;
+  int noise_model = 0;  //!< noise_model events (the data showed the noise optimistic)
 };
 
 //! One simulated run of `duration_s` straight into a pipeline; counts `detected` events.
@@ -117,6 +118,7 @@ RunOutcome run(int n, double duration_s, std::uint64_t seed, const std::vector<s
     if (g_reference) e.reference_q_RB = se.reference_q_RB;
     for (const auto& ev : pipeline->step(e).events) {
       out.reference_rejections += ev.type == fdi::EventType::kReferenceRejected ? 1 : 0;
+      out.noise_model += ev.type == fdi::EventType::kNoiseModel ? 1 : 0;
       if (ev.type != fdi::EventType::kDetected) continue;
       ++out.detections;
       ++out.by_test[static_cast<std::size_t>(ev.test)];
@@ -194,12 +196,16 @@ void false_alarm_sweep(int n, int hours, int run_hours, int jobs) {
   std::vector<int> detections(static_cast<std::size_t>(runs), 0);
   std::vector<int> rejections(static_cast<std::size_t>(runs), 0);
   std::vector<std::array<int, 7>> by_test(static_cast<std::size_t>(runs));
+  std::vector<double> first_s(static_cast<std::size_t>(runs), -1.0);
+  std::vector<int> noise_models(static_cast<std::size_t>(runs), 0);
   parallel(runs, jobs, [&](int i) {
     const RunOutcome o = run(n, 3600.0 * run_hours,
                              1000003ULL * static_cast<std::uint64_t>(n) + static_cast<std::uint64_t>(i), {});
     detections[static_cast<std::size_t>(i)] = o.detections;
     rejections[static_cast<std::size_t>(i)] = o.reference_rejections;
     by_test[static_cast<std::size_t>(i)] = o.by_test;
+    first_s[static_cast<std::size_t>(i)] = o.first_detected_s;
+    noise_models[static_cast<std::size_t>(i)] = o.noise_model;
   });
   int total = 0;
   int runs_with = 0;
@@ -222,8 +228,14 @@ void false_alarm_sweep(int n, int hours, int run_hours, int jobs) {
     std::printf("N=%d  detections by test:", n);
     for (std::size_t j = 1; j < tests.size(); ++j)
       if (tests[j] > 0) std::printf(" %s %d", fdi::to_string(static_cast<fdi::DetectionTest>(j)), tests[j]);
+    std::printf("; the first of a run at [h into it]:");
+    for (double f : first_s)
+      if (f >= 0.0) std::printf(" %.2f", f / 3600.0);
     std::printf("\n");
   }
+  int widened = 0;
+  for (int w : noise_models) widened += w;
+  if (widened > 0) std::printf("N=%d  noise_model events: %d\n", n, widened);
   if (g_reference) {
     int rejected = 0;
     for (int r : rejections) rejected += r;

@@ -69,8 +69,8 @@ const std::vector<ConfigKey>& config_keys() {
        "smallest bias step on any gyro the CUSUM is sized for (k = delta_min/2); also the parity block "
        "match's lower end"},
       {"rate_random_walk_horizon_s", &C::rate_random_walk_horizon_s, "s", above(0), kFree,
-       "a gyro's rate random walk K and rate ramp R enter the detectors as a wandering bias of 1 sigma "
-       "K*sqrt(horizon) and a bound R*horizon (a mission whose runs are longer sets their length)"},
+       "the horizon H of a gyro's rate random walk K and rate ramp R where they are bounded, not tracked: "
+       "1 sigma K*sqrt(H) (the average's reach, the tracker's prior) and R*H on a subset missing a sample"},
       {"clear_after_s", &C::clear_after_s, "s", above(0), kFree,
        "no alarm for this long ends a SUSPECT episode (cleared)"},
       // --- isolation

@@ -250,6 +250,7 @@ Mekf::Mekf(std::vector<GyroNoiseModel> gyros)
   added_gm_var_.assign(gyros_.size(), 0.0);
   added_rrw_var_.assign(gyros_.size(), 0.0);
   step_pinv_ = Eigen::Matrix3Xd::Zero(3, n_);
+  for (const auto& g : gyros_) ramps_ |= g.ramp_rad_s2 > 0.0;
   reset(0.0);
 }
 
@@ -261,6 +262,7 @@ void Mekf::reset(double attitude_sigma_rad) {
   std::fill(added_noise_.begin(), added_noise_.end(), 0.0);
   std::fill(added_gm_var_.begin(), added_gm_var_.end(), 0.0);
   std::fill(added_rrw_var_.begin(), added_rrw_var_.end(), 0.0);
+  ramp_age_s_ = ramp_taken_s_ = 0.0;
   gm_dt_s_ = -1.0;
   step_dt_s_ = -1.0;  // the step constants again from the model's noise
   P_.topLeftCorner<3, 3>().diagonal().setConstant(attitude_sigma_rad * attitude_sigma_rad);
@@ -326,9 +328,7 @@ void Mekf::restore_biases(const double* state, GyroMask gyros, double elapsed_s)
   }
   for (int i = 0; i < n_; ++i) {
     if (!restored(i)) continue;
-    const auto& g = gyros_[static_cast<std::size_t>(i)];
-    P_(c_of(i), c_of(i)) +=
-        (g.rrw_rad_s_rts * g.rrw_rad_s_rts + added_rrw_var_[static_cast<std::size_t>(i)]) * elapsed_s;
+    P_(c_of(i), c_of(i)) += walk_var_rate(static_cast<std::size_t>(i)) * elapsed_s;
     const double d = decay(n_ + i);
     P_(g_of(i), g_of(i)) += gm_stationary_var(static_cast<std::size_t>(i)) * (1.0 - d * d);
   }
@@ -410,6 +410,7 @@ void Mekf::propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, G
   const Eigen::Matrix3d A = rotation.toRotationMatrix().transpose();
   const Eigen::Matrix3d gamma = rotation_integral(omega_B_rad_s, dt_s);
   const GyroMask used = mask & ~frozen_mask_;
+  age_ramps(dt_s);
   refresh_step_constants(pinv, used, dt_s);
   for (int i = 0; i < n_; ++i) {
     if (has_gyro(used, i + 1))
@@ -422,6 +423,15 @@ void Mekf::propagate(const Quaternion& rotation, const Eigen::Matrix3Xd& pinv, G
   prior_var_ += prior_noise_;                // the model's K² only: an opened model does not widen the prior
   bias_.tail(n_).array() *= decay_.array();  // 1 on a frozen gyro
   // Symmetric by construction but for the attitude block (symmetrized above).
+}
+
+void Mekf::age_ramps(double dt_s) {
+  if (!ramps_) return;
+  ramp_age_s_ += dt_s;
+  if (ramp_age_s_ < ramp_taken_s_) return;
+  ramp_taken_s_ = 1.01 * ramp_age_s_ + 1.0;
+  gm_dt_s_ = -1.0;  // the bias transitions and the step constants recomputed for the new age
+  step_dt_s_ = -1.0;
 }
 
 void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, double dt_s) {
@@ -437,7 +447,8 @@ void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, d
     bias_noise_[i] = frozen ? 0.0 : rrw_var_[k];
     bias_noise_[n_ + i] = frozen ? 0.0 : gm_var_[k];
     const auto& g = gyros_[k];
-    prior_noise_[i] = frozen ? 0.0 : g.rrw_rad_s_rts * g.rrw_rad_s_rts * dt_s;
+    const double r2 = 2.0 * g.ramp_rad_s2 * g.ramp_rad_s2 * ramp_taken_s_;
+    prior_noise_[i] = frozen ? 0.0 : (g.rrw_rad_s_rts * g.rrw_rad_s_rts + r2) * dt_s;
     if (has_gyro(used, i + 1))
       q_theta_ +=
           pinv.col(i) * pinv.col(i).transpose() * ((g.arw_rad_rts * g.arw_rad_rts + added_noise_[k]) * dt_s);
@@ -463,7 +474,7 @@ void Mekf::gauss_markov_transitions(double dt_s) {
     // The Gauss–Markov bias decays within the step: its mean over the step is κ·g, κ = T_c(1 − φ)/Δt.
     gm_kappa_[i] =
         stationary > 0.0 ? g.gm_correlation_s * -std::expm1(-dt_s / g.gm_correlation_s) / dt_s : 1.0;
-    rrw_var_[i] = (g.rrw_rad_s_rts * g.rrw_rad_s_rts + added_rrw_var_[i]) * dt_s;
+    rrw_var_[i] = walk_var_rate(i) * dt_s;
     gm_var_[i] = stationary * (1.0 - gm_phi_[i] * gm_phi_[i]);
   }
   gm_dt_s_ = dt_s;

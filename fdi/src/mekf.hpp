@@ -30,6 +30,9 @@ struct GyroNoiseModel {
   double rrw_rad_s_rts = 0.0;       //!< [rad/s/√s] rate random walk K (drives c_i)
   double gm_sigma_rad_s = 0.0;      //!< [rad/s] stationary σ of g_i (1.0760·B)
   double gm_correlation_s = 100.0;  //!< [s] T_c of g_i
+  //! [rad/s²] |R|, the stated rate ramp: c_i's variance grows by 2R²·t per second, t the time since the
+  //! reset, so its 1σ is R·t (a bias that wanders without bound, not a margin over a horizon)
+  double ramp_rad_s2 = 0.0;
 };
 
 //! The outcome of one reference sample.
@@ -141,6 +144,8 @@ class Mekf {
   void set_prior(int i);
   void gauss_markov_transitions(double dt_s);
   void refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, double dt_s);
+  //! The stated ramps one step older: the step's constants recomputed when their age is passed.
+  void age_ramps(double dt_s);
   void propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta);
   //! [rad²/s²] gyro index `i`'s Gauss–Markov stationary variance: the model's σ_GM² and any added.
   double gm_stationary_var(std::size_t i) const {
@@ -159,6 +164,17 @@ class Mekf {
   std::vector<double> rrw_var_;  //!< [rad²/s²] per gyro: K²·Δt, the slow bias's variance gain over a step
   std::vector<double> gm_var_;  //!< [rad²/s²] per gyro: σ_GM²(1 − φ²), the Gauss–Markov's over a step
   double gm_dt_s_ = -1.0;
+  //! [s] the time since the reset (the stated ramps' age), and the age the step's constants take for it: at
+  //! least the true age (recomputed when it is passed, then 1 % + 1 s ahead); only with a stated ramp
+  double ramp_age_s_ = 0.0;
+  double ramp_taken_s_ = 0.0;
+  bool ramps_ = false;
+  //! [rad²/s³] gyro i's slow bias variance rate: K², an opened model's, and the stated ramp's 2R²·t
+  double walk_var_rate(std::size_t i) const {
+    const double r = gyros_[i].ramp_rad_s2;
+    return gyros_[i].rrw_rad_s_rts * gyros_[i].rrw_rad_s_rts + added_rrw_var_[i] +
+           2.0 * r * r * ramp_taken_s_;
+  }
   //! What a step keeps while the gyro set, the frozen set, the rate solution and Δt stay the same (nearly
   //! always), recomputed when the key (`step_pinv_`, `step_used_`, `step_frozen_`, `step_dt_s_`) changes:
   //! the attitude's process noise Qθ = H*·diag(N²)·H*ᵀ·Δt; D on the Gauss–Markov states, d per gyro

@@ -62,6 +62,8 @@ ParityDetector::ParityDetector(int n_gyros, double nominal_window_s)
   p_ = Eigen::VectorXd::Zero(dmax);
   p_raw_ = Eigen::VectorXd::Zero(dmax);
   dp_ = Eigen::VectorXd::Zero(dmax);
+  wander_mean_ = Eigen::VectorXd::Zero(dmax);
+  wander_in_ = Eigen::VectorXd::Zero(dmax);
 }
 
 void ParityDetector::restart(std::int64_t next_index) {
@@ -73,6 +75,7 @@ void ParityDetector::restart(std::int64_t next_index) {
   p_ema_.setZero();
   p_slow_.setZero();
   slow_age_s_ = 0.0;
+  restart_wander();
 }
 
 void ParityDetector::open_episode() {
@@ -113,10 +116,18 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   // leave out the calibration's term, bounded by `calibration_bound` in either whitening (the sample's
   // columns are no longer than the white noise's). The CUSUM sums: it takes the parity as it is and the bound
   // in its reference (below), since moving each sample towards 0 barely moves the mean of noisy samples.
-  const double sum_sq = apply_parity(s, frame.usable, frame.y_rad_s.data(), sqrt_period, p_.data());
+  double sum_sq = apply_parity(s, frame.usable, frame.y_rad_s.data(), sqrt_period, p_.data());
   const auto dof = static_cast<Eigen::Index>(s.dof);
   p_raw_.head(dof) = p_.head(dof);
-  double chi2 = shrink_by(p_.data(), s.dof, calibration_bound, sum_sq);
+  // A tracked wander is taken off the full subset's parity (its mean before this epoch), and with it its
+  // share of the bound.
+  double relief = 0.0;
+  if (s.wander_step_var > 0.0 && frame.usable == active && cusum_mask_ == active && !wander_fresh_) {
+    p_.head(dof) -= wander_mean_.head(dof);
+    sum_sq = p_.head(dof).squaredNorm();
+    relief = s.wander_relief;
+  }
+  double chi2 = shrink_by(p_.data(), s.dof, calibration_bound - relief, sum_sq);
   if (s.quantized)
     chi2 = shrink_by(
         dp_.data(), s.dof, calibration_bound,
@@ -137,6 +148,7 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
     p_ema_.setZero();
     p_slow_.setZero();
     slow_age_s_ = 0.0;
+    restart_wander();
   }
   const double alpha = std::min(1.0, frame.dt_s / 2.0);  // EMA time constant 2 s
   for (int r = 0; r < s.dof; ++r) p_ema_[r] += alpha * (p_[r] - p_ema_[r]);
@@ -151,8 +163,10 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   slow_age_s_ += frame.dt_s;
   std::int64_t onset = d.onset_index;
   // A calibration term m with |m| ≤ D moves the CUSUM's sum by at most D per epoch: with the reference k + D
-  // the statistic never exceeds that of the noise alone (d = 1; for d ≥ 2 its radial drift).
-  const double stat = cusum_.step(p_raw_, s.dof, s.cusum_k + calibration_bound, frame.index, onset);
+  // the statistic never exceeds that of the noise alone (d = 1; for d ≥ 2 its radial drift). A tracked wander
+  // needs no share of D (its innovation is white): only the tracker's lag behind a stated ramp.
+  const double stat =
+      cusum_.step(cusum_input(s), s.dof, s.cusum_k + calibration_bound - s.wander_relief, frame.index, onset);
   health.cusum = stat;
   health.cusum_threshold = s.cusum_h;
   if (level_change(s, frame.index, d)) {
@@ -168,6 +182,27 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   }
   level_alarm_ = false;
   return d;
+}
+
+const Eigen::VectorXd& ParityDetector::cusum_input(const Subset& s) {
+  const double q = s.wander_step_var;
+  if (!(q > 0.0)) return p_raw_;
+  const auto dof = static_cast<Eigen::Index>(s.dof);
+  if (wander_fresh_) {
+    wander_mean_.setZero();
+    wander_var_ = s.bias_wander_sigma * s.bias_wander_sigma;
+    wander_fresh_ = false;
+  }
+  const double p_pred = wander_var_ + q;
+  wander_in_.head(dof) = (p_raw_.head(dof) - wander_mean_.head(dof)) / std::sqrt(1.0 + p_pred);
+  if (episode_) {  // held: the fault is not the wander
+    wander_var_ = p_pred;
+    return wander_in_;
+  }
+  const double gain = p_pred / (1.0 + p_pred);
+  wander_mean_.head(dof) += gain * (p_raw_.head(dof) - wander_mean_.head(dof));
+  wander_var_ = (1.0 - gain) * p_pred;
+  return wander_in_;
 }
 
 bool ParityDetector::level_change(const Subset& s, std::int64_t index, Detection& d) {

@@ -92,6 +92,13 @@ class ParityDetector {
  private:
   //! The level test of an open episode: accumulate the level, then the CUSUM on p minus it.
   bool level_change(const Subset& s, std::int64_t index, Detection& d);
+  //! The CUSUM's input: the parity as measured, or where the subset's wander is tracked
+  //! (`Subset::wander_step_var` > 0) the innovation of the tracked mean m, (p − m)/√(1 + P⁻), white under the
+  //! model however long the run; m follows the parity (a scalar Kalman filter of a random walk) outside an
+  //! episode and is held during one, so a fault is not taken into it.
+  const Eigen::VectorXd& cusum_input(const Subset& s);
+  //! The tracked mean back to 0 with the wander over the horizon as its prior.
+  void restart_wander() { wander_fresh_ = true; }
 
   GyroMask cusum_mask_ = 0;
   Cusum cusum_;
@@ -109,6 +116,10 @@ class ParityDetector {
   Eigen::VectorXd p_;
   Eigen::VectorXd p_raw_;  //!< this epoch's parity before the calibration bound moved it (the CUSUM's input)
   Eigen::VectorXd dp_;     //!< scratch
+  Eigen::VectorXd wander_mean_;  //!< [σ] the tracked mean of the parity (tracked subsets only)
+  Eigen::VectorXd wander_in_;    //!< its innovation, normalized (the CUSUM's input)
+  double wander_var_ = 0.0;      //!< [σ²] per axis: the tracked mean's variance
+  bool wander_fresh_ = true;     //!< the tracker starts again at the next epoch
 };
 
 }  // namespace tetra::fdi::detail

@@ -82,6 +82,8 @@ std::vector<GyroNoiseModel> noise_models(const Calibration& cal, const GyroSerie
     const auto& noise = cal.gyros[i].noise;
     if (noise && noise->rate_random_walk_dps_per_rts)
       m.rrw_rad_s_rts = *noise->rate_random_walk_dps_per_rts * kDegToRad;
+    if (noise && noise->rate_ramp_dps_per_s)
+      m.ramp_rad_s2 = std::abs(*noise->rate_ramp_dps_per_s) * kDegToRad;
   }
   return out;
 }

@@ -24,8 +24,9 @@ double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_
 
 DetectorNoise detector_noise(const Calibration& cal, const PipelineConfig& config) {
   const Eigen::Index n = cal.gyro_count();
-  DetectorNoise out{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n),
-                    Eigen::VectorXd::Zero(n), Eigen::Matrix3Xd::Zero(3, n)};
+  DetectorNoise out{Eigen::VectorXd::Zero(n),    Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n),
+                    Eigen::VectorXd::Zero(n),    Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n),
+                    Eigen::Matrix3Xd::Zero(3, n)};
   for (Eigen::Index i = 0; i < n; ++i) {
     const GyroCalibration& g = cal.gyros[static_cast<std::size_t>(i)];
     if (g.sigma) {  // a log already in deg/s has no scale factor to be wrong (`raw_units_dps`)
@@ -41,6 +42,8 @@ DetectorNoise detector_noise(const Calibration& cal, const PipelineConfig& confi
     const double r = noise->rate_ramp_dps_per_s.value_or(0.0) * kDegToRad;
     out.bias_wander_rad_s[i] = bias_wander_sigma(b, k, config.rate_random_walk_horizon_s);
     out.ramp_bound_rad_s[i] = std::abs(r) * config.rate_random_walk_horizon_s;
+    out.rate_random_walk_rad_s_rts[i] = k;
+    out.rate_ramp_rad_s2[i] = std::abs(r);
   }
   return out;
 }
@@ -52,6 +55,8 @@ SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s
       quantization_rad_(std::move(noise.quantization_rad)),
       bias_wander_rad_s_(std::move(noise.bias_wander_rad_s)),
       ramp_bound_rad_s_(std::move(noise.ramp_bound_rad_s)),
+      rrw_rad_s_rts_(std::move(noise.rate_random_walk_rad_s_rts)),
+      ramp_rad_s2_(std::move(noise.rate_ramp_rad_s2)),
       scale_rel_sigma_(std::move(noise.scale_rel_sigma)),
       axis_sigma_(std::move(noise.axis_sigma)),
       config_(&config) {
@@ -61,6 +66,8 @@ SubsetCache::SubsetCache(GyroGeometry geometry, Eigen::VectorXd bias_sigma_rad_s
     bias_wander_rad_s_ = Eigen::VectorXd::Zero(gyro_count());
   if (ramp_bound_rad_s_.size() != geometry_.gyro_count())
     ramp_bound_rad_s_ = Eigen::VectorXd::Zero(gyro_count());
+  if (rrw_rad_s_rts_.size() != geometry_.gyro_count()) rrw_rad_s_rts_ = Eigen::VectorXd::Zero(gyro_count());
+  if (ramp_rad_s2_.size() != geometry_.gyro_count()) ramp_rad_s2_ = Eigen::VectorXd::Zero(gyro_count());
   if (scale_rel_sigma_.size() != geometry_.gyro_count())
     scale_rel_sigma_ = Eigen::VectorXd::Zero(gyro_count());
   if (axis_sigma_.cols() != geometry_.gyro_count()) axis_sigma_ = Eigen::Matrix3Xd::Zero(3, gyro_count());
@@ -119,6 +126,42 @@ const Subset& SubsetCache::insert(GyroMask mask) {
 const Subset* SubsetCache::find(GyroMask mask) const {
   const auto it = subsets_.find(mask);
   return it == subsets_.end() ? nullptr : &it->second;
+}
+
+CusumDesign SubsetCache::track_wander(Subset& s, GyroMask mask, const CusumDesign& bounded) const {
+  s.wander_step_var = 0.0;
+  s.wander_relief = 0.0;
+  // Tracked: a stated rate random walk beyond the average's reach, and any stated rate ramp (R·t has no
+  // bound); the tracker takes a ramp as the random walk that reaches R·H at the horizon H, K_R² = R²·H, and
+  // lags it by √(T/H) of one sample's σ at most.
+  const double horizon_s = config_->rate_random_walk_horizon_s;
+  double q = 0.0, ramp = 0.0, ramp_bound = 0.0, stationary = 0.0;
+  bool walks = false;
+  for (Eigen::Index i = 0; i < s.parity.cols(); ++i) {
+    if (!has_gyro(mask, static_cast<int>(i) + 1)) continue;
+    const double w2 = s.parity.col(i).squaredNorm();
+    const double k2 = rrw_rad_s_rts_[i] * rrw_rad_s_rts_[i];
+    const double r2 = ramp_rad_s2_[i] * ramp_rad_s2_[i] * horizon_s;
+    walks |= k2 > 0.0 && !bounded.averaged;
+    q += w2 * ((bounded.averaged ? 0.0 : k2) + r2) * period_s_ * period_s_ * period_s_;
+    ramp += s.parity_col_norm[i] * ramp_rad_s2_[i] * sqrt_period_ * period_s_;
+    ramp_bound += s.parity_col_norm[i] * ramp_bound_rad_s_[i] * sqrt_period_;
+    // The bias instability's stationary wander, which the tracker is not told of: averaged in h (the
+    // random walk's share too while it is within the average's reach).
+    const double wander2 = bias_wander_rad_s_[i] * bias_wander_rad_s_[i];
+    stationary += w2 * period_s_ * (bounded.averaged ? wander2 : std::max(0.0, wander2 - k2 * horizon_s));
+  }
+  q /= s.dof;
+  if (!(q > 0.0) || (!walks && !(ramp > 0.0))) return bounded;  // bias instability alone: no tracker
+  const CusumDesign design = cusum_design(s.dof, s.cusum_k, cusum_arl0_epochs(*config_),
+                                          std::sqrt(stationary / s.dof), config_->calibration_error_sigmas);
+  // The steady state of the scalar tracker of a random walk (step variance q) in unit white noise: predicted
+  // variance P⁻ = (q + √(q² + 4q))/2, gain g = P⁻/(1 + P⁻); it lags a ramp of r per epoch by r(1 − g)/g.
+  const double p_pred = 0.5 * (q + std::sqrt(q * q + 4.0 * q));
+  const double gain = p_pred / (1.0 + p_pred);
+  s.wander_step_var = q;
+  s.wander_relief = std::max(0.0, ramp_bound + bounded.k - design.k - ramp * (1.0 - gain) / gain);
+  return design;
 }
 
 double SubsetCache::parity_bias_sigma(const Subset& s, GyroMask mask) const {
@@ -262,7 +305,7 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
                                           config.calibration_error_sigmas);
   s.wander_averaged = design.averaged;
   s.calibration_bias_bound += design.k - s.cusum_k;
-  s.cusum_h = design.h + s.quantization_margin;
+  s.cusum_h = track_wander(s, mask, design).h + s.quantization_margin;
   const double averaged_wander = s.wander_averaged ? s.bias_wander_sigma : 0.0;
   // The held level (mean of M epochs over isolation_window_s) misses the episode's true level by N(0, 1/M)
   // per axis, a constant offset for the level test: its reference k grows by kLevelMarginSigma/√M, which

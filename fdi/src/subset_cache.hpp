@@ -14,6 +14,7 @@
 #include "tetra/core/geometry.hpp"
 #include "tetra/core/result.hpp"
 #include "tetra/fdi/config.hpp"
+#include "tetra/fdi/detectors.hpp"  // CusumDesign
 
 namespace tetra::fdi::detail {
 
@@ -40,6 +41,14 @@ struct Subset {
   double bias_wander_sigma = 0.0;    //!< [σ] per parity axis: the slowly wandering bias (B, K) in the parity
   //! the wander is averaged in h (true), or beyond the average's reach a tolerance e·s in the bound D (false)
   bool wander_averaged = true;
+  //! [σ²] per parity axis and epoch: what the stated rate random walks K_i add to the parity's mean over one
+  //! period, T²·Σ|w_i|²K_i²/d. Nonzero only where the wander is beyond the average's reach: the CUSUM then
+  //! runs on the innovation of the tracked mean (ParityDetector), which is white under the model however
+  //! long the run
+  double wander_step_var = 0.0;
+  //! [σ] what the tracked mean takes off the CUSUM's reference k + D: the tolerance e·s and the stated ramps
+  //! over the horizon, less the tracker's lag behind the stated ramps (0 while `wander_step_var` is 0)
+  double wander_relief = 0.0;
   //! [σ] the constant part D₀ of `calibration_bound`: the calibrated biases within calibration_error_sigmas
   //! (e) of their stated 1σ σ_β,i, e·√T·Σ_{i∈S} |w_i|·σ_β,i; the stated ramps over the horizon,
   //! √T·Σ|w_i|·R_i·H; and a wander beyond the average's reach, e·s (`wander_averaged` false)
@@ -60,6 +69,8 @@ struct DetectorNoise {
   //! [rad/s] what the stated rate ramp R moves the bias by over the horizon, R·horizon: deterministic, of
   //! either sign, it bounds the parity as the calibrated biases do (linearly, `calibration_bias_bound`)
   Eigen::VectorXd ramp_bound_rad_s;
+  Eigen::VectorXd rate_random_walk_rad_s_rts;  //!< [rad/s/√s] the stated rate random walk K_i (0 if absent)
+  Eigen::VectorXd rate_ramp_rad_s2;            //!< [rad/s²] |R_i|, the stated rate ramp (0 if absent)
   //! The calibration's stated 1σ (`sigma:`), for the rate-proportional parity term ("Calibration
   //! uncertainty")
   Eigen::VectorXd scale_rel_sigma;  //!< [-] 1σ of each scale factor relative to it (0 if absent)
@@ -190,6 +201,10 @@ class SubsetCache {
   void build(Subset& s, GyroMask mask) const;
   //! [σ] per parity axis: the wandering biases seen in the subset's normalized parity.
   double parity_bias_sigma(const Subset& s, GyroMask mask) const;
+  //! A wander beyond the average's reach whose rate random walk is stated (`bounded` the design that bounds
+  //! it): `wander_step_var` and `wander_relief`, and the design of the CUSUM on the tracked innovation (the
+  //! bias instability's stationary wander averaged in its h); else `bounded`.
+  CusumDesign track_wander(Subset& s, GyroMask mask, const CusumDesign& bounded) const;
   //! L⁻¹V with L Lᵀ = V diag(r) Vᵀ: the parity V of the subset whitened by per-gyro variances r.
   Eigen::MatrixXd whiten(const Eigen::MatrixXd& v, const Eigen::VectorXd& r) const;
   //! The quantization's sample and jump whitening, its CUSUM margin (needs `cusum_k`) and σ in the
@@ -205,6 +220,8 @@ class SubsetCache {
   Eigen::VectorXd quantization_rad_;   //!< [rad] per gyro (zeros when none)
   Eigen::VectorXd bias_wander_rad_s_;  //!< [rad/s] per gyro (zeros when none)
   Eigen::VectorXd ramp_bound_rad_s_;   //!< [rad/s] per gyro, R·horizon (zeros when none)
+  Eigen::VectorXd rrw_rad_s_rts_;      //!< [rad/s/√s] per gyro, K (zeros when none)
+  Eigen::VectorXd ramp_rad_s2_;        //!< [rad/s²] per gyro, |R| (zeros when none)
   Eigen::VectorXd scale_rel_sigma_;    //!< [-] per gyro (zeros when none)
   Eigen::Matrix3Xd axis_sigma_;        //!< [-] per gyro and component (zeros when none)
   bool calibration_sigma_ = false;     //!< some bias, scale factor or axis has a stated σ > 0
