@@ -68,10 +68,7 @@ void Pipeline::Impl::update_fdi_available() {
   result_.attitude.fdi_available = available;
   if (available == health_.fdi_available) return;
   health_.fdi_available = available;
-  FdiEvent e;
-  e.stamp_ns = frame_.now_ns;
-  e.type = available ? EventType::kFdiAvailable : EventType::kFdiUnavailable;
-  e.gyros = active;
+  FdiEvent e = event_now(available ? EventType::kFdiAvailable : EventType::kFdiUnavailable);
   e.detail = available
                  ? "fault detection available again"
                  : "no parity left among the gyros used and no attitude reference: a new fault would go "
@@ -278,10 +275,7 @@ void Pipeline::Impl::decide_episode() {
     case Verdict::kCleared: {
       detector_.close_episode(frame_.index + 1);  // no level test outside an episode
       attitude_.release_biases();
-      FdiEvent c;
-      c.stamp_ns = frame_.now_ns;
-      c.type = EventType::kCleared;
-      c.gyros = gyro_set_.active();
+      FdiEvent c = event_now(EventType::kCleared);
       c.detail = "no alarm for clear_after_s";
       c.ledger.push_back(stated(EvidenceSource::kQuiet, kHypothesisNone, RowVerdict::kConsistent,
                                 ns_to_seconds(frame_.now_ns - episode.last_alarm_ns), config_.clear_after_s));

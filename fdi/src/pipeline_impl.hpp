@@ -185,6 +185,14 @@ class Pipeline::Impl {
   std::int64_t signature_span_ns() const;
   void update_mode(std::int64_t now_ns);
   void emit(FdiEvent event) { result_.events.push_back(std::move(event)); }
+  //! An event of `type` at this epoch about the active gyros (the rest for the caller to fill).
+  FdiEvent event_now(EventType type) const {
+    FdiEvent e;
+    e.stamp_ns = frame_.now_ns;
+    e.type = type;
+    e.gyros = gyro_set_.active();
+    return e;
+  }
   //! A `detected` event with the rows that rejected H0 (none: the event carries no ledger).
   void emit_detected(DetectionTest test, double statistic, std::int64_t now_ns,
                      const EvidenceRows* rows = nullptr);

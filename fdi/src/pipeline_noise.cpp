@@ -62,11 +62,8 @@ void Pipeline::Impl::widen_noise(const SpreadFinding& f, const char* evidence) {
 }
 
 void Pipeline::Impl::emit_noise_widened(const SpreadFinding& f, const char* evidence) {
-  FdiEvent e;
-  e.stamp_ns = frame_.now_ns;
-  e.type = EventType::kNoiseModel;
+  FdiEvent e = event_now(EventType::kNoiseModel);
   e.statistic = f.statistic;
-  e.gyros = gyro_set_.active();
   // H0 here is "the noise as stated": rejected by the spread; which gyro is noisier, the parity cannot tell,
   // so every gyro's noise is taken the same.
   e.ledger.push_back(stated(EvidenceSource::kParitySpread, kHypothesisNone, RowVerdict::kRejected,
@@ -82,10 +79,7 @@ void Pipeline::Impl::emit_noise_widened(const SpreadFinding& f, const char* evid
 }
 
 void Pipeline::Impl::emit_episode_explained(const SpreadFinding& f) {
-  FdiEvent c;
-  c.stamp_ns = frame_.now_ns;
-  c.type = EventType::kCleared;
-  c.gyros = gyro_set_.active();
+  FdiEvent c = event_now(EventType::kCleared);
   c.detail =
       "the episode's alarm was judged on a noise the data reject (noise_model): the detectors start "
       "again on the noise the data show; sigma keeps what the episode added";
