@@ -168,6 +168,23 @@ const std::vector<DesignConstant>& design_constants() {
       {"reference_noise_max_factor", design::reference_noise_max_factor, "-",
        "a reference rejected for nis alone is used again with its re-estimated noise up to this times "
        "reference_sigma_arcsec"},
+      // --- the noise model checked against the parity's spread
+      {"spread_block_s", design::spread_block_s, "s",
+       "blocks of the long-run spread (second differences of their parity sums)"},
+      {"spread_window_samples", design::spread_window_samples, "samples",
+       "samples of one spread verdict at most; then its sums start again (the looks the threshold counts)"},
+      {"spread_min_samples", design::spread_min_samples, "samples", "samples of one spread verdict at least"},
+      {"spread_hold_samples", design::spread_hold_samples, "samples",
+       "one-sample spread samples after a reset before the noise model counts as checked"},
+      {"spread_hold_epochs", design::spread_hold_epochs, "epochs",
+       "epochs after a reset after which the noise model counts as checked without samples"},
+      {"spread_hold_s", design::spread_hold_s, "s", "time after a reset after which it counts as checked"},
+      {"spread_held_ratio", design::spread_held_ratio, "-",
+       "the white noise variance ratio an unchecked model may hide: an alarm within it (a chi2 up to this "
+       "times its threshold, a sum up to its root times) decides nothing before the check"},
+      {"spread_white_dominates", design::spread_white_dominates, "-",
+       "a unit whose stated quantization is at most this share of one sample's noise: one sample's spread "
+       "is the white noise's (the long-run spread is not waited for)"},
   };
   return constants;
 }

@@ -13,7 +13,7 @@ constexpr int kSearchSteps = 80;         //!< golden-section steps of the likeli
 }  // namespace
 
 ParitySpread::ParitySpread(double false_alarm)
-    : threshold_(std::log(static_cast<double>(kSpreadWindowSamples) / false_alarm)) {}
+    : threshold_(std::log(static_cast<double>(design::spread_window_samples) / false_alarm)) {}
 
 void ParitySpread::clear_sums() {
   samples_ = beyond_ = 0;
@@ -33,18 +33,20 @@ void ParitySpread::restart() {
 }
 
 bool ParitySpread::holds(double statistic, double threshold, bool chi2) const {
-  return !checked_ && statistic <= threshold * (chi2 ? kSpreadHeldRatio : std::sqrt(kSpreadHeldRatio));
+  return !checked_ &&
+         statistic <= threshold * (chi2 ? design::spread_held_ratio : std::sqrt(design::spread_held_ratio));
 }
 
 std::optional<SpreadFinding> ParitySpread::observe(double u, int dof, double cap, std::int64_t now_ns,
                                                    double offset) {
   if (start_ns_ < 0) start_ns_ = now_ns;
-  epochs_ = std::min(epochs_ + 1, kSpreadHoldEpochs);
-  if (epochs_ >= kSpreadHoldEpochs || now_ns - start_ns_ >= static_cast<std::int64_t>(kSpreadHoldS * 1e9))
+  epochs_ = std::min(epochs_ + 1, design::spread_hold_epochs);
+  if (epochs_ >= design::spread_hold_epochs ||
+      now_ns - start_ns_ >= static_cast<std::int64_t>(design::spread_hold_s * 1e9))
     checked_ = true;
   if (!std::isfinite(u) || dof < 1) return std::nullopt;
-  checked_samples_ = std::min(checked_samples_ + 1, kSpreadHoldSamples);
-  if (checked_samples_ >= kSpreadHoldSamples) checked_ = true;
+  checked_samples_ = std::min(checked_samples_ + 1, design::spread_hold_samples);
+  if (checked_samples_ >= design::spread_hold_samples) checked_ = true;
   const double d = dof;
   dof_ = dof;
   ++samples_;
@@ -59,8 +61,8 @@ std::optional<SpreadFinding> ParitySpread::observe(double u, int dof, double cap
   }
   const double mean = sum_capped_ / (sum_d_ + sum_offset_);
   const double g = 0.5 * sum_d_ * (mean - 1.0 - std::log(mean)) / kDifferenceCorrelation;
-  if (g <= threshold_ || samples_ < kSpreadMinSamples) {
-    if (samples_ >= kSpreadWindowSamples) clear_sums();
+  if (g <= threshold_ || samples_ < design::spread_min_samples) {
+    if (samples_ >= design::spread_window_samples) clear_sums();
     return std::nullopt;
   }
   SpreadFinding f;

@@ -7,22 +7,23 @@
 // constant over one sample and does not reach it; a jump beyond the jump test's threshold c is the jump
 // test's (left out: the estimate takes the truncation into account).
 //
-// Over the samples since the last verdict (at most kSpreadWindowSamples, then the sums start again), with λ̂
-// the mean of min(u, c) per degree of freedom, the generalized likelihood ratio of "λ = 1" is
+// Over the samples since the last verdict (at most design::spread_window_samples, then the sums start again),
+// with λ̂ the mean of min(u, c) per degree of freedom, the generalized likelihood ratio of "λ = 1" is
 //
 //   G = ½·Σd·(λ̂ − 1 − ln λ̂) / κ,   κ = kDifferenceCorrelation (successive differences share a sample),
 //
-// rejected when G > ln(kSpreadWindowSamples/p) (p the budget's kParitySpread share; the window's length
-// bounds the looks). Then λ is estimated by maximum likelihood with the samples beyond c censored,
+// rejected when G > ln(design::spread_window_samples/p) (p the budget's kParitySpread share; the window's
+// length bounds the looks). Then λ is estimated by maximum likelihood with the samples beyond c censored,
 //
 //   ℓ(λ) = −½·Σd_below·ln λ − Σu_below/(2λ) + n_beyond·ln S_d(c/λ),
 //
-// and the model's white noise is multiplied by the upper end of its 1σ interval (at least kSpreadMinSamples;
-// never below the stated noise), the detectors restart on it, and the sums start again: a rise later in the
-// run is followed the same way, a fall too (the model comes back towards the stated noise, never below it).
-// Until the first kSpreadHoldSamples samples are in (or kSpreadHoldEpochs epochs or kSpreadHoldS have passed)
-// the model is unchecked: a parity alarm that a white noise up to kSpreadHeldRatio times the model's could
-// explain decides nothing yet (pipeline.cpp); a larger one is decided at once.
+// and the model's white noise is multiplied by the upper end of its 1σ interval (at least
+// design::spread_min_samples; never below the stated noise), the detectors restart on it, and the sums start
+// again: a rise later in the run is followed the same way, a fall too (the model comes back towards the
+// stated noise, never below it). Until the first design::spread_hold_samples samples are in (or
+// design::spread_hold_epochs epochs or design::spread_hold_s have passed) the model is unchecked: a parity
+// alarm that a white noise up to design::spread_held_ratio times the model's could explain decides nothing
+// yet (pipeline.cpp); a larger one is decided at once.
 //
 // What the parity cannot tell: which gyro is noisier. Every gyro's white noise is taken λ times its model (in
 // the filter too: sigma carries it); a single gyro's noise fault is the noise-level test's, which judges each
@@ -32,25 +33,14 @@
 #include <optional>
 #include <vector>
 
+#include "tetra/fdi/config.hpp"
+
 namespace tetra::fdi::detail {
 
-//! [s] the blocks of the long-run spread (BlockDifferences): the quantization's share of a block difference
-//! falls as 1/m, the white noise's does not.
-inline constexpr double kSpreadBlockS = 5.0;
-//! Samples of one verdict at most; then the sums start again.
-inline constexpr int kSpreadWindowSamples = 3000;
-//! Samples of a verdict at least (its estimate's spread is then within a factor of about 1.45).
-inline constexpr int kSpreadMinSamples = 20;
-//! Samples before the model counts as checked.
-inline constexpr int kSpreadHoldSamples = 100;
-//! Epochs after a reset after which the model counts as checked even without samples (a body that never
-//! keeps within the motion bound, three gyros).
-inline constexpr int kSpreadHoldEpochs = 300;
-//! [s] time after a reset after which the model counts as checked (a slow sample rate).
-inline constexpr double kSpreadHoldS = 30.0;
-//! [-] the largest white noise variance ratio an alarm held before the check may be explained by: a χ² up to
-//! this many times its threshold, a sum (CUSUM) up to its root times.
-inline constexpr double kSpreadHeldRatio = 16.0;
+// The spread's constants are fixed design constants (tetra/fdi/config.hpp, namespace design): spread_block_s,
+// spread_window_samples, spread_min_samples, spread_hold_samples, spread_hold_epochs, spread_hold_s,
+// spread_held_ratio.
+
 //! [-] variance inflation of a mean of successive differences' u (lag-one correlation 0.25 for white noise,
 //! 0.47 for quantization, whose rate error is itself a difference): the likelihood ratio is divided by it.
 inline constexpr double kDifferenceCorrelation = 2.0;
@@ -58,7 +48,7 @@ inline constexpr double kDifferenceCorrelation = 2.0;
 //! The model's white noise rejected: the ratio the data show and the one now taken.
 struct SpreadFinding {
   double statistic = 0.0;  //!< [-] G at the verdict
-  double threshold = 0.0;  //!< [-] ln(kSpreadWindowSamples/p)
+  double threshold = 0.0;  //!< [-] ln(design::spread_window_samples/p)
   double estimate = 1.0;   //!< [-] λ̂ relative to the model before
   double ratio = 1.0;      //!< [-] the white noise variance now taken over the stated
   int samples = 0;         //!< samples of the verdict
@@ -81,7 +71,7 @@ class ParitySpread {
   std::optional<SpreadFinding> observe(double u, int dof, double cap, std::int64_t now_ns,
                                        double offset = 0.0);
   //! An alarm of `statistic` against `threshold` (`chi2`: a χ², else a sum in σ) the unchecked model's white
-  //! noise could explain, up to kSpreadHeldRatio: it decides nothing until the model is checked.
+  //! noise could explain, up to design::spread_held_ratio: it decides nothing until the model is checked.
   bool holds(double statistic, double threshold, bool chi2) const;
 
   //! [-] the white noise variance taken, over the stated (≥ 1).
@@ -103,10 +93,10 @@ class ParitySpread {
   double ratio_ = 1.0;
   bool checked_ = false;
   std::int64_t start_ns_ = -1;  //!< [ns] the first epoch after the reset
-  int epochs_ = 0;              //!< epochs since the reset (up to kSpreadHoldEpochs)
+  int epochs_ = 0;              //!< epochs since the reset (up to design::spread_hold_epochs)
   int samples_ = 0;             //!< samples in the sums
   int beyond_ = 0;              //!< of them beyond the cap
-  int checked_samples_ = 0;     //!< samples since the reset (up to kSpreadHoldSamples)
+  int checked_samples_ = 0;     //!< samples since the reset (up to design::spread_hold_samples)
   int dof_ = 1;                 //!< the last sample's
   double sum_capped_ = 0.0;     //!< Σ min(u, c)
   double sum_d_ = 0.0;          //!< Σd of every sample

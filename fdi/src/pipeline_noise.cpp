@@ -12,17 +12,11 @@
 
 namespace tetra::fdi {
 
-namespace {
-//! [-] a unit whose stated quantization is at most this share of one sample's noise: what one sample's
-//! spread shows is the white noise's (the long-run test is then not waited for).
-constexpr double kWhiteDominates = 0.1;
-}  // namespace
-
 void Pipeline::Impl::check_noise_model() {
   const auto found =
       sample_spread_.observe(gate_.spread_sample(), gate_.spread_dof(), gate_.spread_cap(), frame_.now_ns);
   if (!found) return;
-  if (subsets_.quantization_share() <= kWhiteDominates) white_spread_.raise_to(found->ratio);
+  if (subsets_.quantization_share() <= design::spread_white_dominates) white_spread_.raise_to(found->ratio);
   widen_noise(*found, "between consecutive epochs (one sample's noise)");
 }
 
@@ -35,7 +29,7 @@ void Pipeline::Impl::check_long_run_noise() {
   }
   const GyroMask active = gyro_set_.active();
   const Subset& s = subsets_.get(active);
-  const int m = std::max(2, static_cast<int>(std::lround(kSpreadBlockS / subsets_.period_s())));
+  const int m = std::max(2, static_cast<int>(std::lround(design::spread_block_s / subsets_.period_s())));
   // A block's sums need the same gyros on consecutive epochs; the body's motion cancels in the parity, and
   // what the calibration's error makes of it varies slowly enough for a second difference to cancel.
   const bool clean = gate_.consecutive() && frame_.usable == active;

@@ -158,7 +158,7 @@ TEST(ConfigKeys, AtMostThirtyKeys) {
   // what a user has no physical reason to set is a fixed design constant.
   EXPECT_LE(config_keys().size(), 30U);
   EXPECT_EQ(config_keys().size(), 29U);
-  EXPECT_EQ(design_constants().size(), 16U);
+  EXPECT_EQ(design_constants().size(), 24U);
 }
 
 TEST(ConfigKeys, AFileThatSetsADesignConstantIsRefusedNamingIt) {

@@ -119,14 +119,14 @@ TEST(ParitySpread, AnAlarmTheUncheckedNoiseCouldExplainIsHeldAndALargerOneIsNot)
   EXPECT_TRUE(spread.holds(4.0 * 22.8, 22.8, false));
   EXPECT_FALSE(spread.holds(4.1 * 22.8, 22.8, false));
   Differences diff(1, 5);
-  for (int k = 0; k < kSpreadHoldSamples; ++k) (void)spread.observe(diff.next(1.0), 1, 37.3, k);
+  for (int k = 0; k < design::spread_hold_samples; ++k) (void)spread.observe(diff.next(1.0), 1, 37.3, k);
   EXPECT_TRUE(spread.checked());
   EXPECT_FALSE(spread.holds(40.0, 37.3, true));
-  // Without samples (three gyros, a body never within the bound) the check ends after kSpreadHoldS.
+  // Without samples (three gyros, a body never within the bound) the check ends after design::spread_hold_s.
   ParitySpread idle(kP);
   idle.reset();
   (void)idle.observe(std::nan(""), 1, 37.3, 0);
-  (void)idle.observe(std::nan(""), 1, 37.3, static_cast<std::int64_t>(kSpreadHoldS * 1e9));
+  (void)idle.observe(std::nan(""), 1, 37.3, static_cast<std::int64_t>(design::spread_hold_s * 1e9));
   EXPECT_TRUE(idle.checked());
 }
 

@@ -115,6 +115,15 @@ inline constexpr int reference_confirm_count = 3;         //!< [-] consecutive c
 inline constexpr int reference_gate_reset_count = 10;     //!< [samples] gate rejections that set the attitude
 inline constexpr double reference_bias_window_s = 120.0;  //!< [s] block of the mean-innovation test
 inline constexpr double reference_noise_max_factor = 3.0;  //!< [-] × reference_sigma_arcsec: re-estimate
+// --- the noise model checked against the parity's spread
+inline constexpr double spread_block_s = 5.0;       //!< [s] blocks of the long-run spread
+inline constexpr int spread_window_samples = 3000;  //!< [samples] of one verdict at most
+inline constexpr int spread_min_samples = 20;       //!< [samples] of one verdict at least
+inline constexpr int spread_hold_samples = 100;     //!< [samples] before the model counts as checked
+inline constexpr int spread_hold_epochs = 300;      //!< [epochs] after which it counts as checked anyway
+inline constexpr double spread_hold_s = 30.0;       //!< [s] after which it counts as checked anyway
+inline constexpr double spread_held_ratio = 16.0;   //!< [-] noise variance ratio an unchecked model may hide
+inline constexpr double spread_white_dominates = 0.1;  //!< [-] quantization share: one sample shows the white
 }  // namespace design
 
 //! Parses a `pipeline:` YAML map (unknown keys are errors naming the line); `source` names the file.
