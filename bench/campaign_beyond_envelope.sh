@@ -5,7 +5,8 @@
 # 2.5 x the calibration's 1-sigma, white noise and bias instability 0.5-3 x the stated terms, a star
 # tracker of 3-10 arcsec delivering 0-0.3 s late (the pipeline told so: reference_latency_max_s 0.3),
 # bias and stuck faults on every gyro at a random onset and size; 10-minute runs, SEEDS seeds per case
-# plus as many fault-free runs. Prints per N the wrong exclusions, right isolations, unisolated, missed, false alarms per hour and pointing (docs/fdi_validation.md).
+# plus as many fault-free runs. Prints per N the wrong exclusions, right isolations, unisolated, missed,
+# false alarms per hour and pointing (docs/fdi_validation.md).
 # Usage: bench/campaign_beyond_envelope.sh [BUILD_DIR] [SEEDS] [N...]   (defaults: build, 150, 4 5 6: 4,950
 # runs, ~3 min). KEEP=DIR keeps the specs and campaign folders there (DIR/cN/runs.csv; a run again with its
 # events: tetra campaign DIR/specN.yaml --run K --events ev.jsonl). ENVELOPE=stated draws the same campaign
