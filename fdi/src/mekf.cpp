@@ -447,8 +447,7 @@ void Mekf::refresh_step_constants(const Eigen::Matrix3Xd& pinv, GyroMask used, d
     bias_noise_[i] = frozen ? 0.0 : rrw_var_[k];
     bias_noise_[n_ + i] = frozen ? 0.0 : gm_var_[k];
     const auto& g = gyros_[k];
-    const double r2 = 2.0 * g.ramp_rad_s2 * g.ramp_rad_s2 * ramp_taken_s_;
-    prior_noise_[i] = frozen ? 0.0 : (g.rrw_rad_s_rts * g.rrw_rad_s_rts + r2) * dt_s;
+    prior_noise_[i] = frozen ? 0.0 : stated_walk_var_rate(k) * dt_s;
     if (has_gyro(used, i + 1))
       q_theta_ +=
           pinv.col(i) * pinv.col(i).transpose() * ((g.arw_rad_rts * g.arw_rad_rts + added_noise_[k]) * dt_s);

@@ -169,12 +169,13 @@ class Mekf {
   double ramp_age_s_ = 0.0;
   double ramp_taken_s_ = 0.0;
   bool ramps_ = false;
-  //! [rad²/s³] gyro i's slow bias variance rate: K², an opened model's, and the stated ramp's 2R²·t
-  double walk_var_rate(std::size_t i) const {
+  //! [rad²/s³] gyro i's slow bias variance rate as stated: K² and the stated ramp's 2R²·t
+  double stated_walk_var_rate(std::size_t i) const {
     const double r = gyros_[i].ramp_rad_s2;
-    return gyros_[i].rrw_rad_s_rts * gyros_[i].rrw_rad_s_rts + added_rrw_var_[i] +
-           2.0 * r * r * ramp_taken_s_;
+    return gyros_[i].rrw_rad_s_rts * gyros_[i].rrw_rad_s_rts + 2.0 * r * r * ramp_taken_s_;
   }
+  //! [rad²/s³] the same with an opened model's addition
+  double walk_var_rate(std::size_t i) const { return stated_walk_var_rate(i) + added_rrw_var_[i]; }
   //! What a step keeps while the gyro set, the frozen set, the rate solution and Δt stay the same (nearly
   //! always), recomputed when the key (`step_pinv_`, `step_used_`, `step_frozen_`, `step_dt_s_`) changes:
   //! the attitude's process noise Qθ = H*·diag(N²)·H*ᵀ·Δt; D on the Gauss–Markov states, d per gyro
