@@ -29,8 +29,9 @@ struct Tally {
   static constexpr int kReference = kMaxGyros + 1;
   static constexpr int kDrift = kMaxGyros + 2;
   static constexpr int kCalibration = kMaxGyros + 3;
-  std::array<bool, kMaxGyros + 4> rejected{};
-  std::array<bool, kMaxGyros + 4> consistent{};
+  static constexpr int kNoise = kMaxGyros + 4;
+  std::array<bool, kMaxGyros + 5> rejected{};
+  std::array<bool, kMaxGyros + 5> consistent{};
 
   Tally(const LedgerRow* begin, const LedgerRow* end) {
     for (const LedgerRow* row = begin; row != end; ++row) {
@@ -44,6 +45,7 @@ struct Tally {
     if (h == kHypothesisReference) return kReference;
     if (h == kHypothesisDrift) return kDrift;
     if (h == kHypothesisCalibration) return kCalibration;
+    if (h == kHypothesisNoise) return kNoise;
     return h <= kMaxGyros ? static_cast<int>(h) : -1;
   }
   bool is_rejected(int s) const { return rejected[static_cast<std::size_t>(s)]; }
@@ -70,6 +72,11 @@ int arbitrate(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active
     standing = j;
   }
   return standing;
+}
+
+bool arbitrate_detection(const LedgerRow* begin, const LedgerRow* end) {
+  const Tally t(begin, end);
+  return t.is_rejected(0) && !t.stands(Tally::kNoise);
 }
 
 ReferenceDecision arbitrate_reference(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active) {

@@ -38,6 +38,11 @@ class EvidenceRows {
   int n_ = 0;
 };
 
+//! fdi::arbitrate_detection over the rows.
+inline bool arbitrate_detection(const EvidenceRows& rows) {
+  return fdi::arbitrate_detection(rows.begin(), rows.end());
+}
+
 //! fdi::arbitrate over the rows.
 inline int arbitrate(const EvidenceRows& rows, GyroMask active, bool reference_exists) {
   return fdi::arbitrate(rows.begin(), rows.end(), active, reference_exists);

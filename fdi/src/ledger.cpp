@@ -46,6 +46,9 @@ const EvidenceSourceInfo kEvidenceSources[kEvidenceSourceCount] = {
     {EvidenceSource::kParitySpread, "parity_spread", StatisticUnit::kLogLikelihood,
      "the spread of the parity's differences between consecutive epochs, against the white noise the model "
      "states (H0: the unit's white noise as stated)"},
+    {EvidenceSource::kUncheckedNoise, "unchecked_noise", StatisticUnit::kRatio,
+     "the white noise variance, over the model's, that would explain an alarm, while the parity's spread has "
+     "not checked the model (Hnoise consistent up to spread_held_ratio)"},
 };
 
 bool reads_own_signal(EvidenceSource source) {
@@ -117,14 +120,16 @@ std::string hypothesis_name(std::uint8_t hypothesis) {
   if (hypothesis == kHypothesisReference) return "Href";
   if (hypothesis == kHypothesisDrift) return "Hdrift";
   if (hypothesis == kHypothesisCalibration) return "Hcal";
+  if (hypothesis == kHypothesisNoise) return "Hnoise";
   return "H" + std::to_string(hypothesis);
 }
 
 bool hypothesis_from_string(std::string_view text, std::uint8_t& out) {
-  if (text == "Href" || text == "Hdrift" || text == "Hcal") {
+  if (text == "Href" || text == "Hdrift" || text == "Hcal" || text == "Hnoise") {
     out = text == "Href"     ? kHypothesisReference
           : text == "Hdrift" ? kHypothesisDrift
-                             : kHypothesisCalibration;
+          : text == "Hcal"   ? kHypothesisCalibration
+                             : kHypothesisNoise;
     return true;
   }
   if (text.size() < 2 || text.size() > 3 || text[0] != 'H') return false;

@@ -32,9 +32,12 @@ void ParitySpread::restart() {
   clear_sums();
 }
 
-bool ParitySpread::holds(double statistic, double threshold, bool chi2) const {
-  return !checked_ &&
-         statistic <= threshold * (chi2 ? design::spread_held_ratio : std::sqrt(design::spread_held_ratio));
+std::optional<LedgerRow> ParitySpread::noise_row(double statistic, double threshold, bool chi2) const {
+  if (checked_) return std::nullopt;
+  const double excess = statistic / threshold;
+  const double ratio = chi2 ? excess : excess * excess;
+  return judge(EvidenceSource::kUncheckedNoise, kHypothesisNoise, ratio, design::spread_held_ratio,
+               design::spread_held_ratio);
 }
 
 std::optional<SpreadFinding> ParitySpread::observe(double u, int dof, double cap, std::int64_t now_ns,

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "tetra/fdi/config.hpp"
+#include "tetra/fdi/ledger.hpp"
 
 namespace tetra::fdi::detail {
 
@@ -70,9 +71,10 @@ class ParitySpread {
   //! (Σu − Σoffset)/Σd, without a cap.
   std::optional<SpreadFinding> observe(double u, int dof, double cap, std::int64_t now_ns,
                                        double offset = 0.0);
-  //! An alarm of `statistic` against `threshold` (`chi2`: a χ², else a sum in σ) the unchecked model's white
-  //! noise could explain, up to design::spread_held_ratio: it decides nothing until the model is checked.
-  bool holds(double statistic, double threshold, bool chi2) const;
+  //! While the model is unchecked, the Hnoise row of an alarm of `statistic` against `threshold` (`chi2`: a
+  //! χ², else a sum in σ): the white noise variance ratio that would explain it, consistent up to
+  //! design::spread_held_ratio (the arbiter then lets the alarm decide nothing yet). None once checked.
+  std::optional<LedgerRow> noise_row(double statistic, double threshold, bool chi2) const;
 
   //! [-] the white noise variance taken, over the stated (≥ 1).
   double ratio() const { return ratio_; }

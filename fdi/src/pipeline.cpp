@@ -137,6 +137,15 @@ void Pipeline::Impl::cover_unchecked_rate(GyroMask before) {
   attitude_.add_bound(unchecked_rate_bound(full, used, held_parity_, subsets_.sqrt_period()) * frame_.dt_s);
 }
 
+bool Pipeline::Impl::alarm_decides(const Detection& d) {
+  alarm_rows_.clear();
+  alarm_rows_.detection(source_of(d.test), d.statistic, d.threshold, d.dof);
+  // Until the parity's spread has checked the noise model, Hnoise may explain the alarm.
+  const auto noise = sample_spread_.noise_row(d.statistic, d.threshold, d.test == DetectionTest::kChi2);
+  if (noise) alarm_rows_.add(*noise);
+  return arbitrate_detection(alarm_rows_);
+}
+
 void Pipeline::Impl::detect() {
   const Subset& s = subsets_.get(frame_.usable);
   attitude_.measure(s, frame_);
@@ -144,9 +153,8 @@ void Pipeline::Impl::detect() {
   const GyroMask active = gyro_set_.active();
   const double calibration = subsets_.calibration_bound(s, frame_.usable, attitude_.omega_meas_B());
   Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), calibration, health_);
-  // Until the parity's spread has checked the noise model, an alarm judged on it decides nothing.
   parity_ran_ = d.cusum_ran;
-  const bool held = d.alarm && sample_spread_.holds(d.statistic, d.threshold, d.test == DetectionTest::kChi2);
+  const bool held = d.alarm && !alarm_decides(d);
   if (held) d.alarm = false;
   protection_.widen(calibration, frame_.dt_s);  // the CUSUM's reference k + D: a larger fault unseen
   if (d.cusum_ran) {
@@ -171,7 +179,7 @@ void Pipeline::Impl::detect() {
     attitude_.hold_biases(isolator_.episode().onset_ns);  // before the filter opens them to the fault
     detector_.open_episode();
     episode_rows_.clear();
-    episode_rows_.detection(source_of(d.test), d.statistic, d.threshold, d.dof);
+    episode_rows_.add(alarm_rows_);
     emit_detected(d.test, d.statistic, frame_.now_ns, &episode_rows_);
     reconsider_reference_rejection();
     // The fault acted since its onset: widen the uncertainty for the time already spent.

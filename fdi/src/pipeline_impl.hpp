@@ -127,6 +127,9 @@ class Pipeline::Impl {
   //! may be wrong by over this epoch's step.
   void cover_unchecked_rate(GyroMask before);
   void detect();
+  //! The alarm's rows (its detection's, and Hnoise's while the noise model is unchecked) into alarm_rows_;
+  //! true when the arbiter lets it decide.
+  bool alarm_decides(const Detection& d);
   void level_changed(const Detection& d);
   void seek_evidence();
   void isolate_filter_bias(const ReferenceFinding& bias);
@@ -231,6 +234,7 @@ class Pipeline::Impl {
   Eigen::VectorXd held_parity_;  //!< the parity before the jump test, when it left the rest without one
   ReferenceBudget budget_;       //!< the reference's stated bias and latency, which its samples cannot show
   EvidenceRows episode_rows_;    //!< the rows of the detection that opened the open episode
+  EvidenceRows alarm_rows_;      //!< this epoch's alarm's rows
   EvidenceRows decision_rows_;   //!< scratch: an isolation's rows with the episode's
   std::uint64_t arbiter_refusals_ = 0;  //!< findings whose rows the arbiter did not confirm
   ReferenceHorizon horizon_;  //!< a late reference fused at its own time (docs/fdi.md, "Late references")

@@ -2,6 +2,7 @@
 // the parity's differences show another; the ratio taken covers the true one; a fall is followed back.
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -110,18 +111,34 @@ TEST(ParitySpread, ASmallExcessIsSeenWithinAWindowAndAFallIsFollowedBack) {
   EXPECT_GE(seen, 18);
 }
 
+//! Whether an alarm of `statistic` against `threshold` decides: the arbiter over its detection row and, while
+//! the model is unchecked, the spread's Hnoise row.
+bool decides(const ParitySpread& spread, double statistic, double threshold, bool chi2) {
+  std::vector<LedgerRow> rows{judge(EvidenceSource::kCusum, kHypothesisNone, statistic, threshold, threshold)};
+  if (const auto noise = spread.noise_row(statistic, threshold, chi2)) {
+    EXPECT_EQ(noise->hypothesis, kHypothesisNoise);
+    EXPECT_EQ(noise->source, EvidenceSource::kUncheckedNoise);
+    rows.push_back(*noise);
+  }
+  return arbitrate_detection(rows.data(), rows.data() + rows.size());
+}
+
 TEST(ParitySpread, AnAlarmTheUncheckedNoiseCouldExplainIsHeldAndALargerOneIsNot) {
   ParitySpread spread(kP);
   spread.reset();
   EXPECT_FALSE(spread.checked());
-  EXPECT_TRUE(spread.holds(16.0 * 37.3, 37.3, true));
-  EXPECT_FALSE(spread.holds(16.1 * 37.3, 37.3, true));
-  EXPECT_TRUE(spread.holds(4.0 * 22.8, 22.8, false));
-  EXPECT_FALSE(spread.holds(4.1 * 22.8, 22.8, false));
+  // A χ² up to 16 times its threshold, a sum up to 4 times (the root), a white noise 16 times the model's
+  // could explain: Hnoise stands, the alarm decides nothing yet.
+  EXPECT_FALSE(decides(spread, 15.99 * 37.3, 37.3, true));
+  EXPECT_TRUE(decides(spread, 16.01 * 37.3, 37.3, true));
+  EXPECT_FALSE(decides(spread, 3.99 * 22.8, 22.8, false));
+  EXPECT_TRUE(decides(spread, 4.01 * 22.8, 22.8, false));
+  EXPECT_NEAR(spread.noise_row(2.0 * 22.8, 22.8, false)->statistic, 4.0, 1e-12);  // the variance ratio
   Differences diff(1, 5);
   for (int k = 0; k < design::spread_hold_samples; ++k) (void)spread.observe(diff.next(1.0), 1, 37.3, k);
   EXPECT_TRUE(spread.checked());
-  EXPECT_FALSE(spread.holds(40.0, 37.3, true));
+  EXPECT_FALSE(spread.noise_row(40.0, 37.3, true).has_value());  // checked: Hnoise is not written
+  EXPECT_TRUE(decides(spread, 40.0, 37.3, true));
   // Without samples (three gyros, a body never within the bound) the check ends after design::spread_hold_s.
   ParitySpread idle(kP);
   idle.reset();

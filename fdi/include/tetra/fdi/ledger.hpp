@@ -37,9 +37,10 @@ enum class EvidenceSource : std::uint8_t {
   kQuiet,            //!< no alarm for clear_after_s: the episode's fault is gone
   kDriftWander,      //!< the bias wander a common drift of the gyros would need, against a working unit's
   kMotionFit,        //!< the parity's fit to the body rate over a block: scale factors and axes
-  kParitySpread      //!< the parity's differences between consecutive epochs: the unit's white noise
+  kParitySpread,     //!< the parity's differences between consecutive epochs: the unit's white noise
+  kUncheckedNoise    //!< the white noise an alarm needs, while the spread has not checked the model
 };
-constexpr int kEvidenceSourceCount = 20;
+constexpr int kEvidenceSourceCount = 21;
 //! True for the sources that read a gyro's own signal (timeout, invalid, repeated, zero, variance,
 //! noise_level, recurring_spikes): no error of the calibration makes what they see.
 bool reads_own_signal(EvidenceSource source);
@@ -73,14 +74,16 @@ bool evidence_source_from_string(std::string_view text, EvidenceSource& out);
 //! Hypotheses: 0 is H0, 1..N gyro i, kHypothesisReference the reference, kHypothesisDrift the gyros' common
 //! bias drifting beyond their noise model (every gyro's bias together: the parity cannot see it),
 //! kHypothesisCalibration the calibration's scale factors and axes not describing the unit (several gyros
-//! at once, beyond their stated tolerance).
+//! at once, beyond their stated tolerance), kHypothesisNoise every gyro's white noise beyond the model, up to
+//! what a model the parity's spread has not checked yet may hide (design::spread_held_ratio).
 inline constexpr std::uint8_t kHypothesisNone = 0;
+inline constexpr std::uint8_t kHypothesisNoise = 252;
 inline constexpr std::uint8_t kHypothesisCalibration = 253;
 inline constexpr std::uint8_t kHypothesisDrift = 254;
 inline constexpr std::uint8_t kHypothesisReference = 255;
-//! "H0", "H3", "Hcal", "Hdrift", "Href".
+//! "H0", "H3", "Hnoise", "Hcal", "Hdrift", "Href".
 std::string hypothesis_name(std::uint8_t hypothesis);
-//! The hypothesis named by `text` ("H0", "H1".."H32", "Hcal", "Hdrift", "Href"), if any.
+//! The hypothesis named by `text` ("H0", "H1".."H32", "Hnoise", "Hcal", "Hdrift", "Href"), if any.
 bool hypothesis_from_string(std::string_view text, std::uint8_t& out);
 
 //! One ledger row: `source`'s verdict on `hypothesis`. The statistic is compared with `threshold`: above it
@@ -110,6 +113,10 @@ LedgerRow stated(EvidenceSource source, std::uint8_t hypothesis, RowVerdict verd
 //! Href too when a reference exists (`reference_exists`), and Hcal does not stand (a row writes it only
 //! while a calibration mismatch stands). Returns i, or 0 when no hypothesis stands alone.
 int arbitrate(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active, bool reference_exists);
+
+//! The same rule for an alarm: it decides (a detection, an episode opened) when H0 is rejected and Hnoise
+//! does not stand (a row writes it only while the noise model is unchecked).
+bool arbitrate_detection(const LedgerRow* begin, const LedgerRow* end);
 
 //! What the arbiter makes of a reference sample's rows.
 enum class ReferenceDecision : std::uint8_t {
