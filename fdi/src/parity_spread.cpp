@@ -73,15 +73,25 @@ std::optional<SpreadFinding> ParitySpread::observe(double u, int dof, double cap
   f.threshold = threshold_;
   f.samples = samples_;
   f.estimate = estimate(cap);
-  // The estimate's 1σ upper end: u's spread per degree of freedom is about (λ̂ + q̄)·√2 (q̄ the offset's mean).
-  const double upper = f.estimate + kIntervalSigmas * std::sqrt(2.0 * kDifferenceCorrelation / sum_d_) *
-                                        (f.estimate + sum_offset_ / sum_d_);
-  const double next = std::max(1.0, ratio_ * upper);
+  const double next = std::max(1.0, ratio_ * (f.estimate + interval(f.estimate)));
   clear_sums();
   if (next == ratio_ || (f.estimate < 1.0 && next > ratio_)) return std::nullopt;
   ratio_ = next;
   f.ratio = ratio_;
   return f;
+}
+
+double ParitySpread::interval(double estimate) const {
+  // u's spread per degree of freedom is about (λ̂ + q̄)·√2 (q̄ the offset's mean).
+  return kIntervalSigmas * std::sqrt(2.0 * kDifferenceCorrelation / sum_d_) * (estimate + sum_offset_ / sum_d_);
+}
+
+LedgerRow ParitySpread::allowed_row(double statistic, double threshold, double cap) const {
+  // What the sums estimate (before two samples, what an unchecked model may hide).
+  const double allowed =
+      samples_ >= 2 ? std::clamp(estimate(cap), 1.0, design::spread_held_ratio) : design::spread_held_ratio;
+  const double excess = statistic / threshold;
+  return judge(EvidenceSource::kUncheckedNoise, kHypothesisNoise, excess * excess, allowed, allowed);
 }
 
 double ParitySpread::estimate(double cap) const {

@@ -75,6 +75,10 @@ class ParitySpread {
   //! χ², else a sum in σ): the white noise variance ratio that would explain it, consistent up to
   //! design::spread_held_ratio (the arbiter then lets the alarm decide nothing yet). None once checked.
   std::optional<LedgerRow> noise_row(double statistic, double threshold, bool chi2) const;
+  //! The Hnoise row of a sum's alarm (`statistic` against `threshold`, in σ) from the sums since the last
+  //! verdict (`cap` their censoring): the white noise variance ratio the alarm needs, consistent up to the
+  //! ratio the sums estimate (design::spread_held_ratio before two samples, and at most).
+  LedgerRow allowed_row(double statistic, double threshold, double cap) const;
 
   //! [-] the white noise variance taken, over the stated (≥ 1).
   double ratio() const { return ratio_; }
@@ -89,6 +93,8 @@ class ParitySpread {
  private:
   //! [-] the censored maximum-likelihood λ of the sums at the cap `cap` (relative to the current model).
   double estimate(double cap) const;
+  //! [-] the 1σ half-width of `estimate` from the sums.
+  double interval(double estimate) const;
   void clear_sums();
 
   double threshold_ = 0.0;

@@ -137,12 +137,18 @@ void Pipeline::Impl::cover_unchecked_rate(GyroMask before) {
   attitude_.add_bound(unchecked_rate_bound(full, used, held_parity_, subsets_.sqrt_period()) * frame_.dt_s);
 }
 
-bool Pipeline::Impl::alarm_decides(const Detection& d) {
+bool Pipeline::Impl::alarm_decides(const Detection& d, const Subset& s) {
   alarm_rows_.clear();
   alarm_rows_.detection(source_of(d.test), d.statistic, d.threshold, d.dof);
   // Until the parity's spread has checked the noise model, Hnoise may explain the alarm.
   const auto noise = sample_spread_.noise_row(d.statistic, d.threshold, d.test == DetectionTest::kChi2);
   if (noise) alarm_rows_.add(*noise);
+  // A sum's alarm with one degree of freedom, on a unit whose one sample does not show the white noise (the
+  // quantization's): Hnoise stands while the white noise the long-run spread estimates explains it. (With
+  // d ≥ 2 the spread gathers d values a block and rules within minutes: docs/fdi.md, "A unit noisier".)
+  const bool sum = d.test == DetectionTest::kCusum || d.test == DetectionTest::kLevel;
+  if (sum && s.dof == 1 && subsets_.quantization_share() > design::spread_white_dominates)
+    alarm_rows_.add(white_spread_.allowed_row(d.statistic, d.threshold, long_run_cap(s)));
   return arbitrate_detection(alarm_rows_);
 }
 
@@ -154,7 +160,7 @@ void Pipeline::Impl::detect() {
   const double calibration = subsets_.calibration_bound(s, frame_.usable, attitude_.omega_meas_B());
   Detection d = detector_.update(frame_, s, active, subsets_.sqrt_period(), calibration, health_);
   parity_ran_ = d.cusum_ran;
-  const bool held = d.alarm && !alarm_decides(d);
+  const bool held = d.alarm && !alarm_decides(d, s);
   if (held) d.alarm = false;
   protection_.widen(calibration, frame_.dt_s);  // the CUSUM's reference k + D: a larger fault unseen
   if (d.cusum_ran) {

@@ -129,7 +129,7 @@ class Pipeline::Impl {
   void detect();
   //! The alarm's rows (its detection's, and Hnoise's while the noise model is unchecked) into alarm_rows_;
   //! true when the arbiter lets it decide.
-  bool alarm_decides(const Detection& d);
+  bool alarm_decides(const Detection& d, const Subset& s);
   void level_changed(const Detection& d);
   void seek_evidence();
   void isolate_filter_bias(const ReferenceFinding& bias);
@@ -164,6 +164,9 @@ class Pipeline::Impl {
   void match_own_noise();
   void check_noise_model();
   void check_long_run_noise();
+  //! [epochs] a block of the long-run spread, and the censoring of its values for subset `s`.
+  int long_run_block_epochs() const;
+  double long_run_cap(const Subset& s) const;
   void widen_noise(const SpreadFinding& f, const char* evidence);
   void emit_noise_widened(const SpreadFinding& f, const char* evidence);
   void emit_episode_explained(const SpreadFinding& f);

@@ -29,18 +29,25 @@ void Pipeline::Impl::check_long_run_noise() {
   }
   const GyroMask active = gyro_set_.active();
   const Subset& s = subsets_.get(active);
-  const int m = std::max(2, static_cast<int>(std::lround(design::spread_block_s / subsets_.period_s())));
+  const int m = long_run_block_epochs();
   // A block's sums need the same gyros on consecutive epochs; the body's motion cancels in the parity, and
   // what the calibration's error makes of it varies slowly enough for a second difference to cancel.
   const bool clean = gate_.consecutive() && frame_.usable == active;
   if (!blocks_.add(detector_.parity_measured().data(), s.dof, active, clean, m)) return;
+  const double q = subsets_.block_quantization(s, m);
+  const auto found = white_spread_.observe(blocks_.u(), s.dof, long_run_cap(s), frame_.now_ns, q);
+  if (found) widen_noise(*found, "between 5-s sums (the white noise every sum sees)");
+}
+
+double Pipeline::Impl::long_run_cap(const Subset& s) const {
   // A value beyond the test's own χ² threshold (times the quantization's share) is a step, not noise:
   // censored at it.
-  const double q = subsets_.block_quantization(s, m);
-  const double cap =
-      chi2_threshold(allocated_probability(config_, BudgetTest::kParitySpread), s.dof) * (1.0 + q / s.dof);
-  const auto found = white_spread_.observe(blocks_.u(), s.dof, cap, frame_.now_ns, q);
-  if (found) widen_noise(*found, "between 5-s sums (the white noise every sum sees)");
+  const double q = subsets_.block_quantization(s, long_run_block_epochs());
+  return chi2_threshold(allocated_probability(config_, BudgetTest::kParitySpread), s.dof) * (1.0 + q / s.dof);
+}
+
+int Pipeline::Impl::long_run_block_epochs() const {
+  return std::max(2, static_cast<int>(std::lround(design::spread_block_s / subsets_.period_s())));
 }
 
 void Pipeline::Impl::widen_noise(const SpreadFinding& f, const char* evidence) {
