@@ -37,8 +37,7 @@ void Pipeline::Impl::check_long_run_noise() {
   // A value beyond the test's own χ² threshold (times the quantization's share) is a step, not noise:
   // censored at it.
   const double q = subsets_.block_quantization(s, m);
-  const double cap =
-      chi2_threshold(allocated_probability(config_, BudgetTest::kParitySpread), s.dof) * (1.0 + q / s.dof);
+  const double cap = s.spread_threshold * (1.0 + q / s.dof);
   const auto found = white_spread_.observe(blocks_.u(), s.dof, cap, frame_.now_ns, q);
   if (found) widen_noise(*found, "between 5-s sums (the white noise every sum sees)");
 }
