@@ -103,7 +103,7 @@ void OwnNoiseLevel::ingest(const EpochFrame& frame, double period_s) {
       const double d4 = weights_[0] * y + weights_[1] * t.y[0] + weights_[2] * t.y[1] + weights_[3] * t.y[2] +
                         weights_[4] * t.y[3];
       t.d4[static_cast<std::size_t>(t.head)] = std::abs(d4);
-      t.head = (t.head + 1) % window_;
+      if (++t.head == window_) t.head = 0;  // the ring's next slot (no division at every epoch)
       t.count = std::min(t.count + 1, window_);
       t.since_eval = std::min(t.since_eval + 1, kOwnEvalEvery);
     }

@@ -108,6 +108,19 @@ void ParityDetector::restart_after_alarm() {
   }
 }
 
+void ParityDetector::slow_terms(double dt_s, double qs) {
+  if (dt_s == slow_dt_s_ && qs == slow_qs_) return;  // the step and the subset nearly always the last ones
+  slow_dt_s_ = dt_s;
+  slow_qs_ = qs;
+  // The slow mean: white unit-variance input gives an EMA of variance β/(2 − β) in steady state.
+  const double beta = std::min(1.0, dt_s / nominal_window_s_);
+  slow_beta_ = beta;
+  // Quantization: each sample's error term is a difference u_k − u_{k−1} (1σ of u: quantization_sigma), whose
+  // EMA telescopes: β·Σ_j (1 − β)^j (u_{k−j} − u_{k−j−1}) = β·u_k − β²·Σ_j (1 − β)^j u_{k−j−1}, of variance
+  // β²(1 + β/(2 − β))·σ_u² = 2β²/(2 − β)·σ_u².
+  slow_var_ = beta / (2.0 - beta) + 2.0 * beta * beta / (2.0 - beta) * qs * qs;
+}
+
 Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroMask active,
                                  double sqrt_period, double calibration_bound, Health& health) {
   Detection d;
@@ -152,14 +165,8 @@ Detection ParityDetector::update(const EpochFrame& frame, const Subset& s, GyroM
   }
   const double alpha = std::min(1.0, frame.dt_s / 2.0);  // EMA time constant 2 s
   for (int r = 0; r < s.dof; ++r) p_ema_[r] += alpha * (p_[r] - p_ema_[r]);
-  // The slow mean: white unit-variance input gives an EMA of variance β/(2 − β) in steady state.
-  const double beta = std::min(1.0, frame.dt_s / nominal_window_s_);
-  for (int r = 0; r < s.dof; ++r) p_slow_[r] += beta * (p_[r] - p_slow_[r]);
-  // Quantization: each sample's error term is a difference u_k − u_{k−1} (1σ of u: quantization_sigma), whose
-  // EMA telescopes: β·Σ_j (1 − β)^j (u_{k−j} − u_{k−j−1}) = β·u_k − β²·Σ_j (1 − β)^j u_{k−j−1}, of variance
-  // β²(1 + β/(2 − β))·σ_u² = 2β²/(2 − β)·σ_u².
-  const double qs = s.quantization_sigma;
-  slow_var_ = beta / (2.0 - beta) + 2.0 * beta * beta / (2.0 - beta) * qs * qs;
+  slow_terms(frame.dt_s, s.quantization_sigma);
+  for (int r = 0; r < s.dof; ++r) p_slow_[r] += slow_beta_ * (p_[r] - p_slow_[r]);
   slow_age_s_ += frame.dt_s;
   std::int64_t onset = d.onset_index;
   // A calibration term m with |m| ≤ D moves the CUSUM's sum by at most D per epoch: with the reference k + D

@@ -90,6 +90,9 @@ class ParityDetector {
   int vector_count() const { return cusum_.count(); }
 
  private:
+  //! The slow mean's gain and variance (slow_beta_, slow_var_) for the step `dt_s` and the subset's
+  //! quantization σ `qs`: taken again only when either changes.
+  void slow_terms(double dt_s, double qs);
   //! The level test of an open episode: accumulate the level, then the CUSUM on p minus it.
   bool level_change(const Subset& s, std::int64_t index, Detection& d);
   //! The CUSUM's input: the parity as measured, or where the subset's wander is tracked
@@ -112,6 +115,9 @@ class ParityDetector {
   Eigen::VectorXd p_slow_;  //!< EMA of the parity with time constant nominal_window_s_
   double nominal_window_s_ = 30.0;
   double slow_var_ = 0.0;    //!< [σ²] per axis: variance of p_slow_ without fault
+  double slow_beta_ = 0.0;   //!< [-] the slow mean's gain at the step slow_dt_s_
+  double slow_dt_s_ = -1.0;  //!< [s] the step, and the quantization σ, slow_beta_ and slow_var_ are for
+  double slow_qs_ = -1.0;
   double slow_age_s_ = 0.0;  //!< [s] time the slow mean has run since it was last zeroed
   Eigen::VectorXd p_;
   Eigen::VectorXd p_raw_;  //!< this epoch's parity before the calibration bound moved it (the CUSUM's input)

@@ -264,13 +264,12 @@ void Pipeline::Impl::isolate_filter_bias(const ReferenceFinding& bias) {
 }
 
 void Pipeline::Impl::decide_episode() {
-  Isolation found;
   const Episode& episode = isolator_.episode();
-  switch (isolator_.decide(frame_.now_ns, frame_.index, gyro_set_.active(), subsets_, series_, found)) {
+  switch (isolator_.decide(frame_.now_ns, frame_.index, gyro_set_.active(), subsets_, series_, decided_)) {
     case Verdict::kNone:
       break;
     case Verdict::kIsolated:
-      isolate(found);
+      isolate(decided_);
       break;
     case Verdict::kUnisolated: {
       FdiEvent u;

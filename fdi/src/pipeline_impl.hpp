@@ -239,6 +239,8 @@ class Pipeline::Impl {
   EvidenceRows episode_rows_;    //!< the rows of the detection that opened the open episode
   EvidenceRows alarm_rows_;      //!< this epoch's alarm's rows
   EvidenceRows decision_rows_;   //!< scratch: an isolation's rows with the episode's
+  //! scratch: the episode's isolation when decided (its rows' 2 kB not cleared at every epoch)
+  Isolation decided_;
   std::uint64_t arbiter_refusals_ = 0;  //!< findings whose rows the arbiter did not confirm
   ReferenceHorizon horizon_;  //!< a late reference fused at its own time (docs/fdi.md, "Late references")
 

@@ -43,7 +43,7 @@ double Pipeline::Impl::long_run_cap(const Subset& s) const {
   // A value beyond the test's own χ² threshold (times the quantization's share) is a step, not noise:
   // censored at it.
   const double q = subsets_.block_quantization(s, long_run_block_epochs());
-  return chi2_threshold(allocated_probability(config_, BudgetTest::kParitySpread), s.dof) * (1.0 + q / s.dof);
+  return s.spread_threshold * (1.0 + q / s.dof);
 }
 
 int Pipeline::Impl::long_run_block_epochs() const {

@@ -25,7 +25,7 @@ Eigen::Vector3d ProtectionLevel::bound(const Subset& s, const Eigen::Vector3d& s
   Eigen::Vector3d fault = Eigen::Vector3d::Zero();
   for (Eigen::Index i = 0; i < s.pinv.cols(); ++i) {
     if (!has_gyro(s.mask, static_cast<int>(i) + 1)) continue;
-    const double w = s.parity.col(i).head(s.dof).norm() * sqrt_period;  // [σ per rad/s]
+    const double w = s.parity_col_norm[i] * sqrt_period;  // [σ per rad/s]
     if (!(w > 0.0)) return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     fault = fault.cwiseMax(s.pinv.col(i).cwiseAbs() * (reach / w));
   }

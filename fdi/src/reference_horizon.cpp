@@ -40,7 +40,7 @@ void ReferenceHorizon::record(std::int64_t stamp_ns, const Quaternion& q_propaga
   has_final_ = true;
   newest_ = {stamp_ns, gyro_RB_};
   if (ring_.empty()) return;
-  head_ = (head_ + 1) % ring_.size();
+  if (++head_ == ring_.size()) head_ = 0;  // the ring's next slot (no division at every epoch)
   ring_[head_] = newest_;
   if (count_ < ring_.size()) ++count_;
 }

@@ -279,6 +279,7 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   const PipelineConfig& config = *config_;
   s.chi2_threshold = chi2_threshold(allocated_probability(config, BudgetTest::kChi2), s.dof);
   s.jump_threshold = chi2_threshold(allocated_probability(config, BudgetTest::kJump), s.dof);
+  s.spread_threshold = chi2_threshold(allocated_probability(config, BudgetTest::kParitySpread), s.dof);
   s.nominal_threshold = chi2_threshold(1e-3, s.dof);
   // Smallest parity shift [σ] a step of cusum_min_fault_dps on any gyro of the subset produces.
   double min_col = std::numeric_limits<double>::infinity();

@@ -36,6 +36,7 @@ struct Subset {
   Eigen::Vector3d bias_sigma_rad_s;  //!< [rad/s] 1σ rate bias per body axis left by the calibration
   double chi2_threshold = 0.0;       //!< instantaneous χ² threshold
   double jump_threshold = 0.0;       //!< one-epoch jump χ² threshold
+  double spread_threshold = 0.0;     //!< the parity spread's χ² threshold (its block values' cap)
   double cusum_k = 0.0;              //!< [σ] CUSUM reference
   double cusum_h = 0.0;              //!< [σ] CUSUM threshold
   double bias_wander_sigma = 0.0;    //!< [σ] per parity axis: the slowly wandering bias (B, K) in the parity
