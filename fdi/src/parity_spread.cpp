@@ -83,7 +83,8 @@ std::optional<SpreadFinding> ParitySpread::observe(double u, int dof, double cap
 
 double ParitySpread::interval(double estimate) const {
   // u's spread per degree of freedom is about (λ̂ + q̄)·√2 (q̄ the offset's mean).
-  return kIntervalSigmas * std::sqrt(2.0 * kDifferenceCorrelation / sum_d_) * (estimate + sum_offset_ / sum_d_);
+  return kIntervalSigmas * std::sqrt(2.0 * kDifferenceCorrelation / sum_d_) *
+         (estimate + sum_offset_ / sum_d_);
 }
 
 LedgerRow ParitySpread::allowed_row(double statistic, double threshold, double cap) const {

@@ -114,7 +114,8 @@ TEST(ParitySpread, ASmallExcessIsSeenWithinAWindowAndAFallIsFollowedBack) {
 //! Whether an alarm of `statistic` against `threshold` decides: the arbiter over its detection row and, while
 //! the model is unchecked, the spread's Hnoise row.
 bool decides(const ParitySpread& spread, double statistic, double threshold, bool chi2) {
-  std::vector<LedgerRow> rows{judge(EvidenceSource::kCusum, kHypothesisNone, statistic, threshold, threshold)};
+  std::vector<LedgerRow> rows{
+      judge(EvidenceSource::kCusum, kHypothesisNone, statistic, threshold, threshold)};
   if (const auto noise = spread.noise_row(statistic, threshold, chi2)) {
     EXPECT_EQ(noise->hypothesis, kHypothesisNoise);
     EXPECT_EQ(noise->source, EvidenceSource::kUncheckedNoise);
