@@ -32,12 +32,19 @@ void ParitySpread::restart() {
   clear_sums();
 }
 
+namespace {
+//! Hnoise's row: the white noise variance ratio an alarm of `statistic` against `threshold` needs (`chi2`: a
+//! χ², else a sum in σ), consistent up to `allowed`.
+LedgerRow noise_hypothesis_row(double statistic, double threshold, bool chi2, double allowed) {
+  const double excess = statistic / threshold;
+  return judge(EvidenceSource::kUncheckedNoise, kHypothesisNoise, chi2 ? excess : excess * excess, allowed,
+               allowed);
+}
+}  // namespace
+
 std::optional<LedgerRow> ParitySpread::noise_row(double statistic, double threshold, bool chi2) const {
   if (checked_) return std::nullopt;
-  const double excess = statistic / threshold;
-  const double ratio = chi2 ? excess : excess * excess;
-  return judge(EvidenceSource::kUncheckedNoise, kHypothesisNoise, ratio, design::spread_held_ratio,
-               design::spread_held_ratio);
+  return noise_hypothesis_row(statistic, threshold, chi2, design::spread_held_ratio);
 }
 
 std::optional<SpreadFinding> ParitySpread::observe(double u, int dof, double cap, std::int64_t now_ns,
@@ -91,8 +98,7 @@ LedgerRow ParitySpread::allowed_row(double statistic, double threshold, double c
   // What the sums estimate (before two samples, what an unchecked model may hide).
   const double allowed =
       samples_ >= 2 ? std::clamp(estimate(cap), 1.0, design::spread_held_ratio) : design::spread_held_ratio;
-  const double excess = statistic / threshold;
-  return judge(EvidenceSource::kUncheckedNoise, kHypothesisNoise, excess * excess, allowed, allowed);
+  return noise_hypothesis_row(statistic, threshold, false, allowed);
 }
 
 double ParitySpread::estimate(double cap) const {
