@@ -6,11 +6,7 @@
 
 namespace tetra::fdi::detail {
 
-namespace {
-//! A single-gyro model whose residual exceeds this quantile of its χ² is not accepted (the records hold
-//! something no single-gyro fault explains).
-constexpr double kRejectModel = 1e-6;
-}  // namespace
+namespace {}  // namespace
 
 BiasHypothesis::BiasHypothesis(const std::vector<GyroConstants>& constants) : bins_(kBins) {
   for (const auto& c : constants) {
@@ -123,8 +119,9 @@ BiasFit BiasHypothesis::best(const Subset& s, const SpanDisagreement& span, doub
     }
   }
   const int dof = s.dof + compared - 1;
-  if (best == 0 || dof < 1 || total - g_best > chi2_threshold(kRejectModel, dof)) return fit;
-  if (g_best - g_second < kMargin) return fit;
+  if (best == 0 || dof < 1 || total - g_best > chi2_threshold(design::bias_model_reject_probability, dof))
+    return fit;
+  if (g_best - g_second < design::bias_hypothesis_margin_sigma2) return fit;
   return BiasFit{best, size_best, g_best - g_second};
 }
 
@@ -133,7 +130,7 @@ bool BiasHypothesis::persists(int id, double sign, const Subset& s, const SpanDi
   if (late.start < 0 || parity_mean(s, late.start_ns, sqrt_period) < 2) return false;
   double size = 0.0;
   const double g = gain(id, s, late, sqrt_period, size);
-  return size * sign > 0.0 && g >= kPersist;
+  return size * sign > 0.0 && g >= design::bias_hypothesis_persist_sigma2;
 }
 
 }  // namespace tetra::fdi::detail

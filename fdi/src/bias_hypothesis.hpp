@@ -50,15 +50,11 @@ class BiasHypothesis {
   void reset();
 
   //! The single-gyro fault that explains the parity since `span.start_ns` and the reference disagreements
-  //! `span` jointly, if it beats every other gyro's by `kMargin` and its model is accepted; else gyro 0.
+  //! `span` jointly, if it beats every other gyro's by `design::bias_hypothesis_margin_sigma2` and its model
+  //! is accepted; else gyro 0.
   BiasFit best(const Subset& s, const SpanDisagreement& span, double sqrt_period) const;
   //! Gyro `id`'s fault in the latest part of the records (`late`) is significant and of the sign `sign`.
   bool persists(int id, double sign, const Subset& s, const SpanDisagreement& late, double sqrt_period) const;
-
-  //! [σ²] how much more of the records the best gyro must explain than any other (5σ).
-  static constexpr double kMargin = 25.0;
-  //! [σ²] how much of the latest half-span's records the gyro's fault must explain (4σ).
-  static constexpr double kPersist = 16.0;
 
  private:
   static constexpr int kBins = 512;  //!< as many as the reference monitor's snapshots

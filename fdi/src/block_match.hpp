@@ -16,16 +16,10 @@
 
 namespace tetra::fdi::detail {
 
-//! ρ: the matches' alternative, the block's covariance ×4.
-inline constexpr double kBlockMatchRatio = 4.0;
-//! [s] the reference matches' block of the mean innovation.
-inline constexpr double kReferenceBlock_s = 10.0;
-//! γ: a matched ratio's step per block, ×e^{γ(u/d − 1)}.
-inline constexpr double kBlockMatchGain = 0.3;
-
 //! The CUSUM `g` after a block whose statistic `u` has `dof` degrees of freedom under the model.
 inline double block_cusum_step(double g, double u, double dof) {
-  return std::max(0.0, g + 0.5 * ((1.0 - 1.0 / kBlockMatchRatio) * u - dof * std::log(kBlockMatchRatio)));
+  return std::max(0.0, g + 0.5 * ((1.0 - 1.0 / design::block_match_ratio) * u -
+                                  dof * std::log(design::block_match_ratio)));
 }
 
 //! The mean-innovation test's χ²₃ from per-axis sums Σ1/S_aa (`sw`) and Σz_a/S_aa (`swz`): Σ_a swz_a²/sw_a

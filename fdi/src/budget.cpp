@@ -93,7 +93,7 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
                     "one sample left out (the gate), rejection after reference_gate_reset_count"});
   if (parity) {
     b.rows.push_back({"motion_fit", K::kMismatch, "false_alarm_probability",
-                      allocated_probability(c, BudgetTest::kMotionFit), 3600.0 / detail::kMotionFitBlockS,
+                      allocated_probability(c, BudgetTest::kMotionFit), 3600.0 / design::motion_fit_block_s,
                       "one block's H0 rejected (a mismatch needs two in a row and every Hi rejected too)"});
   }
   if (parity) {

@@ -14,8 +14,6 @@ namespace tetra::fdi::detail {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-//! Epochs below which a block is not judged (a set that changed just before the block's end).
-constexpr double kMinEpochs = 10.0;
 //! Eigenvalues of S below this share of the largest carry no information (a rate never varied about them).
 constexpr double kRankTolerance = 1e-12;
 }  // namespace
@@ -79,11 +77,11 @@ bool CalibrationFit::record(const Eigen::VectorXd& p, const Subset& s, GyroMask 
   }
   restart_pending_ = false;
   accumulate(p, s.dof, omega_rad_s);
-  if (now_ns - start_ns_ < seconds_to_ns(kMotionFitBlockS)) return false;
+  if (now_ns - start_ns_ < seconds_to_ns(design::motion_fit_block_s)) return false;
   const bool named = judge_block(s, mask, cache, config);
   restart(s, mask, omega_rad_s, now_ns);
   streak_ = named ? streak_ + 1 : 0;
-  if (streak_ < kMotionFitBlocksInARow || mismatch_) return false;
+  if (streak_ < design::motion_fit_blocks_in_a_row || mismatch_) return false;
   mismatch_ = true;
   return true;
 }
@@ -167,7 +165,7 @@ double CalibrationFit::residual(const Eigen::MatrixXd& basis, int columns, int& 
 bool CalibrationFit::judge_block(const Subset& s, GyroMask mask, const SubsetCache& cache,
                                  const PipelineConfig& config) {
   rows_.clear();
-  if (epochs_ < kMinEpochs) return false;
+  if (epochs_ < design::motion_fit_min_epochs) return false;
   moments(s, mask, cache, config);
   solver_.compute(cov_);
   if (solver_.info() != Eigen::Success) return false;

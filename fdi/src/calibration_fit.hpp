@@ -1,10 +1,10 @@
 #pragma once
 // A calibration that does not describe the unit (docs/fdi.md, "A calibration that does not describe the
 // unit"). Scale factors or axes off make the parity follow the body rate: p_k = p̄ + M·(ω_k − ω̄) + n_k. Over
-// each block of kMotionFitBlockS the gyro set's normalized parity is fitted to the measured rate, and the
-// fit is judged per hypothesis: H0 (M within the calibration's stated tolerance), Hi (M what gyro i alone
-// makes: its scale factor with four gyros, any error of its own from five on), Hcal (any M). Two blocks in
-// a row with H0 and every Hi rejected name a mismatch: the unit's calibration is wrong in several gyros at
+// each block of design::motion_fit_block_s the gyro set's normalized parity is fitted to the measured rate,
+// and the fit is judged per hypothesis: H0 (M within the calibration's stated tolerance), Hi (M what gyro i
+// alone makes: its scale factor with four gyros, any error of its own from five on), Hcal (any M). Two blocks
+// in a row with H0 and every Hi rejected name a mismatch: the unit's calibration is wrong in several gyros at
 // once, which no exclusion mends. It then stands (for the gyro set), and exclusions whose evidence a
 // calibration's error can make are withheld; a gyro's own signal still excludes it.
 
@@ -17,13 +17,6 @@
 #include "subset_cache.hpp"
 
 namespace tetra::fdi::detail {
-
-//! [s] one block of the motion fit: long enough for a slew or two, short enough to name a mismatch within
-//! ten minutes of motion.
-inline constexpr double kMotionFitBlockS = 300.0;
-//! Blocks in a row whose rows make the case before a mismatch is named: a fault's onset inside a block
-//! bends that block's fit; the next block shows the fault as the single gyro's it is.
-inline constexpr int kMotionFitBlocksInARow = 2;
 
 class CalibrationFit {
  public:

@@ -1,5 +1,7 @@
 #include "tetra/fdi/detectors.hpp"
 
+#include "tetra/fdi/config.hpp"
+
 #include <cmath>
 #include <limits>
 
@@ -73,14 +75,9 @@ namespace tetra::fdi {
 
 namespace {
 
-constexpr double kVectorOvershoot = 0.8;    // b − h for Crosier's statistic (detectors.hpp)
-constexpr double kScalarOvershoot = 1.166;  // b − h in Siegmund's formula
-constexpr int kArlSteps = 400;              // trapezoid steps of the ARL integral (relative error < 1e-3)
-//! The averaged design is kept unless absorbing the mean detects the design shift more than this many times
-//! sooner: the two are within a few per cent for a wander well inside the reach, the average's h grows
-//! without bound as the reach passes k.
-constexpr double kAverageKeptWithin = 2.0;
-constexpr int kBiasNodes = 32;  // nodes of the average over the parity bias, out to its reach
+constexpr double kVectorOvershoot = 0.8;  // b − h for Crosier's statistic (detectors.hpp)
+constexpr int kArlSteps = 400;            // trapezoid steps of the ARL integral (relative error < 1e-3)
+constexpr int kBiasNodes = 32;            // nodes of the average over the parity bias, out to its reach
 
 double int_pow(double x, int n) {
   double r = 1.0;
@@ -122,12 +119,12 @@ double cusum_arl0_with_bias(int dof, double k, double h, double bias_sigma) {
   if (dof >= 2) {
     // A mean μ speeds the escape through each direction û as a one-dimensional shift x = μ·û would speed one
     // branch of Siegmund's CUSUM with the same b; x ~ N(0, s²) for every û.
-    const double h1 = h + kVectorOvershoot - kScalarOvershoot;  // Siegmund's formula with b = h + 0.8
+    const double h1 = h + kVectorOvershoot - kSiegmundOvershoot;  // Siegmund's formula with b = h + 0.8
     const double arl_free = cusum_arl(0.0, k, h1);
     double tilt = 0.0;
     double weight = 0.0;
     for (int j = -kBiasNodes; j <= kBiasNodes; ++j) {
-      const double x = kBiasAverageReach * j / kBiasNodes;
+      const double x = design::cusum_bias_average_reach * j / kBiasNodes;
       const double w = std::exp(-0.5 * x * x);
       tilt += w * arl_free / cusum_arl(bias_sigma * x, k, h1);
       weight += w;
@@ -136,7 +133,7 @@ double cusum_arl0_with_bias(int dof, double k, double h, double bias_sigma) {
   }
   // d = 1: E[1/ARL] over |μ| = s·x, x ~ |N(0, 1)|, both branches of Siegmund's formula, on a grid out to x
   // = 6.
-  const double dx = kBiasAverageReach / kBiasNodes;
+  const double dx = design::cusum_bias_average_reach / kBiasNodes;
   double rate = 0.0;
   double weight = 0.0;
   for (int j = 0; j <= kBiasNodes; ++j) {
@@ -156,10 +153,10 @@ CusumDesign cusum_design(int dof, double k, double arl0, double bias_sigma, doub
   if (!std::isfinite(averaged.h)) return absorbed;
   // The delay to the design shift 2k, (h + overshoot) / (2k − reference): none once the reference reaches it.
   const auto delay = [k](const CusumDesign& d) {
-    return d.k < 2.0 * k ? (d.h + kScalarOvershoot) / (2.0 * k - d.k)
+    return d.k < 2.0 * k ? (d.h + kSiegmundOvershoot) / (2.0 * k - d.k)
                          : std::numeric_limits<double>::infinity();
   };
-  return delay(averaged) <= kAverageKeptWithin * delay(absorbed) ? averaged : absorbed;
+  return delay(averaged) <= design::cusum_average_kept_within * delay(absorbed) ? averaged : absorbed;
 }
 
 double cusum_threshold(int dof, double k, double arl0, double bias_sigma) {

@@ -6,9 +6,7 @@
 
 namespace tetra::fdi::detail {
 
-namespace {
-constexpr double kTrendSigmas = 3.0;  //!< the prediction's margin, in its σ
-}  // namespace
+namespace {}  // namespace
 
 void DisagreementTrend::start(std::int64_t now_ns) {
   active_ = true;
@@ -41,13 +39,13 @@ Eigen::Vector3d DisagreementTrend::bound(std::int64_t now_ns) const {
     const double det = s0_[a] * s2_[a] - s1_[a] * s1_[a];
     if (count_ < 3 || det <= 1e-12 * s0_[a] * s2_[a]) {
       // Too few samples for a slope: the mean innovation and its σ.
-      b[a] = std::abs(sz_[a] / s0_[a]) + kTrendSigmas / std::sqrt(s0_[a]);
+      b[a] = std::abs(sz_[a] / s0_[a]) + design::trend_margin_sigmas / std::sqrt(s0_[a]);
       continue;
     }
     const double slope = (s0_[a] * stz_[a] - s1_[a] * sz_[a]) / det;
     const double offset = (s2_[a] * sz_[a] - s1_[a] * stz_[a]) / det;
     const double var = (s2_[a] - 2.0 * t * s1_[a] + t * t * s0_[a]) / det;
-    b[a] = std::abs(offset + slope * t) + kTrendSigmas * std::sqrt(std::max(var, 0.0));
+    b[a] = std::abs(offset + slope * t) + design::trend_margin_sigmas * std::sqrt(std::max(var, 0.0));
   }
   return b;
 }

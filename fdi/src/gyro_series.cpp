@@ -11,21 +11,11 @@ namespace tetra::fdi::detail {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr int kNoiseEvalEvery = 10;  //!< [samples] the noise-level test runs this often
 constexpr double kNoiseExpectedMedian = 0.6744897501960817;  //!< median of |N(0,1)|
 constexpr double kInf = std::numeric_limits<double>::infinity();
 //! [-] relative margin of the counting decision on the noise ratio: far above the few ulps of rounding in
 //! median/level, far below any meaningful change of the limits
 constexpr double kRatioMargin = 1e-9;
-constexpr double kCoarseStepPerSigma = 0.1;  //!< a quantization step beyond this many σ makes repeats normal
-constexpr double kQuietMotion = 2.0;       //!< [σ] motion level the noise-level test still tells from noise
-constexpr double kMotionQuietRatio = 2.0;  //!< noise ratio of a gyro whose own second differences look normal
-//! [samples] another gyro's repeat run that leaves a coarse gyro's repeats unjudged
-constexpr int kOtherRepeats = 3;
-//! Pieces of a repeat run that one other gyro's fault explains: its level changed at most twice during the
-//! run (a step; a spike or a pulse that came and went), so the others' view of the axis may sit at up to
-//! three levels while the gyro's own rate stood still.
-constexpr int kPiecesOneFaultExplains = 3;
 }  // namespace
 
 double select_rank(double* a, int n, int k) {
@@ -306,7 +296,7 @@ double GyroSeries::difference_variance(int id, double sqrt_period) const {
 bool GyroSeries::coarse(int id, double sqrt_period) const {
   const GyroConstants& c = constants(id);
   const double step = std::sqrt(12.0) * c.quantization_rad / (sqrt_period * sqrt_period);
-  return step > kCoarseStepPerSigma * c.arw_rad_rts / sqrt_period;
+  return step > design::coarse_step_per_sigma * c.arw_rad_rts / sqrt_period;
 }
 
 double GyroSeries::d2_sigma(int id, double sqrt_period) const {
@@ -325,15 +315,15 @@ bool GyroSeries::motion_quiet(int id, double sqrt_period, int last) const {
   const int n = std::min({last, t.d2_count, design::noise_window});
   const double motion =
       last == 0 ? noise_ratio(id, sqrt_period, 0, true) : (n < 6 ? kNaN : trimmed_rms(t.m2, t, n));
-  return std::isfinite(motion) && motion <= kQuietMotion;
+  return std::isfinite(motion) && motion <= design::quiet_motion_sigmas;
 }
 
 bool GyroSeries::noise_beyond_motion(int id, const Track& t, double r, double sqrt_period) const {
   // With four gyros a slew's jerk and one gyro's noise leave the same single residual: the gyro's own level
   // tells them apart only while the motion is quiet. The motion the other gyros see along this axis (in units
-  // of their own noise on it, ≈ 1 at rest; ∞ when they could not see it) must be within kQuietMotion, and the
-  // gyro's level beyond the limit by more than that motion could hide: its level in the gyro's own σ units
-  // (the others' noise on it is large where their geometry is poor).
+  // of their own noise on it, ≈ 1 at rest; ∞ when they could not see it) must be within
+  // design::quiet_motion_sigmas, and the gyro's level beyond the limit by more than that motion could hide:
+  // its level in the gyro's own σ units (the others' noise on it is large where their geometry is poor).
   // Another gyro's raised level means motion or a second fault: neither leaves this gyro alone to blame.
   if (!motion_quiet(id, sqrt_period, 0) || !others_normal(id, sqrt_period)) return false;
   const double motion = noise_ratio(id, sqrt_period, 0, true);
@@ -359,28 +349,29 @@ bool GyroSeries::others_normal(int id, double sqrt_period) const {
   for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
     if (j == id || has_gyro(excluded_, j)) continue;
     const double r = noise_ratio(j, sqrt_period);
-    if (!std::isfinite(r) || r > kMotionQuietRatio) return false;
+    if (!std::isfinite(r) || r > design::motion_quiet_ratio) return false;
     // A finely quantized output repeating its value has just stuck (its own test needs more repeats): its
     // frozen output is part of the motion the others see along this axis, which then hides the jerk of a
     // slew's start from it (N = 4, a gyro at 0 V as a slew began: the healthy one was excluded first).
-    if (!coarse(j, sqrt_period) && track(j).repeat_count >= kOtherRepeats) return false;
+    if (!coarse(j, sqrt_period) && track(j).repeat_count >= design::other_repeats_samples) return false;
   }
   return true;
 }
 
 bool GyroSeries::repeats_are_stuck(int id, const Track& t, double sqrt_period) const {
   if (!coarse(id, sqrt_period)) return true;  // identical values of a finely quantized output: stuck
-  // Another gyro repeating too (kOtherRepeats values: it may have just stuck) may be the stuck one, and its
-  // output is part of the motion the others see.
+  // Another gyro repeating too (design::other_repeats_samples values: it may have just stuck) may be the
+  // stuck one, and its output is part of the motion the others see.
   for (int j = 1; j <= static_cast<int>(tracks_.size()); ++j) {
-    if (j != id && !has_gyro(excluded_, j) && track(j).repeat_count >= kOtherRepeats) return false;
+    if (j != id && !has_gyro(excluded_, j) && track(j).repeat_count >= design::other_repeats_samples)
+      return false;
   }
   // A healthy quantized gyro's sample is the mean rate over the sample period within one step: when the rate
   // the others see along its axis moved by two steps beyond their noise, its output must have changed — if
   // the others are healthy. A fault of one of them moves that view too (a bias step of 0.017 deg/s on gyro 1
   // moves gyro 2's by 0.019 deg/s, one width), so its repeats are stuck only when no fault of one other gyro
   // that changed at most twice during the run explains the view: more pieces than such a fault leaves.
-  return t.run_seen && t.run_pieces > kPiecesOneFaultExplains;
+  return t.run_seen && t.run_pieces > design::pieces_one_fault_explains;
 }
 
 double* GyroSeries::recent(const std::vector<double>& ring, const Track& t, int n) const {
@@ -456,7 +447,7 @@ void GyroSeries::check(std::int64_t now_ns, GyroMask excluded, double period_s, 
 bool GyroSeries::may_signal(const Track& t) const {
   // The entry condition of each signature of check_one: most epochs meet none of them.
   return t.absent_since_ns >= 0 || t.invalid_since_ns >= 0 || t.repeat_count >= design::stuck_repeat_count ||
-         t.d2_since_eval >= kNoiseEvalEvery || t.spike_n >= design::spike_count;
+         t.d2_since_eval >= design::noise_eval_every_samples || t.spike_n >= design::spike_count;
 }
 
 bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_s, double sqrt_period,
@@ -479,7 +470,7 @@ bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_
   if (t.repeat_count >= design::stuck_repeat_count && repeats_are_stuck(id, t, sqrt_period))
     return found(FaultKind::kStuck, t.last_raw == 0.0 ? Evidence::kZero : Evidence::kRepeated, t.repeat_count,
                  design::stuck_repeat_count);
-  if (t.d2_since_eval >= kNoiseEvalEvery && period_s > 0.0) {
+  if (t.d2_since_eval >= design::noise_eval_every_samples && period_s > 0.0) {
     t.d2_since_eval = 0;
     if (!noise_ratio_within(t, id, sqrt_period, design::noise_low_ratio, config_.noise_high_ratio)) {
       // A raised level is judged against the unit's own (the gyros' median): a unit noisier than stated is
@@ -500,7 +491,8 @@ bool GyroSeries::check_one(int id, Track& t, std::int64_t now_ns, double period_
       t.spike_ns[static_cast<std::size_t>((t.spike_n - design::spike_count) % kSpikeMemory)];
   const std::int64_t age = now_ns - t_first;
   if (age > seconds_to_ns(design::spike_window_s) ||
-      age < seconds_to_ns(3.0 * kNoiseEvalEvery * period_s + design::noise_window * period_s))
+      age <
+          seconds_to_ns(3.0 * design::noise_eval_every_samples * period_s + design::noise_window * period_s))
     return false;
   const double r = noise_ratio(id, sqrt_period);
   if (std::isfinite(r) && r < design::noise_raised_fraction * config_.noise_high_ratio)

@@ -312,8 +312,9 @@ void Isolator::glt_baseline(std::int64_t index, const Subset& s, double sqrt_per
   glt_baseline_done_ = true;
   glt_pre_n_ = 0;
   const std::int64_t end = episode_.onset_index - 2;  // the onset test's gap
-  const std::int64_t begin = std::max({end - kGltBaselineEpochs, index - kHistory + 1, std::int64_t{0}});
-  if (end - begin < kGltBaselineMin) return;
+  const std::int64_t begin =
+      std::max({end - design::glt_baseline_max_epochs, index - kHistory + 1, std::int64_t{0}});
+  if (end - begin < design::glt_baseline_min_epochs) return;
   std::fill(glt_y_pre_.begin(), glt_y_pre_.end(), 0.0);
   int count = 0;
   for (std::int64_t k = begin; k < end; ++k) {
@@ -322,7 +323,7 @@ void Isolator::glt_baseline(std::int64_t index, const Subset& s, double sqrt_per
     for (int i = 0; i < n_; ++i) glt_y_pre_[static_cast<std::size_t>(i)] += y_at(slot, i);
     ++count;
   }
-  if (count < kGltBaselineMin) return;
+  if (count < design::glt_baseline_min_epochs) return;
   for (double& v : glt_y_pre_) v /= count;
   double p[kMaxGyros];
   (void)apply_parity(s, s.mask, glt_y_pre_.data(), sqrt_period, p);
@@ -334,10 +335,10 @@ void Isolator::glt_baseline(std::int64_t index, const Subset& s, double sqrt_per
 
 // The noise the baseline's parity shows: a unit noisier than its `noise:` section (or one gyro of it) makes
 // the parity's spread larger than the model's identity, and the GLT's white-noise term follows it. The
-// sample covariance of means of kGltNoiseBlock epochs, times that count (a mean's covariance, in which the
-// angle quantization telescopes away as it does in the GLT's own means; one sample's spread would count it
-// whole), each eigenvalue raised to at least the model's 1, so a direction the data show no noisier is
-// taken as stated. Once per episode (the eigenvalue solver allocates).
+// sample covariance of means of design::glt_noise_block_epochs epochs, times that count (a mean's covariance,
+// in which the angle quantization telescopes away as it does in the GLT's own means; one sample's spread
+// would count it whole), each eigenvalue raised to at least the model's 1, so a direction the data show no
+// noisier is taken as stated. Once per episode (the eigenvalue solver allocates).
 void Isolator::baseline_noise(std::int64_t begin, std::int64_t end, const Subset& s, double sqrt_period) {
   glt_noise_cov_.setIdentity();
   Eigen::MatrixXd scatter = Eigen::MatrixXd::Zero(s.dof, s.dof);
@@ -350,15 +351,15 @@ void Isolator::baseline_noise(std::int64_t begin, std::int64_t end, const Subset
     if ((hist_valid_[slot] & s.mask) != s.mask) continue;
     (void)apply_parity(s, s.mask, &hist_y_[slot * static_cast<std::size_t>(n_)], sqrt_period, p);
     for (int r = 0; r < s.dof; ++r) block[r] += p[r] - glt_pre_[r];
-    if (++in_block < kGltNoiseBlock) continue;
-    block /= kGltNoiseBlock;
+    if (++in_block < design::glt_noise_block_epochs) continue;
+    block /= design::glt_noise_block_epochs;
     scatter.noalias() += block * block.transpose();
     block.setZero();
     in_block = 0;
     ++blocks;
   }
   if (blocks < 2 || !scatter.allFinite()) return;
-  scatter *= static_cast<double>(kGltNoiseBlock) / blocks;
+  scatter *= static_cast<double>(design::glt_noise_block_epochs) / blocks;
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(scatter);
   const Eigen::VectorXd raised = eig.eigenvalues().cwiseMax(1.0);
   glt_noise_cov_.topLeftCorner(s.dof, s.dof) =
@@ -369,9 +370,9 @@ void Isolator::baseline_noise(std::int64_t begin, std::int64_t end, const Subset
 // the fault's onset inside it) is explained by a step f·[t ≥ t_m] or by a ramp r·(t − t_m)₊, each with its
 // best change time t_m. In units of the normalized parity, each fit removes G = (Σ x·u)²/Σ u² of the squared
 // sum (u the model's shape; a change time before the history gives a constant or a line a + b·t); the kind is
-// the model whose G is larger by kDriftMargin; an offset without a trend (slope below 3σ) is a bias that
-// began before the history; otherwise `unknown` (a step seen shortly after a ramp began fits both). Without
-// parity (three gyros) the data cannot tell: unknown.
+// the model whose G is larger by design::drift_margin_sigma2; an offset without a trend (slope below 3σ) is a
+// bias that began before the history; otherwise `unknown` (a step seen shortly after a ramp began fits both).
+// Without parity (three gyros) the data cannot tell: unknown.
 FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets) const {
   const Subset& s = subsets.get(active);
   if (!s.observable || s.dof < 1) return FaultKind::kUnknown;
@@ -390,7 +391,7 @@ FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, 
     drift_t_[static_cast<std::size_t>(n)] = ns_to_seconds(hist_ns_[slot] - t0);
     ++n;
   }
-  if (n < 20) return FaultKind::kUnknown;
+  if (n < design::drift_min_epochs) return FaultKind::kUnknown;
   // Suffix sums from the change sample m on: Σx, Σx·t, Σt, Σt², count.
   double sx = 0.0, sxt = 0.0, st = 0.0, stt = 0.0;
   double g_step = 0.0, g_ramp = 0.0;
@@ -413,10 +414,11 @@ FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, 
   const double sxx_t = stt - st * st / n;
   const double slope_gain = sxx_t > 0.0 ? (sxt - st * sx / n) * (sxt - st * sx / n) / sxx_t : 0.0;
   g_ramp = std::max(g_ramp, g_const + slope_gain);
-  if (g_step > g_ramp + kDriftMargin) return FaultKind::kBias;
-  if (g_ramp > g_step + kDriftMargin) return FaultKind::kRamp;
+  if (g_step > g_ramp + design::drift_margin_sigma2) return FaultKind::kBias;
+  if (g_ramp > g_step + design::drift_margin_sigma2) return FaultKind::kRamp;
   // An offset through the whole history with no trend in it (slope below 3σ): a bias that began before.
-  if (slope_gain < 9.0 && g_const > kDriftMargin) return FaultKind::kBias;
+  if (slope_gain < design::drift_no_trend_sigma2 && g_const > design::drift_margin_sigma2)
+    return FaultKind::kBias;
   return FaultKind::kUnknown;
 }
 

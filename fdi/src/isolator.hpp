@@ -78,8 +78,6 @@ class Isolator {
 
  private:
   static constexpr int kHistory = 256;  //!< [epochs] history kept for the onset test
-  //! [σ²] how much more of the parity one drift model must explain than the other (a 4σ difference)
-  static constexpr double kDriftMargin = 16.0;
   int onset_test(std::int64_t index, GyroMask active, SubsetCache& subsets, const GyroSeries& series);
   //! Means of two history windows [b1, e1) and [b2, e2) into the pre/post scratch; their separation [s].
   double two_windows(std::int64_t b1, std::int64_t e1, std::int64_t b2, std::int64_t e2);
@@ -92,13 +90,10 @@ class Isolator {
   //! r_i for every gyro i of `s`: the residual of m after the best fault along w_i, in the metric C⁻¹.
   void glt_residuals(const Subset& s, const Eigen::VectorXd& m, const Eigen::MatrixXd& cov, double* r) const;
   //! The GLT's baseline: the mean normalized parity and rate over the clean epochs before the onset kept in
-  //! the history (all of `s`'s gyros valid), at most kGltBaselineEpochs of them; none when fewer than
-  //! kGltBaselineMin are kept.
+  //! the history (all of `s`'s gyros valid), at most design::glt_baseline_max_epochs of them; none when fewer
+  //! than design::glt_baseline_min_epochs are kept.
   void glt_baseline(std::int64_t index, const Subset& s, double sqrt_period);
   void baseline_noise(std::int64_t begin, std::int64_t end, const Subset& s, double sqrt_period);
-  static constexpr int kGltBaselineEpochs = 200;  //!< [epochs] the baseline's longest window
-  static constexpr int kGltBaselineMin = 20;      //!< [epochs] its shortest
-  static constexpr int kGltNoiseBlock = 10;       //!< [epochs] the baseline's blocks for its noise
   //! Window means of each gyro's rate over history epochs [b, e); returns the mean time offset from b [s].
   double window_means(std::int64_t b, std::int64_t e, std::vector<double>& mean,
                       std::vector<int>& count) const;

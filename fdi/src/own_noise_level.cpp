@@ -10,12 +10,9 @@
 namespace tetra::fdi::detail {
 
 namespace {
-constexpr int kOwnEvalEvery = 10;                           //!< [values] the level is evaluated this often
 constexpr double kMedianOfHalfNormal = 0.6744897501960817;  //!< median of |N(0,1)|
 constexpr double kWhiteD4 = 70.0;                           //!< var(Δ⁴) of unit white noise: C(8,4)
-constexpr double kQuantizationD4 = 252.0;    //!< var(Δ⁵e) of unit white angle error: C(10,5)
-constexpr double kSmoothEvaluations = 10.0;  //!< λ's smoothing, in evaluations
-constexpr double kNamedNormalRatio = 1.5;    //!< [-] a named gyro's smoothed level back below this: normal
+constexpr double kQuantizationD4 = 252.0;  //!< var(Δ⁵e) of unit white angle error: C(10,5)
 }  // namespace
 
 OwnNoiseLevel::OwnNoiseLevel(const std::vector<GyroConstants>& constants, const PipelineConfig& config)
@@ -105,7 +102,7 @@ void OwnNoiseLevel::ingest(const EpochFrame& frame, double period_s) {
       t.d4[static_cast<std::size_t>(t.head)] = std::abs(d4);
       if (++t.head == window_) t.head = 0;  // the ring's next slot (no division at every epoch)
       t.count = std::min(t.count + 1, window_);
-      t.since_eval = std::min(t.since_eval + 1, kOwnEvalEvery);
+      t.since_eval = std::min(t.since_eval + 1, design::own_noise_eval_every);
     }
     t.y[3] = t.y[2];
     t.y[2] = t.y[1];
@@ -135,7 +132,7 @@ double OwnNoiseLevel::white_ratio(int id, double r, double sqrt_period) const {
   const double s = d4_sigma(id, sqrt_period);
   const double white = kWhiteD4 * c.arw_rad_rts * c.arw_rad_rts / (sqrt_period * sqrt_period);
   if (!(white > 0.0) || !(r > 1.0)) return 1.0;
-  const double cap = ReferenceNoiseMatch::kMaxNoiseRatio * ReferenceNoiseMatch::kMaxNoiseRatio;
+  const double cap = design::reference_max_noise_ratio * design::reference_max_noise_ratio;
   return std::min(1.0 + (r * r - 1.0) * s * s / white, cap);
 }
 
@@ -144,7 +141,7 @@ bool OwnNoiseLevel::evaluate(GyroMask candidates, double sqrt_period, std::vecto
   bool changed = false;
   for (int id = 1; id <= static_cast<int>(tracks_.size()); ++id) {
     Track& t = tracks_[static_cast<std::size_t>(id - 1)];
-    if (!(t.named || has_gyro(candidates, id)) || t.since_eval < kOwnEvalEvery) continue;
+    if (!(t.named || has_gyro(candidates, id)) || t.since_eval < design::own_noise_eval_every) continue;
     t.since_eval = 0;
     const double r = level(id, sqrt_period);
     if (!std::isfinite(r)) continue;
@@ -164,9 +161,9 @@ bool OwnNoiseLevel::evaluate(GyroMask candidates, double sqrt_period, std::vecto
 
 bool OwnNoiseLevel::follow(Track& t, int id, double r, double sqrt_period) const {
   const double lambda = white_ratio(id, r, sqrt_period);
-  t.smoothed += (lambda - t.smoothed) / kSmoothEvaluations;
+  t.smoothed += (lambda - t.smoothed) / design::own_noise_smoothing_evaluations;
   t.ratio = std::max(t.smoothed, lambda);
-  return t.smoothed >= white_ratio(id, kNamedNormalRatio, sqrt_period);
+  return t.smoothed >= white_ratio(id, design::own_noise_normal_ratio, sqrt_period);
 }
 
 void OwnNoiseLevel::clear_name(Track& t) {

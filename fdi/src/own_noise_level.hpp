@@ -22,12 +22,13 @@
 //
 // Beyond that limit the gyro is named (an event, never an exclusion: three gyros are the rate) and from
 // then on its white noise in the filter is matched to the level: the variance ratio λ = 1 + (r² − 1)·σ²_Δ⁴ /
-// (70·N²/T) (the whole excess read as white noise), smoothed over kSmoothEvaluations evaluations (so that a
-// window that happens to be low does not shrink sigma) and never below the last window's (so that a rise
-// counts at once). A named gyro's level is followed whatever the set (with parity back, the noise-level test
-// of gyro_series judges it); it is named no more once the smoothed λ is back below λ(kNormalLevel), and then
-// matched no more. An epoch farther than half a sample period from the next expected one (a dropped epoch) or
-// a gap breaks every series: a difference across a missing sample would carry the body's acceleration.
+// (70·N²/T) (the whole excess read as white noise), smoothed over design::own_noise_smoothing_evaluations
+// evaluations (so that a window that happens to be low does not shrink sigma) and never below the last
+// window's (so that a rise counts at once). A named gyro's level is followed whatever the set (with parity
+// back, the noise-level test of gyro_series judges it); it is named no more once the smoothed λ is back below
+// λ(kNormalLevel), and then matched no more. An epoch farther than half a sample period from the next
+// expected one (a dropped epoch) or a gap breaks every series: a difference across a missing sample would
+// carry the body's acceleration.
 
 #include <cstdint>
 #include <vector>

@@ -10,10 +10,7 @@
 
 namespace tetra::fdi::detail {
 
-namespace {
-constexpr double kBiasBlock_s = 30.0;  //!< [s] the block of the mean parity innovation
-constexpr int kQuietBlocks = 10;       //!< matched: blocks in a row with every CUSUM at 0 that end it
-}  // namespace
+namespace {}  // namespace
 
 ParityBiasMatch::ParityBiasMatch(const PipelineConfig& config, int gyro_count)
     : false_alarm_(allocated_probability(config, BudgetTest::kParityBlockMatch)),
@@ -85,7 +82,7 @@ void ParityBiasMatch::observe(std::int64_t now_ns, const Subset& s, const Eigen:
     sum_w2_[k] += a * a;
   }
   ++block_epochs_;
-  if (now_ns - block_start_ns_ < seconds_to_ns(kBiasBlock_s)) return;
+  if (now_ns - block_start_ns_ < seconds_to_ns(design::parity_bias_block_s)) return;
   close_block(s, ns_to_seconds(now_ns - block_start_ns_), filter);
   block_start_ns_ = now_ns;
   block_epochs_ = 0;
@@ -133,7 +130,7 @@ void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter)
     for (int i = 0; i < n; ++i)
       quiet = quiet && !(has_gyro(s.mask, i + 1) && cusum_[static_cast<std::size_t>(i)] > 0.0);
     quiet_blocks_ = quiet ? quiet_blocks_ + 1 : 0;
-    if (quiet_blocks_ >= kQuietBlocks) {
+    if (quiet_blocks_ >= design::parity_bias_quiet_blocks) {
       release(filter);
       return;
     }

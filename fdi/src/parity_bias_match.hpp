@@ -3,11 +3,11 @@
 // is too small for the CUSUM (sized for cusum_min_fault_dps) yet larger and faster than its bias model — a
 // scale change seen only through the attitude control's wobble, a small wandering bias — moves the parity
 // all the same, and averaging shows it. Per gyro i of the active set, the filter's parity innovations
-// ν = p − √T·W·(ĉ + ĝ) are projected on the gyro's parity column w_i and summed over blocks of kBiasBlock_s
-// (30 s): the block's mean rate error on the gyro, f̂_i = Σ w_iᵀν / Σ |w_i|², has the variance
-// 1/Σ|w_i|² + v_i while the filter's model holds (white parity noise; v_i the filter's own uncertainty of the
-// biases seen the same way), so u_i = f̂_i²/(1/Σ|w_i|² + v_i) is χ²₁. A CUSUM per gyro of the log-likelihood
-// ratio for a block variance ρ = 4 times the predicted,
+// ν = p − √T·W·(ĉ + ĝ) are projected on the gyro's parity column w_i and summed over blocks of
+// design::parity_bias_block_s (30 s): the block's mean rate error on the gyro, f̂_i = Σ w_iᵀν / Σ |w_i|², has
+// the variance 1/Σ|w_i|² + v_i while the filter's model holds (white parity noise; v_i the filter's own
+// uncertainty of the biases seen the same way), so u_i = f̂_i²/(1/Σ|w_i|² + v_i) is χ²₁. A CUSUM per gyro of
+// the log-likelihood ratio for a block variance ρ = 4 times the predicted,
 //
 //   g_i ← max(0, g_i + ½·((1 − 1/ρ)·u_i − ln ρ));   matched when some g_i > ln(1/(p·n·|S|))
 //
@@ -23,8 +23,8 @@
 // been seen (before it the filter estimates no bias, and the biases' own wander, slower than a block, would
 // make successive blocks correlated). The random-walk bias also opens, by the largest excess of a
 // block-to-block change over both blocks' predicted variances, per second of block. The match ends — every
-// model the calibration's again — at an exclusion, or after kQuietBlocks (10) blocks in a row with every
-// CUSUM at 0; the bias states' prior spread (the filter-bias test's) keeps the model's K.
+// model the calibration's again — at an exclusion, or after design::parity_bias_quiet_blocks (10) blocks in a
+// row with every CUSUM at 0; the bias states' prior spread (the filter-bias test's) keeps the model's K.
 
 #include <cstdint>
 #include <vector>
@@ -56,7 +56,7 @@ class ParityBiasMatch {
   void forget(int id);
   //! Nothing matched any more: every gyro's bias model in `filter` is the calibration's again and the blocks
   //! judge afresh — after an exclusion (the error that matched may have been the excluded gyro's), or after
-  //! kQuietBlocks blocks in which no gyro's CUSUM was above 0.
+  //! design::parity_bias_quiet_blocks blocks in which no gyro's CUSUM was above 0.
   void release(Mekf& filter);
 
  private:

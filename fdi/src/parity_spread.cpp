@@ -8,8 +8,7 @@
 namespace tetra::fdi::detail {
 
 namespace {
-constexpr double kIntervalSigmas = 1.0;  //!< [σ] the estimate's interval whose upper end the model takes
-constexpr int kSearchSteps = 80;         //!< golden-section steps of the likelihood's maximum
+constexpr int kSearchSteps = 80;  //!< golden-section steps of the likelihood's maximum
 }  // namespace
 
 ParitySpread::ParitySpread(double false_alarm)
@@ -70,7 +69,7 @@ std::optional<SpreadFinding> ParitySpread::observe(double u, int dof, double cap
     ++beyond_;
   }
   const double mean = sum_capped_ / (sum_d_ + sum_offset_);
-  const double g = 0.5 * sum_d_ * (mean - 1.0 - std::log(mean)) / kDifferenceCorrelation;
+  const double g = 0.5 * sum_d_ * (mean - 1.0 - std::log(mean)) / design::spread_difference_inflation;
   if (g <= threshold_ || samples_ < design::spread_min_samples) {
     if (samples_ >= design::spread_window_samples) clear_sums();
     return std::nullopt;
@@ -90,7 +89,7 @@ std::optional<SpreadFinding> ParitySpread::observe(double u, int dof, double cap
 
 double ParitySpread::interval(double estimate) const {
   // u's spread per degree of freedom is about (λ̂ + q̄)·√2 (q̄ the offset's mean).
-  return kIntervalSigmas * std::sqrt(2.0 * kDifferenceCorrelation / sum_d_) *
+  return design::spread_interval_sigmas * std::sqrt(2.0 * design::spread_difference_inflation / sum_d_) *
          (estimate + sum_offset_ / sum_d_);
 }
 

@@ -10,7 +10,8 @@
 // Over the samples since the last verdict (at most design::spread_window_samples, then the sums start again),
 // with λ̂ the mean of min(u, c) per degree of freedom, the generalized likelihood ratio of "λ = 1" is
 //
-//   G = ½·Σd·(λ̂ − 1 − ln λ̂) / κ,   κ = kDifferenceCorrelation (successive differences share a sample),
+//   G = ½·Σd·(λ̂ − 1 − ln λ̂) / κ,   κ = design::spread_difference_inflation (successive differences share a
+//   sample),
 //
 // rejected when G > ln(design::spread_window_samples/p) (p the budget's kParitySpread share; the window's
 // length bounds the looks). Then λ is estimated by maximum likelihood with the samples beyond c censored,
@@ -41,10 +42,6 @@ namespace tetra::fdi::detail {
 // The spread's constants are fixed design constants (tetra/fdi/config.hpp, namespace design): spread_block_s,
 // spread_window_samples, spread_min_samples, spread_hold_samples, spread_hold_epochs, spread_hold_s,
 // spread_held_ratio.
-
-//! [-] variance inflation of a mean of successive differences' u (lag-one correlation 0.25 for white noise,
-//! 0.47 for quantization, whose rate error is itself a difference): the likelihood ratio is divided by it.
-inline constexpr double kDifferenceCorrelation = 2.0;
 
 //! The model's white noise rejected: the ratio the data show and the one now taken.
 struct SpreadFinding {

@@ -77,7 +77,7 @@ void Pipeline::Impl::write_reference_rows(const ReferenceEvidence& evidence, dou
     rows.add(
         stated(EvidenceSource::kDriftWander, kHypothesisDrift,
                evidence.bias_statistic > drift_threshold ? RowVerdict::kConsistent : RowVerdict::kRejected,
-               drift_ratio_needed_, ReferenceBiasMatch::kMaxWanderRatio));
+               drift_ratio_needed_, design::reference_max_wander_ratio));
   // Each gyro's: no call unless the gyros vouch; then rejected by the parity for a slow test's evidence (a
   // gyro's fault that moved the attitude so far would have shown in it) and by the test itself for a jump or
   // a lag (a gyro's fault below the parity's threshold is neither).
@@ -202,7 +202,7 @@ double Pipeline::Impl::drift_threshold(GyroMask active) {
                                                                active, attitude_.filter())
                             : std::numeric_limits<double>::quiet_NaN();
   const bool possible = gyros_vouch_ && drift_match_.may_explain(frame_.now_ns) &&
-                        drift_ratio_needed_ <= ReferenceBiasMatch::kMaxWanderRatio;
+                        drift_ratio_needed_ <= design::reference_max_wander_ratio;
   return possible ? drift_match_.threshold() : std::numeric_limits<double>::infinity();
 }
 

@@ -5,13 +5,9 @@
 
 #include "tetra/core/allan_stats.hpp"
 #include "tetra/core/units.hpp"
+#include "tetra/fdi/detectors.hpp"
 
 namespace tetra::fdi::detail {
-
-namespace {
-//! Siegmund's overshoot of the CUSUM's threshold (docs/fdi.md, "Detection").
-constexpr double kCusumOvershoot = 1.166;
-}  // namespace
 
 ProtectionLevel::ProtectionLevel(const PipelineConfig& config)
     : k_md_(std::sqrt(allan::chi2_quantile(1.0 - config.integrity_risk, 1.0))) {}
@@ -21,7 +17,8 @@ Eigen::Vector3d ProtectionLevel::bound(const Subset& s, const Eigen::Vector3d& s
   if (s.dof < 1 || !s.observable) return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   const double period = sqrt_period * sqrt_period;
   const double t = std::max(0.0, ns_to_seconds(now_ns - anchor_ns_));
-  const double reach = s.cusum_k * t + calibration_reach_ + (s.cusum_h + kCusumOvershoot) * period;  // [σ·s]
+  const double reach =
+      s.cusum_k * t + calibration_reach_ + (s.cusum_h + kSiegmundOvershoot) * period;  // [σ·s]
   Eigen::Vector3d fault = Eigen::Vector3d::Zero();
   for (Eigen::Index i = 0; i < s.pinv.cols(); ++i) {
     if (!has_gyro(s.mask, static_cast<int>(i) + 1)) continue;

@@ -12,12 +12,6 @@
 namespace tetra::fdi::detail {
 
 namespace {
-//! [s] how long the acceleration the gyros saw is remembered for a lost rate's bound: a slew's acceleration
-//! changes over seconds, and a few epochs without a rate are what drops and gaps make.
-constexpr double kAccelMemory_s = 5.0;
-//! [σ] the noise of a seen slope left out before it counts as the body's acceleration: the largest of the
-//! three axes' slopes over the memory (about 150 steps at 10 Hz) passes 5σ with probability below 1e-4.
-constexpr double kSlopeNoiseSigmas = 5.0;
 
 //! [rad/s] f_i = wᵢᵀp̄/|wᵢ|²: the fault on gyro i (column i of the subset's parity) that explains p̄.
 double single_gyro_fault(const Subset& s, Eigen::Index i, const Eigen::VectorXd& parity_ema,
@@ -203,14 +197,15 @@ bool RateAttitude::measure_unprepared(const GyroGeometry& geometry, const EpochF
 double RateAttitude::gap_bound_rad(double tau_s, const Subset& s) const {
   // A slew faster than the configured bound shows in the slopes before the gap: a body that turned at that
   // acceleration may go on doing so unseen. A slope is the difference of two noisy rates over a step, its
-  // 1σ √(2N²/T)/T per axis (T the step they were seen over); beyond kSlopeNoiseSigmas of it, the seen slope
-  // is the body's. The angle it may hide is about any axis, and the body turns on after the gap, carrying an
-  // error about one axis into the others: the bound is the same on every axis, the acceleration's norm.
+  // 1σ √(2N²/T)/T per axis (T the step they were seen over); beyond design::slope_noise_sigmas of it, the
+  // seen slope is the body's. The angle it may hide is about any axis, and the body turns on after the gap,
+  // carrying an error about one axis into the others: the bound is the same on every axis, the acceleration's
+  // norm.
   double a = config_.max_angular_acceleration_dps2 * kDegToRad;
   const double step_s = accel_decay_dt_s_;
   if (s.observable && step_s > 0.0) {
     const Eigen::Vector3d noise = (2.0 * s.arw_sq_rad2_s / step_s).cwiseSqrt() / step_s;
-    a = std::max(a, (accel_seen_ - kSlopeNoiseSigmas * noise).cwiseMax(0.0).norm());
+    a = std::max(a, (accel_seen_ - design::slope_noise_sigmas * noise).cwiseMax(0.0).norm());
   }
   return 0.25 * tau_s * tau_s * a;
 }
@@ -229,7 +224,7 @@ void RateAttitude::propagate(const EpochFrame& frame, const Subset& sol, const S
     lost_since_ns_ = -1;
     if (frame.dt_s != accel_decay_dt_s_) {  // the step is nearly always the last one's: one exp per change
       accel_decay_dt_s_ = frame.dt_s;
-      accel_decay_ = std::exp(-frame.dt_s / kAccelMemory_s);
+      accel_decay_ = std::exp(-frame.dt_s / design::accel_memory_s);
     }
     accel_seen_ =
         (accel_seen_ * accel_decay_).cwiseMax(((omega_meas_ - omega_prev_) / frame.dt_s).cwiseAbs());

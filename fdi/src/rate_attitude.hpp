@@ -143,11 +143,12 @@ class RateAttitude {
   Eigen::Vector3d omega_meas_ = Eigen::Vector3d::Zero();  //!< [rad/s] last estimate (Earth rate included)
   Eigen::Vector3d slope_prev_ = Eigen::Vector3d::Zero();  //!< [rad/s²] the previous step's (ω_k − ω_{k−1})/Δt
   bool have_slope_ = false;
-  //! [rad/s²] per axis: the largest |slope| of recent observable steps (decaying over kAccelMemory_s), so a
-  //! lost rate's bound covers the acceleration the gyros saw when it exceeds the configured bound.
+  //! [rad/s²] per axis: the largest |slope| of recent observable steps (decaying over
+  //! design::accel_memory_s), so a lost rate's bound covers the acceleration the gyros saw when it exceeds
+  //! the configured bound.
   Eigen::Vector3d accel_seen_ = Eigen::Vector3d::Zero();
   double accel_decay_dt_s_ = -1.0;  //!< [s] the step of accel_decay_
-  double accel_decay_ = 1.0;        //!< e^{−Δt/kAccelMemory_s}
+  double accel_decay_ = 1.0;        //!< e^{−Δt/design::accel_memory_s}
   std::int64_t lost_since_ns_ = -1;
   std::int64_t measured_ns_ = -1;  //!< [ns] the last epoch whose rate was measured
 };

@@ -15,7 +15,7 @@ ReferenceBiasMatch::ReferenceBiasMatch(const PipelineConfig& config)
     : threshold_(
           allan::chi2_quantile(1.0 - allocated_probability(config, BudgetTest::kReferenceBiasMatch), 3.0)),
       bias_window_ns_(seconds_to_ns(design::reference_bias_window_s)),
-      long_window_ns_(seconds_to_ns(kLongWindows * design::reference_bias_window_s)) {}
+      long_window_ns_(seconds_to_ns(design::reference_long_windows * design::reference_bias_window_s)) {}
 
 void ReferenceBiasMatch::reset() {
   restart();
@@ -54,7 +54,7 @@ double ReferenceBiasMatch::needed_ratio(const Eigen::Vector3d& mean_rad, double 
                                         const Mekf& filter) {
   if (!(span_s > 0.0)) return std::numeric_limits<double>::infinity();
   const double rate_rad_s = 2.0 * mean_rad.norm() / span_s;
-  const double walk = kBlockMatchRatio * rate_rad_s * rate_rad_s / span_s;  // [rad²/s³], ρ·|b|²/T
+  const double walk = design::block_match_ratio * rate_rad_s * rate_rad_s / span_s;  // [rad²/s³], ρ·|b|²/T
   double smallest = std::numeric_limits<double>::infinity();
   for (int id = 1; id <= filter.gyro_count(); ++id)
     if (has_gyro(active, id)) smallest = std::min(smallest, wander(filter.noise_model(id)));
@@ -65,10 +65,10 @@ double ReferenceBiasMatch::needed_ratio(const Eigen::Vector3d& mean_rad, double 
 bool ReferenceBiasMatch::match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s,
                                     GyroMask active, Mekf& filter) {
   const double needed = needed_ratio(mean_rad, span_s, active, filter);
-  if (!(needed <= kMaxWanderRatio)) return false;
+  if (!(needed <= design::reference_max_wander_ratio)) return false;
   last_match_ns_ = now_ns;
   matched_ = true;
-  ratio_ = std::clamp(needed, kBlockMatchRatio * ratio_, kMaxWanderRatio);
+  ratio_ = std::clamp(needed, design::block_match_ratio * ratio_, design::reference_max_wander_ratio);
   open(active, filter);
   return true;
 }

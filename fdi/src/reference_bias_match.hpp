@@ -14,10 +14,10 @@
 // (p_m = the budget's kReferenceBiasMatch share per sample). A match opens every active gyro's slow bias c_i
 // to a random walk of K_i² + λ·q_i [rad²/s³] (Mekf::open_bias_model), q_i = K_i² + 2σ_GM,i²/T_c + N_i²/T_c²
 // the model's own wander per second: a body-rate error b = 2·z̄/T grown within the window T is a random walk
-// of |b|²/T, and λ is at least ρ (kBlockMatchRatio) times that over q_i — and at least ρ times its last
-// value, so a drift that goes on opens the model further at every match. A mean that persists within W of a
-// match, the model opened, is the reference's: its bias test rejects it as before. The match is kept (the
-// models only open) until a reset or an exclusion; each match is a noise_model event.
+// of |b|²/T, and λ is at least ρ (design::block_match_ratio) times that over q_i — and at least ρ times its
+// last value, so a drift that goes on opens the model further at every match. A mean that persists within W
+// of a match, the model opened, is the reference's: its bias test rejects it as before. The match is kept
+// (the models only open) until a reset or an exclusion; each match is a noise_model event.
 
 #include <cstdint>
 #include <optional>
@@ -41,13 +41,6 @@ struct DriftFinding {
 
 class ReferenceBiasMatch {
  public:
-  //! The largest λ: a mean that needs more (a random walk 100 times the model's own wander in σ) is not a
-  //! drift of working gyros but the reference's, and is left to its tests (a warm-up of 5e-6 to 8e-5 deg/s
-  //! over minutes needs up to about 700; a reference's bias of 10–40″ 5e4 in the median).
-  static constexpr double kMaxWanderRatio = 1.0e4;
-  //! The long window, in reference bias windows.
-  static constexpr double kLongWindows = 4.0;
-
   explicit ReferenceBiasMatch(const PipelineConfig& config);
 
   void reset();    //!< nothing matched, the window empty
@@ -71,9 +64,9 @@ class ReferenceBiasMatch {
   //! λ·q_i ≥ ρ·|b|²/T: the ratio the mean `mean_rad` over `span_s` needs (+∞ without a span or a wander).
   static double needed_ratio(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
                              const Mekf& filter);
-  //! Whether that mean may be a drift of working gyros: its ratio at most kMaxWanderRatio.
+  //! Whether that mean may be a drift of working gyros: its ratio at most design::reference_max_wander_ratio.
   static bool plausible(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active, const Mekf& filter) {
-    return needed_ratio(mean_rad, span_s, active, filter) <= kMaxWanderRatio;
+    return needed_ratio(mean_rad, span_s, active, filter) <= design::reference_max_wander_ratio;
   }
   double threshold() const { return threshold_; }  //!< χ²₃(1 − p_m)
   bool matched() const { return matched_; }

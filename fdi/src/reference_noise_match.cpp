@@ -53,7 +53,7 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
   if (first) block_start_ns_ = now_ns;
   last_ns_ = now_ns;
   block_samples_ = first ? 1 : block_samples_ + 1;
-  const bool close_block = now_ns - block_start_ns_ >= seconds_to_ns(kReferenceBlock_s);
+  const bool close_block = now_ns - block_start_ns_ >= seconds_to_ns(design::reference_match_block_s);
   // A block of n samples stands for n of the per-sample false-alarm probability p.
   // (p·n at most 1/2, so the threshold stays above ln 2 whatever p the configuration allows)
   const double threshold = block_cusum_threshold(false_alarm_ * block_samples_);
@@ -86,14 +86,14 @@ std::optional<NoiseFinding> ReferenceNoiseMatch::observe(std::int64_t now_ns, co
     block_s_[k] = 0.0;
     cusum_[k] = block_cusum_step(cusum_[k], u, 1.0);
     if (matched_[k]) {
-      ratio_[k] =
-          std::clamp(ratio_[k] * std::exp(kBlockMatchGain * (u - 1.0)), 1.0, kMaxNoiseRatio * kMaxNoiseRatio);
+      ratio_[k] = std::clamp(ratio_[k] * std::exp(design::block_match_gain * (u - 1.0)), 1.0,
+                             design::reference_max_noise_ratio * design::reference_max_noise_ratio);
     } else if (cusum_[k] > threshold) {
       matched_[k] = true;
       filter.add_attitude_variance_along(d, std::max(mean_square_[k] - s, 0.0));
       const double n2 = filter.arw_rad_rts(i + 1) * filter.arw_rad_rts(i + 1);
       ratio_[k] = std::clamp(1.0 + mapped_noise(i, d, h2, T, pinv, mask, filter) / n2, 1.0,
-                             kMaxNoiseRatio * kMaxNoiseRatio);
+                             design::reference_max_noise_ratio * design::reference_max_noise_ratio);
       if (!found) found = NoiseFinding{i + 1, cusum_[k]};
     }
     apply(k, filter);
@@ -108,13 +108,13 @@ void ReferenceNoiseMatch::apply(std::size_t k, Mekf& filter) const {
 }
 
 void ReferenceNoiseMatch::set_common_ratio(double ratio, Mekf& filter) {
-  common_ = std::clamp(ratio, 1.0, kMaxNoiseRatio * kMaxNoiseRatio);
+  common_ = std::clamp(ratio, 1.0, design::reference_max_noise_ratio * design::reference_max_noise_ratio);
   for (std::size_t k = 0; k < own_.size(); ++k) apply(k, filter);
 }
 
 void ReferenceNoiseMatch::set_own_ratio(int id, double ratio, Mekf& filter) {
   const auto k = static_cast<std::size_t>(id - 1);
-  own_[k] = std::clamp(ratio, 1.0, kMaxNoiseRatio * kMaxNoiseRatio);
+  own_[k] = std::clamp(ratio, 1.0, design::reference_max_noise_ratio * design::reference_max_noise_ratio);
   apply(k, filter);
 }
 

@@ -3,11 +3,11 @@
 // a gyro whose bias starts to ramp (or whose noise rises where its own level, own_noise_level.hpp, cannot
 // show it) shows only in the reference's innovations, along that gyro's column h_i of the rate solution H* (a
 // rate error f on gyro i turns the attitude by h_i·f). Per gyro, the innovations z projected on d_i =
-// h_i/|h_i| are summed over blocks of kReferenceBlock_s (10 s); a block's u_i = (Σ d_iᵀz)²/Σ s_i (s_i =
-// d_iᵀ·S·d_i) is χ²₁ while the filter's model holds (its innovations are white with covariance S) and grows
-// when the attitude error wanders beyond the model (it is slow: the extra error is correlated over tens of
-// seconds, so a block mean sees it where one sample, dominated by the reference's own noise, barely does). A
-// CUSUM of the log-likelihood ratio for a block variance ρ times the predicted,
+// h_i/|h_i| are summed over blocks of design::reference_match_block_s (10 s); a block's u_i = (Σ d_iᵀz)²/Σ
+// s_i (s_i = d_iᵀ·S·d_i) is χ²₁ while the filter's model holds (its innovations are white with covariance S)
+// and grows when the attitude error wanders beyond the model (it is slow: the extra error is correlated over
+// tens of seconds, so a block mean sees it where one sample, dominated by the reference's own noise, barely
+// does). A CUSUM of the log-likelihood ratio for a block variance ρ times the predicted,
 //
 //   g_i ← max(0, g_i + ½·((1 − 1/ρ)·u_i − ln ρ)),   ρ = 4;   detected when g_i > ln(1/(p·n))
 //
@@ -16,11 +16,11 @@
 // in the filter is N_i²·λ_i: λ_i starts where covariance matching puts it (m_i, the mean square of d_iᵀz over
 // reference_window_s, less the reference's variance r is the a-priori error variance P along d_i; a
 // step noise q·T along d_i has that steady state when q·T = P²/(P + r)) and then follows the blocks,
-// λ_i ← λ_i·e^{γ(u_i − 1)} (γ = kBlockMatchGain = 0.3), which settles where the block means are as the filter
-// predicts them (E u_i = 1); 1 ≤ λ_i ≤ kMaxNoiseRatio². At the detection the attitude's variance along d_i
-// grows by m_i − s_i (what the error has already done beyond the model). A failed test of the reference with
-// three gyros (which gyro, the data cannot tell) matches every gyro's noise the same way, from λ = 1. The
-// gyro is never excluded: three gyros are the rate.
+// λ_i ← λ_i·e^{γ(u_i − 1)} (γ = design::block_match_gain = 0.3), which settles where the block means are as
+// the filter predicts them (E u_i = 1); 1 ≤ λ_i ≤ kMaxNoiseRatio². At the detection the attitude's variance
+// along d_i grows by m_i − s_i (what the error has already done beyond the model). A failed test of the
+// reference with three gyros (which gyro, the data cannot tell) matches every gyro's noise the same way, from
+// λ = 1. The gyro is never excluded: three gyros are the rate.
 
 #include <cstdint>
 #include <optional>
@@ -43,10 +43,6 @@ struct NoiseFinding {
 
 class ReferenceNoiseMatch {
  public:
-  //! The largest white rate noise the filter takes on, as a multiple of the model's N (a noise ×30 of a
-  //! fiber-optic gyro is a failed gyro, not a degraded one).
-  static constexpr double kMaxNoiseRatio = 30.0;
-
   ReferenceNoiseMatch(const PipelineConfig& config, int gyro_count);
 
   //! No gyro detected or matched, the statistics empty (a reset).

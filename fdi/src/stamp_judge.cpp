@@ -7,7 +7,7 @@ namespace tetra::fdi::detail {
 std::int64_t StampJudge::window_ns() const {
   // Saturated: a period near the int64 range (1000 periods of ~1e7 s) never overflows the window.
   constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max() / 4;
-  return period_ns_ > kMax / kWindowPeriods ? kMax : period_ns_ * kWindowPeriods;
+  return period_ns_ > kMax / design::stamp_window_periods ? kMax : period_ns_ * design::stamp_window_periods;
 }
 
 StampVerdict StampJudge::judge(std::int64_t stamp_ns) {
@@ -39,7 +39,7 @@ StampVerdict StampJudge::judge(std::int64_t stamp_ns) {
                           static_cast<long double>(window);
   candidate_count_ = agrees ? candidate_count_ + 1 : 1;
   candidate_ns_ = stamp_ns;
-  if (candidate_count_ < kConfirmStamps) return StampVerdict::kOutlier;
+  if (candidate_count_ < design::stamp_confirm_count) return StampVerdict::kOutlier;
   last_ns_ = stamp_ns;  // the stream's time jumped for good: a gap
   candidate_ns_.reset();
   candidate_count_ = 0;

@@ -1,9 +1,10 @@
 #pragma once
 // The epoch time check (docs/fdi.md, "Per epoch", step 1): each epoch's stamp judged against the stream's own
-// last accepted time. A stamp more than kWindowPeriods sample periods away from it is a time outlier:
-// counted, dropped, and it never moves the time. A forward jump is followed once kConfirmStamps stamps in a
-// row agree with it (each increasing, within the window of the one before): the last of them is accepted and
-// the jump is a gap. A stream's time never goes back: a stamp far behind is always an outlier.
+// last accepted time. A stamp more than design::stamp_window_periods sample periods away from it is a time
+// outlier: counted, dropped, and it never moves the time. A forward jump is followed once
+// design::stamp_confirm_count stamps in a row agree with it (each increasing, within the window of the one
+// before): the last of them is accepted and the jump is a gap. A stream's time never goes back: a stamp far
+// behind is always an outlier.
 
 #include <cstdint>
 #include <optional>
@@ -18,9 +19,6 @@ enum class StampVerdict : std::uint8_t {
 
 class StampJudge {
  public:
-  static constexpr std::int64_t kWindowPeriods = 1000;  //!< the window, in sample periods
-  static constexpr int kConfirmStamps = 3;              //!< agreeing stamps that confirm a forward jump
-
   //! Judges `stamp_ns`; an accepted stamp becomes the last accepted time.
   StampVerdict judge(std::int64_t stamp_ns);
   //! [ns] the sample period that sets the window (> 0); until it is set (the pipeline sets it from the

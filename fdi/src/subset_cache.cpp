@@ -12,9 +12,7 @@
 
 namespace tetra::fdi::detail {
 
-namespace {
-constexpr double kLevelMarginSigma = 3.0;  //!< [σ of the held level] offset the level test's k absorbs
-}  // namespace
+namespace {}  // namespace
 
 double bias_wander_sigma(double bias_instability_rad_s, double rate_random_walk_rad_s_rts, double horizon_s) {
   const double b = kBiasWanderPerB * bias_instability_rad_s;
@@ -309,11 +307,11 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
   s.cusum_h = track_wander(s, mask, design).h + s.quantization_margin;
   const double averaged_wander = s.wander_averaged ? s.bias_wander_sigma : 0.0;
   // The held level (mean of M epochs over isolation_window_s) misses the episode's true level by N(0, 1/M)
-  // per axis, a constant offset for the level test: its reference k grows by kLevelMarginSigma/√M, which
-  // absorbs such an offset (a larger one, rarer than 3σ, only hastens the test's false alarms in that
+  // per axis, a constant offset for the level test: its reference k grows by design::level_margin_sigmas/√M,
+  // which absorbs such an offset (a larger one, rarer than 3σ, only hastens the test's false alarms in that
   // episode).
   s.level_epochs = std::max(2, static_cast<int>(std::lround(design::isolation_window_s / period_s_)));
-  s.level_k = s.cusum_k + kLevelMarginSigma / std::sqrt(static_cast<double>(s.level_epochs));
+  s.level_k = s.cusum_k + design::level_margin_sigmas / std::sqrt(static_cast<double>(s.level_epochs));
   s.level_h = cusum_threshold(s.dof, s.level_k, cusum_arl0_epochs(config), averaged_wander) +
               quantization_margin(s, mask, s.level_k);
   if (s.dof >= 2) {

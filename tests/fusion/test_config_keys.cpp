@@ -3,7 +3,9 @@
 // listing (tetra replay --config-keys) shows each key's unit, range and default. Its second section, the
 // fixed design constants: listed with their unit and value, named in docs/fdi.md, refused in a file.
 #include <cmath>
+#include <filesystem>
 #include <limits>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -69,14 +71,30 @@ TEST(ConfigKeys, TheDocsConfigurationSectionNamesEveryKeyAndNoOther) {
   ASSERT_NE(start, std::string::npos);
   const auto end = doc.find("\n## ", start + 1);
   const std::string section = doc.substr(start, end == std::string::npos ? std::string::npos : end - start);
-  // The keys' table, then the constants' (under their own heading).
+  // The keys' table; the constants under their own heading point to their page.
   const auto constants = section.find("\n### Fixed design constants");
   ASSERT_NE(constants, std::string::npos);
   const std::regex row(R"(^\| `([A-Za-z0-9_]+)` \|)");
   expect_same_keys(names_matching(section.substr(0, constants), row), "docs/fdi.md \"Configuration\"");
-  expect_same_names(names_matching(section.substr(constants), row), constant_names(),
-                    "docs/fdi.md \"Fixed design constants\"");
+  EXPECT_NE(section.find("fdi_design_constants.md", constants), std::string::npos);
   EXPECT_NE(section.find("tetra replay --config-keys"), std::string::npos);
+}
+
+TEST(ConfigKeys, TheConstantsPageNamesEveryConstantWithItsValue) {
+  const std::string page = test::read_file(test::source_path("docs/fdi_design_constants.md"));
+  const std::regex row(R"(^\| `([A-Za-z0-9_]+)` \| [^|]+ \| ([^ |]+) \|)");
+  expect_same_names(names_matching(page, row), constant_names(), "docs/fdi_design_constants.md");
+  std::istringstream in(page);
+  std::string line;
+  std::smatch m;
+  while (std::getline(in, line)) {
+    if (!std::regex_search(line, m, row)) continue;
+    for (const auto& constant : design_constants()) {
+      if (m[1].str() == constant.name) {
+        EXPECT_EQ(std::stod(m[2].str()), constant.value) << line;
+      }
+    }
+  }
 }
 
 // Sets the key to v.
@@ -158,7 +176,74 @@ TEST(ConfigKeys, AtMostThirtyKeys) {
   // what a user has no physical reason to set is a fixed design constant.
   EXPECT_LE(config_keys().size(), 30U);
   EXPECT_EQ(config_keys().size(), 29U);
-  EXPECT_EQ(design_constants().size(), 24U);
+  EXPECT_EQ(design_constants().size(), 63U);
+}
+
+// Issue 37's rule: no decision constant outside the one table. Every named constant the library's sources
+// declare is either a row of design_constants() (namespace design) or one of these, which decide nothing: a
+// number of mathematics, a numerical method's step, a store's size, a code or an index.
+TEST(ConfigKeys, NoDecisionConstantOutsideTheTable) {
+  const std::map<std::string, std::string> not_decisions = {
+      {"kNaN", "a value"},
+      {"kInf", "a value"},
+      {"kNotAProbability", "a value"},
+      {"kMedianOfHalfNormal", "mathematics: median of |N(0,1)|"},
+      {"kNoiseExpectedMedian", "mathematics: median of |N(0,1)|"},
+      {"kWhiteD4", "mathematics: C(8,4)"},
+      {"kQuantizationD4", "mathematics: C(10,5)"},
+      {"kEven", "mathematics: the fourth difference's weights"},
+      {"kSiegmundOvershoot", "mathematics: Siegmund's overshoot"},
+      {"kVectorOvershoot", "mathematics: Crosier's overshoot"},
+      {"kBiasWanderPerB", "mathematics: a Gauss-Markov sigma per bias instability"},
+      {"kArlSteps", "numerics: quadrature steps"},
+      {"kBiasNodes", "numerics: quadrature nodes"},
+      {"kSearchSteps", "numerics: golden-section steps"},
+      {"kRankTolerance", "numerics: rank"},
+      {"kRatioMargin", "numerics: rounding"},
+      {"kMaxSpan_s", "numerics: overflow guard"},
+      {"kMax", "numerics: overflow guard"},
+      {"kBins", "store"},
+      {"kCopies", "store"},
+      {"kSpacing_ns", "store"},
+      {"kCapacity", "store"},
+      {"kSpikeMemory", "store"},
+      {"kHistory", "store"},
+      {"kSnapshots", "store"},
+      {"kCachedGyros", "store"},
+      {"kMaxUnitGyros", "store: a mask's bits"},
+      {"kColumn", "a matrix's size"},
+      {"kPerGyro", "a matrix's size"},
+      {"kWidth", "text width"},
+      {"kFree", "a range without an edge"},
+      {"kBudgetTestCount", "a count of the budget's rows"},
+      {"kEvidenceSourceCount", "a count of sources"},
+      {"kLargestShare", "the budget table's largest share"},
+      {"kReference", "an index"},
+      {"kDrift", "an index"},
+      {"kCalibration", "an index"},
+      {"kNoise", "an index"},
+      {"kHypothesisNone", "a code"},
+      {"kHypothesisNoise", "a code"},
+      {"kHypothesisCalibration", "a code"},
+      {"kHypothesisDrift", "a code"},
+      {"kHypothesisReference", "a code"}};
+  const std::regex declaration(
+      R"(constexpr\s+(?:static\s+)?(?:const\s+)?[A-Za-z_:<>0-9, ]+\s+(k[A-Za-z0-9_]+)\s*[=\[{])");
+  int files = 0;
+  for (const char* folder : {"fdi/src", "fdi/include/tetra/fdi"}) {
+    for (const auto& entry : std::filesystem::directory_iterator(test::source_path(folder))) {
+      const std::string text = test::read_file(entry.path().string());
+      ++files;
+      for (auto it = std::sregex_iterator(text.begin(), text.end(), declaration);
+           it != std::sregex_iterator(); ++it) {
+        const std::string name = (*it)[1].str();
+        EXPECT_EQ(not_decisions.count(name), 1U)
+            << entry.path().filename().string() << " declares " << name
+            << ": a decision constant belongs in namespace design and design_constants(), one row";
+      }
+    }
+  }
+  EXPECT_GT(files, 40);
 }
 
 TEST(ConfigKeys, AFileThatSetsADesignConstantIsRefusedNamingIt) {

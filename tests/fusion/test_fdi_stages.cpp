@@ -505,7 +505,7 @@ TEST(BiasHypothesis, OneGyrosPersistingFaultIsToldAndAPassingOneIsNot) {
     const BiasFit fit = check.best(s, span, std::sqrt(kPeriod));
     EXPECT_EQ(fit.gyro, 2);
     EXPECT_NEAR(fit.size_rad_s, 5e-4 * kDegToRad, 1e-9);  // noise-free: the fit is exact to rounding
-    EXPECT_GT(fit.margin, BiasHypothesis::kMargin);
+    EXPECT_GT(fit.margin, design::bias_hypothesis_margin_sigma2);
     SpanDisagreement late = span;
     late.start_ns = seconds_to_ns(15.0);
     late.span_s = 15.0;

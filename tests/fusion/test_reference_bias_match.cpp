@@ -84,7 +84,7 @@ TEST(ReferenceBiasMatch, AMeanOnlyTheReferenceCouldMakeIsNotADrift) {
   // far above 1e4 times the seed unit's own wander — a star tracker's bias step, not a warm-up.
   const Mekf f = seed_like_filter();
   const Eigen::Vector3d mean = Eigen::Vector3d::Constant(30.0 * kArcsecToRad / std::sqrt(3.0));
-  EXPECT_GT(ReferenceBiasMatch::needed_ratio(mean, 10.0, 0b1111, f), ReferenceBiasMatch::kMaxWanderRatio);
+  EXPECT_GT(ReferenceBiasMatch::needed_ratio(mean, 10.0, 0b1111, f), design::reference_max_wander_ratio);
   EXPECT_FALSE(ReferenceBiasMatch::plausible(mean, 10.0, 0b1111, f));
   // 2″ over 100 s: plausible.
   const Eigen::Vector3d small = Eigen::Vector3d::Constant(2.0 * kArcsecToRad / std::sqrt(3.0));

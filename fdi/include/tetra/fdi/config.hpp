@@ -124,6 +124,90 @@ inline constexpr int spread_hold_epochs = 300;      //!< [epochs] after which it
 inline constexpr double spread_hold_s = 30.0;       //!< [s] after which it counts as checked anyway
 inline constexpr double spread_held_ratio = 16.0;   //!< [-] noise variance ratio an unchecked model may hide
 inline constexpr double spread_white_dominates = 0.1;  //!< [-] quantization share: one sample shows the white
+//! [σ] the estimate's interval whose upper end it takes
+inline constexpr double spread_interval_sigmas = 1.0;
+//! [-] variance of a mean of successive differences' u
+inline constexpr double spread_difference_inflation = 2.0;
+// --- the CUSUM's design, the level test and the block matches
+//! [bias σ] reach of the design's average over a mean
+inline constexpr double cusum_bias_average_reach = 6.0;
+//! [-] the averaged design kept unless this × slower
+inline constexpr double cusum_average_kept_within = 2.0;
+//! [σ of the held level] offset the level test absorbs
+inline constexpr double level_margin_sigmas = 3.0;
+//! [s] block of the parity block match's mean
+inline constexpr double parity_bias_block_s = 30.0;
+//! [blocks] quiet blocks in a row that end a match
+inline constexpr int parity_bias_quiet_blocks = 10;
+//! [-] a block match's alternative: the covariance ×
+inline constexpr double block_match_ratio = 4.0;
+//! [-] a matched ratio's step per block, e^{γ(u/d − 1)}
+inline constexpr double block_match_gain = 0.3;
+//! [s] block of the reference matches' mean innovation
+inline constexpr double reference_match_block_s = 10.0;
+// --- isolation
+//! [-] a single-gyro fit beyond this quantile: none
+inline constexpr double bias_model_reject_probability = 1e-6;
+//! [σ²] the best gyro's fit over any other's (5σ)
+inline constexpr double bias_hypothesis_margin_sigma2 = 25.0;
+//! [σ²] its fit of the latest half-span (4σ)
+inline constexpr double bias_hypothesis_persist_sigma2 = 16.0;
+//! [σ²] one drift model's fit over the other's (4σ)
+inline constexpr double drift_margin_sigma2 = 16.0;
+//! [epochs] the drift models judge from this many on
+inline constexpr int drift_min_epochs = 20;
+//! [σ²] a slope's fit below: no trend (3σ)
+inline constexpr double drift_no_trend_sigma2 = 9.0;
+//! [epochs] the GLT baseline's longest window
+inline constexpr int glt_baseline_max_epochs = 200;
+//! [epochs] its shortest
+inline constexpr int glt_baseline_min_epochs = 20;
+//! [epochs] its blocks for the noise it shows
+inline constexpr int glt_noise_block_epochs = 10;
+//! [σ] the disagreement trend's prediction margin
+inline constexpr double trend_margin_sigmas = 3.0;
+// --- a gyro's own samples (continued)
+//! [samples] the noise-level test runs this often
+inline constexpr int noise_eval_every_samples = 10;
+//! [σ] a quantization step beyond: repeats are normal
+inline constexpr double coarse_step_per_sigma = 0.1;
+//! [σ] motion the noise-level test tells from noise
+inline constexpr double quiet_motion_sigmas = 2.0;
+//! [-] own second differences that look normal
+inline constexpr double motion_quiet_ratio = 2.0;
+//! [samples] another gyro's run leaving repeats unjudged
+inline constexpr int other_repeats_samples = 3;
+//! [-] levels of a repeat run one other fault explains
+inline constexpr int pieces_one_fault_explains = 3;
+//! [values] the own noise level is evaluated this often
+inline constexpr int own_noise_eval_every = 10;
+//! [evaluations] its ratio's smoothing
+inline constexpr double own_noise_smoothing_evaluations = 10.0;
+//! [-] a named gyro's smoothed level below: normal
+inline constexpr double own_noise_normal_ratio = 1.5;
+// --- the data path
+//! [s] the acceleration seen is remembered this long
+inline constexpr double accel_memory_s = 5.0;
+//! [σ] a seen slope's noise left out of the acceleration
+inline constexpr double slope_noise_sigmas = 5.0;
+//! [sample periods] the stamp judge's window
+inline constexpr int stamp_window_periods = 1000;
+//! [-] agreeing stamps that confirm a forward jump
+inline constexpr int stamp_confirm_count = 3;
+// --- the reference (continued)
+//! [-] λ beyond: the reference's drift, not the gyros'
+inline constexpr double reference_max_wander_ratio = 1.0e4;
+//! [reference bias windows] the bias match's long window
+inline constexpr double reference_long_windows = 4.0;
+//! [-] × N: the largest white noise taken on
+inline constexpr double reference_max_noise_ratio = 30.0;
+// --- the calibration's motion fit
+//! [s] one block of the motion fit
+inline constexpr double motion_fit_block_s = 300.0;
+//! [blocks] in a row that name a mismatch
+inline constexpr int motion_fit_blocks_in_a_row = 2;
+//! [epochs] a block with fewer is not judged
+inline constexpr int motion_fit_min_epochs = 10;
 }  // namespace design
 
 //! Parses a `pipeline:` YAML map (unknown keys are errors naming the line); `source` names the file.

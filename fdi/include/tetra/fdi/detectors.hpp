@@ -44,12 +44,14 @@ double cusum_threshold(double k, double arl0);
 //! statistic's norm drifts by −k per step away from 0 (the radial diffusion above; k may be negative: a
 //! shift larger than k).
 double vector_cusum_arl(int dof, double k, double h);
+//! Siegmund's overshoot of a one-sided CUSUM's threshold (b − h), in its σ (docs/fdi.md, "Detection").
+inline constexpr double kSiegmundOvershoot = 1.166;
 //! In-control ARL of the CUSUM used for dimension `dof` (two-sided scalar for 1, Crosier's for ≥ 2) when
 //! the parity carries a quasi-static mean N(0, bias_sigma² I) [σ units], averaged as 1/ARL₀ = E[1/ARL] over
-//! a mean out to kBiasAverageReach × bias_sigma. A mean beyond k drifts the statistic up at (mean − k) per
-//! step whatever h: once the reach passes k the average's h grows without bound (cusum_design below).
+//! a mean out to design::cusum_bias_average_reach × bias_sigma. A mean beyond k drifts the statistic up at
+//! (mean − k) per step whatever h: once the reach passes k the average's h grows without bound (cusum_design
+//! below).
 double cusum_arl0_with_bias(int dof, double k, double h, double bias_sigma);
-inline constexpr double kBiasAverageReach = 6.0;  //!< [bias_sigma] the average's reach
 
 //! A CUSUM's reference and threshold for a quasi-static mean of 1σ `bias_sigma` per axis, in-control ARL
 //! `arl0`, designed for a shift 2k. Two designs hold the ARL, each in its model: the mean averaged
