@@ -262,6 +262,17 @@ const std::vector<DesignConstant>& design_constants() {
       {"stamp_confirm_count", design::stamp_confirm_count, "-",
        "agreeing stamps that confirm a forward jump"},
       // --- the reference (continued)
+      {"lone_gyro_others_fraction", design::lone_gyro_others_fraction, "-",
+       "the reference comparison's lone-gyro rule: one gyro beyond the threshold, every other below this "
+       "fraction of it (the reference's hypothesis rejected only then)"},
+      {"scale_slope_sigmas", design::scale_slope_sigmas, "σ",
+       "a gyro's disagreement with the reference whose slope against the rotation is beyond this many σ is a "
+       "scale-factor error"},
+      {"filter_bias_min_span_fraction", design::filter_bias_min_span_fraction, "-",
+       "the shortest span, in reference_window_s, over which the filter-bias isolation's fault-model check "
+       "fits the episode"},
+      {"filter_bias_late_span_fraction", design::filter_bias_late_span_fraction, "-",
+       "the shortest latest half-span, in reference_window_s, in which that fault must persist"},
       {"reference_max_wander_ratio", design::reference_max_wander_ratio, "-",
        "a common drift needing a wander beyond this ratio of the model's is the reference's, not the gyros'"},
       {"reference_long_windows", design::reference_long_windows, "windows",

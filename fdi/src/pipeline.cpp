@@ -249,12 +249,15 @@ void Pipeline::Impl::isolate_filter_bias(const ReferenceFinding& bias) {
   const std::int64_t from = std::max(isolator_.episode().onset_ns, now - seconds_to_ns(window_s));
   reference_.filter_rearm(bias.gyro);  // until the check agrees, it is retried at every sample
   SpanDisagreement span;
-  if (!reference_.span(from, 0.5 * window_s, gyro_set_.excluded(), series_, span)) return;
+  if (!reference_.span(from, design::filter_bias_min_span_fraction * window_s, gyro_set_.excluded(), series_,
+                       span))
+    return;
   const BiasFit fit = bias_check_.best(s, span, subsets_.sqrt_period());
   if (fit.gyro != bias.gyro || fit.size_rad_s * attitude_.filter().bias_rad_s(bias.gyro) <= 0.0) return;
   SpanDisagreement late;
   const std::int64_t middle = span.start_ns + (now - span.start_ns) / 2;
-  if (!reference_.span(middle, 0.25 * window_s, gyro_set_.excluded(), series_, late) ||
+  if (!reference_.span(middle, design::filter_bias_late_span_fraction * window_s, gyro_set_.excluded(),
+                       series_, late) ||
       !bias_check_.persists(fit.gyro, fit.size_rad_s, s, late, subsets_.sqrt_period()))
     return;
   const FaultKind kind = reference_.span_scale(fit.gyro, span)

@@ -55,7 +55,7 @@ void LoneGyro::add(int id, double z, double threshold) {
     ++flagged_;
     culprit_ = id;
     stat_ = z;
-  } else if (z > 0.5 * threshold) {
+  } else if (z > design::lone_gyro_others_fraction * threshold) {
     ++loud_;
   }
 }
@@ -72,9 +72,11 @@ void LoneGyro::rows(EvidenceSource source, GyroMask active, EvidenceRows& out) c
   };
   for (int j = 1; j <= kMaxGyros; ++j) {
     if (has_gyro(active, j))
-      out.add(judge(source, static_cast<std::uint8_t>(j), largest_without(j), 0.5 * threshold_, threshold_));
+      out.add(judge(source, static_cast<std::uint8_t>(j), largest_without(j),
+                    design::lone_gyro_others_fraction * threshold_, threshold_));
   }
-  out.add(judge(source, kHypothesisNone, largest_without(0), 0.5 * threshold_, threshold_));
+  out.add(judge(source, kHypothesisNone, largest_without(0), design::lone_gyro_others_fraction * threshold_,
+                threshold_));
   const bool lone = flagged_ == 1 && loud_ == 0;
   out.add(stated(source, kHypothesisReference, lone ? RowVerdict::kRejected : RowVerdict::kNoCall, stat_,
                  threshold_));
@@ -249,7 +251,7 @@ bool ReferenceMonitor::scale_significant(int culprit, int old) const {
   const double b = (stt * sre - str * ste) / det;
   const double sig_ref = sigma_ref_rad_;
   const double sigma_b = std::sqrt(2.0) * sig_ref * std::sqrt(stt / det);
-  return std::abs(b) > 5.0 * sigma_b;
+  return std::abs(b) > design::scale_slope_sigmas * sigma_b;
 }
 
 }  // namespace tetra::fdi::detail

@@ -195,6 +195,14 @@ inline constexpr int stamp_window_periods = 1000;
 //! [-] agreeing stamps that confirm a forward jump
 inline constexpr int stamp_confirm_count = 3;
 // --- the reference (continued)
+//! [-] the lone-gyro rule: every other gyro below this fraction of the reference threshold
+inline constexpr double lone_gyro_others_fraction = 0.5;
+//! [σ] a gyro's disagreement that follows the rotation beyond this many σ of its slope: a scale error
+inline constexpr double scale_slope_sigmas = 5.0;
+//! [-] of reference_window_s: the shortest span the filter-bias fault-model check fits
+inline constexpr double filter_bias_min_span_fraction = 0.5;
+//! [-] of reference_window_s: the shortest latest half-span the fault must persist in
+inline constexpr double filter_bias_late_span_fraction = 0.25;
 //! [-] λ beyond: the reference's drift, not the gyros'
 inline constexpr double reference_max_wander_ratio = 1.0e4;
 //! [reference bias windows] the bias match's long window
