@@ -126,12 +126,15 @@ inline constexpr double spread_held_ratio = 16.0;   //!< [-] noise variance rati
 inline constexpr double spread_white_dominates = 0.1;  //!< [-] quantization share: one sample shows the white
 //! [σ] the estimate's interval whose upper end it takes
 inline constexpr double spread_interval_sigmas = 1.0;
-//! [-] variance of a mean of successive differences' u
+//! [-] variance inflation of a mean of successive differences' u (lag-one correlation 0.25 for white noise,
+//! 0.47 for quantization, whose rate error is itself a difference): the likelihood ratio is divided by it
 inline constexpr double spread_difference_inflation = 2.0;
 // --- the CUSUM's design, the level test and the block matches
 //! [bias σ] reach of the design's average over a mean
 inline constexpr double cusum_bias_average_reach = 6.0;
-//! [-] the averaged design kept unless this × slower
+//! [-] the averaged CUSUM design is kept unless absorbing the mean detects the design shift more than this
+//! many times sooner: the two are within a few per cent for a wander well inside the reach, the average's h
+//! grows without bound as the reach passes k
 inline constexpr double cusum_average_kept_within = 2.0;
 //! [σ of the held level] offset the level test absorbs
 inline constexpr double level_margin_sigmas = 3.0;
@@ -146,7 +149,8 @@ inline constexpr double block_match_gain = 0.3;
 //! [s] block of the reference matches' mean innovation
 inline constexpr double reference_match_block_s = 10.0;
 // --- isolation
-//! [-] a single-gyro fit beyond this quantile: none
+//! [-] a single-gyro model whose residual exceeds this quantile of its χ² is not accepted (the records hold
+//! something no single-gyro fault explains)
 inline constexpr double bias_model_reject_probability = 1e-6;
 //! [σ²] the best gyro's fit over any other's (5σ)
 inline constexpr double bias_hypothesis_margin_sigma2 = 25.0;
@@ -177,7 +181,9 @@ inline constexpr double quiet_motion_sigmas = 2.0;
 inline constexpr double motion_quiet_ratio = 2.0;
 //! [samples] another gyro's run leaving repeats unjudged
 inline constexpr int other_repeats_samples = 3;
-//! [-] levels of a repeat run one other fault explains
+//! [-] pieces of a repeat run that one other gyro's fault explains: its level changed at most twice during
+//! the run (a step; a spike or a pulse that came and went), so the others' view of the axis may sit at up to
+//! three levels while the gyro's own rate stood still
 inline constexpr int pieces_one_fault_explains = 3;
 //! [values] the own noise level is evaluated this often
 inline constexpr int own_noise_eval_every = 10;
@@ -186,9 +192,11 @@ inline constexpr double own_noise_smoothing_evaluations = 10.0;
 //! [-] a named gyro's smoothed level below: normal
 inline constexpr double own_noise_normal_ratio = 1.5;
 // --- the data path
-//! [s] the acceleration seen is remembered this long
+//! [s] how long the acceleration the gyros saw is remembered for a lost rate's bound: a slew's acceleration
+//! changes over seconds, and a few epochs without a rate are what drops and gaps make
 inline constexpr double accel_memory_s = 5.0;
-//! [σ] a seen slope's noise left out of the acceleration
+//! [σ] the noise of a seen slope left out before it counts as the body's acceleration: the largest of the
+//! three axes' slopes over the memory (about 150 steps at 10 Hz) passes 5σ with probability below 1e-4
 inline constexpr double slope_noise_sigmas = 5.0;
 //! [sample periods] the stamp judge's window
 inline constexpr int stamp_window_periods = 1000;
@@ -203,18 +211,23 @@ inline constexpr double scale_slope_sigmas = 5.0;
 inline constexpr double filter_bias_min_span_fraction = 0.5;
 //! [-] of reference_window_s: the shortest latest half-span the fault must persist in
 inline constexpr double filter_bias_late_span_fraction = 0.25;
-//! [-] λ beyond: the reference's drift, not the gyros'
+//! [-] the largest λ: a mean that needs more (a random walk 100 times the model's own wander in σ) is not a
+//! drift of working gyros but the reference's, and is left to its tests (a warm-up of 5e-6 to 8e-5 deg/s over
+//! minutes needs up to about 700; a reference's bias of 10–40″ 5e4 in the median)
 inline constexpr double reference_max_wander_ratio = 1.0e4;
 //! [reference bias windows] the bias match's long window
 inline constexpr double reference_long_windows = 4.0;
-//! [-] × N: the largest white noise taken on
+//! [-] the largest white rate noise the filter takes on, as a multiple of the model's N (a noise ×30 of a
+//! fiber-optic gyro is a failed gyro, not a degraded one)
 inline constexpr double reference_max_noise_ratio = 30.0;
 // --- the calibration's motion fit
-//! [s] one block of the motion fit
+//! [s] one block of the motion fit: long enough for a slew or two, short enough to name a mismatch within
+//! ten minutes of motion
 inline constexpr double motion_fit_block_s = 300.0;
-//! [blocks] in a row that name a mismatch
+//! [blocks] blocks in a row whose rows make the case before a mismatch is named: a fault's onset inside a
+//! block bends that block's fit; the next block shows the fault as the single gyro's it is
 inline constexpr int motion_fit_blocks_in_a_row = 2;
-//! [epochs] a block with fewer is not judged
+//! [epochs] a block with fewer is not judged (a set that changed just before the block's end)
 inline constexpr int motion_fit_min_epochs = 10;
 }  // namespace design
 
