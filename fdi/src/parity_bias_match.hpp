@@ -5,8 +5,10 @@
 // all the same, and averaging shows it. Per gyro i of the active set, the filter's parity innovations
 // ν = p − √T·W·(ĉ + ĝ) are projected on the gyro's parity column w_i and summed over blocks of
 // design::parity_bias_block_s (30 s): the block's mean rate error on the gyro, f̂_i = Σ w_iᵀν / Σ |w_i|², has
-// the variance 1/Σ|w_i|² + v_i while the filter's model holds (white parity noise; v_i the filter's own
-// uncertainty of the biases seen the same way), so u_i = f̂_i²/(1/Σ|w_i|² + v_i) is χ²₁. A CUSUM per gyro of
+// the variance 1/Σ|w_i|² + v_i/n while the filter's model holds (white parity noise; v_i the filter's own
+// uncertainty of the biases seen the same way, n the block's epochs: the innovations of a filter whose model
+// holds are white, so v_i enters each epoch's innovation afresh, not the block's mean as a whole), so u_i =
+// f̂_i²/(1/Σ|w_i|² + v_i/n) is χ²₁. A CUSUM per gyro of
 // the log-likelihood ratio for a block variance ρ = 4 times the predicted,
 //
 //   g_i ← max(0, g_i + ½·((1 − 1/ρ)·u_i − ln ρ));   matched when some g_i > ln(1/(p·n·|S|))
