@@ -25,8 +25,9 @@ const Allocation kAllocations[kBudgetTestCount] = {
      "per epoch (1/ARL0): most of the budget's false alarms, spent on the delay of the smallest fault "
      "(h grows as ln ARL0)"},
     {BudgetTest::kJump, "jump", 1.0, "per epoch; confirmed over onset_confirm_epochs before it names a step"},
-    {BudgetTest::kParityBlockMatch, "parity_block_match", 1.0,
-     "per epoch, by Wald's bound on the block match's mean run length"},
+    {BudgetTest::kParityBlockMatch, "parity_block_match", kLargestShare,
+     "per epoch, by Wald's bound on the block match's mean run length: a match opens the gyros' bias models "
+     "(sigma carries what the blocks show), it decides nothing"},
     {BudgetTest::kGlt, "glt", 1.0, "per form and epoch: two forms, the larger decides"},
     {BudgetTest::kReferenceCheck, "reference_test", 1.0, "per sample and test of a good reference"},
     {BudgetTest::kReferenceNoiseMatch, "reference_noise_match", 1.0, "per sample, three gyros only"},
@@ -97,6 +98,12 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
                       "one block's H0 rejected (a mismatch needs two in a row and every Hi rejected too)"});
   }
   if (parity) {
+    // Wald's bound: each gyro's block CUSUM runs at least 1/(p·n·|S|) blocks of n epochs between false
+    // matches, the first of the |S| at least 1/(p·n·|S|²): at most p·|S|² per epoch (the gyros' CUSUMs share
+    // the parity, so the bound is loose by up to |S|).
+    b.rows.push_back({"parity_block_match", K::kNoiseModel, "false_alarm_probability",
+                      allocated_probability(c, BudgetTest::kParityBlockMatch) * gyros * gyros, epochs_per_hour,
+                      "a bias model opened by the parity's block means of the filter's innovations"});
     b.rows.push_back(
         {"parity_spread", K::kNoiseModel, "false_alarm_probability",
          allocated_probability(c, BudgetTest::kParitySpread), epochs_per_hour,

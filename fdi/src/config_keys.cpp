@@ -59,8 +59,9 @@ constexpr ConfigKey kKeys[] = {
     // --- the error budget
     {"false_alarm_probability", &C::false_alarm_probability, "-", above(0), below(0.5 / kLargestShare),
      "the budget's unit: each test's error probability per epoch or sample is its share of this (chi2, "
-     "jump, parity block match, GLT, each reference test 1; CUSUM 10, i.e. ARL0 = 1/(10 p); reference "
-     "gate 1000; the verbose replay prints the budget)"},
+     "jump, GLT, each reference test, reference noise match 1; CUSUM 10, i.e. ARL0 = 1/(10 p); reference "
+     "gate, bias matches, motion fit, parity spread 1000: they decide nothing; the verbose replay prints "
+     "the budget)"},
     // --- detection on the parity residual
     {"cusum_min_fault_dps", &C::cusum_min_fault_dps, "deg/s", above(0), kFree,
      "smallest bias step on any gyro the CUSUM is sized for (k = delta_min/2); also the parity block "

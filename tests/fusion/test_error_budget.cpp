@@ -66,6 +66,28 @@ TEST(ErrorBudget, EveryProbabilityIsItsShareOfTheOneKey) {
   EXPECT_FALSE(validate(c).ok());
 }
 
+TEST(ErrorBudget, TheTestsThatDecideNothingTakeTheLargestShareAndAreListed) {
+  // The parity block match opens bias models and decides nothing, as the reference bias match, the motion fit
+  // and the parity's spread: each takes the largest share (1e-6 at the default p). The block match's row is
+  // Wald's bound for the first of |S| gyros' CUSUMs, p·|S|² per epoch: 1.6e-5 for four gyros, 5.76e-1 per
+  // hour at 10 Hz; it is a noise-model row, not a false alarm.
+  const PipelineConfig c;
+  for (const BudgetTest t : {BudgetTest::kParityBlockMatch, BudgetTest::kReferenceBiasMatch,
+                             BudgetTest::kMotionFit, BudgetTest::kParitySpread, BudgetTest::kReferenceGate})
+    EXPECT_DOUBLE_EQ(allocated_probability(c, t), 1e-6) << kAllocations[static_cast<int>(t)].name;
+  const Budget b = error_budget(c, 4, 0.1);
+  int rows = 0;
+  for (const BudgetRow& r : b.rows) {
+    if (std::string(r.source) != "parity_block_match") continue;
+    ++rows;
+    EXPECT_EQ(r.kind, BudgetKind::kNoiseModel);
+    EXPECT_NEAR(r.per_evaluation, 1.6e-5, 1e-18);
+    EXPECT_NEAR(r.total(), 0.576, 1e-12);
+  }
+  EXPECT_EQ(rows, 1);
+  EXPECT_NEAR(b.false_alarms_per_hour * 1000.0, 0.396, 1e-9);  // not in the false alarms
+}
+
 TEST(ErrorBudget, SignaturesAreListedWithoutAFigure) {
   const Budget b = error_budget(PipelineConfig{}, 5, 0.1);
   int unbudgeted = 0;
