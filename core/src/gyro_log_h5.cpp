@@ -613,8 +613,11 @@ Result<GyroLog> read_gyro_log_h5(const std::string& path) {
   return read_whole(**reader, path);
 }
 
-Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, const std::string& name,
-                                       const GyroLogH5Header& header) {
+namespace {
+
+// The image opened into `reader` with `header` as the child sent it, reading no attribute.
+Status open_image(std::span<const std::uint8_t> bytes, const std::string& name, const GyroLogH5Header& header,
+                  H5Reader& reader) {
   init_hdf5();
   if (bytes.empty()) return bad_input(name + ": not an HDF5 file");
   Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
@@ -625,10 +628,22 @@ Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, cons
   }
   Handle file(H5Fopen(name.c_str(), H5F_ACC_RDONLY, fapl.get()), H5Fclose);
   if (!file.valid()) return bad_input(name + ": cannot open as HDF5");
-  H5Reader reader;
   // As the process that opens a checked file: the header given, no attribute read.
-  if (Status s = reader.open_file(std::move(file), name, &header, VariableStrings::kRefuse); !s)
-    return s.error();
+  return reader.open_file(std::move(file), name, &header, VariableStrings::kRefuse);
+}
+
+}  // namespace
+
+Status open_gyro_log_h5_image(std::span<const std::uint8_t> bytes, const std::string& name,
+                              const GyroLogH5Header& header) {
+  H5Reader reader;
+  return open_image(bytes, name, header, reader);
+}
+
+Result<GyroLog> read_gyro_log_h5_image(std::span<const std::uint8_t> bytes, const std::string& name,
+                                       const GyroLogH5Header& header) {
+  H5Reader reader;
+  if (Status s = open_image(bytes, name, header, reader); !s) return s.error();
   return read_whole(reader, name);
 }
 

@@ -109,6 +109,9 @@ Result<H5Header> probe_in_child(const std::string& path, Inspect inspect) {
   }
   if (pid == 0) {
     ::close(fds[0]);
+    // A fault of libhdf5 ends the child by its signal, whatever handler the host process installed (a
+    // crash reporter, an interpreter's): the parent names the signal.
+    for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) ::signal(sig, SIG_DFL);
     ::alarm(kProbeSeconds);
     limit_child_memory();
     const auto header = inspect(path);
