@@ -49,6 +49,9 @@ const EvidenceSourceInfo kEvidenceSources[kEvidenceSourceCount] = {
     {EvidenceSource::kUncheckedNoise, "unchecked_noise", StatisticUnit::kRatio,
      "the white noise variance, over the model's, that would explain an alarm, while the parity's spread has "
      "not checked the model (Hnoise consistent up to spread_held_ratio)"},
+    {EvidenceSource::kParityBlockMatch, "parity_block_match", StatisticUnit::kLogLikelihood,
+     "the CUSUM of the parity's block means of the filter's innovations on a gyro's column, against their "
+     "variance under the model (H0: the bias model as stated)"},
 };
 
 bool reads_own_signal(EvidenceSource source) {

@@ -59,9 +59,10 @@ void ParityBiasMatch::forget(int id) {
   cusum_[k] = 0.0;
 }
 
-void ParityBiasMatch::observe(std::int64_t now_ns, const Subset& s, const Eigen::VectorXd& p,
-                              double sqrt_period, Mekf& filter) {
-  if (s.dof < 1 || !s.observable) return;
+std::optional<BlockFinding> ParityBiasMatch::observe(std::int64_t now_ns, const Subset& s,
+                                                     const Eigen::VectorXd& p, double sqrt_period,
+                                                     Mekf& filter) {
+  if (s.dof < 1 || !s.observable) return std::nullopt;
   if (s.mask != mask_) {  // other gyros: statistics afresh (a matched gyro keeps its bias model)
     restart();
     mask_ = s.mask;
@@ -82,19 +83,20 @@ void ParityBiasMatch::observe(std::int64_t now_ns, const Subset& s, const Eigen:
     sum_w2_[k] += a * a;
   }
   ++block_epochs_;
-  if (now_ns - block_start_ns_ < seconds_to_ns(design::parity_bias_block_s)) return;
-  close_block(s, ns_to_seconds(now_ns - block_start_ns_), filter);
+  if (now_ns - block_start_ns_ < seconds_to_ns(design::parity_bias_block_s)) return std::nullopt;
+  auto found = close_block(s, ns_to_seconds(now_ns - block_start_ns_), filter);
   block_start_ns_ = now_ns;
   block_epochs_ = 0;
+  return found;
 }
 
-void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter) {
+std::optional<BlockFinding> ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter) {
   // A block of n epochs stands for n of the per-epoch false-alarm probability p, and each gyro's CUSUM is one
   // test (p·n·|S| at most 1/2, so the threshold stays above ln 2 whatever p the configuration allows).
   const double threshold = block_cusum_threshold(false_alarm_ * block_epochs_ * tetra::gyro_count(s.mask));
   const int n = static_cast<int>(sum_wnu_.size());
   const Eigen::MatrixXd& P = filter.covariance();
-  bool alarm = false;
+  std::optional<BlockFinding> first;  // the gyro whose CUSUM is furthest beyond the threshold
   for (int i = 0; i < n; ++i) {
     const auto k = static_cast<std::size_t>(i);
     if (!has_gyro(s.mask, i + 1) || !(sum_w2_[k] > 0.0)) continue;
@@ -121,12 +123,14 @@ void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter)
     sum_wnu_[k] = 0.0;
     sum_w2_[k] = 0.0;
     cusum_[k] = block_cusum_step(cusum_[k], u, 1.0);
-    alarm = alarm || cusum_[k] > threshold;
+    if (cusum_[k] > threshold && (!first || cusum_[k] > first->statistic))
+      first = BlockFinding{i + 1, cusum_[k], threshold, u};
     // The excess under gyro i's hypothesis (the error is gyro i's alone): kept per gyro, used once matched.
     block_excess_[k] = f * f - predicted;
     block_f_[k] = f;
     block_var_[k] = predicted;
   }
+  const bool alarm = first.has_value();
   if (matched_ && !alarm) {
     bool quiet = true;
     for (int i = 0; i < n; ++i)
@@ -134,9 +138,10 @@ void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter)
     quiet_blocks_ = quiet ? quiet_blocks_ + 1 : 0;
     if (quiet_blocks_ >= design::parity_bias_quiet_blocks) {
       release(filter);
-      return;
+      return std::nullopt;
     }
   }
+  const bool begun = alarm && !matched_;
   matched_ = matched_ || alarm;
   // Which gyro the parity's blocks cannot always tell (their columns are not orthogonal): every gyro of the
   // set takes the excess its own hypothesis gives, so sigma covers each single-gyro explanation.
@@ -157,6 +162,7 @@ void ParityBiasMatch::close_block(const Subset& s, double block_s, Mekf& filter)
     last_f_[k] = block_f_[k];
     last_var_[k] = has_gyro(s.mask, i + 1) ? block_var_[k] : 0.0;
   }
+  return begun ? first : std::nullopt;
 }
 
 }  // namespace tetra::fdi::detail

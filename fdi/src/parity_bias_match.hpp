@@ -19,8 +19,9 @@
 // block does not always tell which gyro it is: once matched, every gyro's slow bias is a Gauss–Markov process
 // whose stationary variance carries, beyond the model's σ_GM², the excess its own hypothesis gives, F_i² =
 // f̂_i² − (1/Σ|w_i|² + v_i) (the largest of the blocks since) — sigma covers each single-gyro explanation, and
-// the filter follows the error through the parity (and the reference). No event: nothing is excluded or
-// reported; the bias model is matched to the data. Blocks run on the epochs whose parity is over the whole
+// the filter follows the error through the parity (and the reference). Nothing is excluded; the first block
+// of a match is a noise_model event (row parity_block_match: the crossing CUSUM against its threshold), the
+// bias model then follows the data without further events. Blocks run on the epochs whose parity is over the whole
 // active set, outside fault episodes (a fault the detectors see is theirs to judge), once the reference has
 // been seen (before it the filter estimates no bias, and the biases' own wander, slower than a block, would
 // make successive blocks correlated). The random-walk bias also opens, by the largest excess of a
@@ -29,6 +30,7 @@
 // row with every CUSUM at 0; the bias states' prior spread (the filter-bias test's) keeps the model's K.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -41,6 +43,14 @@ namespace tetra::fdi::detail {
 
 class Mekf;
 
+//! A match begun at this block: the gyro whose CUSUM crossed first.
+struct BlockFinding {
+  int gyro = 0;            //!< 1..N
+  double statistic = 0.0;  //!< [-] its CUSUM g_i (a log-likelihood ratio)
+  double threshold = 0.0;  //!< [-] ln(1/(p·n·|S|))
+  double ratio = 0.0;      //!< [-] the block's u_i: its mean's square over the variance the model predicts
+};
+
 class ParityBiasMatch {
  public:
   ParityBiasMatch(const PipelineConfig& config, int gyro_count);
@@ -51,9 +61,9 @@ class ParityBiasMatch {
   void restart();
   //! One epoch's normalized parity `p` over the active set's subset `s` (no episode open), before the
   //! filter's parity update. At a block's end a gyro whose mean rate error exceeds the model has its slow
-  //! bias opened in `filter` (Mekf::open_bias_model).
-  void observe(std::int64_t now_ns, const Subset& s, const Eigen::VectorXd& p, double sqrt_period,
-               Mekf& filter);
+  //! bias opened in `filter` (Mekf::open_bias_model); the block that begins a match returns its finding.
+  std::optional<BlockFinding> observe(std::int64_t now_ns, const Subset& s, const Eigen::VectorXd& p,
+                                      double sqrt_period, Mekf& filter);
   //! Gyro `id` reinstated: its match forgotten (the filter's thaw restores its bias model).
   void forget(int id);
   //! Nothing matched any more: every gyro's bias model in `filter` is the calibration's again and the blocks
@@ -62,7 +72,7 @@ class ParityBiasMatch {
   void release(Mekf& filter);
 
  private:
-  void close_block(const Subset& s, double block_s, Mekf& filter);
+  std::optional<BlockFinding> close_block(const Subset& s, double block_s, Mekf& filter);
 
   double false_alarm_ = 0.0;          //!< p per epoch
   GyroMask mask_ = 0;                 //!< the gyros of the statistics

@@ -331,9 +331,11 @@ void Pipeline::Impl::publish_attitude() {
       if (frame_.usable == measured_ && sol.observable) {
         if (episode)
           bias_match_.restart();
-        else if (frame_.usable == gyro_set_.active() && attitude_.reference_aided())
-          bias_match_.observe(frame_.now_ns, sol, detector_.parity(), subsets_.sqrt_period(),
-                              attitude_.filter());
+        else if (frame_.usable == gyro_set_.active() && attitude_.reference_aided()) {
+          if (const auto found = bias_match_.observe(frame_.now_ns, sol, detector_.parity(),
+                                                     subsets_.sqrt_period(), attitude_.filter()))
+            emit_block_matched(*found);
+        }
         attitude_.parity(sol, detector_.parity(), subsets_.sqrt_period());
       }
     }

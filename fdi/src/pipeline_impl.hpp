@@ -170,6 +170,10 @@ class Pipeline::Impl {
   void widen_noise(const SpreadFinding& f, const char* evidence);
   void emit_noise_widened(const SpreadFinding& f, const char* evidence);
   void emit_episode_explained(const SpreadFinding& f);
+  //! A noise_model event whose one row is `source` rejecting H0 ("the model as stated") at `statistic`.
+  FdiEvent model_rejected(EvidenceSource source, double statistic, double threshold) const;
+  //! The parity block match has begun: the noise_model event (its row parity_block_match).
+  void emit_block_matched(const BlockFinding& f);
   //! The rate solution of the gyros in use when they are exactly three (no parity left), else null.
   const Subset* three_gyros_without_parity();
 

@@ -5,6 +5,7 @@
 // it.
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "pipeline_impl.hpp"
@@ -62,19 +63,37 @@ void Pipeline::Impl::widen_noise(const SpreadFinding& f, const char* evidence) {
   if (episode) emit_episode_explained(f);
 }
 
-void Pipeline::Impl::emit_noise_widened(const SpreadFinding& f, const char* evidence) {
+FdiEvent Pipeline::Impl::model_rejected(EvidenceSource source, double statistic, double threshold) const {
   FdiEvent e = event_now(EventType::kNoiseModel);
-  e.statistic = f.statistic;
+  e.statistic = statistic;
+  e.ledger.push_back(stated(source, kHypothesisNone, RowVerdict::kRejected, statistic, threshold));
+  return e;
+}
+
+void Pipeline::Impl::emit_noise_widened(const SpreadFinding& f, const char* evidence) {
   // H0 here is "the noise as stated": rejected by the spread; which gyro is noisier, the parity cannot tell,
   // so every gyro's noise is taken the same.
-  e.ledger.push_back(stated(EvidenceSource::kParitySpread, kHypothesisNone, RowVerdict::kRejected,
-                            f.statistic, f.threshold));
+  FdiEvent e = model_rejected(EvidenceSource::kParitySpread, f.statistic, f.threshold);
   char text[400];
   std::snprintf(text, sizeof text,
                 "the parity's spread %s is %.3g times the model's over %d samples: every gyro's white noise "
                 "is taken as %.3g times its stated variance from now on (every sum and sigma), one sample's "
                 "noise as at least %.3g times (the parity cannot tell which gyro)",
                 evidence, f.estimate, f.samples, subsets_.white_ratio(), subsets_.sample_ratio());
+  e.detail = text;
+  emit(std::move(e));
+}
+
+void Pipeline::Impl::emit_block_matched(const BlockFinding& f) {
+  // H0 here is "the bias model as stated": rejected by the blocks; which gyro, the parity's columns cannot
+  // always tell, so every gyro's model opens by what its own hypothesis needs.
+  FdiEvent e = model_rejected(EvidenceSource::kParityBlockMatch, f.statistic, f.threshold);
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "a slow rate error beyond the bias model in the parity's %.0f-s block means of the filter's "
+                "innovations (gyro %d's block %.3g times the variance the model predicts): every gyro's bias "
+                "model opened by what its own hypothesis needs (sigma carries it); nothing excluded",
+                design::parity_bias_block_s, f.gyro, f.ratio);
   e.detail = text;
   emit(std::move(e));
 }

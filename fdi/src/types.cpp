@@ -275,8 +275,9 @@ bool calibration_ruling_of(const FdiEvent& event) {
 
 bool noise_ruling_of(const FdiEvent& event) {
   for (const LedgerRow& row : event.ledger) {
-    if (row.source == EvidenceSource::kParitySpread && row.hypothesis == kHypothesisNone &&
-        row.verdict == RowVerdict::kRejected)
+    const bool model_rejected =
+        row.source == EvidenceSource::kParitySpread || row.source == EvidenceSource::kParityBlockMatch;
+    if (model_rejected && row.hypothesis == kHypothesisNone && row.verdict == RowVerdict::kRejected)
       return true;
   }
   return reference_ruling_of(event) == ReferenceDecision::kMatchDrift;

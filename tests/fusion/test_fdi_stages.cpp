@@ -369,10 +369,12 @@ TEST(ParityBiasMatch, WhiteParityNeverOpensTheBiasModelAndASlowErrorDoes) {
   Eigen::VectorXd p(1);
   std::int64_t k = 0;
   const auto ns = [&] { return static_cast<std::int64_t>(k) * 100'000'000; };
+  int findings = 0;  // the block that begins a match returns it (a noise_model event), once per match
   for (; k < 72'000; ++k) {
     p[0] = normal(rng);
-    match.observe(ns(), s, p, f.subsets->sqrt_period(), filter);
+    findings += match.observe(ns(), s, p, f.subsets->sqrt_period(), filter) ? 1 : 0;
   }
+  EXPECT_EQ(findings, 0);
   for (int id = 1; id <= 4; ++id) EXPECT_EQ(filter.added_bias_instability(id), 0.0) << id;
   const double amplitude = 1e-6;  // [rad/s]
   const double a = f.subsets->sqrt_period() * s.parity(0, 0);
@@ -381,12 +383,18 @@ TEST(ParityBiasMatch, WhiteParityNeverOpensTheBiasModelAndASlowErrorDoes) {
   for (; k < start + 6000; ++k) {
     const double t = static_cast<double>(k - start) * kPeriod;
     p[0] = normal(rng) + a * amplitude * std::sin(2.0 * kPi * t / 126.0);
-    match.observe(ns(), s, p, f.subsets->sqrt_period(), filter);
+    if (const auto found = match.observe(ns(), s, p, f.subsets->sqrt_period(), filter)) {
+      ++findings;
+      EXPECT_GT(found->statistic, found->threshold);
+      EXPECT_GE(found->gyro, 1);
+      EXPECT_LE(found->gyro, 4);
+    }
     if (matched_after_s < 0.0 && filter.added_bias_instability(1) + filter.added_rate_random_walk(1) > 0.0)
       matched_after_s = t;
   }
   std::printf("slow error matched after %.0f s\n", matched_after_s);
   EXPECT_GE(matched_after_s, 0.0);
+  EXPECT_EQ(findings, 1);
   for (int id = 1; id <= 4; ++id) {
     EXPECT_GT(filter.added_bias_instability(id), 0.0) << id;
     EXPECT_LT(filter.added_bias_instability(id), 2.0 * amplitude * amplitude) << id;

@@ -38,9 +38,10 @@ enum class EvidenceSource : std::uint8_t {
   kDriftWander,      //!< the bias wander a common drift of the gyros would need, against a working unit's
   kMotionFit,        //!< the parity's fit to the body rate over a block: scale factors and axes
   kParitySpread,     //!< the parity's differences between consecutive epochs: the unit's white noise
-  kUncheckedNoise    //!< the white noise an alarm needs, while the spread has not checked the model
+  kUncheckedNoise,   //!< the white noise an alarm needs, while the spread has not checked the model
+  kParityBlockMatch  //!< the parity's block means of the filter's innovations: each gyro's bias model
 };
-constexpr int kEvidenceSourceCount = 21;
+constexpr int kEvidenceSourceCount = 22;
 //! True for the sources that read a gyro's own signal (timeout, invalid, repeated, zero, variance,
 //! noise_level, recurring_spikes): no error of the calibration makes what they see.
 bool reads_own_signal(EvidenceSource source);
