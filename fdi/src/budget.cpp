@@ -102,7 +102,8 @@ Budget error_budget(const PipelineConfig& c, int gyros, double sample_period_s) 
     // matches, the first of the |S| at least 1/(p·n·|S|²): at most p·|S|² per epoch (the gyros' CUSUMs share
     // the parity, so the bound is loose by up to |S|).
     b.rows.push_back({"parity_block_match", K::kNoiseModel, "false_alarm_probability",
-                      allocated_probability(c, BudgetTest::kParityBlockMatch) * gyros * gyros, epochs_per_hour,
+                      allocated_probability(c, BudgetTest::kParityBlockMatch) * gyros * gyros,
+                      epochs_per_hour,
                       "a bias model opened by the parity's block means of the filter's innovations"});
     b.rows.push_back(
         {"parity_spread", K::kNoiseModel, "false_alarm_probability",

@@ -18,14 +18,14 @@
 // of the |S| at least about 1/(p·n·|S|²)). The parity columns of different gyros are not orthogonal, so a
 // block does not always tell which gyro it is: once matched, every gyro's slow bias is a Gauss–Markov process
 // whose stationary variance carries, beyond the model's σ_GM², the excess its own hypothesis gives, F_i² =
-// f̂_i² − (1/Σ|w_i|² + v_i) (the largest of the blocks since) — sigma covers each single-gyro explanation, and
-// the filter follows the error through the parity (and the reference). Nothing is excluded; the first block
-// of a match is a noise_model event (row parity_block_match: the crossing CUSUM against its threshold), the
-// bias model then follows the data without further events. Blocks run on the epochs whose parity is over the whole
-// active set, outside fault episodes (a fault the detectors see is theirs to judge), once the reference has
-// been seen (before it the filter estimates no bias, and the biases' own wander, slower than a block, would
-// make successive blocks correlated). The random-walk bias also opens, by the largest excess of a
-// block-to-block change over both blocks' predicted variances, per second of block. The match ends — every
+// f̂_i² − (1/Σ|w_i|² + v_i/n) (the largest of the blocks since) — sigma covers each single-gyro explanation,
+// and the filter follows the error through the parity (and the reference). Nothing is excluded; the first
+// block of a match is a noise_model event (row parity_block_match: the crossing CUSUM against its threshold),
+// the bias model then follows the data without further events. Blocks run on the epochs whose parity is over
+// the whole active set, outside fault episodes (a fault the detectors see is theirs to judge), once the
+// reference has been seen (before it the filter estimates no bias, and the biases' own wander, slower than a
+// block, would make successive blocks correlated). The random-walk bias also opens, by the largest excess of
+// a block-to-block change over both blocks' predicted variances, per second of block. The match ends — every
 // model the calibration's again — at an exclusion, or after design::parity_bias_quiet_blocks (10) blocks in a
 // row with every CUSUM at 0; the bias states' prior spread (the filter-bias test's) keeps the model's K.
 

@@ -251,4 +251,3 @@ TEST(PerturbationFamilies, TheFirstRateAfterALostOneIsNotTheHeldOne) {
 
 }  // namespace
 }  // namespace tetra
-
