@@ -39,7 +39,7 @@ const EvidenceSourceInfo kEvidenceSources[kEvidenceSourceCount] = {
     {EvidenceSource::kQuiet, "quiet", StatisticUnit::kSeconds, "time since the last alarm of the episode"},
     {EvidenceSource::kDriftWander, "drift_wander", StatisticUnit::kRatio,
      "the bias random walk a common drift of the gyros needs for the reference's mean innovation, over the "
-     "model's own wander (working gyros: at most 1e4, and not again within a bias window of a match)"},
+     "model's own wander, at least rho times the last match's (working gyros: at most 1e4)"},
     {EvidenceSource::kMotionFit, "motion_fit", StatisticUnit::kChi2,
      "the parity's linear fit to the body rate over a block (the hypothesis's own form fitted: H0 none, "
      "Hi gyro i's alone), against the noise and the calibration's stated tolerance"},

@@ -270,7 +270,8 @@ class Pipeline::Impl {
   std::optional<std::int64_t> reference_rejected_ns_;
   EvidenceRows rejection_rows_;
   EvidenceRows reference_rows_;  //!< the last reference decision's rows
-  //! [-] this sample: the bias wander a common drift would need for the reference's mean (NaN: not judged)
+  //! [-] this sample: the λ a match of the reference's mean as a common drift would set, at least ρ times the
+  //! last match's (NaN: not judged)
   double drift_ratio_needed_ = std::numeric_limits<double>::quiet_NaN();
 };
 

@@ -14,14 +14,12 @@ namespace tetra::fdi::detail {
 ReferenceBiasMatch::ReferenceBiasMatch(const PipelineConfig& config)
     : threshold_(
           allan::chi2_quantile(1.0 - allocated_probability(config, BudgetTest::kReferenceBiasMatch), 3.0)),
-      bias_window_ns_(seconds_to_ns(design::reference_bias_window_s)),
       long_window_ns_(seconds_to_ns(design::reference_long_windows * design::reference_bias_window_s)) {}
 
 void ReferenceBiasMatch::reset() {
   restart();
   matched_ = false;
   ratio_ = 1.0;
-  last_match_ns_ = -1;
 }
 
 void ReferenceBiasMatch::restart() {
@@ -41,11 +39,10 @@ std::optional<DriftFinding> ReferenceBiasMatch::observe(std::int64_t now_ns, con
   sw_ += w;
   swz_ += w.cwiseProduct(z_rad);
   const double statistic = mean_innovation_chi2(sw_, swz_);
-  if (!(statistic > threshold_) || !may_explain(now_ns)) return std::nullopt;
+  if (!(statistic > threshold_)) return std::nullopt;
   const Eigen::Vector3d mean_rad = swz_.cwiseQuotient(sw_);
   const double span_s = ns_to_seconds(now_ns - start_ns_);
-  if (!plausible(mean_rad, span_s, active, filter)) return std::nullopt;
-  match_mean(now_ns, mean_rad, span_s, active, filter);
+  if (!match_mean(mean_rad, span_s, active, filter)) return std::nullopt;
   restart();
   return DriftFinding{statistic, threshold_, ratio_};
 }
@@ -62,13 +59,12 @@ double ReferenceBiasMatch::needed_ratio(const Eigen::Vector3d& mean_rad, double 
   return smallest > 0.0 && std::isfinite(ratio) ? ratio : std::numeric_limits<double>::infinity();
 }
 
-bool ReferenceBiasMatch::match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s,
-                                    GyroMask active, Mekf& filter) {
+bool ReferenceBiasMatch::match_mean(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
+                                    Mekf& filter) {
   const double needed = needed_ratio(mean_rad, span_s, active, filter);
-  if (!(needed <= design::reference_max_wander_ratio)) return false;
-  last_match_ns_ = now_ns;
+  if (!may_explain(needed)) return false;
   matched_ = true;
-  ratio_ = std::clamp(needed, design::block_match_ratio * ratio_, design::reference_max_wander_ratio);
+  ratio_ = next_ratio(needed);
   open(active, filter);
   return true;
 }

@@ -15,10 +15,12 @@
 // to a random walk of K_i² + λ·q_i [rad²/s³] (Mekf::open_bias_model), q_i = K_i² + 2σ_GM,i²/T_c + N_i²/T_c²
 // the model's own wander per second: a body-rate error b = 2·z̄/T grown within the window T is a random walk
 // of |b|²/T, and λ is at least ρ (design::block_match_ratio) times that over q_i — and at least ρ times its
-// last value, so a drift that goes on opens the model further at every match. A mean that persists within W
-// of a match, the model opened, is the reference's: its bias test rejects it as before. The match is kept
-// (the models only open) until a reset or an exclusion; each match is a noise_model event.
+// last value, so a drift that goes on opens the model further at every match. A mean that persists, the model
+// opened, asks for ρ times more at each match: once the λ a match would set exceeds a working unit's wander
+// (design::reference_max_wander_ratio) the mean is the reference's, and its bias test rejects it as before.
+// The match is kept (the models only open) until a reset or an exclusion; each match is a noise_model event.
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 
@@ -51,16 +53,16 @@ class ReferenceBiasMatch {
   //! opens `filter`'s bias models and is returned.
   std::optional<DriftFinding> observe(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
                                       const Eigen::Matrix3d& S, GyroMask active, Mekf& filter);
-  //! The mean `mean_rad` [rad] over `span_s` [s] matched as a drift at `now_ns` (the reference's bias block,
-  //! or the long window): every active gyro's slow bias opened; false (nothing opened) when it is not
-  //! plausible.
-  bool match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
-                  Mekf& filter);
-  //! Whether a mean at `now_ns` may be matched as a drift: not within reference_bias_window_s of the last
-  //! match (a mean that persists with the model opened is the reference's).
-  bool may_explain(std::int64_t now_ns) const {
-    return last_match_ns_ < 0 || now_ns - last_match_ns_ >= bias_window_ns_;
-  }
+  //! The mean `mean_rad` [rad] over `span_s` [s] matched as a drift (the reference's bias block, or the long
+  //! window): every active gyro's slow bias opened; false (nothing opened) when it may not be a drift of
+  //! working gyros (may_explain).
+  bool match_mean(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active, Mekf& filter);
+  //! The λ a match of a mean that needs `needed` would set: at least ρ times the last match's.
+  double next_ratio(double needed) const { return std::max(needed, design::block_match_ratio * ratio_); }
+  //! Whether a mean that needs `needed` may be matched as a drift of working gyros: the λ its match would
+  //! set at most design::reference_max_wander_ratio (a mean that persists with the model opened asks for ρ
+  //! times more at each match, and ends the reference's).
+  bool may_explain(double needed) const { return next_ratio(needed) <= design::reference_max_wander_ratio; }
   //! λ·q_i ≥ ρ·|b|²/T: the ratio the mean `mean_rad` over `span_s` needs (+∞ without a span or a wander).
   static double needed_ratio(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
                              const Mekf& filter);
@@ -78,12 +80,10 @@ class ReferenceBiasMatch {
   static double wander(const GyroNoiseModel& m);
 
   double threshold_ = 0.0;                         //!< χ²₃(1 − p_m)
-  std::int64_t bias_window_ns_ = 0;                //!< W
   std::int64_t long_window_ns_ = 0;                //!< 4W
   std::int64_t start_ns_ = -1;                     //!< the long window's first sample
   Eigen::Vector3d sw_ = Eigen::Vector3d::Zero();   //!< [1/rad²] per axis Σ 1/S_aa
   Eigen::Vector3d swz_ = Eigen::Vector3d::Zero();  //!< [1/rad] per axis Σ z_a/S_aa
-  std::int64_t last_match_ns_ = -1;
   bool matched_ = false;
   double ratio_ = 1.0;  //!< λ
 };

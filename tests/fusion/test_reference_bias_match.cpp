@@ -75,8 +75,16 @@ TEST(ReferenceBiasMatch, AWarmUpsMeanMatchesAndOpensEveryActiveGyro) {
   for (int id = 1; id <= 3; ++id) EXPECT_GT(f.added_rate_random_walk(id), 0.0) << id;
   EXPECT_EQ(f.added_rate_random_walk(4), 0.0);  // not active: left alone
   EXPECT_TRUE(m.matched());
-  EXPECT_FALSE(m.may_explain((at + 60) * kSecond_ns));  // within reference_bias_window_s (120 s)
-  EXPECT_TRUE(m.may_explain((at + 120) * kSecond_ns));
+  // A mean that goes on asks for ρ times more at each match, whatever it needs itself...
+  EXPECT_DOUBLE_EQ(m.next_ratio(0.0), design::block_match_ratio * found->ratio);
+  // ...so one the model opened does not explain ends the reference's within log_ρ(1e4) ≈ 6.6 matches.
+  const Eigen::Vector3d persisting = Eigen::Vector3d::Constant(0.3 * kSigma_rad);
+  int matches = 0;
+  while (m.match_mean(persisting, 120.0, 0b0111, f)) ++matches;
+  EXPECT_GE(matches, 1);
+  EXPECT_LE(matches, 7);
+  EXPECT_LE(m.ratio(), design::reference_max_wander_ratio);
+  EXPECT_FALSE(m.may_explain(0.0));
 }
 
 TEST(ReferenceBiasMatch, AMeanOnlyTheReferenceCouldMakeIsNotADrift) {
