@@ -198,7 +198,7 @@ TEST(PerturbationFamilies, ABiasInstabilityBeyondTheStatedIsMatchedByTheParityBl
   // χ²₁ and these runs' (0.5–13) never matched: sigma 0.8″ for errors of per-axis NEES 2.4–2.6 and 2.4 (runs
   // worse than their twins over 20 draws of the noise: charged). A filter whose model holds has white
   // innovations, so v_i enters the block's mean as v_i/n (docs/fdi.md, "A slow error below the detectors"):
-  // matched after 240 s, a noise_model event says so (its row parity_block_match rebuilds it), sigma honest
+  // matched after 180 s, a noise_model event says so (its row parity_block_match rebuilds it), sigma honest
   // over the run. Runs of the sweep (seed 3): noisy-unit #35, #263.
   for (const std::uint64_t index : {35u, 263u}) {
     const sim::PerturbedRun r = sim::perturbed_run(sim::Family::kNoisyUnit, 3, index);
