@@ -554,11 +554,6 @@ Eigen::Vector3d Mekf::attitude_sigma_rad() const {
   return P_.topLeftCorner<3, 3>().diagonal().cwiseMax(0.0).cwiseSqrt();
 }
 
-double Mekf::bias_rad_s(int id) const {
-  const int i = id - 1;
-  return bias_[i] + bias_[n_ + i];
-}
-
 double Mekf::bias_sigma_rad_s(int id) const {
   const int i = id - 1;
   const double v = P_(c_of(i), c_of(i)) + P_(g_of(i), g_of(i)) + 2.0 * P_(c_of(i), g_of(i));

@@ -129,7 +129,7 @@ class Mekf {
   //! [rad] 1σ of the attitude error per body axis.
   Eigen::Vector3d attitude_sigma_rad() const;
   //! [rad/s] gyro `id`'s bias estimate (c + g) and its 1σ.
-  double bias_rad_s(int id) const;
+  double bias_rad_s(int id) const { return bias_[id - 1] + bias_[n_ + id - 1]; }
   double bias_sigma_rad_s(int id) const;
   int gyro_count() const { return n_; }
   //! Gyro `id`'s noise as the filter models it (the calibration's, without anything added).

@@ -69,17 +69,23 @@ std::optional<BlockFinding> ParityBiasMatch::observe(std::int64_t now_ns, const 
   }
   if (block_start_ns_ < 0) block_start_ns_ = now_ns;
   const int n = static_cast<int>(sum_wnu_.size());
-  // ν = p − √T·W·(ĉ + ĝ): the parity the filter's bias estimates do not explain.
-  auto nu = innovation_.head(s.dof);
-  nu = p.head(s.dof);
+  // ν = p − √T·W·(ĉ + ĝ): the parity the filter's bias estimates do not explain (element by element, as
+  // the vector expression was; the columns are the parity matrix's own, d rows each).
+  const int d = s.dof;
+  double* nu = innovation_.data();
+  for (int r = 0; r < d; ++r) nu[r] = p[r];
   for (int i = 0; i < n; ++i) {
-    if (has_gyro(s.mask, i + 1)) nu -= s.parity.col(i).head(s.dof) * (sqrt_period * filter.bias_rad_s(i + 1));
+    if (!has_gyro(s.mask, i + 1)) continue;
+    const double* w = s.parity.col(i).data();
+    const double c = sqrt_period * filter.bias_rad_s(i + 1);
+    for (int r = 0; r < d; ++r) nu[r] -= w[r] * c;
   }
+  const Eigen::Map<const Eigen::VectorXd> innovation(nu, d);
   for (int i = 0; i < n; ++i) {
     if (!has_gyro(s.mask, i + 1)) continue;
     const auto k = static_cast<std::size_t>(i);
     const double a = sqrt_period * s.parity_col_norm[i];
-    sum_wnu_[k] += sqrt_period * s.parity.col(i).head(s.dof).dot(nu);
+    sum_wnu_[k] += sqrt_period * (d == 1 ? s.parity(0, i) * nu[0] : s.parity.col(i).head(d).dot(innovation));
     sum_w2_[k] += a * a;
   }
   ++block_epochs_;
