@@ -43,7 +43,8 @@ namespace tetra::fdi::detail {
 
 class Mekf;
 
-//! A match begun at this block: the gyro whose CUSUM crossed first.
+//! A match begun at this block: the gyro whose CUSUM is furthest beyond the threshold (with one parity row
+//! every gyro's u is the same, and the lowest id is named).
 struct BlockFinding {
   int gyro = 0;            //!< 1..N
   double statistic = 0.0;  //!< [-] its CUSUM g_i (a log-likelihood ratio)

@@ -197,11 +197,13 @@ double Pipeline::Impl::drift_threshold(GyroMask active) {
   // The bias block's mean so far may be matched as a drift only while the gyros vouch, and when a working
   // unit's drift could be that large: the λ its match would set (the Hdrift row's) at most
   // design::reference_max_wander_ratio.
-  drift_ratio_needed_ = gyros_vouch_
-                            ? drift_match_.next_ratio(ReferenceBiasMatch::needed_ratio(
-                                  consistency_.bias_mean_rad(), consistency_.bias_span_s(frame_.now_ns),
-                                  active, attitude_.filter()))
-                            : std::numeric_limits<double>::quiet_NaN();
+  drift_ratio_needed_ =
+      gyros_vouch_
+          ? drift_match_.next_ratio(ReferenceBiasMatch::needed_ratio(consistency_.bias_mean_rad(),
+                                                                     consistency_.bias_span_s(frame_.now_ns),
+                                                                     active, attitude_.filter()),
+                                    frame_.now_ns)
+          : std::numeric_limits<double>::quiet_NaN();
   const bool possible = gyros_vouch_ && drift_ratio_needed_ <= design::reference_max_wander_ratio;
   return possible ? drift_match_.threshold() : std::numeric_limits<double>::infinity();
 }
@@ -212,7 +214,7 @@ void Pipeline::Impl::match_drift_mean(const ReferenceVerdict& v, GyroMask active
   // the reference rejected only if its mean persists (docs/fdi.md, "A common drift below the detectors").
   // (A mean that grew beyond a working unit's drift with this very sample opens nothing and says nothing.)
   drift_match_.restart();
-  if (drift_match_.match_mean(v.bias_mean_rad, v.bias_span_s, active, attitude_.filter()))
+  if (drift_match_.match_mean(frame_.now_ns, v.bias_mean_rad, v.bias_span_s, active, attitude_.filter()))
     emit_drift_matched(consistency_.drift_check().statistic, consistency_.drift_check().threshold,
                        "the reference's mean innovation", &reference_rows_);
 }

@@ -20,6 +20,7 @@ void ReferenceBiasMatch::reset() {
   restart();
   matched_ = false;
   ratio_ = 1.0;
+  last_match_ns_ = -1;
 }
 
 void ReferenceBiasMatch::restart() {
@@ -42,7 +43,7 @@ std::optional<DriftFinding> ReferenceBiasMatch::observe(std::int64_t now_ns, con
   if (!(statistic > threshold_)) return std::nullopt;
   const Eigen::Vector3d mean_rad = swz_.cwiseQuotient(sw_);
   const double span_s = ns_to_seconds(now_ns - start_ns_);
-  if (!match_mean(mean_rad, span_s, active, filter)) return std::nullopt;
+  if (!match_mean(now_ns, mean_rad, span_s, active, filter)) return std::nullopt;
   restart();
   return DriftFinding{statistic, threshold_, ratio_};
 }
@@ -59,12 +60,13 @@ double ReferenceBiasMatch::needed_ratio(const Eigen::Vector3d& mean_rad, double 
   return smallest > 0.0 && std::isfinite(ratio) ? ratio : std::numeric_limits<double>::infinity();
 }
 
-bool ReferenceBiasMatch::match_mean(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
-                                    Mekf& filter) {
+bool ReferenceBiasMatch::match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s,
+                                    GyroMask active, Mekf& filter) {
   const double needed = needed_ratio(mean_rad, span_s, active, filter);
-  if (!may_explain(needed)) return false;
+  if (!may_explain(needed, now_ns)) return false;
   matched_ = true;
-  ratio_ = next_ratio(needed);
+  ratio_ = next_ratio(needed, now_ns);
+  last_match_ns_ = now_ns;
   open(active, filter);
   return true;
 }

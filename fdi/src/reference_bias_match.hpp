@@ -16,9 +16,10 @@
 // the model's own wander per second: a body-rate error b = 2·z̄/T grown within the window T is a random walk
 // of |b|²/T, and λ is at least ρ (design::block_match_ratio) times that over q_i — and at least ρ times its
 // last value, so a drift that goes on opens the model further at every match. A mean that persists, the model
-// opened, asks for ρ times more at each match: once the λ a match would set exceeds a working unit's wander
-// (design::reference_max_wander_ratio) the mean is the reference's, and its bias test rejects it as before.
-// The match is kept (the models only open) until a reset or an exclusion; each match is a noise_model event.
+// opened (a match within the long window of the last), asks for ρ times more at each match: once the λ a
+// match would set exceeds a working unit's wander (design::reference_max_wander_ratio) the mean is the
+// reference's, and its bias test rejects it as before. The match is kept (the models only open) until a reset
+// or an exclusion; each match is a noise_model event.
 
 #include <algorithm>
 #include <cstdint>
@@ -56,13 +57,20 @@ class ReferenceBiasMatch {
   //! The mean `mean_rad` [rad] over `span_s` [s] matched as a drift (the reference's bias block, or the long
   //! window): every active gyro's slow bias opened; false (nothing opened) when it may not be a drift of
   //! working gyros (may_explain).
-  bool match_mean(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active, Mekf& filter);
-  //! The λ a match of a mean that needs `needed` would set: at least ρ times the last match's.
-  double next_ratio(double needed) const { return std::max(needed, design::block_match_ratio * ratio_); }
+  bool match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
+                  Mekf& filter);
+  //! The λ a match at `now_ns` of a mean that needs `needed` would set: at least ρ times the last match's
+  //! while the mean persists (the last match within the long window), at least ρ once it has not.
+  double next_ratio(double needed, std::int64_t now_ns) const {
+    const bool persists = last_match_ns_ >= 0 && now_ns - last_match_ns_ <= long_window_ns_;
+    return std::max(needed, design::block_match_ratio * (persists ? ratio_ : 1.0));
+  }
   //! Whether a mean that needs `needed` may be matched as a drift of working gyros: the λ its match would
   //! set at most design::reference_max_wander_ratio (a mean that persists with the model opened asks for ρ
   //! times more at each match, and ends the reference's).
-  bool may_explain(double needed) const { return next_ratio(needed) <= design::reference_max_wander_ratio; }
+  bool may_explain(double needed, std::int64_t now_ns) const {
+    return next_ratio(needed, now_ns) <= design::reference_max_wander_ratio;
+  }
   //! λ·q_i ≥ ρ·|b|²/T: the ratio the mean `mean_rad` over `span_s` needs (+∞ without a span or a wander).
   static double needed_ratio(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
                              const Mekf& filter);
@@ -85,7 +93,8 @@ class ReferenceBiasMatch {
   Eigen::Vector3d sw_ = Eigen::Vector3d::Zero();   //!< [1/rad²] per axis Σ 1/S_aa
   Eigen::Vector3d swz_ = Eigen::Vector3d::Zero();  //!< [1/rad] per axis Σ z_a/S_aa
   bool matched_ = false;
-  double ratio_ = 1.0;  //!< λ
+  std::int64_t last_match_ns_ = -1;  //!< the last match (-1: none since the reset)
+  double ratio_ = 1.0;               //!< λ
 };
 
 }  // namespace tetra::fdi::detail

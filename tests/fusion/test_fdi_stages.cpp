@@ -346,12 +346,13 @@ TEST(ParityDetector, CusumDetectsAShiftInTheoryTimeAndRestarts) {
 
 TEST(ParityBiasMatch, WhiteParityNeverOpensTheBiasModelAndASlowErrorDoes) {
   // Four gyros (one parity row, so every gyro's column is along it). Two hours of white N(0, 1) parity — 240
-  // blocks of 30 s, each at the per-block false-alarm p·n·|S| = 1e-9·300·4 — leave every gyro's bias model
+  // blocks of 30 s, each at the per-block false-alarm p·n·|S| = 1e-6·300·4 — leave every gyro's bias model
   // as it is. Then a slow error on gyro 1, 5.7e-5 deg/s in amplitude with a 126-s period (the +2.8 % scale
   // change seen through the attitude control's wobble, docs/fdi.md "A slow error below the detectors"), a
   // quarter of the CUSUM's 2e-4 deg/s: matched within its 600 s (here after 60 s: a block's mean is at most
   // 0.64 of the amplitude A, its white noise σ_f = 1/√(n·a²) = 0.21·A, and the filter's prior bias
-  // uncertainty v enters as v/n, so u reaches ≈ 9 and two blocks pass ln(1/(p·n·|S|)) = 14.3), after which
+  // uncertainty v enters as v/n, so u reaches ≈ 9–12, a CUSUM step of ½(¾u − ln 4) ≈ 2.7–3.8, and two blocks
+  // pass ln(1/(p·n·|S|)) = 6.7), after which
   // every gyro's slow bias carries an excess of the error's order: the largest block's f̂² − σ_f², at most
   // (0.64·A + 3σ_f)² ≈ 1.6·A² over the 20 blocks, below 2·A².
   Fixture f;

@@ -75,16 +75,23 @@ TEST(ReferenceBiasMatch, AWarmUpsMeanMatchesAndOpensEveryActiveGyro) {
   for (int id = 1; id <= 3; ++id) EXPECT_GT(f.added_rate_random_walk(id), 0.0) << id;
   EXPECT_EQ(f.added_rate_random_walk(4), 0.0);  // not active: left alone
   EXPECT_TRUE(m.matched());
-  // A mean that goes on asks for ρ times more at each match, whatever it needs itself...
-  EXPECT_DOUBLE_EQ(m.next_ratio(0.0), design::block_match_ratio * found->ratio);
-  // ...so one the model opened does not explain ends the reference's within log_ρ(1e4) ≈ 6.6 matches.
+  // A mean that goes on (within the long window, 480 s) asks for ρ times more at each match, whatever it
+  // needs itself...
+  const std::int64_t now = (at + 60) * kSecond_ns;
+  EXPECT_DOUBLE_EQ(m.next_ratio(0.0, now), design::block_match_ratio * found->ratio);
+  // ...so one the model opened does not explain ends the reference's within log_ρ(1e4) ≈ 6.6 matches...
   const Eigen::Vector3d persisting = Eigen::Vector3d::Constant(0.3 * kSigma_rad);
   int matches = 0;
-  while (m.match_mean(persisting, 120.0, 0b0111, f)) ++matches;
+  while (m.match_mean(now + matches * kSecond_ns, persisting, 120.0, 0b0111, f)) ++matches;
   EXPECT_GE(matches, 1);
   EXPECT_LE(matches, 7);
   EXPECT_LE(m.ratio(), design::reference_max_wander_ratio);
-  EXPECT_FALSE(m.may_explain(0.0));
+  EXPECT_FALSE(m.may_explain(0.0, now + matches * kSecond_ns));
+  // ...while a drift that comes back after a long window without a match (the next thermal transient of an
+  // orbit) is matched afresh, from ρ.
+  const std::int64_t later = now + (matches + 481) * kSecond_ns;
+  EXPECT_DOUBLE_EQ(m.next_ratio(0.0, later), design::block_match_ratio);
+  EXPECT_TRUE(m.match_mean(later, persisting, 120.0, 0b0111, f));
 }
 
 TEST(ReferenceBiasMatch, AMeanOnlyTheReferenceCouldMakeIsNotADrift) {

@@ -5,10 +5,13 @@
 // would send it, then every dataset's shape, type, layout, filters and chunks checked and the rows read. The
 // child's own work (the attributes: libhdf5 faults there are what it isolates) is not fuzzed in process;
 // HostileH5.* and the regress_* inputs cover it.
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstddef>
@@ -53,14 +56,14 @@ namespace {
 // input it survives is read below, instrumented.
 class OpeningHelper {
  public:
-  //! Whether opening `image` with `header` ends the helper by a signal (it is started again next time).
+  //! Whether opening `image` with `header` ends the helper by one of the faults the checking child meets (a
+  //! fatal signal, or its alarm: a hang); it is started again next time.
   bool faults(std::span<const std::uint8_t> image, const tetra::GyroLogH5Header& header) {
     if (pid_ < 0 && !start()) return false;
     const std::uint64_t size = image.size();
     const auto info = static_cast<std::uint8_t>(header.gyro_count | (header.units_dps ? 0x80 : 0));
     char ack = 0;
-    if (put(&size, sizeof size) && put(&info, 1) && put(image.data(), image.size()) &&
-        ::read(from_, &ack, 1) == 1)
+    if (put(&size, sizeof size) && put(&info, 1) && put(image.data(), image.size()) && get(from_, &ack, 1))
       return false;
     int status = 0;
     ::close(to_);
@@ -68,15 +71,17 @@ class OpeningHelper {
     while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
     }
     pid_ = -1;
-    return WIFSIGNALED(status);
+    if (!WIFSIGNALED(status)) return false;
+    const int sig = WTERMSIG(status);
+    return std::find(kFaults.begin(), kFaults.end(), sig) != kFaults.end() || sig == SIGALRM;
   }
 
  private:
   bool start() {
     int in[2];
     int out[2];
-    if (::pipe(in) != 0) return false;
-    if (::pipe(out) != 0) {
+    if (::pipe2(in, O_CLOEXEC) != 0) return false;
+    if (::pipe2(out, O_CLOEXEC) != 0) {
       ::close(in[0]);
       ::close(in[1]);
       return false;
@@ -100,7 +105,8 @@ class OpeningHelper {
     return true;
   }
   [[noreturn]] static void serve(int from, int to) {
-    for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL}) ::signal(sig, SIG_DFL);
+    for (const int sig : kFaults) ::signal(sig, SIG_DFL);
+    ::signal(SIGALRM, SIG_DFL);  // not libFuzzer's timeout handler: a hang ends the helper
     std::vector<std::uint8_t> image;
     for (;;) {
       std::uint64_t size = 0;
@@ -111,7 +117,10 @@ class OpeningHelper {
       tetra::GyroLogH5Header header;
       header.gyro_count = info & 0x7f;
       header.units_dps = (info & 0x80) != 0;
+      ::alarm(
+          kHelperSeconds);  // below libFuzzer's -timeout: a libhdf5 hang is the helper's, not the fuzzer's
       (void)tetra::open_gyro_log_h5_image(image, "fuzz.h5", header);
+      ::alarm(0);
       const char ack = 1;
       if (::write(to, &ack, 1) != 1) ::_exit(0);
     }
@@ -138,6 +147,10 @@ class OpeningHelper {
     }
     return true;
   }
+
+  //! The signals the checking child dies by when libhdf5 faults (gyro_log_h5_probe.cpp resets the same).
+  static constexpr std::array<int, 5> kFaults = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
+  static constexpr unsigned kHelperSeconds = 5;  //!< [s] longest one opening may take in the helper
 
   pid_t pid_ = -1;
   int to_ = -1;    //!< the helper's input
