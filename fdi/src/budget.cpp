@@ -140,10 +140,10 @@ std::string to_text(const Budget& b) {
                             ? "/h"
                         : r.kind == BudgetKind::kWrongExclusion ? "/episode"
                                                                 : "/sample";
-      std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %9.3g x %-9.4g = %9.3g %s  (%s)\n", r.source,
+      std::snprintf(line, sizeof line, "  %-18s %-18s %-40s %9.3g x %-9.4g = %9.3g %s  (%s)\n", r.source,
                     kind, r.key, r.per_evaluation, r.evaluations, r.total(), per, r.note);
     } else {
-      std::snprintf(line, sizeof line, "  %-16s %-18s %-40s %s\n", r.source, kind, "-", r.note);
+      std::snprintf(line, sizeof line, "  %-18s %-18s %-40s %s\n", r.source, kind, "-", r.note);
     }
     out += line;
   }
