@@ -74,10 +74,6 @@ class ReferenceBiasMatch {
   //! λ·q_i ≥ ρ·|b|²/T: the ratio the mean `mean_rad` over `span_s` needs (+∞ without a span or a wander).
   static double needed_ratio(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active,
                              const Mekf& filter);
-  //! Whether that mean may be a drift of working gyros: its ratio at most design::reference_max_wander_ratio.
-  static bool plausible(const Eigen::Vector3d& mean_rad, double span_s, GyroMask active, const Mekf& filter) {
-    return needed_ratio(mean_rad, span_s, active, filter) <= design::reference_max_wander_ratio;
-  }
   double threshold() const { return threshold_; }  //!< χ²₃(1 − p_m)
   bool matched() const { return matched_; }
   double ratio() const { return ratio_; }

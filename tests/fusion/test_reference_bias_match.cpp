@@ -100,11 +100,15 @@ TEST(ReferenceBiasMatch, AMeanOnlyTheReferenceCouldMakeIsNotADrift) {
   const Mekf f = seed_like_filter();
   const Eigen::Vector3d mean = Eigen::Vector3d::Constant(30.0 * kArcsecToRad / std::sqrt(3.0));
   EXPECT_GT(ReferenceBiasMatch::needed_ratio(mean, 10.0, 0b1111, f), design::reference_max_wander_ratio);
-  EXPECT_FALSE(ReferenceBiasMatch::plausible(mean, 10.0, 0b1111, f));
+  EXPECT_FALSE(ReferenceBiasMatch(PipelineConfig{})
+                   .may_explain(ReferenceBiasMatch::needed_ratio(mean, 10.0, 0b1111, f), 0));
   // 2″ over 100 s: plausible.
   const Eigen::Vector3d small = Eigen::Vector3d::Constant(2.0 * kArcsecToRad / std::sqrt(3.0));
-  EXPECT_TRUE(ReferenceBiasMatch::plausible(small, 100.0, 0b1111, f));
-  EXPECT_FALSE(ReferenceBiasMatch::plausible(small, 0.0, 0b1111, f));  // no span: nothing to match
+  EXPECT_TRUE(ReferenceBiasMatch(PipelineConfig{})
+                  .may_explain(ReferenceBiasMatch::needed_ratio(small, 100.0, 0b1111, f), 0));
+  EXPECT_FALSE(ReferenceBiasMatch(PipelineConfig{})
+                   .may_explain(ReferenceBiasMatch::needed_ratio(small, 0.0, 0b1111, f),
+                                0));  // no span: nothing to match
 }
 
 }  // namespace

@@ -125,27 +125,26 @@ class OpeningHelper {
       if (::write(to, &ack, 1) != 1) ::_exit(0);
     }
   }
-  static bool get(int fd, void* data, std::size_t n) {
-    auto* p = static_cast<char*>(data);
-    while (n > 0) {
-      const ssize_t got = ::read(fd, p, n);
-      if (got < 0 && errno == EINTR) continue;
-      if (got <= 0) return false;
-      p += got;
-      n -= static_cast<std::size_t>(got);
+  //! `n` bytes through `io` (read or write, retried on EINTR): false at an end or an error.
+  template <typename Io>
+  static bool whole(Io io, std::size_t n) {
+    std::size_t done = 0;
+    while (done < n) {
+      const ssize_t moved = io(done, n - done);
+      if (moved < 0 && errno == EINTR) continue;
+      if (moved <= 0) return false;
+      done += static_cast<std::size_t>(moved);
     }
     return true;
   }
+  static bool get(int fd, void* data, std::size_t n) {
+    return whole(
+        [&](std::size_t at, std::size_t left) { return ::read(fd, static_cast<char*>(data) + at, left); }, n);
+  }
   bool put(const void* data, std::size_t n) const {
-    const auto* p = static_cast<const char*>(data);
-    while (n > 0) {
-      const ssize_t done = ::write(to_, p, n);
-      if (done < 0 && errno == EINTR) continue;
-      if (done <= 0) return false;
-      p += done;
-      n -= static_cast<std::size_t>(done);
-    }
-    return true;
+    return whole([&](std::size_t at,
+                     std::size_t left) { return ::write(to_, static_cast<const char*>(data) + at, left); },
+                 n);
   }
 
   //! The signals the checking child dies by when libhdf5 faults (gyro_log_h5_probe.cpp resets the same).
