@@ -3,6 +3,7 @@
 #include "tetra/core/allan.hpp"
 
 #include "allan_internal.hpp"
+#include "tetra/core/units.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -15,8 +16,6 @@
 namespace tetra::allan {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Work limit of --taus all: samples × averaging times (≈ 1 ns each).
 constexpr double kAllTauWorkLimit = 4e9;

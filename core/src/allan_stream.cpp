@@ -21,12 +21,11 @@
 #include "tetra/core/allan.hpp"
 #include "tetra/core/gyro_log.hpp"
 #include "tetra/core/gyro_log_prefetch.hpp"
+#include "tetra/core/units.hpp"
 
 namespace tetra::allan {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A fixed-size array in its own anonymous mapping; pages are committed as they are written.
 template <class T>
@@ -96,7 +95,7 @@ class ChunkedColumn {
 };
 
 // What the reading pass keeps.
-struct Columns {
+struct StreamColumns {
   GyroLog header;
   ChunkedColumn time_s;
   std::vector<std::pair<std::size_t, std::size_t>> line_breaks;  // (row, line) where line != previous + 1
@@ -118,7 +117,8 @@ Error out_of_memory(const std::string& source) {
 }
 
 // Reads the log once, keeping the times and each wanted gyro's rate (calibrated when asked).
-Status read_columns(GyroLogPrefetcher& reader, const LogAllanOptions& options, bool calibrate, Columns& c) {
+Status read_columns(GyroLogPrefetcher& reader, const LogAllanOptions& options, bool calibrate,
+                    StreamColumns& c) {
   const auto ng = static_cast<std::size_t>(c.header.gyro_count);
   c.rate.resize(c.ids.size());
   c.invalid.assign(c.ids.size(), 0);
@@ -222,7 +222,7 @@ Result<AllanResult> analyse_column(ChunkedColumn& column, const SamplingGrid& gr
 Result<LogAllan> analyze_gyro_log_file(const std::string& path, const LogAllanOptions& options) {
   auto reader = GyroLogReader::open(path);
   if (!reader) return reader.error();
-  Columns c;
+  StreamColumns c;
   c.header = (*reader)->header();
   const GyroLog& log = c.header;
   const bool calibrate = !log.units_dps && options.calibration != nullptr;

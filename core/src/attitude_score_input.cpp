@@ -35,7 +35,7 @@ Result<double> sigma_cell(const CsvTable& t, std::size_t row, std::size_t col) {
   return v;
 }
 
-struct Columns {
+struct ScoreColumns {
   std::size_t time = 0;
   std::array<std::size_t, 4> q{};
   std::array<std::size_t, 3> rate{};
@@ -43,8 +43,8 @@ struct Columns {
   std::optional<std::array<std::size_t, 3>> sigma_axis;
 };
 
-Result<Columns> find_columns(const CsvTable& t, bool with_sigma) {
-  Columns c;
+Result<ScoreColumns> find_columns(const CsvTable& t, bool with_sigma) {
+  ScoreColumns c;
   const char* q_names[4] = {"qw", "qx", "qy", "qz"};
   const char* rate_names[3] = {"wx_dps", "wy_dps", "wz_dps"};
   auto time = require_column(t, "time_s");
@@ -71,7 +71,7 @@ Result<Columns> find_columns(const CsvTable& t, bool with_sigma) {
   return c;
 }
 
-Status read_row(const CsvTable& t, const Columns& c, std::size_t r, AttitudeSeries& s) {
+Status read_row(const CsvTable& t, const ScoreColumns& c, std::size_t r, AttitudeSeries& s) {
   auto time = finite_cell(t, r, c.time);
   if (!time) return time.error();
   if (!s.time_s.empty() && !(*time > s.time_s.back())) {

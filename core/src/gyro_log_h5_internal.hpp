@@ -13,6 +13,7 @@
 
 #include "gyro_log_h5.hpp"
 #include "tetra/core/result.hpp"
+#include "tetra/core/units.hpp"
 
 namespace tetra::h5io {
 
@@ -23,7 +24,6 @@ constexpr hsize_t kChunkRows = 65536;  // rows per chunk, and per block written
 constexpr hsize_t kBlockRows = kChunkRows / 2;
 constexpr unsigned kDeflateLevel = 1;  // with compression: the noise in gyro values barely compresses anyway
 constexpr std::array<const char*, 4> kRefNames = {"ref_qw", "ref_qx", "ref_qy", "ref_qz"};
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::size_t kMaxAttributeBytes = std::size_t{16} << 20;  // [bytes] one string attribute read
 
 using H5Header = GyroLogH5Header;

@@ -121,10 +121,10 @@ Result<TdmsChannelMap> parse_tdms_channel_map(const std::string& text, const std
 
 namespace {
 
-using Columns = std::vector<std::pair<std::string, const TdmsChannel*>>;
+using ChannelColumns = std::vector<std::pair<std::string, const TdmsChannel*>>;
 
 // The table without its cells: metadata, comments, columns and row count.
-CsvTable table_header(const TdmsFile& file, const TdmsChannelMap& map, const Columns& cols) {
+CsvTable table_header(const TdmsFile& file, const TdmsChannelMap& map, const ChannelColumns& cols) {
   CsvTable t;
   t.source = file.source;
   for (const auto& [name, value] : file.properties) {
@@ -199,7 +199,7 @@ Status allocate_cells(CsvTable& t, TdmsCells cells) try {
 }
 
 // A second pass over the file that decodes the columns' values straight into the table's cells.
-Status fill_cells(tdms_detail::Source& src, const TdmsFile& file, const Columns& cols, CsvTable& t) {
+Status fill_cells(tdms_detail::Source& src, const TdmsFile& file, const ChannelColumns& cols, CsvTable& t) {
   if (t.cells.empty()) return ok_status();  // no rows: nothing to decode
   tdms_detail::Fill fill;
   fill.column.assign(file.channels.size(), nullptr);

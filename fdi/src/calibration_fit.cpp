@@ -13,7 +13,6 @@
 namespace tetra::fdi::detail {
 
 namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 //! Eigenvalues of S below this share of the largest carry no information (a rate never varied about them).
 constexpr double kRankTolerance = 1e-12;
 }  // namespace

@@ -10,7 +10,6 @@
 namespace tetra::fdi::detail {
 
 namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kNoiseExpectedMedian = 0.6744897501960817;  //!< median of |N(0,1)|
 constexpr double kInf = std::numeric_limits<double>::infinity();
 //! [-] relative margin of the counting decision on the noise ratio: far above the few ulps of rounding in

@@ -31,7 +31,7 @@ std::string duration_text(double s) {
 }
 
 //! "tetra campaign: 120/520 runs (1 error), 31.2 runs/s, 4 s elapsed, about 13 s left".
-void print_progress(const campaign::Progress& p) {
+void print_campaign_progress(const campaign::Progress& p) {
   const std::size_t done = p.done_before + p.done_now;
   const double eta = p.eta_s();
   const bool all_in = done >= p.total;
@@ -104,7 +104,7 @@ Result<sim::CampaignSpec> campaign_setup(const CampaignArgs& a, campaign::RunOpt
     };
   }
   options.spec_path = a.spec_path;
-  options.on_progress = print_progress;
+  options.on_progress = print_campaign_progress;
   return spec;
 }
 

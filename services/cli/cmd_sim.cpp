@@ -24,7 +24,7 @@ namespace {
 
 constexpr const char* kSimName = "sim";
 
-void print_progress(double fraction) {
+void print_sim_progress(double fraction) {
   std::cerr << "tetra sim: " << std::lround(fraction * 100.0) << " %\n";
 }
 
@@ -172,7 +172,7 @@ void complete_run_options(SimArgs& a) {
     if (a.turntable_only[k]->count()) r.plan_given.emplace_back(plan_arguments[k]);
   }
   r.closed_loop = a.loop.enabled;
-  r.progress = print_progress;
+  r.progress = print_sim_progress;
   r.names.insert({{"command", "tetra sim"},
                   {"unit_path", "--unit"},
                   {"scenario", "SCENARIO"},

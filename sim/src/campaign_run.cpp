@@ -5,6 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "tetra/core/units.hpp"
 #include "tetra/sim/campaign.hpp"
 #include "tetra/sim/closed_loop_run.hpp"
 #include "tetra/sim/open_loop_run.hpp"
@@ -13,8 +14,6 @@
 namespace tetra::sim {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 //! The columns that describe the case.
 CampaignRow case_columns(const CampaignSpec& spec, const CampaignCase& c) {

@@ -10,7 +10,6 @@ namespace tetra::sim {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kRadPerSecToRpm = 60.0 / (2.0 * kPi);
 
 AttitudeKnowledge knowledge_of(const fdi::AttitudeEstimate& e) {

@@ -13,7 +13,7 @@ namespace tetra::sim {
 
 namespace {
 
-constexpr std::pair<FaultKind, std::string_view> kKinds[] = {
+constexpr std::pair<FaultKind, std::string_view> kFaultKindNames[] = {
     {FaultKind::kBias, "bias"},   {FaultKind::kRamp, "ramp"},       {FaultKind::kScale, "scale"},
     {FaultKind::kStuck, "stuck"}, {FaultKind::kZero, "zero"},       {FaultKind::kNoise, "noise"},
     {FaultKind::kSpike, "spike"}, {FaultKind::kDropout, "dropout"}, {FaultKind::kInvalid, "invalid"}};
@@ -34,14 +34,14 @@ bool kind_takes_size(FaultKind kind) {
 }
 
 std::optional<FaultKind> fault_kind_from_name(std::string_view name) {
-  for (const auto& [k, text] : kKinds) {
+  for (const auto& [k, text] : kFaultKindNames) {
     if (text == name) return k;
   }
   return std::nullopt;
 }
 
 std::string_view fault_kind_name(FaultKind kind) {
-  for (const auto& [k, name] : kKinds) {
+  for (const auto& [k, name] : kFaultKindNames) {
     if (k == kind) return name;
   }
   return "unknown";

@@ -131,9 +131,9 @@ PerturbedRun fault_in_slew(Rng& rng, std::uint64_t index) {
   const double at = kSlewStart_s + 0.5 * when * slew.duration_s;
   r.options.faults = {slew_fault(rng, kind, 1 + pick(rng, n), at)};
   r.max_angular_acceleration_dps2 = rng.uniform() < 0.5 ? 2e-4 : 1e-3;
-  static constexpr std::array<const char*, 7> kKinds = {
+  static constexpr std::array<const char*, 7> kSlewCaseNames = {
       "stuck", "zero", "bias 1e-2..3e-2", "bias 1e-3..3e-3", "noise", "ramp", "scale"};
-  r.case_name = std::string(kKinds[static_cast<std::size_t>(kind)]) + " at the " +
+  r.case_name = std::string(kSlewCaseNames[static_cast<std::size_t>(kind)]) + " at the " +
                 kWhen[static_cast<std::size_t>(when)];
   r.label = "N=" + std::to_string(n) + " " + fault_text(r.options.faults[0]) + " at the " +
             kWhen[static_cast<std::size_t>(when)] + " of " + slew_text(slew) + (reference ? " ref" : "");
@@ -311,9 +311,9 @@ PerturbedRun second_fault(Rng& rng, std::uint64_t index) {
       break;
     }
   }
-  static constexpr std::array<const char*, 4> kKinds = {"bias 3e-4..1e-3", "ramp 1e-6..1e-5", "noise x5..x10",
-                                                        "two biases cancelling in the parity"};
-  r.case_name = kKinds[static_cast<std::size_t>(kind)];
+  static constexpr std::array<const char*, 4> kEdgeCaseNames = {
+      "bias 3e-4..1e-3", "ramp 1e-6..1e-5", "noise x5..x10", "two biases cancelling in the parity"};
+  r.case_name = kEdgeCaseNames[static_cast<std::size_t>(kind)];
   r.label = std::string(kind == 3 ? "N=4, two biases cancelling in the parity:" : "N=3:");
   for (const auto& f : r.options.faults) r.label += " " + fault_text(f);
   r.label += " ref, orbit";

@@ -13,20 +13,20 @@ namespace tetra::report {
 
 namespace {
 
-using nlohmann::json;
+using Json = nlohmann::json;
 
 Result<RecordedCommand> parse_line(const std::string& line, const std::string& where) {
   // A key given twice is refused (JSON leaves its meaning open; the parser would keep the last).
   std::set<std::string> keys;
   std::string repeated;
-  const json::parser_callback_t note_keys = [&](int depth, json::parse_event_t event, json& parsed) {
-    if (event == json::parse_event_t::key && depth == 1 && parsed.is_string() &&
+  const Json::parser_callback_t note_keys = [&](int depth, Json::parse_event_t event, Json& parsed) {
+    if (event == Json::parse_event_t::key && depth == 1 && parsed.is_string() &&
         !keys.insert(parsed.get<std::string>()).second && repeated.empty()) {
       repeated = parsed.get<std::string>();
     }
     return true;
   };
-  const json j = json::parse(line, note_keys, false);
+  const Json j = Json::parse(line, note_keys, false);
   if (j.is_discarded() || !j.is_object()) return bad_input(where + ": not a JSON object");
   if (!repeated.empty()) return bad_input(where + ": field '" + repeated + "' appears twice");
   RecordedCommand c;
@@ -42,7 +42,7 @@ Result<RecordedCommand> parse_line(const std::string& line, const std::string& w
     return bad_input(where + ": field 'command' must be reset, exclude or reinstate");
   if (c.action != "reset") {
     if (!j.contains("gyro")) return bad_input(where + ": field 'gyro' missing");
-    const json& gyro = j["gyro"];
+    const Json& gyro = j["gyro"];
     if (!gyro.is_number_integer()) {
       return bad_input(where + ": field 'gyro' must be a whole number (a gyro id 1..64), not " + gyro.dump());
     }

@@ -3,11 +3,13 @@
 // files and the command line use degrees, deg/s, volts and seconds (docs/interfaces.md §1).
 
 #include <cstdint>
+#include <limits>
 #include <numbers>
 
 namespace tetra {
 
 inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();  //!< "no value"
 inline constexpr double kDegToRad = kPi / 180.0;
 inline constexpr double kRadToDeg = 180.0 / kPi;
 inline constexpr double kArcsecToRad = kDegToRad / 3600.0;
