@@ -48,7 +48,7 @@ int cmd_demo(int argc, char** argv) {
   dds::ShutdownSignal shutdown;
   CLI::App app{
       "Simulator + fusion service + monitor on a private loopback DDS domain, with a gyro failure "
-      "injected mid-run, and a summary. Takes about 10 s (--seconds / --speed).",
+      "injected mid-run, and a summary. Takes about 5 s (--seconds / --speed; --speed 1 to watch it live).",
       "demo"};
   DemoOptions o;
   o.domain = static_cast<dds_domainid_t>(150 + getpid() % 80);  // private to this run

@@ -23,7 +23,7 @@ struct DemoOptions {
   std::string fault_text = "gyro=2,kind=stuck,at=15";  //!< the injected failure, as given (printed)
   double seconds = 40.0;                               //!< [s] simulated duration
   double rate_hz = 50.0;                               //!< [Hz] gyro rate
-  double speed = 4.0;                                  //!< times faster than real time
+  double speed = 8.0;                                  //!< times faster than real time (1: watch it live)
   std::uint64_t seed = 1;                              //!< simulation seed
   std::string keep_dir;                                //!< keep the service's files here (empty: removed)
   bool web = false;                                    //!< also run the ground station
