@@ -215,24 +215,24 @@ Status OutputFile::write(std::string_view data) {
 // that waiting for a window reports is returned here: the kernel reports it once, to this wait, and a
 // later fsync would not see it again (the run then fails and the output is not committed).
 Status OutputFile::write_behind() {
-  constexpr off_t kWindowBytes = off_t{8} << 20;
-  while (write_behind_ && written_bytes_ - queued_bytes_ >= kWindowBytes) {
-    if (::sync_file_range(fd_, queued_bytes_, kWindowBytes, SYNC_FILE_RANGE_WRITE) != 0) {
+  constexpr off_t kWriteBehindBytes = off_t{8} << 20;
+  while (write_behind_ && written_bytes_ - queued_bytes_ >= kWriteBehindBytes) {
+    if (::sync_file_range(fd_, queued_bytes_, kWriteBehindBytes, SYNC_FILE_RANGE_WRITE) != 0) {
       if (errno != EINVAL && errno != ESPIPE && errno != ENOSYS)
         return failure(path_ + ": cannot write: " + errno_text());
       write_behind_ = false;  // a file system without it: the file is written as any other
       break;
     }
-    if (queued_bytes_ >= kWindowBytes) {
-      const off_t previous = queued_bytes_ - kWindowBytes;
+    if (queued_bytes_ >= kWriteBehindBytes) {
+      const off_t previous = queued_bytes_ - kWriteBehindBytes;
       if (::sync_file_range(
-              fd_, previous, kWindowBytes,
+              fd_, previous, kWriteBehindBytes,
               SYNC_FILE_RANGE_WAIT_BEFORE | SYNC_FILE_RANGE_WRITE | SYNC_FILE_RANGE_WAIT_AFTER) != 0)
         return failure(path_ + ": cannot write: " + errno_text());
-      ::posix_fadvise(fd_, previous, kWindowBytes,
+      ::posix_fadvise(fd_, previous, kWriteBehindBytes,
                       POSIX_FADV_DONTNEED);  // advice only: its result changes nothing
     }
-    queued_bytes_ += kWindowBytes;
+    queued_bytes_ += kWriteBehindBytes;
   }
   return ok_status();
 }
