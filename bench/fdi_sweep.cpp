@@ -58,7 +58,8 @@ struct RunOutcome {
   int reference_rejections = 0;  //!< reference_rejected events (--reference 1)
   std::array<int, 7> by_test{};  //!< detections per DetectionTest
   double first_detected_s = -1.0;
-  int noise_model = 0;  //!< noise_model events (the data showed the noise optimistic)
+  int noise_model = 0;                     //!< noise_model events (the data showed the noise optimistic)
+  std::vector<std::string> detected_json;  //!< --events 1: each detected event, with its ledger rows
 };
 
 //! One simulated run of `duration_s` straight into a pipeline; counts `detected` events.
@@ -68,7 +69,8 @@ double g_quantization_deg = 0.0;  // --quantization; set once by main
 double g_rrw_dps_rts = 0.0;       // --rate-random-walk; set once by main
 double g_ramp_dps_s = 0.0;        // --rate-ramp; set once by main
 bool g_reference =
-    false;  // --reference 1: the orbit's 1 Hz, 5″ reference into the pipeline; set once by main
+    false;              // --reference 1: the orbit's 1 Hz, 5″ reference into the pipeline; set once by main
+bool g_events = false;  // --events 1: each false alarm's event printed; set once by main
 
 //! The unit of the sweep with n gyros: --unit's (its own N), else the seed's as-built unit cut or extended,
 //! with --quantization's angle quantization on every gyro.
@@ -122,6 +124,7 @@ RunOutcome run(int n, double duration_s, std::uint64_t seed, const std::vector<s
       if (ev.type != fdi::EventType::kDetected) continue;
       ++out.detections;
       ++out.by_test[static_cast<std::size_t>(ev.test)];
+      if (g_events) out.detected_json.push_back(fdi::to_json(ev, n));
       out.own_level += ev.detail.find("own noise level") != std::string::npos ? 1 : 0;
       if (out.first_detected_s < 0.0) out.first_detected_s = ns_to_seconds(ev.stamp_ns);
     }
@@ -198,6 +201,7 @@ void false_alarm_sweep(int n, int hours, int run_hours, int jobs) {
   std::vector<std::array<int, 7>> by_test(static_cast<std::size_t>(runs));
   std::vector<double> first_s(static_cast<std::size_t>(runs), -1.0);
   std::vector<int> noise_models(static_cast<std::size_t>(runs), 0);
+  std::vector<std::vector<std::string>> events(static_cast<std::size_t>(runs));
   parallel(runs, jobs, [&](int i) {
     const RunOutcome o = run(n, 3600.0 * run_hours,
                              1000003ULL * static_cast<std::uint64_t>(n) + static_cast<std::uint64_t>(i), {});
@@ -206,6 +210,7 @@ void false_alarm_sweep(int n, int hours, int run_hours, int jobs) {
     by_test[static_cast<std::size_t>(i)] = o.by_test;
     first_s[static_cast<std::size_t>(i)] = o.first_detected_s;
     noise_models[static_cast<std::size_t>(i)] = o.noise_model;
+    events[static_cast<std::size_t>(i)] = o.detected_json;
   });
   int total = 0;
   int runs_with = 0;
@@ -233,6 +238,8 @@ void false_alarm_sweep(int n, int hours, int run_hours, int jobs) {
       if (f >= 0.0) std::printf(" %.2f", f / 3600.0);
     std::printf("\n");
   }
+  for (std::size_t i = 0; i < events.size(); ++i)
+    for (const std::string& json : events[i]) std::printf("N=%d  run %zu: %s\n", n, i, json.c_str());
   int widened = 0;
   for (int w : noise_models) widened += w;
   if (widened > 0) std::printf("N=%d  noise_model events: %d\n", n, widened);
@@ -319,6 +326,7 @@ int main(int argc, char** argv) {
   int jobs = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   int delay_seeds = 10;
   int three_gyro_hours = 0;
+  int only_n = 0;  // --gyros: one N of the default unit
   int run_hours = 1;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
@@ -338,7 +346,9 @@ int main(int argc, char** argv) {
           "gyro\n"
           "          of the default unit (the ramp +R on each).\n"
           "  --run-hours L: H/L runs of L hours each (default 1).\n"
-          "  --reference 1: feed the orbit's 1 Hz, 5\" reference too and count reference rejections.\n");
+          "  --reference 1: feed the orbit's 1 Hz, 5\" reference too and count reference rejections.\n"
+          "  --events 1: print each false alarm's detected event with its ledger rows (JSON).\n"
+          "  --gyros N: the default unit with N gyros only (4, 5 or 6).\n");
       return 0;
     }
     if (a + 1 >= argc) {
@@ -388,6 +398,14 @@ int main(int argc, char** argv) {
       delay_seeds = value;
     } else if (arg == "--reference") {
       g_reference = value != 0;
+    } else if (arg == "--events") {
+      g_events = value != 0;
+    } else if (arg == "--gyros") {
+      if (value < 4 || value > 6) {
+        std::fprintf(stderr, "fdi_sweep: option --gyros must be 4, 5 or 6\n");
+        return 2;
+      }
+      only_n = value;
     } else if (arg == "--run-hours") {
       run_hours = std::max(1, value);
     } else if (arg == "--three-gyro-hours") {
@@ -397,8 +415,8 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  const int n_first = g_unit ? g_unit->gyro_count() : 4;
-  const int n_last = g_unit ? g_unit->gyro_count() : 6;
+  const int n_first = g_unit ? g_unit->gyro_count() : only_n > 0 ? only_n : 4;
+  const int n_last = g_unit ? g_unit->gyro_count() : only_n > 0 ? only_n : 6;
   for (int n = n_first; n <= n_last && hours > 0; ++n) false_alarm_sweep(n, hours, run_hours, jobs);
   if (three_gyro_hours > 0) three_gyro_sweep(three_gyro_hours, jobs);
   if (delay_seeds > 0) {
