@@ -6,7 +6,6 @@
 #include <hdf5.h>
 
 #include <array>
-#include <limits>
 #include <optional>
 #include <string>
 #include <vector>

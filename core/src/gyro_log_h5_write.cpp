@@ -13,7 +13,6 @@ using h5io::init_hdf5;
 using h5io::kChunkRows;
 using h5io::kDeflateLevel;
 using h5io::kFormat;
-
 using h5io::kRefNames;
 using h5io::kVersion;
 using h5io::write_int_attribute;
