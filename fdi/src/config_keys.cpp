@@ -163,6 +163,8 @@ constexpr DesignConstant kConstants[] = {
     {"reference_noise_max_factor", design::reference_noise_max_factor, "-",
      "a reference rejected for nis alone is used again with its re-estimated noise up to this times "
      "reference_sigma_arcsec"},
+    {"reference_step_samples", design::reference_step_samples, "samples",
+     "the reference step test's window: the onsets it searches, its threshold at p over this many"},
     // --- the noise model checked against the parity's spread
     {"spread_block_s", design::spread_block_s, "s",
      "blocks of the long-run spread (second differences of their parity sums)"},

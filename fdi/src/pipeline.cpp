@@ -345,7 +345,10 @@ void Pipeline::Impl::publish_attitude() {
   if (frame_.reference_q_RB && !reference_usable_) ++health_.counters.reference_rejected;
   if (frame_.reference_q_RB && reference_usable_) {
     // Never set the attitude onto a reference that disagrees with gyros that vouch for theirs.
+    const Quaternion q_before_RB = attitude_.q_RB();
     const ReferenceUse use = attitude_.reference(*frame_.reference_q_RB, !gyros_vouch_);
+    if (use == ReferenceUse::kAccepted)
+      pull_.add(frame_.now_ns, q_before_RB, attitude_.reference_correction_rad(), attitude_.rate_bias_B_rad_s());
     if (use != ReferenceUse::kRejected) {
       protection_.anchor(frame_.now_ns);  // the error known again
       budget_.used(ns_to_seconds(frame_.now_ns), attitude_.omega_BR_B());
@@ -373,6 +376,12 @@ void Pipeline::Impl::publish_attitude() {
   } else {
     a.protection_level_rad = protection_.k_md() * a.sigma_rad;
   }
+  // Href where a drift was matched: the reference's bias the data could not tell from the drift.
+  // (what the matches left, and what the reference has pulled the attitude by since the last one).
+  if (budget_.ambiguous_rad() > 0.0)
+    a.protection_level_rad = a.protection_level_rad.cwiseMax(
+        protection_.k_md() * a.sigma_rad +
+        Eigen::Vector3d::Constant(budget_.ambiguous_rad() + pull_.total_rad()));
   health_.protection_level_rad = a.protection_level_rad;
   a.mode = observable ? persistent_mode_ : Mode::kLost;
   a.gyros = observable ? frame_.usable : GyroMask{0};

@@ -29,6 +29,7 @@
 #include "rate_attitude.hpp"
 #include "reference_bias_match.hpp"
 #include "reference_budget.hpp"
+#include "reference_pull.hpp"
 #include "reference_consistency.hpp"
 #include "reference_horizon.hpp"
 #include "reference_monitor.hpp"
@@ -156,6 +157,7 @@ class Pipeline::Impl {
   void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
   void match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
   //! A noise_model event: `rows` the arbiter's decision's (null: the long window's match, its three rows).
+  void learn_pull();
   void emit_drift_matched(double statistic, double threshold, const char* evidence,
                           const EvidenceRows* rows = nullptr);
   //! The bias statistic above which the reference's mean is matched as a common drift (+∞: not now).
@@ -240,6 +242,7 @@ class Pipeline::Impl {
   std::vector<OwnNoiseFinding> own_named_;  //!< the gyros own_noise_ named at this epoch (capacity N)
   Eigen::VectorXd held_parity_;  //!< the parity before the jump test, when it left the rest without one
   ReferenceBudget budget_;       //!< the reference's stated bias and latency, which its samples cannot show
+  ReferencePull pull_;           //!< what the reference pulled the attitude by since the bias block began
   EvidenceRows episode_rows_;    //!< the rows of the detection that opened the open episode
   EvidenceRows alarm_rows_;      //!< this epoch's alarm's rows
   EvidenceRows decision_rows_;   //!< scratch: an isolation's rows with the episode's

@@ -44,9 +44,18 @@ void Pipeline::Impl::reconsider_reference_rejection() {
   emit(std::move(e));
 }
 
+namespace {
+//! The sample's evidence is a mean, which a common drift may explain: no test failed, the bias test did, or
+//! the step test did with the long mean beyond the drift match's level (a step fitted to a mean).
+bool shows_a_mean(const ReferenceEvidence& evidence, double drift_threshold) {
+  return !evidence.failed || *evidence.failed == ReferenceCheck::kBias ||
+         (*evidence.failed == ReferenceCheck::kStep && evidence.bias_statistic > drift_threshold);
+}
+}  // namespace
+
 ReferenceDecision Pipeline::Impl::decide_reference(const ReferenceEvidence& evidence, double drift_threshold,
                                                    GyroMask active) {
-  const bool mean = !evidence.failed || *evidence.failed == ReferenceCheck::kBias;
+  const bool mean = shows_a_mean(evidence, drift_threshold);
   if (!evidence.failed && !(mean && evidence.bias_statistic > drift_threshold))
     return ReferenceDecision::kUse;  // every test passed: H0 stands (no rows)
   reference_rows_.clear();
@@ -58,7 +67,7 @@ void Pipeline::Impl::write_reference_rows(const ReferenceEvidence& evidence, dou
                                           GyroMask active, EvidenceRows& rows) const {
   const auto src = EvidenceSource::kReferenceTest;
   const auto& c = consistency_.failed_check();  // the failing test's, or (none failed) the bias test's
-  const bool mean = !evidence.failed || *evidence.failed == ReferenceCheck::kBias;
+  const bool mean = shows_a_mean(evidence, drift_threshold);
   const bool slow = mean || *evidence.failed == ReferenceCheck::kNis;
   // H0: the failing test rejects it, or the bias test's mean at the drift match's level.
   if (evidence.failed)
@@ -113,7 +122,8 @@ void Pipeline::Impl::judge_reference() {
     return;
   // The tests write the evidence, the arbiter decides, the reference's state follows.
   const double drift_level = drift_threshold(active);
-  const ReferenceEvidence evidence = consistency_.test_sample(frame_.now_ns, z, S, attitude_.omega_BR_B());
+  const ReferenceEvidence evidence = consistency_.test_sample(
+      frame_.now_ns, z, S, attitude_.omega_BR_B(), subsets_.get(active).calibration_rate_fraction, gyros_vouch_);
   const ReferenceDecision decision =
       consistency_.judged() ? decide_reference(evidence, drift_level, active) : ReferenceDecision::kUse;
   const ReferenceVerdict v = consistency_.decide(frame_.now_ns, z, S, evidence, decision, drift_level);
@@ -127,6 +137,10 @@ void Pipeline::Impl::judge_reference() {
   apply_reference_verdict(v, z, S, active);
   if (v.use) match_three_gyro_noise(z, S);
   if (v.use) match_common_drift(z, S);
+  // The pull is measured over the bias blocks the drift matches judge.
+  if (!pull_.started()) pull_.start(frame_.now_ns, attitude_.rate_bias_B_rad_s());
+  if (consistency_.bias_start_ns() >= 0 && consistency_.bias_start_ns() != pull_.block_ns())
+    pull_.roll(consistency_.bias_start_ns());
 }
 
 void Pipeline::Impl::apply_reference_verdict(const ReferenceVerdict& v, const Eigen::Vector3d& z,
@@ -152,6 +166,7 @@ void Pipeline::Impl::apply_reference_verdict(const ReferenceVerdict& v, const Ei
   }
   if (v.rejected) {
     attitude_.add_variance(v.contamination_rad2);
+    budget_.learn(v.step_rad);  // a step the samples carry from now on, which no test of them can see
     // An attitude the reference itself set a block ago or less rests on its samples alone: the rejecting
     // sample's innovation, on every axis, bounds what they put in.
     if (reference_set_ns_ && frame_.now_ns - *reference_set_ns_ <= seconds_to_ns(config_.reference_window_s))
@@ -214,9 +229,11 @@ void Pipeline::Impl::match_drift_mean(const ReferenceVerdict& v, GyroMask active
   // the reference rejected only if its mean persists (docs/fdi.md, "A common drift below the detectors").
   // (A mean that grew beyond a working unit's drift with this very sample opens nothing and says nothing.)
   drift_match_.restart();
-  if (drift_match_.match_mean(frame_.now_ns, v.bias_mean_rad, v.bias_span_s, active, attitude_.filter()))
+  if (drift_match_.match_mean(frame_.now_ns, v.bias_mean_rad, v.bias_span_s, active, attitude_.filter())) {
+    learn_pull();
     emit_drift_matched(consistency_.drift_check().statistic, consistency_.drift_check().threshold,
                        "the reference's mean innovation", &reference_rows_);
+  }
 }
 
 void Pipeline::Impl::match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S) {
@@ -228,10 +245,18 @@ void Pipeline::Impl::match_common_drift(const Eigen::Vector3d& z, const Eigen::M
     return;
   }
   if (const auto found = drift_match_.observe(frame_.now_ns, z, S, gyro_set_.active(), attitude_.filter())) {
+    learn_pull();
     consistency_.restart_bias_block(frame_.now_ns);
     emit_drift_matched(found->statistic, found->threshold,
                        "the reference's mean innovation over four bias windows");
   }
+}
+
+void Pipeline::Impl::learn_pull() {
+  // A drift matched: the reference's bias stands beside it, and the attitude may be off by what the
+  // reference pulled it by over the blocks the match judged; the pull is measured afresh from here.
+  budget_.learn_ambiguity(pull_.blocks_rad());
+  pull_.start(frame_.now_ns, attitude_.rate_bias_B_rad_s());
 }
 
 void Pipeline::Impl::emit_drift_matched(double statistic, double threshold, const char* evidence,

@@ -161,6 +161,7 @@ ReferenceUse RateAttitude::reference(const Quaternion& q_ref_RB, bool may_reinit
   last_chi2_ = u.chi2;
   if (u.accepted) {
     rejected_run_ = 0;
+    last_correction_rad_ = u.correction_rad;
     propagator_.reset(propagator_.q_RB() * quat_exp(u.correction_rad));
     return ReferenceUse::kAccepted;
   }

@@ -127,6 +127,10 @@ class RateAttitude {
   Mekf& filter() { return mekf_; }
   //! The last reference sample's χ² (3 dof); 0 before any.
   double reference_chi2() const { return last_chi2_; }
+  //! [rad] body: the last accepted reference update's attitude correction δθ
+  const Eigen::Vector3d& reference_correction_rad() const { return last_correction_rad_; }
+  //! [rad/s] body: the bias estimates' projection the attitude was last propagated with, H*·b̂
+  const Eigen::Vector3d& rate_bias_B_rad_s() const { return correction_; }
 
  private:
   const PipelineConfig& config_;
@@ -139,6 +143,7 @@ class RateAttitude {
   double sigma_ref_rad_ = 0.0;  //!< [rad] 1σ of a reference sample per axis
   int rejected_run_ = 0;        //!< reference samples rejected in a row
   double last_chi2_ = 0.0;
+  Eigen::Vector3d last_correction_rad_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d omega_prev_ = Eigen::Vector3d::Zero();  //!< [rad/s] previous epoch's estimate
   Eigen::Vector3d omega_meas_ = Eigen::Vector3d::Zero();  //!< [rad/s] last estimate (Earth rate included)
   Eigen::Vector3d slope_prev_ = Eigen::Vector3d::Zero();  //!< [rad/s²] the previous step's (ω_k − ω_{k−1})/Δt

@@ -29,7 +29,7 @@ void ReferenceBudget::used(double time_s, const Eigen::Vector3d& omega_B_rad_s) 
 Eigen::Vector3d ReferenceBudget::sigma_rad() const {
   if (!active()) return Eigen::Vector3d::Zero();
   const Eigen::Vector3d lag = latency_max_s_ * rate_held_rad_s_;
-  return root_sum_square(lag, Eigen::Vector3d::Constant(bias_rad_));
+  return root_sum_square(lag, Eigen::Vector3d::Constant(std::hypot(bias_rad_, learned_rad_)));
 }
 
 }  // namespace tetra::fdi::detail

@@ -24,15 +24,23 @@ class ReferenceBudget {
   //! A reference sample was used (initialized, accepted, re-initialized) at `time_s` [s] while the body
   //! turned at `omega_B_rad_s` [rad/s].
   void used(double time_s, const Eigen::Vector3d& omega_B_rad_s);
+  //! The reference was rejected for a step of `step_rad` [rad] (0: another reason, nothing learned).
+  void learn(double step_rad) { learned_rad_ += step_rad; }
+  //! A drift was matched while the reference had pulled the attitude by `pull_rad` [rad] over the block.
+  void learn_ambiguity(double pull_rad) { ambiguous_rad_ += pull_rad; }
+  //! [rad] the attitude error the reference's bias may have left where a drift was matched (0: none).
+  double ambiguous_rad() const { return ambiguous_rad_; }
   //! [rad] per axis: the budget's 1σ, zero before the first sample used or with an empty budget.
   Eigen::Vector3d sigma_rad() const;
-  bool active() const { return used_ && (bias_rad_ > 0.0 || latency_max_s_ > 0.0); }
+  bool active() const { return used_ && (bias_rad_ > 0.0 || latency_max_s_ > 0.0 || learned_rad_ > 0.0); }
 
  private:
   double bias_rad_ = 0.0;
   double latency_max_s_ = 0.0;
   double hold_s_ = 30.0;
   bool used_ = false;
+  double learned_rad_ = 0.0;    //!< [rad] the steps the reference has shown
+  double ambiguous_rad_ = 0.0;  //!< [rad] Σ|D| of the drift matches
   double last_s_ = 0.0;
   Eigen::Vector3d rate_held_rad_s_ = Eigen::Vector3d::Zero();  //!< [rad/s] per axis, decaying peak of |ω|
 };

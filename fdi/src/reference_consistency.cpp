@@ -26,7 +26,8 @@ ReferenceConsistency::ReferenceConsistency(const PipelineConfig& config)
       lag_chi2_(allan::chi2_quantile(1.0 - allocated_probability(config, BudgetTest::kReferenceCheck), 1.0)),
       z_tail_(std::sqrt(
           allan::chi2_quantile(1.0 - 2.0 * allocated_probability(config, BudgetTest::kReferenceCheck), 1.0))),
-      sigma_config_rad_(config.reference_sigma_arcsec * kArcsecToRad) {
+      sigma_config_rad_(config.reference_sigma_arcsec * kArcsecToRad),
+      step_(config) {
   reset();
 }
 
@@ -46,6 +47,8 @@ void ReferenceConsistency::reopen() {
 void ReferenceConsistency::restart() {
   block_start_ns_ = -1;
   bias_start_ns_ = -1;
+  step_.reset();
+  last_sample_ns_ = -1;
 }
 
 void ReferenceConsistency::restart_blocks(std::int64_t now_ns) {
@@ -55,10 +58,12 @@ void ReferenceConsistency::restart_blocks(std::int64_t now_ns) {
   block_count_ = 0;
   block_nis_ = 0.0;
   for (Eigen::Vector3d* v : {&sw_, &swo_, &swz_, &swoo_, &swoz_, &szz_, &sss_}) v->setZero();
+  step_.reset();
   restart_bias_block(now_ns);
 }
 
 void ReferenceConsistency::restart_bias_block(std::int64_t now_ns) {
+  step_.reset();  // the mean matched elsewhere is in no later step either
   bias_start_ns_ = now_ns;
   bias_count_ = 0;
   bias_sw_.setZero();
@@ -68,6 +73,7 @@ void ReferenceConsistency::restart_bias_block(std::int64_t now_ns) {
 std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, const Eigen::Vector3d& z,
                                                          const Eigen::Vector3d& w, double nis,
                                                          const Eigen::Vector3d& omega,
+                                                         double calibration_fraction,
                                                          double& bias_statistic) {
   // Blocks: a new one when the last has run its length (the sample opens the next).
   if (block_start_ns_ < 0 || now_ns - block_start_ns_ > seconds_to_ns(config_.reference_window_s)) {
@@ -96,6 +102,9 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
   bias_swz_ += w.cwiseProduct(z);
   const double dof = 3.0 * block_count_;
   nis_per_dof_ = block_nis_ / dof;
+  const double turn_rad = last_sample_ns_ < 0 ? 0.0 : omega.norm() * ns_to_seconds(now_ns - last_sample_ns_);
+  last_sample_ns_ = now_ns;
+  step_.add(z, w.cwiseInverse(), sigma_rad_ * sigma_rad_, turn_rad);
 
   // Lag: z = a − ω·τ with a per-axis offset a; τ̂ = −num/den, var(τ̂) = 1/den.
   double num = 0.0;
@@ -134,10 +143,20 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
     failed_ = {block_nis_, chi2_upper_wh(dof, z_tail_), static_cast<int>(dof)};
     return ReferenceCheck::kNis;
   }
+  // The long mean before the step: a mean the drift match explains is not a step (the caller's arbiter
+  // judges a step with a mean beyond the match's level as the mean it is).
   const double bias = mean_innovation_chi2(bias_sw_, bias_swz_);
-  failed_ = {bias, jump_chi2_, 3};
   bias_statistic = bias;
-  if (bias > jump_chi2_) return ReferenceCheck::kBias;
+  if (bias > jump_chi2_) {
+    failed_ = {bias, jump_chi2_, 3};
+    return ReferenceCheck::kBias;
+  }
+  step_fit_ = step_.evaluate(calibration_fraction);
+  if (step_fit_.statistic > step_.threshold()) {
+    failed_ = {step_fit_.statistic, step_.threshold(), 3};
+    return ReferenceCheck::kStep;
+  }
+  failed_ = {bias, jump_chi2_, 3};
   return std::nullopt;
 }
 
@@ -180,13 +199,15 @@ bool ReferenceConsistency::reestimate_noise(std::int64_t now_ns, const Eigen::Ve
 
 ReferenceEvidence ReferenceConsistency::test_sample(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
                                                     const Eigen::Matrix3d& S,
-                                                    const Eigen::Vector3d& omega_rad_s) {
+                                                    const Eigen::Vector3d& omega_rad_s,
+                                                    double calibration_fraction, bool steps_judged) {
+  if (!steps_judged) step_.reset();
   const double nis = z_rad.dot(S.ldlt().solve(z_rad));
   const Eigen::Vector3d w = S.diagonal().cwiseInverse();
   ReferenceEvidence e;
   e.used_excess_rad2 = szz_ - sss_;  // before the sample (which may open the next block)
   e.used_count = block_start_ns_ < 0 ? 0 : block_count_;
-  e.failed = test(now_ns, z_rad, w, nis, omega_rad_s, e.bias_statistic);
+  e.failed = test(now_ns, z_rad, w, nis, omega_rad_s, calibration_fraction, e.bias_statistic);
   return e;
 }
 
@@ -227,6 +248,12 @@ ReferenceVerdict ReferenceConsistency::decide(std::int64_t now_ns, const Eigen::
     v.contamination_rad2 = (evidence.used_excess_rad2 / evidence.used_count).cwiseMax(0.0);
   if (*evidence.failed == ReferenceCheck::kLag)
     v.contamination_rad2 += lag_offset_rad_.cwiseProduct(lag_offset_rad_);
+  if (*evidence.failed == ReferenceCheck::kStep) {
+    // The share of the step the filter has taken is in the attitude; the rest is in the samples to come.
+    const Eigen::Vector3d taken = step_fit_.step_rad.cwiseProduct(step_fit_.absorbed);
+    v.contamination_rad2 += taken.cwiseProduct(taken);
+    v.step_rad = step_fit_.step_rad.norm();
+  }
   v.use = false;
   v.rejected = evidence.failed;
   reject(now_ns, *evidence.failed);

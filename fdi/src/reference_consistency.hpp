@@ -7,6 +7,7 @@
 //   nis   the window's sum:    Σ zᵀS⁻¹z over m samples        > χ²_{3m}(1 − p)
 //   lag   z = a − ω·τ fitted over the window (a per-axis offset, τ common): τ̂²/var(τ̂) > χ²₁(1 − p)
 //   bias  the long window's weighted mean innovation: Σ_a (Σ z_a/S_aa)²/Σ 1/S_aa > χ²₃(1 − p)
+//   step  a step the filter is absorbing, fitted over the last samples (reference_step.hpp) > χ²₃(1 − p/M)
 //
 // p = the budget's kReferenceCheck share per sample. Windows are consecutive blocks (the nis and lag
 // tests' of reference_window_s, the bias test's of reference_bias_window_s), each test evaluated at
@@ -28,6 +29,7 @@
 
 #include <Eigen/Core>
 
+#include "reference_step.hpp"
 #include "tetra/core/units.hpp"
 #include "tetra/fdi/config.hpp"
 #include "tetra/fdi/ledger.hpp"
@@ -53,6 +55,9 @@ struct ReferenceVerdict {
   //! parity or an open episode): the reference or a gyro is wrong, and the data cannot tell which.
   std::optional<ReferenceCheck> inconsistent;
   Eigen::Vector3d contamination_rad2 = Eigen::Vector3d::Zero();  //!< rejected: what the used samples put in
+  //! [rad] rejected for `step`: the step's size |ĉ|, which the reference's samples carry from then on (the
+  //! caller's ReferenceBudget learns it)
+  double step_rad = 0.0;
   //! The gyros' common drift matched (ReferenceDecision::kMatchDrift): the sample is used, and the caller
   //! opens the gyros' bias model by what the test saw — [rad] its weighted mean innovation per axis over its
   //! block, and [s] the block's span to this sample.
@@ -70,9 +75,13 @@ class ReferenceConsistency {
   void restart();  //!< windows empty (the gyro set changed, an episode ended); the state kept
 
   //! One sample at `now_ns`: its innovation `z_rad` with covariance `S` and the body rate `omega_rad_s` at
-  //! its time, into the tests' blocks; what they show (nothing decided).
+  //! its time, into the tests' blocks; what they show (nothing decided). `calibration_fraction` [-]: the
+  //! rate error per unit rate the calibration's tolerance allows (Subset::calibration_rate_fraction);
+  //! `steps_judged`: the gyros vouch for their attitude over the step test's window (parity, no episode) —
+  //! without, a gyro's noise or ramp walks the attitude in steps of its own, and the window starts afresh.
   ReferenceEvidence test_sample(std::int64_t now_ns, const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S,
-                                const Eigen::Vector3d& omega_rad_s);
+                                const Eigen::Vector3d& omega_rad_s, double calibration_fraction,
+                                bool steps_judged);
   //! Whether the arbiter decides this sample: the reference is not rejected (a rejected one is used again
   //! here, once its samples pass every test for a block).
   bool judged() const { return state_ != ReferenceState::kRejected; }
@@ -106,6 +115,7 @@ class ReferenceConsistency {
   //! [rad] the bias test's weighted mean innovation per axis over its block so far, and [s] the block's span
   //! to `now_ns` (0 before a sample).
   Eigen::Vector3d bias_mean_rad() const { return bias_swz_.cwiseQuotient(bias_sw_); }
+  std::int64_t bias_start_ns() const { return bias_start_ns_; }  //!< the bias block's start (−1: none)
   double bias_span_s(std::int64_t now_ns) const {
     return bias_start_ns_ < 0 ? 0.0 : ns_to_seconds(now_ns - bias_start_ns_);
   }
@@ -114,7 +124,8 @@ class ReferenceConsistency {
   //! The first test that fails over the blocks with this sample in, or none.
   //! (`bias_statistic` the bias test's χ²₃, left as it is when the test is not reached).
   std::optional<ReferenceCheck> test(std::int64_t now_ns, const Eigen::Vector3d& z, const Eigen::Vector3d& w,
-                                     double nis, const Eigen::Vector3d& omega, double& bias_statistic);
+                                     double nis, const Eigen::Vector3d& omega, double calibration_fraction,
+                                     double& bias_statistic);
   void restart_blocks(std::int64_t now_ns);
   //! A sample used: its innovation's second moment against the predicted one, into the block.
   void add_used(const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S);
@@ -150,6 +161,9 @@ class ReferenceConsistency {
   bool have_last_z_ = false;
   bool noise_explained_ = false;  //!< the last block's estimate is within sigma_rad_
   CheckValue failed_;             //!< the last test's statistic and threshold
+  ReferenceStep step_;            //!< the step test's window
+  StepFit step_fit_;              //!< its best onset at the last sample
+  std::int64_t last_sample_ns_ = -1;  //!< the previous sample tested (the rotation since, for the step test)
 
   // the nis and lag block (reference_window_s)
   std::int64_t block_start_ns_ = -1;

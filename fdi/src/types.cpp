@@ -100,13 +100,16 @@ const char* to_string(ReferenceCheck check) {
       return "bias";
     case ReferenceCheck::kJump:
       return "jump";
+    case ReferenceCheck::kStep:
+      return "step";
   }
   return "";
 }
 
 ReferenceCheck reference_check_from_string(std::string_view text) {
   for (const ReferenceCheck c :
-       {ReferenceCheck::kNis, ReferenceCheck::kLag, ReferenceCheck::kBias, ReferenceCheck::kJump}) {
+       {ReferenceCheck::kNis, ReferenceCheck::kLag, ReferenceCheck::kBias, ReferenceCheck::kJump,
+        ReferenceCheck::kStep}) {
     if (text == to_string(c)) return c;
   }
   return ReferenceCheck::kNone;

@@ -115,6 +115,8 @@ inline constexpr int reference_confirm_count = 3;         //!< [-] consecutive c
 inline constexpr int reference_gate_reset_count = 10;     //!< [samples] gate rejections that set the attitude
 inline constexpr double reference_bias_window_s = 120.0;  //!< [s] block of the mean-innovation test
 inline constexpr double reference_noise_max_factor = 3.0;  //!< [-] × reference_sigma_arcsec: re-estimate
+//! [samples] the step test's window: the onsets it searches (its threshold at p / this many)
+inline constexpr int reference_step_samples = 64;
 // --- the noise model checked against the parity's spread
 inline constexpr double spread_block_s = 5.0;       //!< [s] blocks of the long-run spread
 inline constexpr int spread_window_samples = 3000;  //!< [samples] of one verdict at most

@@ -74,8 +74,8 @@ enum class ReferenceState : std::uint8_t {
 const char* to_string(ReferenceState state);  // "absent", "accepted", "rejected"
 
 //! Why a reference was rejected.
-enum class ReferenceCheck : std::uint8_t { kNone, kNis, kLag, kBias, kJump };
-const char* to_string(ReferenceCheck check);  // "", "nis", "lag", "bias", "jump"
+enum class ReferenceCheck : std::uint8_t { kNone, kNis, kLag, kBias, kJump, kStep };
+const char* to_string(ReferenceCheck check);  // "", "nis", "lag", "bias", "jump", "step"
 //! The check named by `text` (as written by to_string); kNone for any other text.
 ReferenceCheck reference_check_from_string(std::string_view text);
 

@@ -1,0 +1,67 @@
+#pragma once
+// The reference's step test (docs/fdi.md, "Reference consistency"): a reference whose error steps by b at
+// sample j (a star tracker re-identifying, a thermal snap) shows in the innovations as b·g_k from j on, g the
+// filter's absorption of an offset — g_j = 1, g_{k+1} = g_k·ρ_k, ρ_k = 1 − K_k per axis, K_k = P/S the
+// attitude's gain at sample k (σ_ref²/S_aa = 1 − K). The filter takes the step into its attitude within a
+// few 1/K samples, so no one sample and no long mean shows a step of a few σ_ref; the matched fit does. Over
+// the last design::reference_step_samples samples, for every onset j, per axis the weighted fit z = c·g
+// (a good reference's innovations have no mean; a drift's mean is the bias test's, judged first) gives
+// ĉ = Σwgz/Σwg² (w = 1/S_aa) and, under a good reference (white innovations of covariance S), ĉ²·Σwg² is
+// χ²₁. Two things a good reference does that can look like a step are allowed for:
+//   - a calibration within calibration_error_sigmas of its stated σ turns the gyros' attitude by at most
+//     f·θ (f the subset's calibration_rate_fraction, θ the rotation in the window): |ĉ| less that bound;
+//   - a noisier unit or reference scales the innovations: each axis's term is divided by its residual
+//     variance ratio r̂_a about the fit (when above 1), so the test sees a step's shape, `nis` the scale.
+//   statistic = max_j Σ_a max(0, |ĉ_a| − f·θ)²·Σwg² / max(1, r̂_a,j)  >  χ²₃(1 − p/M)
+// (M onsets searched, p the budget's kReferenceCheck share: its union bound over the onsets is p per
+// sample). The fit's ĉ and the share of it the filter has already taken, 1 − Π ρ, are what a rejection
+// puts into the attitude's variance and the reference's budget (reference_budget.hpp).
+
+#include <array>
+
+#include <Eigen/Core>
+
+#include "tetra/fdi/config.hpp"
+
+namespace tetra::fdi::detail {
+
+//! The best onset's fit over the window.
+struct StepFit {
+  double statistic = 0.0;                                //!< [-] as in the header, χ²₃ under a good reference
+  Eigen::Vector3d step_rad = Eigen::Vector3d::Zero();   //!< [rad] ĉ per axis
+  Eigen::Vector3d absorbed = Eigen::Vector3d::Zero();   //!< [-] per axis the share the filter has taken
+};
+
+class ReferenceStep {
+ public:
+  explicit ReferenceStep(const PipelineConfig& config);
+
+  void reset() { count_ = 0; }  //!< the window empty
+  //! One sample: its innovation `z_rad` [rad], its covariance's diagonal `s_rad2` [rad²], the reference's
+  //! variance `reference_var_rad2` [rad²] (the filter's gain is 1 − that over S) and `turn_rad` [rad] the
+  //! body's rotation since the previous sample.
+  void add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_rad2, double reference_var_rad2,
+           double turn_rad);
+  //! The best onset over the window, with `calibration_fraction` [-] the rate error per unit rate a
+  //! calibration within its tolerance can leave (Subset::calibration_rate_fraction).
+  StepFit evaluate(double calibration_fraction) const;
+  double threshold() const { return threshold_; }  //!< χ²₃(1 − p/M)
+
+ private:
+  struct Sample {
+    Eigen::Vector3d z = Eigen::Vector3d::Zero();    //!< [rad]
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();    //!< [1/rad²] 1/S_aa
+    Eigen::Vector3d rho = Eigen::Vector3d::Zero();  //!< [-] 1 − K
+    double turn_rad = 0.0;
+  };
+  const Sample& at(int k) const {  //!< k-th oldest sample of the window
+    return ring_[static_cast<std::size_t>((head_ + kCapacity - count_ + k) % kCapacity)];
+  }
+  static constexpr int kCapacity = design::reference_step_samples;
+  std::array<Sample, kCapacity> ring_{};
+  int head_ = 0;   //!< where the next sample goes
+  int count_ = 0;  //!< samples in the window
+  double threshold_ = 0.0;
+};
+
+}  // namespace tetra::fdi::detail
