@@ -151,7 +151,7 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
     failed_ = {bias, jump_chi2_, 3};
     return ReferenceCheck::kBias;
   }
-  step_fit_ = step_.evaluate(calibration_fraction);
+  step_fit_ = step_.evaluate(calibration_fraction, step_.threshold());
   if (step_fit_.statistic > step_.threshold()) {
     failed_ = {step_fit_.statistic, step_.threshold(), 3};
     return ReferenceCheck::kStep;

@@ -15,48 +15,67 @@ ReferenceStep::ReferenceStep(const PipelineConfig& config)
 void ReferenceStep::add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_rad2, double reference_var_rad2,
                         double turn_rad) {
   Sample& s = ring_[static_cast<std::size_t>(head_)];
-  s.z = z_rad;
-  s.w = s_rad2.cwiseInverse();
-  s.rho = (reference_var_rad2 * s.w).cwiseMin(1.0);
+  for (int a = 0; a < 3; ++a) {
+    const double w = 1.0 / s_rad2[a];
+    s.w[a] = w;
+    s.wz[a] = w * z_rad[a];
+    s.wzz[a] = s.wz[a] * z_rad[a];
+    s.rho[a] = std::min(reference_var_rad2 * w, 1.0);
+    s.rho2[a] = s.rho[a] * s.rho[a];
+  }
   s.turn_rad = turn_rad;
   head_ = (head_ + 1) % kCapacity;
   count_ = std::min(count_ + 1, kCapacity);
 }
 
-StepFit ReferenceStep::evaluate(double calibration_fraction) const {
+StepFit ReferenceStep::evaluate(double calibration_fraction, double level) const {
   StepFit best;
   const int m = count_;
   if (m < 3) return best;  // a step and two residual degrees of freedom per axis at least
   // Σwz² per axis over the window, and the rotation from its first sample to its last.
-  Eigen::Vector3d q0 = Eigen::Vector3d::Zero();
+  std::array<double, 3> q0{};
   double turn = 0.0;
   for (int k = 0; k < m; ++k) {
     const Sample& s = at(k);
-    q0 += s.w.cwiseProduct(s.z).cwiseProduct(s.z);
+    for (int a = 0; a < 3; ++a) q0[a] += s.wzz[a];
     if (k > 0) turn += s.turn_rad;
   }
   const double allowed = calibration_fraction * turn;  // [rad] a calibration's step within its tolerance
   // Onsets from the newest back: A = Σ w g z, C = Σ w g² from the onset on (g_j = 1, g_{k+1} = ρ_k·g_k),
-  // and Π ρ the share of the step the filter has not yet taken.
-  Eigen::Vector3d a = Eigen::Vector3d::Zero(), c = Eigen::Vector3d::Zero();
-  Eigen::Vector3d left = Eigen::Vector3d::Ones();
+  // and Π ρ the share of the step the filter has not yet taken. The residual ratio only lowers a term, so an
+  // onset whose terms without it stay below `level` (and the best so far) is passed over.
+  std::array<double, 3> a_sum{}, c_sum{}, left{1.0, 1.0, 1.0}, step{}, term{};
   for (int j = m - 1; j >= 0; --j) {
     const Sample& s = at(j);
-    a = s.w.cwiseProduct(s.z) + s.rho.cwiseProduct(a);
-    c = s.w + s.rho.cwiseProduct(s.rho).cwiseProduct(c);
-    if (j < m - 1) left = left.cwiseProduct(s.rho);
+    std::array<double, 3> reach{};  // max(0, |A| − f·θ·C)²: the term times C, without a division
+    for (int a = 0; a < 3; ++a) {
+      a_sum[a] = s.wz[a] + s.rho[a] * a_sum[a];
+      c_sum[a] = s.w[a] + s.rho2[a] * c_sum[a];
+      if (j < m - 1) left[a] *= s.rho[a];
+      const double r = std::max(0.0, std::abs(a_sum[a]) - allowed * c_sum[a]);
+      reach[a] = r * r;
+    }
+    // Σ reach_a/C_a ≤ the level, multiplied through by C₀C₁C₂ (with a margin far above the rounding).
+    const double c01 = c_sum[0] * c_sum[1];
+    const double bound =
+        reach[0] * c_sum[1] * c_sum[2] + reach[1] * c_sum[0] * c_sum[2] + reach[2] * c01;
+    if (bound <= (1.0 - 1e-9) * std::max(level, best.statistic) * c01 * c_sum[2]) continue;
     double statistic = 0.0;
-    Eigen::Vector3d step = Eigen::Vector3d::Zero();
-    for (int ax = 0; ax < 3; ++ax) {
-      step[ax] = a[ax] / c[ax];
-      const double beyond = std::max(0.0, std::abs(step[ax]) - allowed);
-      const double ratio = std::max(1.0, (q0[ax] - a[ax] * a[ax] / c[ax]) / (m - 1));
-      statistic += beyond * beyond * c[ax] / ratio;
+    for (int a = 0; a < 3; ++a) {
+      step[a] = a_sum[a] / c_sum[a];
+      const double beyond = std::max(0.0, std::abs(step[a]) - allowed);
+      term[a] = beyond * beyond * c_sum[a];
+    }
+    for (int a = 0; a < 3; ++a) {
+      const double ratio = std::max(1.0, (q0[a] - a_sum[a] * a_sum[a] / c_sum[a]) / (m - 1));
+      statistic += term[a] / ratio;
     }
     if (statistic > best.statistic) {
       best.statistic = statistic;
-      best.step_rad = step;
-      best.absorbed = Eigen::Vector3d::Ones() - left;
+      for (int a = 0; a < 3; ++a) {
+        best.step_rad[a] = step[a];
+        best.absorbed[a] = 1.0 - left[a];
+      }
     }
   }
   return best;

@@ -25,7 +25,8 @@
 
 namespace tetra::fdi::detail {
 
-//! The best onset's fit over the window.
+//! The best onset's fit over the window, among those whose statistic exceeds the level asked for (none:
+//! statistic 0).
 struct StepFit {
   double statistic = 0.0;                                //!< [-] as in the header, χ²₃ under a good reference
   Eigen::Vector3d step_rad = Eigen::Vector3d::Zero();   //!< [rad] ĉ per axis
@@ -42,16 +43,19 @@ class ReferenceStep {
   //! body's rotation since the previous sample.
   void add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_rad2, double reference_var_rad2,
            double turn_rad);
-  //! The best onset over the window, with `calibration_fraction` [-] the rate error per unit rate a
-  //! calibration within its tolerance can leave (Subset::calibration_rate_fraction).
-  StepFit evaluate(double calibration_fraction) const;
+  //! The best onset over the window beyond `level` (the test's threshold, or a lower one to see the
+  //! statistic's distribution), with `calibration_fraction` [-] the rate error per unit rate a calibration
+  //! within its tolerance can leave (Subset::calibration_rate_fraction).
+  StepFit evaluate(double calibration_fraction, double level) const;
   double threshold() const { return threshold_; }  //!< χ²₃(1 − p/M)
 
  private:
-  struct Sample {
-    Eigen::Vector3d z = Eigen::Vector3d::Zero();    //!< [rad]
-    Eigen::Vector3d w = Eigen::Vector3d::Zero();    //!< [1/rad²] 1/S_aa
-    Eigen::Vector3d rho = Eigen::Vector3d::Zero();  //!< [-] 1 − K
+  struct Sample {  //!< per axis
+    std::array<double, 3> w{};     //!< [1/rad²] 1/S_aa
+    std::array<double, 3> wz{};    //!< [1/rad] w·z
+    std::array<double, 3> wzz{};   //!< [-] w·z²
+    std::array<double, 3> rho{};   //!< [-] 1 − K
+    std::array<double, 3> rho2{};  //!< [-] ρ²
     double turn_rad = 0.0;
   };
   const Sample& at(int k) const {  //!< k-th oldest sample of the window

@@ -48,7 +48,7 @@ TEST(ReferenceStep, AGoodReferenceFailsNoMoreOftenThanTheBudgetAllowsOverManyWin
   constexpr int kWindows = 20000;
   for (int w = 0; w < kWindows; ++w) {
     const auto s = window(rng, fdi::design::reference_step_samples, 1.0, Eigen::Vector3d::Zero(), 0);
-    above += s.evaluate(0.0).statistic > threshold ? 1 : 0;
+    above += s.evaluate(0.0, threshold).statistic > threshold ? 1 : 0;
   }
   const double rate = static_cast<double>(above) / kWindows;
   std::printf("good reference: %d of %d windows beyond the alpha = %.0e threshold (%.3f %%)\n", above, kWindows,
@@ -66,7 +66,7 @@ TEST(ReferenceStep, AStepOfTwoSigmaOfOneSampleIsFoundAtItsSize) {
   int close = 0;
   for (int seed = 0; seed < 200; ++seed) {
     const auto s = window(rng, fdi::design::reference_step_samples, 1.0, step, 20);
-    const fdi::detail::StepFit f = s.evaluate(0.0);
+    const fdi::detail::StepFit f = s.evaluate(0.0, s.threshold());
     found += f.statistic > s.threshold() ? 1 : 0;
     // σ(ĉ) = 1/√(Σ w g²) over the 44 samples from the onset: about 1.1″.
     close += (f.step_rad - step).cwiseAbs().maxCoeff() < 3.0 * 1.2 * kArcsecToRad ? 1 : 0;
@@ -86,8 +86,8 @@ TEST(ReferenceStep, ACalibrationWithinItsToleranceTurningTheBodyIsNoStep) {
   const Eigen::Vector3d step(20.0 * kArcsecToRad, 0.0, 0.0);
   std::mt19937_64 rng(11);
   const auto s = window(rng, fdi::design::reference_step_samples, 1.0, step, 30, 40.0 * kDegToRad);
-  EXPECT_LT(s.evaluate(3e-4).statistic, s.threshold());
-  EXPECT_GT(s.evaluate(0.0).statistic, s.threshold());
+  EXPECT_LT(s.evaluate(3e-4, s.threshold()).statistic, s.threshold());
+  EXPECT_GT(s.evaluate(0.0, s.threshold()).statistic, s.threshold());
 }
 
 TEST(ReferenceStep, AReferenceThreeTimesNoisierThanModelledIsNoStep) {
@@ -98,7 +98,7 @@ TEST(ReferenceStep, AReferenceThreeTimesNoisierThanModelledIsNoStep) {
   int above = 0;
   for (int w = 0; w < 2000; ++w) {
     const auto s = window(rng, fdi::design::reference_step_samples, 3.0, Eigen::Vector3d::Zero(), 0);
-    above += s.evaluate(0.0).statistic > s.threshold() ? 1 : 0;
+    above += s.evaluate(0.0, s.threshold()).statistic > s.threshold() ? 1 : 0;
   }
   EXPECT_EQ(above, 0);
 }
@@ -107,11 +107,11 @@ TEST(ReferenceStep, TooFewSamplesJudgeNothingAndAResetEmptiesTheWindow) {
   std::mt19937_64 rng(17);
   const Eigen::Vector3d step = Eigen::Vector3d::Constant(1e-3);  // 206″: any window of three would show it
   auto s = window(rng, 2, 1.0, step, 0);
-  EXPECT_EQ(s.evaluate(0.0).statistic, 0.0);
+  EXPECT_EQ(s.evaluate(0.0, s.threshold()).statistic, 0.0);
   s = window(rng, 10, 1.0, step, 0);
-  EXPECT_GT(s.evaluate(0.0).statistic, s.threshold());
+  EXPECT_GT(s.evaluate(0.0, s.threshold()).statistic, s.threshold());
   s.reset();
-  EXPECT_EQ(s.evaluate(0.0).statistic, 0.0);
+  EXPECT_EQ(s.evaluate(0.0, s.threshold()).statistic, 0.0);
 }
 
 }  // namespace
