@@ -348,7 +348,8 @@ void Pipeline::Impl::publish_attitude() {
     const Quaternion q_before_RB = attitude_.q_RB();
     const ReferenceUse use = attitude_.reference(*frame_.reference_q_RB, !gyros_vouch_);
     if (use == ReferenceUse::kAccepted)
-      pull_.add(frame_.now_ns, q_before_RB, attitude_.reference_correction_rad(), attitude_.rate_bias_B_rad_s());
+      pull_.add(frame_.now_ns, q_before_RB, attitude_.reference_correction_rad(),
+                attitude_.rate_bias_B_rad_s());
     if (use != ReferenceUse::kRejected) {
       protection_.anchor(frame_.now_ns);  // the error known again
       budget_.used(ns_to_seconds(frame_.now_ns), attitude_.omega_BR_B());

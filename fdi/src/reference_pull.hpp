@@ -47,8 +47,9 @@ class ReferencePull {
     block_R_rad_ += d;
     total_R_rad_ += d;
   }
-  double blocks_rad() const { return (previous_R_rad_ + block_R_rad_).norm(); }  //!< [rad] this block and the last
-  double total_rad() const { return total_R_rad_.norm(); }                        //!< [rad] since the start
+  //! [rad] |D| over this bias block and the last
+  double blocks_rad() const { return (previous_R_rad_ + block_R_rad_).norm(); }
+  double total_rad() const { return total_R_rad_.norm(); }  //!< [rad] |D| since the start
 
  private:
   bool started_ = false;

@@ -12,8 +12,8 @@ ReferenceStep::ReferenceStep(const PipelineConfig& config)
     : threshold_(allan::chi2_quantile(
           1.0 - allocated_probability(config, BudgetTest::kReferenceCheck) / kCapacity, 3.0)) {}
 
-void ReferenceStep::add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_rad2, double reference_var_rad2,
-                        double turn_rad) {
+void ReferenceStep::add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_rad2,
+                        double reference_var_rad2, double turn_rad) {
   Sample& s = ring_[static_cast<std::size_t>(head_)];
   for (int a = 0; a < 3; ++a) {
     const double w = 1.0 / s_rad2[a];
@@ -57,8 +57,7 @@ StepFit ReferenceStep::evaluate(double calibration_fraction, double level) const
     }
     // Σ reach_a/C_a ≤ the level, multiplied through by C₀C₁C₂ (with a margin far above the rounding).
     const double c01 = c_sum[0] * c_sum[1];
-    const double bound =
-        reach[0] * c_sum[1] * c_sum[2] + reach[1] * c_sum[0] * c_sum[2] + reach[2] * c01;
+    const double bound = reach[0] * c_sum[1] * c_sum[2] + reach[1] * c_sum[0] * c_sum[2] + reach[2] * c01;
     if (bound <= (1.0 - 1e-9) * std::max(level, best.statistic) * c01 * c_sum[2]) continue;
     double statistic = 0.0;
     for (int a = 0; a < 3; ++a) {

@@ -28,9 +28,9 @@ namespace tetra::fdi::detail {
 //! The best onset's fit over the window, among those whose statistic exceeds the level asked for (none:
 //! statistic 0).
 struct StepFit {
-  double statistic = 0.0;                                //!< [-] as in the header, χ²₃ under a good reference
-  Eigen::Vector3d step_rad = Eigen::Vector3d::Zero();   //!< [rad] ĉ per axis
-  Eigen::Vector3d absorbed = Eigen::Vector3d::Zero();   //!< [-] per axis the share the filter has taken
+  double statistic = 0.0;  //!< [-] as in the header, χ²₃ under a good reference
+  Eigen::Vector3d step_rad = Eigen::Vector3d::Zero();  //!< [rad] ĉ per axis
+  Eigen::Vector3d absorbed = Eigen::Vector3d::Zero();  //!< [-] per axis the share the filter has taken
 };
 
 class ReferenceStep {
@@ -50,7 +50,7 @@ class ReferenceStep {
   double threshold() const { return threshold_; }  //!< χ²₃(1 − p/M)
 
  private:
-  struct Sample {  //!< per axis
+  struct Sample {                  //!< per axis
     std::array<double, 3> w{};     //!< [1/rad²] 1/S_aa
     std::array<double, 3> wz{};    //!< [1/rad] w·z
     std::array<double, 3> wzz{};   //!< [-] w·z²

@@ -107,9 +107,8 @@ const char* to_string(ReferenceCheck check) {
 }
 
 ReferenceCheck reference_check_from_string(std::string_view text) {
-  for (const ReferenceCheck c :
-       {ReferenceCheck::kNis, ReferenceCheck::kLag, ReferenceCheck::kBias, ReferenceCheck::kJump,
-        ReferenceCheck::kStep}) {
+  for (const ReferenceCheck c : {ReferenceCheck::kNis, ReferenceCheck::kLag, ReferenceCheck::kBias,
+                                 ReferenceCheck::kJump, ReferenceCheck::kStep}) {
     if (text == to_string(c)) return c;
   }
   return ReferenceCheck::kNone;

@@ -14,7 +14,7 @@
 namespace tetra {
 namespace {
 
-constexpr double kSigmaRef_rad = 5.0 * kArcsecToRad;          //!< the reference's 1σ per axis
+constexpr double kSigmaRef_rad = 5.0 * kArcsecToRad;                     //!< the reference's 1σ per axis
 constexpr double kAttitudeVar_rad2 = 0.7 * kArcsecToRad * kArcsecToRad;  //!< P per axis: a 1 Hz tracker's
 constexpr double kS_rad2 = kSigmaRef_rad * kSigmaRef_rad + kAttitudeVar_rad2;
 
@@ -33,7 +33,8 @@ fdi::detail::ReferenceStep window(std::mt19937_64& rng, int samples, double nois
       z += left * step_rad;
       left *= rho;
     }
-    step.add(z, Eigen::Vector3d::Constant(kS_rad2), kSigmaRef_rad * kSigmaRef_rad, k == onset ? turn_rad : 0.0);
+    step.add(z, Eigen::Vector3d::Constant(kS_rad2), kSigmaRef_rad * kSigmaRef_rad,
+             k == onset ? turn_rad : 0.0);
   }
   return step;
 }
@@ -51,8 +52,8 @@ TEST(ReferenceStep, AGoodReferenceFailsNoMoreOftenThanTheBudgetAllowsOverManyWin
     above += s.evaluate(0.0, threshold).statistic > threshold ? 1 : 0;
   }
   const double rate = static_cast<double>(above) / kWindows;
-  std::printf("good reference: %d of %d windows beyond the alpha = %.0e threshold (%.3f %%)\n", above, kWindows,
-              kAlpha, 100.0 * rate);
+  std::printf("good reference: %d of %d windows beyond the alpha = %.0e threshold (%.3f %%)\n", above,
+              kWindows, kAlpha, 100.0 * rate);
   EXPECT_LE(rate, kAlpha + 3.0 * std::sqrt(kAlpha * (1.0 - kAlpha) / kWindows));
 }
 
@@ -71,9 +72,10 @@ TEST(ReferenceStep, AStepOfTwoSigmaOfOneSampleIsFoundAtItsSize) {
     // σ(ĉ) = 1/√(Σ w g²) over the 44 samples from the onset: about 1.1″.
     close += (f.step_rad - step).cwiseAbs().maxCoeff() < 3.0 * 1.2 * kArcsecToRad ? 1 : 0;
     if (seed == 0)
-      std::printf("step 12 arcsec: statistic %.1f (threshold %.1f), fitted %.1f %.1f %.1f arcsec, taken %.2f\n",
-                  f.statistic, s.threshold(), f.step_rad.x() / kArcsecToRad, f.step_rad.y() / kArcsecToRad,
-                  f.step_rad.z() / kArcsecToRad, f.absorbed.x());
+      std::printf(
+          "step 12 arcsec: statistic %.1f (threshold %.1f), fitted %.1f %.1f %.1f arcsec, taken %.2f\n",
+          f.statistic, s.threshold(), f.step_rad.x() / kArcsecToRad, f.step_rad.y() / kArcsecToRad,
+          f.step_rad.z() / kArcsecToRad, f.absorbed.x());
   }
   EXPECT_GE(found, 195);
   EXPECT_GE(close, 190);
