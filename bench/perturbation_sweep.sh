@@ -12,6 +12,8 @@
 # RUNS = 300: 2,400 runs (4,800 with the twins); about 3.5 min of CPU.
 # Usage: bench/perturbation_sweep.sh [BUILD_DIR] [RUNS] [SEED]   (defaults: build, 300, 1); TETRA_FAMILY_FILTER
 #   selects families (a gtest filter, e.g. '*.Reference:*.SecondFault').
+# One run listed, its events and figures beside its twin's:
+#   TETRA_FAMILY_SHOW=reference:3:197 build/tests/test_perturbation_families --gtest_filter='*ShowOneRun'
 # Build: scripts/build.sh --target test_perturbation_families
 set -euo pipefail
 build="${1:-build}"

@@ -33,7 +33,7 @@ StepFit ReferenceStep::evaluate(double calibration_fraction, double level) const
   const int m = count_;
   if (m < 3) return best;  // a step and two residual degrees of freedom per axis at least
   // Σwz² per axis over the window, and the rotation from its first sample to its last.
-  std::array<double, 3> q0{};
+  Eigen::Vector3d q0 = Eigen::Vector3d::Zero();
   double turn = 0.0;
   for (int k = 0; k < m; ++k) {
     const Sample& s = at(k);
@@ -44,10 +44,11 @@ StepFit ReferenceStep::evaluate(double calibration_fraction, double level) const
   // Onsets from the newest back: A = Σ w g z, C = Σ w g² from the onset on (g_j = 1, g_{k+1} = ρ_k·g_k),
   // and Π ρ the share of the step the filter has not yet taken. The residual ratio only lowers a term, so an
   // onset whose terms without it stay below `level` (and the best so far) is passed over.
-  std::array<double, 3> a_sum{}, c_sum{}, left{1.0, 1.0, 1.0}, step{}, term{};
+  Eigen::Vector3d a_sum = Eigen::Vector3d::Zero(), c_sum = Eigen::Vector3d::Zero(), step, term;
+  Eigen::Vector3d left = Eigen::Vector3d::Ones();
   for (int j = m - 1; j >= 0; --j) {
     const Sample& s = at(j);
-    std::array<double, 3> reach{};  // max(0, |A| − f·θ·C)²: the term times C, without a division
+    Eigen::Vector3d reach;  // max(0, |A| − f·θ·C)²: the term times C, without a division
     for (int a = 0; a < 3; ++a) {
       a_sum[a] = s.wz[a] + s.rho[a] * a_sum[a];
       c_sum[a] = s.w[a] + s.rho2[a] * c_sum[a];

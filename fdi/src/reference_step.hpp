@@ -50,12 +50,12 @@ class ReferenceStep {
   double threshold() const { return threshold_; }  //!< χ²₃(1 − p/M)
 
  private:
-  struct Sample {                  //!< per axis
-    std::array<double, 3> w{};     //!< [1/rad²] 1/S_aa
-    std::array<double, 3> wz{};    //!< [1/rad] w·z
-    std::array<double, 3> wzz{};   //!< [-] w·z²
-    std::array<double, 3> rho{};   //!< [-] 1 − K
-    std::array<double, 3> rho2{};  //!< [-] ρ²
+  struct Sample {                                    //!< per axis
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();     //!< [1/rad²] 1/S_aa
+    Eigen::Vector3d wz = Eigen::Vector3d::Zero();    //!< [1/rad] w·z
+    Eigen::Vector3d wzz = Eigen::Vector3d::Zero();   //!< [-] w·z²
+    Eigen::Vector3d rho = Eigen::Vector3d::Zero();   //!< [-] 1 − K
+    Eigen::Vector3d rho2 = Eigen::Vector3d::Zero();  //!< [-] ρ²
     double turn_rad = 0.0;
   };
   const Sample& at(int k) const {  //!< k-th oldest sample of the window
