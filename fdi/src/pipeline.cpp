@@ -377,12 +377,12 @@ void Pipeline::Impl::publish_attitude() {
   } else {
     a.protection_level_rad = protection_.k_md() * a.sigma_rad;
   }
-  // Href where a drift was matched: the reference's bias the data could not tell from the drift.
+  // Href where a drift was matched: the reference's bias the data could not tell from the drift
   // (what the matches left, and what the reference has pulled the attitude by since the last one).
   if (budget_.ambiguous_rad() > 0.0)
     a.protection_level_rad = a.protection_level_rad.cwiseMax(
         protection_.k_md() * a.sigma_rad +
-        Eigen::Vector3d::Constant(budget_.ambiguous_rad() + pull_.total_rad()));
+        Eigen::Vector3d::Constant(budget_.ambiguous_rad() + pull_.since_rad()));
   health_.protection_level_rad = a.protection_level_rad;
   a.mode = observable ? persistent_mode_ : Mode::kLost;
   a.gyros = observable ? frame_.usable : GyroMask{0};

@@ -141,7 +141,7 @@ void Pipeline::Impl::judge_reference() {
   // The pull is measured over the bias blocks the drift matches judge.
   if (!pull_.started()) pull_.start(frame_.now_ns, attitude_.rate_bias_B_rad_s());
   if (consistency_.bias_start_ns() >= 0 && consistency_.bias_start_ns() != pull_.block_ns())
-    pull_.roll(consistency_.bias_start_ns());
+    pull_.roll(consistency_.bias_start_ns(), attitude_.rate_bias_B_rad_s());
 }
 
 void Pipeline::Impl::apply_reference_verdict(const ReferenceVerdict& v, const Eigen::Vector3d& z,
