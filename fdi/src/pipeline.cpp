@@ -341,6 +341,25 @@ void Pipeline::Impl::publish_attitude() {
     }
   }
   const Quaternion q_propagated_RB = attitude_.q_RB();  // the gyros' step, for the fusion horizon
+  use_reference_sample();
+  publish_filter();
+  auto& a = result_.attitude;
+  a.omega_BR_B_rad_s = attitude_.omega_BR_B();
+  a.stamp_ns = frame_.now_ns;
+  a.q_RB = attitude_.q_RB();
+  a.sigma_rad = attitude_.sigma_rad();
+  if (trend_.active()) a.sigma_rad = root_sum_square(a.sigma_rad, trend_.bound(frame_.now_ns));
+  if (budget_.active()) a.sigma_rad = root_sum_square(a.sigma_rad, budget_.sigma_rad());
+  a.protection_level_rad = protection_level(observable, a.sigma_rad);
+  health_.protection_level_rad = a.protection_level_rad;
+  a.mode = observable ? persistent_mode_ : Mode::kLost;
+  a.gyros = observable ? frame_.usable : GyroMask{0};
+  health_.used = a.gyros;
+  attitude_.finish_epoch();
+  horizon_.record(frame_.now_ns, q_propagated_RB, attitude_.q_RB());
+}
+
+void Pipeline::Impl::use_reference_sample() {
   // The reference sample, at this epoch's time, once the attitude is there too.
   if (frame_.reference_q_RB && !reference_usable_) ++health_.counters.reference_rejected;
   if (frame_.reference_q_RB && reference_usable_) {
@@ -361,34 +380,19 @@ void Pipeline::Impl::publish_attitude() {
     if (use == ReferenceUse::kReinitialized) ++health_.counters.reference_reinitialized;
     if (!isolator_.episode().active) attitude_.snapshot_biases(frame_.now_ns);
   }
-  publish_filter();
-  auto& a = result_.attitude;
-  a.omega_BR_B_rad_s = attitude_.omega_BR_B();
-  a.stamp_ns = frame_.now_ns;
-  a.q_RB = attitude_.q_RB();
-  a.sigma_rad = attitude_.sigma_rad();
-  if (trend_.active()) a.sigma_rad = root_sum_square(a.sigma_rad, trend_.bound(frame_.now_ns));
-  if (budget_.active()) a.sigma_rad = root_sum_square(a.sigma_rad, budget_.sigma_rad());
-  if (!observable) {
-    a.protection_level_rad.setConstant(std::numeric_limits<double>::infinity());
-  } else if (subsets_.ready()) {
-    a.protection_level_rad = protection_.bound(subsets_.get(gyro_set_.active()), a.sigma_rad, frame_.now_ns,
-                                               subsets_.sqrt_period());
-  } else {
-    a.protection_level_rad = protection_.k_md() * a.sigma_rad;
-  }
+}
+
+Eigen::Vector3d Pipeline::Impl::protection_level(bool observable, const Eigen::Vector3d& sigma_rad) {
+  if (!observable) return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d pl = subsets_.ready() ? protection_.bound(subsets_.get(gyro_set_.active()), sigma_rad,
+                                                            frame_.now_ns, subsets_.sqrt_period())
+                                        : Eigen::Vector3d(protection_.k_md() * sigma_rad);
   // Href where a drift was matched: the reference's bias the data could not tell from the drift
   // (what the matches left, and what the reference has pulled the attitude by since the last one).
   if (budget_.ambiguous_rad() > 0.0)
-    a.protection_level_rad = a.protection_level_rad.cwiseMax(
-        protection_.k_md() * a.sigma_rad +
-        Eigen::Vector3d::Constant(budget_.ambiguous_rad() + pull_.since_rad()));
-  health_.protection_level_rad = a.protection_level_rad;
-  a.mode = observable ? persistent_mode_ : Mode::kLost;
-  a.gyros = observable ? frame_.usable : GyroMask{0};
-  health_.used = a.gyros;
-  attitude_.finish_epoch();
-  horizon_.record(frame_.now_ns, q_propagated_RB, attitude_.q_RB());
+    pl = pl.cwiseMax(protection_.k_md() * sigma_rad +
+                     Eigen::Vector3d::Constant(budget_.ambiguous_rad() + pull_.since_rad()));
+  return pl;
 }
 
 void Pipeline::Impl::publish_filter() {

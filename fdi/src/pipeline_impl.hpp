@@ -136,6 +136,11 @@ class Pipeline::Impl {
   void isolate_filter_bias(const ReferenceFinding& bias);
   void decide_episode();
   void publish_attitude();
+  //! The reference sample of this epoch, judged usable, into the attitude (and the pull, the budget, the
+  //! anchor).
+  void use_reference_sample();
+  //! [rad] per axis: the published protection level for the published `sigma_rad`.
+  Eigen::Vector3d protection_level(bool observable, const Eigen::Vector3d& sigma_rad);
   void publish_filter();
   void publish_filter_health() const;
   void update_fdi_available();

@@ -122,9 +122,9 @@ void Pipeline::Impl::judge_reference() {
     return;
   // The tests write the evidence, the arbiter decides, the reference's state follows.
   const double drift_level = drift_threshold(active);
-  const ReferenceEvidence evidence =
-      consistency_.test_sample(frame_.now_ns, z, S, attitude_.omega_BR_B(),
-                               subsets_.get(active).calibration_rate_fraction, gyros_vouch_);
+  const ReferenceEvidence evidence = consistency_.test_sample(
+      frame_.now_ns, z, S, attitude_.omega_BR_B(),
+      subsets_.calibration_rate_bound(subsets_.get(active), active, attitude_.omega_meas_B()), gyros_vouch_);
   const ReferenceDecision decision =
       consistency_.judged() ? decide_reference(evidence, drift_level, active) : ReferenceDecision::kUse;
   const ReferenceVerdict v = consistency_.decide(frame_.now_ns, z, S, evidence, decision, drift_level);

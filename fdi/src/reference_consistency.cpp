@@ -70,11 +70,9 @@ void ReferenceConsistency::restart_bias_block(std::int64_t now_ns) {
   bias_swz_.setZero();
 }
 
-std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, const Eigen::Vector3d& z,
-                                                         const Eigen::Vector3d& w, double nis,
-                                                         const Eigen::Vector3d& omega,
-                                                         double calibration_fraction,
-                                                         double& bias_statistic) {
+void ReferenceConsistency::accumulate(std::int64_t now_ns, const Eigen::Vector3d& z, const Eigen::Vector3d& w,
+                                      double nis, const Eigen::Vector3d& omega,
+                                      const Eigen::Vector3d& calibration_rad_s) {
   // Blocks: a new one when the last has run its length (the sample opens the next).
   if (block_start_ns_ < 0 || now_ns - block_start_ns_ > seconds_to_ns(config_.reference_window_s)) {
     if (block_start_ns_ >= 0) reaccept_den_ += lag_den_;
@@ -100,12 +98,19 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
   ++bias_count_;
   bias_sw_ += w;
   bias_swz_ += w.cwiseProduct(z);
-  const double dof = 3.0 * block_count_;
-  nis_per_dof_ = block_nis_ / dof;
-  const double turn_rad = last_sample_ns_ < 0 ? 0.0 : omega.norm() * ns_to_seconds(now_ns - last_sample_ns_);
+  nis_per_dof_ = block_nis_ / (3.0 * block_count_);
+  const double since_s = last_sample_ns_ < 0 ? 0.0 : ns_to_seconds(now_ns - last_sample_ns_);
   last_sample_ns_ = now_ns;
-  step_.add(z, w.cwiseInverse(), sigma_rad_ * sigma_rad_, turn_rad);
+  step_.add(z, w.cwiseInverse(), sigma_rad_ * sigma_rad_, calibration_rad_s * since_s);
+}
 
+std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, const Eigen::Vector3d& z,
+                                                         const Eigen::Vector3d& w, double nis,
+                                                         const Eigen::Vector3d& omega,
+                                                         const Eigen::Vector3d& calibration_rad_s,
+                                                         double& bias_statistic) {
+  accumulate(now_ns, z, w, nis, omega, calibration_rad_s);
+  const double dof = 3.0 * block_count_;
   // Lag: z = a − ω·τ with a per-axis offset a; τ̂ = −num/den, var(τ̂) = 1/den.
   double num = 0.0;
   double den = 0.0;
@@ -151,7 +156,7 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
     failed_ = {bias, jump_chi2_, 3};
     return ReferenceCheck::kBias;
   }
-  step_fit_ = step_.evaluate(calibration_fraction, step_.threshold());
+  step_fit_ = step_.evaluate(step_.threshold());
   if (step_fit_.statistic > step_.threshold()) {
     failed_ = {step_fit_.statistic, step_.threshold(), 3};
     return ReferenceCheck::kStep;
@@ -200,14 +205,15 @@ bool ReferenceConsistency::reestimate_noise(std::int64_t now_ns, const Eigen::Ve
 ReferenceEvidence ReferenceConsistency::test_sample(std::int64_t now_ns, const Eigen::Vector3d& z_rad,
                                                     const Eigen::Matrix3d& S,
                                                     const Eigen::Vector3d& omega_rad_s,
-                                                    double calibration_fraction, bool steps_judged) {
+                                                    const Eigen::Vector3d& calibration_rad_s,
+                                                    bool steps_judged) {
   if (!steps_judged) step_.reset();
   const double nis = z_rad.dot(S.ldlt().solve(z_rad));
   const Eigen::Vector3d w = S.diagonal().cwiseInverse();
   ReferenceEvidence e;
   e.used_excess_rad2 = szz_ - sss_;  // before the sample (which may open the next block)
   e.used_count = block_start_ns_ < 0 ? 0 : block_count_;
-  e.failed = test(now_ns, z_rad, w, nis, omega_rad_s, calibration_fraction, e.bias_statistic);
+  e.failed = test(now_ns, z_rad, w, nis, omega_rad_s, calibration_rad_s, e.bias_statistic);
   return e;
 }
 

@@ -75,12 +75,13 @@ class ReferenceConsistency {
   void restart();  //!< windows empty (the gyro set changed, an episode ended); the state kept
 
   //! One sample at `now_ns`: its innovation `z_rad` with covariance `S` and the body rate `omega_rad_s` at
-  //! its time, into the tests' blocks; what they show (nothing decided). `calibration_fraction` [-]: the
-  //! rate error per unit rate the calibration's tolerance allows (Subset::calibration_rate_fraction);
-  //! `steps_judged`: the gyros vouch for their attitude over the step test's window (parity, no episode) —
-  //! without, a gyro's noise or ramp walks the attitude in steps of its own, and the window starts afresh.
+  //! its time, into the tests' blocks; what they show (nothing decided). `calibration_rad_s` [rad/s] per
+  //! axis: the rate error the calibration's tolerance allows at that rate
+  //! (SubsetCache::calibration_rate_bound); `steps_judged`: the gyros vouch for their attitude over the step
+  //! test's window (parity, no episode) — without, a gyro's noise or ramp walks the attitude in steps of its
+  //! own, and the window starts afresh.
   ReferenceEvidence test_sample(std::int64_t now_ns, const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S,
-                                const Eigen::Vector3d& omega_rad_s, double calibration_fraction,
+                                const Eigen::Vector3d& omega_rad_s, const Eigen::Vector3d& calibration_rad_s,
                                 bool steps_judged);
   //! Whether the arbiter decides this sample: the reference is not rejected (a rejected one is used again
   //! here, once its samples pass every test for a block).
@@ -124,8 +125,12 @@ class ReferenceConsistency {
   //! The first test that fails over the blocks with this sample in, or none.
   //! (`bias_statistic` the bias test's χ²₃, left as it is when the test is not reached).
   std::optional<ReferenceCheck> test(std::int64_t now_ns, const Eigen::Vector3d& z, const Eigen::Vector3d& w,
-                                     double nis, const Eigen::Vector3d& omega, double calibration_fraction,
-                                     double& bias_statistic);
+                                     double nis, const Eigen::Vector3d& omega,
+                                     const Eigen::Vector3d& calibration_rad_s, double& bias_statistic);
+  //! The sample into the blocks (the nis and lag block, the bias block, the step test's window), each
+  //! started afresh once it has run its length.
+  void accumulate(std::int64_t now_ns, const Eigen::Vector3d& z, const Eigen::Vector3d& w, double nis,
+                  const Eigen::Vector3d& omega, const Eigen::Vector3d& calibration_rad_s);
   void restart_blocks(std::int64_t now_ns);
   //! A sample used: its innovation's second moment against the predicted one, into the block.
   void add_used(const Eigen::Vector3d& z_rad, const Eigen::Matrix3d& S);
@@ -159,10 +164,10 @@ class ReferenceConsistency {
   int noise_count_ = 0;                                     //!< differences in the block
   Eigen::Vector3d last_z_ = Eigen::Vector3d::Zero();  //!< [rad] the previous rejected sample's innovation
   bool have_last_z_ = false;
-  bool noise_explained_ = false;  //!< the last block's estimate is within sigma_rad_
-  CheckValue failed_;             //!< the last test's statistic and threshold
-  ReferenceStep step_;            //!< the step test's window
-  StepFit step_fit_;              //!< its best onset at the last sample
+  bool noise_explained_ = false;      //!< the last block's estimate is within sigma_rad_
+  CheckValue failed_;                 //!< the last test's statistic and threshold
+  ReferenceStep step_;                //!< the step test's window
+  StepFit step_fit_;                  //!< its best onset at the last sample
   std::int64_t last_sample_ns_ = -1;  //!< the previous sample tested (the rotation since, for the step test)
 
   // the nis and lag block (reference_window_s)

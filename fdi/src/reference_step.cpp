@@ -13,7 +13,7 @@ ReferenceStep::ReferenceStep(const PipelineConfig& config)
           1.0 - allocated_probability(config, BudgetTest::kReferenceCheck) / kCapacity, 3.0)) {}
 
 void ReferenceStep::add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_rad2,
-                        double reference_var_rad2, double turn_rad) {
+                        double reference_var_rad2, const Eigen::Vector3d& calibration_rad) {
   Sample& s = ring_[static_cast<std::size_t>(head_)];
   for (int a = 0; a < 3; ++a) {
     const double w = 1.0 / s_rad2[a];
@@ -23,24 +23,23 @@ void ReferenceStep::add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_r
     s.rho[a] = std::min(reference_var_rad2 * w, 1.0);
     s.rho2[a] = s.rho[a] * s.rho[a];
   }
-  s.turn_rad = turn_rad;
+  s.calibration_rad = calibration_rad;
   head_ = (head_ + 1) % kCapacity;
   count_ = std::min(count_ + 1, kCapacity);
 }
 
-StepFit ReferenceStep::evaluate(double calibration_fraction, double level) const {
+StepFit ReferenceStep::evaluate(double level) const {
   StepFit best;
   const int m = count_;
   if (m < 3) return best;  // a step and two residual degrees of freedom per axis at least
-  // Σwz² per axis over the window, and the rotation from its first sample to its last.
+  // Σwz² per axis over the window, and what the calibration allows from its first sample to its last.
   Eigen::Vector3d q0 = Eigen::Vector3d::Zero();
-  double turn = 0.0;
+  Eigen::Vector3d allowed = Eigen::Vector3d::Zero();  // [rad] β
   for (int k = 0; k < m; ++k) {
     const Sample& s = at(k);
     for (int a = 0; a < 3; ++a) q0[a] += s.wzz[a];
-    if (k > 0) turn += s.turn_rad;
+    if (k > 0) allowed += s.calibration_rad;
   }
-  const double allowed = calibration_fraction * turn;  // [rad] a calibration's step within its tolerance
   // Onsets from the newest back: A = Σ w g z, C = Σ w g² from the onset on (g_j = 1, g_{k+1} = ρ_k·g_k),
   // and Π ρ the share of the step the filter has not yet taken. The residual ratio only lowers a term, so an
   // onset whose terms without it stay below `level` (and the best so far) is passed over.
@@ -48,12 +47,12 @@ StepFit ReferenceStep::evaluate(double calibration_fraction, double level) const
   Eigen::Vector3d left = Eigen::Vector3d::Ones();
   for (int j = m - 1; j >= 0; --j) {
     const Sample& s = at(j);
-    Eigen::Vector3d reach;  // max(0, |A| − f·θ·C)²: the term times C, without a division
+    Eigen::Vector3d reach;  // max(0, |A| − β·C)²: the term times C, without a division
     for (int a = 0; a < 3; ++a) {
       a_sum[a] = s.wz[a] + s.rho[a] * a_sum[a];
       c_sum[a] = s.w[a] + s.rho2[a] * c_sum[a];
       if (j < m - 1) left[a] *= s.rho[a];
-      const double r = std::max(0.0, std::abs(a_sum[a]) - allowed * c_sum[a]);
+      const double r = std::max(0.0, std::abs(a_sum[a]) - allowed[a] * c_sum[a]);
       reach[a] = r * r;
     }
     // Σ reach_a/C_a ≤ the level, multiplied through by C₀C₁C₂ (with a margin far above the rounding).
@@ -63,7 +62,7 @@ StepFit ReferenceStep::evaluate(double calibration_fraction, double level) const
     double statistic = 0.0;
     for (int a = 0; a < 3; ++a) {
       step[a] = a_sum[a] / c_sum[a];
-      const double beyond = std::max(0.0, std::abs(step[a]) - allowed);
+      const double beyond = std::max(0.0, std::abs(step[a]) - allowed[a]);
       term[a] = beyond * beyond * c_sum[a];
     }
     for (int a = 0; a < 3; ++a) {

@@ -9,10 +9,11 @@
 // ĉ = Σwgz/Σwg² (w = 1/S_aa) and, under a good reference (white innovations of covariance S), ĉ²·Σwg² is
 // χ²₁. Two things a good reference does that can look like a step are allowed for:
 //   - a calibration within calibration_error_sigmas of its stated σ turns the gyros' attitude by at most
-//     f·θ (f the subset's calibration_rate_fraction, θ the rotation in the window): |ĉ| less that bound;
+//     β_a, its rate bound integrated over the window (SubsetCache::calibration_rate_bound, the bound sigma
+//     integrates too): |ĉ_a| less that;
 //   - a noisier unit or reference scales the innovations: each axis's term is divided by its residual
 //     variance ratio r̂_a about the fit (when above 1), so the test sees a step's shape, `nis` the scale.
-//   statistic = max_j Σ_a max(0, |ĉ_a| − f·θ)²·Σwg² / max(1, r̂_a,j)  >  χ²₃(1 − p/M)
+//   statistic = max_j Σ_a max(0, |ĉ_a| − β_a)²·Σwg² / max(1, r̂_a,j)  >  χ²₃(1 − p/M)
 // (M onsets searched, p the budget's kReferenceCheck share: its union bound over the onsets is p per
 // sample). The fit's ĉ and the share of it the filter has already taken, 1 − Π ρ, are what a rejection
 // puts into the attitude's variance and the reference's budget (reference_budget.hpp).
@@ -39,24 +40,23 @@ class ReferenceStep {
 
   void reset() { count_ = 0; }  //!< the window empty
   //! One sample: its innovation `z_rad` [rad], its covariance's diagonal `s_rad2` [rad²], the reference's
-  //! variance `reference_var_rad2` [rad²] (the filter's gain is 1 − that over S) and `turn_rad` [rad] the
-  //! body's rotation since the previous sample.
+  //! variance `reference_var_rad2` [rad²] (the filter's gain is 1 − that over S) and `calibration_rad` [rad]
+  //! per axis the attitude error the calibration's tolerance allows since the previous sample.
   void add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_rad2, double reference_var_rad2,
-           double turn_rad);
+           const Eigen::Vector3d& calibration_rad);
   //! The best onset over the window beyond `level` (the test's threshold, or a lower one to see the
-  //! statistic's distribution), with `calibration_fraction` [-] the rate error per unit rate a calibration
-  //! within its tolerance can leave (Subset::calibration_rate_fraction).
-  StepFit evaluate(double calibration_fraction, double level) const;
+  //! statistic's distribution).
+  StepFit evaluate(double level) const;
   double threshold() const { return threshold_; }  //!< χ²₃(1 − p/M)
 
  private:
-  struct Sample {                                    //!< per axis
-    Eigen::Vector3d w = Eigen::Vector3d::Zero();     //!< [1/rad²] 1/S_aa
-    Eigen::Vector3d wz = Eigen::Vector3d::Zero();    //!< [1/rad] w·z
-    Eigen::Vector3d wzz = Eigen::Vector3d::Zero();   //!< [-] w·z²
-    Eigen::Vector3d rho = Eigen::Vector3d::Zero();   //!< [-] 1 − K
-    Eigen::Vector3d rho2 = Eigen::Vector3d::Zero();  //!< [-] ρ²
-    double turn_rad = 0.0;
+  struct Sample {                                               //!< per axis
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();                //!< [1/rad²] 1/S_aa
+    Eigen::Vector3d wz = Eigen::Vector3d::Zero();               //!< [1/rad] w·z
+    Eigen::Vector3d wzz = Eigen::Vector3d::Zero();              //!< [-] w·z²
+    Eigen::Vector3d rho = Eigen::Vector3d::Zero();              //!< [-] 1 − K
+    Eigen::Vector3d rho2 = Eigen::Vector3d::Zero();             //!< [-] ρ²
+    Eigen::Vector3d calibration_rad = Eigen::Vector3d::Zero();  //!< [rad] allowed since the previous sample
   };
   const Sample& at(int k) const {  //!< k-th oldest sample of the window
     return ring_[static_cast<std::size_t>((head_ + kCapacity - count_ + k) % kCapacity)];

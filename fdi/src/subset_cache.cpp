@@ -293,12 +293,6 @@ void SubsetCache::build(Subset& s, GyroMask mask) const {
     if (has_gyro(mask, i + 1)) s.calibration_bias_bound += s.parity_col_norm[i] * bias_sigma_rad_s_[i];
   }
   s.calibration_bias_bound *= config.calibration_error_sigmas * sqrt_period_;
-  Eigen::Vector3d per_rate = Eigen::Vector3d::Zero();
-  for (int i = 0; i < n; ++i) {
-    if (has_gyro(mask, i + 1))
-      per_rate += s.pinv.col(i).cwiseAbs() * (scale_rel_sigma_[i] + axis_sigma_.col(i).norm());
-  }
-  s.calibration_rate_fraction = config.calibration_error_sigmas * per_rate.maxCoeff();
   for (int i = 0; i < n; ++i) {  // the stated ramps over the horizon, each of either sign
     if (has_gyro(mask, i + 1))
       s.calibration_bias_bound += s.parity_col_norm[i] * ramp_bound_rad_s_[i] * sqrt_period_;

@@ -54,10 +54,6 @@ struct Subset {
   //! (e) of their stated 1σ σ_β,i, e·√T·Σ_{i∈S} |w_i|·σ_β,i; the stated ramps over the horizon,
   //! √T·Σ|w_i|·R_i·H; and a wander beyond the average's reach, e·s (`wander_averaged` false)
   double calibration_bias_bound = 0.0;
-  //! [-] the body-rate error per unit body rate a calibration within calibration_error_sigmas (e) of its
-  //! stated σ can leave in the rate estimate: e·max_a Σ_{i∈S} |H*(a, i)|·(σ_s,i + |σ_h,i|), scale factor and
-  //! axis (0 without stated σ): what the gyros' attitude may turn by per radian turned
-  double calibration_rate_fraction = 0.0;
   int level_epochs = 1;            //!< epochs an episode's parity level is averaged over before it is held
   double level_k = 0.0;            //!< [σ] reference of the CUSUM on the parity minus the held level
   double level_h = 0.0;            //!< [σ] its threshold

@@ -135,8 +135,8 @@ TEST(PerturbationFamilies, Gap) {
   check_family(sim::Family::kGap, 18);
 }
 // A reference bias of 10–40″: a step is caught by the step test from about 10″ (6 of 8 at 10″, all from 12″;
-// the rest the filter follows within its noise), a ramp over 20–60 s is a common drift to the data (matched, the
-// reference kept: sigma the drift's, the protection level the reference's from the match on); a late
+// the rest the filter follows within its noise), a ramp over 20–60 s is a common drift to the data (matched,
+// the reference kept: sigma the drift's, the protection level the reference's from the match on); a late
 // reference at a steady rate is an offset: docs/fdi.md, "Reference consistency", Limits. Before a flag the
 // protection level takes the reference samples it anchors on as true.
 TEST(PerturbationFamilies, Reference) {

@@ -19,9 +19,10 @@ constexpr double kAttitudeVar_rad2 = 0.7 * kArcsecToRad * kArcsecToRad;  //!< P 
 constexpr double kS_rad2 = kSigmaRef_rad * kSigmaRef_rad + kAttitudeVar_rad2;
 
 //! `samples` innovations of a good reference (N(0, S) per axis, times `noise_scale`), then a step of
-//! `step_rad` per axis from sample `onset` on, absorbed by the filter at its gain (ρ = σ²/S per sample).
+//! `step_rad` per axis from sample `onset` on, absorbed by the filter at its gain (ρ = σ²/S per sample),
+//! the calibration allowing `calibration_rad` on each axis at the onset.
 fdi::detail::ReferenceStep window(std::mt19937_64& rng, int samples, double noise_scale,
-                                  const Eigen::Vector3d& step_rad, int onset, double turn_rad = 0.0) {
+                                  const Eigen::Vector3d& step_rad, int onset, double calibration_rad = 0.0) {
   fdi::detail::ReferenceStep step{fdi::PipelineConfig{}};
   std::normal_distribution<double> n01(0.0, 1.0);
   const double rho = kSigmaRef_rad * kSigmaRef_rad / kS_rad2;
@@ -34,7 +35,7 @@ fdi::detail::ReferenceStep window(std::mt19937_64& rng, int samples, double nois
       left *= rho;
     }
     step.add(z, Eigen::Vector3d::Constant(kS_rad2), kSigmaRef_rad * kSigmaRef_rad,
-             k == onset ? turn_rad : 0.0);
+             Eigen::Vector3d::Constant(k == onset ? calibration_rad : 0.0));
   }
   return step;
 }
@@ -49,7 +50,7 @@ TEST(ReferenceStep, AGoodReferenceFailsNoMoreOftenThanTheBudgetAllowsOverManyWin
   constexpr int kWindows = 20000;
   for (int w = 0; w < kWindows; ++w) {
     const auto s = window(rng, fdi::design::reference_step_samples, 1.0, Eigen::Vector3d::Zero(), 0);
-    above += s.evaluate(0.0, threshold).statistic > threshold ? 1 : 0;
+    above += s.evaluate(threshold).statistic > threshold ? 1 : 0;
   }
   const double rate = static_cast<double>(above) / kWindows;
   std::printf("good reference: %d of %d windows beyond the alpha = %.0e threshold (%.3f %%)\n", above,
@@ -67,7 +68,7 @@ TEST(ReferenceStep, AStepOfTwoSigmaOfOneSampleIsFoundAtItsSize) {
   int close = 0;
   for (int seed = 0; seed < 200; ++seed) {
     const auto s = window(rng, fdi::design::reference_step_samples, 1.0, step, 20);
-    const fdi::detail::StepFit f = s.evaluate(0.0, s.threshold());
+    const fdi::detail::StepFit f = s.evaluate(s.threshold());
     found += f.statistic > s.threshold() ? 1 : 0;
     // σ(ĉ) = 1/√(Σ w g²) over the 44 samples from the onset: about 1.1″.
     close += (f.step_rad - step).cwiseAbs().maxCoeff() < 3.0 * 1.2 * kArcsecToRad ? 1 : 0;
@@ -83,13 +84,16 @@ TEST(ReferenceStep, AStepOfTwoSigmaOfOneSampleIsFoundAtItsSize) {
 
 TEST(ReferenceStep, ACalibrationWithinItsToleranceTurningTheBodyIsNoStep) {
   // A 20″ step while the body turned 40° (0.70 rad): what a scale-factor error of 1.4e-4 leaves in the
-  // gyros' attitude. A calibration whose tolerance allows 3e-4 per radian turned (43″ over the turn) makes
-  // it no step; one stated exact (0) leaves it a step.
+  // gyros' attitude. A calibration whose tolerance allows 3e-4 of the turn (43″ on each axis) makes it no
+  // step; one stated exact (nothing allowed) leaves it a step.
   const Eigen::Vector3d step(20.0 * kArcsecToRad, 0.0, 0.0);
   std::mt19937_64 rng(11);
-  const auto s = window(rng, fdi::design::reference_step_samples, 1.0, step, 30, 40.0 * kDegToRad);
-  EXPECT_LT(s.evaluate(3e-4, s.threshold()).statistic, s.threshold());
-  EXPECT_GT(s.evaluate(0.0, s.threshold()).statistic, s.threshold());
+  const auto allowed =
+      window(rng, fdi::design::reference_step_samples, 1.0, step, 30, 3e-4 * 40.0 * kDegToRad);
+  EXPECT_LT(allowed.evaluate(allowed.threshold()).statistic, allowed.threshold());
+  std::mt19937_64 same(11);
+  const auto exact = window(same, fdi::design::reference_step_samples, 1.0, step, 30);
+  EXPECT_GT(exact.evaluate(exact.threshold()).statistic, exact.threshold());
 }
 
 TEST(ReferenceStep, AReferenceThreeTimesNoisierThanModelledIsNoStep) {
@@ -100,7 +104,7 @@ TEST(ReferenceStep, AReferenceThreeTimesNoisierThanModelledIsNoStep) {
   int above = 0;
   for (int w = 0; w < 2000; ++w) {
     const auto s = window(rng, fdi::design::reference_step_samples, 3.0, Eigen::Vector3d::Zero(), 0);
-    above += s.evaluate(0.0, s.threshold()).statistic > s.threshold() ? 1 : 0;
+    above += s.evaluate(s.threshold()).statistic > s.threshold() ? 1 : 0;
   }
   EXPECT_EQ(above, 0);
 }
@@ -109,11 +113,11 @@ TEST(ReferenceStep, TooFewSamplesJudgeNothingAndAResetEmptiesTheWindow) {
   std::mt19937_64 rng(17);
   const Eigen::Vector3d step = Eigen::Vector3d::Constant(1e-3);  // 206″: any window of three would show it
   auto s = window(rng, 2, 1.0, step, 0);
-  EXPECT_EQ(s.evaluate(0.0, s.threshold()).statistic, 0.0);
+  EXPECT_EQ(s.evaluate(s.threshold()).statistic, 0.0);
   s = window(rng, 10, 1.0, step, 0);
-  EXPECT_GT(s.evaluate(0.0, s.threshold()).statistic, s.threshold());
+  EXPECT_GT(s.evaluate(s.threshold()).statistic, s.threshold());
   s.reset();
-  EXPECT_EQ(s.evaluate(0.0, s.threshold()).statistic, 0.0);
+  EXPECT_EQ(s.evaluate(s.threshold()).statistic, 0.0);
 }
 
 }  // namespace
