@@ -40,46 +40,84 @@ Spacecraft::Spacecraft(const ClosedLoopSpec& spec, double orbit_period_s)
       disturbance_(spec.disturbance),
       orbit_rate_rad_s_(2.0 * kPi / orbit_period_s) {}
 
-Eigen::Vector3d Spacecraft::disturbance_B_Nm(const Quaternion& q_NB, double t_s) const {
+Spacecraft::TimeTerms Spacecraft::at_time(double t_s) const {
   const double n = orbit_rate_rad_s_;
-  Eigen::Vector3d tau = disturbance_.constant_Nm + disturbance_.periodic_Nm * std::sin(n * t_s);
+  TimeTerms at;
+  at.tau_B_Nm = disturbance_.constant_Nm + disturbance_.periodic_Nm * std::sin(n * t_s);
+  // Zenith = −Z of the orbit frame; in B through N.
+  if (disturbance_.gravity_gradient) at.zenith_N = orbit_frame_q_NO(n, t_s) * Eigen::Vector3d(0.0, 0.0, -1.0);
+  return at;
+}
+
+Eigen::Vector3d Spacecraft::disturbance_B_Nm(const Quaternion& q_NB, const TimeTerms& at) const {
+  const double n = orbit_rate_rad_s_;
+  Eigen::Vector3d tau = at.tau_B_Nm;
   if (disturbance_.gravity_gradient) {
-    // Zenith = −Z of the orbit frame; in B through N.
-    const Eigen::Vector3d zenith_N = orbit_frame_q_NO(n, t_s) * Eigen::Vector3d(0.0, 0.0, -1.0);
-    const Eigen::Vector3d r_B = q_NB.conjugate() * zenith_N;
+    const Eigen::Vector3d r_B = q_NB.conjugate() * at.zenith_N;
     tau += 3.0 * n * n * r_B.cross(inertia_ * r_B);
   }
   return tau;
 }
 
-Spacecraft::Derivative Spacecraft::derivative(const Eigen::Vector4d& q_wxyz, const Eigen::Vector3d& omega,
-                                              const Eigen::VectorXd& h, const Eigen::VectorXd& tau_w,
-                                              double t_s) const {
-  const Quaternion q = quat_from(q_wxyz).normalized();
-  Derivative d;
-  const Quaternion q_dot = quat_from(q_wxyz) * Quaternion(0.0, omega.x(), omega.y(), omega.z());
-  d.q_dot = 0.5 * wxyz_of(q_dot);
-  const Eigen::Vector3d h_B = axes_B_ * h;
-  const Eigen::Vector3d tau_ext = disturbance_B_Nm(q, t_s);
-  d.omega_dot = inertia_inv_ * (tau_ext - axes_B_ * tau_w - omega.cross(inertia_ * omega + h_B));
-  d.h_dot = tau_w;
-  return d;
+namespace {
+
+//! [in B] G·v over the wheels (`v` n values along their axes), summed as Eigen's general matrix-vector
+//! product sums a 3×n product (each row from 0, wheel by wheel): the same bits, without the call.
+Eigen::Vector3d wheels_in_body(const Eigen::MatrixXd& G, const double* v, Eigen::Index n) {
+  Eigen::Vector3d out;
+  for (int a = 0; a < 3; ++a) {
+    double sum = 0.0;
+    for (Eigen::Index j = 0; j < n; ++j) sum += G(a, j) * v[j];
+    out[a] = sum;
+  }
+  return out;
 }
 
-void Spacecraft::step(BodyState& s, const Eigen::VectorXd& tau_w, double t_s, double dt_s) const {
-  const Eigen::Vector4d q0 = wxyz_of(s.q_NB);
-  const Derivative k1 = derivative(q0, s.omega_BN_B_rad_s, s.h_wheels_Nms, tau_w, t_s);
+//! The state's derivative at one point of a step (the wheels' ḣ is the held τ_w itself).
+struct Derivative {
+  Eigen::Vector4d q_dot;  //!< (w, x, y, z)
+  Eigen::Vector3d omega_dot;
+};
+
+}  // namespace
+
+template <typename WheelVector>
+void Spacecraft::integrate(BodyState& s, const Eigen::VectorXd& tau_w, double t_s, double dt_s) const {
+  const Eigen::Vector3d tau_wheels_B_Nm = wheels_in_body(axes_B_, tau_w.data(), tau_w.size());  // held
+  const auto derivative = [&](const Eigen::Vector4d& q_wxyz, const Eigen::Vector3d& omega,
+                              const WheelVector& h, const TimeTerms& at) {
+    const Quaternion q = quat_from(q_wxyz).normalized();
+    Derivative d;
+    const Quaternion q_dot = quat_from(q_wxyz) * Quaternion(0.0, omega.x(), omega.y(), omega.z());
+    d.q_dot = 0.5 * wxyz_of(q_dot);
+    const Eigen::Vector3d h_B = wheels_in_body(axes_B_, h.data(), h.size());
+    const Eigen::Vector3d tau_ext = disturbance_B_Nm(q, at);
+    d.omega_dot = inertia_inv_ * (tau_ext - tau_wheels_B_Nm - omega.cross(inertia_ * omega + h_B));
+    return d;
+  };
   const double h2 = 0.5 * dt_s;
-  const Derivative k2 = derivative(q0 + h2 * k1.q_dot, s.omega_BN_B_rad_s + h2 * k1.omega_dot,
-                                   s.h_wheels_Nms + h2 * k1.h_dot, tau_w, t_s + h2);
-  const Derivative k3 = derivative(q0 + h2 * k2.q_dot, s.omega_BN_B_rad_s + h2 * k2.omega_dot,
-                                   s.h_wheels_Nms + h2 * k2.h_dot, tau_w, t_s + h2);
-  const Derivative k4 = derivative(q0 + dt_s * k3.q_dot, s.omega_BN_B_rad_s + dt_s * k3.omega_dot,
-                                   s.h_wheels_Nms + dt_s * k3.h_dot, tau_w, t_s + dt_s);
+  const TimeTerms start = at_time(t_s), middle = at_time(t_s + h2), end = at_time(t_s + dt_s);
+  const Eigen::Vector4d q0 = wxyz_of(s.q_NB);
+  const WheelVector h0 = s.h_wheels_Nms;
+  const WheelVector h_mid = h0 + h2 * tau_w;  // h + h2·ḣ of k1 and of k2: ḣ is τ_w at every point
+  const Derivative k1 = derivative(q0, s.omega_BN_B_rad_s, h0, start);
+  const Derivative k2 = derivative(q0 + h2 * k1.q_dot, s.omega_BN_B_rad_s + h2 * k1.omega_dot, h_mid, middle);
+  const Derivative k3 = derivative(q0 + h2 * k2.q_dot, s.omega_BN_B_rad_s + h2 * k2.omega_dot, h_mid, middle);
+  const WheelVector h_end = h0 + dt_s * tau_w;
+  const Derivative k4 = derivative(q0 + dt_s * k3.q_dot, s.omega_BN_B_rad_s + dt_s * k3.omega_dot, h_end, end);
   const double w = dt_s / 6.0;
   s.q_NB = canonical(quat_from(q0 + w * (k1.q_dot + 2.0 * k2.q_dot + 2.0 * k3.q_dot + k4.q_dot)));
   s.omega_BN_B_rad_s += w * (k1.omega_dot + 2.0 * k2.omega_dot + 2.0 * k3.omega_dot + k4.omega_dot);
-  s.h_wheels_Nms += w * (k1.h_dot + 2.0 * k2.h_dot + 2.0 * k3.h_dot + k4.h_dot);
+  s.h_wheels_Nms += w * (tau_w + 2.0 * tau_w + 2.0 * tau_w + tau_w);
+}
+
+void Spacecraft::step(BodyState& s, const Eigen::VectorXd& tau_w, double t_s, double dt_s) const {
+  constexpr int kStackWheels = 4;  // the most a spec validates (closed_loop_spec.cpp)
+  using StackWheels = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kStackWheels, 1>;
+  if (s.h_wheels_Nms.size() <= kStackWheels && tau_w.size() == s.h_wheels_Nms.size())
+    integrate<StackWheels>(s, tau_w, t_s, dt_s);
+  else
+    integrate<Eigen::VectorXd>(s, tau_w, t_s, dt_s);
 }
 
 }  // namespace tetra::sim

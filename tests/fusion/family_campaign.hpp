@@ -39,6 +39,8 @@ struct FamilyVerdict {
   double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
   int beyond_protection = 0;              //!< axis-epochs with |e| above the (finite) protection level
   double worst_protection_ratio = 0.0;    //!< largest |e|/PL of an axis (0 where PL is +∞)
+  double beyond_from_s = -1.0;            //!< [s] the first and last epoch above it (−1: none)
+  double beyond_until_s = -1.0;
   std::optional<double> flagged_after_s;  //!< [s] first detection, reference rejection or noise_model after
                                           //!< the perturbation began
   //! Sigma meets the per-run criterion over the epochs from the first flag on: what the perturbation did
@@ -61,6 +63,8 @@ struct Honesty {
   double worst_error_deg = 0.0;                    //!< [deg] largest |e| of an axis
   int beyond_protection = 0;                       //!< axis-epochs with |e| above the protection level
   double worst_protection_ratio = 0.0;             //!< largest |e|/PL of an axis
+  double beyond_from_s = -1.0;                     //!< [s] the first and last epoch above it (−1: none)
+  double beyond_until_s = -1.0;
 };
 
 inline Honesty honesty(const CampaignRun& run, double from_s) {
@@ -81,6 +85,10 @@ inline Honesty honesty(const CampaignRun& run, double from_s) {
       const bool alarm = run.mode[k] == fdi::Mode::kSuspect || run.mode[k] == fdi::Mode::kLost;
       const double pl = alarm ? 0.0 : std::abs(run.error_rad[k][a]) / run.protection_level_rad[k][a];
       h.beyond_protection += pl > 1.0 ? 1 : 0;
+      if (pl > 1.0) {
+        if (h.beyond_from_s < 0.0) h.beyond_from_s = run.time_s[k];
+        h.beyond_until_s = run.time_s[k];
+      }
       h.worst_protection_ratio = std::max(h.worst_protection_ratio, pl);
     }
   }
@@ -143,6 +151,8 @@ inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
   v.worst_sigmas = whole.worst_sigmas;
   v.beyond_protection = whole.beyond_protection;
   v.worst_protection_ratio = whole.worst_protection_ratio;
+  v.beyond_from_s = whole.beyond_from_s;
+  v.beyond_until_s = whole.beyond_until_s;
   if (v.flagged_after_s) {
     const Honesty after = honesty(run, std::max(kHonestyFrom_s, start + *v.flagged_after_s));
     v.honest_after_flag = after.within >= kMinWithin3Sigma && after.nees.maxCoeff() <= kMaxNeesPerAxis;

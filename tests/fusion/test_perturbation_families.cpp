@@ -284,11 +284,11 @@ TEST(PerturbationFamilies, ShowOneRun) {
   for (const bool twin : {false, true}) {
     const test::FamilyVerdict f = test::judge_run(twin ? sim::unperturbed_twin(r) : r);
     std::printf(
-        "%s%s: within 3 sigma %.2f %%, NEES %.2f %.2f %.2f, worst %.1f sigma, >PL %d (|e|/PL %.2f), "
-        "flagged after %.1f s\n%s",
+        "%s%s: within 3 sigma %.2f %%, NEES %.2f %.2f %.2f, worst %.1f sigma, >PL %d (|e|/PL %.2f; "
+        "%.1f-%.1f s), flagged after %.1f s\n%s",
         twin ? "twin of " : "", r.label.c_str(), 100.0 * f.within, f.nees.x(), f.nees.y(), f.nees.z(),
-        f.worst_sigmas, f.beyond_protection, f.worst_protection_ratio, f.flagged_after_s.value_or(-1.0),
-        f.events.c_str());
+        f.worst_sigmas, f.beyond_protection, f.worst_protection_ratio, f.beyond_from_s, f.beyond_until_s,
+        f.flagged_after_s.value_or(-1.0), f.events.c_str());
   }
 }
 

@@ -7,7 +7,9 @@
 // G (3×n) holds the wheel spin axes in B; H_w_B = G·h_w. The external torque τ_ext is the sum of the
 // disturbances (constant, orbital-periodic, gravity gradient 3n²·r̂ × I·r̂ with r̂ the zenith unit
 // vector in B). Integrated by classic fixed-step RK4 (the quaternion renormalized after each step);
-// the wheel torques are held over a control period (zero-order hold).
+// the wheel torques are held over a control period (zero-order hold). The disturbance's terms that depend
+// on time alone are computed once per distinct time of a step (RK4's two midpoints share theirs), G·τ_w
+// once per step, and the wheel vectors of a step live on the stack (no allocation per step).
 
 #include <vector>
 
@@ -35,7 +37,9 @@ class Spacecraft {
   Spacecraft(const ClosedLoopSpec& spec, double orbit_period_s);
 
   //! [N·m] external torque in B at time t for the attitude q_NB.
-  Eigen::Vector3d disturbance_B_Nm(const Quaternion& q_NB, double t_s) const;
+  Eigen::Vector3d disturbance_B_Nm(const Quaternion& q_NB, double t_s) const {
+    return disturbance_B_Nm(q_NB, at_time(t_s));
+  }
   //! Integrates `state` from t to t + dt with the wheel motor torques `tau_wheels_Nm` held.
   void step(BodyState& state, const Eigen::VectorXd& tau_wheels_Nm, double t_s, double dt_s) const;
 
@@ -44,13 +48,17 @@ class Spacecraft {
   double orbit_rate_rad_s() const { return orbit_rate_rad_s_; }
 
  private:
-  struct Derivative {
-    Eigen::Vector4d q_dot;  //!< (w, x, y, z)
-    Eigen::Vector3d omega_dot;
-    Eigen::VectorXd h_dot;
+  //! What the external torque at a time needs of the time alone.
+  struct TimeTerms {
+    Eigen::Vector3d tau_B_Nm = Eigen::Vector3d::Zero();  //!< [N·m] in B: constant + periodic
+    Eigen::Vector3d zenith_N = Eigen::Vector3d::Zero();  //!< [-] the zenith in N (gravity gradient)
   };
-  Derivative derivative(const Eigen::Vector4d& q_wxyz, const Eigen::Vector3d& omega, const Eigen::VectorXd& h,
-                        const Eigen::VectorXd& tau_w, double t_s) const;
+  TimeTerms at_time(double t_s) const;
+  Eigen::Vector3d disturbance_B_Nm(const Quaternion& q_NB, const TimeTerms& at) const;
+  //! One RK4 step with the wheel vectors of type `WheelVector` (on the stack for the 3 or 4 wheels a spec
+  //! validates; Eigen::VectorXd otherwise).
+  template <typename WheelVector>
+  void integrate(BodyState& state, const Eigen::VectorXd& tau_wheels_Nm, double t_s, double dt_s) const;
 
   Eigen::Matrix3d inertia_;
   Eigen::Matrix3d inertia_inv_;
