@@ -63,9 +63,7 @@ const ControlOutput& ClosedLoopSimulator::control(const std::optional<AttitudeKn
   const double dynamics_hz = scenario_.closed_loop->dynamics_hz;
   const auto steps = std::max<long long>(1, std::llround(std::ceil(dynamics_hz * period_s - 1e-9)));
   const double h = period_s / static_cast<double>(steps);
-  for (long long i = 0; i < steps; ++i) {
-    spacecraft_.step(state_, last_control_.tau_wheels_Nm, t0 + static_cast<double>(i) * h, h);
-  }
+  spacecraft_.advance(state_, last_control_.tau_wheels_Nm, t0, h, steps);
   ++k_;
   awaiting_control_ = false;
   return last_control_;

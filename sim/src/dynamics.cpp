@@ -82,7 +82,8 @@ struct Derivative {
 }  // namespace
 
 template <typename WheelVector>
-void Spacecraft::integrate(BodyState& s, const Eigen::VectorXd& tau_w, double t_s, double dt_s) const {
+void Spacecraft::integrate(BodyState& s, const Eigen::VectorXd& tau_w, double t0_s, double dt_s,
+                           long long steps) const {
   const Eigen::Vector3d tau_wheels_B_Nm = wheels_in_body(axes_B_, tau_w.data(), tau_w.size());  // held
   const auto derivative = [&](const Eigen::Vector4d& q_wxyz, const Eigen::Vector3d& omega,
                               const WheelVector& h, const TimeTerms& at) {
@@ -96,28 +97,40 @@ void Spacecraft::integrate(BodyState& s, const Eigen::VectorXd& tau_w, double t_
     return d;
   };
   const double h2 = 0.5 * dt_s;
-  const TimeTerms start = at_time(t_s), middle = at_time(t_s + h2), end = at_time(t_s + dt_s);
-  const Eigen::Vector4d q0 = wxyz_of(s.q_NB);
-  const WheelVector h0 = s.h_wheels_Nms;
-  const WheelVector h_mid = h0 + h2 * tau_w;  // h + h2·ḣ of k1 and of k2: ḣ is τ_w at every point
-  const Derivative k1 = derivative(q0, s.omega_BN_B_rad_s, h0, start);
-  const Derivative k2 = derivative(q0 + h2 * k1.q_dot, s.omega_BN_B_rad_s + h2 * k1.omega_dot, h_mid, middle);
-  const Derivative k3 = derivative(q0 + h2 * k2.q_dot, s.omega_BN_B_rad_s + h2 * k2.omega_dot, h_mid, middle);
-  const WheelVector h_end = h0 + dt_s * tau_w;
-  const Derivative k4 = derivative(q0 + dt_s * k3.q_dot, s.omega_BN_B_rad_s + dt_s * k3.omega_dot, h_end, end);
-  const double w = dt_s / 6.0;
-  s.q_NB = canonical(quat_from(q0 + w * (k1.q_dot + 2.0 * k2.q_dot + 2.0 * k3.q_dot + k4.q_dot)));
-  s.omega_BN_B_rad_s += w * (k1.omega_dot + 2.0 * k2.omega_dot + 2.0 * k3.omega_dot + k4.omega_dot);
-  s.h_wheels_Nms += w * (tau_w + 2.0 * tau_w + 2.0 * tau_w + tau_w);
+  TimeTerms end;
+  double end_s = kNaN;  // the previous step's end: its terms are this step's start when the times agree
+  for (long long i = 0; i < steps; ++i) {
+    const double t_s = t0_s + static_cast<double>(i) * dt_s;
+    const TimeTerms start = t_s == end_s ? end : at_time(t_s);
+    const TimeTerms middle = at_time(t_s + h2);
+    end_s = t_s + dt_s;
+    end = at_time(end_s);
+    const Eigen::Vector4d q0 = wxyz_of(s.q_NB);
+    const WheelVector h0 = s.h_wheels_Nms;
+    const WheelVector h_mid = h0 + h2 * tau_w;  // h + h2·ḣ of k1 and of k2: ḣ is τ_w at every point
+    const Derivative k1 = derivative(q0, s.omega_BN_B_rad_s, h0, start);
+    const Derivative k2 =
+        derivative(q0 + h2 * k1.q_dot, s.omega_BN_B_rad_s + h2 * k1.omega_dot, h_mid, middle);
+    const Derivative k3 =
+        derivative(q0 + h2 * k2.q_dot, s.omega_BN_B_rad_s + h2 * k2.omega_dot, h_mid, middle);
+    const WheelVector h_end = h0 + dt_s * tau_w;
+    const Derivative k4 =
+        derivative(q0 + dt_s * k3.q_dot, s.omega_BN_B_rad_s + dt_s * k3.omega_dot, h_end, end);
+    const double w = dt_s / 6.0;
+    s.q_NB = canonical(quat_from(q0 + w * (k1.q_dot + 2.0 * k2.q_dot + 2.0 * k3.q_dot + k4.q_dot)));
+    s.omega_BN_B_rad_s += w * (k1.omega_dot + 2.0 * k2.omega_dot + 2.0 * k3.omega_dot + k4.omega_dot);
+    s.h_wheels_Nms += w * (tau_w + 2.0 * tau_w + 2.0 * tau_w + tau_w);
+  }
 }
 
-void Spacecraft::step(BodyState& s, const Eigen::VectorXd& tau_w, double t_s, double dt_s) const {
+void Spacecraft::advance(BodyState& s, const Eigen::VectorXd& tau_w, double t0_s, double dt_s,
+                         long long steps) const {
   constexpr int kStackWheels = 4;  // the most a spec validates (closed_loop_spec.cpp)
   using StackWheels = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kStackWheels, 1>;
   if (s.h_wheels_Nms.size() <= kStackWheels && tau_w.size() == s.h_wheels_Nms.size())
-    integrate<StackWheels>(s, tau_w, t_s, dt_s);
+    integrate<StackWheels>(s, tau_w, t0_s, dt_s, steps);
   else
-    integrate<Eigen::VectorXd>(s, tau_w, t_s, dt_s);
+    integrate<Eigen::VectorXd>(s, tau_w, t0_s, dt_s, steps);
 }
 
 }  // namespace tetra::sim

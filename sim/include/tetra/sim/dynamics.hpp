@@ -41,7 +41,12 @@ class Spacecraft {
     return disturbance_B_Nm(q_NB, at_time(t_s));
   }
   //! Integrates `state` from t to t + dt with the wheel motor torques `tau_wheels_Nm` held.
-  void step(BodyState& state, const Eigen::VectorXd& tau_wheels_Nm, double t_s, double dt_s) const;
+  void step(BodyState& state, const Eigen::VectorXd& tau_wheels_Nm, double t_s, double dt_s) const {
+    advance(state, tau_wheels_Nm, t_s, dt_s, 1);
+  }
+  //! `steps` steps of dt from t0 (the i-th from t0 + i·dt) with the torques held: step() at each, one call.
+  void advance(BodyState& state, const Eigen::VectorXd& tau_wheels_Nm, double t0_s, double dt_s,
+               long long steps) const;
 
   const Eigen::Matrix3d& inertia() const { return inertia_; }
   const Eigen::MatrixXd& wheel_axes() const { return axes_B_; }
@@ -55,10 +60,11 @@ class Spacecraft {
   };
   TimeTerms at_time(double t_s) const;
   Eigen::Vector3d disturbance_B_Nm(const Quaternion& q_NB, const TimeTerms& at) const;
-  //! One RK4 step with the wheel vectors of type `WheelVector` (on the stack for the 3 or 4 wheels a spec
+  //! advance() with the wheel vectors of type `WheelVector` (on the stack for the 3 or 4 wheels a spec
   //! validates; Eigen::VectorXd otherwise).
   template <typename WheelVector>
-  void integrate(BodyState& state, const Eigen::VectorXd& tau_wheels_Nm, double t_s, double dt_s) const;
+  void integrate(BodyState& state, const Eigen::VectorXd& tau_wheels_Nm, double t0_s, double dt_s,
+                 long long steps) const;
 
   Eigen::Matrix3d inertia_;
   Eigen::Matrix3d inertia_inv_;
