@@ -37,9 +37,9 @@ struct FamilyVerdict {
   double within = 1.0;  //!< share of axis-epochs with |e| ≤ 3σ from kHonestyFrom_s
   Eigen::Vector3d nees = Eigen::Vector3d::Zero();  //!< per-axis mean e²/σ² over the same epochs
   double worst_sigmas = 0.0;                       //!< largest |e|/σ of an axis
-  int beyond_protection = 0;              //!< axis-epochs with |e| above the (finite) protection level
-  double worst_protection_ratio = 0.0;    //!< largest |e|/PL of an axis (0 where PL is +∞)
-  double beyond_from_s = -1.0;            //!< [s] the first and last epoch above it (−1: none)
+  int beyond_protection = 0;            //!< axis-epochs with |e| above the (finite) protection level
+  double worst_protection_ratio = 0.0;  //!< largest |e|/PL of an axis (0 where PL is +∞)
+  double beyond_from_s = -1.0;          //!< [s] the first and last epoch above it (−1: none)
   double beyond_until_s = -1.0;
   std::optional<double> flagged_after_s;  //!< [s] first detection, reference rejection or noise_model after
                                           //!< the perturbation began
