@@ -8,8 +8,9 @@
 // disturbances (constant, orbital-periodic, gravity gradient 3n²·r̂ × I·r̂ with r̂ the zenith unit
 // vector in B). Integrated by classic fixed-step RK4 (the quaternion renormalized after each step);
 // the wheel torques are held over a control period (zero-order hold). The disturbance's terms that depend
-// on time alone are computed once per distinct time of a step (RK4's two midpoints share theirs), G·τ_w
-// once per step, and the wheel vectors of a step live on the stack (no allocation per step).
+// on time alone are computed once per distinct time (RK4's two midpoints share theirs, a step's end is the
+// next one's start), G·τ_w once per advance() (the torques are held), and the wheel vectors live on the
+// stack (no allocation per step).
 
 #include <vector>
 
