@@ -72,6 +72,71 @@ TEST(ClosedLoopDynamics, TorqueFreeBodyKeepsMomentumAndEnergy) {
   EXPECT_LT(std::abs(energy() - e0) / e0, 1e-9);
 }
 
+// A tumbling body with a full inertia, every disturbance, and wheel torques that change each 0.1-s period,
+// stepped at 30 Hz (three steps a period: step times that do not all add up exactly).
+struct DynamicsTrace {
+  Quaternion q_NB;
+  Eigen::Vector3d omega_BN_B_rad_s;
+  Eigen::VectorXd h_wheels_Nms;
+};
+
+DynamicsTrace run_dynamics_trace(int wheels, bool in_periods) {
+  ClosedLoopSpec spec;
+  spec.inertia_kg_m2 << 12.0, 0.5, -0.3, 0.5, 10.0, 0.2, -0.3, 0.2, 8.0;
+  spec.wheels.count = wheels;
+  spec.disturbance.constant_Nm = Eigen::Vector3d(2e-6, -1e-6, 1.5e-6);
+  spec.disturbance.periodic_Nm = Eigen::Vector3d(1e-6, 2e-6, 1e-6);
+  spec.disturbance.gravity_gradient = true;
+  const Spacecraft craft(spec, 6000.0);
+  BodyState s;
+  s.q_NB = quat_exp(Eigen::Vector3d(0.1, -0.2, 0.3));
+  s.omega_BN_B_rad_s = Eigen::Vector3d(10.0, -20.0, 5.0) * kDegToRad;  // the wheels' term dominant in ω̇
+  s.h_wheels_Nms = Eigen::VectorXd::LinSpaced(wheels, -0.5, 0.5);
+  Eigen::VectorXd tau(wheels);
+  const double h = 0.1 / 3.0;
+  for (int k = 0; k < 6000; ++k) {
+    for (int i = 0; i < wheels; ++i) tau[i] = 1e-2 * std::sin(0.01 * k + i);
+    if (in_periods) {
+      craft.advance(s, tau, 0.1 * k, h, 3);
+    } else {
+      for (int i = 0; i < 3; ++i) craft.step(s, tau, 0.1 * k + i * h, h);
+    }
+  }
+  return {s.q_NB, s.omega_BN_B_rad_s, s.h_wheels_Nms};
+}
+
+// The rigid-body step's every bit, recorded (as hexadecimal floats) from the implementation before the
+// allocation-free one (each evaluation's own wheel vectors and matrix-vector products): a change of the
+// arithmetic's order in the step shows here after its 18,000 steps (summing G·h's wheels in reverse order
+// does, for the four-wheel pyramid; with three wheels on the axes the order cannot matter).
+TEST(ClosedLoopDynamics, StepsReproduceTheirRecordedBits) {
+  const DynamicsTrace four = run_dynamics_trace(4, false);
+  EXPECT_EQ(four.q_NB.coeffs(), Eigen::Vector4d(0x1.31abdc36d302fp-1, -0x1.523b5e4b4d3aap-1,
+                                                -0x1.1f539884647ebp-5, 0x1.d0b2535910e28p-2));  // x y z w
+  EXPECT_EQ(four.omega_BN_B_rad_s,
+            Eigen::Vector3d(0x1.3be0510611895p-2, -0x1.0224a5ab41a5ep-2, -0x1.8affd42cff5e7p-5));
+  EXPECT_EQ(four.h_wheels_Nms, Eigen::Vector4d(-0x1.37eb23b8e9e5ap-2, -0x1.5ff0f2312520dp-4,
+                                               0x1.df72c93336e43p-5, 0x1.35a83f0891acfp-2));
+  const DynamicsTrace three = run_dynamics_trace(3, false);
+  EXPECT_EQ(three.q_NB.coeffs(), Eigen::Vector4d(-0x1.52db29ea6fb0fp-2, -0x1.edb72ee3d9004p-3,
+                                                 -0x1.79c576ba75fd1p-2, 0x1.ab3aee9d0df4ap-1));
+  EXPECT_EQ(three.omega_BN_B_rad_s,
+            Eigen::Vector3d(0x1.3569fc321f988p-2, -0x1.6ec06921928a9p-5, -0x1.06c4fa7a31f09p-2));
+  EXPECT_EQ(three.h_wheels_Nms,
+            Eigen::Vector3d(-0x1.37eb23b8e9e5ap-2, 0x1.4ab9b87985865p-4, 0x1.9143ae7bbc2c1p-2));
+}
+
+// advance() over a period is its steps one by one, bit for bit (the carried time terms are the same ones).
+TEST(ClosedLoopDynamics, AdvanceIsItsStepsOneByOne) {
+  for (int wheels : {3, 4}) {
+    const DynamicsTrace steps = run_dynamics_trace(wheels, false);
+    const DynamicsTrace periods = run_dynamics_trace(wheels, true);
+    EXPECT_EQ(steps.q_NB.coeffs(), periods.q_NB.coeffs()) << wheels << " wheels";
+    EXPECT_EQ(steps.omega_BN_B_rad_s, periods.omega_BN_B_rad_s) << wheels << " wheels";
+    EXPECT_EQ(steps.h_wheels_Nms, periods.h_wheels_Nms) << wheels << " wheels";
+  }
+}
+
 TEST(ClosedLoopDynamics, GravityGradientTorqueOfATiltedBody) {
   ClosedLoopSpec spec;
   const Spacecraft craft(spec, 6000.0);
