@@ -165,6 +165,9 @@ constexpr DesignConstant kConstants[] = {
      "reference_sigma_arcsec"},
     {"reference_step_samples", design::reference_step_samples, "samples",
      "the reference step test's window: the onsets it searches, its threshold at p over this many"},
+    {"reference_mean_accept_probability", design::reference_mean_accept_probability, "-",
+     "the bias test's mean is consistent up to chi2_3(1 - this); beyond, the protection level carries the "
+     "reference's pull until a match or a rejection decides"},
     // --- the noise model checked against the parity's spread
     {"spread_block_s", design::spread_block_s, "s",
      "blocks of the long-run spread (second differences of their parity sums)"},

@@ -24,6 +24,7 @@ ReferenceConsistency::ReferenceConsistency(const PipelineConfig& config)
     : config_(config),
       jump_chi2_(allan::chi2_quantile(1.0 - allocated_probability(config, BudgetTest::kReferenceCheck), 3.0)),
       lag_chi2_(allan::chi2_quantile(1.0 - allocated_probability(config, BudgetTest::kReferenceCheck), 1.0)),
+      mean_accept_chi2_(allan::chi2_quantile(1.0 - design::reference_mean_accept_probability, 3.0)),
       z_tail_(std::sqrt(
           allan::chi2_quantile(1.0 - 2.0 * allocated_probability(config, BudgetTest::kReferenceCheck), 1.0))),
       sigma_config_rad_(config.reference_sigma_arcsec * kArcsecToRad),
@@ -47,6 +48,7 @@ void ReferenceConsistency::reopen() {
 void ReferenceConsistency::restart() {
   block_start_ns_ = -1;
   bias_start_ns_ = -1;
+  mean_unresolved_ = false;
   step_.reset();
   last_sample_ns_ = -1;
 }
@@ -66,6 +68,7 @@ void ReferenceConsistency::restart_bias_block(std::int64_t now_ns) {
   step_.reset();  // the mean matched elsewhere is in no later step either
   bias_start_ns_ = now_ns;
   bias_count_ = 0;
+  mean_unresolved_ = false;
   bias_sw_.setZero();
   bias_swz_.setZero();
 }
@@ -152,6 +155,7 @@ std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, co
   // judges a step with a mean beyond the match's level as the mean it is).
   const double bias = mean_innovation_chi2(bias_sw_, bias_swz_);
   bias_statistic = bias;
+  mean_unresolved_ = bias > mean_accept_chi2_;
   if (bias > jump_chi2_) {
     failed_ = {bias, jump_chi2_, 3};
     return ReferenceCheck::kBias;

@@ -117,6 +117,9 @@ class ReferenceConsistency {
   //! to `now_ns` (0 before a sample).
   Eigen::Vector3d bias_mean_rad() const { return bias_swz_.cwiseQuotient(bias_sw_); }
   std::int64_t bias_start_ns() const { return bias_start_ns_; }  //!< the bias block's start (−1: none)
+  //! The bias block's mean at the last sample beyond what a good reference shows (χ²₃(1 −
+  //! design::reference_mean_accept_probability)) and not yet decided: Href (or Hdrift) not consistent.
+  bool mean_unresolved() const { return mean_unresolved_; }
   double bias_span_s(std::int64_t now_ns) const {
     return bias_start_ns_ < 0 ? 0.0 : ns_to_seconds(now_ns - bias_start_ns_);
   }
@@ -143,10 +146,12 @@ class ReferenceConsistency {
   bool reestimate_noise(std::int64_t now_ns, const Eigen::Vector3d& z);
 
   const PipelineConfig& config_;
-  double jump_chi2_ = 0.0;  //!< χ²₃(1 − p)
-  double lag_chi2_ = 0.0;   //!< χ²₁(1 − p)
-  CheckValue drift_check_;  //!< the bias statistic at the last drift match, and its threshold
-  double z_tail_ = 0.0;     //!< Φ⁻¹(1 − p), for the Wilson–Hilferty χ²_{3m} quantile
+  double jump_chi2_ = 0.0;         //!< χ²₃(1 − p)
+  double lag_chi2_ = 0.0;          //!< χ²₁(1 − p)
+  double mean_accept_chi2_ = 0.0;  //!< χ²₃(1 − design::reference_mean_accept_probability)
+  bool mean_unresolved_ = false;   //!< the bias statistic beyond mean_accept_chi2_ at the last sample
+  CheckValue drift_check_;         //!< the bias statistic at the last drift match, and its threshold
+  double z_tail_ = 0.0;            //!< Φ⁻¹(1 − p), for the Wilson–Hilferty χ²_{3m} quantile
   ReferenceState state_ = ReferenceState::kAbsent;
   std::int64_t consistent_since_ns_ = 0;  //!< rejected: every sample since passed every test
   double nis_per_dof_ = 0.0;

@@ -117,6 +117,9 @@ inline constexpr double reference_bias_window_s = 120.0;  //!< [s] block of the 
 inline constexpr double reference_noise_max_factor = 3.0;  //!< [-] × reference_sigma_arcsec: re-estimate
 //! [samples] the step test's window: the onsets it searches (its threshold at p / this many)
 inline constexpr int reference_step_samples = 64;
+//! [-] the bias test's mean is consistent with a good reference up to χ²₃(1 − this); beyond, until a match
+//! or a rejection decides, the protection level carries the reference's pull as a match would
+inline constexpr double reference_mean_accept_probability = 1.0e-3;
 // --- the noise model checked against the parity's spread
 inline constexpr double spread_block_s = 5.0;       //!< [s] blocks of the long-run spread
 inline constexpr int spread_window_samples = 3000;  //!< [samples] of one verdict at most
