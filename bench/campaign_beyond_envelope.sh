@@ -11,6 +11,10 @@
 # runs, ~3 min). KEEP=DIR keeps the specs and campaign folders there (DIR/cN/runs.csv; a run again with its
 # events: tetra campaign DIR/specN.yaml --run K --events ev.jsonl). ENVELOPE=stated draws the same campaign
 # inside the stated envelope instead: the unit at 1 x its calibration's 1-sigma, the noise as stated.
+# FALSE_ALARMS=1 draws the same units for their false alarms instead: each seed a fault-free run and one
+# with gyro 1's bias fault at 590 s (the 590 s before it fault-free flight too): about 0.33 h of fault-free
+# flight a seed, 13,800 seeds (27,600 runs) for the 4,600 h a 0 count needs to bound the rate at 2 x the
+# design (0.0004/h, Garwood 95 %).
 set -euo pipefail
 build="$(realpath "${1:-build}")"
 seeds="${2:-150}"
@@ -25,9 +29,9 @@ else
   trap 'rm -rf "$out"' EXIT
 fi
 echo "cores: $(nproc); load before: $(cut -d' ' -f1-3 /proc/loadavg)"
-python3 - "$src" "$out" "$seeds" "${ENVELOPE:-beyond}" <<'PY'
+python3 - "$src" "$out" "$seeds" "${ENVELOPE:-beyond}" "${FALSE_ALARMS:-0}" <<'PY'
 import math, sys
-src, out, seeds, envelope = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
+src, out, seeds, envelope, false_alarms = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5] == "1"
 k = "1.0" if envelope == "stated" else "2.5"
 noise = "" if envelope == "stated" else (
     "  unit.arw_factor: {uniform: [0.5, 3.0]}\n  unit.bias_instability_factor: {uniform: [0.5, 3.0]}\n")
@@ -44,13 +48,16 @@ units[6] = units[5].rstrip("\n") + gyro(6, [0.3, -0.5, 0.8])
 for n, text in units.items():
     open(f"{out}/unit{n}.yaml", "w").write(text)
     open(f"{out}/scen{n}.yaml", "w").write(scenario.replace("unit: calibrated_unit.yaml", f"unit: unit{n}.yaml"))
-    gyros = ", ".join(str(i) for i in range(1, n + 1))
+    gyros = "1" if false_alarms else ", ".join(str(i) for i in range(1, n + 1))
+    kinds, onset = ("bias", 590) if false_alarms else ("bias, stuck", 100)
+    faults = "" if false_alarms else (
+        "  fault.onset_s: {uniform: [0, 400]}\n  fault.size_factor: {log_uniform: [0.1, 10]}\n")
     open(f"{out}/spec{n}.yaml", "w").write(f"""scenarios: [scen{n}.yaml]
 duration_s: 600
-kinds: [bias, stuck]
+kinds: [{kinds}]
 sizes: {{bias: [0.002]}}
 gyros: [{gyros}]
-onsets_s: [100]
+onsets_s: [{onset}]
 seeds: {{first: 1, count: {seeds}}}
 fault_free: true
 pipeline: {{exclusion_enabled: true, reference_latency_max_s: 0.3}}
@@ -63,9 +70,7 @@ dispersions:
   disturbance.constant_Nm: {{normal: [0, 1.0e-6]}}
   reference.noise_arcsec: {{uniform: [3, 10]}}
   reference.latency_s: {{uniform: [0, 0.3]}}
-  fault.onset_s: {{uniform: [0, 400]}}
-  fault.size_factor: {{log_uniform: [0.1, 10]}}
-""")
+{faults}""")
 PY
 for n in "${ns[@]}"; do
   "$build/tetra" campaign "$out/spec$n.yaml" --out "$out/c$n" >"$out/log$n.txt" 2>&1
