@@ -387,14 +387,13 @@ Eigen::Vector3d Pipeline::Impl::protection_level(bool observable, const Eigen::V
   Eigen::Vector3d pl = subsets_.ready() ? protection_.bound(subsets_.get(gyro_set_.active()), sigma_rad,
                                                             frame_.now_ns, subsets_.sqrt_period())
                                         : Eigen::Vector3d(protection_.k_md() * sigma_rad);
-  // Href where a drift was matched: the reference's bias the data could not tell from the drift
-  // (what the matches left, and what the reference has pulled the attitude by since the last one); and
-  // while the bias block's mean stands beyond a good reference's, undecided, what a match would learn now.
-  const double pending_rad = consistency_.mean_unresolved() ? pull_.blocks_rad() : 0.0;
-  if (budget_.ambiguous_rad() > 0.0 || pending_rad > 0.0)
-    pl = pl.cwiseMax(
-        protection_.k_md() * sigma_rad +
-        Eigen::Vector3d::Constant(budget_.ambiguous_rad() + std::max(pull_.since_rad(), pending_rad)));
+  // Href where a drift was matched: the reference's bias the data could not tell from the drift (what the
+  // matches left, and what the reference has pulled the attitude by since the last one); and while the bias
+  // block's mean stands beyond a good reference's, undecided, what a match would learn now.
+  const double ambiguous_rad = budget_.ambiguous_rad();
+  double href_rad = ambiguous_rad > 0.0 ? ambiguous_rad + pull_.since_rad() : 0.0;
+  if (consistency_.mean_unresolved()) href_rad = std::max(href_rad, ambiguous_rad + pull_.blocks_rad());
+  if (href_rad > 0.0) pl = pl.cwiseMax(protection_.k_md() * sigma_rad + Eigen::Vector3d::Constant(href_rad));
   return pl;
 }
 
