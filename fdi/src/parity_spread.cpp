@@ -93,10 +93,23 @@ double ParitySpread::interval(double estimate) const {
          (estimate + sum_offset_ / sum_d_);
 }
 
+double ParitySpread::upper(double cap) const {
+  // u·ν/(λ + q̄) ~ χ²_ν with ν = Σd/κ effective degrees of freedom (successive values share a block): the
+  // upper end of λ's one-sided interval at design::spread_interval_sigmas is where χ²_ν's lower quantile
+  // (Wilson–Hilferty) meets the sums' mean. Few samples bound λ loosely: a model checked by three values has
+  // not been checked.
+  const double nu = sum_d_ / design::spread_difference_inflation;
+  const double spread = std::sqrt(2.0 / (9.0 * nu));
+  const double cube = 1.0 - spread * spread - design::spread_interval_sigmas * spread;
+  if (cube <= 0.0) return design::spread_held_ratio;
+  const double q_mean = sum_offset_ / sum_d_;
+  return (estimate(cap) + q_mean) / (cube * cube * cube) - q_mean;
+}
+
 LedgerRow ParitySpread::allowed_row(double statistic, double threshold, double cap) const {
-  // What the sums estimate (before two samples, what an unchecked model may hide).
+  // The largest white noise the sums leave possible (before two samples, what an unchecked model may hide).
   const double allowed =
-      samples_ >= 2 ? std::clamp(estimate(cap), 1.0, design::spread_held_ratio) : design::spread_held_ratio;
+      samples_ >= 2 ? std::clamp(upper(cap), 1.0, design::spread_held_ratio) : design::spread_held_ratio;
   return noise_hypothesis_row(statistic, threshold, false, allowed);
 }
 

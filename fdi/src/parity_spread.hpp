@@ -74,7 +74,8 @@ class ParitySpread {
   std::optional<LedgerRow> noise_row(double statistic, double threshold, bool chi2) const;
   //! The Hnoise row of a sum's alarm (`statistic` against `threshold`, in σ) from the sums since the last
   //! verdict (`cap` their censoring): the white noise variance ratio the alarm needs, consistent up to the
-  //! ratio the sums estimate (design::spread_held_ratio before two samples, and at most).
+  //! upper end of the ratio's interval from the sums (design::spread_held_ratio before two samples, and at
+  //! most).
   LedgerRow allowed_row(double statistic, double threshold, double cap) const;
 
   //! [-] the white noise variance taken, over the stated (≥ 1).
@@ -90,6 +91,8 @@ class ParitySpread {
  private:
   //! [-] the censored maximum-likelihood λ of the sums at the cap `cap` (relative to the current model).
   double estimate(double cap) const;
+  //! [-] the upper end of λ's one-sided interval at design::spread_interval_sigmas from the sums.
+  double upper(double cap) const;
   //! [-] the 1σ half-width of `estimate` from the sums.
   double interval(double estimate) const;
   void clear_sums();

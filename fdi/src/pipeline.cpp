@@ -578,7 +578,8 @@ void Pipeline::Impl::emit_detected(DetectionTest test, double statistic, std::in
   d.statistic = statistic;
   if (rows != nullptr) {
     for (const LedgerRow& row : *rows) {
-      if (row.hypothesis == kHypothesisNone || row.hypothesis == kHypothesisReference)
+      if (row.hypothesis == kHypothesisNone || row.hypothesis == kHypothesisReference ||
+          row.hypothesis == kHypothesisNoise)
         d.ledger.push_back(row);
     }
   }
