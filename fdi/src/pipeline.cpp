@@ -373,8 +373,10 @@ void Pipeline::Impl::use_reference_sample() {
       protection_.anchor(frame_.now_ns);  // the error known again
       budget_.used(ns_to_seconds(frame_.now_ns), attitude_.omega_BR_B());
     }
-    if (use == ReferenceUse::kInitialized || use == ReferenceUse::kReinitialized)
+    if (use == ReferenceUse::kInitialized || use == ReferenceUse::kReinitialized) {
       reference_set_ns_ = frame_.now_ns;
+      innovation_mean_.reset();  // the attitude set onto the reference: its error is new
+    }
     ++(use == ReferenceUse::kRejected ? health_.counters.reference_rejected
                                       : health_.counters.reference_accepted);
     if (use == ReferenceUse::kReinitialized) ++health_.counters.reference_reinitialized;
@@ -394,6 +396,12 @@ Eigen::Vector3d Pipeline::Impl::protection_level(bool observable, const Eigen::V
   double href_rad = ambiguous_rad > 0.0 ? ambiguous_rad + pull_.since_rad() : 0.0;
   if (consistency_.mean_unresolved()) href_rad = std::max(href_rad, ambiguous_rad + pull_.blocks_rad());
   if (href_rad > 0.0) pl = pl.cwiseMax(protection_.k_md() * sigma_rad + Eigen::Vector3d::Constant(href_rad));
+  // Hdrift before any match: the error the used samples show now, beside the filter's σ and the mean's noise.
+  if (!innovation_mean_.empty()) {
+    const Eigen::Vector3d spread = (sigma_rad.cwiseAbs2() + innovation_mean_.variance_rad2()).cwiseSqrt();
+    const double shown_rad = innovation_mean_.mean_rad().norm();
+    pl = pl.cwiseMax(protection_.k_md() * spread + Eigen::Vector3d::Constant(shown_rad));
+  }
   return pl;
 }
 
@@ -641,6 +649,7 @@ void Pipeline::Impl::reset() {
   consistency_.reset();
   trend_.stop();
   budget_.reset();
+  innovation_mean_.reset();
   noise_match_.reset();
   bias_match_.reset();
   drift_match_.reset();

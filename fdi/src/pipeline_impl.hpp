@@ -17,6 +17,7 @@
 #include "disagreement_trend.hpp"
 #include "gyro_series.hpp"
 #include "gyro_set.hpp"
+#include "innovation_mean.hpp"
 #include "isolator.hpp"
 #include "mekf.hpp"
 #include "outlier_gate.hpp"
@@ -88,6 +89,7 @@ class Pipeline::Impl {
         drift_match_(config_),
         protection_(config_),
         budget_(config_),
+        innovation_mean_(config_.reference_window_s),
         horizon_(config_.reference_horizon_s) {
     frame_.resize(n_);
     found_.reserve(static_cast<std::size_t>(n_));
@@ -248,9 +250,10 @@ class Pipeline::Impl {
   Eigen::VectorXd held_parity_;  //!< the parity before the jump test, when it left the rest without one
   ReferenceBudget budget_;       //!< the reference's stated bias and latency, which its samples cannot show
   ReferencePull pull_;           //!< what the reference pulled the attitude by since the bias block began
-  EvidenceRows episode_rows_;    //!< the rows of the detection that opened the open episode
-  EvidenceRows alarm_rows_;      //!< this epoch's alarm's rows
-  EvidenceRows decision_rows_;   //!< scratch: an isolation's rows with the episode's
+  InnovationMean innovation_mean_;  //!< what the used samples show of the attitude's error now (Hdrift)
+  EvidenceRows episode_rows_;       //!< the rows of the detection that opened the open episode
+  EvidenceRows alarm_rows_;         //!< this epoch's alarm's rows
+  EvidenceRows decision_rows_;      //!< scratch: an isolation's rows with the episode's
   //! scratch: the episode's isolation when decided (its rows' 2 kB not cleared at every epoch)
   Isolation decided_;
   std::uint64_t arbiter_refusals_ = 0;  //!< findings whose rows the arbiter did not confirm

@@ -130,6 +130,7 @@ void Pipeline::Impl::judge_reference() {
   const ReferenceVerdict v = consistency_.decide(frame_.now_ns, z, S, evidence, decision, drift_level);
   if (v.drift) match_drift_mean(v, active);
   reference_usable_ = v.use;
+  if (v.use) innovation_mean_.add(frame_.now_ns, z, S.diagonal());
   // The σ the sample is used with: the configured one, or the re-estimated noise (an operator's reset judges
   // the reference afresh, from the configured σ).
   attitude_.set_reference_sigma_rad(consistency_.sigma_rad());
