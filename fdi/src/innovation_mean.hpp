@@ -43,18 +43,22 @@ class InnovationMean {
     weight_ += w;
     weighted_ += w.cwiseProduct(z_rad);
     weight_squared_ += w;
+    mean_rad_ = weighted_.cwiseQuotient(weight_);  // once a sample, read at every epoch
+    variance_rad2_ = weight_squared_.cwiseQuotient(weight_.cwiseAbs2());
   }
   bool empty() const { return last_ns_ < 0; }
   //! [rad] per axis the weighted mean m
-  Eigen::Vector3d mean_rad() const { return weighted_.cwiseQuotient(weight_); }
+  const Eigen::Vector3d& mean_rad() const { return mean_rad_; }
   //! [rad²] per axis its variance
-  Eigen::Vector3d variance_rad2() const { return weight_squared_.cwiseQuotient(weight_.cwiseAbs2()); }
+  const Eigen::Vector3d& variance_rad2() const { return variance_rad2_; }
 
  private:
   double tau_s_;
   Eigen::Vector3d weight_ = Eigen::Vector3d::Zero();          //!< Σ λ/S
   Eigen::Vector3d weighted_ = Eigen::Vector3d::Zero();        //!< Σ λ·z/S
   Eigen::Vector3d weight_squared_ = Eigen::Vector3d::Zero();  //!< Σ λ²/S
+  Eigen::Vector3d mean_rad_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d variance_rad2_ = Eigen::Vector3d::Zero();
   std::int64_t last_ns_ = -1;
 };
 
