@@ -1,5 +1,7 @@
 #include "bias_hypothesis.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "tetra/fdi/detectors.hpp"
@@ -88,7 +90,8 @@ double BiasHypothesis::gain(int i, const Subset& s, const SpanDisagreement& span
   return den > 0.0 ? num * num / den : 0.0;
 }
 
-BiasFit BiasHypothesis::best(const Subset& s, const SpanDisagreement& span, double sqrt_period) const {
+BiasFit BiasHypothesis::best(const Subset& s, const SpanDisagreement& span, double sqrt_period,
+                             EvidenceRows& rows) const {
   BiasFit fit;
   if (span.start < 0 || s.dof < 1 || parity_mean(s, span.start_ns, sqrt_period) < 2) return fit;
   // Everything the records hold (squared, in σ) and how much of it each gyro's fault explains.
@@ -100,6 +103,7 @@ BiasFit BiasHypothesis::best(const Subset& s, const SpanDisagreement& span, doub
   int compared = 0;
   double g_best = -1.0, g_second = 0.0, size_best = 0.0;
   int best = 0;
+  std::array<double, kMaxGyros> gains{};
   for (int i = 1; i <= static_cast<int>(s.parity.cols()); ++i) {
     if (!has_gyro(s.mask, i)) continue;
     if (has_gyro(span.gyros, i)) {
@@ -109,6 +113,7 @@ BiasFit BiasHypothesis::best(const Subset& s, const SpanDisagreement& span, doub
     }
     double size = 0.0;
     const double g = gain(i, s, span, sqrt_period, size);
+    gains[static_cast<std::size_t>(i - 1)] = g;
     if (g > g_best) {
       g_second = std::max(g_second, g_best);
       g_best = g;
@@ -119,18 +124,29 @@ BiasFit BiasHypothesis::best(const Subset& s, const SpanDisagreement& span, doub
     }
   }
   const int dof = s.dof + compared - 1;
-  if (best == 0 || dof < 1 || total - g_best > chi2_threshold(design::bias_model_reject_probability, dof))
-    return fit;
-  if (g_best - g_second < design::bias_hypothesis_margin_sigma2) return fit;
+  const double residual_limit = dof >= 1 ? chi2_threshold(design::bias_model_reject_probability, dof) : 0.0;
+  const bool model = best != 0 && dof >= 1 && total - g_best <= residual_limit;
+  for (int i = 1; i <= static_cast<int>(s.parity.cols()); ++i) {
+    if (!has_gyro(s.mask, i)) continue;
+    const auto h = static_cast<std::uint8_t>(i);
+    rows.add(model ? judge(EvidenceSource::kBiasFit, h, g_best - gains[static_cast<std::size_t>(i - 1)], 0.0,
+                           design::bias_hypothesis_margin_sigma2, 1)
+                   : stated(EvidenceSource::kBiasFit, h, RowVerdict::kNoCall, total - g_best, residual_limit,
+                            std::max(dof, 0)));
+  }
+  if (!model || g_best - g_second < design::bias_hypothesis_margin_sigma2) return fit;
   return BiasFit{best, size_best, g_best - g_second};
 }
 
-bool BiasHypothesis::persists(int id, double sign, const Subset& s, const SpanDisagreement& late,
-                              double sqrt_period) const {
-  if (late.start < 0 || parity_mean(s, late.start_ns, sqrt_period) < 2) return false;
+std::optional<LedgerRow> BiasHypothesis::persists(int id, double sign, const Subset& s,
+                                                  const SpanDisagreement& late, double sqrt_period) const {
+  if (late.start < 0 || parity_mean(s, late.start_ns, sqrt_period) < 2) return std::nullopt;
   double size = 0.0;
   const double g = gain(id, s, late, sqrt_period, size);
-  return size * sign > 0.0 && g >= design::bias_hypothesis_persist_sigma2;
+  const bool there = size * sign > 0.0 && g >= design::bias_hypothesis_persist_sigma2;
+  return stated(EvidenceSource::kBiasPersists, static_cast<std::uint8_t>(id),
+                there ? RowVerdict::kConsistent : RowVerdict::kRejected, g,
+                design::bias_hypothesis_persist_sigma2, 1);
 }
 
 }  // namespace tetra::fdi::detail

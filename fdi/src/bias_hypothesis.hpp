@@ -8,10 +8,12 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "evidence_rows.hpp"
 #include "gyro_series.hpp"
 #include "subset_cache.hpp"
 #include "tetra/core/geometry.hpp"
@@ -51,10 +53,15 @@ class BiasHypothesis {
 
   //! The single-gyro fault that explains the parity since `span.start_ns` and the reference disagreements
   //! `span` jointly, if it beats every other gyro's by `design::bias_hypothesis_margin_sigma2` and its model
-  //! is accepted; else gyro 0.
-  BiasFit best(const Subset& s, const SpanDisagreement& span, double sqrt_period) const;
-  //! Gyro `id`'s fault in the latest part of the records (`late`) is significant and of the sign `sign`.
-  bool persists(int id, double sign, const Subset& s, const SpanDisagreement& late, double sqrt_period) const;
+  //! is accepted; else gyro 0. Writes the `bias_fit` row of every gyro of `s` into `rows` (none without
+  //! records): Hi's statistic is what the best fault explains beyond gyro i's, rejected beyond the margin;
+  //! every row no call when the best fit's residual is beyond what the model accepts.
+  BiasFit best(const Subset& s, const SpanDisagreement& span, double sqrt_period, EvidenceRows& rows) const;
+  //! The `bias_persists` row of gyro `id`'s fault in the latest part of the records (`late`): consistent
+  //! when significant (χ²₁ at least design::bias_hypothesis_persist_sigma2) and of the sign `sign`, else
+  //! rejected; none without records.
+  std::optional<LedgerRow> persists(int id, double sign, const Subset& s, const SpanDisagreement& late,
+                                    double sqrt_period) const;
 
  private:
   static constexpr int kBins = 512;  //!< as many as the reference monitor's snapshots

@@ -52,6 +52,13 @@ const EvidenceSourceInfo kEvidenceSources[kEvidenceSourceCount] = {
     {EvidenceSource::kParityBlockMatch, "parity_block_match", StatisticUnit::kLogLikelihood,
      "the CUSUM of the parity's block means of the filter's innovations on a gyro's column, against their "
      "variance under the model (H0: the bias model as stated)"},
+    {EvidenceSource::kBiasFit, "bias_fit", StatisticUnit::kChi2,
+     "how much less of an episode's parity mean and reference disagreements the hypothesis's one fault "
+     "explains than the best one's (the best 0; rejected beyond bias_hypothesis_margin_sigma2); no call for "
+     "every hypothesis when the best one's fit leaves more than the model accepts"},
+    {EvidenceSource::kBiasPersists, "bias_persists", StatisticUnit::kChi2,
+     "the best-fitting fault's χ²₁ over the latest half of the span: consistent when at least "
+     "bias_hypothesis_persist_sigma2 and of the filter estimate's sign (a spike has gone by then)"},
 };
 
 bool reads_own_signal(EvidenceSource source) {

@@ -239,31 +239,38 @@ void Pipeline::Impl::seek_evidence() {
 
 void Pipeline::Impl::isolate_filter_bias(const ReferenceFinding& bias) {
   // A fault that is not a bias (a spike, a scale error during a slew, a coarsely quantized output) spreads
-  // over the bias states and can put a healthy gyro's alone beyond the threshold. So the gyro is isolated
-  // only when one single-gyro fault explains the episode's parity and reference records best, by a margin,
-  // of the sign of the filter's estimate, and still does in the latest half of the span (docs/fdi.md).
+  // over the bias states and can put a healthy gyro's alone beyond the threshold. So the filter's rows judge
+  // only the gyro they flag; one single-gyro fault fitted to the episode's parity and reference records
+  // judges every gyro (bias_fit: the others rejected by a margin), and the fault must still be there, of the
+  // filter's sign, in the latest half of the span (bias_persists). The arbiter decides (docs/fdi.md).
   const GyroMask active = gyro_set_.active();
   const Subset& s = subsets_.get(active);
   const std::int64_t now = frame_.now_ns;
   const double window_s = config_.reference_window_s;
   const std::int64_t from = std::max(isolator_.episode().onset_ns, now - seconds_to_ns(window_s));
-  reference_.filter_rearm(bias.gyro);  // until the check agrees, it is retried at every sample
+  reference_.filter_rearm(bias.gyro);  // until the rows make the case, it is retried at every sample
   SpanDisagreement span;
   if (!reference_.span(from, design::filter_bias_min_span_fraction * window_s, gyro_set_.excluded(), series_,
                        span))
-    return;
-  const BiasFit fit = bias_check_.best(s, span, subsets_.sqrt_period());
-  if (fit.gyro != bias.gyro || fit.size_rad_s * attitude_.filter().bias_rad_s(bias.gyro) <= 0.0) return;
+    return;  // too short a span to judge yet
+  Isolation iso{bias.gyro,      FaultKind::kBias, Evidence::kReference, DetectionTest::kReference,
+                bias.statistic, bias.rows};
+  const BiasFit fit = bias_check_.best(s, span, subsets_.sqrt_period(), iso.rows);
+  if (arbitrate(iso.rows.begin(), iso.rows.end(), active, true) != bias.gyro) return;  // not singled out
   SpanDisagreement late;
   const std::int64_t middle = span.start_ns + (now - span.start_ns) / 2;
   if (!reference_.span(middle, design::filter_bias_late_span_fraction * window_s, gyro_set_.excluded(),
-                       series_, late) ||
-      !bias_check_.persists(fit.gyro, fit.size_rad_s, s, late, subsets_.sqrt_period()))
+                       series_, late))
     return;
-  const FaultKind kind = reference_.span_scale(fit.gyro, span)
-                             ? FaultKind::kScale
-                             : isolator_.classify_drift(fit.gyro, frame_.index, active, subsets_);
-  isolate({fit.gyro, kind, Evidence::kReference, DetectionTest::kReference, bias.statistic, bias.rows});
+  const double sign = fit.size_rad_s * attitude_.filter().bias_rad_s(bias.gyro) > 0.0 ? fit.size_rad_s : 0.0;
+  const auto persists = bias_check_.persists(fit.gyro, sign, s, late, subsets_.sqrt_period());
+  if (!persists) return;
+  iso.rows.add(*persists);
+  if (arbitrate(iso.rows.begin(), iso.rows.end(), active, true) != bias.gyro) return;
+  iso.kind = reference_.span_scale(fit.gyro, span)
+                 ? FaultKind::kScale
+                 : isolator_.classify_drift(fit.gyro, frame_.index, active, subsets_);
+  isolate(iso);
 }
 
 void Pipeline::Impl::decide_episode() {

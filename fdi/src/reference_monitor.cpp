@@ -35,7 +35,7 @@ std::optional<ReferenceFinding> ReferenceMonitor::filter_update(const Mekf& filt
   const int culprit = filter_.confirm(design::reference_confirm_count, 3);
   if (culprit == 0) return std::nullopt;
   ReferenceFinding found{culprit, filter_.statistic(), false, {}};
-  filter_.rows(EvidenceSource::kFilterBias, active, found.rows);
+  filter_.rows(EvidenceSource::kFilterBias, active, found.rows, false);
   return found;
 }
 
@@ -60,7 +60,7 @@ void LoneGyro::add(int id, double z, double threshold) {
   }
 }
 
-void LoneGyro::rows(EvidenceSource source, GyroMask active, EvidenceRows& out) const {
+void LoneGyro::rows(EvidenceSource source, GyroMask active, EvidenceRows& out, bool judge_others) const {
   const int members = std::min(members_, kMaxGyros);
   const auto largest_without = [&](int j) {
     double z = 0.0;
@@ -71,9 +71,13 @@ void LoneGyro::rows(EvidenceSource source, GyroMask active, EvidenceRows& out) c
     return z;
   };
   for (int j = 1; j <= kMaxGyros; ++j) {
-    if (has_gyro(active, j))
-      out.add(judge(source, static_cast<std::uint8_t>(j), largest_without(j),
-                    design::lone_gyro_others_fraction * threshold_, threshold_));
+    if (!has_gyro(active, j)) continue;
+    const auto h = static_cast<std::uint8_t>(j);
+    const LedgerRow row =
+        judge(source, h, largest_without(j), design::lone_gyro_others_fraction * threshold_, threshold_);
+    out.add(judge_others || row.verdict != RowVerdict::kRejected
+                ? row
+                : stated(source, h, RowVerdict::kNoCall, row.statistic, threshold_));
   }
   out.add(judge(source, kHypothesisNone, largest_without(0), design::lone_gyro_others_fraction * threshold_,
                 threshold_));

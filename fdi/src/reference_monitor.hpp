@@ -40,8 +40,9 @@ class LoneGyro {
   //! The last comparison as ledger rows: for each gyro j of `active`, Hj's statistic is the largest
   //! disagreement among the gyros it holds healthy (consistent at or below half the threshold, rejected
   //! above it); H0's the largest of all; Href rejected by the flagged gyro's when the others agree with the
-  //! reference (a wrong reference would move them too).
-  void rows(EvidenceSource source, GyroMask active, EvidenceRows& out) const;
+  //! reference (a wrong reference would move them too). `judge_others` false: the other gyros' rows make no
+  //! call (the filter's bias states, where a fault that is not a bias spreads: bias_fit judges them).
+  void rows(EvidenceSource source, GyroMask active, EvidenceRows& out, bool judge_others = true) const;
   void reset() { run_gyro_ = run_ = 0; }
   //! A confirmed gyro that was not acted on: the next comparison that flags it alone confirms it again.
   void rearm(int id, int count) {

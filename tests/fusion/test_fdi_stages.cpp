@@ -500,42 +500,62 @@ SpanDisagreement fault_records(BiasHypothesis& check, const Subset& s, int id,
   return span;
 }
 
+//! The verdict of `source`'s row on `hypothesis` in `rows` (kNoCall when it has none).
+RowVerdict verdict_of(const EvidenceRows& rows, EvidenceSource source, int hypothesis) {
+  for (const LedgerRow& r : rows) {
+    if (r.source == source && r.hypothesis == hypothesis) return r.verdict;
+  }
+  return RowVerdict::kNoCall;
+}
+
 TEST(BiasHypothesis, OneGyrosPersistingFaultIsToldAndAPassingOneIsNot) {
   // Noise-free records of four gyros (d = 1: the parity fits every gyro alike, the reference tells them
-  // apart). A 5e-4 deg/s step on gyro 2 for the whole span: gyro 2 explains everything (54″ against 8″ on
-  // its own reference disagreement), every other gyro leaves that unexplained: margin ≫ 25. The same mean
-  // rate as a spike in the first second: still gyro 2's, but gone from the latest half: not persistent.
-  // Nothing at all: no gyro.
+  // apart). A 5e-4 deg/s step on gyro 2 for the whole span: gyro 2 explains everything (54″ against 8″ on its
+  // own reference disagreement), every other gyro leaves that unexplained: margin ≫ 25, bias_fit rows H2
+  // consistent, H1, H3, H4 rejected. The same mean rate as a spike in the first second: still gyro 2's, but
+  // gone from the latest half: bias_persists rejects H2. Nothing at all: no gyro, no row rejects.
   Fixture f;
   const Subset& s = f.subsets->get(0b1111);
   {
     BiasHypothesis check(f.constants);
     const auto span = fault_records(check, s, 2, [](double) { return 5e-4 * kDegToRad; });
-    const BiasFit fit = check.best(s, span, std::sqrt(kPeriod));
+    EvidenceRows rows;
+    const BiasFit fit = check.best(s, span, std::sqrt(kPeriod), rows);
     EXPECT_EQ(fit.gyro, 2);
     EXPECT_NEAR(fit.size_rad_s, 5e-4 * kDegToRad, 1e-9);  // noise-free: the fit is exact to rounding
     EXPECT_GT(fit.margin, design::bias_hypothesis_margin_sigma2);
+    EXPECT_EQ(rows.size(), 4);
+    for (int j = 1; j <= 4; ++j) {
+      EXPECT_EQ(verdict_of(rows, EvidenceSource::kBiasFit, j),
+                j == 2 ? RowVerdict::kConsistent : RowVerdict::kRejected)
+          << "H" << j;
+    }
     SpanDisagreement late = span;
     late.start_ns = seconds_to_ns(15.0);
     late.span_s = 15.0;
     late.err_rad[1] = 5e-4 * kDegToRad * 15.0;
-    EXPECT_TRUE(check.persists(2, 1.0, s, late, std::sqrt(kPeriod)));
-    EXPECT_FALSE(check.persists(2, -1.0, s, late, std::sqrt(kPeriod)));  // the other sign
+    EXPECT_EQ(check.persists(2, 1.0, s, late, std::sqrt(kPeriod))->verdict, RowVerdict::kConsistent);
+    EXPECT_EQ(check.persists(2, -1.0, s, late, std::sqrt(kPeriod))->verdict,
+              RowVerdict::kRejected);  // the other sign
   }
   {
     BiasHypothesis check(f.constants);
     const auto span = fault_records(check, s, 2, [](double t) { return t <= 1.0 ? 0.015 * kDegToRad : 0.0; });
-    EXPECT_EQ(check.best(s, span, std::sqrt(kPeriod)).gyro, 2);
+    EvidenceRows rows;
+    EXPECT_EQ(check.best(s, span, std::sqrt(kPeriod), rows).gyro, 2);
     SpanDisagreement late = span;
     late.start_ns = seconds_to_ns(15.0);
     late.span_s = 15.0;
     late.err_rad.fill(0.0);
-    EXPECT_FALSE(check.persists(2, 1.0, s, late, std::sqrt(kPeriod)));
+    EXPECT_EQ(check.persists(2, 1.0, s, late, std::sqrt(kPeriod))->verdict, RowVerdict::kRejected);
   }
   {
     BiasHypothesis check(f.constants);
     const auto span = fault_records(check, s, 2, [](double) { return 0.0; });
-    EXPECT_EQ(check.best(s, span, std::sqrt(kPeriod)).gyro, 0);
+    EvidenceRows rows;
+    EXPECT_EQ(check.best(s, span, std::sqrt(kPeriod), rows).gyro, 0);
+    for (int j = 1; j <= 4; ++j)
+      EXPECT_NE(verdict_of(rows, EvidenceSource::kBiasFit, j), RowVerdict::kRejected);
   }
 }
 

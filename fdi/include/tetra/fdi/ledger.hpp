@@ -18,30 +18,32 @@ const char* to_string(RowVerdict verdict);  // "consistent", "rejected", "no cal
 
 //! Every source of evidence, in the order of kEvidenceSources.
 enum class EvidenceSource : std::uint8_t {
-  kChi2,             //!< parity χ² of one epoch
-  kCusum,            //!< parity CUSUM
-  kLevel,            //!< CUSUM on the parity minus an open episode's held level
-  kJump,             //!< one-epoch jump test, confirmed over onset_confirm_epochs
-  kOnset,            //!< window means before and after the onset against the motion bound
-  kGlt,              //!< generalized likelihood test on the mean parity since the onset (N ≥ 5)
-  kTimeout,          //!< a gyro absent for dropout_timeout_s
-  kInvalid,          //!< a gyro invalid for dropout_timeout_s
-  kRepeated,         //!< identical raw values in a row (stuck)
-  kZero,             //!< identical raw values, all 0 V
-  kVariance,         //!< robust noise level too low
-  kNoiseLevel,       //!< robust noise level too high
-  kRecurringSpikes,  //!< confirmed one-epoch outliers, noise otherwise normal
-  kReferenceWindow,  //!< each gyro's angle against the reference's over a window
-  kFilterBias,       //!< the attitude filter's bias estimates (reference and parity)
-  kReferenceTest,    //!< the reference's own consistency tests (NIS, lag, bias, jump)
-  kQuiet,            //!< no alarm for clear_after_s: the episode's fault is gone
-  kDriftWander,      //!< the bias wander a common drift of the gyros would need, against a working unit's
-  kMotionFit,        //!< the parity's fit to the body rate over a block: scale factors and axes
-  kParitySpread,     //!< the parity's differences between consecutive epochs: the unit's white noise
-  kUncheckedNoise,   //!< the white noise an alarm needs, while the spread has not checked the model
-  kParityBlockMatch  //!< the parity's block means of the filter's innovations: each gyro's bias model
+  kChi2,              //!< parity χ² of one epoch
+  kCusum,             //!< parity CUSUM
+  kLevel,             //!< CUSUM on the parity minus an open episode's held level
+  kJump,              //!< one-epoch jump test, confirmed over onset_confirm_epochs
+  kOnset,             //!< window means before and after the onset against the motion bound
+  kGlt,               //!< generalized likelihood test on the mean parity since the onset (N ≥ 5)
+  kTimeout,           //!< a gyro absent for dropout_timeout_s
+  kInvalid,           //!< a gyro invalid for dropout_timeout_s
+  kRepeated,          //!< identical raw values in a row (stuck)
+  kZero,              //!< identical raw values, all 0 V
+  kVariance,          //!< robust noise level too low
+  kNoiseLevel,        //!< robust noise level too high
+  kRecurringSpikes,   //!< confirmed one-epoch outliers, noise otherwise normal
+  kReferenceWindow,   //!< each gyro's angle against the reference's over a window
+  kFilterBias,        //!< the attitude filter's bias estimates (reference and parity)
+  kReferenceTest,     //!< the reference's own consistency tests (NIS, lag, bias, jump)
+  kQuiet,             //!< no alarm for clear_after_s: the episode's fault is gone
+  kDriftWander,       //!< the bias wander a common drift of the gyros would need, against a working unit's
+  kMotionFit,         //!< the parity's fit to the body rate over a block: scale factors and axes
+  kParitySpread,      //!< the parity's differences between consecutive epochs: the unit's white noise
+  kUncheckedNoise,    //!< the white noise an alarm needs, while the spread has not checked the model
+  kParityBlockMatch,  //!< the parity's block means of the filter's innovations: each gyro's bias model
+  kBiasFit,           //!< one gyro's fault fitted to an episode's parity mean and reference disagreements
+  kBiasPersists       //!< the best-fitting fault in the latest half of that span, of the filter's sign
 };
-constexpr int kEvidenceSourceCount = 22;
+constexpr int kEvidenceSourceCount = 24;
 //! True for the sources that read a gyro's own signal (timeout, invalid, repeated, zero, variance,
 //! noise_level, recurring_spikes): no error of the calibration makes what they see.
 bool reads_own_signal(EvidenceSource source);
