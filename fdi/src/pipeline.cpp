@@ -643,41 +643,12 @@ void Pipeline::Impl::update_mode(std::int64_t now_ns) {
   }
 }
 
-void Pipeline::Impl::reset() {
-  publish_filter_health();  // the health keeps the last step's filter
-  series_.reset();
-  own_noise_.reset();
-  sample_spread_.reset();
-  white_spread_.reset();
-  blocks_.restart();
-  if (subsets_.white_ratio() != 1.0 || subsets_.sample_ratio() != 1.0) subsets_.set_noise_ratios(1.0, 1.0);
-  gate_.reset();
-  reference_.reset();
-  consistency_.reset();
-  trend_.stop();
-  budget_.reset();
-  innovation_mean_.reset();
-  noise_match_.reset();
-  bias_match_.reset();
-  drift_match_.reset();
-  bias_check_.reset();
-  calibration_fit_.reset();
-  gyro_set_.reset();
+void Pipeline::Impl::start() {
   attitude_.reset(config_.initial_q_RB);
-  horizon_.reset();
-  has_time_ = false;
-  last_ns_ = 0;
-  clock_.reset();
   protection_.anchor(0);
-  last_reference_ns_.reset();
-  reference_set_ns_.reset();
-  reference_rejected_ns_.reset();
   health_.fdi_available = true;
   result_.attitude.fdi_available = true;
   frame_.index = -1;
-  health_.counters = Counters{};
-  persistent_mode_ = Mode::kNominal;
-  pending_.clear();
   restart_detectors();
   update_mode(0);
 }

@@ -151,7 +151,8 @@ Result<Pipeline> Pipeline::create(const Calibration& stated, const PipelineConfi
 }
 
 void Pipeline::reset() {
-  impl_->reset();
+  // Created again from its inputs: every stage's state, and any a later change adds, is the initial one.
+  impl_ = std::make_unique<Impl>(impl_->inputs());
 }
 const StepResult& Pipeline::step(const Epoch& epoch) {
   return impl_->step(epoch);

@@ -64,11 +64,22 @@ inline std::int64_t pipeline_time_before_ns(std::int64_t now_ns, std::int64_t sp
 
 using namespace detail;
 
+//! What a pipeline is created from, once validated: reset() creates the pipeline again from it.
+struct PipelineInputs {
+  PipelineConfig config;
+  Calibration calibration;
+  GyroGeometry geometry;
+  std::vector<GyroConstants> constants;
+};
+
 class Pipeline::Impl {
  public:
+  explicit Impl(const PipelineInputs& inputs)
+      : Impl(inputs.config, inputs.calibration, inputs.geometry, inputs.constants) {}
   Impl(const PipelineConfig& config, const Calibration& cal, GyroGeometry geometry,
        std::vector<GyroConstants> constants)
-      : config_(config),
+      : inputs_{config, cal, geometry, constants},
+        config_(config),
         n_(cal.gyro_count()),
         subsets_(std::move(geometry), bias_sigmas(constants), config_, detector_noise(cal, config_)),
         bias_check_(constants),
@@ -100,10 +111,11 @@ class Pipeline::Impl {
     health_.gyros.resize(static_cast<std::size_t>(n_));
     result_.attitude.gyro_bias_rad_s.assign(static_cast<std::size_t>(n_), 0.0);
     if (config_.sample_period_s > 0.0) subsets_.prepare(config_.sample_period_s);
-    reset();
+    start();
   }
 
-  void reset();
+  //! What the pipeline was created from: a pipeline created from it again is this one's initial state.
+  const PipelineInputs& inputs() const { return inputs_; }
   const StepResult& step(const Epoch& epoch);
   FdiEvent command_exclude(int id, std::int64_t stamp_ns, bool force);
   FdiEvent command_reinstate(int id, std::int64_t stamp_ns);
@@ -221,6 +233,10 @@ class Pipeline::Impl {
   FdiEvent acknowledge(CommandVerb verb, int id, CommandOutcome outcome, bool changed, std::int64_t stamp_ns);
   void reinstate(int id);
 
+  //! The initial state beyond what the stages' constructors set: the attitude, the detectors' first epoch.
+  void start();
+
+  const PipelineInputs inputs_;
   PipelineConfig config_;
   int n_;
   SubsetCache subsets_;

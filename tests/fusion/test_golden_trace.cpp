@@ -268,8 +268,28 @@ fdi::FdiEvent apply(fdi::Pipeline& p, const OperatorCommand& c, std::int64_t sta
   return p.reset_command(stamp_ns);
 }
 
-//! The trace of one scenario, one line per event, per block of epochs, and the final health.
-std::vector<std::string> trace(const GoldenScenario& g) {
+//! Steps `p` through the whole of scenario `g`, its commands included, and discards what it returns.
+std::string run_through(fdi::Pipeline& p, const GoldenScenario& g) {
+  auto simulator = sim::Simulator::create(g.scenario, g.sim);
+  if (!simulator) return "simulator: " + simulator.error().message;
+  sim::SimEpoch se;
+  fdi::Epoch e;
+  std::size_t next_command = 0;
+  while (simulator->next(se)) {
+    while (next_command < g.commands.size() && g.commands[next_command].at_s <= se.time_s)
+      apply(p, g.commands[next_command++], se.stamp_ns);
+    e.stamp_ns = se.stamp_ns;
+    e.raw = se.raw_V;
+    e.present = se.present;
+    e.reference_q_RB = se.reference_q_RB;
+    p.step(e);
+  }
+  return {};
+}
+
+//! The trace of one scenario, one line per event, per block of epochs, and the final health. With
+//! `reset_first`, of a pipeline that ran the scenario once before and was then reset().
+std::vector<std::string> trace(const GoldenScenario& g, bool reset_first = false) {
   std::vector<std::string> lines{"# " + g.name};
   auto simulator = sim::Simulator::create(g.scenario, g.sim);
   if (!simulator) return {"simulator: " + simulator.error().message};
@@ -279,6 +299,10 @@ std::vector<std::string> trace(const GoldenScenario& g) {
   config.initial_q_RB = se.truth_q_RB;
   auto pipeline = fdi::Pipeline::create(g.calibration, config);
   if (!pipeline) return {"pipeline: " + pipeline.error().message};
+  if (reset_first) {
+    if (auto error = run_through(*pipeline, g); !error.empty()) return {error};
+    pipeline->reset();
+  }
   fdi::Epoch e;
   std::size_t next_command = 0;
   std::int64_t index = 0;
@@ -362,6 +386,18 @@ INSTANTIATE_TEST_SUITE_P(Scenarios, GoldenTrace, ::testing::ValuesIn(scenarios()
                          [](const ::testing::TestParamInfo<GoldenScenario>& param_info) {
                            return param_info.param.name;
                          });
+
+TEST_P(GoldenTrace, IsTheSameAfterAResetAsFromTheStart) {
+  // reset() promises the initial state: a pipeline that ran the scenario once (its episodes, exclusions,
+  // learned noise, reference history, clock) and was reset must give the fresh pipeline's trace, every bit.
+  const GoldenScenario& g = GetParam();
+  const auto fresh = trace(g), reset = trace(g, true);
+  std::size_t i = 0;
+  while (i < fresh.size() && i < reset.size() && fresh[i] == reset[i]) ++i;
+  EXPECT_TRUE(i == fresh.size() && i == reset.size()) << g.name << ": first difference at line " << i + 1
+                                                      << "\n  fresh: " << (i < fresh.size() ? fresh[i] : "")
+                                                      << "\n  reset: " << (i < reset.size() ? reset[i] : "");
+}
 
 TEST(GoldenTrace, SeesTheLastBitOfOneSample) {
   // The gate must see a change that no tolerance-based test would: gyro 1's bias one ulp off changes the last

@@ -32,7 +32,9 @@ class Pipeline {
   //! Validates the calibration and configuration once; errors name what is wrong.
   static Result<Pipeline> create(const Calibration& calibration, const PipelineConfig& config);
 
-  //! Back to the initial state (all gyros reinstated, attitude = config initial attitude).
+  //! Back to the initial state: the pipeline create() made, created again from the same calibration and
+  //! configuration (every gyro reinstated, the attitude the configured one, nothing learned, the clock
+  //! unset). References returned before are invalid.
   void reset();
   //! Processes one epoch. The returned reference is valid until the next call.
   const StepResult& step(const Epoch& epoch);
