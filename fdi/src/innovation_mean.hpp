@@ -8,8 +8,9 @@
 //
 //   m_a = Σ λ_k z_a,k/S_aa,k / Σ λ_k/S_aa,k,   var(m_a) = Σ λ_k²/S_aa,k / (Σ λ_k/S_aa,k)²,
 //
-// λ_k = exp(−age_k/τ), is what the protection level carries for Hdrift: PL ≥ |m| + K·√(σ_a² + var(m_a)).
-// A ramp of e lags in m by its rate times τ; the filter's σ and the mean's own noise cover the rest.
+// λ_k = exp(−age_k/τ), is what the protection level carries for Hdrift: PL ≥ |m| + K·√(σ_a² + var(m_a)); and
+// sigma what of it the filter's σ does not cover (excess_rad). A ramp of e lags in m by its rate times τ; the
+// filter's σ and the mean's own noise cover the rest.
 
 #include <cmath>
 #include <cstdint>
@@ -51,6 +52,14 @@ class InnovationMean {
   const Eigen::Vector3d& mean_rad() const { return mean_rad_; }
   //! [rad²] per axis its variance
   const Eigen::Vector3d& variance_rad2() const { return variance_rad2_; }
+  //! [rad] the error the mean shows beyond what the filter's `sigma_rad` and the mean's own noise cover:
+  //! √max(0, |m|² − Σ var(m_a) − Σ σ_a²), |m|² being e_m² + Σ var(m_a) on average, e_m the error's weighted
+  //! mean, whose square σ covers when it tells the truth (0 without samples).
+  double excess_rad(const Eigen::Vector3d& sigma_rad) const {
+    if (empty()) return 0.0;
+    const double excess = mean_rad_.squaredNorm() - variance_rad2_.sum() - sigma_rad.squaredNorm();
+    return excess > 0.0 ? std::sqrt(excess) : 0.0;
+  }
 
  private:
   double tau_s_;

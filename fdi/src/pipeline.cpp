@@ -355,6 +355,10 @@ void Pipeline::Impl::publish_attitude() {
   a.stamp_ns = frame_.now_ns;
   a.q_RB = attitude_.q_RB();
   a.sigma_rad = attitude_.sigma_rad();
+  // What the used reference samples show of the error beyond the filter's own sigma (a drift below the
+  // detectors, before its match; innovation_mean.hpp), on every axis: the samples' frame turns with the body.
+  if (const double shown_rad = innovation_mean_.excess_rad(a.sigma_rad); shown_rad > 0.0)
+    a.sigma_rad = root_sum_square(a.sigma_rad, Eigen::Vector3d::Constant(shown_rad));
   if (trend_.active()) a.sigma_rad = root_sum_square(a.sigma_rad, trend_.bound(frame_.now_ns));
   if (budget_.active()) a.sigma_rad = root_sum_square(a.sigma_rad, budget_.sigma_rad());
   a.protection_level_rad = protection_level(observable, a.sigma_rad);
