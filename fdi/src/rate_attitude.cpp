@@ -105,6 +105,7 @@ void RateAttitude::reset(const Quaternion& q0_RB) {
   slope_prev_.setZero();
   accel_seen_.setZero();
   have_slope_ = false;
+  set_changed_ = false;
   reference_seen_ = false;
   rejected_run_ = 0;
   last_chi2_ = 0.0;
@@ -123,7 +124,7 @@ void RateAttitude::parity(const Subset& s, const Eigen::VectorXd& p, double sqrt
 }
 
 Eigen::Vector3d RateAttitude::curvature_rad_s(double dt_s, double period_s) const {
-  if (!have_slope_ || dt_s <= 0.0) return Eigen::Vector3d::Zero();
+  if (!have_slope_ || set_changed_ || dt_s <= 0.0) return Eigen::Vector3d::Zero();
   const Eigen::Vector3d slope = (omega_meas_ - omega_prev_) / dt_s;
   return -(period_s * period_s / 12.0) * (slope - slope_prev_) / dt_s;
 }
@@ -237,7 +238,8 @@ void RateAttitude::propagate(const EpochFrame& frame, const Subset& sol, const S
   const Eigen::Vector3d omega =
       0.5 * (omega_prev_ + omega_meas_) + curvature_rad_s(frame.dt_s, period_s) - correction_;
   slope_prev_ = (omega_meas_ - omega_prev_) / frame.dt_s;
-  have_slope_ = true;
+  have_slope_ = !set_changed_;  // a slope across two gyro sets is not the body's
+  set_changed_ = false;
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   (void)propagator_.step(omega, frame.dt_s, zero, zero, bound);
   mekf_.propagate(propagator_.last_increment(), noise.pinv, noise.mask, omega, frame.dt_s);

@@ -98,8 +98,16 @@ class RateAttitude {
   }
 
   //! Gyro `id` leaves the solution (its bias states freeze) or comes back (at its prior).
-  void freeze(int id) { mekf_.freeze(id); }
-  void thaw(int id) { mekf_.thaw(id); }
+  //! Either changes the solution's gyro set: the next step takes no slope across the two sets (their rates
+  //! differ by the fault, not by the motion; docs/fdi.md, "Per epoch" 7).
+  void freeze(int id) {
+    mekf_.freeze(id);
+    set_changed_ = true;
+  }
+  void thaw(int id) {
+    mekf_.thaw(id);
+    set_changed_ = true;
+  }
 
   void add_bound(const Eigen::Vector3d& angle_rad) { propagator_.add_bound(angle_rad); }
   //! [rad] on every axis: the most the trapezoid across a gap of `tau_s` can miss, a·τ²/4 (the rate leaving
@@ -148,6 +156,7 @@ class RateAttitude {
   Eigen::Vector3d omega_meas_ = Eigen::Vector3d::Zero();  //!< [rad/s] last estimate (Earth rate included)
   Eigen::Vector3d slope_prev_ = Eigen::Vector3d::Zero();  //!< [rad/s²] the previous step's (ω_k − ω_{k−1})/Δt
   bool have_slope_ = false;
+  bool set_changed_ = false;  //!< a gyro left or joined the solution since the last step
   //! [rad/s²] per axis: the largest |slope| of recent observable steps (decaying over
   //! design::accel_memory_s), so a lost rate's bound covers the acceleration the gyros saw when it exceeds
   //! the configured bound.
