@@ -78,16 +78,15 @@ class Pipeline::Impl {
       : Impl(inputs.config, inputs.calibration, inputs.geometry, inputs.constants) {}
   Impl(const PipelineConfig& config, const Calibration& cal, GyroGeometry geometry,
        std::vector<GyroConstants> constants)
-      : inputs_{config, cal, geometry, constants},
-        config_(config),
+      : config_(config),
         n_(cal.gyro_count()),
-        subsets_(std::move(geometry), bias_sigmas(constants), config_, detector_noise(cal, config_)),
+        subsets_(geometry, bias_sigmas(constants), config_, detector_noise(cal, config_)),
         bias_check_(constants),
         own_noise_(constants, config_),
         sample_spread_(allocated_probability(config_, BudgetTest::kParitySpread)),
         white_spread_(allocated_probability(config_, BudgetTest::kParitySpread)),
         blocks_(std::max(1, cal.gyro_count() - 3)),
-        series_(std::move(constants), config_),
+        series_(constants, config_),
         gate_(n_, config_),
         detector_(n_, config_.clear_after_s),
         isolator_(n_, config_),
@@ -101,7 +100,8 @@ class Pipeline::Impl {
         protection_(config_),
         budget_(config_),
         innovation_mean_(config_.reference_window_s),
-        horizon_(config_.reference_horizon_s) {
+        horizon_(config_.reference_horizon_s),
+        inputs_{config, cal, std::move(geometry), std::move(constants)} {
     frame_.resize(n_);
     found_.reserve(static_cast<std::size_t>(n_));
     own_named_.reserve(static_cast<std::size_t>(n_));
@@ -236,7 +236,6 @@ class Pipeline::Impl {
   //! The initial state beyond what the stages' constructors set: the attitude, the detectors' first epoch.
   void start();
 
-  const PipelineInputs inputs_;
   PipelineConfig config_;
   int n_;
   SubsetCache subsets_;
@@ -300,6 +299,7 @@ class Pipeline::Impl {
   //! [-] this sample: the λ a match of the reference's mean as a common drift would set, at least ρ times the
   //! last match's (NaN: not judged)
   double drift_ratio_needed_ = std::numeric_limits<double>::quiet_NaN();
+  const PipelineInputs inputs_;  //!< what reset() creates the pipeline again from (last: read once a run)
 };
 
 }  // namespace tetra::fdi
