@@ -55,14 +55,14 @@ class Pipeline {
   //! Start-up echo: the thresholds derived from the configuration and the calibration (multi-line).
   std::string describe_thresholds() const;
   //! Findings of the evidence sources that the arbiter's rule did not confirm from their ledger rows since
-  //! the start, so excluded nothing (docs/fdi.md, "The ledger and the arbiter"); 0 over every golden
+  //! creation or the last reset(), so excluded nothing (docs/fdi.md, "The ledger and the arbiter"); 0 over every golden
   //! scenario.
   std::uint64_t arbiter_refusals() const;
 
  private:
   class Impl;
   explicit Pipeline(std::unique_ptr<Impl> impl);
-  std::unique_ptr<Impl> impl_;  //!< all state; created once, never reallocated in step()
+  std::unique_ptr<Impl> impl_;  //!< all state; created again only by reset(), never in step()
 };
 
 }  // namespace tetra::fdi
