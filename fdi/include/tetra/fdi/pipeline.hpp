@@ -55,8 +55,8 @@ class Pipeline {
   //! Start-up echo: the thresholds derived from the configuration and the calibration (multi-line).
   std::string describe_thresholds() const;
   //! Findings of the evidence sources that the arbiter's rule did not confirm from their ledger rows since
-  //! creation or the last reset(), so excluded nothing (docs/fdi.md, "The ledger and the arbiter"); 0 over every golden
-  //! scenario.
+  //! creation or the last reset(), so excluded nothing (docs/fdi.md, "The ledger and the arbiter"); 0 over
+  //! every golden scenario.
   std::uint64_t arbiter_refusals() const;
 
  private:
