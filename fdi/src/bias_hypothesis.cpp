@@ -134,8 +134,8 @@ BiasFit BiasHypothesis::best(const Subset& s, const SpanDisagreement& span, doub
                    : stated(EvidenceSource::kBiasFit, h, RowVerdict::kNoCall, total - g_best, residual_limit,
                             std::max(dof, 0)));
   }
-  if (!model || g_best - g_second < design::bias_hypothesis_margin_sigma2) return fit;
-  return BiasFit{best, size_best, g_best - g_second};
+  if (!model) return fit;
+  return BiasFit{best, size_best, g_best - g_second};  // by how much it beats the others: the rows' to judge
 }
 
 std::optional<LedgerRow> BiasHypothesis::persists(int id, double sign, const Subset& s,

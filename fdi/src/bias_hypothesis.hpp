@@ -33,7 +33,7 @@ struct SpanDisagreement {
 
 //! The test's outcome for the best-fitting gyro.
 struct BiasFit {
-  int gyro = 0;             //!< 0: no gyro explains the records clearly
+  int gyro = 0;             //!< 0: no single-gyro fault's model fits the records
   double size_rad_s = 0.0;  //!< the fault's mean rate over the span
   double margin = 0.0;      //!< [σ²] of the best hypothesis over the runner-up
 };
@@ -52,10 +52,10 @@ class BiasHypothesis {
   void reset();
 
   //! The single-gyro fault that explains the parity since `span.start_ns` and the reference disagreements
-  //! `span` jointly, if it beats every other gyro's by `design::bias_hypothesis_margin_sigma2` and its model
-  //! is accepted; else gyro 0. Writes the `bias_fit` row of every gyro of `s` into `rows` (none without
-  //! records): Hi's statistic is what the best fault explains beyond gyro i's, rejected beyond the margin;
-  //! every row no call when the best fit's residual is beyond what the model accepts.
+  //! `span` jointly best, when its model is accepted; else gyro 0. Writes the `bias_fit` row of every gyro of
+  //! `s` into `rows` (none without records): Hi's statistic is what the best fault explains beyond gyro i's,
+  //! rejected beyond the margin; every row no call when the best fit's residual is beyond what the model
+  //! accepts.
   BiasFit best(const Subset& s, const SpanDisagreement& span, double sqrt_period, EvidenceRows& rows) const;
   //! The `bias_persists` row of gyro `id`'s fault in the latest part of the records (`late`): consistent
   //! when significant (χ²₁ at least design::bias_hypothesis_persist_sigma2) and of the sign `sign`, else

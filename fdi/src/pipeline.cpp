@@ -262,14 +262,16 @@ void Pipeline::Impl::isolate_filter_bias(const ReferenceFinding& bias) {
   if (!reference_.span(middle, design::filter_bias_late_span_fraction * window_s, gyro_set_.excluded(),
                        series_, late))
     return;
+  // The arbiter singled out the best fit (fit.gyro is bias.gyro); it must persist with the sign of the fit
+  // and of the filter's estimate alike (sign 0, when those differ, persists nowhere).
   const double sign = fit.size_rad_s * attitude_.filter().bias_rad_s(bias.gyro) > 0.0 ? fit.size_rad_s : 0.0;
-  const auto persists = bias_check_.persists(fit.gyro, sign, s, late, subsets_.sqrt_period());
+  const auto persists = bias_check_.persists(bias.gyro, sign, s, late, subsets_.sqrt_period());
   if (!persists) return;
   iso.rows.add(*persists);
   if (arbitrate(iso.rows.begin(), iso.rows.end(), active, true) != bias.gyro) return;
-  iso.kind = reference_.span_scale(fit.gyro, span)
+  iso.kind = reference_.span_scale(bias.gyro, span)
                  ? FaultKind::kScale
-                 : isolator_.classify_drift(fit.gyro, frame_.index, active, subsets_);
+                 : isolator_.classify_drift(bias.gyro, frame_.index, active, subsets_);
   isolate(iso);
 }
 
