@@ -198,24 +198,27 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
   const std::int64_t pre_begin = k0 - gap - design::onset_pre_epochs;
   const std::int64_t pre_end = k0 - gap;
   const std::int64_t post_end = std::min(index + 1, k0 + design::onset_post_max_epochs);
-  if (pre_begin < 0 || pre_begin <= index - kHistory || post_end - k0 < design::onset_min_post_epochs)
-    return 0;
+  if (post_end - k0 < design::onset_min_post_epochs) return 0;  // not yet: the test runs on a later epoch
+  double ratio = std::numeric_limits<double>::quiet_NaN();
+  // The onset's window before it is no longer kept (or precedes the first epoch): it cannot run.
+  if (pre_begin < 0 || pre_begin <= index - kHistory) return no_call(active, ratio);
   // Every hypothesis below is judged against the acceleration bound. Before the onset the data are clean:
   // when the body already turned faster than the bound there (a slew the bound does not cover), the true
   // hypothesis may be the impossible one and a wrong one possible by chance. Nothing can be told.
   const std::int64_t pre_mid = pre_begin + design::onset_pre_epochs / 2;
-  if (motion_within_bound(active, two_windows(pre_begin, pre_mid, pre_mid, pre_end), subsets, series) == 0)
-    return 0;
+  if (motion_within_bound(active, two_windows(pre_begin, pre_mid, pre_mid, pre_end), subsets, series,
+                          &ratio) == 0)
+    return no_call(active, ratio);
   // After the onset a step is constant: the data since then, the fault included, must not show the body
   // turning beyond the bound either. Otherwise a motion that began too gently to show before the onset may be
   // what one gyro sees alone (its axis the only one that sees it, another stuck), and it is not a step.
   const std::int64_t post_mid = k0 + (post_end - k0) / 2;
-  if (motion_within_bound(active, two_windows(k0, post_mid, post_mid, post_end), subsets, series) == 0)
-    return 0;
+  if (motion_within_bound(active, two_windows(k0, post_mid, post_mid, post_end), subsets, series, &ratio) ==
+      0)
+    return no_call(active, ratio);
   const double separation = two_windows(pre_begin, pre_end, k0, post_end);
   // All gyros consistent with a possible motion: no abrupt change beyond motion, nothing to tell. Each
   // hypothesis's row: the rate change of the gyros it holds healthy over the motion bound (docs/fdi.md).
-  double ratio = 0.0;
   const int all = motion_within_bound(active, separation, subsets, series, &ratio);
   rows_.add(stated(EvidenceSource::kOnset, kHypothesisNone,
                    all == 0 ? RowVerdict::kRejected : RowVerdict::kNoCall, ratio, 1.0));
@@ -237,6 +240,16 @@ int Isolator::onset_test(std::int64_t index, GyroMask active, SubsetCache& subse
     }
   }
   return count == 1 ? culprit : 0;
+}
+
+int Isolator::no_call(GyroMask active, double ratio) {
+  rows_.add(stated(EvidenceSource::kOnset, kHypothesisNone, RowVerdict::kNoCall, ratio, 1.0));
+  for (int j = 1; j <= n_; ++j) {
+    if (has_gyro(active, j))
+      rows_.add(
+          stated(EvidenceSource::kOnset, static_cast<std::uint8_t>(j), RowVerdict::kNoCall, ratio, 1.0));
+  }
+  return 0;
 }
 
 // GLT on the mean normalized parity since the onset (N ≥ 5). Under hypothesis i the mean is a fault along

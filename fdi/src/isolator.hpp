@@ -79,6 +79,10 @@ class Isolator {
  private:
   static constexpr int kHistory = 256;  //!< [epochs] history kept for the onset test
   int onset_test(std::int64_t index, GyroMask active, SubsetCache& subsets, const GyroSeries& series);
+  //! The onset test's rows when a window it needs cannot be judged: H0 and every active gyro's hypothesis no
+  //! call, the statistic the window's motion over its bound (> 1: the body turned beyond it there; NaN: the
+  //! window before the onset is no longer kept). Returns 0 (no culprit).
+  int no_call(GyroMask active, double ratio);
   //! Means of two history windows [b1, e1) and [b2, e2) into the pre/post scratch; their separation [s].
   double two_windows(std::int64_t b1, std::int64_t e1, std::int64_t b2, std::int64_t e2);
   //! 1: the change between the two windows' means seen by `mask` is a possible motion (within the

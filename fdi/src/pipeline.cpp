@@ -168,8 +168,10 @@ void Pipeline::Impl::detect() {
     bias_check_.record(detector_.parity(), s);
     if (frame_.usable == active &&
         calibration_fit_.record(detector_.parity_measured(), s, active, attitude_.omega_meas_B(),
-                                frame_.now_ns, subsets_, config_))
+                                frame_.now_ns, subsets_, config_)) {
       emit_calibration_mismatch();
+      reconsider_rejection_for_calibration();
+    }
   }
   if (d.cusum_ran && !d.alarm && !held && !isolator_.episode().active) calibration_fit_.judged_nominal();
   // An open episode ends only once the parity is back to nominal for clear_after_s: a fault whose CUSUM

@@ -173,6 +173,16 @@ class Pipeline::Impl {
   //! A gyro fault just detected, since before a rejection: the parity's rows of that rejection make no call
   //! then, and the arbiter judges it again (the reference used again when it no longer stands alone).
   void reconsider_reference_rejection();
+  //! A reference sample set the attitude reference_window_s ago or less.
+  bool attitude_set_within_block() const {
+    return reference_set_ns_ &&
+           frame_.now_ns - *reference_set_ns_ <= seconds_to_ns(config_.reference_window_s);
+  }
+  //! A calibration mismatch just named: a standing rejection's rows gain Hcal and are judged again.
+  void reconsider_rejection_for_calibration();
+  //! The arbiter's ruling on a standing rejection's `rows` again: unless it still rejects, the reference is
+  //! judged afresh and used (a `reference_accepted` event with `detail` and the rows).
+  void judge_rejection_again(const EvidenceRows& rows, const char* detail);
   void match_three_gyro_noise(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
   void match_common_drift(const Eigen::Vector3d& z, const Eigen::Matrix3d& S);
   //! A noise_model event: `rows` the arbiter's decision's (null: the long window's match, its three rows).

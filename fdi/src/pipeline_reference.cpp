@@ -32,6 +32,23 @@ void Pipeline::Impl::reconsider_reference_rejection() {
     if (row.source == EvidenceSource::kCusum) row.verdict = RowVerdict::kNoCall;
     rows.add(row);
   }
+  judge_rejection_again(rows,
+                        "attitude reference used again: a gyro fault detected since may have caused its "
+                        "rejection");
+}
+
+void Pipeline::Impl::reconsider_rejection_for_calibration() {
+  // The calibration was just found not to describe the unit: the gyros' attitude, not the reference, may be
+  // what disagreed. A standing rejection's rows gain Hcal (consistent), and the arbiter judges it again.
+  if (!reference_rejected_ns_ || consistency_.state() != ReferenceState::kRejected) return;
+  EvidenceRows rows = rejection_rows_;
+  calibration_fit_.add_hcal_rows(EvidenceSource::kReferenceTest, nullptr, rows);
+  judge_rejection_again(rows,
+                        "attitude reference used again: the calibration does not describe the unit, so "
+                        "the gyros' attitude it disagreed with may be the wrong one");
+}
+
+void Pipeline::Impl::judge_rejection_again(const EvidenceRows& rows, const char* detail) {
   if (arbitrate_reference(rows.begin(), rows.end(), gyro_set_.active()) == ReferenceDecision::kReject) return;
   consistency_.reopen();
   trend_.stop();
@@ -39,7 +56,7 @@ void Pipeline::Impl::reconsider_reference_rejection() {
   FdiEvent e;
   e.stamp_ns = frame_.now_ns;
   e.type = EventType::kReferenceAccepted;
-  e.detail = "attitude reference used again: a gyro fault detected since may have caused its rejection";
+  e.detail = detail;
   e.ledger.assign(rows.begin(), rows.end());
   emit(std::move(e));
 }
@@ -101,6 +118,8 @@ void Pipeline::Impl::write_reference_rows(const ReferenceEvidence& evidence, dou
     else
       rows.add(stated(src, h, RowVerdict::kRejected, c.statistic, c.threshold, c.dof));
   }
+  // Hcal: while a calibration mismatch stands, the gyros' own error explains whatever failed.
+  calibration_fit_.add_hcal_rows(src, nullptr, rows);
 }
 
 void Pipeline::Impl::judge_reference() {
@@ -171,8 +190,7 @@ void Pipeline::Impl::apply_reference_verdict(const ReferenceVerdict& v, const Ei
     budget_.learn(v.step_rad);  // a step the samples carry from now on, which no test of them can see
     // An attitude the reference itself set a block ago or less rests on its samples alone: the rejecting
     // sample's innovation, on every axis, bounds what they put in.
-    if (reference_set_ns_ && frame_.now_ns - *reference_set_ns_ <= seconds_to_ns(config_.reference_window_s))
-      attitude_.add_variance(Eigen::Vector3d::Constant(z.squaredNorm()));
+    if (attitude_set_within_block()) attitude_.add_variance(Eigen::Vector3d::Constant(z.squaredNorm()));
   }
   // A jump is left to the gate (a lone wild sample, or ten in a row set the attitude): only the slower tests
   // carry evidence of a gyro fault.

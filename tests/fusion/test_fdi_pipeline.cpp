@@ -1,6 +1,7 @@
 // The pipeline on synthetic epochs (tests/fusion/synth.hpp): fault-free accuracy and silence, each fault kind
 // on each gyro, reference isolation, input checks, operator commands, N = 5 GLT. Statistics are seeded; every
 // tolerance says where it comes from.
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -190,6 +191,30 @@ TEST(Pipeline, RampsAreDetectedAndEndUnisolatedWithoutReference) {
     // Sigma inflated to cover every single-gyro hypothesis: the real error is within it.
     EXPECT_LT(o.final_error_deg, o.final_sigma_deg) << gyro;
   }
+}
+
+TEST(Pipeline, AStepInAMotionBeyondTheBoundEndsUnisolatedAndItsRowsSayWhy) {
+  // A 2e-4 deg/s step on gyro 1 while the body spins up at 0.2 deg/s² (1 deg/s in 5 s), a thousand times the
+  // bound (2e-4 deg/s²): the onset test cannot judge the step against a motion the bound does not cover.
+  // Without a reference and with four gyros nothing else can tell which gyro: `unisolated`, and its rows
+  // carry the onset test's no call for H0 and every gyro, the window's motion over its bound (> 1).
+  SynthFault f{1, FaultKind::kBias, false, 62.0, 2e-4};
+  SynthOptions opt;
+  opt.seed = 2101;
+  opt.slew_start_s = 60.0;
+  const Outcome o = run(f, 100.0, opt);
+  ASSERT_TRUE(o.unisolated) << describe(o);
+  EXPECT_EQ(o.wrong_exclusions, 0) << describe(o);
+  const auto u = std::find_if(o.events.begin(), o.events.end(),
+                              [](const FdiEvent& e) { return e.type == EventType::kUnisolated; });
+  int no_call = 0;
+  for (const LedgerRow& row : u->ledger) {
+    if (row.source != EvidenceSource::kOnset) continue;
+    EXPECT_EQ(row.verdict, RowVerdict::kNoCall) << to_json(*u, 5);
+    EXPECT_GT(row.statistic, 1.0) << to_json(*u, 5);
+    ++no_call;
+  }
+  EXPECT_EQ(no_call, 5) << to_json(*u, 5);  // H0 and H1..H4
 }
 
 TEST(Pipeline, SlowRampStaysVisibleUntilTheEnd) {

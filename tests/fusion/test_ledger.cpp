@@ -139,6 +139,15 @@ TEST(Arbiter, TheReferenceIsRejectedOnlyWhenItsHypothesisStandsAlone) {
   rows[2].verdict = RowVerdict::kRejected;
   rows[1].verdict = RowVerdict::kRejected;
   EXPECT_EQ(reference_rule(rows), ReferenceDecision::kNoCall);
+  // Hcal standing (a calibration mismatch named): the gyros' own error explains the disagreement, no call;
+  // an Hcal row that does not stand changes nothing.
+  rows = a_mean_the_gyros_vouch_for();
+  rows[2].verdict = RowVerdict::kRejected;
+  rows.push_back(
+      stated(EvidenceSource::kMotionFit, kHypothesisCalibration, RowVerdict::kConsistent, 90.0, 30.7, 3));
+  EXPECT_EQ(reference_rule(rows), ReferenceDecision::kNoCall);
+  rows.back().verdict = RowVerdict::kNoCall;
+  EXPECT_EQ(reference_rule(rows), ReferenceDecision::kReject);
   EXPECT_STREQ(to_string(ReferenceDecision::kMatchDrift), "match drift");
   std::uint8_t back = 0;
   ASSERT_TRUE(hypothesis_from_string(hypothesis_name(kHypothesisDrift), back));

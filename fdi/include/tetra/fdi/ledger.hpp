@@ -126,12 +126,13 @@ enum class ReferenceDecision : std::uint8_t {
   kUse,         //!< H0 stands: the sample is used
   kReject,      //!< Href stands alone: the reference is left out
   kMatchDrift,  //!< Hdrift stands (Href may too): the gyros' bias model opened, the reference kept
-  kNoCall       //!< a gyro's hypothesis stands beside Href: reported, nothing else changes
+  kNoCall       //!< a gyro's hypothesis or Hcal stands beside Href: reported, nothing else changes
 };
 const char* to_string(ReferenceDecision decision);  // "use", "reject", "match drift", "no call"
 
 //! The same rule for the reference (docs/fdi.md, "The arbiter"): H0 not rejected — the sample is used;
-//! else, unless every single-gyro hypothesis of `active` is rejected, no call; else a consistent Hdrift is
+//! else, unless every single-gyro hypothesis of `active` is rejected and Hcal does not stand (the gyros'
+//! calibration explains the disagreement), no call; else a consistent Hdrift is
 //! matched (the cheaper step: it opens a model and keeps the reference, and a mean that persists after it
 //! rejects Hdrift); else Href consistent with Hdrift rejected rejects the reference.
 ReferenceDecision arbitrate_reference(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active);
