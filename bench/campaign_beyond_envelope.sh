@@ -15,6 +15,10 @@
 # with gyro 1's bias fault at 590 s (the 590 s before it fault-free flight too): about 0.33 h of fault-free
 # flight a seed, 13,800 seeds (27,600 runs) for the 4,600 h a 0 count needs to bound the rate at 2 x the
 # design (0.0004/h, Garwood 95 %).
+# WARM=1 adds a warm-up and an unstated rate ramp to every run's truth: the unit starting at -5..10 degC and
+# settling at 20 degC (its calibration's temperature) with tau 300 s, each gyro's bias moving by its own
+# 0.5e-6..2e-6 deg/s/K (1e-5..5e-5 deg/s at the start, mostly common to the gyros), and a rate ramp of
+# 1e-10..3e-9 deg/s^2 per gyro the calibration does not state.
 set -euo pipefail
 build="$(realpath "${1:-build}")"
 seeds="${2:-150}"
@@ -29,9 +33,12 @@ else
   trap 'rm -rf "$out"' EXIT
 fi
 echo "cores: $(nproc); load before: $(cut -d' ' -f1-3 /proc/loadavg)"
-python3 - "$src" "$out" "$seeds" "${ENVELOPE:-beyond}" "${FALSE_ALARMS:-0}" <<'PY'
+python3 - "$src" "$out" "$seeds" "${ENVELOPE:-beyond}" "${FALSE_ALARMS:-0}" "${WARM:-0}" <<'PY'
 import math, sys
 src, out, seeds, envelope, false_alarms = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5] == "1"
+warm = "" if sys.argv[6] != "1" else (
+    "  thermal.bias_dps_per_K: {uniform: [0.5e-6, 2.0e-6]}\n  thermal.start_C: {uniform: [-5, 10]}\n"
+    "  unit.rate_ramp_dps2: {log_uniform: [1.0e-10, 3.0e-9]}\n")
 k = "1.0" if envelope == "stated" else "2.5"
 noise = "" if envelope == "stated" else (
     "  unit.arw_factor: {uniform: [0.5, 3.0]}\n  unit.bias_instability_factor: {uniform: [0.5, 3.0]}\n")
@@ -70,7 +77,7 @@ dispersions:
   disturbance.constant_Nm: {{normal: [0, 1.0e-6]}}
   reference.noise_arcsec: {{uniform: [3, 10]}}
   reference.latency_s: {{uniform: [0, 0.3]}}
-{faults}""")
+{warm}{faults}""")
 PY
 for n in "${ns[@]}"; do
   "$build/tetra" campaign "$out/spec$n.yaml" --out "$out/c$n" >"$out/log$n.txt" 2>&1

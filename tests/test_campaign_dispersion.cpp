@@ -109,6 +109,63 @@ TEST(CampaignDispersion, LawsAndTheCalibrationSigma) {
   EXPECT_NEAR(arw_sum / (4.0 * kRuns), 0.9515, 3e-3);
 }
 
+TEST(CampaignDispersion, AWarmUpAndARateRampAreDrawnIntoTheTruthOnly) {
+  // Beyond the stated envelope as the campaign draws it: each gyro's thermal coefficient c_i, the unit's
+  // temperature at the start (settling at the scenario's 20 °C, where it was calibrated), and a rate ramp R
+  // the calibration does not state.
+  TempDir dir;
+  const auto spec = spec_from(dir, spec_head() +
+                                       "dispersions:\n  seed: 5\n"
+                                       "  thermal.bias_dps_per_K: {uniform: [-2.0e-6, 2.0e-6]}\n"
+                                       "  thermal.start_C: {uniform: [-5, 10]}\n"
+                                       "  unit.rate_ramp_dps2: {log_uniform: [1.0e-10, 1.0e-8]}\n");
+  ASSERT_TRUE(spec) << spec.error().message;
+  const CampaignCase a = campaign_case(*spec, 3);
+  ASSERT_EQ(a.draws.size(), 3u);
+  ASSERT_EQ(a.draws[0].size(), 4u);
+  ASSERT_EQ(a.draws[2].size(), 4u);
+  const Scenario truth = campaign_scenario(*spec, a);
+  EXPECT_EQ(truth.thermal.bias_dps_per_K, a.draws[0]);
+  EXPECT_EQ(truth.thermal.start_C, a.draws[1][0]);
+  EXPECT_GE(truth.thermal.start_C, -5.0);
+  EXPECT_LT(truth.thermal.start_C, 10.0);
+  // At t = 0 gyro 1's thermal bias is c_1·(T_start − 20 °C): 25–30 K below, up to 6e-5 deg/s.
+  EXPECT_DOUBLE_EQ(truth.thermal.bias_dps(0, 0.0), a.draws[0][0] * (a.draws[1][0] - 20.0));
+  const Calibration& nominal = spec->scenarios[0].unit;
+  for (std::size_t g = 0; g < 4; ++g) {
+    ASSERT_TRUE(truth.unit.gyros[g].noise);
+    EXPECT_EQ(truth.unit.gyros[g].noise->rate_ramp_dps_per_s, a.draws[2][g]);
+    EXPECT_GE(a.draws[2][g], 1e-10);
+    EXPECT_LT(a.draws[2][g], 1e-8);
+    // The pipeline's calibration (the spec's scenario) states neither.
+    EXPECT_FALSE(nominal.gyros[g].noise && nominal.gyros[g].noise->rate_ramp_dps_per_s);
+  }
+  EXPECT_FALSE(spec->scenarios[0].thermal.active());
+  const std::string header = campaign_csv_header(*spec);
+  EXPECT_NE(header.find(",thermal.bias_dps_per_K.g1,"), std::string::npos) << header;
+  EXPECT_NE(header.find(",thermal.start_C,unit.rate_ramp_dps2.g1,"), std::string::npos) << header;
+  // What a warm-up's supports cannot give is refused before any run, naming the key.
+  struct Case {
+    std::string tail;
+    std::string text;
+  };
+  const std::vector<Case> cases = {
+      {"  thermal.bias_dps_per_K: {normal: [0, 1.0e-6]}\n  thermal.start_C: {uniform: [0, 5]}\n", "bounded"},
+      {"  thermal.bias_dps_per_K: {uniform: [-0.1, 0.1]}\n  thermal.start_C: {uniform: [0, 5]}\n",
+       "is a bias above 1 deg/s"},
+      {"  thermal.bias_dps_per_K: {uniform: [0, 1.0e-6]}\n  thermal.start_C: {uniform: [0, 500]}\n",
+       "thermal.start_C"},
+      {"  thermal.start_C: {uniform: [0, 5]}\n", "needs its coefficients"},
+      {"  unit.rate_ramp_dps2: {uniform: [-1.0e-9, 1.0e-9]}\n", "R is a magnitude"},
+  };
+  for (const Case& c : cases) {
+    const auto bad = spec_from(dir, spec_head() + "dispersions:\n  seed: 1\n" + c.tail);
+    ASSERT_FALSE(bad) << c.tail;
+    EXPECT_NE(bad.error().message.find("spec.yaml:11"), std::string::npos) << bad.error().message;
+    EXPECT_NE(bad.error().message.find(c.text), std::string::npos) << bad.error().message;
+  }
+}
+
 TEST(CampaignDispersion, SpecErrorsNameTheLineAndKey) {
   TempDir dir;
   struct Case {

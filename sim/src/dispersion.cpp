@@ -60,6 +60,9 @@ constexpr ParamInfo kParams[] = {
     {P::kFaultSizeFactor, "fault.size_factor", Shape::kScalar, Domain::kBounded, false},
     {P::kFaultGyro, "fault.gyro", Shape::kScalar, Domain::kChoice, false},
     {P::kFaultKind, "fault.kind", Shape::kScalar, Domain::kChoice, false},
+    {P::kThermalBiasDpsPerK, "thermal.bias_dps_per_K", Shape::kPerGyro, Domain::kBounded, false},
+    {P::kThermalStartC, "thermal.start_C", Shape::kScalar, Domain::kBounded, false},
+    {P::kRateRampDps2, "unit.rate_ramp_dps2", Shape::kPerGyro, Domain::kBounded, false},
 };
 
 const ParamInfo& info_of(P p) {
@@ -310,6 +313,44 @@ Result<DispersionSpec> parse_dispersions(const YamlReader& yaml, const YAML::Nod
   return spec;
 }
 
+namespace {
+
+//! [deg/s²] the largest true rate ramp a run may draw: 3.6 deg/s after an hour, beyond any working gyro.
+constexpr double kMaxRateRamp_dps2 = 1e-3;
+
+//! The warm-up each corner of the thermal draws' supports gives `sc` is a valid scenario's (its biases within
+//! kMaxThermalBias_dps, its temperatures in range), and it has a transient to give.
+Status check_thermal_corners(const DispersionSpec& spec, const Scenario& sc) {
+  std::pair<double, double> c{0.0, 0.0};
+  std::pair<double, double> start{sc.thermal.start_C, sc.thermal.start_C};
+  bool coefficients = sc.thermal.active();
+  for (const Dispersion& d : spec.parameters) {
+    if (d.parameter == P::kThermalBiasDpsPerK) {
+      c = {d.distribution.min, d.distribution.max};
+      coefficients = true;
+    }
+    if (d.parameter == P::kThermalStartC) start = {d.distribution.min, d.distribution.max};
+  }
+  if (!coefficients)
+    return bad_input("a warm-up needs its coefficients: disperse thermal.bias_dps_per_K too, or give the "
+                     "scenario a thermal: section");
+  for (const double ci : {c.first, c.second}) {
+    for (const double t0 : {start.first, start.second}) {
+      Scenario corner = sc;
+      if (spec.parameters.end() != std::find_if(spec.parameters.begin(), spec.parameters.end(),
+                                                [](const Dispersion& d) {
+                                                  return d.parameter == P::kThermalBiasDpsPerK;
+                                                }))
+        corner.thermal.bias_dps_per_K.assign(static_cast<std::size_t>(sc.unit.gyro_count()), ci);
+      corner.thermal.start_C = t0;
+      if (Status st = validate_scenario(corner); !st) return st;
+    }
+  }
+  return ok_status();
+}
+
+}  // namespace
+
 Status check_dispersions(const YamlReader& yaml, const YAML::Node& node, const DispersionSpec& spec,
                          const Scenario& sc, const std::string& name, bool closed_loop,
                          const std::vector<double>& onsets_s, const KindSizes& sizes) {
@@ -348,6 +389,14 @@ Status check_dispersions(const YamlReader& yaml, const YAML::Node& node, const D
                               number_text(*hi + dist.max) + " s do not all lie in [0, " +
                               number_text(sc.duration_s) + ") s of " + name);
     }
+    if (d.parameter == P::kThermalBiasDpsPerK || d.parameter == P::kThermalStartC) {
+      if (Status st = check_thermal_corners(spec, sc); !st) return yaml.error(at, what, st.error().message);
+    }
+    if (d.parameter == P::kRateRampDps2 && !(dist.min >= 0.0 && dist.max <= kMaxRateRamp_dps2))
+      return yaml.error(at, what,
+                        "rate ramps from " + number_text(dist.min) + " to " + number_text(dist.max) +
+                            " deg/s^2: give a distribution within [0, " + number_text(kMaxRateRamp_dps2) +
+                            "] (R is a magnitude, as in a calibration's noise: section)");
     if (d.parameter == P::kFaultSizeFactor) {
       for (const auto& [kind, values] : sizes) {
         for (double size : values) {
@@ -419,6 +468,10 @@ void disperse_unit(Calibration& unit, P p, const std::vector<double>& v) {
       case P::kQuantizationFactor:
         if (g.noise) scale_noise(g.noise->quantization_deg, v[i]);
         break;
+      case P::kRateRampDps2:
+        if (!g.noise) g.noise.emplace();
+        g.noise->rate_ramp_dps_per_s = v[i];
+        break;
       default:
         break;
     }
@@ -461,7 +514,11 @@ Scenario dispersed_scenario(const Scenario& nominal, const DispersionSpec& spec,
     const P p = spec.parameters[i].parameter;
     const std::vector<double>& v = draws[i];
     const Shape shape = info_of(p).shape;
-    if (shape == Shape::kPerGyro || shape == Shape::kPerGyroXyz) {
+    if (p == P::kThermalBiasDpsPerK) {
+      sc.thermal.bias_dps_per_K = v;
+    } else if (p == P::kThermalStartC) {
+      sc.thermal.start_C = v[0];
+    } else if (shape == Shape::kPerGyro || shape == Shape::kPerGyroXyz) {
       disperse_unit(sc.unit, p, v);
     } else if (shape == Shape::kXyz) {
       if (sc.closed_loop) disperse_spacecraft(*sc.closed_loop, p, v);

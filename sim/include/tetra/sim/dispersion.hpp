@@ -65,6 +65,10 @@ enum class DispersedParameter {
   kFaultSizeFactor,           //!< fault.size_factor: the case's size × δ
   kFaultGyro,                 //!< fault.gyro: the gyro (choice)
   kFaultKind,                 //!< fault.kind: the kind (choice), with its first size in `sizes:`
+  // Appended (an engine's seed follows the parameter's place here: the ones above keep their draws).
+  kThermalBiasDpsPerK,  //!< thermal.bias_dps_per_K, per gyro: the warm-up's coefficient c_i [deg/s/K]
+  kThermalStartC,       //!< thermal.start_C: the unit's temperature at t = 0 [°C] (thermal.hpp)
+  kRateRampDps2,        //!< unit.rate_ramp_dps2, per gyro: the true rate ramp R [deg/s²], stated or not
 };
 
 struct Dispersion {
