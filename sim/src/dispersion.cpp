@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Geometry>
@@ -321,27 +322,19 @@ constexpr double kMaxRateRamp_dps2 = 1e-3;
 //! The warm-up each corner of the thermal draws' supports gives `sc` is a valid scenario's (its biases within
 //! kMaxThermalBias_dps, its temperatures in range), and it has a transient to give.
 Status check_thermal_corners(const DispersionSpec& spec, const Scenario& sc) {
-  std::pair<double, double> c{0.0, 0.0};
+  std::optional<std::pair<double, double>> c;  // the coefficients' support, when drawn
   std::pair<double, double> start{sc.thermal.start_C, sc.thermal.start_C};
-  bool coefficients = sc.thermal.active();
   for (const Dispersion& d : spec.parameters) {
-    if (d.parameter == P::kThermalBiasDpsPerK) {
-      c = {d.distribution.min, d.distribution.max};
-      coefficients = true;
-    }
+    if (d.parameter == P::kThermalBiasDpsPerK) c = {d.distribution.min, d.distribution.max};
     if (d.parameter == P::kThermalStartC) start = {d.distribution.min, d.distribution.max};
   }
-  if (!coefficients)
+  if (!c && !sc.thermal.active())
     return bad_input("a warm-up needs its coefficients: disperse thermal.bias_dps_per_K too, or give the "
                      "scenario a thermal: section");
-  for (const double ci : {c.first, c.second}) {
+  for (const double ci : {c ? c->first : 0.0, c ? c->second : 0.0}) {
     for (const double t0 : {start.first, start.second}) {
       Scenario corner = sc;
-      if (spec.parameters.end() != std::find_if(spec.parameters.begin(), spec.parameters.end(),
-                                                [](const Dispersion& d) {
-                                                  return d.parameter == P::kThermalBiasDpsPerK;
-                                                }))
-        corner.thermal.bias_dps_per_K.assign(static_cast<std::size_t>(sc.unit.gyro_count()), ci);
+      if (c) corner.thermal.bias_dps_per_K.assign(static_cast<std::size_t>(sc.unit.gyro_count()), ci);
       corner.thermal.start_C = t0;
       if (Status st = validate_scenario(corner); !st) return st;
     }
