@@ -141,6 +141,13 @@ TEST(CampaignDispersion, AWarmUpAndARateRampAreDrawnIntoTheTruthOnly) {
     EXPECT_FALSE(nominal.gyros[g].noise && nominal.gyros[g].noise->rate_ramp_dps_per_s);
   }
   EXPECT_FALSE(spec->scenarios[0].thermal.active());
+  // The example campaign beyond the envelope draws them for its five-gyro unit.
+  const auto example = read_campaign_spec(test::source_path("examples/campaign_beyond_envelope.yaml"));
+  ASSERT_TRUE(example) << example.error().message;
+  ASSERT_EQ(example->scenarios[0].unit.gyro_count(), 5);
+  const Scenario warm = campaign_scenario(*example, campaign_case(*example, 0));
+  EXPECT_EQ(warm.thermal.bias_dps_per_K.size(), 5u);
+  EXPECT_LE(warm.thermal.start_C, 10.0);
   const std::string header = campaign_csv_header(*spec);
   EXPECT_NE(header.find(",thermal.bias_dps_per_K.g1,"), std::string::npos) << header;
   EXPECT_NE(header.find(",thermal.start_C,unit.rate_ramp_dps2.g1,"), std::string::npos) << header;
