@@ -329,8 +329,9 @@ Status check_thermal_corners(const DispersionSpec& spec, const Scenario& sc) {
     if (d.parameter == P::kThermalStartC) start = {d.distribution.min, d.distribution.max};
   }
   if (!c && !sc.thermal.active())
-    return bad_input("a warm-up needs its coefficients: disperse thermal.bias_dps_per_K too, or give the "
-                     "scenario a thermal: section");
+    return bad_input(
+        "a warm-up needs its coefficients: disperse thermal.bias_dps_per_K too, or give the "
+        "scenario a thermal: section");
   for (const double ci : {c ? c->first : 0.0, c ? c->second : 0.0}) {
     for (const double t0 : {start.first, start.second}) {
       Scenario corner = sc;
