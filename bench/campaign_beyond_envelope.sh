@@ -17,7 +17,7 @@
 # design (0.0004/h, Garwood 95 %).
 # WARM=1 adds a warm-up and an unstated rate ramp to every run's truth: the unit starting at -5..10 degC and
 # settling at 20 degC (its calibration's temperature) with tau 300 s, each gyro's bias moving by its own
-# 0.5e-6..2e-6 deg/s/K (1e-5..5e-5 deg/s at the start, mostly common to the gyros), and a rate ramp of
+# 0.5e-6..2e-6 deg/s/K (5e-6..5e-5 deg/s at the start, mostly common to the gyros), and a rate ramp of
 # 1e-10..3e-9 deg/s^2 per gyro the calibration does not state.
 set -euo pipefail
 build="$(realpath "${1:-build}")"

@@ -129,7 +129,7 @@ TEST(CampaignDispersion, AWarmUpAndARateRampAreDrawnIntoTheTruthOnly) {
   EXPECT_EQ(truth.thermal.start_C, a.draws[1][0]);
   EXPECT_GE(truth.thermal.start_C, -5.0);
   EXPECT_LT(truth.thermal.start_C, 10.0);
-  // At t = 0 gyro 1's thermal bias is c_1·(T_start − 20 °C): 25–30 K below, up to 6e-5 deg/s.
+  // At t = 0 gyro 1's thermal bias is c_1·(T_start − 20 °C): 10–25 K below, up to 5e-5 deg/s.
   EXPECT_DOUBLE_EQ(truth.thermal.bias_dps(0, 0.0), a.draws[0][0] * (a.draws[1][0] - 20.0));
   const Calibration& nominal = spec->scenarios[0].unit;
   for (std::size_t g = 0; g < 4; ++g) {
@@ -163,6 +163,7 @@ TEST(CampaignDispersion, AWarmUpAndARateRampAreDrawnIntoTheTruthOnly) {
       {"  thermal.bias_dps_per_K: {uniform: [0, 1.0e-6]}\n  thermal.start_C: {uniform: [0, 500]}\n",
        "thermal.start_C"},
       {"  thermal.start_C: {uniform: [0, 5]}\n", "needs its coefficients"},
+      {"  thermal.bias_dps_per_K: {uniform: [0, 1.0e-6]}\n", "no warm-up to give"},
       {"  unit.rate_ramp_dps2: {uniform: [-1.0e-9, 1.0e-9]}\n", "R is a magnitude"},
   };
   for (const Case& c : cases) {

@@ -82,8 +82,9 @@ bool arbitrate_detection(const LedgerRow* begin, const LedgerRow* end) {
 ReferenceDecision arbitrate_reference(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active) {
   const Tally t(begin, end);
   if (!t.is_rejected(0)) return ReferenceDecision::kUse;
-  if (!t.every_gyro_rejected(active) || t.stands(Tally::kCalibration)) return ReferenceDecision::kNoCall;
+  if (!t.every_gyro_rejected(active)) return ReferenceDecision::kNoCall;
   if (t.stands(Tally::kDrift)) return ReferenceDecision::kMatchDrift;
+  if (t.stands(Tally::kCalibration)) return ReferenceDecision::kNoCall;
   if (t.stands(Tally::kReference) && t.is_rejected(Tally::kDrift)) return ReferenceDecision::kReject;
   return ReferenceDecision::kNoCall;
 }

@@ -66,8 +66,8 @@ class Isolator {
   void close();
 
   const Episode& episode() const { return episode_; }
-  //! The rows of the last `decide`: the onset test's per hypothesis, or the GLT's when the onset test told
-  //! nothing (empty when neither could run).
+  //! The rows of the last `decide`: the onset test's per hypothesis (no call when a window it needs cannot be
+  //! judged), or the GLT's when it runs (N ≥ 5: the onset test's are then dropped); empty before either can.
   const EvidenceRows& rows() const { return rows_; }
   //! [ns] time of a history epoch.
   std::int64_t time_of(std::int64_t index) const;

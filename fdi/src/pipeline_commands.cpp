@@ -77,6 +77,7 @@ FdiEvent Pipeline::Impl::command_reset(std::int64_t stamp_ns) {
   noise_match_.reset();
   bias_match_.release(attitude_.filter());  // every bias model the calibration's again
   drift_match_.reset();
+  calibration_fit_.reset();  // a standing mismatch judged afresh too
   for (int id = 1; id <= n_; ++id) attitude_.filter().set_added_noise(id, 0.0);
   restart_detectors();
   update_mode(stamp_ns);

@@ -194,21 +194,23 @@ void Pipeline::Impl::apply_reference_verdict(const ReferenceVerdict& v, const Ei
   }
   // A jump is left to the gate (a lone wild sample, or ten in a row set the attitude): only the slower tests
   // carry evidence of a gyro fault.
-  if (v.inconsistent && *v.inconsistent != ReferenceCheck::kJump && subsets_.get(active).dof < 1 &&
+  const bool three = subsets_.get(active).dof < 1;
+  if (v.inconsistent && *v.inconsistent != ReferenceCheck::kJump && (three || calibration_fit_.mismatch()) &&
       !isolator_.episode().active) {
-    // Redundancy exhausted: the reference or one of the gyros used is wrong and nothing tells which (the
-    // arbiter made no call). The reference stays in use (it is the only check left), the fault is reported,
-    // and the filter's attitude and bias states open by what the innovation shows, so the reference can pull
-    // both back.
+    // Redundancy exhausted, or a calibration that does not describe the unit: the reference or the gyros'
+    // attitude is wrong and nothing tells which (the arbiter made no call). The reference stays in use (it is
+    // the only check left), the disagreement is reported, and the filter's attitude and bias states open by
+    // what the innovation shows, so the reference can pull both back.
     emit_detected(DetectionTest::kReference, consistency_.windowed_nis(), frame_.now_ns);
     result_.events.back().why = *v.inconsistent;
-    result_.events.back().detail =
-        std::string("attitude reference and gyros disagree (") + to_string(*v.inconsistent) +
-        "); three gyros: the data cannot tell which, sigma and bias states widened";
+    result_.events.back().detail = std::string("attitude reference and gyros disagree (") +
+                                   to_string(*v.inconsistent) + "); " +
+                                   (three ? "three gyros" : "the calibration does not describe the unit") +
+                                   ": the data cannot tell which, sigma and bias states widened";
     result_.events.back().ledger.assign(reference_rows_.begin(), reference_rows_.end());
     attitude_.add_variance(z.cwiseProduct(z));
     attitude_.fault_opened(z.norm() / config_.reference_window_s);
-    noise_match_.match_all(subsets_.get(active).mask);
+    if (three) noise_match_.match_all(subsets_.get(active).mask);
   }
 }
 

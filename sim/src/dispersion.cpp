@@ -332,6 +332,11 @@ Status check_thermal_corners(const DispersionSpec& spec, const Scenario& sc) {
     return bad_input(
         "a warm-up needs its coefficients: disperse thermal.bias_dps_per_K too, or give the "
         "scenario a thermal: section");
+  const double cal_C = std::isnan(sc.thermal.calibrated_at_C) ? sc.thermal.end_C : sc.thermal.calibrated_at_C;
+  if (start.first == cal_C && start.second == cal_C && sc.thermal.end_C == cal_C)
+    return bad_input("no warm-up to give: the unit starts and settles at its calibration's " +
+                     number_text(cal_C) + " degC; disperse thermal.start_C too, or give the scenario a " +
+                     "thermal: section with start_C");
   for (const double ci : {c ? c->first : 0.0, c ? c->second : 0.0}) {
     for (const double t0 : {start.first, start.second}) {
       Scenario corner = sc;

@@ -8,7 +8,8 @@ namespace tetra::report {
 bool is_decision(fdi::EventType type) {
   return type == fdi::EventType::kDetected || type == fdi::EventType::kIsolated ||
          type == fdi::EventType::kUnisolated || type == fdi::EventType::kCleared ||
-         type == fdi::EventType::kReferenceRejected;
+         type == fdi::EventType::kReferenceRejected || type == fdi::EventType::kReferenceAccepted ||
+         type == fdi::EventType::kCalibrationMismatch;
 }
 
 LedgerExplainer::LedgerExplainer(double at_s, std::size_t decisions_kept)

@@ -131,10 +131,10 @@ enum class ReferenceDecision : std::uint8_t {
 const char* to_string(ReferenceDecision decision);  // "use", "reject", "match drift", "no call"
 
 //! The same rule for the reference (docs/fdi.md, "The arbiter"): H0 not rejected — the sample is used;
-//! else, unless every single-gyro hypothesis of `active` is rejected and Hcal does not stand (the gyros'
-//! calibration explains the disagreement), no call; else a consistent Hdrift is
+//! else, unless every single-gyro hypothesis of `active` is rejected, no call; else a consistent Hdrift is
 //! matched (the cheaper step: it opens a model and keeps the reference, and a mean that persists after it
-//! rejects Hdrift); else Href consistent with Hdrift rejected rejects the reference.
+//! rejects Hdrift); else no call while Hcal stands (the gyros' calibration explains the disagreement as
+//! well); else Href consistent with Hdrift rejected rejects the reference.
 ReferenceDecision arbitrate_reference(const LedgerRow* begin, const LedgerRow* end, std::uint32_t active);
 
 //! The same rule for a block of the motion fit: true when Hcal stands alone — H0 and every single-gyro
