@@ -65,14 +65,7 @@ void CalibrationFit::accumulate(const Eigen::VectorXd& p, int dof, const Eigen::
 bool CalibrationFit::record(const Eigen::VectorXd& p, const Subset& s, GyroMask mask,
                             const Eigen::Vector3d& omega_rad_s, std::int64_t now_ns, const SubsetCache& cache,
                             const PipelineConfig& config) {
-  if (s.dof < 1 || !s.observable) {
-    if (mask != mask_) {  // a set without parity to fit: no mismatch stands for it
-      streak_ = 0;
-      mismatch_ = false;
-      restart_pending_ = true;
-    }
-    return false;
-  }
+  if (s.dof < 1 || !s.observable) return false;
   if (mask != mask_ || s.dof != dof_) {  // a new gyro set: judged anew
     streak_ = 0;
     mismatch_ = false;

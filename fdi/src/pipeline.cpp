@@ -509,6 +509,8 @@ void Pipeline::Impl::cover_fault_span(int gyro, bool episode, std::int64_t now_n
 
 void Pipeline::Impl::reconfigure_without(int gyro, FaultKind kind, std::int64_t now_ns) {
   gyro_set_.exclude(gyro, kind);
+  // A set left without parity has nothing to fit: no mismatch stands for it (one with parity is judged anew).
+  if (subsets_.get(gyro_set_.active()).dof < 1) calibration_fit_.reset();
   attitude_.freeze(gyro);
   bias_match_.release(attitude_.filter());  // the error that opened the bias models may have been this fault
   drift_match_.reset();                     // (and the drift matched may have been it)
