@@ -126,7 +126,8 @@ std::optional<BlockFinding> ParityBiasMatch::close_block(const Subset& s, double
     // The filter's innovations are white while its model holds: its bias uncertainty v enters each epoch's
     // innovation afresh, so the block's mean carries v/n of it, not v (the error is corrected every epoch).
     const double f = sum_wnu_[k] / sum_w2_[k];  // [rad/s] the block's mean error
-    const double predicted = 1.0 / sum_w2_[k] + std::max(v, 0.0) / block_epochs_;  // [rad²/s²] its variance
+    const double predicted =
+        white_ratio_ / sum_w2_[k] + std::max(v, 0.0) / block_epochs_;  // [rad²/s²] its variance
     const double u = f * f / predicted;
     sum_wnu_[k] = 0.0;
     sum_w2_[k] = 0.0;

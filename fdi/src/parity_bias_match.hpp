@@ -65,6 +65,9 @@ class ParityBiasMatch {
   //! bias opened in `filter` (Mekf::open_bias_model); the block that begins a match returns its finding.
   std::optional<BlockFinding> observe(std::int64_t now_ns, const Subset& s, const Eigen::VectorXd& p,
                                       double sqrt_period, Mekf& filter);
+  //! [-] the white noise variance the data show over the model's (≤ 1; ParitySpread::measured): a block's
+  //! white part is predicted with it, so a white noise stated larger than the unit's hides no bias wander.
+  void set_white_ratio(double ratio) { white_ratio_ = ratio; }
   //! Gyro `id` reinstated: its match forgotten (the filter's thaw restores its bias model).
   void forget(int id);
   //! Nothing matched any more: every gyro's bias model in `filter` is the calibration's again and the blocks
@@ -76,6 +79,7 @@ class ParityBiasMatch {
   std::optional<BlockFinding> close_block(const Subset& s, double block_s, Mekf& filter);
 
   double false_alarm_ = 0.0;          //!< p per epoch
+  double white_ratio_ = 1.0;          //!< [-] set_white_ratio()
   GyroMask mask_ = 0;                 //!< the gyros of the statistics
   std::int64_t block_start_ns_ = -1;  //!< the block's first epoch
   int block_epochs_ = 0;

@@ -21,7 +21,7 @@ void ParitySpread::clear_sums() {
 
 void ParitySpread::reset() {
   clear_sums();
-  ratio_ = 1.0;
+  ratio_ = measured_ = 1.0;
   checked_ = false;
   start_ns_ = -1;
   epochs_ = checked_samples_ = 0;
@@ -79,10 +79,15 @@ std::optional<SpreadFinding> ParitySpread::observe(double u, int dof, double cap
   f.threshold = threshold_;
   f.samples = samples_;
   f.estimate = estimate(cap);
-  const double next = std::max(1.0, ratio_ * (f.estimate + interval(f.estimate)));
+  const double shown = ratio_ * (f.estimate + interval(f.estimate));
+  const double next = std::max(1.0, shown);
   clear_sums();
-  if (next == ratio_ || (f.estimate < 1.0 && next > ratio_)) return std::nullopt;
+  if (next == ratio_ || (f.estimate < 1.0 && next > ratio_)) {
+    measured_ = std::min(shown, ratio_);
+    return std::nullopt;
+  }
   ratio_ = next;
+  measured_ = std::min(shown, ratio_);
   f.ratio = ratio_;
   return f;
 }

@@ -80,9 +80,15 @@ class ParitySpread {
 
   //! [-] the white noise variance taken, over the stated (≥ 1).
   double ratio() const { return ratio_; }
+  //! [-] the white noise variance the data show, over the stated: below ratio() once a verdict found the
+  //! model larger than the data (the upper end of that verdict's 1σ interval), else ratio(). The model is
+  //! never taken below the stated noise (a detector whitened with it stays within its budget); a test that
+  //! looks for an excess beyond the white noise (the parity block match) judges against this one, which an
+  //! overstated white noise would otherwise hide.
+  double measured() const { return measured_; }
   //! Another test showed at least `ratio`: taken if larger, the sums empty (they were on the model before).
   void raise_to(double ratio) {
-    if (ratio > ratio_) ratio_ = ratio;
+    if (ratio > ratio_) ratio_ = measured_ = ratio;
     clear_sums();
   }
   //! The model has been checked since the last reset.
@@ -99,6 +105,7 @@ class ParitySpread {
 
   double threshold_ = 0.0;
   double ratio_ = 1.0;
+  double measured_ = 1.0;  //!< [-] measured(): ≤ ratio_
   bool checked_ = false;
   std::int64_t start_ns_ = -1;  //!< [ns] the first epoch after the reset
   int epochs_ = 0;              //!< epochs since the reset (up to design::spread_hold_epochs)

@@ -195,6 +195,8 @@ class Pipeline::Impl {
   void match_own_noise();
   void check_noise_model();
   void check_long_run_noise();
+  //! [-] the white noise variance the parity's spread shows over the model's (≤ 1).
+  double shown_white_ratio() const;
   //! [epochs] a block of the long-run spread, and the censoring of its values for subset `s`.
   int long_run_block_epochs() const;
   double long_run_cap(const Subset& s) const;

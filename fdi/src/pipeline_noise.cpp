@@ -16,6 +16,7 @@ namespace tetra::fdi {
 void Pipeline::Impl::check_noise_model() {
   const auto found =
       sample_spread_.observe(gate_.spread_sample(), gate_.spread_dof(), gate_.spread_cap(), frame_.now_ns);
+  bias_match_.set_white_ratio(shown_white_ratio());
   if (!found) return;
   if (subsets_.quantization_share() <= design::spread_white_dominates) white_spread_.raise_to(found->ratio);
   widen_noise(*found, "between consecutive epochs (one sample's noise)");
@@ -38,6 +39,14 @@ void Pipeline::Impl::check_long_run_noise() {
   const double q = subsets_.block_quantization(s, m);
   const auto found = white_spread_.observe(blocks_.u(), s.dof, long_run_cap(s), frame_.now_ns, q);
   if (found) widen_noise(*found, "between 5-s sums (the white noise every sum sees)");
+}
+
+double Pipeline::Impl::shown_white_ratio() const {
+  // One sample shows the white noise where the quantization is a small share of it (as for raise_to above);
+  // else the block sums do.
+  const ParitySpread& spread =
+      subsets_.quantization_share() <= design::spread_white_dominates ? sample_spread_ : white_spread_;
+  return std::min(1.0, spread.measured() / spread.ratio());
 }
 
 double Pipeline::Impl::long_run_cap(const Subset& s) const {
