@@ -13,9 +13,10 @@ namespace tetra::fdi::detail {
 class EvidenceRows {
  public:
   //! The most one decision holds: a source's N + 2 (H0, H1…HN, Href), the filter-bias check's N + 1
-  //! (bias_fit, bias_persists), the episode's detection rows (up to 4) and the calibration's two (Hcal):
-  //! 2N + 9, for every N the geometry allows; add() beyond it would drop a row unseen.
-  static constexpr int kCapacity = 2 * kMaxGyros + 9;
+  //! (bias_fit, bias_persists), the episode's detection rows (up to 4), the calibration's two (Hcal) and the
+  //! kind's one (drift_shape): 2N + 10, for every N the geometry allows; add() beyond it would drop a row
+  //! unseen.
+  static constexpr int kCapacity = 2 * kMaxGyros + 10;
 
   void clear() { n_ = 0; }
   void add(const LedgerRow& row) {

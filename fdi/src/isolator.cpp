@@ -116,7 +116,7 @@ Verdict Isolator::decide(std::int64_t now_ns, std::int64_t index, GyroMask activ
     } else if (raised && r > config_.noise_high_ratio) {
       kind = FaultKind::kNoise;
     } else if (evidence == Evidence::kGlt) {
-      kind = classify_drift(culprit, index, active, subsets);
+      kind = classify_drift(culprit, index, active, subsets, rows_);
     }
     // A noise level neither normal nor clearly high: wait for more samples rather than guess the kind.
     const bool ambiguous = !repeated && raised && quiet && r <= config_.noise_high_ratio;
@@ -386,9 +386,18 @@ void Isolator::baseline_noise(std::int64_t begin, std::int64_t end, const Subset
 // the model whose G is larger by design::drift_margin_sigma2; an offset without a trend (slope below 3σ) is a
 // bias that began before the history; otherwise `unknown` (a step seen shortly after a ramp began fits both).
 // Without parity (three gyros) the data cannot tell: unknown.
-FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets) const {
+FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets,
+                                   EvidenceRows& rows) const {
+  // The kind's row: G_step − G_ramp against the margin (NaN, JSON null, where there is no history to fit).
+  const auto named = [&](FaultKind kind, double step_less_ramp) {
+    rows.add(stated(EvidenceSource::kDriftShape, static_cast<std::uint8_t>(id),
+                    kind == FaultKind::kUnknown ? RowVerdict::kNoCall : RowVerdict::kConsistent,
+                    step_less_ramp, design::drift_margin_sigma2, 1));
+    return kind;
+  };
+  const double no_fit = std::numeric_limits<double>::quiet_NaN();
   const Subset& s = subsets.get(active);
-  if (!s.observable || s.dof < 1) return FaultKind::kUnknown;
+  if (!s.observable || s.dof < 1) return named(FaultKind::kUnknown, no_fit);
   const double w_norm = s.parity.col(id - 1).norm();
   const std::int64_t first = std::max<std::int64_t>(index - kHistory + 1, 0);
   double p[kMaxGyros];
@@ -404,7 +413,7 @@ FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, 
     drift_t_[static_cast<std::size_t>(n)] = ns_to_seconds(hist_ns_[slot] - t0);
     ++n;
   }
-  if (n < design::drift_min_epochs) return FaultKind::kUnknown;
+  if (n < design::drift_min_epochs) return named(FaultKind::kUnknown, no_fit);
   // Suffix sums from the change sample m on: Σx, Σx·t, Σt, Σt², count.
   double sx = 0.0, sxt = 0.0, st = 0.0, stt = 0.0;
   double g_step = 0.0, g_ramp = 0.0;
@@ -427,12 +436,13 @@ FaultKind Isolator::classify_drift(int id, std::int64_t index, GyroMask active, 
   const double sxx_t = stt - st * st / n;
   const double slope_gain = sxx_t > 0.0 ? (sxt - st * sx / n) * (sxt - st * sx / n) / sxx_t : 0.0;
   g_ramp = std::max(g_ramp, g_const + slope_gain);
-  if (g_step > g_ramp + design::drift_margin_sigma2) return FaultKind::kBias;
-  if (g_ramp > g_step + design::drift_margin_sigma2) return FaultKind::kRamp;
+  const double step_less_ramp = g_step - g_ramp;
+  if (step_less_ramp > design::drift_margin_sigma2) return named(FaultKind::kBias, step_less_ramp);
+  if (-step_less_ramp > design::drift_margin_sigma2) return named(FaultKind::kRamp, step_less_ramp);
   // An offset through the whole history with no trend in it (slope below 3σ): a bias that began before.
   if (slope_gain < design::drift_no_trend_sigma2 && g_const > design::drift_margin_sigma2)
-    return FaultKind::kBias;
-  return FaultKind::kUnknown;
+    return named(FaultKind::kBias, step_less_ramp);
+  return named(FaultKind::kUnknown, step_less_ramp);
 }
 
 Eigen::Vector3d Isolator::fault_angle(int id, std::int64_t from_index, std::int64_t index, GyroMask active,

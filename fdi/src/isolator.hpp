@@ -55,8 +55,10 @@ class Isolator {
   Verdict decide(std::int64_t now_ns, std::int64_t index, GyroMask active, SubsetCache& subsets,
                  const GyroSeries& series, Isolation& found);
   //! Bias or ramp, from the parity projected on gyro `id` over the history (a step or a ramp from the best
-  //! change time); unknown when neither fits clearly better, or without parity.
-  FaultKind classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets) const;
+  //! change time); unknown when neither fits clearly better, or without parity. The kind's one row
+  //! (drift_shape, gyro `id`'s hypothesis) goes to `rows`: consistent when a kind is named, else no call.
+  FaultKind classify_drift(int id, std::int64_t index, GyroMask active, SubsetCache& subsets,
+                           EvidenceRows& rows) const;
   //! [rad] per axis: a bound of the attitude error a fault on gyro `id` caused from history epoch
   //! `from_index` to `index` while in the solution of `active`: Σ |H*(:, id)|·|f_k|·Δt_k, f_k the fault the
   //! epoch's parity puts on that gyro (every epoch of the full set kept in the history; zero without parity).

@@ -59,6 +59,10 @@ const EvidenceSourceInfo kEvidenceSources[kEvidenceSourceCount] = {
     {EvidenceSource::kBiasPersists, "bias_persists", StatisticUnit::kChi2,
      "the best-fitting fault's χ²₁ over the latest half of the span: consistent when at least "
      "bias_hypothesis_persist_sigma2 and of the filter estimate's sign (a spike has gone by then)"},
+    {EvidenceSource::kDriftShape, "drift_shape", StatisticUnit::kChi2,
+     "the isolated gyro's kind: G_step − G_ramp, the parity's best step fit less its best ramp fit over the "
+     "history; beyond ±drift_margin_sigma2 a bias or a ramp (consistent), else no call (unknown) unless an "
+     "offset without a trend (slope's fit below drift_no_trend_sigma2) names a bias"},
 };
 
 bool reads_own_signal(EvidenceSource source) {

@@ -225,10 +225,12 @@ void Pipeline::Impl::seek_evidence() {
     const auto finding =
         reference_.update(frame_.now_ns, *frame_.reference_q_RB, gyro_set_.excluded(), series_);
     if (finding) {
-      const FaultKind drift =
-          isolator_.classify_drift(finding->gyro, frame_.index, gyro_set_.active(), subsets_);
-      isolate({finding->gyro, finding->scale ? FaultKind::kScale : drift, Evidence::kReference,
-               DetectionTest::kReference, finding->statistic, finding->rows});
+      Isolation iso{finding->gyro,      FaultKind::kScale, Evidence::kReference, DetectionTest::kReference,
+                    finding->statistic, finding->rows};
+      if (!finding->scale)
+        iso.kind =
+            isolator_.classify_drift(finding->gyro, frame_.index, gyro_set_.active(), subsets_, iso.rows);
+      isolate(iso);
     } else if (config_.filter_bias_isolation && isolator_.episode().active && attitude_.reference_aided()) {
       // The filter's bias estimates (reference + parity make each gyro's observable): one gyro alone off.
       if (const auto bias = reference_.filter_update(attitude_.filter(), gyro_set_.active()))
@@ -273,7 +275,7 @@ void Pipeline::Impl::isolate_filter_bias(const ReferenceFinding& bias) {
   if (arbitrate(iso.rows.begin(), iso.rows.end(), active, true) != bias.gyro) return;
   iso.kind = reference_.span_scale(bias.gyro, span)
                  ? FaultKind::kScale
-                 : isolator_.classify_drift(bias.gyro, frame_.index, active, subsets_);
+                 : isolator_.classify_drift(bias.gyro, frame_.index, active, subsets_, iso.rows);
   isolate(iso);
 }
 

@@ -262,6 +262,56 @@ TEST(Pipeline, ReferenceIsolatesBiasRampAndScale) {
   }
 }
 
+TEST(Pipeline, AnIsolatedDriftsKindIsOneRowOfItsHypothesis) {
+  // A 1e-3 deg/s step and a 2e-5 deg/s² ramp, each on gyros 1 and 3, a 1 Hz reference (as above): the
+  // `isolated` event carries one drift_shape row, of the isolated gyro's hypothesis, G_step − G_ramp against
+  // drift_margin_sigma2 (design constant: 16 σ², a 4σ difference of fits): consistent and beyond the margin
+  // on the side of the kind it names (a bias above +16, a ramp below −16; a bias within it only as an offset
+  // without a trend), no call for `unknown`; a named kind is the truth. A step the onset test isolates has its
+  // own rows (onset) and no drift_shape. Before the kind was a row: none.
+  SynthOptions opt;
+  opt.reference_period_s = 1.0;
+  opt.reference_sigma_arcsec = 5.0;
+  int named = 0;
+  int drifts = 0;  // isolations whose kind a drift fit named (the reference's, the GLT's)
+  for (const int gyro : {1, 3}) {
+    for (const auto& [kind, size] : {std::pair{FaultKind::kBias, 1e-3}, std::pair{FaultKind::kRamp, 2e-5}}) {
+      opt.seed = 3000U + static_cast<std::uint64_t>(gyro);
+      const Outcome o = run(SynthFault{gyro, kind, false, 60.0, size}, 60.0 + 70.0, opt);
+      const std::string what = std::string(to_string(kind)) + " on gyro " + std::to_string(gyro);
+      const auto isolated = std::find_if(o.events.begin(), o.events.end(),
+                                         [](const FdiEvent& e) { return e.type == EventType::kIsolated; });
+      ASSERT_NE(isolated, o.events.end()) << what << "\n" << describe(o);
+      std::vector<LedgerRow> shape;
+      for (const LedgerRow& r : isolated->ledger)
+        if (r.source == EvidenceSource::kDriftShape) shape.push_back(r);
+      if (isolated->evidence == Evidence::kOnset) {  // a step the onset test saw: its own rows name it
+        EXPECT_TRUE(shape.empty()) << what << "\n" << describe(o);
+        continue;
+      }
+      ++drifts;
+      ASSERT_EQ(shape.size(), 1U) << what << "\n" << describe(o);
+      const LedgerRow& r = shape.front();
+      EXPECT_EQ(r.hypothesis, static_cast<std::uint8_t>(gyro)) << what;
+      EXPECT_DOUBLE_EQ(r.threshold, 16.0) << what;
+      if (isolated->kind == FaultKind::kUnknown) {
+        EXPECT_EQ(r.verdict, RowVerdict::kNoCall) << what << "\n" << describe(o);
+        continue;
+      }
+      ++named;
+      EXPECT_EQ(isolated->kind, kind) << what << "\n" << describe(o);
+      EXPECT_EQ(r.verdict, RowVerdict::kConsistent) << what;
+      if (kind == FaultKind::kRamp) {
+        EXPECT_LT(r.statistic, -16.0) << what;
+      } else {
+        EXPECT_GT(r.statistic, -16.0) << what;
+      }
+    }
+  }
+  EXPECT_GE(drifts, 2);
+  EXPECT_GE(named, 2);
+}
+
 TEST(Pipeline, RejectsAndCountsBadTimesAndShapes) {
   const auto cal = seed_as_built_unit();
   auto p = Pipeline::create(cal, PipelineConfig{});

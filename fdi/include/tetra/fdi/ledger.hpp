@@ -41,9 +41,10 @@ enum class EvidenceSource : std::uint8_t {
   kUncheckedNoise,    //!< the white noise an alarm needs, while the spread has not checked the model
   kParityBlockMatch,  //!< the parity's block means of the filter's innovations: each gyro's bias model
   kBiasFit,           //!< one gyro's fault fitted to an episode's parity mean and reference disagreements
-  kBiasPersists       //!< the best-fitting fault in the latest half of that span, of the filter's sign
+  kBiasPersists,      //!< the best-fitting fault in the latest half of that span, of the filter's sign
+  kDriftShape         //!< the isolated gyro's drift: a step or a ramp (the kind; it decides no exclusion)
 };
-constexpr int kEvidenceSourceCount = 24;
+constexpr int kEvidenceSourceCount = 25;
 //! True for the sources that read a gyro's own signal (timeout, invalid, repeated, zero, variance,
 //! noise_level, recurring_spikes): no error of the calibration makes what they see.
 bool reads_own_signal(EvidenceSource source);
