@@ -267,8 +267,8 @@ TEST(Pipeline, AnIsolatedDriftsKindIsOneRowOfItsHypothesis) {
   // `isolated` event carries one drift_shape row, of the isolated gyro's hypothesis, G_step − G_ramp against
   // drift_margin_sigma2 (design constant: 16 σ², a 4σ difference of fits): consistent and beyond the margin
   // on the side of the kind it names (a bias above +16, a ramp below −16; a bias within it only as an offset
-  // without a trend), no call for `unknown`; a named kind is the truth. A step the onset test isolates has its
-  // own rows (onset) and no drift_shape. Before the kind was a row: none.
+  // without a trend), no call for `unknown`; a named kind is the truth. A step the onset test isolates has
+  // its own rows (onset) and no drift_shape. Before the kind was a row: none.
   SynthOptions opt;
   opt.reference_period_s = 1.0;
   opt.reference_sigma_arcsec = 5.0;
