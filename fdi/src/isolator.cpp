@@ -108,6 +108,9 @@ Verdict Isolator::decide(std::int64_t now_ns, std::int64_t index, GyroMask activ
     // While the body moves, second differences carry its jerk: a raised level may be motion, not noise.
     const bool quiet = series.motion_quiet(culprit, subsets.sqrt_period(), last);
     const bool raised = std::isfinite(r) && r > design::noise_raised_fraction * config_.noise_high_ratio;
+    // A noise level neither normal nor clearly high: wait for more samples rather than guess the kind.
+    const bool ambiguous = !repeated && raised && quiet && r <= config_.noise_high_ratio;
+    if (ambiguous) return Verdict::kNone;
     FaultKind kind = FaultKind::kBias;
     if (repeated) {
       kind = FaultKind::kStuck;
@@ -118,9 +121,6 @@ Verdict Isolator::decide(std::int64_t now_ns, std::int64_t index, GyroMask activ
     } else if (evidence == Evidence::kGlt) {
       kind = classify_drift(culprit, index, active, subsets, rows_);
     }
-    // A noise level neither normal nor clearly high: wait for more samples rather than guess the kind.
-    const bool ambiguous = !repeated && raised && quiet && r <= config_.noise_high_ratio;
-    if (ambiguous) return Verdict::kNone;
     found = {culprit, kind, evidence, episode_.test, episode_.statistic, rows_};
     return Verdict::kIsolated;
   }

@@ -77,10 +77,11 @@ PartitionName=test Nodes=localhost Default=YES MaxTime=10 State=UP
 CONF
 export SLURM_CONF=$dir/slurm.conf
 slurmctld -f "$SLURM_CONF"
-for _ in $(seq 50); do [ -s slurmctld.pid ] && break; sleep 0.1; done
+for _ in $(seq 300); do [ -s slurmctld.pid ] && break; sleep 0.1; done
 pids+=("$(cat slurmctld.pid)")
 slurmd -f "$SLURM_CONF" -N localhost
-for _ in $(seq 50); do [ -s slurmd.pid ] && break; sleep 0.1; done
+for _ in $(seq 300); do [ -s slurmd.pid ] && break; sleep 0.1; done
+[ -s slurmd.pid ] || { echo "slurmd wrote no pid file within 30 s; its log:"; cat slurmd.log 2>/dev/null; exit 1; }
 pids+=("$(cat slurmd.pid)")
 for _ in $(seq 100); do
   sinfo -h -o %t 2>/dev/null | grep -qx idle && break
