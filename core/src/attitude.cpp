@@ -40,13 +40,28 @@ Eigen::Vector3d AttitudePropagator::step(const Eigen::Vector3d& omega_meas_B_rad
   }
   var_random_rad2_ += arw_sq_rad2_s * dt_s;
   systematic_rad_ += bias_sigma_rad_s * dt_s;
-  bound_rad_ += bound_rad_s * dt_s;
+  if ((bound_rad_s.array() != 0.0).any()) add_bound(bound_rad_s * dt_s);
   return omega;
 }
 
+void AttitudePropagator::add_bound(const Eigen::Vector3d& angle_rad) {
+  if ((bound_rad_.array() == 0.0).all()) {
+    bound_q_RB_ = q_RB_;  // a new bound: its axes are the body's now
+    bound_rad_ += angle_rad.cwiseAbs();
+    return;
+  }
+  bound_rad_ += to_bound_axes() * angle_rad.cwiseAbs();
+}
+
+Eigen::Matrix3d AttitudePropagator::to_bound_axes() const {
+  return (bound_q_RB_.conjugate() * q_RB_).toRotationMatrix().cwiseAbs();
+}
+
 Eigen::Vector3d AttitudePropagator::sigma_rad() const {
-  return (var_random_rad2_ + systematic_rad_.cwiseProduct(systematic_rad_) +
-          bound_rad_.cwiseProduct(bound_rad_))
+  if ((bound_rad_.array() == 0.0).all())
+    return (var_random_rad2_ + systematic_rad_.cwiseProduct(systematic_rad_)).cwiseSqrt();
+  const Eigen::Vector3d bound = to_bound_axes().transpose() * bound_rad_;  // in the current body axes
+  return (var_random_rad2_ + systematic_rad_.cwiseProduct(systematic_rad_) + bound.cwiseProduct(bound))
       .cwiseSqrt();
 }
 

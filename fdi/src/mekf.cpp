@@ -262,6 +262,7 @@ void Mekf::reset(double attitude_sigma_rad) {
   std::fill(added_noise_.begin(), added_noise_.end(), 0.0);
   std::fill(added_gm_var_.begin(), added_gm_var_.end(), 0.0);
   std::fill(added_rrw_var_.begin(), added_rrw_var_.end(), 0.0);
+  bias_ratio_ = 1.0;
   ramp_age_s_ = ramp_taken_s_ = 0.0;
   gm_dt_s_ = -1.0;
   step_dt_s_ = -1.0;  // the step constants again from the model's noise
@@ -375,6 +376,18 @@ void Mekf::open_bias_model(int id, double gm_var_rad2_s2, double rrw_var_rad2_s3
     added_gm_var_[k] = gm_var_rad2_s2;
   }
   if (rrw) added_rrw_var_[k] = rrw_var_rad2_s3;
+  gm_dt_s_ = -1.0;  // the bias transitions and the step constants recomputed at the next step
+  step_dt_s_ = -1.0;
+}
+
+void Mekf::set_bias_model_ratio(double ratio) {
+  if (!(ratio > bias_ratio_)) return;
+  for (int i = 0; i < n_; ++i) {
+    if (frozen(i + 1)) continue;
+    const double stated = gyros_[static_cast<std::size_t>(i)].gm_sigma_rad_s;
+    P_(g_of(i), g_of(i)) += (ratio - bias_ratio_) * stated * stated;
+  }
+  bias_ratio_ = ratio;
   gm_dt_s_ = -1.0;  // the bias transitions and the step constants recomputed at the next step
   step_dt_s_ = -1.0;
 }

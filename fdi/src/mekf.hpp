@@ -81,6 +81,12 @@ class Mekf {
   void open_bias_model(int id, double gm_var_rad2_s2, double rrw_var_rad2_s3);
   //! Gyro `id`'s bias back to the model's processes (its current variance kept).
   void clear_bias_model(int id);
+  //! Every gyro's bias terms as stated (σ_GM², K², the ramp's 2R²·t) taken as `ratio` times the
+  //! calibration's from the next step on (≥ 1, only grows): the data showed the unit's white noise that many
+  //! times its stated variance, so its `noise:` does not describe it, and its bias terms, which take far
+  //! longer to measure, are taken no better than its white noise (docs/fdi.md, "A unit noisier than its
+  //! `noise:` section"). The Gauss–Markov variances open by the difference at once. reset() puts 1 back.
+  void set_bias_model_ratio(double ratio);
   //! [rad²/s²] gyro `id`'s variance added to its Gauss–Markov bias (open_bias_model), 0 by default.
   double added_bias_instability(int id) const { return added_gm_var_[static_cast<std::size_t>(id - 1)]; }
   //! [rad²/s³] gyro `id`'s variance rate added to its random-walk bias (open_bias_model), 0 by default.
@@ -149,7 +155,7 @@ class Mekf {
   void propagate_covariance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& q_theta);
   //! [rad²/s²] gyro index `i`'s Gauss–Markov stationary variance: the model's σ_GM² and any added.
   double gm_stationary_var(std::size_t i) const {
-    return gyros_[i].gm_sigma_rad_s * gyros_[i].gm_sigma_rad_s + added_gm_var_[i];
+    return bias_ratio_ * (gyros_[i].gm_sigma_rad_s * gyros_[i].gm_sigma_rad_s) + added_gm_var_[i];
   }
 
   std::vector<GyroNoiseModel> gyros_;
@@ -172,7 +178,7 @@ class Mekf {
   //! [rad²/s³] gyro i's slow bias variance rate as stated: K² and the stated ramp's 2R²·t
   double stated_walk_var_rate(std::size_t i) const {
     const double r = gyros_[i].ramp_rad_s2;
-    return gyros_[i].rrw_rad_s_rts * gyros_[i].rrw_rad_s_rts + 2.0 * r * r * ramp_taken_s_;
+    return bias_ratio_ * (gyros_[i].rrw_rad_s_rts * gyros_[i].rrw_rad_s_rts + 2.0 * r * r * ramp_taken_s_);
   }
   //! [rad²/s³] the same with an opened model's addition
   double walk_var_rate(std::size_t i) const { return stated_walk_var_rate(i) + added_rrw_var_[i]; }
@@ -202,6 +208,7 @@ class Mekf {
   std::vector<double> added_noise_;   //!< [rad²/s] per gyro: white rate noise added to N² (set_added_noise)
   std::vector<double> added_gm_var_;  //!< [rad²/s²] per gyro: added to σ_GM² (open_bias_model)
   std::vector<double> added_rrw_var_;  //!< [rad²/s³] per gyro: added to K² (open_bias_model)
+  double bias_ratio_ = 1.0;            //!< [-] the stated bias terms' factor (set_bias_model_ratio)
 };
 
 //! ∫₀^Δt exp(−[ω×]u) du in closed form (a series for small |ω|Δt).

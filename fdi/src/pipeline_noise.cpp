@@ -63,6 +63,7 @@ int Pipeline::Impl::long_run_block_epochs() const {
 void Pipeline::Impl::widen_noise(const SpreadFinding& f, const char* evidence) {
   subsets_.set_noise_ratios(white_spread_.ratio(), sample_spread_.ratio());
   noise_match_.set_common_ratio(white_spread_.ratio(), attitude_.filter());
+  attitude_.filter().set_bias_model_ratio(white_spread_.ratio());
   calibration_fit_.restart_block();
   blocks_.restart();
   const bool episode = isolator_.episode().active;

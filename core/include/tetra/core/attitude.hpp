@@ -11,6 +11,11 @@
 //   systematic: σ_sys,a   += b_a·Δt           (1σ rate bias left by the calibration [rad/s]: grows with t)
 //   bound:      σ_bnd,a   += e_a·Δt           (rate error bound of an unresolved fault [rad/s], added
 //   linearly) σ_a = √(σ²_rand,a + σ²_sys,a + σ²_bnd,a).
+// The bound is an angle error already made: it turns with the body. It is kept as a box in the body axes
+// of the attitude where it began (B0) and read in the current ones through |C_B0B|, the rotation's
+// element-wise magnitude (the smallest box about the turned one); what a step adds in the current axes
+// enters B0's the same way. A slew after a fault moves the error from one body axis to another, and the
+// bound with it.
 
 #include <optional>
 
@@ -41,7 +46,7 @@ class AttitudePropagator {
                        const Eigen::Vector3d& bound_rad_s);
 
   //! Adds an angle bound [rad] per axis at once (e.g. the error a fault caused before it was isolated).
-  void add_bound(const Eigen::Vector3d& angle_rad) { bound_rad_ += angle_rad.cwiseAbs(); }
+  void add_bound(const Eigen::Vector3d& angle_rad);
 
   const Quaternion& q_RB() const { return q_RB_; }
   //! The last step's body rotation exp(½ ω_B Δt) (ω_B the rate the step turned B by: the measured rate in
@@ -51,12 +56,15 @@ class AttitudePropagator {
   Eigen::Vector3d sigma_rad() const;
 
  private:
-  Quaternion q_RB_;                                //!< body → reference (L in ground mode); unit norm
-  Quaternion increment_ = Quaternion::Identity();  //!< the last step's body rotation
-  std::optional<Eigen::Vector3d> earth_rate_L_;    //!< [rad/s] set in ground-test mode
-  Eigen::Vector3d var_random_rad2_;                //!< [rad²]
-  Eigen::Vector3d systematic_rad_;                 //!< [rad]
-  Eigen::Vector3d bound_rad_;                      //!< [rad]
+  Quaternion q_RB_;                                 //!< body → reference (L in ground mode); unit norm
+  Quaternion increment_ = Quaternion::Identity();   //!< the last step's body rotation
+  std::optional<Eigen::Vector3d> earth_rate_L_;     //!< [rad/s] set in ground-test mode
+  Eigen::Vector3d var_random_rad2_;                 //!< [rad²]
+  Eigen::Vector3d systematic_rad_;                  //!< [rad]
+  Eigen::Vector3d bound_rad_;                       //!< [rad] in the body axes of `bound_q_RB_`
+  Quaternion bound_q_RB_ = Quaternion::Identity();  //!< the attitude where the bound began (B0)
+  //! [-] |C_B0B|: a box in the current body axes, as one in B0's
+  Eigen::Matrix3d to_bound_axes() const;
 };
 
 }  // namespace tetra
