@@ -303,37 +303,6 @@ TEST(MekfParts, PurePropagationGrowsLikeTheNoiseModel) {
   EXPECT_LT((f.attitude_sigma_rad() - expect).norm(), 1e-15);  // rounding of 100 sums
 }
 
-TEST(MekfParts, ABiasModelRatioScalesTheStatedBiasTermsAndOnlyGrows) {
-  // set_bias_model_ratio(λ): σ_GM² and K² taken λ times the stated. Over a step Δt at rest the slow bias's
-  // variance gains λ·K²·Δt and the Gauss–Markov one tends to λ·σ_GM² (opened by (λ − 1)·σ_GM² at once); a
-  // smaller ratio later changes nothing; reset() puts 1 back.
-  fdi::detail::GyroNoiseModel g;
-  g.arw_rad_rts = 1e-6;
-  g.bias_sigma_rad_s = 1e-5;
-  g.gm_sigma_rad_s = 2e-6;
-  g.gm_correlation_s = 100.0;
-  g.rrw_rad_s_rts = 1e-7;
-  fdi::detail::Mekf f(std::vector<fdi::detail::GyroNoiseModel>(3, g));
-  const Eigen::Matrix3Xd pinv = Eigen::Matrix3d::Identity();
-  const auto c = [&](int i) { return f.covariance()(3 + i, 3 + i); };
-  const auto gm = [&](int i) { return f.covariance()(6 + i, 6 + i); };
-  EXPECT_DOUBLE_EQ(gm(0), 4e-12);
-  f.set_bias_model_ratio(4.0);
-  EXPECT_DOUBLE_EQ(gm(0), 16e-12);  // λ·σ_GM², stationary at once
-  const double c0 = c(1);
-  f.propagate(pinv, 0b111, Eigen::Vector3d::Zero(), 1.0);
-  EXPECT_NEAR(c(1) - c0, 4.0 * 1e-14, 1e-25);  // λ·K²·Δt (to the rounding of a 1e-10 variance)
-  EXPECT_NEAR(gm(2), 16e-12, 1e-24);           // stays stationary at the new variance
-  f.set_bias_model_ratio(2.0);                 // only grows
-  f.propagate(pinv, 0b111, Eigen::Vector3d::Zero(), 1.0);
-  EXPECT_NEAR(c(1) - c0, 8.0 * 1e-14, 1e-25);
-  f.reset(1e-3);
-  EXPECT_DOUBLE_EQ(gm(0), 4e-12);
-  const double c1 = c(0);
-  f.propagate(pinv, 0b111, Eigen::Vector3d::Zero(), 1.0);
-  EXPECT_NEAR(c(0) - c1, 1e-14, 1e-25);  // the stated K² again
-}
-
 TEST(MekfParts, GateRejectsAWildReferenceAndCounts) {
   // A reference sample 1° off when the filter is sure to arcseconds: χ² ≫ the gate; nothing changes.
   fdi::detail::GyroNoiseModel g;
@@ -376,6 +345,31 @@ struct DenseFilter {
     return std::vector<fdi::detail::GyroNoiseModel>(static_cast<std::size_t>(n), m);
   }
 };
+
+TEST(MekfParts, ABiasModelRatioScalesTheStatedBiasTermsAndOnlyGrows) {
+  // set_bias_model_ratio(λ): σ_GM² and K² taken λ times the stated. Over a step Δt at rest the slow bias's
+  // variance gains λ·K²·Δt and the Gauss–Markov one tends to λ·σ_GM² (opened by (λ − 1)·σ_GM² at once); a
+  // smaller ratio later changes nothing; reset() puts 1 back.
+  fdi::detail::Mekf f(DenseFilter::noise(3));  // σ_c 1e-5, σ_GM 2e-6 rad/s, T_c 100 s, K 1e-7 rad/s/√s
+  const Eigen::Matrix3Xd pinv = Eigen::Matrix3d::Identity();
+  const auto c = [&](int i) { return f.covariance()(3 + i, 3 + i); };
+  const auto gm = [&](int i) { return f.covariance()(6 + i, 6 + i); };
+  EXPECT_DOUBLE_EQ(gm(0), 4e-12);
+  f.set_bias_model_ratio(4.0);
+  EXPECT_DOUBLE_EQ(gm(0), 16e-12);  // λ·σ_GM², stationary at once
+  const double c0 = c(1);
+  f.propagate(pinv, 0b111, Eigen::Vector3d::Zero(), 1.0);
+  EXPECT_NEAR(c(1) - c0, 4.0 * 1e-14, 1e-25);  // λ·K²·Δt (to the rounding of a 1e-10 variance)
+  EXPECT_NEAR(gm(2), 16e-12, 1e-24);           // stays stationary at the new variance
+  f.set_bias_model_ratio(2.0);                 // only grows
+  f.propagate(pinv, 0b111, Eigen::Vector3d::Zero(), 1.0);
+  EXPECT_NEAR(c(1) - c0, 8.0 * 1e-14, 1e-25);
+  f.reset(1e-3);
+  EXPECT_DOUBLE_EQ(gm(0), 4e-12);
+  const double c1 = c(0);
+  f.propagate(pinv, 0b111, Eigen::Vector3d::Zero(), 1.0);
+  EXPECT_NEAR(c(0) - c1, 1e-14, 1e-25);  // the stated K² again
+}
 
 TEST(MekfParts, PropagationIsTheTransitionOfTheModel) {
   // A dense P, the last gyro frozen and out of the solution; one step against P ← Φ·P·Φᵀ + Q built here in
