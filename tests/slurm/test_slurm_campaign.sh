@@ -83,7 +83,8 @@ slurmd -f "$SLURM_CONF" -N localhost
 for _ in $(seq 300); do [ -s slurmd.pid ] && break; sleep 0.1; done
 [ -s slurmd.pid ] || { echo "slurmd wrote no pid file within 30 s; its log:"; cat slurmd.log 2>/dev/null; exit 1; }
 pids+=("$(cat slurmd.pid)")
-for _ in $(seq 100); do
+# Under a loaded machine (the whole suite on two cores) slurmd can take tens of seconds to register: 60 s.
+for _ in $(seq 300); do
   sinfo -h -o %t 2>/dev/null | grep -qx idle && break
   sleep 0.2
 done
@@ -106,10 +107,11 @@ export TETRA=$tetra
 submitted=$("$src/examples/slurm/submit_campaign.sh" spec.yaml "$dir/cluster" 3 --cpus-per-task=1)
 echo "$submitted"
 merge_job=$(sed -n 's/.*merge job \([0-9]*\).*/\1/p' <<<"$submitted")
-for _ in $(seq 300); do
+for _ in $(seq 600); do  # 120 s: the shards and the merge, each a job of its own
   [ -z "$(squeue -h -j "$merge_job" 2>/dev/null)" ] && break
   sleep 0.2
 done
+[ -z "$(squeue -h -j "$merge_job" 2>/dev/null)" ] || { echo "FAIL: the merge job still queued after 120 s"; squeue; cat slurmctld.log; exit 1; }
 for f in cluster/slurm-*.out; do echo "== $f"; cat "$f"; done
 [ -f cluster/merged/report.md ] || { echo "FAIL: no merged report"; exit 1; }
 for k in 1 2 3; do
