@@ -47,7 +47,7 @@ Eigen::Vector3d AttitudePropagator::step(const Eigen::Vector3d& omega_meas_B_rad
 void AttitudePropagator::add_bound(const Eigen::Vector3d& angle_rad) {
   if ((bound_rad_.array() == 0.0).all()) {
     bound_q_RB_ = q_RB_;  // a new bound: its axes are the body's now
-    bound_rad_ += angle_rad.cwiseAbs();
+    bound_rad_ = angle_rad.cwiseAbs();
     return;
   }
   bound_rad_ += to_bound_axes() * angle_rad.cwiseAbs();

@@ -216,6 +216,14 @@ TEST(PerturbationFamilies, ABiasInstabilityBeyondTheStatedIsMatchedByTheParityBl
   }
 }
 
+//! One run of the sweep judged, its figures printed (the test's record of what it measured).
+test::FamilyVerdict judged(const sim::PerturbedRun& r) {
+  const test::FamilyVerdict v = test::judge_run(r);
+  std::printf("%s: within 3 sigma %.2f %%, NEES %.2f %.2f %.2f\n", r.label.c_str(), 100.0 * v.within,
+              v.nees.x(), v.nees.y(), v.nees.z());
+  return v;
+}
+
 TEST(PerturbationFamilies, AWhiteNoiseStatedLargerThanTheUnitsHidesNoBiasWander) {
   // Six gyros whose white noise is 0.69 times the stated (variance 0.48) and bias instability 1.63 times, a
   // 1 Hz reference, gyro 5 stepped at 53 s: the parity block match judged each 30-s block mean against the
@@ -227,9 +235,7 @@ TEST(PerturbationFamilies, AWhiteNoiseStatedLargerThanTheUnitsHidesNoBiasWander)
   // the 20 draws no longer worse than the twin. This draw's figures barely move (the match comes late): the
   // check is the match, and the run honest. Run of the sweep (seed 3): noisy-unit #267.
   const sim::PerturbedRun r = sim::perturbed_run(sim::Family::kNoisyUnit, 3, 267);
-  const test::FamilyVerdict v = test::judge_run(r);
-  std::printf("%s: within 3 sigma %.2f %%, NEES %.2f %.2f %.2f\n", r.label.c_str(), 100.0 * v.within,
-              v.nees.x(), v.nees.y(), v.nees.z());
+  const test::FamilyVerdict v = judged(r);
   EXPECT_TRUE(test::honest(v)) << r.label << "\n" << v.events;
   EXPECT_NE(v.events.find("noise_model"), std::string::npos) << r.label << "\n" << v.events;
   EXPECT_FALSE(v.wrong_exclusion) << r.label << "\n" << v.events;
@@ -244,9 +250,7 @@ TEST(PerturbationFamilies, AUnitNoisierThanStatedInWhiteNoiseIsTrustedNoBetterIn
   // noisier than its noise: section in one term is now trusted no better in the others until their data
   // (Mekf::set_bias_model_ratio): NEES 1.94 1.12 0.97. Run of the sweep (seed 5): noisy-unit #194.
   const sim::PerturbedRun r = sim::perturbed_run(sim::Family::kNoisyUnit, 5, 194);
-  const test::FamilyVerdict v = test::judge_run(r);
-  std::printf("%s: within 3 sigma %.2f %%, NEES %.2f %.2f %.2f\n", r.label.c_str(), 100.0 * v.within,
-              v.nees.x(), v.nees.y(), v.nees.z());
+  const test::FamilyVerdict v = judged(r);
   EXPECT_TRUE(test::honest(v)) << r.label << "\n" << v.events;
   EXPECT_NE(v.events.find("noise_model"), std::string::npos) << r.label << "\n" << v.events;
   EXPECT_FALSE(v.exclusion_no_fault) << r.label << "\n" << v.events;
@@ -261,9 +265,7 @@ TEST(PerturbationFamilies, AFaultsAngleErrorTurnsWithTheBodyInSigma) {
   // bound now turns with the body (AttitudePropagator): NEES 0.48 0.22 0.28. Run of the sweep (seed 11):
   // calibration-without-noise #57.
   const sim::PerturbedRun r = sim::perturbed_run(sim::Family::kCalibrationWithoutNoise, 11, 57);
-  const test::FamilyVerdict v = test::judge_run(r);
-  std::printf("%s: within 3 sigma %.2f %%, NEES %.2f %.2f %.2f\n", r.label.c_str(), 100.0 * v.within,
-              v.nees.x(), v.nees.y(), v.nees.z());
+  const test::FamilyVerdict v = judged(r);
   EXPECT_TRUE(test::honest(v)) << r.label << "\n" << v.events;
   EXPECT_LT(v.nees.maxCoeff(), 1.0) << r.label;  // 2.09 before; the bound is a bound, so well below 1
   EXPECT_FALSE(v.wrong_exclusion) << r.label << "\n" << v.events;
