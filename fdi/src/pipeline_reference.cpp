@@ -236,10 +236,12 @@ double Pipeline::Impl::drift_threshold(GyroMask active) {
   // design::reference_max_wander_ratio.
   drift_ratio_needed_ =
       gyros_vouch_
-          ? drift_match_.next_ratio(ReferenceBiasMatch::needed_ratio(consistency_.bias_mean_rad(),
-                                                                     consistency_.bias_span_s(frame_.now_ns),
-                                                                     active, attitude_.filter()),
-                                    frame_.now_ns)
+          ? drift_match_.next_ratio(
+                ReferenceBiasMatch::needed_ratio(
+                    consistency_.bias_mean_rad(),
+                    drift_match_.drift_span_s(consistency_.bias_span_s(frame_.now_ns), frame_.now_ns), active,
+                    attitude_.filter()),
+                frame_.now_ns)
           : std::numeric_limits<double>::quiet_NaN();
   const bool possible = gyros_vouch_ && drift_ratio_needed_ <= design::reference_max_wander_ratio;
   return possible ? drift_match_.threshold() : std::numeric_limits<double>::infinity();

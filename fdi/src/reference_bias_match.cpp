@@ -21,6 +21,7 @@ void ReferenceBiasMatch::reset() {
   matched_ = false;
   ratio_ = 1.0;
   last_match_ns_ = -1;
+  seen_from_ns_ = -1;
 }
 
 void ReferenceBiasMatch::restart() {
@@ -62,8 +63,9 @@ double ReferenceBiasMatch::needed_ratio(const Eigen::Vector3d& mean_rad, double 
 
 bool ReferenceBiasMatch::match_mean(std::int64_t now_ns, const Eigen::Vector3d& mean_rad, double span_s,
                                     GyroMask active, Mekf& filter) {
-  const double needed = needed_ratio(mean_rad, span_s, active, filter);
+  const double needed = needed_ratio(mean_rad, drift_span_s(span_s, now_ns), active, filter);
   if (!may_explain(needed, now_ns)) return false;
+  if (!persists(now_ns)) seen_from_ns_ = now_ns - seconds_to_ns(span_s);
   matched_ = true;
   ratio_ = next_ratio(needed, now_ns);
   last_match_ns_ = now_ns;

@@ -14,12 +14,14 @@
 // (p_m = the budget's kReferenceBiasMatch share per sample). A match opens every active gyro's slow bias c_i
 // to a random walk of K_i² + λ·q_i [rad²/s³] (Mekf::open_bias_model), q_i = K_i² + 2σ_GM,i²/T_c + N_i²/T_c²
 // the model's own wander per second: a body-rate error b = 2·z̄/T grown within the window T is a random walk
-// of |b|²/T, and λ is at least ρ (design::block_match_ratio) times that over q_i — and at least ρ times its
-// last value, so a drift that goes on opens the model further at every match. A mean that persists, the model
-// opened (a match within the long window of the last), asks for ρ times more at each match: once the λ a
-// match would set exceeds a working unit's wander (design::reference_max_wander_ratio) the mean is the
-// reference's, and its bias test rejects it as before. The match is kept (the models only open) until a reset
-// or an exclusion; each match is a noise_model event.
+// of |b|²/T (T, while matches persist, from the first sample of the series' first match: what a block shows
+// may be an error the filter still carries from before the block), and λ is at least ρ
+// (design::block_match_ratio) times that over q_i — and at least ρ times its last value, so a drift that goes
+// on opens the model further at every match. A mean that persists, the model opened (a match within the long
+// window of the last), asks for ρ times more at each match: once the λ a match would set exceeds a working
+// unit's wander (design::reference_max_wander_ratio) the mean is the reference's, and its bias test rejects
+// it as before. The match is kept (the models only open) until a reset or an exclusion; each match is a
+// noise_model event.
 
 #include <algorithm>
 #include <cstdint>
@@ -27,6 +29,7 @@
 
 #include <Eigen/Core>
 
+#include "tetra/core/units.hpp"
 #include "tetra/fdi/config.hpp"
 #include "tetra/fdi/types.hpp"
 
@@ -62,8 +65,13 @@ class ReferenceBiasMatch {
   //! The λ a match at `now_ns` of a mean that needs `needed` would set: at least ρ times the last match's
   //! while the mean persists (the last match within the long window), at least ρ once it has not.
   double next_ratio(double needed, std::int64_t now_ns) const {
-    const bool persists = last_match_ns_ >= 0 && now_ns - last_match_ns_ <= long_window_ns_;
-    return std::max(needed, design::block_match_ratio * (persists ? ratio_ : 1.0));
+    return std::max(needed, design::block_match_ratio * (persists(now_ns) ? ratio_ : 1.0));
+  }
+  //! [s] the span a mean judged over `span_s` up to `now_ns` may have grown in under Hdrift: while a match
+  //! persists, since the first sample the series' first match judged (the error a block shows may be one the
+  //! filter still carries from before it; a block just restarted does not make the drift fast).
+  double drift_span_s(double span_s, std::int64_t now_ns) const {
+    return persists(now_ns) ? std::max(span_s, ns_to_seconds(now_ns - seen_from_ns_)) : span_s;
   }
   //! Whether a mean that needs `needed` may be matched as a drift of working gyros: the λ its match would
   //! set at most design::reference_max_wander_ratio (a mean that persists with the model opened asks for ρ
@@ -80,6 +88,10 @@ class ReferenceBiasMatch {
 
  private:
   void open(GyroMask active, Mekf& filter) const;  //!< every active gyro's random walk at λ·q_i
+  //! The last match is within the long window of `now_ns`.
+  bool persists(std::int64_t now_ns) const {
+    return last_match_ns_ >= 0 && now_ns - last_match_ns_ <= long_window_ns_;
+  }
   //! [rad²/s³] q_i, the model's own wander per second: K² + 2σ_GM²/T_c + N²/T_c².
   static double wander(const GyroNoiseModel& m);
 
@@ -90,6 +102,7 @@ class ReferenceBiasMatch {
   Eigen::Vector3d swz_ = Eigen::Vector3d::Zero();  //!< [1/rad] per axis Σ z_a/S_aa
   bool matched_ = false;
   std::int64_t last_match_ns_ = -1;  //!< the last match (-1: none since the reset)
+  std::int64_t seen_from_ns_ = -1;   //!< the first sample the first match of the persisting series judged
   double ratio_ = 1.0;               //!< λ
 };
 

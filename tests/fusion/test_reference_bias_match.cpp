@@ -1,7 +1,8 @@
 // The common-drift match on its own (reference_bias_match.hpp): white innovations of the filter's covariance
 // never match over many seeds; a mean a working unit's drift could make matches within the long window and
 // opens every active gyro's bias random walk; a mean only a reference's bias could make is left to the
-// reference's tests; a second match waits one bias window.
+// reference's tests; a second match waits one bias window; while matches persist, a block's mean is judged
+// over the time since the series' first sample, not over the block alone.
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -92,6 +93,31 @@ TEST(ReferenceBiasMatch, AWarmUpsMeanMatchesAndOpensEveryActiveGyro) {
   const std::int64_t later = now + (matches + 481) * kSecond_ns;
   EXPECT_DOUBLE_EQ(m.next_ratio(0.0, later), design::block_match_ratio);
   EXPECT_TRUE(m.match_mean(later, persisting, 120.0, 0b0111, f));
+}
+
+TEST(ReferenceBiasMatch, APersistingDriftsNextBlockIsJudgedSinceTheDriftWasFirstSeen) {
+  // A warm-up matched over its first 120-s bias block, then 21 s into the next block a mean of 8″ (an error
+  // the filter still carries from before): over 21 s alone it needs a random walk beyond 1e4 times the unit's
+  // wander (ρ·(2·8″/21 s)²/21 s: 12,800), over the 141 s since the drift was first seen (141/21)³ ≈ 300 times
+  // less. (Seen in the warm-up family, seed 7 #251: a healthy 1 Hz tracker rejected at 95 s, the needed ratio
+  // 10,772 against 1e4 over the 21 s since the match at 74 s.)
+  const PipelineConfig config;
+  Mekf f = seed_like_filter();
+  ReferenceBiasMatch m(config);
+  const Eigen::Vector3d first = Eigen::Vector3d::Constant(1.0 * kArcsecToRad / std::sqrt(3.0));
+  const std::int64_t at = 120 * kSecond_ns;
+  ASSERT_TRUE(m.match_mean(at, first, 120.0, 0b1111, f));
+  const Eigen::Vector3d carried = Eigen::Vector3d::Constant(8.0 * kArcsecToRad / std::sqrt(3.0));
+  const std::int64_t next = at + 21 * kSecond_ns;
+  EXPECT_GT(ReferenceBiasMatch::needed_ratio(carried, 21.0, 0b1111, f), design::reference_max_wander_ratio);
+  EXPECT_DOUBLE_EQ(m.drift_span_s(21.0, next), 141.0);
+  EXPECT_TRUE(m.match_mean(next, carried, 21.0, 0b1111, f));
+  // The series' start stays where its first match began; a match after the long window starts a new one.
+  EXPECT_DOUBLE_EQ(m.drift_span_s(10.0, next + 10 * kSecond_ns), 151.0);
+  const std::int64_t later = next + 481 * kSecond_ns;
+  EXPECT_DOUBLE_EQ(m.drift_span_s(10.0, later), 10.0);
+  ASSERT_TRUE(m.match_mean(later, first, 120.0, 0b1111, f));
+  EXPECT_DOUBLE_EQ(m.drift_span_s(10.0, later + 10 * kSecond_ns), 130.0);
 }
 
 TEST(ReferenceBiasMatch, AMeanOnlyTheReferenceCouldMakeIsNotADrift) {
