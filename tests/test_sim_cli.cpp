@@ -146,6 +146,28 @@ namespace {
 // Acceptance: the turntable output, calibrated by `tetra calibrate`, returns the truth unit within
 // the accuracy the calibration issue states for this case (seed unit, 1 turn per sequence at
 // 10 Hz, white rate noise 3e-5 deg/√s): s to 1e-5 relative, axes to 1e-5, β to 2e-6 V.
+TEST(SimCli, AScenarioFileIsJudgedAgainstTheUnitOfTheRun) {
+  // A warm-up and a fault written for a five-gyro unit, run with --unit of five gyros: the file was judged
+  // against the default four-gyro unit before --unit replaced it ("thermal.bias_dps_per_K has 5
+  // coefficients; the unit has 4 gyros"), so a scenario for any N ≠ 4 could not run from the command line.
+  TempDir dir;
+  write_file(dir.file("warm5.yaml"),
+             "scenario: orbit\nduration_s: 60\nrate_hz: 10\nfaults: [\"gyro=5,kind=bias,at=30,size=0.01\"]\n"
+             "thermal: {start_C: 0, end_C: 20, time_constant_s: 300,\n"
+             "          bias_dps_per_K: [1e-6, 1.2e-6, 0.8e-6, 1.5e-6, 1.1e-6]}\n");
+  const std::string unit5 = std::string(TETRA_SOURCE_DIR) + "/examples/sim/calibrated_unit_5.yaml";
+  const auto r =
+      run_tetra("sim " + dir.file("warm5.yaml") + " --unit " + unit5 + " --out " + dir.file("a.csv"));
+  EXPECT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("a.csv")));
+  // Without --unit the file still names its line against the unit it gets.
+  const auto four = run_tetra("sim " + dir.file("warm5.yaml") + " --out " + dir.file("b.csv"));
+  EXPECT_EQ(four.exit_status, 2);
+  EXPECT_NE(four.err.find("warm5.yaml:"), std::string::npos) << four.err;
+  EXPECT_NE(four.err.find("the unit has 4 gyros"), std::string::npos) << four.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("b.csv")));
+}
+
 TEST(SimCli, TurntableCalibratedByTetraCalibrateReturnsTheTruthUnit) {
   const auto help = run_tetra("calibrate --help");
   if (help.exit_status != 0) GTEST_SKIP() << "tetra calibrate is not part of this build yet";

@@ -204,7 +204,8 @@ Status read_closed_loop(const YamlReader& yaml, const YAML::Node& root, Scenario
 }
 
 // The built-in scenario, then each section of the file over it, in this order; then the ranges.
-Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, const std::string& base_dir) {
+Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, const std::string& base_dir,
+                            const Calibration* unit) {
   auto sc = base_scenario(root, yaml);
   if (!sc) return sc.error();
   for (auto* read_section :
@@ -212,6 +213,7 @@ Result<Scenario> parse_yaml(const YAML::Node& root, const YamlReader& yaml, cons
     if (Status st = read_section(yaml, root, *sc); !st) return st.error();
   }
   if (Status st = read_unit(yaml, root, base_dir, *sc); !st) return st.error();
+  if (unit != nullptr) sc->unit = *unit;
   for (auto* read_section : {read_faults, read_closed_loop}) {
     if (Status st = read_section(yaml, root, *sc); !st) return st.error();
   }
@@ -264,24 +266,24 @@ Result<Scenario> builtin_scenario(const std::string& name) {
 }
 
 Result<Scenario> parse_scenario(const std::string& yaml_text, const std::string& source,
-                                const std::string& base_dir) {
+                                const std::string& base_dir, const Calibration* unit) {
   const YamlReader yaml{source};
   try {
     auto loaded = yaml.load(yaml_text);
     if (!loaded) return loaded.error();
     const YAML::Node root = *loaded;
     if (!root || root.IsNull()) return bad_input(source + ": empty scenario file");
-    return parse_yaml(root, yaml, base_dir);
+    return parse_yaml(root, yaml, base_dir, unit);
   } catch (const YAML::Exception& e) {
     return yaml.error(e, "");
   }
 }
 
-Result<Scenario> read_scenario(const std::string& path) {
+Result<Scenario> read_scenario(const std::string& path, const Calibration* unit) {
   auto text = read_input(path, kMaxYamlBytes);
   if (!text) return text.error();
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  return parse_scenario(*text, path, parent.empty() ? "." : parent.string());
+  return parse_scenario(*text, path, parent.empty() ? "." : parent.string(), unit);
 }
 
 namespace {

@@ -147,8 +147,9 @@ std::string overrides_given(const SimRunOptions& run) {
 Result<sim::Scenario> load_scenario(const SimRunOptions& o, const std::optional<Calibration>& unit) {
   if (!o.plan_given.empty())
     return bad_input(name_of(o.names, o.plan_given.front()) + " applies to the turntable scenario only");
-  Result<sim::Scenario> scenario =
-      is_scenario_file(o.scenario) ? sim::read_scenario(o.scenario) : sim::builtin_scenario(o.scenario);
+  Result<sim::Scenario> scenario = is_scenario_file(o.scenario)
+                                       ? sim::read_scenario(o.scenario, unit ? &*unit : nullptr)
+                                       : sim::builtin_scenario(o.scenario);
   if (!scenario) return scenario.error();
   if (unit) scenario->unit = *unit;
   apply_overrides(o.overrides, *scenario);

@@ -63,10 +63,12 @@ inline constexpr double kMaxRange_dps = 1.0e6;              //!< [deg/s] gyro_mo
 std::vector<std::string> builtin_scenario_names();
 //! A built-in scenario: static, lab-orbit, orbit, slews (defaults in docs/sim.md).
 Result<Scenario> builtin_scenario(const std::string& name);
-//! A scenario from YAML text; `source` names it in messages and `base_dir` resolves `unit:` paths.
+//! A scenario from YAML text; `source` names it in messages and `base_dir` resolves `unit:` paths. `unit`,
+//! when given, replaces the file's (or the default) unit before the checks — a command's --unit — so what
+//! depends on the unit (thermal coefficients, fault gyros) is judged against the unit the run will use.
 Result<Scenario> parse_scenario(const std::string& yaml_text, const std::string& source,
-                                const std::string& base_dir = ".");
-Result<Scenario> read_scenario(const std::string& path);
+                                const std::string& base_dir = ".", const Calibration* unit = nullptr);
+Result<Scenario> read_scenario(const std::string& path, const Calibration* unit = nullptr);
 //! Checks everything the simulator relies on (numbers, fault gyros exist, ...).
 Status validate_scenario(const Scenario& scenario);
 
