@@ -224,6 +224,22 @@ test::FamilyVerdict judged(const sim::PerturbedRun& r) {
   return v;
 }
 
+//! A noisy unit's run: honest, and the noise model's excess named (a noise_model event).
+test::FamilyVerdict expect_named_and_honest(const sim::PerturbedRun& r) {
+  const test::FamilyVerdict v = judged(r);
+  EXPECT_TRUE(test::honest(v)) << r.label << "\n" << v.events;
+  EXPECT_NE(v.events.find("noise_model"), std::string::npos) << r.label << "\n" << v.events;
+  return v;
+}
+
+//! A warm-up's run with a healthy tracker: the tracker kept, every decision explained, sigma honest.
+void expect_tracker_kept_and_honest(const sim::PerturbedRun& r) {
+  const test::FamilyVerdict v = judged(r);
+  EXPECT_FALSE(v.healthy_reference_rejected) << r.label << "\n" << v.events;
+  EXPECT_EQ(v.unexplained, 0) << r.label << "\n" << v.events;
+  EXPECT_TRUE(test::honest(v)) << r.label << "\n" << v.events;
+}
+
 TEST(PerturbationFamilies, AWhiteNoiseStatedLargerThanTheUnitsHidesNoBiasWander) {
   // Six gyros whose white noise is 0.69 times the stated (variance 0.48) and bias instability 1.63 times, a
   // 1 Hz reference, gyro 5 stepped at 53 s: the parity block match judged each 30-s block mean against the
@@ -235,9 +251,7 @@ TEST(PerturbationFamilies, AWhiteNoiseStatedLargerThanTheUnitsHidesNoBiasWander)
   // the 20 draws no longer worse than the twin. This draw's figures barely move (the match comes late): the
   // check is the match, and the run honest. Run of the sweep (seed 3): noisy-unit #267.
   const sim::PerturbedRun r = sim::perturbed_run(sim::Family::kNoisyUnit, 3, 267);
-  const test::FamilyVerdict v = judged(r);
-  EXPECT_TRUE(test::honest(v)) << r.label << "\n" << v.events;
-  EXPECT_NE(v.events.find("noise_model"), std::string::npos) << r.label << "\n" << v.events;
+  const test::FamilyVerdict v = expect_named_and_honest(r);
   EXPECT_FALSE(v.wrong_exclusion) << r.label << "\n" << v.events;
 }
 
@@ -250,9 +264,7 @@ TEST(PerturbationFamilies, AUnitNoisierThanStatedInWhiteNoiseIsTrustedNoBetterIn
   // noisier than its noise: section in one term is now trusted no better in the others until their data
   // (Mekf::set_bias_model_ratio): NEES 1.94 1.12 0.97. Run of the sweep (seed 5): noisy-unit #194.
   const sim::PerturbedRun r = sim::perturbed_run(sim::Family::kNoisyUnit, 5, 194);
-  const test::FamilyVerdict v = judged(r);
-  EXPECT_TRUE(test::honest(v)) << r.label << "\n" << v.events;
-  EXPECT_NE(v.events.find("noise_model"), std::string::npos) << r.label << "\n" << v.events;
+  const test::FamilyVerdict v = expect_named_and_honest(r);
   EXPECT_FALSE(v.exclusion_no_fault) << r.label << "\n" << v.events;
 }
 
@@ -279,11 +291,7 @@ TEST(PerturbationFamilies, AWarmUpThatGoesOnAfterItsMatchKeepsTheHealthyReferenc
   // rejected at 101 s (its mean needing 4,022 times the wander, a working unit's). A mean that goes on now
   // asks for rho times more at each match and is the reference's only beyond 1e4 (docs/fdi.md, "A common
   // drift below the detectors"): the tracker kept. Run of the sweep (seed 3): warm-up #250.
-  const sim::PerturbedRun r = sim::perturbed_run(sim::Family::kWarmUp, 3, 250);
-  const test::FamilyVerdict v = test::judge_run(r);
-  EXPECT_FALSE(v.healthy_reference_rejected) << r.label << "\n" << v.events;
-  EXPECT_EQ(v.unexplained, 0) << r.label << "\n" << v.events;
-  EXPECT_TRUE(test::honest(v)) << r.label << "\n" << v.events;
+  expect_tracker_kept_and_honest(sim::perturbed_run(sim::Family::kWarmUp, 3, 250));
 }
 
 TEST(PerturbationFamilies, AWarmUpsMeanJustAfterItsMatchIsJudgedSinceTheDriftWasFirstSeen) {
@@ -294,11 +302,7 @@ TEST(PerturbationFamilies, AWarmUpsMeanJustAfterItsMatchIsJudgedSinceTheDriftWas
   // the rest of the run (per-axis NEES 0.22 0.02 0.02: sigma from the gyros alone). While matches persist the
   // mean is now judged over the time since the drift was first seen: matched again, the tracker kept, NEES
   // 1.01 0.74 0.68. Run of the sweep (seed 7): warm-up #251.
-  const sim::PerturbedRun r = sim::perturbed_run(sim::Family::kWarmUp, 7, 251);
-  const test::FamilyVerdict v = judged(r);
-  EXPECT_FALSE(v.healthy_reference_rejected) << r.label << "\n" << v.events;
-  EXPECT_EQ(v.unexplained, 0) << r.label << "\n" << v.events;
-  EXPECT_TRUE(test::honest(v)) << r.label << "\n" << v.events;
+  expect_tracker_kept_and_honest(sim::perturbed_run(sim::Family::kWarmUp, 7, 251));
 }
 
 TEST(PerturbationFamilies, AGyroStuckAtASlewsStartIsCoveredWhileTheJumpTestHoldsAnotherOut) {

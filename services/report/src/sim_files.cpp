@@ -151,7 +151,7 @@ Result<sim::Scenario> load_scenario(const SimRunOptions& o, const std::optional<
                                        ? sim::read_scenario(o.scenario, unit ? &*unit : nullptr)
                                        : sim::builtin_scenario(o.scenario);
   if (!scenario) return scenario.error();
-  if (unit) scenario->unit = *unit;
+  if (unit) scenario->unit = *unit;  // a built-in scenario's (a file took it before its checks)
   apply_overrides(o.overrides, *scenario);
   if (!o.faults.empty()) scenario->faults.clear();  // the run's faults replace the file's
   // Each override is in its own range; together (e.g. duration × rate) they may still not fit.
