@@ -61,9 +61,12 @@ Eigen::Vector3d Spacecraft::disturbance_B_Nm(const Quaternion& q_NB, const TimeT
 
 namespace {
 
-//! [in B] G·v over the wheels (`v` n values along their axes), summed as Eigen's general matrix-vector
-//! product sums a 3×n product (each row from 0, wheel by wheel): the same bits, without the call.
-Eigen::Vector3d wheels_in_body(const Eigen::MatrixXd& G, const double* v, Eigen::Index n) {
+//! [in B] G·v over the wheels (`v` n values along their axes; `kWheels` > 0: n known at compile time), summed
+//! as Eigen's general matrix-vector product sums a 3×n product (each row from 0, wheel by wheel): the same
+//! bits, without the call.
+template <int kWheels = 0>
+Eigen::Vector3d wheels_in_body(const Eigen::MatrixXd& G, const double* v, Eigen::Index n_runtime) {
+  const Eigen::Index n = kWheels > 0 ? kWheels : n_runtime;
   Eigen::Vector3d out;
   for (int a = 0; a < 3; ++a) {
     double sum = 0.0;
@@ -81,22 +84,31 @@ struct Derivative {
 
 }  // namespace
 
-template <typename WheelVector>
-void Spacecraft::integrate(BodyState& s, const Eigen::VectorXd& tau_w, double t0_s, double dt_s,
+template <int kWheels>
+void Spacecraft::integrate(BodyState& s, const Eigen::VectorXd& tau_wheels, double t0_s, double dt_s,
                            long long steps) const {
-  const Eigen::Vector3d tau_wheels_B_Nm = wheels_in_body(axes_B_, tau_w.data(), tau_w.size());  // held
+  // The wheel vectors of a size known at compile time (`kWheels` > 0: unrolled, on the stack) and the
+  // momenta advanced locally, written back once: each element takes the same operations either way.
+  using WheelVector = Eigen::Matrix<double, (kWheels > 0 ? kWheels : Eigen::Dynamic), 1>;
+  const WheelVector tau_w = tau_wheels;
+  const Eigen::Index n = tau_w.size();
+  const Eigen::Vector3d tau_wheels_B_Nm = wheels_in_body<kWheels>(axes_B_, tau_w.data(), n);  // held
   const auto derivative = [&](const Eigen::Vector4d& q_wxyz, const Eigen::Vector3d& omega,
                               const WheelVector& h, const TimeTerms& at) {
     const Quaternion q = quat_from(q_wxyz).normalized();
     Derivative d;
     const Quaternion q_dot = quat_from(q_wxyz) * Quaternion(0.0, omega.x(), omega.y(), omega.z());
     d.q_dot = 0.5 * wxyz_of(q_dot);
-    const Eigen::Vector3d h_B = wheels_in_body(axes_B_, h.data(), h.size());
+    const Eigen::Vector3d h_B = wheels_in_body<kWheels>(axes_B_, h.data(), n);
     const Eigen::Vector3d tau_ext = disturbance_B_Nm(q, at);
     d.omega_dot = inertia_inv_ * (tau_ext - tau_wheels_B_Nm - omega.cross(inertia_ * omega + h_B));
     return d;
   };
   const double h2 = 0.5 * dt_s;
+  const double w = dt_s / 6.0;
+  // ḣ is τ_w at every point of a step: its RK4 sum is the same every step.
+  const WheelVector h_rate_sum = tau_w + 2.0 * tau_w + 2.0 * tau_w + tau_w;
+  WheelVector h0 = s.h_wheels_Nms;
   TimeTerms end;
   double end_s = kNaN;  // the previous step's end: its terms are this step's start when the times agree
   for (long long i = 0; i < steps; ++i) {
@@ -106,8 +118,7 @@ void Spacecraft::integrate(BodyState& s, const Eigen::VectorXd& tau_w, double t0
     end_s = t_s + dt_s;
     end = at_time(end_s);
     const Eigen::Vector4d q0 = wxyz_of(s.q_NB);
-    const WheelVector h0 = s.h_wheels_Nms;
-    const WheelVector h_mid = h0 + h2 * tau_w;  // h + h2·ḣ of k1 and of k2: ḣ is τ_w at every point
+    const WheelVector h_mid = h0 + h2 * tau_w;  // h + h2·ḣ of k1 and of k2
     const Derivative k1 = derivative(q0, s.omega_BN_B_rad_s, h0, start);
     const Derivative k2 =
         derivative(q0 + h2 * k1.q_dot, s.omega_BN_B_rad_s + h2 * k1.omega_dot, h_mid, middle);
@@ -116,21 +127,23 @@ void Spacecraft::integrate(BodyState& s, const Eigen::VectorXd& tau_w, double t0
     const WheelVector h_end = h0 + dt_s * tau_w;
     const Derivative k4 =
         derivative(q0 + dt_s * k3.q_dot, s.omega_BN_B_rad_s + dt_s * k3.omega_dot, h_end, end);
-    const double w = dt_s / 6.0;
     s.q_NB = canonical(quat_from(q0 + w * (k1.q_dot + 2.0 * k2.q_dot + 2.0 * k3.q_dot + k4.q_dot)));
     s.omega_BN_B_rad_s += w * (k1.omega_dot + 2.0 * k2.omega_dot + 2.0 * k3.omega_dot + k4.omega_dot);
-    s.h_wheels_Nms += w * (tau_w + 2.0 * tau_w + 2.0 * tau_w + tau_w);
+    h0 += w * h_rate_sum;
   }
+  s.h_wheels_Nms = h0;
 }
 
 void Spacecraft::advance(BodyState& s, const Eigen::VectorXd& tau_w, double t0_s, double dt_s,
                          long long steps) const {
-  constexpr int kStackWheels = 4;  // the most a spec validates (closed_loop_spec.cpp)
-  using StackWheels = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kStackWheels, 1>;
-  if (s.h_wheels_Nms.size() <= kStackWheels && tau_w.size() == s.h_wheels_Nms.size())
-    integrate<StackWheels>(s, tau_w, t0_s, dt_s, steps);
+  // The wheel counts a spec validates (closed_loop_spec.cpp) at compile time; any other at run time.
+  const Eigen::Index n = s.h_wheels_Nms.size() == tau_w.size() ? tau_w.size() : 0;
+  if (n == 3)
+    integrate<3>(s, tau_w, t0_s, dt_s, steps);
+  else if (n == 4)
+    integrate<4>(s, tau_w, t0_s, dt_s, steps);
   else
-    integrate<Eigen::VectorXd>(s, tau_w, t0_s, dt_s, steps);
+    integrate<0>(s, tau_w, t0_s, dt_s, steps);
 }
 
 }  // namespace tetra::sim

@@ -115,7 +115,8 @@ inline bool explained(const fdi::FdiEvent& e) {
   }
 }
 
-inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
+//! One perturbed run through the pipeline, every accepted epoch's error, sigma and protection level kept.
+inline CampaignRun run_family_member(const sim::PerturbedRun& r) {
   fdi::PipelineConfig config;
   if (r.sample_period_s > 0.0) config.sample_period_s = r.sample_period_s;
   if (r.max_angular_acceleration_dps2 > 0.0)
@@ -124,7 +125,11 @@ inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
   options.keep_errors = true;
   options.gap_from_s = r.gap_from_s;
   options.gap_until_s = r.gap_until_s;
-  const CampaignRun run = run_campaign(r.scenario, r.options, r.calibration, config, options);
+  return run_campaign(r.scenario, r.options, r.calibration, config, options);
+}
+
+inline FamilyVerdict judge_run(const sim::PerturbedRun& r) {
+  const CampaignRun run = run_family_member(r);
   FamilyVerdict v;
   const int n = r.scenario.unit.gyro_count();
   const double start = perturbation_start_s(r);

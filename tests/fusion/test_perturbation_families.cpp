@@ -5,8 +5,10 @@
 // exclusion in a fault-free run, never LOST from one fault, and every run's sigma honest (≥ 97 % of
 // axis-epochs within 3σ, per-axis NEES ≤ 2). The figures are printed per family.
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <map>
 #include <optional>
 #include <set>
@@ -476,6 +478,24 @@ TEST(PerturbationFamilies, ShowOneRun) {
         twin ? "twin of " : "", r.label.c_str(), 100.0 * f.within, f.nees.x(), f.nees.y(), f.nees.z(),
         f.worst_sigmas, f.beyond_protection, f.worst_protection_ratio, f.beyond_from_s, f.beyond_until_s,
         f.flagged_after_s.value_or(-1.0), f.events.c_str());
+  }
+  // TETRA_FAMILY_TRACE=PATH: the perturbed run's every accepted epoch as CSV, to plot what the figures sum
+  // up.
+  if (const char* path = std::getenv("TETRA_FAMILY_TRACE")) {
+    const test::CampaignRun run = test::run_family_member(r);
+    std::FILE* out = std::fopen(path, "w");
+    ASSERT_NE(out, nullptr) << path << ": " << std::strerror(errno);
+    std::fprintf(out,
+                 "time_s,ex_arcsec,ey_arcsec,ez_arcsec,sx_arcsec,sy_arcsec,sz_arcsec,plx_arcsec,ply_arcsec,"
+                 "plz_arcsec,mode\n");
+    for (std::size_t k = 0; k < run.time_s.size(); ++k) {
+      const Eigen::Vector3d e = run.error_rad[k] / kArcsecToRad;
+      const Eigen::Vector3d s = run.sigma_rad[k] / kArcsecToRad;
+      const Eigen::Vector3d pl = run.protection_level_rad[k] / kArcsecToRad;
+      std::fprintf(out, "%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%s\n", run.time_s[k], e.x(), e.y(),
+                   e.z(), s.x(), s.y(), s.z(), pl.x(), pl.y(), pl.z(), fdi::to_string(run.mode[k]));
+    }
+    ASSERT_EQ(std::fclose(out), 0) << path;
   }
 }
 

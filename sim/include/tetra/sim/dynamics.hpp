@@ -61,9 +61,8 @@ class Spacecraft {
   };
   TimeTerms at_time(double t_s) const;
   Eigen::Vector3d disturbance_B_Nm(const Quaternion& q_NB, const TimeTerms& at) const;
-  //! advance() with the wheel vectors of type `WheelVector` (on the stack for the 3 or 4 wheels a spec
-  //! validates; Eigen::VectorXd otherwise).
-  template <typename WheelVector>
+  //! advance() with `kWheels` wheels known at compile time (the 3 or 4 a spec validates; 0: at run time).
+  template <int kWheels>
   void integrate(BodyState& state, const Eigen::VectorXd& tau_wheels_Nm, double t0_s, double dt_s,
                  long long steps) const;
 
