@@ -6,8 +6,11 @@
 #    with the service's gyro samples dispatched by a listener (default) and by the waitset, the four
 #    samples of an epoch written 100 us apart (asynchronous gyro streams) and back to back;
 # 3. ddsperf again, to bracket the (shared, noisy) machine's load.
+# 4. each p50 and p99 over the floor's in the same mode, and each maximum.
 # FUSION_ARGS: more options for `tetra fusion`, e.g. FUSION_ARGS="--realtime 50" (docs/dds.md, "Real-time
-# scheduling"; ddsperf itself keeps the default scheduling).
+# scheduling"; ddsperf itself keeps the default scheduling). BUSY=1: one busy loop per core but one (on
+# every core but the first, at the default scheduling) for the whole run, floors included: the tail with a
+# second core busy.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
@@ -17,8 +20,21 @@ read -r -a FUSION_ARGS <<< "${FUSION_ARGS:-}"
 export CYCLONEDDS_URI="file://$PWD/config/cyclonedds-loopback.xml"
 WORK=$(mktemp -d)
 FUSION=""
-cleanup() { [ -n "$FUSION" ] && kill "$FUSION" 2>/dev/null; wait 2>/dev/null; rm -rf "$WORK"; }
+BUSY_PIDS=()
+cleanup() {
+  [ -n "$FUSION" ] && kill "$FUSION" 2>/dev/null
+  [ ${#BUSY_PIDS[@]} -gt 0 ] && kill "${BUSY_PIDS[@]}" 2>/dev/null
+  wait 2>/dev/null
+  rm -rf "$WORK"
+}
 trap cleanup EXIT
+if [ "${BUSY:-0}" = 1 ]; then
+  for ((cpu = 1; cpu < $(nproc); ++cpu)); do
+    taskset -c "$cpu" sh -c 'while :; do :; done' &
+    BUSY_PIDS+=($!)
+  done
+  echo "== BUSY=1: ${#BUSY_PIDS[@]} busy loop(s) on cores 1-$(($(nproc) - 1)) for the whole run"
+fi
 
 # floor MODE: ddsperf ping/pong in MODE, listener (ddsperf's default: handled on the receive thread)
 # or waitset; prints the median over its one-second reports of p50 and p99, and appends p50 to
@@ -30,7 +46,7 @@ floor() {
     sed -E 's/.* 50% ([0-9.]+)us .* 99% ([0-9.]+)us .*/\1 \2/' | sort -n |
     awk -v mode="$1" -v out="$WORK/floor_$1" '{p50[NR] = $1; p99[NR] = $2}
       END {m = int((NR + 1) / 2); printf "ddsperf %-8s round trip: p50 %.1f us  p99 %.1f us (median of %d one-second reports)\n", mode, p50[m], p99[m], NR;
-           printf "%.1f\n", p50[m] >> out}'
+           printf "%.1f %.1f\n", p50[m], p99[m] >> out}'
   wait "$pong" 2>/dev/null || true
 }
 
@@ -61,10 +77,13 @@ run waitset waitset 0
 echo "== ddsperf ping/pong again"
 floor listener
 floor waitset
-echo "== p50 / DDS floor (the floor: mean of the two ddsperf runs in the same mode)"
+echo "== p50 and p99 / DDS floor (the floor: mean of the two ddsperf runs in the same mode), and the max"
 for mode in listener waitset; do
-  f=$(awk '{s += $1} END {printf "%.1f", s / NR}' "$WORK/floor_$mode")
-  sed -E 's/.* p50 ([0-9.]+) us .*/\1/' "$WORK/tetra_$mode" | while read -r p50; do
-    awk -v m="$mode" -v p="$p50" -v f="$f" 'BEGIN {printf "%-8s p50 %6.1f us / floor %6.1f us = %.2f\n", m, p, f, p / f}'
-  done
+  read -r f50 f99 < <(awk '{a += $1; b += $2} END {printf "%.1f %.1f\n", a / NR, b / NR}' "$WORK/floor_$mode")
+  sed -E 's/.* p50 ([0-9.]+) us .* p99 ([0-9.]+) us +max ([0-9.]+) us.*/\1 \2 \3/' "$WORK/tetra_$mode" |
+    while read -r p50 p99 max; do
+      awk -v m="$mode" -v a="$p50" -v b="$p99" -v x="$max" -v f="$f50" -v g="$f99" 'BEGIN {
+        printf "%-8s p50 %6.1f us / floor %6.1f us = %.2f   p99 %7.1f us / floor %6.1f us = %.2f   max %8.1f us\n",
+               m, a, f, a / f, b, g, b / g, x}'
+    done
 done
