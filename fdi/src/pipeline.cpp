@@ -367,7 +367,12 @@ void Pipeline::Impl::publish_attitude() {
     a.sigma_rad = root_sum_square(a.sigma_rad, Eigen::Vector3d::Constant(shown_rad));
   if (trend_.active()) a.sigma_rad = root_sum_square(a.sigma_rad, trend_.bound(frame_.now_ns));
   if (budget_.active()) a.sigma_rad = root_sum_square(a.sigma_rad, budget_.sigma_rad());
-  a.protection_level_rad = protection_level(observable, a.sigma_rad);
+  a.protection_level_rad = protection_level(observable, a.sigma_rad);  // its Href term below as a bound
+  // Href where a drift was matched: the reference's own bias the data could not tell from the gyros' drift
+  // (what the matches left and what the reference has pulled the attitude by since). Sigma covers every
+  // hypothesis the data leave consistent (the rule), on every axis: the pull's direction turns with the body.
+  if (const double href_rad = ambiguous_reference_rad(); href_rad > 0.0)
+    a.sigma_rad = root_sum_square(a.sigma_rad, Eigen::Vector3d::Constant(href_rad));
   health_.protection_level_rad = a.protection_level_rad;
   a.mode = observable ? persistent_mode_ : Mode::kLost;
   a.gyros = observable ? frame_.usable : GyroMask{0};
@@ -401,6 +406,11 @@ void Pipeline::Impl::use_reference_sample() {
   }
 }
 
+double Pipeline::Impl::ambiguous_reference_rad() const {
+  const double ambiguous_rad = budget_.ambiguous_rad();
+  return ambiguous_rad > 0.0 ? ambiguous_rad + pull_.since_rad() : 0.0;
+}
+
 Eigen::Vector3d Pipeline::Impl::protection_level(bool observable, const Eigen::Vector3d& sigma_rad) {
   if (!observable) return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d pl = subsets_.ready() ? protection_.bound(subsets_.get(gyro_set_.active()), sigma_rad,
@@ -410,7 +420,7 @@ Eigen::Vector3d Pipeline::Impl::protection_level(bool observable, const Eigen::V
   // matches left, and what the reference has pulled the attitude by since the last one); and while the bias
   // block's mean stands beyond a good reference's, undecided, what a match would learn now.
   const double ambiguous_rad = budget_.ambiguous_rad();
-  double href_rad = ambiguous_rad > 0.0 ? ambiguous_rad + pull_.since_rad() : 0.0;
+  double href_rad = ambiguous_reference_rad();
   if (consistency_.mean_unresolved()) href_rad = std::max(href_rad, ambiguous_rad + pull_.blocks_rad());
   if (href_rad > 0.0) pl = pl.cwiseMax(protection_.k_md() * sigma_rad + Eigen::Vector3d::Constant(href_rad));
   // Hdrift before any match: the error the used samples show now, beside the filter's σ and the mean's noise.

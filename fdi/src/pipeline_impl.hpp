@@ -155,6 +155,9 @@ class Pipeline::Impl {
   void use_reference_sample();
   //! [rad] per axis: the published protection level for the published `sigma_rad`.
   Eigen::Vector3d protection_level(bool observable, const Eigen::Vector3d& sigma_rad);
+  //! [rad] Href's share where a drift was matched: what the matches left of the reference's possible bias
+  //! and what it has pulled the attitude by since the last (0: no match).
+  double ambiguous_reference_rad() const;
   void publish_filter();
   void publish_filter_health() const;
   void update_fdi_available();
