@@ -168,6 +168,8 @@ class Pipeline::Impl {
                                      GyroMask active);
   //! The rows of a sample some test failed (or whose mean reached the drift match's level): H0 rejected,
   //! Href consistent, Hdrift and each active gyro's hypothesis as the gyros' parity and the test show.
+  //! Hdrift's rows for a failed step test: the step against the best ramp (drift_shape), the ramp's wander.
+  void add_drift_shape_rows(const RampFit& ramp, GyroMask active, EvidenceRows& rows) const;
   void write_reference_rows(const ReferenceEvidence& evidence, double drift_threshold, GyroMask active,
                             EvidenceRows& rows) const;
   //! The sample's decision applied: the events, sigma, the reference's σ and the matches.

@@ -68,6 +68,10 @@ bool shows_a_mean(const ReferenceEvidence& evidence, double drift_threshold) {
   return !evidence.failed || *evidence.failed == ReferenceCheck::kBias ||
          (*evidence.failed == ReferenceCheck::kStep && evidence.bias_statistic > drift_threshold);
 }
+//! The step test failed, and not as a mean: its fit beside the best ramp's (a common drift's shape).
+const RampFit* step_against_ramp(const ReferenceEvidence& evidence, bool mean) {
+  return !mean && evidence.failed == ReferenceCheck::kStep && evidence.ramp ? &*evidence.ramp : nullptr;
+}
 }  // namespace
 
 ReferenceDecision Pipeline::Impl::decide_reference(const ReferenceEvidence& evidence, double drift_threshold,
@@ -85,7 +89,9 @@ void Pipeline::Impl::write_reference_rows(const ReferenceEvidence& evidence, dou
   const auto src = EvidenceSource::kReferenceTest;
   const auto& c = consistency_.failed_check();  // the failing test's, or (none failed) the bias test's
   const bool mean = shows_a_mean(evidence, drift_threshold);
-  const bool slow = mean || *evidence.failed == ReferenceCheck::kNis;
+  const RampFit* ramp = step_against_ramp(evidence, mean);
+  const bool drift_shaped = ramp != nullptr && ramp->step_chi2 <= ramp->ramp_chi2;
+  const bool slow = mean || drift_shaped || *evidence.failed == ReferenceCheck::kNis;
   // H0: the failing test rejects it, or the bias test's mean at the drift match's level.
   if (evidence.failed)
     rows.add(judge(src, kHypothesisNone, c.statistic, c.threshold, c.threshold, c.dof));
@@ -97,6 +103,8 @@ void Pipeline::Impl::write_reference_rows(const ReferenceEvidence& evidence, dou
   // the gyros vouch and a working unit's drift could be that large.
   if (!gyros_vouch_)
     rows.add(stated(src, kHypothesisDrift, RowVerdict::kNoCall, c.statistic, c.threshold, c.dof));
+  else if (ramp != nullptr)
+    add_drift_shape_rows(*ramp, active, rows);
   else if (!mean)
     rows.add(stated(src, kHypothesisDrift, RowVerdict::kRejected, c.statistic, c.threshold, c.dof));
   else
@@ -120,6 +128,23 @@ void Pipeline::Impl::write_reference_rows(const ReferenceEvidence& evidence, dou
   }
   // Hcal: while a calibration mismatch stands, the gyros' own error explains whatever failed.
   calibration_fit_.add_hcal_rows(src, nullptr, rows);
+}
+
+void Pipeline::Impl::add_drift_shape_rows(const RampFit& ramp, GyroMask active, EvidenceRows& rows) const {
+  // Hdrift against a step (reference_step.hpp): a common drift makes a ramp, so the step test's failure
+  // rejects it only where the best step explains the innovations better than the best ramp (their
+  // likelihood ratio e^{(χ²_step − χ²_ramp)/2} above 1); where the ramp does at least as well, its rate b
+  // over its span T needs a wander as the mean b·T/2 would (at most a working unit's: drift_wander).
+  const double excess = ramp.step_chi2 - ramp.ramp_chi2;
+  rows.add(judge(EvidenceSource::kDriftShape, kHypothesisDrift, excess, 0.0, 0.0, 3));
+  if (excess > 0.0) return;
+  const double needed = drift_match_.next_ratio(
+      ReferenceBiasMatch::needed_ratio(0.5 * ramp.span_s * ramp.rate_rad_s,
+                                       drift_match_.drift_span_s(ramp.span_s, frame_.now_ns), active,
+                                       attitude_.filter()),
+      frame_.now_ns);
+  rows.add(judge(EvidenceSource::kDriftWander, kHypothesisDrift, needed, design::reference_max_wander_ratio,
+                 design::reference_max_wander_ratio));
 }
 
 void Pipeline::Impl::judge_reference() {
@@ -256,7 +281,10 @@ void Pipeline::Impl::match_drift_mean(const ReferenceVerdict& v, GyroMask active
   if (drift_match_.match_mean(frame_.now_ns, v.bias_mean_rad, v.bias_span_s, active, attitude_.filter())) {
     learn_pull();
     emit_drift_matched(consistency_.drift_check().statistic, consistency_.drift_check().threshold,
-                       "the reference's mean innovation", &reference_rows_);
+                       v.from_ramp ? "a ramp in the reference's innovations (the step test's, a rate error's "
+                                     "shape)"
+                                   : "the reference's mean innovation",
+                       &reference_rows_);
   }
 }
 
@@ -300,7 +328,7 @@ void Pipeline::Impl::emit_drift_matched(double statistic, double threshold, cons
     e.ledger.push_back(stated(src, kHypothesisDrift, RowVerdict::kConsistent, statistic, threshold, 3));
     e.ledger.push_back(stated(src, kHypothesisReference, RowVerdict::kConsistent, statistic, threshold, 3));
   }
-  char text[320];
+  char text[400];
   std::snprintf(
       text, sizeof text,
       "gyro bias drift beyond the noise model, common to the gyros (the parity cannot see it), in %s: "

@@ -104,7 +104,7 @@ void ReferenceConsistency::accumulate(std::int64_t now_ns, const Eigen::Vector3d
   nis_per_dof_ = block_nis_ / (3.0 * block_count_);
   const double since_s = last_sample_ns_ < 0 ? 0.0 : ns_to_seconds(now_ns - last_sample_ns_);
   last_sample_ns_ = now_ns;
-  step_.add(z, w.cwiseInverse(), sigma_rad_ * sigma_rad_, calibration_rad_s * since_s);
+  step_.add(z, w.cwiseInverse(), sigma_rad_ * sigma_rad_, calibration_rad_s * since_s, since_s);
 }
 
 std::optional<ReferenceCheck> ReferenceConsistency::test(std::int64_t now_ns, const Eigen::Vector3d& z,
@@ -218,6 +218,7 @@ ReferenceEvidence ReferenceConsistency::test_sample(std::int64_t now_ns, const E
   e.used_excess_rad2 = szz_ - sss_;  // before the sample (which may open the next block)
   e.used_count = block_start_ns_ < 0 ? 0 : block_count_;
   e.failed = test(now_ns, z_rad, w, nis, omega_rad_s, calibration_rad_s, e.bias_statistic);
+  if (e.failed == ReferenceCheck::kStep) e.ramp = step_.ramp_fit();
   return e;
 }
 
@@ -232,9 +233,11 @@ ReferenceVerdict ReferenceConsistency::decide(std::int64_t now_ns, const Eigen::
       // The caller opens the gyros' bias model — at the match's level, below the rejection's, since a match
       // decides nothing — and the sample is used; the bias block starts afresh.
       v.drift = true;
-      v.bias_mean_rad = bias_mean_rad();
-      v.bias_span_s = ns_to_seconds(now_ns - bias_start_ns_);
-      drift_check_ = {evidence.bias_statistic, drift_threshold, 3};
+      v.from_ramp = evidence.failed == ReferenceCheck::kStep && evidence.ramp;
+      v.bias_mean_rad = v.from_ramp ? Eigen::Vector3d(0.5 * evidence.ramp->span_s * evidence.ramp->rate_rad_s)
+                                    : bias_mean_rad();
+      v.bias_span_s = v.from_ramp ? evidence.ramp->span_s : ns_to_seconds(now_ns - bias_start_ns_);
+      drift_check_ = v.from_ramp ? failed_ : CheckValue{evidence.bias_statistic, drift_threshold, 3};
       restart_bias_block(now_ns);
       add_used(z_rad, S);
       return v;

@@ -44,6 +44,9 @@ struct ReferenceEvidence {
   //! [rad²] per axis Σz² − ΣS_aa of the samples used in the nis block before this sample, and their count
   Eigen::Vector3d used_excess_rad2 = Eigen::Vector3d::Zero();
   int used_count = 0;
+  //! The step test failed: its best step beside the best ramp over its window (a drift of the gyros makes
+  //! a ramp, ReferenceStep::ramp_fit)
+  std::optional<RampFit> ramp;
 };
 
 //! What the sample's decision did.
@@ -60,8 +63,10 @@ struct ReferenceVerdict {
   double step_rad = 0.0;
   //! The gyros' common drift matched (ReferenceDecision::kMatchDrift): the sample is used, and the caller
   //! opens the gyros' bias model by what the test saw — [rad] its weighted mean innovation per axis over its
-  //! block, and [s] the block's span to this sample.
+  //! block, and [s] the block's span to this sample; for a step a ramp explains (`from_ramp`), the mean a
+  //! ramp's rate b makes over its span T, b·T/2, and T.
   bool drift = false;
+  bool from_ramp = false;
   Eigen::Vector3d bias_mean_rad = Eigen::Vector3d::Zero();
   double bias_span_s = 0.0;
 };

@@ -13,7 +13,7 @@ ReferenceStep::ReferenceStep(const PipelineConfig& config)
           1.0 - allocated_probability(config, BudgetTest::kReferenceCheck) / kCapacity, 3.0)) {}
 
 void ReferenceStep::add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_rad2,
-                        double reference_var_rad2, const Eigen::Vector3d& calibration_rad) {
+                        double reference_var_rad2, const Eigen::Vector3d& calibration_rad, double since_s) {
   Sample& s = ring_[static_cast<std::size_t>(head_)];
   for (int a = 0; a < 3; ++a) {
     const double w = 1.0 / s_rad2[a];
@@ -24,6 +24,7 @@ void ReferenceStep::add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_r
     s.rho2[a] = s.rho[a] * s.rho[a];
   }
   s.calibration_rad = calibration_rad;
+  s.since_s = since_s;
   head_ = (head_ + 1) % kCapacity;
   count_ = std::min(count_ + 1, kCapacity);
 }
@@ -78,6 +79,41 @@ StepFit ReferenceStep::evaluate(double level) const {
     }
   }
   return best;
+}
+
+RampFit ReferenceStep::ramp_fit() const {
+  RampFit fit;
+  const int m = count_;
+  // Per axis from the newest sample back, for the onset j: the step's A = Σwgz, C = Σwg²; the ramp's
+  // A_r = Σwhz, C_r = Σwh² and Y = Σwgh (the header's recursions: A_r(j) = A_r(j+1) + Δt_j·A(j),
+  // C_r(j) = C_r(j+1) + 2Δt_j·ρ_j·Y(j+1) + Δt_j²·C(j), Y(j) = ρ_j·Y(j+1) + Δt_j·C(j)).
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), c = Eigen::Vector3d::Zero(), ar = Eigen::Vector3d::Zero();
+  Eigen::Vector3d cr = Eigen::Vector3d::Zero(), y = Eigen::Vector3d::Zero();
+  double span_s = 0.0;
+  for (int j = m - 1; j >= 1; --j) {  // the oldest sample has no interval before it in the window
+    const Sample& s = at(j);
+    const double dt = s.since_s;
+    span_s += dt;
+    double step = 0.0;
+    double ramp = 0.0;
+    for (int x = 0; x < 3; ++x) {
+      const double y_next = y[x];
+      a[x] = s.wz[x] + s.rho[x] * a[x];
+      c[x] = s.w[x] + s.rho2[x] * c[x];
+      cr[x] += 2.0 * dt * s.rho[x] * y_next + dt * dt * c[x];
+      ar[x] += dt * a[x];
+      y[x] = s.rho[x] * y_next + dt * c[x];
+      step += a[x] * a[x] / c[x];
+      ramp += cr[x] > 0.0 ? ar[x] * ar[x] / cr[x] : 0.0;
+    }
+    fit.step_chi2 = std::max(fit.step_chi2, step);
+    if (ramp > fit.ramp_chi2) {
+      fit.ramp_chi2 = ramp;
+      for (int x = 0; x < 3; ++x) fit.rate_rad_s[x] = cr[x] > 0.0 ? ar[x] / cr[x] : 0.0;
+      fit.span_s = span_s;
+    }
+  }
+  return fit;
 }
 
 }  // namespace tetra::fdi::detail

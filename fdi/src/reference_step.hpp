@@ -17,6 +17,14 @@
 // (M onsets searched, p the budget's kReferenceCheck share: its union bound over the onsets is p per
 // sample). The fit's ĉ and the share of it the filter has already taken, 1 − Π ρ, are what a rejection
 // puts into the attitude's variance and the reference's budget (reference_budget.hpp).
+//
+// A step is the reference's (Href); the gyros' common drift (Hdrift: a warm-up) makes a rate error b from
+// its onset on, which the innovations show as b·h_k: h_j = Δt_j, h_{k+1} = ρ_k·h_k + Δt_{k+1} (the error
+// grows by b·Δt between samples, the filter takes K of it at each). Its fit per axis, b̂ = Σwhz/Σwh², reduces
+// the innovations' χ² by (Σwhz)²/Σwh² as a step's fit does by (Σwgz)²/Σwg²; both are found for every onset
+// by recursions from the newest sample back (h from j is Σ_{i≥j} Δt_i times the step's g from i).
+// ramp_fit() gives the best of each over the onsets: when the step explains the innovations beyond the best
+// ramp by less than the step test's own threshold, the step the test found may be a drift's.
 
 #include <array>
 
@@ -34,19 +42,31 @@ struct StepFit {
   Eigen::Vector3d absorbed = Eigen::Vector3d::Zero();  //!< [-] per axis the share the filter has taken
 };
 
+//! The window's best ramp beside its best step (the raw fits, without the calibration's allowance or the
+//! residual scale): what tells a drift of the gyros from a step of the reference.
+struct RampFit {
+  double step_chi2 = 0.0;                                //!< [-] max over the onsets of Σ_a (Σwgz)²/Σwg²
+  double ramp_chi2 = 0.0;                                //!< [-] max over the onsets of Σ_a (Σwhz)²/Σwh²
+  Eigen::Vector3d rate_rad_s = Eigen::Vector3d::Zero();  //!< [rad/s] the best ramp's b̂ per axis
+  double span_s = 0.0;  //!< [s] from the best ramp's onset to the newest sample
+};
+
 class ReferenceStep {
  public:
   explicit ReferenceStep(const PipelineConfig& config);
 
   void reset() { count_ = 0; }  //!< the window empty
   //! One sample: its innovation `z_rad` [rad], its covariance's diagonal `s_rad2` [rad²], the reference's
-  //! variance `reference_var_rad2` [rad²] (the filter's gain is 1 − that over S) and `calibration_rad` [rad]
-  //! per axis the attitude error the calibration's tolerance allows since the previous sample.
+  //! variance `reference_var_rad2` [rad²] (the filter's gain is 1 − that over S), `calibration_rad` [rad]
+  //! per axis the attitude error the calibration's tolerance allows since the previous sample, and
+  //! `since_s` [s] the time since it.
   void add(const Eigen::Vector3d& z_rad, const Eigen::Vector3d& s_rad2, double reference_var_rad2,
-           const Eigen::Vector3d& calibration_rad);
+           const Eigen::Vector3d& calibration_rad, double since_s);
   //! The best onset over the window beyond `level` (the test's threshold, or a lower one to see the
   //! statistic's distribution).
   StepFit evaluate(double level) const;
+  //! The best step's and the best ramp's fits over the window (the header; none: zeros).
+  RampFit ramp_fit() const;
   double threshold() const { return threshold_; }  //!< χ²₃(1 − p/M)
 
  private:
@@ -57,6 +77,7 @@ class ReferenceStep {
     Eigen::Vector3d rho = Eigen::Vector3d::Zero();              //!< [-] 1 − K
     Eigen::Vector3d rho2 = Eigen::Vector3d::Zero();             //!< [-] ρ²
     Eigen::Vector3d calibration_rad = Eigen::Vector3d::Zero();  //!< [rad] allowed since the previous sample
+    double since_s = 0.0;                                       //!< [s] Δt since the previous sample
   };
   const Sample& at(int k) const {  //!< k-th oldest sample of the window
     return ring_[static_cast<std::size_t>((head_ + kCapacity - count_ + k) % kCapacity)];

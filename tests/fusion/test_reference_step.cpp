@@ -1,6 +1,7 @@
 // The reference's step test on its own (fdi/src/reference_step.hpp): its false-alarm rate under a good
 // reference over many windows, the step it fits, and what it allows for (a calibration within its tolerance
-// during a turn, a unit or reference noisier than modelled).
+// during a turn, a unit or reference noisier than modelled); the ramp beside the step that tells the gyros'
+// common drift from the reference's step.
 #include <cmath>
 #include <random>
 
@@ -35,9 +36,66 @@ fdi::detail::ReferenceStep window(std::mt19937_64& rng, int samples, double nois
       left *= rho;
     }
     step.add(z, Eigen::Vector3d::Constant(kS_rad2), kSigmaRef_rad * kSigmaRef_rad,
-             Eigen::Vector3d::Constant(k == onset ? calibration_rad : 0.0));
+             Eigen::Vector3d::Constant(k == onset ? calibration_rad : 0.0), 1.0);
   }
   return step;
+}
+
+//! `samples` innovations of a good reference at 1 Hz, with the gyros' common drift from sample `onset` on:
+//! a rate error `rate_rad_s` per axis whose attitude error the filter takes at its gain (e ← ρ·e + b·1 s).
+fdi::detail::ReferenceStep drift_window(std::mt19937_64& rng, int samples, const Eigen::Vector3d& rate_rad_s,
+                                        int onset) {
+  fdi::detail::ReferenceStep step{fdi::PipelineConfig{}};
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const double rho = kSigmaRef_rad * kSigmaRef_rad / kS_rad2;
+  Eigen::Vector3d error = Eigen::Vector3d::Zero();
+  for (int k = 0; k < samples; ++k) {
+    if (k >= onset) error += rate_rad_s;
+    const Eigen::Vector3d z = Eigen::Vector3d(n01(rng), n01(rng), n01(rng)) * std::sqrt(kS_rad2) + error;
+    error *= rho;
+    step.add(z, Eigen::Vector3d::Constant(kS_rad2), kSigmaRef_rad * kSigmaRef_rad, Eigen::Vector3d::Zero(),
+             1.0);
+  }
+  return step;
+}
+
+TEST(ReferenceStep, AGyroDriftsRampIsFitAsARampAndAReferenceStepAsAStep) {
+  // The shape that tells Hdrift from Href when the step test fails (reference_step.hpp, ramp_fit): 200
+  // windows of 64 samples each. A common drift of 0.3″/s from sample 10 (the step test fails in every one)
+  // is fitted better by a ramp in all of them, its rate within 20 % of the drawn one in most; a reference
+  // step of 20″ at sample 40 (caught in every one) better by a step in all of them. (Nearer the step test's
+  // threshold the two shapes overlap: a drift of 0.15″/s fails the test in 74 of 200 windows and 20 of
+  // those fit a step better; 10″ steps in 97, 2 of them a ramp better.)
+  std::mt19937_64 rng(5);
+  const double rate = 0.3 * kArcsecToRad;
+  int drift_failed = 0, drift_as_ramp = 0, rate_close = 0;
+  int step_failed = 0, step_as_step = 0;
+  for (int w = 0; w < 200; ++w) {
+    const auto d =
+        drift_window(rng, fdi::design::reference_step_samples, Eigen::Vector3d::Constant(rate), 10);
+    if (d.evaluate(d.threshold()).statistic > d.threshold()) {
+      ++drift_failed;
+      const auto r = d.ramp_fit();
+      drift_as_ramp += r.ramp_chi2 >= r.step_chi2 ? 1 : 0;
+      rate_close += (r.rate_rad_s.array() / rate - 1.0).abs().maxCoeff() < 0.2 ? 1 : 0;
+    }
+    const auto s = window(rng, fdi::design::reference_step_samples, 1.0,
+                          Eigen::Vector3d::Constant(20.0 * kArcsecToRad / std::sqrt(3.0)), 40);
+    if (s.evaluate(s.threshold()).statistic > s.threshold()) {
+      ++step_failed;
+      const auto r = s.ramp_fit();
+      step_as_step += r.step_chi2 > r.ramp_chi2 ? 1 : 0;
+    }
+  }
+  std::printf(
+      "drift 0.3\"/s: step test failed in %d of 200, a ramp fits better in %d, rate within 20 %% in %d; "
+      "step 20\": failed in %d, a step fits better in %d\n",
+      drift_failed, drift_as_ramp, rate_close, step_failed, step_as_step);
+  EXPECT_EQ(drift_failed, 200);
+  EXPECT_EQ(drift_as_ramp, drift_failed);
+  EXPECT_GE(rate_close, drift_failed / 2);
+  EXPECT_EQ(step_failed, 200);
+  EXPECT_EQ(step_as_step, step_failed);
 }
 
 TEST(ReferenceStep, AGoodReferenceFailsNoMoreOftenThanTheBudgetAllowsOverManyWindows) {

@@ -42,7 +42,8 @@ enum class EvidenceSource : std::uint8_t {
   kParityBlockMatch,  //!< the parity's block means of the filter's innovations: each gyro's bias model
   kBiasFit,           //!< one gyro's fault fitted to an episode's parity mean and reference disagreements
   kBiasPersists,      //!< the best-fitting fault in the latest half of that span, of the filter's sign
-  kDriftShape         //!< the isolated gyro's drift: a step or a ramp (the kind; it decides no exclusion)
+  kDriftShape  //!< a step or a ramp: the isolated gyro's kind (it decides no exclusion); a reference's step
+               //!< against the gyros' common drift (Hdrift)
 };
 constexpr int kEvidenceSourceCount = 25;
 //! True for the sources that read a gyro's own signal (timeout, invalid, repeated, zero, variance,
