@@ -63,8 +63,8 @@ const EvidenceSourceInfo kEvidenceSources[kEvidenceSourceCount] = {
      "the isolated gyro's kind: G_step − G_ramp, the parity's best step fit less its best ramp fit over the "
      "history; beyond ±drift_margin_sigma2 a bias or a ramp (consistent), else no call (unknown) unless an "
      "offset without a trend (slope's fit below drift_no_trend_sigma2) names a bias; for Hdrift, the "
-     "reference's failed step test: its best step fit less the best ramp fit (3 dof), rejected beyond the "
-     "drift match's level (a common drift of the gyros makes a ramp)"},
+     "reference's failed step test: its best step fit less the best ramp fit (3 dof), rejected above 0 (the "
+     "step explains the innovations better than the ramp a common drift of the gyros makes)"},
 };
 
 bool reads_own_signal(EvidenceSource source) {
